@@ -1,0 +1,70 @@
+//! Errors of the engine. Every error names the offending field, its value and what is accepted.
+
+use thiserror::Error;
+
+#[derive(Debug, Clone, Error, PartialEq)]
+pub enum ModelError {
+    /// A numeric input outside its accepted range (or not finite).
+    #[error("invalid value for `{field}`: {value} (expected {expected})")]
+    InvalidValue {
+        field: String,
+        value: f64,
+        expected: String,
+    },
+    /// A structural inconsistency (sizes, counts, missing items).
+    #[error("invalid `{field}`: {message}")]
+    Invalid { field: String, message: String },
+}
+
+impl ModelError {
+    pub fn value(field: impl Into<String>, value: f64, expected: impl Into<String>) -> Self {
+        ModelError::InvalidValue {
+            field: field.into(),
+            value,
+            expected: expected.into(),
+        }
+    }
+    pub fn invalid(field: impl Into<String>, message: impl Into<String>) -> Self {
+        ModelError::Invalid {
+            field: field.into(),
+            message: message.into(),
+        }
+    }
+}
+
+/// Checks `value` is finite and inside `(lo, hi)` with the given openness; names `field` on failure.
+pub(crate) fn check_range(
+    field: &str,
+    value: f64,
+    lo: Option<(f64, bool)>,
+    hi: Option<(f64, bool)>,
+    expected: &str,
+) -> Result<f64, ModelError> {
+    let ok_lo = match lo {
+        Some((l, inclusive)) => value > l || (inclusive && value == l),
+        None => true,
+    };
+    let ok_hi = match hi {
+        Some((h, inclusive)) => value < h || (inclusive && value == h),
+        None => true,
+    };
+    if value.is_finite() && ok_lo && ok_hi {
+        Ok(value)
+    } else {
+        Err(ModelError::value(field, value, expected))
+    }
+}
+
+pub(crate) fn check_positive(field: &str, value: f64, unit: &str) -> Result<f64, ModelError> {
+    check_range(
+        field,
+        value,
+        Some((0.0, false)),
+        None,
+        &format!("a finite number > 0 {unit}"),
+    )
+}
+
+pub(crate) fn check_finite(field: &str, value: f64) -> Result<f64, ModelError> {
+    check_range(field, value, None, None, "a finite number")
+}

@@ -1,0 +1,469 @@
+//! Linear strain bases `Ψ = Φ q` (gvs-spec §4.1–4.4): Legendre polynomials and FEM-like local
+//! (linear/quadratic) bases per division, multi-division rods with a basis per division, and a
+//! pointwise basis given as values at the sites (POD modes use it).
+//!
+//! Per division j, `Φ_j(X) = S_j Φ̄(X̄)` with `S_j = diag(1/ℓ_j, 1/ℓ_j, 1/ℓ_j, 1, 1, 1)`: angular
+//! coordinates are angles, linear coordinates dimensionless strains (spec §4.1). Columns are ordered
+//! mode by mode (torsion, bend-y, bend-z, elongation, shear-y, shear-z), by increasing degree or node
+//! inside a mode; divisions follow each other in `q`.
+
+use super::{StrainEval, StrainParam};
+use crate::discretize::Discretization;
+use crate::error::ModelError;
+use crate::lie::V6;
+use nalgebra::{DMatrix, DVector, Matrix6xX};
+use serde::{Deserialize, Serialize};
+use std::ops::Range;
+
+/// Polynomial degree of a FEM-like local basis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FemDegree {
+    Linear,
+    Quadratic,
+}
+
+/// The basis of one division. `modes[i]` says whether strain component i is active.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum DivisionBasis {
+    /// Unnormalized Legendre polynomials `P_0..P_k` of `x = 2X̄ − 1`, order `k = orders[i]` per mode.
+    Legendre {
+        modes: [bool; 6],
+        orders: [usize; 6],
+    },
+    /// Local (nodal) basis on `elements` equal elements: `elements·p + 1` columns per active mode.
+    Fem {
+        modes: [bool; 6],
+        elements: usize,
+        degree: FemDegree,
+    },
+}
+
+impl DivisionBasis {
+    /// Number of coordinates of the division.
+    pub fn dofs(&self) -> usize {
+        (0..6).map(|i| self.mode_dofs(i)).sum()
+    }
+
+    fn mode_dofs(&self, i: usize) -> usize {
+        match self {
+            DivisionBasis::Legendre { modes, orders } => {
+                if modes[i] {
+                    orders[i] + 1
+                } else {
+                    0
+                }
+            }
+            DivisionBasis::Fem {
+                modes,
+                elements,
+                degree,
+            } => {
+                if modes[i] {
+                    elements * degree_of(*degree) + 1
+                } else {
+                    0
+                }
+            }
+        }
+    }
+
+    pub fn validate(&self, field: &str) -> Result<(), ModelError> {
+        if self.dofs() == 0 {
+            return Err(ModelError::invalid(
+                field,
+                "the basis is empty: activate at least one strain mode",
+            ));
+        }
+        if let DivisionBasis::Fem { elements, .. } = self {
+            if *elements == 0 {
+                return Err(ModelError::value(
+                    format!("{field}.elements"),
+                    0.0,
+                    "an integer >= 1",
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Writes `Φ̄(X̄)` scaled by `S_j` (6 × dofs) into `out` (which must be zeroed).
+    pub fn fill(&self, x_bar: f64, length: f64, out: &mut nalgebra::DMatrixViewMut<'_, f64>) {
+        let mut col = 0;
+        for i in 0..6 {
+            let nd = self.mode_dofs(i);
+            if nd == 0 {
+                continue;
+            }
+            let scale = if i < 3 { 1.0 / length } else { 1.0 };
+            match self {
+                DivisionBasis::Legendre { .. } => {
+                    let x = 2.0 * x_bar - 1.0;
+                    let (mut p0, mut p1) = (1.0, x);
+                    for m in 0..nd {
+                        let v = match m {
+                            0 => 1.0,
+                            1 => x,
+                            _ => {
+                                let k = (m - 1) as f64;
+                                let p2 = ((2.0 * k + 1.0) * x * p1 - k * p0) / (k + 1.0);
+                                p0 = p1;
+                                p1 = p2;
+                                p2
+                            }
+                        };
+                        out[(i, col + m)] = v * scale;
+                    }
+                }
+                DivisionBasis::Fem {
+                    elements, degree, ..
+                } => {
+                    let ne = *elements;
+                    let e = ((x_bar * ne as f64 + 1e-12).floor() as usize).min(ne - 1);
+                    let chi = x_bar * ne as f64 - e as f64;
+                    match degree {
+                        FemDegree::Linear => {
+                            out[(i, col + e)] += (1.0 - chi) * scale;
+                            out[(i, col + e + 1)] += chi * scale;
+                        }
+                        FemDegree::Quadratic => {
+                            let b = col + 2 * e;
+                            out[(i, b)] += 2.0 * (chi - 0.5) * (chi - 1.0) * scale;
+                            out[(i, b + 1)] += -4.0 * chi * (chi - 1.0) * scale;
+                            out[(i, b + 2)] += 2.0 * chi * (chi - 0.5) * scale;
+                        }
+                    }
+                }
+            }
+            col += nd;
+        }
+    }
+}
+
+fn degree_of(d: FemDegree) -> usize {
+    match d {
+        FemDegree::Linear => 1,
+        FemDegree::Quadratic => 2,
+    }
+}
+
+/// A linear strain basis tabulated at the sites of one discretization: `Ψ_s = Φ_s q`.
+#[derive(Debug, Clone)]
+pub struct LinearBasis {
+    n: usize,
+    /// `Φ_s` of all sites side by side (6 × n·n_sites).
+    phi: Matrix6xX<f64>,
+    cols: Vec<Range<usize>>,
+}
+
+impl LinearBasis {
+    /// One basis per division (spec §4.4); coordinates of the divisions are concatenated.
+    pub fn per_division(
+        disc: &Discretization,
+        bases: &[DivisionBasis],
+    ) -> Result<Self, ModelError> {
+        if bases.len() != disc.div_length.len() {
+            return Err(ModelError::invalid(
+                "basis",
+                format!(
+                    "{} division bases for {} divisions",
+                    bases.len(),
+                    disc.div_length.len()
+                ),
+            ));
+        }
+        let mut offsets = Vec::with_capacity(bases.len());
+        let mut n = 0;
+        for (j, b) in bases.iter().enumerate() {
+            b.validate(&format!("divisions[{j}].basis"))?;
+            offsets.push(n..n + b.dofs());
+            n += b.dofs();
+        }
+        let ns = disc.n_sites();
+        let mut phi = Matrix6xX::zeros(n * ns);
+        let mut cols = Vec::with_capacity(ns);
+        let mut block = DMatrix::zeros(6, n);
+        for (s, site) in disc.sites.iter().enumerate() {
+            let r = offsets[site.div].clone();
+            block.fill(0.0);
+            {
+                let mut v = block.view_mut((0, 0), (6, r.len()));
+                bases[site.div].fill(site.x_bar, disc.div_length[site.div], &mut v);
+            }
+            phi.columns_mut(s * n + r.start, r.len())
+                .copy_from(&block.view((0, 0), (6, r.len())));
+            cols.push(r);
+        }
+        Ok(LinearBasis { n, phi, cols })
+    }
+
+    /// A basis given by its values at every site: `values` is 6·n_sites × n, point-major (site s
+    /// occupies rows 6s..6s+6). Every coordinate may act everywhere (as for POD modes).
+    pub fn from_site_values(
+        disc: &Discretization,
+        values: &DMatrix<f64>,
+    ) -> Result<Self, ModelError> {
+        let ns = disc.n_sites();
+        if values.nrows() != 6 * ns || values.ncols() == 0 {
+            return Err(ModelError::invalid(
+                "basis.values",
+                format!(
+                    "expected a {}×n matrix (6 rows per site, n >= 1), got {}×{}",
+                    6 * ns,
+                    values.nrows(),
+                    values.ncols()
+                ),
+            ));
+        }
+        if values.iter().any(|v| !v.is_finite()) {
+            return Err(ModelError::invalid(
+                "basis.values",
+                "contains NaN or infinite entries",
+            ));
+        }
+        let n = values.ncols();
+        let mut phi = Matrix6xX::zeros(n * ns);
+        for s in 0..ns {
+            phi.columns_mut(s * n, n).copy_from(&values.rows(6 * s, 6));
+        }
+        Ok(LinearBasis {
+            n,
+            phi,
+            cols: vec![0..n; ns],
+        })
+    }
+
+    /// A pointwise basis given at the computational points only (`6·n_points × n`, point-major), as a
+    /// POD basis learned from strain snapshots is. Values at the Magnus sub-points are interpolated
+    /// linearly in X between the two neighbouring points of the same division (2nd-order accurate;
+    /// see gvs-spec §12.1).
+    pub fn from_point_values(
+        disc: &Discretization,
+        values: &DMatrix<f64>,
+    ) -> Result<Self, ModelError> {
+        let np = disc.n_points();
+        if values.nrows() != 6 * np || values.ncols() == 0 {
+            return Err(ModelError::invalid(
+                "basis.values",
+                format!(
+                    "expected a {}×n matrix (6 rows per point, n >= 1), got {}×{}",
+                    6 * np,
+                    values.nrows(),
+                    values.ncols()
+                ),
+            ));
+        }
+        let n = values.ncols();
+        let ns = disc.n_sites();
+        let mut full = DMatrix::zeros(6 * ns, n);
+        full.rows_mut(0, 6 * np).copy_from(values);
+        for st in disc.steps.iter().flatten() {
+            let (a, b) = (disc.points[st.from], disc.points[st.from + 1]);
+            for &site in &st.sites {
+                let t = (disc.sites[site].x - a.x) / (b.x - a.x);
+                let v =
+                    values.rows(6 * st.from, 6) * (1.0 - t) + values.rows(6 * (st.from + 1), 6) * t;
+                full.rows_mut(6 * site, 6).copy_from(&v);
+            }
+        }
+        Self::from_site_values(disc, &full)
+    }
+
+    /// `Φ_s` restricted to its columns.
+    pub fn phi_at(&self, site: usize) -> nalgebra::DMatrix<f64> {
+        let r = &self.cols[site];
+        DMatrix::from_iterator(
+            6,
+            r.len(),
+            self.phi
+                .columns(site * self.n + r.start, r.len())
+                .iter()
+                .cloned(),
+        )
+    }
+}
+
+impl StrainParam for LinearBasis {
+    fn n_dof(&self) -> usize {
+        self.n
+    }
+    fn n_sites(&self) -> usize {
+        self.cols.len()
+    }
+    fn is_linear(&self) -> bool {
+        true
+    }
+    fn columns(&self, site: usize) -> Range<usize> {
+        self.cols[site].clone()
+    }
+    fn new_eval(&self) -> StrainEval {
+        let mut ev = StrainEval::zeros(self.n, self.n_sites());
+        ev.psi_q.copy_from(&self.phi);
+        ev
+    }
+    fn eval(&self, q: &DVector<f64>, ev: &mut StrainEval) {
+        for (s, r) in self.cols.iter().enumerate() {
+            let blk = self.phi.columns(s * self.n + r.start, r.len());
+            ev.psi[s] = blk * q.rows(r.start, r.len());
+        }
+    }
+    fn eval_rate(&self, _q: &DVector<f64>, _qd: &DVector<f64>, _ev: &mut StrainEval) {}
+    fn add_weighted_hessian(&self, _q: &DVector<f64>, _w: &[V6], _out: &mut DMatrix<f64>) {}
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::discretize::{MagnusOrder, Quadrature};
+    use crate::rod::{DivisionGeometry, Material, Rod};
+
+    fn disc(lengths: &[f64], q: Quadrature) -> Discretization {
+        let rod = Rod {
+            material: Material {
+                youngs_modulus: 1e6,
+                poisson_ratio: 0.5,
+                density: 1000.0,
+                damping: 0.0,
+            },
+            divisions: lengths
+                .iter()
+                .map(|&l| DivisionGeometry {
+                    length: l,
+                    radius_start: 0.01,
+                    radius_end: 0.01,
+                })
+                .collect(),
+        };
+        Discretization::new(&rod, &vec![q; lengths.len()], MagnusOrder::Z4, &[]).unwrap()
+    }
+
+    #[test]
+    fn paper_dof_counts() {
+        let a = DivisionBasis::Legendre {
+            modes: [false, true, false, true, false, true],
+            orders: [0, 10, 0, 10, 0, 10],
+        };
+        assert_eq!(a.dofs(), 33);
+        let c = DivisionBasis::Legendre {
+            modes: [true; 6],
+            orders: [1, 2, 2, 1, 1, 1],
+        };
+        assert_eq!(2 * c.dofs(), 28);
+        let b = DivisionBasis::Fem {
+            modes: [false, true, false, false, false, false],
+            elements: 49,
+            degree: FemDegree::Linear,
+        };
+        assert_eq!(b.dofs(), 50);
+        let qd = DivisionBasis::Fem {
+            modes: [true, false, false, false, false, false],
+            elements: 4,
+            degree: FemDegree::Quadratic,
+        };
+        assert_eq!(qd.dofs(), 9);
+    }
+
+    #[test]
+    fn legendre_values_and_angular_scaling() {
+        let d = disc(&[0.5], Quadrature::Gauss { n: 5 });
+        let b = DivisionBasis::Legendre {
+            modes: [false, true, false, true, false, false],
+            orders: [0, 3, 0, 2, 0, 0],
+        };
+        let lb = LinearBasis::per_division(&d, &[b]).unwrap();
+        for (s, site) in d.sites.iter().enumerate() {
+            let x = 2.0 * site.x_bar - 1.0;
+            let p = [
+                1.0,
+                x,
+                0.5 * (3.0 * x * x - 1.0),
+                0.5 * (5.0 * x * x * x - 3.0 * x),
+            ];
+            let phi = lb.phi_at(s);
+            for m in 0..4 {
+                assert!((phi[(1, m)] - p[m] / 0.5).abs() < 1e-14);
+            }
+            for m in 0..3 {
+                assert!((phi[(3, 4 + m)] - p[m]).abs() < 1e-14);
+            }
+            assert_eq!(phi.row(0).amax(), 0.0);
+        }
+    }
+
+    #[test]
+    fn fem_hat_functions_partition_unity_and_interpolate_nodes() {
+        let d = disc(
+            &[0.8],
+            Quadrature::Elements {
+                elements: 7,
+                gauss_per_element: 2,
+            },
+        );
+        for deg in [FemDegree::Linear, FemDegree::Quadratic] {
+            let b = DivisionBasis::Fem {
+                modes: [false, false, false, true, false, false],
+                elements: 7,
+                degree: deg,
+            };
+            let lb = LinearBasis::per_division(&d, &[b]).unwrap();
+            for s in 0..d.n_sites() {
+                let sum: f64 = lb.phi_at(s).row(3).sum();
+                assert!((sum - 1.0).abs() < 1e-13);
+            }
+            // at element ends (weight-0 points) exactly one node is 1
+            for (i, p) in d.points.iter().enumerate() {
+                if p.weight == 0.0 {
+                    let phi = lb.phi_at(i);
+                    assert!(
+                        (phi.row(3).amax() - 1.0).abs() < 1e-12,
+                        "node value at X̄ = {}",
+                        p.x_bar
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn multi_division_columns_are_disjoint() {
+        let d = disc(&[0.3, 0.3], Quadrature::Gauss { n: 5 });
+        let c = DivisionBasis::Legendre {
+            modes: [true; 6],
+            orders: [1, 2, 2, 1, 1, 1],
+        };
+        let lb = LinearBasis::per_division(&d, &[c.clone(), c]).unwrap();
+        assert_eq!(lb.n_dof(), 28);
+        assert_eq!(lb.columns(0), 0..14);
+        assert_eq!(lb.columns(d.n_points() - 1), 14..28);
+    }
+
+    #[test]
+    fn empty_basis_is_an_error() {
+        let d = disc(&[0.3], Quadrature::Gauss { n: 5 });
+        let c = DivisionBasis::Legendre {
+            modes: [false; 6],
+            orders: [1; 6],
+        };
+        let e = LinearBasis::per_division(&d, &[c]).unwrap_err().to_string();
+        assert!(
+            e.contains("divisions[0].basis") && e.contains("empty"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn point_values_are_interpolated_to_sub_points() {
+        let d = disc(&[0.4], Quadrature::Gauss { n: 6 });
+        // a basis linear in X is reproduced exactly at the sub-points
+        let np = d.n_points();
+        let mut v = DMatrix::zeros(6 * np, 1);
+        for (i, p) in d.points.iter().enumerate() {
+            v[(6 * i + 1, 0)] = 1.0 + 2.0 * p.x;
+        }
+        let lb = LinearBasis::from_point_values(&d, &v).unwrap();
+        for (s, site) in d.sites.iter().enumerate() {
+            assert!((lb.phi_at(s)[(1, 0)] - (1.0 + 2.0 * site.x)).abs() < 1e-13);
+        }
+    }
+}
