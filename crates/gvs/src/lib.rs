@@ -11,9 +11,12 @@
 //! Conventions (gvs-spec §1): 6-vectors angular first, `[torsion, bend-y, bend-z, elongation,
 //! shear-y, shear-z]`; the rod runs along its local x-axis; SI units.
 
+pub mod actuation;
 pub mod discretize;
 pub mod error;
 pub mod lie;
+pub mod loads;
+pub mod model;
 pub mod rod;
 pub mod strain;
 

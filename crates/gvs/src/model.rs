@@ -1,0 +1,666 @@
+//! The GVS model: forward kinematics `g(X)`, geometric Jacobian `J(X)`, and the static generalized
+//! forces with their analytic Jacobian — generic over the [`StrainParam`].
+//!
+//! **Kinematics** (gvs-spec §5.3, §6). Between consecutive points of a division
+//! `Ω = h/2 (ξ₁ + ξ₂) + c h² ad_{ξ₁} ξ₂` (Z4, `c = √3/12`; Z2: `Ω = h ξ_Z`), `g_{i+1} = g_i exp(Ω̂)`,
+//! `Z = ∂Ω/∂q = h/2 (Ψ_q1 + Ψ_q2) + c h² (ad_{ξ₁} Ψ_q2 − ad_{ξ₂} Ψ_q1)`, `S = T(Ω) Z`,
+//! `J_{i+1} = Ad⁻¹_{g_s} (J_i + S)`.
+//!
+//! **Statics residual** (paper eq. 9): `R(q) = −K₁(q) + F(q) + B(q)u`. Every term is written as
+//! `R = Σ_s Ψ_q,sᵀ y_s` over the strain sites `s` with a 6-vector `y_s` per site:
+//! * elastic, at points: `y_i −= W_i Es_i Ψ_i` (so `K₁ = Σ W Ψ_qᵀ Es Ψ`, spec §7.3);
+//! * tendons, at points: `y_i += W_i Σ_k α_k Φ_a,k u_k` (paper eq. 11, spec §7.6–7.7);
+//! * external `F = Σ_i J_iᵀ w_i` by the backward pass `F̄_s = coAd_{g_s}(F̄_{s+1} + w_{s+1})`,
+//!   `S_sᵀ F̄_s = Zᵀ v`, `v = Tᵀ F̄`, which lands on the Magnus sub-points as
+//!   `y₁ += h/2 v + c h² coad_{ξ₂} v`, `y₂ += h/2 v − c h² coad_{ξ₁} v` (spec §8.2).
+//!
+//! **Jacobian**: `∂R/∂q = Σ_s Ψ_q,sᵀ ∂y_s/∂q + Σ_s Σ_a y_{s,a} ∇²Ψ_{s,a}`; the second sum is the
+//! parameterization's weighted Hessian (zero for linear bases). `∂F̄/∂q` follows the backward recursion
+//! of spec §8.2; the friction factor's derivative `∂α/∂q` is included, so the Jacobian is exact.
+
+use crate::actuation::{tangent_jacobian, tendon_local, turning_angle, wrench_jacobian, Tendon};
+use crate::discretize::{Discretization, MagnusOrder};
+use crate::error::ModelError;
+use crate::lie::{ad, coad, coad_mul, coadbar, exp_tangent, tilde, ExpTangent, Pose, M6, V3, V6};
+use crate::loads::{Frame, Loads};
+use crate::rod::{Rod, SectionProps};
+use crate::strain::{StrainEval, StrainParam};
+use nalgebra::{DMatrix, DVector, Matrix3xX, Matrix6xX};
+use std::ops::AddAssign;
+
+/// `c = √3/12` of the Zanna step.
+pub const ZANNA_C: f64 = 0.144_337_567_297_406_43;
+
+/// A rod, its discretization, a strain parameterization and its tendons.
+pub struct Model<P: StrainParam> {
+    pub rod: Rod,
+    pub disc: Discretization,
+    pub param: P,
+    pub tendons: Vec<Tendon>,
+    /// Base pose `g(0)`.
+    pub base: Pose,
+    props: Vec<SectionProps>,
+    xi_star: Vec<V6>,
+    tendon_points: Vec<Vec<usize>>,
+    k_lin: Option<DMatrix<f64>>,
+}
+
+/// Loads resolved onto the computational points.
+#[derive(Debug, Clone)]
+pub struct PreparedLoads {
+    gravity: V3,
+    /// Local (follower) wrench per point: point loads plus distributed densities × W.
+    local: Vec<V6>,
+    /// World-fixed wrench per point (world components).
+    global: Vec<V6>,
+}
+
+/// Scratch buffers of one model evaluation (allocated once, reused by every call).
+pub struct Workspace {
+    ev: StrainEval,
+    /// `ξ_s` at every site.
+    xi: Vec<V6>,
+    /// Pose at every point.
+    pub g: Vec<Pose>,
+    /// `J_i` of every point side by side (6 × n·n_points); valid after a forward pass with Jacobians.
+    pub jac: Matrix6xX<f64>,
+    et: Vec<ExpTangent>,
+    z: Matrix6xX<f64>,
+    y: Vec<V6>,
+    w: Vec<V6>,
+    wg: Vec<V6>,
+    dyp: Matrix6xX<f64>,
+    ubar: Matrix6xX<f64>,
+    t1: Matrix6xX<f64>,
+    t2: Matrix6xX<f64>,
+    dtau: Matrix3xX<f64>,
+    dtau_prev: Matrix3xX<f64>,
+    dtheta: DVector<f64>,
+    rtmp: DVector<f64>,
+    /// `max(1, ‖elastic‖∞, ‖external + actuation‖∞)` of the last residual.
+    pub residual_scale: f64,
+}
+
+impl<P: StrainParam> Model<P> {
+    /// Builds a model; validates the rod, the tendons and that `param` was built on `disc`.
+    pub fn new(
+        rod: Rod,
+        disc: Discretization,
+        param: P,
+        tendons: Vec<Tendon>,
+    ) -> Result<Self, ModelError> {
+        rod.validate()?;
+        if param.n_sites() != disc.n_sites() {
+            return Err(ModelError::invalid(
+                "basis",
+                format!(
+                    "built for {} sites, the discretization has {}",
+                    param.n_sites(),
+                    disc.n_sites()
+                ),
+            ));
+        }
+        if param.n_dof() == 0 {
+            return Err(ModelError::invalid("basis", "no generalized coordinates"));
+        }
+        for (k, t) in tendons.iter().enumerate() {
+            t.validate(&rod, k)?;
+        }
+        let props = disc
+            .points
+            .iter()
+            .map(|p| SectionProps::circular(&rod.material, rod.divisions[p.div].radius_at(p.x_bar)))
+            .collect::<Vec<_>>();
+        let xi_star = vec![V6::new(0.0, 0.0, 0.0, 1.0, 0.0, 0.0); disc.n_sites()];
+        let tendon_points = tendons
+            .iter()
+            .map(|t| tendon_point_list(&disc, t))
+            .collect();
+        let mut m = Model {
+            rod,
+            disc,
+            param,
+            tendons,
+            base: Pose::identity(),
+            props,
+            xi_star,
+            tendon_points,
+            k_lin: None,
+        };
+        if m.param.is_linear() {
+            m.k_lin = Some(m.stiffness_linear());
+        }
+        Ok(m)
+    }
+
+    pub fn with_base(mut self, base: Pose) -> Self {
+        self.base = base;
+        self
+    }
+
+    pub fn n_dof(&self) -> usize {
+        self.param.n_dof()
+    }
+
+    pub fn n_actuators(&self) -> usize {
+        self.tendons.len()
+    }
+
+    pub fn section(&self, point: usize) -> &SectionProps {
+        &self.props[point]
+    }
+
+    /// Reference strain `ξ*` at a site.
+    pub fn xi_star(&self, site: usize) -> V6 {
+        self.xi_star[site]
+    }
+
+    pub fn workspace(&self) -> Workspace {
+        let n = self.n_dof();
+        let np = self.disc.n_points();
+        let ns = self.disc.n_sites();
+        Workspace {
+            ev: self.param.new_eval(),
+            xi: vec![V6::zeros(); ns],
+            g: vec![Pose::identity(); np],
+            jac: Matrix6xX::zeros(n * np),
+            et: vec![exp_tangent(&V6::zeros()); np - 1],
+            z: Matrix6xX::zeros(n * (np - 1)),
+            y: vec![V6::zeros(); ns],
+            w: vec![V6::zeros(); np],
+            wg: vec![V6::zeros(); np],
+            dyp: Matrix6xX::zeros(n * np),
+            ubar: Matrix6xX::zeros(n),
+            t1: Matrix6xX::zeros(n),
+            t2: Matrix6xX::zeros(n),
+            dtau: Matrix3xX::zeros(n),
+            dtau_prev: Matrix3xX::zeros(n),
+            dtheta: DVector::zeros(n),
+            rtmp: DVector::zeros(n),
+            residual_scale: 1.0,
+        }
+    }
+
+    /// `K = Σ_i W_i Φ_iᵀ Es_i Φ_i` for a linear basis (spec §7.3).
+    fn stiffness_linear(&self) -> DMatrix<f64> {
+        let n = self.n_dof();
+        let ev = self.param.new_eval();
+        let mut k = DMatrix::zeros(n, n);
+        for (i, p) in self.disc.points.iter().enumerate() {
+            if p.weight == 0.0 {
+                continue;
+            }
+            let c = self.param.columns(i);
+            let phi = ev.psi_q_at(i, &c);
+            let ephi = DMatrix::from_fn(6, c.len(), |a, j| {
+                self.props[i].es[a] * p.weight * phi[(a, j)]
+            });
+            let mut blk = k.view_mut((c.start, c.start), (c.len(), c.len()));
+            blk.gemm_tr(1.0, &phi, &ephi, 1.0);
+        }
+        k
+    }
+
+    /// Constant stiffness matrix of a linear parameterization.
+    pub fn stiffness(&self) -> Option<&DMatrix<f64>> {
+        self.k_lin.as_ref()
+    }
+
+    /// Resolves loads onto the points. Point wrenches must sit on computational points (build the
+    /// discretization with their abscissae as extra points).
+    pub fn prepare_loads(&self, loads: &Loads) -> Result<PreparedLoads, ModelError> {
+        loads.validate(self.disc.length())?;
+        let np = self.disc.n_points();
+        let mut local = vec![V6::zeros(); np];
+        let mut global = vec![V6::zeros(); np];
+        for (k, pw) in loads.point.iter().enumerate() {
+            let i = self.disc.point_at(pw.x).ok_or_else(|| {
+                ModelError::invalid(
+                    format!("loads.point[{k}].x"),
+                    format!("X = {} m is not a computational point; add it to the discretization's extra points", pw.x),
+                )
+            })?;
+            let w = V6::from_row_slice(&pw.wrench);
+            match pw.frame {
+                Frame::Local => local[i] += w,
+                Frame::Global => global[i] += w,
+            }
+        }
+        for d in &loads.distributed {
+            for (i, p) in self.disc.points.iter().enumerate() {
+                if p.weight == 0.0 {
+                    continue;
+                }
+                let (f, frame) = d.density_at(p.x);
+                match frame {
+                    Frame::Local => local[i] += f * p.weight,
+                    Frame::Global => global[i] += f * p.weight,
+                }
+            }
+        }
+        Ok(PreparedLoads {
+            gravity: V3::from_row_slice(&loads.gravity),
+            local,
+            global,
+        })
+    }
+
+    /// Forward pass: strains at all sites, poses at all points, Magnus steps, and (if `jacobians`)
+    /// `Z`, `J` at every point.
+    pub fn forward(&self, q: &DVector<f64>, ws: &mut Workspace, jacobians: bool) {
+        let n = self.n_dof();
+        self.param.eval(q, &mut ws.ev);
+        for s in 0..ws.xi.len() {
+            ws.xi[s] = ws.ev.psi[s] + self.xi_star[s];
+        }
+        ws.g[0] = self.base;
+        if jacobians {
+            ws.jac.columns_mut(0, n).fill(0.0);
+        }
+        let mut hi = 0; // J_i is zero beyond column `hi`
+        for i in 0..self.disc.n_points() - 1 {
+            let Some(st) = self.disc.steps[i] else {
+                ws.g[i + 1] = ws.g[i];
+                if jacobians {
+                    let (a, mut b) = ws
+                        .jac
+                        .columns_range_pair_mut(i * n..(i + 1) * n, (i + 1) * n..(i + 2) * n);
+                    b.copy_from(&a);
+                }
+                continue;
+            };
+            let h = st.h;
+            let [s1, s2] = st.sites;
+            let omega = match self.disc.order {
+                MagnusOrder::Z4 => {
+                    (ws.xi[s1] + ws.xi[s2]) * (0.5 * h)
+                        + crate::lie::ad_mul(&ws.xi[s1], &ws.xi[s2]) * (ZANNA_C * h * h)
+                }
+                MagnusOrder::Z2 => ws.xi[s1] * h,
+            };
+            let et = exp_tangent(&omega);
+            ws.g[i + 1] = ws.g[i].compose(&et.g);
+            if jacobians {
+                let c = self.param.columns(s1);
+                hi = hi.max(c.end);
+                let mut z = ws.z.columns_mut(i * n + c.start, c.len());
+                match self.disc.order {
+                    MagnusOrder::Z4 => {
+                        let p1 = ws.ev.psi_q_at(s1, &c);
+                        let p2 = ws.ev.psi_q_at(s2, &c);
+                        z.zip_zip_apply(&p1, &p2, |zz, a, b| *zz = 0.5 * h * (a + b));
+                        let k = ZANNA_C * h * h;
+                        z.gemm(k, &ad(&ws.xi[s1]), &p2, 1.0);
+                        z.gemm(-k, &ad(&ws.xi[s2]), &p1, 1.0);
+                    }
+                    MagnusOrder::Z2 => {
+                        z.copy_from(&ws.ev.psi_q_at(s1, &c));
+                        z *= h;
+                    }
+                }
+                // J_{i+1} = Ad⁻¹ (J_i + T Z)
+                let mut t1 = ws.t1.columns_mut(0, hi);
+                t1.copy_from(&ws.jac.columns(i * n, hi));
+                t1.columns_mut(c.start, c.len()).gemm(
+                    1.0,
+                    &et.t,
+                    &ws.z.columns(i * n + c.start, c.len()),
+                    1.0,
+                );
+                let adinv = et.g.adjoint_inv();
+                let mut jn = ws.jac.columns_mut((i + 1) * n, n);
+                jn.fill(0.0);
+                jn.columns_mut(0, hi)
+                    .gemm(1.0, &adinv, &ws.t1.columns(0, hi), 0.0);
+            }
+            ws.et[i] = et;
+        }
+    }
+
+    /// Per-point wrenches `w_i` (local frame) of the external loads and gravity at the current poses;
+    /// `wg_i` collects the world-fixed part `[Rᵀm; Rᵀf + W ρA Rᵀ g]` whose derivative is `[m̃; f̃] δθ`.
+    fn point_wrenches(&self, loads: &PreparedLoads, ws: &mut Workspace) {
+        for (i, p) in self.disc.points.iter().enumerate() {
+            let rt = ws.g[i].rot.transpose();
+            let gl = loads.global[i];
+            let m = rt * V3::new(gl[0], gl[1], gl[2]);
+            let mut f = rt * V3::new(gl[3], gl[4], gl[5]);
+            if p.weight > 0.0 {
+                f += rt * loads.gravity * (p.weight * self.props[i].ms[3]);
+            }
+            ws.wg[i] = V6::new(m[0], m[1], m[2], f[0], f[1], f[2]);
+            ws.w[i] = loads.local[i] + ws.wg[i];
+        }
+    }
+
+    /// Statics residual `R(q) = −K₁(q) + F(q) + B(q)u` (paper eq. 9) into `r`.
+    ///
+    /// Also sets `ws.residual_scale = max(1, ‖K₁‖∞, ‖F + Bu‖∞)`, the scale of the convergence test.
+    pub fn statics_residual(
+        &self,
+        q: &DVector<f64>,
+        u: &[f64],
+        loads: &PreparedLoads,
+        ws: &mut Workspace,
+        r: &mut DVector<f64>,
+    ) {
+        self.forward(q, ws, false);
+        self.point_wrenches(loads, ws);
+        ws.y.iter_mut().for_each(|y| *y = V6::zeros());
+        self.tendon_forces(u, ws, false);
+        self.backward(ws, None);
+        r.fill(0.0);
+        self.project(ws, r);
+        let ext = r.amax();
+        // elastic part, projected separately for the scale
+        ws.rtmp.fill(0.0);
+        for (i, p) in self.disc.points.iter().enumerate() {
+            if p.weight > 0.0 {
+                let e = -self.props[i].es.component_mul(&ws.ev.psi[i]) * p.weight;
+                ws.y[i] += e;
+                let c = self.param.columns(i);
+                ws.rtmp
+                    .rows_mut(c.start, c.len())
+                    .gemv_tr(1.0, &ws.ev.psi_q_at(i, &c), &e, 1.0);
+            }
+        }
+        *r += &ws.rtmp;
+        ws.residual_scale = 1f64.max(ext).max(ws.rtmp.amax());
+    }
+
+    /// `r += Σ_s Ψ_q,sᵀ y_s`.
+    fn project(&self, ws: &Workspace, r: &mut DVector<f64>) {
+        for (s, y) in ws.y.iter().enumerate() {
+            if *y == V6::zeros() {
+                continue;
+            }
+            let c = self.param.columns(s);
+            r.rows_mut(c.start, c.len())
+                .gemv_tr(1.0, &ws.ev.psi_q_at(s, &c), y, 1.0);
+        }
+    }
+
+    /// Tendon forces into `ws.y`; with `jac`, their derivatives into `ws.dyp` (per point 6×n).
+    fn tendon_forces(&self, u: &[f64], ws: &mut Workspace, jac: bool) {
+        let n = self.n_dof();
+        for (k, td) in self.tendons.iter().enumerate() {
+            let uk = u[k];
+            if uk == 0.0 {
+                continue;
+            }
+            let mu = td.friction;
+            let dp = td.offset_rate();
+            let mut theta = 0.0;
+            let mut tau_prev = V3::zeros();
+            if jac {
+                ws.dtheta.fill(0.0);
+            }
+            for (m, &i) in self.tendon_points[k].iter().enumerate() {
+                let p = self.disc.points[i];
+                let d = td.offset(p.x);
+                let tl = tendon_local(&ws.xi[i], &d, &dp);
+                if mu > 0.0 {
+                    let rot = ws.g[i].rot;
+                    let tau = rot * tl.t;
+                    if jac {
+                        // δτ = R(−t̃ δθ + ∂t/∂ξ Ψ_q δq), δθ = J_ang δq
+                        let c = self.param.columns(i);
+                        let rt = rot * tilde(&tl.t);
+                        ws.dtau
+                            .gemm(-1.0, &rt, &ws.jac.fixed_rows::<3>(0).columns(i * n, n), 0.0);
+                        let rdt = rot * tangent_jacobian(&d, &tl);
+                        ws.dtau.columns_mut(c.start, c.len()).gemm(
+                            1.0,
+                            &rdt,
+                            &ws.ev.psi_q_at(i, &c),
+                            1.0,
+                        );
+                    }
+                    if m > 0 {
+                        let (phi, ga, gb) = turning_angle(&tau_prev, &tau);
+                        theta += phi;
+                        if jac {
+                            ws.dtheta.gemv_tr(1.0, &ws.dtau_prev, &ga, 1.0);
+                            ws.dtheta.gemv_tr(1.0, &ws.dtau, &gb, 1.0);
+                        }
+                    }
+                    tau_prev = tau;
+                    if jac {
+                        std::mem::swap(&mut ws.dtau, &mut ws.dtau_prev);
+                    }
+                }
+                if p.weight == 0.0 {
+                    continue;
+                }
+                let alpha = (-mu * theta).exp();
+                let scale = p.weight * alpha * uk;
+                ws.y[i] += tl.phi_a * scale;
+                if jac {
+                    let c = self.param.columns(i);
+                    let dphi = wrench_jacobian(&d, &tl) * scale;
+                    let mut dy = ws.dyp.columns_mut(i * n, n);
+                    dy.columns_mut(c.start, c.len())
+                        .gemm(1.0, &dphi, &ws.ev.psi_q_at(i, &c), 1.0);
+                    if mu > 0.0 {
+                        // Φ_a ⊗ ∂α/∂q · W u,  ∂α/∂q = −μ α ∂Θ/∂q
+                        dy.ger(-mu * scale, &tl.phi_a, &ws.dtheta, 1.0);
+                    }
+                }
+            }
+        }
+    }
+
+    /// External forces `Σ J_iᵀ w_i` onto the Magnus sites by the backward pass (spec §8.2); with
+    /// `out`, also adds `Σ_s Ψ_q,sᵀ ∂y_s/∂q` of these forces into it.
+    fn backward(&self, ws: &mut Workspace, mut out: Option<&mut DMatrix<f64>>) {
+        let n = self.n_dof();
+        let mut fbar = V6::zeros();
+        if out.is_some() {
+            ws.ubar.fill(0.0);
+        }
+        for i in (0..self.disc.n_points() - 1).rev() {
+            let w1 = ws.w[i + 1];
+            fbar += w1;
+            if out.is_some() && w1 != V6::zeros() {
+                // Ū += (coadbar(w) + [m̃_g 0; f̃_g 0]) J_{i+1}: the second term is ∂w/∂q of the
+                // world-fixed loads (gravity, global wrenches), spec §7.5
+                let wg = ws.wg[i + 1];
+                let mut c = coadbar(&w1);
+                c.fixed_view_mut::<3, 3>(0, 0)
+                    .add_assign(&tilde(&V3::new(wg[0], wg[1], wg[2])));
+                c.fixed_view_mut::<3, 3>(3, 0)
+                    .add_assign(&tilde(&V3::new(wg[3], wg[4], wg[5])));
+                ws.ubar.gemm(1.0, &c, &ws.jac.columns((i + 1) * n, n), 1.0);
+            }
+            let Some(st) = self.disc.steps[i] else {
+                continue;
+            };
+            let et = &ws.et[i];
+            fbar = et.g.coadjoint_mul(&fbar);
+            let v = et.t.transpose() * fbar;
+            let h = st.h;
+            let [s1, s2] = st.sites;
+            let k = ZANNA_C * h * h;
+            match self.disc.order {
+                MagnusOrder::Z4 => {
+                    ws.y[s1] += v * (0.5 * h) + coad_mul(&ws.xi[s2], &v) * k;
+                    ws.y[s2] += v * (0.5 * h) - coad_mul(&ws.xi[s1], &v) * k;
+                }
+                MagnusOrder::Z2 => ws.y[s1] += v * h,
+            }
+            let Some(out) = out.as_deref_mut() else {
+                continue;
+            };
+            // Ū ← coAd Ū ;  dv = Tᵀ(Ū − coadbar(F̄) J_i) + ∂(TᵀF̄)/∂Ω Z
+            let coadj: M6 = et.g.adjoint_inv().transpose();
+            ws.t1.gemm(1.0, &coadj, &ws.ubar, 0.0);
+            std::mem::swap(&mut ws.t1, &mut ws.ubar);
+            ws.t1.copy_from(&ws.ubar);
+            ws.t1
+                .gemm(-1.0, &coadbar(&fbar), &ws.jac.columns(i * n, n), 1.0);
+            ws.t2.gemm(1.0, &et.t.transpose(), &ws.t1, 0.0); // t2 = dv
+            let c = self.param.columns(s1);
+            ws.t2.columns_mut(c.start, c.len()).gemm(
+                1.0,
+                &et.d_ttf(&fbar),
+                &ws.z.columns(i * n + c.start, c.len()),
+                1.0,
+            );
+            match self.disc.order {
+                MagnusOrder::Z4 => {
+                    let cbv = coadbar(&v) * k;
+                    // dy₁ = (h/2 + k coad_{ξ₂}) dv + k coadbar(v) Ψ_q2
+                    let a1 = M6::identity() * (0.5 * h) + coad(&ws.xi[s2]) * k;
+                    ws.t1.gemm(1.0, &a1, &ws.t2, 0.0);
+                    ws.t1.columns_mut(c.start, c.len()).gemm(
+                        1.0,
+                        &cbv,
+                        &ws.ev.psi_q_at(s2, &c),
+                        1.0,
+                    );
+                    out.rows_mut(c.start, c.len()).gemm_tr(
+                        1.0,
+                        &ws.ev.psi_q_at(s1, &c),
+                        &ws.t1,
+                        1.0,
+                    );
+                    // dy₂ = (h/2 − k coad_{ξ₁}) dv − k coadbar(v) Ψ_q1
+                    let a2 = M6::identity() * (0.5 * h) - coad(&ws.xi[s1]) * k;
+                    ws.t1.gemm(1.0, &a2, &ws.t2, 0.0);
+                    ws.t1.columns_mut(c.start, c.len()).gemm(
+                        -1.0,
+                        &cbv,
+                        &ws.ev.psi_q_at(s1, &c),
+                        1.0,
+                    );
+                    out.rows_mut(c.start, c.len()).gemm_tr(
+                        1.0,
+                        &ws.ev.psi_q_at(s2, &c),
+                        &ws.t1,
+                        1.0,
+                    );
+                }
+                MagnusOrder::Z2 => {
+                    out.rows_mut(c.start, c.len())
+                        .gemm_tr(h, &ws.ev.psi_q_at(s1, &c), &ws.t2, 1.0);
+                }
+            }
+        }
+    }
+
+    /// Analytic statics Jacobian `∂R/∂q` (spec §8.2, with `∂α/∂q` of friction) into `jac`.
+    pub fn statics_jacobian(
+        &self,
+        q: &DVector<f64>,
+        u: &[f64],
+        loads: &PreparedLoads,
+        ws: &mut Workspace,
+        jac: &mut DMatrix<f64>,
+    ) {
+        let n = self.n_dof();
+        self.forward(q, ws, true);
+        self.point_wrenches(loads, ws);
+        ws.y.iter_mut().for_each(|y| *y = V6::zeros());
+        ws.dyp.fill(0.0);
+        jac.fill(0.0);
+        // elastic
+        match &self.k_lin {
+            Some(k) => *jac -= k,
+            None => {
+                for (i, p) in self.disc.points.iter().enumerate() {
+                    if p.weight > 0.0 {
+                        let c = self.param.columns(i);
+                        let psq = ws.ev.psi_q_at(i, &c);
+                        let mut dy = ws.dyp.columns_mut(i * n + c.start, c.len());
+                        for a in 0..6 {
+                            let e = -self.props[i].es[a] * p.weight;
+                            for j in 0..c.len() {
+                                dy[(a, j)] += e * psq[(a, j)];
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        for (i, p) in self.disc.points.iter().enumerate() {
+            if p.weight > 0.0 {
+                ws.y[i] -= self.props[i].es.component_mul(&ws.ev.psi[i]) * p.weight;
+            }
+        }
+        self.tendon_forces(u, ws, true);
+        for (i, p) in self.disc.points.iter().enumerate() {
+            if p.weight == 0.0 {
+                continue;
+            }
+            let c = self.param.columns(i);
+            let dy = ws.dyp.columns(i * n, n);
+            if dy.iter().all(|v| *v == 0.0) {
+                continue;
+            }
+            jac.rows_mut(c.start, c.len())
+                .gemm_tr(1.0, &ws.ev.psi_q_at(i, &c), &dy, 1.0);
+        }
+        self.backward(ws, Some(jac));
+        if !self.param.is_linear() {
+            self.param.add_weighted_hessian(q, &ws.y, jac);
+        }
+    }
+
+    /// Strain `ξ_i` at every computational point after a forward pass.
+    pub fn point_strains(&self, ws: &Workspace) -> Vec<V6> {
+        ws.xi[..self.disc.n_points()].to_vec()
+    }
+
+    /// Position of the centreline at `x` by cubic Hermite interpolation between the neighbouring
+    /// computational points (tangent `r' = R ν`), after a forward pass.
+    pub fn position_at(&self, ws: &Workspace, x: f64) -> V3 {
+        let pts = &self.disc.points;
+        let i = match pts.iter().position(|p| p.x > x) {
+            Some(0) => 0,
+            Some(i) => i - 1,
+            None => return ws.g[pts.len() - 1].pos,
+        };
+        let (a, b) = (pts[i], pts[i + 1]);
+        let hx = b.x - a.x;
+        if hx <= 0.0 {
+            return ws.g[i].pos;
+        }
+        let t = ((x - a.x) / hx).clamp(0.0, 1.0);
+        let ta = ws.g[i].rot * V3::new(ws.xi[i][3], ws.xi[i][4], ws.xi[i][5]);
+        let tb = ws.g[i + 1].rot * V3::new(ws.xi[i + 1][3], ws.xi[i + 1][4], ws.xi[i + 1][5]);
+        let (t2, t3) = (t * t, t * t * t);
+        ws.g[i].pos * (2.0 * t3 - 3.0 * t2 + 1.0)
+            + ta * ((t3 - 2.0 * t2 + t) * hx)
+            + ws.g[i + 1].pos * (-2.0 * t3 + 3.0 * t2)
+            + tb * ((t3 - t2) * hx)
+    }
+
+    /// Tendon points (indices) of tendon `k`.
+    pub fn tendon_points(&self, k: usize) -> &[usize] {
+        &self.tendon_points[k]
+    }
+}
+
+/// The computational points on a tendon's span. At a termination (or start) on a division junction
+/// the duplicated point on the far side is excluded; junctions inside the span keep both points so
+/// that the tangent kink counts in the friction angle.
+fn tendon_point_list(disc: &Discretization, t: &Tendon) -> Vec<usize> {
+    let tol = 1e-12 * disc.length().max(1.0);
+    let pts = &disc.points;
+    (0..pts.len())
+        .filter(|&i| {
+            let x = pts[i].x;
+            if x < t.x_start - tol || x > t.x_end + tol {
+                return false;
+            }
+            if (x - t.x_end).abs() <= tol && i > 0 && (pts[i - 1].x - x).abs() <= tol {
+                return false;
+            }
+            if (x - t.x_start).abs() <= tol && i + 1 < pts.len() && (pts[i + 1].x - x).abs() <= tol
+            {
+                return false;
+            }
+            true
+        })
+        .collect()
+}

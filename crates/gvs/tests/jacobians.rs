@@ -1,0 +1,287 @@
+//! Analytic derivatives against central finite differences (gvs-spec §10.2, §10.3.9):
+//! the geometric Jacobian `J_i` at every point and the statics Jacobian `∂R/∂q` with gravity,
+//! follower and world-fixed wrenches, distributed loads, tendons with and without friction, two
+//! divisions, Z2 and Z4, and a nonlinear (sigmoid) strain parameterization.
+
+use gvs::actuation::Tendon;
+use gvs::discretize::{Discretization, MagnusOrder, Quadrature};
+use gvs::lie::{Pose, V6};
+use gvs::loads::{DistributedWrench, Frame, Loads, PointWrench, PulseMagnitude};
+use gvs::model::Model;
+use gvs::rod::{DivisionGeometry, Material, Rod};
+use gvs::strain::{DivisionBasis, LinearBasis, SigmoidBend, StrainParam};
+use nalgebra::{DMatrix, DVector};
+
+fn material() -> Material {
+    Material {
+        youngs_modulus: 0.617e6,
+        poisson_ratio: 0.5,
+        density: 1121.0,
+        damping: 1e4,
+    }
+}
+
+/// Deterministic pseudo-random vector in [-a, a].
+fn pseudo_random(n: usize, seed: u64, a: f64) -> DVector<f64> {
+    let mut s = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    DVector::from_fn(n, |_, _| {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((s >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) * a
+    })
+}
+
+fn check_geometric_jacobian<P: StrainParam>(model: &Model<P>, q: &DVector<f64>) {
+    let n = model.n_dof();
+    let mut ws = model.workspace();
+    model.forward(q, &mut ws, true);
+    let jac = ws.jac.clone();
+    let g0 = ws.g.clone();
+    let (mut wp, mut wm) = (model.workspace(), model.workspace());
+    let h = 1e-6;
+    let mut worst: f64 = 0.0;
+    for j in 0..n {
+        let mut qp = q.clone();
+        qp[j] += h;
+        let mut qm = q.clone();
+        qm[j] -= h;
+        model.forward(&qp, &mut wp, false);
+        model.forward(&qm, &mut wm, false);
+        for i in 0..model.disc.n_points() {
+            let d = (wp.g[i].to_homogeneous() - wm.g[i].to_homogeneous()) / (2.0 * h);
+            let m = g0[i].inverse().to_homogeneous() * d;
+            let fd = V6::new(
+                m[(2, 1)],
+                m[(0, 2)],
+                m[(1, 0)],
+                m[(0, 3)],
+                m[(1, 3)],
+                m[(2, 3)],
+            );
+            let an = jac.column(i * n + j);
+            for a in 0..6 {
+                worst = worst.max((fd[a] - an[a]).abs() / (1.0 + an[a].abs()));
+            }
+        }
+    }
+    assert!(
+        worst < 1e-7,
+        "J vs central differences: worst relative error {worst:e}"
+    );
+}
+
+fn check_statics_jacobian<P: StrainParam>(
+    model: &Model<P>,
+    q: &DVector<f64>,
+    u: &[f64],
+    loads: &Loads,
+) {
+    let n = model.n_dof();
+    let pl = model.prepare_loads(loads).unwrap();
+    let mut ws = model.workspace();
+    let mut an = DMatrix::zeros(n, n);
+    model.statics_jacobian(q, u, &pl, &mut ws, &mut an);
+    let mut fd = DMatrix::zeros(n, n);
+    let (mut rp, mut rm) = (DVector::zeros(n), DVector::zeros(n));
+    for j in 0..n {
+        let h = 1e-6 * (1.0 + q[j].abs());
+        let mut qp = q.clone();
+        qp[j] += h;
+        let mut qm = q.clone();
+        qm[j] -= h;
+        model.statics_residual(&qp, u, &pl, &mut ws, &mut rp);
+        model.statics_residual(&qm, u, &pl, &mut ws, &mut rm);
+        fd.set_column(j, &((&rp - &rm) / (2.0 * h)));
+    }
+    let err = (&an - &fd).norm() / fd.norm();
+    assert!(
+        err < 1e-6,
+        "statics Jacobian vs central differences: relative error {err:e}"
+    );
+}
+
+fn single_division_model(order: MagnusOrder, friction: f64) -> Model<LinearBasis> {
+    let rod = Rod::tapered(material(), 0.25, 0.0125, 0.005);
+    let disc = Discretization::new(&rod, &[Quadrature::Gauss { n: 12 }], order, &[0.1]).unwrap();
+    let basis = LinearBasis::per_division(
+        &disc,
+        &[DivisionBasis::Legendre {
+            modes: [true; 6],
+            orders: [1, 3, 2, 1, 1, 2],
+        }],
+    )
+    .unwrap();
+    let tendons = vec![
+        Tendon {
+            offset_start: [0.0, 0.01],
+            offset_end: [0.0, 0.003],
+            x_start: 0.0,
+            x_end: 0.25,
+            friction,
+        },
+        Tendon {
+            offset_start: [0.006, -0.002],
+            offset_end: [0.002, 0.001],
+            x_start: 0.0,
+            x_end: 0.25,
+            friction: 0.3,
+        },
+    ];
+    Model::new(rod, disc, basis, tendons).unwrap()
+}
+
+fn all_loads() -> Loads {
+    Loads {
+        gravity: [0.0, 0.0, -9.81],
+        point: vec![
+            PointWrench {
+                x: 0.25,
+                wrench: [0.001, -0.002, 0.003, 0.05, -0.1, 0.2],
+                frame: Frame::Local,
+            },
+            PointWrench {
+                x: 0.25,
+                wrench: [0.002, 0.001, -0.001, -0.1, 0.05, -0.3],
+                frame: Frame::Global,
+            },
+            PointWrench {
+                x: 0.1,
+                wrench: [0.0, 0.01, 0.0, 0.0, 0.2, 0.0],
+                frame: Frame::Global,
+            },
+        ],
+        distributed: vec![
+            DistributedWrench::TriangularPulse {
+                center: 0.12,
+                width: 0.05,
+                magnitude: 0.2,
+                axis: [0.0, 1.0, 0.3],
+                convention: PulseMagnitude::Peak,
+            },
+            DistributedWrench::Uniform {
+                x_start: 0.05,
+                x_end: 0.2,
+                density: [0.0, 0.0, 0.01, 0.0, 0.3, 0.1],
+                frame: Frame::Global,
+            },
+        ],
+    }
+}
+
+#[test]
+fn geometric_jacobian_matches_finite_differences_z4_and_z2() {
+    for order in [MagnusOrder::Z4, MagnusOrder::Z2] {
+        let m = single_division_model(order, 0.0).with_base(Pose::new(
+            nalgebra::Rotation3::from_euler_angles(0.3, -0.2, 0.7).into_inner(),
+            nalgebra::Vector3::new(0.1, -0.2, 0.3),
+        ));
+        let q = pseudo_random(m.n_dof(), 1, 0.6);
+        check_geometric_jacobian(&m, &q);
+    }
+}
+
+#[test]
+fn statics_jacobian_matches_finite_differences_with_all_loads_and_friction() {
+    for order in [MagnusOrder::Z4, MagnusOrder::Z2] {
+        let m = single_division_model(order, 0.88);
+        let q = pseudo_random(m.n_dof(), 2, 0.5);
+        check_statics_jacobian(&m, &q, &[-2.0, -0.7], &all_loads());
+    }
+}
+
+#[test]
+fn statics_jacobian_matches_finite_differences_two_divisions_half_tendon() {
+    let rod = Rod {
+        material: Material {
+            youngs_modulus: 1e6,
+            poisson_ratio: 0.5,
+            density: 1000.0,
+            damping: 1e4,
+        },
+        divisions: vec![
+            DivisionGeometry {
+                length: 0.3,
+                radius_start: 0.02,
+                radius_end: 0.015,
+            },
+            DivisionGeometry {
+                length: 0.3,
+                radius_start: 0.015,
+                radius_end: 0.01,
+            },
+        ],
+    };
+    let q5 = Quadrature::Gauss { n: 5 };
+    let disc = Discretization::new(&rod, &[q5, q5], MagnusOrder::Z4, &[]).unwrap();
+    let b = DivisionBasis::Legendre {
+        modes: [true; 6],
+        orders: [1, 2, 2, 1, 1, 1],
+    };
+    let basis = LinearBasis::per_division(&disc, &[b.clone(), b]).unwrap();
+    let tendons = vec![
+        Tendon {
+            offset_start: [0.02, 0.0],
+            offset_end: [0.01, 0.0],
+            x_start: 0.0,
+            x_end: 0.6,
+            friction: 0.4,
+        },
+        Tendon {
+            offset_start: [0.01, 0.0173],
+            offset_end: [0.0075, 0.01299],
+            x_start: 0.0,
+            x_end: 0.3,
+            friction: 0.2,
+        },
+    ];
+    let m = Model::new(rod, disc, basis, tendons).unwrap();
+    let q = pseudo_random(m.n_dof(), 3, 0.4);
+    check_geometric_jacobian(&m, &q);
+    let loads = Loads {
+        gravity: [0.0, 3.0, -9.81],
+        point: vec![PointWrench {
+            x: 0.6,
+            wrench: [0.01, 0.0, -0.02, 0.1, 0.2, -0.1],
+            frame: Frame::Global,
+        }],
+        distributed: vec![],
+    };
+    check_statics_jacobian(&m, &q, &[-6.0, -3.0], &loads);
+}
+
+#[test]
+fn statics_jacobian_matches_finite_differences_for_nonlinear_sigmoid_basis() {
+    let rod = Rod::tapered(material(), 0.8, 0.015, 0.015);
+    let disc =
+        Discretization::new(&rod, &[Quadrature::Gauss { n: 20 }], MagnusOrder::Z4, &[]).unwrap();
+    let p = SigmoidBend::new(&disc);
+    let tendons = vec![Tendon {
+        offset_start: [0.0, 0.01],
+        offset_end: [0.0, 0.005],
+        x_start: 0.0,
+        x_end: 0.8,
+        friction: 0.5,
+    }];
+    let m = Model::new(rod, disc, p, tendons).unwrap();
+    let q = DVector::from_vec(vec![1.1, 8.0, 0.45]);
+    check_geometric_jacobian(&m, &q);
+    let loads = Loads {
+        gravity: [0.0, 0.0, -9.81],
+        point: vec![PointWrench {
+            x: 0.8,
+            wrench: [0.0, 0.01, 0.0, 0.0, 0.0, -0.05],
+            frame: Frame::Global,
+        }],
+        distributed: vec![DistributedWrench::TriangularPulse {
+            center: 0.3,
+            width: 0.08,
+            magnitude: 2.0,
+            axis: [0.0, 1.0, 0.0],
+            convention: PulseMagnitude::Peak,
+        }],
+    };
+    check_statics_jacobian(&m, &q, &[-1.5], &loads);
+}
