@@ -18,6 +18,7 @@ pub mod lie;
 pub mod loads;
 pub mod model;
 pub mod rod;
+pub mod solve;
 pub mod strain;
 
 pub use error::ModelError;
