@@ -13,6 +13,7 @@
 
 pub mod actuation;
 pub mod discretize;
+pub mod dynamics;
 pub mod error;
 pub mod lie;
 pub mod loads;

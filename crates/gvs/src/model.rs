@@ -39,7 +39,7 @@ pub struct Model<P: StrainParam> {
     pub tendons: Vec<Tendon>,
     /// Base pose `g(0)`.
     pub base: Pose,
-    props: Vec<SectionProps>,
+    pub(crate) props: Vec<SectionProps>,
     xi_star: Vec<V6>,
     tendon_points: Vec<Vec<usize>>,
     k_lin: Option<DMatrix<f64>>,
@@ -57,26 +57,31 @@ pub struct PreparedLoads {
 
 /// Scratch buffers of one model evaluation (allocated once, reused by every call).
 pub struct Workspace {
-    ev: StrainEval,
+    pub(crate) ev: StrainEval,
     /// `ξ_s` at every site.
-    xi: Vec<V6>,
+    pub(crate) xi: Vec<V6>,
     /// Pose at every point.
     pub g: Vec<Pose>,
     /// `J_i` of every point side by side (6 × n·n_points); valid after a forward pass with Jacobians.
     pub jac: Matrix6xX<f64>,
-    et: Vec<ExpTangent>,
-    z: Matrix6xX<f64>,
-    y: Vec<V6>,
-    w: Vec<V6>,
+    pub(crate) et: Vec<ExpTangent>,
+    pub(crate) z: Matrix6xX<f64>,
+    pub(crate) y: Vec<V6>,
+    pub(crate) w: Vec<V6>,
     wg: Vec<V6>,
     dyp: Matrix6xX<f64>,
     ubar: Matrix6xX<f64>,
-    t1: Matrix6xX<f64>,
+    pub(crate) t1: Matrix6xX<f64>,
     t2: Matrix6xX<f64>,
     dtau: Matrix3xX<f64>,
     dtau_prev: Matrix3xX<f64>,
     dtheta: DVector<f64>,
     rtmp: DVector<f64>,
+    /// Body velocity `η_i` and `J̇ˢ_i q̇` at every point (dynamics).
+    pub eta: Vec<V6>,
+    pub(crate) zeta: Vec<V6>,
+    /// Mass matrix of the last dynamics evaluation.
+    pub mass: DMatrix<f64>,
     /// `max(1, ‖elastic‖∞, ‖external + actuation‖∞)` of the last residual.
     pub residual_scale: f64,
 }
@@ -177,6 +182,9 @@ impl<P: StrainParam> Model<P> {
             dtau_prev: Matrix3xX::zeros(n),
             dtheta: DVector::zeros(n),
             rtmp: DVector::zeros(n),
+            eta: vec![V6::zeros(); np],
+            zeta: vec![V6::zeros(); np],
+            mass: DMatrix::zeros(n, n),
             residual_scale: 1.0,
         }
     }
@@ -319,7 +327,7 @@ impl<P: StrainParam> Model<P> {
 
     /// Per-point wrenches `w_i` (local frame) of the external loads and gravity at the current poses;
     /// `wg_i` collects the world-fixed part `[Rᵀm; Rᵀf + W ρA Rᵀ g]` whose derivative is `[m̃; f̃] δθ`.
-    fn point_wrenches(&self, loads: &PreparedLoads, ws: &mut Workspace) {
+    pub(crate) fn point_wrenches(&self, loads: &PreparedLoads, ws: &mut Workspace) {
         for (i, p) in self.disc.points.iter().enumerate() {
             let rt = ws.g[i].rot.transpose();
             let gl = loads.global[i];
@@ -346,19 +354,35 @@ impl<P: StrainParam> Model<P> {
     ) {
         self.forward(q, ws, false);
         self.point_wrenches(loads, ws);
+        self.assemble_forces(u, None, ws, r);
+    }
+
+    /// Generalized forces `r = −K₁ − D₁ + F + Bu` from the point wrenches already in `ws.w` (after a
+    /// forward pass and [`Self::point_wrenches`]); damping `D₁ = Σ W Ψ_qᵀ Ds ξ̇` only if `qd` is given.
+    pub(crate) fn assemble_forces(
+        &self,
+        u: &[f64],
+        qd: Option<&DVector<f64>>,
+        ws: &mut Workspace,
+        r: &mut DVector<f64>,
+    ) {
         ws.y.iter_mut().for_each(|y| *y = V6::zeros());
         self.tendon_forces(u, ws, false);
         self.backward(ws, None);
         r.fill(0.0);
         self.project(ws, r);
         let ext = r.amax();
-        // elastic part, projected separately for the scale
+        // elastic (and damping) part, projected separately for the scale
         ws.rtmp.fill(0.0);
         for (i, p) in self.disc.points.iter().enumerate() {
             if p.weight > 0.0 {
-                let e = -self.props[i].es.component_mul(&ws.ev.psi[i]) * p.weight;
-                ws.y[i] += e;
                 let c = self.param.columns(i);
+                let mut e = -self.props[i].es.component_mul(&ws.ev.psi[i]) * p.weight;
+                if let Some(qd) = qd {
+                    let xid = ws.ev.psi_q_at(i, &c) * qd.rows(c.start, c.len());
+                    e -= self.props[i].ds.component_mul(&xid) * p.weight;
+                }
+                ws.y[i] += e;
                 ws.rtmp
                     .rows_mut(c.start, c.len())
                     .gemv_tr(1.0, &ws.ev.psi_q_at(i, &c), &e, 1.0);

@@ -1,0 +1,318 @@
+//! Equations of motion of the GVS model (paper eq. 8, gvs-spec §6, §7.1–7.4, §7.8, §9.1):
+//!
+//! `M(q) q̈ + C(q, q̇) q̇ + D₁(q, q̇) + K₁(q) = B(q) u + F(q)`,
+//!
+//! generic over the strain parameterization (linear bases and nonlinear ones alike).
+//!
+//! * Velocities: `η_{i+1} = Ad⁻¹_{g_s}(η_i + S q̇)`, and with `ζ_i := J̇ˢ_i q̇` (the acceleration at
+//!   `q̈ = 0`): `ζ_{i+1} = Ad⁻¹_{g_s}(ζ_i + ad_{η_i} S q̇ + Ṡ q̇)`, `Ṡ q̇ = Ṫ Ω̇ + T Ż q̇`, `Ω̇ = Z q̇`;
+//!   Z4: `Ż q̇ = h/2 (Ψ̇_q1 + Ψ̇_q2) q̇ + c h² (ad_{ξ̇₁} ξ̇₂ − ad_{ξ̇₂} ξ̇₁ + ad_{ξ₁} Ψ̇_q2 q̇ − ad_{ξ₂} Ψ̇_q1 q̇)`.
+//! * `M = Σ W J ᵀ Ms J` (§7.1); `C q̇ = Σ W Jᵀ (Ms ζ + coad_η Ms η)` (§7.2), obtained by adding the
+//!   inertial wrenches `−W (Ms ζ + coad_η Ms η)` to the external point wrenches of the statics
+//!   backward pass, so that `M q̈ = −K₁ − D₁ + F + Bu − C q̇` reuses the statics assembly.
+//! * The Coriolis *matrix* `C = Σ W Jᵀ (Ms J̇ˢ + coad_η Ms J)` with SoRoSim's `J̇ˢ = J̇ + ad_η J`
+//!   (recursion `J̇ˢ_{i+1} = Ad⁻¹(J̇ˢ_i + ad_{η_i} S + Ṡ)`) makes `Ṁ − 2C` skew-symmetric.
+
+use crate::discretize::MagnusOrder;
+use crate::lie::{ad, ad_mul, coad_mul, V3, V6};
+use crate::model::{Model, PreparedLoads, Workspace, ZANNA_C};
+use crate::strain::StrainParam;
+use nalgebra::{DMatrix, DVector, Matrix6xX};
+use thiserror::Error;
+
+#[derive(Debug, Clone, Error, PartialEq)]
+pub enum DynamicsError {
+    #[error("the mass matrix is not positive definite (pivot {pivot} = {value:e}); the strain basis may be rank-deficient at this q")]
+    MassNotPositiveDefinite { pivot: usize, value: f64 },
+    #[error("non-finite value in the {what}")]
+    NonFinite { what: &'static str },
+}
+
+/// Energies of a state [J].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Energy {
+    pub kinetic: f64,
+    pub elastic: f64,
+    pub gravitational: f64,
+}
+
+impl Energy {
+    pub fn total(&self) -> f64 {
+        self.kinetic + self.elastic + self.gravitational
+    }
+}
+
+impl<P: StrainParam> Model<P> {
+    /// Forward pass with velocities: after [`Model::forward`] with Jacobians, fills `ws.eta` (`η_i`)
+    /// and `ζ_i = J̇ˢ_i q̇`.
+    pub fn velocities(&self, q: &DVector<f64>, qd: &DVector<f64>, ws: &mut Workspace) {
+        let n = self.n_dof();
+        let nonlinear = !self.param.is_linear();
+        if nonlinear {
+            self.param.eval_rate(q, qd, &mut ws.ev);
+        }
+        ws.eta[0] = V6::zeros();
+        ws.zeta[0] = V6::zeros();
+        for i in 0..self.disc.n_points() - 1 {
+            let Some(st) = self.disc.steps[i] else {
+                ws.eta[i + 1] = ws.eta[i];
+                ws.zeta[i + 1] = ws.zeta[i];
+                continue;
+            };
+            let [s1, s2] = st.sites;
+            let c = self.param.columns(s1);
+            let qdc = qd.rows(c.start, c.len());
+            let h = st.h;
+            let om_dot: V6 = ws.z.columns(i * n + c.start, c.len()) * qdc;
+            let et = &ws.et[i];
+            let xid1: V6 = ws.ev.psi_q_at(s1, &c) * qdc;
+            let mut zd = V6::zeros(); // Ż q̇
+            match self.disc.order {
+                MagnusOrder::Z4 => {
+                    let xid2: V6 = ws.ev.psi_q_at(s2, &c) * qdc;
+                    let k = ZANNA_C * h * h;
+                    zd += (ad_mul(&xid1, &xid2) - ad_mul(&xid2, &xid1)) * k;
+                    if nonlinear {
+                        let a1: V6 = ws.ev.psi_q_dot_at(s1, &c) * qdc;
+                        let a2: V6 = ws.ev.psi_q_dot_at(s2, &c) * qdc;
+                        zd += (a1 + a2) * (0.5 * h)
+                            + (ad_mul(&ws.xi[s1], &a2) - ad_mul(&ws.xi[s2], &a1)) * k;
+                    }
+                }
+                MagnusOrder::Z2 => {
+                    if nonlinear {
+                        let a1: V6 = ws.ev.psi_q_dot_at(s1, &c) * qdc;
+                        zd += a1 * h;
+                    }
+                }
+            }
+            let sqd = et.t * om_dot;
+            let sdqd = et.t_dot(&om_dot) * om_dot + et.t * zd;
+            ws.eta[i + 1] = et.g.adjoint_inv_mul(&(ws.eta[i] + sqd));
+            ws.zeta[i + 1] =
+                et.g.adjoint_inv_mul(&(ws.zeta[i] + ad_mul(&ws.eta[i], &sqd) + sdqd));
+        }
+    }
+
+    /// `J̇_i q̇` (= `J̇ˢ_i q̇`) at point `i` after [`Self::velocities`]: the body acceleration at `q̈ = 0`.
+    pub fn point_acceleration_bias(&self, ws: &Workspace, i: usize) -> V6 {
+        ws.zeta[i]
+    }
+
+    /// `M = Σ_i W_i J_iᵀ Ms_i J_i` into `ws.mass` (after a forward pass with Jacobians).
+    pub fn assemble_mass(&self, ws: &mut Workspace) {
+        let n = self.n_dof();
+        ws.mass.fill(0.0);
+        for (i, p) in self.disc.points.iter().enumerate() {
+            if p.weight == 0.0 {
+                continue;
+            }
+            let ms = self.props[i].ms * p.weight;
+            let j = ws.jac.columns(i * n, n);
+            ws.t1.copy_from(&j);
+            for a in 0..6 {
+                ws.t1.row_mut(a).scale_mut(ms[a]);
+            }
+            ws.mass.gemm_tr(1.0, &j, &ws.t1, 1.0);
+        }
+    }
+
+    /// The mass matrix `M(q)`.
+    pub fn mass_matrix(&self, q: &DVector<f64>, ws: &mut Workspace) -> DMatrix<f64> {
+        self.forward(q, ws, true);
+        self.assemble_mass(ws);
+        ws.mass.clone()
+    }
+
+    /// Generalized forces of the dynamics, `τ = −K₁ − D₁ + F + Bu − C q̇` (so that `M q̈ = τ`), into
+    /// `r`; leaves `M` in `ws.mass`.
+    pub fn dynamic_forces(
+        &self,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        u: &[f64],
+        loads: &PreparedLoads,
+        ws: &mut Workspace,
+        r: &mut DVector<f64>,
+    ) {
+        self.forward(q, ws, true);
+        self.velocities(q, qd, ws);
+        self.assemble_mass(ws);
+        self.point_wrenches(loads, ws);
+        for (i, p) in self.disc.points.iter().enumerate() {
+            if p.weight == 0.0 {
+                continue;
+            }
+            let ms = self.props[i].ms;
+            let inertial =
+                ms.component_mul(&ws.zeta[i]) + coad_mul(&ws.eta[i], &ms.component_mul(&ws.eta[i]));
+            ws.w[i] -= inertial * p.weight;
+        }
+        self.assemble_forces(u, Some(qd), ws, r);
+    }
+
+    /// Accelerations `q̈ = M⁻¹ τ` (spec §9.1) by an in-place Cholesky factorization of `M`.
+    pub fn accelerations(
+        &self,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        u: &[f64],
+        loads: &PreparedLoads,
+        ws: &mut Workspace,
+        qdd: &mut DVector<f64>,
+    ) -> Result<(), DynamicsError> {
+        self.dynamic_forces(q, qd, u, loads, ws, qdd);
+        cholesky_solve_in_place(&mut ws.mass, qdd)?;
+        if qdd.iter().any(|v| !v.is_finite()) {
+            return Err(DynamicsError::NonFinite {
+                what: "accelerations",
+            });
+        }
+        Ok(())
+    }
+
+    /// Coriolis matrix `C(q, q̇) = Σ W Jᵀ (Ms J̇ˢ + coad_η Ms J)` (spec §7.2); for tests and analysis.
+    pub fn coriolis_matrix(
+        &self,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        ws: &mut Workspace,
+    ) -> DMatrix<f64> {
+        let n = self.n_dof();
+        self.forward(q, ws, true);
+        self.velocities(q, qd, ws);
+        if !self.param.is_linear() {
+            self.param.eval_rate(q, qd, &mut ws.ev);
+        }
+        let np = self.disc.n_points();
+        let mut jds = Matrix6xX::<f64>::zeros(n); // J̇ˢ_i
+        let mut c = DMatrix::zeros(n, n);
+        for i in 0..np {
+            if i > 0 {
+                if let Some(st) = self.disc.steps[i - 1] {
+                    let s = i - 1;
+                    let [s1, s2] = st.sites;
+                    let cols = self.param.columns(s1);
+                    let h = st.h;
+                    let et = &ws.et[s];
+                    let z = ws.z.columns(s * n + cols.start, cols.len()).into_owned();
+                    let qdc = qd.rows(cols.start, cols.len());
+                    // Ż (6×cols)
+                    let mut zdot = DMatrix::zeros(6, cols.len());
+                    let p1 = ws.ev.psi_q_at(s1, &cols).into_owned();
+                    let p2 = ws.ev.psi_q_at(s2, &cols).into_owned();
+                    match self.disc.order {
+                        MagnusOrder::Z4 => {
+                            let k = ZANNA_C * h * h;
+                            let xd1: V6 = &p1 * qdc;
+                            let xd2: V6 = &p2 * qdc;
+                            zdot += (ad(&xd1) * &p2 - ad(&xd2) * &p1) * k;
+                            if !self.param.is_linear() {
+                                let d1 = ws.ev.psi_q_dot_at(s1, &cols).into_owned();
+                                let d2 = ws.ev.psi_q_dot_at(s2, &cols).into_owned();
+                                zdot += (&d1 + &d2) * (0.5 * h)
+                                    + (ad(&ws.xi[s1]) * &d2 - ad(&ws.xi[s2]) * &d1) * k;
+                            }
+                        }
+                        MagnusOrder::Z2 => {
+                            if !self.param.is_linear() {
+                                zdot += ws.ev.psi_q_dot_at(s1, &cols).into_owned() * h;
+                            }
+                        }
+                    }
+                    let om_dot: V6 = &z * qdc;
+                    let sdot = et.t_dot(&om_dot) * &z + et.t * zdot;
+                    let smat = et.t * &z;
+                    let mut next = jds.clone();
+                    {
+                        let mut blk = next.columns_mut(cols.start, cols.len());
+                        blk += ad(&ws.eta[s]) * &smat + sdot;
+                    }
+                    jds = et.g.adjoint_inv() * next;
+                }
+            }
+            let w = self.disc.points[i].weight;
+            if w == 0.0 {
+                continue;
+            }
+            let ms = self.props[i].ms;
+            let j = ws.jac.columns(i * n, n).into_owned();
+            let msj = DMatrix::from_fn(6, n, |a, b| ms[a] * j[(a, b)]);
+            let msjd = DMatrix::from_fn(6, n, |a, b| ms[a] * jds[(a, b)]);
+            let inner = msjd + crate::lie::coad(&ws.eta[i]) * msj;
+            c += j.transpose() * inner * w;
+        }
+        c
+    }
+
+    /// Kinetic, elastic and gravitational energies at `(q, q̇)` (spec §9.4):
+    /// `T = ½ q̇ᵀ M q̇`, `U_e = ½ Σ W Ψᵀ Es Ψ`, `U_g = −Σ W ρA g·r`.
+    pub fn energy(
+        &self,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        gravity: &[f64; 3],
+        ws: &mut Workspace,
+    ) -> Energy {
+        self.forward(q, ws, true);
+        self.assemble_mass(ws);
+        let kinetic = 0.5 * qd.dot(&(&ws.mass * qd));
+        let g = V3::from_row_slice(gravity);
+        let mut elastic = 0.0;
+        let mut gravitational = 0.0;
+        for (i, p) in self.disc.points.iter().enumerate() {
+            if p.weight == 0.0 {
+                continue;
+            }
+            let psi = ws.ev.psi[i];
+            elastic += 0.5 * p.weight * psi.dot(&self.props[i].es.component_mul(&psi));
+            gravitational -= p.weight * self.props[i].ms[3] * g.dot(&ws.g[i].pos);
+        }
+        Energy {
+            kinetic,
+            elastic,
+            gravitational,
+        }
+    }
+}
+
+/// Solves `A x = b` for SPD `A` by an in-place Cholesky factorization (`A` is overwritten by `L`).
+pub fn cholesky_solve_in_place(
+    a: &mut DMatrix<f64>,
+    b: &mut DVector<f64>,
+) -> Result<(), DynamicsError> {
+    let n = a.nrows();
+    for j in 0..n {
+        let mut d = a[(j, j)];
+        for k in 0..j {
+            d -= a[(j, k)] * a[(j, k)];
+        }
+        if !(d > 0.0) {
+            return Err(DynamicsError::MassNotPositiveDefinite { pivot: j, value: d });
+        }
+        let d = d.sqrt();
+        a[(j, j)] = d;
+        for i in j + 1..n {
+            let mut s = a[(i, j)];
+            for k in 0..j {
+                s -= a[(i, k)] * a[(j, k)];
+            }
+            a[(i, j)] = s / d;
+        }
+    }
+    for i in 0..n {
+        let mut s = b[i];
+        for k in 0..i {
+            s -= a[(i, k)] * b[k];
+        }
+        b[i] = s / a[(i, i)];
+    }
+    for i in (0..n).rev() {
+        let mut s = b[i];
+        for k in i + 1..n {
+            s -= a[(k, i)] * b[k];
+        }
+        b[i] = s / a[(i, i)];
+    }
+    Ok(())
+}

@@ -1,0 +1,266 @@
+//! Structure of the equations of motion (gvs-spec §9.4, §10.5): M symmetric positive definite,
+//! `Ṁ − 2C` skew-symmetric, the Coriolis matrix consistent with the force path, `J̇ q̇` against finite
+//! differences, and linearized natural frequencies against beam theory.
+
+use gvs::actuation::Tendon;
+use gvs::discretize::{Discretization, MagnusOrder, Quadrature};
+use gvs::loads::Loads;
+use gvs::model::Model;
+use gvs::rod::{Material, Rod, SectionProps};
+use gvs::strain::{DivisionBasis, LinearBasis, SigmoidBend, StrainParam};
+use nalgebra::{DMatrix, DVector, SymmetricEigen};
+use std::f64::consts::PI;
+
+fn pseudo_random(n: usize, seed: u64, a: f64) -> DVector<f64> {
+    let mut s = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    DVector::from_fn(n, |_, _| {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((s >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) * a
+    })
+}
+
+fn material(damping: f64) -> Material {
+    Material {
+        youngs_modulus: 0.617e6,
+        poisson_ratio: 0.5,
+        density: 1121.0,
+        damping,
+    }
+}
+
+fn linear_model(order: MagnusOrder, damping: f64) -> Model<LinearBasis> {
+    let rod = Rod::tapered(material(damping), 0.25, 0.0125, 0.005);
+    let disc = Discretization::new(&rod, &[Quadrature::Gauss { n: 10 }], order, &[]).unwrap();
+    let b = LinearBasis::per_division(
+        &disc,
+        &[DivisionBasis::Legendre {
+            modes: [true; 6],
+            orders: [1, 3, 2, 1, 1, 2],
+        }],
+    )
+    .unwrap();
+    let t = Tendon {
+        offset_start: [0.0, 0.01],
+        offset_end: [0.0, 0.003],
+        x_start: 0.0,
+        x_end: 0.25,
+        friction: 0.5,
+    };
+    Model::new(rod, disc, b, vec![t]).unwrap()
+}
+
+fn sigmoid_model() -> Model<SigmoidBend> {
+    let rod = Rod::tapered(material(0.0), 0.8, 0.015, 0.015);
+    let disc =
+        Discretization::new(&rod, &[Quadrature::Gauss { n: 16 }], MagnusOrder::Z4, &[]).unwrap();
+    let p = SigmoidBend::new(&disc);
+    Model::new(rod, disc, p, vec![]).unwrap()
+}
+
+fn check_mass_spd_and_skew<P: StrainParam>(m: &Model<P>, q: &DVector<f64>, qd: &DVector<f64>) {
+    let mut ws = m.workspace();
+    let mass = m.mass_matrix(q, &mut ws);
+    let asym = (&mass - mass.transpose()).amax() / mass.amax();
+    assert!(asym < 1e-14, "M asymmetry {asym:e}");
+    let eig = SymmetricEigen::new(mass.clone()).eigenvalues;
+    assert!(eig.min() > 0.0, "M not positive definite: {eig}");
+    // Ṁ by central differences along q̇
+    let e = 1e-6;
+    let mp = m.mass_matrix(&(q + qd * e), &mut ws);
+    let mm = m.mass_matrix(&(q - qd * e), &mut ws);
+    let mdot = (mp - mm) / (2.0 * e);
+    let c = m.coriolis_matrix(q, qd, &mut ws);
+    let n = &mdot - &c * 2.0;
+    let sym = (&n + n.transpose()).amax() / mdot.amax().max(c.amax());
+    assert!(sym < 1e-7, "Ṁ − 2C is not skew-symmetric: {sym:e}");
+}
+
+#[test]
+fn mass_matrix_is_spd_and_mdot_minus_2c_is_skew_for_linear_basis() {
+    for order in [MagnusOrder::Z4, MagnusOrder::Z2] {
+        let m = linear_model(order, 0.0);
+        let q = pseudo_random(m.n_dof(), 11, 0.5);
+        let qd = pseudo_random(m.n_dof(), 12, 2.0);
+        check_mass_spd_and_skew(&m, &q, &qd);
+    }
+}
+
+#[test]
+fn mass_matrix_is_spd_and_mdot_minus_2c_is_skew_for_nonlinear_basis() {
+    let m = sigmoid_model();
+    check_mass_spd_and_skew(
+        &m,
+        &DVector::from_vec(vec![1.2, 7.0, 0.4]),
+        &DVector::from_vec(vec![0.8, -4.0, 0.3]),
+    );
+}
+
+fn check_coriolis_force_consistency<P: StrainParam>(
+    m: &Model<P>,
+    q: &DVector<f64>,
+    qd: &DVector<f64>,
+) {
+    // with no damping: τ(q, q̇) − τ(q, 0) = −C(q, q̇) q̇
+    let n = m.n_dof();
+    let mut ws = m.workspace();
+    let loads = m
+        .prepare_loads(&Loads {
+            gravity: [0.0, 0.0, -9.81],
+            ..Default::default()
+        })
+        .unwrap();
+    let u = vec![-1.0; m.n_actuators()];
+    let (mut t1, mut t0) = (DVector::zeros(n), DVector::zeros(n));
+    m.dynamic_forces(q, qd, &u, &loads, &mut ws, &mut t1);
+    m.dynamic_forces(q, &DVector::zeros(n), &u, &loads, &mut ws, &mut t0);
+    let cqd = m.coriolis_matrix(q, qd, &mut ws) * qd;
+    let err = (&t0 - &t1 - &cqd).amax() / cqd.amax();
+    assert!(
+        err < 1e-10,
+        "C q̇ from the force path vs the matrix: {err:e}"
+    );
+}
+
+#[test]
+fn coriolis_matrix_agrees_with_force_path() {
+    let m = linear_model(MagnusOrder::Z4, 0.0);
+    check_coriolis_force_consistency(
+        &m,
+        &pseudo_random(m.n_dof(), 21, 0.5),
+        &pseudo_random(m.n_dof(), 22, 2.0),
+    );
+    let m = sigmoid_model();
+    check_coriolis_force_consistency(
+        &m,
+        &DVector::from_vec(vec![1.2, 7.0, 0.4]),
+        &DVector::from_vec(vec![0.8, -4.0, 0.3]),
+    );
+}
+
+fn check_velocity_recursions<P: StrainParam>(m: &Model<P>, q: &DVector<f64>, qd: &DVector<f64>) {
+    // η_i = J_i q̇ and ζ_i = J̇_i q̇ with J̇ from central differences of J along q̇
+    let n = m.n_dof();
+    let mut ws = m.workspace();
+    m.forward(q, &mut ws, true);
+    m.velocities(q, qd, &mut ws);
+    let eta = ws.eta.clone();
+    let jac = ws.jac.clone();
+    let e = 1e-6;
+    let mut wp = m.workspace();
+    let mut wm = m.workspace();
+    m.forward(&(q + qd * e), &mut wp, true);
+    m.forward(&(q - qd * e), &mut wm, true);
+    // ζ_i = J̇ˢ_i q̇ = J̇_i q̇ since ad_η η = 0 (gvs-spec §6)
+    let mut worst: f64 = 0.0;
+    for i in 0..m.disc.n_points() {
+        let ji = jac.columns(i * n, n);
+        let eta_fd = ji * qd;
+        worst = worst.max((eta_fd - eta[i]).amax());
+        let jdot = (wp.jac.columns(i * n, n) - wm.jac.columns(i * n, n)) / (2.0 * e);
+        let zeta_fd = jdot * qd;
+        let zeta = m.point_acceleration_bias(&ws, i);
+        worst = worst.max((zeta_fd - zeta).amax() / (1.0 + zeta.amax()));
+    }
+    assert!(
+        worst < 1e-7,
+        "velocity recursions vs finite differences: {worst:e}"
+    );
+}
+
+#[test]
+fn velocity_and_jdot_recursions_match_finite_differences() {
+    let m = linear_model(MagnusOrder::Z4, 0.0);
+    check_velocity_recursions(
+        &m,
+        &pseudo_random(m.n_dof(), 31, 0.5),
+        &pseudo_random(m.n_dof(), 32, 2.0),
+    );
+    let m = sigmoid_model();
+    check_velocity_recursions(
+        &m,
+        &DVector::from_vec(vec![1.2, 7.0, 0.4]),
+        &DVector::from_vec(vec![0.8, -4.0, 0.3]),
+    );
+}
+
+/// Natural frequencies [Hz] from det(K − ω² M) = 0 at q = 0.
+fn frequencies(m: &Model<LinearBasis>) -> Vec<f64> {
+    let n = m.n_dof();
+    let mut ws = m.workspace();
+    let mass = m.mass_matrix(&DVector::zeros(n), &mut ws);
+    let k = m.stiffness().unwrap().clone();
+    let l = mass.cholesky().unwrap().l();
+    let linv = l.clone().try_inverse().unwrap();
+    let a: DMatrix<f64> = &linv * k * linv.transpose();
+    let a = (&a + a.transpose()) * 0.5;
+    let mut f: Vec<f64> = SymmetricEigen::new(a)
+        .eigenvalues
+        .iter()
+        .map(|w2| w2.sqrt() / (2.0 * PI))
+        .collect();
+    f.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    f
+}
+
+#[test]
+fn linearized_frequencies_of_clamped_rod_match_beam_theory() {
+    // gvs-spec §10.5: L = 0.5, r = 5 mm, E = 1e6, ρ = 1000, Legendre orders [2,6,6,2,2,2], N = 12
+    let (l, r, e, rho) = (0.5, 0.005, 1e6, 1000.0);
+    let mat = Material {
+        youngs_modulus: e,
+        poisson_ratio: 0.5,
+        density: rho,
+        damping: 0.0,
+    };
+    let rod = Rod::tapered(mat, l, r, r);
+    let disc =
+        Discretization::new(&rod, &[Quadrature::Gauss { n: 12 }], MagnusOrder::Z4, &[]).unwrap();
+    let b = LinearBasis::per_division(
+        &disc,
+        &[DivisionBasis::Legendre {
+            modes: [true; 6],
+            orders: [2, 6, 6, 2, 2, 2],
+        }],
+    )
+    .unwrap();
+    let m = Model::new(rod, disc, b, vec![]).unwrap();
+    let f = frequencies(&m);
+    let s = SectionProps::circular(&mat, r);
+    let eb = |beta_l: f64| beta_l * beta_l / (2.0 * PI * l * l) * (s.es[1] / (rho * s.area)).sqrt();
+    let (f1, f2) = (eb(1.875_104_068_711_96), eb(4.694_091_132_974_17));
+    let torsion = (mat.shear_modulus() / rho).sqrt() / (4.0 * l);
+    let axial = (e / rho).sqrt() / (4.0 * l);
+    // first two bending modes, each doubly degenerate (y and z), within 1 % of Euler–Bernoulli
+    for (k, fe) in [(0, f1), (2, f2)] {
+        for j in [k, k + 1] {
+            assert!(
+                ((f[j] - fe) / fe).abs() < 0.01,
+                "bending f[{j}] = {} vs EB {fe}",
+                f[j]
+            );
+        }
+    }
+    assert!(
+        (f[0] - 0.176917).abs() < 1e-5 && (f[2] - 1.10726).abs() < 1e-4,
+        "{:?}",
+        &f[..4]
+    );
+    // torsion and axial fundamental modes against their closed forms
+    let near = |target: f64| {
+        f.iter()
+            .map(|x| ((x - target) / target).abs())
+            .fold(f64::MAX, f64::min)
+    };
+    assert!(
+        near(torsion) < 0.01,
+        "no mode within 1 % of torsion {torsion} Hz: {f:?}"
+    );
+    assert!(
+        near(axial) < 0.01,
+        "no mode within 1 % of axial {axial} Hz: {f:?}"
+    );
+}
