@@ -1,0 +1,700 @@
+//! Scenario → engine: validates every value against its accepted range (naming the TOML field) and
+//! builds the rod, discretization, strain basis, tendons, loads and solver options of the engine.
+//!
+//! The engine validates too; the checks here come first so that messages use the scenario's own key
+//! paths, and they add what the engine cannot know (conflicting shorthand keys, sizes).
+
+use crate::error::ScenarioError;
+use crate::scenario::{
+    BasisSpec, DistributedLoadSpec, DivisionSpec, QuadratureSpec, Scenario, StrainMode, TendonSpec,
+};
+use gvs::actuation::Tendon;
+use gvs::discretize::{Discretization, Quadrature};
+use gvs::lie::{Pose, M3, V3};
+use gvs::loads::{DistributedWrench, Loads, PointWrench};
+use gvs::model::Model;
+use gvs::rod::{DivisionGeometry, Material, Rod};
+use gvs::solve::statics::StaticsOptions;
+use gvs::strain::{DivisionBasis, FemDegree, LinearBasis};
+
+/// Largest Legendre order per mode accepted (higher orders are numerically pointless here).
+pub const MAX_LEGENDRE_ORDER: usize = 50;
+/// Largest number of Gauss points per division, or of elements per division.
+pub const MAX_POINTS: usize = 5000;
+/// Largest number of Gauss points per element.
+pub const MAX_GAUSS_PER_ELEMENT: usize = 20;
+/// Largest `n_dof × strain sites`: the tabulated basis and Jacobians are 6 × n·sites matrices
+/// (5e6 ≈ 240 MB each).
+pub const MAX_BASIS_SIZE: usize = 5_000_000;
+/// Largest number of centreline samples.
+pub const MAX_CENTERLINE_POINTS: usize = 100_000;
+
+/// Everything a statics run needs, built and validated.
+pub struct Built {
+    pub name: String,
+    pub model: Model<LinearBasis>,
+    pub loads: Loads,
+    /// Tendon tensions u [N], in tendon order.
+    pub u: Vec<f64>,
+    pub options: StaticsOptions,
+    pub centerline_points: usize,
+}
+
+/// Validates `s` and builds the engine's model, loads, tensions and solver options.
+pub fn build(s: &Scenario) -> Result<Built, ScenarioError> {
+    let material = material(s)?;
+    if s.divisions.is_empty() {
+        return Err(ScenarioError::invalid(
+            "divisions",
+            "at least one [[divisions]] entry is required",
+        ));
+    }
+    let geometry = s
+        .divisions
+        .iter()
+        .enumerate()
+        .map(|(j, d)| geometry(j, d))
+        .collect::<Result<Vec<_>, _>>()?;
+    let rod = Rod {
+        material,
+        divisions: geometry,
+    };
+    let length = rod.length();
+    let bases = s
+        .divisions
+        .iter()
+        .enumerate()
+        .map(|(j, d)| basis(j, d))
+        .collect::<Result<Vec<_>, _>>()?;
+    let quads = s
+        .divisions
+        .iter()
+        .enumerate()
+        .map(|(j, d)| quadrature(j, d))
+        .collect::<Result<Vec<_>, _>>()?;
+    let base = base_pose(s)?;
+    let tendons = s
+        .tendons
+        .iter()
+        .enumerate()
+        .map(|(k, t)| tendon(k, t, &rod))
+        .collect::<Result<Vec<_>, _>>()?;
+    let u = s
+        .tendons
+        .iter()
+        .enumerate()
+        .map(|(k, t)| finite(&format!("tendons[{k}].tension"), t.tension))
+        .collect::<Result<Vec<_>, _>>()?;
+    let loads = loads(s, length)?;
+    s.solver.validate()?;
+    let centerline_points = s.output.centerline_points;
+    if !(2..=MAX_CENTERLINE_POINTS).contains(&centerline_points) {
+        return Err(ScenarioError::value(
+            "output.centerline_points",
+            centerline_points as f64,
+            format!("an integer in [2, {MAX_CENTERLINE_POINTS}]"),
+        ));
+    }
+
+    let extra_x = loads.point_abscissae();
+    let disc = Discretization::new(&rod, &quads, s.magnus, &extra_x)?;
+    let n_dof: usize = bases.iter().map(DivisionBasis::dofs).sum();
+    if n_dof.saturating_mul(disc.n_sites()) > MAX_BASIS_SIZE {
+        return Err(ScenarioError::invalid(
+            "divisions",
+            format!(
+                "the model is too large: {n_dof} DOF × {} strain sites = {} (accepted <= {MAX_BASIS_SIZE}); lower the basis orders/elements or the quadrature points",
+                disc.n_sites(),
+                n_dof * disc.n_sites()
+            ),
+        ));
+    }
+    let basis = LinearBasis::per_division(&disc, &bases)?;
+    let model = Model::new(rod, disc, basis, tendons)?.with_base(base);
+    Ok(Built {
+        name: s.name.clone().unwrap_or_else(|| "scenario".to_string()),
+        model,
+        loads,
+        u,
+        options: s.solver.clone(),
+        centerline_points,
+    })
+}
+
+fn finite(field: &str, v: f64) -> Result<f64, ScenarioError> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(ScenarioError::value(field, v, "a finite number"))
+    }
+}
+
+fn positive(field: &str, v: f64, unit: &str) -> Result<f64, ScenarioError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(ScenarioError::value(
+            field,
+            v,
+            format!("a finite number > 0 {unit}"),
+        ))
+    }
+}
+
+fn non_negative(field: &str, v: f64, unit: &str) -> Result<f64, ScenarioError> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(ScenarioError::value(
+            field,
+            v,
+            format!("a finite number >= 0 {unit}"),
+        ))
+    }
+}
+
+fn material(s: &Scenario) -> Result<Material, ScenarioError> {
+    let m = &s.material;
+    positive("material.youngs_modulus", m.youngs_modulus, "Pa")?;
+    if !(m.poisson_ratio.is_finite() && m.poisson_ratio > -1.0 && m.poisson_ratio <= 0.5) {
+        return Err(ScenarioError::value(
+            "material.poisson_ratio",
+            m.poisson_ratio,
+            "a number in (-1, 0.5]",
+        ));
+    }
+    non_negative("material.density", m.density, "kg/m^3")?;
+    non_negative("material.damping", m.damping, "Pa*s")?;
+    Ok(Material {
+        youngs_modulus: m.youngs_modulus,
+        poisson_ratio: m.poisson_ratio,
+        density: m.density,
+        damping: m.damping,
+    })
+}
+
+fn geometry(j: usize, d: &DivisionSpec) -> Result<DivisionGeometry, ScenarioError> {
+    let f = |n: &str| format!("divisions[{j}].{n}");
+    let length = positive(&f("length"), d.length, "m")?;
+    let (r0, r1) = match (d.radius, d.radius_start, d.radius_end) {
+        (Some(r), None, None) => (
+            positive(&f("radius"), r, "m")?,
+            positive(&f("radius"), r, "m")?,
+        ),
+        (None, Some(a), Some(b)) => (
+            positive(&f("radius_start"), a, "m")?,
+            positive(&f("radius_end"), b, "m")?,
+        ),
+        (Some(_), _, _) => return Err(ScenarioError::invalid(
+            f("radius"),
+            "give either `radius` (uniform) or `radius_start` and `radius_end` (tapered), not both",
+        )),
+        (None, Some(_), None) => {
+            return Err(ScenarioError::invalid(
+                f("radius_end"),
+                "missing: `radius_start` needs `radius_end`",
+            ))
+        }
+        (None, None, Some(_)) => {
+            return Err(ScenarioError::invalid(
+                f("radius_start"),
+                "missing: `radius_end` needs `radius_start`",
+            ))
+        }
+        (None, None, None) => {
+            return Err(ScenarioError::invalid(
+                f("radius"),
+                "missing: give `radius` or `radius_start` and `radius_end` [m]",
+            ))
+        }
+    };
+    Ok(DivisionGeometry {
+        length,
+        radius_start: r0,
+        radius_end: r1,
+    })
+}
+
+/// The six active flags of a mode list; rejects an empty list and repeated modes.
+fn mode_flags(field: &str, modes: &[StrainMode]) -> Result<[bool; 6], ScenarioError> {
+    if modes.is_empty() {
+        return Err(ScenarioError::invalid(
+            field,
+            "the basis is empty: list at least one strain mode of torsion, bend_y, bend_z, elongation, shear_y, shear_z",
+        ));
+    }
+    let mut flags = [false; 6];
+    for m in modes {
+        if flags[m.index()] {
+            return Err(ScenarioError::invalid(
+                field,
+                format!("mode `{}` is listed twice", m.name()),
+            ));
+        }
+        flags[m.index()] = true;
+    }
+    Ok(flags)
+}
+
+fn basis(j: usize, d: &DivisionSpec) -> Result<DivisionBasis, ScenarioError> {
+    let f = |n: &str| format!("divisions[{j}].basis.{n}");
+    match &d.basis {
+        BasisSpec::Legendre {
+            modes,
+            order,
+            orders,
+        } => {
+            let flags = mode_flags(&f("modes"), modes)?;
+            let mut ords = [0usize; 6];
+            for m in StrainMode::ALL {
+                let explicit = orders.get(m);
+                if !flags[m.index()] {
+                    if explicit.is_some() {
+                        return Err(ScenarioError::invalid(
+                            f(&format!("orders.{}", m.name())),
+                            format!("mode `{}` is not in `modes`", m.name()),
+                        ));
+                    }
+                    continue;
+                }
+                let (field, k) = match (explicit, order) {
+                    (Some(k), _) => (f(&format!("orders.{}", m.name())), k),
+                    (None, Some(k)) => (f("order"), *k),
+                    (None, None) => {
+                        return Err(ScenarioError::invalid(
+                            f("order"),
+                            format!("missing: give `order` (all modes) or `orders.{}`", m.name()),
+                        ))
+                    }
+                };
+                if k > MAX_LEGENDRE_ORDER {
+                    return Err(ScenarioError::value(
+                        field,
+                        k as f64,
+                        format!("an integer in [0, {MAX_LEGENDRE_ORDER}]"),
+                    ));
+                }
+                ords[m.index()] = k;
+            }
+            Ok(DivisionBasis::Legendre {
+                modes: flags,
+                orders: ords,
+            })
+        }
+        BasisSpec::Fem {
+            modes,
+            elements,
+            degree,
+        } => {
+            let flags = mode_flags(&f("modes"), modes)?;
+            if !(1..=MAX_POINTS).contains(elements) {
+                return Err(ScenarioError::value(
+                    f("elements"),
+                    *elements as f64,
+                    format!("an integer in [1, {MAX_POINTS}]"),
+                ));
+            }
+            Ok(DivisionBasis::Fem {
+                modes: flags,
+                elements: *elements,
+                degree: *degree,
+            })
+        }
+    }
+}
+
+fn quadrature(j: usize, d: &DivisionSpec) -> Result<Quadrature, ScenarioError> {
+    let f = |n: &str| format!("divisions[{j}].quadrature.{n}");
+    let check = |field: String, v: usize, max: usize| {
+        if (1..=max).contains(&v) {
+            Ok(v)
+        } else {
+            Err(ScenarioError::value(
+                field,
+                v as f64,
+                format!("an integer in [1, {max}]"),
+            ))
+        }
+    };
+    let fem_elements = match &d.basis {
+        BasisSpec::Fem {
+            elements, degree, ..
+        } => Some((*elements, *degree)),
+        BasisSpec::Legendre { .. } => None,
+    };
+    let q = d.quadrature.clone().unwrap_or_default();
+    match q {
+        QuadratureSpec {
+            gauss: None,
+            elements: None,
+            gauss_per_element: None,
+        } => Ok(match (&d.basis, fem_elements) {
+            (_, Some((elements, degree))) => Quadrature::Elements {
+                elements,
+                gauss_per_element: match degree {
+                    FemDegree::Linear => 2,
+                    FemDegree::Quadratic => 3,
+                },
+            },
+            (
+                BasisSpec::Legendre {
+                    order, orders: o, ..
+                },
+                None,
+            ) => {
+                let max = StrainMode::ALL
+                    .iter()
+                    .filter_map(|&m| o.get(m))
+                    .chain(*order)
+                    .max()
+                    .unwrap_or(0);
+                Quadrature::Gauss {
+                    n: (max + 1).max(5),
+                }
+            }
+            (BasisSpec::Fem { .. }, None) => unreachable!("FEM bases always carry elements"),
+        }),
+        QuadratureSpec {
+            gauss: Some(n),
+            elements: None,
+            gauss_per_element: None,
+        } => Ok(Quadrature::Gauss {
+            n: check(f("gauss"), n, MAX_POINTS)?,
+        }),
+        QuadratureSpec {
+            gauss: None,
+            elements,
+            gauss_per_element: Some(g),
+        } => {
+            let elements = match (elements, fem_elements) {
+                (Some(e), _) => check(f("elements"), e, MAX_POINTS)?,
+                (None, Some((e, _))) => e,
+                (None, None) => {
+                    return Err(ScenarioError::invalid(
+                        f("elements"),
+                        "missing: per-element quadrature on a Legendre basis needs `elements`",
+                    ))
+                }
+            };
+            Ok(Quadrature::Elements {
+                elements,
+                gauss_per_element: check(f("gauss_per_element"), g, MAX_GAUSS_PER_ELEMENT)?,
+            })
+        }
+        QuadratureSpec {
+            gauss: Some(_), ..
+        } => Err(ScenarioError::invalid(
+            f("gauss"),
+            "give either `gauss` (points over the whole division) or `gauss_per_element` (with optional `elements`), not both",
+        )),
+        QuadratureSpec {
+            gauss: None,
+            elements: Some(_),
+            gauss_per_element: None,
+        } => Err(ScenarioError::invalid(
+            f("gauss_per_element"),
+            "missing: `elements` needs `gauss_per_element`",
+        )),
+    }
+}
+
+fn base_pose(s: &Scenario) -> Result<Pose, ScenarioError> {
+    let b = &s.base;
+    for (i, v) in b.position.iter().enumerate() {
+        finite(&format!("base.position[{i}]"), *v)?;
+    }
+    let rot = match (b.rotation, b.axis, b.angle_deg) {
+        (None, None, None) => M3::identity(),
+        (Some(r), None, None) => {
+            let m = M3::from_fn(|i, j| r[i][j]);
+            for (i, row) in r.iter().enumerate() {
+                for (j, v) in row.iter().enumerate() {
+                    finite(&format!("base.rotation[{i}][{j}]"), *v)?;
+                }
+            }
+            let orth = (m.transpose() * m - M3::identity()).abs().max();
+            let det = m.determinant();
+            if orth > 1e-6 || det <= 0.0 {
+                return Err(ScenarioError::invalid(
+                    "base.rotation",
+                    format!(
+                        "not a rotation matrix (‖RᵀR − I‖max = {orth:.2e}, det = {det:.6}); expected orthonormal rows with det = +1 (to 1e-6)"
+                    ),
+                ));
+            }
+            m
+        }
+        (None, Some(axis), Some(angle)) => {
+            let a = V3::from_row_slice(&axis);
+            let n = a.norm();
+            if !(n.is_finite() && n > 0.0) {
+                return Err(ScenarioError::value(
+                    "base.axis",
+                    n,
+                    "a finite non-zero axis vector (its norm is shown)",
+                ));
+            }
+            let angle = finite("base.angle_deg", angle)?.to_radians();
+            *nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(a), angle).matrix()
+        }
+        (None, Some(_), None) => {
+            return Err(ScenarioError::invalid(
+                "base.angle_deg",
+                "missing: `axis` needs `angle_deg`",
+            ))
+        }
+        (None, None, Some(_)) => {
+            return Err(ScenarioError::invalid(
+                "base.axis",
+                "missing: `angle_deg` needs `axis`",
+            ))
+        }
+        (Some(_), _, _) => {
+            return Err(ScenarioError::invalid(
+                "base.rotation",
+                "give either `rotation` or `axis` and `angle_deg`, not both",
+            ))
+        }
+    };
+    Ok(Pose::new(rot, V3::from_row_slice(&b.position)))
+}
+
+/// Radius at `x` on the side given: `after = true` takes the division starting at `x` at a junction.
+fn radius_at(rod: &Rod, x: f64, after: bool) -> f64 {
+    let starts = rod.division_starts();
+    let tol = 1e-12 * rod.length();
+    let mut found = None;
+    for (j, d) in rod.divisions.iter().enumerate() {
+        let (x0, x1) = (starts[j], starts[j] + d.length);
+        if x >= x0 - tol && x <= x1 + tol {
+            let r = d.radius_at(((x - x0) / d.length).clamp(0.0, 1.0));
+            found = Some(r);
+            if !after {
+                break;
+            }
+        }
+    }
+    found.unwrap_or(f64::NAN)
+}
+
+fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, ScenarioError> {
+    let f = |n: &str| format!("tendons[{k}].{n}");
+    let l = rod.length();
+    let x_start = finite(&f("x_start"), t.x_start)?;
+    if !(0.0..l).contains(&x_start) {
+        return Err(ScenarioError::value(
+            f("x_start"),
+            x_start,
+            format!("an abscissa in [0, {l}) m"),
+        ));
+    }
+    let x_end = finite(&f("x_end"), t.x_end.unwrap_or(l))?;
+    if !(x_end > x_start && x_end <= l * (1.0 + 1e-12)) {
+        return Err(ScenarioError::value(
+            f("x_end"),
+            x_end,
+            format!("an abscissa in ({x_start}, {l}] m (after x_start)"),
+        ));
+    }
+    let x_end = x_end.min(l);
+    let friction = non_negative(&f("friction"), t.friction, "")?;
+    let explicit = t.offset_start.is_some() || t.offset_end.is_some();
+    let polar = t.angle_deg.is_some() || t.radial_fraction.is_some();
+    let (offset_start, offset_end, offset_field) = match (explicit, polar) {
+        (true, true) => {
+            return Err(ScenarioError::invalid(
+                f("angle_deg"),
+                "give either `offset_start` and `offset_end`, or `angle_deg` (with optional `radial_fraction`), not both",
+            ))
+        }
+        (false, false) => {
+            return Err(ScenarioError::invalid(
+                f("offset_start"),
+                "missing: give `offset_start` and `offset_end` ([y, z] in m), or `angle_deg`",
+            ))
+        }
+        (true, false) => {
+            let (Some(a), Some(b)) = (t.offset_start, t.offset_end) else {
+                let missing = if t.offset_start.is_none() { "offset_start" } else { "offset_end" };
+                return Err(ScenarioError::invalid(
+                    f(missing),
+                    "missing: a tendon needs both `offset_start` and `offset_end` ([y, z] in m)",
+                ));
+            };
+            for (name, v) in [("offset_start", a), ("offset_end", b)] {
+                for (i, c) in v.iter().enumerate() {
+                    finite(&f(&format!("{name}[{i}]")), *c)?;
+                }
+            }
+            (a, b, None)
+        }
+        (false, true) => {
+            let Some(angle) = t.angle_deg else {
+                return Err(ScenarioError::invalid(
+                    f("angle_deg"),
+                    "missing: `radial_fraction` needs `angle_deg`",
+                ));
+            };
+            let theta = finite(&f("angle_deg"), angle)?.to_radians();
+            let c = t.radial_fraction.unwrap_or(1.0);
+            if !(c.is_finite() && (0.0..=1.0).contains(&c)) {
+                return Err(ScenarioError::value(
+                    f("radial_fraction"),
+                    c,
+                    "a number in [0, 1] (1 = on the surface)",
+                ));
+            }
+            let (s, co) = theta.sin_cos();
+            let r0 = radius_at(rod, x_start, true) * c;
+            let r1 = radius_at(rod, x_end, false) * c;
+            ([r0 * co, r0 * s], [r1 * co, r1 * s], Some(f("radial_fraction")))
+        }
+    };
+    let tendon = Tendon {
+        offset_start,
+        offset_end,
+        x_start,
+        x_end,
+        friction,
+    };
+    // |d(X)| is convex along the span and r(X) linear per division: checking the span's ends and
+    // the division junctions inside it covers the whole path.
+    let mut checks = vec![(x_start, radius_at(rod, x_start, true), "offset_start")];
+    let starts = rod.division_starts();
+    for &xj in starts.iter().skip(1) {
+        if xj > x_start && xj < x_end {
+            let r = radius_at(rod, xj, true).min(radius_at(rod, xj, false));
+            checks.push((xj, r, "offset_end"));
+        }
+    }
+    checks.push((x_end, radius_at(rod, x_end, false), "offset_end"));
+    for (x, r, which) in checks {
+        let d = tendon.offset(x);
+        let dn = d.norm();
+        if dn > r * (1.0 + 1e-9) {
+            let field = offset_field.clone().unwrap_or_else(|| f(which));
+            return Err(ScenarioError::value(
+                field,
+                dn,
+                format!(
+                    "a tendon offset of norm <= the section radius {r} m at X = {x} m (the tendon must run inside the rod; the value shown is the offset's norm there)"
+                ),
+            ));
+        }
+    }
+    Ok(tendon)
+}
+
+fn wrench(moment: [f64; 3], force: [f64; 3]) -> [f64; 6] {
+    [
+        moment[0], moment[1], moment[2], force[0], force[1], force[2],
+    ]
+}
+
+fn loads(s: &Scenario, l: f64) -> Result<Loads, ScenarioError> {
+    let spec = &s.loads;
+    for (i, g) in spec.gravity.iter().enumerate() {
+        finite(&format!("loads.gravity[{i}]"), *g)?;
+    }
+    let mut point = Vec::new();
+    for (k, p) in spec.point.iter().enumerate() {
+        let f = |n: &str| format!("loads.point[{k}].{n}");
+        let x = finite(&f("x"), p.x)?;
+        if !(0.0..=l).contains(&x) {
+            return Err(ScenarioError::value(
+                f("x"),
+                x,
+                format!("an abscissa in [0, {l}] m"),
+            ));
+        }
+        for (name, v) in [("force", p.force), ("moment", p.moment)] {
+            for (i, c) in v.iter().enumerate() {
+                finite(&f(&format!("{name}[{i}]")), *c)?;
+            }
+        }
+        point.push(PointWrench {
+            x,
+            wrench: wrench(p.moment, p.force),
+            frame: p.frame,
+        });
+    }
+    let mut distributed = Vec::new();
+    for (k, d) in spec.distributed.iter().enumerate() {
+        let f = |n: &str| format!("loads.distributed[{k}].{n}");
+        distributed.push(match *d {
+            DistributedLoadSpec::Uniform {
+                x_start,
+                x_end,
+                force,
+                moment,
+                frame,
+            } => {
+                let x_start = finite(&f("x_start"), x_start)?;
+                if !(0.0..l).contains(&x_start) {
+                    return Err(ScenarioError::value(
+                        f("x_start"),
+                        x_start,
+                        format!("an abscissa in [0, {l}) m"),
+                    ));
+                }
+                let x_end = finite(&f("x_end"), x_end.unwrap_or(l))?;
+                if !(x_end > x_start && x_end <= l) {
+                    return Err(ScenarioError::value(
+                        f("x_end"),
+                        x_end,
+                        format!("an abscissa in ({x_start}, {l}] m"),
+                    ));
+                }
+                for (name, v) in [("force", force), ("moment", moment)] {
+                    for (i, c) in v.iter().enumerate() {
+                        finite(&f(&format!("{name}[{i}]")), *c)?;
+                    }
+                }
+                DistributedWrench::Uniform {
+                    x_start,
+                    x_end,
+                    density: wrench(moment, force),
+                    frame,
+                }
+            }
+            DistributedLoadSpec::TriangularPulse {
+                center,
+                width,
+                magnitude,
+                axis,
+                convention,
+            } => {
+                let center = finite(&f("center"), center)?;
+                if !(0.0..=l).contains(&center) {
+                    return Err(ScenarioError::value(
+                        f("center"),
+                        center,
+                        format!("an abscissa in [0, {l}] m"),
+                    ));
+                }
+                positive(&f("width"), width, "m")?;
+                finite(&f("magnitude"), magnitude)?;
+                let n = V3::from_row_slice(&axis).norm();
+                if !(n.is_finite() && n > 0.0) {
+                    return Err(ScenarioError::value(
+                        f("axis"),
+                        n,
+                        "a finite non-zero axis vector (its norm is shown)",
+                    ));
+                }
+                DistributedWrench::TriangularPulse {
+                    center,
+                    width,
+                    magnitude,
+                    axis,
+                    convention,
+                }
+            }
+        });
+    }
+    Ok(Loads {
+        gravity: spec.gravity,
+        point,
+        distributed,
+    })
+}

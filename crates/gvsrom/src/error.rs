@@ -1,0 +1,61 @@
+//! Errors of scenario loading and building. Every error names the scenario field by its TOML path
+//! (`divisions[0].radius_start`), the offending value, and what is accepted.
+
+use gvs::ModelError;
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum ScenarioError {
+    /// The text is not valid TOML.
+    #[error("{source_name}: not valid TOML: {message}")]
+    Syntax {
+        source_name: String,
+        message: String,
+    },
+    /// The TOML is well formed but does not fit the scenario format (unknown key, wrong type,
+    /// missing key). `field` is the path of the offending key.
+    #[error("`{field}`: {message}")]
+    Format { field: String, message: String },
+    /// A number outside its accepted range (or not finite).
+    #[error("invalid value for `{field}`: {value} (expected {expected})")]
+    InvalidValue {
+        field: String,
+        value: f64,
+        expected: String,
+    },
+    /// A structural problem (conflicting or missing keys, counts).
+    #[error("invalid `{field}`: {message}")]
+    Invalid { field: String, message: String },
+    /// A `--set path=value` override that cannot be applied.
+    #[error("--set {spec}: {message}")]
+    Override { spec: String, message: String },
+    /// Neither a preset name nor a readable file.
+    #[error("unknown preset `{name}` and no such file (presets: {available})")]
+    UnknownPreset { name: String, available: String },
+    #[error("cannot read scenario file `{path}`: {source}")]
+    Io {
+        path: String,
+        #[source]
+        source: std::io::Error,
+    },
+    /// Rejected by the engine's own validation (field names follow the engine's naming).
+    #[error(transparent)]
+    Model(#[from] ModelError),
+}
+
+impl ScenarioError {
+    pub fn value(field: impl Into<String>, value: f64, expected: impl Into<String>) -> Self {
+        ScenarioError::InvalidValue {
+            field: field.into(),
+            value,
+            expected: expected.into(),
+        }
+    }
+
+    pub fn invalid(field: impl Into<String>, message: impl Into<String>) -> Self {
+        ScenarioError::Invalid {
+            field: field.into(),
+            message: message.into(),
+        }
+    }
+}

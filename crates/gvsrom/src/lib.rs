@@ -1,0 +1,16 @@
+//! # gvsrom — scenarios and runs for the GVS engine
+//!
+//! The library half of the `gvsrom` command: TOML scenario files ([`scenario`]), their validation and
+//! conversion to the engine's model ([`build`]), the built-in presets for the paper's robots
+//! ([`presets`]) and statics runs with their JSON report ([`statics`]). The binary only parses the
+//! command line, calls these and prints.
+
+pub mod build;
+pub mod error;
+pub mod presets;
+pub mod scenario;
+pub mod statics;
+
+pub use build::{build, Built};
+pub use error::ScenarioError;
+pub use scenario::Scenario;

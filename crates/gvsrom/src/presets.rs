@@ -1,0 +1,99 @@
+//! Built-in scenarios for the paper's robots (Section IV, gvs-spec §3.4, §10.4). Each is the TOML of
+//! `examples/<name>.toml`, embedded so that `gvsrom statics single-tendon` works from any directory.
+
+use crate::error::ScenarioError;
+use crate::scenario::Scenario;
+use std::path::Path;
+
+/// A built-in scenario.
+#[derive(Debug, Clone, Copy)]
+pub struct Preset {
+    pub name: &'static str,
+    pub summary: &'static str,
+    /// The scenario file's text.
+    pub toml: &'static str,
+}
+
+pub const PRESETS: &[Preset] = &[
+    Preset {
+        name: "single-tendon",
+        summary:
+            "IV-A: tapered single-tendon arm under gravity, friction 0.88, 33-DOF Legendre basis",
+        toml: include_str!("../../../examples/single-tendon.toml"),
+    },
+    Preset {
+        name: "soft-beam",
+        summary: "IV-B: beam under a triangular-pulse moment, 50-DOF linear FEM-like basis",
+        toml: include_str!("../../../examples/soft-beam.toml"),
+    },
+    Preset {
+        name: "six-tendon",
+        summary: "IV-C: two-division arm with three full- and three half-length tendons, 28 DOF",
+        toml: include_str!("../../../examples/six-tendon.toml"),
+    },
+];
+
+/// The preset called `name`.
+pub fn find(name: &str) -> Option<&'static Preset> {
+    PRESETS.iter().find(|p| p.name == name)
+}
+
+/// Comma-separated preset names (for messages).
+pub fn names() -> String {
+    PRESETS
+        .iter()
+        .map(|p| p.name)
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Where a scenario's text came from.
+#[derive(Debug, Clone)]
+pub struct Source {
+    /// The preset name or the file path, for messages.
+    pub origin: String,
+    /// Name used when the scenario sets none: the preset name or the file stem.
+    pub default_name: String,
+    pub text: String,
+}
+
+/// Resolves `arg` as a preset name first, then as a file path.
+pub fn source(arg: &str) -> Result<Source, ScenarioError> {
+    if let Some(p) = find(arg) {
+        return Ok(Source {
+            origin: format!("preset `{}`", p.name),
+            default_name: p.name.to_string(),
+            text: p.toml.to_string(),
+        });
+    }
+    let path = Path::new(arg);
+    if !path.exists() {
+        return Err(ScenarioError::UnknownPreset {
+            name: arg.to_string(),
+            available: names(),
+        });
+    }
+    let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Io {
+        path: arg.to_string(),
+        source: e,
+    })?;
+    Ok(Source {
+        origin: arg.to_string(),
+        default_name: path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "scenario".into()),
+        text,
+    })
+}
+
+/// Loads a preset or a file and applies `--set` overrides; the scenario's name defaults to the
+/// preset name or file stem.
+pub fn load(arg: &str, overrides: &[String]) -> Result<Scenario, ScenarioError> {
+    let src = source(arg)?;
+    let mut s = Scenario::from_toml(&src.origin, &src.text, overrides)?;
+    if s.name.is_none() {
+        s.name = Some(src.default_name);
+    }
+    Ok(s)
+}

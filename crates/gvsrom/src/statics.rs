@@ -1,0 +1,123 @@
+//! A statics run of a built scenario and its report: the equilibrium `q`, the tip pose, the centreline
+//! sampled at equally spaced abscissae, the strain at the computational points, and solver statistics.
+
+use crate::build::Built;
+use gvs::lie::V3;
+use gvs::solve::statics::{StaticsError, StaticsSolver};
+use serde::Serialize;
+use std::io::Write;
+use std::path::Path;
+use std::time::Instant;
+
+/// The result of one statics solve (this is also the `--json` output).
+#[derive(Debug, Clone, Serialize)]
+pub struct StaticsReport {
+    pub scenario: String,
+    /// Tendon tensions u [N].
+    pub u: Vec<f64>,
+    pub n_dof: usize,
+    pub n_points: usize,
+    /// Generalized coordinates at equilibrium.
+    pub q: Vec<f64>,
+    /// Tip position in the world frame [m].
+    pub tip_position: [f64; 3],
+    /// Tip rotation matrix (rows), section frame → world.
+    pub tip_rotation: [[f64; 3]; 3],
+    /// Abscissae of the centreline samples [m].
+    pub centerline_x: Vec<f64>,
+    /// Centreline positions at `centerline_x` [m].
+    pub centerline: Vec<[f64; 3]>,
+    /// Abscissae of the computational points [m].
+    pub strain_x: Vec<f64>,
+    /// ξ at the computational points, `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]`.
+    pub strain: Vec<[f64; 6]>,
+    /// Dogleg iterations over all load stages.
+    pub iterations: usize,
+    pub load_stages: usize,
+    pub residual_evaluations: usize,
+    pub jacobian_evaluations: usize,
+    /// `‖R(q)‖∞` at the solution.
+    pub residual_norm: f64,
+    /// Wall-clock time of the solve alone [s].
+    pub solve_time_s: f64,
+}
+
+impl StaticsReport {
+    /// Tip rotation as a unit axis and an angle [rad] (axis `[1, 0, 0]` for the identity).
+    pub fn tip_axis_angle(&self) -> ([f64; 3], f64) {
+        let r = self.tip_rotation;
+        let m = nalgebra::Matrix3::from_fn(|i, j| r[i][j]);
+        let rot = nalgebra::Rotation3::from_matrix_unchecked(m);
+        match rot.axis_angle() {
+            Some((axis, angle)) => ([axis[0], axis[1], axis[2]], angle),
+            None => ([1.0, 0.0, 0.0], 0.0),
+        }
+    }
+}
+
+/// Solves the statics of `built` from the straight reference and samples the solution.
+pub fn solve(built: &Built) -> Result<StaticsReport, StaticsError> {
+    let model = &built.model;
+    let mut solver = StaticsSolver::new(model, built.options.clone());
+    let t0 = Instant::now();
+    let sol = solver.solve(&built.u, &built.loads, None)?;
+    let solve_time_s = t0.elapsed().as_secs_f64();
+
+    let mut ws = model.workspace();
+    model.forward(&sol.q, &mut ws, false);
+    let tip = &ws.g[model.disc.tip()];
+    let length = model.disc.length();
+    let n = built.centerline_points.max(2);
+    let centerline_x: Vec<f64> = (0..n).map(|i| length * i as f64 / (n - 1) as f64).collect();
+    let centerline = centerline_x
+        .iter()
+        .map(|&x| arr3(&model.position_at(&ws, x)))
+        .collect();
+    let strain = model
+        .point_strains(&ws)
+        .iter()
+        .map(|xi| [xi[0], xi[1], xi[2], xi[3], xi[4], xi[5]])
+        .collect();
+    Ok(StaticsReport {
+        scenario: built.name.clone(),
+        u: built.u.clone(),
+        n_dof: model.n_dof(),
+        n_points: model.disc.n_points(),
+        q: sol.q.iter().copied().collect(),
+        tip_position: arr3(&tip.pos),
+        tip_rotation: std::array::from_fn(|i| std::array::from_fn(|j| tip.rot[(i, j)])),
+        centerline_x,
+        centerline,
+        strain_x: model.disc.points.iter().map(|p| p.x).collect(),
+        strain,
+        iterations: sol.iterations,
+        load_stages: sol.load_stages,
+        residual_evaluations: sol.residual_evaluations,
+        jacobian_evaluations: sol.jacobian_evaluations,
+        residual_norm: sol.residual_norm,
+        solve_time_s,
+    })
+}
+
+fn arr3(v: &V3) -> [f64; 3] {
+    [v[0], v[1], v[2]]
+}
+
+/// Writes `value` as JSON to `path` atomically: to `path.tmp` first, then renamed over `path`, so
+/// an interrupted run never leaves a truncated file under the final name.
+pub fn write_json_atomic<T: Serialize>(path: &Path, value: &T) -> std::io::Result<()> {
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(".tmp");
+    let tmp = std::path::PathBuf::from(tmp);
+    let result = (|| {
+        let mut f = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
+        serde_json::to_writer(&mut f, value)?;
+        f.write_all(b"\n")?;
+        f.into_inner().map_err(|e| e.into_error())?.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
