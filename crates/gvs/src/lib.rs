@@ -15,6 +15,7 @@ pub mod actuation;
 pub mod discretize;
 pub mod dynamics;
 pub mod error;
+pub mod inputs;
 pub mod lie;
 pub mod loads;
 pub mod model;
