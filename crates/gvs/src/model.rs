@@ -55,6 +55,19 @@ pub struct PreparedLoads {
     global: Vec<V6>,
 }
 
+impl PreparedLoads {
+    /// `self = λ · base` without allocating (time-varying load schedules).
+    pub fn scale_from(&mut self, base: &PreparedLoads, lambda: f64) {
+        self.gravity = base.gravity * lambda;
+        for (a, b) in self.local.iter_mut().zip(&base.local) {
+            *a = b * lambda;
+        }
+        for (a, b) in self.global.iter_mut().zip(&base.global) {
+            *a = b * lambda;
+        }
+    }
+}
+
 /// Scratch buffers of one model evaluation (allocated once, reused by every call).
 pub struct Workspace {
     pub(crate) ev: StrainEval,
