@@ -6,7 +6,7 @@
 
 use crate::error::ScenarioError;
 use crate::scenario::{
-    BasisSpec, DistributedLoadSpec, DivisionSpec, QuadratureSpec, Scenario, StrainMode, TendonSpec,
+    default_pulse_axis, BasisKind, DistributedKind, DivisionSpec, Scenario, StrainMode, TendonSpec,
 };
 use gvs::actuation::Tendon;
 use gvs::discretize::{Discretization, Quadrature};
@@ -69,8 +69,9 @@ pub fn build(s: &Scenario) -> Result<Built, ScenarioError> {
     let quads = s
         .divisions
         .iter()
+        .zip(&bases)
         .enumerate()
-        .map(|(j, d)| quadrature(j, d))
+        .map(|(j, (d, b))| quadrature(j, d, b))
         .collect::<Result<Vec<_>, _>>()?;
     let base = base_pose(s)?;
     let tendons = s
@@ -238,16 +239,25 @@ fn mode_flags(field: &str, modes: &[StrainMode]) -> Result<[bool; 6], ScenarioEr
 
 fn basis(j: usize, d: &DivisionSpec) -> Result<DivisionBasis, ScenarioError> {
     let f = |n: &str| format!("divisions[{j}].basis.{n}");
-    match &d.basis {
-        BasisSpec::Legendre {
-            modes,
-            order,
-            orders,
-        } => {
-            let flags = mode_flags(&f("modes"), modes)?;
+    let b = &d.basis;
+    let flags = mode_flags(&f("modes"), &b.modes)?;
+    let not_for = |key: &str, kind: &str| {
+        Err(ScenarioError::invalid(
+            f(key),
+            format!("not used by a {kind} basis (kind = \"{kind}\")"),
+        ))
+    };
+    match b.kind {
+        BasisKind::Legendre => {
+            if b.elements.is_some() {
+                return not_for("elements", "legendre");
+            }
+            if b.degree.is_some() {
+                return not_for("degree", "legendre");
+            }
             let mut ords = [0usize; 6];
             for m in StrainMode::ALL {
-                let explicit = orders.get(m);
+                let explicit = b.orders.get(m);
                 if !flags[m.index()] {
                     if explicit.is_some() {
                         return Err(ScenarioError::invalid(
@@ -257,9 +267,9 @@ fn basis(j: usize, d: &DivisionSpec) -> Result<DivisionBasis, ScenarioError> {
                     }
                     continue;
                 }
-                let (field, k) = match (explicit, order) {
+                let (field, k) = match (explicit, b.order) {
                     (Some(k), _) => (f(&format!("orders.{}", m.name())), k),
-                    (None, Some(k)) => (f("order"), *k),
+                    (None, Some(k)) => (f("order"), k),
                     (None, None) => {
                         return Err(ScenarioError::invalid(
                             f("order"),
@@ -281,29 +291,47 @@ fn basis(j: usize, d: &DivisionSpec) -> Result<DivisionBasis, ScenarioError> {
                 orders: ords,
             })
         }
-        BasisSpec::Fem {
-            modes,
-            elements,
-            degree,
-        } => {
-            let flags = mode_flags(&f("modes"), modes)?;
-            if !(1..=MAX_POINTS).contains(elements) {
+        BasisKind::Fem => {
+            if b.order.is_some() {
+                return not_for("order", "fem");
+            }
+            if let Some(m) = StrainMode::ALL
+                .into_iter()
+                .find(|&m| b.orders.get(m).is_some())
+            {
+                return not_for(&format!("orders.{}", m.name()), "fem");
+            }
+            let Some(elements) = b.elements else {
+                return Err(ScenarioError::invalid(
+                    f("elements"),
+                    format!(
+                        "missing: a fem basis needs `elements`, an integer in [1, {MAX_POINTS}]"
+                    ),
+                ));
+            };
+            if !(1..=MAX_POINTS).contains(&elements) {
                 return Err(ScenarioError::value(
                     f("elements"),
-                    *elements as f64,
+                    elements as f64,
                     format!("an integer in [1, {MAX_POINTS}]"),
                 ));
             }
             Ok(DivisionBasis::Fem {
                 modes: flags,
-                elements: *elements,
-                degree: *degree,
+                elements,
+                degree: b.degree.unwrap_or(FemDegree::Linear),
             })
         }
     }
 }
 
-fn quadrature(j: usize, d: &DivisionSpec) -> Result<Quadrature, ScenarioError> {
+/// The division's quadrature; defaults follow SoRoSim (gvs-spec §5.1): Legendre → `max order + 1`
+/// Gauss points, at least 5; FEM → per element, 2 (linear) or 3 (quadratic) points.
+fn quadrature(
+    j: usize,
+    d: &DivisionSpec,
+    basis: &DivisionBasis,
+) -> Result<Quadrature, ScenarioError> {
     let f = |n: &str| format!("divisions[{j}].quadrature.{n}");
     let check = |field: String, v: usize, max: usize| {
         if (1..=max).contains(&v) {
@@ -316,60 +344,33 @@ fn quadrature(j: usize, d: &DivisionSpec) -> Result<Quadrature, ScenarioError> {
             ))
         }
     };
-    let fem_elements = match &d.basis {
-        BasisSpec::Fem {
-            elements, degree, ..
-        } => Some((*elements, *degree)),
-        BasisSpec::Legendre { .. } => None,
-    };
     let q = d.quadrature.clone().unwrap_or_default();
-    match q {
-        QuadratureSpec {
-            gauss: None,
-            elements: None,
-            gauss_per_element: None,
-        } => Ok(match (&d.basis, fem_elements) {
-            (_, Some((elements, degree))) => Quadrature::Elements {
-                elements,
+    match (q.gauss, q.elements, q.gauss_per_element) {
+        (None, None, None) => Ok(match basis {
+            DivisionBasis::Fem {
+                elements, degree, ..
+            } => Quadrature::Elements {
+                elements: *elements,
                 gauss_per_element: match degree {
                     FemDegree::Linear => 2,
                     FemDegree::Quadratic => 3,
                 },
             },
-            (
-                BasisSpec::Legendre {
-                    order, orders: o, ..
-                },
-                None,
-            ) => {
-                let max = StrainMode::ALL
-                    .iter()
-                    .filter_map(|&m| o.get(m))
-                    .chain(*order)
-                    .max()
-                    .unwrap_or(0);
+            DivisionBasis::Legendre { modes, orders } => {
+                let max = (0..6).filter(|&i| modes[i]).map(|i| orders[i]).max().unwrap_or(0);
                 Quadrature::Gauss {
                     n: (max + 1).max(5),
                 }
             }
-            (BasisSpec::Fem { .. }, None) => unreachable!("FEM bases always carry elements"),
         }),
-        QuadratureSpec {
-            gauss: Some(n),
-            elements: None,
-            gauss_per_element: None,
-        } => Ok(Quadrature::Gauss {
+        (Some(n), None, None) => Ok(Quadrature::Gauss {
             n: check(f("gauss"), n, MAX_POINTS)?,
         }),
-        QuadratureSpec {
-            gauss: None,
-            elements,
-            gauss_per_element: Some(g),
-        } => {
-            let elements = match (elements, fem_elements) {
+        (None, elements, Some(g)) => {
+            let elements = match (elements, basis) {
                 (Some(e), _) => check(f("elements"), e, MAX_POINTS)?,
-                (None, Some((e, _))) => e,
-                (None, None) => {
+                (None, DivisionBasis::Fem { elements, .. }) => *elements,
+                (None, DivisionBasis::Legendre { .. }) => {
                     return Err(ScenarioError::invalid(
                         f("elements"),
                         "missing: per-element quadrature on a Legendre basis needs `elements`",
@@ -381,17 +382,11 @@ fn quadrature(j: usize, d: &DivisionSpec) -> Result<Quadrature, ScenarioError> {
                 gauss_per_element: check(f("gauss_per_element"), g, MAX_GAUSS_PER_ELEMENT)?,
             })
         }
-        QuadratureSpec {
-            gauss: Some(_), ..
-        } => Err(ScenarioError::invalid(
+        (Some(_), _, _) => Err(ScenarioError::invalid(
             f("gauss"),
             "give either `gauss` (points over the whole division) or `gauss_per_element` (with optional `elements`), not both",
         )),
-        QuadratureSpec {
-            gauss: None,
-            elements: Some(_),
-            gauss_per_element: None,
-        } => Err(ScenarioError::invalid(
+        (None, Some(_), None) => Err(ScenarioError::invalid(
             f("gauss_per_element"),
             "missing: `elements` needs `gauss_per_element`",
         )),
@@ -500,7 +495,7 @@ fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, ScenarioError> 
     let friction = non_negative(&f("friction"), t.friction, "")?;
     let explicit = t.offset_start.is_some() || t.offset_end.is_some();
     let polar = t.angle_deg.is_some() || t.radial_fraction.is_some();
-    let (offset_start, offset_end, offset_field) = match (explicit, polar) {
+    let (offset_start, offset_end) = match (explicit, polar) {
         (true, true) => {
             return Err(ScenarioError::invalid(
                 f("angle_deg"),
@@ -526,7 +521,7 @@ fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, ScenarioError> 
                     finite(&f(&format!("{name}[{i}]")), *c)?;
                 }
             }
-            (a, b, None)
+            (a, b)
         }
         (false, true) => {
             let Some(angle) = t.angle_deg else {
@@ -547,7 +542,7 @@ fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, ScenarioError> 
             let (s, co) = theta.sin_cos();
             let r0 = radius_at(rod, x_start, true) * c;
             let r1 = radius_at(rod, x_end, false) * c;
-            ([r0 * co, r0 * s], [r1 * co, r1 * s], Some(f("radial_fraction")))
+            ([r0 * co, r0 * s], [r1 * co, r1 * s])
         }
     };
     let tendon = Tendon {
@@ -559,25 +554,35 @@ fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, ScenarioError> 
     };
     // |d(X)| is convex along the span and r(X) linear per division: checking the span's ends and
     // the division junctions inside it covers the whole path.
-    let mut checks = vec![(x_start, radius_at(rod, x_start, true), "offset_start")];
+    let mut checks = vec![(x_start, radius_at(rod, x_start, true), "offset_start", "")];
     let starts = rod.division_starts();
     for &xj in starts.iter().skip(1) {
         if xj > x_start && xj < x_end {
             let r = radius_at(rod, xj, true).min(radius_at(rod, xj, false));
-            checks.push((xj, r, "offset_end"));
+            checks.push((
+                xj,
+                r,
+                "offset_end",
+                " (a division junction inside the span)",
+            ));
         }
     }
-    checks.push((x_end, radius_at(rod, x_end, false), "offset_end"));
-    for (x, r, which) in checks {
-        let d = tendon.offset(x);
-        let dn = d.norm();
+    checks.push((x_end, radius_at(rod, x_end, false), "offset_end", ""));
+    for (x, r, which, note) in checks {
+        let dn = tendon.offset(x).norm();
         if dn > r * (1.0 + 1e-9) {
-            let field = offset_field.clone().unwrap_or_else(|| f(which));
-            return Err(ScenarioError::value(
+            let (field, how) = if polar {
+                (
+                    f("angle_deg"),
+                    "the straight path between the surface points at x_start and x_end",
+                )
+            } else {
+                (f(which), "the tendon")
+            };
+            return Err(ScenarioError::invalid(
                 field,
-                dn,
                 format!(
-                    "a tendon offset of norm <= the section radius {r} m at X = {x} m (the tendon must run inside the rod; the value shown is the offset's norm there)"
+                    "{how} leaves the cross-section at X = {x} m{note}: offset norm {dn} m > radius {r} m (accepted: |offset| <= r(X) along the whole span)"
                 ),
             ));
         }
@@ -621,15 +626,26 @@ fn loads(s: &Scenario, l: f64) -> Result<Loads, ScenarioError> {
     let mut distributed = Vec::new();
     for (k, d) in spec.distributed.iter().enumerate() {
         let f = |n: &str| format!("loads.distributed[{k}].{n}");
-        distributed.push(match *d {
-            DistributedLoadSpec::Uniform {
-                x_start,
-                x_end,
-                force,
-                moment,
-                frame,
-            } => {
-                let x_start = finite(&f("x_start"), x_start)?;
+        let not_for = |key: &str, kind: &str| {
+            Err(ScenarioError::invalid(
+                f(key),
+                format!("not used by a {kind} load (kind = \"{kind}\")"),
+            ))
+        };
+        distributed.push(match d.kind {
+            DistributedKind::Uniform => {
+                for (key, set) in [
+                    ("center", d.center.is_some()),
+                    ("width", d.width.is_some()),
+                    ("magnitude", d.magnitude.is_some()),
+                    ("axis", d.axis.is_some()),
+                    ("convention", d.convention.is_some()),
+                ] {
+                    if set {
+                        return not_for(key, "uniform");
+                    }
+                }
+                let x_start = finite(&f("x_start"), d.x_start.unwrap_or(0.0))?;
                 if !(0.0..l).contains(&x_start) {
                     return Err(ScenarioError::value(
                         f("x_start"),
@@ -637,7 +653,7 @@ fn loads(s: &Scenario, l: f64) -> Result<Loads, ScenarioError> {
                         format!("an abscissa in [0, {l}) m"),
                     ));
                 }
-                let x_end = finite(&f("x_end"), x_end.unwrap_or(l))?;
+                let x_end = finite(&f("x_end"), d.x_end.unwrap_or(l))?;
                 if !(x_end > x_start && x_end <= l) {
                     return Err(ScenarioError::value(
                         f("x_end"),
@@ -645,6 +661,8 @@ fn loads(s: &Scenario, l: f64) -> Result<Loads, ScenarioError> {
                         format!("an abscissa in ({x_start}, {l}] m"),
                     ));
                 }
+                let force = d.force.unwrap_or_default();
+                let moment = d.moment.unwrap_or_default();
                 for (name, v) in [("force", force), ("moment", moment)] {
                     for (i, c) in v.iter().enumerate() {
                         finite(&f(&format!("{name}[{i}]")), *c)?;
@@ -654,17 +672,33 @@ fn loads(s: &Scenario, l: f64) -> Result<Loads, ScenarioError> {
                     x_start,
                     x_end,
                     density: wrench(moment, force),
-                    frame,
+                    frame: d.frame.unwrap_or_default(),
                 }
             }
-            DistributedLoadSpec::TriangularPulse {
-                center,
-                width,
-                magnitude,
-                axis,
-                convention,
-            } => {
-                let center = finite(&f("center"), center)?;
+            DistributedKind::TriangularPulse => {
+                for (key, set) in [
+                    ("x_start", d.x_start.is_some()),
+                    ("x_end", d.x_end.is_some()),
+                    ("force", d.force.is_some()),
+                    ("moment", d.moment.is_some()),
+                    ("frame", d.frame.is_some()),
+                ] {
+                    if set {
+                        return not_for(key, "triangular_pulse");
+                    }
+                }
+                let required = |key: &str, v: Option<f64>, what: &str| {
+                    v.ok_or_else(|| {
+                        ScenarioError::invalid(
+                            f(key),
+                            format!("missing: a triangular_pulse needs `{key}` ({what})"),
+                        )
+                    })
+                };
+                let center = finite(
+                    &f("center"),
+                    required("center", d.center, "the pulse's centre X [m]")?,
+                )?;
                 if !(0.0..=l).contains(&center) {
                     return Err(ScenarioError::value(
                         f("center"),
@@ -672,8 +706,16 @@ fn loads(s: &Scenario, l: f64) -> Result<Loads, ScenarioError> {
                         format!("an abscissa in [0, {l}] m"),
                     ));
                 }
-                positive(&f("width"), width, "m")?;
-                finite(&f("magnitude"), magnitude)?;
+                let width = positive(
+                    &f("width"),
+                    required("width", d.width, "the base width [m]")?,
+                    "m",
+                )?;
+                let magnitude = finite(
+                    &f("magnitude"),
+                    required("magnitude", d.magnitude, "N*m/m peak, or N*m total")?,
+                )?;
+                let axis = d.axis.unwrap_or_else(default_pulse_axis);
                 let n = V3::from_row_slice(&axis).norm();
                 if !(n.is_finite() && n > 0.0) {
                     return Err(ScenarioError::value(
@@ -687,7 +729,7 @@ fn loads(s: &Scenario, l: f64) -> Result<Loads, ScenarioError> {
                     width,
                     magnitude,
                     axis,
-                    convention,
+                    convention: d.convention.unwrap_or_default(),
                 }
             }
         });

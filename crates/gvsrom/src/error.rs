@@ -32,12 +32,8 @@ pub enum ScenarioError {
     /// Neither a preset name nor a readable file.
     #[error("unknown preset `{name}` and no such file (presets: {available})")]
     UnknownPreset { name: String, available: String },
-    #[error("cannot read scenario file `{path}`: {source}")]
-    Io {
-        path: String,
-        #[source]
-        source: std::io::Error,
-    },
+    #[error("cannot read scenario file `{path}`: {error}")]
+    Io { path: String, error: std::io::Error },
     /// Rejected by the engine's own validation (field names follow the engine's naming).
     #[error(transparent)]
     Model(#[from] ModelError),

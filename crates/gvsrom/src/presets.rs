@@ -75,7 +75,7 @@ pub fn source(arg: &str) -> Result<Source, ScenarioError> {
     }
     let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Io {
         path: arg.to_string(),
-        source: e,
+        error: e,
     })?;
     Ok(Source {
         origin: arg.to_string(),

@@ -1,0 +1,366 @@
+//! The `gvsrom` binary end to end: bad input gives a one-line error naming the field (and the
+//! accepted range), exit code 1 and no panic; good input prints a summary and writes the JSON.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn gvsrom(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_gvsrom"))
+        .args(args)
+        .output()
+        .expect("the gvsrom binary runs")
+}
+
+/// A scratch file path unique to one test.
+fn scratch(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("gvsrom-cli-tests");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+/// Runs `args`, expects a user error (exit code 1, one stderr line starting with `error:`, no
+/// panic) containing every string of `needles`; returns the message.
+fn expect_error(args: &[&str], needles: &[&str]) -> String {
+    let out = gvsrom(args);
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "gvsrom {args:?}: expected exit code 1, got {:?}; stderr: {stderr}",
+        out.status.code()
+    );
+    assert!(
+        !stderr.contains("panicked") && !stderr.contains("internal error"),
+        "gvsrom {args:?} panicked: {stderr}"
+    );
+    assert_eq!(
+        stderr.trim_end().lines().count(),
+        1,
+        "gvsrom {args:?}: expected a one-line error, got: {stderr}"
+    );
+    assert!(stderr.starts_with("error: "), "{stderr}");
+    for n in needles {
+        assert!(
+            stderr.contains(n),
+            "gvsrom {args:?}: error lacks `{n}`: {stderr}"
+        );
+    }
+    stderr
+}
+
+#[test]
+fn negative_or_zero_length_is_rejected_with_field_and_range() {
+    expect_error(
+        &[
+            "statics",
+            "single-tendon",
+            "--set",
+            "divisions.0.length=-0.1",
+        ],
+        &["divisions[0].length", "-0.1", "> 0 m"],
+    );
+    expect_error(
+        &["statics", "soft-beam", "--set", "divisions.0.length=0"],
+        &["divisions[0].length", ": 0 ", "> 0 m"],
+    );
+}
+
+#[test]
+fn non_positive_radius_is_rejected() {
+    expect_error(
+        &[
+            "statics",
+            "single-tendon",
+            "--set",
+            "divisions.0.radius_end=0",
+        ],
+        &["divisions[0].radius_end", "> 0 m"],
+    );
+    expect_error(
+        &["statics", "soft-beam", "--set", "divisions.0.radius=-0.015"],
+        &["divisions[0].radius", "-0.015", "> 0 m"],
+    );
+}
+
+#[test]
+fn poisson_ratio_outside_range_is_rejected() {
+    for v in ["0.7", "-1", "-1.5"] {
+        expect_error(
+            &[
+                "statics",
+                "single-tendon",
+                "--set",
+                &format!("material.poisson_ratio={v}"),
+            ],
+            &["material.poisson_ratio", v, "(-1, 0.5]"],
+        );
+    }
+}
+
+#[test]
+fn tendon_offset_outside_the_section_is_rejected() {
+    // the tip radius is 5 mm
+    expect_error(
+        &[
+            "statics",
+            "single-tendon",
+            "--set",
+            "tendons.0.offset_end=[0, 0.006]",
+        ],
+        &["tendons[0].offset_end", "0.006", "radius 0.005", "X = 0.25"],
+    );
+    expect_error(
+        &[
+            "statics",
+            "six-tendon",
+            "--set",
+            "tendons.1.radial_fraction=1.2",
+        ],
+        &["tendons[1].radial_fraction", "1.2", "[0, 1]"],
+    );
+}
+
+#[test]
+fn empty_basis_is_rejected() {
+    expect_error(
+        &[
+            "statics",
+            "single-tendon",
+            "--set",
+            "divisions.0.basis.modes=[]",
+        ],
+        &["divisions[0].basis.modes", "empty"],
+    );
+}
+
+#[test]
+fn unknown_key_is_named_in_a_file_and_in_an_override() {
+    let preset = gvsrom(&["show", "single-tendon"]);
+    assert!(preset.status.success());
+    let text = String::from_utf8(preset.stdout).unwrap().replace(
+        "poisson_ratio = 0.5",
+        "poisson_ratio = 0.5\nyoungs_moduls = 3",
+    );
+    let path = scratch("unknown-key.toml");
+    std::fs::write(&path, text).unwrap();
+    expect_error(
+        &["statics", path.to_str().unwrap()],
+        &["material.youngs_moduls", "unknown field"],
+    );
+    expect_error(
+        &[
+            "statics",
+            "soft-beam",
+            "--set",
+            "loads.distributed.0.widht=0.1",
+        ],
+        &["loads.distributed[0].widht", "unknown field", "`width`"],
+    );
+    expect_error(
+        &["statics", "single-tendon", "--set", "solver.tolerance=1e-3"],
+        &["solver.tolerance", "unknown field"],
+    );
+}
+
+#[test]
+fn unknown_preset_or_missing_file_lists_the_presets() {
+    expect_error(
+        &["statics", "two-tendon"],
+        &["two-tendon", "single-tendon, soft-beam, six-tendon"],
+    );
+    expect_error(&["statics", "no/such/file.toml"], &["no/such/file.toml"]);
+    expect_error(&["show", "two-tendon"], &["unknown preset `two-tendon`"]);
+}
+
+#[test]
+fn nan_and_infinite_values_are_rejected() {
+    expect_error(
+        &[
+            "statics",
+            "single-tendon",
+            "--set",
+            "material.youngs_modulus=nan",
+        ],
+        &["material.youngs_modulus", "NaN", "finite"],
+    );
+    expect_error(
+        &[
+            "statics",
+            "single-tendon",
+            "--set",
+            "loads.gravity=[0, 0, -inf]",
+        ],
+        &["loads.gravity[2]", "-inf", "finite"],
+    );
+    expect_error(
+        &["statics", "single-tendon", "--tension", "inf"],
+        &["tendons[0].tension", "inf", "finite"],
+    );
+    let text = String::from_utf8(gvsrom(&["show", "soft-beam"]).stdout)
+        .unwrap()
+        .replace("magnitude = 4.0", "magnitude = nan");
+    let path = scratch("nan.toml");
+    std::fs::write(&path, text).unwrap();
+    expect_error(
+        &["statics", path.to_str().unwrap()],
+        &["loads.distributed[0].magnitude", "NaN", "finite"],
+    );
+}
+
+#[test]
+fn malformed_toml_reports_the_line() {
+    let path = scratch("malformed.toml");
+    std::fs::write(&path, "name = \"x\"\n[material\nyoungs_modulus = 1e6\n").unwrap();
+    expect_error(
+        &["statics", path.to_str().unwrap()],
+        &["malformed.toml", "not valid TOML", "line 2"],
+    );
+}
+
+#[test]
+fn bad_overrides_name_the_path() {
+    expect_error(
+        &["statics", "single-tendon", "--set", "tendons.3.tension=-1"],
+        &["tendons.3.tension", "out of range", "1 entries"],
+    );
+    expect_error(
+        &[
+            "statics",
+            "single-tendon",
+            "--set",
+            "divisions.0.basis.order=-1",
+        ],
+        &["divisions[0].basis.order", "integer >= 0"],
+    );
+    expect_error(
+        &["statics", "single-tendon", "--set", "tension"],
+        &["path=value"],
+    );
+    expect_error(
+        &["statics", "six-tendon", "--tension=-10,0"],
+        &["2 tensions", "6 tendons"],
+    );
+}
+
+#[test]
+fn unreachable_load_reports_iterations_and_residual() {
+    let msg = expect_error(
+        &[
+            "statics",
+            "single-tendon",
+            "--tension=-1e4",
+            "--set",
+            "solver.max_iterations=3",
+            "--set",
+            "solver.ramp_steps=1",
+            "--set",
+            "solver.min_increment=1",
+        ],
+        &["did not converge", "3 iterations", "‖R‖∞"],
+    );
+    assert!(msg.contains("tolerance"), "{msg}");
+}
+
+#[test]
+fn statics_prints_summary_and_writes_json_atomically() {
+    let path = scratch("single.json");
+    let _ = std::fs::remove_file(&path);
+    let out = gvsrom(&[
+        "statics",
+        "single-tendon",
+        "--tension",
+        "-2",
+        "--centerline-points",
+        "11",
+        "--json",
+        path.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for needle in [
+        "single-tendon",
+        "33 DOF",
+        "102 computational points",
+        "u = [-2] N",
+        "iteration",
+        "‖R‖∞",
+        " ms",
+        "tip        position",
+        "rotation axis",
+    ] {
+        assert!(
+            stdout.contains(needle),
+            "summary lacks `{needle}`:\n{stdout}"
+        );
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    assert!(!PathBuf::from(format!("{}.tmp", path.display())).exists());
+    assert_eq!(json["scenario"], "single-tendon");
+    assert_eq!(json["u"], serde_json::json!([-2.0]));
+    assert_eq!(json["q"].as_array().unwrap().len(), 33);
+    assert_eq!(json["tip_position"].as_array().unwrap().len(), 3);
+    let rot = json["tip_rotation"].as_array().unwrap();
+    assert!(rot.len() == 3 && rot.iter().all(|r| r.as_array().unwrap().len() == 3));
+    assert_eq!(json["centerline"].as_array().unwrap().len(), 11);
+    assert_eq!(json["centerline_x"][10], 0.25);
+    assert_eq!(json["strain"].as_array().unwrap().len(), 102);
+    assert_eq!(json["strain"][0].as_array().unwrap().len(), 6);
+    assert_eq!(json["strain_x"].as_array().unwrap().len(), 102);
+    assert!(json["iterations"].as_u64().unwrap() >= 1);
+    assert!(json["residual_norm"].as_f64().unwrap() < 1e-6);
+    assert!(json["solve_time_s"].as_f64().unwrap() > 0.0);
+    // the tip is the last centreline sample
+    let tip = &json["tip_position"];
+    let last = &json["centerline"][10];
+    for i in 0..3 {
+        assert!((tip[i].as_f64().unwrap() - last[i].as_f64().unwrap()).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn shown_preset_runs_as_a_file_with_the_same_result() {
+    let text = gvsrom(&["show", "six-tendon"]).stdout;
+    let path = scratch("six.toml");
+    std::fs::write(&path, text).unwrap();
+    let (a, b) = (scratch("six-preset.json"), scratch("six-file.json"));
+    assert!(
+        gvsrom(&["statics", "six-tendon", "--json", a.to_str().unwrap()])
+            .status
+            .success()
+    );
+    assert!(gvsrom(&[
+        "statics",
+        path.to_str().unwrap(),
+        "--json",
+        b.to_str().unwrap()
+    ])
+    .status
+    .success());
+    let read = |p: &PathBuf| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+    };
+    assert_eq!(read(&a)["tip_position"], read(&b)["tip_position"]);
+}
+
+#[test]
+fn presets_lists_all_and_check_validates_without_solving() {
+    let out = gvsrom(&["presets"]);
+    let s = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success());
+    for name in ["single-tendon", "soft-beam", "six-tendon"] {
+        assert!(s.contains(name), "{s}");
+    }
+    let out = gvsrom(&["check", "soft-beam"]);
+    let s = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{s}");
+    assert!(
+        s.contains("50 DOF") && s.contains("148 computational points"),
+        "{s}"
+    );
+    assert!(!s.contains("tip"), "{s}");
+}
