@@ -29,9 +29,12 @@ pub enum ScenarioError {
     /// A `--set path=value` override that cannot be applied.
     #[error("--set {spec}: {message}")]
     Override { spec: String, message: String },
-    /// Neither a preset name nor a readable file.
+    /// Neither a preset name nor an existing file.
     #[error("unknown preset `{name}` and no such file (presets: {available})")]
     UnknownPreset { name: String, available: String },
+    /// A path-like argument (ends in `.toml` or has a directory) that does not exist.
+    #[error("scenario file `{path}` not found (presets: {available})")]
+    NotFound { path: String, available: String },
     #[error("cannot read scenario file `{path}`: {error}")]
     Io { path: String, error: std::io::Error },
     /// Rejected by the engine's own validation (field names follow the engine's naming).

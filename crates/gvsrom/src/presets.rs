@@ -68,6 +68,12 @@ pub fn source(arg: &str) -> Result<Source, ScenarioError> {
     }
     let path = Path::new(arg);
     if !path.exists() {
+        if arg.ends_with(".toml") || arg.contains(std::path::MAIN_SEPARATOR) || arg.contains('/') {
+            return Err(ScenarioError::NotFound {
+                path: arg.to_string(),
+                available: names(),
+            });
+        }
         return Err(ScenarioError::UnknownPreset {
             name: arg.to_string(),
             available: names(),

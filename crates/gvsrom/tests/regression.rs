@@ -111,3 +111,40 @@ fn soft_beam_pulse_moment_matches_anchor() {
     let r = run("soft-beam", &[]);
     assert_tip(&r, [0.59506, 0.0, -0.50863], TOL);
 }
+
+#[test]
+fn single_tendon_remaining_table_rows_match_anchors() {
+    // §10.4 table, tangent-rule friction μ = 0.88 and frictionless, u ∈ {−1, −6, +3} N.
+    let rows: [(f64, [f64; 2], [f64; 2]); 3] = [
+        (-1.0, [0.237670, -0.064376], [0.234090, -0.077831]),
+        (-6.0, [0.091513, 0.083669], [0.181621, 0.110434]),
+        (3.0, [0.107303, -0.166243], [0.164379, -0.162602]),
+    ];
+    for (u, frictionless, friction) in rows {
+        let t = format!("tendons.0.tension={u}");
+        let r = run("single-tendon", &[&t, "tendons.0.friction=0"]);
+        assert_tip(&r, [frictionless[0], 0.0, frictionless[1]], TOL);
+        let r = run("single-tendon", &[&t]);
+        assert_tip(&r, [friction[0], 0.0, friction[1]], TOL);
+    }
+}
+
+#[test]
+fn six_tendon_combined_tensions_match_anchors() {
+    // §10.4: [−5, −5, 0, 0, 0, 0] and [−20, 0, −5, −10, 0, −3]
+    let r = run(
+        "six-tendon",
+        &["tendons.0.tension=-5", "tendons.1.tension=-5"],
+    );
+    assert_tip(&r, [0.427440, 0.301932, 0.107194], TOL);
+    let r = run(
+        "six-tendon",
+        &[
+            "tendons.0.tension=-20",
+            "tendons.2.tension=-5",
+            "tendons.3.tension=-10",
+            "tendons.5.tension=-3",
+        ],
+    );
+    assert_tip(&r, [0.200523, 0.206506, 0.047498], TOL);
+}
