@@ -148,3 +148,25 @@ fn six_tendon_combined_tensions_match_anchors() {
     );
     assert_tip(&r, [0.200523, 0.206506, 0.047498], TOL);
 }
+
+#[test]
+fn soft_beam_other_pulse_loads_match_anchors() {
+    // §10.3.8: M_e = 2 at 0.75 L: (0.53567, 0, −0.50725); M_e = 5 at 0.5 L: (0.01697, 0, −0.64743),
+    // quoted to 1e-5 m.
+    let r = run(
+        "soft-beam",
+        &[
+            "loads.distributed.0.magnitude=2",
+            "loads.distributed.0.center=0.6",
+        ],
+    );
+    assert_tip(&r, [0.53567, 0.0, -0.50725], TOL);
+    let r = run(
+        "soft-beam",
+        &[
+            "loads.distributed.0.magnitude=5",
+            "loads.distributed.0.center=0.4",
+        ],
+    );
+    assert_tip(&r, [0.01697, 0.0, -0.64743], TOL);
+}
