@@ -348,7 +348,7 @@ pub fn cholesky_factor_in_place(a: &mut DMatrix<f64>) -> Result<(), DynamicsErro
         for k in 0..j {
             d -= a[(j, k)] * a[(j, k)];
         }
-        if !(d > 0.0) {
+        if d.is_nan() || d <= 0.0 {
             return Err(DynamicsError::MassNotPositiveDefinite { pivot: j, value: d });
         }
         let d = d.sqrt();

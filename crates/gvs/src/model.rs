@@ -643,6 +643,11 @@ impl<P: StrainParam> Model<P> {
         }
     }
 
+    /// Tip pose `g(L)` after a forward pass.
+    pub fn tip_pose(&self, ws: &Workspace) -> Pose {
+        ws.g[self.disc.tip()]
+    }
+
     /// Strain `ξ_i` at every computational point after a forward pass.
     pub fn point_strains(&self, ws: &Workspace) -> Vec<V6> {
         ws.xi[..self.disc.n_points()].to_vec()

@@ -492,7 +492,7 @@ fn magnus_z2_and_z4_converge_with_orders_two_and_four() {
             let disc =
                 Discretization::new(&rod, &[Quadrature::Gauss { n: 1 }], order, &extra).unwrap();
             assert_eq!(disc.n_points(), steps + 1);
-            let b = LinearBasis::per_division(&disc, &[basis.clone()]).unwrap();
+            let b = LinearBasis::per_division(&disc, std::slice::from_ref(&basis)).unwrap();
             let m = Model::new(rod, disc, b, vec![]).unwrap();
             let mut ws = m.workspace();
             m.forward(&q, &mut ws, false);
