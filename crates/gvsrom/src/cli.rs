@@ -21,6 +21,9 @@ pub struct Cli {
 pub enum Command {
     /// Solve the static equilibrium of a preset or a scenario file and print a summary.
     Statics(StaticsArgs),
+    /// Simulate the dynamics of a preset or scenario file (stiff NDF integrator, ode15s class) and
+    /// write the trajectory as NumPy arrays.
+    Simulate(SimulateArgs),
     /// Validate a preset or scenario file and print the model's size, without solving.
     Check(ScenarioArgs),
     /// List the built-in presets.
@@ -71,10 +74,90 @@ pub struct StaticsArgs {
     pub json: Option<PathBuf>,
 }
 
+#[derive(Debug, Args)]
+pub struct SimulateArgs {
+    #[command(flatten)]
+    pub scenario: ScenarioArgs,
+
+    /// Simulated time [s].
+    #[arg(long, value_name = "T", allow_hyphen_values = true)]
+    pub duration: f64,
+
+    /// Output samples per second [Hz].
+    #[arg(
+        long,
+        value_name = "HZ",
+        default_value_t = 100.0,
+        allow_hyphen_values = true
+    )]
+    pub sample_rate: f64,
+
+    /// Actuation from a CSV file with columns `t, u_1, …, u_na` (held piecewise constant; see
+    /// `--interpolate`). Without an input option the scenario's tensions are held constant.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["steps", "babble"])]
+    pub input: Option<PathBuf>,
+
+    /// Interpolate the CSV input linearly between its rows instead of holding each row.
+    #[arg(long, requires = "input")]
+    pub interpolate: bool,
+
+    /// Random step actuation: every actuator draws a new tension uniformly in [LO, HI] every PERIOD
+    /// seconds (the paper's IV-C test: `--steps=-15,0,1`).
+    #[arg(
+        long,
+        value_name = "LO,HI,PERIOD",
+        value_delimiter = ',',
+        allow_hyphen_values = true,
+        conflicts_with = "babble"
+    )]
+    pub steps: Option<Vec<f64>>,
+
+    /// Actuator babbling: each actuator holds a tension uniform in [LO, HI] for a time uniform in
+    /// [HOLD_MIN, HOLD_MAX] seconds (the paper's IV-C2 data: `--babble=-15,0,0.5,1`).
+    #[arg(
+        long,
+        value_name = "LO,HI,HOLD_MIN,HOLD_MAX",
+        value_delimiter = ',',
+        allow_hyphen_values = true
+    )]
+    pub babble: Option<Vec<f64>>,
+
+    /// Seed of the random inputs (same seed, same signal).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+
+    /// Start at the static equilibrium under the scenario's tensions and loads, then switch to the
+    /// input at t = 0 (a release test when the input differs).
+    #[arg(long)]
+    pub from_equilibrium: bool,
+
+    /// Relative tolerance of the NDF integrator (ode15s default 1e-3).
+    #[arg(long, default_value_t = 1e-3)]
+    pub rtol: f64,
+
+    /// Absolute tolerance of the NDF integrator (ode15s default 1e-6).
+    #[arg(long, default_value_t = 1e-6)]
+    pub atol: f64,
+
+    /// Use the fixed-step implicit method with step H [s] instead of the adaptive NDF (real time).
+    #[arg(long, value_name = "H")]
+    pub fixed_step: Option<f64>,
+
+    /// Use finite differences of the right-hand side for the integrator's Jacobian instead of the
+    /// structured analytic one.
+    #[arg(long)]
+    pub fd_jacobian: bool,
+
+    /// Write the trajectory (t, q, q̇, u, tip pose, strains) as .npy files and meta.json into DIR.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+}
+
 /// Runs the parsed command, printing to `out`.
 pub fn run(cli: Cli, out: &mut impl Write) -> Result<()> {
     match cli.command {
         Command::Statics(args) => statics_cmd(&args, out),
+        Command::Simulate(args) => simulate_cmd(&args, out),
         Command::Check(args) => check_cmd(&args, out),
         Command::Presets => presets_cmd(out),
         Command::Show { preset } => {
@@ -128,6 +211,133 @@ fn statics_cmd(args: &StaticsArgs, out: &mut impl Write) -> Result<()> {
         statics::write_json_atomic(path, &report)
             .with_context(|| format!("cannot write `{}`", path.display()))?;
         writeln!(out, "json       {}", path.display())?;
+    }
+    Ok(())
+}
+
+fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
+    use gvs::inputs::Interpolation;
+    use gvs::solve::dynamics::{IntegratorOptions, Method, OdeJacobian};
+    use gvs::solve::ode::{FixedStepOptions, NdfOptions};
+    use gvsrom::simulate::{self, InputSource, SimulateOptions};
+    use std::io::IsTerminal;
+    let (scenario, built) = load(&args.scenario)?;
+    print_model(&scenario, &built, out)?;
+    let input = if let Some(path) = &args.input {
+        let interpolation = if args.interpolate {
+            Interpolation::Linear
+        } else {
+            Interpolation::Hold
+        };
+        InputSource::Csv {
+            path: path.clone(),
+            interpolation,
+        }
+    } else if let Some(v) = &args.steps {
+        anyhow::ensure!(
+            v.len() == 3,
+            "--steps takes 3 comma-separated values LO,HI,PERIOD, got {}",
+            v.len()
+        );
+        InputSource::Steps {
+            lo: v[0],
+            hi: v[1],
+            period: v[2],
+            seed: args.seed,
+        }
+    } else if let Some(v) = &args.babble {
+        anyhow::ensure!(
+            v.len() == 4,
+            "--babble takes 4 comma-separated values LO,HI,HOLD_MIN,HOLD_MAX, got {}",
+            v.len()
+        );
+        InputSource::Babble {
+            lo: v[0],
+            hi: v[1],
+            hold_min: v[2],
+            hold_max: v[3],
+            seed: args.seed,
+        }
+    } else {
+        InputSource::Constant
+    };
+    let method = match args.fixed_step {
+        Some(h) => Method::Fixed(FixedStepOptions {
+            h,
+            ..FixedStepOptions::default()
+        }),
+        None => Method::Ndf(NdfOptions {
+            rtol: args.rtol,
+            atol: args.atol,
+            ..NdfOptions::default()
+        }),
+    };
+    let opts = SimulateOptions {
+        duration: args.duration,
+        sample_rate: args.sample_rate,
+        input,
+        start_at_equilibrium: args.from_equilibrium,
+        integrator: IntegratorOptions {
+            method,
+            jacobian: if args.fd_jacobian {
+                OdeJacobian::FiniteDifference
+            } else {
+                OdeJacobian::Structured
+            },
+        },
+    };
+    let tty = std::io::stderr().is_terminal();
+    let mut last_pct = usize::MAX;
+    let duration = args.duration;
+    let mut progress = |t: f64| {
+        if tty {
+            let pct = ((t / duration) * 100.0).clamp(0.0, 100.0) as usize;
+            if pct != last_pct {
+                last_pct = pct;
+                let bar = "#".repeat(pct / 4) + &".".repeat(25 - pct / 4);
+                eprint!("\r[{bar}] {pct:3}%  t = {t:.2} s");
+            }
+        }
+    };
+    let (sim, _) = simulate::run(&built, &opts, &mut progress)?;
+    if tty {
+        eprintln!();
+    }
+    let tr = &sim.trajectory;
+    writeln!(
+        out,
+        "simulated  {:.3} s in {:.3} s wall time (real-time factor {:.1}), {} steps ({} failed), {} RHS and {} Jacobian evaluations",
+        tr.t.last().copied().unwrap_or(0.0),
+        sim.wall_time_s,
+        sim.real_time_factor(),
+        sim.stats.steps,
+        sim.stats.failed_steps,
+        sim.stats.rhs_evals,
+        sim.stats.jacobian_evals
+    )?;
+    if let Some(g) = tr.tip.last() {
+        writeln!(
+            out,
+            "tip        position {} m at t = {:.3} s",
+            fmt_vec(&[g.pos[0], g.pos[1], g.pos[2]], 6),
+            tr.t.last().unwrap()
+        )?;
+    }
+    if let Some(dir) = &args.out {
+        simulate::write_trajectory(dir, &built, &sim)
+            .with_context(|| format!("cannot write `{}`", dir.display()))?;
+        writeln!(out, "trajectory {} ({} samples)", dir.display(), tr.t.len())?;
+    }
+    if let Some(e) = &sim.error {
+        anyhow::bail!(
+            "{e} (the {} samples before it were written{})",
+            tr.t.len(),
+            if args.out.is_some() {
+                ""
+            } else {
+                " only with --out"
+            }
+        );
     }
     Ok(())
 }

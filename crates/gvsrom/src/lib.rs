@@ -7,8 +7,10 @@
 
 pub mod build;
 pub mod error;
+pub mod npy;
 pub mod presets;
 pub mod scenario;
+pub mod simulate;
 pub mod statics;
 
 pub use build::{build, Built};

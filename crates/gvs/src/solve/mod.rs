@@ -1,5 +1,7 @@
-//! Solvers: the Powell dogleg trust region for `F(x) = 0` ([`dogleg`]) and static equilibrium
-//! ([`statics`]).
+//! Solvers: the Powell dogleg trust region for `F(x) = 0` ([`dogleg`]), static equilibrium
+//! ([`statics`]), stiff ODE integrators ([`ode`]) and time integration of the rod ([`dynamics`]).
 
 pub mod dogleg;
+pub mod dynamics;
+pub mod ode;
 pub mod statics;

@@ -1,0 +1,315 @@
+//! Time integration of the GVS equations of motion (paper eq. 8, gvs-spec §9) in first-order form
+//! `y = [q; q̇]`, `y' = [q̇; M(q)⁻¹ τ(q, q̇, t)]`, with a stiff variable-order NDF integrator (ode15s
+//! class) or a fixed-step implicit method, piecewise-constant or ramped actuation `u(t)`, a scalar load
+//! schedule `λ(t)` on the external loads, and initial states at rest, given, or at a static equilibrium.
+//!
+//! Input switching times are passed to the integrator as breakpoints (it steps onto them and restarts).
+//! On failure the samples computed so far are kept and the error carries the time reached.
+
+use super::ode::{
+    integrate_fixed, integrate_ndf, FixedStepOptions, NdfOptions, OdeError, OdeStats, OdeSystem,
+    RhsError,
+};
+use super::statics::{StaticsError, StaticsOptions, StaticsSolver};
+use crate::error::ModelError;
+use crate::inputs::Signal;
+use crate::lie::{Pose, V6};
+use crate::loads::Loads;
+use crate::model::{Model, PreparedLoads, Workspace};
+use crate::strain::StrainParam;
+use nalgebra::DVector;
+use std::time::Instant;
+
+/// The integration method.
+#[derive(Debug, Clone)]
+pub enum Method {
+    /// Variable-step, variable-order NDF/BDF (ode15s class).
+    Ndf(NdfOptions),
+    /// Fixed-step implicit method for real-time use.
+    Fixed(FixedStepOptions),
+}
+
+/// Integrator and Jacobian choice.
+#[derive(Debug, Clone, Default)]
+pub struct IntegratorOptions {
+    pub method: Method,
+    pub jacobian: OdeJacobian,
+}
+
+impl Default for Method {
+    fn default() -> Self {
+        Method::Ndf(NdfOptions::default())
+    }
+}
+
+/// How the integrator gets `∂f/∂y`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum OdeJacobian {
+    /// Finite differences of the right-hand side (2n evaluations), reused across steps.
+    FiniteDifference,
+    /// The structured Jacobian `[0 I; M⁻¹∂R/∂q  −M⁻¹D]` from the analytic statics Jacobian
+    /// ([`Model::ode_jacobian_approx`]).
+    #[default]
+    Structured,
+}
+
+/// Where the simulation starts.
+#[derive(Debug, Clone)]
+pub enum InitialState {
+    /// Straight reference configuration at rest (`q = 0`, `q̇ = 0`; linear bases).
+    Rest,
+    /// A given state.
+    Given { q: DVector<f64>, qd: DVector<f64> },
+    /// At rest in the static equilibrium under these tensions and loads (then released to the
+    /// simulation's own inputs at t = 0: a release test).
+    Equilibrium { u: Vec<f64>, loads: Loads },
+}
+
+/// Samples of a simulation.
+#[derive(Debug, Clone, Default)]
+pub struct Trajectory {
+    pub t: Vec<f64>,
+    pub q: Vec<DVector<f64>>,
+    pub qd: Vec<DVector<f64>>,
+    /// Actuation at each sample.
+    pub u: Vec<Vec<f64>>,
+    pub tip: Vec<Pose>,
+    /// Strain `ξ` at the computational points at each sample (point-major).
+    pub strain: Vec<Vec<V6>>,
+}
+
+/// A simulation's result: the samples up to the end (or up to a failure), statistics and timing.
+#[derive(Debug)]
+pub struct Simulation {
+    pub trajectory: Trajectory,
+    pub stats: OdeStats,
+    pub wall_time_s: f64,
+    /// `Some` if the integration stopped early; the trajectory holds the samples before it.
+    pub error: Option<OdeError>,
+}
+
+impl Simulation {
+    /// Simulated time per wall-clock time.
+    pub fn real_time_factor(&self) -> f64 {
+        let span = match (self.trajectory.t.first(), self.trajectory.t.last()) {
+            (Some(a), Some(b)) => b - a,
+            _ => 0.0,
+        };
+        span / self.wall_time_s.max(1e-12)
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum SimulationError {
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    #[error("initial equilibrium: {0}")]
+    Initial(#[from] StaticsError),
+}
+
+/// The rod as a first-order ODE system.
+struct RodOde<'m, P: StrainParam> {
+    model: &'m Model<P>,
+    ws: Workspace,
+    actuation: &'m Signal,
+    load_scale: Option<&'m Signal>,
+    base_loads: PreparedLoads,
+    loads: PreparedLoads,
+    u: Vec<f64>,
+    lambda: [f64; 1],
+    q: DVector<f64>,
+    qd: DVector<f64>,
+    qdd: DVector<f64>,
+    jacobian: OdeJacobian,
+}
+
+impl<P: StrainParam> OdeSystem for RodOde<'_, P> {
+    fn jacobian(
+        &mut self,
+        t: f64,
+        y: &DVector<f64>,
+        jac: &mut nalgebra::DMatrix<f64>,
+    ) -> Result<bool, RhsError> {
+        if self.jacobian == OdeJacobian::FiniteDifference {
+            return Ok(false);
+        }
+        let n = self.model.n_dof();
+        self.q.copy_from(&y.rows(0, n));
+        self.actuation.eval(t, &mut self.u);
+        if let Some(s) = self.load_scale {
+            s.eval(t, &mut self.lambda);
+            self.loads.scale_from(&self.base_loads, self.lambda[0]);
+        }
+        self.model
+            .ode_jacobian_approx(&self.q, &self.u, &self.loads, &mut self.ws, jac)
+            .map_err(|e| RhsError(e.to_string()))?;
+        Ok(true)
+    }
+
+    fn dim(&self) -> usize {
+        2 * self.model.n_dof()
+    }
+
+    fn rhs(&mut self, t: f64, y: &DVector<f64>, dy: &mut DVector<f64>) -> Result<(), RhsError> {
+        let n = self.model.n_dof();
+        self.q.copy_from(&y.rows(0, n));
+        self.qd.copy_from(&y.rows(n, n));
+        self.actuation.eval(t, &mut self.u);
+        if let Some(s) = self.load_scale {
+            s.eval(t, &mut self.lambda);
+            self.loads.scale_from(&self.base_loads, self.lambda[0]);
+        }
+        self.model
+            .accelerations(
+                &self.q,
+                &self.qd,
+                &self.u,
+                &self.loads,
+                &mut self.ws,
+                &mut self.qdd,
+            )
+            .map_err(|e| RhsError(e.to_string()))?;
+        dy.rows_mut(0, n).copy_from(&self.qd);
+        dy.rows_mut(n, n).copy_from(&self.qdd);
+        Ok(())
+    }
+}
+
+/// Simulates `model` under actuation `actuation(t)` and `loads` scaled by `load_scale(t)` (1 if
+/// `None`) from `initial`, sampling at `t_out` (ascending, the first is the start time).
+pub fn simulate<P: StrainParam>(
+    model: &Model<P>,
+    actuation: &Signal,
+    loads: &Loads,
+    load_scale: Option<&Signal>,
+    initial: &InitialState,
+    t_out: &[f64],
+    options: &IntegratorOptions,
+) -> Result<Simulation, SimulationError> {
+    simulate_with_progress(
+        model,
+        actuation,
+        loads,
+        load_scale,
+        initial,
+        t_out,
+        options,
+        &mut |_| {},
+    )
+}
+
+/// [`simulate`], calling `progress(t)` at every sample (for progress bars).
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_with_progress<P: StrainParam>(
+    model: &Model<P>,
+    actuation: &Signal,
+    loads: &Loads,
+    load_scale: Option<&Signal>,
+    initial: &InitialState,
+    t_out: &[f64],
+    options: &IntegratorOptions,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Simulation, SimulationError> {
+    let n = model.n_dof();
+    actuation.validate("actuation", model.n_actuators())?;
+    if let Some(s) = load_scale {
+        s.validate("load_scale", 1)?;
+    }
+    if t_out.is_empty() {
+        return Err(
+            ModelError::invalid("sample_times", "at least one sample time is required").into(),
+        );
+    }
+    let (q0, qd0) = match initial {
+        InitialState::Rest => (DVector::zeros(n), DVector::zeros(n)),
+        InitialState::Given { q, qd } => {
+            if q.len() != n || qd.len() != n {
+                return Err(ModelError::invalid(
+                    "initial_state",
+                    format!(
+                        "q has {} and q̇ {} entries; the model has {n} coordinates",
+                        q.len(),
+                        qd.len()
+                    ),
+                )
+                .into());
+            }
+            if q.iter().chain(qd.iter()).any(|v| !v.is_finite()) {
+                return Err(ModelError::invalid(
+                    "initial_state",
+                    "contains NaN or infinite values",
+                )
+                .into());
+            }
+            (q.clone(), qd.clone())
+        }
+        InitialState::Equilibrium { u, loads } => {
+            let sol = StaticsSolver::new(
+                model,
+                StaticsOptions {
+                    ramp_steps: 2,
+                    ..Default::default()
+                },
+            )
+            .solve(u, loads, None)?;
+            (sol.q, DVector::zeros(n))
+        }
+    };
+    let base_loads = model.prepare_loads(loads)?;
+    let mut sys = RodOde {
+        model,
+        ws: model.workspace(),
+        actuation,
+        load_scale,
+        loads: base_loads.clone(),
+        base_loads,
+        u: vec![0.0; model.n_actuators()],
+        lambda: [1.0],
+        q: DVector::zeros(n),
+        qd: DVector::zeros(n),
+        qdd: DVector::zeros(n),
+        jacobian: options.jacobian,
+    };
+    let mut y0 = DVector::zeros(2 * n);
+    y0.rows_mut(0, n).copy_from(&q0);
+    y0.rows_mut(n, n).copy_from(&qd0);
+    let t0 = t_out[0];
+    let tf = *t_out.last().unwrap();
+    let mut breaks = actuation.breakpoints(t0, tf);
+    if let Some(s) = load_scale {
+        breaks.extend(s.breakpoints(t0, tf));
+        breaks.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        breaks.dedup();
+    }
+    let mut traj = Trajectory::default();
+    let mut out_ws = model.workspace();
+    let mut ubuf = vec![0.0; model.n_actuators()];
+    let mut record = |t: f64, y: &DVector<f64>| {
+        let q = y.rows(0, n).into_owned();
+        model.forward(&q, &mut out_ws, false);
+        actuation.eval(t, &mut ubuf);
+        traj.t.push(t);
+        traj.qd.push(y.rows(n, n).into_owned());
+        traj.q.push(q);
+        traj.u.push(ubuf.clone());
+        traj.tip.push(*out_ws.g.last().unwrap());
+        traj.strain.push(model.point_strains(&out_ws));
+        progress(t);
+    };
+    let start = Instant::now();
+    let result = match &options.method {
+        Method::Ndf(o) => integrate_ndf(&mut sys, t0, &y0, t_out, &breaks, o, &mut record),
+        Method::Fixed(o) => integrate_fixed(&mut sys, t0, &y0, t_out, &breaks, o, &mut record),
+    };
+    let wall_time_s = start.elapsed().as_secs_f64();
+    let (stats, error) = match result {
+        Ok(s) => (s, None),
+        Err(e) => (OdeStats::default(), Some(e)),
+    };
+    Ok(Simulation {
+        trajectory: traj,
+        stats,
+        wall_time_s,
+        error,
+    })
+}

@@ -1,0 +1,323 @@
+//! Fixed-step, second-order, L-stable BDF2 (variable-coefficient form where a step is not of the
+//! nominal length), started and restarted after each breakpoint by backward Euler; simplified
+//! Newton with a Jacobian kept across steps and re-evaluated only when Newton stalls.
+
+use super::{
+    check_common, deliver, invalid, ulp, Counted, FixedStepOptions, JacWork, Lu, OdeError,
+    OdeStats, OdeSystem,
+};
+use nalgebra::{DMatrix, DVector};
+
+/// Step halvings allowed when Newton fails with a fresh Jacobian.
+const MAX_HALVINGS: u32 = 10;
+/// The iteration matrix `I − βJ` is refactored when `β` changes by more than this (relative);
+/// a slightly stale `β` only affects the Newton rate, not the solution.
+const BETA_REUSE: f64 = 1e-6;
+/// BDF2 is used when the step ratio `h_n/h_{n−1}` is at most this (zero-stable below `1 + √2`);
+/// otherwise the step is a backward Euler step.
+const MAX_RATIO: f64 = 2.0;
+
+struct Work {
+    n: usize,
+    y: DVector<f64>,
+    yprev: DVector<f64>,
+    z: DVector<f64>,
+    s: DVector<f64>,
+    f: DVector<f64>,
+    del: DVector<f64>,
+    thresh: DVector<f64>,
+    out: DVector<f64>,
+    jac: DMatrix<f64>,
+    lu: Lu,
+    jw: JacWork,
+}
+
+/// State carried from step to step.
+struct State {
+    t: f64,
+    /// `y_{n−1}` and `h_{n−1}` are valid (no restart since).
+    have_prev: bool,
+    hprev: f64,
+    /// `β` of the current factorization (NaN: none).
+    lu_beta: f64,
+    lu_ok: bool,
+    /// The Jacobian was evaluated at the current `(t, y)`.
+    jac_fresh: bool,
+    /// Newton contraction rate of the previous solve with the current factorization.
+    rate: Option<f64>,
+}
+
+enum Newton {
+    Converged,
+    Stalled,
+    NonFinite,
+}
+
+/// Integrates `y' = f(t, y)` from `(t0, y0)` to the last of `t_out` with fixed steps `opts.h` of
+/// BDF2 (second order, A- and L-stable), each solved by simplified Newton.
+///
+/// * Steps: `t_k = a + k·h` from the start `a` of each piece (`t0` or a breakpoint); the last step
+///   of a piece is shortened (or stretched by up to 10 %) to land exactly on its end, so every
+///   breakpoint is hit by a step. Steps of other than nominal length use the variable-coefficient
+///   BDF2; the first step of every piece (and any step more than twice as long as the previous
+///   one) is a backward Euler step.
+/// * Newton: at most `max_newton` iterations with the iteration matrix `I − βJ` (`β = 2h/3` at the
+///   nominal step), factored only when `β` changes; converged when `ρ/(1−ρ)‖Δ‖ ≤ newton_tol`
+///   (`‖Δ‖ ≤ newton_tol` before a rate `ρ` is known) in the norm `max_i |Δ_i|/max(1, |y_i|)`. The
+///   Jacobian (analytic, or forward differences with increment `√eps·max(|y_j|, 1)`) is evaluated
+///   at the start and re-evaluated, at most once per step, only when Newton stalls (`ρ > 0.9` or no
+///   convergence within `max_newton`); if it still fails, the step is split in halves (up to 10
+///   times) before giving up with [`OdeError::NewtonFailure`] (or [`OdeError::NonFinite`] when the
+///   failure is a NaN/∞ right-hand side).
+/// * Output: same contract as [`super::integrate_ndf`]; values between steps come from the
+///   quadratic through `y_{n−1}, y_n, y_{n+1}` (the linear interpolant on backward Euler steps),
+///   which is second-order accurate and does not overshoot on stiff transients.
+pub fn integrate_fixed<S: OdeSystem>(
+    sys: &mut S,
+    t0: f64,
+    y0: &DVector<f64>,
+    t_out: &[f64],
+    breakpoints: &[f64],
+    opts: &FixedStepOptions,
+    output: &mut dyn FnMut(f64, &DVector<f64>),
+) -> Result<OdeStats, OdeError> {
+    let n = sys.dim();
+    let bounds = check_common(n, t0, y0, t_out, breakpoints)?;
+    let tf = *bounds.last().unwrap_or(&t0);
+    let h = opts.h;
+    if !(h > 0.0 && h.is_finite()) {
+        return Err(invalid(
+            "h",
+            format!("must be positive and finite, got {h}"),
+        ));
+    }
+    if h < 4.0 * ulp(t0.abs().max(tf.abs())) {
+        return Err(invalid(
+            "h",
+            format!("{h:e} is below the time resolution at t = {tf}"),
+        ));
+    }
+    if !(opts.newton_tol > 0.0 && opts.newton_tol.is_finite()) {
+        return Err(invalid(
+            "newton_tol",
+            format!("must be positive and finite, got {}", opts.newton_tol),
+        ));
+    }
+    if opts.max_newton == 0 {
+        return Err(invalid("max_newton", "must be at least 1"));
+    }
+    let v = || DVector::zeros(n);
+    let mut w = Work {
+        n,
+        y: y0.clone(),
+        yprev: v(),
+        z: v(),
+        s: v(),
+        f: v(),
+        del: v(),
+        thresh: DVector::from_element(n, 1.0),
+        out: v(),
+        jac: DMatrix::zeros(n, n),
+        lu: Lu::new(n),
+        jw: JacWork::new(n),
+    };
+    let mut next = 0;
+    deliver(t_out, &mut next, t0, &mut w.out, output, |_, b| {
+        b.copy_from(y0)
+    });
+    let mut cs = Counted::new(sys);
+    let mut st = State {
+        t: t0,
+        have_prev: false,
+        hprev: h,
+        lu_beta: f64::NAN,
+        lu_ok: false,
+        jac_fresh: false,
+        rate: None,
+    };
+    let pieces = bounds.len().saturating_sub(1);
+    if pieces > 0 {
+        cs.set_piece(bounds[0], false, bounds[1], pieces > 1);
+        if !cs.jacobian(t0, &w.y, &w.thresh, &mut w.jac, &mut w.jw)? {
+            return Err(OdeError::NonFinite { t: t0 });
+        }
+        st.jac_fresh = true;
+    }
+    for p in 0..pieces {
+        let (a, b) = (bounds[p], bounds[p + 1]);
+        cs.set_piece(a, p > 0, b, p + 1 < pieces);
+        st.have_prev = false;
+        // Number of steps: the last one is in [0.1h, 1.1h].
+        let nsteps = ((b - a) / h - 0.1).ceil().max(1.0) as usize;
+        for i in 1..=nsteps {
+            let target = if i == nsteps { b } else { a + i as f64 * h };
+            advance(
+                &mut cs, &mut w, &mut st, opts, target, t_out, &mut next, output,
+            )?;
+        }
+    }
+    Ok(cs.stats)
+}
+
+/// Steps from `st.t` to `target` (one step, or halves of it if Newton fails).
+#[allow(clippy::too_many_arguments)]
+fn advance<S: OdeSystem>(
+    cs: &mut Counted<'_, S>,
+    w: &mut Work,
+    st: &mut State,
+    opts: &FixedStepOptions,
+    target: f64,
+    t_out: &[f64],
+    next: &mut usize,
+    output: &mut dyn FnMut(f64, &DVector<f64>),
+) -> Result<(), OdeError> {
+    let n = w.n;
+    let mut halvings = 0u32;
+    let mut hs_max = f64::INFINITY;
+    while st.t < target {
+        let t = st.t;
+        let tn = if target - t <= hs_max {
+            target
+        } else {
+            t + hs_max
+        };
+        let hs = tn - t;
+        let omega = hs / st.hprev;
+        let bdf2 = st.have_prev && omega <= MAX_RATIO;
+        let beta = if bdf2 {
+            let c0 = (1.0 + omega) * (1.0 + omega) / (1.0 + 2.0 * omega);
+            let c1 = omega * omega / (1.0 + 2.0 * omega);
+            for i in 0..n {
+                w.s[i] = c0 * w.y[i] - c1 * w.yprev[i];
+                w.z[i] = w.y[i] + omega * (w.y[i] - w.yprev[i]);
+            }
+            hs * (1.0 + omega) / (1.0 + 2.0 * omega)
+        } else {
+            w.s.copy_from(&w.y);
+            w.z.copy_from(&w.y);
+            hs
+        };
+        let reusable = (beta - st.lu_beta).abs() <= BETA_REUSE * beta; // false for NaN (no factorization)
+        if !reusable {
+            st.lu_ok = w.lu.factor(beta, &w.jac, &mut cs.stats);
+            st.lu_beta = if st.lu_ok { beta } else { f64::NAN };
+            st.rate = None;
+        }
+        let result = if st.lu_ok {
+            newton(cs, w, st, opts, t, tn, beta)?
+        } else {
+            Newton::Stalled
+        };
+        match result {
+            Newton::Converged => {
+                cs.stats.steps += 1;
+                let (y, yprev, z, hprev) = (&w.y, &w.yprev, &w.z, st.hprev);
+                deliver(t_out, next, tn, &mut w.out, output, |tq, buf| {
+                    let sg = tq - t;
+                    if tq == tn {
+                        buf.copy_from(z);
+                    } else if bdf2 {
+                        let l0 = sg * (sg - hs) / (hprev * (hprev + hs));
+                        let l1 = -(sg + hprev) * (sg - hs) / (hprev * hs);
+                        let l2 = (sg + hprev) * sg / ((hprev + hs) * hs);
+                        for i in 0..buf.len() {
+                            buf[i] = l0 * yprev[i] + l1 * y[i] + l2 * z[i];
+                        }
+                    } else {
+                        let l2 = sg / hs;
+                        for i in 0..buf.len() {
+                            buf[i] = (1.0 - l2) * y[i] + l2 * z[i];
+                        }
+                    }
+                });
+                std::mem::swap(&mut w.yprev, &mut w.y);
+                w.y.copy_from(&w.z);
+                st.hprev = hs;
+                st.have_prev = true;
+                st.t = tn;
+                st.jac_fresh = false;
+            }
+            Newton::Stalled if !st.jac_fresh => {
+                cs.stats.failed_steps += 1;
+                if !cs.jacobian(t, &w.y, &w.thresh, &mut w.jac, &mut w.jw)? {
+                    return Err(OdeError::NonFinite { t });
+                }
+                st.jac_fresh = true;
+                st.lu_beta = f64::NAN;
+            }
+            failure => {
+                cs.stats.failed_steps += 1;
+                if halvings >= MAX_HALVINGS {
+                    return Err(match failure {
+                        Newton::NonFinite => OdeError::NonFinite { t },
+                        _ => OdeError::NewtonFailure { t },
+                    });
+                }
+                halvings += 1;
+                hs_max = 0.5 * hs;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Solves `z = s + β f(tn, z)` by simplified Newton from the predictor in `w.z`.
+#[allow(clippy::too_many_arguments)]
+fn newton<S: OdeSystem>(
+    cs: &mut Counted<'_, S>,
+    w: &mut Work,
+    st: &mut State,
+    opts: &FixedStepOptions,
+    t: f64,
+    tn: f64,
+    beta: f64,
+) -> Result<Newton, OdeError> {
+    let n = w.n;
+    let tol = opts.newton_tol;
+    let mut oldnrm = 0.0;
+    // The rate carried over from earlier steps is inflated each step (ρ ← ρ^0.8, as RADAU5 does),
+    // so that a second iteration, which measures it afresh, is forced every few steps.
+    let mut rate = st.rate.map(|r| r.max(f64::EPSILON).powf(0.8));
+    st.rate = rate;
+    for it in 1..=opts.max_newton {
+        if !cs.f(t, tn, &w.z, &mut w.f)? {
+            return Ok(Newton::NonFinite);
+        }
+        for i in 0..n {
+            w.del[i] = w.s[i] + beta * w.f[i] - w.z[i];
+        }
+        w.lu.solve(&mut w.del);
+        cs.stats.newton_iterations += 1;
+        let mut nrm = 0.0f64;
+        for i in 0..n {
+            w.z[i] += w.del[i];
+            nrm = nrm.max(w.del[i].abs() / w.z[i].abs().max(1.0));
+        }
+        if !(nrm.is_finite() && w.z.iter().all(|v| v.is_finite())) {
+            return Ok(Newton::NonFinite);
+        }
+        if nrm <= 100.0 * f64::EPSILON {
+            if it > 1 {
+                st.rate = Some(nrm / oldnrm); // converged to roundoff: a tiny rate
+            }
+            return Ok(Newton::Converged);
+        }
+        if it > 1 {
+            if nrm > 0.9 * oldnrm {
+                return Ok(Newton::Stalled);
+            }
+            let r = nrm / oldnrm;
+            rate = Some(rate.map_or(r, |q| r.max(0.9 * q)));
+        }
+        let converged = match rate {
+            Some(r) => nrm * r / (1.0 - r) <= tol,
+            None => nrm <= tol,
+        };
+        if converged {
+            st.rate = rate;
+            return Ok(Newton::Converged);
+        }
+        oldnrm = nrm;
+    }
+    Ok(Newton::Stalled)
+}

@@ -1,0 +1,625 @@
+//! Stiff initial-value problem integrators for `y' = f(t, y)`: a variable-step, variable-order
+//! NDF/BDF method of the class of MATLAB's `ode15s` ([`integrate_ndf`]) and a cheap fixed-step
+//! BDF2 method for real-time use ([`integrate_fixed`]).
+//!
+//! Reference: L. F. Shampine and M. W. Reichelt, *The MATLAB ODE Suite*, SIAM J. Sci. Comput. 18(1),
+//! 1–22, 1997 (§2: the NDFs, their quasi-constant step size implementation and the step/order
+//! strategy of `ode15s`).
+//!
+//! # The NDF method ([`integrate_ndf`])
+//!
+//! **Formula.** With `∇` the backward difference at the current constant step `h`, the NDF of order
+//! `k` (Klopfenstein–Shampine numerical differentiation formula) is
+//!
+//! ```text
+//!   Σ_{m=1..k} (1/m) ∇^m y_{n+1} − h f(t_{n+1}, y_{n+1}) − κ_k γ_k (y_{n+1} − y⁽⁰⁾_{n+1}) = 0,
+//!   γ_k = Σ_{j=1..k} 1/j,      predictor  y⁽⁰⁾_{n+1} = Σ_{m=0..k} ∇^m y_n,
+//! ```
+//!
+//! with `κ = (−37/200, −1/9, −0.0823, −0.0415, 0)` for `k = 1..5` (`κ = 0` gives the BDFs:
+//! [`NdfOptions::bdf`]). Writing `d = y_{n+1} − y⁽⁰⁾_{n+1}` (which equals `∇^{k+1} y_{n+1}`), the
+//! corrector is
+//!
+//! ```text
+//!   d − h/((1−κ_k)γ_k) · f(t_{n+1}, y⁽⁰⁾ + d) + ψ = 0,    ψ = 1/((1−κ_k)γ_k) · Σ_{m=1..k} γ_m ∇^m y_n,
+//! ```
+//!
+//! solved by simplified Newton, `(I − h/((1−κ_k)γ_k) J) Δ = h/((1−κ_k)γ_k) f(t_{n+1}, y⁽ⁱ⁾) − ψ − d⁽ⁱ⁾`,
+//! at most 4 iterations, with the iteration matrix LU-factored once and reused for as long as `h`,
+//! `k` and `J` do not change (across steps). With `ρ = ‖Δ_i‖/‖Δ_{i−1}‖` the iteration is accepted when
+//! `ρ/(1−ρ)·‖Δ_i‖ ≤ rtol/2` (after one iteration using the previous rate: `≤ rtol/20`), and declared
+//! too slow when `ρ > 0.9` or it cannot reach that within 4 iterations. Too slow: if `J` was not
+//! evaluated at the current point `(t_n, y_n)` it is re-evaluated there, else `h ← 0.3 h`. The
+//! Jacobian is thus only recomputed at the start (and after each breakpoint) and when Newton
+//! converges slowly, as in `ode15s`.
+//!
+//! **Error estimate and norm.** The local error is estimated as `C_k ∇^{k+1} y_{n+1} = C_k d` with
+//! the error constant `C_k = κ_k γ_k + 1/(k+1)`. It is measured in the **maximum norm** with the
+//! weights of `ode15s`: `err = C_k · max_i |d_i| / max(|y_{n,i}|, |y⁽⁰⁾_{n+1,i}|, atol_i/rtol)` and a step
+//! is accepted iff `err ≤ rtol`, i.e. iff `C_k |d_i| ≤ max(rtol·max(|y_{n,i}|, |y⁽⁰⁾_{n+1,i}|), atol_i)`
+//! for every component (a max of the relative and absolute parts, not their sum).
+//!
+//! **Step size and order.** After a rejected step: `h ← h·max(0.1, 0.833 (rtol/err)^{1/(k+1)})`, and
+//! on a first failure at `k > 1` the order drops to `k−1` if `err_{k−1} = C_{k−1}‖∇^k y_{n+1}‖`
+//! allows a larger step (`h·max(0.1, 0.769 (rtol/err_{k−1})^{1/k})`, never larger than `h`); a repeated
+//! failure halves `h`. After `k+2` successful steps at constant `h` and `k`, the step ratios
+//! `1/(1.2 (err_k/rtol)^{1/(k+1)})`, `1/(1.3 (err_{k−1}/rtol)^{1/k})` and
+//! `1/(1.4 (err_{k+1}/rtol)^{1/(k+2)})` (`err_{k+1} = C_{k+1}‖∇^{k+2} y_{n+1}‖`, each ratio at most 10) are
+//! compared; the largest picks the new order, and `h` changes only if that ratio exceeds 1. The
+//! step is stretched by up to 10 % to land on the end of the interval (or a breakpoint).
+//!
+//! **Changing h.** The differences are re-expressed for the new step `h' = r h` by
+//! `[∇y]' = [∇y]·(R U)` with `R_ij = Π_{m=1..i} (m − 1 − j r)/m`, `U_ij = (−1)^i binom(j, i)`
+//! (`i, j = 1..k`).
+//!
+//! **Dense output.** Between `t_n` and `t_{n+1}` the interpolating polynomial of the step is used:
+//! `y(t_{n+1} + s h) ≈ y_{n+1} + Σ_{j=1..k} ∇^j y_{n+1} · Π_{i=1..j} (s + i − 1)/i`, `s ∈ [−1, 0]`.
+//!
+//! **Initial step** (as `ode15s`): `h = min(h_max, span, 1/r)`, first with
+//! `r = 1.25 ‖y'/w‖_∞/√rtol` and then, for the error `½h² y''` of the first (order-1) step, with
+//! `r = 1.25 √(½‖(∂f/∂t + J y')/w‖_∞ / rtol)`, `w = max(|y|, atol/rtol)`. The minimum step is
+//! `16 ulp(t)`.
+//!
+//! # Breakpoints
+//!
+//! The interval is split at the breakpoints; each piece is integrated separately, stepping exactly
+//! onto its end, and the next piece restarts at order 1 with a new initial step and a new Jacobian.
+//! On the piece `[a, b]` the right-hand side is only evaluated at times strictly inside the piece
+//! where `a`, `b` are breakpoints: a call for `t = b` is made at the largest float below `b`, and
+//! for `t = a` at the smallest float above `a`. A piecewise-constant input that switches at `b`
+//! (either left- or right-continuous, e.g. a zero-order hold `u(t) = u_k` for `t ∈ [t_k, t_{k+1})`)
+//! is thus seen as constant on each piece.
+//!
+//! # The fixed-step method ([`integrate_fixed`])
+//!
+//! The two-step BDF with variable-coefficient form for the steps that are not of the nominal length
+//! (`ω = h_n/h_{n−1}`),
+//! `y_{n+1} − (1+ω)²/(1+2ω) y_n + ω²/(1+2ω) y_{n−1} = h_n (1+ω)/(1+2ω) f(t_{n+1}, y_{n+1})`
+//! (`4/3, 1/3, 2/3` at `ω = 1`): second order, A- and L-stable (stiff components are damped, not
+//! left ringing as with the trapezoidal rule), one implicit solve per step. It is started, and
+//! restarted after every breakpoint, by one backward Euler step. See [`integrate_fixed`].
+//!
+//! # Allocation
+//!
+//! All buffers (state vectors, difference table, Jacobian, LU factors) are allocated once per call;
+//! the stepping loop does not allocate (the user's right-hand side and output callback may).
+
+use nalgebra::{DMatrix, DVector};
+
+mod fixed;
+mod ndf;
+#[cfg(test)]
+mod tests;
+#[cfg(test)]
+mod tests_fixed;
+
+pub use fixed::integrate_fixed;
+pub use ndf::integrate_ndf;
+
+/// An error reported by the right-hand side (or its Jacobian); it stops the integration.
+#[derive(Debug, Clone, thiserror::Error, PartialEq)]
+#[error("{0}")]
+pub struct RhsError(pub String);
+
+/// `y' = f(t, y)`, with an optional analytic Jacobian `∂f/∂y`.
+pub trait OdeSystem {
+    /// Dimension of `y`.
+    fn dim(&self) -> usize;
+    /// Writes `f(t, y)` into `dy` (of length [`OdeSystem::dim`]).
+    fn rhs(&mut self, t: f64, y: &DVector<f64>, dy: &mut DVector<f64>) -> Result<(), RhsError>;
+    /// Writes `∂f/∂y` into `jac` (`dim × dim`); returns `Ok(false)` if not provided, in which case
+    /// forward differences are used (column `j` with the increment
+    /// `δ_j = √eps · max(|y_j|, atol_j/rtol)`). Called once per Jacobian evaluation; after an
+    /// `Ok(false)` it is not called again during that integration.
+    fn jacobian(
+        &mut self,
+        _t: f64,
+        _y: &DVector<f64>,
+        _jac: &mut DMatrix<f64>,
+    ) -> Result<bool, RhsError> {
+        Ok(false)
+    }
+}
+
+/// Options of [`integrate_ndf`].
+#[derive(Debug, Clone)]
+pub struct NdfOptions {
+    /// Relative tolerance (default `1e-3`, as `ode15s`); values below `100·eps` are raised to it.
+    pub rtol: f64,
+    /// Absolute tolerance for every component (default `1e-6`).
+    pub atol: f64,
+    /// Per-component absolute tolerances (length `dim`); when `Some`, used instead of `atol`.
+    pub atol_components: Option<Vec<f64>>,
+    /// Maximum order, `1..=5` (default 5).
+    pub max_order: usize,
+    /// `false`: NDFs (default, κ coefficients); `true`: plain BDFs (κ = 0).
+    pub bdf: bool,
+    /// First step; default automatic, as `ode15s`. Only used at `t0` (restarts after breakpoints
+    /// always choose their step automatically).
+    pub initial_step: Option<f64>,
+    /// Maximum step. The default, `f64::INFINITY`, means `0.1·|tf − t0|` (the `ode15s` default);
+    /// a finite positive value is used as given.
+    pub max_step: f64,
+    /// Maximum number of successful steps (default 1 000 000).
+    pub max_steps: usize,
+}
+
+impl Default for NdfOptions {
+    fn default() -> Self {
+        NdfOptions {
+            rtol: 1e-3,
+            atol: 1e-6,
+            atol_components: None,
+            max_order: 5,
+            bdf: false,
+            initial_step: None,
+            max_step: f64::INFINITY,
+            max_steps: 1_000_000,
+        }
+    }
+}
+
+/// Options of [`integrate_fixed`].
+#[derive(Debug, Clone)]
+pub struct FixedStepOptions {
+    /// Nominal step (default `1e-3`).
+    pub h: f64,
+    /// Newton tolerance (default `1e-8`): the iteration stops when the estimated remaining error of
+    /// the iterate, `ρ/(1−ρ)·‖Δ‖`, is at most `newton_tol` in the norm `max_i |Δ_i| / max(1, |y_i|)`
+    /// (absolute for components below 1, relative above).
+    pub newton_tol: f64,
+    /// Maximum Newton iterations per attempt (default 5, at least 1; with 1, an attempt is
+    /// accepted only if its first correction already meets `newton_tol`).
+    pub max_newton: usize,
+}
+
+impl Default for FixedStepOptions {
+    fn default() -> Self {
+        FixedStepOptions {
+            h: 1e-3,
+            newton_tol: 1e-8,
+            max_newton: 5,
+        }
+    }
+}
+
+/// Work counters of one integration.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct OdeStats {
+    /// Successful steps.
+    pub steps: usize,
+    /// Rejected attempts (error test failures and Newton failures).
+    pub failed_steps: usize,
+    /// Right-hand side evaluations (including those for finite-difference Jacobians).
+    pub rhs_evals: usize,
+    /// Jacobian evaluations (analytic or by finite differences).
+    pub jacobian_evals: usize,
+    /// LU factorizations of the iteration matrix.
+    pub lu_decompositions: usize,
+    /// Newton iterations (linear solves).
+    pub newton_iterations: usize,
+}
+
+/// Why an integration stopped. Except for [`OdeError::Invalid`], every output time before
+/// [`OdeError::t_reached`] has been delivered.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum OdeError {
+    #[error("integration stopped at t = {t}: step size {h:e} below the minimum {h_min:e}")]
+    StepSizeUnderflow { t: f64, h: f64, h_min: f64 },
+    #[error("integration stopped at t = {t}: Newton iteration failed to converge repeatedly")]
+    NewtonFailure { t: f64 },
+    #[error(
+        "integration stopped at t = {t}: non-finite value (NaN or infinity) in the solution or the right-hand side"
+    )]
+    NonFinite { t: f64 },
+    #[error("integration stopped at t = {t}: right-hand side failed: {source}")]
+    Rhs { t: f64, source: RhsError },
+    #[error("integration stopped at t = {t}: maximum number of steps {max_steps} reached")]
+    TooManySteps { t: f64, max_steps: usize },
+    #[error("invalid input `{field}`: {message}")]
+    Invalid {
+        field: &'static str,
+        message: String,
+    },
+}
+
+impl OdeError {
+    /// The last time the solution reached (the last accepted step), `None` for invalid input.
+    pub fn t_reached(&self) -> Option<f64> {
+        match self {
+            OdeError::StepSizeUnderflow { t, .. }
+            | OdeError::NewtonFailure { t }
+            | OdeError::NonFinite { t }
+            | OdeError::Rhs { t, .. }
+            | OdeError::TooManySteps { t, .. } => Some(*t),
+            OdeError::Invalid { .. } => None,
+        }
+    }
+}
+
+fn invalid(field: &'static str, message: impl Into<String>) -> OdeError {
+    OdeError::Invalid {
+        field,
+        message: message.into(),
+    }
+}
+
+/// Smallest float above `x` (for finite `x`; `f64::next_up` needs Rust 1.86).
+fn next_up(x: f64) -> f64 {
+    if !x.is_finite() {
+        return x;
+    }
+    if x == 0.0 {
+        return f64::from_bits(1);
+    }
+    let b = x.to_bits();
+    f64::from_bits(if x > 0.0 { b + 1 } else { b - 1 })
+}
+
+/// Largest float below `x` (for finite `x`).
+fn next_down(x: f64) -> f64 {
+    -next_up(-x)
+}
+
+/// Spacing of the floats at `x` (`eps(x)` of MATLAB).
+fn ulp(x: f64) -> f64 {
+    let a = x.abs();
+    next_up(a) - a
+}
+
+/// Checks the arguments shared by both integrators; returns the piece boundaries
+/// `[t0, b_1, …, b_m, tf]` (breakpoints outside `(t0, tf)` dropped, duplicates and breakpoints within
+/// 64 ulp of a neighbour merged).
+fn check_common(
+    dim: usize,
+    t0: f64,
+    y0: &DVector<f64>,
+    t_out: &[f64],
+    breakpoints: &[f64],
+) -> Result<Vec<f64>, OdeError> {
+    if dim == 0 {
+        return Err(invalid("system", "the system has dimension 0"));
+    }
+    if y0.len() != dim {
+        return Err(invalid(
+            "y0",
+            format!("{} entries, the system has dimension {dim}", y0.len()),
+        ));
+    }
+    if !t0.is_finite() {
+        return Err(invalid("t0", format!("must be finite, got {t0}")));
+    }
+    if let Some(i) = y0.iter().position(|v| !v.is_finite()) {
+        return Err(invalid(
+            "y0",
+            format!("entry {i} is not finite ({})", y0[i]),
+        ));
+    }
+    let Some(&tf) = t_out.last() else {
+        return Err(invalid("t_out", "at least one output time is required"));
+    };
+    for (i, &t) in t_out.iter().enumerate() {
+        if !t.is_finite() {
+            return Err(invalid("t_out", format!("entry {i} is not finite ({t})")));
+        }
+        if t < t0 {
+            return Err(invalid(
+                "t_out",
+                format!("entry {i} = {t} is before t0 = {t0}"),
+            ));
+        }
+        if i > 0 && t <= t_out[i - 1] {
+            return Err(invalid(
+                "t_out",
+                format!(
+                    "not strictly ascending at entry {i} ({} then {t})",
+                    t_out[i - 1]
+                ),
+            ));
+        }
+    }
+    let mut bounds = vec![t0];
+    for (i, &b) in breakpoints.iter().enumerate() {
+        if !b.is_finite() {
+            return Err(invalid(
+                "breakpoints",
+                format!("entry {i} is not finite ({b})"),
+            ));
+        }
+        if i > 0 && b < breakpoints[i - 1] {
+            return Err(invalid(
+                "breakpoints",
+                format!(
+                    "not ascending at entry {i} ({} then {b})",
+                    breakpoints[i - 1]
+                ),
+            ));
+        }
+        let last = *bounds.last().unwrap_or(&t0);
+        let gap = 64.0 * ulp(b.abs().max(last.abs()).max(tf.abs()));
+        if b > last + gap && b < tf - gap {
+            bounds.push(b);
+        }
+    }
+    if tf > t0 {
+        bounds.push(tf);
+    }
+    Ok(bounds)
+}
+
+/// The system with evaluation counters, finiteness checks and the time convention of a piece.
+struct Counted<'a, S: OdeSystem> {
+    sys: &'a mut S,
+    stats: OdeStats,
+    /// `None` until the first Jacobian request; then whether `sys.jacobian` provides it.
+    analytic: Option<bool>,
+    /// Evaluation times are clamped to `[lo, hi]` (the open piece when its ends are breakpoints).
+    lo: f64,
+    hi: f64,
+}
+
+impl<'a, S: OdeSystem> Counted<'a, S> {
+    fn new(sys: &'a mut S) -> Self {
+        Counted {
+            sys,
+            stats: OdeStats::default(),
+            analytic: None,
+            lo: f64::NEG_INFINITY,
+            hi: f64::INFINITY,
+        }
+    }
+
+    /// Sets the piece `[a, b]`: evaluation times are kept strictly inside where an end is a breakpoint.
+    fn set_piece(&mut self, a: f64, a_is_break: bool, b: f64, b_is_break: bool) {
+        self.lo = if a_is_break {
+            next_up(a)
+        } else {
+            f64::NEG_INFINITY
+        };
+        self.hi = if b_is_break {
+            next_down(b)
+        } else {
+            f64::INFINITY
+        };
+    }
+
+    fn clamp(&self, t: f64) -> f64 {
+        t.max(self.lo).min(self.hi)
+    }
+
+    /// `dy = f(t, y)`; `Ok(false)` if `dy` is not finite. `t_acc` is the last accepted time (for errors).
+    fn f(
+        &mut self,
+        t_acc: f64,
+        t: f64,
+        y: &DVector<f64>,
+        dy: &mut DVector<f64>,
+    ) -> Result<bool, OdeError> {
+        self.stats.rhs_evals += 1;
+        let te = self.clamp(t);
+        let n = y.len();
+        self.sys
+            .rhs(te, y, dy)
+            .map_err(|source| OdeError::Rhs { t: t_acc, source })?;
+        if dy.len() != n {
+            let message = format!(
+                "the right-hand side has {} entries, the system has dimension {n}",
+                dy.len()
+            );
+            return Err(OdeError::Rhs {
+                t: t_acc,
+                source: RhsError(message),
+            });
+        }
+        Ok(dy.iter().all(|v| v.is_finite()))
+    }
+
+    /// `jac = ∂f/∂y (t, y)`, analytic or by forward differences (`thresh_j = atol_j/rtol`);
+    /// `Ok(false)` if the result (or `f(t, y)`) is not finite.
+    fn jacobian(
+        &mut self,
+        t: f64,
+        y: &DVector<f64>,
+        thresh: &DVector<f64>,
+        jac: &mut DMatrix<f64>,
+        jw: &mut JacWork,
+    ) -> Result<bool, OdeError> {
+        self.stats.jacobian_evals += 1;
+        let te = self.clamp(t);
+        if self.analytic != Some(false) {
+            let given = self
+                .sys
+                .jacobian(te, y, jac)
+                .map_err(|source| OdeError::Rhs { t, source })?;
+            self.analytic = Some(given);
+            if given && jac.shape() != (y.len(), y.len()) {
+                let message = format!(
+                    "the Jacobian is {:?}, the system has dimension {}",
+                    jac.shape(),
+                    y.len()
+                );
+                return Err(OdeError::Rhs {
+                    t,
+                    source: RhsError(message),
+                });
+            }
+            if given {
+                return Ok(jac.iter().all(|v| v.is_finite()));
+            }
+        }
+        if jac.shape() != (y.len(), y.len()) {
+            *jac = DMatrix::zeros(y.len(), y.len()); // only if `jacobian` resized it and declined
+        }
+        if !self.f(t, t, y, &mut jw.f0)? {
+            return Ok(false);
+        }
+        let sqrt_eps = f64::EPSILON.sqrt();
+        jw.ydel.copy_from(y);
+        for j in 0..y.len() {
+            let yj = y[j];
+            let mut del = sqrt_eps * yj.abs().max(thresh[j]);
+            if del == 0.0 || !del.is_finite() {
+                del = sqrt_eps;
+            }
+            if yj < 0.0 {
+                del = -del;
+            }
+            jw.ydel[j] = yj + del;
+            let del = jw.ydel[j] - yj; // the increment actually representable
+            let ok = self.f(t, t, &jw.ydel, &mut jw.fdel)?;
+            jw.ydel[j] = yj;
+            if !ok {
+                return Ok(false);
+            }
+            let inv = 1.0 / del;
+            for i in 0..y.len() {
+                jac[(i, j)] = (jw.fdel[i] - jw.f0[i]) * inv;
+            }
+        }
+        Ok(jac.iter().all(|v| v.is_finite()))
+    }
+}
+
+/// Buffers of the finite-difference Jacobian.
+struct JacWork {
+    f0: DVector<f64>,
+    ydel: DVector<f64>,
+    fdel: DVector<f64>,
+}
+
+impl JacWork {
+    fn new(n: usize) -> Self {
+        JacWork {
+            f0: DVector::zeros(n),
+            ydel: DVector::zeros(n),
+            fdel: DVector::zeros(n),
+        }
+    }
+}
+
+/// In-place LU factorization with partial pivoting of the iteration matrix `I − c J`
+/// (allocation-free after construction).
+struct Lu {
+    a: DMatrix<f64>,
+    piv: Vec<usize>,
+}
+
+impl Lu {
+    fn new(n: usize) -> Self {
+        Lu {
+            a: DMatrix::zeros(n, n),
+            piv: vec![0; n],
+        }
+    }
+
+    /// Factors `I − c·jac`; `false` if it is singular or not finite.
+    fn factor(&mut self, c: f64, jac: &DMatrix<f64>, stats: &mut OdeStats) -> bool {
+        stats.lu_decompositions += 1;
+        let n = self.piv.len();
+        for (dst, src) in self.a.iter_mut().zip(jac.iter()) {
+            *dst = -c * src;
+        }
+        for i in 0..n {
+            self.a[(i, i)] += 1.0;
+        }
+        let a = self.a.as_mut_slice(); // column-major: (i, j) at i + j n
+        for k in 0..n {
+            let mut p = k;
+            let mut best = a[k + k * n].abs();
+            for i in k + 1..n {
+                let v = a[i + k * n].abs();
+                if v > best {
+                    best = v;
+                    p = i;
+                }
+            }
+            if !(best > 0.0 && best.is_finite()) {
+                return false;
+            }
+            self.piv[k] = p;
+            if p != k {
+                for j in 0..n {
+                    a.swap(k + j * n, p + j * n);
+                }
+            }
+            let inv = 1.0 / a[k + k * n];
+            for i in k + 1..n {
+                a[i + k * n] *= inv;
+            }
+            for j in k + 1..n {
+                let akj = a[k + j * n];
+                if akj != 0.0 {
+                    let (left, right) = a.split_at_mut(j * n);
+                    let lcol = &left[k * n..(k + 1) * n];
+                    let col = &mut right[..n];
+                    for i in k + 1..n {
+                        col[i] -= lcol[i] * akj;
+                    }
+                }
+            }
+        }
+        true
+    }
+
+    /// Solves `A x = b` in place with the last successful factorization.
+    fn solve(&self, b: &mut DVector<f64>) {
+        let n = self.piv.len();
+        let a = self.a.as_slice();
+        let x = b.as_mut_slice();
+        for k in 0..n {
+            let p = self.piv[k];
+            if p != k {
+                x.swap(k, p);
+            }
+        }
+        for j in 0..n {
+            let xj = x[j];
+            if xj != 0.0 {
+                for i in j + 1..n {
+                    x[i] -= a[i + j * n] * xj;
+                }
+            }
+        }
+        for j in (0..n).rev() {
+            x[j] /= a[j + j * n];
+            let xj = x[j];
+            if xj != 0.0 {
+                for i in 0..j {
+                    x[i] -= a[i + j * n] * xj;
+                }
+            }
+        }
+    }
+}
+
+/// `max_i |v_i w_i|`, NaN if any term is NaN.
+fn wnorm(v: &DVector<f64>, w: &DVector<f64>) -> f64 {
+    let mut m = 0.0f64;
+    for (a, b) in v.iter().zip(w.iter()) {
+        let x = (a * b).abs();
+        if x.is_nan() {
+            return f64::NAN;
+        }
+        if x > m {
+            m = x;
+        }
+    }
+    m
+}
+
+/// Delivers the outputs `t_out[*next..]` that are `≤ t_new`, computing each with `value`.
+fn deliver(
+    t_out: &[f64],
+    next: &mut usize,
+    t_new: f64,
+    buf: &mut DVector<f64>,
+    output: &mut dyn FnMut(f64, &DVector<f64>),
+    mut value: impl FnMut(f64, &mut DVector<f64>),
+) {
+    while *next < t_out.len() && t_out[*next] <= t_new {
+        let t = t_out[*next];
+        value(t, buf);
+        output(t, buf);
+        *next += 1;
+    }
+}

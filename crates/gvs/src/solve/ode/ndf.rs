@@ -1,0 +1,622 @@
+//! The variable-step, variable-order NDF/BDF integrator (quasi-constant step size, backward
+//! differences), after `ode15s` (Shampine & Reichelt 1997). The formulas are in the documentation
+//! of the parent module.
+
+use super::{
+    check_common, deliver, invalid, ulp, wnorm, Counted, JacWork, Lu, NdfOptions, OdeError,
+    OdeStats, OdeSystem,
+};
+use nalgebra::{DMatrix, DVector};
+
+/// `γ_k = Σ_{j=1..k} 1/j`, `k = 1..5`.
+const GAMMA: [f64; 5] = [1.0, 3.0 / 2.0, 11.0 / 6.0, 25.0 / 12.0, 137.0 / 60.0];
+/// The NDF coefficients `κ_k` (Shampine & Reichelt 1997, table 2.1).
+const KAPPA: [f64; 5] = [-37.0 / 200.0, -1.0 / 9.0, -0.0823, -0.0415, 0.0];
+/// `U_ij = (−1)^i binom(j, i)` (1-based), the difference-rescaling factor; `U = U⁻¹`.
+const DIF_U: [[f64; 5]; 5] = [
+    [-1.0, -2.0, -3.0, -4.0, -5.0],
+    [0.0, 1.0, 3.0, 6.0, 10.0],
+    [0.0, 0.0, -1.0, -4.0, -10.0],
+    [0.0, 0.0, 0.0, 1.0, 5.0],
+    [0.0, 0.0, 0.0, 0.0, -1.0],
+];
+/// Maximum simplified Newton iterations per attempt.
+const MAX_IT: usize = 4;
+
+/// Validated options.
+struct Config {
+    rtol: f64,
+    maxk: usize,
+    hmax: f64,
+    h0: Option<f64>,
+    max_steps: usize,
+    /// `1/((1−κ_k)γ_k)`.
+    inv_ga: [f64; 5],
+    /// `C_k = κ_k γ_k + 1/(k+1)`.
+    erconst: [f64; 5],
+}
+
+fn check_options(
+    o: &NdfOptions,
+    n: usize,
+    t0: f64,
+    tf: f64,
+    thresh: &mut DVector<f64>,
+) -> Result<Config, OdeError> {
+    if !(o.rtol > 0.0 && o.rtol.is_finite()) {
+        return Err(invalid(
+            "rtol",
+            format!("must be positive and finite, got {}", o.rtol),
+        ));
+    }
+    let rtol = o.rtol.max(100.0 * f64::EPSILON);
+    match &o.atol_components {
+        Some(v) => {
+            if v.len() != n {
+                return Err(invalid(
+                    "atol_components",
+                    format!("{} entries, the system has dimension {n}", v.len()),
+                ));
+            }
+            for (i, &a) in v.iter().enumerate() {
+                if !(a > 0.0 && a.is_finite()) {
+                    return Err(invalid(
+                        "atol_components",
+                        format!("entry {i} must be positive and finite, got {a}"),
+                    ));
+                }
+                thresh[i] = a / rtol;
+            }
+        }
+        None => {
+            if !(o.atol > 0.0 && o.atol.is_finite()) {
+                return Err(invalid(
+                    "atol",
+                    format!("must be positive and finite, got {}", o.atol),
+                ));
+            }
+            thresh.fill(o.atol / rtol);
+        }
+    }
+    if !(1..=5).contains(&o.max_order) {
+        return Err(invalid(
+            "max_order",
+            format!("must be in 1..=5, got {}", o.max_order),
+        ));
+    }
+    if let Some(h) = o.initial_step {
+        if !(h > 0.0 && h.is_finite()) {
+            return Err(invalid(
+                "initial_step",
+                format!("must be positive and finite, got {h}"),
+            ));
+        }
+    }
+    if o.max_step.is_nan() || o.max_step <= 0.0 {
+        return Err(invalid(
+            "max_step",
+            format!("must be positive (infinity: automatic), got {}", o.max_step),
+        ));
+    }
+    if o.max_steps == 0 {
+        return Err(invalid("max_steps", "must be at least 1"));
+    }
+    let auto = 0.1 * (tf - t0).abs();
+    let hmax = if o.max_step.is_finite() {
+        o.max_step
+    } else {
+        auto
+    };
+    // Never below the time resolution, so that every step advances t.
+    let hmax = hmax.max(16.0 * ulp(t0.abs().max(tf.abs())));
+    let (inv_ga, erconst) = coefficients(o.bdf);
+    Ok(Config {
+        rtol,
+        maxk: o.max_order,
+        hmax,
+        h0: o.initial_step,
+        max_steps: o.max_steps,
+        inv_ga,
+        erconst,
+    })
+}
+
+/// `(1/((1−κ_k)γ_k), C_k = κ_k γ_k + 1/(k+1))` for `k = 1..5` (`κ = 0` for the BDFs).
+pub(super) fn coefficients(bdf: bool) -> ([f64; 5], [f64; 5]) {
+    let mut inv_ga = [0.0; 5];
+    let mut erconst = [0.0; 5];
+    for k in 0..5 {
+        let kappa = if bdf { 0.0 } else { KAPPA[k] };
+        inv_ga[k] = 1.0 / (GAMMA[k] * (1.0 - kappa));
+        erconst[k] = kappa * GAMMA[k] + 1.0 / (k as f64 + 2.0);
+    }
+    (inv_ga, erconst)
+}
+
+/// All buffers of one integration.
+struct Work {
+    n: usize,
+    y: DVector<f64>,
+    yp: DVector<f64>,
+    ynew: DVector<f64>,
+    pred: DVector<f64>,
+    psi: DVector<f64>,
+    difkp1: DVector<f64>,
+    del: DVector<f64>,
+    f: DVector<f64>,
+    tmp: DVector<f64>,
+    invwt: DVector<f64>,
+    thresh: DVector<f64>,
+    out: DVector<f64>,
+    /// Backward differences `∇^j y_n`, `j = 1..maxk+2`, in columns `0..maxk+2`.
+    dif: DMatrix<f64>,
+    jac: DMatrix<f64>,
+    lu: Lu,
+    jw: JacWork,
+}
+
+impl Work {
+    fn new(n: usize) -> Self {
+        let v = || DVector::zeros(n);
+        Work {
+            n,
+            y: v(),
+            yp: v(),
+            ynew: v(),
+            pred: v(),
+            psi: v(),
+            difkp1: v(),
+            del: v(),
+            f: v(),
+            tmp: v(),
+            invwt: v(),
+            thresh: v(),
+            out: v(),
+            dif: DMatrix::zeros(n, 7),
+            jac: DMatrix::zeros(n, n),
+            lu: Lu::new(n),
+            jw: JacWork::new(n),
+        }
+    }
+}
+
+/// Re-expresses the differences `∇^1..∇^k` for the step ratio `r = h_new/h_old`:
+/// `dif[:, 0..k] ← dif[:, 0..k]·(R U)`, `R_ij = Π_{m=1..i} (m − 1 − j r)/m`.
+pub(super) fn rescale(dif: &mut DMatrix<f64>, k: usize, r: f64) {
+    let mut rm = [[0.0; 5]; 5];
+    for j in 0..k {
+        let mut p = 1.0;
+        for (i, row) in rm.iter_mut().enumerate().take(k) {
+            let m = (i + 1) as f64;
+            p *= (m - 1.0 - (j + 1) as f64 * r) / m;
+            row[j] = p;
+        }
+    }
+    let mut ru = [[0.0; 5]; 5];
+    for i in 0..k {
+        for j in 0..k {
+            ru[i][j] = (0..=j).map(|m| rm[i][m] * DIF_U[m][j]).sum();
+        }
+    }
+    let n = dif.nrows();
+    let d = dif.as_mut_slice();
+    for row in 0..n {
+        let mut old = [0.0; 5];
+        for (m, o) in old.iter_mut().enumerate().take(k) {
+            *o = d[row + m * n];
+        }
+        for j in 0..k {
+            d[row + j * n] = (0..k).map(|m| old[m] * ru[m][j]).sum();
+        }
+    }
+}
+
+/// `y(tq)` from the interpolating polynomial of the step `(t_new − h, t_new]` of order `k`.
+pub(super) fn interpolate(
+    tq: f64,
+    t_new: f64,
+    h: f64,
+    ynew: &DVector<f64>,
+    dif: &DMatrix<f64>,
+    k: usize,
+    out: &mut DVector<f64>,
+) {
+    out.copy_from(ynew);
+    if tq == t_new {
+        return;
+    }
+    let s = (tq - t_new) / h;
+    let mut c = 1.0;
+    for j in 0..k {
+        c *= (s + j as f64) / (j + 1) as f64;
+        out.axpy(c, &dif.column(j), 1.0);
+    }
+}
+
+/// `max_i |a_i w_i|` with `a` a column of the difference table.
+fn wnorm_col(dif: &DMatrix<f64>, col: usize, w: &DVector<f64>) -> f64 {
+    let mut m = 0.0f64;
+    for (a, w) in dif.column(col).iter().zip(w.iter()) {
+        let x = (a * w).abs();
+        if x.is_nan() {
+            return f64::NAN;
+        }
+        m = m.max(x);
+    }
+    m
+}
+
+/// `max_i |(a_i + b_i) w_i|` with `a` a column of the difference table.
+fn wnorm_sum(dif: &DMatrix<f64>, col: usize, b: &DVector<f64>, w: &DVector<f64>) -> f64 {
+    let mut m = 0.0f64;
+    for ((a, b), w) in dif.column(col).iter().zip(b.iter()).zip(w.iter()) {
+        let x = ((a + b) * w).abs();
+        if x.is_nan() {
+            return f64::NAN;
+        }
+        m = m.max(x);
+    }
+    m
+}
+
+/// Integrates `y' = f(t, y)` from `(t0, y0)` to the last of `t_out` with the variable-step,
+/// variable-order NDF method of `ode15s` (see the module documentation for the formulas).
+///
+/// * `t_out`: output times, strictly ascending, `≥ t0`, at least one; `output(t, y)` is called at
+///   each, in order, from the interpolating polynomial of the step covering it (the integrator does
+///   not step onto them). An output time equal to `t0` receives `y0`.
+/// * `breakpoints`: ascending times where `f` is discontinuous (input switches). Those in `(t0, tf)`
+///   are stepped onto exactly, and the integration restarts after each (order 1, new initial step,
+///   new Jacobian); `f` is only called strictly inside each piece (see the module documentation).
+///   Breakpoints outside `(t0, tf)` are ignored, duplicates merged.
+/// * On error, every output time before the time reached has been delivered.
+///
+/// Errors: [`OdeError::Invalid`] for bad options, dimensions, non-finite `y0` or badly ordered
+/// times (nothing is integrated); [`OdeError::NonFinite`] when `f` returns NaN/∞ and no smaller
+/// step avoids it; [`OdeError::StepSizeUnderflow`] when the error test fails at the minimum step
+/// `16 ulp(t)`; [`OdeError::NewtonFailure`] when Newton fails at the minimum step;
+/// [`OdeError::Rhs`] as soon as `f` or its Jacobian returns an error; [`OdeError::TooManySteps`].
+pub fn integrate_ndf<S: OdeSystem>(
+    sys: &mut S,
+    t0: f64,
+    y0: &DVector<f64>,
+    t_out: &[f64],
+    breakpoints: &[f64],
+    opts: &NdfOptions,
+    output: &mut dyn FnMut(f64, &DVector<f64>),
+) -> Result<OdeStats, OdeError> {
+    let n = sys.dim();
+    let bounds = check_common(n, t0, y0, t_out, breakpoints)?;
+    let tf = *bounds.last().unwrap_or(&t0);
+    let mut w = Work::new(n);
+    let cfg = check_options(opts, n, t0, tf, &mut w.thresh)?;
+    w.y.copy_from(y0);
+    let mut next = 0;
+    deliver(t_out, &mut next, t0, &mut w.out, output, |_, b| {
+        b.copy_from(y0)
+    });
+    let mut cs = Counted::new(sys);
+    let pieces = bounds.len().saturating_sub(1);
+    for p in 0..pieces {
+        let (a, b) = (bounds[p], bounds[p + 1]);
+        cs.set_piece(a, p > 0, b, p + 1 < pieces);
+        let h0 = if p == 0 { cfg.h0 } else { None };
+        integrate_piece(&mut cs, &mut w, &cfg, a, b, h0, t_out, &mut next, output)?;
+    }
+    Ok(cs.stats)
+}
+
+/// Integrates the piece `[a, b]` from `w.y` (at `a`) to `b`, leaving `y(b)` in `w.y`.
+#[allow(clippy::too_many_arguments)]
+fn integrate_piece<S: OdeSystem>(
+    cs: &mut Counted<'_, S>,
+    w: &mut Work,
+    cfg: &Config,
+    a: f64,
+    b: f64,
+    h0: Option<f64>,
+    t_out: &[f64],
+    next: &mut usize,
+    output: &mut dyn FnMut(f64, &DVector<f64>),
+) -> Result<(), OdeError> {
+    let n = w.n;
+    let rtol = cfg.rtol;
+    let hmax = cfg.hmax;
+    let inv_ga = &cfg.inv_ga;
+    let erconst = &cfg.erconst;
+    let mut t = a;
+
+    // Initial slope and Jacobian.
+    if !cs.f(t, t, &w.y, &mut w.yp)? {
+        return Err(OdeError::NonFinite { t });
+    }
+    if !cs.jacobian(t, &w.y, &w.thresh, &mut w.jac, &mut w.jw)? {
+        return Err(OdeError::NonFinite { t });
+    }
+    let mut jcurrent = true;
+
+    // Initial step (ode15s).
+    let mut hmin = 16.0 * ulp(t);
+    let span = b - a;
+    let mut absh = match h0 {
+        Some(h) => hmax.min(hmin.max(h)),
+        None => {
+            let wt = |i: usize| w.y[i].abs().max(w.thresh[i]);
+            let rh =
+                1.25 * (0..n).map(|i| (w.yp[i] / wt(i)).abs()).fold(0.0, f64::max) / rtol.sqrt();
+            let mut absh = hmax.min(span);
+            if absh * rh > 1.0 {
+                absh = 1.0 / rh;
+            }
+            absh = absh.max(hmin);
+            // Error ½h²y'' of the first (order-1) step: y'' = ∂f/∂t + J y'.
+            let tdel = (t + (f64::EPSILON.sqrt() * t.abs().max((t + absh).abs())).min(absh)) - t;
+            if tdel > 0.0 && cs.f(t, t + tdel, &w.y, &mut w.f)? {
+                w.tmp.gemv(1.0, &w.jac, &w.yp, 0.0);
+                let ypp = (0..n)
+                    .map(|i| (((w.f[i] - w.yp[i]) / tdel + w.tmp[i]) / wt(i)).abs())
+                    .fold(0.0, f64::max);
+                let rh = 1.25 * (0.5 * ypp / rtol).sqrt();
+                absh = hmax.min(span);
+                if absh * rh > 1.0 {
+                    absh = 1.0 / rh;
+                }
+                absh = absh.max(hmin);
+            }
+            absh
+        }
+    };
+
+    let mut k = 1usize;
+    let mut klast = k;
+    let mut abshlast = absh;
+    w.dif.fill(0.0);
+    w.dif.column_mut(0).axpy(absh, &w.yp, 0.0);
+    let mut hinvgak = absh * inv_ga[0];
+    let mut nconhk = 0usize;
+    let mut lu_ok = w.lu.factor(hinvgak, &w.jac, &mut cs.stats);
+    let mut havrate = false;
+    let mut rate = 0.0f64;
+    let mut done = false;
+    let mut at_hmin = false;
+
+    while !done {
+        hmin = 16.0 * ulp(t);
+        absh = hmax.min(hmin.max(absh));
+        if absh == hmin {
+            if at_hmin {
+                absh = abshlast; // required by step size recovery (ode15s)
+            }
+            at_hmin = true;
+        } else {
+            at_hmin = false;
+        }
+        // Stretch the step if within 10 % of the end of the piece.
+        if 1.1 * absh >= b - t {
+            absh = b - t;
+            done = true;
+        }
+        if absh != abshlast || k != klast {
+            rescale(&mut w.dif, k, absh / abshlast);
+            hinvgak = absh * inv_ga[k - 1];
+            nconhk = 0;
+            lu_ok = w.lu.factor(hinvgak, &w.jac, &mut cs.stats);
+            havrate = false;
+        }
+        if cs.stats.steps >= cfg.max_steps {
+            return Err(OdeError::TooManySteps {
+                t,
+                max_steps: cfg.max_steps,
+            });
+        }
+
+        // Advance one step: retry until the error test passes.
+        let mut nofailed = true;
+        let (tnew, h, err) = loop {
+            // Solve the corrector for ynew (retrying with a new Jacobian or a smaller step).
+            let (tnew, h) = loop {
+                let tnew = if done { b } else { t + absh };
+                let h = tnew - t;
+                {
+                    let d = w.dif.as_slice();
+                    let c = inv_ga[k - 1];
+                    for i in 0..n {
+                        let (mut p, mut s) = (w.y[i], 0.0);
+                        for j in 0..k {
+                            let v = d[i + j * n];
+                            p += v;
+                            s += v * GAMMA[j];
+                        }
+                        w.pred[i] = p;
+                        w.psi[i] = s * c;
+                        w.invwt[i] = 1.0 / w.y[i].abs().max(p.abs()).max(w.thresh[i]);
+                    }
+                }
+                w.ynew.copy_from(&w.pred);
+                w.difkp1.fill(0.0);
+                let minnrm = 100.0 * f64::EPSILON * wnorm(&w.ynew, &w.invwt);
+
+                let mut converged = false;
+                let mut nonfinite = false;
+                if lu_ok {
+                    let mut oldnrm = 0.0;
+                    for iter in 1..=MAX_IT {
+                        if !cs.f(t, tnew, &w.ynew, &mut w.f)? {
+                            nonfinite = true;
+                            break;
+                        }
+                        for i in 0..n {
+                            w.del[i] = hinvgak * w.f[i] - (w.psi[i] + w.difkp1[i]);
+                        }
+                        w.lu.solve(&mut w.del);
+                        cs.stats.newton_iterations += 1;
+                        let newnrm = wnorm(&w.del, &w.invwt);
+                        w.difkp1 += &w.del;
+                        w.ynew.copy_from(&w.pred);
+                        w.ynew += &w.difkp1;
+                        if !newnrm.is_finite() {
+                            nonfinite = true;
+                            break;
+                        }
+                        if newnrm <= minnrm {
+                            converged = true;
+                            break;
+                        } else if iter == 1 {
+                            if havrate {
+                                if newnrm * rate / (1.0 - rate) <= 0.05 * rtol {
+                                    converged = true; // more stringent when using the old rate
+                                    break;
+                                }
+                            } else {
+                                rate = 0.0;
+                            }
+                        } else if newnrm > 0.9 * oldnrm {
+                            break; // too slow
+                        } else {
+                            rate = (0.9 * rate).max(newnrm / oldnrm);
+                            havrate = true;
+                            let errit = newnrm * rate / (1.0 - rate);
+                            if errit <= 0.5 * rtol {
+                                converged = true;
+                                break;
+                            } else if iter == MAX_IT
+                                || 0.5 * rtol < errit * rate.powi((MAX_IT - iter) as i32)
+                            {
+                                break; // too slow
+                            }
+                        }
+                        oldnrm = newnrm;
+                    }
+                }
+                if converged {
+                    break (tnew, h);
+                }
+                // Too slow (or singular iteration matrix, or non-finite values): new Jacobian if
+                // the current one is stale, else a smaller step.
+                cs.stats.failed_steps += 1;
+                if !nonfinite && !jcurrent {
+                    if !cs.jacobian(t, &w.y, &w.thresh, &mut w.jac, &mut w.jw)? {
+                        return Err(OdeError::NonFinite { t });
+                    }
+                    jcurrent = true;
+                } else if absh <= hmin {
+                    return Err(if nonfinite {
+                        OdeError::NonFinite { t }
+                    } else {
+                        OdeError::NewtonFailure { t }
+                    });
+                } else {
+                    abshlast = absh;
+                    absh = (0.3 * absh).max(hmin);
+                    done = false;
+                    rescale(&mut w.dif, k, absh / abshlast);
+                    hinvgak = absh * inv_ga[k - 1];
+                    nconhk = 0;
+                }
+                lu_ok = w.lu.factor(hinvgak, &w.jac, &mut cs.stats);
+                havrate = false;
+            };
+
+            // Error test: ‖∇^{k+1} y_{n+1}‖·C_k ≤ rtol.
+            let err = wnorm(&w.difkp1, &w.invwt) * erconst[k - 1];
+            if err <= rtol {
+                break (tnew, h, err);
+            }
+            cs.stats.failed_steps += 1;
+            if absh <= hmin {
+                return Err(OdeError::StepSizeUnderflow {
+                    t,
+                    h: absh,
+                    h_min: hmin,
+                });
+            }
+            abshlast = absh;
+            if nofailed {
+                nofailed = false;
+                let mut hopt = absh * (0.833 * (rtol / err).powf(1.0 / (k + 1) as f64)).max(0.1);
+                if k > 1 {
+                    let errkm1 = wnorm_sum(&w.dif, k - 1, &w.difkp1, &w.invwt) * erconst[k - 2];
+                    let hkm1 = absh * (0.769 * (rtol / errkm1).powf(1.0 / k as f64)).max(0.1);
+                    if hkm1 > hopt {
+                        hopt = hkm1.min(absh); // no step increase after a failure
+                        k -= 1;
+                    }
+                }
+                absh = hmin.max(hopt);
+            } else {
+                absh = hmin.max(0.5 * absh);
+            }
+            if absh < abshlast {
+                done = false;
+            }
+            rescale(&mut w.dif, k, absh / abshlast);
+            hinvgak = absh * inv_ga[k - 1];
+            nconhk = 0;
+            lu_ok = w.lu.factor(hinvgak, &w.jac, &mut cs.stats);
+            havrate = false;
+        };
+        cs.stats.steps += 1;
+
+        // Update the differences to those of ynew: ∇^{k+2}, ∇^{k+1} = difkp1, then ∇^j += ∇^{j+1}.
+        {
+            let d = w.dif.as_mut_slice();
+            for i in 0..n {
+                let dk1 = w.difkp1[i];
+                d[i + (k + 1) * n] = dk1 - d[i + k * n];
+                d[i + k * n] = dk1;
+                for j in (0..k).rev() {
+                    d[i + j * n] += d[i + (j + 1) * n];
+                }
+            }
+        }
+
+        let (ynew, dif) = (&w.ynew, &w.dif);
+        deliver(t_out, next, tnew, &mut w.out, output, |tq, buf| {
+            interpolate(tq, tnew, h, ynew, dif, k, buf)
+        });
+        t = tnew;
+        w.y.copy_from(&w.ynew);
+        if done {
+            break;
+        }
+
+        // Step size and order for the next step.
+        klast = k;
+        abshlast = absh;
+        nconhk = (nconhk + 1).min(cfg.maxk + 2);
+        if nconhk >= k + 2 {
+            let ratio = |e: f64, safety: f64, p: usize| {
+                let temp = safety * (e / rtol).powf(1.0 / p as f64);
+                if temp > 0.1 {
+                    1.0 / temp
+                } else {
+                    10.0
+                }
+            };
+            let mut hopt = absh * ratio(err, 1.2, k + 1);
+            let mut kopt = k;
+            if k > 1 {
+                let errkm1 = wnorm_col(&w.dif, k - 1, &w.invwt) * erconst[k - 2];
+                let hkm1 = absh * ratio(errkm1, 1.3, k);
+                if hkm1 > hopt {
+                    hopt = hkm1;
+                    kopt = k - 1;
+                }
+            }
+            if k < cfg.maxk {
+                let errkp1 = wnorm_col(&w.dif, k + 1, &w.invwt) * erconst[k];
+                let hkp1 = absh * ratio(errkp1, 1.4, k + 2);
+                if hkp1 > hopt {
+                    hopt = hkp1;
+                    kopt = k + 1;
+                }
+            }
+            if hopt > absh {
+                absh = hopt;
+                k = kopt;
+            }
+        }
+        jcurrent = false;
+    }
+    Ok(())
+}

@@ -1,0 +1,267 @@
+//! Tests of the fixed-step BDF2 integrator.
+
+use super::tests::{forced_exact, forced_rhs, linspace, stiff_exact, stiff_matrix, sys, Samples};
+use super::*;
+use nalgebra::DVector;
+
+fn fixed<S: OdeSystem>(
+    s: &mut S,
+    y0: &[f64],
+    t_out: &[f64],
+    bps: &[f64],
+    o: &FixedStepOptions,
+) -> (Samples, Result<OdeStats, OdeError>) {
+    let mut out = Vec::new();
+    let r = integrate_fixed(
+        s,
+        0.0,
+        &DVector::from_column_slice(y0),
+        t_out,
+        bps,
+        o,
+        &mut |t, y| out.push((t, y.clone())),
+    );
+    (out, r)
+}
+
+fn opts(h: f64) -> FixedStepOptions {
+    FixedStepOptions {
+        h,
+        newton_tol: 1e-12,
+        max_newton: 8,
+    }
+}
+
+/// Max error on `y' = −y + sin t` over `[0, 5]`, sampled off the step grid.
+fn forced_fixed_error(h: f64) -> f64 {
+    let mut s = sys(1, forced_rhs);
+    let t_out: Vec<f64> = linspace(0.0, 5.0, 51).iter().map(|t| t * 0.999).collect();
+    let (out, r) = fixed(&mut s, &[1.0], &t_out, &[], &opts(h));
+    r.unwrap();
+    assert_eq!(out.len(), t_out.len());
+    out.iter()
+        .map(|(t, y)| (y[0] - forced_exact(*t, 1.0)).abs())
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn fixed_step_is_second_order() {
+    let e: Vec<f64> = [0.04, 0.02, 0.01, 0.005]
+        .iter()
+        .map(|&h| forced_fixed_error(h))
+        .collect();
+    println!("fixed-step errors for h = 0.04 .. 0.005: {e:?}");
+    for i in 1..e.len() {
+        let ratio = e[i - 1] / e[i];
+        assert!(
+            (3.4..=4.6).contains(&ratio),
+            "halving h reduced the error by {ratio} (expected ~4)"
+        );
+    }
+    assert!(e[3] < 1e-4);
+}
+
+#[test]
+fn fixed_step_is_stable_on_the_stiff_linear_system_with_large_steps() {
+    let a = stiff_matrix();
+    let mut s = sys(2, move |_t, y: &DVector<f64>, dy: &mut DVector<f64>| {
+        dy.gemv(1.0, &a, y, 0.0)
+    });
+    let y0 = DVector::from_vec(vec![1.0, 1.0]);
+    let t_out = linspace(0.0, 10.0, 101);
+    let o = opts(0.01); // 100 × the fast time constant
+    let (out, r) = fixed(&mut s, y0.as_slice(), &t_out, &[], &o);
+    let st = r.unwrap();
+    println!("fixed step on the stiff system: {st:?}");
+    for (t, y) in out.iter().skip(1) {
+        let ex = stiff_exact(*t, &y0);
+        assert!(
+            (y - &ex).amax() < 1e-3 * (-t).exp().max(1e-3),
+            "t = {t}: {y} vs {ex}"
+        );
+    }
+    assert_eq!(st.steps, 1000);
+    // Linear problem: one Jacobian, a few factorizations, ~1 Newton iteration per step.
+    assert_eq!(st.jacobian_evals, 1);
+    assert!(st.lu_decompositions <= 3, "{st:?}");
+    assert!(st.newton_iterations < 2 * st.steps + 10, "{st:?}");
+}
+
+#[test]
+fn fixed_step_hits_breakpoints_exactly() {
+    let u = |t: f64| {
+        if t < 1.0 {
+            1.0
+        } else if t < 2.0 {
+            -2.0
+        } else {
+            0.5
+        }
+    };
+    let exact = |t: f64| {
+        if t < 1.0 {
+            t
+        } else if t < 2.0 {
+            1.0 - 2.0 * (t - 1.0)
+        } else {
+            -1.0 + 0.5 * (t - 2.0)
+        }
+    };
+    let mut s = sys(1, move |t, _y: &DVector<f64>, dy: &mut DVector<f64>| {
+        dy[0] = u(t)
+    });
+    let t_out = linspace(0.0, 3.0, 31);
+    // h = 0.3 does not divide the breakpoints: they are hit by shortened steps.
+    let (out, r) = fixed(&mut s, &[0.0], &t_out, &[1.0, 2.0], &opts(0.3));
+    r.unwrap();
+    for (t, y) in &out {
+        assert!(
+            (y[0] - exact(*t)).abs() < 1e-10,
+            "t = {t}: {} vs {}",
+            y[0],
+            exact(*t)
+        );
+    }
+    for b in [1.0f64, 2.0] {
+        assert!(s.calls.contains(&next_down(b)), "no step ended at {b}");
+        assert!(!s.calls.contains(&b));
+    }
+}
+
+#[test]
+fn fixed_step_nonlinear_problem_reuses_the_jacobian() {
+    // Van der Pol, mu = 10 (moderately stiff): compare with a tight NDF run.
+    let f = |_t: f64, y: &DVector<f64>, dy: &mut DVector<f64>| {
+        dy[0] = y[1];
+        dy[1] = 10.0 * (1.0 - y[0] * y[0]) * y[1] - y[0];
+    };
+    let t_out = linspace(0.0, 10.0, 11);
+    let mut s = sys(2, f);
+    let (out, r) = fixed(
+        &mut s,
+        &[2.0, 0.0],
+        &t_out,
+        &[],
+        &FixedStepOptions {
+            h: 1e-3,
+            ..Default::default()
+        },
+    );
+    let st = r.unwrap();
+    println!("fixed step, Van der Pol mu = 10: {st:?}");
+    let mut s = sys(2, f);
+    let mut reference = Vec::new();
+    let o = NdfOptions {
+        rtol: 1e-10,
+        atol: 1e-12,
+        ..Default::default()
+    };
+    integrate_ndf(
+        &mut s,
+        0.0,
+        &DVector::from_vec(vec![2.0, 0.0]),
+        &t_out,
+        &[],
+        &o,
+        &mut |_, y| reference.push(y.clone()),
+    )
+    .unwrap();
+    let err = out
+        .iter()
+        .zip(&reference)
+        .map(|((_, y), yr)| (y[0] - yr[0]).abs())
+        .fold(0.0, f64::max);
+    println!("max error vs. reference: {err:e}");
+    assert!(err < 1e-3, "max error {err:e}");
+    assert_eq!(st.steps, 10_000);
+    assert!(st.jacobian_evals * 20 < st.steps, "{st:?}");
+}
+
+#[test]
+fn fixed_step_failures_and_bad_options() {
+    let mut s = sys(1, |t, y: &DVector<f64>, dy: &mut DVector<f64>| {
+        dy[0] = if t > 0.5 { f64::NAN } else { -y[0] }
+    });
+    let t_out = linspace(0.0, 1.0, 11);
+    let (out, r) = fixed(&mut s, &[1.0], &t_out, &[], &opts(0.01));
+    let e = r.unwrap_err();
+    assert!(matches!(e, OdeError::NonFinite { .. }), "{e}");
+    let tr = e.t_reached().unwrap();
+    assert!((tr - 0.5).abs() < 0.011 && tr <= 0.5, "t_reached = {tr}");
+    assert_eq!(out.len(), 6);
+    assert!(out.iter().all(|(t, y)| (y[0] - (-t).exp()).abs() < 1e-3));
+
+    let mut s = sys(1, forced_rhs);
+    let y0 = DVector::from_vec(vec![1.0]);
+    let mut run = |o: &FixedStepOptions, y0: &DVector<f64>, t_out: &[f64]| {
+        integrate_fixed(&mut s, 0.0, y0, t_out, &[], o, &mut |_, _| {}).unwrap_err()
+    };
+    let good = FixedStepOptions::default();
+    for (field, e) in [
+        (
+            "h",
+            run(
+                &FixedStepOptions {
+                    h: 0.0,
+                    ..good.clone()
+                },
+                &y0,
+                &[1.0],
+            ),
+        ),
+        (
+            "h",
+            run(
+                &FixedStepOptions {
+                    h: f64::NAN,
+                    ..good.clone()
+                },
+                &y0,
+                &[1.0],
+            ),
+        ),
+        (
+            "h",
+            run(
+                &FixedStepOptions {
+                    h: 1e-300,
+                    ..good.clone()
+                },
+                &y0,
+                &[1.0],
+            ),
+        ),
+        (
+            "newton_tol",
+            run(
+                &FixedStepOptions {
+                    newton_tol: -1.0,
+                    ..good.clone()
+                },
+                &y0,
+                &[1.0],
+            ),
+        ),
+        (
+            "max_newton",
+            run(
+                &FixedStepOptions {
+                    max_newton: 0,
+                    ..good.clone()
+                },
+                &y0,
+                &[1.0],
+            ),
+        ),
+        ("t_out", run(&good, &y0, &[1.0, 0.0])),
+        (
+            "y0",
+            run(&good, &DVector::from_vec(vec![f64::INFINITY]), &[1.0]),
+        ),
+    ] {
+        assert!(
+            matches!(&e, OdeError::Invalid { field: f, .. } if *f == field),
+            "expected Invalid({field}), got {e}"
+        );
+    }
+}
