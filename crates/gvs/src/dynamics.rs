@@ -171,6 +171,36 @@ impl<P: StrainParam> Model<P> {
         Ok(())
     }
 
+    /// Inverse dynamics `ID(q, q̇, q̈) = Σ_i J_iᵀ w_i` with `w_i = W_i (Ms η̇_i + coad_{η_i} Ms η_i) − w_i^ext`,
+    /// `η̇_i = J_i q̈ + J̇_i q̇` (spec §7.8); satisfies `ID = M q̈ + C q̇ − F`.
+    pub fn inverse_dynamics(
+        &self,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        qdd: &DVector<f64>,
+        loads: &PreparedLoads,
+        ws: &mut Workspace,
+    ) -> DVector<f64> {
+        let n = self.n_dof();
+        self.forward(q, ws, true);
+        self.velocities(q, qd, ws);
+        self.point_wrenches(loads, ws);
+        let mut id = DVector::zeros(n);
+        for (i, p) in self.disc.points.iter().enumerate() {
+            let j = ws.jac.columns(i * n, n);
+            let mut w = -ws.w[i];
+            if p.weight > 0.0 {
+                let ms = self.props[i].ms;
+                let eta_dot: V6 = j * qdd + ws.zeta[i];
+                w += (ms.component_mul(&eta_dot)
+                    + coad_mul(&ws.eta[i], &ms.component_mul(&ws.eta[i])))
+                    * p.weight;
+            }
+            id.gemv_tr(1.0, &j, &w, 1.0);
+        }
+        id
+    }
+
     /// Damping matrix `D = Σ W Ψ_qᵀ Ds Ψ_q` (spec §7.4; constant for linear bases) after a forward pass.
     pub fn damping_matrix(&self, ws: &Workspace) -> DMatrix<f64> {
         let n = self.n_dof();

@@ -64,14 +64,18 @@ enum Newton {
 /// * Newton: at most `max_newton` iterations with the iteration matrix `I − βJ` (`β = 2h/3` at the
 ///   nominal step), factored only when `β` changes; converged when `ρ/(1−ρ)‖Δ‖ ≤ newton_tol`
 ///   (`‖Δ‖ ≤ newton_tol` before a rate `ρ` is known) in the norm `max_i |Δ_i|/max(1, |y_i|)`. The
+///   rate measured in one step is carried to the next, so a step can end after one iteration; it is
+///   inflated (`ρ ← ρ^0.8`) at every step, which forces a re-measuring second iteration every few
+///   steps. The
 ///   Jacobian (analytic, or forward differences with increment `√eps·max(|y_j|, 1)`) is evaluated
 ///   at the start and re-evaluated, at most once per step, only when Newton stalls (`ρ > 0.9` or no
 ///   convergence within `max_newton`); if it still fails, the step is split in halves (up to 10
 ///   times) before giving up with [`OdeError::NewtonFailure`] (or [`OdeError::NonFinite`] when the
 ///   failure is a NaN/∞ right-hand side).
 /// * Output: same contract as [`super::integrate_ndf`]; values between steps come from the
-///   quadratic through `y_{n−1}, y_n, y_{n+1}` (the linear interpolant on backward Euler steps),
-///   which is second-order accurate and does not overshoot on stiff transients.
+///   quadratic through `y_{n−1}, y_n, y_{n+1}` (the linear interpolant on backward Euler steps):
+///   second-order accurate, and built from values only (no derivatives), so a stiff transient
+///   cannot make it overshoot by more than a fraction of the step's values.
 pub fn integrate_fixed<S: OdeSystem>(
     sys: &mut S,
     t0: f64,

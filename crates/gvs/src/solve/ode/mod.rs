@@ -79,6 +79,14 @@
 //! left ringing as with the trapezoidal rule), one implicit solve per step. It is started, and
 //! restarted after every breakpoint, by one backward Euler step. See [`integrate_fixed`].
 //!
+//! # Failures
+//!
+//! A NaN or infinity from `f` (or in a Newton iterate) during a step is treated as a failed attempt
+//! and the step is retried shorter (`0.3 h`); [`OdeError::NonFinite`] is returned only when that
+//! is no longer possible (minimum step), so a solution that blows up or leaves the domain of `f`
+//! stops with the time it reached, never silently. An [`RhsError`] stops the integration at once.
+//! In every case the outputs before the time reached have been delivered.
+//!
 //! # Allocation
 //!
 //! All buffers (state vectors, difference table, Jacobian, LU factors) are allocated once per call;
@@ -90,6 +98,8 @@ mod fixed;
 mod ndf;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_errors;
 #[cfg(test)]
 mod tests_fixed;
 
@@ -165,8 +175,9 @@ pub struct FixedStepOptions {
     /// Nominal step (default `1e-3`).
     pub h: f64,
     /// Newton tolerance (default `1e-8`): the iteration stops when the estimated remaining error of
-    /// the iterate, `ρ/(1−ρ)·‖Δ‖`, is at most `newton_tol` in the norm `max_i |Δ_i| / max(1, |y_i|)`
-    /// (absolute for components below 1, relative above).
+    /// the iterate, `ρ/(1−ρ)·‖Δ‖` with the contraction rate `ρ` (or `‖Δ‖` itself while no rate is
+    /// known), is at most `newton_tol` in the norm `max_i |Δ_i| / max(1, |y_i|)` (absolute for
+    /// components below 1, relative above).
     pub newton_tol: f64,
     /// Maximum Newton iterations per attempt (default 5, at least 1; with 1, an attempt is
     /// accepted only if its first correction already meets `newton_tol`).
