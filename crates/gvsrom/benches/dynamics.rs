@@ -1,0 +1,59 @@
+//! Dynamics speed (issue 3): the six-tendon preset (28 DOF), 10 s of the paper's random step actuation
+//! (new tensions uniform in [−15, 0] N every 1 s, seed 1), ode15s-class NDF at rtol 1e-3 / atol 1e-6,
+//! single thread. The paper's MATLAB took 114.3 s; the target is ≥ 100× faster (≤ 1.2 s).
+//!
+//! Run with `cargo bench -p gvsrom --bench dynamics`.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use gvs::solve::dynamics::{IntegratorOptions, Method, OdeJacobian};
+use gvs::solve::ode::NdfOptions;
+use gvsrom::simulate::{run, InputSource, SimulateOptions};
+use std::hint::black_box;
+
+fn options(jacobian: OdeJacobian) -> SimulateOptions {
+    SimulateOptions {
+        duration: 10.0,
+        sample_rate: 100.0,
+        input: InputSource::Steps {
+            lo: -15.0,
+            hi: 0.0,
+            period: 1.0,
+            seed: 1,
+        },
+        start_at_equilibrium: false,
+        integrator: IntegratorOptions {
+            method: Method::Ndf(NdfOptions {
+                rtol: 1e-3,
+                atol: 1e-6,
+                ..NdfOptions::default()
+            }),
+            jacobian,
+        },
+    }
+}
+
+fn dynamics(c: &mut Criterion) {
+    let built = gvsrom::build(&gvsrom::presets::load("six-tendon", &[]).unwrap()).unwrap();
+    for (label, jac) in [
+        (
+            "dynamics/six-tendon 10s random steps (structured Jacobian)",
+            OdeJacobian::Structured,
+        ),
+        (
+            "dynamics/six-tendon 10s random steps (finite-difference Jacobian)",
+            OdeJacobian::FiniteDifference,
+        ),
+    ] {
+        let opts = options(jac);
+        c.bench_function(label, |b| {
+            b.iter(|| black_box(run(&built, &opts, &mut |_| {}).unwrap()))
+        });
+    }
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(10);
+    targets = dynamics
+}
+criterion_main!(benches);

@@ -1,0 +1,265 @@
+//! `gvsrom simulate` end to end: bad durations, sample rates and input files give one-line errors
+//! naming the option or file line, exit code 1 and no panic; a failing integration reports the time it
+//! reached and still writes the samples before it; a good run writes NumPy arrays of the right shapes.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn gvsrom(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_gvsrom"))
+        .args(args)
+        .output()
+        .expect("the gvsrom binary runs")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("gvsrom-simulate-tests");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+fn expect_error(args: &[&str], needles: &[&str]) -> String {
+    let out = gvsrom(args);
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "gvsrom {args:?}: exit {:?}; stderr: {stderr}",
+        out.status.code()
+    );
+    assert!(
+        !stderr.contains("panicked") && !stderr.contains("internal error"),
+        "{stderr}"
+    );
+    assert_eq!(
+        stderr.trim_end().lines().count(),
+        1,
+        "one-line error expected: {stderr}"
+    );
+    for n in needles {
+        assert!(
+            stderr.contains(n),
+            "gvsrom {args:?}: error lacks `{n}`: {stderr}"
+        );
+    }
+    stderr
+}
+
+/// Shape of a `.npy` file from its header.
+fn npy_shape(path: &Path) -> Vec<usize> {
+    let bytes = std::fs::read(path).unwrap();
+    assert_eq!(&bytes[..6], b"\x93NUMPY");
+    let hl = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    let header = std::str::from_utf8(&bytes[10..10 + hl]).unwrap();
+    let inside = header
+        .split("'shape': (")
+        .nth(1)
+        .unwrap()
+        .split(')')
+        .next()
+        .unwrap();
+    inside
+        .split(',')
+        .filter(|s| !s.trim().is_empty())
+        .map(|s| s.trim().parse().unwrap())
+        .collect()
+}
+
+fn npy_values(path: &Path) -> Vec<f64> {
+    let bytes = std::fs::read(path).unwrap();
+    let hl = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    bytes[10 + hl..]
+        .chunks(8)
+        .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+        .collect()
+}
+
+#[test]
+fn negative_duration_and_sample_rate_are_rejected() {
+    expect_error(
+        &["simulate", "six-tendon", "--duration", "-1"],
+        &["--duration", "-1", "> 0"],
+    );
+    expect_error(
+        &[
+            "simulate",
+            "six-tendon",
+            "--duration",
+            "1",
+            "--sample-rate",
+            "0",
+        ],
+        &["--sample-rate", "> 0"],
+    );
+    expect_error(
+        &["simulate", "six-tendon", "--duration", "nan"],
+        &["--duration", "NaN"],
+    );
+}
+
+#[test]
+fn input_file_with_missing_columns_or_nan_is_rejected_with_its_line() {
+    let f = scratch("missing.csv");
+    std::fs::write(&f, "t,u0\n0,-1\n0.5,-2,3\n").unwrap();
+    expect_error(
+        &[
+            "simulate",
+            "single-tendon",
+            "--duration",
+            "1",
+            "--input",
+            f.to_str().unwrap(),
+        ],
+        &["missing.csv:3", "3 columns, expected 2"],
+    );
+    let f = scratch("nan.csv");
+    std::fs::write(&f, "0,-1\n0.5,nan\n").unwrap();
+    expect_error(
+        &[
+            "simulate",
+            "single-tendon",
+            "--duration",
+            "1",
+            "--input",
+            f.to_str().unwrap(),
+        ],
+        &["nan.csv:2 column 2", "finite"],
+    );
+    let f = scratch("order.csv");
+    std::fs::write(&f, "0,-1\n0.5,-2\n0.2,-3\n").unwrap();
+    expect_error(
+        &[
+            "simulate",
+            "single-tendon",
+            "--duration",
+            "1",
+            "--input",
+            f.to_str().unwrap(),
+        ],
+        &["times[2]", "ascending"],
+    );
+    expect_error(
+        &[
+            "simulate",
+            "single-tendon",
+            "--duration",
+            "1",
+            "--input",
+            "/nonexistent/in.csv",
+        ],
+        &["cannot read the input file"],
+    );
+}
+
+#[test]
+fn actuator_count_mismatch_is_rejected() {
+    let f = scratch("two.csv");
+    std::fs::write(&f, "0,-1,-2\n").unwrap();
+    expect_error(
+        &[
+            "simulate",
+            "six-tendon",
+            "--duration",
+            "1",
+            "--input",
+            f.to_str().unwrap(),
+        ],
+        &["two.csv:1", "3 columns, expected 7"],
+    );
+    expect_error(
+        &["simulate", "six-tendon", "--duration", "1", "--steps=-15,0"],
+        &["--steps", "3 comma-separated values"],
+    );
+}
+
+#[test]
+fn failed_integration_reports_time_reached_and_keeps_samples() {
+    // a tension jump to −1e6 N at t = 0.5 s is far beyond what a 50 ms implicit step can follow
+    let f = scratch("jump.csv");
+    std::fs::write(&f, "t,u\n0,0\n0.5,-1e6\n").unwrap();
+    let out_dir = scratch("failed-run");
+    let msg = expect_error(
+        &[
+            "simulate",
+            "single-tendon",
+            "--duration",
+            "2",
+            "--input",
+            f.to_str().unwrap(),
+            "--fixed-step",
+            "0.05",
+            "--out",
+            out_dir.to_str().unwrap(),
+        ],
+        &[
+            "integration stopped at t = 0.5",
+            "samples before it were written",
+        ],
+    );
+    let t = npy_values(&out_dir.join("t.npy"));
+    assert!(
+        !t.is_empty() && *t.last().unwrap() <= 0.5 + 1e-12,
+        "{msg}: samples up to {:?}",
+        t.last()
+    );
+    assert_eq!(npy_shape(&out_dir.join("q.npy"))[0], t.len());
+    let meta = std::fs::read_to_string(out_dir.join("meta.json")).unwrap();
+    assert!(
+        meta.contains("\"error\": \"integration stopped at t = 0.5"),
+        "{meta}"
+    );
+}
+
+#[test]
+fn simulation_writes_numpy_arrays_with_consistent_shapes() {
+    let out_dir = scratch("babble-run");
+    let out = gvsrom(&[
+        "simulate",
+        "six-tendon",
+        "--duration",
+        "0.5",
+        "--babble=-15,0,0.1,0.2",
+        "--seed",
+        "4",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("real-time factor"), "{stdout}");
+    assert_eq!(npy_shape(&out_dir.join("t.npy")), vec![51]);
+    assert_eq!(npy_shape(&out_dir.join("q.npy")), vec![51, 28]);
+    assert_eq!(npy_shape(&out_dir.join("qd.npy")), vec![51, 28]);
+    assert_eq!(npy_shape(&out_dir.join("u.npy")), vec![51, 6]);
+    assert_eq!(npy_shape(&out_dir.join("tip_position.npy")), vec![51, 3]);
+    assert_eq!(npy_shape(&out_dir.join("tip_rotation.npy")), vec![51, 3, 3]);
+    assert_eq!(npy_shape(&out_dir.join("strain.npy")), vec![51, 14, 6]);
+    assert_eq!(npy_shape(&out_dir.join("strain_x.npy")), vec![14]);
+    // babbled tensions stay in range and the same seed gives the same signal
+    let u = npy_values(&out_dir.join("u.npy"));
+    assert!(u.iter().all(|v| (-15.0..0.0).contains(v)));
+    let again = scratch("babble-run-again");
+    assert!(gvsrom(&[
+        "simulate",
+        "six-tendon",
+        "--duration",
+        "0.5",
+        "--babble=-15,0,0.1,0.2",
+        "--seed",
+        "4",
+        "--out",
+        again.to_str().unwrap()
+    ])
+    .status
+    .success());
+    assert_eq!(npy_values(&again.join("u.npy")), u);
+    assert_eq!(
+        npy_values(&again.join("q.npy")),
+        npy_values(&out_dir.join("q.npy"))
+    );
+    assert!(!out_dir.with_extension("partial").exists());
+}
