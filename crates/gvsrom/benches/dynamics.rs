@@ -29,6 +29,7 @@ fn options(jacobian: OdeJacobian) -> SimulateOptions {
             }),
             jacobian,
         },
+        load_schedule: None,
     }
 }
 

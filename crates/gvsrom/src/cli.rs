@@ -143,6 +143,11 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "H")]
     pub fixed_step: Option<f64>,
 
+    /// Time-varying external loads: a CSV file with columns `t, λ` that scales every external load and
+    /// gravity, linearly interpolated between rows (e.g. a load applied then removed).
+    #[arg(long, value_name = "FILE")]
+    pub load_schedule: Option<PathBuf>,
+
     /// Use finite differences of the right-hand side for the integrator's Jacobian instead of the
     /// structured analytic one.
     #[arg(long)]
@@ -285,6 +290,7 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
                 OdeJacobian::Structured
             },
         },
+        load_schedule: args.load_schedule.clone(),
     };
     let tty = std::io::stderr().is_terminal();
     let mut last_pct = usize::MAX;

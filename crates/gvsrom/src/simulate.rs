@@ -65,6 +65,8 @@ pub struct SimulateOptions {
     /// input signal at t = 0) instead of straight at rest.
     pub start_at_equilibrium: bool,
     pub integrator: IntegratorOptions,
+    /// A CSV file `t, λ` scaling all external loads and gravity over time (linear between rows).
+    pub load_schedule: Option<PathBuf>,
 }
 
 fn positive(field: &str, v: f64, unit: &str) -> Result<f64, ScenarioError> {
@@ -233,11 +235,15 @@ pub fn run(
     } else {
         InitialState::Rest
     };
+    let schedule = match &opts.load_schedule {
+        Some(path) => Some(read_input_csv(path, 1, Interpolation::Linear)?),
+        None => None,
+    };
     let sim = simulate_with_progress(
         &built.model,
         &signal,
         &built.loads,
-        None,
+        schedule.as_ref(),
         &initial,
         &t_out,
         &opts.integrator,

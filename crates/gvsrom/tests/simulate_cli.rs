@@ -263,3 +263,53 @@ fn simulation_writes_numpy_arrays_with_consistent_shapes() {
     );
     assert!(!out_dir.with_extension("partial").exists());
 }
+
+#[test]
+fn load_schedule_scales_loads_over_time() {
+    // gravity on the single-tendon arm ramps from 0 to full over 0.2 s
+    let f = scratch("schedule.csv");
+    std::fs::write(&f, "t,lambda\n0,0\n0.2,1\n").unwrap();
+    let out_dir = scratch("schedule-run");
+    let out = gvsrom(&[
+        "simulate",
+        "single-tendon",
+        "--duration",
+        "0.3",
+        "--tension=0",
+        "--load-schedule",
+        f.to_str().unwrap(),
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // gravity is scaled by λ(0) = 0: the arm starts straight and has not moved at t = 0.01 s much
+    let tip = npy_values(&out_dir.join("tip_position.npy"));
+    assert!(
+        tip[2].abs() < 1e-12 && tip[5].abs() < 1e-4,
+        "tip z at 0 and 0.01 s: {} {}",
+        tip[2],
+        tip[5]
+    );
+    assert!(
+        tip[3 * 30 + 2] < -0.05,
+        "gravity acts by t = 0.3 s: z = {}",
+        tip[3 * 30 + 2]
+    );
+    let bad = scratch("schedule-bad.csv");
+    std::fs::write(&bad, "0,1,2\n").unwrap();
+    expect_error(
+        &[
+            "simulate",
+            "single-tendon",
+            "--duration",
+            "0.3",
+            "--load-schedule",
+            bad.to_str().unwrap(),
+        ],
+        &["schedule-bad.csv:1", "3 columns, expected 2"],
+    );
+}
