@@ -36,6 +36,15 @@ pub struct Energy {
     pub gravitational: f64,
 }
 
+/// A linearized vibration mode.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mode {
+    /// Natural frequency [Hz].
+    pub frequency_hz: f64,
+    /// Mode shape in `q`, mass-normalized.
+    pub shape: DVector<f64>,
+}
+
 impl Energy {
     pub fn total(&self) -> f64 {
         self.kinetic + self.elastic + self.gravitational
@@ -199,6 +208,43 @@ impl<P: StrainParam> Model<P> {
             id.gemv_tr(1.0, &j, &w, 1.0);
         }
         id
+    }
+
+    /// Linearized undamped vibration modes about `q0` (spec §10.5): `(K_T − ω² M) φ = 0` with the
+    /// tangent stiffness `K_T = −∂R/∂q` (elastic plus load stiffness; symmetrized, since follower
+    /// loads and tendons make it slightly non-symmetric). Returned in ascending frequency, shapes
+    /// mass-normalized (`φᵀ M φ = 1`).
+    pub fn linearized_modes(
+        &self,
+        q0: &DVector<f64>,
+        u: &[f64],
+        loads: &PreparedLoads,
+        ws: &mut Workspace,
+    ) -> Result<Vec<Mode>, DynamicsError> {
+        let n = self.n_dof();
+        let mut kt = DMatrix::zeros(n, n);
+        self.statics_jacobian(q0, u, loads, ws, &mut kt);
+        let kt = (&kt + kt.transpose()) * -0.5;
+        self.assemble_mass(ws);
+        let mut l = ws.mass.clone();
+        cholesky_factor_in_place(&mut l)?;
+        let l = l.lower_triangle();
+        let linv = l.try_inverse().ok_or(DynamicsError::NonFinite {
+            what: "mass factor",
+        })?;
+        let a = &linv * kt * linv.transpose();
+        let eig = nalgebra::SymmetricEigen::new((&a + a.transpose()) * 0.5);
+        let mut modes: Vec<Mode> = eig
+            .eigenvalues
+            .iter()
+            .zip(eig.eigenvectors.column_iter())
+            .map(|(w2, v)| Mode {
+                frequency_hz: w2.max(0.0).sqrt() / (2.0 * std::f64::consts::PI),
+                shape: linv.transpose() * v,
+            })
+            .collect();
+        modes.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
+        Ok(modes)
     }
 
     /// Damping matrix `D = Σ W Ψ_qᵀ Ds Ψ_q` (spec §7.4; constant for linear bases) after a forward pass.

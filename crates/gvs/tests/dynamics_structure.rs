@@ -8,7 +8,7 @@ use gvs::loads::Loads;
 use gvs::model::Model;
 use gvs::rod::{Material, Rod, SectionProps};
 use gvs::strain::{DivisionBasis, LinearBasis, SigmoidBend, StrainParam};
-use nalgebra::{DMatrix, DVector, SymmetricEigen};
+use nalgebra::{DVector, SymmetricEigen};
 use std::f64::consts::PI;
 
 fn pseudo_random(n: usize, seed: u64, a: f64) -> DVector<f64> {
@@ -189,21 +189,12 @@ fn velocity_and_jdot_recursions_match_finite_differences() {
 
 /// Natural frequencies [Hz] from det(K − ω² M) = 0 at q = 0.
 fn frequencies(m: &Model<LinearBasis>) -> Vec<f64> {
-    let n = m.n_dof();
+    let loads = m.prepare_loads(&Loads::default()).unwrap();
     let mut ws = m.workspace();
-    let mass = m.mass_matrix(&DVector::zeros(n), &mut ws);
-    let k = m.stiffness().unwrap().clone();
-    let l = mass.cholesky().unwrap().l();
-    let linv = l.clone().try_inverse().unwrap();
-    let a: DMatrix<f64> = &linv * k * linv.transpose();
-    let a = (&a + a.transpose()) * 0.5;
-    let mut f: Vec<f64> = SymmetricEigen::new(a)
-        .eigenvalues
-        .iter()
-        .map(|w2| w2.sqrt() / (2.0 * PI))
-        .collect();
-    f.sort_by(|a, b| a.partial_cmp(b).unwrap());
-    f
+    let modes = m
+        .linearized_modes(&DVector::zeros(m.n_dof()), &[], &loads, &mut ws)
+        .unwrap();
+    modes.iter().map(|md| md.frequency_hz).collect()
 }
 
 #[test]

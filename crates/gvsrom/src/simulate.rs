@@ -76,7 +76,7 @@ fn positive(field: &str, v: f64, unit: &str) -> Result<f64, ScenarioError> {
         Err(ScenarioError::value(
             field,
             v,
-            &format!("a finite number > 0 {unit}"),
+            format!("a finite number > 0 {unit}"),
         ))
     }
 }
@@ -90,7 +90,7 @@ pub fn read_input_csv(
 ) -> Result<Signal, ScenarioError> {
     let field = path.display().to_string();
     let text = std::fs::read_to_string(path)
-        .map_err(|e| ScenarioError::invalid(&field, &format!("cannot read the input file: {e}")))?;
+        .map_err(|e| ScenarioError::invalid(&field, format!("cannot read the input file: {e}")))?;
     let mut times = vec![];
     let mut values = vec![];
     for (ln, line) in text.lines().enumerate() {
@@ -106,7 +106,7 @@ pub fn read_input_csv(
         if cells.len() != n_actuators + 1 {
             return Err(ScenarioError::invalid(
                 &where_,
-                &format!(
+                format!(
                     "{} columns, expected {} (t and one tension per actuator)",
                     cells.len(),
                     n_actuators + 1
@@ -117,13 +117,13 @@ pub fn read_input_csv(
         for (c, cell) in cells.iter().enumerate() {
             let v: f64 = cell.parse().map_err(|_| {
                 ScenarioError::invalid(
-                    &format!("{where_} column {}", c + 1),
-                    &format!("`{cell}` is not a number"),
+                    format!("{where_} column {}", c + 1),
+                    format!("`{cell}` is not a number"),
                 )
             })?;
             if !v.is_finite() {
                 return Err(ScenarioError::value(
-                    &format!("{where_} column {}", c + 1),
+                    format!("{where_} column {}", c + 1),
                     v,
                     "a finite number",
                 ));
@@ -188,7 +188,7 @@ pub fn input_signal(built: &Built, opts: &SimulateOptions) -> Result<Signal, Sce
                 return Err(ScenarioError::value(
                     "--babble hold_max",
                     *hold_max,
-                    &format!("a number >= hold_min = {hold_min} s"),
+                    format!("a number >= hold_min = {hold_min} s"),
                 ));
             }
             babble(na, *lo, *hi, *hold_min, *hold_max, d, *seed)
@@ -202,7 +202,7 @@ fn range_check(field: &str, lo: f64, hi: f64) -> Result<(), ScenarioError> {
     } else {
         Err(ScenarioError::invalid(
             field,
-            &format!("range [{lo}, {hi}] must be finite with lo <= hi"),
+            format!("range [{lo}, {hi}] must be finite with lo <= hi"),
         ))
     }
 }
@@ -251,9 +251,7 @@ pub fn run(
     )
     .map_err(|e| match e {
         SimulationError::Model(m) => ScenarioError::from(m),
-        SimulationError::Initial(s) => {
-            ScenarioError::invalid("initial equilibrium", &s.to_string())
-        }
+        SimulationError::Initial(s) => ScenarioError::invalid("initial equilibrium", s.to_string()),
     })?;
     Ok((sim, signal))
 }
