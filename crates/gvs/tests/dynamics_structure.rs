@@ -8,20 +8,11 @@ use gvs::loads::Loads;
 use gvs::model::Model;
 use gvs::rod::{Material, Rod, SectionProps};
 use gvs::strain::{DivisionBasis, LinearBasis, SigmoidBend, StrainParam};
+mod common;
+
+use common::pseudo_random;
 use nalgebra::{DVector, SymmetricEigen};
 use std::f64::consts::PI;
-
-fn pseudo_random(n: usize, seed: u64, a: f64) -> DVector<f64> {
-    let mut s = seed
-        .wrapping_mul(6364136223846793005)
-        .wrapping_add(1442695040888963407);
-    DVector::from_fn(n, |_, _| {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((s >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) * a
-    })
-}
 
 fn material(damping: f64) -> Material {
     Material {

@@ -10,6 +10,9 @@ use gvs::loads::{DistributedWrench, Frame, Loads, PointWrench, PulseMagnitude};
 use gvs::model::Model;
 use gvs::rod::{DivisionGeometry, Material, Rod};
 use gvs::strain::{DivisionBasis, LinearBasis, SigmoidBend, StrainParam};
+mod common;
+
+use common::pseudo_random;
 use nalgebra::{DMatrix, DVector};
 
 fn material() -> Material {
@@ -19,19 +22,6 @@ fn material() -> Material {
         density: 1121.0,
         damping: 1e4,
     }
-}
-
-/// Deterministic pseudo-random vector in [-a, a].
-fn pseudo_random(n: usize, seed: u64, a: f64) -> DVector<f64> {
-    let mut s = seed
-        .wrapping_mul(6364136223846793005)
-        .wrapping_add(1442695040888963407);
-    DVector::from_fn(n, |_, _| {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((s >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) * a
-    })
 }
 
 fn check_geometric_jacobian<P: StrainParam>(model: &Model<P>, q: &DVector<f64>) {

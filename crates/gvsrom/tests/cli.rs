@@ -1,52 +1,10 @@
 //! The `gvsrom` binary end to end: bad input gives a one-line error naming the field (and the
 //! accepted range), exit code 1 and no panic; good input prints a summary and writes the JSON.
 
+mod common;
+
+use common::{expect_error, gvsrom, scratch};
 use std::path::PathBuf;
-use std::process::{Command, Output};
-
-fn gvsrom(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_gvsrom"))
-        .args(args)
-        .output()
-        .expect("the gvsrom binary runs")
-}
-
-/// A scratch file path unique to one test.
-fn scratch(name: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("gvsrom-cli-tests");
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
-
-/// Runs `args`, expects a user error (exit code 1, one stderr line starting with `error:`, no
-/// panic) containing every string of `needles`; returns the message.
-fn expect_error(args: &[&str], needles: &[&str]) -> String {
-    let out = gvsrom(args);
-    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
-    assert_eq!(
-        out.status.code(),
-        Some(1),
-        "gvsrom {args:?}: expected exit code 1, got {:?}; stderr: {stderr}",
-        out.status.code()
-    );
-    assert!(
-        !stderr.contains("panicked") && !stderr.contains("internal error"),
-        "gvsrom {args:?} panicked: {stderr}"
-    );
-    assert_eq!(
-        stderr.trim_end().lines().count(),
-        1,
-        "gvsrom {args:?}: expected a one-line error, got: {stderr}"
-    );
-    assert!(stderr.starts_with("error: "), "{stderr}");
-    for n in needles {
-        assert!(
-            stderr.contains(n),
-            "gvsrom {args:?}: error lacks `{n}`: {stderr}"
-        );
-    }
-    stderr
-}
 
 #[test]
 fn negative_or_zero_length_is_rejected_with_field_and_range() {

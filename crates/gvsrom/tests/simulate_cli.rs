@@ -2,48 +2,10 @@
 //! naming the option or file line, exit code 1 and no panic; a failing integration reports the time it
 //! reached and still writes the samples before it; a good run writes NumPy arrays of the right shapes.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn gvsrom(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_gvsrom"))
-        .args(args)
-        .output()
-        .expect("the gvsrom binary runs")
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("gvsrom-simulate-tests");
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
-
-fn expect_error(args: &[&str], needles: &[&str]) -> String {
-    let out = gvsrom(args);
-    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
-    assert_eq!(
-        out.status.code(),
-        Some(1),
-        "gvsrom {args:?}: exit {:?}; stderr: {stderr}",
-        out.status.code()
-    );
-    assert!(
-        !stderr.contains("panicked") && !stderr.contains("internal error"),
-        "{stderr}"
-    );
-    assert_eq!(
-        stderr.trim_end().lines().count(),
-        1,
-        "one-line error expected: {stderr}"
-    );
-    for n in needles {
-        assert!(
-            stderr.contains(n),
-            "gvsrom {args:?}: error lacks `{n}`: {stderr}"
-        );
-    }
-    stderr
-}
+use common::{expect_error, gvsrom, scratch};
+use std::path::Path;
 
 /// Shape of a `.npy` file from its header.
 fn npy_shape(path: &Path) -> Vec<usize> {

@@ -1,0 +1,50 @@
+//! Helpers shared by the command-line tests: run the binary, scratch paths, and the check of a
+//! one-line user error.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+pub fn gvsrom(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_gvsrom"))
+        .args(args)
+        .output()
+        .expect("the gvsrom binary runs")
+}
+
+/// A scratch file path unique to one test (files of all tests share one folder).
+pub fn scratch(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("gvsrom-cli-tests");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+/// Runs `args`, expects a user error (exit code 1, one stderr line starting with `error:`, no
+/// panic) containing every string of `needles`; returns the message.
+pub fn expect_error(args: &[&str], needles: &[&str]) -> String {
+    let out = gvsrom(args);
+    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "gvsrom {args:?}: expected exit code 1, got {:?}; stderr: {stderr}",
+        out.status.code()
+    );
+    assert!(
+        !stderr.contains("panicked") && !stderr.contains("internal error"),
+        "gvsrom {args:?} panicked: {stderr}"
+    );
+    assert_eq!(
+        stderr.trim_end().lines().count(),
+        1,
+        "gvsrom {args:?}: expected a one-line error, got: {stderr}"
+    );
+    assert!(stderr.starts_with("error: "), "{stderr}");
+    for n in needles {
+        assert!(
+            stderr.contains(n),
+            "gvsrom {args:?}: error lacks `{n}`: {stderr}"
+        );
+    }
+    stderr
+}
