@@ -310,10 +310,7 @@ impl<P: StrainParam> Model<P> {
     ) -> DMatrix<f64> {
         let n = self.n_dof();
         self.forward(q, ws, true);
-        self.velocities(q, qd, ws);
-        if !self.param.is_linear() {
-            self.param.eval_rate(q, qd, &mut ws.ev);
-        }
+        self.velocities(q, qd, ws); // also fills Ψ̇_q for nonlinear parameterizations
         let np = self.disc.n_points();
         let mut jds = Matrix6xX::<f64>::zeros(n); // J̇ˢ_i
         let mut c = DMatrix::zeros(n, n);

@@ -3,6 +3,9 @@
 //! convergence of damped motion to the statics solution, and free-vibration periods against the
 //! linearized eigenproblem and beam theory.
 
+mod common;
+
+use common::clamped_rod_10_5;
 use gvs::actuation::Tendon;
 use gvs::discretize::{Discretization, MagnusOrder, Quadrature};
 use gvs::inputs::Signal;
@@ -253,25 +256,8 @@ fn fixed_step_method_tracks_the_adaptive_solution() {
 /// measured from the upward zero crossings of the modal coordinate.
 #[test]
 fn free_vibration_periods_match_eigenproblem_and_beam_theory() {
-    let (l, r, e, rho) = (0.5, 0.005, 1e6, 1000.0);
-    let mat = Material {
-        youngs_modulus: e,
-        poisson_ratio: 0.5,
-        density: rho,
-        damping: 0.0,
-    };
-    let rod = Rod::tapered(mat, l, r, r);
-    let disc =
-        Discretization::new(&rod, &[Quadrature::Gauss { n: 12 }], MagnusOrder::Z4, &[]).unwrap();
-    let b = LinearBasis::per_division(
-        &disc,
-        &[DivisionBasis::Legendre {
-            modes: [true; 6],
-            orders: [2, 6, 6, 2, 2, 2],
-        }],
-    )
-    .unwrap();
-    let m = Model::new(rod, disc, b, vec![]).unwrap();
+    let (m, mat) = clamped_rod_10_5();
+    let (l, r, e, rho) = (0.5, 0.005, mat.youngs_modulus, mat.density);
     let n = m.n_dof();
     let mut ws = m.workspace();
     let mass = m.mass_matrix(&DVector::zeros(n), &mut ws);

@@ -10,7 +10,7 @@ use gvs::rod::{Material, Rod, SectionProps};
 use gvs::strain::{DivisionBasis, LinearBasis, SigmoidBend, StrainParam};
 mod common;
 
-use common::pseudo_random;
+use common::{clamped_rod_10_5, pseudo_random};
 use nalgebra::{DVector, SymmetricEigen};
 use std::f64::consts::PI;
 
@@ -191,25 +191,8 @@ fn frequencies(m: &Model<LinearBasis>) -> Vec<f64> {
 #[test]
 fn linearized_frequencies_of_clamped_rod_match_beam_theory() {
     // gvs-spec §10.5: L = 0.5, r = 5 mm, E = 1e6, ρ = 1000, Legendre orders [2,6,6,2,2,2], N = 12
-    let (l, r, e, rho) = (0.5, 0.005, 1e6, 1000.0);
-    let mat = Material {
-        youngs_modulus: e,
-        poisson_ratio: 0.5,
-        density: rho,
-        damping: 0.0,
-    };
-    let rod = Rod::tapered(mat, l, r, r);
-    let disc =
-        Discretization::new(&rod, &[Quadrature::Gauss { n: 12 }], MagnusOrder::Z4, &[]).unwrap();
-    let b = LinearBasis::per_division(
-        &disc,
-        &[DivisionBasis::Legendre {
-            modes: [true; 6],
-            orders: [2, 6, 6, 2, 2, 2],
-        }],
-    )
-    .unwrap();
-    let m = Model::new(rod, disc, b, vec![]).unwrap();
+    let (m, mat) = clamped_rod_10_5();
+    let (l, r, e, rho) = (0.5, 0.005, mat.youngs_modulus, mat.density);
     let f = frequencies(&m);
     let s = SectionProps::circular(&mat, r);
     let eb = |beta_l: f64| beta_l * beta_l / (2.0 * PI * l * l) * (s.es[1] / (rho * s.area)).sqrt();

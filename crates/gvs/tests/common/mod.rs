@@ -1,7 +1,34 @@
 //! Helpers shared by the engine's integration tests.
 #![allow(dead_code)]
 
+use gvs::discretize::{Discretization, MagnusOrder, Quadrature};
+use gvs::model::Model;
+use gvs::rod::{Material, Rod};
+use gvs::strain::{DivisionBasis, LinearBasis};
 use nalgebra::DVector;
+
+/// The uniform clamped rod of gvs-spec §10.5: L = 0.5 m, r = 5 mm, E = 1e6 Pa, ρ = 1000 kg/m³, no
+/// damping, Legendre orders [2, 6, 6, 2, 2, 2] on all six modes, N = 12 Gauss points.
+pub fn clamped_rod_10_5() -> (Model<LinearBasis>, Material) {
+    let mat = Material {
+        youngs_modulus: 1e6,
+        poisson_ratio: 0.5,
+        density: 1000.0,
+        damping: 0.0,
+    };
+    let rod = Rod::tapered(mat, 0.5, 0.005, 0.005);
+    let disc =
+        Discretization::new(&rod, &[Quadrature::Gauss { n: 12 }], MagnusOrder::Z4, &[]).unwrap();
+    let b = LinearBasis::per_division(
+        &disc,
+        &[DivisionBasis::Legendre {
+            modes: [true; 6],
+            orders: [2, 6, 6, 2, 2, 2],
+        }],
+    )
+    .unwrap();
+    (Model::new(rod, disc, b, vec![]).unwrap(), mat)
+}
 
 /// Deterministic pseudo-random vector with entries in [-a, a] (an LCG; no dependency, same on every
 /// platform).
