@@ -7,6 +7,11 @@
 //! **Load ramping**: the loads and tensions are scaled by `λ_m = m/N` and each solve is warm-started
 //! from the previous one; if a stage fails, the increment is halved (down to `min_increment`) before
 //! the failure is reported.
+//!
+//! **Bounded work**: the options are capped ([`MAX_RAMP_STEPS`], [`MAX_ITERATIONS`],
+//! [`MIN_INCREMENT_FLOOR`]) and one solve stops with [`StaticsError::NotConverged`] after
+//! [`MAX_LOAD_STAGES`] load stages or [`MAX_TOTAL_ITERATIONS`] dogleg iterations in all, so that no
+//! input makes a solve run unbounded (e.g. ramping by a halved increment of 1e-6 for 1e6 stages).
 
 use super::dogleg::{
     self, DoglegError, DoglegOptions, DoglegWorkspace, EvalError, NonlinearSystem,
@@ -18,6 +23,18 @@ use crate::strain::StrainParam;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
+
+/// Largest `solver.ramp_steps` accepted: 1e4 warm-started stages are far more than any load needs.
+pub const MAX_RAMP_STEPS: usize = 10_000;
+/// Largest `solver.max_iterations` (per load stage) accepted.
+pub const MAX_ITERATIONS: usize = 10_000;
+/// Smallest `solver.min_increment` accepted: 20 halvings of a unit increment (`2⁻²⁰ ≈ 9.5e-7`).
+pub const MIN_INCREMENT_FLOOR: f64 = 1e-6;
+/// Largest number of load stages (including retries after halving) of one solve:
+/// `2 · MAX_RAMP_STEPS`, room for the largest ramp plus its retries.
+pub const MAX_LOAD_STAGES: usize = 2 * MAX_RAMP_STEPS;
+/// Largest number of dogleg iterations over all load stages of one solve.
+pub const MAX_TOTAL_ITERATIONS: usize = 100_000;
 
 /// Options of a statics solve.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -48,28 +65,31 @@ impl Default for StaticsOptions {
 }
 
 impl StaticsOptions {
+    /// Checks every option against its accepted range: `ramp_steps` in [1, [`MAX_RAMP_STEPS`]],
+    /// `min_increment` in [[`MIN_INCREMENT_FLOOR`], 1], `ftol`, `xtol` > 0, `max_iterations` in
+    /// [1, [`MAX_ITERATIONS`]].
     pub fn validate(&self) -> Result<(), ModelError> {
-        if self.ramp_steps == 0 {
+        if !(1..=MAX_RAMP_STEPS).contains(&self.ramp_steps) {
             return Err(ModelError::value(
                 "solver.ramp_steps",
-                0.0,
-                "an integer >= 1",
+                self.ramp_steps as f64,
+                format!("an integer in [1, {MAX_RAMP_STEPS}]"),
             ));
         }
         crate::error::check_range(
             "solver.min_increment",
             self.min_increment,
-            Some((0.0, false)),
+            Some((MIN_INCREMENT_FLOOR, true)),
             Some((1.0, true)),
-            "a number in (0, 1]",
+            &format!("a number in [{MIN_INCREMENT_FLOOR:e}, 1]"),
         )?;
         crate::error::check_positive("solver.ftol", self.ftol, "")?;
         crate::error::check_positive("solver.xtol", self.xtol, "")?;
-        if self.max_iterations == 0 {
+        if !(1..=MAX_ITERATIONS).contains(&self.max_iterations) {
             return Err(ModelError::value(
                 "solver.max_iterations",
-                0.0,
-                "an integer >= 1",
+                self.max_iterations as f64,
+                format!("an integer in [1, {MAX_ITERATIONS}]"),
             ));
         }
         Ok(())
@@ -163,6 +183,18 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
         loads: &Loads,
         q0: Option<&DVector<f64>>,
     ) -> Result<StaticsSolution, StaticsError> {
+        self.solve_within(u, loads, q0, MAX_LOAD_STAGES, MAX_TOTAL_ITERATIONS)
+    }
+
+    /// [`Self::solve`] with explicit caps on the load stages and total iterations of the solve.
+    fn solve_within(
+        &mut self,
+        u: &[f64],
+        loads: &Loads,
+        q0: Option<&DVector<f64>>,
+        max_stages: usize,
+        max_total_iterations: usize,
+    ) -> Result<StaticsSolution, StaticsError> {
         self.options.validate()?;
         let n = self.model.n_dof();
         if u.len() != self.model.n_actuators() {
@@ -202,7 +234,21 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
         };
         let mut lambda = 0.0;
         let mut inc = 1.0 / self.options.ramp_steps as f64;
+        // ‖R‖∞ and its tolerance at the end of the last stage (converged or not)
+        let mut last_tolerance = f64::NAN;
         while lambda < 1.0 {
+            if total.load_stages >= max_stages || total.iterations >= max_total_iterations {
+                return Err(StaticsError::NotConverged {
+                    load_factor: lambda,
+                    iterations: total.iterations,
+                    residual_norm: total.residual_norm,
+                    tolerance: last_tolerance,
+                    reason: format!(
+                        "stopped after {} load stages and {} iterations (limits per solve: {max_stages} stages, {max_total_iterations} iterations) with the load increment at {inc:.3e}",
+                        total.load_stages, total.iterations
+                    ),
+                });
+            }
             let target = (lambda + inc).min(1.0);
             let loads_l = if target == 1.0 {
                 loads.clone()
@@ -222,6 +268,7 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                     total.residual_evaluations += rep.residual_evaluations;
                     total.jacobian_evaluations += rep.jacobian_evaluations;
                     total.residual_norm = rep.residual_norm;
+                    last_tolerance = self.options.ftol * self.ws.residual_scale;
                     q = rep.x;
                     lambda = target;
                 }
@@ -237,6 +284,8 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                         other => (0, f64::NAN, f64::NAN, other.to_string()),
                     };
                     total.iterations += iterations;
+                    total.residual_norm = residual_norm;
+                    last_tolerance = tolerance;
                     if inc / 2.0 >= self.options.min_increment * (1.0 - 1e-12) {
                         inc /= 2.0;
                         continue;
@@ -270,4 +319,148 @@ pub fn solve_statics<P: StrainParam>(
     options: &StaticsOptions,
 ) -> Result<StaticsSolution, StaticsError> {
     StaticsSolver::new(model, options.clone()).solve(u, loads, q0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::discretize::{Discretization, MagnusOrder, Quadrature};
+    use crate::rod::{Material, Rod};
+    use crate::strain::{DivisionBasis, LinearBasis};
+
+    /// A uniform 0.5 m rod, r = 5 mm, E = 1e6 Pa, bending about y with a quadratic Legendre basis.
+    fn rod_model() -> Model<LinearBasis> {
+        let mat = Material {
+            youngs_modulus: 1e6,
+            poisson_ratio: 0.5,
+            density: 1000.0,
+            damping: 0.0,
+        };
+        let rod = Rod::tapered(mat, 0.5, 0.005, 0.005);
+        let disc = Discretization::new(&rod, &[Quadrature::Gauss { n: 5 }], MagnusOrder::Z4, &[])
+            .unwrap();
+        let mut modes = [false; 6];
+        modes[1] = true;
+        let b = LinearBasis::per_division(
+            &disc,
+            &[DivisionBasis::Legendre {
+                modes,
+                orders: [0, 2, 0, 0, 0, 0],
+            }],
+        )
+        .unwrap();
+        Model::new(rod, disc, b, vec![]).unwrap()
+    }
+
+    fn gravity() -> Loads {
+        Loads {
+            gravity: [0.0, 0.0, -9.81],
+            ..Loads::default()
+        }
+    }
+
+    fn rejected(options: StaticsOptions) -> String {
+        options.validate().unwrap_err().to_string()
+    }
+
+    #[test]
+    fn ramp_steps_above_the_limit_are_rejected_with_the_limit() {
+        let ok = StaticsOptions {
+            ramp_steps: MAX_RAMP_STEPS,
+            ..StaticsOptions::default()
+        };
+        assert!(ok.validate().is_ok());
+        let e = rejected(StaticsOptions {
+            ramp_steps: 1_000_000_000,
+            ..StaticsOptions::default()
+        });
+        assert!(
+            e.contains("solver.ramp_steps") && e.contains("1000000000") && e.contains("[1, 10000]"),
+            "{e}"
+        );
+        let e = rejected(StaticsOptions {
+            ramp_steps: 0,
+            ..StaticsOptions::default()
+        });
+        assert!(e.contains("solver.ramp_steps") && e.contains("[1, 10000]"), "{e}");
+    }
+
+    #[test]
+    fn max_iterations_above_the_limit_are_rejected_with_the_limit() {
+        let e = rejected(StaticsOptions {
+            max_iterations: MAX_ITERATIONS + 1,
+            ..StaticsOptions::default()
+        });
+        assert!(
+            e.contains("solver.max_iterations") && e.contains("10001") && e.contains("[1, 10000]"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn min_increment_below_the_floor_is_rejected_with_the_floor() {
+        let ok = StaticsOptions {
+            min_increment: MIN_INCREMENT_FLOOR,
+            ..StaticsOptions::default()
+        };
+        assert!(ok.validate().is_ok());
+        let e = rejected(StaticsOptions {
+            min_increment: 1e-9,
+            ..StaticsOptions::default()
+        });
+        assert!(
+            e.contains("solver.min_increment") && e.contains("0.000000001") && e.contains("[1e-6, 1]"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_solve_stops_at_its_stage_cap_with_iterations_and_residual() {
+        // 10 ramp stages, capped at 3: stops at λ = 3/10 having solved 3 stages
+        let model = rod_model();
+        let options = StaticsOptions {
+            ramp_steps: 10,
+            ..StaticsOptions::default()
+        };
+        let mut solver = StaticsSolver::new(&model, options.clone());
+        let e = solver
+            .solve_within(&[], &gravity(), None, 3, MAX_TOTAL_ITERATIONS)
+            .unwrap_err();
+        match &e {
+            StaticsError::NotConverged {
+                load_factor,
+                iterations,
+                residual_norm,
+                reason,
+                ..
+            } => {
+                assert!((load_factor - 0.3).abs() < 1e-12, "{e}");
+                assert!(*iterations >= 3, "{e}");
+                assert!(residual_norm.is_finite(), "{e}");
+                assert!(reason.contains("3 load stages") && reason.contains("3 stages"), "{e}");
+            }
+            other => panic!("expected NotConverged, got {other}"),
+        }
+        // the same solve within the default caps converges
+        assert!(StaticsSolver::new(&model, options)
+            .solve(&[], &gravity(), None)
+            .is_ok());
+    }
+
+    #[test]
+    fn a_solve_stops_at_its_iteration_cap() {
+        let model = rod_model();
+        let options = StaticsOptions {
+            ramp_steps: 10,
+            ..StaticsOptions::default()
+        };
+        let e = StaticsSolver::new(&model, options)
+            .solve_within(&[], &gravity(), None, MAX_LOAD_STAGES, 1)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("did not converge") && e.contains("stages, 1 iterations)"),
+            "{e}"
+        );
+    }
 }
