@@ -491,7 +491,12 @@ fn parse_path(path: &str) -> Result<Vec<Seg>, String> {
                 .ok_or_else(|| format!("unclosed `[` in `{part}`"))?;
             let idx = rest[1..close]
                 .parse::<usize>()
-                .map_err(|_| format!("`{}` is not a list index", &rest[1..close]))?;
+                .map_err(|_| {
+                    format!(
+                        "`{}` is not a list index (indices are 0-based non-negative integers)",
+                        &rest[1..close]
+                    )
+                })?;
             segs.push(Seg::Index(idx));
             rest = &rest[close + 1..];
             if !rest.is_empty() && !rest.starts_with('[') {
@@ -500,6 +505,13 @@ fn parse_path(path: &str) -> Result<Vec<Seg>, String> {
         }
     }
     Ok(segs)
+}
+
+/// A key segment meant as a list index that is not a valid one: a signed integer or one too large
+/// for an index (`-1`, `-0`, `99999999999999999999999`).
+fn looks_like_index(key: &str) -> bool {
+    let digits = key.trim_start_matches(['-', '+']);
+    !digits.is_empty() && digits.chars().all(|c| c.is_ascii_digit())
 }
 
 /// Parses the right-hand side of `--set` as a TOML value (number, bool, array, inline table,
@@ -553,9 +565,9 @@ fn set_at(node: &mut Value, segs: &[Seg], depth: usize, value: Value) -> Result<
                 t.insert(k.clone(), value);
                 return Ok(());
             }
-            let child = t.entry(k.clone()).or_insert_with(|| match segs[depth + 1] {
-                Seg::Key(_) => Value::Table(Table::new()),
-                Seg::Index(_) => Value::Array(Vec::new()),
+            let child = t.entry(k.clone()).or_insert_with(|| match &segs[depth + 1] {
+                Seg::Key(k) if !looks_like_index(k) => Value::Table(Table::new()),
+                _ => Value::Array(Vec::new()),
             });
             set_at(child, segs, depth + 1, value)
         }
@@ -588,6 +600,15 @@ fn set_at(node: &mut Value, segs: &[Seg], depth: usize, value: Value) -> Result<
         (Seg::Index(i), Value::Table(_)) => Err(format!(
             "{} is a table, not a list: it has no index {i}",
             here()
+        )),
+        (Seg::Key(k), Value::Array(a)) if looks_like_index(k) => Err(format!(
+            "`{k}` is not a valid index of {}: indices are 0-based non-negative integers and the list has {} entries ({})",
+            here(),
+            a.len(),
+            match a.len() {
+                0 => "give 0 to add the first".to_string(),
+                n => format!("0 to {} to change one, {n} to append one", n - 1),
+            }
         )),
         (Seg::Key(k), Value::Array(_)) => Err(format!(
             "{} is a list: give an index before `{k}` (e.g. `{}.0.{k}`)",
@@ -698,6 +719,35 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("path=value"), "{e}");
+    }
+
+    #[test]
+    fn negative_override_index_is_named_as_invalid_with_the_list_size() {
+        for path in ["tendons.-1.tension=1", "tendons.-0.tension=1"] {
+            let e = Scenario::from_toml("t", MINIMAL, &[path.into()])
+                .unwrap_err()
+                .to_string();
+            let seg = &path[8..10];
+            assert!(
+                e.contains(&format!("`{seg}` is not a valid index of `tendons`"))
+                    && e.contains("0-based non-negative integers")
+                    && e.contains("the list has 1 entries"),
+                "{e}"
+            );
+            assert!(!e.contains("tendons.0."), "{e}");
+        }
+        let e = Scenario::from_toml("t", MINIMAL, &["tendons[-1].tension=1".into()])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("`-1` is not a list index") && e.contains("non-negative"), "{e}");
+        // a list the scenario does not have yet: 0 entries
+        let e = Scenario::from_toml("t", MINIMAL, &["loads.point.-1.x=0.1".into()])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("`-1` is not a valid index of `loads.point`") && e.contains("0 entries"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -322,3 +322,17 @@ fn presets_lists_all_and_check_validates_without_solving() {
     );
     assert!(!s.contains("tip"), "{s}");
 }
+
+#[test]
+fn negative_override_index_says_it_is_not_an_index() {
+    let msg = expect_error(
+        &["statics", "single-tendon", "--set", "tendons.-1.tension=1"],
+        &[
+            "tendons.-1.tension",
+            "`-1` is not a valid index of `tendons`",
+            "0-based non-negative integers",
+            "1 entries",
+        ],
+    );
+    assert!(!msg.contains("tendons.0.-1"), "{msg}");
+}
