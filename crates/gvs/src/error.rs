@@ -5,7 +5,7 @@ use thiserror::Error;
 #[derive(Debug, Clone, Error, PartialEq)]
 pub enum ModelError {
     /// A numeric input outside its accepted range (or not finite).
-    #[error("invalid value for `{field}`: {value} (expected {expected})")]
+    #[error("invalid value for `{field}`: {} (expected {expected})", fmt_value(*value))]
     InvalidValue {
         field: String,
         value: f64,
@@ -29,6 +29,16 @@ impl ModelError {
             field: field.into(),
             message: message.into(),
         }
+    }
+}
+
+/// A number for a message: plain decimal when `1e-4 ≤ |v| < 1e15` (or 0), otherwise in exponent form
+/// (`1e-300`, not three hundred zeros).
+pub fn fmt_value(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-4..1e15).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
     }
 }
 

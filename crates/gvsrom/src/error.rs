@@ -1,6 +1,7 @@
 //! Errors of scenario loading and building. Every error names the scenario field by its TOML path
 //! (`divisions[0].radius_start`), the offending value, and what is accepted.
 
+use gvs::error::fmt_value;
 use gvs::ModelError;
 use thiserror::Error;
 
@@ -17,7 +18,7 @@ pub enum ScenarioError {
     #[error("`{field}`: {message}")]
     Format { field: String, message: String },
     /// A number outside its accepted range (or not finite).
-    #[error("invalid value for `{field}`: {value} (expected {expected})")]
+    #[error("invalid value for `{field}`: {} (expected {expected})", fmt_value(*value))]
     InvalidValue {
         field: String,
         value: f64,

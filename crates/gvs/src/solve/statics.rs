@@ -337,8 +337,8 @@ mod tests {
             damping: 0.0,
         };
         let rod = Rod::tapered(mat, 0.5, 0.005, 0.005);
-        let disc = Discretization::new(&rod, &[Quadrature::Gauss { n: 5 }], MagnusOrder::Z4, &[])
-            .unwrap();
+        let disc =
+            Discretization::new(&rod, &[Quadrature::Gauss { n: 5 }], MagnusOrder::Z4, &[]).unwrap();
         let mut modes = [false; 6];
         modes[1] = true;
         let b = LinearBasis::per_division(
@@ -382,7 +382,10 @@ mod tests {
             ramp_steps: 0,
             ..StaticsOptions::default()
         });
-        assert!(e.contains("solver.ramp_steps") && e.contains("[1, 10000]"), "{e}");
+        assert!(
+            e.contains("solver.ramp_steps") && e.contains("[1, 10000]"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -409,7 +412,7 @@ mod tests {
             ..StaticsOptions::default()
         });
         assert!(
-            e.contains("solver.min_increment") && e.contains("0.000000001") && e.contains("[1e-6, 1]"),
+            e.contains("solver.min_increment") && e.contains("1e-9") && e.contains("[1e-6, 1]"),
             "{e}"
         );
     }
@@ -437,7 +440,10 @@ mod tests {
                 assert!((load_factor - 0.3).abs() < 1e-12, "{e}");
                 assert!(*iterations >= 3, "{e}");
                 assert!(residual_norm.is_finite(), "{e}");
-                assert!(reason.contains("3 load stages") && reason.contains("3 stages"), "{e}");
+                assert!(
+                    reason.contains("3 load stages") && reason.contains("3 stages"),
+                    "{e}"
+                );
             }
             other => panic!("expected NotConverged, got {other}"),
         }
