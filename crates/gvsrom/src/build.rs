@@ -26,6 +26,20 @@ pub const MAX_GAUSS_PER_ELEMENT: usize = 20;
 /// Largest `n_dof × strain sites`: the tabulated basis and Jacobians are 6 × n·sites matrices
 /// (5e6 ≈ 240 MB each).
 pub const MAX_BASIS_SIZE: usize = 5_000_000;
+/// Largest number of generalized coordinates (DOF). Statics factorizes a dense n × n Jacobian per
+/// iteration (O(n³)): 2000 DOF is about a second per iteration on one core.
+pub const MAX_DOF: usize = 2000;
+/// Accepted Young's modulus E [Pa]: from the softest hydrogels (≈ 1 kPa) with three decades of
+/// room below, to stiffer than diamond (1.2e12 Pa).
+pub const YOUNGS_MODULUS_RANGE: (f64, f64) = (1.0, 1e13);
+/// Accepted density ρ [kg/m³]: 0 (massless) to 1e5, five times the densest element (osmium 2.26e4).
+pub const DENSITY_RANGE: (f64, f64) = (0.0, 1e5);
+/// Largest gravitational acceleration |g| [m/s²] (1000 g).
+pub const MAX_GRAVITY: f64 = 1e4;
+/// Accepted division length ℓ_j [m]: 1 µm to 1 km.
+pub const DIVISION_LENGTH_RANGE: (f64, f64) = (1e-6, 1e3);
+/// Smallest radius [m] (0.1 µm); the largest is the rod's total length L (a rod is slender).
+pub const MIN_RADIUS: f64 = 1e-7;
 /// Largest number of centreline samples.
 pub const MAX_CENTERLINE_POINTS: usize = 100_000;
 
@@ -60,12 +74,24 @@ pub fn build(s: &Scenario) -> Result<Built, ScenarioError> {
         divisions: geometry,
     };
     let length = rod.length();
+    for (j, d) in s.divisions.iter().enumerate() {
+        radius_range(j, d, length)?;
+    }
     let bases = s
         .divisions
         .iter()
         .enumerate()
         .map(|(j, d)| basis(j, d))
         .collect::<Result<Vec<_>, _>>()?;
+    let n_dof: usize = bases.iter().map(DivisionBasis::dofs).sum();
+    if n_dof > MAX_DOF {
+        return Err(ScenarioError::invalid(
+            "divisions",
+            format!(
+                "the basis has {n_dof} DOF (accepted <= {MAX_DOF}): statics factorizes a dense {n_dof} × {n_dof} Jacobian per iteration; lower the basis orders or elements"
+            ),
+        ));
+    }
     let quads = s
         .divisions
         .iter()
@@ -99,7 +125,6 @@ pub fn build(s: &Scenario) -> Result<Built, ScenarioError> {
 
     let extra_x = loads.point_abscissae();
     let disc = Discretization::new(&rod, &quads, s.magnus, &extra_x)?;
-    let n_dof: usize = bases.iter().map(DivisionBasis::dofs).sum();
     if n_dof.saturating_mul(disc.n_sites()) > MAX_BASIS_SIZE {
         return Err(ScenarioError::invalid(
             "divisions",
@@ -130,6 +155,28 @@ fn finite(field: &str, v: f64) -> Result<f64, ScenarioError> {
     }
 }
 
+/// A bound for a message: plain in [1e-3, 1e4), else in exponent form (`1e13`).
+pub(crate) fn num(v: f64) -> String {
+    if v == 0.0 || (1e-3..1e4).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
+/// `v` in the closed range `[lo, hi]`, else an error naming `field` and the range.
+fn in_range(field: &str, v: f64, (lo, hi): (f64, f64), unit: &str) -> Result<f64, ScenarioError> {
+    if v.is_finite() && v >= lo && v <= hi {
+        Ok(v)
+    } else {
+        Err(ScenarioError::value(
+            field,
+            v,
+            format!("a number in [{}, {}] {unit}", num(lo), num(hi)),
+        ))
+    }
+}
+
 fn positive(field: &str, v: f64, unit: &str) -> Result<f64, ScenarioError> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
@@ -156,7 +203,12 @@ fn non_negative(field: &str, v: f64, unit: &str) -> Result<f64, ScenarioError> {
 
 fn material(s: &Scenario) -> Result<Material, ScenarioError> {
     let m = &s.material;
-    positive("material.youngs_modulus", m.youngs_modulus, "Pa")?;
+    in_range(
+        "material.youngs_modulus",
+        m.youngs_modulus,
+        YOUNGS_MODULUS_RANGE,
+        "Pa",
+    )?;
     if !(m.poisson_ratio.is_finite() && m.poisson_ratio > -1.0 && m.poisson_ratio <= 0.5) {
         return Err(ScenarioError::value(
             "material.poisson_ratio",
@@ -164,7 +216,7 @@ fn material(s: &Scenario) -> Result<Material, ScenarioError> {
             "a number in (-1, 0.5]",
         ));
     }
-    non_negative("material.density", m.density, "kg/m^3")?;
+    in_range("material.density", m.density, DENSITY_RANGE, "kg/m^3")?;
     non_negative("material.damping", m.damping, "Pa*s")?;
     Ok(Material {
         youngs_modulus: m.youngs_modulus,
@@ -176,7 +228,8 @@ fn material(s: &Scenario) -> Result<Material, ScenarioError> {
 
 fn geometry(j: usize, d: &DivisionSpec) -> Result<DivisionGeometry, ScenarioError> {
     let f = |n: &str| format!("divisions[{j}].{n}");
-    let length = positive(&f("length"), d.length, "m")?;
+    positive(&f("length"), d.length, "m")?;
+    let length = in_range(&f("length"), d.length, DIVISION_LENGTH_RANGE, "m")?;
     let (r0, r1) = match (d.radius, d.radius_start, d.radius_end) {
         (Some(r), None, None) => (
             positive(&f("radius"), r, "m")?,
@@ -214,6 +267,30 @@ fn geometry(j: usize, d: &DivisionSpec) -> Result<DivisionGeometry, ScenarioErro
         radius_start: r0,
         radius_end: r1,
     })
+}
+
+/// Checks the radii of division `j` lie in `[MIN_RADIUS, L]`, `L` the rod's total length.
+fn radius_range(j: usize, d: &DivisionSpec, l: f64) -> Result<(), ScenarioError> {
+    let pairs = [
+        ("radius", d.radius),
+        ("radius_start", d.radius_start),
+        ("radius_end", d.radius_end),
+    ];
+    for (name, r) in pairs {
+        if let Some(r) = r {
+            if !(r >= MIN_RADIUS && r <= l) {
+                return Err(ScenarioError::value(
+                    format!("divisions[{j}].{name}"),
+                    r,
+                    format!(
+                        "a number in [{}, {l}] m (at most the rod's length)",
+                        num(MIN_RADIUS)
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The six active flags of a mode list; rejects an empty list and repeated modes.
@@ -600,6 +677,17 @@ fn loads(s: &Scenario, l: f64) -> Result<Loads, ScenarioError> {
     let spec = &s.loads;
     for (i, g) in spec.gravity.iter().enumerate() {
         finite(&format!("loads.gravity[{i}]"), *g)?;
+    }
+    let g = V3::from_row_slice(&spec.gravity).norm();
+    if !(g <= MAX_GRAVITY) {
+        return Err(ScenarioError::value(
+            "loads.gravity",
+            g,
+            format!(
+                "a vector of magnitude <= {} m/s^2 (its magnitude is shown)",
+                num(MAX_GRAVITY)
+            ),
+        ));
     }
     let mut point = Vec::new();
     for (k, p) in spec.point.iter().enumerate() {

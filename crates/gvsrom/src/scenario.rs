@@ -489,14 +489,12 @@ fn parse_path(path: &str) -> Result<Vec<Seg>, String> {
             let close = rest
                 .find(']')
                 .ok_or_else(|| format!("unclosed `[` in `{part}`"))?;
-            let idx = rest[1..close]
-                .parse::<usize>()
-                .map_err(|_| {
-                    format!(
-                        "`{}` is not a list index (indices are 0-based non-negative integers)",
-                        &rest[1..close]
-                    )
-                })?;
+            let idx = rest[1..close].parse::<usize>().map_err(|_| {
+                format!(
+                    "`{}` is not a list index (indices are 0-based non-negative integers)",
+                    &rest[1..close]
+                )
+            })?;
             segs.push(Seg::Index(idx));
             rest = &rest[close + 1..];
             if !rest.is_empty() && !rest.starts_with('[') {
@@ -739,7 +737,10 @@ mod tests {
         let e = Scenario::from_toml("t", MINIMAL, &["tendons[-1].tension=1".into()])
             .unwrap_err()
             .to_string();
-        assert!(e.contains("`-1` is not a list index") && e.contains("non-negative"), "{e}");
+        assert!(
+            e.contains("`-1` is not a list index") && e.contains("non-negative"),
+            "{e}"
+        );
         // a list the scenario does not have yet: 0 entries
         let e = Scenario::from_toml("t", MINIMAL, &["loads.point.-1.x=0.1".into()])
             .unwrap_err()

@@ -336,3 +336,117 @@ fn negative_override_index_says_it_is_not_an_index() {
     );
     assert!(!msg.contains("tendons.0.-1"), "{msg}");
 }
+
+#[test]
+fn physically_absurd_material_and_geometry_are_rejected_before_solving() {
+    let set = |kv: &str| {
+        vec!["statics", "single-tendon", "--set"]
+            .into_iter()
+            .chain([kv])
+            .map(String::from)
+            .collect::<Vec<_>>()
+    };
+    let cases: [(&str, &[&str]); 10] = [
+        (
+            "material.youngs_modulus=1e-300",
+            &["material.youngs_modulus", "1e-300", "[1, 1e13] Pa"],
+        ),
+        (
+            "material.youngs_modulus=1e14",
+            &["material.youngs_modulus", "[1, 1e13] Pa"],
+        ),
+        (
+            "material.density=1e308",
+            &["material.density", "[0, 1e5] kg/m^3"],
+        ),
+        (
+            "loads.gravity=[0, 0, -1e308]",
+            &["loads.gravity", "<= 1e4 m/s^2"],
+        ),
+        (
+            "loads.gravity=[1e4, 0, -1e4]",
+            &["loads.gravity", "14142.1", "<= 1e4 m/s^2"],
+        ),
+        (
+            "divisions.0.length=1e308",
+            &["divisions[0].length", "[1e-6, 1000] m"],
+        ),
+        (
+            "divisions.0.length=1e-100",
+            &["divisions[0].length", "1e-100", "[1e-6, 1000] m"],
+        ),
+        (
+            "divisions.0.radius_start=1e308",
+            &["divisions[0].radius_start", "[1e-7, 0.25] m"],
+        ),
+        (
+            "divisions.0.radius_end=1e-100",
+            &["divisions[0].radius_end", "1e-100", "[1e-7, 0.25] m"],
+        ),
+        (
+            "divisions.0.radius_start=0.3",
+            &[
+                "divisions[0].radius_start",
+                "0.3",
+                "at most the rod's length",
+            ],
+        ),
+    ];
+    for (kv, needles) in cases {
+        let args = set(kv);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        expect_error(&args, needles);
+    }
+    // the soft end of the range is accepted: a 1 kPa hydrogel arm builds
+    let out = gvsrom(&[
+        "check",
+        "single-tendon",
+        "--set",
+        "material.youngs_modulus=1e3",
+        "--tension=0",
+        "--set",
+        "loads.gravity=[0,0,0]",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn a_basis_with_too_many_dof_is_rejected_naming_its_size() {
+    // 6 modes × (2·175 + 1) quadratic nodes = 2106 DOF
+    let basis = |e: usize| {
+        format!("divisions.0.basis={{ kind = \"fem\", modes = [\"torsion\",\"bend_y\",\"bend_z\",\"elongation\",\"shear_y\",\"shear_z\"], elements = {e}, degree = \"quadratic\" }}")
+    };
+    let quad =
+        |e: usize| format!("divisions.0.quadrature={{ gauss_per_element = 3, elements = {e} }}");
+    expect_error(
+        &[
+            "check",
+            "soft-beam",
+            "--set",
+            &basis(175),
+            "--set",
+            &quad(175),
+        ],
+        &["divisions", "2106 DOF", "accepted <= 2000"],
+    );
+    // 6 × 321 = 1926 DOF stays accepted
+    let out = gvsrom(&[
+        "check",
+        "soft-beam",
+        "--set",
+        &basis(160),
+        "--set",
+        &quad(160),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("1926 DOF"), "{stdout}");
+}
