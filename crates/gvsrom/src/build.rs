@@ -54,7 +54,8 @@ pub struct Built {
     pub centerline_points: usize,
 }
 
-/// Validates `s` and builds the engine's model, loads, tensions and solver options.
+/// Validates `s` and builds the engine's model, loads, tensions and solver options; the loads must
+/// pass [`crate::plausibility::check`] with the scenario's tensions and load factor 1.
 pub fn build(s: &Scenario) -> Result<Built, ScenarioError> {
     let material = material(s)?;
     if s.divisions.is_empty() {
@@ -137,14 +138,17 @@ pub fn build(s: &Scenario) -> Result<Built, ScenarioError> {
     }
     let basis = LinearBasis::per_division(&disc, &bases)?;
     let model = Model::new(rod, disc, basis, tendons)?.with_base(base);
-    Ok(Built {
+    let built = Built {
         name: s.name.clone().unwrap_or_else(|| "scenario".to_string()),
         model,
         loads,
         u,
         options: s.solver.clone(),
         centerline_points,
-    })
+    };
+    let u_abs: Vec<f64> = built.u.iter().map(|v| v.abs()).collect();
+    crate::plausibility::check(&built, &u_abs, 1.0)?;
+    Ok(built)
 }
 
 fn finite(field: &str, v: f64) -> Result<f64, ScenarioError> {

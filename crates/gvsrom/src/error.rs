@@ -2,6 +2,7 @@
 //! (`divisions[0].radius_start`), the offending value, and what is accepted.
 
 use gvs::error::fmt_value;
+use gvs::solve::statics::StaticsError;
 use gvs::ModelError;
 use thiserror::Error;
 
@@ -27,6 +28,10 @@ pub enum ScenarioError {
     /// A structural problem (conflicting or missing keys, counts).
     #[error("invalid `{field}`: {message}")]
     Invalid { field: String, message: String },
+    /// A load far beyond the rod's elastic range (see [`crate::plausibility`]); `load` names it by its
+    /// scenario path and value.
+    #[error("{load} {message}")]
+    Implausible { load: String, message: String },
     /// A `--set path=value` override that cannot be applied.
     #[error("--set {spec}: {message}")]
     Override { spec: String, message: String },
@@ -58,4 +63,16 @@ impl ScenarioError {
             message: message.into(),
         }
     }
+}
+
+/// A statics run that failed: the engine's error and, for a non-convergence, what the scenario says
+/// about its cause: `"…; the largest load is tendons[0].tension = -40 N (implied bending ~32 rad);
+/// try solver.ramp_steps = 10"`.
+#[derive(Debug, Error)]
+#[error("{error}{hint}")]
+pub struct StaticsFailure {
+    /// The engine's error.
+    pub error: StaticsError,
+    /// Empty, or `"; "`-separated context appended to the engine's message.
+    pub hint: String,
 }

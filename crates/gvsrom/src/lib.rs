@@ -8,6 +8,7 @@
 pub mod build;
 pub mod error;
 pub mod npy;
+pub mod plausibility;
 pub mod presets;
 pub mod scenario;
 pub mod simulate;

@@ -2,8 +2,9 @@
 //! sampled at equally spaced abscissae, the strain at the computational points, and solver statistics.
 
 use crate::build::Built;
+use crate::error::StaticsFailure;
 use gvs::lie::V3;
-use gvs::solve::statics::{StaticsError, StaticsSolver};
+use gvs::solve::statics::{StaticsError, StaticsSolver, MAX_RAMP_STEPS};
 use serde::Serialize;
 use std::io::Write;
 use std::path::Path;
@@ -55,12 +56,16 @@ impl StaticsReport {
     }
 }
 
-/// Solves the statics of `built` from the straight reference and samples the solution.
-pub fn solve(built: &Built) -> Result<StaticsReport, StaticsError> {
+/// Solves the statics of `built` from the straight reference and samples the solution. A
+/// non-convergence names the scenario's largest load ([`crate::plausibility::largest_load`]) and
+/// suggests more ramp steps.
+pub fn solve(built: &Built) -> Result<StaticsReport, StaticsFailure> {
     let model = &built.model;
     let mut solver = StaticsSolver::new(model, built.options.clone());
     let t0 = Instant::now();
-    let sol = solver.solve(&built.u, &built.loads, None)?;
+    let sol = solver
+        .solve(&built.u, &built.loads, None)
+        .map_err(|error| failure(built, error))?;
     let solve_time_s = t0.elapsed().as_secs_f64();
 
     let mut ws = model.workspace();
@@ -97,6 +102,24 @@ pub fn solve(built: &Built) -> Result<StaticsReport, StaticsError> {
         residual_norm: sol.residual_norm,
         solve_time_s,
     })
+}
+
+/// The engine's error with, for a non-convergence, the largest load and a remedy.
+fn failure(built: &Built, error: StaticsError) -> StaticsFailure {
+    let mut hint = String::new();
+    if let StaticsError::NotConverged { .. } = error {
+        if let Some(load) = crate::plausibility::largest_load(built, &built.u, 1.0) {
+            hint.push_str(&format!("; {load}"));
+        }
+        let steps = built.options.ramp_steps;
+        if steps < MAX_RAMP_STEPS {
+            let more = (steps * 10).clamp(10, MAX_RAMP_STEPS);
+            hint.push_str(&format!("; try solver.ramp_steps = {more}"));
+        } else {
+            hint.push_str("; lower the load: the ramp is already at its limit");
+        }
+    }
+    StaticsFailure { error, hint }
 }
 
 fn arr3(v: &V3) -> [f64; 3] {

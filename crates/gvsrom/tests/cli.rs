@@ -206,7 +206,7 @@ fn unreachable_load_reports_iterations_and_residual() {
         &[
             "statics",
             "single-tendon",
-            "--tension=-1e4",
+            "--tension=-30",
             "--set",
             "solver.max_iterations=3",
             "--set",
@@ -214,7 +214,13 @@ fn unreachable_load_reports_iterations_and_residual() {
             "--set",
             "solver.min_increment=1",
         ],
-        &["did not converge", "3 iterations", "‖R‖∞"],
+        &[
+            "did not converge",
+            "3 iterations",
+            "‖R‖∞",
+            "the largest load is tendons[0].tension = -30 N (implied bending ~24 rad",
+            "try solver.ramp_steps = 10",
+        ],
     );
     assert!(msg.contains("tolerance"), "{msg}");
 }
@@ -449,4 +455,52 @@ fn a_basis_with_too_many_dof_is_rejected_naming_its_size() {
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(stdout.contains("1926 DOF"), "{stdout}");
+}
+
+#[test]
+fn loads_far_beyond_the_elastic_range_are_rejected_naming_the_load() {
+    for cmd in ["statics", "check"] {
+        expect_error(
+            &[cmd, "single-tendon", "--tension", "1e300"],
+            &[
+                "tendons[0].tension = 1e300 N",
+                "implies a bending of ~",
+                "(accepted <= 200 rad)",
+                "axial strain of ~",
+                "(accepted <= 1)",
+                "far beyond the rod's elastic range",
+            ],
+        );
+    }
+    expect_error(
+        &[
+            "statics",
+            "soft-beam",
+            "--set",
+            "loads.distributed.0.magnitude=-1e6",
+        ],
+        &[
+            "loads.distributed[0].magnitude = -1000000 N*m/m",
+            "bending of ~",
+        ],
+    );
+    expect_error(
+        &[
+            "statics",
+            "six-tendon",
+            "--set",
+            "loads.point.0={ x = 0.6, force = [0, 0, -1e9] }",
+        ],
+        &[
+            "loads.point[0].force = [0, 0, -1000000000] N",
+            "axial/shear strain of ~",
+        ],
+    );
+    // the paper's six-tendon range: all six tendons at -30 N at once solve
+    let out = gvsrom(&["statics", "six-tendon", "--tension=-30"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
