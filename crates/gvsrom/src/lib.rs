@@ -6,6 +6,7 @@
 //! command line, calls these and prints.
 
 pub mod build;
+pub mod csv_input;
 pub mod error;
 pub mod npy;
 pub mod plausibility;

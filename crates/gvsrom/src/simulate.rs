@@ -81,74 +81,6 @@ fn positive(field: &str, v: f64, unit: &str) -> Result<f64, ScenarioError> {
     }
 }
 
-/// Reads an input CSV: every non-empty, non-comment line after an optional header holds `1 + n_a`
-/// numbers `t, u_1, …, u_na`; times ascending.
-pub fn read_input_csv(
-    path: &Path,
-    n_actuators: usize,
-    interpolation: Interpolation,
-) -> Result<Signal, ScenarioError> {
-    let field = path.display().to_string();
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| ScenarioError::invalid(&field, format!("cannot read the input file: {e}")))?;
-    let mut times = vec![];
-    let mut values = vec![];
-    for (ln, line) in text.lines().enumerate() {
-        let line = line.trim();
-        if line.is_empty() || line.starts_with('#') {
-            continue;
-        }
-        let cells: Vec<&str> = line.split(',').map(|c| c.trim()).collect();
-        if times.is_empty() && values.is_empty() && cells[0].parse::<f64>().is_err() {
-            continue; // header
-        }
-        let where_ = format!("{field}:{}", ln + 1);
-        if cells.len() != n_actuators + 1 {
-            return Err(ScenarioError::invalid(
-                &where_,
-                format!(
-                    "{} columns, expected {} (t and one tension per actuator)",
-                    cells.len(),
-                    n_actuators + 1
-                ),
-            ));
-        }
-        let mut row = Vec::with_capacity(cells.len());
-        for (c, cell) in cells.iter().enumerate() {
-            let v: f64 = cell.parse().map_err(|_| {
-                ScenarioError::invalid(
-                    format!("{where_} column {}", c + 1),
-                    format!("`{cell}` is not a number"),
-                )
-            })?;
-            if !v.is_finite() {
-                return Err(ScenarioError::value(
-                    format!("{where_} column {}", c + 1),
-                    v,
-                    "a finite number",
-                ));
-            }
-            row.push(v);
-        }
-        times.push(row[0]);
-        values.push(row[1..].to_vec());
-    }
-    if times.is_empty() {
-        return Err(ScenarioError::invalid(
-            &field,
-            "the input file holds no data rows",
-        ));
-    }
-    let s = Signal {
-        times,
-        values,
-        interpolation,
-    };
-    s.validate(&field, n_actuators)
-        .map_err(ScenarioError::from)?;
-    Ok(s)
-}
-
 /// Builds the actuation signal of a run.
 pub fn input_signal(built: &Built, opts: &SimulateOptions) -> Result<Signal, ScenarioError> {
     let na = built.model.n_actuators();
@@ -158,7 +90,7 @@ pub fn input_signal(built: &Built, opts: &SimulateOptions) -> Result<Signal, Sce
         InputSource::Csv {
             path,
             interpolation,
-        } => read_input_csv(path, na, *interpolation)?,
+        } => crate::csv_input::read_csv_signal(path, na, *interpolation)?,
         InputSource::Steps {
             lo,
             hi,
@@ -236,7 +168,11 @@ pub fn run(
         InitialState::Rest
     };
     let schedule = match &opts.load_schedule {
-        Some(path) => Some(read_input_csv(path, 1, Interpolation::Linear)?),
+        Some(path) => Some(crate::csv_input::read_csv_signal(
+            path,
+            1,
+            Interpolation::Linear,
+        )?),
         None => None,
     };
     let sim = simulate_with_progress(

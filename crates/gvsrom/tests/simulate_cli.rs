@@ -275,3 +275,39 @@ fn load_schedule_scales_loads_over_time() {
         &["schedule-bad.csv:1", "3 columns, expected 2"],
     );
 }
+
+#[test]
+fn semicolon_input_file_keeps_its_rows_and_mixed_delimiters_name_the_line() {
+    // `;`-delimited with a header: both rows are read (u = -1 then -2 from t = 0.05 s)
+    let f = scratch("semicolon.csv");
+    std::fs::write(&f, "t;u0\n0;-1\n0.05;-2\n").unwrap();
+    let out_dir = scratch("semicolon-run");
+    let out = gvsrom(&[
+        "simulate",
+        "single-tendon",
+        "--duration",
+        "0.1",
+        "--sample-rate",
+        "100",
+        "--input",
+        f.to_str().unwrap(),
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let u = npy_values(&out_dir.join("u.npy"));
+    assert_eq!((u[0], u[4], u[5], u[10]), (-1.0, -1.0, -2.0, -2.0), "{u:?}");
+    let f = scratch("mixed-delim.csv");
+    std::fs::write(&f, "0;-1\n0.05,-2\n").unwrap();
+    expect_error(
+        &[
+            "simulate",
+            "single-tendon",
+            "--duration",
+            "0.1",
+            "--input",
+            f.to_str().unwrap(),
+        ],
+        &["mixed-delim.csv:2", "the delimiter is `,`", "line 1", "uses `;`"],
+    );
+}
