@@ -682,7 +682,8 @@ fn loads(s: &Scenario, l: f64) -> Result<Loads, ScenarioError> {
     for (i, g) in spec.gravity.iter().enumerate() {
         finite(&format!("loads.gravity[{i}]"), *g)?;
     }
-    let g = V3::from_row_slice(&spec.gravity).norm();
+    let [gx, gy, gz] = spec.gravity;
+    let g = gx.hypot(gy).hypot(gz); // no overflow to inf for finite components
     if !(g <= MAX_GRAVITY) {
         return Err(ScenarioError::value(
             "loads.gravity",

@@ -605,7 +605,8 @@ fn set_at(node: &mut Value, segs: &[Seg], depth: usize, value: Value) -> Result<
             a.len(),
             match a.len() {
                 0 => "give 0 to add the first".to_string(),
-                n => format!("0 to {} to change one, {n} to append one", n - 1),
+                1 => "0 changes it, 1 appends one".to_string(),
+                n => format!("0 to {} change one, {n} appends one", n - 1),
             }
         )),
         (Seg::Key(k), Value::Array(_)) => Err(format!(

@@ -294,7 +294,11 @@ fn semicolon_input_file_keeps_its_rows_and_mixed_delimiters_name_the_line() {
         "--out",
         out_dir.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let u = npy_values(&out_dir.join("u.npy"));
     assert_eq!((u[0], u[4], u[5], u[10]), (-1.0, -1.0, -2.0, -2.0), "{u:?}");
     let f = scratch("mixed-delim.csv");
@@ -308,6 +312,11 @@ fn semicolon_input_file_keeps_its_rows_and_mixed_delimiters_name_the_line() {
             "--input",
             f.to_str().unwrap(),
         ],
-        &["mixed-delim.csv:2", "the delimiter is `,`", "line 1", "uses `;`"],
+        &[
+            "mixed-delim.csv:2",
+            "the delimiter is `,`",
+            "line 1",
+            "uses `;`",
+        ],
     );
 }
