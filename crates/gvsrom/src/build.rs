@@ -684,7 +684,7 @@ fn loads(s: &Scenario, l: f64) -> Result<Loads, ScenarioError> {
     }
     let [gx, gy, gz] = spec.gravity;
     let g = gx.hypot(gy).hypot(gz); // no overflow to inf for finite components
-    if !(g <= MAX_GRAVITY) {
+    if g.is_nan() || g > MAX_GRAVITY {
         return Err(ScenarioError::value(
             "loads.gravity",
             g,
