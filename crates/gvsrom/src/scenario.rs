@@ -524,6 +524,11 @@ fn parse_value(raw: &str) -> Value {
     }
 }
 
+/// Most segments in a `--set` key path. The deepest key of the format has 5
+/// (`divisions[0].basis.orders.bend_y`); the limit keeps a path of thousands of segments from
+/// building a tree as deep, whose recursive walks would overflow the stack.
+pub const MAX_OVERRIDE_SEGMENTS: usize = 16;
+
 /// Applies one `path=value` override. Missing tables on the path are created (the deserializer
 /// then rejects keys the format does not know, naming the path); a list index may be at most the
 /// list's length (equal appends a new entry).
@@ -536,6 +541,12 @@ pub fn apply_override(table: &mut Table, spec: &str) -> Result<(), ScenarioError
         .split_once('=')
         .ok_or_else(|| err("expected `path=value`, e.g. `tendons.0.tension=-2`".into()))?;
     let segs = parse_path(path.trim()).map_err(&err)?;
+    if segs.len() > MAX_OVERRIDE_SEGMENTS {
+        return Err(err(format!(
+            "the key path has {} segments (accepted: at most {MAX_OVERRIDE_SEGMENTS})",
+            segs.len()
+        )));
+    }
     let Some(Seg::Key(_)) = segs.first() else {
         return Err(err("the path must start with a key".into()));
     };
@@ -750,6 +761,29 @@ mod tests {
             e.contains("`-1` is not a valid index of `loads.point`") && e.contains("0 entries"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn override_path_of_thousands_of_segments_is_rejected_not_a_stack_overflow() {
+        // Found by tests/scenario_fuzz.rs: 12 000 segments overflowed the stack (an abort, not a
+        // panic) in the recursive walks of the tree the path builds.
+        for spec in [
+            format!("{}=1", vec!["a"; 100_001].join(".")),
+            format!("tendons{}=1", "[0]".repeat(100_000)),
+        ] {
+            let e = Scenario::from_toml("t", MINIMAL, &[spec])
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains("100001 segments") && e.contains("at most 16"),
+                "{}",
+                &e[e.len() - 80..]
+            );
+        }
+        // The deepest keys of the format stay well inside the limit.
+        let s = Scenario::from_toml("t", MINIMAL, &["divisions[0].basis.orders.bend_y=4".into()])
+            .unwrap();
+        assert_eq!(s.divisions[0].basis.orders.bend_y, Some(4));
     }
 
     #[test]
