@@ -338,3 +338,59 @@ fn free_vibration_periods_match_eigenproblem_and_beam_theory() {
         );
     }
 }
+
+#[test]
+fn streaming_sink_sees_the_same_samples_and_can_stop_the_run() {
+    use gvs::solve::dynamics::simulate_streaming;
+    use gvs::solve::ode::OdeError;
+    use std::ops::ControlFlow;
+    let m = arm(1e4, 0.0);
+    let u = Signal::constant(&[-2.0]);
+    let t_out = samples(1.0, 20);
+    let full = simulate(
+        &m,
+        &u,
+        &gravity(),
+        None,
+        &InitialState::Rest,
+        &t_out,
+        &ndf(1e-6, 1e-9),
+    )
+    .unwrap();
+    assert_eq!(full.trajectory.t.len(), t_out.len());
+    // the sink breaks after the 6th sample: the run ends there, reported as Stopped at that time
+    let mut seen: Vec<(f64, Vec<f64>)> = vec![];
+    let summary = simulate_streaming(
+        &m,
+        &u,
+        &gravity(),
+        None,
+        &InitialState::Rest,
+        &t_out,
+        &ndf(1e-6, 1e-9),
+        &mut |s| {
+            seen.push((s.t, s.q.to_vec()));
+            assert_eq!(s.strain.len(), m.disc.n_points());
+            if seen.len() == 6 {
+                ControlFlow::Break("enough".into())
+            } else {
+                ControlFlow::Continue(())
+            }
+        },
+    )
+    .unwrap();
+    assert_eq!(summary.samples, 6);
+    assert_eq!(summary.t_last, Some(t_out[5]));
+    match summary.error {
+        Some(OdeError::Stopped { t, ref reason }) => {
+            assert_eq!(t, t_out[5]);
+            assert_eq!(reason, "enough");
+        }
+        ref other => panic!("expected Stopped, got {other:?}"),
+    }
+    // the samples before the stop are those of the uninterrupted run, bit for bit
+    for (k, (t, q)) in seen.iter().enumerate() {
+        assert_eq!(*t, full.trajectory.t[k]);
+        assert_eq!(q.as_slice(), full.trajectory.q[k].as_slice());
+    }
+}

@@ -3,11 +3,16 @@
 
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
+use gvsrom::output::OutputFile;
 use gvsrom::presets::{self, PRESETS};
+use gvsrom::simulate::{Ending, TrajectoryWriter};
 use gvsrom::statics::{self, StaticsReport};
 use gvsrom::{build, Built, Scenario};
 use std::io::Write;
+use std::ops::ControlFlow;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Arc;
 
 /// Simulate slender soft robots with the Geometric Variable Strain (GVS) Cosserat-rod model.
 #[derive(Debug, Parser)]
@@ -69,9 +74,14 @@ pub struct StaticsArgs {
     #[command(flatten)]
     pub scenario: ScenarioArgs,
 
-    /// Also write the solution (q, tip pose, centreline, strains, solver statistics) as JSON to FILE.
+    /// Also write the solution (q, tip pose, centreline, strains, solver statistics) as JSON to FILE
+    /// (a new file; see `--force`).
     #[arg(long, value_name = "FILE")]
     pub json: Option<PathBuf>,
+
+    /// Replace FILE if it is an earlier gvsrom output (never anything else).
+    #[arg(long, requires = "json")]
+    pub force: bool,
 }
 
 #[derive(Debug, Args)]
@@ -153,9 +163,15 @@ pub struct SimulateArgs {
     #[arg(long)]
     pub fd_jacobian: bool,
 
-    /// Write the trajectory (t, q, q̇, u, tip pose, strains) as .npy files and meta.json into DIR.
+    /// Write the trajectory (t, q, q̇, u, tip pose, strains) as .npy files and meta.json into the new
+    /// directory DIR, streamed as it is computed. An interrupted (Ctrl-C, SIGTERM) or failed run
+    /// still writes what it has, marked `"complete": false`.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+
+    /// Replace DIR if it is an earlier gvsrom output holding only its own files (never anything else).
+    #[arg(long, requires = "out")]
+    pub force: bool,
 }
 
 /// Runs the parsed command, printing to `out`.
@@ -209,12 +225,16 @@ fn check_cmd(args: &ScenarioArgs, out: &mut impl Write) -> Result<()> {
 
 fn statics_cmd(args: &StaticsArgs, out: &mut impl Write) -> Result<()> {
     let (scenario, built) = load(&args.scenario)?;
+    // the output is checked, locked and staged before the solve, so a bad path fails at once
+    let json = match &args.json {
+        Some(path) => Some(OutputFile::create("--json", path, "statics", args.force)?),
+        None => None,
+    };
     print_model(&scenario, &built, out)?;
     let report = statics::solve(&built)?;
     print_solution(&report, out)?;
-    if let Some(path) = &args.json {
-        statics::write_json_atomic(path, &report)
-            .with_context(|| format!("cannot write `{}`", path.display()))?;
+    if let Some(json) = json {
+        let path = json.commit_json(&report)?;
         writeln!(out, "json       {}", path.display())?;
     }
     Ok(())
@@ -227,7 +247,6 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
     use gvsrom::simulate::{self, InputSource, SimulateOptions};
     use std::io::IsTerminal;
     let (scenario, built) = load(&args.scenario)?;
-    print_model(&scenario, &built, out)?;
     let input = if let Some(path) = &args.input {
         let interpolation = if args.interpolate {
             Interpolation::Linear
@@ -292,10 +311,21 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
         },
         load_schedule: args.load_schedule.clone(),
     };
+    // everything is checked, and the output staged, before the computation starts
+    let plan = simulate::plan(&built, &opts)?;
+    let mut writer = match &args.out {
+        Some(dir) => {
+            simulate::check_output_size(&built, &plan)?;
+            Some(TrajectoryWriter::create(dir, args.force, &built)?)
+        }
+        None => None,
+    };
+    print_model(&scenario, &built, out)?;
+    let signal = interrupt_flag();
     let tty = std::io::stderr().is_terminal();
     let mut last_pct = usize::MAX;
     let duration = args.duration;
-    let mut progress = |t: f64| {
+    let mut control = |t: f64| {
         if tty {
             let pct = ((t / duration) * 100.0).clamp(0.0, 100.0) as usize;
             if pct != last_pct {
@@ -304,48 +334,108 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
                 eprint!("\r[{bar}] {pct:3}%  t = {t:.2} s");
             }
         }
+        match signal.load(Ordering::SeqCst) {
+            0 => ControlFlow::Continue(()),
+            s => ControlFlow::Break(format!("interrupted by {}", signal_name(s))),
+        }
     };
-    let (sim, _) = simulate::run(&built, &opts, &mut progress)?;
+    let outcome = simulate::run(
+        &built,
+        &plan,
+        &opts.integrator,
+        writer.as_mut(),
+        &mut control,
+    )?;
     if tty {
         eprintln!();
     }
-    let tr = &sim.trajectory;
+    let sm = &outcome.summary;
+    let t_last = sm.t_last.unwrap_or(0.0);
     writeln!(
         out,
-        "simulated  {:.3} s in {:.3} s wall time (real-time factor {:.1}), {} steps ({} failed), {} RHS and {} Jacobian evaluations",
-        tr.t.last().copied().unwrap_or(0.0),
-        sim.wall_time_s,
-        sim.real_time_factor(),
-        sim.stats.steps,
-        sim.stats.failed_steps,
-        sim.stats.rhs_evals,
-        sim.stats.jacobian_evals
+        "simulated  {t_last:.3} s in {:.3} s wall time (real-time factor {:.1}), {} steps ({} failed), {} RHS and {} Jacobian evaluations",
+        sm.wall_time_s,
+        outcome.real_time_factor(),
+        sm.stats.steps,
+        sm.stats.failed_steps,
+        sm.stats.rhs_evals,
+        sm.stats.jacobian_evals
     )?;
-    if let Some(g) = tr.tip.last() {
+    if let Some(g) = &outcome.last_tip {
         writeln!(
             out,
-            "tip        position {} m at t = {:.3} s",
+            "tip        position {} m at t = {t_last:.3} s",
             fmt_vec(&[g.pos[0], g.pos[1], g.pos[2]], 6),
-            tr.t.last().unwrap()
         )?;
     }
-    if let Some(dir) = &args.out {
-        simulate::write_trajectory(dir, &built, &sim)
-            .with_context(|| format!("cannot write `{}`", dir.display()))?;
-        writeln!(out, "trajectory {} ({} samples)", dir.display(), tr.t.len())?;
-    }
-    if let Some(e) = &sim.error {
-        anyhow::bail!(
-            "{e} (the {} samples before it were written{})",
-            tr.t.len(),
-            if args.out.is_some() {
+    let written = match writer {
+        Some(w) => {
+            let samples = w.samples();
+            let dir = w.finish(&built, &outcome, *plan.t_out.last().unwrap())?;
+            let partial = if outcome.ending == Ending::Complete {
                 ""
             } else {
-                " only with --out"
-            }
-        );
+                ", marked partial"
+            };
+            writeln!(
+                out,
+                "trajectory {} ({samples} samples{partial})",
+                dir.display()
+            )?;
+            Some((dir, samples))
+        }
+        None => None,
+    };
+    let kept = match &written {
+        Some((dir, n)) => format!(
+            "the {n} samples before it were written to `{}`, marked partial",
+            dir.display()
+        ),
+        None => format!(
+            "{} samples computed; nothing was written (no --out)",
+            sm.samples
+        ),
+    };
+    match &outcome.ending {
+        Ending::Complete => Ok(()),
+        Ending::Failed { error } => anyhow::bail!("{error} ({kept})"),
+        Ending::Interrupted { reason } => Err(Interrupted {
+            signal: signal.load(Ordering::SeqCst) as i32,
+            message: format!("{reason} at t = {t_last} s; {kept}"),
+        }
+        .into()),
     }
-    Ok(())
+}
+
+/// A run stopped by SIGINT or SIGTERM; the binary exits with 128 + the signal number.
+#[derive(Debug, thiserror::Error)]
+#[error("{message}")]
+pub struct Interrupted {
+    pub signal: i32,
+    pub message: String,
+}
+
+/// Installs SIGINT/SIGTERM handlers that record the signal in the returned flag (the run then stops
+/// at its next sample and writes what it has); a second signal ends the process at once.
+fn interrupt_flag() -> Arc<AtomicUsize> {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let which = Arc::new(AtomicUsize::new(0));
+    let again = Arc::new(AtomicBool::new(false));
+    for sig in [SIGINT, SIGTERM] {
+        // order matters: the shutdown checks the flag set by the earlier signal
+        let _ = signal_hook::flag::register_conditional_shutdown(sig, 128 + sig, again.clone());
+        let _ = signal_hook::flag::register(sig, again.clone());
+        let _ = signal_hook::flag::register_usize(sig, which.clone(), sig as usize);
+    }
+    which
+}
+
+fn signal_name(sig: usize) -> &'static str {
+    match sig as i32 {
+        signal_hook::consts::SIGINT => "SIGINT",
+        signal_hook::consts::SIGTERM => "SIGTERM",
+        _ => "a signal",
+    }
 }
 
 fn fmt_vec(v: &[f64], prec: usize) -> String {

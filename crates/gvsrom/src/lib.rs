@@ -9,6 +9,7 @@ pub mod build;
 pub mod csv_input;
 pub mod error;
 pub mod npy;
+pub mod output;
 pub mod plausibility;
 pub mod presets;
 pub mod scenario;

@@ -25,6 +25,10 @@ fn main() -> ExitCode {
                 return ExitCode::SUCCESS;
             }
             let msg = format!("{e:#}").replace('\n', " ");
+            if let Some(i) = e.downcast_ref::<cli::Interrupted>() {
+                eprintln!("interrupted: {msg}");
+                return ExitCode::from((128 + i.signal).clamp(0, 255) as u8);
+            }
             eprintln!("error: {msg}");
             ExitCode::FAILURE
         }

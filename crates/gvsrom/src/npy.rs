@@ -1,64 +1,117 @@
-//! A minimal writer of NumPy `.npy` files (format version 1.0, little-endian f64, C order), so that
-//! trajectories open with `numpy.load` without any dependency on our side.
+//! NumPy `.npy` arrays (little-endian f64, C order, written by npyz) inside an [`OutputDir`]:
+//! whole arrays, and arrays streamed row by row whose number of rows is known only at the end.
 
-use std::io::{self, Write};
+use crate::output::OutputDir;
+use npyz::WriterBuilder;
+use std::fs::File;
+use std::io::{self, BufWriter, Write};
 
-/// Writes `data` (C order, `shape.iter().product()` values) as a `.npy` array.
-pub fn write_npy(w: &mut impl Write, shape: &[usize], data: &[f64]) -> io::Result<()> {
+fn shape_u64(shape: &[usize]) -> Vec<u64> {
+    shape.iter().map(|&d| d as u64).collect()
+}
+
+/// Writes `data` (C order, `shape.iter().product()` values) as the array `name` of `dir`.
+pub fn write_array(
+    dir: &mut OutputDir,
+    name: &str,
+    shape: &[usize],
+    data: &[f64],
+) -> io::Result<()> {
     let n: usize = shape.iter().product();
     if n != data.len() {
         return Err(io::Error::new(
             io::ErrorKind::InvalidInput,
-            format!("npy: shape {shape:?} holds {n} values, got {}", data.len()),
+            format!(
+                "{name}: shape {shape:?} holds {n} values, got {}",
+                data.len()
+            ),
         ));
     }
-    let dims = match shape.len() {
-        1 => format!("({},)", shape[0]),
-        _ => format!(
-            "({})",
-            shape
-                .iter()
-                .map(|d| d.to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        ),
-    };
-    let mut header = format!("{{'descr': '<f8', 'fortran_order': False, 'shape': {dims}, }}");
-    // magic (6) + version (2) + header length (2) + header + '\n' is a multiple of 64
-    let total = 10 + header.len() + 1;
-    header.push_str(&" ".repeat((64 - total % 64) % 64));
-    header.push('\n');
-    w.write_all(b"\x93NUMPY\x01\x00")?;
-    w.write_all(&(header.len() as u16).to_le_bytes())?;
-    w.write_all(header.as_bytes())?;
-    let mut buf = Vec::with_capacity(8 * data.len());
-    for v in data {
-        buf.extend_from_slice(&v.to_le_bytes());
-    }
-    w.write_all(&buf)
+    dir.write_file(name, |w| {
+        let mut npy = npyz::WriteOptions::new()
+            .default_dtype()
+            .shape(&shape_u64(shape))
+            .writer(w)
+            .begin_nd()?;
+        npy.extend(data.iter().copied())?;
+        npy.finish()
+    })
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
+/// An array of shape `(rows, row_shape…)` written one row at a time, with memory independent of the
+/// number of rows: rows go to the scratch file `NAME.rows` of the output; [`NpyRows::finish`] writes
+/// the header for the final row count followed by the data as `NAME` and removes the scratch file.
+pub struct NpyRows {
+    name: String,
+    scratch: String,
+    row_shape: Vec<usize>,
+    row_len: usize,
+    rows: usize,
+    out: BufWriter<File>,
+}
 
-    #[test]
-    fn header_is_aligned_and_data_follows() {
-        let mut out = Vec::new();
-        write_npy(&mut out, &[2, 3], &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0]).unwrap();
-        assert_eq!(&out[..8], b"\x93NUMPY\x01\x00");
-        let hl = u16::from_le_bytes([out[8], out[9]]) as usize;
-        assert_eq!((10 + hl) % 64, 0);
-        let header = std::str::from_utf8(&out[10..10 + hl]).unwrap();
-        assert!(header.contains("'shape': (2, 3)") && header.ends_with('\n'));
-        assert_eq!(out.len(), 10 + hl + 48);
-        assert_eq!(
-            f64::from_le_bytes(out[10 + hl + 40..].try_into().unwrap()),
-            6.0
-        );
-        let mut out = Vec::new();
-        write_npy(&mut out, &[4], &[0.0; 4]).unwrap();
-        assert!(std::str::from_utf8(&out[10..74]).unwrap().contains("(4,)"));
-        assert!(write_npy(&mut Vec::new(), &[3], &[1.0]).is_err());
+impl NpyRows {
+    pub fn new(dir: &mut OutputDir, name: &str, row_shape: &[usize]) -> io::Result<Self> {
+        let scratch = format!("{name}.rows");
+        let out = BufWriter::with_capacity(1 << 16, dir.create_file(&scratch)?);
+        Ok(NpyRows {
+            name: name.into(),
+            scratch,
+            row_shape: row_shape.to_vec(),
+            row_len: row_shape.iter().product(),
+            rows: 0,
+            out,
+        })
+    }
+
+    /// Appends one row (`row_shape.iter().product()` values, C order).
+    pub fn push(&mut self, row: impl IntoIterator<Item = f64>) -> io::Result<()> {
+        let mut k = 0;
+        for v in row {
+            self.out.write_all(&v.to_le_bytes())?;
+            k += 1;
+        }
+        if k != self.row_len {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                format!(
+                    "{}: a row of {k} values, expected {}",
+                    self.name, self.row_len
+                ),
+            ));
+        }
+        self.rows += 1;
+        Ok(())
+    }
+
+    /// Rows written so far.
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// Writes the array `NAME` (header for the rows written, then the data) and removes the scratch.
+    pub fn finish(self, dir: &mut OutputDir) -> io::Result<()> {
+        let NpyRows {
+            name,
+            scratch,
+            row_shape,
+            rows,
+            out,
+            ..
+        } = self;
+        out.into_inner().map_err(|e| e.into_error())?;
+        let mut shape = vec![rows];
+        shape.extend(&row_shape);
+        let scratch_path = dir.staging().join(&scratch);
+        dir.write_file(&name, |w| {
+            let w = npyz::WriteOptions::<f64>::new()
+                .default_dtype()
+                .shape(&shape_u64(&shape))
+                .writer(w)
+                .write_header_only()?;
+            io::copy(&mut File::open(&scratch_path)?, w)?;
+            Ok(())
+        })?;
+        dir.remove_file(&scratch)
     }
 }

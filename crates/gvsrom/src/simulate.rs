@@ -2,8 +2,10 @@
 //! file, the paper's random steps or actuator babbling), the initial state, the integrator, and the
 //! trajectory written as NumPy arrays.
 //!
-//! Output directory (written as `DIR.partial` and renamed when complete; after a failed integration
-//! the samples up to the failure are still written and `meta.json` says why it stopped):
+//! The samples stream to disk as they are computed (memory does not grow with the run's length),
+//! through [`crate::output`]: into a hidden staging directory beside `DIR`, moved into place at the
+//! end. A run that fails or is interrupted (SIGINT/SIGTERM) still writes the samples computed so far,
+//! with `"complete": false`, the reason and the last time reached in `meta.json`.
 //!
 //! | file | shape | content |
 //! |---|---|---|
@@ -14,16 +16,20 @@
 //! | `tip_rotation.npy` | (N, 3, 3) | tip rotation matrices (section → world) |
 //! | `strain.npy` | (N, p, 6) | ξ at the p computational points, `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]` |
 //! | `strain_x.npy` | (p,) | abscissae of the computational points [m] |
-//! | `meta.json` | | scenario, sizes, integrator statistics, wall time, real-time factor, error |
+//! | `meta.json` | | manifest (`gvsrom`: format, version, files), scenario, `complete`, `reason`, `t_reached`, sizes, integrator statistics, wall time, real-time factor, error |
 
 use crate::build::Built;
 use crate::error::ScenarioError;
-use crate::npy::write_npy;
+use crate::npy::NpyRows;
+use crate::output::{OutputDir, OutputError};
 use gvs::inputs::{babble, random_steps, Interpolation, Signal};
+use gvs::lie::Pose;
 use gvs::solve::dynamics::{
-    simulate_with_progress, InitialState, IntegratorOptions, Simulation, SimulationError,
+    simulate_streaming, InitialState, IntegratorOptions, Method, RunSummary, Sample,
+    SimulationError,
 };
 use serde::Serialize;
+use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
 /// Where the actuation comes from.
@@ -139,34 +145,92 @@ fn range_check(field: &str, lo: f64, hi: f64) -> Result<(), ScenarioError> {
     }
 }
 
-/// Runs the simulation; `progress(t)` is called at every sample.
-pub fn run(
-    built: &Built,
-    opts: &SimulateOptions,
-    progress: &mut dyn FnMut(f64),
-) -> Result<(Simulation, Signal), ScenarioError> {
-    positive("--duration", opts.duration, "s")?;
-    positive("--sample-rate", opts.sample_rate, "Hz")?;
-    let n_samples = (opts.duration * opts.sample_rate).floor() as usize + 1;
-    if n_samples > 10_000_000 {
-        return Err(ScenarioError::value(
-            "--sample-rate",
-            opts.sample_rate,
-            "at most 1e7 samples in all",
+/// Most output samples of one run.
+pub const MAX_SAMPLES: usize = 10_000_000;
+/// Most steps of one fixed-step run (`--duration / --fixed-step`).
+pub const MAX_FIXED_STEPS: f64 = 1e7;
+/// Most input switches of a random-step or babbling signal (`--duration / period`).
+pub const MAX_INPUT_SWITCHES: f64 = 1e7;
+/// Largest trajectory one run writes [bytes] (16 GiB).
+pub const MAX_OUTPUT_BYTES: f64 = 16.0 * 1024.0 * 1024.0 * 1024.0;
+
+/// The output times `t_k = k / rate` for `t_k ≤ duration`, followed by `duration` itself when it is
+/// not a multiple of the sample period, so the last sample is always at `duration`.
+pub fn sample_times(duration: f64, rate: f64) -> Result<Vec<f64>, ScenarioError> {
+    positive("--duration", duration, "s")?;
+    positive("--sample-rate", rate, "Hz")?;
+    let periods = (duration * rate * (1.0 + 4.0 * f64::EPSILON)).floor();
+    if !periods.is_finite() || periods >= (MAX_SAMPLES - 1) as f64 {
+        return Err(ScenarioError::invalid(
+            "--duration",
+            format!(
+                "{} s at --sample-rate {} Hz gives {} samples (accepted <= {MAX_SAMPLES}); lower --duration or --sample-rate",
+                gvs::error::fmt_value(duration),
+                gvs::error::fmt_value(rate),
+                gvs::error::fmt_value(periods + 1.0)
+            ),
         ));
     }
-    let t_out: Vec<f64> = (0..n_samples)
-        .map(|k| k as f64 / opts.sample_rate)
-        .collect();
-    let signal = input_signal(built, opts)?;
-    let initial = if opts.start_at_equilibrium {
-        InitialState::Equilibrium {
-            u: built.u.clone(),
-            loads: built.loads.clone(),
+    let m = periods as usize;
+    let mut t: Vec<f64> = (0..=m).map(|k| k as f64 / rate).collect();
+    let last = t[m];
+    if last > duration {
+        t[m] = duration; // rounding put k/rate a hair past the end
+    } else if duration - last > 1e-9 * duration.max(1.0) / rate.max(1.0) {
+        t.push(duration);
+    }
+    Ok(t)
+}
+
+/// A run checked before anything is computed or written: its sample times, actuation, load schedule
+/// and initial state. Inputs whose loads or tensions lie far beyond the rod's elastic range are
+/// refused here (see [`crate::plausibility`]).
+pub struct Plan {
+    pub t_out: Vec<f64>,
+    pub signal: Signal,
+    pub schedule: Option<Signal>,
+    pub initial: InitialState,
+}
+
+/// Validates `opts` against `built` and builds the [`Plan`] of the run.
+pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError> {
+    let t_out = sample_times(opts.duration, opts.sample_rate)?;
+    if let Method::Fixed(f) = &opts.integrator.method {
+        let h = positive("--fixed-step", f.h, "s")?;
+        if opts.duration / h > MAX_FIXED_STEPS {
+            return Err(ScenarioError::invalid(
+                "--fixed-step",
+                format!(
+                    "{} s over --duration {} s is {} steps (accepted <= {}); use a larger step or the adaptive integrator",
+                    gvs::error::fmt_value(h),
+                    gvs::error::fmt_value(opts.duration),
+                    gvs::error::fmt_value(opts.duration / h),
+                    gvs::error::fmt_value(MAX_FIXED_STEPS)
+                ),
+            ));
         }
-    } else {
-        InitialState::Rest
+    }
+    let switch_period = match &opts.input {
+        InputSource::Steps { period, .. } => Some(("--steps period", *period)),
+        InputSource::Babble { hold_min, .. } => Some(("--babble hold_min", *hold_min)),
+        _ => None,
     };
+    if let Some((field, p)) = switch_period {
+        let p = positive(field, p, "s")?;
+        if opts.duration / p > MAX_INPUT_SWITCHES {
+            return Err(ScenarioError::invalid(
+                field,
+                format!(
+                    "{} s over --duration {} s is {} input switches (accepted <= {})",
+                    gvs::error::fmt_value(p),
+                    gvs::error::fmt_value(opts.duration),
+                    gvs::error::fmt_value(opts.duration / p),
+                    gvs::error::fmt_value(MAX_INPUT_SWITCHES)
+                ),
+            ));
+        }
+    }
+    let signal = input_signal(built, opts)?;
     let schedule = match &opts.load_schedule {
         Some(path) => Some(crate::csv_input::read_csv_signal(
             path,
@@ -175,31 +239,301 @@ pub fn run(
         )?),
         None => None,
     };
-    let sim = simulate_with_progress(
+    let u_max = crate::csv_input::max_abs_per_column(&signal);
+    let lambda_max = schedule
+        .as_ref()
+        .map(|s| crate::csv_input::max_abs_per_column(s)[0])
+        .unwrap_or(1.0);
+    crate::plausibility::check(built, &u_max, lambda_max)?;
+    let initial = if opts.start_at_equilibrium {
+        InitialState::Equilibrium {
+            u: built.u.clone(),
+            loads: built.loads.clone(),
+        }
+    } else {
+        InitialState::Rest
+    };
+    Ok(Plan {
+        t_out,
+        signal,
+        schedule,
+        initial,
+    })
+}
+
+/// How a run ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Ending {
+    /// Every sample up to the requested duration was computed.
+    Complete,
+    /// Stopped on request (an interrupt) after the last sample delivered.
+    Interrupted { reason: String },
+    /// The integrator failed; the samples before the failure were delivered.
+    Failed { error: String },
+}
+
+/// The result of [`run`]: the summary of the streamed simulation and the last sample's tip.
+#[derive(Debug)]
+pub struct Outcome {
+    pub summary: RunSummary,
+    pub ending: Ending,
+    /// Tip pose of the last sample.
+    pub last_tip: Option<Pose>,
+}
+
+impl Outcome {
+    /// Simulated time per wall-clock time.
+    pub fn real_time_factor(&self) -> f64 {
+        self.summary.t_last.unwrap_or(0.0) / self.summary.wall_time_s.max(1e-12)
+    }
+}
+
+/// Runs the planned simulation, streaming each sample to `writer` (if any) and calling
+/// `control(t)` after each: returning `ControlFlow::Break(reason)` interrupts the run (the samples so
+/// far are kept). A failed write stops the run with an error.
+pub fn run(
+    built: &Built,
+    plan: &Plan,
+    integrator: &IntegratorOptions,
+    mut writer: Option<&mut TrajectoryWriter>,
+    control: &mut dyn FnMut(f64) -> ControlFlow<String>,
+) -> Result<Outcome, ScenarioError> {
+    let mut last_tip = None;
+    let mut write_error: Option<std::io::Error> = None;
+    let mut interrupted = None;
+    let summary = simulate_streaming(
         &built.model,
-        &signal,
+        &plan.signal,
         &built.loads,
-        schedule.as_ref(),
-        &initial,
-        &t_out,
-        &opts.integrator,
-        progress,
+        plan.schedule.as_ref(),
+        &plan.initial,
+        &plan.t_out,
+        integrator,
+        &mut |s| {
+            last_tip = Some(*s.tip);
+            if let Some(w) = writer.as_deref_mut() {
+                if let Err(e) = w.push(s) {
+                    let msg = format!("cannot write the trajectory: {e}");
+                    write_error = Some(e);
+                    return ControlFlow::Break(msg);
+                }
+            }
+            let flow = control(s.t);
+            if let ControlFlow::Break(reason) = &flow {
+                interrupted = Some(reason.clone());
+            }
+            flow
+        },
     )
     .map_err(|e| match e {
         SimulationError::Model(m) => ScenarioError::from(m),
-        SimulationError::Initial(s) => ScenarioError::invalid("initial equilibrium", s.to_string()),
+        SimulationError::Initial(s) => ScenarioError::invalid(
+            "--from-equilibrium",
+            format!(
+                "the initial equilibrium failed: {s}{}",
+                crate::plausibility::largest_load(built, &built.u, 1.0)
+                    .map(|l| format!("; {l}"))
+                    .unwrap_or_default()
+            ),
+        ),
     })?;
-    Ok((sim, signal))
+    if let Some(e) = write_error {
+        return Err(ScenarioError::invalid(
+            "--out",
+            format!(
+                "cannot write the trajectory at t = {}: {e}",
+                summary.t_last.unwrap_or(0.0)
+            ),
+        ));
+    }
+    let ending = match (&summary.error, interrupted) {
+        (None, _) => Ending::Complete,
+        (Some(_), Some(reason)) => Ending::Interrupted { reason },
+        (Some(e), None) => Ending::Failed {
+            error: e.to_string(),
+        },
+    };
+    Ok(Outcome {
+        summary,
+        ending,
+        last_tip,
+    })
+}
+
+/// Bytes written per sample: `t`, `q`, `q̇`, `u`, tip position and rotation, strains (f64 each).
+fn bytes_per_sample(built: &Built) -> f64 {
+    let m = &built.model;
+    8.0 * (1 + 2 * m.n_dof() + m.n_actuators() + 3 + 9 + 6 * m.disc.n_points()) as f64
+}
+
+/// Refuses a trajectory larger than [`MAX_OUTPUT_BYTES`] before anything is computed.
+pub fn check_output_size(built: &Built, plan: &Plan) -> Result<(), ScenarioError> {
+    let bytes = plan.t_out.len() as f64 * bytes_per_sample(built);
+    if bytes > MAX_OUTPUT_BYTES {
+        return Err(ScenarioError::invalid(
+            "--out",
+            format!(
+                "the trajectory would take {:.1} GB ({} samples of {} kB; accepted <= {:.1} GB); lower --duration or --sample-rate",
+                bytes / 1e9,
+                plan.t_out.len(),
+                bytes_per_sample(built) / 1e3,
+                MAX_OUTPUT_BYTES / 1e9
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// A trajectory being written sample by sample into an output directory (see the module
+/// documentation for the files). Memory does not depend on the number of samples.
+pub struct TrajectoryWriter {
+    dir: OutputDir,
+    t: NpyRows,
+    q: NpyRows,
+    qd: NpyRows,
+    u: NpyRows,
+    tip_position: NpyRows,
+    tip_rotation: NpyRows,
+    strain: NpyRows,
+}
+
+impl TrajectoryWriter {
+    /// Opens the output directory `path` (refusing unsafe targets, see [`crate::output`]) and the
+    /// arrays, before the run starts.
+    pub fn create(path: &Path, force: bool, built: &Built) -> Result<Self, OutputError> {
+        let mut dir = OutputDir::create("--out", path, "trajectory", force)?;
+        let m = &built.model;
+        let (n, na, np) = (m.n_dof(), m.n_actuators(), m.disc.n_points());
+        let open = |dir: &mut OutputDir| -> std::io::Result<_> {
+            Ok((
+                NpyRows::new(dir, "t.npy", &[])?,
+                NpyRows::new(dir, "q.npy", &[n])?,
+                NpyRows::new(dir, "qd.npy", &[n])?,
+                NpyRows::new(dir, "u.npy", &[na])?,
+                NpyRows::new(dir, "tip_position.npy", &[3])?,
+                NpyRows::new(dir, "tip_rotation.npy", &[3, 3])?,
+                NpyRows::new(dir, "strain.npy", &[np, 6])?,
+            ))
+        };
+        let (t, q, qd, u, tip_position, tip_rotation, strain) =
+            open(&mut dir).map_err(|e| dir.io_error("create the trajectory files", e))?;
+        Ok(TrajectoryWriter {
+            dir,
+            t,
+            q,
+            qd,
+            u,
+            tip_position,
+            tip_rotation,
+            strain,
+        })
+    }
+
+    /// Appends one sample.
+    pub fn push(&mut self, s: &Sample<'_>) -> std::io::Result<()> {
+        self.t.push([s.t])?;
+        self.q.push(s.q.iter().copied())?;
+        self.qd.push(s.qd.iter().copied())?;
+        self.u.push(s.u.iter().copied())?;
+        self.tip_position.push(s.tip.pos.iter().copied())?;
+        let r = &s.tip.rot;
+        self.tip_rotation
+            .push((0..3).flat_map(|i| (0..3).map(move |j| r[(i, j)])))?;
+        self.strain
+            .push(s.strain.iter().flat_map(|xi| xi.iter().copied()))
+    }
+
+    /// Samples written so far.
+    pub fn samples(&self) -> usize {
+        self.t.rows()
+    }
+
+    /// Completes the arrays, writes `meta.json` (with `"complete"`, the reason for an early end and
+    /// the last time reached) and moves the directory into place.
+    pub fn finish(
+        self,
+        built: &Built,
+        outcome: &Outcome,
+        requested_end: f64,
+    ) -> Result<PathBuf, OutputError> {
+        let TrajectoryWriter {
+            mut dir,
+            t,
+            q,
+            qd,
+            u,
+            tip_position,
+            tip_rotation,
+            strain,
+        } = self;
+        let samples = t.rows();
+        let arrays = [t, q, qd, u, tip_position, tip_rotation, strain];
+        (|| -> std::io::Result<()> {
+            for a in arrays {
+                a.finish(&mut dir)?;
+            }
+            crate::npy::write_array(
+                &mut dir,
+                "strain_x.npy",
+                &[built.model.disc.n_points()],
+                &built
+                    .model
+                    .disc
+                    .points
+                    .iter()
+                    .map(|p| p.x)
+                    .collect::<Vec<_>>(),
+            )
+        })()
+        .map_err(|e| dir.io_error("write the trajectory arrays", e))?;
+        let sm = &outcome.summary;
+        let (complete, reason, error) = match &outcome.ending {
+            Ending::Complete => (true, None, None),
+            Ending::Interrupted { reason } => (false, Some(reason.clone()), None),
+            Ending::Failed { error } => (
+                false,
+                Some("the integration failed".into()),
+                Some(error.clone()),
+            ),
+        };
+        let meta = Meta {
+            scenario: &built.name,
+            complete,
+            reason,
+            t_reached: sm.t_last,
+            t_requested: requested_end,
+            samples,
+            n_dof: built.model.n_dof(),
+            n_points: built.model.disc.n_points(),
+            n_actuators: built.model.n_actuators(),
+            wall_time_s: sm.wall_time_s,
+            real_time_factor: outcome.real_time_factor(),
+            steps: sm.stats.steps,
+            failed_steps: sm.stats.failed_steps,
+            rhs_evaluations: sm.stats.rhs_evals,
+            jacobian_evaluations: sm.stats.jacobian_evals,
+            lu_decompositions: sm.stats.lu_decompositions,
+            error,
+        };
+        dir.commit(meta)
+    }
 }
 
 #[derive(Serialize)]
 struct Meta<'a> {
     scenario: &'a str,
+    /// `false` if the run ended before `t_requested` (interrupted or failed): the arrays hold the
+    /// samples up to `t_reached`.
+    complete: bool,
+    /// Why an incomplete run ended.
+    reason: Option<String>,
+    /// Time of the last sample written.
+    t_reached: Option<f64>,
+    t_requested: f64,
+    samples: usize,
     n_dof: usize,
     n_points: usize,
     n_actuators: usize,
-    samples: usize,
-    t_end: f64,
     wall_time_s: f64,
     real_time_factor: f64,
     steps: usize,
@@ -207,90 +541,6 @@ struct Meta<'a> {
     rhs_evaluations: usize,
     jacobian_evaluations: usize,
     lu_decompositions: usize,
-    /// `null` if the run completed; otherwise why it stopped (the arrays hold the samples before).
+    /// The integrator's error if it failed.
     error: Option<String>,
-}
-
-/// Writes the trajectory as `.npy` arrays plus `meta.json` into `dir` (atomically, via `dir.partial`).
-pub fn write_trajectory(dir: &Path, built: &Built, sim: &Simulation) -> std::io::Result<()> {
-    let tr = &sim.trajectory;
-    let n = built.model.n_dof();
-    let na = built.model.n_actuators();
-    let np = built.model.disc.n_points();
-    let ns = tr.t.len();
-    let partial = dir.with_extension("partial");
-    if partial.exists() {
-        std::fs::remove_dir_all(&partial)?;
-    }
-    std::fs::create_dir_all(&partial)?;
-    let save = |name: &str, shape: &[usize], data: Vec<f64>| -> std::io::Result<()> {
-        let mut f = std::io::BufWriter::new(std::fs::File::create(partial.join(name))?);
-        write_npy(&mut f, shape, &data)?;
-        std::io::Write::flush(&mut f)
-    };
-    save("t.npy", &[ns], tr.t.clone())?;
-    save(
-        "q.npy",
-        &[ns, n],
-        tr.q.iter().flat_map(|q| q.iter().copied()).collect(),
-    )?;
-    save(
-        "qd.npy",
-        &[ns, n],
-        tr.qd.iter().flat_map(|q| q.iter().copied()).collect(),
-    )?;
-    save("u.npy", &[ns, na], tr.u.iter().flatten().copied().collect())?;
-    save(
-        "tip_position.npy",
-        &[ns, 3],
-        tr.tip
-            .iter()
-            .flat_map(|g| g.pos.iter().copied().collect::<Vec<_>>())
-            .collect(),
-    )?;
-    save(
-        "tip_rotation.npy",
-        &[ns, 3, 3],
-        tr.tip
-            .iter()
-            .flat_map(|g| (0..3).flat_map(move |i| (0..3).map(move |j| g.rot[(i, j)])))
-            .collect(),
-    )?;
-    save(
-        "strain.npy",
-        &[ns, np, 6],
-        tr.strain
-            .iter()
-            .flat_map(|s| s.iter().flat_map(|x| x.iter().copied().collect::<Vec<_>>()))
-            .collect(),
-    )?;
-    save(
-        "strain_x.npy",
-        &[np],
-        built.model.disc.points.iter().map(|p| p.x).collect(),
-    )?;
-    let meta = Meta {
-        scenario: &built.name,
-        n_dof: n,
-        n_points: np,
-        n_actuators: na,
-        samples: ns,
-        t_end: tr.t.last().copied().unwrap_or(0.0),
-        wall_time_s: sim.wall_time_s,
-        real_time_factor: sim.real_time_factor(),
-        steps: sim.stats.steps,
-        failed_steps: sim.stats.failed_steps,
-        rhs_evaluations: sim.stats.rhs_evals,
-        jacobian_evaluations: sim.stats.jacobian_evals,
-        lu_decompositions: sim.stats.lu_decompositions,
-        error: sim.error.as_ref().map(|e| e.to_string()),
-    };
-    std::fs::write(
-        partial.join("meta.json"),
-        serde_json::to_string_pretty(&meta)? + "\n",
-    )?;
-    if dir.exists() {
-        std::fs::remove_dir_all(dir)?;
-    }
-    std::fs::rename(&partial, dir)
 }

@@ -6,8 +6,6 @@ use crate::error::StaticsFailure;
 use gvs::lie::V3;
 use gvs::solve::statics::{StaticsError, StaticsSolver, MAX_RAMP_STEPS};
 use serde::Serialize;
-use std::io::Write;
-use std::path::Path;
 use std::time::Instant;
 
 /// The result of one statics solve (this is also the `--json` output).
@@ -124,23 +122,4 @@ fn failure(built: &Built, error: StaticsError) -> StaticsFailure {
 
 fn arr3(v: &V3) -> [f64; 3] {
     [v[0], v[1], v[2]]
-}
-
-/// Writes `value` as JSON to `path` atomically: to `path.tmp` first, then renamed over `path`, so
-/// an interrupted run never leaves a truncated file under the final name.
-pub fn write_json_atomic<T: Serialize>(path: &Path, value: &T) -> std::io::Result<()> {
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".tmp");
-    let tmp = std::path::PathBuf::from(tmp);
-    let result = (|| {
-        let mut f = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
-        serde_json::to_writer(&mut f, value)?;
-        f.write_all(b"\n")?;
-        f.into_inner().map_err(|e| e.into_error())?.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
 }

@@ -18,6 +18,7 @@ use crate::loads::Loads;
 use crate::model::{Model, PreparedLoads, Workspace};
 use crate::strain::StrainParam;
 use nalgebra::DVector;
+use std::ops::ControlFlow;
 use std::time::Instant;
 
 /// The integration method.
@@ -175,8 +176,38 @@ impl<P: StrainParam> OdeSystem for RodOde<'_, P> {
     }
 }
 
+/// One output sample of a simulation, lent to the sample callback of [`simulate_streaming`].
+#[derive(Debug, Clone, Copy)]
+pub struct Sample<'a> {
+    pub t: f64,
+    pub q: &'a [f64],
+    pub qd: &'a [f64],
+    /// Actuation `u(t)`.
+    pub u: &'a [f64],
+    /// Tip pose `g(L)`.
+    pub tip: &'a Pose,
+    /// Strain `ξ` at the computational points.
+    pub strain: &'a [V6],
+}
+
+/// What a streamed simulation reports besides its samples.
+#[derive(Debug)]
+pub struct RunSummary {
+    /// Samples delivered.
+    pub samples: usize,
+    /// Time of the last sample delivered (`None` if none was).
+    pub t_last: Option<f64>,
+    pub stats: OdeStats,
+    pub wall_time_s: f64,
+    /// `Some` if the integration stopped before the last output time: a failure of the method, or
+    /// [`OdeError::Stopped`] when the sample callback asked to stop. The samples before it were
+    /// delivered.
+    pub error: Option<OdeError>,
+}
+
 /// Simulates `model` under actuation `actuation(t)` and `loads` scaled by `load_scale(t)` (1 if
-/// `None`) from `initial`, sampling at `t_out` (ascending, the first is the start time).
+/// `None`) from `initial`, sampling at `t_out` (ascending, the first is the start time), and keeps
+/// the samples in memory. See [`simulate_streaming`] for runs too long to hold.
 pub fn simulate<P: StrainParam>(
     model: &Model<P>,
     actuation: &Signal,
@@ -186,7 +217,8 @@ pub fn simulate<P: StrainParam>(
     t_out: &[f64],
     options: &IntegratorOptions,
 ) -> Result<Simulation, SimulationError> {
-    simulate_with_progress(
+    let mut traj = Trajectory::default();
+    let summary = simulate_streaming(
         model,
         actuation,
         loads,
@@ -194,13 +226,29 @@ pub fn simulate<P: StrainParam>(
         initial,
         t_out,
         options,
-        &mut |_| {},
-    )
+        &mut |s| {
+            traj.t.push(s.t);
+            traj.q.push(DVector::from_column_slice(s.q));
+            traj.qd.push(DVector::from_column_slice(s.qd));
+            traj.u.push(s.u.to_vec());
+            traj.tip.push(*s.tip);
+            traj.strain.push(s.strain.to_vec());
+            ControlFlow::Continue(())
+        },
+    )?;
+    Ok(Simulation {
+        trajectory: traj,
+        stats: summary.stats,
+        wall_time_s: summary.wall_time_s,
+        error: summary.error,
+    })
 }
 
-/// [`simulate`], calling `progress(t)` at every sample (for progress bars).
+/// [`simulate`], handing every sample to `sink` instead of keeping it, so memory does not grow with
+/// the number of samples. `sink` returning `ControlFlow::Break(reason)` stops the integration after
+/// that sample; the summary then reports [`OdeError::Stopped`].
 #[allow(clippy::too_many_arguments)]
-pub fn simulate_with_progress<P: StrainParam>(
+pub fn simulate_streaming<P: StrainParam>(
     model: &Model<P>,
     actuation: &Signal,
     loads: &Loads,
@@ -208,8 +256,8 @@ pub fn simulate_with_progress<P: StrainParam>(
     initial: &InitialState,
     t_out: &[f64],
     options: &IntegratorOptions,
-    progress: &mut dyn FnMut(f64),
-) -> Result<Simulation, SimulationError> {
+    sink: &mut dyn FnMut(&Sample<'_>) -> ControlFlow<String>,
+) -> Result<RunSummary, SimulationError> {
     let n = model.n_dof();
     actuation.validate("actuation", model.n_actuators())?;
     if let Some(s) = load_scale {
@@ -281,20 +329,25 @@ pub fn simulate_with_progress<P: StrainParam>(
         breaks.sort_by(|a, b| a.partial_cmp(b).unwrap());
         breaks.dedup();
     }
-    let mut traj = Trajectory::default();
     let mut out_ws = model.workspace();
+    let mut qbuf = DVector::zeros(n);
     let mut ubuf = vec![0.0; model.n_actuators()];
+    let mut samples = 0;
+    let mut t_last = None;
     let mut record = |t: f64, y: &DVector<f64>| {
-        let q = y.rows(0, n).into_owned();
-        model.forward(&q, &mut out_ws, false);
+        qbuf.copy_from(&y.rows(0, n));
+        model.forward(&qbuf, &mut out_ws, false);
         actuation.eval(t, &mut ubuf);
-        traj.t.push(t);
-        traj.qd.push(y.rows(n, n).into_owned());
-        traj.q.push(q);
-        traj.u.push(ubuf.clone());
-        traj.tip.push(*out_ws.g.last().unwrap());
-        traj.strain.push(model.point_strains(&out_ws));
-        progress(t);
+        samples += 1;
+        t_last = Some(t);
+        sink(&Sample {
+            t,
+            q: &y.as_slice()[..n],
+            qd: &y.as_slice()[n..],
+            u: &ubuf,
+            tip: out_ws.g.last().unwrap(),
+            strain: &out_ws.xi[..model.disc.n_points()],
+        })
     };
     let start = Instant::now();
     let result = match &options.method {
@@ -306,8 +359,9 @@ pub fn simulate_with_progress<P: StrainParam>(
         Ok(s) => (s, None),
         Err(e) => (OdeStats::default(), Some(e)),
     };
-    Ok(Simulation {
-        trajectory: traj,
+    Ok(RunSummary {
+        samples,
+        t_last,
         stats,
         wall_time_s,
         error,

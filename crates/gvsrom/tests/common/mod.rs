@@ -12,11 +12,18 @@ pub fn gvsrom(args: &[&str]) -> Output {
         .expect("the gvsrom binary runs")
 }
 
-/// A scratch file path unique to one test (files of all tests share one folder).
+/// A scratch path unique to one test (files of all tests share one folder), cleared of what an
+/// earlier run of the test left there: gvsrom refuses to replace outputs without `--force`.
 pub fn scratch(name: &str) -> PathBuf {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("gvsrom-cli-tests");
     std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
+    let path = dir.join(name);
+    if path.is_dir() {
+        std::fs::remove_dir_all(&path).unwrap();
+    } else if path.exists() {
+        std::fs::remove_file(&path).unwrap();
+    }
+    path
 }
 
 /// Runs `args`, expects a user error (exit code 1, one stderr line starting with `error:`, no

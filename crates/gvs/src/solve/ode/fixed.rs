@@ -4,7 +4,7 @@
 
 use super::{
     check_common, deliver, invalid, ulp, Counted, FixedStepOptions, JacWork, Lu, OdeError,
-    OdeStats, OdeSystem,
+    OdeStats, OdeSystem, Output,
 };
 use nalgebra::{DMatrix, DVector};
 
@@ -83,7 +83,7 @@ pub fn integrate_fixed<S: OdeSystem>(
     t_out: &[f64],
     breakpoints: &[f64],
     opts: &FixedStepOptions,
-    output: &mut dyn FnMut(f64, &DVector<f64>),
+    output: &mut Output<'_>,
 ) -> Result<OdeStats, OdeError> {
     let n = sys.dim();
     let bounds = check_common(n, t0, y0, t_out, breakpoints)?;
@@ -128,7 +128,7 @@ pub fn integrate_fixed<S: OdeSystem>(
     let mut next = 0;
     deliver(t_out, &mut next, t0, &mut w.out, output, |_, b| {
         b.copy_from(y0)
-    });
+    })?;
     let mut cs = Counted::new(sys);
     let mut st = State {
         t: t0,
@@ -173,7 +173,7 @@ fn advance<S: OdeSystem>(
     target: f64,
     t_out: &[f64],
     next: &mut usize,
-    output: &mut dyn FnMut(f64, &DVector<f64>),
+    output: &mut Output<'_>,
 ) -> Result<(), OdeError> {
     let n = w.n;
     let mut halvings = 0u32;
@@ -233,7 +233,7 @@ fn advance<S: OdeSystem>(
                             buf[i] = (1.0 - l2) * y[i] + l2 * z[i];
                         }
                     }
-                });
+                })?;
                 std::mem::swap(&mut w.yprev, &mut w.y);
                 w.y.copy_from(&w.z);
                 st.hprev = hs;

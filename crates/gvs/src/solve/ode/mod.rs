@@ -93,6 +93,7 @@
 //! the stepping loop does not allocate (the user's right-hand side and output callback may).
 
 use nalgebra::{DMatrix, DVector};
+use std::ops::ControlFlow;
 
 mod fixed;
 mod ndf;
@@ -104,6 +105,10 @@ mod tests_errors;
 mod tests_fixed;
 
 pub use fixed::integrate_fixed;
+
+/// The output callback of the integrators: called with every output time and the solution there;
+/// `ControlFlow::Break(reason)` stops the integration with [`OdeError::Stopped`].
+pub type Output<'a> = dyn FnMut(f64, &DVector<f64>) -> ControlFlow<String> + 'a;
 pub use ndf::integrate_ndf;
 
 /// An error reported by the right-hand side (or its Jacobian); it stops the integration.
@@ -227,6 +232,10 @@ pub enum OdeError {
     Rhs { t: f64, source: RhsError },
     #[error("integration stopped at t = {t}: maximum number of steps {max_steps} reached")]
     TooManySteps { t: f64, max_steps: usize },
+    /// The output callback asked to stop after delivering the sample at `t` (an interrupt, a full
+    /// disk): not a failure of the method.
+    #[error("integration stopped at t = {t}: {reason}")]
+    Stopped { t: f64, reason: String },
     #[error("invalid input `{field}`: {message}")]
     Invalid {
         field: &'static str,
@@ -242,7 +251,8 @@ impl OdeError {
             | OdeError::NewtonFailure { t }
             | OdeError::NonFinite { t }
             | OdeError::Rhs { t, .. }
-            | OdeError::TooManySteps { t, .. } => Some(*t),
+            | OdeError::TooManySteps { t, .. }
+            | OdeError::Stopped { t, .. } => Some(*t),
             OdeError::Invalid { .. } => None,
         }
     }
@@ -624,13 +634,16 @@ fn deliver(
     next: &mut usize,
     t_new: f64,
     buf: &mut DVector<f64>,
-    output: &mut dyn FnMut(f64, &DVector<f64>),
+    output: &mut Output<'_>,
     mut value: impl FnMut(f64, &mut DVector<f64>),
-) {
+) -> Result<(), OdeError> {
     while *next < t_out.len() && t_out[*next] <= t_new {
         let t = t_out[*next];
         value(t, buf);
-        output(t, buf);
         *next += 1;
+        if let ControlFlow::Break(reason) = output(t, buf) {
+            return Err(OdeError::Stopped { t, reason });
+        }
     }
+    Ok(())
 }

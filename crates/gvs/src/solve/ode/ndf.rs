@@ -4,7 +4,7 @@
 
 use super::{
     check_common, deliver, invalid, ulp, wnorm, Counted, JacWork, Lu, NdfOptions, OdeError,
-    OdeStats, OdeSystem,
+    OdeStats, OdeSystem, Output,
 };
 use nalgebra::{DMatrix, DVector};
 
@@ -283,7 +283,7 @@ pub fn integrate_ndf<S: OdeSystem>(
     t_out: &[f64],
     breakpoints: &[f64],
     opts: &NdfOptions,
-    output: &mut dyn FnMut(f64, &DVector<f64>),
+    output: &mut Output<'_>,
 ) -> Result<OdeStats, OdeError> {
     let n = sys.dim();
     let bounds = check_common(n, t0, y0, t_out, breakpoints)?;
@@ -294,7 +294,7 @@ pub fn integrate_ndf<S: OdeSystem>(
     let mut next = 0;
     deliver(t_out, &mut next, t0, &mut w.out, output, |_, b| {
         b.copy_from(y0)
-    });
+    })?;
     let mut cs = Counted::new(sys);
     let pieces = bounds.len().saturating_sub(1);
     for p in 0..pieces {
@@ -317,7 +317,7 @@ fn integrate_piece<S: OdeSystem>(
     h0: Option<f64>,
     t_out: &[f64],
     next: &mut usize,
-    output: &mut dyn FnMut(f64, &DVector<f64>),
+    output: &mut Output<'_>,
 ) -> Result<(), OdeError> {
     let n = w.n;
     let rtol = cfg.rtol;
@@ -573,7 +573,7 @@ fn integrate_piece<S: OdeSystem>(
         let (ynew, dif) = (&w.ynew, &w.dif);
         deliver(t_out, next, tnew, &mut w.out, output, |tq, buf| {
             interpolate(tq, tnew, h, ynew, dif, k, buf)
-        });
+        })?;
         t = tnew;
         w.y.copy_from(&w.ynew);
         if done {

@@ -70,7 +70,10 @@ pub(super) fn ndf<S: OdeSystem>(
         t_out,
         bps,
         o,
-        &mut |t, y| out.push((t, y.clone())),
+        &mut |t, y| {
+            out.push((t, y.clone()));
+            std::ops::ControlFlow::Continue(())
+        },
     );
     (out, r)
 }

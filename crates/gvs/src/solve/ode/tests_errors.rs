@@ -71,7 +71,10 @@ fn bad_input_is_rejected_without_panic() {
     let y0 = DVector::from_vec(vec![1.0]);
     let good = NdfOptions::default();
     let mut run = |y0: &DVector<f64>, t_out: &[f64], bps: &[f64], o: &NdfOptions| {
-        integrate_ndf(&mut s, 0.0, y0, t_out, bps, o, &mut |_, _| {}).unwrap_err()
+        integrate_ndf(&mut s, 0.0, y0, t_out, bps, o, &mut |_, _| {
+            std::ops::ControlFlow::Continue(())
+        })
+        .unwrap_err()
     };
     let cases: Vec<(&str, OdeError)> = vec![
         (

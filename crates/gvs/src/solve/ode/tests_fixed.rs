@@ -19,7 +19,10 @@ fn fixed<S: OdeSystem>(
         t_out,
         bps,
         o,
-        &mut |t, y| out.push((t, y.clone())),
+        &mut |t, y| {
+            out.push((t, y.clone()));
+            std::ops::ControlFlow::Continue(())
+        },
     );
     (out, r)
 }
@@ -163,7 +166,10 @@ fn fixed_step_nonlinear_problem_reuses_the_jacobian() {
         &t_out,
         &[],
         &o,
-        &mut |_, y| reference.push(y.clone()),
+        &mut |_, y| {
+            reference.push(y.clone());
+            std::ops::ControlFlow::Continue(())
+        },
     )
     .unwrap();
     let err = out
@@ -194,7 +200,10 @@ fn fixed_step_failures_and_bad_options() {
     let mut s = sys(1, forced_rhs);
     let y0 = DVector::from_vec(vec![1.0]);
     let mut run = |o: &FixedStepOptions, y0: &DVector<f64>, t_out: &[f64]| {
-        integrate_fixed(&mut s, 0.0, y0, t_out, &[], o, &mut |_, _| {}).unwrap_err()
+        integrate_fixed(&mut s, 0.0, y0, t_out, &[], o, &mut |_, _| {
+            std::ops::ControlFlow::Continue(())
+        })
+        .unwrap_err()
     };
     let good = FixedStepOptions::default();
     for (field, e) in [
