@@ -164,10 +164,10 @@ pub fn sample_times(duration: f64, rate: f64) -> Result<Vec<f64>, ScenarioError>
         return Err(ScenarioError::invalid(
             "--duration",
             format!(
-                "{} s at --sample-rate {} Hz gives {} samples (accepted <= {MAX_SAMPLES}); lower --duration or --sample-rate",
+                "{} s at --sample-rate {} Hz gives {:.2e} samples (accepted <= {MAX_SAMPLES}); lower --duration or --sample-rate",
                 gvs::error::fmt_value(duration),
                 gvs::error::fmt_value(rate),
-                gvs::error::fmt_value(periods + 1.0)
+                periods + 1.0
             ),
         ));
     }
@@ -201,10 +201,10 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
             return Err(ScenarioError::invalid(
                 "--fixed-step",
                 format!(
-                    "{} s over --duration {} s is {} steps (accepted <= {}); use a larger step or the adaptive integrator",
+                    "{} s over --duration {} s is {:.2e} steps (accepted <= {}); use a larger step or the adaptive integrator",
                     gvs::error::fmt_value(h),
                     gvs::error::fmt_value(opts.duration),
-                    gvs::error::fmt_value(opts.duration / h),
+                    opts.duration / h,
                     gvs::error::fmt_value(MAX_FIXED_STEPS)
                 ),
             ));
@@ -221,10 +221,10 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
             return Err(ScenarioError::invalid(
                 field,
                 format!(
-                    "{} s over --duration {} s is {} input switches (accepted <= {})",
+                    "{} s over --duration {} s is {:.2e} input switches (accepted <= {})",
                     gvs::error::fmt_value(p),
                     gvs::error::fmt_value(opts.duration),
-                    gvs::error::fmt_value(opts.duration / p),
+                    opts.duration / p,
                     gvs::error::fmt_value(MAX_INPUT_SWITCHES)
                 ),
             ));
