@@ -363,6 +363,60 @@ fn remove_previous_dir(dir: &Path, files: &[String]) -> io::Result<()> {
     fs::remove_dir(dir)
 }
 
+/// A checked, locked target with its fresh staging (a directory or an empty file) beside it.
+struct Prepared {
+    named: Named,
+    parent: PathBuf,
+    name: String,
+    target: PathBuf,
+    staging: PathBuf,
+    lock: TargetLock,
+}
+
+impl Prepared {
+    fn new(option: &str, path: &Path, kind: Kind, force: bool) -> Result<Self, OutputError> {
+        let named = Named {
+            option: option.into(),
+            path: path.to_path_buf(),
+        };
+        let (parent, name) = split_target(&named)?;
+        refuse_special(&named, &parent, &name)?;
+        let lock = TargetLock::acquire(&named, &parent, &name)?;
+        let target = parent.join(&name);
+        inspect(&named, &target, kind, force)?;
+        let staging = loop {
+            let s = unique_sibling(&parent, &name, "staging");
+            let made = match kind {
+                Kind::Dir => fs::create_dir(&s),
+                Kind::File => OpenOptions::new()
+                    .write(true)
+                    .create_new(true)
+                    .open(&s)
+                    .map(drop),
+            };
+            match made {
+                Ok(()) => break s,
+                Err(e) if e.kind() == io::ErrorKind::AlreadyExists => continue,
+                Err(e) => {
+                    return Err(named.io(format!(
+                        "create its staging {} in `{}`",
+                        kind.noun(),
+                        parent.display()
+                    ))(e))
+                }
+            }
+        };
+        Ok(Prepared {
+            named,
+            parent,
+            name,
+            target,
+            staging,
+            lock,
+        })
+    }
+}
+
 /// A directory output being written: files go into its staging directory; [`OutputDir::commit`]
 /// moves it into place. Dropped without a commit, it removes its staging.
 #[derive(Debug)]
@@ -389,28 +443,14 @@ impl OutputDir {
         format: &str,
         force: bool,
     ) -> Result<Self, OutputError> {
-        let named = Named {
-            option: option.into(),
-            path: path.to_path_buf(),
-        };
-        let (parent, name) = split_target(&named)?;
-        refuse_special(&named, &parent, &name)?;
-        let lock = TargetLock::acquire(&named, &parent, &name)?;
-        let target = parent.join(&name);
-        inspect(&named, &target, Kind::Dir, force)?;
-        let staging = loop {
-            let s = unique_sibling(&parent, &name, "staging");
-            match fs::create_dir(&s) {
-                Ok(()) => break s,
-                Err(e) if e.kind() == io::ErrorKind::AlreadyExists => continue,
-                Err(e) => {
-                    return Err(named.io(format!(
-                        "create its staging directory in `{}`",
-                        parent.display()
-                    ))(e))
-                }
-            }
-        };
+        let Prepared {
+            named,
+            parent,
+            name,
+            target,
+            staging,
+            lock,
+        } = Prepared::new(option, path, Kind::Dir, force)?;
         Ok(OutputDir {
             named,
             format: format.into(),
@@ -598,28 +638,14 @@ impl OutputFile {
         format: &str,
         force: bool,
     ) -> Result<Self, OutputError> {
-        let named = Named {
-            option: option.into(),
-            path: path.to_path_buf(),
-        };
-        let (parent, name) = split_target(&named)?;
-        refuse_special(&named, &parent, &name)?;
-        let lock = TargetLock::acquire(&named, &parent, &name)?;
-        let target = parent.join(&name);
-        inspect(&named, &target, Kind::File, force)?;
-        let staging = loop {
-            let s = unique_sibling(&parent, &name, "staging");
-            match OpenOptions::new().write(true).create_new(true).open(&s) {
-                Ok(_) => break s,
-                Err(e) if e.kind() == io::ErrorKind::AlreadyExists => continue,
-                Err(e) => {
-                    return Err(named
-                        .io(format!("create its staging file in `{}`", parent.display()))(
-                        e,
-                    ))
-                }
-            }
-        };
+        let Prepared {
+            named,
+            parent,
+            target,
+            staging,
+            lock,
+            ..
+        } = Prepared::new(option, path, Kind::File, force)?;
         Ok(OutputFile {
             named,
             format: format.into(),
@@ -677,6 +703,94 @@ impl Drop for OutputFile {
     fn drop(&mut self) {
         if !self.committed {
             let _ = fs::remove_file(&self.staging);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    /// A fresh empty directory in the system's temporary directory (never the current directory).
+    fn sandbox(name: &str) -> PathBuf {
+        let d = std::env::temp_dir()
+            .join(format!("gvsrom-output-unit-{}", std::process::id()))
+            .join(name);
+        let _ = fs::remove_dir_all(&d);
+        fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    fn names(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn dropping_an_uncommitted_output_leaves_nothing_behind() {
+        let d = sandbox("drop");
+        {
+            let mut out = OutputDir::create("--out", &d.join("run"), "test", false).unwrap();
+            out.write_file("a.bin", |w| w.write_all(b"123")).unwrap();
+            assert_eq!(names(&d).len(), 2, "staging and lock exist while writing");
+            let _f = OutputFile::create("--json", &d.join("x.json"), "test", false).unwrap();
+        }
+        assert!(names(&d).is_empty(), "left behind: {:?}", names(&d));
+    }
+
+    #[test]
+    fn a_directory_that_appears_during_the_run_is_not_replaced_and_the_results_are_kept() {
+        let d = sandbox("appears");
+        let target = d.join("run");
+        let mut out = OutputDir::create("--out", &target, "test", true).unwrap();
+        out.write_file("a.bin", |w| w.write_all(b"new")).unwrap();
+        fs::create_dir(&target).unwrap();
+        fs::write(target.join("user.txt"), "mine").unwrap();
+        let err = out.commit(json!({})).unwrap_err().to_string();
+        assert!(err.contains("results are kept in"), "{err}");
+        assert_eq!(fs::read_to_string(target.join("user.txt")).unwrap(), "mine");
+        let staging: Vec<_> = names(&d)
+            .into_iter()
+            .filter(|n| n.contains("gvsrom-staging"))
+            .collect();
+        assert_eq!(staging.len(), 1, "{:?}", names(&d));
+        assert_eq!(fs::read(d.join(&staging[0]).join("a.bin")).unwrap(), b"new");
+    }
+
+    #[test]
+    fn a_committed_directory_lists_its_files_and_force_replaces_only_it() {
+        let d = sandbox("replace");
+        let target = d.join("run");
+        let mut out = OutputDir::create("--out", &target, "test", false).unwrap();
+        out.write_file("a.bin", |w| w.write_all(b"old")).unwrap();
+        out.commit(json!({ "k": 1 })).unwrap();
+        let meta: Value =
+            serde_json::from_str(&fs::read_to_string(target.join(MANIFEST_FILE)).unwrap()).unwrap();
+        assert_eq!(meta[MANIFEST_KEY]["format"], "test");
+        assert_eq!(meta[MANIFEST_KEY]["files"], json!(["a.bin"]));
+        assert_eq!(meta["k"], 1);
+
+        let refused = OutputDir::create("--out", &target, "test", false).unwrap_err();
+        assert!(refused.to_string().contains("--force"), "{refused}");
+
+        let mut out = OutputDir::create("--out", &target, "test", true).unwrap();
+        out.write_file("b.bin", |w| w.write_all(b"new")).unwrap();
+        out.commit(json!({})).unwrap();
+        assert_eq!(names(&target), ["b.bin", "meta.json"]);
+        assert_eq!(names(&d), ["run"], "no staging, lock or old copy left");
+    }
+
+    #[test]
+    fn file_names_inside_an_output_are_plain() {
+        let d = sandbox("names");
+        let mut out = OutputDir::create("--out", &d.join("run"), "test", false).unwrap();
+        for bad in ["", ".hidden", "../escape", "a/b", MANIFEST_FILE] {
+            assert!(out.create_file(bad).is_err(), "{bad:?} accepted");
         }
     }
 }
