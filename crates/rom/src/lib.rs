@@ -1,1 +1,6 @@
-//! rom
+//! Reduced-order models for the GVS engine: POD modes and autoencoder decoders learned from strain
+//! snapshots, used as the strain parameterization of the same Lagrangian model.
+//!
+//! - [`map`]: the [`map::CoefficientMap`] interface of a smooth reduced map and its derivatives.
+
+pub mod map;
