@@ -22,7 +22,7 @@ use thiserror::Error;
 
 #[derive(Debug, Clone, Error, PartialEq)]
 pub enum DynamicsError {
-    #[error("the mass matrix is not positive definite (pivot {pivot} = {value:e}); the strain basis may be rank-deficient at this q")]
+    #[error("the mass matrix is not positive semi-definite (pivot {pivot} = {value:e}): non-finite or inconsistent inertia at this q")]
     MassNotPositiveDefinite { pivot: usize, value: f64 },
     #[error("non-finite value in the {what}")]
     NonFinite { what: &'static str },
@@ -413,18 +413,38 @@ pub fn cholesky_solve_in_place(
     Ok(())
 }
 
-/// `A = L Lᵀ` in place (the lower triangle of `a` holds `L`).
+/// Relative floor of the Cholesky pivots of `M`, as a fraction of its largest diagonal entry.
+///
+/// A nonlinear parameterization can lose rank (`Ψ_q` singular, e.g. a decoder at a latent point where
+/// a direction stops changing the strain; spec §9.1): `M = Σ W Jᵀ Ms J` is then only semi-definite.
+/// Pivots below the floor are raised to it, which adds a tiny inertia along the lost direction
+/// (where the generalized forces vanish too) instead of stopping the run. A well-posed linear basis
+/// never comes near it (its pivots are > 1e-8 of the largest diagonal entry on the presets).
+pub const MASS_PIVOT_FLOOR: f64 = 1e-12;
+
+/// `A = L Lᵀ` in place (the lower triangle of `a` holds `L`), for symmetric positive
+/// (semi-)definite `A`: pivots below [`MASS_PIVOT_FLOOR`] `· max diag(A)` are raised to it.
+/// Errors on a NaN, on a zero matrix, and on a pivot clearly negative (an indefinite matrix).
 pub fn cholesky_factor_in_place(a: &mut DMatrix<f64>) -> Result<(), DynamicsError> {
     let n = a.nrows();
+    let max_diag = (0..n).map(|j| a[(j, j)]).fold(0.0f64, f64::max);
+    if n > 0 && (max_diag.is_nan() || max_diag <= 0.0) {
+        return Err(DynamicsError::MassNotPositiveDefinite {
+            pivot: 0,
+            value: max_diag,
+        });
+    }
+    let floor = MASS_PIVOT_FLOOR * max_diag;
     for j in 0..n {
         let mut d = a[(j, j)];
         for k in 0..j {
             d -= a[(j, k)] * a[(j, k)];
         }
-        if d.is_nan() || d <= 0.0 {
+        // Round-off of a semi-definite matrix leaves pivots of order ε·max_diag of either sign.
+        if d.is_nan() || d < -1e-8 * max_diag {
             return Err(DynamicsError::MassNotPositiveDefinite { pivot: j, value: d });
         }
-        let d = d.sqrt();
+        let d = d.max(floor).sqrt();
         a[(j, j)] = d;
         for i in j + 1..n {
             let mut s = a[(i, j)];
@@ -453,5 +473,32 @@ pub fn cholesky_solve_factored(a: &DMatrix<f64>, b: &mut DVector<f64>) {
             s -= a[(k, i)] * b[k];
         }
         b[i] = s / a[(i, i)];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cholesky_of_a_semi_definite_mass_regularizes_and_of_an_indefinite_one_fails() {
+        // M = v vᵀ + diag(0, 0, 0): rank 1; b in its range
+        let v = DVector::from_vec(vec![1.0, 2.0, -1.0]);
+        let mut m = &v * v.transpose();
+        let mut b = &v * 3.0;
+        cholesky_solve_in_place(&mut m, &mut b).unwrap();
+        assert!(b.iter().all(|x| x.is_finite()));
+        let m0 = &v * v.transpose();
+        assert!((&m0 * &b - &v * 3.0).amax() < 1e-6, "M x = b within the floor");
+        // SPD: exact
+        let mut a = DMatrix::from_row_slice(2, 2, &[4.0, 1.0, 1.0, 3.0]);
+        let mut x = DVector::from_vec(vec![1.0, 2.0]);
+        cholesky_solve_in_place(&mut a, &mut x).unwrap();
+        assert!((x[0] - 1.0 / 11.0).abs() < 1e-15 && (x[1] - 7.0 / 11.0).abs() < 1e-15);
+        // indefinite and NaN
+        let mut ind = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]);
+        assert!(cholesky_factor_in_place(&mut ind).is_err());
+        let mut nan = DMatrix::from_row_slice(1, 1, &[f64::NAN]);
+        assert!(cholesky_factor_in_place(&mut nan).is_err());
     }
 }

@@ -639,7 +639,7 @@ impl<P: StrainParam> Model<P> {
         }
         self.backward(ws, Some(jac));
         if !self.param.is_linear() {
-            self.param.add_weighted_hessian(q, &ws.y, jac);
+            self.param.add_weighted_hessian(q, &ws.y, &mut ws.ev, jac);
         }
     }
 

@@ -15,8 +15,9 @@
 //!
 //! Matrices are column-major slices (`m × r`: element `(i, j)` at `i + j·m`). `eval` stores whatever
 //! the later calls reuse (activations, their derivatives) in `scratch`, so a network's forward pass
-//! runs once per evaluation; `eval_rate` and `add_weighted_hessian` must be called after `eval` at the
-//! same `z` with the same `scratch`. No call allocates.
+//! runs once per evaluation; `eval_rate` and `add_weighted_hessian` are called after `eval` at the
+//! same `z` with the same `scratch`, may use the rest of it as work space but must keep what `eval`
+//! stored. No call allocates.
 
 /// A smooth map `c: Rʳ → Rᵐ` with first derivatives, the eq. (17) term and weighted Hessians.
 pub trait CoefficientMap: Send + Sync {
@@ -29,7 +30,7 @@ pub trait CoefficientMap: Send + Sync {
     /// `c = c(z)` and `c_z = ∂c/∂z` (m × r, column-major); fills `scratch` for the calls below.
     fn eval(&self, z: &[f64], c: &mut [f64], c_z: &mut [f64], scratch: &mut [f64]);
     /// `c_z_dot = (∂²c/∂z² ż)` (m × r): the derivative of `C_z` along `ż` (paper eq. 17).
-    fn eval_rate(&self, z: &[f64], zd: &[f64], c_z_dot: &mut [f64], scratch: &[f64]);
+    fn eval_rate(&self, z: &[f64], zd: &[f64], c_z_dot: &mut [f64], scratch: &mut [f64]);
     /// `out += Σ_k g_k ∇²_z c_k` (r × r, column-major, symmetric).
-    fn add_weighted_hessian(&self, z: &[f64], g: &[f64], out: &mut [f64], scratch: &[f64]);
+    fn add_weighted_hessian(&self, z: &[f64], g: &[f64], out: &mut [f64], scratch: &mut [f64]);
 }

@@ -57,7 +57,8 @@ pub enum OdeJacobian {
 /// Where the simulation starts.
 #[derive(Debug, Clone)]
 pub enum InitialState {
-    /// Straight reference configuration at rest (`q = 0`, `q̇ = 0`; linear bases).
+    /// Straight reference configuration at rest (`q` = [`StrainParam::rest_coordinates`]: 0 for
+    /// linear bases; `q̇ = 0`).
     Rest,
     /// A given state.
     Given { q: DVector<f64>, qd: DVector<f64> },
@@ -269,7 +270,7 @@ pub fn simulate_streaming<P: StrainParam>(
         );
     }
     let (q0, qd0) = match initial {
-        InitialState::Rest => (DVector::zeros(n), DVector::zeros(n)),
+        InitialState::Rest => (model.param.rest_coordinates(), DVector::zeros(n)),
         InitialState::Given { q, qd } => {
             if q.len() != n || qd.len() != n {
                 return Err(ModelError::invalid(

@@ -175,8 +175,8 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
         }
     }
 
-    /// Solves for the equilibrium under tensions `u` and `loads`, starting from `q0` (straight
-    /// reference `q = 0` if `None`).
+    /// Solves for the equilibrium under tensions `u` and `loads`, starting from `q0` (the straight
+    /// reference, [`StrainParam::rest_coordinates`], if `None`).
     pub fn solve(
         &mut self,
         u: &[f64],
@@ -216,7 +216,7 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                 )
                 .into())
             }
-            None => DVector::zeros(n),
+            None => self.model.param.rest_coordinates(),
         };
         let opts = DoglegOptions {
             max_iterations: self.options.max_iterations,

@@ -270,6 +270,42 @@ impl LinearBasis {
         Self::from_site_values(disc, &full)
     }
 
+    /// `Φ_s B` at every site: the basis whose coordinates are mapped onto this one's by the constant
+    /// `n × k` matrix `B` (`q = B q_r`). A POD basis expressed on the high-order model's own basis
+    /// is one (`B` = the POD modes' coefficients); every coordinate then acts everywhere.
+    pub fn compose(&self, b: &DMatrix<f64>) -> Result<LinearBasis, ModelError> {
+        if b.nrows() != self.n || b.ncols() == 0 {
+            return Err(ModelError::invalid(
+                "basis.coefficients",
+                format!(
+                    "expected a {}×k matrix (k >= 1), got {}×{}",
+                    self.n,
+                    b.nrows(),
+                    b.ncols()
+                ),
+            ));
+        }
+        if b.iter().any(|v| !v.is_finite()) {
+            return Err(ModelError::invalid(
+                "basis.coefficients",
+                "contains NaN or infinite entries",
+            ));
+        }
+        let k = b.ncols();
+        let ns = self.cols.len();
+        let mut phi = Matrix6xX::zeros(k * ns);
+        for (s, r) in self.cols.iter().enumerate() {
+            let blk = self.phi.columns(s * self.n + r.start, r.len());
+            phi.columns_mut(s * k, k)
+                .copy_from(&(blk * b.rows(r.start, r.len())));
+        }
+        Ok(LinearBasis {
+            n: k,
+            phi,
+            cols: vec![0..k; ns],
+        })
+    }
+
     /// `Φ_s` restricted to its columns.
     pub fn phi_at(&self, site: usize) -> nalgebra::DMatrix<f64> {
         let r = &self.cols[site];
@@ -309,7 +345,14 @@ impl StrainParam for LinearBasis {
         }
     }
     fn eval_rate(&self, _q: &DVector<f64>, _qd: &DVector<f64>, _ev: &mut StrainEval) {}
-    fn add_weighted_hessian(&self, _q: &DVector<f64>, _w: &[V6], _out: &mut DMatrix<f64>) {}
+    fn add_weighted_hessian(
+        &self,
+        _q: &DVector<f64>,
+        _w: &[V6],
+        _ev: &mut StrainEval,
+        _out: &mut DMatrix<f64>,
+    ) {
+    }
 }
 
 #[cfg(test)]
@@ -450,6 +493,27 @@ mod tests {
             e.contains("divisions[0].basis") && e.contains("empty"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn a_composed_basis_is_the_product_at_every_site() {
+        let d = disc(&[0.3, 0.3], Quadrature::Gauss { n: 4 });
+        let c = DivisionBasis::Legendre {
+            modes: [true; 6],
+            orders: [1, 2, 2, 1, 1, 1],
+        };
+        let lb = LinearBasis::per_division(&d, &[c.clone(), c]).unwrap();
+        let b = DMatrix::from_fn(28, 3, |i, j| ((i * 5 + j * 3) % 7) as f64 - 3.0);
+        let pb = lb.compose(&b).unwrap();
+        assert_eq!(pb.n_dof(), 3);
+        let q_r = DVector::from_vec(vec![0.3, -1.2, 0.7]);
+        let (mut e1, mut e2) = (lb.new_eval(), pb.new_eval());
+        lb.eval(&(&b * &q_r), &mut e1);
+        pb.eval(&q_r, &mut e2);
+        for s in 0..d.n_sites() {
+            assert!((e1.psi[s] - e2.psi[s]).amax() < 1e-13);
+        }
+        assert!(lb.compose(&DMatrix::zeros(27, 3)).is_err());
     }
 
     #[test]

@@ -83,7 +83,13 @@ impl StrainParam for SigmoidBend {
             }
         }
     }
-    fn add_weighted_hessian(&self, q: &DVector<f64>, w: &[V6], out: &mut DMatrix<f64>) {
+    fn add_weighted_hessian(
+        &self,
+        q: &DVector<f64>,
+        w: &[V6],
+        _ev: &mut StrainEval,
+        out: &mut DMatrix<f64>,
+    ) {
         for (s, ws) in w.iter().enumerate() {
             if ws[1] == 0.0 {
                 continue;
@@ -103,7 +109,7 @@ mod tests {
     use super::*;
     use crate::discretize::{MagnusOrder, Quadrature};
     use crate::rod::{Material, Rod};
-    use crate::strain::test_support::check_derivatives;
+    use crate::strain::testing::check_derivatives;
 
     #[test]
     fn sigmoid_derivatives_match_central_differences() {
