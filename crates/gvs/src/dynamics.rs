@@ -489,7 +489,10 @@ mod tests {
         cholesky_solve_in_place(&mut m, &mut b).unwrap();
         assert!(b.iter().all(|x| x.is_finite()));
         let m0 = &v * v.transpose();
-        assert!((&m0 * &b - &v * 3.0).amax() < 1e-6, "M x = b within the floor");
+        assert!(
+            (&m0 * &b - &v * 3.0).amax() < 1e-6,
+            "M x = b within the floor"
+        );
         // SPD: exact
         let mut a = DMatrix::from_row_slice(2, 2, &[4.0, 1.0, 1.0, 3.0]);
         let mut x = DVector::from_vec(vec![1.0, 2.0]);

@@ -2,5 +2,7 @@
 //! snapshots, used as the strain parameterization of the same Lagrangian model.
 //!
 //! - [`map`]: the [`map::CoefficientMap`] interface of a smooth reduced map and its derivatives.
+//! - [`reduced`]: reduced strain on the HOM's own basis, `Ψ_s(q_r) = Φ_s P D(q_r)`.
 
 pub mod map;
+pub mod reduced;

@@ -260,6 +260,9 @@ pub mod testing {
         tol: f64,
     ) {
         let e = derivative_errors(p, q, qd, 1e-6);
-        assert!(e.max() <= tol, "derivatives vs central differences: {e:?} > {tol}");
+        assert!(
+            e.max() <= tol,
+            "derivatives vs central differences: {e:?} > {tol}"
+        );
     }
 }
