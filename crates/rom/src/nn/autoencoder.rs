@@ -119,7 +119,7 @@ impl Autoencoder {
         };
         let outcome = fit(problem, opts, &mut rng, progress);
 
-        let mut ws = Workspace::new(&sizes, opts.batch_size);
+        let mut ws = Workspace::new(&sizes, opts.batch_size.min(rows));
         let mut errors = |index: &[usize]| {
             let mse = dataset_mse(&layers, &tanh, &scaled, index, &mut ws);
             (

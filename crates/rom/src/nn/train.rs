@@ -36,7 +36,8 @@ pub struct TrainOptions {
     pub learning_rate: f64,
     /// Fraction of the rows held out for validation, in `[0, 1)`.
     pub validation_fraction: f64,
-    /// Stop a phase after this many epochs without a lower monitored loss; `None` never stops early.
+    /// Stop a phase after this many (≥ 1) epochs without a lower monitored loss; `None` never stops
+    /// early.
     pub patience: Option<usize>,
     /// The final phase after the main Adam phase.
     pub fine_tune: FineTune,
@@ -85,6 +86,9 @@ impl TrainOptions {
         }
         if !(0.0..1.0).contains(&self.validation_fraction) {
             return bad("validation_fraction", self.validation_fraction, "in [0, 1)");
+        }
+        if self.patience == Some(0) {
+            return bad("patience", 0.0, "≥ 1 epoch, or None");
         }
         if let FineTune::Adam {
             learning_rate_factor: f,
@@ -327,7 +331,8 @@ pub(crate) fn fit(
         .map(|l| l.n_in)
         .chain(p.layers.last().map(|l| l.n_out))
         .collect();
-    let mut ws = Workspace::new(&sizes, opts.batch_size);
+    // Batches never exceed the training rows; the validation pass reuses the same buffers.
+    let mut ws = Workspace::new(&sizes, opts.batch_size.min(p.train.len()));
     let mut t = Tracker {
         best: p.layers.to_vec(),
         best_loss: f64::INFINITY,
