@@ -6,10 +6,11 @@
 //! `θ ← θ − η m̂/(√v̂ + ε)`, `m̂ = m/(1−β₁ᵗ)`, `v̂ = v/(1−β₂ᵗ)`) on the gradient of
 //! `(1/(B·n)) Σ‖x̂ − x‖² + λ Σ‖W‖²` (see [`crate::nn::batch`]). The monitored loss is the validation
 //! reconstruction MSE (scaled units, no penalty), or the epoch's training MSE without validation rows;
-//! the weights with the lowest monitored loss are kept. An optional fine-tuning phase restarts from
-//! the best weights; it only changes the result if it lowers the monitored loss; it is Adam with a smaller rate or full-batch L-BFGS ([`FineTune`]), which
-//! converges much further on smooth small problems. Everything runs on one thread in a fixed order: the same seed and data give
-//! bit-identical weights.
+//! the weights with the lowest monitored loss are kept. An optional fine-tuning phase ([`FineTune`]:
+//! Adam with a smaller rate, or full-batch L-BFGS, which converges much further on smooth small
+//! problems) restarts from the best weights and only changes the result if it lowers the monitored
+//! loss. Everything runs on one thread in a fixed order: the same seed and data give bit-identical
+//! weights.
 
 use super::batch::{backward_batch, dataset_mse, forward_batch, reconstruction_mse, Workspace};
 use super::lbfgs::{Lbfgs, Objective};
