@@ -1,0 +1,286 @@
+//! The autoencoder of paper §III: `Ψ̄_rec = D(E(Ψ̄))` (eq. 14) trained on the loss of eq. (15).
+//!
+//! Architecture (paper: "the encoder halves the size at each layer, while the decoder doubles it"):
+//! with `h = 2d + 1` hidden layers the sizes are
+//! `n, ⌊n/2⌋', …, ⌊n/2ᵈ⌋', r, ⌊n/2ᵈ⌋', …, ⌊n/2⌋', n` where `⌊x⌋' = max(⌊x⌋, r + 1)`: sizes are
+//! rounded down but a hidden layer beside the bottleneck never has fewer than `r + 1` units. For
+//! n = 306, r = 1, h = 7: `306, 153, 76, 38, 1, 38, 76, 153, 306`.
+//!
+//! Activations: tanh on every hidden layer, linear on the encoder's last layer (the latent `z`) and on
+//! the decoder's last layer (the reconstruction; see [`crate::nn::mlp`]). A linear latent does not
+//! bound the reduced coordinates `q_r = z` or saturate the bottleneck's gradients; the decoder's first
+//! tanh layer supplies the nonlinearity, so `D` is the same smooth tanh network either way. Both
+//! halves are therefore plain [`Mlp`]s. The networks work in scaled units (see [`Scaling`]):
+//! `E(x) = enc((x − μ)/s)`, `D(z) = s ⊙ dec(z) + μ`.
+
+use super::batch::{dataset_mse, forward_batch, Workspace};
+use super::decoder_map::DecoderMap;
+use super::mlp::{Layer, Mlp};
+use super::train::{fit, shuffle, Problem, Progress, TrainOptions, TrainReport};
+use super::{NnError, Scaling};
+use gvs::inputs::SplitMix64;
+use std::time::Instant;
+
+/// Encoder, decoder and the data scaling they work in.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Autoencoder {
+    encoder: Mlp,
+    decoder: Mlp,
+    scaling: Scaling,
+}
+
+impl Autoencoder {
+    /// Layer sizes `[n, …, r, …, n]` (`hidden_layers + 2` values) of the symmetric architecture in the
+    /// module docs. Errors: `latent ∉ 1..n_features`, `hidden_layers` even or zero.
+    pub fn architecture(
+        n_features: usize,
+        latent: usize,
+        hidden_layers: usize,
+    ) -> Result<Vec<usize>, NnError> {
+        if latent == 0 || latent >= n_features {
+            return Err(NnError::InvalidLatent { latent, n_features });
+        }
+        if hidden_layers.is_multiple_of(2) {
+            return Err(NnError::InvalidHiddenLayers {
+                value: hidden_layers,
+            });
+        }
+        let depth = (hidden_layers - 1) / 2;
+        let halves =
+            (1..=depth).map(|k| (n_features >> k.min(usize::BITS as usize - 1)).max(latent + 1));
+        let encoder: Vec<usize> = std::iter::once(n_features).chain(halves).collect();
+        let decoder = encoder.iter().rev().copied();
+        Ok(encoder
+            .iter()
+            .copied()
+            .chain(std::iter::once(latent))
+            .chain(decoder)
+            .collect())
+    }
+
+    /// An autoencoder from its parts; the encoder must map `n → r`, the decoder `r → n`, and the
+    /// scaling have `n` features.
+    pub fn new(encoder: Mlp, decoder: Mlp, scaling: Scaling) -> Result<Self, NnError> {
+        let n = encoder.n_in();
+        let checks = [
+            (
+                "decoder input vs encoder output",
+                decoder.n_in(),
+                encoder.n_out(),
+            ),
+            ("decoder output vs encoder input", decoder.n_out(), n),
+            ("scaling features vs encoder input", scaling.len(), n),
+        ];
+        for (what, got, expected) in checks {
+            if got != expected {
+                return Err(NnError::Mismatch {
+                    what,
+                    got,
+                    expected,
+                });
+            }
+        }
+        Ok(Autoencoder {
+            encoder,
+            decoder,
+            scaling,
+        })
+    }
+
+    /// Trains an autoencoder on row-major `data` (`rows × n_features`, one snapshot `Ψ̄` of eq. 13 per
+    /// row) with the architecture, loss and optimiser described in this module and
+    /// [`crate::nn::train`]. The scaling is computed from the training rows (after the seeded split).
+    pub fn train(
+        data: &[f64],
+        n_features: usize,
+        opts: &TrainOptions,
+        progress: Progress,
+    ) -> Result<(Self, TrainReport), NnError> {
+        let start = Instant::now();
+        opts.validate()?;
+        let sizes = Self::architecture(n_features, opts.latent, opts.hidden_layers)?;
+        let rows = check_data(data, n_features)?;
+        let mut rng = SplitMix64::new(opts.seed);
+        let mut layers: Vec<Layer> = sizes
+            .windows(2)
+            .map(|s| Layer::glorot(s[0], s[1], &mut rng))
+            .collect();
+        let (train, val) = split_rows(rows, opts.validation_fraction, &mut rng);
+        let scaling = Scaling::from_rows(data, n_features, &train);
+        let mut scaled = data.to_vec();
+        scaling.to_scaled(&mut scaled);
+        let tanh = chain_tanh_flags(opts.hidden_layers);
+        let problem = Problem {
+            layers: &mut layers,
+            tanh: &tanh,
+            data: &scaled,
+            train: &train,
+            val: &val,
+        };
+        let outcome = fit(problem, opts, &mut rng, progress);
+
+        let mut ws = Workspace::new(&sizes, opts.batch_size.min(rows));
+        let mut errors = |index: &[usize]| {
+            let mse = dataset_mse(&layers, &tanh, &scaled, index, &mut ws);
+            (
+                mse,
+                physical_rmse(&layers, &tanh, &scaled, index, &scaling, &mut ws),
+            )
+        };
+        let (final_train_loss, final_train_rmse) = errors(&train);
+        let final_val = (!val.is_empty()).then(|| errors(&val));
+        let decoder = Mlp::from_layers(layers.split_off(layers.len() / 2));
+        let encoder = Mlp::from_layers(layers);
+        let report = TrainReport {
+            epochs_run: outcome.train_loss.len(),
+            train_loss: outcome.train_loss,
+            val_loss: outcome.val_loss,
+            final_train_loss,
+            final_val_loss: final_val.map(|e| e.0),
+            final_train_rmse,
+            final_val_rmse: final_val.map(|e| e.1),
+            best_epoch: outcome.best_epoch,
+            fine_tune_epochs_run: outcome.fine_tune_epochs_run,
+            stop: outcome.stop,
+            n_train: train.len(),
+            n_val: val.len(),
+            wall_time: start.elapsed(),
+        };
+        Ok((
+            Autoencoder {
+                encoder,
+                decoder,
+                scaling,
+            },
+            report,
+        ))
+    }
+
+    /// Number of features `n` of a snapshot.
+    pub fn n_features(&self) -> usize {
+        self.encoder.n_in()
+    }
+
+    /// Latent size `r`.
+    pub fn latent(&self) -> usize {
+        self.encoder.n_out()
+    }
+
+    /// The encoder network (scaled units in, `z` out).
+    pub fn encoder(&self) -> &Mlp {
+        &self.encoder
+    }
+
+    /// The decoder network (`z` in, scaled units out).
+    pub fn decoder(&self) -> &Mlp {
+        &self.decoder
+    }
+
+    /// The data scaling.
+    pub fn scaling(&self) -> &Scaling {
+        &self.scaling
+    }
+
+    /// `z = E(x) = enc((x − μ)/s)` for row-major snapshots (`rows × n` → `rows × r`).
+    pub fn encode(&self, x: &[f64]) -> Result<Vec<f64>, NnError> {
+        check_rows(x, self.n_features(), "snapshots to encode")?;
+        let mut scaled = x.to_vec();
+        self.scaling.to_scaled(&mut scaled);
+        self.encoder.forward(&scaled)
+    }
+
+    /// `Ψ̄ = D(z) = s ⊙ dec(z) + μ` for row-major latent points (`rows × r` → `rows × n`).
+    pub fn decode(&self, z: &[f64]) -> Result<Vec<f64>, NnError> {
+        check_rows(z, self.latent(), "latent points to decode")?;
+        let mut y = self.decoder.forward(z)?;
+        self.scaling.to_physical(&mut y);
+        Ok(y)
+    }
+
+    /// `D(E(x))` (eq. 14) for row-major snapshots.
+    pub fn reconstruct(&self, x: &[f64]) -> Result<Vec<f64>, NnError> {
+        self.decode(&self.encode(x)?)
+    }
+
+    /// The decoder as a [`crate::map::CoefficientMap`] `c(z) = A (s ⊙ dec(z) + μ)` with `A` an
+    /// `m × n` column-major matrix (see [`DecoderMap::new`]).
+    pub fn decoder_map(&self, a: &[f64], m: usize) -> Result<DecoderMap, NnError> {
+        DecoderMap::new(&self.decoder, &self.scaling, a, m)
+    }
+}
+
+/// Number of rows of row-major `data` with `n` features; rejects empty, ragged and non-finite data.
+fn check_data(data: &[f64], n: usize) -> Result<usize, NnError> {
+    if data.is_empty() {
+        return Err(NnError::EmptyData);
+    }
+    check_rows(data, n, "training data")?;
+    match data.iter().position(|x| !x.is_finite()) {
+        Some(i) => Err(NnError::NonFiniteData {
+            row: i / n,
+            feature: i % n,
+            value: data[i],
+        }),
+        None => Ok(data.len() / n),
+    }
+}
+
+/// `x.len()` is a multiple of `n`.
+fn check_rows(x: &[f64], n: usize, what: &'static str) -> Result<(), NnError> {
+    if n == 0 || !x.len().is_multiple_of(n) {
+        return Err(NnError::DataShape {
+            what,
+            got: x.len(),
+            expected: n,
+            shape: "rows × features, row-major",
+        });
+    }
+    Ok(())
+}
+
+/// Seeded split of `0..rows` into (training, validation) rows, `⌊rows·fraction⌋` validation rows
+/// but at least one training row.
+fn split_rows(rows: usize, fraction: f64, rng: &mut SplitMix64) -> (Vec<usize>, Vec<usize>) {
+    let mut index: Vec<usize> = (0..rows).collect();
+    shuffle(&mut index, rng);
+    let n_val = ((rows as f64 * fraction) as usize).min(rows - 1);
+    let train = index.split_off(n_val);
+    (train, index)
+}
+
+/// Tanh flags of the whole chain: each half has `(h + 1)/2` layers, the last one linear.
+fn chain_tanh_flags(hidden_layers: usize) -> Vec<bool> {
+    let half = hidden_layers.div_ceil(2);
+    let flags: Vec<bool> = (0..half).map(|k| k + 1 < half).collect();
+    flags.iter().chain(&flags).copied().collect()
+}
+
+/// `√((1/(N·n)) Σ_b Σ_j (s_j (ŷ_bj − y_bj))²)`: the RMSE in physical units from scaled data.
+fn physical_rmse(
+    layers: &[Layer],
+    tanh: &[bool],
+    scaled: &[f64],
+    index: &[usize],
+    scaling: &Scaling,
+    ws: &mut Workspace,
+) -> f64 {
+    let n = scaling.len();
+    let mut sum = 0.0;
+    for chunk in index.chunks(ws.capacity()) {
+        ws.load_rows(scaled, n, chunk);
+        forward_batch(layers, tanh, ws, chunk.len());
+        let (x, y) = (&ws.acts[0][..chunk.len() * n], ws.output(chunk.len()));
+        for (xr, yr) in x.chunks_exact(n).zip(y.chunks_exact(n)) {
+            sum += xr
+                .iter()
+                .zip(yr)
+                .zip(scaling.scale())
+                .map(|((x, y), s)| (s * (y - x)).powi(2))
+                .sum::<f64>();
+        }
+    }
+    (sum / (index.len() * n).max(1) as f64).sqrt()
+}
+
+#[cfg(test)]
+mod tests;

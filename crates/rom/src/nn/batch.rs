@@ -1,0 +1,335 @@
+//! Batched forward and backward passes of a layer chain on `matrixmultiply::dgemm`.
+//!
+//! A batch of `B` samples is stored row-major, one sample per row: `H_k` is `B × n_k`. Layer `k`
+//! computes `A_{k+1} = H_k W_kᵀ + 1 b_kᵀ`, `H_{k+1} = σ_k(A_{k+1})` (tanh or identity per layer).
+//!
+//! The loss is paper eq. (15) with the reconstruction term normalised as a mean squared error over
+//! the batch and the features, on scaled data (see [`crate::nn::Scaling`]):
+//!
+//! `L = (1/(B·n)) Σ_b ‖x̂_b − x_b‖² + λ Σ_k ‖W_k‖²_F`   (biases are not regularised),
+//!
+//! where the target `x_b` is the chain's own input (an autoencoder). Backpropagation:
+//! `Δ_L = (2/(B·n)) (X̂ − X)`, `∂L/∂W_k = Δ_{k+1}ᵀ H_k + 2λ W_k`, `∂L/∂b_k = Δ_{k+1}ᵀ 1`,
+//! `Δ_k = (Δ_{k+1} W_k) ⊙ σ'_{k−1}` with `σ' = 1 − H_k²` for tanh and 1 for identity.
+//!
+//! All buffers live in a [`Workspace`] sized once for the largest batch, so a training epoch allocates
+//! nothing of its own (`dgemm` may use its internal packing cache).
+
+use super::mlp::Layer;
+
+/// Buffers for batches of up to `capacity` rows: activations, backpropagated errors, gradients.
+#[derive(Debug, Clone)]
+pub struct Workspace {
+    capacity: usize,
+    /// `H_k` (`capacity × n_k`, row-major) for `k = 0..=L`; `H_0` is the input batch.
+    pub(crate) acts: Vec<Vec<f64>>,
+    /// Two `capacity × max n_k` buffers for `Δ_k` (ping-pong).
+    delta: [Vec<f64>; 2],
+    /// `∂L/∂W_k`, same layout as `W_k`.
+    pub(crate) grad_w: Vec<Vec<f64>>,
+    /// `∂L/∂b_k`.
+    pub(crate) grad_b: Vec<Vec<f64>>,
+}
+
+impl Workspace {
+    /// Buffers for a chain with layer sizes `sizes = [n_0, …, n_L]` and batches of ≤ `capacity` rows.
+    pub fn new(sizes: &[usize], capacity: usize) -> Self {
+        let capacity = capacity.max(1);
+        let widest = sizes.iter().copied().max().unwrap_or(0);
+        Workspace {
+            capacity,
+            acts: sizes.iter().map(|&n| vec![0.0; capacity * n]).collect(),
+            delta: [vec![0.0; capacity * widest], vec![0.0; capacity * widest]],
+            grad_w: sizes.windows(2).map(|s| vec![0.0; s[0] * s[1]]).collect(),
+            grad_b: sizes.windows(2).map(|s| vec![0.0; s[1]]).collect(),
+        }
+    }
+
+    /// The largest batch the buffers hold.
+    pub fn capacity(&self) -> usize {
+        self.capacity
+    }
+
+    /// Copies data rows `index` (row-major data with `n` features) into the input batch `H_0`.
+    pub(crate) fn load_rows(&mut self, data: &[f64], n: usize, index: &[usize]) {
+        for (b, &i) in index.iter().enumerate() {
+            self.acts[0][b * n..(b + 1) * n].copy_from_slice(&data[i * n..(i + 1) * n]);
+        }
+    }
+
+    /// The chain's output `H_L` for the first `rows` samples.
+    pub(crate) fn output(&self, rows: usize) -> &[f64] {
+        let last = &self.acts[self.acts.len() - 1];
+        &last[..rows * (last.len() / self.capacity)]
+    }
+}
+
+/// `C = α·A·B + β·C` for `A` (`m × k`), `B` (`k × n`), `C` (`m × n`) with explicit (row, column)
+/// strides; checks that every addressed element lies inside its slice.
+#[allow(clippy::too_many_arguments)]
+fn gemm(
+    (m, k, n): (usize, usize, usize),
+    a: &[f64],
+    (rsa, csa): (usize, usize),
+    b: &[f64],
+    (rsb, csb): (usize, usize),
+    beta: f64,
+    c: &mut [f64],
+    (rsc, csc): (usize, usize),
+) {
+    if m == 0 || n == 0 {
+        return;
+    }
+    let last = |rows: usize, cols: usize, rs: usize, cs: usize| {
+        (rows - 1) * rs + cols.saturating_sub(1) * cs
+    };
+    assert!(k == 0 || (last(m, k, rsa, csa) < a.len() && last(k, n, rsb, csb) < b.len()));
+    assert!(last(m, n, rsc, csc) < c.len());
+    // SAFETY: the assertions above bound every element the kernel reads or writes; `c` is a unique
+    // borrow and cannot alias `a` or `b`.
+    unsafe {
+        matrixmultiply::dgemm(
+            m,
+            k,
+            n,
+            1.0,
+            a.as_ptr(),
+            rsa as isize,
+            csa as isize,
+            b.as_ptr(),
+            rsb as isize,
+            csb as isize,
+            beta,
+            c.as_mut_ptr(),
+            rsc as isize,
+            csc as isize,
+        );
+    }
+}
+
+/// Forward pass of the first `rows` samples of `H_0`: `H_{k+1} = σ_k(H_k W_kᵀ + 1 b_kᵀ)`.
+pub(crate) fn forward_batch(layers: &[Layer], tanh: &[bool], ws: &mut Workspace, rows: usize) {
+    for (k, layer) in layers.iter().enumerate() {
+        let (head, tail) = ws.acts.split_at_mut(k + 1);
+        let (h, out) = (&head[k], &mut tail[0]);
+        let (n_in, n_out) = (layer.n_in, layer.n_out);
+        for row in out[..rows * n_out].chunks_exact_mut(n_out) {
+            row.copy_from_slice(&layer.b);
+        }
+        // W_kᵀ as a (n_in × n_out) matrix: element (p, j) = W[j, p] at j·n_in + p.
+        gemm(
+            (rows, n_in, n_out),
+            h,
+            (n_in, 1),
+            &layer.w,
+            (1, n_in),
+            1.0,
+            out,
+            (n_out, 1),
+        );
+        if tanh[k] {
+            out[..rows * n_out].iter_mut().for_each(|a| *a = a.tanh());
+        }
+    }
+}
+
+/// Reconstruction mean squared error `(1/(B·n)) Σ ‖x̂_b − x_b‖²` of the last forward pass.
+pub(crate) fn reconstruction_mse(ws: &Workspace, rows: usize) -> f64 {
+    let n = ws.acts[0].len() / ws.capacity;
+    let x = &ws.acts[0][..rows * n];
+    let sum: f64 = ws
+        .output(rows)
+        .iter()
+        .zip(x)
+        .map(|(y, x)| (y - x) * (y - x))
+        .sum();
+    sum / (rows * n) as f64
+}
+
+/// Gradients of eq. (15) (module docs) after [`forward_batch`] on the same `rows`, into
+/// `ws.grad_w`, `ws.grad_b`.
+pub(crate) fn backward_batch(
+    layers: &[Layer],
+    tanh: &[bool],
+    ws: &mut Workspace,
+    rows: usize,
+    lambda: f64,
+) {
+    let n_layers = layers.len();
+    let n = layers[n_layers - 1].n_out;
+    let scale = 2.0 / (rows * n) as f64;
+    let [d_cur, d_prev] = &mut ws.delta;
+    for (d, (y, x)) in d_cur.iter_mut().zip(
+        ws.acts[n_layers][..rows * n]
+            .iter()
+            .zip(&ws.acts[0][..rows * n]),
+    ) {
+        *d = scale * (y - x);
+    }
+    if tanh[n_layers - 1] {
+        apply_tanh_derivative(&mut d_cur[..rows * n], &ws.acts[n_layers][..rows * n]);
+    }
+    for k in (0..n_layers).rev() {
+        let layer = &layers[k];
+        let (n_in, n_out) = (layer.n_in, layer.n_out);
+        let (delta, h) = (&d_cur[..rows * n_out], &ws.acts[k][..rows * n_in]);
+        // ∂L/∂W_k = Δᵀ H_k + 2λ W_k: Δᵀ is (n_out × B) with element (j, b) at b·n_out + j.
+        let gw = &mut ws.grad_w[k];
+        for (g, w) in gw.iter_mut().zip(&layer.w) {
+            *g = 2.0 * lambda * w;
+        }
+        gemm(
+            (n_out, rows, n_in),
+            delta,
+            (1, n_out),
+            h,
+            (n_in, 1),
+            1.0,
+            gw,
+            (n_in, 1),
+        );
+        column_sums(delta, n_out, &mut ws.grad_b[k]);
+        if k > 0 {
+            // Δ_k = (Δ_{k+1} W_k) ⊙ σ'_{k−1}(H_k).
+            gemm(
+                (rows, n_out, n_in),
+                delta,
+                (n_out, 1),
+                &layer.w,
+                (n_in, 1),
+                0.0,
+                d_prev,
+                (n_in, 1),
+            );
+            if tanh[k - 1] {
+                apply_tanh_derivative(&mut d_prev[..rows * n_in], h);
+            }
+            std::mem::swap(d_cur, d_prev);
+        }
+    }
+}
+
+/// `d ← d ⊙ (1 − h²)`, the tanh derivative expressed through its output `h = tanh(a)`.
+fn apply_tanh_derivative(d: &mut [f64], h: &[f64]) {
+    d.iter_mut().zip(h).for_each(|(d, h)| *d *= 1.0 - h * h);
+}
+
+/// `out_j = Σ_b m[b, j]` for a row-major `B × n` matrix.
+fn column_sums(m: &[f64], n: usize, out: &mut [f64]) {
+    out.iter_mut().for_each(|o| *o = 0.0);
+    for row in m.chunks_exact(n) {
+        out.iter_mut().zip(row).for_each(|(o, v)| *o += v);
+    }
+}
+
+/// Applies the chain to `rows` row-major inputs `x` in chunks of the workspace capacity, writing the
+/// row-major outputs to `out`.
+pub(crate) fn forward_rows(
+    layers: &[Layer],
+    tanh: &[bool],
+    x: &[f64],
+    rows: usize,
+    ws: &mut Workspace,
+    out: &mut [f64],
+) {
+    let n_in = layers[0].n_in;
+    let n_out = layers[layers.len() - 1].n_out;
+    let mut start = 0;
+    while start < rows {
+        let count = ws.capacity.min(rows - start);
+        ws.acts[0][..count * n_in].copy_from_slice(&x[start * n_in..(start + count) * n_in]);
+        forward_batch(layers, tanh, ws, count);
+        out[start * n_out..(start + count) * n_out].copy_from_slice(ws.output(count));
+        start += count;
+    }
+}
+
+/// Mean reconstruction error `(1/(N·n)) Σ ‖x̂ − x‖²` of an autoencoder chain over the data rows
+/// `index` (row-major data with `n` features), evaluated in workspace-sized chunks.
+pub(crate) fn dataset_mse(
+    layers: &[Layer],
+    tanh: &[bool],
+    data: &[f64],
+    index: &[usize],
+    ws: &mut Workspace,
+) -> f64 {
+    let n = layers[0].n_in;
+    let mut sum = 0.0;
+    for chunk in index.chunks(ws.capacity) {
+        ws.load_rows(data, n, chunk);
+        forward_batch(layers, tanh, ws, chunk.len());
+        sum += reconstruction_mse(ws, chunk.len()) * chunk.len() as f64;
+    }
+    sum / index.len().max(1) as f64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gvs::inputs::SplitMix64;
+
+    /// Total loss eq. (15) of the chain on the first `rows` samples of `H_0`.
+    fn total_loss(
+        layers: &[Layer],
+        tanh: &[bool],
+        ws: &mut Workspace,
+        rows: usize,
+        lambda: f64,
+    ) -> f64 {
+        forward_batch(layers, tanh, ws, rows);
+        let penalty: f64 = layers.iter().map(Layer::sum_squared_weights).sum();
+        reconstruction_mse(ws, rows) + lambda * penalty
+    }
+
+    #[test]
+    fn gradient_matches_central_differences_on_tiny_autoencoder() {
+        // 4 → 3 → 2 (linear latent) → 3 → 4 (linear output), 5 samples, random biases.
+        let sizes = [4, 3, 2, 3, 4];
+        let tanh = [true, false, true, false];
+        let mut rng = SplitMix64::new(7);
+        let mut layers: Vec<Layer> = sizes
+            .windows(2)
+            .map(|s| Layer::glorot(s[0], s[1], &mut rng))
+            .collect();
+        layers
+            .iter_mut()
+            .flat_map(|l| l.b.iter_mut())
+            .for_each(|b| *b = rng.range(-0.5, 0.5));
+        let (rows, lambda) = (5, 0.03);
+        let mut ws = Workspace::new(&sizes, 8);
+        let x: Vec<f64> = (0..rows * 4).map(|_| rng.range(-1.0, 1.0)).collect();
+        ws.acts[0][..rows * 4].copy_from_slice(&x);
+        forward_batch(&layers, &tanh, &mut ws, rows);
+        backward_batch(&layers, &tanh, &mut ws, rows, lambda);
+        let (gw, gb) = (ws.grad_w.clone(), ws.grad_b.clone());
+        let h = 1e-5;
+        for k in 0..layers.len() {
+            for (is_w, grad) in [(true, &gw[k]), (false, &gb[k])] {
+                for i in 0..grad.len() {
+                    let probe = |delta: f64, layers: &mut Vec<Layer>| {
+                        let p = if is_w {
+                            &mut layers[k].w[i]
+                        } else {
+                            &mut layers[k].b[i]
+                        };
+                        *p += delta;
+                    };
+                    probe(h, &mut layers);
+                    let up = total_loss(&layers, &tanh, &mut ws, rows, lambda);
+                    probe(-2.0 * h, &mut layers);
+                    let down = total_loss(&layers, &tanh, &mut ws, rows, lambda);
+                    probe(h, &mut layers);
+                    let fd = (up - down) / (2.0 * h);
+                    // Central differences: truncation O(h²) ≈ 1e-10, rounding ≈ 1e-16/h ≈ 1e-11.
+                    let err = (fd - grad[i]).abs() / grad[i].abs().max(1e-3);
+                    assert!(
+                        err <= 1e-6,
+                        "layer {k} {} [{i}]: fd {fd} vs {}",
+                        if is_w { "W" } else { "b" },
+                        grad[i]
+                    );
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,96 @@
+//! Autoencoder strain parameterization (paper §III, eqs. 13–17): a hand-written f64 tanh MLP, its
+//! training on strain snapshots (loss eq. 15, Adam), and the decoder as a [`crate::map::CoefficientMap`].
+//!
+//! - [`mlp`]: dense layers `h_{k+1} = tanh(W_k h_k + b_k)` with a linear last layer; plain-data access.
+//! - [`scaling`]: the per-feature affine map between physical snapshots and network units.
+//! - [`batch`]: batched forward/backward passes on `matrixmultiply::dgemm` with a reusable workspace.
+//! - [`train`]: options, Adam, early stopping, the training report.
+//! - [`lbfgs`]: full-batch L-BFGS, the optional final training phase.
+//! - [`autoencoder`]: the symmetric architecture, encode/decode, training entry point.
+//! - [`decoder_map`]: the decoder folded with an output projection; value, Jacobian, eq. (17), Hessians.
+
+pub mod autoencoder;
+pub mod batch;
+pub mod decoder_map;
+pub mod lbfgs;
+pub mod mlp;
+pub mod scaling;
+pub mod train;
+
+pub use autoencoder::Autoencoder;
+pub use decoder_map::DecoderMap;
+pub use mlp::Mlp;
+pub use scaling::Scaling;
+pub use train::{FineTune, Progress, StopReason, TrainOptions, TrainReport};
+
+use thiserror::Error;
+
+/// Errors of network construction, training and evaluation; each names the offending quantity.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum NnError {
+    #[error("an MLP needs at least 2 layer sizes (input and output), got {got}")]
+    TooFewLayers { got: usize },
+    #[error("layer size {index} is 0; every layer needs at least one unit")]
+    ZeroLayerSize { index: usize },
+    #[error("got {got} {what} vectors for {expected} layers")]
+    LayerCount {
+        what: &'static str,
+        got: usize,
+        expected: usize,
+    },
+    #[error("layer {layer}: {what} has {got} values, expected {expected} ({shape})")]
+    LayerShape {
+        layer: usize,
+        what: &'static str,
+        got: usize,
+        expected: usize,
+        shape: String,
+    },
+    #[error("layer {layer}: {what}[{index}] = {value} is not finite")]
+    NonFiniteParameter {
+        layer: usize,
+        what: &'static str,
+        index: usize,
+        value: f64,
+    },
+    #[error("{what} has {got} values, expected a multiple of {expected} ({shape})")]
+    DataShape {
+        what: &'static str,
+        got: usize,
+        expected: usize,
+        shape: &'static str,
+    },
+    #[error("the training data is empty")]
+    EmptyData,
+    #[error("data row {row}, feature {feature}: value {value} is not finite")]
+    NonFiniteData {
+        row: usize,
+        feature: usize,
+        value: f64,
+    },
+    #[error(
+        "latent size {latent} must be in 1..{n_features} (fewer than the {n_features} features)"
+    )]
+    InvalidLatent { latent: usize, n_features: usize },
+    #[error("hidden_layers = {value}: expected an odd number ≥ 1 (1, 3, 5, 7, …)")]
+    InvalidHiddenLayers { value: usize },
+    #[error("invalid option {field} = {value}: expected {expected}")]
+    InvalidOption {
+        field: &'static str,
+        value: f64,
+        expected: &'static str,
+    },
+    #[error("scaling {what}[{index}] = {value}: expected {expected}")]
+    InvalidScaling {
+        what: &'static str,
+        index: usize,
+        value: f64,
+        expected: &'static str,
+    },
+    #[error("{what}: {got} does not match {expected}")]
+    Mismatch {
+        what: &'static str,
+        got: usize,
+        expected: usize,
+    },
+}

@@ -1,0 +1,465 @@
+//! Mini-batch Adam on the loss of eq. (15) with early stopping on the validation loss.
+//!
+//! Per epoch: the training rows are shuffled (Fisher–Yates driven by `SplitMix64`), cut into batches
+//! of `batch_size` rows (the last one may be smaller), and each batch takes one Adam step
+//! (Kingma & Ba 2015: `m ← β₁m + (1−β₁)g`, `v ← β₂v + (1−β₂)g²`,
+//! `θ ← θ − η m̂/(√v̂ + ε)`, `m̂ = m/(1−β₁ᵗ)`, `v̂ = v/(1−β₂ᵗ)`) on the gradient of
+//! `(1/(B·n)) Σ‖x̂ − x‖² + λ Σ‖W‖²` (see [`crate::nn::batch`]). The monitored loss is the validation
+//! reconstruction MSE (scaled units, no penalty), or the epoch's training MSE without validation rows;
+//! the weights with the lowest monitored loss are kept. An optional fine-tuning phase ([`FineTune`]:
+//! Adam with a smaller rate, or full-batch L-BFGS, which converges much further on smooth small
+//! problems) restarts from the best weights and only changes the result if it lowers the monitored
+//! loss. Everything runs on one thread in a fixed order: the same seed and data give bit-identical
+//! weights.
+
+use super::batch::{backward_batch, dataset_mse, forward_batch, reconstruction_mse, Workspace};
+use super::lbfgs::{Lbfgs, Objective};
+use super::mlp::Layer;
+use super::NnError;
+use gvs::inputs::SplitMix64;
+use std::ops::ControlFlow;
+use std::time::Duration;
+
+/// Training options; [`TrainOptions::default`] gives the paper's λ and common Adam settings.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrainOptions {
+    /// Latent size `r` (the reduced coordinates `q_r`).
+    pub latent: usize,
+    /// Number of hidden layers, odd (paper: 3, 5, 7); see [`crate::nn::Autoencoder::architecture`].
+    pub hidden_layers: usize,
+    /// L2 weight penalty `λ` of eq. (15) (paper: 1e-4).
+    pub lambda: f64,
+    /// Maximum number of epochs of the main phase.
+    pub epochs: usize,
+    /// Rows per mini-batch.
+    pub batch_size: usize,
+    /// Adam step size `η` of the main phase.
+    pub learning_rate: f64,
+    /// Fraction of the rows held out for validation, in `[0, 1)`.
+    pub validation_fraction: f64,
+    /// Stop a phase after this many (≥ 1) epochs without a lower monitored loss; `None` never stops
+    /// early.
+    pub patience: Option<usize>,
+    /// The final phase after the main Adam phase.
+    pub fine_tune: FineTune,
+    /// Seed of the initialisation, the train/validation split and the shuffles.
+    pub seed: u64,
+}
+
+impl Default for TrainOptions {
+    fn default() -> Self {
+        TrainOptions {
+            latent: 1,
+            hidden_layers: 7,
+            lambda: 1e-4,
+            epochs: 1000,
+            batch_size: 64,
+            learning_rate: 1e-3,
+            validation_fraction: 0.1,
+            patience: Some(50),
+            fine_tune: FineTune::Lbfgs {
+                iterations: 300,
+                memory: 10,
+            },
+            seed: 0,
+        }
+    }
+}
+
+impl TrainOptions {
+    /// Checks the numeric options (the architecture is checked by `Autoencoder::architecture`).
+    pub(crate) fn validate(&self) -> Result<(), NnError> {
+        let bad = |field, value: f64, expected| {
+            Err(NnError::InvalidOption {
+                field,
+                value,
+                expected,
+            })
+        };
+        if self.batch_size == 0 {
+            return bad("batch_size", 0.0, "≥ 1");
+        }
+        if !(self.lambda.is_finite() && self.lambda >= 0.0) {
+            return bad("lambda", self.lambda, "finite and ≥ 0");
+        }
+        if !(self.learning_rate.is_finite() && self.learning_rate > 0.0) {
+            return bad("learning_rate", self.learning_rate, "finite and > 0");
+        }
+        if !(0.0..1.0).contains(&self.validation_fraction) {
+            return bad("validation_fraction", self.validation_fraction, "in [0, 1)");
+        }
+        if self.patience == Some(0) {
+            return bad("patience", 0.0, "≥ 1 epoch, or None");
+        }
+        if let FineTune::Adam {
+            learning_rate_factor: f,
+            ..
+        } = self.fine_tune
+        {
+            if !(f > 0.0 && f <= 1.0) {
+                return bad("fine_tune.learning_rate_factor", f, "in (0, 1]");
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The final training phase; it starts from the best weights of the main phase and, like it, keeps
+/// the weights with the lowest monitored loss, so it never makes the result worse on that loss.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FineTune {
+    /// No final phase.
+    None,
+    /// Adam restarted (fresh moments) with `learning_rate · learning_rate_factor` for up to `epochs`.
+    Adam {
+        epochs: usize,
+        learning_rate_factor: f64,
+    },
+    /// Full-batch L-BFGS ([`crate::nn::lbfgs`]) for up to `iterations`, each counted as an epoch.
+    Lbfgs { iterations: usize, memory: usize },
+}
+
+/// Why training stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StopReason {
+    /// All epochs of every phase ran.
+    EpochLimit,
+    /// The last phase saw `patience` epochs without improvement.
+    EarlyStopping,
+    /// The progress callback returned `ControlFlow::Break`.
+    Interrupted,
+    /// A training loss was not finite; the best weights before it are kept.
+    Diverged,
+    /// L-BFGS found no descent step (a stationary point to rounding).
+    Converged,
+}
+
+/// Loss curves and final errors of a training run. Losses are reconstruction mean squared errors
+/// `(1/(N·n)) Σ‖x̂ − x‖²` in scaled units without the weight penalty; RMSEs are in physical units,
+/// `√((1/(N·n)) Σ‖x̂ − x‖²)` over all rows and features (as the paper's Table I).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrainReport {
+    /// Per epoch: mean of the batch losses seen during the epoch (before each step).
+    pub train_loss: Vec<f64>,
+    /// Per epoch: validation loss after the epoch; empty without validation rows.
+    pub val_loss: Vec<f64>,
+    /// Training-set loss of the kept (best) weights.
+    pub final_train_loss: f64,
+    /// Validation-set loss of the kept weights.
+    pub final_val_loss: Option<f64>,
+    /// Training-set RMSE of the kept weights, physical units.
+    pub final_train_rmse: f64,
+    /// Validation-set RMSE of the kept weights, physical units.
+    pub final_val_rmse: Option<f64>,
+    /// Epoch (1-based, counted over both phases) whose weights were kept.
+    pub best_epoch: usize,
+    /// Epochs run in total (main + fine-tuning).
+    pub epochs_run: usize,
+    /// Of which in the fine-tuning phase.
+    pub fine_tune_epochs_run: usize,
+    pub stop: StopReason,
+    pub n_train: usize,
+    pub n_val: usize,
+    pub wall_time: Duration,
+}
+
+/// Progress callback: `(epoch, train_loss, val_loss)` after every epoch; `Break` stops training
+/// (the best weights so far are kept).
+pub type Progress<'a> = &'a mut dyn FnMut(usize, f64, Option<f64>) -> ControlFlow<()>;
+
+/// Adam moments for every weight and bias.
+struct Adam {
+    m_w: Vec<Vec<f64>>,
+    v_w: Vec<Vec<f64>>,
+    m_b: Vec<Vec<f64>>,
+    v_b: Vec<Vec<f64>>,
+    t: i32,
+}
+
+const BETA1: f64 = 0.9;
+const BETA2: f64 = 0.999;
+const EPS: f64 = 1e-8;
+
+impl Adam {
+    fn new(layers: &[Layer]) -> Self {
+        let zeros =
+            |f: fn(&Layer) -> usize| layers.iter().map(|l| vec![0.0; f(l)]).collect::<Vec<_>>();
+        Adam {
+            m_w: zeros(|l| l.w.len()),
+            v_w: zeros(|l| l.w.len()),
+            m_b: zeros(|l| l.b.len()),
+            v_b: zeros(|l| l.b.len()),
+            t: 0,
+        }
+    }
+
+    /// One step `θ ← θ − η m̂/(√v̂ + ε)` on every layer with the gradients in `ws`.
+    fn step(&mut self, layers: &mut [Layer], ws: &Workspace, lr: f64) {
+        self.t = self.t.saturating_add(1);
+        let c1 = 1.0 - BETA1.powi(self.t);
+        let c2 = 1.0 - BETA2.powi(self.t);
+        for (k, layer) in layers.iter_mut().enumerate() {
+            adam_update(
+                &mut layer.w,
+                &ws.grad_w[k],
+                &mut self.m_w[k],
+                &mut self.v_w[k],
+                lr,
+                c1,
+                c2,
+            );
+            adam_update(
+                &mut layer.b,
+                &ws.grad_b[k],
+                &mut self.m_b[k],
+                &mut self.v_b[k],
+                lr,
+                c1,
+                c2,
+            );
+        }
+    }
+}
+
+/// Elementwise Adam update with bias corrections `c1 = 1 − β₁ᵗ`, `c2 = 1 − β₂ᵗ`.
+fn adam_update(
+    theta: &mut [f64],
+    g: &[f64],
+    m: &mut [f64],
+    v: &mut [f64],
+    lr: f64,
+    c1: f64,
+    c2: f64,
+) {
+    for i in 0..theta.len() {
+        m[i] = BETA1 * m[i] + (1.0 - BETA1) * g[i];
+        v[i] = BETA2 * v[i] + (1.0 - BETA2) * g[i] * g[i];
+        theta[i] -= lr * (m[i] / c1) / ((v[i] / c2).sqrt() + EPS);
+    }
+}
+
+/// Fisher–Yates shuffle driven by `rng`.
+pub(crate) fn shuffle(index: &mut [usize], rng: &mut SplitMix64) {
+    for i in (1..index.len()).rev() {
+        let j = ((rng.uniform() * (i + 1) as f64) as usize).min(i);
+        index.swap(i, j);
+    }
+}
+
+/// Copies parameters between two chains of the same shape (no allocation).
+fn copy_layers(dst: &mut [Layer], src: &[Layer]) {
+    for (d, s) in dst.iter_mut().zip(src) {
+        d.w.copy_from_slice(&s.w);
+        d.b.copy_from_slice(&s.b);
+    }
+}
+
+/// A chain to train on row-major scaled data.
+pub(crate) struct Problem<'a> {
+    pub layers: &'a mut [Layer],
+    pub tanh: &'a [bool],
+    pub data: &'a [f64],
+    pub train: &'a [usize],
+    pub val: &'a [usize],
+}
+
+/// What [`fit`] observed; the chain ends with the best weights.
+pub(crate) struct FitOutcome {
+    pub train_loss: Vec<f64>,
+    pub val_loss: Vec<f64>,
+    pub best_epoch: usize,
+    pub fine_tune_epochs_run: usize,
+    pub stop: StopReason,
+}
+
+/// Curves, the best weights so far and the early-stopping counter.
+struct Tracker<'p, 'q> {
+    best: Vec<Layer>,
+    best_loss: f64,
+    since_best: usize,
+    patience: Option<usize>,
+    out: FitOutcome,
+    progress: Progress<'p>,
+    val: &'q [usize],
+}
+
+impl Tracker<'_, '_> {
+    /// Records an epoch with training loss `train` (validation evaluated here); returns why to stop
+    /// the phase (`Interrupted`, `Diverged` end the whole run), or `None` to continue.
+    fn record(
+        &mut self,
+        p: &mut Problem,
+        ws: &mut Workspace,
+        train: f64,
+        fine: bool,
+    ) -> Option<StopReason> {
+        let val =
+            (!self.val.is_empty()).then(|| dataset_mse(p.layers, p.tanh, p.data, self.val, ws));
+        self.out.train_loss.push(train);
+        self.out.val_loss.extend(val);
+        self.out.fine_tune_epochs_run += usize::from(fine);
+        let monitored = val.unwrap_or(train);
+        if !train.is_finite() || !monitored.is_finite() {
+            return Some(StopReason::Diverged);
+        }
+        if monitored < self.best_loss {
+            (self.best_loss, self.out.best_epoch, self.since_best) =
+                (monitored, self.out.train_loss.len(), 0);
+            copy_layers(&mut self.best, p.layers);
+        } else {
+            self.since_best += 1;
+        }
+        if (self.progress)(self.out.train_loss.len(), train, val).is_break() {
+            return Some(StopReason::Interrupted);
+        }
+        self.patience
+            .is_some_and(|patience| self.since_best >= patience)
+            .then_some(StopReason::EarlyStopping)
+    }
+}
+
+/// Runs the main Adam phase and the fine-tuning phase (module docs) and leaves the best weights in
+/// the chain.
+pub(crate) fn fit(
+    mut p: Problem,
+    opts: &TrainOptions,
+    rng: &mut SplitMix64,
+    progress: Progress,
+) -> FitOutcome {
+    let sizes: Vec<usize> = p
+        .layers
+        .iter()
+        .map(|l| l.n_in)
+        .chain(p.layers.last().map(|l| l.n_out))
+        .collect();
+    // Batches never exceed the training rows; the validation pass reuses the same buffers.
+    let mut ws = Workspace::new(&sizes, opts.batch_size.min(p.train.len()));
+    let mut t = Tracker {
+        best: p.layers.to_vec(),
+        best_loss: f64::INFINITY,
+        since_best: 0,
+        patience: opts.patience,
+        out: FitOutcome {
+            train_loss: Vec::new(),
+            val_loss: Vec::new(),
+            best_epoch: 0,
+            fine_tune_epochs_run: 0,
+            stop: StopReason::EpochLimit,
+        },
+        progress,
+        val: p.val,
+    };
+    let mut stop = adam_phase(
+        &mut p,
+        &mut ws,
+        &mut t,
+        rng,
+        (opts.epochs, opts.learning_rate, opts.lambda),
+        false,
+    );
+    let resumable =
+        matches!(stop, StopReason::EpochLimit | StopReason::EarlyStopping) && t.out.best_epoch > 0;
+    if resumable && !matches!(opts.fine_tune, FineTune::None) {
+        copy_layers(p.layers, &t.best);
+        t.since_best = 0;
+        stop = match opts.fine_tune {
+            FineTune::Adam {
+                epochs,
+                learning_rate_factor: f,
+            } => adam_phase(
+                &mut p,
+                &mut ws,
+                &mut t,
+                rng,
+                (epochs, opts.learning_rate * f, opts.lambda),
+                true,
+            ),
+            FineTune::Lbfgs { iterations, memory } => {
+                lbfgs_phase(&mut p, &mut ws, &mut t, (iterations, memory), opts.lambda)
+            }
+            FineTune::None => stop,
+        };
+    }
+    if t.out.best_epoch > 0 {
+        copy_layers(p.layers, &t.best);
+    }
+    t.out.stop = stop;
+    t.out
+}
+
+/// Up to `epochs` epochs of mini-batch Adam with a fresh optimiser state.
+fn adam_phase(
+    p: &mut Problem,
+    ws: &mut Workspace,
+    t: &mut Tracker,
+    rng: &mut SplitMix64,
+    (epochs, lr, lambda): (usize, f64, f64),
+    fine: bool,
+) -> StopReason {
+    let mut adam = Adam::new(p.layers);
+    let mut order = p.train.to_vec();
+    for _ in 0..epochs {
+        shuffle(&mut order, rng);
+        let train = run_epoch(
+            p.layers,
+            p.tanh,
+            p.data,
+            &order,
+            ws,
+            &mut adam,
+            (lr, lambda),
+        );
+        if let Some(stop) = t.record(p, ws, train, fine) {
+            return stop;
+        }
+    }
+    StopReason::EpochLimit
+}
+
+/// Up to `iterations` full-batch L-BFGS iterations, each recorded as an epoch.
+fn lbfgs_phase(
+    p: &mut Problem,
+    ws: &mut Workspace,
+    t: &mut Tracker,
+    (iterations, memory): (usize, usize),
+    lambda: f64,
+) -> StopReason {
+    let obj = Objective {
+        tanh: p.tanh,
+        data: p.data,
+        rows: p.train,
+        lambda,
+    };
+    let mut lbfgs = Lbfgs::new(p.layers, memory, &obj, ws);
+    for _ in 0..iterations {
+        let Some(train) = lbfgs.step(p.layers, &obj, ws) else {
+            return StopReason::Converged;
+        };
+        if let Some(stop) = t.record(p, ws, train, true) {
+            return stop;
+        }
+    }
+    StopReason::EpochLimit
+}
+
+/// One pass over the rows in `order`, one Adam step per batch; returns the mean batch loss.
+fn run_epoch(
+    layers: &mut [Layer],
+    tanh: &[bool],
+    data: &[f64],
+    order: &[usize],
+    ws: &mut Workspace,
+    adam: &mut Adam,
+    (lr, lambda): (f64, f64),
+) -> f64 {
+    let n = layers[0].n_in;
+    let mut sum = 0.0;
+    for batch in order.chunks(ws.capacity()) {
+        ws.load_rows(data, n, batch);
+        forward_batch(layers, tanh, ws, batch.len());
+        sum += reconstruction_mse(ws, batch.len()) * batch.len() as f64;
+        backward_batch(layers, tanh, ws, batch.len(), lambda);
+        adam.step(layers, ws, lr);
+    }
+    sum / order.len().max(1) as f64
+}

@@ -1,0 +1,54 @@
+//! `DecoderMap`'s `CoefficientMap` calls allocate nothing (the map.rs contract), checked with a
+//! counting global allocator in this test binary.
+
+use gvs::inputs::SplitMix64;
+use rom::map::CoefficientMap;
+use rom::nn::{DecoderMap, Mlp, Scaling};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+struct Counting;
+
+thread_local! {
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+// SAFETY: forwards to the system allocator; only counts calls on the current thread.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.with(|a| a.set(a.get() + 1));
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn eval_rate_and_weighted_hessian_do_not_allocate() {
+    let (r, n, m) = (3, 40, 5);
+    let mut rng = SplitMix64::new(9);
+    let decoder = Mlp::glorot(&[r, 10, 20, n], &mut rng).unwrap();
+    let a: Vec<f64> = (0..m * n).map(|_| rng.range(-1.0, 1.0)).collect();
+    let map = DecoderMap::new(&decoder, &Scaling::identity(n), &a, m).unwrap();
+    let (z, zd, g) = (vec![0.3, -0.2, 0.5], vec![1.0, 0.5, -0.4], vec![0.1; m]);
+    let (mut c, mut c_z, mut c_z_dot) = (vec![0.0; m], vec![0.0; m * r], vec![0.0; m * r]);
+    let (mut hess, mut scratch) = (vec![0.0; r * r], vec![0.0; map.scratch_len()]);
+    let before = ALLOCATIONS.with(Cell::get);
+    map.eval(&z, &mut c, &mut c_z, &mut scratch);
+    map.eval_rate(&z, &zd, &mut c_z_dot, &mut scratch);
+    map.add_weighted_hessian(&z, &g, &mut hess, &mut scratch);
+    assert_eq!(ALLOCATIONS.with(Cell::get) - before, 0);
+    // The counter does see allocations.
+    drop(std::hint::black_box(vec![0u8; 8]));
+    assert_eq!(ALLOCATIONS.with(Cell::get) - before, 1);
+    assert!(c
+        .iter()
+        .chain(&c_z)
+        .chain(&c_z_dot)
+        .chain(&hess)
+        .all(|v| v.is_finite()));
+}
