@@ -1,0 +1,163 @@
+//! Proper orthogonal decomposition of strain snapshots (paper Section IV, the POD-ROM baseline).
+//!
+//! With the snapshots as the rows of `X` (N × L, L = p·n_a point strains, eq. 13), the thin SVD
+//! `X = U Σ Vᵀ` gives the POD modes as the columns of `V` (orthonormal in R^L) and the captured
+//! energy of the first K modes as `Σ_{k<K} σ_k² / Σ_k σ_k²`. The snapshots are **not** centred: the
+//! modes span the strain deviations themselves, so `q_r = 0` is the straight rod, as for the HOM.
+//! The reduced basis on the HOM is then `Φ_s (P V_K)` (see [`crate::reduced`]), a constant linear
+//! basis: `gvs::strain::LinearBasis::compose`.
+
+use nalgebra::{DMatrix, DVector};
+use thiserror::Error;
+
+#[derive(Debug, Error, PartialEq)]
+pub enum PodError {
+    #[error("snapshots: {0}")]
+    Data(String),
+    #[error("--modes {requested}: {reason}")]
+    Modes { requested: usize, reason: String },
+    #[error("the SVD of the snapshot matrix did not converge")]
+    Svd,
+}
+
+/// The POD of a snapshot set: all singular values, and the leading modes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pod {
+    /// σ_k, non-increasing (min(N, L) values).
+    pub singular_values: Vec<f64>,
+    /// The first K right singular vectors as columns (L × K), sign fixed so that each mode's largest
+    /// entry in magnitude is positive (repeatable across platforms and runs).
+    pub modes: DMatrix<f64>,
+}
+
+impl Pod {
+    /// POD of the `n_rows` snapshots stored row-major in `rows` (each of length `n_features`), keeping
+    /// `modes` modes. Rows with any non-finite value are an error naming the row.
+    pub fn compute(rows: &[f64], n_features: usize, modes: usize) -> Result<Pod, PodError> {
+        if n_features == 0 || rows.is_empty() || rows.len() % n_features != 0 {
+            return Err(PodError::Data(format!(
+                "{} values do not form rows of {n_features}",
+                rows.len()
+            )));
+        }
+        let n = rows.len() / n_features;
+        if let Some(i) = rows.iter().position(|v| !v.is_finite()) {
+            return Err(PodError::Data(format!(
+                "row {} has a non-finite value at feature {}",
+                i / n_features,
+                i % n_features
+            )));
+        }
+        let rank_max = n.min(n_features);
+        if modes == 0 || modes > rank_max {
+            return Err(PodError::Modes {
+                requested: modes,
+                reason: format!(
+                    "must be between 1 and min(snapshots, features) = min({n}, {n_features}) = {rank_max}"
+                ),
+            });
+        }
+        faer::set_global_parallelism(faer::Par::Seq);
+        let x = faer::Mat::<f64>::from_fn(n, n_features, |i, j| rows[i * n_features + j]);
+        let svd = x.thin_svd().map_err(|_| PodError::Svd)?;
+        let s = svd.S().column_vector();
+        let singular_values: Vec<f64> = (0..rank_max).map(|k| s[k]).collect();
+        let v = svd.V();
+        let mut m = DMatrix::from_fn(n_features, modes, |i, k| v[(i, k)]);
+        for mut col in m.column_iter_mut() {
+            let imax = col.iamax();
+            if col[imax] < 0.0 {
+                col.neg_mut();
+            }
+        }
+        Ok(Pod {
+            singular_values,
+            modes: m,
+        })
+    }
+
+    /// Fraction of the snapshot energy `Σ σ²` captured by the first `k` modes, for k = 1..=all.
+    pub fn captured_energy(&self) -> Vec<f64> {
+        let total: f64 = self.singular_values.iter().map(|s| s * s).sum();
+        let mut acc = 0.0;
+        self.singular_values
+            .iter()
+            .map(|s| {
+                acc += s * s;
+                if total > 0.0 {
+                    acc / total
+                } else {
+                    1.0
+                }
+            })
+            .collect()
+    }
+
+    /// Number of modes with a singular value above `rel · σ_max` (the numerical rank of the data).
+    pub fn rank(&self, rel: f64) -> usize {
+        let smax = self.singular_values.first().copied().unwrap_or(0.0);
+        self.singular_values
+            .iter()
+            .filter(|&&s| s > rel * smax)
+            .count()
+    }
+
+    /// Projection of a snapshot onto the modes, `Vᵀ x`.
+    pub fn encode(&self, x: &DVector<f64>) -> DVector<f64> {
+        self.modes.tr_mul(x)
+    }
+
+    /// `V q_r`.
+    pub fn decode(&self, q_r: &DVector<f64>) -> DVector<f64> {
+        &self.modes * q_r
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Rows `x(θ) = a(θ) u + b(θ) w` with orthonormal `u`, `w`: rank 2, modes span {u, w}.
+    fn rank_two(n: usize, l: usize) -> (Vec<f64>, DVector<f64>, DVector<f64>) {
+        let u = DVector::from_fn(l, |j, _| ((j as f64) * 0.3).sin()).normalize();
+        let w0 = DVector::from_fn(l, |j, _| ((j as f64) * 0.11).cos());
+        let w = (&w0 - &u * u.dot(&w0)).normalize();
+        let mut rows = Vec::with_capacity(n * l);
+        for i in 0..n {
+            let t = i as f64 / (n - 1) as f64 * 2.0 - 1.0;
+            let x = &u * (3.0 * t) + &w * (t * t);
+            rows.extend(x.iter());
+        }
+        (rows, u, w)
+    }
+
+    #[test]
+    fn pod_of_rank_two_data_finds_its_span_and_energy() {
+        let (rows, u, w) = rank_two(50, 40);
+        let pod = Pod::compute(&rows, 40, 2).unwrap();
+        assert_eq!(pod.rank(1e-10), 2);
+        let e = pod.captured_energy();
+        assert!((e[1] - 1.0).abs() < 1e-14 && e[0] < 1.0);
+        // orthonormal modes spanning {u, w}
+        let g = pod.modes.tr_mul(&pod.modes);
+        assert!((g - DMatrix::identity(2, 2)).amax() < 1e-13);
+        for v in [&u, &w] {
+            assert!((pod.decode(&pod.encode(v)) - v).amax() < 1e-12);
+        }
+        // the leading singular value: Σ (3t)² over the rows dominates
+        assert!(pod.singular_values[0] > pod.singular_values[1]);
+    }
+
+    #[test]
+    fn bad_snapshots_and_mode_counts_are_named() {
+        let (mut rows, _, _) = rank_two(5, 4);
+        assert!(Pod::compute(&rows, 4, 5)
+            .unwrap_err()
+            .to_string()
+            .contains("min(5, 4) = 4"));
+        assert!(Pod::compute(&rows, 3, 1).is_err());
+        rows[9] = f64::NAN;
+        let e = Pod::compute(&rows, 4, 1).unwrap_err().to_string();
+        assert!(e.contains("row 2") && e.contains("feature 1"), "{e}");
+    }
+}
