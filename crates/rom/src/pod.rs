@@ -34,7 +34,7 @@ impl Pod {
     /// POD of the `n_rows` snapshots stored row-major in `rows` (each of length `n_features`), keeping
     /// `modes` modes. Rows with any non-finite value are an error naming the row.
     pub fn compute(rows: &[f64], n_features: usize, modes: usize) -> Result<Pod, PodError> {
-        if n_features == 0 || rows.is_empty() || rows.len() % n_features != 0 {
+        if n_features == 0 || rows.is_empty() || !rows.len().is_multiple_of(n_features) {
             return Err(PodError::Data(format!(
                 "{} values do not form rows of {n_features}",
                 rows.len()
