@@ -1,0 +1,325 @@
+//! Reduced-model files (`gvsrom pod … --out MODEL`, `gvsrom train … --out MODEL`): a directory
+//! written through [`crate::output`] holding
+//!
+//! - `weights.safetensors`: the numbers, f64 little-endian, which Python opens with
+//!   `safetensors.numpy.load_file`. POD: `modes` (L × K), `singular_values`. Autoencoder:
+//!   `encoder.{k}.weight` (out × in, row-major), `encoder.{k}.bias`, `decoder.{k}.…`,
+//!   `scaling.mean`, `scaling.scale` (`x = mean + scale ⊙ y` undoes the data scaling);
+//! - `meta.json`: the kind, the point layout the model was learned on (scenario, `strain_x`, active
+//!   components, HOM size), the dataset it came from (path, hash of its `strain.npy`, rows used),
+//!   the rest coordinates of the straight rod, and the training settings and results;
+//! - training curves (`train_loss.npy`, `val_loss.npy`) or the POD spectrum (`singular_values.npy`,
+//!   `captured_energy.npy`).
+//!
+//! Loading checks every tensor's name, dtype and shape against the metadata: a truncated or edited
+//! file is an error naming it, never a different model. Saved and loaded models are bit-identical.
+
+use crate::npy::write_array;
+use crate::output::{OutputDir, OutputError, MANIFEST_KEY};
+use rom::nn::{Autoencoder, Mlp, Scaling};
+use safetensors::tensor::{Dtype, SafeTensors, TensorView};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// The manifest format of a model directory.
+pub const MODEL_FORMAT: &str = "reduced-model";
+/// The weights file of a model directory.
+pub const WEIGHTS_FILE: &str = "weights.safetensors";
+
+#[derive(Debug, Error)]
+pub enum ModelFileError {
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    #[error("model `{path}`: {message}")]
+    Invalid { path: PathBuf, message: String },
+}
+
+/// The strain layout a model was learned on; a scenario must match it to use the model.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ModelLayout {
+    /// Name of the scenario the dataset came from.
+    pub scenario: String,
+    /// Its TOML text.
+    pub scenario_toml: String,
+    /// Abscissae of the computational points [m].
+    pub strain_x: Vec<f64>,
+    /// Names of the active strain components, in 6-vector order.
+    pub active: Vec<String>,
+    /// Number of generalized coordinates of the HOM basis.
+    pub hom_dof: usize,
+}
+
+impl ModelLayout {
+    /// Length of one snapshot (points × active components).
+    pub fn features(&self) -> usize {
+        self.strain_x.len() * self.active.len()
+    }
+}
+
+/// Where the training data came from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DatasetRef {
+    pub path: String,
+    /// FNV-1a 64 of the dataset's `strain.npy` bytes (a change detector, not a signature).
+    pub strain_hash: String,
+    /// Rows used (failed samples skipped).
+    pub rows: usize,
+}
+
+/// The autoencoder's training record.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrainingMeta {
+    pub hidden_layers: usize,
+    pub encoder_sizes: Vec<usize>,
+    pub decoder_sizes: Vec<usize>,
+    pub lambda: f64,
+    pub epochs: usize,
+    pub batch_size: usize,
+    pub learning_rate: f64,
+    pub validation_fraction: f64,
+    pub patience: Option<usize>,
+    pub seed: u64,
+    pub epochs_run: usize,
+    pub best_epoch: usize,
+    pub stop: String,
+    pub final_train_loss: f64,
+    pub final_val_loss: Option<f64>,
+    /// RMSE of the reconstruction in physical strain units (paper Table I).
+    pub final_train_rmse: f64,
+    pub final_val_rmse: Option<f64>,
+    pub wall_time_s: f64,
+}
+
+/// `meta.json` of a model directory.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ModelMeta {
+    /// `"pod"` or `"autoencoder"`.
+    pub kind: String,
+    /// Number of reduced coordinates r.
+    pub latent: usize,
+    pub layout: ModelLayout,
+    pub dataset: DatasetRef,
+    /// Reduced coordinates of the straight rod.
+    pub rest: Vec<f64>,
+    /// POD: fraction of the snapshot energy the kept modes capture.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub captured_energy: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub training: Option<TrainingMeta>,
+    /// Largest relative part of a reconstructed training snapshot the HOM basis cannot represent,
+    /// `max ‖x − Φ̄Px‖/‖x‖` (see `rom::reduced`).
+    pub projection_residual: f64,
+    pub crate_version: String,
+}
+
+/// The numbers of a model.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ModelWeights {
+    /// POD modes (L × K, column k = mode k) and all singular values.
+    Pod {
+        modes: nalgebra::DMatrix<f64>,
+        singular_values: Vec<f64>,
+    },
+    Autoencoder(Autoencoder),
+}
+
+/// A reduced model: its metadata and its numbers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReducedModel {
+    pub meta: ModelMeta,
+    pub weights: ModelWeights,
+}
+
+/// FNV-1a 64-bit hash, as 16 hex digits.
+pub fn fnv1a64(bytes: &[u8]) -> String {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for &b in bytes {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    }
+    format!("{h:016x}")
+}
+
+fn f64_bytes(v: &[f64]) -> Vec<u8> {
+    v.iter().flat_map(|x| x.to_le_bytes()).collect()
+}
+
+fn mlp_tensors(prefix: &str, mlp: &Mlp, out: &mut BTreeMap<String, (Vec<usize>, Vec<u8>)>) {
+    let sizes = mlp.layer_sizes();
+    for k in 0..mlp.n_layers() {
+        out.insert(
+            format!("{prefix}.{k}.weight"),
+            (vec![sizes[k + 1], sizes[k]], f64_bytes(mlp.weights(k))),
+        );
+        out.insert(
+            format!("{prefix}.{k}.bias"),
+            (vec![sizes[k + 1]], f64_bytes(mlp.biases(k))),
+        );
+    }
+}
+
+impl ReducedModel {
+    fn tensors(&self) -> BTreeMap<String, (Vec<usize>, Vec<u8>)> {
+        let mut t = BTreeMap::new();
+        match &self.weights {
+            ModelWeights::Pod {
+                modes,
+                singular_values,
+            } => {
+                // row-major L × K
+                let rm: Vec<f64> = modes.transpose().iter().copied().collect();
+                t.insert("modes".into(), (vec![modes.nrows(), modes.ncols()], f64_bytes(&rm)));
+                t.insert(
+                    "singular_values".into(),
+                    (vec![singular_values.len()], f64_bytes(singular_values)),
+                );
+            }
+            ModelWeights::Autoencoder(ae) => {
+                mlp_tensors("encoder", ae.encoder(), &mut t);
+                mlp_tensors("decoder", ae.decoder(), &mut t);
+                let s = ae.scaling();
+                t.insert("scaling.mean".into(), (vec![s.len()], f64_bytes(s.mean())));
+                t.insert("scaling.scale".into(), (vec![s.len()], f64_bytes(s.scale())));
+            }
+        }
+        t
+    }
+
+    /// Writes the weights, the curves in `extra` (name → 1-D values, as `.npy`) and `meta.json`
+    /// into `out` and commits it.
+    pub fn save(
+        &self,
+        mut out: OutputDir,
+        extra: &[(&str, &[f64])],
+    ) -> Result<PathBuf, ModelFileError> {
+        let tensors = self.tensors();
+        let views: Vec<(String, TensorView<'_>)> = tensors
+            .iter()
+            .map(|(k, (shape, data))| {
+                TensorView::new(Dtype::F64, shape.clone(), data).map(|v| (k.clone(), v))
+            })
+            .collect::<Result<_, _>>()
+            .map_err(|e| out.io_error("encode the weights", std::io::Error::other(e.to_string())))?;
+        let mut info = std::collections::HashMap::new();
+        info.insert("format".to_string(), format!("gvsrom {MODEL_FORMAT}"));
+        info.insert("kind".to_string(), self.meta.kind.clone());
+        let bytes = safetensors::serialize(views, Some(info))
+            .map_err(|e| out.io_error("encode the weights", std::io::Error::other(e.to_string())))?;
+        out.write_file(WEIGHTS_FILE, |w| std::io::Write::write_all(w, &bytes))
+            .map_err(|e| out.io_error("write weights.safetensors", e))?;
+        for (name, values) in extra {
+            let file = format!("{name}.npy");
+            write_array(&mut out, &file, &[values.len()], values)
+                .map_err(|e| out.io_error(&format!("write {file}"), e))?;
+        }
+        Ok(out.commit(&self.meta)?)
+    }
+
+    /// Reads and checks a model directory.
+    pub fn load(dir: &Path) -> Result<ReducedModel, ModelFileError> {
+        let bad = |message: String| ModelFileError::Invalid {
+            path: dir.to_path_buf(),
+            message,
+        };
+        let meta_path = dir.join("meta.json");
+        let text = std::fs::read_to_string(&meta_path)
+            .map_err(|e| bad(format!("cannot read meta.json: {e}")))?;
+        let value: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| bad(format!("meta.json: {e}")))?;
+        let format = value
+            .get(MANIFEST_KEY)
+            .and_then(|m| m.get("format"))
+            .and_then(|f| f.as_str());
+        if format != Some(MODEL_FORMAT) {
+            return Err(bad(format!(
+                "not a gvsrom reduced model (meta.json format {}, expected \"{MODEL_FORMAT}\")",
+                format.map_or("missing".to_string(), |f| format!("\"{f}\""))
+            )));
+        }
+        let meta: ModelMeta =
+            serde_json::from_value(value).map_err(|e| bad(format!("meta.json: {e}")))?;
+        if meta.latent == 0 || meta.rest.len() != meta.latent {
+            return Err(bad(format!(
+                "meta.json: latent {} with {} rest coordinates",
+                meta.latent,
+                meta.rest.len()
+            )));
+        }
+        let bytes = std::fs::read(dir.join(WEIGHTS_FILE))
+            .map_err(|e| bad(format!("cannot read {WEIGHTS_FILE}: {e}")))?;
+        let st = SafeTensors::deserialize(&bytes)
+            .map_err(|e| bad(format!("{WEIGHTS_FILE} is damaged: {e}")))?;
+        let get = |name: &str, shape: &[usize]| -> Result<Vec<f64>, ModelFileError> {
+            let t = st
+                .tensor(name)
+                .map_err(|_| bad(format!("{WEIGHTS_FILE}: tensor `{name}` is missing")))?;
+            if t.dtype() != Dtype::F64 || t.shape() != shape {
+                return Err(bad(format!(
+                    "{WEIGHTS_FILE}: tensor `{name}` is {:?} {:?}, expected F64 {shape:?}",
+                    t.dtype(),
+                    t.shape()
+                )));
+            }
+            Ok(t.data()
+                .chunks_exact(8)
+                .map(|c| f64::from_le_bytes(c.try_into().expect("chunks of 8")))
+                .collect())
+        };
+        let features = meta.layout.features();
+        let weights = match meta.kind.as_str() {
+            "pod" => {
+                let rm = get("modes", &[features, meta.latent])?;
+                let n_sv = st
+                    .tensor("singular_values")
+                    .map(|t| t.shape().first().copied().unwrap_or(0))
+                    .unwrap_or(0);
+                let singular_values = get("singular_values", &[n_sv])?;
+                ModelWeights::Pod {
+                    modes: nalgebra::DMatrix::from_row_slice(features, meta.latent, &rm),
+                    singular_values,
+                }
+            }
+            "autoencoder" => {
+                let tr = meta
+                    .training
+                    .as_ref()
+                    .ok_or_else(|| bad("meta.json: autoencoder without `training`".into()))?;
+                let mlp = |prefix: &str, sizes: &[usize]| -> Result<Mlp, ModelFileError> {
+                    let mut ws = vec![];
+                    let mut bs = vec![];
+                    for k in 0..sizes.len().saturating_sub(1) {
+                        ws.push(get(&format!("{prefix}.{k}.weight"), &[sizes[k + 1], sizes[k]])?);
+                        bs.push(get(&format!("{prefix}.{k}.bias"), &[sizes[k + 1]])?);
+                    }
+                    Mlp::new(sizes, ws, bs).map_err(|e| bad(format!("{prefix}: {e}")))
+                };
+                let encoder = mlp("encoder", &tr.encoder_sizes)?;
+                let decoder = mlp("decoder", &tr.decoder_sizes)?;
+                let scaling = Scaling::new(
+                    get("scaling.mean", &[features])?,
+                    get("scaling.scale", &[features])?,
+                )
+                .map_err(|e| bad(format!("scaling: {e}")))?;
+                let ae = Autoencoder::new(encoder, decoder, scaling)
+                    .map_err(|e| bad(e.to_string()))?;
+                if ae.n_features() != features || ae.latent() != meta.latent {
+                    return Err(bad(format!(
+                        "the network maps {} features to {} coordinates, meta.json says {features} and {}",
+                        ae.n_features(),
+                        ae.latent(),
+                        meta.latent
+                    )));
+                }
+                ModelWeights::Autoencoder(ae)
+            }
+            other => {
+                return Err(bad(format!(
+                    "meta.json: unknown kind \"{other}\" (expected \"pod\" or \"autoencoder\")"
+                )))
+            }
+        };
+        Ok(ReducedModel { meta, weights })
+    }
+}
