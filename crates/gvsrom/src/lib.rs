@@ -7,6 +7,7 @@
 
 pub mod build;
 pub mod csv_input;
+pub mod dataset;
 pub mod error;
 pub mod npy;
 pub mod output;

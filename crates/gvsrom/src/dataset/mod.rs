@@ -1,0 +1,650 @@
+//! Strain snapshot datasets (paper eq. 13, Section IV): the HOM solved over a sampling plan, one row
+//! per sample, written as NumPy arrays through [`crate::output`].
+//!
+//! | file | shape | dtype | content |
+//! |---|---|---|---|
+//! | `inputs.npy` | (N, k) | f64 | the plan's parameter values (`parameters` in meta.json names the columns) |
+//! | `strain.npy` | (N, p·a) | f64 | ξ − ξ* at the p computational points, the a active components, point-major: column `j·a + c` is point j, component `components[c]`; NaN rows for failed samples |
+//! | `q.npy` | (N, n) | f64 | HOM coordinates |
+//! | `tip_position.npy` | (N, 3) | f64 | tip position [m] |
+//! | `tip_rotation.npy` | (N, 3, 3) | f64 | tip rotation (section → world) |
+//! | `status.npy` | (N,) | u8 | 0 ok, 1 failed (reason in meta.json `failures`), 2 not computed (incomplete dataset) |
+//! | `iterations.npy` | (N,) | u32 | dogleg iterations of the successful solve |
+//! | `residual.npy` | (N,) | f64 | ‖R‖∞ at the solution |
+//! | `strain_x.npy` | (p,) | f64 | abscissae of the computational points [m] |
+//! | `meta.json` | | | manifest, scenario TOML (after `--set`), plan, seed, parameters, point layout, active components, chunking and `chunk_done`, counts, failures, `complete`, crate version, wall time |
+//!
+//! A strain component is *active* if the scenario's basis can excite it at some site; the others are
+//! identically zero and not stored. Samples are solved in chunks (see [`generate`]) in parallel; the
+//! files are bit-identical for a given plan and seed whatever the thread count. An interrupted run
+//! writes its finished chunks with `"complete": false`; `--resume` computes only the missing chunks.
+
+pub mod generate;
+pub mod plan;
+pub mod reader;
+
+pub use generate::Layout;
+pub use plan::{Plan, PlanKind};
+pub use reader::Dataset;
+
+use crate::build::Built;
+use crate::error::ScenarioError;
+use crate::output::{OutputDir, OutputError};
+use crate::scenario::StrainMode;
+use generate::{Generator, SampleResult, STATUS_FAILED, STATUS_NOT_COMPUTED, STATUS_OK};
+use serde::{Deserialize, Serialize};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Instant;
+use thiserror::Error;
+
+/// The arrays of a dataset, in the order [`Dataset::load`] reads them.
+pub const FILES: [&str; 9] = [
+    "inputs.npy",
+    "strain.npy",
+    "q.npy",
+    "tip_position.npy",
+    "tip_rotation.npy",
+    "status.npy",
+    "iterations.npy",
+    "residual.npy",
+    "strain_x.npy",
+];
+
+/// Samples per chunk unless `--chunk-size` says otherwise.
+pub const DEFAULT_CHUNK_SIZE: usize = 128;
+/// Largest `--chunk-size`.
+pub const MAX_CHUNK_SIZE: usize = 4096;
+/// Largest dataset held in memory while it is generated [bytes] (8 GiB).
+pub const MAX_DATASET_BYTES: f64 = 8.0 * 1024.0 * 1024.0 * 1024.0;
+
+#[derive(Debug, Error)]
+pub enum DatasetError {
+    /// A bad plan or option (the message names it, its value and what is accepted).
+    #[error("{0}")]
+    Plan(String),
+    #[error(transparent)]
+    Scenario(#[from] ScenarioError),
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    /// A dataset file that is missing, truncated or inconsistent.
+    #[error("{file}: {message}")]
+    File { file: String, message: String },
+    /// `--resume` on something that cannot be resumed.
+    #[error("--resume `{path}`: {message}")]
+    Resume { path: String, message: String },
+}
+
+/// `gvsrom dataset`: the scenario, the plan and the output.
+#[derive(Debug, clap::Args)]
+pub struct DatasetArgs {
+    /// A preset name (see `gvsrom presets`) or the path of a scenario TOML file.
+    pub scenario: String,
+
+    /// Override a scenario value by its TOML path before sampling (as for `statics`); repeatable.
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    pub set: Vec<String>,
+
+    /// Sweep PATH over an even 1-D grid from LO to HI including both ends (`--samples` values).
+    /// Repeat it (or use `*`, e.g. `tendons.*.tension`) to sweep several values together.
+    #[arg(long, value_name = "PATH=LO:HI", allow_hyphen_values = true)]
+    pub sweep: Vec<String>,
+
+    /// Grid over the product of the ranges: round(samples^(1/d)) even values per parameter, which
+    /// must give exactly `--samples` (e.g. 15625 = 5^6 for `tendons.*.tension` on six tendons).
+    #[arg(long, value_name = "PATH=LO:HI", allow_hyphen_values = true)]
+    pub grid: Vec<String>,
+
+    /// Uniform random values in [LO, HI), seeded by `--seed`; repeatable, `*` allowed.
+    #[arg(long, value_name = "PATH=LO:HI", allow_hyphen_values = true)]
+    pub random: Vec<String>,
+
+    /// Number of samples.
+    #[arg(long, value_name = "N")]
+    pub samples: Option<usize>,
+
+    /// Seed of `--random` (same seed, same dataset).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+
+    /// Samples per chunk: the unit of parallel work, of warm-start chains and of resuming. Part of
+    /// the plan (a different chunk size gives slightly different last digits).
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_CHUNK_SIZE)]
+    pub chunk_size: usize,
+
+    /// Worker threads (default: one per core). The files do not depend on it.
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+
+    /// Write the dataset into the new directory DIR.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+
+    /// Replace DIR if it is an earlier gvsrom output holding only its own files.
+    #[arg(long, conflicts_with = "resume")]
+    pub force: bool,
+
+    /// Continue the incomplete dataset in DIR (same scenario, plan and seed): its finished chunks are
+    /// kept, the missing ones computed, and DIR replaced by the result.
+    #[arg(long)]
+    pub resume: bool,
+
+    /// Testing aid: stop (as if interrupted) once N chunks have been started.
+    #[arg(long, value_name = "N", hide = true)]
+    pub stop_after_chunks: Option<usize>,
+}
+
+/// Sample counts of a dataset.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Counts {
+    pub ok: usize,
+    pub failed: usize,
+    pub not_computed: usize,
+    /// Samples solved from a neighbour's solution (the rest were ramped from straight).
+    pub warm_started: usize,
+}
+
+/// A failed sample and why.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Failure {
+    pub index: usize,
+    pub reason: String,
+}
+
+/// The dataset part of `meta.json` (the manifest sits beside it under `"gvsrom"`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Meta {
+    /// `"statics"`.
+    pub kind: String,
+    pub scenario: String,
+    /// The scenario's TOML after `--set` overrides.
+    pub scenario_toml: String,
+    pub plan: Plan,
+    pub seed: u64,
+    /// Column names of `inputs.npy`.
+    pub parameters: Vec<String>,
+    pub samples: usize,
+    pub n_dof: usize,
+    pub n_points: usize,
+    pub strain_x: Vec<f64>,
+    /// Names of the stored strain components, in column order within a point.
+    pub components: Vec<String>,
+    /// How a strain row is laid out.
+    pub strain_layout: String,
+    pub chunk_size: usize,
+    /// Per chunk (samples `c·chunk_size ..`): finished or not.
+    pub chunk_done: Vec<bool>,
+    pub complete: bool,
+    /// Why an incomplete dataset stopped.
+    pub reason: Option<String>,
+    pub counts: Counts,
+    pub failures: Vec<Failure>,
+    pub crate_version: String,
+    /// Wall time of this run (a resumed run: of its own part).
+    pub wall_time_s: f64,
+    pub threads: usize,
+}
+
+/// The result of [`run`].
+#[derive(Debug)]
+pub struct Outcome {
+    pub path: PathBuf,
+    pub meta: Meta,
+    /// `Some(reason)` if the run was interrupted (the finished chunks were written).
+    pub interrupted: Option<String>,
+    /// Chunks taken over from the resumed dataset.
+    pub resumed_chunks: usize,
+}
+
+fn plan_err(e: String) -> DatasetError {
+    DatasetError::Plan(e)
+}
+
+/// The scenario table after `--set`, the scenario built from it, and its TOML text.
+fn load_scenario(args: &DatasetArgs) -> Result<(toml::Table, Built, String), DatasetError> {
+    let src = crate::presets::source(&args.scenario)?;
+    let mut table = crate::scenario::parse_table(&src.origin, &src.text)?;
+    for spec in &args.set {
+        crate::scenario::apply_override(&mut table, spec)?;
+    }
+    if !table.contains_key("name") {
+        table.insert("name".into(), toml::Value::String(src.default_name));
+    }
+    let scenario = crate::scenario::from_table(table.clone())?;
+    let built = crate::build(&scenario)?;
+    let text = toml::to_string(&table).map_err(|e| plan_err(format!("scenario: {e}")))?;
+    Ok((table, built, text))
+}
+
+/// Checks the extremes of the plan before computing: the tensions against the rod's elastic range
+/// (shared model), or the scenario rebuilt with every parameter at LO and at HI (which also names an
+/// unknown path or a value the format rejects).
+fn check_plan(plan: &Plan, table: &toml::Table, built: &Built) -> Result<(), DatasetError> {
+    if plan.parameters.iter().all(|p| p.tendon.is_some()) {
+        let mut u_max: Vec<f64> = built.u.iter().map(|v| v.abs()).collect();
+        for p in &plan.parameters {
+            if let Some(t) = p.tendon {
+                u_max[t] = p.lo.abs().max(p.hi.abs());
+            }
+        }
+        return crate::plausibility::check(built, &u_max, 1.0).map_err(|e| {
+            plan_err(format!(
+                "{} {}: {e}",
+                plan.kind.option(),
+                plan.specs.join(" ")
+            ))
+        });
+    }
+    for end in [false, true] {
+        let mut t = table.clone();
+        for p in &plan.parameters {
+            let v = if end { p.hi } else { p.lo };
+            crate::scenario::apply_override(&mut t, &format!("{}={v}", p.path)).map_err(|e| {
+                let why = match e {
+                    ScenarioError::Override { message, .. } => message,
+                    other => other.to_string(),
+                };
+                plan_err(format!("{} {}: {why}", plan.kind.option(), p.spec))
+            })?;
+        }
+        let build = crate::scenario::from_table(t).and_then(|s| crate::build(&s));
+        if let Err(e) = build {
+            let which = if end { "HI" } else { "LO" };
+            return Err(plan_err(format!(
+                "{} {}: with every parameter at {which}: {e}",
+                plan.kind.option(),
+                plan.specs.join(" ")
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Builds the dataset described by `args`, writing a summary to `out`. `interrupt` holds a signal
+/// number once SIGINT/SIGTERM arrived: the run then stops after the chunks under way.
+pub fn run(
+    args: &DatasetArgs,
+    interrupt: &AtomicUsize,
+    out: &mut dyn Write,
+) -> Result<Outcome, DatasetError> {
+    let t0 = Instant::now();
+    let (table, built, scenario_toml) = load_scenario(args)?;
+    let plan = Plan::new(
+        &args.sweep,
+        &args.grid,
+        &args.random,
+        args.samples,
+        args.seed,
+        &table,
+    )
+    .map_err(plan_err)?;
+    if !(1..=MAX_CHUNK_SIZE).contains(&args.chunk_size) {
+        return Err(plan_err(format!(
+            "--chunk-size {}: expected an integer in [1, {MAX_CHUNK_SIZE}]",
+            args.chunk_size
+        )));
+    }
+    if args.threads == Some(0) || args.threads.is_some_and(|t| t > 1024) {
+        return Err(plan_err(format!(
+            "--threads {}: expected an integer in [1, 1024]",
+            args.threads.unwrap_or(0)
+        )));
+    }
+    check_plan(&plan, &table, &built)?;
+    let layout = Layout::of(&built);
+    let n = plan.samples;
+    let per_sample = (plan.parameters.len() + layout.row_len() + layout.n_dof + 14) as f64 * 8.0;
+    if n as f64 * per_sample > MAX_DATASET_BYTES {
+        return Err(plan_err(format!(
+            "--samples {n}: the dataset would take {:.1} GB in memory (accepted <= {:.1} GB); use fewer samples",
+            n as f64 * per_sample / 1e9,
+            MAX_DATASET_BYTES / 1e9
+        )));
+    }
+    let values = plan.values();
+    let gen = Generator {
+        base: &built,
+        table: &table,
+        plan: &plan,
+        values: &values,
+        layout: &layout,
+        chunk_size: args.chunk_size,
+    };
+    let n_chunks = gen.n_chunks();
+    let mut meta = Meta {
+        kind: "statics".into(),
+        scenario: built.name.clone(),
+        scenario_toml,
+        seed: plan.seed,
+        parameters: plan.names(),
+        samples: n,
+        n_dof: layout.n_dof,
+        n_points: layout.strain_x.len(),
+        strain_x: layout.strain_x.clone(),
+        components: layout
+            .active
+            .iter()
+            .map(|&a| StrainMode::ALL[a].name().to_string())
+            .collect(),
+        strain_layout: "point-major: column j*len(components) + c holds point j (abscissa strain_x[j]), component components[c]; values are xi - xi_star".into(),
+        chunk_size: args.chunk_size,
+        chunk_done: vec![false; n_chunks],
+        complete: false,
+        reason: None,
+        counts: Counts::default(),
+        failures: vec![],
+        crate_version: env!("CARGO_PKG_VERSION").into(),
+        wall_time_s: 0.0,
+        threads: 0,
+        plan: plan.clone(),
+    };
+    // the output is checked, locked and staged before the computation
+    let mut dir = OutputDir::create("--out", &args.out, "dataset", args.force || args.resume)?;
+    let mut results: Vec<Option<Vec<SampleResult>>> = vec![None; n_chunks];
+    let mut resumed_chunks = 0;
+    if args.resume {
+        let prev = resumable(&args.out, &meta)?;
+        for c in 0..n_chunks {
+            if prev.meta.chunk_done[c] {
+                results[c] = Some(
+                    gen.chunk_range(c)
+                        .map(|k| from_previous(&prev, k))
+                        .collect(),
+                );
+                resumed_chunks += 1;
+            }
+        }
+    }
+    let todo: Vec<usize> = (0..n_chunks).filter(|&c| results[c].is_none()).collect();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.unwrap_or(0))
+        .build()
+        .map_err(|e| plan_err(format!("--threads: cannot start the worker threads: {e}")))?;
+    meta.threads = pool.current_num_threads();
+    let todo_samples: usize = todo.iter().map(|&c| gen.chunk_range(c).len()).sum();
+    let bar = progress_bar(todo_samples as u64);
+    let started = AtomicUsize::new(0);
+    let stop_after = args.stop_after_chunks.unwrap_or(usize::MAX);
+    let computed: Vec<(usize, Option<Vec<SampleResult>>)> = pool.install(|| {
+        use rayon::prelude::*;
+        todo.par_iter()
+            .map(|&c| {
+                if interrupt.load(Ordering::SeqCst) != 0
+                    || started.fetch_add(1, Ordering::SeqCst) >= stop_after
+                {
+                    return (c, None);
+                }
+                let r = gen.chunk(c);
+                bar.inc(r.len() as u64);
+                (c, Some(r))
+            })
+            .collect()
+    });
+    bar.finish_and_clear();
+    for (c, r) in computed {
+        if r.is_some() {
+            results[c] = r;
+        }
+    }
+    let signal = interrupt.load(Ordering::SeqCst);
+    let interrupted = if results.iter().all(Option::is_some) {
+        None
+    } else if signal != 0 {
+        Some(format!("interrupted by {}", signal_name(signal)))
+    } else {
+        Some(format!(
+            "stopped after {stop_after} chunks (--stop-after-chunks)"
+        ))
+    };
+    meta.complete = interrupted.is_none();
+    meta.reason = interrupted.clone();
+    meta.wall_time_s = t0.elapsed().as_secs_f64();
+    write(&mut dir, &mut meta, &gen, results)?;
+    let path = dir.commit(&meta)?;
+    summary(out, &path, &meta, resumed_chunks).map_err(|e| plan_err(format!("stdout: {e}")))?;
+    Ok(Outcome {
+        path,
+        meta,
+        interrupted,
+        resumed_chunks,
+    })
+}
+
+fn signal_name(sig: usize) -> &'static str {
+    match sig {
+        2 => "SIGINT",
+        15 => "SIGTERM",
+        _ => "a signal",
+    }
+}
+
+fn progress_bar(len: u64) -> indicatif::ProgressBar {
+    use std::io::IsTerminal;
+    if !std::io::stderr().is_terminal() {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(len);
+    if let Ok(style) = indicatif::ProgressStyle::with_template(
+        "[{bar:30}] {pos}/{len} samples  {elapsed_precise} elapsed, ETA {eta_precise}",
+    ) {
+        bar.set_style(style.progress_chars("#>."));
+    }
+    bar
+}
+
+/// The incomplete dataset at `path`, checked to be a continuation of `meta`'s run.
+fn resumable(path: &Path, meta: &Meta) -> Result<Dataset, DatasetError> {
+    let shown = path.display().to_string();
+    let resume = |message: String| DatasetError::Resume {
+        path: shown.clone(),
+        message,
+    };
+    if !path.exists() {
+        return Err(resume(
+            "there is no dataset to resume (run without --resume to start one)".into(),
+        ));
+    }
+    let prev = Dataset::load(path).map_err(|e| resume(format!("cannot be resumed: {e}")))?;
+    let p = &prev.meta;
+    if p.complete {
+        return Err(resume(
+            "the dataset is already complete: nothing to resume".into(),
+        ));
+    }
+    let differs = |what: &str, old: String, new: String| {
+        resume(format!(
+            "the {what} differs from the incomplete dataset's ({old} there, {new} now); rerun with the same arguments, or use --force instead of --resume to start again"
+        ))
+    };
+    if p.scenario_toml != meta.scenario_toml {
+        return Err(differs(
+            "scenario (after --set)",
+            format!("`{}`", p.scenario),
+            format!("`{}`", meta.scenario),
+        ));
+    }
+    let (a, b) = (&p.plan, &meta.plan);
+    if a.kind != b.kind || a.specs != b.specs {
+        return Err(differs(
+            "plan",
+            format!("{} {}", a.kind.option(), a.specs.join(" ")),
+            format!("{} {}", b.kind.option(), b.specs.join(" ")),
+        ));
+    }
+    if a.samples != b.samples {
+        return Err(differs(
+            "--samples",
+            a.samples.to_string(),
+            b.samples.to_string(),
+        ));
+    }
+    if p.seed != meta.seed {
+        return Err(differs("--seed", p.seed.to_string(), meta.seed.to_string()));
+    }
+    if p.chunk_size != meta.chunk_size {
+        return Err(differs(
+            "--chunk-size",
+            p.chunk_size.to_string(),
+            meta.chunk_size.to_string(),
+        ));
+    }
+    if p.parameters != meta.parameters
+        || p.components != meta.components
+        || p.n_dof != meta.n_dof
+        || prev.strain_x.len() != meta.strain_x.len()
+        || prev
+            .strain_x
+            .iter()
+            .zip(&meta.strain_x)
+            .any(|(x, y)| x.to_bits() != y.to_bits())
+    {
+        return Err(resume(
+            "its parameters or point layout differ from this run's; use --force instead of --resume to start again".into(),
+        ));
+    }
+    Ok(prev)
+}
+
+/// Sample `k` as stored in a previous dataset.
+fn from_previous(prev: &Dataset, k: usize) -> SampleResult {
+    let r = prev.row_len();
+    let n = prev.meta.n_dof;
+    let reason = prev
+        .meta
+        .failures
+        .iter()
+        .find(|f| f.index == k)
+        .map(|f| f.reason.clone());
+    SampleResult {
+        status: prev.status[k],
+        strain: prev.strain[k * r..(k + 1) * r].to_vec(),
+        q: prev.q[k * n..(k + 1) * n].to_vec(),
+        tip_position: std::array::from_fn(|i| prev.tip_position[3 * k + i]),
+        tip_rotation: std::array::from_fn(|i| prev.tip_rotation[9 * k + i]),
+        iterations: prev.iterations[k],
+        residual: prev.residual[k],
+        warm_started: false,
+        reason,
+    }
+}
+
+/// Writes the arrays of all samples (missing chunks as not computed) and fills the counts.
+fn write(
+    dir: &mut OutputDir,
+    meta: &mut Meta,
+    gen: &Generator<'_>,
+    results: Vec<Option<Vec<SampleResult>>>,
+) -> Result<(), DatasetError> {
+    let n = meta.samples;
+    let layout = gen.layout;
+    let mut strain = Vec::with_capacity(n * layout.row_len());
+    let mut q = Vec::with_capacity(n * layout.n_dof);
+    let mut tip_position = Vec::with_capacity(3 * n);
+    let mut tip_rotation = Vec::with_capacity(9 * n);
+    let mut status = Vec::with_capacity(n);
+    let mut iterations = Vec::with_capacity(n);
+    let mut residual = Vec::with_capacity(n);
+    let mut counts = Counts::default();
+    let mut failures = vec![];
+    for (c, chunk) in results.into_iter().enumerate() {
+        meta.chunk_done[c] = chunk.is_some();
+        let rows = chunk.unwrap_or_else(|| {
+            gen.chunk_range(c)
+                .map(|_| SampleResult::missing(layout, STATUS_NOT_COMPUTED, None))
+                .collect()
+        });
+        for (k, s) in gen.chunk_range(c).zip(rows) {
+            match s.status {
+                STATUS_OK => counts.ok += 1,
+                STATUS_FAILED => {
+                    counts.failed += 1;
+                    failures.push(Failure {
+                        index: k,
+                        reason: s.reason.clone().unwrap_or_default(),
+                    });
+                }
+                _ => counts.not_computed += 1,
+            }
+            counts.warm_started += s.warm_started as usize;
+            strain.extend_from_slice(&s.strain);
+            q.extend_from_slice(&s.q);
+            tip_position.extend_from_slice(&s.tip_position);
+            tip_rotation.extend_from_slice(&s.tip_rotation);
+            status.push(s.status);
+            iterations.push(s.iterations);
+            residual.push(s.residual);
+        }
+    }
+    meta.counts = counts;
+    meta.failures = failures;
+    let d = meta.parameters.len();
+    let p = layout.strain_x.len();
+    (|| -> std::io::Result<()> {
+        use crate::npy::{write_array, write_array_of};
+        write_array(dir, FILES[0], &[n, d], gen.values)?;
+        write_array(dir, FILES[1], &[n, layout.row_len()], &strain)?;
+        write_array(dir, FILES[2], &[n, layout.n_dof], &q)?;
+        write_array(dir, FILES[3], &[n, 3], &tip_position)?;
+        write_array(dir, FILES[4], &[n, 3, 3], &tip_rotation)?;
+        write_array_of(dir, FILES[5], &[n], &status)?;
+        write_array_of(dir, FILES[6], &[n], &iterations)?;
+        write_array(dir, FILES[7], &[n], &residual)?;
+        write_array(dir, FILES[8], &[p], &layout.strain_x)
+    })()
+    .map_err(|e| DatasetError::Output(dir.io_error("write the dataset arrays", e)))
+}
+
+fn summary(out: &mut dyn Write, path: &Path, m: &Meta, resumed: usize) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "scenario   {}: {} DOF, {} computational points, active strains [{}]",
+        m.scenario,
+        m.n_dof,
+        m.n_points,
+        m.components.join(", ")
+    )?;
+    writeln!(
+        out,
+        "plan       {} {} ({} samples, {} parameters, seed {})",
+        m.plan.kind.option(),
+        m.plan.specs.join(" "),
+        m.samples,
+        m.parameters.len(),
+        m.seed
+    )?;
+    let c = &m.counts;
+    writeln!(
+        out,
+        "solved     {} ok ({} warm-started), {} failed, {} not computed in {:.2} s on {} threads{}",
+        c.ok,
+        c.warm_started,
+        c.failed,
+        c.not_computed,
+        m.wall_time_s,
+        m.threads,
+        if resumed > 0 {
+            format!(" ({resumed} chunks kept from the resumed run)")
+        } else {
+            String::new()
+        }
+    )?;
+    for f in m.failures.iter().take(5) {
+        writeln!(out, "failed     sample {}: {}", f.index, f.reason)?;
+    }
+    if m.failures.len() > 5 {
+        writeln!(
+            out,
+            "failed     … {} more in meta.json",
+            m.failures.len() - 5
+        )?;
+    }
+    writeln!(
+        out,
+        "dataset    {} ({} × {} strain values{})",
+        path.display(),
+        m.samples,
+        m.n_points * m.components.len(),
+        if m.complete { "" } else { ", incomplete" }
+    )
+}
