@@ -480,3 +480,63 @@ fn bad_plans_are_one_line_errors_naming_the_option() {
     );
     assert!(!out.exists());
 }
+
+#[test]
+fn a_dynamic_dataset_stores_every_sample_of_the_simulate_run() {
+    let dir = scratch("ds-dynamic");
+    let traj = scratch("ds-dynamic-simulate");
+    let common = [
+        "six-tendon",
+        "--duration",
+        "0.3",
+        "--babble=-15,0,0.05,0.1",
+        "--sample-rate",
+        "100",
+        "--seed",
+        "3",
+    ];
+    let mut a = vec!["dataset"];
+    a.extend(common);
+    a.extend(["--out", dir.to_str().unwrap()]);
+    run_ok(&a);
+    let mut b = vec!["simulate"];
+    b.extend(common);
+    b.extend(["--out", traj.to_str().unwrap()]);
+    run_ok(&b);
+    let ds = Dataset::load(&dir).unwrap();
+    assert_eq!(ds.meta.kind, "dynamics");
+    assert_eq!(ds.samples(), 31);
+    assert!(ds.meta.complete);
+    assert_eq!(ds.t.as_ref().unwrap().len(), 31);
+    assert_eq!(ds.inputs.len(), 31 * 6);
+    // the same run as `simulate`: identical q, u and strain (ξ − ξ*, all six components active)
+    let raw = |name: &str| -> Vec<f64> {
+        let bytes = std::fs::read(traj.join(name)).unwrap();
+        let hl = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+        bytes[10 + hl..]
+            .chunks(8)
+            .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+            .collect()
+    };
+    assert_eq!(ds.q, raw("q.npy"));
+    assert_eq!(ds.inputs, raw("u.npy"));
+    let xi = raw("strain.npy");
+    assert_eq!(xi.len(), ds.strain.len());
+    for (i, (d, x)) in ds.strain.iter().zip(&xi).enumerate() {
+        let star = if i % 6 == 3 { 1.0 } else { 0.0 };
+        assert_eq!(*d, x - star, "value {i}");
+    }
+    expect_error(
+        &[
+            "dataset",
+            "six-tendon",
+            "--duration",
+            "1",
+            "--random",
+            "tendons.0.tension=0:1",
+            "--out",
+            dir.to_str().unwrap(),
+        ],
+        &["--random", "--duration"],
+    );
+}

@@ -19,6 +19,7 @@
 //! files are bit-identical for a given plan and seed whatever the thread count. An interrupted run
 //! writes its finished chunks with `"complete": false`; `--resume` computes only the missing chunks.
 
+pub mod dynamic;
 pub mod generate;
 pub mod plan;
 pub mod reader;
@@ -51,6 +52,12 @@ pub const FILES: [&str; 9] = [
     "residual.npy",
     "strain_x.npy",
 ];
+
+/// How a strain row is laid out (in meta.json).
+pub const STRAIN_LAYOUT: &str = "point-major: column j*len(components) + c holds point j (abscissa strain_x[j]), component components[c]; values are xi - xi_star";
+
+/// The sample times of a dynamic dataset.
+pub const T_FILE: &str = "t.npy";
 
 /// Samples per chunk unless `--chunk-size` says otherwise.
 pub const DEFAULT_CHUNK_SIZE: usize = 128;
@@ -130,6 +137,60 @@ pub struct DatasetArgs {
     #[arg(long)]
     pub resume: bool,
 
+    /// Dynamic dataset: simulate T seconds (inputs as for `simulate`) and store every output sample.
+    #[arg(long, value_name = "T", allow_hyphen_values = true)]
+    pub duration: Option<f64>,
+
+    /// Dynamic dataset: output samples per second [Hz].
+    #[arg(
+        long,
+        value_name = "HZ",
+        allow_hyphen_values = true,
+        requires = "duration"
+    )]
+    pub sample_rate: Option<f64>,
+
+    /// Dynamic dataset: actuation from a CSV file `t, u_1, …, u_na` (as for `simulate`).
+    #[arg(long, value_name = "FILE", requires = "duration", conflicts_with_all = ["steps", "babble"])]
+    pub input: Option<PathBuf>,
+
+    /// Dynamic dataset: interpolate the CSV input linearly.
+    #[arg(long, requires = "input")]
+    pub interpolate: bool,
+
+    /// Dynamic dataset: random step actuation LO,HI,PERIOD (seeded by `--seed`).
+    #[arg(
+        long,
+        value_name = "LO,HI,PERIOD",
+        value_delimiter = ',',
+        allow_hyphen_values = true,
+        requires = "duration",
+        conflicts_with = "babble"
+    )]
+    pub steps: Option<Vec<f64>>,
+
+    /// Dynamic dataset: actuator babbling LO,HI,HOLD_MIN,HOLD_MAX (paper IV-C2: `--babble=-15,0,0.5,1`).
+    #[arg(
+        long,
+        value_name = "LO,HI,HOLD_MIN,HOLD_MAX",
+        value_delimiter = ',',
+        allow_hyphen_values = true,
+        requires = "duration"
+    )]
+    pub babble: Option<Vec<f64>>,
+
+    /// Dynamic dataset: start at the static equilibrium under the scenario's loads and tensions.
+    #[arg(long, requires = "duration")]
+    pub from_equilibrium: bool,
+
+    /// Dynamic dataset: relative tolerance of the NDF integrator.
+    #[arg(long, default_value_t = 1e-3)]
+    pub rtol: f64,
+
+    /// Dynamic dataset: absolute tolerance of the NDF integrator.
+    #[arg(long, default_value_t = 1e-6)]
+    pub atol: f64,
+
     /// Testing aid: stop (as if interrupted) once N chunks have been started.
     #[arg(long, value_name = "N", hide = true)]
     pub stop_after_chunks: Option<usize>,
@@ -155,12 +216,15 @@ pub struct Failure {
 /// The dataset part of `meta.json` (the manifest sits beside it under `"gvsrom"`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Meta {
-    /// `"statics"`.
+    /// `"statics"` or `"dynamics"`.
     pub kind: String,
     pub scenario: String,
     /// The scenario's TOML after `--set` overrides.
     pub scenario_toml: String,
-    pub plan: Plan,
+    /// The sampling plan of a static dataset.
+    pub plan: Option<Plan>,
+    /// The run of a dynamic dataset.
+    pub dynamic: Option<dynamic::DynamicInfo>,
     pub seed: u64,
     /// Column names of `inputs.npy`.
     pub parameters: Vec<String>,
@@ -270,6 +334,9 @@ pub fn run(
 ) -> Result<Outcome, DatasetError> {
     let t0 = Instant::now();
     let (table, built, scenario_toml) = load_scenario(args)?;
+    if args.duration.is_some() {
+        return dynamic::run(args, &built, scenario_toml, interrupt, out, t0);
+    }
     let plan = Plan::new(
         &args.sweep,
         &args.grid,
@@ -327,7 +394,7 @@ pub fn run(
             .iter()
             .map(|&a| StrainMode::ALL[a].name().to_string())
             .collect(),
-        strain_layout: "point-major: column j*len(components) + c holds point j (abscissa strain_x[j]), component components[c]; values are xi - xi_star".into(),
+        strain_layout: STRAIN_LAYOUT.into(),
         chunk_size: args.chunk_size,
         chunk_done: vec![false; n_chunks],
         complete: false,
@@ -337,7 +404,8 @@ pub fn run(
         crate_version: env!("CARGO_PKG_VERSION").into(),
         wall_time_s: 0.0,
         threads: 0,
-        plan: plan.clone(),
+        plan: Some(plan.clone()),
+        dynamic: None,
     };
     // the output is checked, locked and staged before the computation
     let mut dir = OutputDir::create("--out", &args.out, "dataset", args.force || args.resume)?;
@@ -411,7 +479,7 @@ pub fn run(
     })
 }
 
-fn signal_name(sig: usize) -> &'static str {
+pub(crate) fn signal_name(sig: usize) -> &'static str {
     match sig {
         2 => "SIGINT",
         15 => "SIGTERM",
@@ -419,7 +487,7 @@ fn signal_name(sig: usize) -> &'static str {
     }
 }
 
-fn progress_bar(len: u64) -> indicatif::ProgressBar {
+pub(crate) fn progress_bar(len: u64) -> indicatif::ProgressBar {
     use std::io::IsTerminal;
     if !std::io::stderr().is_terminal() {
         return indicatif::ProgressBar::hidden();
@@ -464,7 +532,11 @@ fn resumable(path: &Path, meta: &Meta) -> Result<Dataset, DatasetError> {
             format!("`{}`", meta.scenario),
         ));
     }
-    let (a, b) = (&p.plan, &meta.plan);
+    let (Some(a), Some(b)) = (&p.plan, &meta.plan) else {
+        return Err(resume(
+            "only static datasets can be resumed: rerun a dynamic dataset with --force".into(),
+        ));
+    };
     if a.kind != b.kind || a.specs != b.specs {
         return Err(differs(
             "plan",
@@ -536,8 +608,29 @@ fn write(
     gen: &Generator<'_>,
     results: Vec<Option<Vec<SampleResult>>>,
 ) -> Result<(), DatasetError> {
+    let mut rows = Vec::with_capacity(meta.samples);
+    for (c, chunk) in results.into_iter().enumerate() {
+        meta.chunk_done[c] = chunk.is_some();
+        rows.extend(chunk.unwrap_or_else(|| {
+            gen.chunk_range(c)
+                .map(|_| SampleResult::missing(gen.layout, STATUS_NOT_COMPUTED, None))
+                .collect()
+        }));
+    }
+    write_arrays(dir, meta, gen.layout, gen.values, &rows, None)
+}
+
+/// Writes the arrays of `rows` (one per sample, inputs `samples × parameters`; `t` for a dynamic
+/// dataset) and fills the counts and failures of `meta`.
+pub(crate) fn write_arrays(
+    dir: &mut OutputDir,
+    meta: &mut Meta,
+    layout: &Layout,
+    inputs: &[f64],
+    rows: &[SampleResult],
+    t: Option<&[f64]>,
+) -> Result<(), DatasetError> {
     let n = meta.samples;
-    let layout = gen.layout;
     let mut strain = Vec::with_capacity(n * layout.row_len());
     let mut q = Vec::with_capacity(n * layout.n_dof);
     let mut tip_position = Vec::with_capacity(3 * n);
@@ -547,34 +640,26 @@ fn write(
     let mut residual = Vec::with_capacity(n);
     let mut counts = Counts::default();
     let mut failures = vec![];
-    for (c, chunk) in results.into_iter().enumerate() {
-        meta.chunk_done[c] = chunk.is_some();
-        let rows = chunk.unwrap_or_else(|| {
-            gen.chunk_range(c)
-                .map(|_| SampleResult::missing(layout, STATUS_NOT_COMPUTED, None))
-                .collect()
-        });
-        for (k, s) in gen.chunk_range(c).zip(rows) {
-            match s.status {
-                STATUS_OK => counts.ok += 1,
-                STATUS_FAILED => {
-                    counts.failed += 1;
-                    failures.push(Failure {
-                        index: k,
-                        reason: s.reason.clone().unwrap_or_default(),
-                    });
-                }
-                _ => counts.not_computed += 1,
+    for (k, s) in rows.iter().enumerate() {
+        match s.status {
+            STATUS_OK => counts.ok += 1,
+            STATUS_FAILED => {
+                counts.failed += 1;
+                failures.push(Failure {
+                    index: k,
+                    reason: s.reason.clone().unwrap_or_default(),
+                });
             }
-            counts.warm_started += s.warm_started as usize;
-            strain.extend_from_slice(&s.strain);
-            q.extend_from_slice(&s.q);
-            tip_position.extend_from_slice(&s.tip_position);
-            tip_rotation.extend_from_slice(&s.tip_rotation);
-            status.push(s.status);
-            iterations.push(s.iterations);
-            residual.push(s.residual);
+            _ => counts.not_computed += 1,
         }
+        counts.warm_started += s.warm_started as usize;
+        strain.extend_from_slice(&s.strain);
+        q.extend_from_slice(&s.q);
+        tip_position.extend_from_slice(&s.tip_position);
+        tip_rotation.extend_from_slice(&s.tip_rotation);
+        status.push(s.status);
+        iterations.push(s.iterations);
+        residual.push(s.residual);
     }
     meta.counts = counts;
     meta.failures = failures;
@@ -582,7 +667,7 @@ fn write(
     let p = layout.strain_x.len();
     (|| -> std::io::Result<()> {
         use crate::npy::{write_array, write_array_of};
-        write_array(dir, FILES[0], &[n, d], gen.values)?;
+        write_array(dir, FILES[0], &[n, d], inputs)?;
         write_array(dir, FILES[1], &[n, layout.row_len()], &strain)?;
         write_array(dir, FILES[2], &[n, layout.n_dof], &q)?;
         write_array(dir, FILES[3], &[n, 3], &tip_position)?;
@@ -590,12 +675,21 @@ fn write(
         write_array_of(dir, FILES[5], &[n], &status)?;
         write_array_of(dir, FILES[6], &[n], &iterations)?;
         write_array(dir, FILES[7], &[n], &residual)?;
-        write_array(dir, FILES[8], &[p], &layout.strain_x)
+        write_array(dir, FILES[8], &[p], &layout.strain_x)?;
+        if let Some(t) = t {
+            write_array(dir, T_FILE, &[n], t)?;
+        }
+        Ok(())
     })()
     .map_err(|e| DatasetError::Output(dir.io_error("write the dataset arrays", e)))
 }
 
-fn summary(out: &mut dyn Write, path: &Path, m: &Meta, resumed: usize) -> std::io::Result<()> {
+pub(crate) fn summary(
+    out: &mut dyn Write,
+    path: &Path,
+    m: &Meta,
+    resumed: usize,
+) -> std::io::Result<()> {
     writeln!(
         out,
         "scenario   {}: {} DOF, {} computational points, active strains [{}]",
@@ -604,31 +698,47 @@ fn summary(out: &mut dyn Write, path: &Path, m: &Meta, resumed: usize) -> std::i
         m.n_points,
         m.components.join(", ")
     )?;
-    writeln!(
-        out,
-        "plan       {} {} ({} samples, {} parameters, seed {})",
-        m.plan.kind.option(),
-        m.plan.specs.join(" "),
-        m.samples,
-        m.parameters.len(),
-        m.seed
-    )?;
+    match (&m.plan, &m.dynamic) {
+        (Some(p), _) => writeln!(
+            out,
+            "plan       {} {} ({} samples, {} parameters, seed {})",
+            p.kind.option(),
+            p.specs.join(" "),
+            m.samples,
+            m.parameters.len(),
+            m.seed
+        )?,
+        (None, Some(d)) => writeln!(
+            out,
+            "run        {} s at {} Hz, input {} ({} samples)",
+            d.duration, d.sample_rate, d.input, m.samples
+        )?,
+        (None, None) => {}
+    }
     let c = &m.counts;
-    writeln!(
-        out,
-        "solved     {} ok ({} warm-started), {} failed, {} not computed in {:.2} s on {} threads{}",
-        c.ok,
-        c.warm_started,
-        c.failed,
-        c.not_computed,
-        m.wall_time_s,
-        m.threads,
-        if resumed > 0 {
-            format!(" ({resumed} chunks kept from the resumed run)")
-        } else {
-            String::new()
-        }
-    )?;
+    if m.dynamic.is_some() {
+        writeln!(
+            out,
+            "simulated  {} samples stored in {:.2} s",
+            c.ok, m.wall_time_s
+        )?;
+    } else {
+        writeln!(
+            out,
+            "solved     {} ok ({} warm-started), {} failed, {} not computed in {:.2} s on {} threads{}",
+            c.ok,
+            c.warm_started,
+            c.failed,
+            c.not_computed,
+            m.wall_time_s,
+            m.threads,
+            if resumed > 0 {
+                format!(" ({resumed} chunks kept from the resumed run)")
+            } else {
+                String::new()
+            }
+        )?;
+    }
     for f in m.failures.iter().take(5) {
         writeln!(out, "failed     sample {}: {}", f.index, f.reason)?;
     }

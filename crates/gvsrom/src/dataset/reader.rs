@@ -3,7 +3,7 @@
 //! dataset.
 
 use super::generate::{STATUS_FAILED, STATUS_NOT_COMPUTED, STATUS_OK};
-use super::{DatasetError, Meta, FILES};
+use super::{DatasetError, Meta, FILES, T_FILE};
 use std::path::Path;
 
 /// A dataset loaded from its directory. Arrays are row-major; see the module documentation of
@@ -26,6 +26,8 @@ pub struct Dataset {
     pub iterations: Vec<u32>,
     pub residual: Vec<f64>,
     pub strain_x: Vec<f64>,
+    /// Sample times of a dynamic dataset.
+    pub t: Option<Vec<f64>>,
 }
 
 fn file_error(file: &str, message: impl Into<String>) -> DatasetError {
@@ -134,6 +136,10 @@ impl Dataset {
             iterations: read_npy(dir, FILES[6], "<u4", &[n])?,
             residual: read_npy(dir, FILES[7], f8, &[n])?,
             strain_x: read_npy(dir, FILES[8], f8, &[p])?,
+            t: match meta.kind.as_str() {
+                "dynamics" => Some(read_npy(dir, T_FILE, f8, &[n])?),
+                _ => None,
+            },
             meta,
         };
         ds.check_consistency(dir)?;
