@@ -540,3 +540,85 @@ fn a_dynamic_dataset_stores_every_sample_of_the_simulate_run() {
         &["--random", "--duration"],
     );
 }
+
+/// `max |strain row k − (ξ − ξ*)| / max |ξ − ξ*|` against an independent `gvsrom statics` run with
+/// `set` overrides, for a dataset whose active components are `active`. Both solutions meet the
+/// solver's tolerance (‖R‖∞ ≤ 1e-10 of the force scale) from different starts (warm vs straight),
+/// so they agree to about 1e-9 relative.
+fn max_strain_difference(
+    ds: &Dataset,
+    k: usize,
+    scenario: &str,
+    set: &[String],
+    active: &[usize],
+) -> f64 {
+    let file = scratch(&format!("ds-check-{scenario}-{k}.json"));
+    let mut args = vec!["statics".to_string(), scenario.to_string()];
+    for s in set {
+        args.push("--set".into());
+        args.push(s.clone());
+    }
+    args.extend(["--json".into(), file.to_str().unwrap().to_string()]);
+    run_ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    let sol = json(&file);
+    let row = ds.strain_row(k);
+    let a = active.len();
+    let (mut max, mut scale) = (0.0f64, 0.0f64);
+    for (j, xi) in sol["strain"].as_array().unwrap().iter().enumerate() {
+        for (c, &i) in active.iter().enumerate() {
+            let dev = xi[i].as_f64().unwrap() - if i == 3 { 1.0 } else { 0.0 };
+            max = max.max((row[a * j + c] - dev).abs());
+            scale = scale.max(dev.abs());
+        }
+    }
+    max / scale.max(1e-300)
+}
+
+#[test]
+fn load_and_material_parameters_match_statics_with_set() {
+    // loads only: the model is shared, the loads rebuilt per sample
+    let dir = scratch("ds-soft-beam");
+    run_ok(&[
+        "dataset",
+        "soft-beam",
+        "--random",
+        "loads.distributed.0.center=0.1:0.7",
+        "--random",
+        "loads.distributed.0.magnitude=-5:5",
+        "--samples",
+        "4",
+        "--seed",
+        "1",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let ds = Dataset::load(&dir).unwrap();
+    assert_eq!(ds.meta.components, ["bend_y"]);
+    for k in [0, 3] {
+        let (c, m) = (ds.inputs[2 * k], ds.inputs[2 * k + 1]);
+        let set = [
+            format!("loads.distributed.0.center={c}"),
+            format!("loads.distributed.0.magnitude={m}"),
+        ];
+        let d = max_strain_difference(&ds, k, "soft-beam", &set, &[1]);
+        assert!(d < 2e-9, "soft-beam sample {k}: {d:e}");
+    }
+    // a material value: the model is rebuilt per sample
+    let dir = scratch("ds-material");
+    run_ok(&[
+        "dataset",
+        "single-tendon",
+        "--sweep",
+        "material.youngs_modulus=5e5:8e5",
+        "--samples",
+        "3",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let ds = Dataset::load(&dir).unwrap();
+    for k in 0..3 {
+        let set = [format!("material.youngs_modulus={}", ds.inputs[k])];
+        let d = max_strain_difference(&ds, k, "single-tendon", &set, &[1, 3, 5]);
+        assert!(d < 2e-9, "single-tendon sample {k}: {d:e}");
+    }
+}

@@ -105,7 +105,11 @@ pub struct Generator<'a> {
 
 /// The model a sample is solved on: the shared one with new tensions, or one rebuilt from the table.
 enum Setup {
+    /// New tensions on the scenario's model and loads.
     Shared(Vec<f64>),
+    /// New tensions and loads on the scenario's model.
+    Loads(Vec<f64>, gvs::loads::Loads),
+    /// A model rebuilt from the scenario with the sample's values.
     Rebuilt(Box<Built>),
 }
 
@@ -128,22 +132,45 @@ impl Generator<'_> {
         self.plan.parameters.iter().all(|p| p.tendon.is_some())
     }
 
+    /// `true` when every parameter is a tension or a load that does not move computational points
+    /// (everything under `loads.` except point-load abscissae `loads.point.K.x`).
+    fn loads_only(&self) -> bool {
+        self.plan.parameters.iter().all(|p| {
+            p.tendon.is_some()
+                || (p.path.starts_with("loads.")
+                    && !(p.path.starts_with("loads.point.") && p.path.ends_with(".x")))
+        })
+    }
+
     fn setup(&self, k: usize) -> Result<Setup, String> {
         let row = self.row(k);
-        if self.shared_model() {
-            let mut u = self.base.u.clone();
-            for (p, v) in self.plan.parameters.iter().zip(row) {
-                if let Some(t) = p.tendon {
-                    u[t] = *v;
-                }
+        let mut u = self.base.u.clone();
+        for (p, v) in self.plan.parameters.iter().zip(row) {
+            if let Some(t) = p.tendon {
+                u[t] = *v;
             }
+        }
+        if self.shared_model() {
             return Ok(Setup::Shared(u));
         }
         let mut table = self.table.clone();
         for (p, v) in self.plan.parameters.iter().zip(row) {
-            apply_override(&mut table, &format!("{}={v}", p.path)).map_err(|e| e.to_string())?;
+            if p.tendon.is_none() {
+                apply_override(&mut table, &format!("{}={v}", p.path))
+                    .map_err(|e| e.to_string())?;
+            }
         }
         let mut scenario = from_table(table).map_err(|e| e.to_string())?;
+        if self.loads_only() {
+            let loads = crate::build::loads(&scenario, self.base.model.rod.length())
+                .map_err(|e| e.to_string())?;
+            return Ok(Setup::Loads(u, loads));
+        }
+        for (p, v) in self.plan.parameters.iter().zip(row) {
+            if let Some(t) = p.tendon {
+                scenario.tendons[t].tension = *v;
+            }
+        }
         scenario.name = Some(self.base.name.clone());
         let built = crate::build(&scenario).map_err(|e| e.to_string())?;
         let layout = Layout::of(&built);
@@ -240,12 +267,16 @@ impl Generator<'_> {
             let result = match self.setup(k) {
                 Err(reason) => SampleResult::missing(self.layout, STATUS_FAILED, Some(reason)),
                 Ok(Setup::Shared(u)) => {
-                    let r = solve(&mut shared, &self.base.options, &u, self.base, warm);
+                    let r = solve(&mut shared, &self.base.options, &u, &self.base.loads, warm);
+                    record(base, &mut ws, self.layout, r)
+                }
+                Ok(Setup::Loads(u, loads)) => {
+                    let r = solve(&mut shared, &self.base.options, &u, &loads, warm);
                     record(base, &mut ws, self.layout, r)
                 }
                 Ok(Setup::Rebuilt(b)) => {
                     let mut solver = StaticsSolver::new(&b.model, b.options.clone());
-                    let r = solve(&mut solver, &b.options, &b.u, &b, warm);
+                    let r = solve(&mut solver, &b.options, &b.u, &b.loads, warm);
                     let mut ws = b.model.workspace();
                     record(&b.model, &mut ws, self.layout, r)
                 }
@@ -273,7 +304,7 @@ fn solve(
     solver: &mut StaticsSolver<'_, LinearBasis>,
     options: &StaticsOptions,
     u: &[f64],
-    built: &Built,
+    loads: &gvs::loads::Loads,
     warm: Option<&DVector<f64>>,
 ) -> Result<(StaticsSolution, bool), String> {
     if let Some(q0) = warm {
@@ -283,13 +314,13 @@ fn solve(
             max_iterations: options.max_iterations.min(WARM_MAX_ITERATIONS),
             ..options.clone()
         };
-        if let Ok(s) = solver.solve(u, &built.loads, Some(q0)) {
+        if let Ok(s) = solver.solve(u, loads, Some(q0)) {
             return Ok((s, true));
         }
     }
     solver.options = options.clone();
     solver
-        .solve(u, &built.loads, None)
+        .solve(u, loads, None)
         .map(|s| (s, false))
         .map_err(|e| e.to_string())
 }
