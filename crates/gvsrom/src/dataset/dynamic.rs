@@ -5,7 +5,7 @@
 
 use super::generate::{Layout, SampleResult, STATUS_OK};
 use super::{
-    progress_bar, summary, write_arrays, Counts, DatasetArgs, DatasetError, Meta, Outcome,
+    progress_bar, summary, write::write_arrays, Counts, DatasetArgs, DatasetError, Meta, Outcome,
     MAX_DATASET_BYTES,
 };
 use crate::build::Built;

@@ -23,6 +23,8 @@ pub mod dynamic;
 pub mod generate;
 pub mod plan;
 pub mod reader;
+mod resume;
+mod write;
 
 pub use generate::Layout;
 pub use plan::{Plan, PlanKind};
@@ -32,7 +34,7 @@ use crate::build::Built;
 use crate::error::ScenarioError;
 use crate::output::{OutputDir, OutputError};
 use crate::scenario::StrainMode;
-use generate::{Generator, SampleResult, STATUS_FAILED, STATUS_NOT_COMPUTED, STATUS_OK};
+use generate::{Generator, SampleResult};
 use serde::{Deserialize, Serialize};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -202,7 +204,8 @@ pub struct Counts {
     pub ok: usize,
     pub failed: usize,
     pub not_computed: usize,
-    /// Samples solved from a neighbour's solution (the rest were ramped from straight).
+    /// Samples solved from a neighbour's solution by this run (the rest were ramped from straight;
+    /// chunks kept by `--resume` are not counted).
     pub warm_started: usize,
 }
 
@@ -412,12 +415,12 @@ pub fn run(
     let mut results: Vec<Option<Vec<SampleResult>>> = vec![None; n_chunks];
     let mut resumed_chunks = 0;
     if args.resume {
-        let prev = resumable(&args.out, &meta)?;
+        let prev = resume::resumable(&args.out, &meta)?;
         for c in 0..n_chunks {
             if prev.meta.chunk_done[c] {
                 results[c] = Some(
                     gen.chunk_range(c)
-                        .map(|k| from_previous(&prev, k))
+                        .map(|k| resume::from_previous(&prev, k))
                         .collect(),
                 );
                 resumed_chunks += 1;
@@ -468,7 +471,7 @@ pub fn run(
     meta.complete = interrupted.is_none();
     meta.reason = interrupted.clone();
     meta.wall_time_s = t0.elapsed().as_secs_f64();
-    write(&mut dir, &mut meta, &gen, results)?;
+    write::write(&mut dir, &mut meta, &gen, results)?;
     let path = dir.commit(&meta)?;
     summary(out, &path, &meta, resumed_chunks).map_err(|e| plan_err(format!("stdout: {e}")))?;
     Ok(Outcome {
@@ -499,189 +502,6 @@ pub(crate) fn progress_bar(len: u64) -> indicatif::ProgressBar {
         bar.set_style(style.progress_chars("#>."));
     }
     bar
-}
-
-/// The incomplete dataset at `path`, checked to be a continuation of `meta`'s run.
-fn resumable(path: &Path, meta: &Meta) -> Result<Dataset, DatasetError> {
-    let shown = path.display().to_string();
-    let resume = |message: String| DatasetError::Resume {
-        path: shown.clone(),
-        message,
-    };
-    if !path.exists() {
-        return Err(resume(
-            "there is no dataset to resume (run without --resume to start one)".into(),
-        ));
-    }
-    let prev = Dataset::load(path).map_err(|e| resume(format!("cannot be resumed: {e}")))?;
-    let p = &prev.meta;
-    if p.complete {
-        return Err(resume(
-            "the dataset is already complete: nothing to resume".into(),
-        ));
-    }
-    let differs = |what: &str, old: String, new: String| {
-        resume(format!(
-            "the {what} differs from the incomplete dataset's ({old} there, {new} now); rerun with the same arguments, or use --force instead of --resume to start again"
-        ))
-    };
-    if p.scenario_toml != meta.scenario_toml {
-        return Err(differs(
-            "scenario (after --set)",
-            format!("`{}`", p.scenario),
-            format!("`{}`", meta.scenario),
-        ));
-    }
-    let (Some(a), Some(b)) = (&p.plan, &meta.plan) else {
-        return Err(resume(
-            "only static datasets can be resumed: rerun a dynamic dataset with --force".into(),
-        ));
-    };
-    if a.kind != b.kind || a.specs != b.specs {
-        return Err(differs(
-            "plan",
-            format!("{} {}", a.kind.option(), a.specs.join(" ")),
-            format!("{} {}", b.kind.option(), b.specs.join(" ")),
-        ));
-    }
-    if a.samples != b.samples {
-        return Err(differs(
-            "--samples",
-            a.samples.to_string(),
-            b.samples.to_string(),
-        ));
-    }
-    if p.seed != meta.seed {
-        return Err(differs("--seed", p.seed.to_string(), meta.seed.to_string()));
-    }
-    if p.chunk_size != meta.chunk_size {
-        return Err(differs(
-            "--chunk-size",
-            p.chunk_size.to_string(),
-            meta.chunk_size.to_string(),
-        ));
-    }
-    if p.parameters != meta.parameters
-        || p.components != meta.components
-        || p.n_dof != meta.n_dof
-        || prev.strain_x.len() != meta.strain_x.len()
-        || prev
-            .strain_x
-            .iter()
-            .zip(&meta.strain_x)
-            .any(|(x, y)| x.to_bits() != y.to_bits())
-    {
-        return Err(resume(
-            "its parameters or point layout differ from this run's; use --force instead of --resume to start again".into(),
-        ));
-    }
-    Ok(prev)
-}
-
-/// Sample `k` as stored in a previous dataset.
-fn from_previous(prev: &Dataset, k: usize) -> SampleResult {
-    let r = prev.row_len();
-    let n = prev.meta.n_dof;
-    let reason = prev
-        .meta
-        .failures
-        .iter()
-        .find(|f| f.index == k)
-        .map(|f| f.reason.clone());
-    SampleResult {
-        status: prev.status[k],
-        strain: prev.strain[k * r..(k + 1) * r].to_vec(),
-        q: prev.q[k * n..(k + 1) * n].to_vec(),
-        tip_position: std::array::from_fn(|i| prev.tip_position[3 * k + i]),
-        tip_rotation: std::array::from_fn(|i| prev.tip_rotation[9 * k + i]),
-        iterations: prev.iterations[k],
-        residual: prev.residual[k],
-        warm_started: false,
-        reason,
-    }
-}
-
-/// Writes the arrays of all samples (missing chunks as not computed) and fills the counts.
-fn write(
-    dir: &mut OutputDir,
-    meta: &mut Meta,
-    gen: &Generator<'_>,
-    results: Vec<Option<Vec<SampleResult>>>,
-) -> Result<(), DatasetError> {
-    let mut rows = Vec::with_capacity(meta.samples);
-    for (c, chunk) in results.into_iter().enumerate() {
-        meta.chunk_done[c] = chunk.is_some();
-        rows.extend(chunk.unwrap_or_else(|| {
-            gen.chunk_range(c)
-                .map(|_| SampleResult::missing(gen.layout, STATUS_NOT_COMPUTED, None))
-                .collect()
-        }));
-    }
-    write_arrays(dir, meta, gen.layout, gen.values, &rows, None)
-}
-
-/// Writes the arrays of `rows` (one per sample, inputs `samples × parameters`; `t` for a dynamic
-/// dataset) and fills the counts and failures of `meta`.
-pub(crate) fn write_arrays(
-    dir: &mut OutputDir,
-    meta: &mut Meta,
-    layout: &Layout,
-    inputs: &[f64],
-    rows: &[SampleResult],
-    t: Option<&[f64]>,
-) -> Result<(), DatasetError> {
-    let n = meta.samples;
-    let mut strain = Vec::with_capacity(n * layout.row_len());
-    let mut q = Vec::with_capacity(n * layout.n_dof);
-    let mut tip_position = Vec::with_capacity(3 * n);
-    let mut tip_rotation = Vec::with_capacity(9 * n);
-    let mut status = Vec::with_capacity(n);
-    let mut iterations = Vec::with_capacity(n);
-    let mut residual = Vec::with_capacity(n);
-    let mut counts = Counts::default();
-    let mut failures = vec![];
-    for (k, s) in rows.iter().enumerate() {
-        match s.status {
-            STATUS_OK => counts.ok += 1,
-            STATUS_FAILED => {
-                counts.failed += 1;
-                failures.push(Failure {
-                    index: k,
-                    reason: s.reason.clone().unwrap_or_default(),
-                });
-            }
-            _ => counts.not_computed += 1,
-        }
-        counts.warm_started += s.warm_started as usize;
-        strain.extend_from_slice(&s.strain);
-        q.extend_from_slice(&s.q);
-        tip_position.extend_from_slice(&s.tip_position);
-        tip_rotation.extend_from_slice(&s.tip_rotation);
-        status.push(s.status);
-        iterations.push(s.iterations);
-        residual.push(s.residual);
-    }
-    meta.counts = counts;
-    meta.failures = failures;
-    let d = meta.parameters.len();
-    let p = layout.strain_x.len();
-    (|| -> std::io::Result<()> {
-        use crate::npy::{write_array, write_array_of};
-        write_array(dir, FILES[0], &[n, d], inputs)?;
-        write_array(dir, FILES[1], &[n, layout.row_len()], &strain)?;
-        write_array(dir, FILES[2], &[n, layout.n_dof], &q)?;
-        write_array(dir, FILES[3], &[n, 3], &tip_position)?;
-        write_array(dir, FILES[4], &[n, 3, 3], &tip_rotation)?;
-        write_array_of(dir, FILES[5], &[n], &status)?;
-        write_array_of(dir, FILES[6], &[n], &iterations)?;
-        write_array(dir, FILES[7], &[n], &residual)?;
-        write_array(dir, FILES[8], &[p], &layout.strain_x)?;
-        if let Some(t) = t {
-            write_array(dir, T_FILE, &[n], t)?;
-        }
-        Ok(())
-    })()
-    .map_err(|e| DatasetError::Output(dir.io_error("write the dataset arrays", e)))
 }
 
 pub(crate) fn summary(
