@@ -422,9 +422,14 @@ fn dataset_cmd(args: &gvsrom::dataset::DatasetArgs, out: &mut impl Write) -> Res
                 s => s as i32,
             },
             message: format!(
-                "{reason}; the {} finished samples were written to `{}`, marked incomplete (continue with --resume)",
+                "{reason}; the {} finished samples were written to `{}`, marked incomplete{}",
                 outcome.meta.counts.ok + outcome.meta.counts.failed,
-                outcome.path.display()
+                outcome.path.display(),
+                if outcome.meta.plan.is_some() {
+                    " (continue with --resume)"
+                } else {
+                    ""
+                }
             ),
         }
         .into()),

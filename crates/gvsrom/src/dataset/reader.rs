@@ -115,6 +115,20 @@ impl Dataset {
         }
         let meta: Meta = serde_json::from_value(value)
             .map_err(|e| file_error(&shown, format!("does not describe a dataset: {e}")))?;
+        let kind_ok = match meta.kind.as_str() {
+            "statics" => meta.plan.is_some(),
+            "dynamics" => meta.dynamic.is_some(),
+            _ => false,
+        };
+        if !kind_ok {
+            return Err(file_error(
+                &shown,
+                format!(
+                    "kind `{}` without its plan (expected \"statics\" with `plan` or \"dynamics\" with `dynamic`)",
+                    meta.kind
+                ),
+            ));
+        }
         let n = meta.samples;
         let d = meta.parameters.len();
         let p = meta.strain_x.len();
