@@ -156,8 +156,9 @@ fn expand(kind: PlanKind, spec: &str, path: &str, table: &Table) -> Result<Vec<V
 }
 
 impl Plan {
-    /// Checks the plan arguments against the scenario table (after `--set`). Exactly one kind may be
-    /// given; `samples` must be ≥ 1 (≥ 2 for a sweep with a non-degenerate range is not required).
+    /// Checks the plan arguments against the scenario table (after `--set`): exactly one kind,
+    /// `samples` in [1, [`MAX_SAMPLES`]], ranges `LO <= HI`, `*` over an existing non-empty list.
+    /// (A one-sample sweep is its LO end.)
     pub fn new(
         sweep: &[String],
         grid: &[String],
