@@ -677,7 +677,9 @@ fn wrench(moment: [f64; 3], force: [f64; 3]) -> [f64; 6] {
     ]
 }
 
-fn loads(s: &Scenario, l: f64) -> Result<Loads, ScenarioError> {
+/// The validated loads of `s` on a rod of length `l` (part of [`build`]; a dataset that varies only
+/// loads rebuilds just these).
+pub fn loads(s: &Scenario, l: f64) -> Result<Loads, ScenarioError> {
     let spec = &s.loads;
     for (i, g) in spec.gravity.iter().enumerate() {
         finite(&format!("loads.gravity[{i}]"), *g)?;

@@ -29,6 +29,9 @@ pub enum Command {
     /// Simulate the dynamics of a preset or scenario file (stiff NDF integrator, ode15s class) and
     /// write the trajectory as NumPy arrays.
     Simulate(SimulateArgs),
+    /// Generate a strain snapshot dataset: solve the statics over a sampling plan (`--sweep`,
+    /// `--grid`, `--random`) in parallel and write NumPy arrays (see README "Datasets").
+    Dataset(gvsrom::dataset::DatasetArgs),
     /// Validate a preset or scenario file and print the model's size, without solving.
     Check(ScenarioArgs),
     /// List the built-in presets.
@@ -179,6 +182,7 @@ pub fn run(cli: Cli, out: &mut impl Write) -> Result<()> {
     match cli.command {
         Command::Statics(args) => statics_cmd(&args, out),
         Command::Simulate(args) => simulate_cmd(&args, out),
+        Command::Dataset(args) => dataset_cmd(&args, out),
         Command::Check(args) => check_cmd(&args, out),
         Command::Presets => presets_cmd(out),
         Command::Show { preset } => {
@@ -402,6 +406,31 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
         Ending::Interrupted { reason } => Err(Interrupted {
             signal: signal.load(Ordering::SeqCst) as i32,
             message: format!("{reason} at t = {t_last} s; {kept}"),
+        }
+        .into()),
+    }
+}
+
+fn dataset_cmd(args: &gvsrom::dataset::DatasetArgs, out: &mut impl Write) -> Result<()> {
+    let signal = interrupt_flag();
+    let outcome = gvsrom::dataset::run(args, &signal, out)?;
+    match outcome.interrupted {
+        None => Ok(()),
+        Some(reason) => Err(Interrupted {
+            signal: match signal.load(Ordering::SeqCst) {
+                0 => signal_hook::consts::SIGINT,
+                s => s as i32,
+            },
+            message: format!(
+                "{reason}; the {} finished samples were written to `{}`, marked incomplete{}",
+                outcome.meta.counts.ok + outcome.meta.counts.failed,
+                outcome.path.display(),
+                if outcome.meta.plan.is_some() {
+                    " (continue with --resume)"
+                } else {
+                    ""
+                }
+            ),
         }
         .into()),
     }

@@ -7,11 +7,13 @@
 
 pub mod build;
 pub mod csv_input;
+pub mod dataset;
 pub mod error;
 pub mod npy;
 pub mod output;
 pub mod plausibility;
 pub mod presets;
+pub mod reduced_model;
 pub mod scenario;
 pub mod simulate;
 pub mod statics;

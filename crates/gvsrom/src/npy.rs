@@ -17,6 +17,16 @@ pub fn write_array(
     shape: &[usize],
     data: &[f64],
 ) -> io::Result<()> {
+    write_array_of(dir, name, shape, data)
+}
+
+/// [`write_array`] for any plain element type (`u8` → `|u1`, `u32` → `<u4`, `f64` → `<f8`).
+pub fn write_array_of<T: npyz::AutoSerialize + Copy>(
+    dir: &mut OutputDir,
+    name: &str,
+    shape: &[usize],
+    data: &[T],
+) -> io::Result<()> {
     let n: usize = shape.iter().product();
     if n != data.len() {
         return Err(io::Error::new(
@@ -28,7 +38,7 @@ pub fn write_array(
         ));
     }
     dir.write_file(name, |w| {
-        let mut npy = npyz::WriteOptions::new()
+        let mut npy = npyz::WriteOptions::<T>::new()
             .default_dtype()
             .shape(&shape_u64(shape))
             .writer(w)

@@ -170,7 +170,10 @@ impl ReducedModel {
             } => {
                 // row-major L × K
                 let rm: Vec<f64> = modes.transpose().iter().copied().collect();
-                t.insert("modes".into(), (vec![modes.nrows(), modes.ncols()], f64_bytes(&rm)));
+                t.insert(
+                    "modes".into(),
+                    (vec![modes.nrows(), modes.ncols()], f64_bytes(&rm)),
+                );
                 t.insert(
                     "singular_values".into(),
                     (vec![singular_values.len()], f64_bytes(singular_values)),
@@ -181,7 +184,10 @@ impl ReducedModel {
                 mlp_tensors("decoder", ae.decoder(), &mut t);
                 let s = ae.scaling();
                 t.insert("scaling.mean".into(), (vec![s.len()], f64_bytes(s.mean())));
-                t.insert("scaling.scale".into(), (vec![s.len()], f64_bytes(s.scale())));
+                t.insert(
+                    "scaling.scale".into(),
+                    (vec![s.len()], f64_bytes(s.scale())),
+                );
             }
         }
         t
@@ -201,12 +207,12 @@ impl ReducedModel {
                 TensorView::new(Dtype::F64, shape.clone(), data).map(|v| (k.clone(), v))
             })
             .collect::<Result<_, _>>()
-            .map_err(|e| out.io_error("encode the weights", std::io::Error::other(e.to_string())))?;
-        let mut info = std::collections::HashMap::new();
-        info.insert("format".to_string(), format!("gvsrom {MODEL_FORMAT}"));
-        info.insert("kind".to_string(), self.meta.kind.clone());
-        let bytes = safetensors::serialize(views, Some(info))
-            .map_err(|e| out.io_error("encode the weights", std::io::Error::other(e.to_string())))?;
+            .map_err(|e| {
+                out.io_error("encode the weights", std::io::Error::other(e.to_string()))
+            })?;
+        let bytes = safetensors::serialize(views, None).map_err(|e| {
+            out.io_error("encode the weights", std::io::Error::other(e.to_string()))
+        })?;
         out.write_file(WEIGHTS_FILE, |w| std::io::Write::write_all(w, &bytes))
             .map_err(|e| out.io_error("write weights.safetensors", e))?;
         for (name, values) in extra {
@@ -290,7 +296,10 @@ impl ReducedModel {
                     let mut ws = vec![];
                     let mut bs = vec![];
                     for k in 0..sizes.len().saturating_sub(1) {
-                        ws.push(get(&format!("{prefix}.{k}.weight"), &[sizes[k + 1], sizes[k]])?);
+                        ws.push(get(
+                            &format!("{prefix}.{k}.weight"),
+                            &[sizes[k + 1], sizes[k]],
+                        )?);
                         bs.push(get(&format!("{prefix}.{k}.bias"), &[sizes[k + 1]])?);
                     }
                     Mlp::new(sizes, ws, bs).map_err(|e| bad(format!("{prefix}: {e}")))
@@ -302,8 +311,8 @@ impl ReducedModel {
                     get("scaling.scale", &[features])?,
                 )
                 .map_err(|e| bad(format!("scaling: {e}")))?;
-                let ae = Autoencoder::new(encoder, decoder, scaling)
-                    .map_err(|e| bad(e.to_string()))?;
+                let ae =
+                    Autoencoder::new(encoder, decoder, scaling).map_err(|e| bad(e.to_string()))?;
                 if ae.n_features() != features || ae.latent() != meta.latent {
                     return Err(bad(format!(
                         "the network maps {} features to {} coordinates, meta.json says {features} and {}",

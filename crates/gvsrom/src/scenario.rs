@@ -443,13 +443,13 @@ fn check_finite(v: &Value, path: &mut Vec<Seg>) -> Result<(), ScenarioError> {
 
 /// A segment of a key path.
 #[derive(Debug, Clone, PartialEq)]
-enum Seg {
+pub enum Seg {
     Key(String),
     Index(usize),
 }
 
 /// `a.b[0].c`
-fn render_path(path: &[Seg]) -> String {
+pub fn render_path(path: &[Seg]) -> String {
     let mut s = String::new();
     for seg in path {
         match seg {
@@ -467,7 +467,7 @@ fn render_path(path: &[Seg]) -> String {
 
 /// Parses `tendons.0.tension`, `tendons[0].tension` or `loads.gravity[2]` into segments. A purely
 /// numeric dotted segment is an index.
-fn parse_path(path: &str) -> Result<Vec<Seg>, String> {
+pub fn parse_path(path: &str) -> Result<Vec<Seg>, String> {
     let mut segs = Vec::new();
     for part in path.split('.') {
         if part.is_empty() {
@@ -503,6 +503,21 @@ fn parse_path(path: &str) -> Result<Vec<Seg>, String> {
         }
     }
     Ok(segs)
+}
+
+/// The value at `path` in `table`, if there is one.
+pub fn lookup<'a>(table: &'a Table, path: &[Seg]) -> Option<&'a Value> {
+    let (first, rest) = path.split_first()?;
+    let Seg::Key(k) = first else { return None };
+    let mut node = table.get(k)?;
+    for seg in rest {
+        node = match (seg, node) {
+            (Seg::Key(k), Value::Table(t)) => t.get(k)?,
+            (Seg::Index(i), Value::Array(a)) => a.get(*i)?,
+            _ => return None,
+        };
+    }
+    Some(node)
 }
 
 /// A key segment meant as a list index that is not a valid one: a signed integer or one too large

@@ -60,6 +60,65 @@ pub enum InputSource {
     },
 }
 
+impl InputSource {
+    /// The input of the command-line options `--input FILE [--interpolate]`, `--steps LO,HI,PERIOD`
+    /// or `--babble LO,HI,HOLD_MIN,HOLD_MAX` (at most one), else the scenario's constant tensions.
+    pub fn from_options(
+        input: Option<&Path>,
+        interpolate: bool,
+        steps: Option<&[f64]>,
+        babble: Option<&[f64]>,
+        seed: u64,
+    ) -> Result<InputSource, ScenarioError> {
+        let count = |opt: &str, v: &[f64], n: usize, names: &str| {
+            if v.len() == n {
+                Ok(())
+            } else {
+                Err(ScenarioError::invalid(
+                    opt,
+                    format!("takes {n} comma-separated values {names}, got {}", v.len()),
+                ))
+            }
+        };
+        Ok(match (input, steps, babble) {
+            (Some(path), None, None) => InputSource::Csv {
+                path: path.to_path_buf(),
+                interpolation: if interpolate {
+                    Interpolation::Linear
+                } else {
+                    Interpolation::Hold
+                },
+            },
+            (None, Some(v), None) => {
+                count("--steps", v, 3, "LO,HI,PERIOD")?;
+                InputSource::Steps {
+                    lo: v[0],
+                    hi: v[1],
+                    period: v[2],
+                    seed,
+                }
+            }
+            (None, None, Some(v)) => {
+                count("--babble", v, 4, "LO,HI,HOLD_MIN,HOLD_MAX")?;
+                InputSource::Babble {
+                    lo: v[0],
+                    hi: v[1],
+                    hold_min: v[2],
+                    hold_max: v[3],
+                    seed,
+                }
+            }
+            (None, None, None) => InputSource::Constant,
+            _ => {
+                return Err(ScenarioError::invalid(
+                    "--input/--steps/--babble",
+                    "give at most one input option",
+                ))
+            }
+        })
+    }
+}
+
 /// Options of a dynamics run.
 #[derive(Debug, Clone)]
 pub struct SimulateOptions {

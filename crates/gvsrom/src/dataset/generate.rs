@@ -1,0 +1,358 @@
+//! Solving the samples of a static dataset, chunk by chunk.
+//!
+//! Samples are cut into chunks of `chunk_size` consecutive plan indices; the chunks are independent
+//! (each starts from the straight configuration), so they run in parallel and the results do not
+//! depend on the thread count. Within a chunk the samples are solved along a greedy nearest-neighbour
+//! chain in normalised parameter space (starting from the sample closest to zero), and each solve is
+//! warm-started from the nearest already solved sample of the chunk: one full-load dogleg solve from
+//! its `q`, without ramping. If that fails, the sample is solved again from the straight
+//! configuration with the scenario's own solver options (load ramping). A sample that fails both is
+//! recorded with the reason.
+
+use super::plan::Plan;
+use crate::build::Built;
+use crate::scenario::{apply_override, from_table};
+use gvs::model::Model;
+use gvs::solve::statics::{StaticsOptions, StaticsSolution, StaticsSolver};
+use gvs::strain::{LinearBasis, StrainParam};
+use nalgebra::DVector;
+use toml::Table;
+
+/// Status of a sample in `status.npy`.
+pub const STATUS_OK: u8 = 0;
+pub const STATUS_FAILED: u8 = 1;
+pub const STATUS_NOT_COMPUTED: u8 = 2;
+
+/// Iteration limit of a warm-started solve before falling back to the ramp from straight.
+const WARM_MAX_ITERATIONS: usize = 50;
+
+/// What every sample row holds: the computational points and the strain components stored.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Layout {
+    pub n_dof: usize,
+    pub strain_x: Vec<f64>,
+    /// Indices (0..6) of the active strain components.
+    pub active: Vec<usize>,
+}
+
+impl Layout {
+    /// The layout of `built`: a strain component is active if the basis can excite it at any site.
+    pub fn of(built: &Built) -> Layout {
+        let m = &built.model;
+        let mut on = [false; 6];
+        for s in 0..m.param.n_sites() {
+            let phi = m.param.phi_at(s);
+            for (a, flag) in on.iter_mut().enumerate() {
+                *flag |= phi.row(a).iter().any(|v| *v != 0.0);
+            }
+        }
+        Layout {
+            n_dof: m.n_dof(),
+            strain_x: m.disc.points.iter().map(|p| p.x).collect(),
+            active: (0..6).filter(|&a| on[a]).collect(),
+        }
+    }
+
+    /// Values per strain row: points × active components.
+    pub fn row_len(&self) -> usize {
+        self.strain_x.len() * self.active.len()
+    }
+}
+
+/// One solved (or failed) sample.
+#[derive(Debug, Clone)]
+pub struct SampleResult {
+    pub status: u8,
+    /// ξ − ξ* at the points, active components, point-major (NaN if failed).
+    pub strain: Vec<f64>,
+    pub q: Vec<f64>,
+    pub tip_position: [f64; 3],
+    /// Row-major 3×3.
+    pub tip_rotation: [f64; 9],
+    pub iterations: u32,
+    pub residual: f64,
+    pub warm_started: bool,
+    pub reason: Option<String>,
+}
+
+impl SampleResult {
+    pub fn missing(layout: &Layout, status: u8, reason: Option<String>) -> Self {
+        SampleResult {
+            status,
+            strain: vec![f64::NAN; layout.row_len()],
+            q: vec![f64::NAN; layout.n_dof],
+            tip_position: [f64::NAN; 3],
+            tip_rotation: [f64::NAN; 9],
+            iterations: 0,
+            residual: f64::NAN,
+            warm_started: false,
+            reason,
+        }
+    }
+}
+
+/// Everything the chunks share (read-only).
+pub struct Generator<'a> {
+    pub base: &'a Built,
+    /// The scenario table after `--set`, for parameters other than tensions.
+    pub table: &'a Table,
+    pub plan: &'a Plan,
+    /// `samples × d` plan values.
+    pub values: &'a [f64],
+    pub layout: &'a Layout,
+    pub chunk_size: usize,
+}
+
+/// The model a sample is solved on: the shared one with new tensions, or one rebuilt from the table.
+enum Setup {
+    /// New tensions on the scenario's model and loads.
+    Shared(Vec<f64>),
+    /// New tensions and loads on the scenario's model.
+    Loads(Vec<f64>, gvs::loads::Loads),
+    /// A model rebuilt from the scenario with the sample's values.
+    Rebuilt(Box<Built>),
+}
+
+impl Generator<'_> {
+    pub fn n_chunks(&self) -> usize {
+        self.plan.samples.div_ceil(self.chunk_size)
+    }
+
+    pub fn chunk_range(&self, c: usize) -> std::ops::Range<usize> {
+        c * self.chunk_size..((c + 1) * self.chunk_size).min(self.plan.samples)
+    }
+
+    fn row(&self, k: usize) -> &[f64] {
+        let d = self.plan.parameters.len();
+        &self.values[k * d..(k + 1) * d]
+    }
+
+    /// `true` when every parameter is a tendon tension (no rebuild needed).
+    fn shared_model(&self) -> bool {
+        self.plan.parameters.iter().all(|p| p.tendon.is_some())
+    }
+
+    /// `true` when every parameter is a tension or a load that does not move computational points
+    /// (everything under `loads.` except point-load abscissae `loads.point.K.x`).
+    fn loads_only(&self) -> bool {
+        self.plan.parameters.iter().all(|p| {
+            p.tendon.is_some()
+                || (p.path.starts_with("loads.")
+                    && !(p.path.starts_with("loads.point.") && p.path.ends_with(".x")))
+        })
+    }
+
+    fn setup(&self, k: usize) -> Result<Setup, String> {
+        let row = self.row(k);
+        let mut u = self.base.u.clone();
+        for (p, v) in self.plan.parameters.iter().zip(row) {
+            if let Some(t) = p.tendon {
+                u[t] = *v;
+            }
+        }
+        if self.shared_model() {
+            return Ok(Setup::Shared(u));
+        }
+        let mut table = self.table.clone();
+        for (p, v) in self.plan.parameters.iter().zip(row) {
+            if p.tendon.is_none() {
+                apply_override(&mut table, &format!("{}={v}", p.path))
+                    .map_err(|e| e.to_string())?;
+            }
+        }
+        let mut scenario = from_table(table).map_err(|e| e.to_string())?;
+        if self.loads_only() {
+            let loads = crate::build::loads(&scenario, self.base.model.rod.length())
+                .map_err(|e| e.to_string())?;
+            return Ok(Setup::Loads(u, loads));
+        }
+        for (p, v) in self.plan.parameters.iter().zip(row) {
+            if let Some(t) = p.tendon {
+                scenario.tendons[t].tension = *v;
+            }
+        }
+        scenario.name = Some(self.base.name.clone());
+        let built = crate::build(&scenario).map_err(|e| e.to_string())?;
+        let layout = Layout::of(&built);
+        if layout.n_dof != self.layout.n_dof
+            || layout.strain_x.len() != self.layout.strain_x.len()
+            || layout
+                .strain_x
+                .iter()
+                .zip(&self.layout.strain_x)
+                .any(|(a, b)| a.to_bits() != b.to_bits())
+        {
+            return Err(
+                "these values change the model's coordinates or computational points, so the sample would not fit the dataset's columns"
+                    .into(),
+            );
+        }
+        Ok(Setup::Rebuilt(Box::new(built)))
+    }
+
+    /// Order of the chunk's samples (indices into the chunk): a greedy nearest-neighbour chain in
+    /// normalised parameters, from the sample closest to zero load. Ties go to the lower index.
+    fn chain(&self, z: &[Vec<f64>], zero: &[f64]) -> Vec<usize> {
+        let n = z.len();
+        let mut done = vec![false; n];
+        let mut order = Vec::with_capacity(n);
+        let mut cur = (0..n)
+            .min_by(|&a, &b| zero[a].total_cmp(&zero[b]).then(a.cmp(&b)))
+            .unwrap_or(0);
+        for _ in 0..n {
+            done[cur] = true;
+            order.push(cur);
+            let next = (0..n)
+                .filter(|&j| !done[j])
+                .min_by(|&a, &b| dist(&z[cur], &z[a]).total_cmp(&dist(&z[cur], &z[b])));
+            match next {
+                Some(j) => cur = j,
+                None => break,
+            }
+        }
+        order
+    }
+
+    /// Solves chunk `c`; results in plan order.
+    pub fn chunk(&self, c: usize) -> Vec<SampleResult> {
+        let range = self.chunk_range(c);
+        let params = &self.plan.parameters;
+        // normalised coordinates for distances, and the distance to zero for the chain's start
+        let z: Vec<Vec<f64>> = range
+            .clone()
+            .map(|k| {
+                params
+                    .iter()
+                    .zip(self.row(k))
+                    .map(|(p, v)| {
+                        let w = p.hi - p.lo;
+                        if w > 0.0 {
+                            (v - p.lo) / w
+                        } else {
+                            0.0
+                        }
+                    })
+                    .collect()
+            })
+            .collect();
+        let zero: Vec<f64> = range
+            .clone()
+            .map(|k| {
+                params
+                    .iter()
+                    .zip(self.row(k))
+                    .map(|(p, v)| {
+                        let s = p.lo.abs().max(p.hi.abs());
+                        if s > 0.0 {
+                            (v / s) * (v / s)
+                        } else {
+                            0.0
+                        }
+                    })
+                    .sum()
+            })
+            .collect();
+        let order = self.chain(&z, &zero);
+        let mut out: Vec<Option<SampleResult>> = vec![None; range.len()];
+        let mut solved: Vec<(usize, DVector<f64>)> = vec![];
+        let base = &self.base.model;
+        let mut shared = StaticsSolver::new(base, self.base.options.clone());
+        let mut ws = base.workspace();
+        for &i in &order {
+            let k = range.start + i;
+            let warm = solved
+                .iter()
+                .min_by(|a, b| dist(&z[i], &z[a.0]).total_cmp(&dist(&z[i], &z[b.0])))
+                .map(|(_, q)| q);
+            let result = match self.setup(k) {
+                Err(reason) => SampleResult::missing(self.layout, STATUS_FAILED, Some(reason)),
+                Ok(Setup::Shared(u)) => {
+                    let r = solve(&mut shared, &self.base.options, &u, &self.base.loads, warm);
+                    record(base, &mut ws, self.layout, r)
+                }
+                Ok(Setup::Loads(u, loads)) => {
+                    let r = solve(&mut shared, &self.base.options, &u, &loads, warm);
+                    record(base, &mut ws, self.layout, r)
+                }
+                Ok(Setup::Rebuilt(b)) => {
+                    let mut solver = StaticsSolver::new(&b.model, b.options.clone());
+                    let r = solve(&mut solver, &b.options, &b.u, &b.loads, warm);
+                    let mut ws = b.model.workspace();
+                    record(&b.model, &mut ws, self.layout, r)
+                }
+            };
+            if result.status == STATUS_OK {
+                solved.push((i, DVector::from_column_slice(&result.q)));
+            }
+            out[i] = Some(result);
+        }
+        out.into_iter()
+            .map(|r| {
+                r.unwrap_or_else(|| SampleResult::missing(self.layout, STATUS_NOT_COMPUTED, None))
+            })
+            .collect()
+    }
+}
+
+fn dist(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()
+}
+
+/// A warm-started full-load solve from `warm` if given, else (or if it fails) the scenario's solve
+/// from straight. Returns the solution and whether the warm start was used.
+fn solve(
+    solver: &mut StaticsSolver<'_, LinearBasis>,
+    options: &StaticsOptions,
+    u: &[f64],
+    loads: &gvs::loads::Loads,
+    warm: Option<&DVector<f64>>,
+) -> Result<(StaticsSolution, bool), String> {
+    if let Some(q0) = warm {
+        solver.options = StaticsOptions {
+            ramp_steps: 1,
+            min_increment: 1.0,
+            max_iterations: options.max_iterations.min(WARM_MAX_ITERATIONS),
+            ..options.clone()
+        };
+        if let Ok(s) = solver.solve(u, loads, Some(q0)) {
+            return Ok((s, true));
+        }
+    }
+    solver.options = options.clone();
+    solver
+        .solve(u, loads, None)
+        .map(|s| (s, false))
+        .map_err(|e| e.to_string())
+}
+
+/// The sample's row values at a solution (forward kinematics at `q`).
+fn record(
+    model: &Model<LinearBasis>,
+    ws: &mut gvs::model::Workspace,
+    layout: &Layout,
+    r: Result<(StaticsSolution, bool), String>,
+) -> SampleResult {
+    let (sol, warm) = match r {
+        Ok(s) => s,
+        Err(reason) => return SampleResult::missing(layout, STATUS_FAILED, Some(reason)),
+    };
+    model.forward(&sol.q, ws, false);
+    let xi = model.point_strains(ws);
+    let mut strain = Vec::with_capacity(layout.row_len());
+    for (j, x) in xi.iter().enumerate() {
+        let dev = x - model.xi_star(j);
+        strain.extend(layout.active.iter().map(|&a| dev[a]));
+    }
+    let tip = model.tip_pose(ws);
+    SampleResult {
+        status: STATUS_OK,
+        strain,
+        q: sol.q.iter().copied().collect(),
+        tip_position: [tip.pos[0], tip.pos[1], tip.pos[2]],
+        tip_rotation: std::array::from_fn(|i| tip.rot[(i / 3, i % 3)]),
+        iterations: sol.iterations as u32,
+        residual: sol.residual_norm,
+        warm_started: warm,
+        reason: None,
+    }
+}

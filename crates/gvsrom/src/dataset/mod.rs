@@ -1,0 +1,580 @@
+//! Strain snapshot datasets (paper eq. 13, Section IV): the HOM solved over a sampling plan, one row
+//! per sample, written as NumPy arrays through [`crate::output`].
+//!
+//! | file | shape | dtype | content |
+//! |---|---|---|---|
+//! | `inputs.npy` | (N, k) | f64 | the plan's parameter values (`parameters` in meta.json names the columns) |
+//! | `strain.npy` | (N, p·a) | f64 | ξ − ξ* at the p computational points, the a active components, point-major: column `j·a + c` is point j, component `components[c]`; NaN rows for failed samples |
+//! | `q.npy` | (N, n) | f64 | HOM coordinates |
+//! | `tip_position.npy` | (N, 3) | f64 | tip position [m] |
+//! | `tip_rotation.npy` | (N, 3, 3) | f64 | tip rotation (section → world) |
+//! | `status.npy` | (N,) | u8 | 0 ok, 1 failed (reason in meta.json `failures`), 2 not computed (incomplete dataset) |
+//! | `iterations.npy` | (N,) | u32 | dogleg iterations of the successful solve |
+//! | `residual.npy` | (N,) | f64 | ‖R‖∞ at the solution |
+//! | `strain_x.npy` | (p,) | f64 | abscissae of the computational points [m] |
+//! | `meta.json` | | | manifest, scenario TOML (after `--set`), plan, seed, parameters, point layout, active components, chunking and `chunk_done`, counts, failures, `complete`, crate version, wall time |
+//!
+//! A strain component is *active* if the scenario's basis can excite it at some site; the others are
+//! identically zero and not stored. Samples are solved in chunks (see [`generate`]) in parallel; the
+//! files are bit-identical for a given plan and seed whatever the thread count. An interrupted run
+//! writes its finished chunks with `"complete": false`; `--resume` computes only the missing chunks.
+
+pub mod dynamic;
+pub mod generate;
+pub mod plan;
+pub mod reader;
+mod resume;
+mod write;
+
+pub use generate::Layout;
+pub use plan::{Plan, PlanKind};
+pub use reader::Dataset;
+
+use crate::build::Built;
+use crate::error::ScenarioError;
+use crate::output::{OutputDir, OutputError};
+use crate::scenario::StrainMode;
+use generate::{Generator, SampleResult};
+use serde::{Deserialize, Serialize};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Instant;
+use thiserror::Error;
+
+/// The arrays of a dataset, in the order [`Dataset::load`] reads them.
+pub const FILES: [&str; 9] = [
+    "inputs.npy",
+    "strain.npy",
+    "q.npy",
+    "tip_position.npy",
+    "tip_rotation.npy",
+    "status.npy",
+    "iterations.npy",
+    "residual.npy",
+    "strain_x.npy",
+];
+
+/// How a strain row is laid out (in meta.json).
+pub const STRAIN_LAYOUT: &str = "point-major: column j*len(components) + c holds point j (abscissa strain_x[j]), component components[c]; values are xi - xi_star";
+
+/// The sample times of a dynamic dataset.
+pub const T_FILE: &str = "t.npy";
+
+/// Samples per chunk unless `--chunk-size` says otherwise.
+pub const DEFAULT_CHUNK_SIZE: usize = 128;
+/// Largest `--chunk-size`.
+pub const MAX_CHUNK_SIZE: usize = 4096;
+/// Largest dataset held in memory while it is generated [bytes] (8 GiB).
+pub const MAX_DATASET_BYTES: f64 = 8.0 * 1024.0 * 1024.0 * 1024.0;
+
+#[derive(Debug, Error)]
+pub enum DatasetError {
+    /// A bad plan or option (the message names it, its value and what is accepted).
+    #[error("{0}")]
+    Plan(String),
+    #[error(transparent)]
+    Scenario(#[from] ScenarioError),
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    /// A dataset file that is missing, truncated or inconsistent.
+    #[error("{file}: {message}")]
+    File { file: String, message: String },
+    /// `--resume` on something that cannot be resumed.
+    #[error("--resume `{path}`: {message}")]
+    Resume { path: String, message: String },
+}
+
+/// `gvsrom dataset`: the scenario, the plan and the output.
+#[derive(Debug, clap::Args)]
+pub struct DatasetArgs {
+    /// A preset name (see `gvsrom presets`) or the path of a scenario TOML file.
+    pub scenario: String,
+
+    /// Override a scenario value by its TOML path before sampling (as for `statics`); repeatable.
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    pub set: Vec<String>,
+
+    /// Sweep PATH over an even 1-D grid from LO to HI including both ends (`--samples` values).
+    /// Repeat it (or use `*`, e.g. `tendons.*.tension`) to sweep several values together.
+    #[arg(long, value_name = "PATH=LO:HI", allow_hyphen_values = true)]
+    pub sweep: Vec<String>,
+
+    /// Grid over the product of the ranges: round(samples^(1/d)) even values per parameter, which
+    /// must give exactly `--samples` (e.g. 15625 = 5^6 for `tendons.*.tension` on six tendons).
+    #[arg(long, value_name = "PATH=LO:HI", allow_hyphen_values = true)]
+    pub grid: Vec<String>,
+
+    /// Uniform random values in [LO, HI), seeded by `--seed`; repeatable, `*` allowed.
+    #[arg(long, value_name = "PATH=LO:HI", allow_hyphen_values = true)]
+    pub random: Vec<String>,
+
+    /// Number of samples.
+    #[arg(long, value_name = "N")]
+    pub samples: Option<usize>,
+
+    /// Seed of `--random` (same seed, same dataset).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+
+    /// Samples per chunk: the unit of parallel work, of warm-start chains and of resuming. Part of
+    /// the plan (a different chunk size gives slightly different last digits).
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_CHUNK_SIZE)]
+    pub chunk_size: usize,
+
+    /// Worker threads (default: one per core). The files do not depend on it.
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+
+    /// Write the dataset into the new directory DIR.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+
+    /// Replace DIR if it is an earlier gvsrom output holding only its own files.
+    #[arg(long, conflicts_with = "resume")]
+    pub force: bool,
+
+    /// Continue the incomplete dataset in DIR (same scenario, plan and seed): its finished chunks are
+    /// kept, the missing ones computed, and DIR replaced by the result.
+    #[arg(long)]
+    pub resume: bool,
+
+    /// Dynamic dataset: simulate T seconds (inputs as for `simulate`) and store every output sample.
+    #[arg(long, value_name = "T", allow_hyphen_values = true)]
+    pub duration: Option<f64>,
+
+    /// Dynamic dataset: output samples per second [Hz].
+    #[arg(
+        long,
+        value_name = "HZ",
+        allow_hyphen_values = true,
+        requires = "duration"
+    )]
+    pub sample_rate: Option<f64>,
+
+    /// Dynamic dataset: actuation from a CSV file `t, u_1, …, u_na` (as for `simulate`).
+    #[arg(long, value_name = "FILE", requires = "duration", conflicts_with_all = ["steps", "babble"])]
+    pub input: Option<PathBuf>,
+
+    /// Dynamic dataset: interpolate the CSV input linearly.
+    #[arg(long, requires = "input")]
+    pub interpolate: bool,
+
+    /// Dynamic dataset: random step actuation LO,HI,PERIOD (seeded by `--seed`).
+    #[arg(
+        long,
+        value_name = "LO,HI,PERIOD",
+        value_delimiter = ',',
+        allow_hyphen_values = true,
+        requires = "duration",
+        conflicts_with = "babble"
+    )]
+    pub steps: Option<Vec<f64>>,
+
+    /// Dynamic dataset: actuator babbling LO,HI,HOLD_MIN,HOLD_MAX (paper IV-C2: `--babble=-15,0,0.5,1`).
+    #[arg(
+        long,
+        value_name = "LO,HI,HOLD_MIN,HOLD_MAX",
+        value_delimiter = ',',
+        allow_hyphen_values = true,
+        requires = "duration"
+    )]
+    pub babble: Option<Vec<f64>>,
+
+    /// Dynamic dataset: start at the static equilibrium under the scenario's loads and tensions.
+    #[arg(long, requires = "duration")]
+    pub from_equilibrium: bool,
+
+    /// Dynamic dataset: relative tolerance of the NDF integrator.
+    #[arg(long, default_value_t = 1e-3)]
+    pub rtol: f64,
+
+    /// Dynamic dataset: absolute tolerance of the NDF integrator.
+    #[arg(long, default_value_t = 1e-6)]
+    pub atol: f64,
+
+    /// Testing aid: stop (as if interrupted) once N chunks have been started.
+    #[arg(long, value_name = "N", hide = true)]
+    pub stop_after_chunks: Option<usize>,
+}
+
+/// Sample counts of a dataset.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Counts {
+    pub ok: usize,
+    pub failed: usize,
+    pub not_computed: usize,
+    /// Samples solved from a neighbour's solution by this run (the rest were ramped from straight;
+    /// chunks kept by `--resume` are not counted).
+    pub warm_started: usize,
+}
+
+/// A failed sample and why.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Failure {
+    pub index: usize,
+    pub reason: String,
+}
+
+/// The dataset part of `meta.json` (the manifest sits beside it under `"gvsrom"`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Meta {
+    /// `"statics"` or `"dynamics"`.
+    pub kind: String,
+    pub scenario: String,
+    /// The scenario's TOML after `--set` overrides.
+    pub scenario_toml: String,
+    /// The sampling plan of a static dataset.
+    pub plan: Option<Plan>,
+    /// The run of a dynamic dataset.
+    pub dynamic: Option<dynamic::DynamicInfo>,
+    pub seed: u64,
+    /// Column names of `inputs.npy`.
+    pub parameters: Vec<String>,
+    pub samples: usize,
+    pub n_dof: usize,
+    pub n_points: usize,
+    pub strain_x: Vec<f64>,
+    /// Names of the stored strain components, in column order within a point.
+    pub components: Vec<String>,
+    /// How a strain row is laid out.
+    pub strain_layout: String,
+    pub chunk_size: usize,
+    /// Per chunk (samples `c·chunk_size ..`): finished or not.
+    pub chunk_done: Vec<bool>,
+    pub complete: bool,
+    /// Why an incomplete dataset stopped.
+    pub reason: Option<String>,
+    pub counts: Counts,
+    pub failures: Vec<Failure>,
+    pub crate_version: String,
+    /// Wall time of this run (a resumed run: of its own part).
+    pub wall_time_s: f64,
+    pub threads: usize,
+}
+
+/// The result of [`run`].
+#[derive(Debug)]
+pub struct Outcome {
+    pub path: PathBuf,
+    pub meta: Meta,
+    /// `Some(reason)` if the run was interrupted (the finished chunks were written).
+    pub interrupted: Option<String>,
+    /// Chunks taken over from the resumed dataset.
+    pub resumed_chunks: usize,
+}
+
+fn plan_err(e: String) -> DatasetError {
+    DatasetError::Plan(e)
+}
+
+/// The scenario table after `--set`, the scenario built from it, and its TOML text.
+fn load_scenario(args: &DatasetArgs) -> Result<(toml::Table, Built, String), DatasetError> {
+    let src = crate::presets::source(&args.scenario)?;
+    let mut table = crate::scenario::parse_table(&src.origin, &src.text)?;
+    for spec in &args.set {
+        crate::scenario::apply_override(&mut table, spec)?;
+    }
+    if !table.contains_key("name") {
+        table.insert("name".into(), toml::Value::String(src.default_name));
+    }
+    let scenario = crate::scenario::from_table(table.clone())?;
+    let built = crate::build(&scenario)?;
+    let text = toml::to_string(&table).map_err(|e| plan_err(format!("scenario: {e}")))?;
+    Ok((table, built, text))
+}
+
+/// Checks the extremes of the plan before computing: the tensions against the rod's elastic range
+/// (shared model), or the scenario rebuilt with every parameter at LO and at HI (which also names an
+/// unknown path or a value the format rejects).
+fn check_plan(plan: &Plan, table: &toml::Table, built: &Built) -> Result<(), DatasetError> {
+    if plan.parameters.iter().all(|p| p.tendon.is_some()) {
+        let mut u_max: Vec<f64> = built.u.iter().map(|v| v.abs()).collect();
+        for p in &plan.parameters {
+            if let Some(t) = p.tendon {
+                u_max[t] = p.lo.abs().max(p.hi.abs());
+            }
+        }
+        return crate::plausibility::check(built, &u_max, 1.0).map_err(|e| {
+            plan_err(format!(
+                "{} {}: {e}",
+                plan.kind.option(),
+                plan.specs.join(" ")
+            ))
+        });
+    }
+    for end in [false, true] {
+        let mut t = table.clone();
+        for p in &plan.parameters {
+            let v = if end { p.hi } else { p.lo };
+            crate::scenario::apply_override(&mut t, &format!("{}={v}", p.path)).map_err(|e| {
+                let why = match e {
+                    ScenarioError::Override { message, .. } => message,
+                    other => other.to_string(),
+                };
+                plan_err(format!("{} {}: {why}", plan.kind.option(), p.spec))
+            })?;
+        }
+        let build = crate::scenario::from_table(t).and_then(|s| crate::build(&s));
+        if let Err(e) = build {
+            let which = if end { "HI" } else { "LO" };
+            return Err(plan_err(format!(
+                "{} {}: with every parameter at {which}: {e}",
+                plan.kind.option(),
+                plan.specs.join(" ")
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Builds the dataset described by `args`, writing a summary to `out`. `interrupt` holds a signal
+/// number once SIGINT/SIGTERM arrived: the run then stops after the chunks under way.
+pub fn run(
+    args: &DatasetArgs,
+    interrupt: &AtomicUsize,
+    out: &mut dyn Write,
+) -> Result<Outcome, DatasetError> {
+    let t0 = Instant::now();
+    let (table, built, scenario_toml) = load_scenario(args)?;
+    if args.duration.is_some() {
+        return dynamic::run(args, &built, scenario_toml, interrupt, out, t0);
+    }
+    let plan = Plan::new(
+        &args.sweep,
+        &args.grid,
+        &args.random,
+        args.samples,
+        args.seed,
+        &table,
+    )
+    .map_err(plan_err)?;
+    if !(1..=MAX_CHUNK_SIZE).contains(&args.chunk_size) {
+        return Err(plan_err(format!(
+            "--chunk-size {}: expected an integer in [1, {MAX_CHUNK_SIZE}]",
+            args.chunk_size
+        )));
+    }
+    if args.threads == Some(0) || args.threads.is_some_and(|t| t > 1024) {
+        return Err(plan_err(format!(
+            "--threads {}: expected an integer in [1, 1024]",
+            args.threads.unwrap_or(0)
+        )));
+    }
+    check_plan(&plan, &table, &built)?;
+    let layout = Layout::of(&built);
+    let n = plan.samples;
+    let per_sample = (plan.parameters.len() + layout.row_len() + layout.n_dof + 14) as f64 * 8.0;
+    if n as f64 * per_sample > MAX_DATASET_BYTES {
+        return Err(plan_err(format!(
+            "--samples {n}: the dataset would take {:.1} GB in memory (accepted <= {:.1} GB); use fewer samples",
+            n as f64 * per_sample / 1e9,
+            MAX_DATASET_BYTES / 1e9
+        )));
+    }
+    let values = plan.values();
+    let gen = Generator {
+        base: &built,
+        table: &table,
+        plan: &plan,
+        values: &values,
+        layout: &layout,
+        chunk_size: args.chunk_size,
+    };
+    let n_chunks = gen.n_chunks();
+    let mut meta = Meta {
+        kind: "statics".into(),
+        scenario: built.name.clone(),
+        scenario_toml,
+        seed: plan.seed,
+        parameters: plan.names(),
+        samples: n,
+        n_dof: layout.n_dof,
+        n_points: layout.strain_x.len(),
+        strain_x: layout.strain_x.clone(),
+        components: layout
+            .active
+            .iter()
+            .map(|&a| StrainMode::ALL[a].name().to_string())
+            .collect(),
+        strain_layout: STRAIN_LAYOUT.into(),
+        chunk_size: args.chunk_size,
+        chunk_done: vec![false; n_chunks],
+        complete: false,
+        reason: None,
+        counts: Counts::default(),
+        failures: vec![],
+        crate_version: env!("CARGO_PKG_VERSION").into(),
+        wall_time_s: 0.0,
+        threads: 0,
+        plan: Some(plan.clone()),
+        dynamic: None,
+    };
+    // the output is checked, locked and staged before the computation
+    let mut dir = OutputDir::create("--out", &args.out, "dataset", args.force || args.resume)?;
+    let mut results: Vec<Option<Vec<SampleResult>>> = vec![None; n_chunks];
+    let mut resumed_chunks = 0;
+    if args.resume {
+        let prev = resume::resumable(&args.out, &meta)?;
+        for c in 0..n_chunks {
+            if prev.meta.chunk_done[c] {
+                results[c] = Some(
+                    gen.chunk_range(c)
+                        .map(|k| resume::from_previous(&prev, k))
+                        .collect(),
+                );
+                resumed_chunks += 1;
+            }
+        }
+    }
+    let todo: Vec<usize> = (0..n_chunks).filter(|&c| results[c].is_none()).collect();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.unwrap_or(0))
+        .build()
+        .map_err(|e| plan_err(format!("--threads: cannot start the worker threads: {e}")))?;
+    meta.threads = pool.current_num_threads();
+    let todo_samples: usize = todo.iter().map(|&c| gen.chunk_range(c).len()).sum();
+    let bar = progress_bar(todo_samples as u64);
+    let started = AtomicUsize::new(0);
+    let stop_after = args.stop_after_chunks.unwrap_or(usize::MAX);
+    let computed: Vec<(usize, Option<Vec<SampleResult>>)> = pool.install(|| {
+        use rayon::prelude::*;
+        todo.par_iter()
+            .map(|&c| {
+                if interrupt.load(Ordering::SeqCst) != 0
+                    || started.fetch_add(1, Ordering::SeqCst) >= stop_after
+                {
+                    return (c, None);
+                }
+                let r = gen.chunk(c);
+                bar.inc(r.len() as u64);
+                (c, Some(r))
+            })
+            .collect()
+    });
+    bar.finish_and_clear();
+    for (c, r) in computed {
+        if r.is_some() {
+            results[c] = r;
+        }
+    }
+    let signal = interrupt.load(Ordering::SeqCst);
+    let interrupted = if results.iter().all(Option::is_some) {
+        None
+    } else if signal != 0 {
+        Some(format!("interrupted by {}", signal_name(signal)))
+    } else {
+        Some(format!(
+            "stopped after {stop_after} chunks (--stop-after-chunks)"
+        ))
+    };
+    meta.complete = interrupted.is_none();
+    meta.reason = interrupted.clone();
+    meta.wall_time_s = t0.elapsed().as_secs_f64();
+    write::write(&mut dir, &mut meta, &gen, results)?;
+    let path = dir.commit(&meta)?;
+    summary(out, &path, &meta, resumed_chunks).map_err(|e| plan_err(format!("stdout: {e}")))?;
+    Ok(Outcome {
+        path,
+        meta,
+        interrupted,
+        resumed_chunks,
+    })
+}
+
+pub(crate) fn signal_name(sig: usize) -> &'static str {
+    match sig {
+        2 => "SIGINT",
+        15 => "SIGTERM",
+        _ => "a signal",
+    }
+}
+
+pub(crate) fn progress_bar(len: u64) -> indicatif::ProgressBar {
+    use std::io::IsTerminal;
+    if !std::io::stderr().is_terminal() {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(len);
+    if let Ok(style) = indicatif::ProgressStyle::with_template(
+        "[{bar:30}] {pos}/{len} samples  {elapsed_precise} elapsed, ETA {eta_precise}",
+    ) {
+        bar.set_style(style.progress_chars("#>."));
+    }
+    bar
+}
+
+pub(crate) fn summary(
+    out: &mut dyn Write,
+    path: &Path,
+    m: &Meta,
+    resumed: usize,
+) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "scenario   {}: {} DOF, {} computational points, active strains [{}]",
+        m.scenario,
+        m.n_dof,
+        m.n_points,
+        m.components.join(", ")
+    )?;
+    match (&m.plan, &m.dynamic) {
+        (Some(p), _) => writeln!(
+            out,
+            "plan       {} {} ({} samples, {} parameters, seed {})",
+            p.kind.option(),
+            p.specs.join(" "),
+            m.samples,
+            m.parameters.len(),
+            m.seed
+        )?,
+        (None, Some(d)) => writeln!(
+            out,
+            "run        {} s at {} Hz, input {} ({} samples)",
+            d.duration, d.sample_rate, d.input, m.samples
+        )?,
+        (None, None) => {}
+    }
+    let c = &m.counts;
+    if m.dynamic.is_some() {
+        writeln!(
+            out,
+            "simulated  {} samples stored in {:.2} s",
+            c.ok, m.wall_time_s
+        )?;
+    } else {
+        writeln!(
+            out,
+            "solved     {} ok ({} warm-started), {} failed, {} not computed in {:.2} s on {} threads{}",
+            c.ok,
+            c.warm_started,
+            c.failed,
+            c.not_computed,
+            m.wall_time_s,
+            m.threads,
+            if resumed > 0 {
+                format!(" ({resumed} chunks kept from the resumed run)")
+            } else {
+                String::new()
+            }
+        )?;
+    }
+    for f in m.failures.iter().take(5) {
+        writeln!(out, "failed     sample {}: {}", f.index, f.reason)?;
+    }
+    if m.failures.len() > 5 {
+        writeln!(
+            out,
+            "failed     … {} more in meta.json",
+            m.failures.len() - 5
+        )?;
+    }
+    writeln!(
+        out,
+        "dataset    {} ({} × {} strain values{})",
+        path.display(),
+        m.samples,
+        m.n_points * m.components.len(),
+        if m.complete { "" } else { ", incomplete" }
+    )
+}

@@ -1,0 +1,261 @@
+//! Reading a dataset back: every array is checked against `meta.json` (dtype, shape, exact byte
+//! length) so a truncated, corrupted or missing file is an error naming the file, never a wrong
+//! dataset.
+
+use super::generate::{STATUS_FAILED, STATUS_NOT_COMPUTED, STATUS_OK};
+use super::{DatasetError, Meta, FILES, T_FILE};
+use std::path::Path;
+
+/// A dataset loaded from its directory. Arrays are row-major; see the module documentation of
+/// [`crate::dataset`] for the files.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Dataset {
+    pub meta: Meta,
+    /// `samples × parameters`.
+    pub inputs: Vec<f64>,
+    /// `samples × (points · active components)`, point-major; NaN rows for failed samples.
+    pub strain: Vec<f64>,
+    /// `samples × n_dof`.
+    pub q: Vec<f64>,
+    /// `samples × 3`.
+    pub tip_position: Vec<f64>,
+    /// `samples × 3 × 3`.
+    pub tip_rotation: Vec<f64>,
+    /// 0 ok, 1 failed, 2 not computed (an incomplete dataset).
+    pub status: Vec<u8>,
+    pub iterations: Vec<u32>,
+    pub residual: Vec<f64>,
+    pub strain_x: Vec<f64>,
+    /// Sample times of a dynamic dataset.
+    pub t: Option<Vec<f64>>,
+}
+
+fn file_error(file: &str, message: impl Into<String>) -> DatasetError {
+    DatasetError::File {
+        file: file.into(),
+        message: message.into(),
+    }
+}
+
+/// Reads `dir/name` as a C-order array of dtype `descr` and shape `shape`, with no byte missing or
+/// extra.
+fn read_npy<T: npyz::Deserialize>(
+    dir: &Path,
+    name: &str,
+    descr: &str,
+    shape: &[usize],
+) -> Result<Vec<T>, DatasetError> {
+    let path = dir.join(name);
+    let shown = path.display().to_string();
+    let bytes = std::fs::read(&path).map_err(|e| match e.kind() {
+        std::io::ErrorKind::NotFound => file_error(&shown, "missing array"),
+        _ => file_error(&shown, format!("cannot read it: {e}")),
+    })?;
+    let npy = npyz::NpyFile::new(&bytes[..])
+        .map_err(|e| file_error(&shown, format!("not a valid .npy file: {e}")))?;
+    let dtype = npy.dtype().descr();
+    if dtype != format!("'{descr}'") {
+        return Err(file_error(
+            &shown,
+            format!("dtype {dtype}, expected '{descr}'"),
+        ));
+    }
+    if npy.order() != npyz::Order::C {
+        return Err(file_error(&shown, "Fortran order, expected C order"));
+    }
+    let got: Vec<usize> = npy.shape().iter().map(|&d| d as usize).collect();
+    if got != shape {
+        return Err(file_error(
+            &shown,
+            format!("shape {got:?}, expected {shape:?} from meta.json"),
+        ));
+    }
+    let n: usize = shape.iter().product();
+    let size = std::mem::size_of::<T>();
+    let data_len = npy.into_inner().len();
+    if data_len != n * size {
+        return Err(file_error(
+            &shown,
+            format!(
+                "{} ({data_len} data bytes, expected {} for shape {shape:?})",
+                if data_len < n * size {
+                    "truncated"
+                } else {
+                    "has trailing bytes"
+                },
+                n * size
+            ),
+        ));
+    }
+    npyz::NpyFile::new(&bytes[..])
+        .and_then(|f| f.into_vec::<T>())
+        .map_err(|e| file_error(&shown, format!("cannot read the data: {e}")))
+}
+
+impl Dataset {
+    /// Loads and validates the dataset in `dir`.
+    pub fn load(dir: &Path) -> Result<Dataset, DatasetError> {
+        let meta_path = dir.join(crate::output::MANIFEST_FILE);
+        let shown = meta_path.display().to_string();
+        let text = std::fs::read_to_string(&meta_path).map_err(|e| match e.kind() {
+            std::io::ErrorKind::NotFound => file_error(&shown, "missing (not a gvsrom dataset)"),
+            _ => file_error(&shown, format!("cannot read it: {e}")),
+        })?;
+        let value: serde_json::Value = serde_json::from_str(&text)
+            .map_err(|e| file_error(&shown, format!("not valid JSON: {e}")))?;
+        let format = value
+            .get(crate::output::MANIFEST_KEY)
+            .and_then(|m| m.get("format"))
+            .and_then(|f| f.as_str());
+        if format != Some("dataset") {
+            return Err(file_error(
+                &shown,
+                "not a gvsrom dataset (its manifest does not say format \"dataset\")",
+            ));
+        }
+        let meta: Meta = serde_json::from_value(value)
+            .map_err(|e| file_error(&shown, format!("does not describe a dataset: {e}")))?;
+        let kind_ok = match meta.kind.as_str() {
+            "statics" => meta.plan.is_some(),
+            "dynamics" => meta.dynamic.is_some(),
+            _ => false,
+        };
+        if !kind_ok {
+            return Err(file_error(
+                &shown,
+                format!(
+                    "kind `{}` without its plan (expected \"statics\" with `plan` or \"dynamics\" with `dynamic`)",
+                    meta.kind
+                ),
+            ));
+        }
+        let n = meta.samples;
+        let d = meta.parameters.len();
+        let p = meta.strain_x.len();
+        if meta.components.is_empty() || p == 0 || meta.n_dof == 0 {
+            return Err(file_error(
+                &shown,
+                "no strain components, points or coordinates",
+            ));
+        }
+        let row = p * meta.components.len();
+        let f8 = "<f8";
+        let ds = Dataset {
+            inputs: read_npy(dir, FILES[0], f8, &[n, d])?,
+            strain: read_npy(dir, FILES[1], f8, &[n, row])?,
+            q: read_npy(dir, FILES[2], f8, &[n, meta.n_dof])?,
+            tip_position: read_npy(dir, FILES[3], f8, &[n, 3])?,
+            tip_rotation: read_npy(dir, FILES[4], f8, &[n, 3, 3])?,
+            status: read_npy(dir, FILES[5], "|u1", &[n])?,
+            iterations: read_npy(dir, FILES[6], "<u4", &[n])?,
+            residual: read_npy(dir, FILES[7], f8, &[n])?,
+            strain_x: read_npy(dir, FILES[8], f8, &[p])?,
+            t: match meta.kind.as_str() {
+                "dynamics" => Some(read_npy(dir, T_FILE, f8, &[n])?),
+                _ => None,
+            },
+            meta,
+        };
+        ds.check_consistency(dir)?;
+        Ok(ds)
+    }
+
+    fn check_consistency(&self, dir: &Path) -> Result<(), DatasetError> {
+        let at = |f: &str| dir.join(f).display().to_string();
+        let m = &self.meta;
+        for (a, b) in self.strain_x.iter().zip(&m.strain_x) {
+            if (a - b).abs() > 1e-12 * (1.0 + b.abs()) {
+                return Err(file_error(
+                    &at(FILES[8]),
+                    "differs from strain_x in meta.json",
+                ));
+            }
+        }
+        let mut counts = [0usize; 3];
+        for (k, &s) in self.status.iter().enumerate() {
+            if s > STATUS_NOT_COMPUTED {
+                return Err(file_error(
+                    &at(FILES[5]),
+                    format!("row {k} has status {s} (accepted: 0 ok, 1 failed, 2 not computed)"),
+                ));
+            }
+            counts[s as usize] += 1;
+            let done = m
+                .chunk_done
+                .get(k / m.chunk_size.max(1))
+                .copied()
+                .unwrap_or(false);
+            if done == (s == STATUS_NOT_COMPUTED) {
+                return Err(file_error(
+                    &at(FILES[5]),
+                    format!("row {k} has status {s}, inconsistent with chunk_done in meta.json"),
+                ));
+            }
+            if s == STATUS_OK && self.strain_row(k).iter().any(|v| !v.is_finite()) {
+                return Err(file_error(
+                    &at(FILES[1]),
+                    format!("row {k} has status ok but holds NaN or infinite values"),
+                ));
+            }
+        }
+        let c = &m.counts;
+        if counts != [c.ok, c.failed, c.not_computed] {
+            return Err(file_error(
+                &at(FILES[5]),
+                format!(
+                    "{} ok, {} failed, {} not computed, but meta.json counts {} ok, {} failed, {} not computed",
+                    counts[0], counts[1], counts[2], c.ok, c.failed, c.not_computed
+                ),
+            ));
+        }
+        if m.chunk_done.len() != m.samples.div_ceil(m.chunk_size.max(1)) {
+            return Err(file_error(
+                &at(crate::output::MANIFEST_FILE),
+                "chunk_done does not have one entry per chunk",
+            ));
+        }
+        Ok(())
+    }
+
+    pub fn samples(&self) -> usize {
+        self.meta.samples
+    }
+
+    /// Values per strain row.
+    pub fn row_len(&self) -> usize {
+        self.strain_x.len() * self.meta.components.len()
+    }
+
+    /// The strain row of sample `k`.
+    pub fn strain_row(&self, k: usize) -> &[f64] {
+        let r = self.row_len();
+        &self.strain[k * r..(k + 1) * r]
+    }
+
+    /// Indices of the samples with status ok (the rows to learn from).
+    pub fn ok_rows(&self) -> Vec<usize> {
+        (0..self.samples())
+            .filter(|&k| self.status[k] == STATUS_OK)
+            .collect()
+    }
+
+    /// One line per sample that is not usable: failed (with its reason) or not computed.
+    pub fn problems(&self) -> Vec<String> {
+        let mut v = vec![];
+        for (k, &s) in self.status.iter().enumerate() {
+            if s == STATUS_FAILED {
+                let reason = self
+                    .meta
+                    .failures
+                    .iter()
+                    .find(|f| f.index == k)
+                    .map(|f| f.reason.as_str())
+                    .unwrap_or("no reason recorded");
+                v.push(format!("sample {k}: failed: {reason}"));
+            } else if s == STATUS_NOT_COMPUTED {
+                v.push(format!("sample {k}: not computed (incomplete dataset)"));
+            }
+        }
+        v
+    }
+}

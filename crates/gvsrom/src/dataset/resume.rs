@@ -1,0 +1,105 @@
+//! `--resume`: the incomplete dataset to continue, checked against this run, and its finished rows.
+
+use super::generate::SampleResult;
+use super::{Dataset, DatasetError, Meta};
+use std::path::Path;
+
+/// The incomplete dataset at `path`, checked to be a continuation of `meta`'s run.
+pub(super) fn resumable(path: &Path, meta: &Meta) -> Result<Dataset, DatasetError> {
+    let shown = path.display().to_string();
+    let resume = |message: String| DatasetError::Resume {
+        path: shown.clone(),
+        message,
+    };
+    if !path.exists() {
+        return Err(resume(
+            "there is no dataset to resume (run without --resume to start one)".into(),
+        ));
+    }
+    let prev = Dataset::load(path).map_err(|e| resume(format!("cannot be resumed: {e}")))?;
+    let p = &prev.meta;
+    if p.complete {
+        return Err(resume(
+            "the dataset is already complete: nothing to resume".into(),
+        ));
+    }
+    let differs = |what: &str, old: String, new: String| {
+        resume(format!(
+            "the {what} differs from the incomplete dataset's ({old} there, {new} now); rerun with the same arguments, or use --force instead of --resume to start again"
+        ))
+    };
+    if p.scenario_toml != meta.scenario_toml {
+        return Err(differs(
+            "scenario (after --set)",
+            format!("`{}`", p.scenario),
+            format!("`{}`", meta.scenario),
+        ));
+    }
+    let (Some(a), Some(b)) = (&p.plan, &meta.plan) else {
+        return Err(resume(
+            "only static datasets can be resumed: rerun a dynamic dataset with --force".into(),
+        ));
+    };
+    if a.kind != b.kind || a.specs != b.specs {
+        return Err(differs(
+            "plan",
+            format!("{} {}", a.kind.option(), a.specs.join(" ")),
+            format!("{} {}", b.kind.option(), b.specs.join(" ")),
+        ));
+    }
+    if a.samples != b.samples {
+        return Err(differs(
+            "--samples",
+            a.samples.to_string(),
+            b.samples.to_string(),
+        ));
+    }
+    if p.seed != meta.seed {
+        return Err(differs("--seed", p.seed.to_string(), meta.seed.to_string()));
+    }
+    if p.chunk_size != meta.chunk_size {
+        return Err(differs(
+            "--chunk-size",
+            p.chunk_size.to_string(),
+            meta.chunk_size.to_string(),
+        ));
+    }
+    if p.parameters != meta.parameters
+        || p.components != meta.components
+        || p.n_dof != meta.n_dof
+        || prev.strain_x.len() != meta.strain_x.len()
+        || prev
+            .strain_x
+            .iter()
+            .zip(&meta.strain_x)
+            .any(|(x, y)| x.to_bits() != y.to_bits())
+    {
+        return Err(resume(
+            "its parameters or point layout differ from this run's; use --force instead of --resume to start again".into(),
+        ));
+    }
+    Ok(prev)
+}
+
+/// Sample `k` as stored in a previous dataset.
+pub(super) fn from_previous(prev: &Dataset, k: usize) -> SampleResult {
+    let r = prev.row_len();
+    let n = prev.meta.n_dof;
+    let reason = prev
+        .meta
+        .failures
+        .iter()
+        .find(|f| f.index == k)
+        .map(|f| f.reason.clone());
+    SampleResult {
+        status: prev.status[k],
+        strain: prev.strain[k * r..(k + 1) * r].to_vec(),
+        q: prev.q[k * n..(k + 1) * n].to_vec(),
+        tip_position: std::array::from_fn(|i| prev.tip_position[3 * k + i]),
+        tip_rotation: std::array::from_fn(|i| prev.tip_rotation[9 * k + i]),
+        iterations: prev.iterations[k],
+        residual: prev.residual[k],
+        warm_started: false,
+        reason,
+    }
+}
