@@ -52,6 +52,18 @@ pub struct Built {
     pub u: Vec<f64>,
     pub options: StaticsOptions,
     pub centerline_points: usize,
+    /// A reduced model (`--model`) that replaces the scenario's basis in statics and dynamics.
+    pub reduced: Option<crate::reduce::Reduced>,
+}
+
+impl Built {
+    /// Generalized coordinates of the model that runs: the reduced one if attached.
+    pub fn n_dof(&self) -> usize {
+        match &self.reduced {
+            Some(r) => r.model.n_dof(),
+            None => self.model.n_dof(),
+        }
+    }
 }
 
 /// Validates `s` and builds the engine's model, loads, tensions and solver options; the loads must
@@ -145,6 +157,7 @@ pub fn build(s: &Scenario) -> Result<Built, ScenarioError> {
         u,
         options: s.solver.clone(),
         centerline_points,
+        reduced: None,
     };
     let u_abs: Vec<f64> = built.u.iter().map(|v| v.abs()).collect();
     crate::plausibility::check(&built, &u_abs, 1.0)?;

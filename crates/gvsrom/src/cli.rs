@@ -5,6 +5,7 @@ use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 use gvsrom::output::OutputFile;
 use gvsrom::presets::{self, PRESETS};
+use gvsrom::reduce;
 use gvsrom::simulate::{Ending, TrajectoryWriter};
 use gvsrom::statics::{self, StaticsReport};
 use gvsrom::{build, Built, Scenario};
@@ -32,6 +33,12 @@ pub enum Command {
     /// Generate a strain snapshot dataset: solve the statics over a sampling plan (`--sweep`,
     /// `--grid`, `--random`) in parallel and write NumPy arrays (see README "Datasets").
     Dataset(gvsrom::dataset::DatasetArgs),
+    /// POD of a dataset's strain snapshots: K modes become a reduced model (`--model` on `statics`
+    /// and `simulate`).
+    Pod(PodArgs),
+    /// Train a tanh autoencoder on a dataset's strain snapshots; its decoder becomes a nonlinear
+    /// reduced model (`--model` on `statics` and `simulate`).
+    Train(TrainArgs),
     /// Validate a preset or scenario file and print the model's size, without solving.
     Check(ScenarioArgs),
     /// List the built-in presets.
@@ -84,6 +91,71 @@ pub struct StaticsArgs {
 
     /// Replace FILE if it is an earlier gvsrom output (never anything else).
     #[arg(long, requires = "json")]
+    pub force: bool,
+
+    /// Solve with the reduced model in directory MODEL (from `gvsrom pod` or `gvsrom train`) in
+    /// place of the scenario's basis; the model must have been learned on this scenario's points.
+    #[arg(long, value_name = "MODEL")]
+    pub model: Option<PathBuf>,
+
+    /// With `--model`: also solve the full model and report the strain error (MAE, % of the peak
+    /// strain), the tip error (% of the length) and both solve times.
+    #[arg(long, requires = "model")]
+    pub compare: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct PodArgs {
+    /// A dataset directory (from `gvsrom dataset`).
+    pub dataset: PathBuf,
+    /// Number of POD modes kept (reduced coordinates).
+    #[arg(long, value_name = "K")]
+    pub modes: usize,
+    /// The new model directory.
+    #[arg(long, value_name = "MODEL")]
+    pub out: PathBuf,
+    /// Replace MODEL if it is an earlier gvsrom output.
+    #[arg(long)]
+    pub force: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct TrainArgs {
+    /// A dataset directory (from `gvsrom dataset`).
+    pub dataset: PathBuf,
+    /// Latent size r (reduced coordinates).
+    #[arg(long, value_name = "R", default_value_t = 1)]
+    pub latent: usize,
+    /// Hidden layers of the whole autoencoder (odd: 3, 5, 7…); layer sizes halve from the snapshot
+    /// size towards the latent size (paper Section III).
+    #[arg(long, value_name = "N", default_value_t = 7)]
+    pub hidden_layers: usize,
+    /// Maximum Adam epochs.
+    #[arg(long, default_value_t = 1000)]
+    pub epochs: usize,
+    /// Mini-batch size.
+    #[arg(long, default_value_t = 64)]
+    pub batch_size: usize,
+    /// Adam learning rate.
+    #[arg(long, default_value_t = 1e-3)]
+    pub learning_rate: f64,
+    /// L2 weight regularization λ of eq. (15) (paper: 1e-4).
+    #[arg(long, default_value_t = 1e-4)]
+    pub lambda: f64,
+    /// Fraction of the snapshots held out for validation and early stopping.
+    #[arg(long, default_value_t = 0.1)]
+    pub validation_fraction: f64,
+    /// Epochs without a better validation loss before stopping (0: never stop early).
+    #[arg(long, default_value_t = 50)]
+    pub patience: usize,
+    /// Seed of the initialization, the split and the shuffles (same seed, same model).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// The new model directory.
+    #[arg(long, value_name = "MODEL")]
+    pub out: PathBuf,
+    /// Replace MODEL if it is an earlier gvsrom output.
+    #[arg(long)]
     pub force: bool,
 }
 
@@ -175,6 +247,11 @@ pub struct SimulateArgs {
     /// Replace DIR if it is an earlier gvsrom output holding only its own files (never anything else).
     #[arg(long, requires = "out")]
     pub force: bool,
+
+    /// Simulate with the reduced model in directory MODEL (from `gvsrom pod` or `gvsrom train`) in
+    /// place of the scenario's basis.
+    #[arg(long, value_name = "MODEL")]
+    pub model: Option<PathBuf>,
 }
 
 /// Runs the parsed command, printing to `out`.
@@ -183,6 +260,8 @@ pub fn run(cli: Cli, out: &mut impl Write) -> Result<()> {
         Command::Statics(args) => statics_cmd(&args, out),
         Command::Simulate(args) => simulate_cmd(&args, out),
         Command::Dataset(args) => dataset_cmd(&args, out),
+        Command::Pod(args) => pod_cmd(&args, out),
+        Command::Train(args) => train_cmd(&args, out),
         Command::Check(args) => check_cmd(&args, out),
         Command::Presets => presets_cmd(out),
         Command::Show { preset } => {
@@ -207,6 +286,17 @@ fn load(args: &ScenarioArgs) -> Result<(Scenario, Built)> {
     Ok((scenario, built))
 }
 
+/// `--model DIR`: attaches a reduced model to `built` (the scenario table supplies the dataset
+/// inputs of the model's initial guess).
+fn attach_model(built: &mut Built, args: &ScenarioArgs, dir: &std::path::Path) -> Result<()> {
+    let src = presets::source(&args.scenario)?;
+    let mut table = gvsrom::scenario::parse_table(&src.origin, &src.text)?;
+    for spec in &args.set {
+        gvsrom::scenario::apply_override(&mut table, spec)?;
+    }
+    reduce::attach(built, Some(&table), dir)
+}
+
 fn presets_cmd(out: &mut impl Write) -> Result<()> {
     let width = PRESETS.iter().map(|p| p.name.len()).max().unwrap_or(0);
     for p in PRESETS {
@@ -228,7 +318,10 @@ fn check_cmd(args: &ScenarioArgs, out: &mut impl Write) -> Result<()> {
 }
 
 fn statics_cmd(args: &StaticsArgs, out: &mut impl Write) -> Result<()> {
-    let (scenario, built) = load(&args.scenario)?;
+    let (scenario, mut built) = load(&args.scenario)?;
+    if let Some(dir) = &args.model {
+        attach_model(&mut built, &args.scenario, dir)?;
+    }
     // the output is checked, locked and staged before the solve, so a bad path fails at once
     let json = match &args.json {
         Some(path) => Some(OutputFile::create("--json", path, "statics", args.force)?),
@@ -237,9 +330,160 @@ fn statics_cmd(args: &StaticsArgs, out: &mut impl Write) -> Result<()> {
     print_model(&scenario, &built, out)?;
     let report = statics::solve(&built)?;
     print_solution(&report, out)?;
+    if let Some(r) = &built.reduced {
+        r.check_range(&report.q)?;
+    }
+    let comparison = if args.compare {
+        let reduced = built.reduced.take();
+        let hom = statics::solve(&built)?;
+        built.reduced = reduced;
+        let c = statics::compare(&built, &hom, &report);
+        writeln!(
+            out,
+            "full model {} DOF solved in {:.2} ms; reduced {} DOF in {:.2} ms: {:.1}× faster",
+            hom.n_dof,
+            hom.solve_time_s * 1e3,
+            report.n_dof,
+            report.solve_time_s * 1e3,
+            c.speedup
+        )?;
+        writeln!(
+            out,
+            "error      strain {:.3} % (MAE / peak |ξ − ξ*|), tip {:.4} % of the length",
+            c.strain_error_percent, c.tip_error_percent
+        )?;
+        Some(c)
+    } else {
+        None
+    };
     if let Some(json) = json {
-        let path = json.commit_json(&report)?;
+        let doc = statics::StaticsJson {
+            report: &report,
+            model: args.model.as_ref().map(|p| p.display().to_string()),
+            comparison,
+        };
+        let path = json.commit_json(&doc)?;
         writeln!(out, "json       {}", path.display())?;
+    }
+    Ok(())
+}
+
+fn pod_cmd(args: &PodArgs, out: &mut impl Write) -> Result<()> {
+    let s = reduce::pod(&args.dataset, args.modes, &args.out, args.force)?;
+    writeln!(
+        out,
+        "snapshots  {} × {} (failed samples skipped), numerical rank {}",
+        s.rows, s.features, s.numerical_rank
+    )?;
+    let shown: Vec<String> = s
+        .singular_values
+        .iter()
+        .take(10)
+        .map(|v| format!("{v:.4e}"))
+        .collect();
+    writeln!(
+        out,
+        "σ          {}{}",
+        shown.join(" "),
+        if s.singular_values.len() > 10 {
+            " …"
+        } else {
+            ""
+        }
+    )?;
+    writeln!(
+        out,
+        "modes      {} capture {:.8} of the snapshot energy",
+        s.modes, s.captured_energy
+    )?;
+    writeln!(out, "model      {}", s.path.display())?;
+    Ok(())
+}
+
+fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
+    use rom::nn::TrainOptions;
+    let options = TrainOptions {
+        latent: args.latent,
+        hidden_layers: args.hidden_layers,
+        lambda: args.lambda,
+        epochs: args.epochs,
+        batch_size: args.batch_size,
+        learning_rate: args.learning_rate,
+        validation_fraction: args.validation_fraction,
+        patience: (args.patience > 0).then_some(args.patience),
+        seed: args.seed,
+        ..TrainOptions::default()
+    };
+    let signal = interrupt_flag();
+    let bar = gvsrom::dataset::progress_bar_of(args.epochs as u64, "epochs");
+    let mut progress = |epoch: usize, train: f64, val: Option<f64>| {
+        bar.set_position(epoch as u64);
+        bar.set_message(match val {
+            Some(v) => format!("loss {train:.3e} / validation {v:.3e}"),
+            None => format!("loss {train:.3e}"),
+        });
+        match signal.load(Ordering::SeqCst) {
+            0 => ControlFlow::Continue(()),
+            _ => ControlFlow::Break(()),
+        }
+    };
+    let s = reduce::train(
+        &args.dataset,
+        &options,
+        &args.out,
+        args.force,
+        &mut progress,
+    )?;
+    bar.finish_and_clear();
+    let r = &s.report;
+    writeln!(
+        out,
+        "snapshots  {} × {} ({} training, {} validation)",
+        s.rows, s.features, r.n_train, r.n_val
+    )?;
+    writeln!(
+        out,
+        "network    {} (encoder; the decoder mirrors it), tanh hidden layers, linear output",
+        s.encoder_sizes
+            .iter()
+            .map(|v| v.to_string())
+            .collect::<Vec<_>>()
+            .join("-")
+    )?;
+    writeln!(
+        out,
+        "trained    {} epochs (best {}, {:?}) + {} fine-tuning in {:.1} s",
+        r.epochs_run,
+        r.best_epoch,
+        r.stop,
+        r.fine_tune_epochs_run,
+        r.wall_time.as_secs_f64()
+    )?;
+    writeln!(
+        out,
+        "RMSE       {:.4e} training{}",
+        r.final_train_rmse,
+        r.final_val_rmse
+            .map(|v| format!(", {v:.4e} validation"))
+            .unwrap_or_default()
+    )?;
+    writeln!(
+        out,
+        "rest       q_r = {} (the sample closest to the straight rod, ‖ξ − ξ*‖ = {:.3e}); projection residual ≤ {:.1e}",
+        fmt_vec(&s.rest, 6),
+        s.rest_residual,
+        s.projection_residual
+    )?;
+    writeln!(out, "model      {}", s.path.display())?;
+    if signal.load(Ordering::SeqCst) != 0 {
+        return Err(Interrupted {
+            signal: signal.load(Ordering::SeqCst) as i32,
+            message: format!(
+                "training interrupted; the best weights so far were saved to `{}`",
+                s.path.display()
+            ),
+        }
+        .into());
     }
     Ok(())
 }
@@ -250,7 +494,10 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
     use gvs::solve::ode::{FixedStepOptions, NdfOptions};
     use gvsrom::simulate::{self, InputSource, SimulateOptions};
     use std::io::IsTerminal;
-    let (scenario, built) = load(&args.scenario)?;
+    let (scenario, mut built) = load(&args.scenario)?;
+    if let Some(dir) = &args.model {
+        attach_model(&mut built, &args.scenario, dir)?;
+    }
     let input = if let Some(path) = &args.input {
         let interpolation = if args.interpolate {
             Interpolation::Linear
@@ -503,6 +750,16 @@ fn print_model(scenario: &Scenario, built: &Built, out: &mut impl Write) -> Resu
         m.rod.length(),
         m.disc.order
     )?;
+    if let Some(r) = &built.reduced {
+        writeln!(
+            out,
+            "reduced    {} model `{}`: {} coordinates on the {}-DOF basis",
+            r.kind,
+            r.path.display(),
+            r.model.n_dof(),
+            m.n_dof()
+        )?;
+    }
     if built.u.is_empty() {
         writeln!(out, "tendons    none")?;
     } else {

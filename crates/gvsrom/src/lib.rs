@@ -13,6 +13,7 @@ pub mod npy;
 pub mod output;
 pub mod plausibility;
 pub mod presets;
+pub mod reduce;
 pub mod reduced_model;
 pub mod scenario;
 pub mod simulate;

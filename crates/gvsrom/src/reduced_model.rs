@@ -101,8 +101,18 @@ pub struct ModelMeta {
     pub latent: usize,
     pub layout: ModelLayout,
     pub dataset: DatasetRef,
-    /// Reduced coordinates of the straight rod.
+    /// Reduced coordinates where statics and dynamics start "from rest": for an autoencoder the
+    /// encoding of the training snapshot closest to the straight rod (zero strain may lie off the
+    /// learned manifold, e.g. under gravity).
     pub rest: Vec<f64>,
+    /// Per reduced coordinate, the `[min, max]` of the training snapshots' encodings: a reduced
+    /// solution far outside it is off the learned manifold and is reported as an error.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub latent_range: Vec<[f64; 2]>,
+    /// Names of the dataset inputs stored as anchors (`anchors.inputs` in the weights): the
+    /// nearest training sample's encoding is the initial guess of a reduced statics solve.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub anchor_parameters: Vec<String>,
     /// POD: fraction of the snapshot energy the kept modes capture.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub captured_energy: Option<f64>,
@@ -125,11 +135,22 @@ pub enum ModelWeights {
     Autoencoder(Autoencoder),
 }
 
+/// Training samples as (inputs, encoding) pairs: initial guesses for reduced solves.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Anchors {
+    pub n: usize,
+    /// `n × k` row-major, columns named by [`ModelMeta::anchor_parameters`].
+    pub inputs: Vec<f64>,
+    /// `n × r` row-major.
+    pub latent: Vec<f64>,
+}
+
 /// A reduced model: its metadata and its numbers.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ReducedModel {
     pub meta: ModelMeta,
     pub weights: ModelWeights,
+    pub anchors: Option<Anchors>,
 }
 
 /// FNV-1a 64-bit hash, as 16 hex digits.
@@ -189,6 +210,17 @@ impl ReducedModel {
                     (vec![s.len()], f64_bytes(s.scale())),
                 );
             }
+        }
+        if let Some(a) = &self.anchors {
+            let k = self.meta.anchor_parameters.len();
+            t.insert(
+                "anchors.inputs".into(),
+                (vec![a.n, k], f64_bytes(&a.inputs)),
+            );
+            t.insert(
+                "anchors.latent".into(),
+                (vec![a.n, self.meta.latent], f64_bytes(&a.latent)),
+            );
         }
         t
     }
@@ -329,6 +361,29 @@ impl ReducedModel {
                 )))
             }
         };
-        Ok(ReducedModel { meta, weights })
+        let anchors = match st.tensor("anchors.latent") {
+            Ok(t) => {
+                let n = t.shape().first().copied().unwrap_or(0);
+                let k = meta.anchor_parameters.len();
+                Some(Anchors {
+                    n,
+                    inputs: get("anchors.inputs", &[n, k])?,
+                    latent: get("anchors.latent", &[n, meta.latent])?,
+                })
+            }
+            Err(_) => None,
+        };
+        if !meta.latent_range.is_empty() && meta.latent_range.len() != meta.latent {
+            return Err(bad(format!(
+                "meta.json: {} latent ranges for {} coordinates",
+                meta.latent_range.len(),
+                meta.latent
+            )));
+        }
+        Ok(ReducedModel {
+            meta,
+            weights,
+            anchors,
+        })
     }
 }

@@ -360,30 +360,43 @@ pub fn run(
     let mut last_tip = None;
     let mut write_error: Option<std::io::Error> = None;
     let mut interrupted = None;
-    let summary = simulate_streaming(
-        &built.model,
-        &plan.signal,
-        &built.loads,
-        plan.schedule.as_ref(),
-        &plan.initial,
-        &plan.t_out,
-        integrator,
-        &mut |s| {
-            last_tip = Some(*s.tip);
-            if let Some(w) = writer.as_deref_mut() {
-                if let Err(e) = w.push(s) {
-                    let msg = format!("cannot write the trajectory: {e}");
-                    write_error = Some(e);
-                    return ControlFlow::Break(msg);
-                }
+    let mut sink = |s: &Sample<'_>| {
+        last_tip = Some(*s.tip);
+        if let Some(w) = writer.as_deref_mut() {
+            if let Err(e) = w.push(s) {
+                let msg = format!("cannot write the trajectory: {e}");
+                write_error = Some(e);
+                return ControlFlow::Break(msg);
             }
-            let flow = control(s.t);
-            if let ControlFlow::Break(reason) = &flow {
-                interrupted = Some(reason.clone());
-            }
-            flow
-        },
-    )
+        }
+        let flow = control(s.t);
+        if let ControlFlow::Break(reason) = &flow {
+            interrupted = Some(reason.clone());
+        }
+        flow
+    };
+    let summary = match &built.reduced {
+        Some(r) => simulate_streaming(
+            &r.model,
+            &plan.signal,
+            &built.loads,
+            plan.schedule.as_ref(),
+            &plan.initial,
+            &plan.t_out,
+            integrator,
+            &mut sink,
+        ),
+        None => simulate_streaming(
+            &built.model,
+            &plan.signal,
+            &built.loads,
+            plan.schedule.as_ref(),
+            &plan.initial,
+            &plan.t_out,
+            integrator,
+            &mut sink,
+        ),
+    }
     .map_err(|e| match e {
         SimulationError::Model(m) => ScenarioError::from(m),
         SimulationError::Initial(s) => ScenarioError::invalid(
@@ -422,7 +435,7 @@ pub fn run(
 /// Bytes written per sample: `t`, `q`, `q̇`, `u`, tip position and rotation, strains (f64 each).
 fn bytes_per_sample(built: &Built) -> f64 {
     let m = &built.model;
-    8.0 * (1 + 2 * m.n_dof() + m.n_actuators() + 3 + 9 + 6 * m.disc.n_points()) as f64
+    8.0 * (1 + 2 * built.n_dof() + m.n_actuators() + 3 + 9 + 6 * m.disc.n_points()) as f64
 }
 
 /// Refuses a trajectory larger than [`MAX_OUTPUT_BYTES`] before anything is computed.
@@ -462,7 +475,7 @@ impl TrajectoryWriter {
     pub fn create(path: &Path, force: bool, built: &Built) -> Result<Self, OutputError> {
         let mut dir = OutputDir::create("--out", path, "trajectory", force)?;
         let m = &built.model;
-        let (n, na, np) = (m.n_dof(), m.n_actuators(), m.disc.n_points());
+        let (n, na, np) = (built.n_dof(), m.n_actuators(), m.disc.n_points());
         let open = |dir: &mut OutputDir| -> std::io::Result<_> {
             Ok((
                 NpyRows::new(dir, "t.npy", &[])?,
@@ -562,7 +575,7 @@ impl TrajectoryWriter {
             t_reached: sm.t_last,
             t_requested: requested_end,
             samples,
-            n_dof: built.model.n_dof(),
+            n_dof: built.n_dof(),
             n_points: built.model.disc.n_points(),
             n_actuators: built.model.n_actuators(),
             wall_time_s: sm.wall_time_s,

@@ -4,7 +4,10 @@
 use crate::build::Built;
 use crate::error::StaticsFailure;
 use gvs::lie::V3;
-use gvs::solve::statics::{StaticsError, StaticsSolver, MAX_RAMP_STEPS};
+use gvs::model::Model;
+use gvs::solve::statics::{StaticsError, StaticsOptions, StaticsSolver, MAX_RAMP_STEPS};
+use gvs::strain::StrainParam;
+use nalgebra::DVector;
 use serde::Serialize;
 use std::time::Instant;
 
@@ -58,12 +61,38 @@ impl StaticsReport {
 /// non-convergence names the scenario's largest load ([`crate::plausibility::largest_load`]) and
 /// suggests more ramp steps.
 pub fn solve(built: &Built) -> Result<StaticsReport, StaticsFailure> {
-    let model = &built.model;
-    let mut solver = StaticsSolver::new(model, built.options.clone());
+    match &built.reduced {
+        Some(r) => solve_on(built, &r.model, r.initial.as_ref()),
+        None => solve_on(built, &built.model, None),
+    }
+}
+
+/// [`solve`] on `model`: the scenario's own or a reduced one with the same rod, points and tendons.
+///
+/// With an initial guess `q0` (a reduced model's nearest training sample), the full load is first
+/// solved from `q0` in one stage; if that fails, the scenario's load ramp from rest follows.
+fn solve_on<P: StrainParam>(
+    built: &Built,
+    model: &Model<P>,
+    q0: Option<&DVector<f64>>,
+) -> Result<StaticsReport, StaticsFailure> {
     let t0 = Instant::now();
-    let sol = solver
-        .solve(&built.u, &built.loads, None)
-        .map_err(|error| failure(built, error))?;
+    let warm = q0.and_then(|q0| {
+        let options = StaticsOptions {
+            ramp_steps: 1,
+            min_increment: 1.0,
+            ..built.options.clone()
+        };
+        StaticsSolver::new(model, options)
+            .solve(&built.u, &built.loads, Some(q0))
+            .ok()
+    });
+    let sol = match warm {
+        Some(sol) => sol,
+        None => StaticsSolver::new(model, built.options.clone())
+            .solve(&built.u, &built.loads, None)
+            .map_err(|error| failure(built, error))?,
+    };
     let solve_time_s = t0.elapsed().as_secs_f64();
 
     let mut ws = model.workspace();
@@ -100,6 +129,63 @@ pub fn solve(built: &Built) -> Result<StaticsReport, StaticsFailure> {
         residual_norm: sol.residual_norm,
         solve_time_s,
     })
+}
+
+/// The `--json` document: the report, the reduced model used and the comparison with the full model.
+#[derive(Debug, Serialize)]
+pub struct StaticsJson<'a> {
+    #[serde(flatten)]
+    pub report: &'a StaticsReport,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub model: Option<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub comparison: Option<Comparison>,
+}
+
+/// A reduced equilibrium against the full model's (`statics --model --compare`), see `rom::metrics`.
+#[derive(Debug, Clone, Serialize)]
+pub struct Comparison {
+    /// Mean absolute strain error over the points and active components, % of the HOM's peak
+    /// |ξ − ξ*|.
+    pub strain_error_percent: f64,
+    /// Tip position error, % of the rod length.
+    pub tip_error_percent: f64,
+    pub hom_tip_position: [f64; 3],
+    pub hom_solve_time_s: f64,
+    pub rom_solve_time_s: f64,
+    /// `hom_solve_time_s / rom_solve_time_s` (same process, same run).
+    pub speedup: f64,
+}
+
+/// Strain deviations `ξ − ξ*` of a report at its points, the active components of `built` only.
+pub fn active_deviations(built: &Built, report: &StaticsReport) -> Vec<f64> {
+    let active = crate::dataset::Layout::of(built).active;
+    let star = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0];
+    report
+        .strain
+        .iter()
+        .flat_map(|xi| active.iter().map(move |&a| xi[a] - star[a]))
+        .collect()
+}
+
+/// Compares a reduced solution `rom` with the full one `hom` of the same scenario.
+pub fn compare(built: &Built, hom: &StaticsReport, rom: &StaticsReport) -> Comparison {
+    let length = built.model.disc.length();
+    Comparison {
+        strain_error_percent: rom::metrics::strain_error_percent(
+            &active_deviations(built, hom),
+            &active_deviations(built, rom),
+        ),
+        tip_error_percent: rom::metrics::tip_error_percent(
+            &hom.tip_position,
+            &rom.tip_position,
+            length,
+        ),
+        hom_tip_position: hom.tip_position,
+        hom_solve_time_s: hom.solve_time_s,
+        rom_solve_time_s: rom.solve_time_s,
+        speedup: hom.solve_time_s / rom.solve_time_s.max(1e-12),
+    }
 }
 
 /// The engine's error with, for a non-convergence, the largest load and a remedy.

@@ -1,0 +1,467 @@
+//! Reduction commands and reduced models on a scenario (issue 7, paper Sections III–IV):
+//!
+//! - [`pod`]: `gvsrom pod DATASET --modes K --out MODEL`;
+//! - [`train`]: `gvsrom train DATASET --latent R --hidden-layers 3|5|7 --out MODEL`;
+//! - [`attach`]: `--model MODEL` on `statics` and `simulate`: the scenario's engine with the model's
+//!   strain parameterization in place of its basis (no physics re-implemented).
+//!
+//! POD and decoders alike act on the HOM's own basis through the least-squares projection `P` of
+//! point strains onto its coefficients (`rom::reduced`): `Ψ_s(q_r) = Φ_s P V q_r` (POD, a constant
+//! linear basis) or `Φ_s P D(q_r)` (autoencoder).
+
+use crate::build::{build, Built};
+use crate::dataset::{Dataset, Layout};
+use crate::error::ScenarioError;
+use crate::output::OutputDir;
+use crate::reduced_model::{
+    fnv1a64, DatasetRef, ModelLayout, ModelMeta, ModelWeights, ReducedModel, TrainingMeta,
+};
+use crate::scenario::{Scenario, StrainMode};
+use gvs::model::Model;
+use gvs::strain::{LinearBasis, StrainParam};
+use nalgebra::{DMatrix, DVector};
+use rom::nn::{Autoencoder, TrainOptions, TrainReport};
+use rom::pod::Pod;
+use rom::reduced::{point_matrix, projection, projection_residual, PointLayout, ReducedParam};
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
+
+/// A reduced model bound to a scenario.
+pub struct Reduced {
+    /// The scenario's rod, points, tendons and loads with the reduced parameterization.
+    pub model: Model<Box<dyn StrainParam>>,
+    /// `"pod"` or `"autoencoder"`.
+    pub kind: String,
+    pub path: PathBuf,
+    /// Initial guess of a statics solve: the encoding of the training sample nearest to this
+    /// scenario's inputs (autoencoders whose dataset inputs the scenario defines).
+    pub initial: Option<DVector<f64>>,
+    /// The training encodings' range per coordinate (autoencoders).
+    pub latent_range: Vec<[f64; 2]>,
+}
+
+impl Reduced {
+    /// Errors if `q` lies outside the training encodings' range by more than half its width in
+    /// some coordinate: the decoder is extrapolating there (tanh layers saturate, `Ψ_q → 0`, and
+    /// spurious equilibria appear), so the result is not to be trusted.
+    pub fn check_range(&self, q: &[f64]) -> Result<(), ScenarioError> {
+        for (d, (v, [lo, hi])) in q.iter().zip(&self.latent_range).enumerate() {
+            let margin = 0.5 * (hi - lo).max(1e-12);
+            if *v < lo - margin || *v > hi + margin || !v.is_finite() {
+                return Err(invalid(
+                    "--model",
+                    format!(
+                        "the reduced solution q_r[{d}] = {v:.6} lies far outside the range of the training data [{lo:.6}, {hi:.6}] of `{}`: the decoder is extrapolating (the load is outside the dataset, or the model is poor)",
+                        self.path.display()
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The value of a dataset input `path` in the scenario being run: tensions from `built` (they
+/// include `--tension`), anything else from the scenario table.
+fn input_value(built: &Built, table: Option<&toml::Table>, path: &str) -> Option<f64> {
+    let segs = crate::scenario::parse_path(path).ok()?;
+    if let [crate::scenario::Seg::Key(t), crate::scenario::Seg::Index(k), crate::scenario::Seg::Key(f)] =
+        segs.as_slice()
+    {
+        if t == "tendons" && f == "tension" {
+            return built.u.get(*k).copied();
+        }
+    }
+    match crate::scenario::lookup(table?, &segs)? {
+        toml::Value::Float(v) => Some(*v),
+        toml::Value::Integer(v) => Some(*v as f64),
+        _ => None,
+    }
+}
+
+/// The encoding of the anchor nearest to the scenario's inputs (each input scaled by its range).
+fn nearest_anchor(
+    built: &Built,
+    table: Option<&toml::Table>,
+    model: &ReducedModel,
+) -> Option<DVector<f64>> {
+    let a = model.anchors.as_ref()?;
+    let names = &model.meta.anchor_parameters;
+    let k = names.len();
+    if a.n == 0 || k == 0 {
+        return None;
+    }
+    let x: Vec<f64> = names
+        .iter()
+        .map(|p| input_value(built, table, p))
+        .collect::<Option<_>>()?;
+    let mut scale = vec![0.0f64; k];
+    for row in a.inputs.chunks_exact(k) {
+        for (d, v) in row.iter().enumerate() {
+            scale[d] = scale[d].max(v.abs());
+        }
+    }
+    let best = a
+        .inputs
+        .chunks_exact(k)
+        .map(|row| {
+            row.iter()
+                .zip(&x)
+                .zip(&scale)
+                .map(|((v, w), s)| ((v - w) / s.max(1e-300)).powi(2))
+                .sum::<f64>()
+        })
+        .enumerate()
+        .min_by(|a, b| a.1.total_cmp(&b.1))?
+        .0;
+    let r = model.meta.latent;
+    Some(DVector::from_column_slice(
+        &a.latent[best * r..(best + 1) * r],
+    ))
+}
+
+fn invalid(field: &str, message: impl Into<String>) -> ScenarioError {
+    ScenarioError::invalid(field, message)
+}
+
+/// The HOM a dataset was generated on (its scenario TOML, as stored).
+pub fn dataset_scenario(ds: &Dataset) -> Result<Built, ScenarioError> {
+    let s = Scenario::from_toml(&ds.meta.scenario, &ds.meta.scenario_toml, &[])?;
+    build(&s)
+}
+
+/// The point layout of `built` in `rom`'s terms, and `Φ̄` and `P` of its basis.
+fn projection_of(
+    built: &Built,
+) -> Result<(PointLayout, DMatrix<f64>, DMatrix<f64>), ScenarioError> {
+    let l = Layout::of(built);
+    let layout = PointLayout {
+        n_points: l.strain_x.len(),
+        active: l.active,
+    };
+    let pm = point_matrix(&built.model.param, &layout);
+    let p = projection(&pm).map_err(|e| invalid("basis", e.to_string()))?;
+    Ok((layout, pm, p))
+}
+
+fn component_names(active: &[usize]) -> Vec<String> {
+    active
+        .iter()
+        .map(|&a| StrainMode::ALL[a].name().to_string())
+        .collect()
+}
+
+/// The usable rows of a dataset (status ok), row-major, and their count; an error if none.
+fn snapshot_rows(ds: &Dataset, option: &str) -> Result<(Vec<f64>, usize), ScenarioError> {
+    let rows = ds.ok_rows();
+    if rows.is_empty() {
+        return Err(invalid(
+            option,
+            "the dataset has no solved samples (every status is failed or not computed)",
+        ));
+    }
+    let mut x = Vec::with_capacity(rows.len() * ds.row_len());
+    for &k in &rows {
+        x.extend_from_slice(ds.strain_row(k));
+    }
+    Ok((x, rows.len()))
+}
+
+fn model_layout(ds: &Dataset, built: &Built) -> ModelLayout {
+    ModelLayout {
+        scenario: ds.meta.scenario.clone(),
+        scenario_toml: ds.meta.scenario_toml.clone(),
+        strain_x: ds.meta.strain_x.clone(),
+        active: ds.meta.components.clone(),
+        hom_dof: built.model.n_dof(),
+    }
+}
+
+fn dataset_ref(dir: &Path, rows: usize) -> Result<DatasetRef, ScenarioError> {
+    let bytes = std::fs::read(dir.join("strain.npy"))
+        .map_err(|e| invalid("DATASET", format!("cannot read strain.npy: {e}")))?;
+    Ok(DatasetRef {
+        path: dir.display().to_string(),
+        strain_hash: fnv1a64(&bytes),
+        rows,
+    })
+}
+
+/// What `gvsrom pod` reports.
+pub struct PodSummary {
+    pub path: PathBuf,
+    pub rows: usize,
+    pub features: usize,
+    pub modes: usize,
+    pub captured_energy: f64,
+    pub singular_values: Vec<f64>,
+    pub numerical_rank: usize,
+}
+
+/// POD of a dataset's strain snapshots, `modes` modes, saved as a model at `out`.
+pub fn pod(
+    dataset: &Path,
+    modes: usize,
+    out: &Path,
+    force: bool,
+) -> Result<PodSummary, anyhow::Error> {
+    let ds = Dataset::load(dataset)?;
+    let built = dataset_scenario(&ds)?;
+    projection_of(&built)?; // the HOM basis must be recoverable from point strains
+    let (x, rows) = snapshot_rows(&ds, "DATASET")?;
+    let features = ds.row_len();
+    let dir = OutputDir::create("--out", out, crate::reduced_model::MODEL_FORMAT, force)?;
+    let pod = Pod::compute(&x, features, modes).map_err(|e| invalid("--modes", e.to_string()))?;
+    let energy = pod.captured_energy();
+    let meta = ModelMeta {
+        kind: "pod".into(),
+        latent: modes,
+        layout: model_layout(&ds, &built),
+        dataset: dataset_ref(dataset, rows)?,
+        rest: vec![0.0; modes],
+        latent_range: vec![],
+        anchor_parameters: vec![],
+        captured_energy: Some(energy[modes - 1]),
+        training: None,
+        projection_residual: 0.0,
+        crate_version: env!("CARGO_PKG_VERSION").into(),
+    };
+    let model = ReducedModel {
+        meta,
+        weights: ModelWeights::Pod {
+            modes: pod.modes.clone(),
+            singular_values: pod.singular_values.clone(),
+        },
+        anchors: None,
+    };
+    let path = model.save(
+        dir,
+        &[
+            ("singular_values", &pod.singular_values),
+            ("captured_energy", &energy),
+        ],
+    )?;
+    Ok(PodSummary {
+        path,
+        rows,
+        features,
+        modes,
+        captured_energy: energy[modes - 1],
+        numerical_rank: pod.rank(1e-12),
+        singular_values: pod.singular_values,
+    })
+}
+
+/// What `gvsrom train` reports.
+pub struct TrainSummary {
+    pub path: PathBuf,
+    pub rows: usize,
+    pub features: usize,
+    pub report: TrainReport,
+    pub encoder_sizes: Vec<usize>,
+    pub rest: Vec<f64>,
+    pub rest_residual: f64,
+    pub projection_residual: f64,
+}
+
+/// Trains an autoencoder on a dataset's snapshots and saves it at `out`. `progress(epoch, train,
+/// validation)` is called after every epoch; `Break` stops training early (the best weights so far
+/// are kept and saved, marked by the stop reason).
+pub fn train(
+    dataset: &Path,
+    options: &TrainOptions,
+    out: &Path,
+    force: bool,
+    progress: &mut dyn FnMut(usize, f64, Option<f64>) -> ControlFlow<()>,
+) -> Result<TrainSummary, anyhow::Error> {
+    let ds = Dataset::load(dataset)?;
+    let built = dataset_scenario(&ds)?;
+    let (_, pm, p) = projection_of(&built)?;
+    let (x, rows) = snapshot_rows(&ds, "DATASET")?;
+    let features = ds.row_len();
+    let dir = OutputDir::create("--out", out, crate::reduced_model::MODEL_FORMAT, force)?;
+    let (ae, report) = Autoencoder::train(&x, features, options, progress)
+        .map_err(|e| invalid("train", e.to_string()))?;
+    // what the HOM basis cannot represent of the reconstructions
+    let mut worst = 0.0f64;
+    for row in x.chunks_exact(features) {
+        let rec = ae
+            .reconstruct(row)
+            .map_err(|e| invalid("train", e.to_string()))?;
+        worst = worst.max(projection_residual(&pm, &p, &DVector::from_vec(rec)));
+    }
+    // encodings of the usable samples: their range, the anchors, and the rest point (the sample
+    // closest to the straight rod)
+    let r = options.latent;
+    let ok = ds.ok_rows();
+    let k_in = ds.meta.parameters.len();
+    let mut latent = Vec::with_capacity(rows * r);
+    let mut inputs = Vec::with_capacity(rows * k_in);
+    let mut range = vec![[f64::INFINITY, f64::NEG_INFINITY]; r];
+    let (mut rest, mut rest_norm) = (vec![0.0; r], f64::INFINITY);
+    for (i, row) in x.chunks_exact(features).enumerate() {
+        let z = ae
+            .encode(row)
+            .map_err(|e| invalid("train", e.to_string()))?;
+        for (d, v) in z.iter().enumerate() {
+            range[d][0] = range[d][0].min(*v);
+            range[d][1] = range[d][1].max(*v);
+        }
+        let norm = row.iter().map(|v| v * v).sum::<f64>();
+        if norm < rest_norm {
+            rest_norm = norm;
+            rest = z.clone();
+        }
+        latent.extend_from_slice(&z);
+        let sample = ok[i];
+        inputs.extend_from_slice(&ds.inputs[sample * k_in..(sample + 1) * k_in]);
+    }
+    let rest = DVector::from_vec(rest);
+    let rest_residual = rest_norm.sqrt();
+    let meta = ModelMeta {
+        kind: "autoencoder".into(),
+        latent: options.latent,
+        layout: model_layout(&ds, &built),
+        dataset: dataset_ref(dataset, rows)?,
+        rest: rest.iter().copied().collect(),
+        latent_range: range,
+        anchor_parameters: ds.meta.parameters.clone(),
+        captured_energy: None,
+        training: Some(TrainingMeta {
+            hidden_layers: options.hidden_layers,
+            encoder_sizes: ae.encoder().layer_sizes().to_vec(),
+            decoder_sizes: ae.decoder().layer_sizes().to_vec(),
+            lambda: options.lambda,
+            epochs: options.epochs,
+            batch_size: options.batch_size,
+            learning_rate: options.learning_rate,
+            validation_fraction: options.validation_fraction,
+            patience: options.patience,
+            seed: options.seed,
+            epochs_run: report.epochs_run,
+            best_epoch: report.best_epoch,
+            stop: format!("{:?}", report.stop),
+            final_train_loss: report.final_train_loss,
+            final_val_loss: report.final_val_loss,
+            final_train_rmse: report.final_train_rmse,
+            final_val_rmse: report.final_val_rmse,
+            wall_time_s: report.wall_time.as_secs_f64(),
+        }),
+        projection_residual: worst,
+        crate_version: env!("CARGO_PKG_VERSION").into(),
+    };
+    let encoder_sizes = ae.encoder().layer_sizes().to_vec();
+    let model = ReducedModel {
+        meta,
+        weights: ModelWeights::Autoencoder(ae),
+        anchors: Some(crate::reduced_model::Anchors {
+            n: rows,
+            inputs,
+            latent,
+        }),
+    };
+    let path = model.save(
+        dir,
+        &[
+            ("train_loss", &report.train_loss),
+            ("val_loss", &report.val_loss),
+        ],
+    )?;
+    Ok(TrainSummary {
+        path,
+        rows,
+        features,
+        report,
+        encoder_sizes,
+        rest: rest.iter().copied().collect(),
+        rest_residual,
+        projection_residual: worst,
+    })
+}
+
+/// Checks that `model` was learned on the layout of `built` (points, active components, HOM size).
+fn check_layout(built: &Built, model: &ReducedModel, path: &Path) -> Result<(), ScenarioError> {
+    let l = Layout::of(built);
+    let ml = &model.meta.layout;
+    let names = component_names(&l.active);
+    let length = built.model.disc.length();
+    let same_points = ml.strain_x.len() == l.strain_x.len()
+        && ml
+            .strain_x
+            .iter()
+            .zip(&l.strain_x)
+            .all(|(a, b)| (a - b).abs() <= 1e-12 * length.max(1.0));
+    if !same_points || ml.active != names || ml.hom_dof != built.model.n_dof() {
+        return Err(invalid(
+            "--model",
+            format!(
+                "`{}` was learned on {} points × [{}] with a {}-DOF basis (scenario `{}`); this scenario has {} points × [{}] with {} DOF{}",
+                path.display(),
+                ml.strain_x.len(),
+                ml.active.join(", "),
+                ml.hom_dof,
+                ml.scenario,
+                l.strain_x.len(),
+                names.join(", "),
+                built.model.n_dof(),
+                if ml.strain_x.len() == l.strain_x.len() && !same_points {
+                    " (the points are at other abscissae)"
+                } else {
+                    ""
+                }
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The reduced parameterization of `model` on the sites of `built`.
+pub fn parameterization(
+    built: &Built,
+    model: &ReducedModel,
+) -> Result<Box<dyn StrainParam>, ScenarioError> {
+    let (_, _, p) = projection_of(built)?;
+    let basis: &LinearBasis = &built.model.param;
+    Ok(match &model.weights {
+        ModelWeights::Pod { modes, .. } => {
+            let b = &p * modes;
+            Box::new(basis.compose(&b)?)
+        }
+        ModelWeights::Autoencoder(ae) => {
+            let map = ae
+                .decoder_map(p.as_slice(), p.nrows())
+                .map_err(|e| invalid("--model", e.to_string()))?;
+            let rest = DVector::from_vec(model.meta.rest.clone());
+            Box::new(
+                ReducedParam::new(basis, map, rest)
+                    .map_err(|e| invalid("--model", e.to_string()))?,
+            )
+        }
+    })
+}
+
+/// `--model DIR`: loads the model, checks it against the scenario and attaches it to `built`.
+/// `table` (the scenario's TOML after `--set`) supplies the values of non-tension dataset inputs
+/// for the initial guess.
+pub fn attach(
+    built: &mut Built,
+    table: Option<&toml::Table>,
+    dir: &Path,
+) -> Result<(), anyhow::Error> {
+    let model = ReducedModel::load(dir)?;
+    check_layout(built, &model, dir)?;
+    let param = parameterization(built, &model)?;
+    let m = &built.model;
+    let reduced = Model::new(m.rod.clone(), m.disc.clone(), param, m.tendons.clone())
+        .map_err(ScenarioError::from)?
+        .with_base(m.base);
+    let initial = nearest_anchor(built, table, &model);
+    built.reduced = Some(Reduced {
+        model: reduced,
+        kind: model.meta.kind.clone(),
+        path: dir.to_path_buf(),
+        initial,
+        latent_range: model.meta.latent_range.clone(),
+    });
+    Ok(())
+}
