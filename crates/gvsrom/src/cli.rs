@@ -102,6 +102,10 @@ pub struct StaticsArgs {
     /// strain), the tip error (% of the length) and both solve times.
     #[arg(long, requires = "model")]
     pub compare: bool,
+
+    /// Solve N times and report the mean solve time (warm caches; for timing comparisons).
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub repeat: u32,
 }
 
 #[derive(Debug, Args)]
@@ -328,14 +332,14 @@ fn statics_cmd(args: &StaticsArgs, out: &mut impl Write) -> Result<()> {
         None => None,
     };
     print_model(&scenario, &built, out)?;
-    let report = statics::solve(&built)?;
+    let report = statics::solve_repeated(&built, args.repeat)?;
     print_solution(&report, out)?;
     if let Some(r) = &built.reduced {
         r.check_range(&report.q)?;
     }
     let comparison = if args.compare {
         let reduced = built.reduced.take();
-        let hom = statics::solve(&built)?;
+        let hom = statics::solve_repeated(&built, args.repeat)?;
         built.reduced = reduced;
         let c = statics::compare(&built, &hom, &report);
         writeln!(

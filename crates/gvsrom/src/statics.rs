@@ -67,6 +67,17 @@ pub fn solve(built: &Built) -> Result<StaticsReport, StaticsFailure> {
     }
 }
 
+/// [`solve`] `repeat` times (≥ 1); the report's `solve_time_s` is the mean over the repetitions.
+pub fn solve_repeated(built: &Built, repeat: u32) -> Result<StaticsReport, StaticsFailure> {
+    let mut report = solve(built)?;
+    let mut total = report.solve_time_s;
+    for _ in 1..repeat {
+        total += solve(built)?.solve_time_s;
+    }
+    report.solve_time_s = total / repeat.max(1) as f64;
+    Ok(report)
+}
+
 /// [`solve`] on `model`: the scenario's own or a reduced one with the same rod, points and tendons.
 ///
 /// With an initial guess `q0` (a reduced model's nearest training sample), the full load is first
