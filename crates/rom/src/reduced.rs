@@ -260,6 +260,42 @@ impl<M: CoefficientMap> ReducedParam<M> {
     }
 }
 
+/// At site `s`: returns `Φ_s c[cols]` (zero if `c` is empty) and writes `Φ_s D[cols, :]` (6 × r,
+/// column-major) into `out`, for `D` given column-major `m × r`. One pass over `Φ_s`.
+#[inline]
+fn site_products<M: CoefficientMap>(
+    p: &ReducedParam<M>,
+    s: usize,
+    c: &[f64],
+    d: &[f64],
+    out: &mut [f64],
+) -> V6 {
+    let (m, r) = (p.m, p.r);
+    let cols = &p.cols[s];
+    let phi = &p.phi.as_slice()[6 * p.offsets[s]..6 * (p.offsets[s] + cols.len())];
+    out.fill(0.0);
+    let mut acc = [0.0f64; 6];
+    for (j, col) in cols.clone().enumerate() {
+        let ph = &phi[6 * j..6 * j + 6];
+        if !c.is_empty() {
+            let cj = c[col];
+            for a in 0..6 {
+                acc[a] += ph[a] * cj;
+            }
+        }
+        for k in 0..r {
+            let w = d[k * m + col];
+            if w != 0.0 {
+                let o = &mut out[6 * k..6 * k + 6];
+                for a in 0..6 {
+                    o[a] += ph[a] * w;
+                }
+            }
+        }
+    }
+    V6::from_column_slice(&acc)
+}
+
 impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
     fn n_dof(&self) -> usize {
         self.r
@@ -290,20 +326,11 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
             self.map.eval(q.as_slice(), c, cz, &mut map_scratch[..]);
         }
         let sc = &ev.scratch;
-        for (s, cols) in self.cols.iter().enumerate() {
-            let phi = self.phi.columns(self.offsets[s], cols.len());
-            let mut psi = V6::zeros();
-            for (j, col) in cols.clone().enumerate() {
-                psi += phi.column(j) * sc[l.c + col];
-            }
-            ev.psi[s] = psi;
-            for k in 0..r {
-                let mut v = V6::zeros();
-                for (j, col) in cols.clone().enumerate() {
-                    v += phi.column(j) * sc[l.cz + k * m + col];
-                }
-                ev.psi_q.set_column(s * r + k, &v);
-            }
+        let c = &sc[l.c..l.c + m];
+        let cz = &sc[l.cz..l.cz + m * r];
+        let out = ev.psi_q.as_mut_slice();
+        for (s, psi) in ev.psi.iter_mut().enumerate() {
+            *psi = site_products(self, s, c, cz, &mut out[6 * s * r..6 * (s + 1) * r]);
         }
     }
 
@@ -318,15 +345,10 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
                 .eval_rate(q.as_slice(), qd.as_slice(), czd, &mut map_scratch[..]);
         }
         let sc = &ev.scratch;
-        for (s, cols) in self.cols.iter().enumerate() {
-            let phi = self.phi.columns(self.offsets[s], cols.len());
-            for k in 0..r {
-                let mut v = V6::zeros();
-                for (j, col) in cols.clone().enumerate() {
-                    v += phi.column(j) * sc[l.czd + k * m + col];
-                }
-                ev.psi_q_dot.set_column(s * r + k, &v);
-            }
+        let czd = &sc[l.czd..l.czd + m * r];
+        let out = ev.psi_q_dot.as_mut_slice();
+        for s in 0..self.cols.len() {
+            site_products(self, s, &[], czd, &mut out[6 * s * r..6 * (s + 1) * r]);
         }
     }
 
