@@ -1,0 +1,599 @@
+//! A trained autoencoder decoder as the engine's strain parameterization keeps every engine identity
+//! (gvs-spec §10.2, §10.5; the checks of `gvs/tests/jacobians.rs` and `dynamics_structure.rs`, run on
+//! `ReducedParam<DecoderMap>` instead of a linear or sigmoid basis).
+//!
+//! Fixture (built once, shared by the tests): the single-tendon-like rod (tapered 0.25 m, radius
+//! 12.5 → 5 mm, E = 0.617 MPa, ρ = 1121 kg/m³; Legendre bend-y 4, elongation 3, shear-z 3; 10 Gauss
+//! points, Z4), gravity −z and one tendon with friction. The HOM statics is solved for 60 tensions in
+//! [−6, 3] N; the point strains `ξ − ξ*` of the active components (eq. 13 layout) train tanh
+//! autoencoders with r = 1 and r = 2 (3 hidden layers); each decoder is folded with the least-squares
+//! projection `P` onto the HOM coefficients and bound to the basis by `ReducedParam`.
+
+use gvs::actuation::Tendon;
+use gvs::discretize::{Discretization, MagnusOrder, Quadrature};
+use gvs::inputs::Signal;
+use gvs::loads::Loads;
+use gvs::model::Model;
+use gvs::rod::{Material, Rod};
+use gvs::solve::dynamics::{simulate, InitialState, IntegratorOptions, Method, OdeJacobian};
+use gvs::solve::ode::NdfOptions;
+use gvs::solve::statics::{StaticsOptions, StaticsSolver};
+use gvs::strain::testing::derivative_errors;
+use gvs::strain::{DivisionBasis, LinearBasis, StrainParam};
+use nalgebra::{DMatrix, DVector, SymmetricEigen};
+use rom::map::CoefficientMap;
+use rom::metrics::strain_error_percent;
+use rom::nn::{Autoencoder, DecoderMap, FineTune, TrainOptions};
+use rom::reduced::{point_matrix, projection, projection_residual, PointLayout, ReducedParam};
+use std::sync::OnceLock;
+use std::time::Instant;
+
+type AeModel = Model<ReducedParam<DecoderMap>>;
+
+const N_SAMPLES: usize = 60;
+const U_MIN: f64 = -6.0;
+const U_MAX: f64 = 3.0;
+const GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
+const FRICTION: f64 = 0.5;
+
+fn material(damping: f64) -> Material {
+    Material {
+        youngs_modulus: 0.617e6,
+        poisson_ratio: 0.5,
+        density: 1121.0,
+        damping,
+    }
+}
+
+fn gravity() -> Loads {
+    Loads {
+        gravity: GRAVITY,
+        ..Loads::default()
+    }
+}
+
+/// The high-order model: planar bending in x–z (modes bend-y, elongation, shear-z), one tendon.
+fn hom(damping: f64) -> Model<LinearBasis> {
+    let rod = Rod::tapered(material(damping), 0.25, 0.0125, 0.005);
+    let disc =
+        Discretization::new(&rod, &[Quadrature::Gauss { n: 10 }], MagnusOrder::Z4, &[]).unwrap();
+    let basis = LinearBasis::per_division(
+        &disc,
+        &[DivisionBasis::Legendre {
+            modes: [false, true, false, true, false, true],
+            orders: [0, 4, 0, 3, 0, 3],
+        }],
+    )
+    .unwrap();
+    let tendon = Tendon {
+        offset_start: [0.0, 0.01],
+        offset_end: [0.0, 0.003],
+        x_start: 0.0,
+        x_end: 0.25,
+        friction: FRICTION,
+    };
+    Model::new(rod, disc, basis, vec![tendon]).unwrap()
+}
+
+fn tension(k: usize) -> f64 {
+    U_MIN + (U_MAX - U_MIN) * k as f64 / (N_SAMPLES - 1) as f64
+}
+
+/// The point strains `ξ_i − ξ*` of the active components at `q` (eq. 13 layout, point-major).
+fn snapshot<P: StrainParam>(m: &Model<P>, layout: &PointLayout, q: &DVector<f64>) -> Vec<f64> {
+    let mut ws = m.workspace();
+    m.forward(q, &mut ws, false);
+    let xi = m.point_strains(&ws);
+    let mut out = Vec::with_capacity(layout.len());
+    for (i, x) in xi.iter().enumerate() {
+        let d = x - m.xi_star(i);
+        out.extend(layout.active.iter().map(|&a| d[a]));
+    }
+    out
+}
+
+/// HOM statics at `u` (gravity on) from `q0`.
+fn hom_statics(m: &Model<LinearBasis>, u: f64, q0: Option<&DVector<f64>>) -> DVector<f64> {
+    let mut solver = StaticsSolver::new(m, StaticsOptions::default());
+    solver
+        .solve(&[u], &gravity(), q0)
+        .unwrap_or_else(|e| panic!("HOM statics at u = {u}: {e}"))
+        .q
+}
+
+struct Trained {
+    ae: Autoencoder,
+    /// Encodings of the snapshots, row-major (N × r).
+    latent: Vec<f64>,
+    /// Per latent coordinate, `[min, max]` of the encodings.
+    range: Vec<[f64; 2]>,
+    rest: DVector<f64>,
+}
+
+struct Fixture {
+    layout: PointLayout,
+    pm: DMatrix<f64>,
+    p: DMatrix<f64>,
+    /// Snapshots, row-major (N × p·n_a), sample k at tension `tension(k)`.
+    snapshots: Vec<f64>,
+    /// Trained for r = 1 and r = 2.
+    trained: [Trained; 2],
+}
+
+impl Fixture {
+    fn nf(&self) -> usize {
+        self.layout.len()
+    }
+
+    fn row(&self, k: usize) -> &[f64] {
+        &self.snapshots[k * self.nf()..(k + 1) * self.nf()]
+    }
+
+    fn trained(&self, r: usize) -> &Trained {
+        &self.trained[r - 1]
+    }
+
+    /// The encoding of training sample `k` for latent size `r`.
+    fn z(&self, r: usize, k: usize) -> DVector<f64> {
+        DVector::from_column_slice(&self.trained(r).latent[k * r..(k + 1) * r])
+    }
+
+    /// The ROM: the HOM's rod, discretization and tendon with the AE parameterization.
+    fn rom(&self, r: usize, damping: f64) -> AeModel {
+        let h = hom(damping);
+        let t = self.trained(r);
+        let map = t.ae.decoder_map(self.p.as_slice(), self.p.nrows()).unwrap();
+        let param = ReducedParam::new(&h.param, map, t.rest.clone()).unwrap();
+        Model::new(h.rod, h.disc, param, h.tendons).unwrap()
+    }
+}
+
+fn train(x: &[f64], nf: usize, latent: usize) -> Trained {
+    let opts = TrainOptions {
+        latent,
+        hidden_layers: 3,
+        lambda: 1e-6,
+        epochs: 400,
+        batch_size: 16,
+        learning_rate: 3e-3,
+        validation_fraction: 0.0,
+        patience: None,
+        fine_tune: FineTune::Lbfgs {
+            iterations: 400,
+            memory: 10,
+        },
+        seed: 7 + latent as u64,
+    };
+    let (ae, report) = Autoencoder::train(x, nf, &opts, &mut |_, _, _| {
+        std::ops::ControlFlow::Continue(())
+    })
+    .unwrap();
+    eprintln!(
+        "AE r = {latent}: train RMSE {:.3e} (strain units), {} epochs, {:?}",
+        report.final_train_rmse, report.epochs_run, report.wall_time
+    );
+    let latent_rows = ae.encode(x).unwrap();
+    let mut range = vec![[f64::INFINITY, f64::NEG_INFINITY]; latent];
+    for z in latent_rows.chunks_exact(latent) {
+        for (d, v) in z.iter().enumerate() {
+            range[d][0] = range[d][0].min(*v);
+            range[d][1] = range[d][1].max(*v);
+        }
+    }
+    // the rest guess: the encoding of the snapshot closest to the straight rod, refined
+    let nearest = x
+        .chunks_exact(nf)
+        .enumerate()
+        .map(|(k, row)| (k, row.iter().map(|v| v * v).sum::<f64>()))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .unwrap()
+        .0;
+    let z0 = DVector::from_column_slice(&latent_rows[nearest * latent..(nearest + 1) * latent]);
+    Trained {
+        ae,
+        latent: latent_rows,
+        range,
+        rest: z0,
+    }
+}
+
+fn fixture() -> &'static Fixture {
+    static FX: OnceLock<Fixture> = OnceLock::new();
+    FX.get_or_init(|| {
+        let start = Instant::now();
+        let m = hom(1e4);
+        let layout = PointLayout::active_in(&m.param, &m.disc);
+        assert_eq!(layout.active, vec![1, 3, 5]);
+        let pm = point_matrix(&m.param, &layout);
+        let p = projection(&pm).unwrap();
+        // sweep from the sample nearest u = 0 outwards, warm-starting each solve
+        let k0 = (0..N_SAMPLES)
+            .min_by(|&a, &b| tension(a).abs().total_cmp(&tension(b).abs()))
+            .unwrap();
+        let mut qs: Vec<Option<DVector<f64>>> = vec![None; N_SAMPLES];
+        qs[k0] = Some(hom_statics(&m, tension(k0), None));
+        for k in (0..k0).rev() {
+            qs[k] = Some(hom_statics(&m, tension(k), qs[k + 1].as_ref()));
+        }
+        for k in k0 + 1..N_SAMPLES {
+            qs[k] = Some(hom_statics(&m, tension(k), qs[k - 1].as_ref()));
+        }
+        let mut snapshots = Vec::with_capacity(N_SAMPLES * layout.len());
+        for q in qs.iter().flatten() {
+            let x = snapshot(&m, &layout, q);
+            // HOM snapshots lie in the HOM's span: P recovers q
+            let back = &p * DVector::from_column_slice(&x);
+            assert!((&back - q).amax() < 1e-8 * (1.0 + q.amax()));
+            snapshots.extend(x);
+        }
+        let hom_time = start.elapsed();
+        let nf = layout.len();
+        let t1 = train(&snapshots, nf, 1);
+        let t2 = train(&snapshots, nf, 2);
+        eprintln!(
+            "fixture: {N_SAMPLES} HOM statics in {hom_time:?}, total with training {:?}",
+            start.elapsed()
+        );
+        let mut fx = Fixture {
+            layout,
+            pm,
+            p,
+            snapshots,
+            trained: [t1, t2],
+        };
+        // refine the rest coordinates (c(z) ≈ 0) from the nearest encoding
+        for r in [1, 2] {
+            let t = &fx.trained[r - 1];
+            let map = t.ae.decoder_map(fx.p.as_slice(), fx.p.nrows()).unwrap();
+            let (z, norm) = ReducedParam::find_rest(&map, &t.rest);
+            eprintln!("r = {r}: rest z = {:?}, ‖c(z)‖ = {norm:.3e}", z.as_slice());
+            fx.trained[r - 1].rest = z;
+        }
+        fx
+    })
+}
+
+/// Latent points inside the training range: the encodings of a few training samples.
+fn latent_points(fx: &Fixture, r: usize) -> Vec<DVector<f64>> {
+    [8, 25, 41, 55].iter().map(|&k| fx.z(r, k)).collect()
+}
+
+/// A latent velocity of the size of the training range (per coordinate) over about 0.1 s.
+fn latent_velocity(fx: &Fixture, r: usize, seed: usize) -> DVector<f64> {
+    let range = &fx.trained(r).range;
+    DVector::from_fn(r, |i, _| {
+        let w = range[i][1] - range[i][0];
+        let sign = if (i + seed).is_multiple_of(2) {
+            1.0
+        } else {
+            -0.7
+        };
+        sign * 10.0 * w
+    })
+}
+
+#[test]
+fn trained_decoders_reconstruct_the_hom_snapshots_within_the_hom_span() {
+    let fx = fixture();
+    for r in [1, 2] {
+        let ae = &fx.trained(r).ae;
+        // the folded map is c(z) = P D(z) (A passed column-major, m × n)
+        let map = ae.decoder_map(fx.p.as_slice(), fx.p.nrows()).unwrap();
+        let m = map.n_out();
+        let mut scratch = vec![0.0; map.scratch_len()];
+        let (mut c, mut cz) = (vec![0.0; m], vec![0.0; m * r]);
+        let mut fold_err = 0.0f64;
+        for k in [0, 20, 40, 59] {
+            let z = fx.z(r, k);
+            map.eval(z.as_slice(), &mut c, &mut cz, &mut scratch);
+            let expected = &fx.p * DVector::from_vec(ae.decode(z.as_slice()).unwrap());
+            fold_err =
+                fold_err.max((DVector::from_vec(c.clone()) - &expected).amax() / expected.amax());
+        }
+        eprintln!("r = {r}: folded decoder map vs P·D(z): {fold_err:.3e}");
+        assert!(fold_err < 1e-12, "r = {r}: c(z) vs P D(z) {fold_err:e}");
+        let (mut worst_err, mut worst_proj) = (0.0f64, 0.0f64);
+        for k in 0..N_SAMPLES {
+            let x = fx.row(k);
+            let rec = ae.reconstruct(x).unwrap();
+            worst_err = worst_err.max(strain_error_percent(x, &rec));
+            worst_proj =
+                worst_proj.max(projection_residual(&fx.pm, &fx.p, &DVector::from_vec(rec)));
+        }
+        eprintln!(
+            "r = {r}: worst reconstruction strain error {worst_err:.3} %, worst projection residual {worst_proj:.3e}"
+        );
+        assert!(
+            worst_err < 1.0,
+            "r = {r}: reconstruction error {worst_err} %"
+        );
+    }
+}
+
+#[test]
+fn decoder_param_derivatives_match_central_differences() {
+    // value/Jacobian Ψ_q, the eq. (17) term Ψ̇_q and the weighted Hessian, at latent points inside the
+    // training range
+    let fx = fixture();
+    for r in [1, 2] {
+        let m = fx.rom(r, 0.0);
+        for (k, z) in latent_points(fx, r).iter().enumerate() {
+            let zd = latent_velocity(fx, r, k);
+            let e = derivative_errors(&m.param, z, &zd, 1e-6);
+            eprintln!("r = {r}, z = {:?}: {e:?}", z.as_slice());
+            assert!(e.max() <= 1e-6, "r = {r}, z = {z}: {e:?}");
+        }
+    }
+}
+
+#[test]
+fn geometric_jacobian_matches_finite_differences_with_ae_param() {
+    let fx = fixture();
+    for r in [1, 2] {
+        let m = fx.rom(r, 0.0);
+        let n = m.n_dof();
+        for q in latent_points(fx, r) {
+            let mut ws = m.workspace();
+            m.forward(&q, &mut ws, true);
+            let (mut wp, mut wm) = (m.workspace(), m.workspace());
+            let h = 1e-6;
+            let mut worst: f64 = 0.0;
+            for j in 0..n {
+                let mut qp = q.clone();
+                qp[j] += h;
+                let mut qm = q.clone();
+                qm[j] -= h;
+                m.forward(&qp, &mut wp, false);
+                m.forward(&qm, &mut wm, false);
+                for i in 0..m.disc.n_points() {
+                    let d = (wp.g[i].to_homogeneous() - wm.g[i].to_homogeneous()) / (2.0 * h);
+                    let g = ws.g[i].inverse().to_homogeneous() * d;
+                    let fd = [
+                        g[(2, 1)],
+                        g[(0, 2)],
+                        g[(1, 0)],
+                        g[(0, 3)],
+                        g[(1, 3)],
+                        g[(2, 3)],
+                    ];
+                    let an = ws.jac.column(i * n + j);
+                    for a in 0..6 {
+                        worst = worst.max((fd[a] - an[a]).abs() / (1.0 + an[a].abs()));
+                    }
+                }
+            }
+            eprintln!("r = {r}: J vs central differences, worst relative error {worst:.3e}");
+            assert!(worst < 1e-7, "r = {r}: J vs FD {worst:e}");
+        }
+    }
+}
+
+#[test]
+fn statics_jacobian_matches_finite_differences_with_gravity_and_tendon_friction() {
+    let fx = fixture();
+    for r in [1, 2] {
+        let m = fx.rom(r, 1e4);
+        let n = m.n_dof();
+        let pl = m.prepare_loads(&gravity()).unwrap();
+        let mut ws = m.workspace();
+        // off equilibrium: the shape of one tension under another
+        for (k, u) in [(8, -1.5), (30, -4.2), (50, 0.8)] {
+            let q = fx.z(r, k);
+            let mut an = DMatrix::zeros(n, n);
+            m.statics_jacobian(&q, &[u], &pl, &mut ws, &mut an);
+            let mut fd = DMatrix::zeros(n, n);
+            let (mut rp, mut rm) = (DVector::zeros(n), DVector::zeros(n));
+            for j in 0..n {
+                let h = 1e-6 * (1.0 + q[j].abs());
+                let mut qp = q.clone();
+                qp[j] += h;
+                let mut qm = q.clone();
+                qm[j] -= h;
+                m.statics_residual(&qp, &[u], &pl, &mut ws, &mut rp);
+                m.statics_residual(&qm, &[u], &pl, &mut ws, &mut rm);
+                fd.set_column(j, &((&rp - &rm) / (2.0 * h)));
+            }
+            let err = (&an - &fd).norm() / fd.norm();
+            eprintln!("r = {r}, u = {u}: statics Jacobian vs central differences {err:.3e}");
+            assert!(err < 1e-6, "r = {r}, u = {u}: ∂R/∂q vs FD {err:e}");
+        }
+    }
+}
+
+#[test]
+fn mass_matrix_is_spd_and_mdot_minus_2c_is_skew_with_ae_param() {
+    let fx = fixture();
+    for r in [1, 2] {
+        let m = fx.rom(r, 0.0);
+        let mut ws = m.workspace();
+        for (k, q) in latent_points(fx, r).iter().enumerate() {
+            let qd = latent_velocity(fx, r, k);
+            let mass = m.mass_matrix(q, &mut ws);
+            let asym = (&mass - mass.transpose()).amax() / mass.amax();
+            let eig = SymmetricEigen::new(mass.clone()).eigenvalues;
+            let e = 1e-6;
+            let mp = m.mass_matrix(&(q + &qd * e), &mut ws);
+            let mm = m.mass_matrix(&(q - &qd * e), &mut ws);
+            let mdot = (mp - mm) / (2.0 * e);
+            let c = m.coriolis_matrix(q, &qd, &mut ws);
+            let nmat = &mdot - &c * 2.0;
+            let sym = (&nmat + nmat.transpose()).amax() / mdot.amax().max(c.amax());
+            eprintln!(
+                "r = {r}, z = {:?}: M asymmetry {asym:.1e}, λ_min(M) = {:.3e}, ‖Ṁ − 2C + (Ṁ − 2C)ᵀ‖/‖·‖ = {sym:.3e}",
+                q.as_slice(),
+                eig.min()
+            );
+            assert!(asym < 1e-14, "r = {r}: M asymmetry {asym:e}");
+            assert!(eig.min() > 0.0, "r = {r}: M not positive definite: {eig}");
+            assert!(sym < 1e-7, "r = {r}: Ṁ − 2C not skew-symmetric: {sym:e}");
+        }
+    }
+}
+
+#[test]
+fn coriolis_matrix_agrees_with_force_path_with_ae_param() {
+    // without damping: τ(q, q̇) − τ(q, 0) = −C(q, q̇) q̇
+    let fx = fixture();
+    for r in [1, 2] {
+        let m = fx.rom(r, 0.0);
+        let n = m.n_dof();
+        let loads = m.prepare_loads(&gravity()).unwrap();
+        let mut ws = m.workspace();
+        for (k, q) in latent_points(fx, r).iter().enumerate() {
+            let qd = latent_velocity(fx, r, k);
+            let (mut t1, mut t0) = (DVector::zeros(n), DVector::zeros(n));
+            m.dynamic_forces(q, &qd, &[-1.0], &loads, &mut ws, &mut t1);
+            m.dynamic_forces(q, &DVector::zeros(n), &[-1.0], &loads, &mut ws, &mut t0);
+            let cqd = m.coriolis_matrix(q, &qd, &mut ws) * &qd;
+            let err = (&t0 - &t1 - &cqd).amax() / cqd.amax();
+            eprintln!("r = {r}: C q̇ force path vs matrix {err:.3e}");
+            assert!(err < 1e-10, "r = {r}: C q̇ vs force path {err:e}");
+        }
+    }
+}
+
+#[test]
+fn velocity_and_jdot_recursions_match_finite_differences_with_ae_param() {
+    // η_i = J_i q̇ and ζ_i = J̇_i q̇ with J̇ from central differences of J along q̇
+    let fx = fixture();
+    for r in [1, 2] {
+        let m = fx.rom(r, 0.0);
+        let n = m.n_dof();
+        for (k, q) in latent_points(fx, r).iter().enumerate() {
+            let qd = latent_velocity(fx, r, k);
+            let mut ws = m.workspace();
+            m.forward(q, &mut ws, true);
+            m.velocities(q, &qd, &mut ws);
+            let e = 1e-6;
+            let (mut wp, mut wm) = (m.workspace(), m.workspace());
+            m.forward(&(q + &qd * e), &mut wp, true);
+            m.forward(&(q - &qd * e), &mut wm, true);
+            let (mut worst_eta, mut worst_zeta): (f64, f64) = (0.0, 0.0);
+            for i in 0..m.disc.n_points() {
+                let ji = ws.jac.columns(i * n, n);
+                let eta_fd = ji * &qd;
+                worst_eta = worst_eta.max((eta_fd - ws.eta[i]).amax());
+                let jdot = (wp.jac.columns(i * n, n) - wm.jac.columns(i * n, n)) / (2.0 * e);
+                let zeta_fd = jdot * &qd;
+                let zeta = m.point_acceleration_bias(&ws, i);
+                worst_zeta = worst_zeta.max((zeta_fd - zeta).amax() / (1.0 + zeta.amax()));
+            }
+            eprintln!(
+                "r = {r}, z = {:?}: η error {worst_eta:.3e}, ζ = J̇q̇ relative error {worst_zeta:.3e}",
+                q.as_slice()
+            );
+            assert!(worst_eta < 1e-10, "r = {r}: η vs J q̇ {worst_eta:e}");
+            assert!(worst_zeta < 1e-7, "r = {r}: ζ vs FD {worst_zeta:e}");
+        }
+    }
+}
+
+#[test]
+fn energy_is_conserved_without_damping_and_actuation_with_ae_param() {
+    // released at rest from the shape of a pulled tendon, under gravity, no damping, tension 0:
+    // kinetic, elastic and gravitational energy are exchanged, the total stays constant. The release
+    // shape (u ≈ −1.3 N) is chosen so that the swing stays inside the training range: released from
+    // u ≈ −4.5 N the r = 1 ROM overshoots the encodings' range, the decoder's tanh units saturate,
+    // M(z) → 0 (z → −12 at t = 0.15 s, M = 8e-9) and the integrator stops with a step-size underflow.
+    let fx = fixture();
+    for r in [1, 2] {
+        let m = fx.rom(r, 0.0);
+        let n = m.n_dof();
+        let q0 = fx.z(r, 31);
+        let t: Vec<f64> = (0..=40).map(|k| 0.3 * k as f64 / 40.0).collect();
+        let options = IntegratorOptions {
+            method: Method::Ndf(NdfOptions {
+                rtol: 1e-9,
+                atol: 1e-12,
+                ..NdfOptions::default()
+            }),
+            jacobian: OdeJacobian::Structured,
+        };
+        let sim = simulate(
+            &m,
+            &Signal::constant(&[0.0]),
+            &gravity(),
+            None,
+            &InitialState::Given {
+                q: q0,
+                qd: DVector::zeros(n),
+            },
+            &t,
+            &options,
+        )
+        .unwrap();
+        assert!(sim.error.is_none(), "r = {r}: {:?}", sim.error);
+        let mut ws = m.workspace();
+        let e: Vec<_> = sim
+            .trajectory
+            .q
+            .iter()
+            .zip(&sim.trajectory.qd)
+            .map(|(q, qd)| m.energy(q, qd, &GRAVITY, &mut ws))
+            .collect();
+        let exchanged = e.iter().map(|x| x.kinetic).fold(0.0, f64::max);
+        let drift = e
+            .iter()
+            .map(|x| (x.total() - e[0].total()).abs())
+            .fold(0.0, f64::max);
+        eprintln!(
+            "r = {r}: max kinetic energy {exchanged:.3e} J, energy drift {drift:.3e} J ({:.2e} relative), {} steps, {:.2} s wall",
+            drift / exchanged,
+            sim.stats.steps,
+            sim.wall_time_s
+        );
+        // how far the swing leaves the encodings' box, in units of the box width
+        let range = &fx.trained(r).range;
+        let mut outside = 0.0f64;
+        for q in &sim.trajectory.q {
+            for (d, v) in q.iter().enumerate() {
+                let w = range[d][1] - range[d][0];
+                outside = outside.max((range[d][0] - v).max(v - range[d][1]) / w);
+            }
+        }
+        eprintln!("r = {r}: largest excursion beyond the training range {outside:.3} × its width");
+        if r == 1 {
+            // r = 1: the latent line is the data manifold; the swing stays on the trained part. (r = 2
+            // leaves the box along the direction the data do not constrain, where M is small and the
+            // motion fast, and still conserves energy.)
+            assert!(
+                outside <= 0.0,
+                "r = 1: the swing leaves the training range by {outside} × its width"
+            );
+        }
+        assert!(exchanged > 1e-5, "r = {r}: the rod moves: {exchanged:e} J");
+        assert!(
+            drift < 1e-6 * exchanged,
+            "r = {r}: energy drift {drift:e} J vs {exchanged:e} J exchanged"
+        );
+    }
+}
+
+#[test]
+fn rom_statics_with_ae_param_matches_the_hom_inside_the_training_range() {
+    let fx = fixture();
+    let hom_model = hom(1e4);
+    for u in [-4.37, -1.91, 1.23] {
+        let q_hom = hom_statics(&hom_model, u, None);
+        let x_hom = snapshot(&hom_model, &fx.layout, &q_hom);
+        // nearest training sample
+        let k = (0..N_SAMPLES)
+            .min_by(|&a, &b| (tension(a) - u).abs().total_cmp(&(tension(b) - u).abs()))
+            .unwrap();
+        for r in [1, 2] {
+            let m = fx.rom(r, 1e4);
+            let z0 = fx.z(r, k);
+            let mut solver = StaticsSolver::new(&m, StaticsOptions::default());
+            let sol = solver
+                .solve(&[u], &gravity(), Some(&z0))
+                .unwrap_or_else(|e| panic!("r = {r}, u = {u}: ROM statics: {e}"));
+            let x_rom = snapshot(&m, &fx.layout, &sol.q);
+            let err = strain_error_percent(&x_hom, &x_rom);
+            eprintln!(
+                "r = {r}, u = {u}: ROM statics in {} iterations, ‖R‖∞ = {:.2e}, strain error {err:.3} % (MAE / peak)",
+                sol.iterations, sol.residual_norm
+            );
+            assert!(err < 1.0, "r = {r}, u = {u}: strain error {err} %");
+        }
+    }
+}
