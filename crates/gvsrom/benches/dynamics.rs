@@ -7,8 +7,9 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use gvs::solve::dynamics::{IntegratorOptions, Method, OdeJacobian};
 use gvs::solve::ode::NdfOptions;
-use gvsrom::simulate::{run, InputSource, SimulateOptions};
+use gvsrom::simulate::{plan, run, InputSource, SimulateOptions};
 use std::hint::black_box;
+use std::ops::ControlFlow;
 
 fn options(jacobian: OdeJacobian) -> SimulateOptions {
     SimulateOptions {
@@ -46,8 +47,16 @@ fn dynamics(c: &mut Criterion) {
         ),
     ] {
         let opts = options(jac);
+        let plan = plan(&built, &opts).unwrap();
         c.bench_function(label, |b| {
-            b.iter(|| black_box(run(&built, &opts, &mut |_| {}).unwrap()))
+            b.iter(|| {
+                black_box(
+                    run(&built, &plan, &opts.integrator, None, &mut |_| {
+                        ControlFlow::Continue(())
+                    })
+                    .unwrap(),
+                )
+            })
         });
     }
 }
