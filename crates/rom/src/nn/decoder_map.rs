@@ -5,20 +5,20 @@
 //! construction: `W'_L = A diag(s) W_L`, `b'_L = A (s ⊙ b_L + μ)`, so an evaluation costs
 //! `O(m·h_L)` in the last layer (m outputs) rather than `O(n·h_L)`.
 //!
-//! Forward mode with second-order tangents. Each layer input carries its value `h`, its Jacobian
-//! `T = ∂h/∂z` (`n_k × r`) and its second derivatives `S_lj = ∂²h/∂z_l∂z_j` (`l ≤ j`, `r(r+1)/2`
-//! columns); at the input `h = z`, `T = I`, `S = 0`. A layer `a = W h + b` gives `∂a = W T`,
-//! `∂²a_lj = W S_lj`, and with `σ = tanh`, `σ' = 1 − σ²`, `σ'' = −2σσ'`:
+//! With `σ = tanh`, `σ' = 1 − σ²`, `σ'' = −2σσ'`, hidden layers `h_{k+1} = σ(a_k)`,
+//! `a_k = W_k h_k + b_k`, and the input tangent `T_k = ∂h_k/∂z` (`T_0 = I`):
 //!
-//! `h⁺ = σ(a)`, `T⁺_l = σ'(a) ⊙ (W T)_l`, `S⁺_lj = σ'(a) ⊙ (W S_lj) + σ''(a) ⊙ (W T)_l ⊙ (W T)_j`;
+//! - [`CoefficientMap::eval`], forward mode with `r` tangents: `P_k = W_k T_k = ∂a_k/∂z`,
+//!   `T_{k+1} = σ'(a_k) ⊙ P_k`; the linear last layer gives `c = W h + b`, `C_z = W T`. It keeps
+//!   `σ(a_k)` and `P_k` of every hidden layer in `scratch` (`Σ_k n_k (1 + r)` values) and nothing of
+//!   second order, so residual-only evaluations pay for value and Jacobian alone.
+//! - [`CoefficientMap::eval_rate`], one directional pass along `ż` (eq. 17): with `Ṫ_0 = 0`,
+//!   `Ṫ_{k+1} = σ'(a_k) ⊙ (W_k Ṫ_k) + σ''(a_k) ⊙ (P_k ż) ⊙ P_k` (row-wise), `Ċ_z = W_L Ṫ_L`.
+//! - [`CoefficientMap::add_weighted_hessian`], reverse over forward: for `φ = gᵀ c`, the linear
+//!   maps have no curvature, so `∇²φ = Σ_k P_kᵀ diag(μ_k ⊙ σ''(a_k)) P_k` with the adjoints
+//!   `μ_{L−1} = W_Lᵀ g`, `μ_{k−1} = W_kᵀ (σ'(a_k) ⊙ μ_k)` — `O(Σ n_k r²)`, no third-order tensor.
 //!
-//! the linear last layer gives `c = W h + b`, `C_z = W T`, `∂²c/∂z_l∂z_j = W S_lj`. [`CoefficientMap::eval`]
-//! keeps the full output Hessian `H_ilj = ∂²c_i/∂z_l∂z_j` (`m·r²` values) in `scratch`; then
-//! `(∂²c/∂z² ż)_il = Σ_j H_ilj ż_j` (eq. 17, the derivative of `C_z` along `ż`) and
-//! `Σ_i g_i ∇²c_i` are contractions that need no further buffers, as the trait's read-only scratch
-//! requires. The second-order columns cost `r(r+1)/2` extra matrix–vector products per layer (for
-//! r ≤ 3 at most 1.5× the work of value + Jacobian + one directional pass). No call allocates; the
-//! products are plain loops (no `dgemm`, whose packing buffers may allocate).
+//! No call allocates; the products are plain loops (no `dgemm`, whose packing buffers may allocate).
 
 use super::mlp::{Layer, Mlp};
 use super::{NnError, Scaling};
@@ -79,54 +79,17 @@ impl DecoderMap {
         })
     }
 
-    /// Number of tangent columns carried per unit: value, `r` first and `r(r+1)/2` second derivatives.
-    fn n_cols(&self) -> usize {
-        1 + self.r + self.r * (self.r + 1) / 2
+    /// Offset in `scratch` of hidden layer `k`'s stored `σ(a_k)` (then `P_k`, `n_k × r`).
+    fn store(&self, k: usize) -> usize {
+        self.layers[..k]
+            .iter()
+            .map(|l| l.n_out * (1 + self.r))
+            .sum()
     }
 
-    /// Column of `∂²/∂z_l∂z_j` (symmetric in `l`, `j`) among [`Self::n_cols`].
-    fn second_col(&self, l: usize, j: usize) -> usize {
-        let (l, j) = (l.min(j), l.max(j));
-        1 + self.r + j * (j + 1) / 2 + l
-    }
-
-    /// One layer on the tangent block `x` (`n_in × n_cols`, column-major) into `y` (`n_out × n_cols`).
-    /// Each row of `W` is read once for all tangent columns.
-    fn layer_forward(&self, layer: &Layer, tanh: bool, first: bool, x: &[f64], y: &mut [f64]) {
-        let (n_in, n_out, cols) = (layer.n_in, layer.n_out, self.n_cols());
-        // At the input S = 0, so W S = 0: skip those products.
-        let computed = if first { 1 + self.r } else { cols };
-        for i in 0..n_out {
-            let w_row = &layer.w[i * n_in..(i + 1) * n_in];
-            for col in 0..computed {
-                y[col * n_out + i] = dot(w_row, &x[col * n_in..(col + 1) * n_in]);
-            }
-            for col in computed..cols {
-                y[col * n_out + i] = 0.0;
-            }
-            y[i] += layer.b[i];
-            if tanh {
-                self.apply_tanh_row(y, n_out, i);
-            }
-        }
-    }
-
-    /// Row `i` of a pre-activation block through tanh: `S⁺ = σ' WS + σ'' (WT)_l (WT)_j`, `T⁺ = σ' WT`,
-    /// `h⁺ = σ` (module docs).
-    fn apply_tanh_row(&self, y: &mut [f64], ld: usize, i: usize) {
-        let sigma = y[i].tanh();
-        let d1 = 1.0 - sigma * sigma;
-        let d2 = -2.0 * sigma * d1;
-        for j in 0..self.r {
-            for l in 0..=j {
-                let p = self.second_col(l, j) * ld + i;
-                y[p] = d1 * y[p] + d2 * y[(1 + l) * ld + i] * y[(1 + j) * ld + i];
-            }
-        }
-        for l in 0..self.r {
-            y[(1 + l) * ld + i] *= d1;
-        }
-        y[i] = sigma;
+    /// Length of the stored part of `scratch`.
+    fn stored_len(&self) -> usize {
+        self.store(self.layers.len() - 1)
     }
 }
 
@@ -184,58 +147,146 @@ impl CoefficientMap for DecoderMap {
         self.m
     }
 
-    /// `m·r²` for the output Hessian plus two tangent blocks of `widest × n_cols`.
+    /// The stored `σ(a_k)`, `P_k` of the hidden layers, plus two work blocks of `widest × (1 + r)`.
     fn scratch_len(&self) -> usize {
-        self.m * self.r * self.r + 2 * self.widest * self.n_cols()
+        self.stored_len() + 2 * self.widest * (1 + self.r)
     }
 
     fn eval(&self, z: &[f64], c: &mut [f64], c_z: &mut [f64], scratch: &mut [f64]) {
         let (r, m) = (self.r, self.m);
-        let (hess, work) = scratch.split_at_mut(m * r * r);
-        let (x, y) = work.split_at_mut(self.widest * self.n_cols());
-        let cols = self.n_cols();
+        let cols = 1 + r;
+        let (stored, work) = scratch.split_at_mut(self.stored_len());
+        let (x, y) = work.split_at_mut(self.widest * cols);
+        let (mut x, mut y) = (x, y);
+        // input block: value z, tangents I
         x[..r * cols].iter_mut().for_each(|v| *v = 0.0);
         x[..r].copy_from_slice(z);
         for l in 0..r {
             x[(1 + l) * r + l] = 1.0;
         }
-        let (mut x, mut y) = (x, y);
         let last = self.layers.len() - 1;
+        let mut off = 0;
         for (k, layer) in self.layers.iter().enumerate() {
-            self.layer_forward(layer, k < last, k == 0, x, y);
+            let (n_in, n_out) = (layer.n_in, layer.n_out);
+            for i in 0..n_out {
+                let w_row = &layer.w[i * n_in..(i + 1) * n_in];
+                for col in 0..cols {
+                    y[col * n_out + i] = dot(w_row, &x[col * n_in..(col + 1) * n_in]);
+                }
+                y[i] += layer.b[i];
+            }
+            if k < last {
+                let st = &mut stored[off..off + n_out * cols];
+                for i in 0..n_out {
+                    let sigma = y[i].tanh();
+                    let d1 = 1.0 - sigma * sigma;
+                    st[i] = sigma;
+                    for l in 0..r {
+                        let p = (1 + l) * n_out + i;
+                        st[p] = y[p];
+                        y[p] *= d1;
+                    }
+                    y[i] = sigma;
+                }
+                off += n_out * cols;
+            }
             std::mem::swap(&mut x, &mut y);
         }
-        // The output block (m × n_cols) is now in `x`.
         c.copy_from_slice(&x[..m]);
-        c_z.copy_from_slice(&x[m..m * (1 + r)]);
-        for j in 0..r {
-            for l in 0..r {
-                let col = self.second_col(l, j);
-                hess[(l + r * j) * m..(l + r * j + 1) * m]
-                    .copy_from_slice(&x[col * m..(col + 1) * m]);
-            }
-        }
+        c_z.copy_from_slice(&x[m..m * cols]);
     }
 
     fn eval_rate(&self, _z: &[f64], zd: &[f64], c_z_dot: &mut [f64], scratch: &mut [f64]) {
-        let (r, m) = (self.r, self.m);
-        c_z_dot.iter_mut().for_each(|v| *v = 0.0);
-        for l in 0..r {
-            for (j, zd_j) in zd.iter().enumerate() {
-                let h = &scratch[(l + r * j) * m..(l + r * j + 1) * m];
-                c_z_dot[l * m..(l + 1) * m]
-                    .iter_mut()
-                    .zip(h)
-                    .for_each(|(o, h)| *o += h * zd_j);
+        let r = self.r;
+        let (stored, work) = scratch.split_at_mut(self.stored_len());
+        let (x, y) = work.split_at_mut(self.widest * (1 + r));
+        let (mut x, mut y) = (x, y);
+        let last = self.layers.len() - 1;
+        let mut off = 0;
+        for (k, layer) in self.layers.iter().enumerate() {
+            let (n_in, n_out) = (layer.n_in, layer.n_out);
+            // W Ṫ_k (Ṫ_0 = 0)
+            for i in 0..n_out {
+                let w_row = &layer.w[i * n_in..(i + 1) * n_in];
+                for l in 0..r {
+                    y[l * n_out + i] = if k == 0 {
+                        0.0
+                    } else {
+                        dot(w_row, &x[l * n_in..(l + 1) * n_in])
+                    };
+                }
             }
+            if k == last {
+                c_z_dot.copy_from_slice(&y[..n_out * r]);
+                return;
+            }
+            let st = &stored[off..off + n_out * (1 + r)];
+            for i in 0..n_out {
+                let sigma = st[i];
+                let d1 = 1.0 - sigma * sigma;
+                let d2 = -2.0 * sigma * d1;
+                let v: f64 = (0..r).map(|l| st[(1 + l) * n_out + i] * zd[l]).sum();
+                for l in 0..r {
+                    let p = l * n_out + i;
+                    y[p] = d1 * y[p] + d2 * v * st[(1 + l) * n_out + i];
+                }
+            }
+            off += n_out * (1 + r);
+            std::mem::swap(&mut x, &mut y);
         }
     }
 
     fn add_weighted_hessian(&self, _z: &[f64], g: &[f64], out: &mut [f64], scratch: &mut [f64]) {
-        let (r, m) = (self.r, self.m);
-        for lj in 0..r * r {
-            let h = &scratch[lj * m..(lj + 1) * m];
-            out[lj] += h.iter().zip(g).map(|(h, g)| h * g).sum::<f64>();
+        let r = self.r;
+        let (stored, work) = scratch.split_at_mut(self.stored_len());
+        let (mu, next) = work.split_at_mut(self.widest * (1 + r));
+        let (mut mu, mut next) = (mu, next);
+        let last = self.layers.len() - 1;
+        // μ_{L−1} = W_Lᵀ g
+        let wl = &self.layers[last];
+        mu[..wl.n_in].iter_mut().for_each(|v| *v = 0.0);
+        for (i, gi) in g.iter().enumerate() {
+            let w_row = &wl.w[i * wl.n_in..(i + 1) * wl.n_in];
+            for (mv, w) in mu[..wl.n_in].iter_mut().zip(w_row) {
+                *mv += gi * w;
+            }
+        }
+        for k in (0..last).rev() {
+            let layer = &self.layers[k];
+            let (n_in, n_out) = (layer.n_in, layer.n_out);
+            let off = self.store(k);
+            let st = &stored[off..off + n_out * (1 + r)];
+            for i in 0..n_out {
+                let sigma = st[i];
+                let d1 = 1.0 - sigma * sigma;
+                let q = mu[i] * (-2.0 * sigma * d1);
+                if q != 0.0 {
+                    // out += q P_iᵀ P_i (row i of P_k)
+                    for j in 0..r {
+                        let pj = q * st[(1 + j) * n_out + i];
+                        for l in 0..=j {
+                            let v = pj * st[(1 + l) * n_out + i];
+                            out[l + r * j] += v;
+                            if l != j {
+                                out[j + r * l] += v;
+                            }
+                        }
+                    }
+                }
+                mu[i] *= d1;
+            }
+            if k > 0 {
+                // μ_{k−1} = W_kᵀ (σ' ⊙ μ_k)
+                next[..n_in].iter_mut().for_each(|v| *v = 0.0);
+                for i in 0..n_out {
+                    let w_row = &layer.w[i * n_in..(i + 1) * n_in];
+                    let a = mu[i];
+                    for (nv, w) in next[..n_in].iter_mut().zip(w_row) {
+                        *nv += a * w;
+                    }
+                }
+                std::mem::swap(&mut mu, &mut next);
+            }
         }
     }
 }
