@@ -421,6 +421,10 @@ fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
     let signal = interrupt_flag();
     let bar = gvsrom::dataset::progress_bar_of(args.epochs as u64, "epochs");
     let mut progress = |epoch: usize, train: f64, val: Option<f64>| {
+        // the fine-tuning phase runs past --epochs
+        if epoch as u64 > bar.length().unwrap_or(0) {
+            bar.set_length(epoch as u64);
+        }
         bar.set_position(epoch as u64);
         bar.set_message(match val {
             Some(v) => format!("loss {train:.3e} / validation {v:.3e}"),

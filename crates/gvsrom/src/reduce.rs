@@ -280,8 +280,8 @@ pub fn train(
     let (x, rows) = snapshot_rows(&ds, "DATASET")?;
     let features = ds.row_len();
     let dir = OutputDir::create("--out", out, crate::reduced_model::MODEL_FORMAT, force)?;
-    let (ae, report) = Autoencoder::train(&x, features, options, progress)
-        .map_err(|e| invalid("train", e.to_string()))?;
+    let (ae, report) =
+        Autoencoder::train(&x, features, options, progress).map_err(|e| train_error(&e))?;
     // what the HOM basis cannot represent of the reconstructions
     let mut worst = 0.0f64;
     for row in x.chunks_exact(features) {
@@ -377,6 +377,19 @@ pub fn train(
         rest_residual,
         projection_residual: worst,
     })
+}
+
+/// A training error named by the command-line option it comes from.
+fn train_error(e: &rom::nn::NnError) -> ScenarioError {
+    use rom::nn::NnError;
+    let option = match e {
+        NnError::InvalidLatent { .. } => "--latent".to_string(),
+        NnError::InvalidHiddenLayers { .. } => "--hidden-layers".to_string(),
+        NnError::InvalidOption { field, .. } => format!("--{}", field.replace('_', "-")),
+        NnError::EmptyData | NnError::NonFiniteData { .. } => "DATASET".to_string(),
+        _ => "train".to_string(),
+    };
+    invalid(&option, e.to_string())
 }
 
 /// Checks that `model` was learned on the layout of `built` (points, active components, HOM size).

@@ -436,7 +436,7 @@ fn a_damaged_model_or_dataset_is_an_error_not_a_wrong_model() {
     let out = scratch("red-bad-latent");
     expect_error(
         &["train", s(dataset40()), "--latent", "400", "--out", s(&out)],
-        &["latent size 400", "306"],
+        &["--latent", "latent size 400", "306"],
     );
     assert!(!out.exists(), "no model is left behind");
     // modes out of range
