@@ -16,7 +16,7 @@ use crate::output::OutputDir;
 use crate::reduced_model::{
     fnv1a64, DatasetRef, ModelLayout, ModelMeta, ModelWeights, ReducedModel, TrainingMeta,
 };
-use crate::scenario::{Scenario, StrainMode};
+use crate::scenario::Scenario;
 use gvs::model::Model;
 use gvs::strain::{LinearBasis, StrainParam};
 use nalgebra::{DMatrix, DVector};
@@ -142,13 +142,6 @@ fn projection_of(
     let pm = point_matrix(&built.model.param, &layout);
     let p = projection(&pm).map_err(|e| invalid("basis", e.to_string()))?;
     Ok((layout, pm, p))
-}
-
-fn component_names(active: &[usize]) -> Vec<String> {
-    active
-        .iter()
-        .map(|&a| StrainMode::ALL[a].name().to_string())
-        .collect()
 }
 
 /// The usable rows of a dataset (status ok), row-major, and their count; an error if none.
@@ -396,7 +389,7 @@ fn train_error(e: &rom::nn::NnError) -> ScenarioError {
 fn check_layout(built: &Built, model: &ReducedModel, path: &Path) -> Result<(), ScenarioError> {
     let l = Layout::of(built);
     let ml = &model.meta.layout;
-    let names = component_names(&l.active);
+    let names = l.component_names();
     let length = built.model.disc.length();
     let same_points = ml.strain_x.len() == l.strain_x.len()
         && ml

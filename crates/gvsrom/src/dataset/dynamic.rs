@@ -11,7 +11,6 @@ use super::{
 use crate::build::Built;
 use crate::error::ScenarioError;
 use crate::output::OutputDir;
-use crate::scenario::StrainMode;
 use crate::simulate::{self, InputSource, SimulateOptions};
 use gvs::solve::dynamics::{
     simulate_streaming, IntegratorOptions, Method, OdeJacobian, SimulationError,
@@ -197,11 +196,7 @@ pub fn run(
         n_dof: layout.n_dof,
         n_points: layout.strain_x.len(),
         strain_x: layout.strain_x.clone(),
-        components: layout
-            .active
-            .iter()
-            .map(|&a| StrainMode::ALL[a].name().to_string())
-            .collect(),
+        components: layout.component_names(),
         strain_layout: super::STRAIN_LAYOUT.into(),
         chunk_size: n.max(1),
         chunk_done: vec![true; n.div_ceil(n.max(1))],

@@ -53,6 +53,14 @@ impl Layout {
         }
     }
 
+    /// Names of the active components (`bend_y`, …), in column order within a point.
+    pub fn component_names(&self) -> Vec<String> {
+        self.active
+            .iter()
+            .map(|&a| crate::scenario::StrainMode::ALL[a].name().to_string())
+            .collect()
+    }
+
     /// Values per strain row: points × active components.
     pub fn row_len(&self) -> usize {
         self.strain_x.len() * self.active.len()

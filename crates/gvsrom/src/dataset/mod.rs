@@ -33,7 +33,6 @@ pub use reader::Dataset;
 use crate::build::Built;
 use crate::error::ScenarioError;
 use crate::output::{OutputDir, OutputError};
-use crate::scenario::StrainMode;
 use generate::{Generator, SampleResult};
 use serde::{Deserialize, Serialize};
 use std::io::Write;
@@ -392,11 +391,7 @@ pub fn run(
         n_dof: layout.n_dof,
         n_points: layout.strain_x.len(),
         strain_x: layout.strain_x.clone(),
-        components: layout
-            .active
-            .iter()
-            .map(|&a| StrainMode::ALL[a].name().to_string())
-            .collect(),
+        components: layout.component_names(),
         strain_layout: STRAIN_LAYOUT.into(),
         chunk_size: args.chunk_size,
         chunk_done: vec![false; n_chunks],
