@@ -460,12 +460,13 @@ fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
     )?;
     writeln!(
         out,
-        "trained    {} epochs (best {}, {:?}) + {} fine-tuning in {:.1} s",
-        r.epochs_run,
-        r.best_epoch,
-        r.stop,
+        "trained    {} Adam epochs + {} fine-tuning iterations in {:.1} s (best at {} of {}; last phase ended by {:?})",
+        r.epochs_run - r.fine_tune_epochs_run,
         r.fine_tune_epochs_run,
-        r.wall_time.as_secs_f64()
+        r.wall_time.as_secs_f64(),
+        r.best_epoch,
+        r.epochs_run,
+        r.stop
     )?;
     writeln!(
         out,
