@@ -213,6 +213,9 @@ fn inspect(n: &Named, target: &Path, kind: Kind, force: bool) -> Result<Existing
             "exists (a gvsrom {format} output); pass --force to replace it, or choose another path"
         )));
     }
+    // Only the regular files actually present *and* listed are ever removed later: a manifest
+    // naming `../elsewhere` or a missing file removes nothing outside the directory.
+    let mut present = vec![];
     if kind == Kind::Dir {
         let mut foreign = vec![];
         for entry in fs::read_dir(target).map_err(n.io("list it"))? {
@@ -222,6 +225,8 @@ fn inspect(n: &Named, target: &Path, kind: Kind, force: bool) -> Result<Existing
             let plain = entry.file_type().map(|t| t.is_file()).unwrap_or(false);
             if !(listed && plain) {
                 foreign.push(name);
+            } else if name != MANIFEST_FILE {
+                present.push(name);
             }
         }
         if !foreign.is_empty() {
@@ -235,7 +240,7 @@ fn inspect(n: &Named, target: &Path, kind: Kind, force: bool) -> Result<Existing
             )));
         }
     }
-    Ok(Existing::Previous { files })
+    Ok(Existing::Previous { files: present })
 }
 
 /// A unique hidden name beside the target: `.NAME.gvsrom-TAG-<pid>-<counter><nanos>`.
@@ -354,7 +359,13 @@ fn with_manifest(value: impl Serialize, manifest: Value) -> io::Result<Value> {
 
 /// Removes a previous output set aside: its listed files and manifest, then the directory if empty.
 fn remove_previous_dir(dir: &Path, files: &[String]) -> io::Result<()> {
-    for f in files.iter().map(String::as_str).chain([MANIFEST_FILE]) {
+    let plain = |f: &&str| !f.is_empty() && *f != "." && *f != ".." && !f.contains(['/', '\\']);
+    for f in files
+        .iter()
+        .map(String::as_str)
+        .chain([MANIFEST_FILE])
+        .filter(plain)
+    {
         match fs::remove_file(dir.join(f)) {
             Err(e) if e.kind() != io::ErrorKind::NotFound => return Err(e),
             _ => {}
@@ -783,6 +794,28 @@ mod tests {
         out.commit(json!({})).unwrap();
         assert_eq!(names(&target), ["b.bin", "meta.json"]);
         assert_eq!(names(&d), ["run"], "no staging, lock or old copy left");
+    }
+
+    #[test]
+    fn a_manifest_naming_paths_outside_its_directory_removes_nothing_there() {
+        let d = sandbox("escape");
+        let target = d.join("run");
+        let mut out = OutputDir::create("--out", &target, "test", false).unwrap();
+        out.write_file("a.bin", |w| w.write_all(b"old")).unwrap();
+        out.commit(json!({})).unwrap();
+        fs::write(d.join("victim.txt"), "keep").unwrap();
+        // an edited manifest that lists a file outside the output and one that is not there
+        let meta_path = target.join(MANIFEST_FILE);
+        let mut meta: Value =
+            serde_json::from_str(&fs::read_to_string(&meta_path).unwrap()).unwrap();
+        meta[MANIFEST_KEY]["files"] = json!(["a.bin", "../victim.txt", "missing.bin"]);
+        fs::write(&meta_path, serde_json::to_string(&meta).unwrap()).unwrap();
+        let mut out = OutputDir::create("--out", &target, "test", true).unwrap();
+        out.write_file("b.bin", |w| w.write_all(b"new")).unwrap();
+        out.commit(json!({})).unwrap();
+        assert_eq!(fs::read_to_string(d.join("victim.txt")).unwrap(), "keep");
+        assert_eq!(names(&target), ["b.bin", "meta.json"]);
+        assert_eq!(names(&d), ["run", "victim.txt"]);
     }
 
     #[test]
