@@ -238,7 +238,7 @@ pub struct SimulateArgs {
     pub load_schedule: Option<PathBuf>,
 
     /// Use finite differences of the right-hand side for the integrator's Jacobian instead of the
-    /// structured analytic one.
+    /// structured analytic one (automatic with an autoencoder `--model`).
     #[arg(long)]
     pub fd_jacobian: bool,
 
@@ -563,7 +563,16 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
         start_at_equilibrium: args.from_equilibrium,
         integrator: IntegratorOptions {
             method,
-            jacobian: if args.fd_jacobian {
+            // The structured Jacobian drops ∂M/∂q q̈ and the velocity terms; for a decoder, whose
+            // M(q) varies strongly, that costs many rejected steps, while finite differences cost
+            // only 2r right-hand sides (r small): measured on IV-C2, 2780 steps (477 failed)
+            // against 5429 (2054 failed).
+            jacobian: if args.fd_jacobian
+                || built
+                    .reduced
+                    .as_ref()
+                    .is_some_and(|r| !r.model.param.is_linear())
+            {
                 OdeJacobian::FiniteDifference
             } else {
                 OdeJacobian::Structured
