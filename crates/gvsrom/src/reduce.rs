@@ -134,11 +134,7 @@ pub fn dataset_scenario(ds: &Dataset) -> Result<Built, ScenarioError> {
 fn projection_of(
     built: &Built,
 ) -> Result<(PointLayout, DMatrix<f64>, DMatrix<f64>), ScenarioError> {
-    let l = Layout::of(built);
-    let layout = PointLayout {
-        n_points: l.strain_x.len(),
-        active: l.active,
-    };
+    let layout = PointLayout::active_in(&built.model.param, &built.model.disc);
     let pm = point_matrix(&built.model.param, &layout);
     let p = projection(&pm).map_err(|e| invalid("basis", e.to_string()))?;
     Ok((layout, pm, p))
@@ -275,16 +271,9 @@ pub fn train(
     let dir = OutputDir::create("--out", out, crate::reduced_model::MODEL_FORMAT, force)?;
     let (ae, report) =
         Autoencoder::train(&x, features, options, progress).map_err(|e| train_error(&e))?;
-    // what the HOM basis cannot represent of the reconstructions
+    // one encoding per usable sample: its range, the anchors, the rest point (the sample closest
+    // to the straight rod), and what the HOM basis cannot represent of the reconstructions
     let mut worst = 0.0f64;
-    for row in x.chunks_exact(features) {
-        let rec = ae
-            .reconstruct(row)
-            .map_err(|e| invalid("train", e.to_string()))?;
-        worst = worst.max(projection_residual(&pm, &p, &DVector::from_vec(rec)));
-    }
-    // encodings of the usable samples: their range, the anchors, and the rest point (the sample
-    // closest to the straight rod)
     let r = options.latent;
     let ok = ds.ok_rows();
     let k_in = ds.meta.parameters.len();
@@ -296,6 +285,8 @@ pub fn train(
         let z = ae
             .encode(row)
             .map_err(|e| invalid("train", e.to_string()))?;
+        let rec = ae.decode(&z).map_err(|e| invalid("train", e.to_string()))?;
+        worst = worst.max(projection_residual(&pm, &p, &DVector::from_vec(rec)));
         for (d, v) in z.iter().enumerate() {
             range[d][0] = range[d][0].min(*v);
             range[d][1] = range[d][1].max(*v);

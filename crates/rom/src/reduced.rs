@@ -61,13 +61,20 @@ impl PointLayout {
         self.len() == 0
     }
 
-    /// The components a basis can excite anywhere (a row of `Φ_s` non-zero at some point).
+    /// The components a basis can excite anywhere: a row of `Φ_s` non-zero at some site (points
+    /// and Magnus sub-points).
     pub fn active_in(basis: &LinearBasis, disc: &Discretization) -> PointLayout {
-        let n_points = disc.n_points();
-        let active = (0..6)
-            .filter(|&a| (0..n_points).any(|i| basis.phi_at(i).row(a).amax() > 0.0))
-            .collect();
-        PointLayout { n_points, active }
+        let mut on = [false; 6];
+        for s in 0..basis.n_sites() {
+            let phi = basis.phi_at(s);
+            for (a, flag) in on.iter_mut().enumerate() {
+                *flag |= phi.row(a).iter().any(|v| *v != 0.0);
+            }
+        }
+        PointLayout {
+            n_points: disc.n_points(),
+            active: (0..6).filter(|&a| on[a]).collect(),
+        }
     }
 }
 

@@ -14,7 +14,7 @@ use crate::build::Built;
 use crate::scenario::{apply_override, from_table};
 use gvs::model::Model;
 use gvs::solve::statics::{StaticsOptions, StaticsSolution, StaticsSolver};
-use gvs::strain::{LinearBasis, StrainParam};
+use gvs::strain::LinearBasis;
 use nalgebra::DVector;
 use toml::Table;
 
@@ -39,17 +39,10 @@ impl Layout {
     /// The layout of `built`: a strain component is active if the basis can excite it at any site.
     pub fn of(built: &Built) -> Layout {
         let m = &built.model;
-        let mut on = [false; 6];
-        for s in 0..m.param.n_sites() {
-            let phi = m.param.phi_at(s);
-            for (a, flag) in on.iter_mut().enumerate() {
-                *flag |= phi.row(a).iter().any(|v| *v != 0.0);
-            }
-        }
         Layout {
             n_dof: m.n_dof(),
             strain_x: m.disc.points.iter().map(|p| p.x).collect(),
-            active: (0..6).filter(|&a| on[a]).collect(),
+            active: rom::reduced::PointLayout::active_in(&m.param, &m.disc).active,
         }
     }
 
