@@ -379,31 +379,36 @@ impl ExpTangent {
 
     /// `∂(Tᵀ F)/∂Ω = Σ_r (−1)ʳ [φ_r (Cʳ F)[Ω_kᵀ, 0] + f_r Σ_{u=1}^{r} C^{u−1} coadbar(C^{r−u} F)]`,
     /// `C = coad_Ω = −Aᵀ` (spec §2.5, SoRoSim's `compute_dSTdqFC`).
+    ///
+    /// Evaluated by grouping the double sum by `u` (`coadbar` is linear in its argument):
+    /// `Σ_u C^{u−1} coadbar(v_u)`, `v_u = Σ_{r≥u} (−1)ʳ f_r C^{r−u} F`, in Horner form
+    /// `coadbar(v_1) + C (coadbar(v_2) + C (coadbar(v_3) + C coadbar(v_4)))`: three 6×6 products.
     pub fn d_ttf(&self, f: &V6) -> M6 {
         let c1 = coad(&self.omega);
-        let c2 = c1 * c1;
-        let c3 = c2 * c1;
-        let cp = [c1, c2, c3];
+        // cf[j] = Cʲ F
         let mut cf = [*f; 5];
-        for m in 1..5 {
-            cf[m] = c1 * cf[m - 1];
+        for j in 1..5 {
+            cf[j] = c1 * cf[j - 1];
         }
+        let sign = |r: usize| if r % 2 == 0 { 1.0 } else { -1.0 };
+        let v = |u: usize| -> V6 {
+            (u..=4).fold(V6::zeros(), |acc, r| {
+                acc + cf[r - u] * (sign(r) * self.coeffs.f[r - 1])
+            })
+        };
+        let mut out = coadbar(&v(4));
+        for u in (1..4).rev() {
+            out = coadbar(&v(u)) + c1 * out;
+        }
+        // rank-one part: (Σ_r (−1)ʳ φ_r Cʳ F) [Ω_kᵀ, 0]
+        let col = (1..=4).fold(V6::zeros(), |acc, r| {
+            acc + cf[r] * (sign(r) * self.coeffs.phi[r - 1])
+        });
         let ok = ang(&self.omega);
-        let mut out = M6::zeros();
-        for r in 1..=4 {
-            let sign = if r % 2 == 0 { 1.0 } else { -1.0 };
-            let mut term = M6::zeros();
-            let col = cf[r] * self.coeffs.phi[r - 1];
-            for c in 0..3 {
-                for i in 0..6 {
-                    term[(i, c)] += col[i] * ok[c];
-                }
+        for c in 0..3 {
+            for i in 0..6 {
+                out[(i, c)] += col[i] * ok[c];
             }
-            for u in 1..=r {
-                let cb = coadbar(&cf[r - u]);
-                term += (if u == 1 { cb } else { cp[u - 2] * cb }) * self.coeffs.f[r - 1];
-            }
-            out += term * sign;
         }
         out
     }

@@ -269,25 +269,14 @@ impl<P: StrainParam> Model<P> {
     /// Forward pass: strains at all sites, poses at all points, Magnus steps, and (if `jacobians`)
     /// `Z`, `J` at every point.
     pub fn forward(&self, q: &DVector<f64>, ws: &mut Workspace, jacobians: bool) {
-        let n = self.n_dof();
         self.param.eval(q, &mut ws.ev);
         for s in 0..ws.xi.len() {
             ws.xi[s] = ws.ev.psi[s] + self.xi_star[s];
         }
         ws.g[0] = self.base;
-        if jacobians {
-            ws.jac.columns_mut(0, n).fill(0.0);
-        }
-        let mut hi = 0; // J_i is zero beyond column `hi`
         for i in 0..self.disc.n_points() - 1 {
             let Some(st) = self.disc.steps[i] else {
                 ws.g[i + 1] = ws.g[i];
-                if jacobians {
-                    let (a, mut b) = ws
-                        .jac
-                        .columns_range_pair_mut(i * n..(i + 1) * n, (i + 1) * n..(i + 2) * n);
-                    b.copy_from(&a);
-                }
                 continue;
             };
             let h = st.h;
@@ -301,40 +290,61 @@ impl<P: StrainParam> Model<P> {
             };
             let et = exp_tangent(&omega);
             ws.g[i + 1] = ws.g[i].compose(&et.g);
-            if jacobians {
-                let c = self.param.columns(s1);
-                hi = hi.max(c.end);
-                let mut z = ws.z.columns_mut(i * n + c.start, c.len());
-                match self.disc.order {
-                    MagnusOrder::Z4 => {
-                        let p1 = ws.ev.psi_q_at(s1, &c);
-                        let p2 = ws.ev.psi_q_at(s2, &c);
-                        z.zip_zip_apply(&p1, &p2, |zz, a, b| *zz = 0.5 * h * (a + b));
-                        let k = ZANNA_C * h * h;
-                        z.gemm(k, &ad(&ws.xi[s1]), &p2, 1.0);
-                        z.gemm(-k, &ad(&ws.xi[s2]), &p1, 1.0);
-                    }
-                    MagnusOrder::Z2 => {
-                        z.copy_from(&ws.ev.psi_q_at(s1, &c));
-                        z *= h;
-                    }
-                }
-                // J_{i+1} = Ad⁻¹ (J_i + T Z)
-                let mut t1 = ws.t1.columns_mut(0, hi);
-                t1.copy_from(&ws.jac.columns(i * n, hi));
-                t1.columns_mut(c.start, c.len()).gemm(
-                    1.0,
-                    &et.t,
-                    &ws.z.columns(i * n + c.start, c.len()),
-                    1.0,
-                );
-                let adinv = et.g.adjoint_inv();
-                let mut jn = ws.jac.columns_mut((i + 1) * n, n);
-                jn.fill(0.0);
-                jn.columns_mut(0, hi)
-                    .gemm(1.0, &adinv, &ws.t1.columns(0, hi), 0.0);
-            }
             ws.et[i] = et;
+        }
+        if jacobians {
+            self.forward_jacobians(ws);
+        }
+    }
+
+    /// The Jacobian part of the forward pass, from the strains and Magnus steps already in `ws`:
+    /// `Z_i = ∂Ω_i/∂q` and `J_{i+1} = Ad⁻¹_{exp Ω_i} (J_i + T(Ω_i) Z_i)` (spec §5).
+    fn forward_jacobians(&self, ws: &mut Workspace) {
+        let n = self.n_dof();
+        ws.jac.columns_mut(0, n).fill(0.0);
+        let mut hi = 0; // J_i is zero beyond column `hi`
+        for i in 0..self.disc.n_points() - 1 {
+            let Some(st) = self.disc.steps[i] else {
+                let (a, mut b) = ws
+                    .jac
+                    .columns_range_pair_mut(i * n..(i + 1) * n, (i + 1) * n..(i + 2) * n);
+                b.copy_from(&a);
+                continue;
+            };
+            let h = st.h;
+            let [s1, s2] = st.sites;
+            let c = self.param.columns(s1);
+            hi = hi.max(c.end);
+            let mut z = ws.z.columns_mut(i * n + c.start, c.len());
+            match self.disc.order {
+                MagnusOrder::Z4 => {
+                    let p1 = ws.ev.psi_q_at(s1, &c);
+                    let p2 = ws.ev.psi_q_at(s2, &c);
+                    z.zip_zip_apply(&p1, &p2, |zz, a, b| *zz = 0.5 * h * (a + b));
+                    let k = ZANNA_C * h * h;
+                    z.gemm(k, &ad(&ws.xi[s1]), &p2, 1.0);
+                    z.gemm(-k, &ad(&ws.xi[s2]), &p1, 1.0);
+                }
+                MagnusOrder::Z2 => {
+                    z.copy_from(&ws.ev.psi_q_at(s1, &c));
+                    z *= h;
+                }
+            }
+            let et = &ws.et[i];
+            // J_{i+1} = Ad⁻¹ (J_i + T Z)
+            let mut t1 = ws.t1.columns_mut(0, hi);
+            t1.copy_from(&ws.jac.columns(i * n, hi));
+            t1.columns_mut(c.start, c.len()).gemm(
+                1.0,
+                &et.t,
+                &ws.z.columns(i * n + c.start, c.len()),
+                1.0,
+            );
+            let adinv = et.g.adjoint_inv();
+            let mut jn = ws.jac.columns_mut((i + 1) * n, n);
+            jn.fill(0.0);
+            jn.columns_mut(0, hi)
+                .gemm(1.0, &adinv, &ws.t1.columns(0, hi), 0.0);
         }
     }
 
@@ -594,8 +604,23 @@ impl<P: StrainParam> Model<P> {
         ws: &mut Workspace,
         jac: &mut DMatrix<f64>,
     ) {
+        self.forward(q, ws, false);
+        self.statics_jacobian_after_forward(q, u, loads, ws, jac);
+    }
+
+    /// [`Self::statics_jacobian`] when the last evaluation with `ws` was a forward pass at this same
+    /// `q` (e.g. [`Self::statics_residual`] at the point where the solver now wants `∂R/∂q`): the
+    /// strains, poses and Magnus steps are reused, only the Jacobians are added.
+    pub fn statics_jacobian_after_forward(
+        &self,
+        q: &DVector<f64>,
+        u: &[f64],
+        loads: &PreparedLoads,
+        ws: &mut Workspace,
+        jac: &mut DMatrix<f64>,
+    ) {
         let n = self.n_dof();
-        self.forward(q, ws, true);
+        self.forward_jacobians(ws);
         self.point_wrenches(loads, ws);
         ws.y.iter_mut().for_each(|y| *y = V6::zeros());
         ws.dyp.fill(0.0);

@@ -7,6 +7,7 @@
 //! - [`pod`]: POD modes of strain snapshots (thin SVD, faer).
 //! - [`nn`]: the autoencoder (tanh MLP, training on eq. 15) and its decoder as a [`map::CoefficientMap`].
 
+mod gemm;
 pub mod map;
 pub mod metrics;
 pub mod nn;

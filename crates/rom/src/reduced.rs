@@ -20,6 +20,7 @@
 //! not represent, a part [`projection_residual`] measures. Every derivative of `Ψ_s` is `Φ_s` times
 //! the same derivative of `c`, so the engine's statics, dynamics and Jacobians apply unchanged.
 
+use crate::gemm::gemm;
 use crate::map::CoefficientMap;
 use gvs::discretize::Discretization;
 use gvs::lie::V6;
@@ -142,19 +143,58 @@ pub struct ReducedParam<M: CoefficientMap> {
     phi: Matrix6xX<f64>,
     offsets: Vec<usize>,
     cols: Vec<Range<usize>>,
+    /// The same `Φ_s` stacked densely for one GEMM per evaluation, when the basis is dense enough.
+    stacked: Option<Stacked>,
     m: usize,
     r: usize,
     rest: DVector<f64>,
 }
 
-/// Where the parts of [`StrainEval::scratch`] start: `c`, `C_z`, `Ċ_z`, `g`, `H`, the map's own.
+/// `Φ_s` of every site on the active rows only, stacked: row `s·n_a + i` is row `active[i]` of
+/// `Φ_s` (`n_a·n_sites × m`, column-major, zero outside each site's columns). With it, `Ψ`, `Ψ_q`
+/// and `Ψ̇_q` at all sites are one product `Φ [c | C_z]`, and `g = Φᵀ w` one more.
+struct Stacked {
+    active: Vec<usize>,
+    rows: usize,
+    mat: Vec<f64>,
+}
+
+impl Stacked {
+    /// Stacks `basis` if that stores at most twice the entries of its per-site blocks (global bases,
+    /// Legendre, POD); `None` for local-support bases, where the per-site loop is cheaper.
+    fn of(basis: &LinearBasis, phi: &Matrix6xX<f64>) -> Option<Stacked> {
+        let (ns, m) = (basis.n_sites(), basis.n_dof());
+        let active: Vec<usize> = (0..6)
+            .filter(|&a| phi.row(a).iter().any(|v| *v != 0.0))
+            .collect();
+        let rows = active.len() * ns;
+        if rows * m > 2 * active.len() * phi.ncols() {
+            return None;
+        }
+        let mut mat = vec![0.0; rows * m];
+        for s in 0..ns {
+            let cols = basis.columns(s);
+            let block = basis.phi_at(s);
+            for (i, &a) in active.iter().enumerate() {
+                for (j, col) in cols.clone().enumerate() {
+                    mat[col * rows + s * active.len() + i] = block[(a, j)];
+                }
+            }
+        }
+        Some(Stacked { active, rows, mat })
+    }
+}
+
+/// Where the parts of [`StrainEval::scratch`] start: `c`, `C_z` (adjacent: `[c | C_z]` is one
+/// `m × (1 + r)` matrix), `Ċ_z`, `g`, `H`, the stacked products `Y`, the map's own.
 #[derive(Debug, Clone, Copy)]
 struct Layout {
-    c: usize,
+    /// `c` starts at 0.
     cz: usize,
     czd: usize,
     g: usize,
     h: usize,
+    y: usize,
     map: usize,
     end: usize,
 }
@@ -193,9 +233,11 @@ impl<M: CoefficientMap> ReducedParam<M> {
             phi.columns_mut(offsets[s], cols[s].len())
                 .copy_from(&basis.phi_at(s));
         }
+        let stacked = Stacked::of(basis, &phi);
         Ok(ReducedParam {
             map,
             phi,
+            stacked,
             offsets,
             cols,
             m,
@@ -210,18 +252,18 @@ impl<M: CoefficientMap> ReducedParam<M> {
 
     fn layout(&self) -> Layout {
         let (m, r) = (self.m, self.r);
-        let c = 0;
-        let cz = c + m;
+        let cz = m; // c at 0
         let czd = cz + m * r;
         let g = czd + m * r;
         let h = g + m;
-        let map = h + r * r;
+        let y = h + r * r;
+        let map = y + self.stacked.as_ref().map_or(0, |st| st.rows * (1 + r));
         Layout {
-            c,
             cz,
             czd,
             g,
             h,
+            y,
             map,
             end: map + self.map.scratch_len(),
         }
@@ -326,18 +368,37 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
     fn eval(&self, q: &DVector<f64>, ev: &mut StrainEval) {
         let l = self.layout();
         let (m, r) = (self.m, self.r);
+        let (head, map_scratch) = ev.scratch.split_at_mut(l.map);
+        let (cc, rest) = head.split_at_mut(l.czd);
         {
-            let (head, map_scratch) = ev.scratch.split_at_mut(l.map);
-            let (c, rest) = head.split_at_mut(l.cz);
-            let cz = &mut rest[..m * r];
-            self.map.eval(q.as_slice(), c, cz, &mut map_scratch[..]);
+            let (c, cz) = cc.split_at_mut(l.cz);
+            self.map.eval(q.as_slice(), c, cz, map_scratch);
         }
-        let sc = &ev.scratch;
-        let c = &sc[l.c..l.c + m];
-        let cz = &sc[l.cz..l.cz + m * r];
         let out = ev.psi_q.as_mut_slice();
-        for (s, psi) in ev.psi.iter_mut().enumerate() {
-            *psi = site_products(self, s, c, cz, &mut out[6 * s * r..6 * (s + 1) * r]);
+        match &self.stacked {
+            Some(st) => {
+                // Y = Φ [c | C_z]   (rows × (1 + r))
+                let y = &mut rest[l.y - l.czd..l.map - l.czd];
+                let rows = st.rows;
+                gemm((rows, m, 1 + r), &st.mat, (1, rows), cc, (1, m), 0.0, y, (1, rows));
+                let na = st.active.len();
+                for (s, psi) in ev.psi.iter_mut().enumerate() {
+                    *psi = V6::zeros();
+                    for (i, &a) in st.active.iter().enumerate() {
+                        let row = s * na + i;
+                        psi[a] = y[row];
+                        for k in 0..r {
+                            out[6 * (s * r + k) + a] = y[(k + 1) * rows + row];
+                        }
+                    }
+                }
+            }
+            None => {
+                let (c, cz) = cc.split_at(l.cz);
+                for (s, psi) in ev.psi.iter_mut().enumerate() {
+                    *psi = site_products(self, s, c, cz, &mut out[6 * s * r..6 * (s + 1) * r]);
+                }
+            }
         }
     }
 
@@ -345,17 +406,30 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
     fn eval_rate(&self, q: &DVector<f64>, qd: &DVector<f64>, ev: &mut StrainEval) {
         let l = self.layout();
         let (m, r) = (self.m, self.r);
-        {
-            let (head, map_scratch) = ev.scratch.split_at_mut(l.map);
-            let czd = &mut head[l.czd..l.czd + m * r];
-            self.map
-                .eval_rate(q.as_slice(), qd.as_slice(), czd, &mut map_scratch[..]);
-        }
-        let sc = &ev.scratch;
-        let czd = &sc[l.czd..l.czd + m * r];
+        let (head, map_scratch) = ev.scratch.split_at_mut(l.map);
+        let (czd, y) = head[l.czd..].split_at_mut(l.y - l.czd);
+        let czd = &mut czd[..m * r];
+        self.map
+            .eval_rate(q.as_slice(), qd.as_slice(), czd, map_scratch);
         let out = ev.psi_q_dot.as_mut_slice();
-        for s in 0..self.cols.len() {
-            site_products(self, s, &[], czd, &mut out[6 * s * r..6 * (s + 1) * r]);
+        match &self.stacked {
+            Some(st) => {
+                let rows = st.rows;
+                gemm((rows, m, r), &st.mat, (1, rows), czd, (1, m), 0.0, y, (1, rows));
+                let na = st.active.len();
+                for s in 0..self.cols.len() {
+                    for (i, &a) in st.active.iter().enumerate() {
+                        for k in 0..r {
+                            out[6 * (s * r + k) + a] = y[k * rows + s * na + i];
+                        }
+                    }
+                }
+            }
+            None => {
+                for s in 0..self.cols.len() {
+                    site_products(self, s, &[], czd, &mut out[6 * s * r..6 * (s + 1) * r]);
+                }
+            }
         }
     }
 
@@ -370,15 +444,31 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
         let l = self.layout();
         let r = self.r;
         let (head, map_scratch) = ev.scratch.split_at_mut(l.map);
-        let (g, h) = head[l.g..].split_at_mut(l.h - l.g);
-        g.fill(0.0);
-        for (s, cols) in self.cols.iter().enumerate() {
-            if w[s] == V6::zeros() {
-                continue;
+        let (g, rest) = head[l.g..].split_at_mut(l.h - l.g);
+        let (h, y) = rest.split_at_mut(l.y - l.h);
+        match &self.stacked {
+            Some(st) => {
+                // g = Φᵀ w   (w on the active rows, stacked like Φ)
+                let na = st.active.len();
+                for (s, ws) in w.iter().enumerate() {
+                    for (i, &a) in st.active.iter().enumerate() {
+                        y[s * na + i] = ws[a];
+                    }
+                }
+                let rows = st.rows;
+                gemm((self.m, rows, 1), &st.mat, (rows, 1), y, (1, rows), 0.0, g, (1, self.m));
             }
-            let phi = self.phi.columns(self.offsets[s], cols.len());
-            for (j, col) in cols.clone().enumerate() {
-                g[col] += phi.column(j).dot(&w[s]);
+            None => {
+                g.fill(0.0);
+                for (s, cols) in self.cols.iter().enumerate() {
+                    if w[s] == V6::zeros() {
+                        continue;
+                    }
+                    let phi = self.phi.columns(self.offsets[s], cols.len());
+                    for (j, col) in cols.clone().enumerate() {
+                        g[col] += phi.column(j).dot(&w[s]);
+                    }
+                }
             }
         }
         h.fill(0.0);
@@ -524,6 +614,46 @@ mod tests {
             let qd = DVector::from_fn(r, |i, _| 0.7 + 0.5 * i as f64);
             let e = derivative_errors(&p, &q, &qd, 1e-6);
             assert!(e.max() < 1e-6, "r = {r}: {e:?}");
+        }
+    }
+
+    #[test]
+    fn the_stacked_products_equal_the_per_site_loop() {
+        let (_disc, basis) = single_tendon_like();
+        let m = basis.n_dof();
+        for r in [1, 3] {
+            let map = || TanhMap {
+                a: pattern(m, 6, r) * 0.5,
+                b: pattern(6, r, 2 * r + 1),
+                bias: DVector::from_fn(6, |i, _| 0.1 * i as f64 - 0.2),
+            };
+            let stacked = ReducedParam::new(&basis, map(), DVector::zeros(r)).unwrap();
+            assert!(stacked.stacked.is_some(), "a global basis is stacked");
+            let mut looped = ReducedParam::new(&basis, map(), DVector::zeros(r)).unwrap();
+            looped.stacked = None;
+            let q = DVector::from_fn(r, |i, _| 0.3 - 0.25 * i as f64);
+            let qd = DVector::from_fn(r, |i, _| 0.7 + 0.5 * i as f64);
+            let w: Vec<V6> = (0..basis.n_sites())
+                .map(|s| V6::from_fn(|a, _| ((s * 5 + a * 3) % 7) as f64 - 3.0))
+                .collect();
+            let run = |p: &ReducedParam<TanhMap>| {
+                let mut ev = p.new_eval();
+                p.eval(&q, &mut ev);
+                p.eval_rate(&q, &qd, &mut ev);
+                let mut h = DMatrix::zeros(r, r);
+                p.add_weighted_hessian(&q, &w, &mut ev, &mut h);
+                (ev, h)
+            };
+            let ((a, ha), (b, hb)) = (run(&stacked), run(&looped));
+            let close = |x: &[f64], y: &[f64]| {
+                let scale = y.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+                x.iter().zip(y).all(|(u, v)| (u - v).abs() <= 1e-12 * scale)
+            };
+            let psi = |e: &StrainEval| e.psi.iter().flat_map(|v| v.iter().copied()).collect::<Vec<_>>();
+            assert!(close(&psi(&a), &psi(&b)), "Ψ, r = {r}");
+            assert!(close(a.psi_q.as_slice(), b.psi_q.as_slice()), "Ψ_q, r = {r}");
+            assert!(close(a.psi_q_dot.as_slice(), b.psi_q_dot.as_slice()), "Ψ̇_q, r = {r}");
+            assert!(close(ha.as_slice(), hb.as_slice()), "weighted Hessian, r = {r}");
         }
     }
 

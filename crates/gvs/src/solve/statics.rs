@@ -131,6 +131,7 @@ pub struct StaticsSolver<'m, P: StrainParam> {
     model: &'m Model<P>,
     ws: Workspace,
     dws: DoglegWorkspace,
+    at: DVector<f64>,
     pub options: StaticsOptions,
 }
 
@@ -139,6 +140,11 @@ struct System<'a, 'm, P: StrainParam> {
     ws: &'a mut Workspace,
     u: Vec<f64>,
     loads: PreparedLoads,
+    /// Where the last residual was evaluated, if `ws` still holds its forward pass: a Jacobian
+    /// asked for at that same point (the dogleg always asks at its current, evaluated point)
+    /// reuses the strains, poses and Magnus steps.
+    at: &'a mut DVector<f64>,
+    fresh: bool,
 }
 
 impl<P: StrainParam> NonlinearSystem for System<'_, '_, P> {
@@ -148,6 +154,8 @@ impl<P: StrainParam> NonlinearSystem for System<'_, '_, P> {
     fn residual(&mut self, x: &DVector<f64>, f: &mut DVector<f64>) -> Result<(), EvalError> {
         self.model
             .statics_residual(x, &self.u, &self.loads, self.ws, f);
+        self.at.copy_from(x);
+        self.fresh = true;
         Ok(())
     }
     fn jacobian(
@@ -156,8 +164,14 @@ impl<P: StrainParam> NonlinearSystem for System<'_, '_, P> {
         _f: &DVector<f64>,
         jac: &mut DMatrix<f64>,
     ) -> Result<(), EvalError> {
-        self.model
-            .statics_jacobian(x, &self.u, &self.loads, self.ws, jac);
+        if self.fresh && *self.at == *x {
+            self.model
+                .statics_jacobian_after_forward(x, &self.u, &self.loads, self.ws, jac);
+        } else {
+            self.model
+                .statics_jacobian(x, &self.u, &self.loads, self.ws, jac);
+        }
+        self.fresh = false;
         Ok(())
     }
     fn residual_scale(&self, _x: &DVector<f64>) -> f64 {
@@ -171,6 +185,7 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
             model,
             ws: model.workspace(),
             dws: DoglegWorkspace::new(model.n_dof()),
+            at: DVector::zeros(model.n_dof()),
             options,
         }
     }
@@ -260,6 +275,8 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                 ws: &mut self.ws,
                 u: u.iter().map(|v| v * target).collect(),
                 loads: self.model.prepare_loads(&loads_l)?,
+                at: &mut self.at,
+                fresh: false,
             };
             total.load_stages += 1;
             match dogleg::solve(&mut sys, &q, &opts, &mut self.dws) {
