@@ -52,10 +52,24 @@ impl Energy {
 }
 
 impl<P: StrainParam> Model<P> {
-    /// Forward pass with velocities: after [`Model::forward`] with Jacobians, fills `ws.eta` (`η_i`)
+    /// Forward pass with velocities: after [`Model::forward`], fills `ws.eta` (`η_i`)
     /// and `ζ_i = J̇ˢ_i q̇`.
     pub fn velocities(&self, q: &DVector<f64>, qd: &DVector<f64>, ws: &mut Workspace) {
-        let n = self.n_dof();
+        self.velocities_with(q, qd, None, ws);
+    }
+
+    /// [`Self::velocities`], and with `qdd` the body accelerations `η̇_i = J_i q̈ + J̇ˢ_i q̇` in
+    /// `ws.zeta` instead of `ζ_i`: the recursion of the module doc with `T Z q̈` added to `Ṡ q̇`.
+    /// `Ω̇ = Z q̇` is formed from the site strain rates `ξ̇_s = Ψ_q,s q̇` (Z4:
+    /// `Ω̇ = h/2 (ξ̇₁ + ξ̇₂) + c h² (ad_{ξ₁} ξ̇₂ − ad_{ξ₂} ξ̇₁)`), so no `Z` or `J` is needed: after a
+    /// forward pass without Jacobians this costs `O(n)` per site.
+    pub fn velocities_with(
+        &self,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        qdd: Option<&DVector<f64>>,
+        ws: &mut Workspace,
+    ) {
         let nonlinear = !self.param.is_linear();
         if nonlinear {
             self.param.eval_rate(q, qd, &mut ws.ev);
@@ -72,11 +86,10 @@ impl<P: StrainParam> Model<P> {
             let c = self.param.columns(s1);
             let qdc = qd.rows(c.start, c.len());
             let h = st.h;
-            let om_dot: V6 = ws.z.columns(i * n + c.start, c.len()) * qdc;
             let et = &ws.et[i];
             let xid1: V6 = ws.ev.psi_q_at(s1, &c) * qdc;
-            let mut zd = V6::zeros(); // Ż q̇
-            match self.disc.order {
+            let mut zd = V6::zeros(); // Ż q̇ (+ Z q̈)
+            let om_dot: V6 = match self.disc.order {
                 MagnusOrder::Z4 => {
                     let xid2: V6 = ws.ev.psi_q_at(s2, &c) * qdc;
                     let k = ZANNA_C * h * h;
@@ -87,14 +100,28 @@ impl<P: StrainParam> Model<P> {
                         zd += (a1 + a2) * (0.5 * h)
                             + (ad_mul(&ws.xi[s1], &a2) - ad_mul(&ws.xi[s2], &a1)) * k;
                     }
+                    if let Some(qdd) = qdd {
+                        let qddc = qdd.rows(c.start, c.len());
+                        let b1: V6 = ws.ev.psi_q_at(s1, &c) * qddc;
+                        let b2: V6 = ws.ev.psi_q_at(s2, &c) * qddc;
+                        zd += (b1 + b2) * (0.5 * h)
+                            + (ad_mul(&ws.xi[s1], &b2) - ad_mul(&ws.xi[s2], &b1)) * k;
+                    }
+                    (xid1 + xid2) * (0.5 * h)
+                        + (ad_mul(&ws.xi[s1], &xid2) - ad_mul(&ws.xi[s2], &xid1)) * k
                 }
                 MagnusOrder::Z2 => {
                     if nonlinear {
                         let a1: V6 = ws.ev.psi_q_dot_at(s1, &c) * qdc;
                         zd += a1 * h;
                     }
+                    if let Some(qdd) = qdd {
+                        let b1: V6 = ws.ev.psi_q_at(s1, &c) * qdd.rows(c.start, c.len());
+                        zd += b1 * h;
+                    }
+                    xid1 * h
                 }
-            }
+            };
             let sqd = et.t * om_dot;
             let sdqd = et.t_dot(&om_dot) * om_dot + et.t * zd;
             ws.eta[i + 1] = et.g.adjoint_inv_mul(&(ws.eta[i] + sqd));
@@ -158,6 +185,62 @@ impl<P: StrainParam> Model<P> {
             ws.w[i] -= inertial * p.weight;
         }
         self.assemble_forces(u, Some(qd), ws, r);
+    }
+
+    /// Residual of the equations of motion `ε = M(q) q̈ − τ(q, q̇)` (paper eq. 8), for implicit
+    /// integrators in second-order form, without forming `M`: the inertial wrenches
+    /// `W (Ms η̇_i + coad_{η_i} Ms η_i)` with the body accelerations `η̇_i = J_i q̈ + J̇ˢ_i q̇` of
+    /// [`Self::velocities_with`] join the external ones in the statics backward pass
+    /// (recursive Newton–Euler, spec §7.8). Cost: one statics residual plus `O(n)` per site.
+    #[allow(clippy::too_many_arguments)]
+    pub fn dynamics_residual(
+        &self,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        qdd: &DVector<f64>,
+        u: &[f64],
+        loads: &PreparedLoads,
+        ws: &mut Workspace,
+        r: &mut DVector<f64>,
+    ) {
+        self.forward(q, ws, false);
+        self.velocities_with(q, qd, Some(qdd), ws);
+        self.point_wrenches(loads, ws);
+        for (i, p) in self.disc.points.iter().enumerate() {
+            if p.weight == 0.0 {
+                continue;
+            }
+            let ms = self.props[i].ms;
+            let inertial =
+                ms.component_mul(&ws.zeta[i]) + coad_mul(&ws.eta[i], &ms.component_mul(&ws.eta[i]));
+            ws.w[i] -= inertial * p.weight;
+        }
+        self.assemble_forces(u, Some(qd), ws, r);
+        r.neg_mut();
+    }
+
+    /// Iteration matrix of an implicit integrator in second-order form,
+    /// `S = M + c_v D + c_q K_T ≈ ∂ε/∂q̈ + c_v ∂ε/∂q̇ + c_q ∂ε/∂q` for `ε` of
+    /// [`Self::dynamics_residual`] when `q̇` and `q` move with `q̈` at the rates `c_v`, `c_q`
+    /// (Newmark: `γ h`, `β h²`), with the tangent stiffness `K_T = −∂R/∂q` of the statics
+    /// Jacobian (elastic, tendons, loads) and the damping matrix `D`; the gyroscopic and `∂M/∂q q̈`
+    /// terms are dropped (they vanish at rest). Exact at an equilibrium at rest.
+    #[allow(clippy::too_many_arguments)]
+    pub fn iteration_parts(
+        &self,
+        q: &DVector<f64>,
+        u: &[f64],
+        loads: &PreparedLoads,
+        ws: &mut Workspace,
+        mass: &mut DMatrix<f64>,
+        damping: &mut DMatrix<f64>,
+        stiffness: &mut DMatrix<f64>,
+    ) {
+        self.statics_jacobian(q, u, loads, ws, stiffness);
+        stiffness.neg_mut();
+        self.assemble_mass(ws); // J from the statics Jacobian's forward pass
+        mass.copy_from(&ws.mass);
+        damping.copy_from(&self.damping_matrix(ws));
     }
 
     /// Accelerations `q̈ = M⁻¹ τ` (spec §9.1) by an in-place Cholesky factorization of `M`.

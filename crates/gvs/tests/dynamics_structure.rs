@@ -132,6 +132,101 @@ fn coriolis_matrix_agrees_with_force_path() {
     );
 }
 
+/// `ε(q, q̇, q̈) = M q̈ − τ` of the recursive path against the assembled `M` and the force path,
+/// with damping, friction, tendons and gravity.
+fn check_dynamics_residual<P: StrainParam>(
+    m: &Model<P>,
+    q: &DVector<f64>,
+    qd: &DVector<f64>,
+    qdd: &DVector<f64>,
+) {
+    let n = m.n_dof();
+    let mut ws = m.workspace();
+    let loads = m
+        .prepare_loads(&Loads {
+            gravity: [0.0, 0.0, -9.81],
+            ..Default::default()
+        })
+        .unwrap();
+    let u = vec![-1.5; m.n_actuators()];
+    let mut tau = DVector::zeros(n);
+    m.dynamic_forces(q, qd, &u, &loads, &mut ws, &mut tau);
+    let expected = &ws.mass * qdd - &tau;
+    let mut eps = DVector::from_element(n, f64::NAN);
+    m.dynamics_residual(q, qd, qdd, &u, &loads, &mut ws, &mut eps);
+    let err = (&eps - &expected).amax() / expected.amax();
+    assert!(err < 1e-11, "M q̈ − τ recursive vs assembled: {err:e}");
+}
+
+#[test]
+fn recursive_dynamics_residual_equals_mass_times_acceleration_minus_forces() {
+    let m = linear_model(MagnusOrder::Z4, 2e4);
+    check_dynamics_residual(
+        &m,
+        &pseudo_random(m.n_dof(), 31, 0.5),
+        &pseudo_random(m.n_dof(), 32, 2.0),
+        &pseudo_random(m.n_dof(), 33, 50.0),
+    );
+    let m = linear_model(MagnusOrder::Z2, 2e4);
+    check_dynamics_residual(
+        &m,
+        &pseudo_random(m.n_dof(), 34, 0.5),
+        &pseudo_random(m.n_dof(), 35, 2.0),
+        &pseudo_random(m.n_dof(), 36, 50.0),
+    );
+    let m = sigmoid_model();
+    check_dynamics_residual(
+        &m,
+        &DVector::from_vec(vec![1.2, 7.0, 0.4]),
+        &DVector::from_vec(vec![0.8, -4.0, 0.3]),
+        &DVector::from_vec(vec![-3.0, 20.0, 1.0]),
+    );
+}
+
+/// At an equilibrium at rest the iteration matrix `M + c_v D + c_q K_T` is the exact derivative of
+/// `q̈ ↦ ε(q_e + c_q q̈, c_v q̈, q̈)` at `q̈ = 0` (central differences).
+#[test]
+fn iteration_matrix_is_exact_at_an_equilibrium_at_rest() {
+    use gvs::solve::statics::{StaticsOptions, StaticsSolver};
+    let m = linear_model(MagnusOrder::Z4, 2e4);
+    let n = m.n_dof();
+    let loads = Loads {
+        gravity: [0.0, 0.0, -9.81],
+        ..Default::default()
+    };
+    let u = [-1.5];
+    let qe = StaticsSolver::new(&m, StaticsOptions::default())
+        .solve(&u, &loads, None)
+        .unwrap()
+        .q;
+    let pl = m.prepare_loads(&loads).unwrap();
+    let mut ws = m.workspace();
+    let (mut mm, mut dd, mut kk) = (
+        nalgebra::DMatrix::zeros(n, n),
+        nalgebra::DMatrix::zeros(n, n),
+        nalgebra::DMatrix::zeros(n, n),
+    );
+    m.iteration_parts(&qe, &u, &pl, &mut ws, &mut mm, &mut dd, &mut kk);
+    let (cv, cq) = (0.61 * 1e-3, 0.31 * 1e-6);
+    let s = &mm + &dd * cv + &kk * cq;
+    let mut fd = nalgebra::DMatrix::zeros(n, n);
+    let (mut ep, mut em) = (DVector::zeros(n), DVector::zeros(n));
+    for j in 0..n {
+        let e = 1e-3;
+        let mut a = DVector::zeros(n);
+        a[j] = e;
+        m.dynamics_residual(&(&qe + &a * cq), &(&a * cv), &a, &u, &pl, &mut ws, &mut ep);
+        a[j] = -e;
+        m.dynamics_residual(&(&qe + &a * cq), &(&a * cv), &a, &u, &pl, &mut ws, &mut em);
+        fd.set_column(j, &((&ep - &em) / (2.0 * e)));
+    }
+    let err = (&s - &fd).amax() / fd.amax();
+    assert!(
+        err < 1e-6,
+        "iteration matrix vs central differences: {err:e}"
+    );
+}
+
 fn check_velocity_recursions<P: StrainParam>(m: &Model<P>, q: &DVector<f64>, qd: &DVector<f64>) {
     // η_i = J_i q̇ and ζ_i = J̇_i q̇ with J̇ from central differences of J along q̇
     let n = m.n_dof();
