@@ -390,7 +390,7 @@ impl ExpTangent {
         for j in 1..5 {
             cf[j] = c1 * cf[j - 1];
         }
-        let sign = |r: usize| if r % 2 == 0 { 1.0 } else { -1.0 };
+        let sign = |r: usize| if r.is_multiple_of(2) { 1.0 } else { -1.0 };
         let v = |u: usize| -> V6 {
             (u..=4).fold(V6::zeros(), |acc, r| {
                 acc + cf[r - u] * (sign(r) * self.coeffs.f[r - 1])

@@ -11,6 +11,13 @@ use gvsrom::statics::{self, StaticsReport};
 use gvsrom::{build, Built, Scenario};
 use std::io::Write;
 use std::ops::ControlFlow;
+
+/// `simulate --method`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum MethodChoice {
+    Ndf,
+    Galpha,
+}
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
@@ -231,6 +238,19 @@ pub struct SimulateArgs {
     /// Use the fixed-step implicit method with step H [s] instead of the adaptive NDF (real time).
     #[arg(long, value_name = "H")]
     pub fixed_step: Option<f64>,
+
+    /// Adaptive integrator: `ndf` (variable order, ode15s class) or `galpha` (generalized-α in
+    /// second-order form with numerical dissipation `--rho-inf`, Newton on n unknowns).
+    #[arg(long, value_enum, default_value_t = MethodChoice::Ndf)]
+    pub method: MethodChoice,
+
+    /// Highest order of the NDF, 1–5 (orders ≤ 2 are A-stable).
+    #[arg(long, default_value_t = 5)]
+    pub max_order: usize,
+
+    /// Generalized-α: spectral radius at infinite frequency in [0, 1] (1: no numerical dissipation).
+    #[arg(long, default_value_t = 0.8)]
+    pub rho_inf: f64,
 
     /// Time-varying external loads: a CSV file with columns `t, λ` that scales every external load and
     /// gravity, linearly interpolated between rows (e.g. a load applied then removed).
@@ -500,7 +520,7 @@ fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
 fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
     use gvs::inputs::Interpolation;
     use gvs::solve::dynamics::{IntegratorOptions, Method, OdeJacobian};
-    use gvs::solve::ode::{FixedStepOptions, NdfOptions};
+    use gvs::solve::ode::{FixedStepOptions, GeneralizedAlphaOptions, NdfOptions};
     use gvsrom::simulate::{self, InputSource, SimulateOptions};
     use std::io::IsTerminal;
     let (scenario, mut built) = load(&args.scenario)?;
@@ -545,14 +565,21 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
     } else {
         InputSource::Constant
     };
-    let method = match args.fixed_step {
-        Some(h) => Method::Fixed(FixedStepOptions {
+    let method = match (args.fixed_step, args.method) {
+        (Some(h), _) => Method::Fixed(FixedStepOptions {
             h,
             ..FixedStepOptions::default()
         }),
-        None => Method::Ndf(NdfOptions {
+        (None, MethodChoice::Galpha) => Method::GeneralizedAlpha(GeneralizedAlphaOptions {
             rtol: args.rtol,
             atol: args.atol,
+            rho_inf: args.rho_inf,
+            ..GeneralizedAlphaOptions::default()
+        }),
+        (None, MethodChoice::Ndf) => Method::Ndf(NdfOptions {
+            rtol: args.rtol,
+            atol: args.atol,
+            max_order: args.max_order,
             ..NdfOptions::default()
         }),
     };

@@ -7,8 +7,8 @@
 //! On failure the samples computed so far are kept and the error carries the time reached.
 
 use super::ode::{
-    integrate_fixed, integrate_ndf, FixedStepOptions, NdfOptions, OdeError, OdeStats, OdeSystem,
-    RhsError,
+    integrate_fixed, integrate_generalized_alpha, integrate_ndf, FixedStepOptions,
+    GeneralizedAlphaOptions, MechanicalSystem, NdfOptions, OdeError, OdeStats, OdeSystem, RhsError,
 };
 use super::statics::{StaticsError, StaticsOptions, StaticsSolver};
 use crate::error::ModelError;
@@ -28,6 +28,8 @@ pub enum Method {
     Ndf(NdfOptions),
     /// Fixed-step implicit method for real-time use.
     Fixed(FixedStepOptions),
+    /// Adaptive generalized-α in second-order form (lightly damped rods).
+    GeneralizedAlpha(GeneralizedAlphaOptions),
 }
 
 /// Integrator and Jacobian choice.
@@ -137,11 +139,7 @@ impl<P: StrainParam> OdeSystem for RodOde<'_, P> {
         }
         let n = self.model.n_dof();
         self.q.copy_from(&y.rows(0, n));
-        self.actuation.eval(t, &mut self.u);
-        if let Some(s) = self.load_scale {
-            s.eval(t, &mut self.lambda);
-            self.loads.scale_from(&self.base_loads, self.lambda[0]);
-        }
+        self.inputs_at(t);
         self.model
             .ode_jacobian_approx(&self.q, &self.u, &self.loads, &mut self.ws, jac)
             .map_err(|e| RhsError(e.to_string()))?;
@@ -156,11 +154,7 @@ impl<P: StrainParam> OdeSystem for RodOde<'_, P> {
         let n = self.model.n_dof();
         self.q.copy_from(&y.rows(0, n));
         self.qd.copy_from(&y.rows(n, n));
-        self.actuation.eval(t, &mut self.u);
-        if let Some(s) = self.load_scale {
-            s.eval(t, &mut self.lambda);
-            self.loads.scale_from(&self.base_loads, self.lambda[0]);
-        }
+        self.inputs_at(t);
         self.model
             .accelerations(
                 &self.q,
@@ -173,6 +167,65 @@ impl<P: StrainParam> OdeSystem for RodOde<'_, P> {
             .map_err(|e| RhsError(e.to_string()))?;
         dy.rows_mut(0, n).copy_from(&self.qd);
         dy.rows_mut(n, n).copy_from(&self.qdd);
+        Ok(())
+    }
+}
+
+impl<P: StrainParam> RodOde<'_, P> {
+    /// Inputs at `t`: `self.u` and the scaled loads.
+    fn inputs_at(&mut self, t: f64) {
+        self.actuation.eval(t, &mut self.u);
+        if let Some(s) = self.load_scale {
+            s.eval(t, &mut self.lambda);
+            self.loads.scale_from(&self.base_loads, self.lambda[0]);
+        }
+    }
+}
+
+impl<P: StrainParam> MechanicalSystem for RodOde<'_, P> {
+    fn dim(&self) -> usize {
+        self.model.n_dof()
+    }
+
+    fn residual(
+        &mut self,
+        t: f64,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        qdd: &DVector<f64>,
+        eps: &mut DVector<f64>,
+    ) -> Result<(), RhsError> {
+        self.inputs_at(t);
+        self.model
+            .dynamics_residual(q, qd, qdd, &self.u, &self.loads, &mut self.ws, eps);
+        Ok(())
+    }
+
+    fn accelerations(
+        &mut self,
+        t: f64,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        qdd: &mut DVector<f64>,
+    ) -> Result<(), RhsError> {
+        self.inputs_at(t);
+        self.model
+            .accelerations(q, qd, &self.u, &self.loads, &mut self.ws, qdd)
+            .map_err(|e| RhsError(e.to_string()))
+    }
+
+    fn iteration_parts(
+        &mut self,
+        t: f64,
+        q: &DVector<f64>,
+        _qd: &DVector<f64>,
+        m: &mut nalgebra::DMatrix<f64>,
+        d: &mut nalgebra::DMatrix<f64>,
+        k: &mut nalgebra::DMatrix<f64>,
+    ) -> Result<(), RhsError> {
+        self.inputs_at(t);
+        self.model
+            .iteration_parts(q, &self.u, &self.loads, &mut self.ws, m, d, k);
         Ok(())
     }
 }
@@ -354,6 +407,9 @@ pub fn simulate_streaming<P: StrainParam>(
     let result = match &options.method {
         Method::Ndf(o) => integrate_ndf(&mut sys, t0, &y0, t_out, &breaks, o, &mut record),
         Method::Fixed(o) => integrate_fixed(&mut sys, t0, &y0, t_out, &breaks, o, &mut record),
+        Method::GeneralizedAlpha(o) => {
+            integrate_generalized_alpha(&mut sys, t0, &q0, &qd0, t_out, &breaks, o, &mut record)
+        }
     };
     let wall_time_s = start.elapsed().as_secs_f64();
     let (stats, error) = match result {

@@ -96,6 +96,7 @@ use nalgebra::{DMatrix, DVector};
 use std::ops::ControlFlow;
 
 mod fixed;
+mod galpha;
 mod ndf;
 #[cfg(test)]
 mod tests;
@@ -103,8 +104,11 @@ mod tests;
 mod tests_errors;
 #[cfg(test)]
 mod tests_fixed;
+#[cfg(test)]
+mod tests_galpha;
 
 pub use fixed::integrate_fixed;
+pub use galpha::{integrate_generalized_alpha, GeneralizedAlphaOptions, MechanicalSystem};
 
 /// The output callback of the integrators: called with every output time and the solution there;
 /// `ControlFlow::Break(reason)` stops the integration with [`OdeError::Stopped`].
