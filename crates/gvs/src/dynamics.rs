@@ -175,15 +175,7 @@ impl<P: StrainParam> Model<P> {
         self.velocities(q, qd, ws);
         self.assemble_mass(ws);
         self.point_wrenches(loads, ws);
-        for (i, p) in self.disc.points.iter().enumerate() {
-            if p.weight == 0.0 {
-                continue;
-            }
-            let ms = self.props[i].ms;
-            let inertial =
-                ms.component_mul(&ws.zeta[i]) + coad_mul(&ws.eta[i], &ms.component_mul(&ws.eta[i]));
-            ws.w[i] -= inertial * p.weight;
-        }
+        self.subtract_inertial_wrenches(ws);
         self.assemble_forces(u, Some(qd), ws, r);
     }
 
@@ -206,15 +198,7 @@ impl<P: StrainParam> Model<P> {
         self.forward(q, ws, false);
         self.velocities_with(q, qd, Some(qdd), ws);
         self.point_wrenches(loads, ws);
-        for (i, p) in self.disc.points.iter().enumerate() {
-            if p.weight == 0.0 {
-                continue;
-            }
-            let ms = self.props[i].ms;
-            let inertial =
-                ms.component_mul(&ws.zeta[i]) + coad_mul(&ws.eta[i], &ms.component_mul(&ws.eta[i]));
-            ws.w[i] -= inertial * p.weight;
-        }
+        self.subtract_inertial_wrenches(ws);
         self.assemble_forces(u, Some(qd), ws, r);
         r.neg_mut();
     }
@@ -241,6 +225,20 @@ impl<P: StrainParam> Model<P> {
         self.assemble_mass(ws); // J from the statics Jacobian's forward pass
         mass.copy_from(&ws.mass);
         damping.copy_from(&self.damping_matrix(ws));
+    }
+
+    /// `w_i −= W_i (Ms ζ_i + coad_{η_i} Ms η_i)`: the inertial wrenches (with `ζ_i` the body
+    /// acceleration at `q̈ = 0`, or the full `η̇_i` after [`Self::velocities_with`] with `q̈`).
+    fn subtract_inertial_wrenches(&self, ws: &mut Workspace) {
+        for (i, p) in self.disc.points.iter().enumerate() {
+            if p.weight == 0.0 {
+                continue;
+            }
+            let ms = self.props[i].ms;
+            let inertial =
+                ms.component_mul(&ws.zeta[i]) + coad_mul(&ws.eta[i], &ms.component_mul(&ws.eta[i]));
+            ws.w[i] -= inertial * p.weight;
+        }
     }
 
     /// Accelerations `q̈ = M⁻¹ τ` (spec §9.1) by an in-place Cholesky factorization of `M`.
