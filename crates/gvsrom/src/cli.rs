@@ -37,6 +37,9 @@ pub enum Command {
     /// Simulate the dynamics of a preset or scenario file (stiff NDF integrator, ode15s class) and
     /// write the trajectory as NumPy arrays.
     Simulate(SimulateArgs),
+    /// Natural frequencies and mode shapes about the static equilibrium under the scenario's loads
+    /// and tensions (undamped, linearized; see README "Natural frequencies and mode shapes").
+    Modes(ModesArgs),
     /// Generate a strain snapshot dataset: solve the statics over a sampling plan (`--sweep`,
     /// `--grid`, `--random`) in parallel and write NumPy arrays (see README "Datasets").
     Dataset(gvsrom::dataset::DatasetArgs),
@@ -113,6 +116,31 @@ pub struct StaticsArgs {
     /// Solve N times and report the mean solve time (warm caches; for timing comparisons).
     #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100_000))]
     pub repeat: u32,
+}
+
+#[derive(Debug, Args)]
+pub struct ModesArgs {
+    #[command(flatten)]
+    pub scenario: ScenarioArgs,
+
+    /// Number of modes reported, lowest first (an integer ≥ 1, default 10); more than the model's DOF
+    /// count reports all of them, with a note.
+    #[arg(long, value_name = "K", allow_hyphen_values = true)]
+    pub count: Option<String>,
+
+    /// Also write the equilibrium, the frequencies and the mode shapes (q-space, tip displacement
+    /// and rotation, strain at the computational points) as JSON to FILE (a new file; see `--force`).
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+
+    /// Replace FILE if it is an earlier gvsrom output (never anything else).
+    #[arg(long, requires = "json")]
+    pub force: bool,
+
+    /// Use the reduced model in directory MODEL (from `gvsrom pod` or `gvsrom train`) in place of
+    /// the scenario's basis, for the equilibrium and the modes.
+    #[arg(long, value_name = "MODEL")]
+    pub model: Option<PathBuf>,
 }
 
 #[derive(Debug, Args)]
@@ -283,6 +311,7 @@ pub fn run(cli: Cli, out: &mut impl Write) -> Result<()> {
     match cli.command {
         Command::Statics(args) => statics_cmd(&args, out),
         Command::Simulate(args) => simulate_cmd(&args, out),
+        Command::Modes(args) => modes_cmd(&args, out),
         Command::Dataset(args) => dataset_cmd(&args, out),
         Command::Pod(args) => pod_cmd(&args, out),
         Command::Train(args) => train_cmd(&args, out),
@@ -385,6 +414,88 @@ fn statics_cmd(args: &StaticsArgs, out: &mut impl Write) -> Result<()> {
             report: &report,
             model: args.model.as_ref().map(|p| p.display().to_string()),
             comparison,
+        };
+        let path = json.commit_json(&doc)?;
+        writeln!(out, "json       {}", path.display())?;
+    }
+    Ok(())
+}
+
+fn modes_cmd(args: &ModesArgs, out: &mut impl Write) -> Result<()> {
+    use gvsrom::modes;
+    let (scenario, mut built) = load(&args.scenario)?;
+    if let Some(dir) = &args.model {
+        attach_model(&mut built, &args.scenario, dir)?;
+    }
+    let n_dof = built.n_dof();
+    let (count, clipped) = modes::parse_count(args.count.as_deref(), n_dof)?;
+    // the output is checked, locked and staged before the solve, so a bad path fails at once
+    let json = match &args.json {
+        Some(path) => Some(OutputFile::create("--json", path, "modes", args.force)?),
+        None => None,
+    };
+    print_model(&scenario, &built, out)?;
+    if clipped {
+        writeln!(
+            out,
+            "note       --count {} exceeds the model's {n_dof} DOF: reporting all {n_dof} modes",
+            args.count.as_deref().unwrap_or_default()
+        )?;
+    }
+    let (eq, report) = modes::compute(&built, count)?;
+    writeln!(
+        out,
+        "solved     equilibrium in {} and {}, ‖R‖∞ = {:.3e} (as `gvsrom statics`)",
+        plural(eq.iterations, "iteration"),
+        plural(eq.load_stages, "load stage"),
+        eq.residual_norm,
+    )?;
+    writeln!(
+        out,
+        "tip        position {} m",
+        fmt_vec(&eq.tip_position, 6)
+    )?;
+    writeln!(
+        out,
+        "modes      lowest {count} of {n_dof}, undamped, linearized about the equilibrium; each shape by its largest share of the strain energy and its tip motion (world axes)"
+    )?;
+    writeln!(
+        out,
+        "{:>4}  {:>14}  {:>12}  {:<20}  tip motion",
+        "mode", "frequency [Hz]", "period [s]", "strain energy"
+    )?;
+    let length = built.model.disc.length();
+    let mut unstable = 0;
+    for m in &report.modes {
+        let period = match m.period_s {
+            Some(t) => format!("{t:.6}"),
+            None => "∞".into(),
+        };
+        let mut tip = modes::tip_motion(m, length);
+        if m.omega_squared < 0.0 {
+            unstable += 1;
+            tip.push_str(&format!(" (ω² = {:.3e} < 0: unstable)", m.omega_squared));
+        }
+        writeln!(
+            out,
+            "{:>4}  {:>14.6}  {:>12}  {:<20}  {tip}",
+            m.mode,
+            m.frequency_hz,
+            period,
+            format!("{} {:.1} %", m.dominant_strain, 100.0 * m.dominant_share()),
+        )?;
+    }
+    if unstable > 0 {
+        writeln!(
+            out,
+            "note       {} with ω² < 0: the equilibrium is unstable (it buckles) along them; their frequency is shown as 0",
+            plural(unstable, "mode")
+        )?;
+    }
+    if let Some(json) = json {
+        let doc = modes::ModesJson {
+            report: &report,
+            model: args.model.as_ref().map(|p| p.display().to_string()),
         };
         let path = json.commit_json(&doc)?;
         writeln!(out, "json       {}", path.display())?;

@@ -2,13 +2,15 @@
 //!
 //! The library half of the `gvsrom` command: TOML scenario files ([`scenario`]), their validation and
 //! conversion to the engine's model ([`build`]), the built-in presets for the paper's robots
-//! ([`presets`]) and statics runs with their JSON report ([`statics`]). The binary only parses the
-//! command line, calls these and prints.
+//! ([`presets`]), statics runs with their JSON report ([`statics`]) and the natural frequencies and
+//! mode shapes about an equilibrium ([`modes`]). The binary only parses the command line, calls these
+//! and prints.
 
 pub mod build;
 pub mod csv_input;
 pub mod dataset;
 pub mod error;
+pub mod modes;
 pub mod npy;
 pub mod output;
 pub mod plausibility;
