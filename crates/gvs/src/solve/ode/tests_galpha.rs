@@ -3,6 +3,7 @@
 
 use super::*;
 use nalgebra::{DMatrix, DVector};
+use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
 /// `m q̈ + c q̇ + k q = f(t)` per coordinate (decoupled), `f` a step at `t_step`.
@@ -240,5 +241,3 @@ fn invalid_options_are_refused_with_the_field() {
         assert!(e.to_string().contains(field), "{e}");
     }
 }
-
-use std::f64::consts::PI;
