@@ -8,7 +8,7 @@ use crate::error::ScenarioError;
 use crate::scenario::{
     default_pulse_axis, BasisKind, DistributedKind, DivisionSpec, Scenario, StrainMode, TendonSpec,
 };
-use gvs::actuation::Tendon;
+use gvs::actuation::{Tendon, DEFAULT_FRICTION_SMOOTHING};
 use gvs::discretize::{Discretization, Quadrature};
 use gvs::lie::{Pose, M3, V3};
 use gvs::loads::{DistributedWrench, Loads, PointWrench};
@@ -645,6 +645,7 @@ fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, ScenarioError> 
         x_start,
         x_end,
         friction,
+        friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
     };
     // |d(X)| is convex along the span and r(X) linear per division: checking the span's ends and
     // the division junctions inside it covers the whole path.
