@@ -53,7 +53,7 @@ pub struct Tendon {
     pub friction: f64,
     /// Curvature scale `κ_ε ≥ 0` [rad/m] below which the friction angle is smoothed: each turning
     /// angle between consecutive tendon points is [`smoothed_turning_angle`] with
-    /// `ε = κ_ε h̄` ([`Tendon::smoothing_angle`]); 0 gives the exact, kinked tangent rule. Default
+    /// `ε = κ_ε |ΔX|` ([`Tendon::smoothing_angle`]); 0 gives the exact, kinked tangent rule. Default
     /// [`DEFAULT_FRICTION_SMOOTHING`].
     #[serde(default = "default_friction_smoothing")]
     pub friction_smoothing: f64,
