@@ -18,7 +18,9 @@
 //! parameterization's weighted Hessian (zero for linear bases). `∂F̄/∂q` follows the backward recursion
 //! of spec §8.2; the friction factor's derivative `∂α/∂q` is included, so the Jacobian is exact.
 
-use crate::actuation::{tangent_jacobian, tendon_local, turning_angle, wrench_jacobian, Tendon};
+use crate::actuation::{
+    smoothed_turning_angle, tangent_jacobian, tendon_local, wrench_jacobian, Tendon,
+};
 use crate::discretize::{Discretization, MagnusOrder};
 use crate::error::ModelError;
 use crate::lie::{ad, coad, coad_mul, coadbar, exp_tangent, tilde, ExpTangent, Pose, M6, V3, V6};
@@ -464,7 +466,9 @@ impl<P: StrainParam> Model<P> {
                         );
                     }
                     if m > 0 {
-                        let (phi, ga, gb) = turning_angle(&tau_prev, &tau);
+                        let x_prev = self.disc.points[self.tendon_points[k][m - 1]].x;
+                        let eps = td.smoothing_angle(p.x - x_prev);
+                        let (phi, ga, gb) = smoothed_turning_angle(&tau_prev, &tau, eps);
                         theta += phi;
                         if jac {
                             ws.dtheta.gemv_tr(1.0, &ws.dtau_prev, &ga, 1.0);

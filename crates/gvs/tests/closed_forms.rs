@@ -2,7 +2,7 @@
 //! after the case it checks. Expected values come from formulas or from independent integrations
 //! written here, never from the code under test.
 
-use gvs::actuation::Tendon;
+use gvs::actuation::{Tendon, DEFAULT_FRICTION_SMOOTHING};
 use gvs::discretize::{Discretization, MagnusOrder, Quadrature};
 use gvs::lie::{exp_se3, hat, Pose, V3, V6};
 use gvs::loads::{DistributedWrench, Frame, Loads, PointWrench, PulseMagnitude};
@@ -238,6 +238,7 @@ fn constant_offset_tendon_gives_uniform_curvature_and_contraction() {
         x_start: 0.0,
         x_end: l,
         friction: 0.0,
+        friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
     };
     let m = model(
         Rod::tapered(mat(e, 0.0), l, r, r),
@@ -266,6 +267,7 @@ fn constant_offset_tendon_with_friction_follows_capstan_curvature() {
         x_start: 0.0,
         x_end: l,
         friction: mu,
+        friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
     };
     let m = model(
         Rod::tapered(mat(e, 0.0), l, r, r),
@@ -542,6 +544,7 @@ fn rotating_base_and_gravity_together_leaves_equilibrium_unchanged() {
         x_start: 0.0,
         x_end: 0.25,
         friction: 0.88,
+        friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
     };
     let m = model(
         rod.clone(),
@@ -602,6 +605,7 @@ fn planar_loading_keeps_out_of_plane_coordinates_exactly_zero() {
         x_start: 0.0,
         x_end: 0.25,
         friction: 0.88,
+        friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
     };
     let m = model(rod, 30, legendre([Some(3); 6]), vec![tendon], &[]);
     let loads = Loads {

@@ -6,7 +6,7 @@
 mod common;
 
 use common::clamped_rod_10_5;
-use gvs::actuation::Tendon;
+use gvs::actuation::{Tendon, DEFAULT_FRICTION_SMOOTHING};
 use gvs::discretize::{Discretization, MagnusOrder, Quadrature};
 use gvs::inputs::Signal;
 use gvs::loads::Loads;
@@ -43,6 +43,7 @@ fn arm(damping: f64, friction: f64) -> Model<LinearBasis> {
         x_start: 0.0,
         x_end: 0.25,
         friction,
+        friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
     };
     Model::new(rod, disc, b, vec![t]).unwrap()
 }

@@ -2,7 +2,7 @@
 //! `Ṁ − 2C` skew-symmetric, the Coriolis matrix consistent with the force path, `J̇ q̇` against finite
 //! differences, and linearized natural frequencies against beam theory.
 
-use gvs::actuation::Tendon;
+use gvs::actuation::{Tendon, DEFAULT_FRICTION_SMOOTHING};
 use gvs::discretize::{Discretization, MagnusOrder, Quadrature};
 use gvs::loads::Loads;
 use gvs::model::Model;
@@ -40,6 +40,7 @@ fn linear_model(order: MagnusOrder, damping: f64) -> Model<LinearBasis> {
         x_start: 0.0,
         x_end: 0.25,
         friction: 0.5,
+        friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
     };
     Model::new(rod, disc, b, vec![t]).unwrap()
 }

@@ -4,7 +4,7 @@
 //! divisions, Z2 and Z4, and a nonlinear (sigmoid) strain parameterization; the Jacobian that
 //! reuses a residual's forward pass is the same matrix.
 
-use gvs::actuation::Tendon;
+use gvs::actuation::{Tendon, DEFAULT_FRICTION_SMOOTHING};
 use gvs::discretize::{Discretization, MagnusOrder, Quadrature};
 use gvs::lie::{Pose, V6};
 use gvs::loads::{DistributedWrench, Frame, Loads, PointWrench, PulseMagnitude};
@@ -121,6 +121,7 @@ fn single_division_model(order: MagnusOrder, friction: f64) -> Model<LinearBasis
             x_start: 0.0,
             x_end: 0.25,
             friction,
+            friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         },
         Tendon {
             offset_start: [0.006, -0.002],
@@ -128,6 +129,7 @@ fn single_division_model(order: MagnusOrder, friction: f64) -> Model<LinearBasis
             x_start: 0.0,
             x_end: 0.25,
             friction: 0.3,
+            friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         },
     ];
     Model::new(rod, disc, basis, tendons).unwrap()
@@ -228,6 +230,7 @@ fn statics_jacobian_matches_finite_differences_two_divisions_half_tendon() {
             x_start: 0.0,
             x_end: 0.6,
             friction: 0.4,
+            friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         },
         Tendon {
             offset_start: [0.01, 0.0173],
@@ -235,6 +238,7 @@ fn statics_jacobian_matches_finite_differences_two_divisions_half_tendon() {
             x_start: 0.0,
             x_end: 0.3,
             friction: 0.2,
+            friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         },
     ];
     let m = Model::new(rod, disc, basis, tendons).unwrap();
@@ -264,6 +268,7 @@ fn statics_jacobian_matches_finite_differences_for_nonlinear_sigmoid_basis() {
         x_start: 0.0,
         x_end: 0.8,
         friction: 0.5,
+        friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
     }];
     let m = Model::new(rod, disc, p, tendons).unwrap();
     let q = DVector::from_vec(vec![1.1, 8.0, 0.45]);

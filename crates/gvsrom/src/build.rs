@@ -8,7 +8,7 @@ use crate::error::ScenarioError;
 use crate::scenario::{
     default_pulse_axis, BasisKind, DistributedKind, DivisionSpec, Scenario, StrainMode, TendonSpec,
 };
-use gvs::actuation::Tendon;
+use gvs::actuation::{Tendon, DEFAULT_FRICTION_SMOOTHING};
 use gvs::discretize::{Discretization, Quadrature};
 use gvs::lie::{Pose, M3, V3};
 use gvs::loads::{DistributedWrench, Loads, PointWrench};
@@ -587,6 +587,11 @@ fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, ScenarioError> 
     }
     let x_end = x_end.min(l);
     let friction = non_negative(&f("friction"), t.friction, "")?;
+    let friction_smoothing = non_negative(
+        &f("friction_smoothing"),
+        t.friction_smoothing.unwrap_or(DEFAULT_FRICTION_SMOOTHING),
+        "rad/m (a curvature scale; 0 = no smoothing)",
+    )?;
     let explicit = t.offset_start.is_some() || t.offset_end.is_some();
     let polar = t.angle_deg.is_some() || t.radial_fraction.is_some();
     let (offset_start, offset_end) = match (explicit, polar) {
@@ -645,6 +650,7 @@ fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, ScenarioError> 
         x_start,
         x_end,
         friction,
+        friction_smoothing,
     };
     // |d(X)| is convex along the span and r(X) linear per division: checking the span's ends and
     // the division junctions inside it covers the whole path.

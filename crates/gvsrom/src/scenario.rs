@@ -221,6 +221,10 @@ pub struct TendonSpec {
     /// Capstan friction coefficient μ.
     #[serde(default)]
     pub friction: f64,
+    /// Curvature scale κ_ε [rad/m] below which the friction angle is smoothed (default
+    /// `gvs::actuation::DEFAULT_FRICTION_SMOOTHING`; 0 = the exact, kinked tangent rule).
+    #[serde(default)]
+    pub friction_smoothing: Option<f64>,
     /// Tension u [N]; negative pulls (bends the rod toward the tendon).
     #[serde(default)]
     pub tension: f64,

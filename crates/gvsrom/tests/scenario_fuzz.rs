@@ -63,6 +63,7 @@ offset_end = [0.0, 0.002]
 x_start = 0.1
 x_end = 0.4
 friction = 0.2
+friction_smoothing = 0.2
 tension = -0.5
 [[tendons]]
 angle_deg = 90.0
@@ -174,6 +175,7 @@ const KEYS: &[&str] = &[
     "x_start",
     "x_end",
     "friction",
+    "friction_smoothing",
     "tension",
     "loads",
     "gravity",

@@ -9,7 +9,7 @@
 //! autoencoders with r = 1 and r = 2 (3 hidden layers); each decoder is folded with the least-squares
 //! projection `P` onto the HOM coefficients and bound to the basis by `ReducedParam`.
 
-use gvs::actuation::Tendon;
+use gvs::actuation::{Tendon, DEFAULT_FRICTION_SMOOTHING};
 use gvs::discretize::{Discretization, MagnusOrder, Quadrature};
 use gvs::inputs::Signal;
 use gvs::loads::Loads;
@@ -71,6 +71,7 @@ fn hom(damping: f64) -> Model<LinearBasis> {
         x_start: 0.0,
         x_end: 0.25,
         friction: FRICTION,
+        friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
     };
     Model::new(rod, disc, basis, vec![tendon]).unwrap()
 }
