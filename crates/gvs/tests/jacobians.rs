@@ -97,7 +97,10 @@ fn check_statics_jacobian<P: StrainParam>(
     let mut reused = DMatrix::from_element(n, n, f64::NAN);
     model.statics_residual(q, u, &pl, &mut ws, &mut r);
     model.statics_jacobian_after_forward(q, u, &pl, &mut ws, &mut reused);
-    assert_eq!(reused, an, "Jacobian after a residual's forward pass differs");
+    assert_eq!(
+        reused, an,
+        "Jacobian after a residual's forward pass differs"
+    );
 }
 
 fn single_division_model(order: MagnusOrder, friction: f64) -> Model<LinearBasis> {

@@ -380,7 +380,16 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
                 // Y = Φ [c | C_z]   (rows × (1 + r))
                 let y = &mut rest[l.y - l.czd..l.map - l.czd];
                 let rows = st.rows;
-                gemm((rows, m, 1 + r), &st.mat, (1, rows), cc, (1, m), 0.0, y, (1, rows));
+                gemm(
+                    (rows, m, 1 + r),
+                    &st.mat,
+                    (1, rows),
+                    cc,
+                    (1, m),
+                    0.0,
+                    y,
+                    (1, rows),
+                );
                 let na = st.active.len();
                 for (s, psi) in ev.psi.iter_mut().enumerate() {
                     *psi = V6::zeros();
@@ -415,7 +424,16 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
         match &self.stacked {
             Some(st) => {
                 let rows = st.rows;
-                gemm((rows, m, r), &st.mat, (1, rows), czd, (1, m), 0.0, y, (1, rows));
+                gemm(
+                    (rows, m, r),
+                    &st.mat,
+                    (1, rows),
+                    czd,
+                    (1, m),
+                    0.0,
+                    y,
+                    (1, rows),
+                );
                 let na = st.active.len();
                 for s in 0..self.cols.len() {
                     for (i, &a) in st.active.iter().enumerate() {
@@ -456,7 +474,16 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
                     }
                 }
                 let rows = st.rows;
-                gemm((self.m, rows, 1), &st.mat, (rows, 1), y, (1, rows), 0.0, g, (1, self.m));
+                gemm(
+                    (self.m, rows, 1),
+                    &st.mat,
+                    (rows, 1),
+                    y,
+                    (1, rows),
+                    0.0,
+                    g,
+                    (1, self.m),
+                );
             }
             None => {
                 g.fill(0.0);
@@ -649,11 +676,25 @@ mod tests {
                 let scale = y.iter().fold(1.0f64, |m, v| m.max(v.abs()));
                 x.iter().zip(y).all(|(u, v)| (u - v).abs() <= 1e-12 * scale)
             };
-            let psi = |e: &StrainEval| e.psi.iter().flat_map(|v| v.iter().copied()).collect::<Vec<_>>();
+            let psi = |e: &StrainEval| {
+                e.psi
+                    .iter()
+                    .flat_map(|v| v.iter().copied())
+                    .collect::<Vec<_>>()
+            };
             assert!(close(&psi(&a), &psi(&b)), "Ψ, r = {r}");
-            assert!(close(a.psi_q.as_slice(), b.psi_q.as_slice()), "Ψ_q, r = {r}");
-            assert!(close(a.psi_q_dot.as_slice(), b.psi_q_dot.as_slice()), "Ψ̇_q, r = {r}");
-            assert!(close(ha.as_slice(), hb.as_slice()), "weighted Hessian, r = {r}");
+            assert!(
+                close(a.psi_q.as_slice(), b.psi_q.as_slice()),
+                "Ψ_q, r = {r}"
+            );
+            assert!(
+                close(a.psi_q_dot.as_slice(), b.psi_q_dot.as_slice()),
+                "Ψ̇_q, r = {r}"
+            );
+            assert!(
+                close(ha.as_slice(), hb.as_slice()),
+                "weighted Hessian, r = {r}"
+            );
         }
     }
 
