@@ -25,8 +25,12 @@ use crate::lie::{ad, coad, coad_mul, coadbar, exp_tangent, tilde, ExpTangent, Po
 use crate::loads::{Frame, Loads};
 use crate::rod::{Rod, SectionProps};
 use crate::strain::{StrainEval, StrainParam};
-use nalgebra::{DMatrix, DVector, Matrix3xX, Matrix6xX};
-use std::ops::AddAssign;
+use nalgebra::{DMatrix, DMatrixViewMut, DVector, Matrix3xX, Matrix6xX};
+use std::ops::{AddAssign, Range};
+
+#[cfg(test)]
+#[path = "model_dense_reference.rs"]
+mod dense_reference;
 
 /// `c = √3/12` of the Zanna step.
 pub const ZANNA_C: f64 = 0.144_337_567_297_406_43;
@@ -76,7 +80,15 @@ pub struct Workspace {
     /// Pose at every point.
     pub g: Vec<Pose>,
     /// `J_i` of every point side by side (6 × n·n_points); valid after a forward pass with Jacobians.
+    /// `J_i` is zero from column [`Workspace::jac_bound`]`(i)` on (the coordinates of the sites
+    /// beyond point i); the engine never writes those columns, so they must stay zero.
     pub jac: Matrix6xX<f64>,
+    /// Per point: `J_i` is zero at columns `>= jac_hi[i]`.
+    jac_hi: Vec<usize>,
+    /// Per point: `∂y_i/∂q` in `dyp` is zero at columns `>= dy_hi[i]`.
+    pub(crate) dy_hi: Vec<usize>,
+    /// `Gᵀ`-shaped scratch (up to n × 6, column-major) of the row updates `out[c, :] += G X`.
+    gbuf: Vec<f64>,
     pub(crate) et: Vec<ExpTangent>,
     pub(crate) z: Matrix6xX<f64>,
     pub(crate) y: Vec<V6>,
@@ -85,7 +97,6 @@ pub struct Workspace {
     dyp: Matrix6xX<f64>,
     ubar: Matrix6xX<f64>,
     pub(crate) t1: Matrix6xX<f64>,
-    t2: Matrix6xX<f64>,
     dtau: Matrix3xX<f64>,
     dtau_prev: Matrix3xX<f64>,
     dtheta: DVector<f64>,
@@ -97,6 +108,24 @@ pub struct Workspace {
     pub mass: DMatrix<f64>,
     /// `max(1, ‖elastic‖∞, ‖external + actuation‖∞)` of the last residual.
     pub residual_scale: f64,
+}
+
+impl Workspace {
+    /// The column from which `J_i` is zero (after a forward pass with Jacobians).
+    pub fn jac_bound(&self, i: usize) -> usize {
+        self.jac_hi[i]
+    }
+
+    /// Records that `J_i` is written on columns `< hi` only, zeroing what an earlier pass wrote
+    /// beyond.
+    fn set_jac_bound(&mut self, i: usize, hi: usize) {
+        let n = self.ev.n;
+        let old = self.jac_hi[i];
+        if old > hi {
+            self.jac.columns_mut(i * n + hi, old - hi).fill(0.0);
+        }
+        self.jac_hi[i] = hi;
+    }
 }
 
 impl<P: StrainParam> Model<P> {
@@ -182,6 +211,9 @@ impl<P: StrainParam> Model<P> {
             xi: vec![V6::zeros(); ns],
             g: vec![Pose::identity(); np],
             jac: Matrix6xX::zeros(n * np),
+            jac_hi: vec![0; np],
+            dy_hi: vec![0; np],
+            gbuf: vec![0.0; 6 * n],
             et: vec![exp_tangent(&V6::zeros()); np - 1],
             z: Matrix6xX::zeros(n * (np - 1)),
             y: vec![V6::zeros(); ns],
@@ -190,7 +222,6 @@ impl<P: StrainParam> Model<P> {
             dyp: Matrix6xX::zeros(n * np),
             ubar: Matrix6xX::zeros(n),
             t1: Matrix6xX::zeros(n),
-            t2: Matrix6xX::zeros(n),
             dtau: Matrix3xX::zeros(n),
             dtau_prev: Matrix3xX::zeros(n),
             dtheta: DVector::zeros(n),
@@ -299,16 +330,20 @@ impl<P: StrainParam> Model<P> {
 
     /// The Jacobian part of the forward pass, from the strains and Magnus steps already in `ws`:
     /// `Z_i = ∂Ω_i/∂q` and `J_{i+1} = Ad⁻¹_{exp Ω_i} (J_i + T(Ω_i) Z_i)` (spec §5).
+    ///
+    /// `Z_i` lives on the step's columns `c` only, and `J_{i+1}` is zero beyond `hi = max c.end` of
+    /// the steps so far: the recursion costs `36·hi` per step, one pass over the columns.
     fn forward_jacobians(&self, ws: &mut Workspace) {
         let n = self.n_dof();
-        ws.jac.columns_mut(0, n).fill(0.0);
-        let mut hi = 0; // J_i is zero beyond column `hi`
+        ws.set_jac_bound(0, 0);
+        let mut hi = 0;
         for i in 0..self.disc.n_points() - 1 {
             let Some(st) = self.disc.steps[i] else {
                 let (a, mut b) = ws
                     .jac
-                    .columns_range_pair_mut(i * n..(i + 1) * n, (i + 1) * n..(i + 2) * n);
+                    .columns_range_pair_mut(i * n..i * n + hi, (i + 1) * n..(i + 1) * n + hi);
                 b.copy_from(&a);
+                ws.set_jac_bound(i + 1, hi);
                 continue;
             };
             let h = st.h;
@@ -331,20 +366,21 @@ impl<P: StrainParam> Model<P> {
                 }
             }
             let et = &ws.et[i];
-            // J_{i+1} = Ad⁻¹ (J_i + T Z)
-            let mut t1 = ws.t1.columns_mut(0, hi);
-            t1.copy_from(&ws.jac.columns(i * n, hi));
-            t1.columns_mut(c.start, c.len()).gemm(
-                1.0,
-                &et.t,
-                &ws.z.columns(i * n + c.start, c.len()),
-                1.0,
-            );
+            // S = T Z on the step's columns, then J_{i+1} = Ad⁻¹ (J_i + S) column by column
+            let mut sm = ws.t1.columns_mut(0, c.len());
+            sm.gemm(1.0, &et.t, &ws.z.columns(i * n + c.start, c.len()), 0.0);
             let adinv = et.g.adjoint_inv();
-            let mut jn = ws.jac.columns_mut((i + 1) * n, n);
-            jn.fill(0.0);
-            jn.columns_mut(0, hi)
-                .gemm(1.0, &adinv, &ws.t1.columns(0, hi), 0.0);
+            let (a, mut b) = ws
+                .jac
+                .columns_range_pair_mut(i * n..i * n + hi, (i + 1) * n..(i + 1) * n + hi);
+            for j in 0..hi {
+                let mut x: V6 = a.fixed_columns::<1>(j).into_owned();
+                if c.contains(&j) {
+                    x += ws.t1.fixed_columns::<1>(j - c.start);
+                }
+                b.fixed_columns_mut::<1>(j).copy_from(&(adinv * x));
+            }
+            ws.set_jac_bound(i + 1, hi);
         }
     }
 
@@ -484,6 +520,8 @@ impl<P: StrainParam> Model<P> {
                 ws.y[i] += tl.phi_a * scale;
                 if jac {
                     let c = self.param.columns(i);
+                    let bound = if mu > 0.0 { n } else { c.end };
+                    ws.dy_hi[i] = ws.dy_hi[i].max(bound);
                     let dphi = wrench_jacobian(&d, &tl) * scale;
                     let mut dy = ws.dyp.columns_mut(i * n, n);
                     dy.columns_mut(c.start, c.len())
@@ -499,27 +537,40 @@ impl<P: StrainParam> Model<P> {
 
     /// External forces `Σ J_iᵀ w_i` onto the Magnus sites by the backward pass (spec §8.2); with
     /// `out`, also adds `Σ_s Ψ_q,sᵀ ∂y_s/∂q` of these forces into it.
+    ///
+    /// `∂y/∂q` of a step (spec §8.2): with `Ū ← coAd (Ū + C_w J_{i+1})` (`C_w = coadbar(w) +
+    /// [m̃_g 0; f̃_g 0]`, the last term the derivative of world-fixed loads, spec §7.5) and
+    /// `t = Ū − coadbar(F̄) J_i`, `dv = Tᵀ t + ∂(TᵀF̄)/∂Ω Z`, and (Z4)
+    /// `dy₁ = (h/2 + k coad_{ξ₂}) dv + k coadbar(v) Ψ_q2`, `dy₂ = (h/2 − k coad_{ξ₁}) dv − k coadbar(v) Ψ_q1`.
+    /// Hence `Ψ_q1ᵀ dy₁ + Ψ_q2ᵀ dy₂ = G t + (local terms on the step's columns c)` with the
+    /// `|c| × 6` matrix `G = (Ψ_q1ᵀ A₁ + Ψ_q2ᵀ A₂) Tᵀ`: one pass over the columns where `Ū` or
+    /// `J_i` is non-zero adds `G t_j` to rows `c` of column j.
     fn backward(&self, ws: &mut Workspace, mut out: Option<&mut DMatrix<f64>>) {
         let n = self.n_dof();
         let mut fbar = V6::zeros();
+        let mut ub = 0; // Ū is zero at columns >= ub
         if out.is_some() {
             ws.ubar.fill(0.0);
         }
         for i in (0..self.disc.n_points() - 1).rev() {
             let w1 = ws.w[i + 1];
             fbar += w1;
-            if out.is_some() && w1 != V6::zeros() {
-                // Ū += (coadbar(w) + [m̃_g 0; f̃_g 0]) J_{i+1}: the second term is ∂w/∂q of the
-                // world-fixed loads (gravity, global wrenches), spec §7.5
-                let wg = ws.wg[i + 1];
-                let mut c = coadbar(&w1);
-                c.fixed_view_mut::<3, 3>(0, 0)
-                    .add_assign(&tilde(&V3::new(wg[0], wg[1], wg[2])));
-                c.fixed_view_mut::<3, 3>(3, 0)
-                    .add_assign(&tilde(&V3::new(wg[3], wg[4], wg[5])));
-                ws.ubar.gemm(1.0, &c, &ws.jac.columns((i + 1) * n, n), 1.0);
-            }
+            // C_w J_{i+1} is added to Ū on the columns < h1
+            let (cw, h1) = match out.is_some() && w1 != V6::zeros() {
+                true => (self.load_derivative(&w1, &ws.wg[i + 1]), ws.jac_hi[i + 1]),
+                false => (M6::zeros(), 0),
+            };
+            ub = ub.max(h1);
             let Some(st) = self.disc.steps[i] else {
+                for j in 0..h1 {
+                    let jj = ws
+                        .jac
+                        .column((i + 1) * n + j)
+                        .fixed_rows::<6>(0)
+                        .into_owned();
+                    let mut u = ws.ubar.fixed_columns_mut::<1>(j);
+                    u += cw * jj;
+                }
                 continue;
             };
             let et = &ws.et[i];
@@ -538,61 +589,87 @@ impl<P: StrainParam> Model<P> {
             let Some(out) = out.as_deref_mut() else {
                 continue;
             };
-            // Ū ← coAd Ū ;  dv = Tᵀ(Ū − coadbar(F̄) J_i) + ∂(TᵀF̄)/∂Ω Z
-            let coadj: M6 = et.g.adjoint_inv().transpose();
-            ws.t1.gemm(1.0, &coadj, &ws.ubar, 0.0);
-            std::mem::swap(&mut ws.t1, &mut ws.ubar);
-            ws.t1.copy_from(&ws.ubar);
-            ws.t1
-                .gemm(-1.0, &coadbar(&fbar), &ws.jac.columns(i * n, n), 1.0);
-            ws.t2.gemm(1.0, &et.t.transpose(), &ws.t1, 0.0); // t2 = dv
             let c = self.param.columns(s1);
-            ws.t2.columns_mut(c.start, c.len()).gemm(
-                1.0,
-                &et.d_ttf(&fbar),
-                &ws.z.columns(i * n + c.start, c.len()),
-                1.0,
-            );
+            let tt = et.t.transpose();
+            let (m1, m2) = match self.disc.order {
+                MagnusOrder::Z4 => (
+                    (M6::identity() * (0.5 * h) + coad(&ws.xi[s2]) * k) * tt,
+                    (M6::identity() * (0.5 * h) - coad(&ws.xi[s1]) * k) * tt,
+                ),
+                MagnusOrder::Z2 => (tt * h, M6::zeros()),
+            };
+            // G = Ψ_q1ᵀ M₁ + Ψ_q2ᵀ M₂ (|c| × 6, column-major in gbuf)
+            {
+                let mut g = DMatrixViewMut::from_slice(&mut ws.gbuf[..6 * c.len()], c.len(), 6);
+                g.gemm_tr(1.0, &ws.ev.psi_q_at(s1, &c), &m1, 0.0);
+                if self.disc.order == MagnusOrder::Z4 {
+                    g.gemm_tr(1.0, &ws.ev.psi_q_at(s2, &c), &m2, 1.0);
+                }
+            }
+            // one pass: Ū_j ← coAd (Ū_j + C_w J_{i+1,j}); t = Ū_j − coadbar(F̄) J_{i,j}; out[c, j] += G t
+            let coadj: M6 = et.g.adjoint_inv().transpose();
+            let bf = if fbar == V6::zeros() {
+                M6::zeros()
+            } else {
+                coadbar(&fbar)
+            };
+            let hj = if fbar == V6::zeros() { 0 } else { ws.jac_hi[i] };
+            let tb = ub.max(hj);
+            let g = &ws.gbuf[..6 * c.len()];
+            for j in 0..tb {
+                let mut t = V6::zeros();
+                if j < ub {
+                    let mut u: V6 = ws.ubar.fixed_columns::<1>(j).into_owned();
+                    if j < h1 {
+                        u += cw * ws.jac.fixed_columns::<1>((i + 1) * n + j);
+                    }
+                    u = coadj * u;
+                    ws.ubar.fixed_columns_mut::<1>(j).copy_from(&u);
+                    t = u;
+                }
+                if j < hj {
+                    t -= bf * ws.jac.fixed_columns::<1>(i * n + j);
+                }
+                add_g_times(out, &c, j, g, &t);
+            }
+            // terms local to the step's columns: Ψ_q1ᵀ (A₁ D Z + k coadbar(v) Ψ_q2) and
+            // Ψ_q2ᵀ (A₂ D Z − k coadbar(v) Ψ_q1), D = ∂(TᵀF̄)/∂Ω; for Z2 h Ψ_qᵀ D Z.
+            let d = et.d_ttf(&fbar);
+            let zc = ws.z.columns(i * n + c.start, c.len());
+            let p1 = ws.ev.psi_q_at(s1, &c);
+            let mut x = ws.t1.columns_mut(0, c.len());
             match self.disc.order {
                 MagnusOrder::Z4 => {
-                    let cbv = coadbar(&v) * k;
-                    // dy₁ = (h/2 + k coad_{ξ₂}) dv + k coadbar(v) Ψ_q2
                     let a1 = M6::identity() * (0.5 * h) + coad(&ws.xi[s2]) * k;
-                    ws.t1.gemm(1.0, &a1, &ws.t2, 0.0);
-                    ws.t1.columns_mut(c.start, c.len()).gemm(
-                        1.0,
-                        &cbv,
-                        &ws.ev.psi_q_at(s2, &c),
-                        1.0,
-                    );
-                    out.rows_mut(c.start, c.len()).gemm_tr(
-                        1.0,
-                        &ws.ev.psi_q_at(s1, &c),
-                        &ws.t1,
-                        1.0,
-                    );
-                    // dy₂ = (h/2 − k coad_{ξ₁}) dv − k coadbar(v) Ψ_q1
                     let a2 = M6::identity() * (0.5 * h) - coad(&ws.xi[s1]) * k;
-                    ws.t1.gemm(1.0, &a2, &ws.t2, 0.0);
-                    ws.t1.columns_mut(c.start, c.len()).gemm(
-                        -1.0,
-                        &cbv,
-                        &ws.ev.psi_q_at(s1, &c),
-                        1.0,
-                    );
-                    out.rows_mut(c.start, c.len()).gemm_tr(
-                        1.0,
-                        &ws.ev.psi_q_at(s2, &c),
-                        &ws.t1,
-                        1.0,
-                    );
+                    let cbv = coadbar(&v) * k;
+                    let p2 = ws.ev.psi_q_at(s2, &c);
+                    x.gemm(1.0, &(a1 * d), &zc, 0.0);
+                    x.gemm(1.0, &cbv, &p2, 1.0);
+                    let mut blk = out.view_mut((c.start, c.start), (c.len(), c.len()));
+                    blk.gemm_tr(1.0, &p1, &x, 1.0);
+                    x.gemm(1.0, &(a2 * d), &zc, 0.0);
+                    x.gemm(-1.0, &cbv, &p1, 1.0);
+                    blk.gemm_tr(1.0, &p2, &x, 1.0);
                 }
                 MagnusOrder::Z2 => {
-                    out.rows_mut(c.start, c.len())
-                        .gemm_tr(h, &ws.ev.psi_q_at(s1, &c), &ws.t2, 1.0);
+                    x.gemm(h, &d, &zc, 0.0);
+                    let mut blk = out.view_mut((c.start, c.start), (c.len(), c.len()));
+                    blk.gemm_tr(1.0, &p1, &x, 1.0);
                 }
             }
         }
+    }
+
+    /// `C_w = coadbar(w) + [m̃_g 0; f̃_g 0]`: `∂w/∂J` of a point wrench, the second term from the
+    /// world-fixed part `wg = [m_g; f_g]` (gravity, global wrenches; spec §7.5).
+    fn load_derivative(&self, w: &V6, wg: &V6) -> M6 {
+        let mut c = coadbar(w);
+        c.fixed_view_mut::<3, 3>(0, 0)
+            .add_assign(&tilde(&V3::new(wg[0], wg[1], wg[2])));
+        c.fixed_view_mut::<3, 3>(3, 0)
+            .add_assign(&tilde(&V3::new(wg[3], wg[4], wg[5])));
+        c
     }
 
     /// Analytic statics Jacobian `∂R/∂q` (spec §8.2, with `∂α/∂q` of friction) into `jac`.
@@ -623,23 +700,28 @@ impl<P: StrainParam> Model<P> {
         self.forward_jacobians(ws);
         self.point_wrenches(loads, ws);
         ws.y.iter_mut().for_each(|y| *y = V6::zeros());
-        ws.dyp.fill(0.0);
-        jac.fill(0.0);
-        // elastic
+        for (i, hi) in ws.dy_hi.iter_mut().enumerate() {
+            ws.dyp.columns_mut(i * n, *hi).fill(0.0);
+            *hi = 0;
+        }
+        // elastic: −K (linear), or −Σ W Ψ_qᵀ Es Ψ_q on each point's columns
         match &self.k_lin {
-            Some(k) => *jac -= k,
+            Some(k) => jac.zip_apply(k, |a, b| *a = -b),
             None => {
+                jac.fill(0.0);
                 for (i, p) in self.disc.points.iter().enumerate() {
                     if p.weight > 0.0 {
                         let c = self.param.columns(i);
                         let psq = ws.ev.psi_q_at(i, &c);
-                        let mut dy = ws.dyp.columns_mut(i * n + c.start, c.len());
+                        let mut e = ws.t1.columns_mut(0, c.len());
                         for a in 0..6 {
-                            let e = -self.props[i].es[a] * p.weight;
+                            let es = -self.props[i].es[a] * p.weight;
                             for j in 0..c.len() {
-                                dy[(a, j)] += e * psq[(a, j)];
+                                e[(a, j)] = es * psq[(a, j)];
                             }
                         }
+                        jac.view_mut((c.start, c.start), (c.len(), c.len()))
+                            .gemm_tr(1.0, &psq, &e, 1.0);
                     }
                 }
             }
@@ -649,18 +731,21 @@ impl<P: StrainParam> Model<P> {
                 ws.y[i] -= self.props[i].es.component_mul(&ws.ev.psi[i]) * p.weight;
             }
         }
+        // tendons: Ψ_qᵀ ∂y_i/∂q at the points they reach
         self.tendon_forces(u, ws, true);
         for (i, p) in self.disc.points.iter().enumerate() {
-            if p.weight == 0.0 {
+            let hi = ws.dy_hi[i];
+            if p.weight == 0.0 || hi == 0 {
                 continue;
             }
             let c = self.param.columns(i);
-            let dy = ws.dyp.columns(i * n, n);
-            if dy.iter().all(|v| *v == 0.0) {
-                continue;
+            let mut g = DMatrixViewMut::from_slice(&mut ws.gbuf[..6 * c.len()], c.len(), 6);
+            g.tr_copy_from(&ws.ev.psi_q_at(i, &c));
+            let dy = ws.dyp.columns(i * n, hi);
+            for j in 0..hi {
+                let t: V6 = dy.fixed_columns::<1>(j).into_owned();
+                add_g_times(jac, &c, j, &ws.gbuf[..6 * c.len()], &t);
             }
-            jac.rows_mut(c.start, c.len())
-                .gemm_tr(1.0, &ws.ev.psi_q_at(i, &c), &dy, 1.0);
         }
         self.backward(ws, Some(jac));
         if !self.param.is_linear() {
@@ -705,6 +790,20 @@ impl<P: StrainParam> Model<P> {
     /// Tendon points (indices) of tendon `k`.
     pub fn tendon_points(&self, k: usize) -> &[usize] {
         &self.tendon_points[k]
+    }
+}
+
+/// `out[c, j] += G t` for the `|c| × 6` column-major `g`: six axpys down column j of `out`.
+#[inline]
+fn add_g_times(out: &mut DMatrix<f64>, c: &Range<usize>, j: usize, g: &[f64], t: &V6) {
+    let nr = out.nrows();
+    let col = &mut out.as_mut_slice()[j * nr + c.start..j * nr + c.end];
+    let k = c.len();
+    for a in 0..6 {
+        let ta = t[a];
+        for (o, gv) in col.iter_mut().zip(&g[a * k..(a + 1) * k]) {
+            *o += gv * ta;
+        }
     }
 }
 
