@@ -46,6 +46,9 @@ pub struct Model<P: StrainParam> {
     pub(crate) props: Vec<SectionProps>,
     xi_star: Vec<V6>,
     tendon_points: Vec<Vec<usize>>,
+    /// Per point: its block in the workspace's `dyp` (`∂y_i/∂q` of tendons), `usize::MAX` for the
+    /// points no tendon acts on.
+    dy_slot: Vec<usize>,
     k_lin: Option<DMatrix<f64>>,
 }
 
@@ -104,7 +107,7 @@ pub struct Workspace {
     /// Body velocity `η_i` and `J̇ˢ_i q̇` at every point (dynamics).
     pub eta: Vec<V6>,
     pub(crate) zeta: Vec<V6>,
-    /// Mass matrix of the last dynamics evaluation.
+    /// Mass matrix of the last dynamics evaluation (empty until the first one).
     pub mass: DMatrix<f64>,
     /// `max(1, ‖elastic‖∞, ‖external + actuation‖∞)` of the last residual.
     pub residual_scale: f64,
@@ -159,10 +162,17 @@ impl<P: StrainParam> Model<P> {
             .map(|p| SectionProps::circular(&rod.material, rod.divisions[p.div].radius_at(p.x_bar)))
             .collect::<Vec<_>>();
         let xi_star = vec![V6::new(0.0, 0.0, 0.0, 1.0, 0.0, 0.0); disc.n_sites()];
-        let tendon_points = tendons
+        let tendon_points: Vec<Vec<usize>> = tendons
             .iter()
             .map(|t| tendon_point_list(&disc, t))
             .collect();
+        let mut dy_slot = vec![usize::MAX; disc.n_points()];
+        let mut slots = 0;
+        for &i in tendon_points.iter().flatten() {
+            if dy_slot[i] == usize::MAX && disc.points[i].weight > 0.0 {
+                (dy_slot[i], slots) = (slots, slots + 1);
+            }
+        }
         let mut m = Model {
             rod,
             disc,
@@ -172,6 +182,7 @@ impl<P: StrainParam> Model<P> {
             props,
             xi_star,
             tendon_points,
+            dy_slot,
             k_lin: None,
         };
         if m.param.is_linear() {
@@ -210,16 +221,16 @@ impl<P: StrainParam> Model<P> {
             ev: self.param.new_eval(),
             xi: vec![V6::zeros(); ns],
             g: vec![Pose::identity(); np],
-            jac: Matrix6xX::zeros(n * np),
+            jac: zeros6_lazy(n * np),
             jac_hi: vec![0; np],
             dy_hi: vec![0; np],
             gbuf: vec![0.0; 6 * n],
             et: vec![exp_tangent(&V6::zeros()); np - 1],
-            z: Matrix6xX::zeros(n * (np - 1)),
+            z: zeros6_lazy(n * (np - 1)),
             y: vec![V6::zeros(); ns],
             w: vec![V6::zeros(); np],
             wg: vec![V6::zeros(); np],
-            dyp: Matrix6xX::zeros(n * np),
+            dyp: zeros6_lazy(n * self.dy_slot.iter().filter(|s| **s != usize::MAX).count()),
             ubar: Matrix6xX::zeros(n),
             t1: Matrix6xX::zeros(n),
             dtau: Matrix3xX::zeros(n),
@@ -228,7 +239,7 @@ impl<P: StrainParam> Model<P> {
             rtmp: DVector::zeros(n),
             eta: vec![V6::zeros(); np],
             zeta: vec![V6::zeros(); np],
-            mass: DMatrix::zeros(n, n),
+            mass: DMatrix::zeros(0, 0),
             residual_scale: 1.0,
         }
     }
@@ -523,7 +534,7 @@ impl<P: StrainParam> Model<P> {
                     let bound = if mu > 0.0 { n } else { c.end };
                     ws.dy_hi[i] = ws.dy_hi[i].max(bound);
                     let dphi = wrench_jacobian(&d, &tl) * scale;
-                    let mut dy = ws.dyp.columns_mut(i * n, n);
+                    let mut dy = ws.dyp.columns_mut(self.dy_slot[i] * n, n);
                     dy.columns_mut(c.start, c.len())
                         .gemm(1.0, &dphi, &ws.ev.psi_q_at(i, &c), 1.0);
                     if mu > 0.0 {
@@ -701,8 +712,10 @@ impl<P: StrainParam> Model<P> {
         self.point_wrenches(loads, ws);
         ws.y.iter_mut().for_each(|y| *y = V6::zeros());
         for (i, hi) in ws.dy_hi.iter_mut().enumerate() {
-            ws.dyp.columns_mut(i * n, *hi).fill(0.0);
-            *hi = 0;
+            if *hi > 0 {
+                ws.dyp.columns_mut(self.dy_slot[i] * n, *hi).fill(0.0);
+                *hi = 0;
+            }
         }
         // elastic: −K (linear), or −Σ W Ψ_qᵀ Es Ψ_q on each point's columns
         match &self.k_lin {
@@ -741,7 +754,7 @@ impl<P: StrainParam> Model<P> {
             let c = self.param.columns(i);
             let mut g = DMatrixViewMut::from_slice(&mut ws.gbuf[..6 * c.len()], c.len(), 6);
             g.tr_copy_from(&ws.ev.psi_q_at(i, &c));
-            let dy = ws.dyp.columns(i * n, hi);
+            let dy = ws.dyp.columns(self.dy_slot[i] * n, hi);
             for j in 0..hi {
                 let t: V6 = dy.fixed_columns::<1>(j).into_owned();
                 add_g_times(jac, &c, j, &ws.gbuf[..6 * c.len()], &t);
@@ -791,6 +804,18 @@ impl<P: StrainParam> Model<P> {
     pub fn tendon_points(&self, k: usize) -> &[usize] {
         &self.tendon_points[k]
     }
+}
+
+/// A zero `rows × cols` matrix from zeroed memory (`calloc`): the OS provides zero pages lazily, so
+/// large workspace buffers of which a pass touches a part (`J_i` up to its column bound, `Z` on the
+/// step's columns) cost nothing where untouched. (`DMatrix::zeros` writes every entry.)
+pub(crate) fn zeros_lazy(rows: usize, cols: usize) -> DMatrix<f64> {
+    DMatrix::from_vec(rows, cols, vec![0.0; rows * cols])
+}
+
+/// [`zeros_lazy`] for 6 × `cols`.
+pub(crate) fn zeros6_lazy(cols: usize) -> Matrix6xX<f64> {
+    Matrix6xX::from_vec(vec![0.0; 6 * cols])
 }
 
 /// `out[c, j] += G t` for the `|c| × 6` column-major `g`: six axpys down column j of `out`.

@@ -166,7 +166,10 @@ impl<P: StrainParam> Model<P> {
         self.dense_forward_jacobians(ws);
         self.point_wrenches(loads, ws);
         ws.y.iter_mut().for_each(|y| *y = V6::zeros());
+        // ∂y_i/∂q of every point, 6 × n each (the workspace's `dyp` holds the tendon points only)
+        let mut dyp = Matrix6xX::zeros(n * self.disc.n_points());
         ws.dyp.fill(0.0);
+        ws.dy_hi.fill(0);
         jac.fill(0.0);
         // elastic
         match &self.k_lin {
@@ -176,7 +179,7 @@ impl<P: StrainParam> Model<P> {
                     if p.weight > 0.0 {
                         let c = self.param.columns(i);
                         let psq = ws.ev.psi_q_at(i, &c);
-                        let mut dy = ws.dyp.columns_mut(i * n + c.start, c.len());
+                        let mut dy = dyp.columns_mut(i * n + c.start, c.len());
                         for a in 0..6 {
                             let e = -self.props[i].es[a] * p.weight;
                             for j in 0..c.len() {
@@ -193,12 +196,18 @@ impl<P: StrainParam> Model<P> {
             }
         }
         self.tendon_forces(u, ws, true);
+        for (i, &slot) in self.dy_slot.iter().enumerate() {
+            if slot != usize::MAX {
+                let mut dy = dyp.columns_mut(i * n, n);
+                dy += ws.dyp.columns(slot * n, n);
+            }
+        }
         for (i, p) in self.disc.points.iter().enumerate() {
             if p.weight == 0.0 {
                 continue;
             }
             let c = self.param.columns(i);
-            let dy = ws.dyp.columns(i * n, n);
+            let dy = dyp.columns(i * n, n);
             if dy.iter().all(|v| *v == 0.0) {
                 continue;
             }

@@ -55,6 +55,7 @@
 //! All vectors and matrices live in a [`DoglegWorkspace`]; the iteration allocates
 //! nothing (only the returned `x` is cloned).
 
+use crate::model::zeros_lazy;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::{factor, solve as lu_solve_faer};
 use faer::perm::PermRef;
@@ -199,7 +200,7 @@ impl Lu {
         ]);
         Lu {
             state: None,
-            factors: DMatrix::zeros(n, n),
+            factors: zeros_lazy(n, n),
             perm: vec![0; n],
             perm_inv: vec![0; n],
             mem: MemBuffer::new(req),
@@ -276,7 +277,7 @@ impl Lu {
 impl DoglegWorkspace {
     /// Buffers for systems of `n` unknowns.
     pub fn new(n: usize) -> Self {
-        let (v, m) = (|| DVector::zeros(n), || DMatrix::zeros(n, n));
+        let (v, m) = (|| DVector::zeros(n), || zeros_lazy(n, n));
         let (x, x_new, f, f_new, diag, p, p_gn, grad, tmp) =
             (v(), v(), v(), v(), v(), v(), v(), v(), v());
         Self {
@@ -364,8 +365,13 @@ impl DoglegWorkspace {
     }
 }
 
-/// Euclidean norm without spurious overflow or underflow (like MINPACK's `enorm`).
+/// Euclidean norm without spurious overflow or underflow (like MINPACK's `enorm`): the plain
+/// `√Σx²` when that sum is safely inside the normal range, otherwise rescaled by `max|x|`.
 fn norm2(v: impl Iterator<Item = f64> + Clone) -> f64 {
+    let s = v.clone().fold(0.0_f64, |s, x| s + x * x);
+    if s.is_finite() && s > f64::MIN_POSITIVE / f64::EPSILON {
+        return s.sqrt();
+    }
     let m = v.clone().fold(0.0_f64, |m, x| m.max(x.abs()));
     if m == 0.0 || !m.is_finite() {
         return m;

@@ -67,8 +67,8 @@ impl StrainEval {
         StrainEval {
             n,
             psi: vec![V6::zeros(); cols.len()],
-            psi_q: Matrix6xX::zeros(total),
-            psi_q_dot: Matrix6xX::zeros(total),
+            psi_q: crate::model::zeros6_lazy(total),
+            psi_q_dot: crate::model::zeros6_lazy(total),
             scratch: Vec::new(),
             cols: cols.to_vec(),
             offsets,
