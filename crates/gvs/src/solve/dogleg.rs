@@ -263,7 +263,7 @@ impl Lu {
         w.copy_from(u);
         self.solve(w);
         let sigma = 1.0 + v.dot(w);
-        if !(sigma.abs() >= SM_MIN_SIGMA) || w.iter().any(|x| !x.is_finite()) {
+        if sigma.is_nan() || sigma.abs() < SM_MIN_SIGMA || w.iter().any(|x| !x.is_finite()) {
             self.state = None;
             return;
         }
