@@ -90,7 +90,7 @@ pub struct Workspace {
     jac_hi: Vec<usize>,
     /// Per point: `∂y_i/∂q` in `dyp` is zero at columns `>= dy_hi[i]`.
     pub(crate) dy_hi: Vec<usize>,
-    /// `Gᵀ`-shaped scratch (up to n × 6, column-major) of the row updates `out[c, :] += G X`.
+    /// Scratch (up to n × 18, column-major) of the row updates `out[c, :] += G X`.
     gbuf: Vec<f64>,
     pub(crate) et: Vec<ExpTangent>,
     pub(crate) z: Matrix6xX<f64>,
@@ -224,7 +224,7 @@ impl<P: StrainParam> Model<P> {
             jac: zeros6_lazy(n * np),
             jac_hi: vec![0; np],
             dy_hi: vec![0; np],
-            gbuf: vec![0.0; 6 * n],
+            gbuf: vec![0.0; 18 * n],
             et: vec![exp_tangent(&V6::zeros()); np - 1],
             z: zeros6_lazy(n * (np - 1)),
             y: vec![V6::zeros(); ns],
@@ -377,17 +377,16 @@ impl<P: StrainParam> Model<P> {
                 }
             }
             let et = &ws.et[i];
-            // S = T Z on the step's columns, then J_{i+1} = Ad⁻¹ (J_i + S) column by column
-            let mut sm = ws.t1.columns_mut(0, c.len());
-            sm.gemm(1.0, &et.t, &ws.z.columns(i * n + c.start, c.len()), 0.0);
+            // J_{i+1} = Ad⁻¹ (J_i + T Z) column by column (Z only on the step's columns)
             let adinv = et.g.adjoint_inv();
+            let zi = ws.z.columns(i * n, n);
             let (a, mut b) = ws
                 .jac
                 .columns_range_pair_mut(i * n..i * n + hi, (i + 1) * n..(i + 1) * n + hi);
             for j in 0..hi {
                 let mut x: V6 = a.fixed_columns::<1>(j).into_owned();
                 if c.contains(&j) {
-                    x += ws.t1.fixed_columns::<1>(j - c.start);
+                    x += et.t * zi.fixed_columns::<1>(j);
                 }
                 b.fixed_columns_mut::<1>(j).copy_from(&(adinv * x));
             }
@@ -609,15 +608,32 @@ impl<P: StrainParam> Model<P> {
                 ),
                 MagnusOrder::Z2 => (tt * h, M6::zeros()),
             };
-            // G = Ψ_q1ᵀ M₁ + Ψ_q2ᵀ M₂ (|c| × 6, column-major in gbuf)
+            // H = [G | Ψ_q1ᵀ | Ψ_q2ᵀ] (|c| × 18, column-major in gbuf), G = Ψ_q1ᵀ M₁ + Ψ_q2ᵀ M₂
+            let nc = c.len();
             {
-                let mut g = DMatrixViewMut::from_slice(&mut ws.gbuf[..6 * c.len()], c.len(), 6);
-                g.gemm_tr(1.0, &ws.ev.psi_q_at(s1, &c), &m1, 0.0);
+                let (p1, p2) = (ws.ev.psi_q_at(s1, &c), ws.ev.psi_q_at(s2, &c));
+                let mut hm = DMatrixViewMut::from_slice(&mut ws.gbuf[..18 * nc], nc, 18);
+                hm.columns_mut(0, 6).gemm_tr(1.0, &p1, &m1, 0.0);
                 if self.disc.order == MagnusOrder::Z4 {
-                    g.gemm_tr(1.0, &ws.ev.psi_q_at(s2, &c), &m2, 1.0);
+                    hm.columns_mut(0, 6).gemm_tr(1.0, &p2, &m2, 1.0);
                 }
+                hm.columns_mut(6, 6).tr_copy_from(&p1);
+                hm.columns_mut(12, 6).tr_copy_from(&p2);
             }
-            // one pass: Ū_j ← coAd (Ū_j + C_w J_{i+1,j}); t = Ū_j − coadbar(F̄) J_{i,j}; out[c, j] += G t
+            // Local terms on the step's columns (j ∈ c): Ψ_q1ᵀ x₁ + Ψ_q2ᵀ x₂ with
+            // Z4: x₁ = A₁ D Z_j + k coadbar(v) Ψ_q2,j, x₂ = A₂ D Z_j − k coadbar(v) Ψ_q1,j;
+            // Z2: x₁ = h D Z_j, x₂ = 0 (D = ∂(TᵀF̄)/∂Ω).
+            let d = et.d_ttf(&fbar);
+            let (e1, e2, cbv) = match self.disc.order {
+                MagnusOrder::Z4 => (
+                    (M6::identity() * (0.5 * h) + coad(&ws.xi[s2]) * k) * d,
+                    (M6::identity() * (0.5 * h) - coad(&ws.xi[s1]) * k) * d,
+                    coadbar(&v) * k,
+                ),
+                MagnusOrder::Z2 => (d * h, M6::zeros(), M6::zeros()),
+            };
+            // one pass: Ū_j ← coAd (Ū_j + C_w J_{i+1,j}); t = Ū_j − coadbar(F̄) J_{i,j};
+            // out[c, j] += G t (+ the local terms)
             let coadj: M6 = et.g.adjoint_inv().transpose();
             let bf = if fbar == V6::zeros() {
                 M6::zeros()
@@ -626,8 +642,9 @@ impl<P: StrainParam> Model<P> {
             };
             let hj = if fbar == V6::zeros() { 0 } else { ws.jac_hi[i] };
             let tb = ub.max(hj);
-            let g = &ws.gbuf[..6 * c.len()];
-            for j in 0..tb {
+            let hm = &ws.gbuf[..18 * nc];
+            let zi = ws.z.columns(i * n, n);
+            for j in 0..tb.max(c.end) {
                 let mut t = V6::zeros();
                 if j < ub {
                     let mut u: V6 = ws.ubar.fixed_columns::<1>(j).into_owned();
@@ -641,32 +658,15 @@ impl<P: StrainParam> Model<P> {
                 if j < hj {
                     t -= bf * ws.jac.fixed_columns::<1>(i * n + j);
                 }
-                add_g_times(out, &c, j, g, &t);
-            }
-            // terms local to the step's columns: Ψ_q1ᵀ (A₁ D Z + k coadbar(v) Ψ_q2) and
-            // Ψ_q2ᵀ (A₂ D Z − k coadbar(v) Ψ_q1), D = ∂(TᵀF̄)/∂Ω; for Z2 h Ψ_qᵀ D Z.
-            let d = et.d_ttf(&fbar);
-            let zc = ws.z.columns(i * n + c.start, c.len());
-            let p1 = ws.ev.psi_q_at(s1, &c);
-            let mut x = ws.t1.columns_mut(0, c.len());
-            match self.disc.order {
-                MagnusOrder::Z4 => {
-                    let a1 = M6::identity() * (0.5 * h) + coad(&ws.xi[s2]) * k;
-                    let a2 = M6::identity() * (0.5 * h) - coad(&ws.xi[s1]) * k;
-                    let cbv = coadbar(&v) * k;
-                    let p2 = ws.ev.psi_q_at(s2, &c);
-                    x.gemm(1.0, &(a1 * d), &zc, 0.0);
-                    x.gemm(1.0, &cbv, &p2, 1.0);
-                    let mut blk = out.view_mut((c.start, c.start), (c.len(), c.len()));
-                    blk.gemm_tr(1.0, &p1, &x, 1.0);
-                    x.gemm(1.0, &(a2 * d), &zc, 0.0);
-                    x.gemm(-1.0, &cbv, &p1, 1.0);
-                    blk.gemm_tr(1.0, &p2, &x, 1.0);
-                }
-                MagnusOrder::Z2 => {
-                    x.gemm(h, &d, &zc, 0.0);
-                    let mut blk = out.view_mut((c.start, c.start), (c.len(), c.len()));
-                    blk.gemm_tr(1.0, &p1, &x, 1.0);
+                if c.contains(&j) {
+                    let zj: V6 = zi.fixed_columns::<1>(j).into_owned();
+                    let p1j: V6 = ws.ev.psi_q_at(s1, &c).column(j - c.start).into_owned();
+                    let p2j: V6 = ws.ev.psi_q_at(s2, &c).column(j - c.start).into_owned();
+                    let x1 = e1 * zj + cbv * p2j;
+                    let x2 = e2 * zj - cbv * p1j;
+                    add_h_times(out, &c, j, hm, &t, &x1, &x2);
+                } else if j < tb {
+                    add_g_times(out, &c, j, &hm[..6 * nc], &t);
                 }
             }
         }
@@ -828,6 +828,31 @@ fn add_g_times(out: &mut DMatrix<f64>, c: &Range<usize>, j: usize, g: &[f64], t:
         let ta = t[a];
         for (o, gv) in col.iter_mut().zip(&g[a * k..(a + 1) * k]) {
             *o += gv * ta;
+        }
+    }
+}
+
+/// `out[c, j] += H [t; x₁; x₂]` for the `|c| × 18` column-major `h`: eighteen axpys down column j.
+#[inline]
+fn add_h_times(
+    out: &mut DMatrix<f64>,
+    c: &Range<usize>,
+    j: usize,
+    h: &[f64],
+    t: &V6,
+    x1: &V6,
+    x2: &V6,
+) {
+    let nr = out.nrows();
+    let col = &mut out.as_mut_slice()[j * nr + c.start..j * nr + c.end];
+    let k = c.len();
+    for (b, x) in [t, x1, x2].into_iter().enumerate() {
+        for a in 0..6 {
+            let xa = x[a];
+            let hb = &h[(6 * b + a) * k..(6 * b + a + 1) * k];
+            for (o, hv) in col.iter_mut().zip(hb) {
+                *o += hv * xa;
+            }
         }
     }
 }
