@@ -600,37 +600,36 @@ impl<P: StrainParam> Model<P> {
                 continue;
             };
             let c = self.param.columns(s1);
-            let tt = et.t.transpose();
-            let (m1, m2) = match self.disc.order {
+            let (a1, a2) = match self.disc.order {
                 MagnusOrder::Z4 => (
-                    (M6::identity() * (0.5 * h) + coad(&ws.xi[s2]) * k) * tt,
-                    (M6::identity() * (0.5 * h) - coad(&ws.xi[s1]) * k) * tt,
+                    M6::identity() * (0.5 * h) + coad(&ws.xi[s2]) * k,
+                    M6::identity() * (0.5 * h) - coad(&ws.xi[s1]) * k,
                 ),
-                MagnusOrder::Z2 => (tt * h, M6::zeros()),
+                MagnusOrder::Z2 => (M6::identity() * h, M6::zeros()),
             };
-            // H = [G | Ψ_q1ᵀ | Ψ_q2ᵀ] (|c| × 18, column-major in gbuf), G = Ψ_q1ᵀ M₁ + Ψ_q2ᵀ M₂
+            // H = [G | Ψ_q1ᵀ | Ψ_q2ᵀ] (|c| × 18, column-major in gbuf), Gᵀ = T (A₁ᵀ Ψ_q1 + A₂ᵀ Ψ_q2)
             let nc = c.len();
             {
+                let (a1t, a2t) = (a1.transpose(), a2.transpose());
                 let (p1, p2) = (ws.ev.psi_q_at(s1, &c), ws.ev.psi_q_at(s2, &c));
-                let mut hm = DMatrixViewMut::from_slice(&mut ws.gbuf[..18 * nc], nc, 18);
-                hm.columns_mut(0, 6).gemm_tr(1.0, &p1, &m1, 0.0);
-                if self.disc.order == MagnusOrder::Z4 {
-                    hm.columns_mut(0, 6).gemm_tr(1.0, &p2, &m2, 1.0);
+                for r in 0..nc {
+                    let (p1r, p2r): (V6, V6) =
+                        (p1.column(r).into_owned(), p2.column(r).into_owned());
+                    let g = et.t * (a1t * p1r + a2t * p2r);
+                    for a in 0..6 {
+                        ws.gbuf[a * nc + r] = g[a];
+                        ws.gbuf[(6 + a) * nc + r] = p1r[a];
+                        ws.gbuf[(12 + a) * nc + r] = p2r[a];
+                    }
                 }
-                hm.columns_mut(6, 6).tr_copy_from(&p1);
-                hm.columns_mut(12, 6).tr_copy_from(&p2);
             }
             // Local terms on the step's columns (j ∈ c): Ψ_q1ᵀ x₁ + Ψ_q2ᵀ x₂ with
-            // Z4: x₁ = A₁ D Z_j + k coadbar(v) Ψ_q2,j, x₂ = A₂ D Z_j − k coadbar(v) Ψ_q1,j;
-            // Z2: x₁ = h D Z_j, x₂ = 0 (D = ∂(TᵀF̄)/∂Ω).
+            // x₁ = A₁ D Z_j + k coadbar(v) Ψ_q2,j, x₂ = A₂ D Z_j − k coadbar(v) Ψ_q1,j
+            // (D = ∂(TᵀF̄)/∂Ω; Z2: A₁ = h, A₂ = 0, no coadbar term).
             let d = et.d_ttf(&fbar);
-            let (e1, e2, cbv) = match self.disc.order {
-                MagnusOrder::Z4 => (
-                    (M6::identity() * (0.5 * h) + coad(&ws.xi[s2]) * k) * d,
-                    (M6::identity() * (0.5 * h) - coad(&ws.xi[s1]) * k) * d,
-                    coadbar(&v) * k,
-                ),
-                MagnusOrder::Z2 => (d * h, M6::zeros(), M6::zeros()),
+            let cbv = match self.disc.order {
+                MagnusOrder::Z4 => coadbar(&v) * k,
+                MagnusOrder::Z2 => M6::zeros(),
             };
             // one pass: Ū_j ← coAd (Ū_j + C_w J_{i+1,j}); t = Ū_j − coadbar(F̄) J_{i,j};
             // out[c, j] += G t (+ the local terms)
@@ -662,8 +661,9 @@ impl<P: StrainParam> Model<P> {
                     let zj: V6 = zi.fixed_columns::<1>(j).into_owned();
                     let p1j: V6 = ws.ev.psi_q_at(s1, &c).column(j - c.start).into_owned();
                     let p2j: V6 = ws.ev.psi_q_at(s2, &c).column(j - c.start).into_owned();
-                    let x1 = e1 * zj + cbv * p2j;
-                    let x2 = e2 * zj - cbv * p1j;
+                    let dz = d * zj;
+                    let x1 = a1 * dz + cbv * p2j;
+                    let x2 = a2 * dz - cbv * p1j;
                     add_h_times(out, &c, j, hm, &t, &x1, &x2);
                 } else if j < tb {
                     add_g_times(out, &c, j, &hm[..6 * nc], &t);
