@@ -379,6 +379,39 @@ fn norm2(v: impl Iterator<Item = f64> + Clone) -> f64 {
     m * v.map(|x| (x / m).powi(2)).sum::<f64>().sqrt()
 }
 
+/// Whether every entry is finite: `Σ 0·x` is 0, or NaN if some `x` is infinite or NaN (eight
+/// independent partial sums, so the pass over an n × n Jacobian vectorizes).
+fn all_finite(v: &[f64]) -> bool {
+    let mut acc = [0.0f64; 8];
+    let chunks = v.chunks_exact(8);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for l in 0..8 {
+            acc[l] += c[l] * 0.0;
+        }
+    }
+    acc.iter().sum::<f64>() == 0.0 && rest.iter().all(|x| x.is_finite())
+}
+
+/// [`norm2`] of a contiguous column: the sum of squares by eight independent partial sums (it
+/// vectorizes), the rescaled [`norm2`] when that sum leaves the safe range.
+fn column_norm(v: &[f64]) -> f64 {
+    let mut acc = [0.0f64; 8];
+    let chunks = v.chunks_exact(8);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for l in 0..8 {
+            acc[l] += c[l] * c[l];
+        }
+    }
+    let s = acc.iter().sum::<f64>() + rest.iter().map(|x| x * x).sum::<f64>();
+    if s.is_finite() && s > f64::MIN_POSITIVE / f64::EPSILON {
+        s.sqrt()
+    } else {
+        norm2(v.iter().copied())
+    }
+}
+
 /// `‖D v‖₂`.
 fn scaled_norm(diag: &DVector<f64>, v: &DVector<f64>) -> f64 {
     norm2(diag.iter().zip(v.iter()).map(|(d, x)| d * x))
@@ -396,7 +429,7 @@ fn check(size_ok: bool, v: &[f64], it: usize, what: &'static str) -> Result<(), 
         return Err(eval_err(it)(EvalError(msg)));
     }
     let iterations = it;
-    match v.iter().all(|x| x.is_finite()) {
+    match all_finite(v) {
         true => Ok(()),
         false => Err(DoglegError::NonFinite { iterations, what }),
     }
@@ -477,7 +510,7 @@ pub fn solve<S: NonlinearSystem>(
             check(shape_ok, ws.jac.as_slice(), iter, "Jacobian")?;
             // D ← max(D, column norms); zero columns of the first Jacobian get 1.
             for j in 0..n {
-                let c = norm2(ws.jac.column(j).iter().copied()).min(f64::MAX);
+                let c = column_norm(ws.jac.column(j).as_slice()).min(f64::MAX);
                 ws.diag[j] = ws.diag[j].max(c);
                 if ws.diag[j] == 0.0 {
                     ws.diag[j] = 1.0;
@@ -556,7 +589,7 @@ pub fn solve<S: NonlinearSystem>(
             ws.lu.update(&ws.tmp, &ws.grad, &mut ws.p_gn);
             jac_fresh = false;
             // An update that overflowed is discarded: the analytic Jacobian replaces it.
-            need_jac = ws.jac.iter().any(|v| !v.is_finite());
+            need_jac = !all_finite(ws.jac.as_slice());
         }
 
         if ratio >= 1e-4 {
