@@ -135,21 +135,31 @@ impl<P: StrainParam> Model<P> {
         ws.zeta[i]
     }
 
-    /// `M = Σ_i W_i J_iᵀ Ms_i J_i` into `ws.mass` (after a forward pass with Jacobians).
+    /// `M = Σ_i W_i J_iᵀ Ms_i J_i` into `ws.mass` (after a forward pass with Jacobians; `ws.mass`
+    /// is allocated on first use). `J_i` is zero beyond its column bound `h_i`, so point i adds to
+    /// the leading `h_i × h_i` block only.
     pub fn assemble_mass(&self, ws: &mut Workspace) {
         let n = self.n_dof();
-        ws.mass.fill(0.0);
+        if ws.mass.shape() != (n, n) {
+            ws.mass = DMatrix::zeros(n, n);
+        } else {
+            ws.mass.fill(0.0);
+        }
         for (i, p) in self.disc.points.iter().enumerate() {
-            if p.weight == 0.0 {
+            let h = ws.jac_bound(i);
+            if p.weight == 0.0 || h == 0 {
                 continue;
             }
             let ms = self.props[i].ms * p.weight;
-            let j = ws.jac.columns(i * n, n);
-            ws.t1.copy_from(&j);
+            let j = ws.jac.columns(i * n, h);
+            let mut t1 = ws.t1.columns_mut(0, h);
+            t1.copy_from(&j);
             for a in 0..6 {
-                ws.t1.row_mut(a).scale_mut(ms[a]);
+                t1.row_mut(a).scale_mut(ms[a]);
             }
-            ws.mass.gemm_tr(1.0, &j, &ws.t1, 1.0);
+            ws.mass
+                .view_mut((0, 0), (h, h))
+                .gemm_tr(1.0, &j, &ws.t1.columns(0, h), 1.0);
         }
     }
 

@@ -27,8 +27,12 @@ use crate::lie::{ad, coad, coad_mul, coadbar, exp_tangent, tilde, ExpTangent, Po
 use crate::loads::{Frame, Loads};
 use crate::rod::{Rod, SectionProps};
 use crate::strain::{StrainEval, StrainParam};
-use nalgebra::{DMatrix, DVector, Matrix3xX, Matrix6xX};
-use std::ops::AddAssign;
+use nalgebra::{DMatrix, DMatrixViewMut, DVector, Matrix3xX, Matrix6xX};
+use std::ops::{AddAssign, Range};
+
+#[cfg(test)]
+#[path = "model_dense_reference.rs"]
+mod dense_reference;
 
 /// `c = √3/12` of the Zanna step.
 pub const ZANNA_C: f64 = 0.144_337_567_297_406_43;
@@ -44,6 +48,9 @@ pub struct Model<P: StrainParam> {
     pub(crate) props: Vec<SectionProps>,
     xi_star: Vec<V6>,
     tendon_points: Vec<Vec<usize>>,
+    /// Per point: its block in the workspace's `dyp` (`∂y_i/∂q` of tendons), `usize::MAX` for the
+    /// points no tendon acts on.
+    dy_slot: Vec<usize>,
     k_lin: Option<DMatrix<f64>>,
 }
 
@@ -78,7 +85,15 @@ pub struct Workspace {
     /// Pose at every point.
     pub g: Vec<Pose>,
     /// `J_i` of every point side by side (6 × n·n_points); valid after a forward pass with Jacobians.
+    /// `J_i` is zero from column [`Workspace::jac_bound`]`(i)` on (the coordinates of the sites
+    /// beyond point i); the engine never writes those columns, so they must stay zero.
     pub jac: Matrix6xX<f64>,
+    /// Per point: `J_i` is zero at columns `>= jac_hi[i]`.
+    jac_hi: Vec<usize>,
+    /// Per point: `∂y_i/∂q` in `dyp` is zero at columns `>= dy_hi[i]`.
+    pub(crate) dy_hi: Vec<usize>,
+    /// Scratch (up to n × 18, column-major) of the row updates `out[c, :] += G X`.
+    gbuf: Vec<f64>,
     pub(crate) et: Vec<ExpTangent>,
     pub(crate) z: Matrix6xX<f64>,
     pub(crate) y: Vec<V6>,
@@ -87,7 +102,6 @@ pub struct Workspace {
     dyp: Matrix6xX<f64>,
     ubar: Matrix6xX<f64>,
     pub(crate) t1: Matrix6xX<f64>,
-    t2: Matrix6xX<f64>,
     dtau: Matrix3xX<f64>,
     dtau_prev: Matrix3xX<f64>,
     dtheta: DVector<f64>,
@@ -95,10 +109,28 @@ pub struct Workspace {
     /// Body velocity `η_i` and `J̇ˢ_i q̇` at every point (dynamics).
     pub eta: Vec<V6>,
     pub(crate) zeta: Vec<V6>,
-    /// Mass matrix of the last dynamics evaluation.
+    /// Mass matrix of the last dynamics evaluation (empty until the first one).
     pub mass: DMatrix<f64>,
     /// `max(1, ‖elastic‖∞, ‖external + actuation‖∞)` of the last residual.
     pub residual_scale: f64,
+}
+
+impl Workspace {
+    /// The column from which `J_i` is zero (after a forward pass with Jacobians).
+    pub fn jac_bound(&self, i: usize) -> usize {
+        self.jac_hi[i]
+    }
+
+    /// Records that `J_i` is written on columns `< hi` only, zeroing what an earlier pass wrote
+    /// beyond.
+    fn set_jac_bound(&mut self, i: usize, hi: usize) {
+        let n = self.ev.n;
+        let old = self.jac_hi[i];
+        if old > hi {
+            self.jac.columns_mut(i * n + hi, old - hi).fill(0.0);
+        }
+        self.jac_hi[i] = hi;
+    }
 }
 
 impl<P: StrainParam> Model<P> {
@@ -132,10 +164,17 @@ impl<P: StrainParam> Model<P> {
             .map(|p| SectionProps::circular(&rod.material, rod.divisions[p.div].radius_at(p.x_bar)))
             .collect::<Vec<_>>();
         let xi_star = vec![V6::new(0.0, 0.0, 0.0, 1.0, 0.0, 0.0); disc.n_sites()];
-        let tendon_points = tendons
+        let tendon_points: Vec<Vec<usize>> = tendons
             .iter()
             .map(|t| tendon_point_list(&disc, t))
             .collect();
+        let mut dy_slot = vec![usize::MAX; disc.n_points()];
+        let mut slots = 0;
+        for &i in tendon_points.iter().flatten() {
+            if dy_slot[i] == usize::MAX && disc.points[i].weight > 0.0 {
+                (dy_slot[i], slots) = (slots, slots + 1);
+            }
+        }
         let mut m = Model {
             rod,
             disc,
@@ -145,6 +184,7 @@ impl<P: StrainParam> Model<P> {
             props,
             xi_star,
             tendon_points,
+            dy_slot,
             k_lin: None,
         };
         if m.param.is_linear() {
@@ -183,23 +223,25 @@ impl<P: StrainParam> Model<P> {
             ev: self.param.new_eval(),
             xi: vec![V6::zeros(); ns],
             g: vec![Pose::identity(); np],
-            jac: Matrix6xX::zeros(n * np),
+            jac: zeros6_lazy(n * np),
+            jac_hi: vec![0; np],
+            dy_hi: vec![0; np],
+            gbuf: vec![0.0; 18 * n],
             et: vec![exp_tangent(&V6::zeros()); np - 1],
-            z: Matrix6xX::zeros(n * (np - 1)),
+            z: zeros6_lazy(n * (np - 1)),
             y: vec![V6::zeros(); ns],
             w: vec![V6::zeros(); np],
             wg: vec![V6::zeros(); np],
-            dyp: Matrix6xX::zeros(n * np),
+            dyp: zeros6_lazy(n * self.dy_slot.iter().filter(|s| **s != usize::MAX).count()),
             ubar: Matrix6xX::zeros(n),
             t1: Matrix6xX::zeros(n),
-            t2: Matrix6xX::zeros(n),
             dtau: Matrix3xX::zeros(n),
             dtau_prev: Matrix3xX::zeros(n),
             dtheta: DVector::zeros(n),
             rtmp: DVector::zeros(n),
             eta: vec![V6::zeros(); np],
             zeta: vec![V6::zeros(); np],
-            mass: DMatrix::zeros(n, n),
+            mass: DMatrix::zeros(0, 0),
             residual_scale: 1.0,
         }
     }
@@ -301,16 +343,20 @@ impl<P: StrainParam> Model<P> {
 
     /// The Jacobian part of the forward pass, from the strains and Magnus steps already in `ws`:
     /// `Z_i = ∂Ω_i/∂q` and `J_{i+1} = Ad⁻¹_{exp Ω_i} (J_i + T(Ω_i) Z_i)` (spec §5).
+    ///
+    /// `Z_i` lives on the step's columns `c` only, and `J_{i+1}` is zero beyond `hi = max c.end` of
+    /// the steps so far: the recursion costs `36·hi` per step, one pass over the columns.
     fn forward_jacobians(&self, ws: &mut Workspace) {
         let n = self.n_dof();
-        ws.jac.columns_mut(0, n).fill(0.0);
-        let mut hi = 0; // J_i is zero beyond column `hi`
+        ws.set_jac_bound(0, 0);
+        let mut hi = 0;
         for i in 0..self.disc.n_points() - 1 {
             let Some(st) = self.disc.steps[i] else {
                 let (a, mut b) = ws
                     .jac
-                    .columns_range_pair_mut(i * n..(i + 1) * n, (i + 1) * n..(i + 2) * n);
+                    .columns_range_pair_mut(i * n..i * n + hi, (i + 1) * n..(i + 1) * n + hi);
                 b.copy_from(&a);
+                ws.set_jac_bound(i + 1, hi);
                 continue;
             };
             let h = st.h;
@@ -333,20 +379,20 @@ impl<P: StrainParam> Model<P> {
                 }
             }
             let et = &ws.et[i];
-            // J_{i+1} = Ad⁻¹ (J_i + T Z)
-            let mut t1 = ws.t1.columns_mut(0, hi);
-            t1.copy_from(&ws.jac.columns(i * n, hi));
-            t1.columns_mut(c.start, c.len()).gemm(
-                1.0,
-                &et.t,
-                &ws.z.columns(i * n + c.start, c.len()),
-                1.0,
-            );
+            // J_{i+1} = Ad⁻¹ (J_i + T Z) column by column (Z only on the step's columns)
             let adinv = et.g.adjoint_inv();
-            let mut jn = ws.jac.columns_mut((i + 1) * n, n);
-            jn.fill(0.0);
-            jn.columns_mut(0, hi)
-                .gemm(1.0, &adinv, &ws.t1.columns(0, hi), 0.0);
+            let zi = ws.z.columns(i * n, n);
+            let (a, mut b) = ws
+                .jac
+                .columns_range_pair_mut(i * n..i * n + hi, (i + 1) * n..(i + 1) * n + hi);
+            for j in 0..hi {
+                let mut x: V6 = a.fixed_columns::<1>(j).into_owned();
+                if c.contains(&j) {
+                    x += et.t * zi.fixed_columns::<1>(j);
+                }
+                b.fixed_columns_mut::<1>(j).copy_from(&(adinv * x));
+            }
+            ws.set_jac_bound(i + 1, hi);
         }
     }
 
@@ -488,8 +534,10 @@ impl<P: StrainParam> Model<P> {
                 ws.y[i] += tl.phi_a * scale;
                 if jac {
                     let c = self.param.columns(i);
+                    let bound = if mu > 0.0 { n } else { c.end };
+                    ws.dy_hi[i] = ws.dy_hi[i].max(bound);
                     let dphi = wrench_jacobian(&d, &tl) * scale;
-                    let mut dy = ws.dyp.columns_mut(i * n, n);
+                    let mut dy = ws.dyp.columns_mut(self.dy_slot[i] * n, n);
                     dy.columns_mut(c.start, c.len())
                         .gemm(1.0, &dphi, &ws.ev.psi_q_at(i, &c), 1.0);
                     if mu > 0.0 {
@@ -503,27 +551,40 @@ impl<P: StrainParam> Model<P> {
 
     /// External forces `Σ J_iᵀ w_i` onto the Magnus sites by the backward pass (spec §8.2); with
     /// `out`, also adds `Σ_s Ψ_q,sᵀ ∂y_s/∂q` of these forces into it.
+    ///
+    /// `∂y/∂q` of a step (spec §8.2): with `Ū ← coAd (Ū + C_w J_{i+1})` (`C_w = coadbar(w) +
+    /// [m̃_g 0; f̃_g 0]`, the last term the derivative of world-fixed loads, spec §7.5) and
+    /// `t = Ū − coadbar(F̄) J_i`, `dv = Tᵀ t + ∂(TᵀF̄)/∂Ω Z`, and (Z4)
+    /// `dy₁ = (h/2 + k coad_{ξ₂}) dv + k coadbar(v) Ψ_q2`, `dy₂ = (h/2 − k coad_{ξ₁}) dv − k coadbar(v) Ψ_q1`.
+    /// Hence `Ψ_q1ᵀ dy₁ + Ψ_q2ᵀ dy₂ = G t + (local terms on the step's columns c)` with the
+    /// `|c| × 6` matrix `G = (Ψ_q1ᵀ A₁ + Ψ_q2ᵀ A₂) Tᵀ`: one pass over the columns where `Ū` or
+    /// `J_i` is non-zero adds `G t_j` to rows `c` of column j.
     fn backward(&self, ws: &mut Workspace, mut out: Option<&mut DMatrix<f64>>) {
         let n = self.n_dof();
         let mut fbar = V6::zeros();
+        let mut ub = 0; // Ū is zero at columns >= ub
         if out.is_some() {
             ws.ubar.fill(0.0);
         }
         for i in (0..self.disc.n_points() - 1).rev() {
             let w1 = ws.w[i + 1];
             fbar += w1;
-            if out.is_some() && w1 != V6::zeros() {
-                // Ū += (coadbar(w) + [m̃_g 0; f̃_g 0]) J_{i+1}: the second term is ∂w/∂q of the
-                // world-fixed loads (gravity, global wrenches), spec §7.5
-                let wg = ws.wg[i + 1];
-                let mut c = coadbar(&w1);
-                c.fixed_view_mut::<3, 3>(0, 0)
-                    .add_assign(&tilde(&V3::new(wg[0], wg[1], wg[2])));
-                c.fixed_view_mut::<3, 3>(3, 0)
-                    .add_assign(&tilde(&V3::new(wg[3], wg[4], wg[5])));
-                ws.ubar.gemm(1.0, &c, &ws.jac.columns((i + 1) * n, n), 1.0);
-            }
+            // C_w J_{i+1} is added to Ū on the columns < h1
+            let (cw, h1) = match out.is_some() && w1 != V6::zeros() {
+                true => (self.load_derivative(&w1, &ws.wg[i + 1]), ws.jac_hi[i + 1]),
+                false => (M6::zeros(), 0),
+            };
+            ub = ub.max(h1);
             let Some(st) = self.disc.steps[i] else {
+                for j in 0..h1 {
+                    let jj = ws
+                        .jac
+                        .column((i + 1) * n + j)
+                        .fixed_rows::<6>(0)
+                        .into_owned();
+                    let mut u = ws.ubar.fixed_columns_mut::<1>(j);
+                    u += cw * jj;
+                }
                 continue;
             };
             let et = &ws.et[i];
@@ -542,61 +603,88 @@ impl<P: StrainParam> Model<P> {
             let Some(out) = out.as_deref_mut() else {
                 continue;
             };
-            // Ū ← coAd Ū ;  dv = Tᵀ(Ū − coadbar(F̄) J_i) + ∂(TᵀF̄)/∂Ω Z
-            let coadj: M6 = et.g.adjoint_inv().transpose();
-            ws.t1.gemm(1.0, &coadj, &ws.ubar, 0.0);
-            std::mem::swap(&mut ws.t1, &mut ws.ubar);
-            ws.t1.copy_from(&ws.ubar);
-            ws.t1
-                .gemm(-1.0, &coadbar(&fbar), &ws.jac.columns(i * n, n), 1.0);
-            ws.t2.gemm(1.0, &et.t.transpose(), &ws.t1, 0.0); // t2 = dv
             let c = self.param.columns(s1);
-            ws.t2.columns_mut(c.start, c.len()).gemm(
-                1.0,
-                &et.d_ttf(&fbar),
-                &ws.z.columns(i * n + c.start, c.len()),
-                1.0,
-            );
-            match self.disc.order {
-                MagnusOrder::Z4 => {
-                    let cbv = coadbar(&v) * k;
-                    // dy₁ = (h/2 + k coad_{ξ₂}) dv + k coadbar(v) Ψ_q2
-                    let a1 = M6::identity() * (0.5 * h) + coad(&ws.xi[s2]) * k;
-                    ws.t1.gemm(1.0, &a1, &ws.t2, 0.0);
-                    ws.t1.columns_mut(c.start, c.len()).gemm(
-                        1.0,
-                        &cbv,
-                        &ws.ev.psi_q_at(s2, &c),
-                        1.0,
-                    );
-                    out.rows_mut(c.start, c.len()).gemm_tr(
-                        1.0,
-                        &ws.ev.psi_q_at(s1, &c),
-                        &ws.t1,
-                        1.0,
-                    );
-                    // dy₂ = (h/2 − k coad_{ξ₁}) dv − k coadbar(v) Ψ_q1
-                    let a2 = M6::identity() * (0.5 * h) - coad(&ws.xi[s1]) * k;
-                    ws.t1.gemm(1.0, &a2, &ws.t2, 0.0);
-                    ws.t1.columns_mut(c.start, c.len()).gemm(
-                        -1.0,
-                        &cbv,
-                        &ws.ev.psi_q_at(s1, &c),
-                        1.0,
-                    );
-                    out.rows_mut(c.start, c.len()).gemm_tr(
-                        1.0,
-                        &ws.ev.psi_q_at(s2, &c),
-                        &ws.t1,
-                        1.0,
-                    );
+            let (a1, a2) = match self.disc.order {
+                MagnusOrder::Z4 => (
+                    M6::identity() * (0.5 * h) + coad(&ws.xi[s2]) * k,
+                    M6::identity() * (0.5 * h) - coad(&ws.xi[s1]) * k,
+                ),
+                MagnusOrder::Z2 => (M6::identity() * h, M6::zeros()),
+            };
+            // H = [G | Ψ_q1ᵀ | Ψ_q2ᵀ] (|c| × 18, column-major in gbuf), Gᵀ = T (A₁ᵀ Ψ_q1 + A₂ᵀ Ψ_q2)
+            let nc = c.len();
+            {
+                let (a1t, a2t) = (a1.transpose(), a2.transpose());
+                let (p1, p2) = (ws.ev.psi_q_at(s1, &c), ws.ev.psi_q_at(s2, &c));
+                for r in 0..nc {
+                    let (p1r, p2r): (V6, V6) =
+                        (p1.column(r).into_owned(), p2.column(r).into_owned());
+                    let g = et.t * (a1t * p1r + a2t * p2r);
+                    for a in 0..6 {
+                        ws.gbuf[a * nc + r] = g[a];
+                        ws.gbuf[(6 + a) * nc + r] = p1r[a];
+                        ws.gbuf[(12 + a) * nc + r] = p2r[a];
+                    }
                 }
-                MagnusOrder::Z2 => {
-                    out.rows_mut(c.start, c.len())
-                        .gemm_tr(h, &ws.ev.psi_q_at(s1, &c), &ws.t2, 1.0);
+            }
+            // Local terms on the step's columns (j ∈ c): Ψ_q1ᵀ x₁ + Ψ_q2ᵀ x₂ with
+            // x₁ = A₁ D Z_j + k coadbar(v) Ψ_q2,j, x₂ = A₂ D Z_j − k coadbar(v) Ψ_q1,j
+            // (D = ∂(TᵀF̄)/∂Ω; Z2: A₁ = h, A₂ = 0, no coadbar term).
+            let d = et.d_ttf(&fbar);
+            let cbv = match self.disc.order {
+                MagnusOrder::Z4 => coadbar(&v) * k,
+                MagnusOrder::Z2 => M6::zeros(),
+            };
+            // one pass: Ū_j ← coAd (Ū_j + C_w J_{i+1,j}); t = Ū_j − coadbar(F̄) J_{i,j};
+            // out[c, j] += G t (+ the local terms)
+            let coadj: M6 = et.g.adjoint_inv().transpose();
+            let bf = if fbar == V6::zeros() {
+                M6::zeros()
+            } else {
+                coadbar(&fbar)
+            };
+            let hj = if fbar == V6::zeros() { 0 } else { ws.jac_hi[i] };
+            let tb = ub.max(hj);
+            let hm = &ws.gbuf[..18 * nc];
+            let zi = ws.z.columns(i * n, n);
+            for j in 0..tb.max(c.end) {
+                let mut t = V6::zeros();
+                if j < ub {
+                    let mut u: V6 = ws.ubar.fixed_columns::<1>(j).into_owned();
+                    if j < h1 {
+                        u += cw * ws.jac.fixed_columns::<1>((i + 1) * n + j);
+                    }
+                    u = coadj * u;
+                    ws.ubar.fixed_columns_mut::<1>(j).copy_from(&u);
+                    t = u;
+                }
+                if j < hj {
+                    t -= bf * ws.jac.fixed_columns::<1>(i * n + j);
+                }
+                if c.contains(&j) {
+                    let zj: V6 = zi.fixed_columns::<1>(j).into_owned();
+                    let p1j: V6 = ws.ev.psi_q_at(s1, &c).column(j - c.start).into_owned();
+                    let p2j: V6 = ws.ev.psi_q_at(s2, &c).column(j - c.start).into_owned();
+                    let dz = d * zj;
+                    let x1 = a1 * dz + cbv * p2j;
+                    let x2 = a2 * dz - cbv * p1j;
+                    add_h_times(out, &c, j, hm, &t, &x1, &x2);
+                } else if j < tb {
+                    add_g_times(out, &c, j, &hm[..6 * nc], &t);
                 }
             }
         }
+    }
+
+    /// `C_w = coadbar(w) + [m̃_g 0; f̃_g 0]`: `∂w/∂J` of a point wrench, the second term from the
+    /// world-fixed part `wg = [m_g; f_g]` (gravity, global wrenches; spec §7.5).
+    fn load_derivative(&self, w: &V6, wg: &V6) -> M6 {
+        let mut c = coadbar(w);
+        c.fixed_view_mut::<3, 3>(0, 0)
+            .add_assign(&tilde(&V3::new(wg[0], wg[1], wg[2])));
+        c.fixed_view_mut::<3, 3>(3, 0)
+            .add_assign(&tilde(&V3::new(wg[3], wg[4], wg[5])));
+        c
     }
 
     /// Analytic statics Jacobian `∂R/∂q` (spec §8.2, with `∂α/∂q` of friction) into `jac`.
@@ -627,23 +715,30 @@ impl<P: StrainParam> Model<P> {
         self.forward_jacobians(ws);
         self.point_wrenches(loads, ws);
         ws.y.iter_mut().for_each(|y| *y = V6::zeros());
-        ws.dyp.fill(0.0);
-        jac.fill(0.0);
-        // elastic
+        for (i, hi) in ws.dy_hi.iter_mut().enumerate() {
+            if *hi > 0 {
+                ws.dyp.columns_mut(self.dy_slot[i] * n, *hi).fill(0.0);
+                *hi = 0;
+            }
+        }
+        // elastic: −K (linear), or −Σ W Ψ_qᵀ Es Ψ_q on each point's columns
         match &self.k_lin {
-            Some(k) => *jac -= k,
+            Some(k) => jac.zip_apply(k, |a, b| *a = -b),
             None => {
+                jac.fill(0.0);
                 for (i, p) in self.disc.points.iter().enumerate() {
                     if p.weight > 0.0 {
                         let c = self.param.columns(i);
                         let psq = ws.ev.psi_q_at(i, &c);
-                        let mut dy = ws.dyp.columns_mut(i * n + c.start, c.len());
+                        let mut e = ws.t1.columns_mut(0, c.len());
                         for a in 0..6 {
-                            let e = -self.props[i].es[a] * p.weight;
+                            let es = -self.props[i].es[a] * p.weight;
                             for j in 0..c.len() {
-                                dy[(a, j)] += e * psq[(a, j)];
+                                e[(a, j)] = es * psq[(a, j)];
                             }
                         }
+                        jac.view_mut((c.start, c.start), (c.len(), c.len()))
+                            .gemm_tr(1.0, &psq, &e, 1.0);
                     }
                 }
             }
@@ -653,18 +748,21 @@ impl<P: StrainParam> Model<P> {
                 ws.y[i] -= self.props[i].es.component_mul(&ws.ev.psi[i]) * p.weight;
             }
         }
+        // tendons: Ψ_qᵀ ∂y_i/∂q at the points they reach
         self.tendon_forces(u, ws, true);
         for (i, p) in self.disc.points.iter().enumerate() {
-            if p.weight == 0.0 {
+            let hi = ws.dy_hi[i];
+            if p.weight == 0.0 || hi == 0 {
                 continue;
             }
             let c = self.param.columns(i);
-            let dy = ws.dyp.columns(i * n, n);
-            if dy.iter().all(|v| *v == 0.0) {
-                continue;
+            let mut g = DMatrixViewMut::from_slice(&mut ws.gbuf[..6 * c.len()], c.len(), 6);
+            g.tr_copy_from(&ws.ev.psi_q_at(i, &c));
+            let dy = ws.dyp.columns(self.dy_slot[i] * n, hi);
+            for j in 0..hi {
+                let t: V6 = dy.fixed_columns::<1>(j).into_owned();
+                add_g_times(jac, &c, j, &ws.gbuf[..6 * c.len()], &t);
             }
-            jac.rows_mut(c.start, c.len())
-                .gemm_tr(1.0, &ws.ev.psi_q_at(i, &c), &dy, 1.0);
         }
         self.backward(ws, Some(jac));
         if !self.param.is_linear() {
@@ -709,6 +807,57 @@ impl<P: StrainParam> Model<P> {
     /// Tendon points (indices) of tendon `k`.
     pub fn tendon_points(&self, k: usize) -> &[usize] {
         &self.tendon_points[k]
+    }
+}
+
+/// A zero `rows × cols` matrix from zeroed memory (`calloc`): the OS provides zero pages lazily, so
+/// large workspace buffers of which a pass touches a part (`J_i` up to its column bound, `Z` on the
+/// step's columns) cost nothing where untouched. (`DMatrix::zeros` writes every entry.)
+pub(crate) fn zeros_lazy(rows: usize, cols: usize) -> DMatrix<f64> {
+    DMatrix::from_vec(rows, cols, vec![0.0; rows * cols])
+}
+
+/// [`zeros_lazy`] for 6 × `cols`.
+pub(crate) fn zeros6_lazy(cols: usize) -> Matrix6xX<f64> {
+    Matrix6xX::from_vec(vec![0.0; 6 * cols])
+}
+
+/// `out[c, j] += G t` for the `|c| × 6` column-major `g`: six axpys down column j of `out`.
+#[inline]
+fn add_g_times(out: &mut DMatrix<f64>, c: &Range<usize>, j: usize, g: &[f64], t: &V6) {
+    let nr = out.nrows();
+    let col = &mut out.as_mut_slice()[j * nr + c.start..j * nr + c.end];
+    let k = c.len();
+    for a in 0..6 {
+        let ta = t[a];
+        for (o, gv) in col.iter_mut().zip(&g[a * k..(a + 1) * k]) {
+            *o += gv * ta;
+        }
+    }
+}
+
+/// `out[c, j] += H [t; x₁; x₂]` for the `|c| × 18` column-major `h`: eighteen axpys down column j.
+#[inline]
+fn add_h_times(
+    out: &mut DMatrix<f64>,
+    c: &Range<usize>,
+    j: usize,
+    h: &[f64],
+    t: &V6,
+    x1: &V6,
+    x2: &V6,
+) {
+    let nr = out.nrows();
+    let col = &mut out.as_mut_slice()[j * nr + c.start..j * nr + c.end];
+    let k = c.len();
+    for (b, x) in [t, x1, x2].into_iter().enumerate() {
+        for a in 0..6 {
+            let xa = x[a];
+            let hb = &h[(6 * b + a) * k..(6 * b + a + 1) * k];
+            for (o, hv) in col.iter_mut().zip(hb) {
+                *o += hv * xa;
+            }
+        }
     }
 }
 

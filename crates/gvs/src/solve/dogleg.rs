@@ -11,15 +11,20 @@
 //!   evaluation (initially `‖J_{:,j}‖₂`, or 1 for a zero column), as in MINPACK. The first
 //!   radius is `Δ₀ = factor·‖D x₀‖₂` (or `factor` if that is 0), cut to `‖D p₀‖₂` after
 //!   the first step.
-//! * **Dogleg step.** Gauss–Newton step `p_GN = −J⁻¹F` (in-place LU with partial
-//!   pivoting). Scaled gradient direction `s = D⁻² JᵀF` (so `‖D s‖₂ = ‖D⁻¹JᵀF‖₂ = g`),
+//! * **Dogleg step.** Gauss–Newton step `p_GN = −J⁻¹F` by an LU factorization with partial
+//!   pivoting (blocked, faer), computed once per analytic Jacobian (and again only when `J`
+//!   changed). After Broyden updates `J_k = J₀ + Σ u_i v_iᵀ` the LU of `J₀` is kept and the
+//!   updates are applied by Sherman–Morrison, `J_{k+1}⁻¹ = (I − w_k v_kᵀ/σ_k) J_k⁻¹` with
+//!   `w_k = J_k⁻¹u_k`, `σ_k = 1 + v_kᵀw_k` (O(n²) per update instead of O(n³)); `J_k` is
+//!   refactored instead after [`MAX_SM_UPDATES`] updates or when `|σ_k| < `[`SM_MIN_SIGMA`]
+//!   (the update nearly singular). Scaled gradient direction `s = D⁻² JᵀF` (so `‖D s‖₂ = ‖D⁻¹JᵀF‖₂ = g`),
 //!   Cauchy point `p_C = −α s` with `α = g² / ‖J s‖₂²`. Then
 //!   - `p = p_GN` if `‖D p_GN‖₂ ≤ Δ`;
 //!   - `p = −(Δ/g) s` if `α g ≥ Δ` (steepest descent cut at the boundary);
 //!   - otherwise `p = p_C + τ (p_GN − p_C)` with `τ ∈ [0, 1]` solving `‖D p‖₂ = Δ`.
 //!
-//!   If the LU is singular or `p_GN` is not finite, only the steepest-descent leg is
-//!   used (`p = −min(α, Δ/g) s`) instead of failing.
+//!   If the LU is singular (a pivot at most `n ε max|J|`) or `p_GN` is not finite, only
+//!   the steepest-descent leg is used (`p = −min(α, Δ/g) s`) instead of failing.
 //! * **Ratio.** `ρ = actred / prered` with `actred = 1 − (‖F(x+p)‖₂/‖F‖₂)²` (−1 if the
 //!   residual grew) and `prered = 1 − (‖F + J p‖₂/‖F‖₂)²`. The step is accepted when
 //!   `ρ ≥ 10⁻⁴`. Radius (MINPACK `hybrj`): `ρ < 0.1` → `Δ = ½Δ`; otherwise, after a
@@ -50,7 +55,17 @@
 //! All vectors and matrices live in a [`DoglegWorkspace`]; the iteration allocates
 //! nothing (only the returned `x` is cloned).
 
+use crate::model::zeros_lazy;
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::lu::partial_pivoting::{factor, solve as lu_solve_faer};
+use faer::perm::PermRef;
+use faer::{MatMut, MatRef, Par};
 use nalgebra::{DMatrix, DVector};
+
+/// Broyden updates applied to a kept LU by Sherman–Morrison before `J` is refactored.
+pub const MAX_SM_UPDATES: usize = 16;
+/// Smallest `|σ| = |1 + vᵀJ⁻¹u|` of a Sherman–Morrison update; below it `J` is refactored.
+pub const SM_MIN_SIGMA: f64 = 1e-3;
 
 /// A square nonlinear system F(x) = 0 with an analytic Jacobian.
 pub trait NonlinearSystem {
@@ -152,9 +167,8 @@ pub struct DoglegWorkspace {
     f_new: DVector<f64>,
     /// Current Jacobian: analytic, or Broyden-updated since the last evaluation.
     jac: DMatrix<f64>,
-    /// LU factors of `jac` (unit lower L below the diagonal, U on and above), row swaps in `perm`.
-    lu: DMatrix<f64>,
-    perm: Vec<usize>,
+    /// The LU factorization of `jac` (or of the Jacobian before its last Broyden updates).
+    lu: Lu,
     /// MINPACK scaling `D`.
     diag: DVector<f64>,
     p: DVector<f64>,
@@ -163,21 +177,116 @@ pub struct DoglegWorkspace {
     tmp: DVector<f64>,
 }
 
+/// `P J₀ = L U` of a Jacobian `J₀` (unit lower L below the diagonal, U on and above) and the
+/// Broyden updates `u_i v_iᵀ` since, as Sherman–Morrison factors `w_i = J_i⁻¹u_i`, `v_i`, `σ_i`.
+struct Lu {
+    /// `Some(nonsingular)` once `factors` holds the LU of `J₀`; `None` when `J` must be factored.
+    state: Option<bool>,
+    factors: DMatrix<f64>,
+    perm: Vec<usize>,
+    perm_inv: Vec<usize>,
+    mem: MemBuffer,
+    w: DMatrix<f64>,
+    v: DMatrix<f64>,
+    sigma: Vec<f64>,
+}
+
+impl Lu {
+    fn new(n: usize) -> Self {
+        let par = Par::Seq;
+        let req = StackReq::any_of(&[
+            factor::lu_in_place_scratch::<usize, f64>(n, n, par, Default::default()),
+            lu_solve_faer::solve_in_place_scratch::<usize, f64>(n, 1, par),
+        ]);
+        Lu {
+            state: None,
+            factors: zeros_lazy(n, n),
+            perm: vec![0; n],
+            perm_inv: vec![0; n],
+            mem: MemBuffer::new(req),
+            w: DMatrix::zeros(n, MAX_SM_UPDATES),
+            v: DMatrix::zeros(n, MAX_SM_UPDATES),
+            sigma: Vec::with_capacity(MAX_SM_UPDATES),
+        }
+    }
+
+    /// Factors `a` (finite) with partial pivoting; returns false when `a` is zero or a pivot is
+    /// at most `n ε max|a|` (numerically singular).
+    fn factor(&mut self, a: &DMatrix<f64>) -> bool {
+        let n = a.nrows();
+        self.factors.copy_from(a);
+        self.sigma.clear();
+        let amax = a.amax();
+        let ok = if amax == 0.0 {
+            n == 0
+        } else {
+            let m = MatMut::from_column_major_slice_mut(self.factors.as_mut_slice(), n, n);
+            let stack = MemStack::new(&mut self.mem);
+            let params = Default::default();
+            factor::lu_in_place(
+                m,
+                &mut self.perm,
+                &mut self.perm_inv,
+                Par::Seq,
+                stack,
+                params,
+            );
+            let tol = amax * n as f64 * f64::EPSILON;
+            (0..n).all(|k| self.factors[(k, k)].abs() > tol)
+        };
+        self.state = Some(ok);
+        ok
+    }
+
+    /// `b ← J⁻¹ b` for the current `J = J₀ + Σ u_i v_iᵀ` (nonsingular LU).
+    fn solve(&mut self, b: &mut DVector<f64>) {
+        let n = b.len();
+        let lu = MatRef::from_column_major_slice(self.factors.as_slice(), n, n);
+        let perm = PermRef::new_checked(&self.perm, &self.perm_inv, n);
+        let rhs = MatMut::from_column_major_slice_mut(b.as_mut_slice(), n, 1);
+        let stack = MemStack::new(&mut self.mem);
+        lu_solve_faer::solve_in_place(lu, lu, perm, rhs, Par::Seq, stack);
+        for (i, s) in self.sigma.iter().enumerate() {
+            let c = self.v.column(i).dot(b) / s;
+            b.axpy(-c, &self.w.column(i), 1.0);
+        }
+    }
+
+    /// Takes the rank-1 update `J ← J + u vᵀ` into account (Sherman–Morrison) when the LU is
+    /// nonsingular, fewer than [`MAX_SM_UPDATES`] are stored and `|σ| ≥ `[`SM_MIN_SIGMA`];
+    /// otherwise marks `J` for refactoring. `w` is scratch.
+    fn update(&mut self, u: &DVector<f64>, v: &DVector<f64>, w: &mut DVector<f64>) {
+        if self.state != Some(true) || self.sigma.len() == MAX_SM_UPDATES {
+            self.state = None;
+            return;
+        }
+        w.copy_from(u);
+        self.solve(w);
+        let sigma = 1.0 + v.dot(w);
+        if sigma.is_nan() || sigma.abs() < SM_MIN_SIGMA || w.iter().any(|x| !x.is_finite()) {
+            self.state = None;
+            return;
+        }
+        let k = self.sigma.len();
+        self.w.column_mut(k).copy_from(w);
+        self.v.column_mut(k).copy_from(v);
+        self.sigma.push(sigma);
+    }
+}
+
 impl DoglegWorkspace {
     /// Buffers for systems of `n` unknowns.
     pub fn new(n: usize) -> Self {
-        let (v, m) = (|| DVector::zeros(n), || DMatrix::zeros(n, n));
+        let (v, m) = (|| DVector::zeros(n), || zeros_lazy(n, n));
         let (x, x_new, f, f_new, diag, p, p_gn, grad, tmp) =
             (v(), v(), v(), v(), v(), v(), v(), v(), v());
-        let perm = vec![0; n];
         Self {
             x,
             x_new,
             f,
             f_new,
             jac: m(),
-            lu: m(),
-            perm,
+            lu: Lu::new(n),
             diag,
             p,
             p_gn,
@@ -189,20 +298,22 @@ impl DoglegWorkspace {
     /// Whether every buffer (those handed to the system included) has size `n`.
     fn fits(&self, n: usize) -> bool {
         let vecs = [&self.x, &self.x_new, &self.f, &self.f_new, &self.p];
-        vecs.iter().all(|v| v.len() == n) && self.jac.shape() == (n, n) && self.perm.len() == n
+        vecs.iter().all(|v| v.len() == n) && self.jac.shape() == (n, n) && self.lu.perm.len() == n
     }
 
     /// Dogleg step for the radius `delta` into `self.p` (see the module docs); false when
     /// the Jacobian is singular and the gradient of ‖F‖² vanishes.
     fn dogleg(&mut self, delta: f64) -> bool {
         let n = self.x.len();
-        self.lu.copy_from(&self.jac);
-        let mut gn_ok = lu_factor(&mut self.lu, &mut self.perm);
+        let mut gn_ok = match self.lu.state {
+            Some(ok) => ok,
+            None => self.lu.factor(&self.jac),
+        };
         let mut gn_norm = f64::INFINITY;
         if gn_ok {
             self.p_gn.copy_from(&self.f);
             self.p_gn.neg_mut();
-            lu_solve(&self.lu, &self.perm, &mut self.p_gn);
+            self.lu.solve(&mut self.p_gn);
             gn_norm = scaled_norm(&self.diag, &self.p_gn);
             gn_ok = gn_norm.is_finite();
             if gn_ok && gn_norm <= delta {
@@ -254,8 +365,13 @@ impl DoglegWorkspace {
     }
 }
 
-/// Euclidean norm without spurious overflow or underflow (like MINPACK's `enorm`).
+/// Euclidean norm without spurious overflow or underflow (like MINPACK's `enorm`): the plain
+/// `√Σx²` when that sum is safely inside the normal range, otherwise rescaled by `max|x|`.
 fn norm2(v: impl Iterator<Item = f64> + Clone) -> f64 {
+    let s = v.clone().fold(0.0_f64, |s, x| s + x * x);
+    if s.is_finite() && s > f64::MIN_POSITIVE / f64::EPSILON {
+        return s.sqrt();
+    }
     let m = v.clone().fold(0.0_f64, |m, x| m.max(x.abs()));
     if m == 0.0 || !m.is_finite() {
         return m;
@@ -263,64 +379,42 @@ fn norm2(v: impl Iterator<Item = f64> + Clone) -> f64 {
     m * v.map(|x| (x / m).powi(2)).sum::<f64>().sqrt()
 }
 
+/// Whether every entry is finite: `Σ 0·x` is 0, or NaN if some `x` is infinite or NaN (eight
+/// independent partial sums, so the pass over an n × n Jacobian vectorizes).
+fn all_finite(v: &[f64]) -> bool {
+    let mut acc = [0.0f64; 8];
+    let chunks = v.chunks_exact(8);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for l in 0..8 {
+            acc[l] += c[l] * 0.0;
+        }
+    }
+    acc.iter().sum::<f64>() == 0.0 && rest.iter().all(|x| x.is_finite())
+}
+
+/// [`norm2`] of a contiguous column: the sum of squares by eight independent partial sums (it
+/// vectorizes), the rescaled [`norm2`] when that sum leaves the safe range.
+fn column_norm(v: &[f64]) -> f64 {
+    let mut acc = [0.0f64; 8];
+    let chunks = v.chunks_exact(8);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for l in 0..8 {
+            acc[l] += c[l] * c[l];
+        }
+    }
+    let s = acc.iter().sum::<f64>() + rest.iter().map(|x| x * x).sum::<f64>();
+    if s.is_finite() && s > f64::MIN_POSITIVE / f64::EPSILON {
+        s.sqrt()
+    } else {
+        norm2(v.iter().copied())
+    }
+}
+
 /// `‖D v‖₂`.
 fn scaled_norm(diag: &DVector<f64>, v: &DVector<f64>) -> f64 {
     norm2(diag.iter().zip(v.iter()).map(|(d, x)| d * x))
-}
-
-/// In-place LU with partial pivoting, `P A = L U` (`perm[k]` = row swapped with row k at step k).
-/// Returns false when `A` is zero or a pivot is at most `n ε max|A|` (numerically singular).
-/// `A` must be finite.
-fn lu_factor(a: &mut DMatrix<f64>, perm: &mut [usize]) -> bool {
-    let n = a.nrows();
-    let amax = a.amax();
-    let tol = amax * n as f64 * f64::EPSILON;
-    if amax == 0.0 {
-        return n == 0;
-    }
-    for k in 0..n {
-        let (mut piv, mut best) = (k, a[(k, k)].abs());
-        for i in k + 1..n {
-            if a[(i, k)].abs() > best {
-                (piv, best) = (i, a[(i, k)].abs());
-            }
-        }
-        if best <= tol {
-            return false;
-        }
-        perm[k] = piv;
-        a.swap_rows(k, piv);
-        let pivot = a[(k, k)];
-        for i in k + 1..n {
-            a[(i, k)] /= pivot;
-        }
-        for j in k + 1..n {
-            let akj = a[(k, j)];
-            for i in k + 1..n {
-                a[(i, j)] -= a[(i, k)] * akj;
-            }
-        }
-    }
-    true
-}
-
-/// Solves `A x = b` in place from the factors of [`lu_factor`].
-fn lu_solve(lu: &DMatrix<f64>, perm: &[usize], b: &mut DVector<f64>) {
-    let n = lu.nrows();
-    for (k, &p) in perm.iter().enumerate() {
-        b.swap_rows(k, p);
-    }
-    for j in 0..n {
-        for i in j + 1..n {
-            b[i] -= lu[(i, j)] * b[j];
-        }
-    }
-    for j in (0..n).rev() {
-        b[j] /= lu[(j, j)];
-        for i in 0..j {
-            b[i] -= lu[(i, j)] * b[j];
-        }
-    }
 }
 
 /// Wraps an evaluation failure at iteration `iterations`.
@@ -335,7 +429,7 @@ fn check(size_ok: bool, v: &[f64], it: usize, what: &'static str) -> Result<(), 
         return Err(eval_err(it)(EvalError(msg)));
     }
     let iterations = it;
-    match v.iter().all(|x| x.is_finite()) {
+    match all_finite(v) {
         true => Ok(()),
         false => Err(DoglegError::NonFinite { iterations, what }),
     }
@@ -410,12 +504,13 @@ pub fn solve<S: NonlinearSystem>(
         if need_jac {
             sys.jacobian(&ws.x, &ws.f, &mut ws.jac)
                 .map_err(eval_err(iter))?;
+            ws.lu.state = None;
             njev += 1;
             let shape_ok = ws.jac.shape() == (n, n);
             check(shape_ok, ws.jac.as_slice(), iter, "Jacobian")?;
             // D ← max(D, column norms); zero columns of the first Jacobian get 1.
             for j in 0..n {
-                let c = norm2(ws.jac.column(j).iter().copied()).min(f64::MAX);
+                let c = column_norm(ws.jac.column(j).as_slice()).min(f64::MAX);
                 ws.diag[j] = ws.diag[j].max(c);
                 if ws.diag[j] == 0.0 {
                     ws.diag[j] = 1.0;
@@ -491,9 +586,10 @@ pub fn solve<S: NonlinearSystem>(
                 ws.grad[j] = ws.diag[j] * (ws.diag[j] * ws.p[j] / pnorm);
             }
             ws.jac.ger(1.0, &ws.tmp, &ws.grad, 1.0);
+            ws.lu.update(&ws.tmp, &ws.grad, &mut ws.p_gn);
             jac_fresh = false;
             // An update that overflowed is discarded: the analytic Jacobian replaces it.
-            need_jac = ws.jac.iter().any(|v| !v.is_finite());
+            need_jac = !all_finite(ws.jac.as_slice());
         }
 
         if ratio >= 1e-4 {
@@ -861,6 +957,43 @@ mod tests {
         assert!(a.residual_norm <= 1e-10 && c.residual_norm <= 1e-10);
         // Results do not depend on what the workspace held before.
         assert!(b.x == fresh.x && b2.x == fresh.x && b.iterations == fresh.iterations);
+    }
+
+    #[test]
+    fn sherman_morrison_updates_solve_like_a_refactored_jacobian() {
+        // J₀ (non-symmetric, needs pivoting) and three rank-1 updates: the kept LU with the
+        // updates solves like the LU of J₀ + Σ u vᵀ, to round-off.
+        let n = 7;
+        let j0 = DMatrix::from_fn(n, n, |i, j| {
+            ((i * 5 + j * 3) % 7) as f64 - 3.0 + 0.1 * i as f64
+        });
+        let mut lu = Lu::new(n);
+        assert!(lu.factor(&j0));
+        let mut j = j0.clone();
+        let mut w = V::zeros(n);
+        for k in 0..3 {
+            let u = V::from_fn(n, |i, _| ((i + 2 * k) % 3) as f64 - 0.7);
+            let v = V::from_fn(n, |i, _| 0.2 * ((i * k + 1) % 4) as f64);
+            j.ger(1.0, &u, &v, 1.0);
+            lu.update(&u, &v, &mut w);
+            assert_eq!(lu.state, Some(true), "update {k} kept");
+        }
+        let b = V::from_fn(n, |i, _| 1.0 + i as f64);
+        let mut x = b.clone();
+        lu.solve(&mut x);
+        let mut fresh = Lu::new(n);
+        assert!(fresh.factor(&j));
+        let mut y = b.clone();
+        fresh.solve(&mut y);
+        assert!((&x - &y).amax() <= 1e-12 * y.amax(), "{x} vs {y}");
+        assert!((&j * &x - &b).amax() <= 1e-12 * b.amax());
+        // an update that makes J singular (σ = 0) is not applied: J is refactored instead
+        let u = -j.column(0).into_owned();
+        let e0 = V::from_fn(n, |i, _| if i == 0 { 1.0 } else { 0.0 });
+        lu.update(&u, &e0, &mut w);
+        assert_eq!(lu.state, None);
+        j.ger(1.0, &u, &e0, 1.0);
+        assert!(!lu.factor(&j), "a zero column is singular");
     }
 
     #[test]

@@ -3,11 +3,17 @@
 //! pointwise basis given as values at the sites (POD modes use it).
 //!
 //! Per division j, `Φ_j(X) = S_j Φ̄(X̄)` with `S_j = diag(1/ℓ_j, 1/ℓ_j, 1/ℓ_j, 1, 1, 1)`: angular
-//! coordinates are angles, linear coordinates dimensionless strains (spec §4.1). Columns are ordered
-//! mode by mode (torsion, bend-y, bend-z, elongation, shear-y, shear-z), by increasing degree or node
-//! inside a mode; divisions follow each other in `q`.
+//! coordinates are angles, linear coordinates dimensionless strains (spec §4.1). Legendre columns are
+//! ordered mode by mode (torsion, bend-y, bend-z, elongation, shear-y, shear-z), by increasing degree
+//! inside a mode (spec §4.1). FEM-like columns are ordered **node by node**, the active modes in that
+//! order inside a node (column `k·m + a` is node `k` of the `a`-th of the `m` active modes; with one
+//! active mode this is spec §4.1's order), so that the support of a site — the nodes of its element,
+//! every mode — is one contiguous range of `(p + 1)·m` columns ([`StrainParam::columns`]).
+//! Divisions follow each other in `q`.
+//!
+//! `Φ` is stored per site on its support only (6 × Σ_s |cols_s|), not as 6 × n per site.
 
-use super::{StrainEval, StrainParam};
+use super::{SiteJacobian, StrainEval, StrainParam};
 use crate::discretize::Discretization;
 use crate::error::ModelError;
 use crate::lie::V6;
@@ -90,16 +96,13 @@ impl DivisionBasis {
 
     /// Writes `Φ̄(X̄)` scaled by `S_j` (6 × dofs) into `out` (which must be zeroed).
     pub fn fill(&self, x_bar: f64, length: f64, out: &mut nalgebra::DMatrixViewMut<'_, f64>) {
-        let mut col = 0;
-        for i in 0..6 {
-            let nd = self.mode_dofs(i);
-            if nd == 0 {
-                continue;
-            }
-            let scale = if i < 3 { 1.0 / length } else { 1.0 };
-            match self {
-                DivisionBasis::Legendre { .. } => {
-                    let x = 2.0 * x_bar - 1.0;
+        let scale = |i: usize| if i < 3 { 1.0 / length } else { 1.0 };
+        match self {
+            DivisionBasis::Legendre { .. } => {
+                let x = 2.0 * x_bar - 1.0;
+                let mut col = 0;
+                for i in 0..6 {
+                    let nd = self.mode_dofs(i);
                     let (mut p0, mut p1) = (1.0, x);
                     for m in 0..nd {
                         let v = match m {
@@ -113,31 +116,62 @@ impl DivisionBasis {
                                 p2
                             }
                         };
-                        out[(i, col + m)] = v * scale;
+                        out[(i, col + m)] = v * scale(i);
                     }
+                    col += nd;
                 }
-                DivisionBasis::Fem {
-                    elements, degree, ..
-                } => {
-                    let ne = *elements;
-                    let e = ((x_bar * ne as f64 + 1e-12).floor() as usize).min(ne - 1);
-                    let chi = x_bar * ne as f64 - e as f64;
-                    match degree {
-                        FemDegree::Linear => {
-                            out[(i, col + e)] += (1.0 - chi) * scale;
-                            out[(i, col + e + 1)] += chi * scale;
-                        }
-                        FemDegree::Quadratic => {
-                            let b = col + 2 * e;
-                            out[(i, b)] += 2.0 * (chi - 0.5) * (chi - 1.0) * scale;
-                            out[(i, b + 1)] += -4.0 * chi * (chi - 1.0) * scale;
-                            out[(i, b + 2)] += 2.0 * chi * (chi - 0.5) * scale;
-                        }
+            }
+            DivisionBasis::Fem {
+                modes,
+                elements,
+                degree,
+            } => {
+                let m = modes.iter().filter(|&&a| a).count();
+                let (first, values) = fem_shape(x_bar, *elements, *degree);
+                let active = (0..6).filter(|&i| modes[i]);
+                for (slot, i) in active.enumerate() {
+                    for (k, v) in values.iter().enumerate().take(degree_of(*degree) + 1) {
+                        out[(i, (first + k) * m + slot)] += v * scale(i);
                     }
                 }
             }
-            col += nd;
         }
+    }
+
+    /// The columns (relative to the division's first) on which `Φ̄(X̄)` may be non-zero: all of them
+    /// for Legendre; the nodes of the element holding `X̄`, every active mode, for FEM-like bases.
+    pub fn support(&self, x_bar: f64) -> Range<usize> {
+        match self {
+            DivisionBasis::Legendre { .. } => 0..self.dofs(),
+            DivisionBasis::Fem {
+                modes,
+                elements,
+                degree,
+            } => {
+                let m = modes.iter().filter(|&&a| a).count();
+                let (first, _) = fem_shape(x_bar, *elements, *degree);
+                first * m..(first + degree_of(*degree) + 1) * m
+            }
+        }
+    }
+}
+
+/// The FEM-like shape functions at `X̄` (spec §4.3): the first node of the element holding `X̄` and
+/// the values of its `p + 1` nodal functions (element `e = ⌊n_e X̄⌋`, `χ = n_e X̄ − e`; linear
+/// `1 − χ, χ`; quadratic `2(χ − ½)(χ − 1), −4χ(χ − 1), 2χ(χ − ½)`).
+fn fem_shape(x_bar: f64, ne: usize, degree: FemDegree) -> (usize, [f64; 3]) {
+    let e = ((x_bar * ne as f64 + 1e-12).floor() as usize).min(ne - 1);
+    let chi = x_bar * ne as f64 - e as f64;
+    match degree {
+        FemDegree::Linear => (e, [1.0 - chi, chi, 0.0]),
+        FemDegree::Quadratic => (
+            2 * e,
+            [
+                2.0 * (chi - 0.5) * (chi - 1.0),
+                -4.0 * chi * (chi - 1.0),
+                2.0 * chi * (chi - 0.5),
+            ],
+        ),
     }
 }
 
@@ -148,17 +182,58 @@ fn degree_of(d: FemDegree) -> usize {
     }
 }
 
+/// A mutable 6 × k block of `Φ`.
+type SiteBlockMut<'a> = nalgebra::Matrix<
+    f64,
+    nalgebra::U6,
+    nalgebra::Dyn,
+    nalgebra::ViewStorageMut<'a, f64, nalgebra::U6, nalgebra::Dyn, nalgebra::U1, nalgebra::U6>,
+>;
+
 /// A linear strain basis tabulated at the sites of one discretization: `Ψ_s = Φ_s q`.
 #[derive(Debug, Clone)]
 pub struct LinearBasis {
     n: usize,
-    /// `Φ_s` of all sites side by side (6 × n·n_sites).
+    /// `Φ_s` of all sites on their columns `cols[s]`, side by side (6 × Σ_s |cols_s|); site `s`
+    /// starts at `offsets[s]`.
     phi: Matrix6xX<f64>,
+    offsets: Vec<usize>,
     cols: Vec<Range<usize>>,
 }
 
 impl LinearBasis {
-    /// One basis per division (spec §4.4); coordinates of the divisions are concatenated.
+    /// A basis from `Φ_s` restricted to `cols[s]`, written per site by `block(s, cols[s], out)`.
+    fn from_blocks(
+        n: usize,
+        cols: Vec<Range<usize>>,
+        mut block: impl FnMut(usize, &Range<usize>, &mut SiteBlockMut<'_>),
+    ) -> Self {
+        let mut offsets = Vec::with_capacity(cols.len());
+        let mut total = 0;
+        for c in &cols {
+            offsets.push(total);
+            total += c.len();
+        }
+        let mut phi = Matrix6xX::zeros(total);
+        for (s, c) in cols.iter().enumerate() {
+            block(s, c, &mut phi.columns_mut(offsets[s], c.len()));
+        }
+        LinearBasis {
+            n,
+            phi,
+            offsets,
+            cols,
+        }
+    }
+
+    /// `Φ_s` on its columns, as a view.
+    fn block(&self, s: usize) -> SiteJacobian<'_> {
+        self.phi.columns(self.offsets[s], self.cols[s].len())
+    }
+
+    /// One basis per division (spec §4.4); coordinates of the divisions are concatenated. A site's
+    /// columns are its division's support at the site ([`DivisionBasis::support`]); the two Magnus
+    /// sub-points of a step get the union of theirs.
     pub fn per_division(
         disc: &Discretization,
         bases: &[DivisionBasis],
@@ -177,25 +252,34 @@ impl LinearBasis {
         let mut n = 0;
         for (j, b) in bases.iter().enumerate() {
             b.validate(&format!("divisions[{j}].basis"))?;
-            offsets.push(n..n + b.dofs());
+            offsets.push(n);
             n += b.dofs();
         }
-        let ns = disc.n_sites();
-        let mut phi = Matrix6xX::zeros(n * ns);
-        let mut cols = Vec::with_capacity(ns);
-        let mut block = DMatrix::zeros(6, n);
-        for (s, site) in disc.sites.iter().enumerate() {
-            let r = offsets[site.div].clone();
-            block.fill(0.0);
-            {
-                let mut v = block.view_mut((0, 0), (6, r.len()));
-                bases[site.div].fill(site.x_bar, disc.div_length[site.div], &mut v);
-            }
-            phi.columns_mut(s * n + r.start, r.len())
-                .copy_from(&block.view((0, 0), (6, r.len())));
-            cols.push(r);
+        let mut cols: Vec<Range<usize>> = disc
+            .sites
+            .iter()
+            .map(|site| {
+                let r = bases[site.div].support(site.x_bar);
+                let o = offsets[site.div];
+                o + r.start..o + r.end
+            })
+            .collect();
+        for st in disc.steps.iter().flatten() {
+            let [s1, s2] = st.sites;
+            let hull = cols[s1].start.min(cols[s2].start)..cols[s1].end.max(cols[s2].end);
+            cols[s1] = hull.clone();
+            cols[s2] = hull;
         }
-        Ok(LinearBasis { n, phi, cols })
+        // Φ of a division at a site, all its columns (reused scratch), then the site's columns.
+        let mut full = DMatrix::zeros(6, bases.iter().map(|b| b.dofs()).max().unwrap_or(0));
+        Ok(Self::from_blocks(n, cols, |s, c, out| {
+            let site = disc.sites[s];
+            let (o, nd) = (offsets[site.div], bases[site.div].dofs());
+            full.fill(0.0);
+            let mut v = full.view_mut((0, 0), (6, nd));
+            bases[site.div].fill(site.x_bar, disc.div_length[site.div], &mut v);
+            out.copy_from(&full.columns(c.start - o, c.len()));
+        }))
     }
 
     /// A basis given by its values at every site: `values` is 6·n_sites × n, point-major (site s
@@ -223,15 +307,9 @@ impl LinearBasis {
             ));
         }
         let n = values.ncols();
-        let mut phi = Matrix6xX::zeros(n * ns);
-        for s in 0..ns {
-            phi.columns_mut(s * n, n).copy_from(&values.rows(6 * s, 6));
-        }
-        Ok(LinearBasis {
-            n,
-            phi,
-            cols: vec![0..n; ns],
-        })
+        Ok(Self::from_blocks(n, vec![0..n; ns], |s, _, out| {
+            out.copy_from(&values.rows(6 * s, 6))
+        }))
     }
 
     /// A pointwise basis given at the computational points only (`6·n_points × n`, point-major), as a
@@ -293,30 +371,16 @@ impl LinearBasis {
         }
         let k = b.ncols();
         let ns = self.cols.len();
-        let mut phi = Matrix6xX::zeros(k * ns);
-        for (s, r) in self.cols.iter().enumerate() {
-            let blk = self.phi.columns(s * self.n + r.start, r.len());
-            phi.columns_mut(s * k, k)
-                .copy_from(&(blk * b.rows(r.start, r.len())));
-        }
-        Ok(LinearBasis {
-            n: k,
-            phi,
-            cols: vec![0..k; ns],
-        })
+        Ok(Self::from_blocks(k, vec![0..k; ns], |s, _, out| {
+            let r = &self.cols[s];
+            out.gemm(1.0, &self.block(s), &b.rows(r.start, r.len()), 0.0);
+        }))
     }
 
     /// `Φ_s` restricted to its columns.
     pub fn phi_at(&self, site: usize) -> nalgebra::DMatrix<f64> {
         let r = &self.cols[site];
-        DMatrix::from_iterator(
-            6,
-            r.len(),
-            self.phi
-                .columns(site * self.n + r.start, r.len())
-                .iter()
-                .cloned(),
-        )
+        DMatrix::from_iterator(6, r.len(), self.block(site).iter().cloned())
     }
 }
 
@@ -334,14 +398,13 @@ impl StrainParam for LinearBasis {
         self.cols[site].clone()
     }
     fn new_eval(&self) -> StrainEval {
-        let mut ev = StrainEval::zeros(self.n, self.n_sites());
+        let mut ev = StrainEval::with_columns(self.n, &self.cols);
         ev.psi_q.copy_from(&self.phi);
         ev
     }
     fn eval(&self, q: &DVector<f64>, ev: &mut StrainEval) {
         for (s, r) in self.cols.iter().enumerate() {
-            let blk = self.phi.columns(s * self.n + r.start, r.len());
-            ev.psi[s] = blk * q.rows(r.start, r.len());
+            ev.psi[s] = self.block(s) * q.rows(r.start, r.len());
         }
     }
     fn eval_rate(&self, _q: &DVector<f64>, _qd: &DVector<f64>, _ev: &mut StrainEval) {}

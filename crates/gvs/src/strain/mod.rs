@@ -29,8 +29,11 @@ pub type SiteJacobian<'a> = nalgebra::Matrix<f64, U6, Dyn, ViewStorage<'a, f64, 
 
 /// Values of a parameterization at all sites for one `q` (and optionally `q̇`).
 ///
-/// `psi_q` stores the 6×n blocks of all sites side by side (`6 × n·n_sites`); only the columns in
-/// [`StrainParam::columns`] of a site may be non-zero and only those are read by the engine.
+/// `psi_q` stores the 6×|cols_s| blocks of all sites side by side: site `s` holds the columns
+/// `cols_s` of `Ψ_q,s` (its [`StrainParam::columns`]) from `offsets[s]` on. Only those columns may be
+/// non-zero and only those are read by the engine. [`StrainEval::zeros`] gives every site all `n`
+/// columns (`offsets[s] = s·n`, the layout nonlinear parameterizations write into);
+/// [`StrainEval::with_columns`] stores local-support bases compactly.
 #[derive(Debug, Clone)]
 pub struct StrainEval {
     pub n: usize,
@@ -41,30 +44,72 @@ pub struct StrainEval {
     /// [`StrainParam::eval_rate`] and [`StrainParam::add_weighted_hessian`] reuse at the same `q`
     /// (e.g. a network's activations). Sized by [`StrainParam::new_eval`]; never resized after.
     pub scratch: Vec<f64>,
+    /// Per site: the stored columns and where they start in `psi_q`.
+    cols: Vec<Range<usize>>,
+    offsets: Vec<usize>,
 }
 
 impl StrainEval {
+    /// Every site stores all `n` columns (`6 × n·n_sites`).
     pub fn zeros(n: usize, n_sites: usize) -> Self {
+        let cols = vec![0..n; n_sites];
+        Self::with_columns(n, &cols)
+    }
+
+    /// Site `s` stores the columns `cols[s]` only (`6 × Σ_s |cols[s]|`).
+    pub fn with_columns(n: usize, cols: &[Range<usize>]) -> Self {
+        let mut offsets = Vec::with_capacity(cols.len());
+        let mut total = 0;
+        for c in cols {
+            offsets.push(total);
+            total += c.len();
+        }
         StrainEval {
             n,
-            psi: vec![V6::zeros(); n_sites],
-            psi_q: Matrix6xX::zeros(n * n_sites),
-            psi_q_dot: Matrix6xX::zeros(n * n_sites),
+            psi: vec![V6::zeros(); cols.len()],
+            psi_q: crate::model::zeros6_lazy(total),
+            psi_q_dot: crate::model::zeros6_lazy(total),
             scratch: Vec::new(),
+            cols: cols.to_vec(),
+            offsets,
         }
     }
 
-    /// `Ψ_q` at `site`, restricted to `cols`.
+    /// The columns stored for `site`.
     #[inline]
-    pub fn psi_q_at(&self, site: usize, cols: &Range<usize>) -> SiteJacobian<'_> {
-        self.psi_q.columns(site * self.n + cols.start, cols.len())
+    pub fn stored_columns(&self, site: usize) -> Range<usize> {
+        self.cols[site].clone()
     }
 
-    /// `Ψ̇_q` at `site`, restricted to `cols`.
+    /// Where `Ψ_q` at `site`, column `col` (a stored column), sits in `psi_q`.
+    #[inline]
+    fn index(&self, site: usize, col: usize) -> usize {
+        debug_assert!(self.cols[site].start <= col && col <= self.cols[site].end);
+        self.offsets[site] + col - self.cols[site].start
+    }
+
+    /// `Ψ_q` at `site`, restricted to `cols` (within the stored columns).
+    #[inline]
+    pub fn psi_q_at(&self, site: usize, cols: &Range<usize>) -> SiteJacobian<'_> {
+        debug_assert!(cols.end <= self.cols[site].end);
+        self.psi_q.columns(self.index(site, cols.start), cols.len())
+    }
+
+    /// `Ψ̇_q` at `site`, restricted to `cols` (within the stored columns).
     #[inline]
     pub fn psi_q_dot_at(&self, site: usize, cols: &Range<usize>) -> SiteJacobian<'_> {
+        debug_assert!(cols.end <= self.cols[site].end);
         self.psi_q_dot
-            .columns(site * self.n + cols.start, cols.len())
+            .columns(self.index(site, cols.start), cols.len())
+    }
+
+    /// Column `col` of `Ψ_q` at `site` (zero outside the stored columns).
+    pub fn psi_q_column(&self, site: usize, col: usize) -> V6 {
+        if self.cols[site].contains(&col) {
+            self.psi_q.column(self.index(site, col)).into_owned()
+        } else {
+            V6::zeros()
+        }
     }
 }
 
@@ -81,8 +126,9 @@ pub trait StrainParam: Send + Sync {
     /// `true` if `Ψ(q) = Φ q` with constant `Φ` (then `Ψ̇_q = 0` and all Hessians vanish).
     fn is_linear(&self) -> bool;
 
-    /// The contiguous range of coordinates that may influence the strain at `site` (the division's
-    /// columns for a multi-division basis; everything for a global basis).
+    /// The contiguous range of coordinates that may influence the strain at `site`: its true support
+    /// for a local (FEM-like) basis, the division's columns for a multi-division basis, everything
+    /// for a global basis. The two Magnus sub-points of one step report the same range.
     fn columns(&self, site: usize) -> Range<usize> {
         let _ = site;
         0..self.n_dof()
@@ -208,7 +254,7 @@ pub mod testing {
             eval_at(&qm, &mut em);
             for s in 0..ns {
                 let fd = (ep.psi[s] - em.psi[s]) / (2.0 * h);
-                let an = ev.psi_q.column(s * n + j);
+                let an = ev.psi_q_column(s, j);
                 d_psi_q = d_psi_q.max((fd - an).amax());
                 m_psi_q = m_psi_q.max(fd.amax());
             }
@@ -225,7 +271,9 @@ pub mod testing {
         let g = |e: &StrainEval| {
             let mut out = DVector::zeros(n);
             for s in 0..ns {
-                out += e.psi_q.columns(s * n, n).transpose() * w[s];
+                let c = e.stored_columns(s);
+                let mut o = out.rows_mut(c.start, c.len());
+                o += e.psi_q_at(s, &c).transpose() * w[s];
             }
             out
         };
