@@ -315,7 +315,7 @@ fn a_resumed_run_equals_an_uninterrupted_one() {
         ],
         &["--resume", "--seed", "7 there, 9 now"],
     );
-    let out = gvsrom(&[
+    let same_args = [
         "dataset",
         "six-tendon",
         "--random",
@@ -329,7 +329,20 @@ fn a_resumed_run_equals_an_uninterrupted_one() {
         "--out",
         part.to_str().unwrap(),
         "--resume",
-    ]);
+    ];
+    // a dataset written before the coordinate order was recorded (FEM bases were mode-major then)
+    // is refused: its q rows would not fit this run's
+    let meta_path = part.join("meta.json");
+    let meta_text = std::fs::read_to_string(&meta_path).unwrap();
+    let mut legacy = json(&meta_path);
+    legacy.as_object_mut().unwrap().remove("q_order").unwrap();
+    std::fs::write(&meta_path, serde_json::to_string(&legacy).unwrap()).unwrap();
+    expect_error(
+        &same_args,
+        &["--resume", "q_order", "`fem-mode-major` there"],
+    );
+    std::fs::write(&meta_path, meta_text).unwrap();
+    let out = gvsrom(&same_args);
     assert!(
         out.status.success(),
         "{}",

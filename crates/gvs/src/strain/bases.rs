@@ -21,6 +21,11 @@ use nalgebra::{DMatrix, DVector, Matrix6xX};
 use serde::{Deserialize, Serialize};
 use std::ops::Range;
 
+/// Names the order of the generalized coordinates `q` (module docs): files that store `q` record it,
+/// so that coordinates written under another order are never mixed with these. Before it, FEM-like
+/// bases with several modes were ordered mode by mode (`"fem-mode-major"`).
+pub const COORDINATE_ORDER: &str = "fem-node-major";
+
 /// Polynomial degree of a FEM-like local basis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]

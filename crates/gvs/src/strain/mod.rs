@@ -17,7 +17,7 @@
 mod bases;
 mod sigmoid;
 
-pub use bases::{DivisionBasis, FemDegree, LinearBasis};
+pub use bases::{DivisionBasis, FemDegree, LinearBasis, COORDINATE_ORDER};
 pub use sigmoid::SigmoidBend;
 
 use crate::lie::V6;

@@ -205,6 +205,7 @@ pub fn run(
         counts: Counts::default(),
         failures: vec![],
         crate_version: env!("CARGO_PKG_VERSION").into(),
+        q_order: gvs::strain::COORDINATE_ORDER.into(),
         wall_time_s: t0.elapsed().as_secs_f64(),
         threads: 1,
     };

@@ -5,7 +5,7 @@
 //! |---|---|---|---|
 //! | `inputs.npy` | (N, k) | f64 | the plan's parameter values (`parameters` in meta.json names the columns) |
 //! | `strain.npy` | (N, p·a) | f64 | ξ − ξ* at the p computational points, the a active components, point-major: column `j·a + c` is point j, component `components[c]`; NaN rows for failed samples |
-//! | `q.npy` | (N, n) | f64 | HOM coordinates |
+//! | `q.npy` | (N, n) | f64 | HOM coordinates, in the order `q_order` of meta.json names ([`gvs::strain::COORDINATE_ORDER`]) |
 //! | `tip_position.npy` | (N, 3) | f64 | tip position [m] |
 //! | `tip_rotation.npy` | (N, 3, 3) | f64 | tip rotation (section → world) |
 //! | `status.npy` | (N,) | u8 | 0 ok, 1 failed (reason in meta.json `failures`), 2 not computed (incomplete dataset) |
@@ -247,6 +247,10 @@ pub struct Meta {
     pub counts: Counts,
     pub failures: Vec<Failure>,
     pub crate_version: String,
+    /// Order of the coordinates in `q.npy` ([`gvs::strain::COORDINATE_ORDER`]); datasets written
+    /// before it was recorded used `"fem-mode-major"`.
+    #[serde(default = "legacy_q_order")]
+    pub q_order: String,
     /// Wall time of this run (a resumed run: of its own part).
     pub wall_time_s: f64,
     pub threads: usize,
@@ -261,6 +265,10 @@ pub struct Outcome {
     pub interrupted: Option<String>,
     /// Chunks taken over from the resumed dataset.
     pub resumed_chunks: usize,
+}
+
+fn legacy_q_order() -> String {
+    "fem-mode-major".into()
 }
 
 fn plan_err(e: String) -> DatasetError {
@@ -400,6 +408,7 @@ pub fn run(
         counts: Counts::default(),
         failures: vec![],
         crate_version: env!("CARGO_PKG_VERSION").into(),
+        q_order: gvs::strain::COORDINATE_ORDER.into(),
         wall_time_s: 0.0,
         threads: 0,
         plan: Some(plan.clone()),

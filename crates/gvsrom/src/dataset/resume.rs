@@ -64,6 +64,13 @@ pub(super) fn resumable(path: &Path, meta: &Meta) -> Result<Dataset, DatasetErro
             meta.chunk_size.to_string(),
         ));
     }
+    if p.q_order != meta.q_order {
+        return Err(differs(
+            "order of the coordinates in q.npy (q_order)",
+            format!("`{}`", p.q_order),
+            format!("`{}`", meta.q_order),
+        ));
+    }
     if p.parameters != meta.parameters
         || p.components != meta.components
         || p.n_dof != meta.n_dof
