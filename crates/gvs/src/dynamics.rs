@@ -17,6 +17,8 @@ use crate::discretize::MagnusOrder;
 use crate::lie::{ad, ad_mul, coad_mul, V3, V6};
 use crate::model::{Model, PreparedLoads, Workspace, ZANNA_C};
 use crate::strain::StrainParam;
+use faer::linalg::matmul::matmul;
+use faer::{Accum, MatMut, MatRef, Par};
 use nalgebra::{DMatrix, DVector, Matrix6xX};
 use thiserror::Error;
 
@@ -50,6 +52,9 @@ impl Energy {
         self.kinetic + self.elastic + self.gravitational
     }
 }
+
+/// Points per blocked product in [`Model::assemble_mass`].
+pub const MASS_CHUNK: usize = 32;
 
 impl<P: StrainParam> Model<P> {
     /// Forward pass with velocities: after [`Model::forward`], fills `ws.eta` (`η_i`)
@@ -136,8 +141,10 @@ impl<P: StrainParam> Model<P> {
     }
 
     /// `M = Σ_i W_i J_iᵀ Ms_i J_i` into `ws.mass` (after a forward pass with Jacobians; `ws.mass`
-    /// is allocated on first use). `J_i` is zero beyond its column bound `h_i`, so point i adds to
-    /// the leading `h_i × h_i` block only.
+    /// is allocated on first use), as `M = Σ_chunks Bᵀ B` with the rows `√(W_i Ms_i,a) J_i[a, :]`
+    /// of [`MASS_CHUNK`] points stacked in `B` (one blocked product per chunk instead of a rank-6
+    /// update per point). `J_i` is zero beyond its column bound `h_i`, so a chunk adds to the
+    /// leading `h × h` block only, `h` its largest bound. `Ms` is diagonal and non-negative.
     pub fn assemble_mass(&self, ws: &mut Workspace) {
         let n = self.n_dof();
         if ws.mass.shape() != (n, n) {
@@ -145,21 +152,46 @@ impl<P: StrainParam> Model<P> {
         } else {
             ws.mass.fill(0.0);
         }
-        for (i, p) in self.disc.points.iter().enumerate() {
-            let h = ws.jac_bound(i);
-            if p.weight == 0.0 || h == 0 {
-                continue;
+        let rows = 6 * MASS_CHUNK;
+        if ws.mass_b.len() != rows * n {
+            ws.mass_b = vec![0.0; rows * n];
+        }
+        let np = self.disc.n_points();
+        let mut start = 0;
+        while start < np {
+            let end = (start + MASS_CHUNK).min(np);
+            let h = (start..end).map(|i| ws.jac_bound(i)).max().unwrap_or(0);
+            if h > 0 {
+                // B (rows × h, column-major, leading dimension `rows`)
+                let bounds = &ws.jac_hi[start..end];
+                let b = &mut ws.mass_b[..rows * h];
+                b.fill(0.0);
+                for (k, i) in (start..end).enumerate() {
+                    let p = &self.disc.points[i];
+                    let hi = bounds[k];
+                    if p.weight == 0.0 || hi == 0 {
+                        continue;
+                    }
+                    let ms = self.props[i].ms;
+                    let sq: [f64; 6] = std::array::from_fn(|a| (ms[a] * p.weight).sqrt());
+                    let j = ws.jac.columns(i * n, hi);
+                    for c in 0..hi {
+                        let col = &mut b[c * rows + 6 * k..c * rows + 6 * k + 6];
+                        for a in 0..6 {
+                            col[a] = sq[a] * j[(a, c)];
+                        }
+                    }
+                }
+                let bm = MatRef::from_column_major_slice(&ws.mass_b[..rows * h], rows, h);
+                let dst = MatMut::from_column_major_slice_with_stride_mut(
+                    ws.mass.as_mut_slice(),
+                    h,
+                    h,
+                    n,
+                );
+                matmul(dst, Accum::Add, bm.transpose(), bm, 1.0, Par::Seq);
             }
-            let ms = self.props[i].ms * p.weight;
-            let j = ws.jac.columns(i * n, h);
-            let mut t1 = ws.t1.columns_mut(0, h);
-            t1.copy_from(&j);
-            for a in 0..6 {
-                t1.row_mut(a).scale_mut(ms[a]);
-            }
-            ws.mass
-                .view_mut((0, 0), (h, h))
-                .gemm_tr(1.0, &j, &ws.t1.columns(0, h), 1.0);
+            start = end;
         }
     }
 

@@ -89,7 +89,7 @@ pub struct Workspace {
     /// beyond point i); the engine never writes those columns, so they must stay zero.
     pub jac: Matrix6xX<f64>,
     /// Per point: `J_i` is zero at columns `>= jac_hi[i]`.
-    jac_hi: Vec<usize>,
+    pub(crate) jac_hi: Vec<usize>,
     /// Per point: `∂y_i/∂q` in `dyp` is zero at columns `>= dy_hi[i]`.
     pub(crate) dy_hi: Vec<usize>,
     /// Scratch (up to n × 18, column-major) of the row updates `out[c, :] += G X`.
@@ -111,6 +111,8 @@ pub struct Workspace {
     pub(crate) zeta: Vec<V6>,
     /// Mass matrix of the last dynamics evaluation (empty until the first one).
     pub mass: DMatrix<f64>,
+    /// Scratch of the mass matrix assembly (empty until the first one).
+    pub(crate) mass_b: Vec<f64>,
     /// `max(1, ‖elastic‖∞, ‖external + actuation‖∞)` of the last residual.
     pub residual_scale: f64,
 }
@@ -242,6 +244,7 @@ impl<P: StrainParam> Model<P> {
             eta: vec![V6::zeros(); np],
             zeta: vec![V6::zeros(); np],
             mass: DMatrix::zeros(0, 0),
+            mass_b: Vec::new(),
             residual_scale: 1.0,
         }
     }

@@ -1,14 +1,18 @@
-//! Time integration of the GVS equations of motion (paper eq. 8, gvs-spec §9) in first-order form
-//! `y = [q; q̇]`, `y' = [q̇; M(q)⁻¹ τ(q, q̇, t)]`, with a stiff variable-order NDF integrator (ode15s
-//! class) or a fixed-step implicit method, piecewise-constant or ramped actuation `u(t)`, a scalar load
-//! schedule `λ(t)` on the external loads, and initial states at rest, given, or at a static equilibrium.
+//! Time integration of the GVS equations of motion (paper eq. 8, gvs-spec §9) with the state
+//! `y = [q; q̇]`, `y' = [q̇; M(q)⁻¹ τ(q, q̇, t)]`: a stiff variable-order NDF integrator (ode15s
+//! class) — by default in second-order form, each Newton iteration evaluating the recursive residual
+//! `M q̈ − τ` and solving with the `n × n` matrix `M + c D + c² K`
+//! ([`super::ode::integrate_ndf_second_order`]) —, a fixed-step implicit method or generalized-α;
+//! piecewise-constant or ramped actuation `u(t)`, a scalar load schedule `λ(t)` on the external
+//! loads, and initial states at rest, given, or at a static equilibrium.
 //!
 //! Input switching times are passed to the integrator as breakpoints (it steps onto them and restarts).
 //! On failure the samples computed so far are kept and the error carries the time reached.
 
 use super::ode::{
-    integrate_fixed, integrate_generalized_alpha, integrate_ndf, FixedStepOptions,
-    GeneralizedAlphaOptions, MechanicalSystem, NdfOptions, OdeError, OdeStats, OdeSystem, RhsError,
+    integrate_fixed, integrate_generalized_alpha, integrate_ndf, integrate_ndf_second_order,
+    FixedStepOptions, GeneralizedAlphaOptions, MechanicalSystem, NdfOptions, OdeError, OdeStats,
+    OdeSystem, RhsError,
 };
 use super::statics::{StaticsError, StaticsOptions, StaticsSolver};
 use crate::error::ModelError;
@@ -48,9 +52,15 @@ impl Default for Method {
 /// How the integrator gets `∂f/∂y`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum OdeJacobian {
-    /// Finite differences of the right-hand side (2n evaluations), reused across steps.
+    /// First-order form `y' = f(y)`, `f = [q̇; M⁻¹τ]` evaluated by [`Model::accelerations`], with
+    /// finite differences of `f` (2n evaluations) for the `2n × 2n` iteration matrix, reused
+    /// across steps. Slow; a cross-check of the structured path.
     FiniteDifference,
-    /// The structured Jacobian `[0 I; M⁻¹∂R/∂q  −M⁻¹D]` from the analytic statics Jacobian
+    /// The structured parts `M`, `D`, `K_T` ([`Model::iteration_parts`]: the analytic statics
+    /// Jacobian and the damping matrix). The NDF then runs in second-order form
+    /// ([`super::ode::integrate_ndf_second_order`]): each Newton iteration is one recursive
+    /// residual `M q̈ − τ` ([`Model::dynamics_residual`]) and an `n × n` solve. The fixed-step
+    /// method uses the first-order form with `[0 I; M⁻¹∂R/∂q  −M⁻¹D]`
     /// ([`Model::ode_jacobian_approx`]).
     #[default]
     Structured,
@@ -212,6 +222,19 @@ impl<P: StrainParam> MechanicalSystem for RodOde<'_, P> {
         self.model
             .accelerations(q, qd, &self.u, &self.loads, &mut self.ws, qdd)
             .map_err(|e| RhsError(e.to_string()))
+    }
+
+    fn mass(
+        &mut self,
+        t: f64,
+        q: &DVector<f64>,
+        m: &mut nalgebra::DMatrix<f64>,
+    ) -> Result<(), RhsError> {
+        self.inputs_at(t);
+        self.model.forward(q, &mut self.ws, true);
+        self.model.assemble_mass(&mut self.ws);
+        m.copy_from(&self.ws.mass);
+        Ok(())
     }
 
     fn iteration_parts(
@@ -405,7 +428,12 @@ pub fn simulate_streaming<P: StrainParam>(
     };
     let start = Instant::now();
     let result = match &options.method {
-        Method::Ndf(o) => integrate_ndf(&mut sys, t0, &y0, t_out, &breaks, o, &mut record),
+        Method::Ndf(o) => match options.jacobian {
+            OdeJacobian::Structured => {
+                integrate_ndf_second_order(&mut sys, t0, &q0, &qd0, t_out, &breaks, o, &mut record)
+            }
+            _ => integrate_ndf(&mut sys, t0, &y0, t_out, &breaks, o, &mut record),
+        },
         Method::Fixed(o) => integrate_fixed(&mut sys, t0, &y0, t_out, &breaks, o, &mut record),
         Method::GeneralizedAlpha(o) => {
             integrate_generalized_alpha(&mut sys, t0, &q0, &qd0, t_out, &breaks, o, &mut record)

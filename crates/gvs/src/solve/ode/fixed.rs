@@ -3,7 +3,7 @@
 //! Newton with a Jacobian kept across steps and re-evaluated only when Newton stalls.
 
 use super::{
-    check_common, deliver, invalid, ulp, Counted, FixedStepOptions, JacWork, Lu, OdeError,
+    check_common, deliver, invalid, ulp, Clamp, Counted, FixedStepOptions, JacWork, Lu, OdeError,
     OdeStats, OdeSystem, Output,
 };
 use nalgebra::{DMatrix, DVector};
@@ -141,7 +141,7 @@ pub fn integrate_fixed<S: OdeSystem>(
     };
     let pieces = bounds.len().saturating_sub(1);
     if pieces > 0 {
-        cs.set_piece(bounds[0], false, bounds[1], pieces > 1);
+        cs.clamp = Clamp::piece(bounds[0], false, bounds[1], pieces > 1);
         if !cs.jacobian(t0, &w.y, &w.thresh, &mut w.jac, &mut w.jw)? {
             return Err(OdeError::NonFinite { t: t0 });
         }
@@ -149,7 +149,7 @@ pub fn integrate_fixed<S: OdeSystem>(
     }
     for p in 0..pieces {
         let (a, b) = (bounds[p], bounds[p + 1]);
-        cs.set_piece(a, p > 0, b, p + 1 < pieces);
+        cs.clamp = Clamp::piece(a, p > 0, b, p + 1 < pieces);
         st.have_prev = false;
         // Number of steps: the last one is in [0.1h, 1.1h].
         let nsteps = ((b - a) / h - 0.1).ceil().max(1.0) as usize;

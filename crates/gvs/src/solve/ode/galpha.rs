@@ -68,6 +68,8 @@ pub trait MechanicalSystem {
         qd: &DVector<f64>,
         qdd: &mut DVector<f64>,
     ) -> Result<(), RhsError>;
+    /// The mass matrix `M(q)` at time `t`.
+    fn mass(&mut self, t: f64, q: &DVector<f64>, m: &mut DMatrix<f64>) -> Result<(), RhsError>;
     /// `M`, `D ≈ −∂τ/∂q̇` and `K ≈ ∂(M q̈ − τ)/∂q` at `(t, q, q̇)` for the iteration matrix
     /// `S = M + c_v D + c_q K`.
     #[allow(clippy::too_many_arguments)]

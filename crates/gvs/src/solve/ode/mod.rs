@@ -1,6 +1,8 @@
 //! Stiff initial-value problem integrators for `y' = f(t, y)`: a variable-step, variable-order
-//! NDF/BDF method of the class of MATLAB's `ode15s` ([`integrate_ndf`]) and a cheap fixed-step
-//! BDF2 method for real-time use ([`integrate_fixed`]).
+//! NDF/BDF method of the class of MATLAB's `ode15s` ([`integrate_ndf`]; for mechanical systems
+//! `M(q) q̈ = τ` the same method with an `n × n` Newton iteration on the residual `M q̈ − τ`,
+//! [`integrate_ndf_second_order`], see `corrector`), a cheap fixed-step BDF2 method for real-time
+//! use ([`integrate_fixed`]) and adaptive generalized-α ([`integrate_generalized_alpha`]).
 //!
 //! Reference: L. F. Shampine and M. W. Reichelt, *The MATLAB ODE Suite*, SIAM J. Sci. Comput. 18(1),
 //! 1–22, 1997 (§2: the NDFs, their quasi-constant step size implementation and the step/order
@@ -95,6 +97,7 @@
 use nalgebra::{DMatrix, DVector};
 use std::ops::ControlFlow;
 
+mod corrector;
 mod fixed;
 mod galpha;
 mod ndf;
@@ -106,6 +109,8 @@ mod tests_errors;
 mod tests_fixed;
 #[cfg(test)]
 mod tests_galpha;
+#[cfg(test)]
+mod tests_ndf_second_order;
 
 pub use fixed::integrate_fixed;
 pub use galpha::{integrate_generalized_alpha, GeneralizedAlphaOptions, MechanicalSystem};
@@ -113,7 +118,7 @@ pub use galpha::{integrate_generalized_alpha, GeneralizedAlphaOptions, Mechanica
 /// The output callback of the integrators: called with every output time and the solution there;
 /// `ControlFlow::Break(reason)` stops the integration with [`OdeError::Stopped`].
 pub type Output<'a> = dyn FnMut(f64, &DVector<f64>) -> ControlFlow<String> + 'a;
-pub use ndf::integrate_ndf;
+pub use ndf::{integrate_ndf, integrate_ndf_second_order};
 
 /// An error reported by the right-hand side (or its Jacobian); it stops the integration.
 #[derive(Debug, Clone, thiserror::Error, PartialEq)]
@@ -378,9 +383,46 @@ struct Counted<'a, S: OdeSystem> {
     stats: OdeStats,
     /// `None` until the first Jacobian request; then whether `sys.jacobian` provides it.
     analytic: Option<bool>,
-    /// Evaluation times are clamped to `[lo, hi]` (the open piece when its ends are breakpoints).
+    /// Evaluation times of the current piece.
+    clamp: Clamp,
+}
+
+/// Evaluation times are clamped to `[lo, hi]`: the open piece when its ends are breakpoints.
+#[derive(Debug, Clone, Copy)]
+struct Clamp {
     lo: f64,
     hi: f64,
+}
+
+impl Default for Clamp {
+    fn default() -> Self {
+        Clamp {
+            lo: f64::NEG_INFINITY,
+            hi: f64::INFINITY,
+        }
+    }
+}
+
+impl Clamp {
+    /// The piece `[a, b]`: evaluation times are kept strictly inside where an end is a breakpoint.
+    fn piece(a: f64, a_is_break: bool, b: f64, b_is_break: bool) -> Self {
+        Clamp {
+            lo: if a_is_break {
+                next_up(a)
+            } else {
+                f64::NEG_INFINITY
+            },
+            hi: if b_is_break {
+                next_down(b)
+            } else {
+                f64::INFINITY
+            },
+        }
+    }
+
+    fn apply(&self, t: f64) -> f64 {
+        t.max(self.lo).min(self.hi)
+    }
 }
 
 impl<'a, S: OdeSystem> Counted<'a, S> {
@@ -389,27 +431,12 @@ impl<'a, S: OdeSystem> Counted<'a, S> {
             sys,
             stats: OdeStats::default(),
             analytic: None,
-            lo: f64::NEG_INFINITY,
-            hi: f64::INFINITY,
+            clamp: Clamp::default(),
         }
     }
 
-    /// Sets the piece `[a, b]`: evaluation times are kept strictly inside where an end is a breakpoint.
-    fn set_piece(&mut self, a: f64, a_is_break: bool, b: f64, b_is_break: bool) {
-        self.lo = if a_is_break {
-            next_up(a)
-        } else {
-            f64::NEG_INFINITY
-        };
-        self.hi = if b_is_break {
-            next_down(b)
-        } else {
-            f64::INFINITY
-        };
-    }
-
     fn clamp(&self, t: f64) -> f64 {
-        t.max(self.lo).min(self.hi)
+        self.clamp.apply(t)
     }
 
     /// `dy = f(t, y)`; `Ok(false)` if `dy` is not finite. `t_acc` is the last accepted time (for errors).
@@ -539,14 +566,23 @@ impl Lu {
 
     /// Factors `I − c·jac`; `false` if it is singular or not finite.
     fn factor(&mut self, c: f64, jac: &DMatrix<f64>, stats: &mut OdeStats) -> bool {
+        let n = self.piv.len();
+        self.factor_with(stats, |a| {
+            for (dst, src) in a.iter_mut().zip(jac.iter()) {
+                *dst = -c * src;
+            }
+            for i in 0..n {
+                a[(i, i)] += 1.0;
+            }
+        })
+    }
+
+    /// Factors the matrix `fill` writes (into an `n × n` buffer); `false` if it is singular or
+    /// not finite.
+    fn factor_with(&mut self, stats: &mut OdeStats, fill: impl FnOnce(&mut DMatrix<f64>)) -> bool {
         stats.lu_decompositions += 1;
         let n = self.piv.len();
-        for (dst, src) in self.a.iter_mut().zip(jac.iter()) {
-            *dst = -c * src;
-        }
-        for i in 0..n {
-            self.a[(i, i)] += 1.0;
-        }
+        fill(&mut self.a);
         let a = self.a.as_mut_slice(); // column-major: (i, j) at i + j n
         for k in 0..n {
             let mut p = k;

@@ -2,8 +2,9 @@
 //! differences), after `ode15s` (Shampine & Reichelt 1997). The formulas are in the documentation
 //! of the parent module.
 
+use super::corrector::{Corrector, FirstOrder, SecondOrder};
 use super::{
-    check_common, deliver, invalid, ulp, wnorm, Counted, JacWork, Lu, NdfOptions, OdeError,
+    check_common, deliver, invalid, ulp, wnorm, Clamp, MechanicalSystem, NdfOptions, OdeError,
     OdeStats, OdeSystem, Output,
 };
 use nalgebra::{DMatrix, DVector};
@@ -150,9 +151,6 @@ struct Work {
     out: DVector<f64>,
     /// Backward differences `∇^j y_n`, `j = 1..maxk+2`, in columns `0..maxk+2`.
     dif: DMatrix<f64>,
-    jac: DMatrix<f64>,
-    lu: Lu,
-    jw: JacWork,
 }
 
 impl Work {
@@ -173,9 +171,6 @@ impl Work {
             thresh: v(),
             out: v(),
             dif: DMatrix::zeros(n, 7),
-            jac: DMatrix::zeros(n, n),
-            lu: Lu::new(n),
-            jw: JacWork::new(n),
         }
     }
 }
@@ -286,6 +281,71 @@ pub fn integrate_ndf<S: OdeSystem>(
     output: &mut Output<'_>,
 ) -> Result<OdeStats, OdeError> {
     let n = sys.dim();
+    integrate(
+        &mut FirstOrder::new(sys),
+        n,
+        t0,
+        y0,
+        t_out,
+        breakpoints,
+        opts,
+        output,
+    )
+}
+
+/// [`integrate_ndf`] for a mechanical system `M(q) q̈ = τ(t, q, q̇)` in second-order form, with the
+/// state `y = [q; q̇]` (of dimension `2n`) for the differences, the error test and the output: the
+/// same method and the same discrete solution, but each Newton iteration evaluates the residual
+/// `ε = M q̈ − τ` instead of `M⁻¹ τ` and solves with the `n × n` matrix `M + c D + c² K` (see
+/// `corrector`). `output` receives `[q; q̇]`.
+#[allow(clippy::too_many_arguments)]
+pub fn integrate_ndf_second_order<S: MechanicalSystem>(
+    sys: &mut S,
+    t0: f64,
+    q0: &DVector<f64>,
+    qd0: &DVector<f64>,
+    t_out: &[f64],
+    breakpoints: &[f64],
+    opts: &NdfOptions,
+    output: &mut Output<'_>,
+) -> Result<OdeStats, OdeError> {
+    let n = sys.dim();
+    if q0.len() != n || qd0.len() != n {
+        return Err(invalid(
+            "y0",
+            format!(
+                "q0 and q̇0 have {} and {} entries, the system has {n} coordinates",
+                q0.len(),
+                qd0.len()
+            ),
+        ));
+    }
+    let mut y0 = DVector::zeros(2 * n);
+    y0.rows_mut(0, n).copy_from(q0);
+    y0.rows_mut(n, n).copy_from(qd0);
+    integrate(
+        &mut SecondOrder::new(sys),
+        2 * n,
+        t0,
+        &y0,
+        t_out,
+        breakpoints,
+        opts,
+        output,
+    )
+}
+
+#[allow(clippy::too_many_arguments)]
+fn integrate<C: Corrector>(
+    cs: &mut C,
+    n: usize,
+    t0: f64,
+    y0: &DVector<f64>,
+    t_out: &[f64],
+    breakpoints: &[f64],
+    opts: &NdfOptions,
+    output: &mut Output<'_>,
+) -> Result<OdeStats, OdeError> {
     let bounds = check_common(n, t0, y0, t_out, breakpoints)?;
     let tf = *bounds.last().unwrap_or(&t0);
     let mut w = Work::new(n);
@@ -295,21 +355,20 @@ pub fn integrate_ndf<S: OdeSystem>(
     deliver(t_out, &mut next, t0, &mut w.out, output, |_, b| {
         b.copy_from(y0)
     })?;
-    let mut cs = Counted::new(sys);
     let pieces = bounds.len().saturating_sub(1);
     for p in 0..pieces {
         let (a, b) = (bounds[p], bounds[p + 1]);
-        cs.set_piece(a, p > 0, b, p + 1 < pieces);
+        cs.set_clamp(Clamp::piece(a, p > 0, b, p + 1 < pieces));
         let h0 = if p == 0 { cfg.h0 } else { None };
-        integrate_piece(&mut cs, &mut w, &cfg, a, b, h0, t_out, &mut next, output)?;
+        integrate_piece(cs, &mut w, &cfg, a, b, h0, t_out, &mut next, output)?;
     }
-    Ok(cs.stats)
+    Ok(cs.stats().clone())
 }
 
 /// Integrates the piece `[a, b]` from `w.y` (at `a`) to `b`, leaving `y(b)` in `w.y`.
 #[allow(clippy::too_many_arguments)]
-fn integrate_piece<S: OdeSystem>(
-    cs: &mut Counted<'_, S>,
+fn integrate_piece<C: Corrector>(
+    cs: &mut C,
     w: &mut Work,
     cfg: &Config,
     a: f64,
@@ -327,10 +386,10 @@ fn integrate_piece<S: OdeSystem>(
     let mut t = a;
 
     // Initial slope and Jacobian.
-    if !cs.f(t, t, &w.y, &mut w.yp)? {
+    if !cs.slope(t, t, &w.y, &mut w.yp)? {
         return Err(OdeError::NonFinite { t });
     }
-    if !cs.jacobian(t, &w.y, &w.thresh, &mut w.jac, &mut w.jw)? {
+    if !cs.refresh(t, &w.y, &w.thresh)? {
         return Err(OdeError::NonFinite { t });
     }
     let mut jcurrent = true;
@@ -351,8 +410,8 @@ fn integrate_piece<S: OdeSystem>(
             absh = absh.max(hmin);
             // Error ½h²y'' of the first (order-1) step: y'' = ∂f/∂t + J y'.
             let tdel = (t + (f64::EPSILON.sqrt() * t.abs().max((t + absh).abs())).min(absh)) - t;
-            if tdel > 0.0 && cs.f(t, t + tdel, &w.y, &mut w.f)? {
-                w.tmp.gemv(1.0, &w.jac, &w.yp, 0.0);
+            if tdel > 0.0 && cs.slope(t, t + tdel, &w.y, &mut w.f)? {
+                cs.jacobian_times(&w.yp, &mut w.tmp);
                 let ypp = (0..n)
                     .map(|i| (((w.f[i] - w.yp[i]) / tdel + w.tmp[i]) / wt(i)).abs())
                     .fold(0.0, f64::max);
@@ -374,7 +433,7 @@ fn integrate_piece<S: OdeSystem>(
     w.dif.column_mut(0).axpy(absh, &w.yp, 0.0);
     let mut hinvgak = absh * inv_ga[0];
     let mut nconhk = 0usize;
-    let mut lu_ok = w.lu.factor(hinvgak, &w.jac, &mut cs.stats);
+    let mut lu_ok = cs.factor(hinvgak);
     let mut havrate = false;
     let mut rate = 0.0f64;
     let mut done = false;
@@ -400,10 +459,10 @@ fn integrate_piece<S: OdeSystem>(
             rescale(&mut w.dif, k, absh / abshlast);
             hinvgak = absh * inv_ga[k - 1];
             nconhk = 0;
-            lu_ok = w.lu.factor(hinvgak, &w.jac, &mut cs.stats);
+            lu_ok = cs.factor(hinvgak);
             havrate = false;
         }
-        if cs.stats.steps >= cfg.max_steps {
+        if cs.stats().steps >= cfg.max_steps {
             return Err(OdeError::TooManySteps {
                 t,
                 max_steps: cfg.max_steps,
@@ -439,17 +498,18 @@ fn integrate_piece<S: OdeSystem>(
                 let mut converged = false;
                 let mut nonfinite = false;
                 if lu_ok {
+                    lu_ok = cs.begin_step(t, tnew, hinvgak, &w.ynew, &w.psi)?;
+                }
+                if lu_ok {
                     let mut oldnrm = 0.0;
                     for iter in 1..=MAX_IT {
-                        if !cs.f(t, tnew, &w.ynew, &mut w.f)? {
+                        if !cs
+                            .correction(t, tnew, hinvgak, &w.ynew, &w.psi, &w.difkp1, &mut w.del)?
+                        {
                             nonfinite = true;
                             break;
                         }
-                        for i in 0..n {
-                            w.del[i] = hinvgak * w.f[i] - (w.psi[i] + w.difkp1[i]);
-                        }
-                        w.lu.solve(&mut w.del);
-                        cs.stats.newton_iterations += 1;
+                        cs.stats().newton_iterations += 1;
                         let newnrm = wnorm(&w.del, &w.invwt);
                         w.difkp1 += &w.del;
                         w.ynew.copy_from(&w.pred);
@@ -489,13 +549,16 @@ fn integrate_piece<S: OdeSystem>(
                     }
                 }
                 if converged {
+                    cs.converged(rate);
                     break (tnew, h);
                 }
                 // Too slow (or singular iteration matrix, or non-finite values): new Jacobian if
                 // the current one is stale, else a smaller step.
-                cs.stats.failed_steps += 1;
-                if !nonfinite && !jcurrent {
-                    if !cs.jacobian(t, &w.y, &w.thresh, &mut w.jac, &mut w.jw)? {
+                cs.stats().failed_steps += 1;
+                if !nonfinite && cs.renew_cheaply() {
+                    // retry the step with the cheap remedy first
+                } else if !nonfinite && !jcurrent {
+                    if !cs.refresh(t, &w.y, &w.thresh)? {
                         return Err(OdeError::NonFinite { t });
                     }
                     jcurrent = true;
@@ -513,7 +576,7 @@ fn integrate_piece<S: OdeSystem>(
                     hinvgak = absh * inv_ga[k - 1];
                     nconhk = 0;
                 }
-                lu_ok = w.lu.factor(hinvgak, &w.jac, &mut cs.stats);
+                lu_ok = cs.factor(hinvgak);
                 havrate = false;
             };
 
@@ -522,7 +585,7 @@ fn integrate_piece<S: OdeSystem>(
             if err <= rtol {
                 break (tnew, h, err);
             }
-            cs.stats.failed_steps += 1;
+            cs.stats().failed_steps += 1;
             if absh <= hmin {
                 return Err(OdeError::StepSizeUnderflow {
                     t,
@@ -552,10 +615,10 @@ fn integrate_piece<S: OdeSystem>(
             rescale(&mut w.dif, k, absh / abshlast);
             hinvgak = absh * inv_ga[k - 1];
             nconhk = 0;
-            lu_ok = w.lu.factor(hinvgak, &w.jac, &mut cs.stats);
+            lu_ok = cs.factor(hinvgak);
             havrate = false;
         };
-        cs.stats.steps += 1;
+        cs.stats().steps += 1;
 
         // Update the differences to those of ynew: ∇^{k+2}, ∇^{k+1} = difkp1, then ∇^j += ∇^{j+1}.
         {

@@ -54,6 +54,11 @@ impl MechanicalSystem for Oscillators {
         }
         Ok(())
     }
+    fn mass(&mut self, _t: f64, _q: &DVector<f64>, m: &mut DMatrix<f64>) -> Result<(), RhsError> {
+        let n = self.k.len();
+        m.copy_from(&DMatrix::from_diagonal_element(n, n, self.m));
+        Ok(())
+    }
     fn iteration_parts(
         &mut self,
         _t: f64,
