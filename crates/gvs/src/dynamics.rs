@@ -128,7 +128,7 @@ impl<P: StrainParam> Model<P> {
                 }
             };
             let sqd = et.t * om_dot;
-            let sdqd = et.t_dot(&om_dot) * om_dot + et.t * zd;
+            let sdqd = et.t_dot_mul(&om_dot, &om_dot) + et.t * zd;
             ws.eta[i + 1] = et.g.adjoint_inv_mul(&(ws.eta[i] + sqd));
             ws.zeta[i + 1] =
                 et.g.adjoint_inv_mul(&(ws.zeta[i] + ad_mul(&ws.eta[i], &sqd) + sdqd));

@@ -349,6 +349,22 @@ impl ExpTangent {
         out
     }
 
+    /// `Ṫ(Ω̇) y` without forming `Ṫ`: with `w_r = d(Aʳ) y`, `w_1 = Ȧ y`,
+    /// `w_r = A w_{r−1} + Ȧ A^{r−1} y` (`d(Aʳ) = A d(A^{r−1}) + Ȧ A^{r−1}`), all by `ad` products
+    /// of 6-vectors: `Ṫ y = Σ_r [φ_r (Ω_k·Ω̇_k) Aʳ y + f_r w_r]` (see [`ExpTangent::t_dot`]).
+    pub fn t_dot_mul(&self, omega_dot: &V6, y: &V6) -> V6 {
+        let kk = ang(&self.omega).dot(&ang(omega_dot));
+        let mut ay = *y; // A^{r−1} y
+        let mut w = V6::zeros(); // w_{r−1}
+        let mut out = V6::zeros();
+        for r in 0..4 {
+            w = ad_mul(&self.omega, &w) + ad_mul(omega_dot, &ay);
+            ay = ad_mul(&self.omega, &ay);
+            out += ay * (self.coeffs.phi[r] * kk) + w * self.coeffs.f[r];
+        }
+        out
+    }
+
     /// `∂(T y)/∂Ω = Σ_r [φ_r (Aʳy) [Ω_kᵀ, 0] − f_r Σ_{u=1}^{r} A^{u−1} ad_{(A^{r−u} y)}]` (spec §2.5).
     pub fn d_ty(&self, y: &V6) -> M6 {
         let a = &self.pow[0];
@@ -674,6 +690,8 @@ mod tests {
             // Ṫ along Ω̇
             let fd = (tangent(&(om + od * e)) - tangent(&(om - od * e))) / (2.0 * e);
             assert_relative_eq!(et.t_dot(&od), fd, epsilon = 1e-8);
+            assert_relative_eq!(et.t_dot_mul(&od, &y), fd * y, epsilon = 1e-8);
+            assert_relative_eq!(et.t_dot_mul(&od, &y), et.t_dot(&od) * y, epsilon = 1e-14);
             // ∂(Ty)/∂Ω and ∂(TᵀF)/∂Ω column by column
             let dty = et.d_ty(&y);
             let dtf = et.d_ttf(&f);

@@ -18,6 +18,15 @@ pub enum MethodChoice {
     Ndf,
     Galpha,
 }
+
+/// `simulate --error-norm`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ErrorNormChoice {
+    /// Every coordinate to its own tolerance (ode15s).
+    Componentwise,
+    /// Positions and velocities in the mass-matrix norm (mass-weighted displacement).
+    Mass,
+}
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
@@ -275,6 +284,11 @@ pub struct SimulateArgs {
     /// Highest order of the NDF, 1–5 (orders ≤ 2 are A-stable).
     #[arg(long, default_value_t = 5)]
     pub max_order: usize,
+
+    /// NDF error test: `componentwise` (ode15s) or `mass` (positions and velocities in the norm of
+    /// the mass matrix: modes that move little mass do not limit the step).
+    #[arg(long, value_enum, default_value_t = ErrorNormChoice::Componentwise)]
+    pub error_norm: ErrorNormChoice,
 
     /// Generalized-α: spectral radius at infinite frequency in [0, 1] (1: no numerical dissipation).
     #[arg(long, default_value_t = 0.8)]
@@ -691,6 +705,10 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
             rtol: args.rtol,
             atol: args.atol,
             max_order: args.max_order,
+            error_norm: match args.error_norm {
+                ErrorNormChoice::Componentwise => gvs::solve::ode::ErrorNorm::Componentwise,
+                ErrorNormChoice::Mass => gvs::solve::ode::ErrorNorm::Mass,
+            },
             ..NdfOptions::default()
         }),
     };

@@ -79,6 +79,15 @@ pub(super) trait Corrector {
     }
     /// After a converged Newton iteration, with its contraction rate estimate.
     fn converged(&mut self, _rate: f64) {}
+    /// Whether the system has a mass matrix ([`Corrector::mass`]).
+    fn has_mass(&self) -> bool {
+        false
+    }
+    /// The latest mass matrix of a mechanical system (after the first [`Corrector::refresh`]),
+    /// with the number of times it has been evaluated (it changes exactly when `M` does).
+    fn mass(&self) -> Option<(&DMatrix<f64>, usize)> {
+        None
+    }
     /// The Newton correction `del` of `d` at the iterate `ynew = y⁽⁰⁾ + d`; `Ok(false)` if an
     /// evaluation is not finite.
     #[allow(clippy::too_many_arguments)]
@@ -189,6 +198,8 @@ pub(super) struct SecondOrder<'a, S: MechanicalSystem> {
     lu: Lu,
     lu_m: Lu,
     m_factored: bool,
+    /// Evaluations of `M` so far.
+    m_evals: usize,
     /// Renew `M` at the next attempt's predicted configuration.
     m_renew: bool,
     /// Whether `M` was renewed for the current attempt.
@@ -215,6 +226,7 @@ impl<'a, S: MechanicalSystem> SecondOrder<'a, S> {
             lu: Lu::new(n),
             lu_m: Lu::new(n),
             m_factored: false,
+            m_evals: 0,
             m_renew: false,
             m_renewed: false,
             q: v(),
@@ -278,6 +290,7 @@ impl<S: MechanicalSystem> Corrector for SecondOrder<'_, S> {
             )
             .map_err(Self::rhs_err(t))?;
         self.m_factored = false;
+        self.m_evals += 1;
         let finite = |a: &DMatrix<f64>| a.iter().all(|x| x.is_finite());
         Ok(finite(&self.m) && finite(&self.d) && finite(&self.k))
     }
@@ -334,6 +347,7 @@ impl<S: MechanicalSystem> Corrector for SecondOrder<'_, S> {
             .mass(self.clamp.apply(tnew), &self.q, &mut self.m)
             .map_err(Self::rhs_err(t_acc))?;
         self.m_factored = false;
+        self.m_evals += 1;
         if !self.m.iter().all(|x| x.is_finite()) {
             return Ok(false);
         }
@@ -344,6 +358,14 @@ impl<S: MechanicalSystem> Corrector for SecondOrder<'_, S> {
     fn renew_cheaply(&mut self) -> bool {
         self.m_renew = !self.m_renewed;
         self.m_renew
+    }
+
+    fn has_mass(&self) -> bool {
+        true
+    }
+
+    fn mass(&self) -> Option<(&DMatrix<f64>, usize)> {
+        Some((&self.m, self.m_evals))
     }
 
     /// A slow contraction (`ρ > 0.2`) renews `M` for the next step.

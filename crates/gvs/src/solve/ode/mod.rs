@@ -166,6 +166,26 @@ pub struct NdfOptions {
     pub max_step: f64,
     /// Maximum number of successful steps (default 1 000 000).
     pub max_steps: usize,
+    /// How local errors (and Newton corrections) are measured (default componentwise, as
+    /// `ode15s`).
+    pub error_norm: ErrorNorm,
+}
+
+/// The norm of the NDF's error test.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ErrorNorm {
+    /// `max_i |e_i| / max(|y_i|, |y⁽⁰⁾_i|, atol_i/rtol)` (`ode15s`): every component to its own
+    /// relative tolerance.
+    #[default]
+    Componentwise,
+    /// Mechanical systems in second-order form only: the errors of positions and of velocities
+    /// each in the norm of the mass matrix, `‖e‖_M̂ = √(eᵀ M̂ e)` with `M̂ = M·n/tr M` (unit mean
+    /// diagonal, so `‖e_i‖ ≈ |e_i|` for one coordinate), relative to the same norm of the
+    /// state (`atol` as a floor): the mass-weighted displacement of the cross-sections, not
+    /// each coordinate. A high-frequency mode that moves little mass (shear, elongation, a
+    /// coordinate at the tip) does not force the step to resolve it; with an A-stable order
+    /// (`max_order ≤ 2`) the method damps it instead.
+    Mass,
 }
 
 impl Default for NdfOptions {
@@ -179,6 +199,7 @@ impl Default for NdfOptions {
             initial_step: None,
             max_step: f64::INFINITY,
             max_steps: 1_000_000,
+            error_norm: ErrorNorm::Componentwise,
         }
     }
 }

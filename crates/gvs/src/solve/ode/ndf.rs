@@ -4,8 +4,8 @@
 
 use super::corrector::{Corrector, FirstOrder, SecondOrder};
 use super::{
-    check_common, deliver, invalid, ulp, wnorm, Clamp, MechanicalSystem, NdfOptions, OdeError,
-    OdeStats, OdeSystem, Output,
+    check_common, deliver, invalid, ulp, wnorm, Clamp, ErrorNorm, MechanicalSystem, NdfOptions,
+    OdeError, OdeStats, OdeSystem, Output,
 };
 use nalgebra::{DMatrix, DVector};
 
@@ -151,6 +151,16 @@ struct Work {
     out: DVector<f64>,
     /// Backward differences `∇^j y_n`, `j = 1..maxk+2`, in columns `0..maxk+2`.
     dif: DMatrix<f64>,
+    /// [`ErrorNorm::Mass`]: the lower Cholesky factor `L` of `M̂ = M·m/tr M = L Lᵀ` (`m × m`,
+    /// `m = n/2`; `M̂` itself if it is not positive definite, `mhat_chol` false), the evaluation
+    /// count of the `M` it was made from, the scales of the `q` and `q̇` halves, and a buffer.
+    mass_norm: bool,
+    mhat: DMatrix<f64>,
+    mhat_chol: bool,
+    mhat_of: usize,
+    scale_q: f64,
+    scale_v: f64,
+    nbuf: DVector<f64>,
 }
 
 impl Work {
@@ -171,8 +181,131 @@ impl Work {
             thresh: v(),
             out: v(),
             dif: DMatrix::zeros(n, 7),
+            mass_norm: false,
+            mhat: DMatrix::zeros(0, 0),
+            mhat_chol: false,
+            mhat_of: usize::MAX,
+            scale_q: 1.0,
+            scale_v: 1.0,
+            nbuf: v(),
         }
     }
+
+    /// The error norm of `x` (relative, as `‖x‖ / scale`): componentwise
+    /// `max_i |x_i| / max(|y_i|, |y⁽⁰⁾_i|, atol_i/rtol)`, or with [`ErrorNorm::Mass`]
+    /// `max(‖x_q‖_M̂ / s_q, ‖x_v‖_M̂ / s_v)`, `s = max(‖y‖_M̂, ‖y⁽⁰⁾‖_M̂, max_i atol_i/rtol)` per half.
+    fn norm(&self, x: &DVector<f64>) -> f64 {
+        if !self.mass_norm {
+            return wnorm(x, &self.invwt);
+        }
+        let m = self.n / 2;
+        let q = self.half_norm(x, 0) / self.scale_q;
+        let v = self.half_norm(x, m) / self.scale_v;
+        if q.is_nan() || v.is_nan() {
+            f64::NAN
+        } else {
+            q.max(v)
+        }
+    }
+
+    /// [`Work::norm`] of column `col` of the difference table, plus `b` if given.
+    fn norm_col(&mut self, col: usize, b: Option<&DVector<f64>>) -> f64 {
+        self.nbuf.copy_from(&self.dif.column(col));
+        if let Some(b) = b {
+            self.nbuf += b;
+        }
+        let x = std::mem::replace(&mut self.nbuf, DVector::zeros(0));
+        let r = self.norm(&x);
+        self.nbuf = x;
+        r
+    }
+
+    /// `‖x[lo..lo+m]‖_M̂ = ‖R x‖` (`m²/2` products; `mhat` holds `L = Rᵀ`, so row `i` of `R` is
+    /// the contiguous column `i` of `L` from the diagonal down), or `√(xᵀM̂x)`.
+    fn half_norm(&self, x: &DVector<f64>, lo: usize) -> f64 {
+        let m = self.n / 2;
+        let x = &x.as_slice()[lo..lo + m];
+        let a = self.mhat.as_slice();
+        let mut sum = 0.0;
+        if self.mhat_chol {
+            for i in 0..m {
+                let col = &a[i + i * m..(i + 1) * m];
+                let dot: f64 = col.iter().zip(&x[i..]).map(|(l, x)| l * x).sum();
+                sum += dot * dot;
+            }
+        } else {
+            for (j, xj) in x.iter().enumerate() {
+                let col = &a[j * m..(j + 1) * m];
+                let dot: f64 = col.iter().zip(x).map(|(aij, xi)| aij * xi).sum();
+                sum += xj * dot;
+            }
+        }
+        sum.max(0.0).sqrt()
+    }
+
+    /// Sets `M̂` (and its factor) from `M` if `M` changed (`count`: its evaluation count).
+    fn set_mass(&mut self, mass: &DMatrix<f64>, count: usize) {
+        if count == self.mhat_of {
+            return;
+        }
+        self.mhat_of = count;
+        let tr = mass.trace();
+        if !(tr > 0.0 && tr.is_finite()) {
+            return; // keep the last one
+        }
+        self.mhat.copy_from(mass);
+        self.mhat *= mass.nrows() as f64 / tr;
+        self.mhat_chol = cholesky_upper_in_place(&mut self.mhat);
+        if self.mhat_chol {
+            self.mhat.transpose_mut();
+        } else {
+            self.mhat.copy_from(mass);
+            self.mhat *= mass.nrows() as f64 / tr;
+        }
+    }
+
+    /// The scales of the mass norm at the predictor (after [`Work::set_mass`]).
+    fn set_mass_scales(&mut self) {
+        let m = self.n / 2;
+        let thr = |lo: usize| self.thresh.rows(lo, m).amax();
+        self.scale_q = self
+            .half_norm(&self.y, 0)
+            .max(self.half_norm(&self.pred, 0))
+            .max(thr(0));
+        self.scale_v = self
+            .half_norm(&self.y, m)
+            .max(self.half_norm(&self.pred, m))
+            .max(thr(m));
+    }
+}
+
+/// `A = RᵀR` in place (upper triangle `R`, lower triangle zeroed) for a symmetric positive
+/// definite `A`; `false` (with `A` overwritten) if it is not.
+fn cholesky_upper_in_place(a: &mut DMatrix<f64>) -> bool {
+    let m = a.nrows();
+    let s = a.as_mut_slice();
+    for j in 0..m {
+        // R_ij = (A_ij − Σ_{k<i} R_ki R_kj) / R_ii for i < j; R_jj = √(A_jj − Σ_k R_kj²)
+        for i in 0..j {
+            let mut v = s[i + j * m];
+            for k in 0..i {
+                v -= s[k + i * m] * s[k + j * m];
+            }
+            s[i + j * m] = v / s[i + i * m];
+        }
+        let mut d = s[j + j * m];
+        for k in 0..j {
+            d -= s[k + j * m] * s[k + j * m];
+        }
+        if !(d > 0.0 && d.is_finite()) {
+            return false;
+        }
+        s[j + j * m] = d.sqrt();
+        for i in j + 1..m {
+            s[i + j * m] = 0.0;
+        }
+    }
+    true
 }
 
 /// Re-expresses the differences `∇^1..∇^k` for the step ratio `r = h_new/h_old`:
@@ -226,32 +359,6 @@ pub(super) fn interpolate(
         c *= (s + j as f64) / (j + 1) as f64;
         out.axpy(c, &dif.column(j), 1.0);
     }
-}
-
-/// `max_i |a_i w_i|` with `a` a column of the difference table.
-fn wnorm_col(dif: &DMatrix<f64>, col: usize, w: &DVector<f64>) -> f64 {
-    let mut m = 0.0f64;
-    for (a, w) in dif.column(col).iter().zip(w.iter()) {
-        let x = (a * w).abs();
-        if x.is_nan() {
-            return f64::NAN;
-        }
-        m = m.max(x);
-    }
-    m
-}
-
-/// `max_i |(a_i + b_i) w_i|` with `a` a column of the difference table.
-fn wnorm_sum(dif: &DMatrix<f64>, col: usize, b: &DVector<f64>, w: &DVector<f64>) -> f64 {
-    let mut m = 0.0f64;
-    for ((a, b), w) in dif.column(col).iter().zip(b.iter()).zip(w.iter()) {
-        let x = ((a + b) * w).abs();
-        if x.is_nan() {
-            return f64::NAN;
-        }
-        m = m.max(x);
-    }
-    m
 }
 
 /// Integrates `y' = f(t, y)` from `(t0, y0)` to the last of `t_out` with the variable-step,
@@ -350,6 +457,16 @@ fn integrate<C: Corrector>(
     let tf = *bounds.last().unwrap_or(&t0);
     let mut w = Work::new(n);
     let cfg = check_options(opts, n, t0, tf, &mut w.thresh)?;
+    if opts.error_norm == ErrorNorm::Mass {
+        if !cs.has_mass() {
+            return Err(invalid(
+                "error_norm",
+                "the mass norm needs a mechanical system (integrate_ndf_second_order)",
+            ));
+        }
+        w.mass_norm = true;
+        w.mhat = DMatrix::zeros(n / 2, n / 2);
+    }
     w.y.copy_from(y0);
     let mut next = 0;
     deliver(t_out, &mut next, t0, &mut w.out, output, |_, b| {
@@ -491,9 +608,15 @@ fn integrate_piece<C: Corrector>(
                         w.invwt[i] = 1.0 / w.y[i].abs().max(p.abs()).max(w.thresh[i]);
                     }
                 }
+                if w.mass_norm {
+                    if let Some((m, count)) = cs.mass() {
+                        w.set_mass(m, count);
+                    }
+                    w.set_mass_scales();
+                }
                 w.ynew.copy_from(&w.pred);
                 w.difkp1.fill(0.0);
-                let minnrm = 100.0 * f64::EPSILON * wnorm(&w.ynew, &w.invwt);
+                let minnrm = 100.0 * f64::EPSILON * w.norm(&w.ynew);
 
                 let mut converged = false;
                 let mut nonfinite = false;
@@ -510,7 +633,7 @@ fn integrate_piece<C: Corrector>(
                             break;
                         }
                         cs.stats().newton_iterations += 1;
-                        let newnrm = wnorm(&w.del, &w.invwt);
+                        let newnrm = w.norm(&w.del);
                         w.difkp1 += &w.del;
                         w.ynew.copy_from(&w.pred);
                         w.ynew += &w.difkp1;
@@ -581,7 +704,7 @@ fn integrate_piece<C: Corrector>(
             };
 
             // Error test: ‖∇^{k+1} y_{n+1}‖·C_k ≤ rtol.
-            let err = wnorm(&w.difkp1, &w.invwt) * erconst[k - 1];
+            let err = w.norm(&w.difkp1) * erconst[k - 1];
             if err <= rtol {
                 break (tnew, h, err);
             }
@@ -598,7 +721,9 @@ fn integrate_piece<C: Corrector>(
                 nofailed = false;
                 let mut hopt = absh * (0.833 * (rtol / err).powf(1.0 / (k + 1) as f64)).max(0.1);
                 if k > 1 {
-                    let errkm1 = wnorm_sum(&w.dif, k - 1, &w.difkp1, &w.invwt) * erconst[k - 2];
+                    let d = std::mem::replace(&mut w.difkp1, DVector::zeros(0));
+                    let errkm1 = w.norm_col(k - 1, Some(&d)) * erconst[k - 2];
+                    w.difkp1 = d;
                     let hkm1 = absh * (0.769 * (rtol / errkm1).powf(1.0 / k as f64)).max(0.1);
                     if hkm1 > hopt {
                         hopt = hkm1.min(absh); // no step increase after a failure
@@ -659,7 +784,7 @@ fn integrate_piece<C: Corrector>(
             let mut hopt = absh * ratio(err, 1.2, k + 1);
             let mut kopt = k;
             if k > 1 {
-                let errkm1 = wnorm_col(&w.dif, k - 1, &w.invwt) * erconst[k - 2];
+                let errkm1 = w.norm_col(k - 1, None) * erconst[k - 2];
                 let hkm1 = absh * ratio(errkm1, 1.3, k);
                 if hkm1 > hopt {
                     hopt = hkm1;
@@ -667,7 +792,7 @@ fn integrate_piece<C: Corrector>(
                 }
             }
             if k < cfg.maxk {
-                let errkp1 = wnorm_col(&w.dif, k + 1, &w.invwt) * erconst[k];
+                let errkp1 = w.norm_col(k + 1, None) * erconst[k];
                 let hkp1 = absh * ratio(errkp1, 1.4, k + 2);
                 if hkp1 > hopt {
                     hopt = hkp1;
