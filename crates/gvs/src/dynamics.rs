@@ -195,6 +195,20 @@ impl<P: StrainParam> Model<P> {
         }
     }
 
+    /// The smallest ratio `Ds/Es` over the sections and the strain components with `Es > 0` [s]
+    /// (Kelvin–Voigt: `3η/E` for an incompressible material; 0 without damping).
+    pub fn damping_time(&self) -> f64 {
+        self.props
+            .iter()
+            .flat_map(|p| {
+                (0..6)
+                    .filter(|&a| p.es[a] > 0.0)
+                    .map(move |a| p.ds[a] / p.es[a])
+            })
+            .fold(f64::INFINITY, f64::min)
+            .clamp(0.0, f64::MAX)
+    }
+
     /// The mass matrix `M(q)`.
     pub fn mass_matrix(&self, q: &DVector<f64>, ws: &mut Workspace) -> DMatrix<f64> {
         self.forward(q, ws, true);

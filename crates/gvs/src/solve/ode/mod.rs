@@ -94,6 +94,10 @@
 //! All buffers (state vectors, difference table, Jacobian, LU factors) are allocated once per call;
 //! the stepping loop does not allocate (the user's right-hand side and output callback may).
 
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::lu::partial_pivoting::{factor as lu_factor, solve as lu_solve};
+use faer::perm::PermRef;
+use faer::{MatMut, MatRef, Par};
 use nalgebra::{DMatrix, DVector};
 use std::ops::ControlFlow;
 
@@ -570,24 +574,33 @@ impl JacWork {
     }
 }
 
-/// In-place LU factorization with partial pivoting of the iteration matrix `I − c J`
+/// LU factorization with partial pivoting (faer, blocked) of an iteration matrix, in place
 /// (allocation-free after construction).
 struct Lu {
     a: DMatrix<f64>,
-    piv: Vec<usize>,
+    perm: Vec<usize>,
+    perm_inv: Vec<usize>,
+    mem: MemBuffer,
 }
 
 impl Lu {
     fn new(n: usize) -> Self {
+        let par = Par::Seq;
+        let req = StackReq::any_of(&[
+            lu_factor::lu_in_place_scratch::<usize, f64>(n, n, par, Default::default()),
+            lu_solve::solve_in_place_scratch::<usize, f64>(n, 1, par),
+        ]);
         Lu {
             a: DMatrix::zeros(n, n),
-            piv: vec![0; n],
+            perm: vec![0; n],
+            perm_inv: vec![0; n],
+            mem: MemBuffer::new(req),
         }
     }
 
     /// Factors `I − c·jac`; `false` if it is singular or not finite.
     fn factor(&mut self, c: f64, jac: &DMatrix<f64>, stats: &mut OdeStats) -> bool {
-        let n = self.piv.len();
+        let n = self.perm.len();
         self.factor_with(stats, |a| {
             for (dst, src) in a.iter_mut().zip(jac.iter()) {
                 *dst = -c * src;
@@ -598,79 +611,37 @@ impl Lu {
         })
     }
 
-    /// Factors the matrix `fill` writes (into an `n × n` buffer); `false` if it is singular or
-    /// not finite.
+    /// Factors the matrix `fill` writes (into an `n × n` buffer); `false` if it is singular
+    /// (a zero pivot) or not finite.
     fn factor_with(&mut self, stats: &mut OdeStats, fill: impl FnOnce(&mut DMatrix<f64>)) -> bool {
         stats.lu_decompositions += 1;
-        let n = self.piv.len();
+        let n = self.perm.len();
         fill(&mut self.a);
-        let a = self.a.as_mut_slice(); // column-major: (i, j) at i + j n
-        for k in 0..n {
-            let mut p = k;
-            let mut best = a[k + k * n].abs();
-            for i in k + 1..n {
-                let v = a[i + k * n].abs();
-                if v > best {
-                    best = v;
-                    p = i;
-                }
-            }
-            if !(best > 0.0 && best.is_finite()) {
-                return false;
-            }
-            self.piv[k] = p;
-            if p != k {
-                for j in 0..n {
-                    a.swap(k + j * n, p + j * n);
-                }
-            }
-            let inv = 1.0 / a[k + k * n];
-            for i in k + 1..n {
-                a[i + k * n] *= inv;
-            }
-            for j in k + 1..n {
-                let akj = a[k + j * n];
-                if akj != 0.0 {
-                    let (left, right) = a.split_at_mut(j * n);
-                    let lcol = &left[k * n..(k + 1) * n];
-                    let col = &mut right[..n];
-                    for i in k + 1..n {
-                        col[i] -= lcol[i] * akj;
-                    }
-                }
-            }
+        if !self.a.iter().all(|x| x.is_finite()) {
+            return false;
         }
-        true
+        let m = MatMut::from_column_major_slice_mut(self.a.as_mut_slice(), n, n);
+        lu_factor::lu_in_place(
+            m,
+            &mut self.perm,
+            &mut self.perm_inv,
+            Par::Seq,
+            MemStack::new(&mut self.mem),
+            Default::default(),
+        );
+        (0..n).all(|k| {
+            let p = self.a[(k, k)];
+            p != 0.0 && p.is_finite()
+        })
     }
 
     /// Solves `A x = b` in place with the last successful factorization.
-    fn solve(&self, b: &mut DVector<f64>) {
-        let n = self.piv.len();
-        let a = self.a.as_slice();
-        let x = b.as_mut_slice();
-        for k in 0..n {
-            let p = self.piv[k];
-            if p != k {
-                x.swap(k, p);
-            }
-        }
-        for j in 0..n {
-            let xj = x[j];
-            if xj != 0.0 {
-                for i in j + 1..n {
-                    x[i] -= a[i + j * n] * xj;
-                }
-            }
-        }
-        for j in (0..n).rev() {
-            x[j] /= a[j + j * n];
-            let xj = x[j];
-            if xj != 0.0 {
-                for i in 0..j {
-                    x[i] -= a[i + j * n] * xj;
-                }
-            }
-        }
+    fn solve(&mut self, b: &mut DVector<f64>) {
+        let n = self.perm.len();
+        let lu = MatRef::from_column_major_slice(self.a.as_slice(), n, n);
+        let perm = PermRef::new_checked(&self.perm, &self.perm_inv, n);
+        let rhs = MatMut::from_column_major_slice_mut(b.as_mut_slice(), n, 1);
+        lu_solve::solve_in_place(lu, lu, perm, rhs, Par::Seq, MemStack::new(&mut self.mem));
     }
 }
 

@@ -229,15 +229,12 @@ impl Work {
         let mut sum = 0.0;
         if self.mhat_chol {
             for i in 0..m {
-                let col = &a[i + i * m..(i + 1) * m];
-                let dot: f64 = col.iter().zip(&x[i..]).map(|(l, x)| l * x).sum();
-                sum += dot * dot;
+                let d = dot(&a[i + i * m..(i + 1) * m], &x[i..]);
+                sum += d * d;
             }
         } else {
             for (j, xj) in x.iter().enumerate() {
-                let col = &a[j * m..(j + 1) * m];
-                let dot: f64 = col.iter().zip(x).map(|(aij, xi)| aij * xi).sum();
-                sum += xj * dot;
+                sum += xj * dot(&a[j * m..(j + 1) * m], x);
             }
         }
         sum.max(0.0).sqrt()
@@ -277,6 +274,20 @@ impl Work {
             .max(self.half_norm(&self.pred, m))
             .max(thr(m));
     }
+}
+
+/// `Σ a_i b_i` with four partial sums (vectorizable).
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ra, rb) = (a4.remainder(), b4.remainder());
+    let mut s = [0.0f64; 4];
+    for (x, y) in a4.zip(b4) {
+        for k in 0..4 {
+            s[k] += x[k] * y[k];
+        }
+    }
+    let tail: f64 = ra.iter().zip(rb).map(|(x, y)| x * y).sum();
+    (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
 /// `A = RᵀR` in place (upper triangle `R`, lower triangle zeroed) for a symmetric positive
