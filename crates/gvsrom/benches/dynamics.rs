@@ -2,6 +2,10 @@
 //! (new tensions uniform in [−15, 0] N every 1 s, seed 1), ode15s-class NDF at rtol 1e-3 / atol 1e-6,
 //! single thread. The paper's MATLAB took 114.3 s; the target is ≥ 100× faster (≤ 1.2 s).
 //!
+//! Also the undamped release of issue 8 (`examples/undamped-release.toml`, 75 DOF, 6 s, the tip
+//! force removed at t = 0) with the automatically chosen method for lightly damped rods (NDF
+//! orders ≤ 2, mass-norm error test) at rtol 1e-3 and 1e-4.
+//!
 //! Run with `cargo bench -p gvsrom --bench dynamics`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
@@ -61,9 +65,50 @@ fn dynamics(c: &mut Criterion) {
     }
 }
 
+fn release(c: &mut Criterion) {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples");
+    let built = gvsrom::build(
+        &gvsrom::presets::load(&format!("{root}/undamped-release.toml"), &[]).unwrap(),
+    )
+    .unwrap();
+    for rtol in [1e-3, 1e-4] {
+        let base = NdfOptions {
+            rtol,
+            ..NdfOptions::default()
+        };
+        let (ndf, regime) = gvs::solve::dynamics::ndf_for_rod(&built.model, &base).unwrap();
+        assert!(regime.is_light());
+        let opts = SimulateOptions {
+            duration: 6.0,
+            sample_rate: 50.0,
+            input: InputSource::Constant,
+            start_at_equilibrium: true,
+            integrator: IntegratorOptions {
+                method: Method::Ndf(ndf),
+                jacobian: OdeJacobian::Structured,
+            },
+            load_schedule: Some(format!("{root}/release-zero.csv").into()),
+        };
+        let plan = plan(&built, &opts).unwrap();
+        c.bench_function(
+            &format!("dynamics/undamped release 6s (automatic method, rtol {rtol:e})"),
+            |b| {
+                b.iter(|| {
+                    black_box(
+                        run(&built, &plan, &opts.integrator, None, &mut |_| {
+                            ControlFlow::Continue(())
+                        })
+                        .unwrap(),
+                    )
+                })
+            },
+        );
+    }
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(10);
-    targets = dynamics
+    targets = dynamics, release
 }
 criterion_main!(benches);
