@@ -127,8 +127,8 @@ impl<P: StrainParam> Model<P> {
                     xid1 * h
                 }
             };
-            let sqd = et.t * om_dot;
-            let sdqd = et.t_dot_mul(&om_dot, &om_dot) + et.t * zd;
+            let sqd = et.t_mul(&om_dot);
+            let sdqd = et.t_dot_mul(&om_dot, &om_dot) + et.t_mul(&zd);
             ws.eta[i + 1] = et.g.adjoint_inv_mul(&(ws.eta[i] + sqd));
             ws.zeta[i + 1] =
                 et.g.adjoint_inv_mul(&(ws.zeta[i] + ad_mul(&ws.eta[i], &sqd) + sdqd));

@@ -302,6 +302,8 @@ pub struct ExpTangent {
     /// `ad_Ωʳ`, r = 1..4.
     pub pow: [M6; 4],
     pub omega: V6,
+    /// Whether `t` and `pow` are computed ([`exp_tangent_lean`] leaves them NaN).
+    pub full: bool,
 }
 
 /// `exp(Ω̂)` and the left-trivialized tangent `T(Ω) = Σ_j ad_Ωʲ/(j+1)!` (spec §2.3–2.4).
@@ -321,6 +323,25 @@ pub fn exp_tangent(omega: &V6) -> ExpTangent {
         coeffs,
         pow,
         omega: *omega,
+        full: true,
+    }
+}
+
+/// [`exp_tangent`] without the powers `ad_Ωʳ` and the matrix `T` (NaN until
+/// [`ExpTangent::complete`]): what a pass that only needs `exp Ω`, `T y` and `Tᵀ y`
+/// ([`ExpTangent::t_mul`], [`ExpTangent::t_tr_mul`]) pays — no 6×6 products.
+pub fn exp_tangent_lean(omega: &V6) -> ExpTangent {
+    let k = ang(omega);
+    let theta = k.norm();
+    let coeffs = exp_coeffs(theta);
+    let g = exp_with(&k, &lin(omega), theta, &coeffs);
+    ExpTangent {
+        g,
+        t: M6::from_element(f64::NAN),
+        coeffs,
+        pow: [M6::from_element(f64::NAN); 4],
+        omega: *omega,
+        full: false,
     }
 }
 
@@ -330,6 +351,47 @@ pub fn tangent(omega: &V6) -> M6 {
 }
 
 impl ExpTangent {
+    /// Computes `pow` and `t` of a lean step ([`exp_tangent_lean`]).
+    pub fn complete(&mut self) {
+        if !self.full {
+            self.pow = ad_powers(&self.omega);
+            let mut t = M6::identity();
+            for r in 0..4 {
+                t += self.pow[r] * self.coeffs.f[r];
+            }
+            self.t = t;
+            self.full = true;
+        }
+    }
+
+    /// `T y = y + Σ_r f_r ad_Ωʳ y` (by `ad` products of 6-vectors when `T` is not formed).
+    pub fn t_mul(&self, y: &V6) -> V6 {
+        if self.full {
+            return self.t * y;
+        }
+        let mut ay = *y;
+        let mut out = *y;
+        for r in 0..4 {
+            ay = ad_mul(&self.omega, &ay);
+            out += ay * self.coeffs.f[r];
+        }
+        out
+    }
+
+    /// `Tᵀ y = y + Σ_r f_r (ad_Ωᵀ)ʳ y`, `ad_Ωᵀ y = −coad_Ω y`.
+    pub fn t_tr_mul(&self, y: &V6) -> V6 {
+        if self.full {
+            return self.t.transpose() * y;
+        }
+        let mut ay = *y;
+        let mut out = *y;
+        for r in 0..4 {
+            ay = -coad_mul(&self.omega, &ay);
+            out += ay * self.coeffs.f[r];
+        }
+        out
+    }
+
     /// Time derivative `Ṫ = Σ_r [φ_r (Ω_k·Ω̇_k) Aʳ + f_r Σ_{u=1}^{r} A^{u−1} Ȧ A^{r−u}]`, `A = ad_Ω`,
     /// `Ȧ = ad_Ω̇` (spec §2.5).
     pub fn t_dot(&self, omega_dot: &V6) -> M6 {
@@ -690,6 +752,16 @@ mod tests {
             // Ṫ along Ω̇
             let fd = (tangent(&(om + od * e)) - tangent(&(om - od * e))) / (2.0 * e);
             assert_relative_eq!(et.t_dot(&od), fd, epsilon = 1e-8);
+            // the lean step's products against the full matrices
+            let lean = exp_tangent_lean(&om);
+            assert!(!lean.full && lean.t[(0, 0)].is_nan());
+            assert_relative_eq!(lean.t_mul(&y), et.t * y, epsilon = 1e-14);
+            assert_relative_eq!(lean.t_tr_mul(&f), et.t.transpose() * f, epsilon = 1e-14);
+            assert_relative_eq!(lean.t_dot_mul(&od, &y), et.t_dot(&od) * y, epsilon = 1e-14);
+            let mut done = lean;
+            done.complete();
+            assert!(done.full);
+            assert_relative_eq!(done.t, et.t, epsilon = 1e-15);
             assert_relative_eq!(et.t_dot_mul(&od, &y), fd * y, epsilon = 1e-8);
             assert_relative_eq!(et.t_dot_mul(&od, &y), et.t_dot(&od) * y, epsilon = 1e-14);
             // ∂(Ty)/∂Ω and ∂(TᵀF)/∂Ω column by column

@@ -23,7 +23,9 @@ use crate::actuation::{
 };
 use crate::discretize::{Discretization, MagnusOrder};
 use crate::error::ModelError;
-use crate::lie::{ad, coad, coad_mul, coadbar, exp_tangent, tilde, ExpTangent, Pose, M6, V3, V6};
+use crate::lie::{
+    ad, coad, coad_mul, coadbar, exp_tangent, exp_tangent_lean, tilde, ExpTangent, Pose, M6, V3, V6,
+};
 use crate::loads::{Frame, Loads};
 use crate::rod::{Rod, SectionProps};
 use crate::strain::{StrainEval, StrainParam};
@@ -95,6 +97,8 @@ pub struct Workspace {
     /// Scratch (up to n × 18, column-major) of the row updates `out[c, :] += G X`.
     gbuf: Vec<f64>,
     pub(crate) et: Vec<ExpTangent>,
+    /// Whether every step in `et` has `T` and the powers (not after a residual-only forward pass).
+    pub(crate) et_full: bool,
     pub(crate) z: Matrix6xX<f64>,
     pub(crate) y: Vec<V6>,
     pub(crate) w: Vec<V6>,
@@ -230,6 +234,7 @@ impl<P: StrainParam> Model<P> {
             dy_hi: vec![0; np],
             gbuf: vec![0.0; 18 * n],
             et: vec![exp_tangent(&V6::zeros()); np - 1],
+            et_full: true,
             z: zeros6_lazy(n * (np - 1)),
             y: vec![V6::zeros(); ns],
             w: vec![V6::zeros(); np],
@@ -335,10 +340,15 @@ impl<P: StrainParam> Model<P> {
                 }
                 MagnusOrder::Z2 => ws.xi[s1] * h,
             };
-            let et = exp_tangent(&omega);
+            let et = if jacobians {
+                exp_tangent(&omega)
+            } else {
+                exp_tangent_lean(&omega)
+            };
             ws.g[i + 1] = ws.g[i].compose(&et.g);
             ws.et[i] = et;
         }
+        ws.et_full = jacobians;
         if jacobians {
             self.forward_jacobians(ws);
         }
@@ -350,6 +360,11 @@ impl<P: StrainParam> Model<P> {
     /// `Z_i` lives on the step's columns `c` only, and `J_{i+1}` is zero beyond `hi = max c.end` of
     /// the steps so far: the recursion costs `36·hi` per step, one pass over the columns.
     fn forward_jacobians(&self, ws: &mut Workspace) {
+        if !ws.et_full {
+            // after a residual-only forward pass: the powers and T of every step
+            ws.et.iter_mut().for_each(|et| et.complete());
+            ws.et_full = true;
+        }
         let n = self.n_dof();
         ws.set_jac_bound(0, 0);
         let mut hi = 0;
@@ -592,7 +607,7 @@ impl<P: StrainParam> Model<P> {
             };
             let et = &ws.et[i];
             fbar = et.g.coadjoint_mul(&fbar);
-            let v = et.t.transpose() * fbar;
+            let v = et.t_tr_mul(&fbar);
             let h = st.h;
             let [s1, s2] = st.sites;
             let k = ZANNA_C * h * h;

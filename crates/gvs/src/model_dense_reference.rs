@@ -7,6 +7,8 @@ use super::*;
 
 impl<P: StrainParam> Model<P> {
     fn dense_forward_jacobians(&self, ws: &mut Workspace) {
+        ws.et.iter_mut().for_each(|et| et.complete());
+        ws.et_full = true;
         let n = self.n_dof();
         ws.jac.columns_mut(0, n).fill(0.0);
         let mut hi = 0; // J_i is zero beyond column `hi`
@@ -81,7 +83,7 @@ impl<P: StrainParam> Model<P> {
             };
             let et = &ws.et[i];
             fbar = et.g.coadjoint_mul(&fbar);
-            let v = et.t.transpose() * fbar;
+            let v = et.t_tr_mul(&fbar);
             let h = st.h;
             let [s1, s2] = st.sites;
             let k = ZANNA_C * h * h;
