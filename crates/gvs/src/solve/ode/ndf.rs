@@ -160,6 +160,10 @@ struct Work {
     mhat_of: usize,
     scale_q: f64,
     scale_v: f64,
+    /// `(mhat_of, ‖y_q‖, ‖y_v‖)` of the current `y` (the same for every attempt at a step).
+    ynorm: Option<(usize, f64, f64)>,
+    /// `‖y⁽⁰⁾‖` of the current attempt in the error norm (for the Newton floor).
+    pred_norm: f64,
     nbuf: DVector<f64>,
 }
 
@@ -187,6 +191,8 @@ impl Work {
             mhat_of: usize::MAX,
             scale_q: 1.0,
             scale_v: 1.0,
+            ynorm: None,
+            pred_norm: 0.0,
             nbuf: v(),
         }
     }
@@ -265,14 +271,18 @@ impl Work {
     fn set_mass_scales(&mut self) {
         let m = self.n / 2;
         let thr = |lo: usize| self.thresh.rows(lo, m).amax();
-        self.scale_q = self
-            .half_norm(&self.y, 0)
-            .max(self.half_norm(&self.pred, 0))
-            .max(thr(0));
-        self.scale_v = self
-            .half_norm(&self.y, m)
-            .max(self.half_norm(&self.pred, m))
-            .max(thr(m));
+        let (yq, yv) = match self.ynorm {
+            Some((of, q, v)) if of == self.mhat_of => (q, v),
+            _ => {
+                let (q, v) = (self.half_norm(&self.y, 0), self.half_norm(&self.y, m));
+                self.ynorm = Some((self.mhat_of, q, v));
+                (q, v)
+            }
+        };
+        let (pq, pv) = (self.half_norm(&self.pred, 0), self.half_norm(&self.pred, m));
+        self.scale_q = yq.max(pq).max(thr(0));
+        self.scale_v = yv.max(pv).max(thr(m));
+        self.pred_norm = (pq / self.scale_q).max(pv / self.scale_v);
     }
 }
 
@@ -627,7 +637,13 @@ fn integrate_piece<C: Corrector>(
                 }
                 w.ynew.copy_from(&w.pred);
                 w.difkp1.fill(0.0);
-                let minnrm = 100.0 * f64::EPSILON * w.norm(&w.ynew);
+                let minnrm = 100.0
+                    * f64::EPSILON
+                    * if w.mass_norm {
+                        w.pred_norm // ynew = y⁽⁰⁾ here
+                    } else {
+                        w.norm(&w.ynew)
+                    };
 
                 let mut converged = false;
                 let mut nonfinite = false;
@@ -775,6 +791,7 @@ fn integrate_piece<C: Corrector>(
         })?;
         t = tnew;
         w.y.copy_from(&w.ynew);
+        w.ynorm = None;
         if done {
             break;
         }
