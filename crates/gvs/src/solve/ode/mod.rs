@@ -104,6 +104,7 @@ use std::ops::ControlFlow;
 mod corrector;
 mod fixed;
 mod galpha;
+mod mass_norm;
 mod ndf;
 #[cfg(test)]
 mod tests;

@@ -3,6 +3,7 @@
 //! of the parent module.
 
 use super::corrector::{Corrector, FirstOrder, SecondOrder};
+use super::mass_norm::MassNorm;
 use super::{
     check_common, deliver, invalid, ulp, wnorm, Clamp, ErrorNorm, MechanicalSystem, NdfOptions,
     OdeError, OdeStats, OdeSystem, Output,
@@ -151,13 +152,9 @@ struct Work {
     out: DVector<f64>,
     /// Backward differences `∇^j y_n`, `j = 1..maxk+2`, in columns `0..maxk+2`.
     dif: DMatrix<f64>,
-    /// [`ErrorNorm::Mass`]: the lower Cholesky factor `L` of `M̂ = M·m/tr M = L Lᵀ` (`m × m`,
-    /// `m = n/2`; `M̂` itself if it is not positive definite, `mhat_chol` false), the evaluation
-    /// count of the `M` it was made from, the scales of the `q` and `q̇` halves, and a buffer.
+    /// [`ErrorNorm::Mass`]: the norm of `M̂`, the scales of the `q` and `q̇` halves, and a buffer.
     mass_norm: bool,
-    mhat: DMatrix<f64>,
-    mhat_chol: bool,
-    mhat_of: usize,
+    mnorm: MassNorm,
     scale_q: f64,
     scale_v: f64,
     /// `(mhat_of, ‖y_q‖, ‖y_v‖)` of the current `y` (the same for every attempt at a step).
@@ -186,9 +183,7 @@ impl Work {
             out: v(),
             dif: DMatrix::zeros(n, 7),
             mass_norm: false,
-            mhat: DMatrix::zeros(0, 0),
-            mhat_chol: false,
-            mhat_of: usize::MAX,
+            mnorm: MassNorm::new(0),
             scale_q: 1.0,
             scale_v: 1.0,
             ynorm: None,
@@ -205,8 +200,8 @@ impl Work {
             return wnorm(x, &self.invwt);
         }
         let m = self.n / 2;
-        let q = self.half_norm(x, 0) / self.scale_q;
-        let v = self.half_norm(x, m) / self.scale_v;
+        let q = self.mnorm.half(&x.as_slice()[..m]) / self.scale_q;
+        let v = self.mnorm.half(&x.as_slice()[m..]) / self.scale_v;
         if q.is_nan() || v.is_nan() {
             f64::NAN
         } else {
@@ -226,107 +221,25 @@ impl Work {
         r
     }
 
-    /// `‖x[lo..lo+m]‖_M̂ = ‖R x‖` (`m²/2` products; `mhat` holds `L = Rᵀ`, so row `i` of `R` is
-    /// the contiguous column `i` of `L` from the diagonal down), or `√(xᵀM̂x)`.
-    fn half_norm(&self, x: &DVector<f64>, lo: usize) -> f64 {
-        let m = self.n / 2;
-        let x = &x.as_slice()[lo..lo + m];
-        let a = self.mhat.as_slice();
-        let mut sum = 0.0;
-        if self.mhat_chol {
-            for i in 0..m {
-                let d = dot(&a[i + i * m..(i + 1) * m], &x[i..]);
-                sum += d * d;
-            }
-        } else {
-            for (j, xj) in x.iter().enumerate() {
-                sum += xj * dot(&a[j * m..(j + 1) * m], x);
-            }
-        }
-        sum.max(0.0).sqrt()
-    }
-
-    /// Sets `M̂` (and its factor) from `M` if `M` changed (`count`: its evaluation count).
-    fn set_mass(&mut self, mass: &DMatrix<f64>, count: usize) {
-        if count == self.mhat_of {
-            return;
-        }
-        self.mhat_of = count;
-        let tr = mass.trace();
-        if !(tr > 0.0 && tr.is_finite()) {
-            return; // keep the last one
-        }
-        self.mhat.copy_from(mass);
-        self.mhat *= mass.nrows() as f64 / tr;
-        self.mhat_chol = cholesky_upper_in_place(&mut self.mhat);
-        if self.mhat_chol {
-            self.mhat.transpose_mut();
-        } else {
-            self.mhat.copy_from(mass);
-            self.mhat *= mass.nrows() as f64 / tr;
-        }
-    }
-
     /// The scales of the mass norm at the predictor (after [`Work::set_mass`]).
     fn set_mass_scales(&mut self) {
         let m = self.n / 2;
         let thr = |lo: usize| self.thresh.rows(lo, m).amax();
         let (yq, yv) = match self.ynorm {
-            Some((of, q, v)) if of == self.mhat_of => (q, v),
+            Some((of, q, v)) if of == self.mnorm.of() => (q, v),
             _ => {
-                let (q, v) = (self.half_norm(&self.y, 0), self.half_norm(&self.y, m));
-                self.ynorm = Some((self.mhat_of, q, v));
+                let y = self.y.as_slice();
+                let (q, v) = (self.mnorm.half(&y[..m]), self.mnorm.half(&y[m..]));
+                self.ynorm = Some((self.mnorm.of(), q, v));
                 (q, v)
             }
         };
-        let (pq, pv) = (self.half_norm(&self.pred, 0), self.half_norm(&self.pred, m));
+        let p = self.pred.as_slice();
+        let (pq, pv) = (self.mnorm.half(&p[..m]), self.mnorm.half(&p[m..]));
         self.scale_q = yq.max(pq).max(thr(0));
         self.scale_v = yv.max(pv).max(thr(m));
         self.pred_norm = (pq / self.scale_q).max(pv / self.scale_v);
     }
-}
-
-/// `Σ a_i b_i` with four partial sums (vectorizable).
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
-    let (ra, rb) = (a4.remainder(), b4.remainder());
-    let mut s = [0.0f64; 4];
-    for (x, y) in a4.zip(b4) {
-        for k in 0..4 {
-            s[k] += x[k] * y[k];
-        }
-    }
-    let tail: f64 = ra.iter().zip(rb).map(|(x, y)| x * y).sum();
-    (s[0] + s[1]) + (s[2] + s[3]) + tail
-}
-
-/// `A = RᵀR` in place (upper triangle `R`, lower triangle zeroed) for a symmetric positive
-/// definite `A`; `false` (with `A` overwritten) if it is not.
-fn cholesky_upper_in_place(a: &mut DMatrix<f64>) -> bool {
-    let m = a.nrows();
-    let s = a.as_mut_slice();
-    for j in 0..m {
-        // R_ij = (A_ij − Σ_{k<i} R_ki R_kj) / R_ii for i < j; R_jj = √(A_jj − Σ_k R_kj²)
-        for i in 0..j {
-            let mut v = s[i + j * m];
-            for k in 0..i {
-                v -= s[k + i * m] * s[k + j * m];
-            }
-            s[i + j * m] = v / s[i + i * m];
-        }
-        let mut d = s[j + j * m];
-        for k in 0..j {
-            d -= s[k + j * m] * s[k + j * m];
-        }
-        if !(d > 0.0 && d.is_finite()) {
-            return false;
-        }
-        s[j + j * m] = d.sqrt();
-        for i in j + 1..m {
-            s[i + j * m] = 0.0;
-        }
-    }
-    true
 }
 
 /// Re-expresses the differences `∇^1..∇^k` for the step ratio `r = h_new/h_old`:
@@ -486,7 +399,7 @@ fn integrate<C: Corrector>(
             ));
         }
         w.mass_norm = true;
-        w.mhat = DMatrix::zeros(n / 2, n / 2);
+        w.mnorm = MassNorm::new(n / 2);
     }
     w.y.copy_from(y0);
     let mut next = 0;
@@ -631,7 +544,7 @@ fn integrate_piece<C: Corrector>(
                 }
                 if w.mass_norm {
                     if let Some((m, count)) = cs.mass() {
-                        w.set_mass(m, count);
+                        w.mnorm.set(m, count);
                     }
                     w.set_mass_scales();
                 }
