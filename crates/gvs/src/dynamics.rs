@@ -41,7 +41,9 @@ pub struct Energy {
 /// A linearized vibration mode.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Mode {
-    /// Natural frequency [Hz].
+    /// The eigenvalue `ω²` [rad²/s²], negative for a direction in which the equilibrium is unstable.
+    pub omega_squared: f64,
+    /// Natural frequency `√max(ω², 0) / 2π` [Hz] (0 for an unstable direction).
     pub frequency_hz: f64,
     /// Mode shape in `q`, mass-normalized.
     pub shape: DVector<f64>,
@@ -349,8 +351,8 @@ impl<P: StrainParam> Model<P> {
 
     /// Linearized undamped vibration modes about `q0` (spec §10.5): `(K_T − ω² M) φ = 0` with the
     /// tangent stiffness `K_T = −∂R/∂q` (elastic plus load stiffness; symmetrized, since follower
-    /// loads and tendons make it slightly non-symmetric). Returned in ascending frequency, shapes
-    /// mass-normalized (`φᵀ M φ = 1`).
+    /// loads and tendons make it slightly non-symmetric). Returned in ascending `ω²` (directions in
+    /// which the equilibrium is unstable, `ω² < 0`, first), shapes mass-normalized (`φᵀ M φ = 1`).
     pub fn linearized_modes(
         &self,
         q0: &DVector<f64>,
@@ -376,11 +378,13 @@ impl<P: StrainParam> Model<P> {
             .iter()
             .zip(eig.eigenvectors.column_iter())
             .map(|(w2, v)| Mode {
+                omega_squared: *w2,
                 frequency_hz: w2.max(0.0).sqrt() / (2.0 * std::f64::consts::PI),
                 shape: linv.transpose() * v,
             })
             .collect();
-        modes.sort_by(|a, b| a.frequency_hz.total_cmp(&b.frequency_hz));
+        // unstable directions (ω² < 0) first, then by frequency
+        modes.sort_by(|a, b| a.omega_squared.total_cmp(&b.omega_squared));
         Ok(modes)
     }
 

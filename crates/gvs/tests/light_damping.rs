@@ -183,6 +183,11 @@ fn small_free_vibration_has_the_first_linearized_period() {
     let mut ws = m.workspace();
     let q_rest = DVector::zeros(n);
     let modes = m.linearized_modes(&q_rest, &[], &loads, &mut ws).unwrap();
+    assert!(modes
+        .windows(2)
+        .all(|p| p[0].omega_squared <= p[1].omega_squared));
+    let w2 = (2.0 * std::f64::consts::PI * modes[0].frequency_hz).powi(2);
+    assert!((modes[0].omega_squared / w2 - 1.0).abs() < 1e-12);
     let mode = modes[0].shape.clone();
     let period = 1.0 / modes[0].frequency_hz;
     let mass = m.mass_matrix(&q_rest, &mut ws);
