@@ -24,7 +24,8 @@ use crate::actuation::{
 use crate::discretize::{Discretization, MagnusOrder};
 use crate::error::ModelError;
 use crate::lie::{
-    ad, coad, coad_mul, coadbar, exp_tangent, exp_tangent_lean, tilde, ExpTangent, Pose, M6, V3, V6,
+    ad_mul, coad, coad_mul, coadbar, exp_tangent, exp_tangent_lean, tilde, ExpTangent, Pose, M6,
+    V3, V6,
 };
 use crate::loads::{Frame, Loads};
 use crate::rod::{Rod, SectionProps};
@@ -386,10 +387,16 @@ impl<P: StrainParam> Model<P> {
                 MagnusOrder::Z4 => {
                     let p1 = ws.ev.psi_q_at(s1, &c);
                     let p2 = ws.ev.psi_q_at(s2, &c);
-                    z.zip_zip_apply(&p1, &p2, |zz, a, b| *zz = 0.5 * h * (a + b));
                     let k = ZANNA_C * h * h;
-                    z.gemm(k, &ad(&ws.xi[s1]), &p2, 1.0);
-                    z.gemm(-k, &ad(&ws.xi[s2]), &p1, 1.0);
+                    // Z = h/2 (Ψ_q1 + Ψ_q2) + k (ad_ξ1 Ψ_q2 − ad_ξ2 Ψ_q1), column by column
+                    // (6-vector products: no GEMM call and its packing buffers per step)
+                    for j in 0..c.len() {
+                        let (a, b): (V6, V6) =
+                            (p1.column(j).into_owned(), p2.column(j).into_owned());
+                        let zj = (a + b) * (0.5 * h)
+                            + (ad_mul(&ws.xi[s1], &b) - ad_mul(&ws.xi[s2], &a)) * k;
+                        z.column_mut(j).copy_from(&zj);
+                    }
                 }
                 MagnusOrder::Z2 => {
                     z.copy_from(&ws.ev.psi_q_at(s1, &c));
@@ -556,8 +563,14 @@ impl<P: StrainParam> Model<P> {
                     ws.dy_hi[i] = ws.dy_hi[i].max(bound);
                     let dphi = wrench_jacobian(&d, &tl) * scale;
                     let mut dy = ws.dyp.columns_mut(self.dy_slot[i] * n, n);
-                    dy.columns_mut(c.start, c.len())
-                        .gemm(1.0, &dphi, &ws.ev.psi_q_at(i, &c), 1.0);
+                    // dy[:, c] += ∂Φ/∂ξ Ψ_q column by column (6×6 times 6-vectors; no GEMM call
+                    // and its packing buffers per point)
+                    let psq = ws.ev.psi_q_at(i, &c);
+                    for j in 0..c.len() {
+                        let col: V6 = dphi * psq.column(j);
+                        let mut d = dy.column_mut(c.start + j);
+                        d += col;
+                    }
                     if mu > 0.0 {
                         // Φ_a ⊗ ∂α/∂q · W u,  ∂α/∂q = −μ α ∂Θ/∂q
                         dy.ger(-mu * scale, &tl.phi_a, &ws.dtheta, 1.0);

@@ -4,6 +4,7 @@
 //! rows of the Jacobian), whatever the support of the basis.
 
 use super::*;
+use crate::lie::ad;
 
 impl<P: StrainParam> Model<P> {
     fn dense_forward_jacobians(&self, ws: &mut Workspace) {
