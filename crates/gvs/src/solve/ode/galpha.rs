@@ -43,7 +43,8 @@
 //! `M q̈ = τ` (the input may jump there).
 
 use super::{
-    check_common, deliver, invalid, next_down, next_up, ulp, OdeError, OdeStats, Output, RhsError,
+    check_common, deliver, invalid, mechanical_state, next_down, next_up, ulp, OdeError, OdeStats,
+    Output, RhsError,
 };
 use nalgebra::{DMatrix, DVector};
 
@@ -210,15 +211,7 @@ pub fn integrate_generalized_alpha<S: MechanicalSystem>(
     output: &mut Output<'_>,
 ) -> Result<OdeStats, OdeError> {
     let n = sys.dim();
-    if qd0.len() != n {
-        return Err(invalid(
-            "y0",
-            format!("q̇0 has {} entries, the system has {n}", qd0.len()),
-        ));
-    }
-    let mut y0 = DVector::zeros(2 * n);
-    y0.rows_mut(0, n).copy_from(q0);
-    y0.rows_mut(n, n).copy_from(qd0);
+    let y0 = mechanical_state(n, q0, qd0)?;
     let bounds = check_common(2 * n, t0, &y0, t_out, breakpoints)?;
     if !(0.0..=1.0).contains(&opts.rho_inf) {
         return Err(invalid(

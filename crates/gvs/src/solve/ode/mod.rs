@@ -300,6 +300,28 @@ fn invalid(field: &'static str, message: impl Into<String>) -> OdeError {
     }
 }
 
+/// The state `y = [q; q̇]` of a mechanical system with `n` coordinates (lengths checked).
+fn mechanical_state(
+    n: usize,
+    q0: &DVector<f64>,
+    qd0: &DVector<f64>,
+) -> Result<DVector<f64>, OdeError> {
+    if q0.len() != n || qd0.len() != n {
+        return Err(invalid(
+            "y0",
+            format!(
+                "q0 and q̇0 have {} and {} entries, the system has {n} coordinates",
+                q0.len(),
+                qd0.len()
+            ),
+        ));
+    }
+    let mut y0 = DVector::zeros(2 * n);
+    y0.rows_mut(0, n).copy_from(q0);
+    y0.rows_mut(n, n).copy_from(qd0);
+    Ok(y0)
+}
+
 /// Smallest float above `x` (for finite `x`; `f64::next_up` needs Rust 1.86).
 fn next_up(x: f64) -> f64 {
     if !x.is_finite() {

@@ -5,8 +5,8 @@
 use super::corrector::{Corrector, FirstOrder, SecondOrder};
 use super::mass_norm::MassNorm;
 use super::{
-    check_common, deliver, invalid, ulp, wnorm, Clamp, ErrorNorm, MechanicalSystem, NdfOptions,
-    OdeError, OdeStats, OdeSystem, Output,
+    check_common, deliver, invalid, mechanical_state, ulp, wnorm, Clamp, ErrorNorm,
+    MechanicalSystem, NdfOptions, OdeError, OdeStats, OdeSystem, Output,
 };
 use nalgebra::{DMatrix, DVector};
 
@@ -351,19 +351,7 @@ pub fn integrate_ndf_second_order<S: MechanicalSystem>(
     output: &mut Output<'_>,
 ) -> Result<OdeStats, OdeError> {
     let n = sys.dim();
-    if q0.len() != n || qd0.len() != n {
-        return Err(invalid(
-            "y0",
-            format!(
-                "q0 and q̇0 have {} and {} entries, the system has {n} coordinates",
-                q0.len(),
-                qd0.len()
-            ),
-        ));
-    }
-    let mut y0 = DVector::zeros(2 * n);
-    y0.rows_mut(0, n).copy_from(q0);
-    y0.rows_mut(n, n).copy_from(qd0);
+    let y0 = mechanical_state(n, q0, qd0)?;
     integrate(
         &mut SecondOrder::new(sys),
         2 * n,

@@ -289,4 +289,20 @@ fn bad_initial_state_is_an_error_naming_it() {
         matches!(err, OdeError::Invalid { field: "y0", .. }),
         "{err}"
     );
+    // the generalized-α method checks the same way (it used to check q̇0 only)
+    let err = integrate_generalized_alpha(
+        &mut bead(0.0, 0.0, true),
+        0.0,
+        &DVector::from_element(2, 0.0),
+        &DVector::from_element(1, 0.0),
+        &[0.0, 1.0],
+        &[],
+        &GeneralizedAlphaOptions::default(),
+        &mut |_, _| ControlFlow::Continue(()),
+    )
+    .unwrap_err();
+    assert!(
+        matches!(err, OdeError::Invalid { field: "y0", .. }),
+        "{err}"
+    );
 }
