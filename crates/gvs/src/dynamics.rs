@@ -282,7 +282,7 @@ impl<P: StrainParam> Model<P> {
         stiffness.neg_mut();
         self.assemble_mass(ws); // J from the statics Jacobian's forward pass
         mass.copy_from(&ws.mass);
-        damping.copy_from(&self.damping_matrix(ws));
+        self.damping_matrix_into(ws, damping);
     }
 
     /// `w_i −= W_i (Ms ζ_i + coad_{η_i} Ms η_i)`: the inertial wrenches (with `ζ_i` the body
@@ -392,19 +392,28 @@ impl<P: StrainParam> Model<P> {
     pub fn damping_matrix(&self, ws: &Workspace) -> DMatrix<f64> {
         let n = self.n_dof();
         let mut d = DMatrix::zeros(n, n);
+        self.damping_matrix_into(ws, &mut d);
+        d
+    }
+
+    /// [`Self::damping_matrix`] into `d` (`n × n`), without allocating: `Σ_i W_i Ψ_qᵀ Ds_i Ψ_q`
+    /// on each point's columns.
+    pub fn damping_matrix_into(&self, ws: &Workspace, d: &mut DMatrix<f64>) {
+        d.fill(0.0);
         for (i, p) in self.disc.points.iter().enumerate() {
             if p.weight == 0.0 {
                 continue;
             }
             let c = self.param.columns(i);
             let psq = ws.ev.psi_q_at(i, &c);
-            let dpsq = DMatrix::from_fn(6, c.len(), |a, j| {
-                self.props[i].ds[a] * p.weight * psq[(a, j)]
-            });
-            d.view_mut((c.start, c.start), (c.len(), c.len()))
-                .gemm_tr(1.0, &psq, &dpsq, 1.0);
+            let wds: V6 = self.props[i].ds * p.weight;
+            for b in 0..c.len() {
+                let x: V6 = wds.component_mul(&psq.column(b));
+                for a in 0..c.len() {
+                    d[(c.start + a, c.start + b)] += psq.column(a).dot(&x);
+                }
+            }
         }
-        d
     }
 
     /// Structured approximation of the ODE Jacobian of `y' = [q̇; M⁻¹τ]` (spec §9.3):

@@ -1,5 +1,6 @@
 //! The evaluations an implicit integrator repeats — the statics residual, the recursive dynamics
-//! residual `M q̈ − τ`, the mass matrix, and the statics Jacobian — allocate nothing once the
+//! residual `M q̈ − τ`, the mass matrix, the statics Jacobian and the iteration parts `M, D, K` —
+//! allocate nothing once the
 //! workspace exists (issue 8), checked with a counting global allocator in this test binary, on a
 //! FEM (local-support) and a Legendre (global) basis, with a friction tendon, damping and gravity.
 
@@ -101,8 +102,10 @@ fn residuals_mass_matrix_and_statics_jacobian_do_not_allocate() {
         m.forward(&q, &mut ws, true);
         m.assemble_mass(&mut ws);
         m.statics_jacobian(&q, &u, &loads, &mut ws, &mut jac);
+        let (mut mm, mut dd, mut kk) = (DMatrix::zeros(n, n), DMatrix::zeros(n, n), jac.clone());
+        m.iteration_parts(&q, &u, &loads, &mut ws, &mut mm, &mut dd, &mut kk);
         let before = allocations();
-        let mut counts = [0usize; 5];
+        let mut counts = [0usize; 6];
         let mut mark = before;
         let mut tick = |k: usize| {
             let now = allocations();
@@ -119,14 +122,20 @@ fn residuals_mass_matrix_and_statics_jacobian_do_not_allocate() {
         tick(3);
         m.statics_jacobian(&q, &u, &loads, &mut ws, &mut jac);
         tick(4);
+        m.iteration_parts(&q, &u, &loads, &mut ws, &mut mm, &mut dd, &mut kk);
+        tick(5);
         assert_eq!(
             counts,
-            [0; 5],
-            "allocations of: statics residual, dynamics residual, forward pass with Jacobians, mass matrix, statics Jacobian (n = {n})"
+            [0; 6],
+            "allocations of: statics residual, dynamics residual, forward pass with Jacobians, mass matrix, statics Jacobian, iteration parts M, D, K (n = {n})"
         );
         // the counter does see allocations
         drop(std::hint::black_box(vec![0u8; 8]));
         assert_eq!(allocations() - before, 1);
+        // D is symmetric (it allocates: after the count)
+        assert!(
+            dd.iter().all(|v| v.is_finite()) && (&dd - dd.transpose()).amax() < 1e-12 * dd.amax()
+        );
         assert!(r.iter().chain(jac.iter()).all(|v| v.is_finite()));
     }
 }
