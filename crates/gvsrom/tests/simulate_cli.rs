@@ -326,3 +326,44 @@ fn semicolon_input_file_keeps_its_rows_and_mixed_delimiters_name_the_line() {
         ],
     );
 }
+
+#[test]
+fn lightly_damped_rod_gets_the_a_stable_orders_and_says_so() {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples");
+    let scenario = format!("{root}/undamped-release.toml");
+    let schedule = format!("{root}/release-zero.csv");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "simulate",
+            scenario.as_str(),
+            "--duration",
+            "0.05",
+            "--from-equilibrium",
+            "--load-schedule",
+            schedule.as_str(),
+        ];
+        args.extend_from_slice(extra);
+        let out = gvsrom(&args);
+        let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        stdout
+    };
+    let auto = run(&[]);
+    assert!(
+        auto.contains("integrator NDF orders ≤ 2 with the mass-norm error test: lightly damped (stiffest mode ζ = 0.000"),
+        "{auto}"
+    );
+    // a choice by hand is kept, and not announced
+    for extra in [["--max-order", "5"], ["--error-norm", "componentwise"]] {
+        let manual = run(&extra);
+        assert!(!manual.contains("integrator "), "{extra:?}: {manual}");
+    }
+    // a damped preset keeps the default NDF
+    let out = gvsrom(&["simulate", "six-tendon", "--duration", "0.05"]);
+    assert!(out.status.success());
+    assert!(!String::from_utf8_lossy(&out.stdout).contains("integrator "));
+}
