@@ -32,7 +32,9 @@
 //!   discrete solution is the same as with [`FirstOrder`] (the same corrector equation); only the
 //!   way Newton reaches it differs.
 
-use super::{Clamp, Counted, JacWork, Lu, MechanicalSystem, OdeError, OdeStats, OdeSystem};
+use super::{
+    rhs_err, Clamp, Counted, JacWork, Lu, MechanicalSystem, OdeError, OdeStats, OdeSystem,
+};
 use nalgebra::{DMatrix, DVector};
 
 /// One Newton iteration of the NDF corrector and what it needs (see the module documentation).
@@ -235,10 +237,6 @@ impl<'a, S: MechanicalSystem> SecondOrder<'a, S> {
             eps: v(),
         }
     }
-
-    fn rhs_err(t: f64) -> impl Fn(super::RhsError) -> OdeError {
-        move |source| OdeError::Rhs { t, source }
-    }
 }
 
 impl<S: MechanicalSystem> Corrector for SecondOrder<'_, S> {
@@ -263,7 +261,7 @@ impl<S: MechanicalSystem> Corrector for SecondOrder<'_, S> {
         self.v.copy_from(&y.rows(n, n));
         self.sys
             .accelerations(self.clamp.apply(t), &self.q, &self.v, &mut self.a)
-            .map_err(Self::rhs_err(t_acc))?;
+            .map_err(rhs_err(t_acc))?;
         yp.rows_mut(0, n).copy_from(&self.v);
         yp.rows_mut(n, n).copy_from(&self.a);
         Ok(yp.iter().all(|x| x.is_finite()))
@@ -288,7 +286,7 @@ impl<S: MechanicalSystem> Corrector for SecondOrder<'_, S> {
                 &mut self.d,
                 &mut self.k,
             )
-            .map_err(Self::rhs_err(t))?;
+            .map_err(rhs_err(t))?;
         self.m_factored = false;
         self.m_evals += 1;
         let finite = |a: &DMatrix<f64>| a.iter().all(|x| x.is_finite());
@@ -345,7 +343,7 @@ impl<S: MechanicalSystem> Corrector for SecondOrder<'_, S> {
         }
         self.sys
             .mass(self.clamp.apply(tnew), &self.q, &mut self.m)
-            .map_err(Self::rhs_err(t_acc))?;
+            .map_err(rhs_err(t_acc))?;
         self.m_factored = false;
         self.m_evals += 1;
         if !self.m.iter().all(|x| x.is_finite()) {
@@ -403,7 +401,7 @@ impl<S: MechanicalSystem> Corrector for SecondOrder<'_, S> {
                 &self.a,
                 &mut self.eps,
             )
-            .map_err(Self::rhs_err(t_acc))?;
+            .map_err(rhs_err(t_acc))?;
         if !self.eps.iter().all(|x| x.is_finite()) {
             return Ok(false);
         }

@@ -43,8 +43,8 @@
 //! `M q̈ = τ` (the input may jump there).
 
 use super::{
-    check_common, deliver, invalid, mechanical_state, next_down, next_up, ulp, OdeError, OdeStats,
-    Output, RhsError,
+    check_common, deliver, invalid, mechanical_state, next_down, next_up, rhs_err, ulp, OdeError,
+    OdeStats, Output, RhsError,
 };
 use nalgebra::{DMatrix, DVector};
 
@@ -276,10 +276,6 @@ struct Piece {
     lo: f64,
     hi: f64,
     hmax: f64,
-}
-
-fn rhs_err(t: f64) -> impl Fn(RhsError) -> OdeError {
-    move |source| OdeError::Rhs { t, source }
 }
 
 /// `max_i |v_i| / (rtol·max(|x_i|, |y_i|) + atol)`.

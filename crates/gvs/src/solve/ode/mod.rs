@@ -293,6 +293,11 @@ impl OdeError {
     }
 }
 
+/// Maps a right-hand-side error to the integration error at the last accepted time `t`.
+fn rhs_err(t: f64) -> impl Fn(RhsError) -> OdeError {
+    move |source| OdeError::Rhs { t, source }
+}
+
 fn invalid(field: &'static str, message: impl Into<String>) -> OdeError {
     OdeError::Invalid {
         field,

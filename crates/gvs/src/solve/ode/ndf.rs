@@ -209,19 +209,16 @@ impl Work {
         }
     }
 
-    /// [`Work::norm`] of column `col` of the difference table, plus `b` if given.
-    fn norm_col(&mut self, col: usize, b: Option<&DVector<f64>>) -> f64 {
+    /// [`Work::norm`] of column `col` of the difference table, plus `difkp1` if asked.
+    fn norm_col(&mut self, col: usize, plus_difkp1: bool) -> f64 {
         self.nbuf.copy_from(&self.dif.column(col));
-        if let Some(b) = b {
-            self.nbuf += b;
+        if plus_difkp1 {
+            self.nbuf += &self.difkp1;
         }
-        let x = std::mem::replace(&mut self.nbuf, DVector::zeros(0));
-        let r = self.norm(&x);
-        self.nbuf = x;
-        r
+        self.norm(&self.nbuf)
     }
 
-    /// The scales of the mass norm at the predictor (after [`Work::set_mass`]).
+    /// The scales of the mass norm at the predictor (after `mnorm` is set).
     fn set_mass_scales(&mut self) {
         let m = self.n / 2;
         let thr = |lo: usize| self.thresh.rows(lo, m).amax();
@@ -649,9 +646,7 @@ fn integrate_piece<C: Corrector>(
                 nofailed = false;
                 let mut hopt = absh * (0.833 * (rtol / err).powf(1.0 / (k + 1) as f64)).max(0.1);
                 if k > 1 {
-                    let d = std::mem::replace(&mut w.difkp1, DVector::zeros(0));
-                    let errkm1 = w.norm_col(k - 1, Some(&d)) * erconst[k - 2];
-                    w.difkp1 = d;
+                    let errkm1 = w.norm_col(k - 1, true) * erconst[k - 2];
                     let hkm1 = absh * (0.769 * (rtol / errkm1).powf(1.0 / k as f64)).max(0.1);
                     if hkm1 > hopt {
                         hopt = hkm1.min(absh); // no step increase after a failure
@@ -713,7 +708,7 @@ fn integrate_piece<C: Corrector>(
             let mut hopt = absh * ratio(err, 1.2, k + 1);
             let mut kopt = k;
             if k > 1 {
-                let errkm1 = w.norm_col(k - 1, None) * erconst[k - 2];
+                let errkm1 = w.norm_col(k - 1, false) * erconst[k - 2];
                 let hkm1 = absh * ratio(errkm1, 1.3, k);
                 if hkm1 > hopt {
                     hopt = hkm1;
@@ -721,7 +716,7 @@ fn integrate_piece<C: Corrector>(
                 }
             }
             if k < cfg.maxk {
-                let errkp1 = w.norm_col(k + 1, None) * erconst[k];
+                let errkp1 = w.norm_col(k + 1, false) * erconst[k];
                 let hkp1 = absh * ratio(errkp1, 1.4, k + 2);
                 if hkp1 > hopt {
                     hopt = hkp1;
