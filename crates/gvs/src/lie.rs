@@ -462,33 +462,70 @@ impl ExpTangent {
     /// `Σ_u C^{u−1} coadbar(v_u)`, `v_u = Σ_{r≥u} (−1)ʳ f_r C^{r−u} F`, in Horner form
     /// `coadbar(v_1) + C (coadbar(v_2) + C (coadbar(v_3) + C coadbar(v_4)))`: three 6×6 products.
     pub fn d_ttf(&self, f: &V6) -> M6 {
-        let c1 = coad(&self.omega);
-        // cf[j] = Cʲ F
-        let mut cf = [*f; 5];
-        for j in 1..5 {
-            cf[j] = c1 * cf[j - 1];
+        let DTtf { omega, v, col } = self.d_ttf_vectors(f);
+        let c1 = coad(&omega);
+        let mut out = coadbar(&v[3]);
+        for u in (0..3).rev() {
+            out = coadbar(&v[u]) + c1 * out;
         }
-        let sign = |r: usize| if r.is_multiple_of(2) { 1.0 } else { -1.0 };
-        let v = |u: usize| -> V6 {
-            (u..=4).fold(V6::zeros(), |acc, r| {
-                acc + cf[r - u] * (sign(r) * self.coeffs.f[r - 1])
-            })
-        };
-        let mut out = coadbar(&v(4));
-        for u in (1..4).rev() {
-            out = coadbar(&v(u)) + c1 * out;
-        }
-        // rank-one part: (Σ_r (−1)ʳ φ_r Cʳ F) [Ω_kᵀ, 0]
-        let col = (1..=4).fold(V6::zeros(), |acc, r| {
-            acc + cf[r] * (sign(r) * self.coeffs.phi[r - 1])
-        });
-        let ok = ang(&self.omega);
+        // rank-one part: col [Ω_kᵀ, 0]
+        let ok = ang(&omega);
         for c in 0..3 {
             for i in 0..6 {
                 out[(i, c)] += col[i] * ok[c];
             }
         }
         out
+    }
+
+    /// [`ExpTangent::d_ttf`] as its vectors, for matrix-free products ([`DTtf::mul`]). Needs only
+    /// the coefficients, not the powers (works on a lean step).
+    pub fn d_ttf_vectors(&self, f: &V6) -> DTtf {
+        // cf[j] = Cʲ F, C = coad_Ω
+        let mut cf = [*f; 5];
+        for j in 1..5 {
+            cf[j] = coad_mul(&self.omega, &cf[j - 1]);
+        }
+        let sign = |r: usize| if r.is_multiple_of(2) { 1.0 } else { -1.0 };
+        let v = std::array::from_fn(|u0| {
+            let u = u0 + 1;
+            (u..=4).fold(V6::zeros(), |acc, r| {
+                acc + cf[r - u] * (sign(r) * self.coeffs.f[r - 1])
+            })
+        });
+        let col = (1..=4).fold(V6::zeros(), |acc, r| {
+            acc + cf[r] * (sign(r) * self.coeffs.phi[r - 1])
+        });
+        DTtf {
+            omega: self.omega,
+            v,
+            col,
+        }
+    }
+}
+
+/// The `F`-dependent vectors of [`ExpTangent::d_ttf`], for products `∂(TᵀF)/∂Ω · z` without the
+/// 6×6 matrix ([`DTtf::mul`]): worth it when only a few `z` follow one `F` (a reduced model's one or
+/// two coordinates per step), where forming the matrix would cost more than all the products.
+#[derive(Debug, Clone, Copy)]
+pub struct DTtf {
+    omega: V6,
+    /// `v_u = Σ_{r≥u} (−1)ʳ f_r C^{r−u} F`, u = 1..4.
+    v: [V6; 4],
+    /// `Σ_r (−1)ʳ φ_r Cʳ F`, the rank-one part's column.
+    col: V6,
+}
+
+impl DTtf {
+    /// `∂(TᵀF)/∂Ω · z = coadbar(v₁) z + C (coadbar(v₂) z + C (coadbar(v₃) z + C coadbar(v₄) z))
+    /// + col (Ω_k · z_k)`, with `coadbar(v) z = coad_z v` and `C x = coad_Ω x`.
+    #[inline]
+    pub fn mul(&self, z: &V6) -> V6 {
+        let mut out = coad_mul(z, &self.v[3]);
+        for u in (0..3).rev() {
+            out = coad_mul(z, &self.v[u]) + coad_mul(&self.omega, &out);
+        }
+        out + self.col * ang(&self.omega).dot(&ang(z))
     }
 }
 
@@ -767,6 +804,11 @@ mod tests {
             // ∂(Ty)/∂Ω and ∂(TᵀF)/∂Ω column by column
             let dty = et.d_ty(&y);
             let dtf = et.d_ttf(&f);
+            // the matrix-free product, also from a lean step
+            let dv = lean.d_ttf_vectors(&f);
+            for z in [y, od] {
+                assert_relative_eq!(dv.mul(&z), dtf * z, epsilon = 1e-14);
+            }
             for c in 0..6 {
                 let mut dv = V6::zeros();
                 dv[c] = e;

@@ -24,14 +24,13 @@ use crate::actuation::{
 use crate::discretize::{Discretization, MagnusOrder};
 use crate::error::ModelError;
 use crate::lie::{
-    ad_mul, coad, coad_mul, coadbar, exp_tangent, exp_tangent_lean, tilde, ExpTangent, Pose, M6,
-    V3, V6,
+    ad_mul, coad_mul, exp_tangent, exp_tangent_lean, tilde, ExpTangent, Pose, V3, V6,
 };
 use crate::loads::{Frame, Loads};
 use crate::rod::{Rod, SectionProps};
 use crate::strain::{StrainEval, StrainParam};
 use nalgebra::{DMatrix, DMatrixViewMut, DVector, Matrix3xX, Matrix6xX};
-use std::ops::{AddAssign, Range};
+use std::ops::Range;
 
 #[cfg(test)]
 #[path = "model_dense_reference.rs"]
@@ -98,8 +97,6 @@ pub struct Workspace {
     /// Scratch (up to n × 18, column-major) of the row updates `out[c, :] += G X`.
     gbuf: Vec<f64>,
     pub(crate) et: Vec<ExpTangent>,
-    /// Whether every step in `et` has `T` and the powers (not after a residual-only forward pass).
-    pub(crate) et_full: bool,
     pub(crate) z: Matrix6xX<f64>,
     pub(crate) y: Vec<V6>,
     pub(crate) w: Vec<V6>,
@@ -235,7 +232,6 @@ impl<P: StrainParam> Model<P> {
             dy_hi: vec![0; np],
             gbuf: vec![0.0; 18 * n],
             et: vec![exp_tangent(&V6::zeros()); np - 1],
-            et_full: true,
             z: zeros6_lazy(n * (np - 1)),
             y: vec![V6::zeros(); ns],
             w: vec![V6::zeros(); np],
@@ -349,7 +345,6 @@ impl<P: StrainParam> Model<P> {
             ws.g[i + 1] = ws.g[i].compose(&et.g);
             ws.et[i] = et;
         }
-        ws.et_full = jacobians;
         if jacobians {
             self.forward_jacobians(ws);
         }
@@ -361,11 +356,6 @@ impl<P: StrainParam> Model<P> {
     /// `Z_i` lives on the step's columns `c` only, and `J_{i+1}` is zero beyond `hi = max c.end` of
     /// the steps so far: the recursion costs `36·hi` per step, one pass over the columns.
     fn forward_jacobians(&self, ws: &mut Workspace) {
-        if !ws.et_full {
-            // after a residual-only forward pass: the powers and T of every step
-            ws.et.iter_mut().for_each(|et| et.complete());
-            ws.et_full = true;
-        }
         let n = self.n_dof();
         ws.set_jac_bound(0, 0);
         let mut hi = 0;
@@ -382,6 +372,11 @@ impl<P: StrainParam> Model<P> {
             let [s1, s2] = st.sites;
             let c = self.param.columns(s1);
             hi = hi.max(c.end);
+            if c.len() > T_MATRIX_COLUMNS {
+                // after a residual-only forward pass: T and the powers, for the many products
+                // with T on this step's columns here and in the backward pass
+                ws.et[i].complete();
+            }
             let mut z = ws.z.columns_mut(i * n + c.start, c.len());
             match self.disc.order {
                 MagnusOrder::Z4 => {
@@ -405,7 +400,6 @@ impl<P: StrainParam> Model<P> {
             }
             let et = &ws.et[i];
             // J_{i+1} = Ad⁻¹ (J_i + T Z) column by column (Z only on the step's columns)
-            let adinv = et.g.adjoint_inv();
             let zi = ws.z.columns(i * n, n);
             let (a, mut b) = ws
                 .jac
@@ -413,9 +407,10 @@ impl<P: StrainParam> Model<P> {
             for j in 0..hi {
                 let mut x: V6 = a.fixed_columns::<1>(j).into_owned();
                 if c.contains(&j) {
-                    x += et.t * zi.fixed_columns::<1>(j);
+                    x += et.t_mul(&zi.fixed_columns::<1>(j).into_owned());
                 }
-                b.fixed_columns_mut::<1>(j).copy_from(&(adinv * x));
+                b.fixed_columns_mut::<1>(j)
+                    .copy_from(&et.g.adjoint_inv_mul(&x));
             }
             ws.set_jac_bound(i + 1, hi);
         }
@@ -601,9 +596,9 @@ impl<P: StrainParam> Model<P> {
             let w1 = ws.w[i + 1];
             fbar += w1;
             // C_w J_{i+1} is added to Ū on the columns < h1
-            let (cw, h1) = match out.is_some() && w1 != V6::zeros() {
-                true => (self.load_derivative(&w1, &ws.wg[i + 1]), ws.jac_hi[i + 1]),
-                false => (M6::zeros(), 0),
+            let h1 = match out.is_some() && w1 != V6::zeros() {
+                true => ws.jac_hi[i + 1],
+                false => 0,
             };
             ub = ub.max(h1);
             let Some(st) = self.disc.steps[i] else {
@@ -614,7 +609,7 @@ impl<P: StrainParam> Model<P> {
                         .fixed_rows::<6>(0)
                         .into_owned();
                     let mut u = ws.ubar.fixed_columns_mut::<1>(j);
-                    u += cw * jj;
+                    u += load_derivative_mul(&w1, &ws.wg[i + 1], &jj);
                 }
                 continue;
             };
@@ -635,22 +630,32 @@ impl<P: StrainParam> Model<P> {
                 continue;
             };
             let c = self.param.columns(s1);
-            let (a1, a2) = match self.disc.order {
-                MagnusOrder::Z4 => (
-                    M6::identity() * (0.5 * h) + coad(&ws.xi[s2]) * k,
-                    M6::identity() * (0.5 * h) - coad(&ws.xi[s1]) * k,
-                ),
-                MagnusOrder::Z2 => (M6::identity() * h, M6::zeros()),
+            let nc = c.len();
+            // A₁ = h/2 + k coad_ξ₂, A₂ = h/2 − k coad_ξ₁ (Z2: A₁ = h, A₂ = 0), applied as
+            // products (coadᵀ = −ad): no 6×6 matrix per step.
+            let (xi1, xi2) = (ws.xi[s1], ws.xi[s2]);
+            let z4 = self.disc.order == MagnusOrder::Z4;
+            let a1_mul = |x: &V6| match z4 {
+                true => x * (0.5 * h) + coad_mul(&xi2, x) * k,
+                false => x * h,
+            };
+            let a2_mul = |x: &V6| match z4 {
+                true => x * (0.5 * h) - coad_mul(&xi1, x) * k,
+                false => V6::zeros(),
             };
             // H = [G | Ψ_q1ᵀ | Ψ_q2ᵀ] (|c| × 18, column-major in gbuf), Gᵀ = T (A₁ᵀ Ψ_q1 + A₂ᵀ Ψ_q2)
-            let nc = c.len();
             {
-                let (a1t, a2t) = (a1.transpose(), a2.transpose());
                 let (p1, p2) = (ws.ev.psi_q_at(s1, &c), ws.ev.psi_q_at(s2, &c));
                 for r in 0..nc {
                     let (p1r, p2r): (V6, V6) =
                         (p1.column(r).into_owned(), p2.column(r).into_owned());
-                    let g = et.t * (a1t * p1r + a2t * p2r);
+                    let atp = match z4 {
+                        true => {
+                            (p1r + p2r) * (0.5 * h) + (ad_mul(&xi1, &p2r) - ad_mul(&xi2, &p1r)) * k
+                        }
+                        false => p1r * h,
+                    };
+                    let g = et.t_mul(&atp);
                     for a in 0..6 {
                         ws.gbuf[a * nc + r] = g[a];
                         ws.gbuf[(6 + a) * nc + r] = p1r[a];
@@ -660,62 +665,56 @@ impl<P: StrainParam> Model<P> {
             }
             // Local terms on the step's columns (j ∈ c): Ψ_q1ᵀ x₁ + Ψ_q2ᵀ x₂ with
             // x₁ = A₁ D Z_j + k coadbar(v) Ψ_q2,j, x₂ = A₂ D Z_j − k coadbar(v) Ψ_q1,j
-            // (D = ∂(TᵀF̄)/∂Ω; Z2: A₁ = h, A₂ = 0, no coadbar term).
-            let d = et.d_ttf(&fbar);
-            let cbv = match self.disc.order {
-                MagnusOrder::Z4 => coadbar(&v) * k,
-                MagnusOrder::Z2 => M6::zeros(),
-            };
+            // (D = ∂(TᵀF̄)/∂Ω; Z2: no coadbar term). D as a matrix when it serves enough
+            // columns to repay its products, else by its vectors.
+            let d_vec = et.d_ttf_vectors(&fbar);
+            let d_mat = (nc > D_TTF_MATRIX_COLUMNS).then(|| et.d_ttf(&fbar));
             // one pass: Ū_j ← coAd (Ū_j + C_w J_{i+1,j}); t = Ū_j − coadbar(F̄) J_{i,j};
             // out[c, j] += G t (+ the local terms)
-            let coadj: M6 = et.g.adjoint_inv().transpose();
-            let bf = if fbar == V6::zeros() {
-                M6::zeros()
-            } else {
-                coadbar(&fbar)
-            };
             let hj = if fbar == V6::zeros() { 0 } else { ws.jac_hi[i] };
             let tb = ub.max(hj);
             let hm = &ws.gbuf[..18 * nc];
             let zi = ws.z.columns(i * n, n);
+            let wg1 = ws.wg[i + 1];
             for j in 0..tb.max(c.end) {
                 let mut t = V6::zeros();
                 if j < ub {
                     let mut u: V6 = ws.ubar.fixed_columns::<1>(j).into_owned();
                     if j < h1 {
-                        u += cw * ws.jac.fixed_columns::<1>((i + 1) * n + j);
+                        u += load_derivative_mul(
+                            &w1,
+                            &wg1,
+                            &ws.jac.fixed_columns::<1>((i + 1) * n + j).into_owned(),
+                        );
                     }
-                    u = coadj * u;
+                    u = et.g.coadjoint_mul(&u);
                     ws.ubar.fixed_columns_mut::<1>(j).copy_from(&u);
                     t = u;
                 }
                 if j < hj {
-                    t -= bf * ws.jac.fixed_columns::<1>(i * n + j);
+                    // coadbar(F̄) J = coad_J F̄
+                    t -= coad_mul(&ws.jac.fixed_columns::<1>(i * n + j).into_owned(), &fbar);
                 }
                 if c.contains(&j) {
                     let zj: V6 = zi.fixed_columns::<1>(j).into_owned();
                     let p1j: V6 = ws.ev.psi_q_at(s1, &c).column(j - c.start).into_owned();
                     let p2j: V6 = ws.ev.psi_q_at(s2, &c).column(j - c.start).into_owned();
-                    let dz = d * zj;
-                    let x1 = a1 * dz + cbv * p2j;
-                    let x2 = a2 * dz - cbv * p1j;
+                    let dz = match &d_mat {
+                        Some(d) => d * zj,
+                        None => d_vec.mul(&zj),
+                    };
+                    let (mut x1, mut x2) = (a1_mul(&dz), a2_mul(&dz));
+                    if z4 {
+                        // k coadbar(v) p = k coad_p v
+                        x1 += coad_mul(&p2j, &v) * k;
+                        x2 -= coad_mul(&p1j, &v) * k;
+                    }
                     add_h_times(out, &c, j, hm, &t, &x1, &x2);
                 } else if j < tb {
                     add_g_times(out, &c, j, &hm[..6 * nc], &t);
                 }
             }
         }
-    }
-
-    /// `C_w = coadbar(w) + [m̃_g 0; f̃_g 0]`: `∂w/∂J` of a point wrench, the second term from the
-    /// world-fixed part `wg = [m_g; f_g]` (gravity, global wrenches; spec §7.5).
-    fn load_derivative(&self, w: &V6, wg: &V6) -> M6 {
-        let mut c = coadbar(w);
-        c.fixed_view_mut::<3, 3>(0, 0)
-            .add_assign(&tilde(&V3::new(wg[0], wg[1], wg[2])));
-        c.fixed_view_mut::<3, 3>(3, 0)
-            .add_assign(&tilde(&V3::new(wg[3], wg[4], wg[5])));
-        c
     }
 
     /// Analytic statics Jacobian `∂R/∂q` (spec §8.2, with `∂α/∂q` of friction) into `jac`.
@@ -852,6 +851,26 @@ pub(crate) fn zeros_lazy(rows: usize, cols: usize) -> DMatrix<f64> {
 pub(crate) fn zeros6_lazy(cols: usize) -> Matrix6xX<f64> {
     Matrix6xX::from_vec(vec![0.0; 6 * cols])
 }
+
+/// `C_w x` for `C_w = coadbar(w) + [m̃_g 0; f̃_g 0]`: `∂w/∂J` of a point wrench, the second term
+/// from its world-fixed part `wg = [m_g; f_g]` (gravity, global wrenches; spec §7.5), applied to
+/// a Jacobian column `x = [δθ; δp]`: `coad_x w + [m_g × δθ; f_g × δθ]`.
+#[inline]
+fn load_derivative_mul(w: &V6, wg: &V6, x: &V6) -> V6 {
+    let dth = V3::new(x[0], x[1], x[2]);
+    let m = V3::new(wg[0], wg[1], wg[2]).cross(&dth);
+    let f = V3::new(wg[3], wg[4], wg[5]).cross(&dth);
+    coad_mul(x, w) + V6::new(m[0], m[1], m[2], f[0], f[1], f[2])
+}
+
+/// Columns of a step beyond which the Jacobian passes complete a lean Magnus step (form `T(Ω)`
+/// and the powers of `ad_Ω`, three 6×6 products) instead of applying `T` by `ad` products: `T` is
+/// applied twice per column (forward `T Z`, backward `G`).
+const T_MATRIX_COLUMNS: usize = 6;
+
+/// Columns of a step beyond which the backward pass forms `∂(TᵀF̄)/∂Ω` as a 6×6 matrix (three
+/// 6×6 products) rather than applying it by its vectors (seven `coad` products per column).
+const D_TTF_MATRIX_COLUMNS: usize = 4;
 
 /// `out[c, j] += G t` for the `|c| × 6` column-major `g`: six axpys down column j of `out`.
 #[inline]

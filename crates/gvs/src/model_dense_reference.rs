@@ -4,12 +4,12 @@
 //! rows of the Jacobian), whatever the support of the basis.
 
 use super::*;
-use crate::lie::ad;
+use crate::lie::{ad, coad, coadbar, M6};
+use std::ops::AddAssign;
 
 impl<P: StrainParam> Model<P> {
     fn dense_forward_jacobians(&self, ws: &mut Workspace) {
         ws.et.iter_mut().for_each(|et| et.complete());
-        ws.et_full = true;
         let n = self.n_dof();
         ws.jac.columns_mut(0, n).fill(0.0);
         let mut hi = 0; // J_i is zero beyond column `hi`

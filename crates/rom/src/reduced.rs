@@ -20,7 +20,7 @@
 //! not represent, a part [`projection_residual`] measures. Every derivative of `Ψ_s` is `Φ_s` times
 //! the same derivative of `c`, so the engine's statics, dynamics and Jacobians apply unchanged.
 
-use crate::gemm::gemm;
+use crate::gemm::{mul_cols, mul_tr_cols};
 use crate::map::CoefficientMap;
 use gvs::discretize::Discretization;
 use gvs::lie::V6;
@@ -380,16 +380,7 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
                 // Y = Φ [c | C_z]   (rows × (1 + r))
                 let y = &mut rest[l.y - l.czd..l.map - l.czd];
                 let rows = st.rows;
-                gemm(
-                    (rows, m, 1 + r),
-                    &st.mat,
-                    (1, rows),
-                    cc,
-                    (1, m),
-                    0.0,
-                    y,
-                    (1, rows),
-                );
+                mul_cols((rows, m, 1 + r), &st.mat, cc, y);
                 let na = st.active.len();
                 for (s, psi) in ev.psi.iter_mut().enumerate() {
                     *psi = V6::zeros();
@@ -424,16 +415,7 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
         match &self.stacked {
             Some(st) => {
                 let rows = st.rows;
-                gemm(
-                    (rows, m, r),
-                    &st.mat,
-                    (1, rows),
-                    czd,
-                    (1, m),
-                    0.0,
-                    y,
-                    (1, rows),
-                );
+                mul_cols((rows, m, r), &st.mat, czd, y);
                 let na = st.active.len();
                 for s in 0..self.cols.len() {
                     for (i, &a) in st.active.iter().enumerate() {
@@ -474,16 +456,7 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
                     }
                 }
                 let rows = st.rows;
-                gemm(
-                    (self.m, rows, 1),
-                    &st.mat,
-                    (rows, 1),
-                    y,
-                    (1, rows),
-                    0.0,
-                    g,
-                    (1, self.m),
-                );
+                mul_tr_cols((rows, self.m, 1), &st.mat, y, g);
             }
             None => {
                 g.fill(0.0);

@@ -18,17 +18,19 @@
 //!   maps have no curvature, so `∇²φ = Σ_k P_kᵀ diag(μ_k ⊙ σ''(a_k)) P_k` with the adjoints
 //!   `μ_{L−1} = W_Lᵀ g`, `μ_{k−1} = W_kᵀ (σ'(a_k) ⊙ μ_k)` — `O(Σ n_k r²)`, no third-order tensor.
 //!
-//! No call allocates; the products are plain loops (no `dgemm`, whose packing buffers may allocate).
+//! No call allocates. The weights are kept column-major, so every product is one faer call
+//! (value and tangents together; no packing `dgemm`).
 
 use super::mlp::{Layer, Mlp};
 use super::{NnError, Scaling};
+use crate::gemm::{mul_cols, mul_tr_cols};
 use crate::map::CoefficientMap;
 
 /// A decoder network whose last layer is folded with `c = A (s ⊙ y + μ)`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DecoderMap {
     /// Hidden tanh layers, then the folded linear output layer (`m` outputs).
-    layers: Vec<Layer>,
+    layers: Vec<ColLayer>,
     r: usize,
     m: usize,
     widest: usize,
@@ -72,7 +74,7 @@ impl DecoderMap {
             .max()
             .unwrap_or(m);
         Ok(DecoderMap {
-            layers,
+            layers: layers.iter().map(ColLayer::of).collect(),
             r: decoder.n_in(),
             m,
             widest,
@@ -93,23 +95,31 @@ impl DecoderMap {
     }
 }
 
-/// `Σ a_i b_i` with four partial sums (lets the compiler vectorize; the order is fixed, so results
-/// are repeatable).
-#[inline]
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut acc = [0.0f64; 4];
-    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
-    let (ra, rb) = (ca.remainder(), cb.remainder());
-    for (x, y) in ca.zip(cb) {
-        for k in 0..4 {
-            acc[k] += x[k] * y[k];
+/// A layer as the evaluation uses it: `W` column-major `n_out × n_in` (element `(i, j)` at
+/// `i + j·n_out`, the transpose of [`Layer`]'s storage), `b` of `n_out`.
+#[derive(Debug, Clone, PartialEq)]
+struct ColLayer {
+    n_in: usize,
+    n_out: usize,
+    w: Vec<f64>,
+    b: Vec<f64>,
+}
+
+impl ColLayer {
+    fn of(l: &Layer) -> Self {
+        let mut w = vec![0.0; l.n_out * l.n_in];
+        for i in 0..l.n_out {
+            for j in 0..l.n_in {
+                w[i + j * l.n_out] = l.w[i * l.n_in + j];
+            }
+        }
+        ColLayer {
+            n_in: l.n_in,
+            n_out: l.n_out,
+            w,
+            b: l.b.clone(),
         }
     }
-    let mut s = (acc[0] + acc[1]) + (acc[2] + acc[3]);
-    for (x, y) in ra.iter().zip(rb) {
-        s += x * y;
-    }
-    s
 }
 
 /// `W' = A diag(s) W`, `b' = A (s ⊙ b + μ)` for the row-major `n × h` last layer and column-major `A`.
@@ -168,13 +178,11 @@ impl CoefficientMap for DecoderMap {
         let mut off = 0;
         for (k, layer) in self.layers.iter().enumerate() {
             let (n_in, n_out) = (layer.n_in, layer.n_out);
-            for i in 0..n_out {
-                let w_row = &layer.w[i * n_in..(i + 1) * n_in];
-                for col in 0..cols {
-                    y[col * n_out + i] = dot(w_row, &x[col * n_in..(col + 1) * n_in]);
-                }
-                y[i] += layer.b[i];
-            }
+            mul_cols((n_out, n_in, cols), &layer.w, x, y);
+            y[..n_out]
+                .iter_mut()
+                .zip(&layer.b)
+                .for_each(|(yi, b)| *yi += b);
             if k < last {
                 let st = &mut stored[off..off + n_out * cols];
                 for i in 0..n_out {
@@ -206,15 +214,10 @@ impl CoefficientMap for DecoderMap {
         for (k, layer) in self.layers.iter().enumerate() {
             let (n_in, n_out) = (layer.n_in, layer.n_out);
             // W Ṫ_k (Ṫ_0 = 0)
-            for i in 0..n_out {
-                let w_row = &layer.w[i * n_in..(i + 1) * n_in];
-                for l in 0..r {
-                    y[l * n_out + i] = if k == 0 {
-                        0.0
-                    } else {
-                        dot(w_row, &x[l * n_in..(l + 1) * n_in])
-                    };
-                }
+            if k == 0 {
+                y[..n_out * r].fill(0.0);
+            } else {
+                mul_cols((n_out, n_in, r), &layer.w, x, y);
             }
             if k == last {
                 c_z_dot.copy_from_slice(&y[..n_out * r]);
@@ -244,13 +247,7 @@ impl CoefficientMap for DecoderMap {
         let last = self.layers.len() - 1;
         // μ_{L−1} = W_Lᵀ g
         let wl = &self.layers[last];
-        mu[..wl.n_in].iter_mut().for_each(|v| *v = 0.0);
-        for (i, gi) in g.iter().enumerate() {
-            let w_row = &wl.w[i * wl.n_in..(i + 1) * wl.n_in];
-            for (mv, w) in mu[..wl.n_in].iter_mut().zip(w_row) {
-                *mv += gi * w;
-            }
-        }
+        mul_tr_cols((wl.n_out, wl.n_in, 1), &wl.w, g, mu);
         for k in (0..last).rev() {
             let layer = &self.layers[k];
             let (n_in, n_out) = (layer.n_in, layer.n_out);
@@ -277,14 +274,7 @@ impl CoefficientMap for DecoderMap {
             }
             if k > 0 {
                 // μ_{k−1} = W_kᵀ (σ' ⊙ μ_k)
-                next[..n_in].iter_mut().for_each(|v| *v = 0.0);
-                for i in 0..n_out {
-                    let w_row = &layer.w[i * n_in..(i + 1) * n_in];
-                    let a = mu[i];
-                    for (nv, w) in next[..n_in].iter_mut().zip(w_row) {
-                        *nv += a * w;
-                    }
-                }
+                mul_tr_cols((n_out, n_in, 1), &layer.w, mu, next);
                 std::mem::swap(&mut mu, &mut next);
             }
         }
