@@ -20,8 +20,9 @@
 //! not represent, a part [`projection_residual`] measures. Every derivative of `Ψ_s` is `Φ_s` times
 //! the same derivative of `c`, so the engine's statics, dynamics and Jacobians apply unchanged.
 
-use crate::gemm::{mul_cols, mul_tr_cols};
 use crate::map::CoefficientMap;
+use faer::linalg::matmul::matmul;
+use faer::{Accum, MatMut, MatRef, Par};
 use gvs::discretize::Discretization;
 use gvs::lie::V6;
 use gvs::strain::{LinearBasis, StrainEval, StrainParam};
@@ -150,38 +151,100 @@ pub struct ReducedParam<M: CoefficientMap> {
     rest: DVector<f64>,
 }
 
-/// `Φ_s` of every site on the active rows only, stacked: row `s·n_a + i` is row `active[i]` of
-/// `Φ_s` (`n_a·n_sites × m`, column-major, zero outside each site's columns). With it, `Ψ`, `Ψ_q`
-/// and `Ψ̇_q` at all sites are one product `Φ [c | C_z]`, and `g = Φᵀ w` one more.
+/// `Φ_s` of every site stacked per active strain component: block `i` holds row `active[i]` of every
+/// `Φ_s` (`n_sites × width`, column-major) on the coordinates `cols` where that row is non-zero at
+/// some site. For a global basis whose strain components have coefficients of their own (Legendre),
+/// a block is one component's coefficients only, a third or less of all `Φ_s`. With the blocks,
+/// `Ψ`, `Ψ_q` (and `Ψ̇_q`) at all sites are one product `Φ_i [c | C_z]_{cols}` per component, and
+/// `g = Σ_s Φ_sᵀ w_s` is `Σ_i Φ_iᵀ w_i`.
 struct Stacked {
-    active: Vec<usize>,
-    rows: usize,
+    n_sites: usize,
+    blocks: Vec<Block>,
+}
+
+struct Block {
+    /// Index into the strain 6-vector.
+    a: usize,
+    cols: Range<usize>,
     mat: Vec<f64>,
 }
 
 impl Stacked {
-    /// Stacks `basis` if that stores at most twice the entries of its per-site blocks (global bases,
-    /// Legendre, POD); `None` for local-support bases, where the per-site loop is cheaper.
+    /// Stacks `basis` if the blocks store at most twice the entries of its per-site blocks (global
+    /// bases: Legendre, POD); `None` for local-support bases, where the per-site loop is cheaper.
     fn of(basis: &LinearBasis, phi: &Matrix6xX<f64>) -> Option<Stacked> {
-        let (ns, m) = (basis.n_sites(), basis.n_dof());
-        let active: Vec<usize> = (0..6)
-            .filter(|&a| phi.row(a).iter().any(|v| *v != 0.0))
-            .collect();
-        let rows = active.len() * ns;
-        if rows * m > 2 * active.len() * phi.ncols() {
+        let ns = basis.n_sites();
+        let mut blocks = Vec::new();
+        for a in 0..6 {
+            let (mut lo, mut hi) = (usize::MAX, 0);
+            for s in 0..ns {
+                let block = basis.phi_at(s);
+                for (j, col) in basis.columns(s).enumerate() {
+                    if block[(a, j)] != 0.0 {
+                        (lo, hi) = (lo.min(col), hi.max(col + 1));
+                    }
+                }
+            }
+            if lo < hi {
+                blocks.push(Block {
+                    a,
+                    cols: lo..hi,
+                    mat: vec![0.0; ns * (hi - lo)],
+                });
+            }
+        }
+        let stored: usize = blocks.iter().map(|b| b.mat.len()).sum();
+        if stored > 2 * blocks.len() * phi.ncols() {
             return None;
         }
-        let mut mat = vec![0.0; rows * m];
-        for s in 0..ns {
-            let cols = basis.columns(s);
-            let block = basis.phi_at(s);
-            for (i, &a) in active.iter().enumerate() {
-                for (j, col) in cols.clone().enumerate() {
-                    mat[col * rows + s * active.len() + i] = block[(a, j)];
+        for b in &mut blocks {
+            for s in 0..ns {
+                let block = basis.phi_at(s);
+                for (j, col) in basis.columns(s).enumerate() {
+                    if b.cols.contains(&col) {
+                        b.mat[s + (col - b.cols.start) * ns] = block[(b.a, j)];
+                    }
                 }
             }
         }
-        Some(Stacked { active, rows, mat })
+        Some(Stacked {
+            n_sites: ns,
+            blocks,
+        })
+    }
+
+    /// Length of the product buffer for `k` right-hand columns.
+    fn y_len(&self, k: usize) -> usize {
+        self.blocks.len() * self.n_sites * k
+    }
+
+    /// `Y_i = Φ_i X[cols_i, :]` for every block, `X` column-major `m × k`; `Y_i` at
+    /// `i·n_sites·k` in `y`, column-major `n_sites × k`.
+    fn mul(&self, x: &[f64], m: usize, k: usize, y: &mut [f64]) {
+        let ns = self.n_sites;
+        for (b, yb) in self.blocks.iter().zip(y.chunks_exact_mut(ns * k)) {
+            let w = b.cols.len();
+            let phi = MatRef::from_column_major_slice(&b.mat, ns, w);
+            let xb = MatRef::from_column_major_slice_with_stride(&x[b.cols.start..], w, k, m);
+            let yb = MatMut::from_column_major_slice_mut(yb, ns, k);
+            matmul(yb, Accum::Replace, phi, xb, 1.0, Par::Seq);
+        }
+    }
+
+    /// `g = Σ_i Φ_iᵀ w_i` (`g` of length m) with `w_i` the component `a_i` of `w` at every site,
+    /// gathered into `buf` (`n_sites`).
+    fn mul_tr(&self, w: &[V6], buf: &mut [f64], g: &mut [f64]) {
+        g.fill(0.0);
+        let ns = self.n_sites;
+        for b in &self.blocks {
+            for (v, ws) in buf[..ns].iter_mut().zip(w) {
+                *v = ws[b.a];
+            }
+            let phi = MatRef::from_column_major_slice(&b.mat, ns, b.cols.len());
+            let wb = MatRef::from_column_major_slice(&buf[..ns], ns, 1);
+            let gb = MatMut::from_column_major_slice_mut(&mut g[b.cols.clone()], b.cols.len(), 1);
+            matmul(gb, Accum::Add, phi.transpose(), wb, 1.0, Par::Seq);
+        }
     }
 }
 
@@ -257,7 +320,7 @@ impl<M: CoefficientMap> ReducedParam<M> {
         let g = czd + m * r;
         let h = g + m;
         let y = h + r * r;
-        let map = y + self.stacked.as_ref().map_or(0, |st| st.rows * (1 + r));
+        let map = y + self.stacked.as_ref().map_or(0, |st| st.y_len(1 + r));
         Layout {
             cz,
             czd,
@@ -377,18 +440,16 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
         let out = ev.psi_q.as_mut_slice();
         match &self.stacked {
             Some(st) => {
-                // Y = Φ [c | C_z]   (rows × (1 + r))
+                // Y_i = Φ_i [c | C_z]   (n_sites × (1 + r) per component)
                 let y = &mut rest[l.y - l.czd..l.map - l.czd];
-                let rows = st.rows;
-                mul_cols((rows, m, 1 + r), &st.mat, cc, y);
-                let na = st.active.len();
-                for (s, psi) in ev.psi.iter_mut().enumerate() {
-                    *psi = V6::zeros();
-                    for (i, &a) in st.active.iter().enumerate() {
-                        let row = s * na + i;
-                        psi[a] = y[row];
+                st.mul(cc, m, 1 + r, y);
+                ev.psi.iter_mut().for_each(|psi| *psi = V6::zeros());
+                let ns = st.n_sites;
+                for (b, yb) in st.blocks.iter().zip(y.chunks_exact(ns * (1 + r))) {
+                    for (s, psi) in ev.psi.iter_mut().enumerate() {
+                        psi[b.a] = yb[s];
                         for k in 0..r {
-                            out[6 * (s * r + k) + a] = y[(k + 1) * rows + row];
+                            out[6 * (s * r + k) + b.a] = yb[(k + 1) * ns + s];
                         }
                     }
                 }
@@ -414,13 +475,12 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
         let out = ev.psi_q_dot.as_mut_slice();
         match &self.stacked {
             Some(st) => {
-                let rows = st.rows;
-                mul_cols((rows, m, r), &st.mat, czd, y);
-                let na = st.active.len();
-                for s in 0..self.cols.len() {
-                    for (i, &a) in st.active.iter().enumerate() {
+                st.mul(czd, m, r, y);
+                let ns = st.n_sites;
+                for (b, yb) in st.blocks.iter().zip(y.chunks_exact(ns * r)) {
+                    for s in 0..ns {
                         for k in 0..r {
-                            out[6 * (s * r + k) + a] = y[k * rows + s * na + i];
+                            out[6 * (s * r + k) + b.a] = yb[k * ns + s];
                         }
                     }
                 }
@@ -447,17 +507,7 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
         let (g, rest) = head[l.g..].split_at_mut(l.h - l.g);
         let (h, y) = rest.split_at_mut(l.y - l.h);
         match &self.stacked {
-            Some(st) => {
-                // g = Φᵀ w   (w on the active rows, stacked like Φ)
-                let na = st.active.len();
-                for (s, ws) in w.iter().enumerate() {
-                    for (i, &a) in st.active.iter().enumerate() {
-                        y[s * na + i] = ws[a];
-                    }
-                }
-                let rows = st.rows;
-                mul_tr_cols((rows, self.m, 1), &st.mat, y, g);
-            }
+            Some(st) => st.mul_tr(w, y, g),
             None => {
                 g.fill(0.0);
                 for (s, cols) in self.cols.iter().enumerate() {
