@@ -365,6 +365,7 @@ impl ExpTangent {
     }
 
     /// `T y = y + Σ_r f_r ad_Ωʳ y` (by `ad` products of 6-vectors when `T` is not formed).
+    #[inline]
     pub fn t_mul(&self, y: &V6) -> V6 {
         if self.full {
             return self.t * y;
@@ -379,6 +380,7 @@ impl ExpTangent {
     }
 
     /// `Tᵀ y = y + Σ_r f_r (ad_Ωᵀ)ʳ y`, `ad_Ωᵀ y = −coad_Ω y`.
+    #[inline]
     pub fn t_tr_mul(&self, y: &V6) -> V6 {
         if self.full {
             return self.t.transpose() * y;

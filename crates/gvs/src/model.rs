@@ -24,13 +24,14 @@ use crate::actuation::{
 use crate::discretize::{Discretization, MagnusOrder};
 use crate::error::ModelError;
 use crate::lie::{
-    ad_mul, coad_mul, exp_tangent, exp_tangent_lean, tilde, ExpTangent, Pose, V3, V6,
+    ad_mul, coad, coad_mul, coadbar, exp_tangent, exp_tangent_lean, tilde, ExpTangent, Pose, M6,
+    V3, V6,
 };
 use crate::loads::{Frame, Loads};
 use crate::rod::{Rod, SectionProps};
 use crate::strain::{StrainEval, StrainParam};
 use nalgebra::{DMatrix, DMatrixViewMut, DVector, Matrix3xX, Matrix6xX};
-use std::ops::Range;
+use std::ops::{AddAssign, Range};
 
 #[cfg(test)]
 #[path = "model_dense_reference.rs"]
@@ -372,7 +373,8 @@ impl<P: StrainParam> Model<P> {
             let [s1, s2] = st.sites;
             let c = self.param.columns(s1);
             hi = hi.max(c.end);
-            if c.len() > T_MATRIX_COLUMNS {
+            let wide = c.len() > STEP_MATRIX_COLUMNS;
+            if wide {
                 // after a residual-only forward pass: T and the powers, for the many products
                 // with T on this step's columns here and in the backward pass
                 ws.et[i].complete();
@@ -404,13 +406,18 @@ impl<P: StrainParam> Model<P> {
             let (a, mut b) = ws
                 .jac
                 .columns_range_pair_mut(i * n..i * n + hi, (i + 1) * n..(i + 1) * n + hi);
+            let adinv = (hi > STEP_MATRIX_COLUMNS).then(|| et.g.adjoint_inv());
             for j in 0..hi {
                 let mut x: V6 = a.fixed_columns::<1>(j).into_owned();
                 if c.contains(&j) {
-                    x += et.t_mul(&zi.fixed_columns::<1>(j).into_owned());
+                    let zj: V6 = zi.fixed_columns::<1>(j).into_owned();
+                    x += if wide { et.t * zj } else { et.t_mul(&zj) };
                 }
-                b.fixed_columns_mut::<1>(j)
-                    .copy_from(&et.g.adjoint_inv_mul(&x));
+                let y = match &adinv {
+                    Some(m) => m * x,
+                    None => et.g.adjoint_inv_mul(&x),
+                };
+                b.fixed_columns_mut::<1>(j).copy_from(&y);
             }
             ws.set_jac_bound(i + 1, hi);
         }
@@ -631,31 +638,55 @@ impl<P: StrainParam> Model<P> {
             };
             let c = self.param.columns(s1);
             let nc = c.len();
-            // A₁ = h/2 + k coad_ξ₂, A₂ = h/2 − k coad_ξ₁ (Z2: A₁ = h, A₂ = 0), applied as
-            // products (coadᵀ = −ad): no 6×6 matrix per step.
+            let hj = if fbar == V6::zeros() { 0 } else { ws.jac_hi[i] };
+            let tb = ub.max(hj);
+            // The step's 6×6 maps, as matrices where they serve many columns (a matrix–vector
+            // product is the cheapest per column), by their 6-vector products otherwise (a reduced
+            // model's step has one or two columns: forming the matrices would cost more).
+            // A₁ = h/2 + k coad_ξ₂, A₂ = h/2 − k coad_ξ₁ (Z2: A₁ = h, A₂ = 0), coadᵀ = −ad.
             let (xi1, xi2) = (ws.xi[s1], ws.xi[s2]);
             let z4 = self.disc.order == MagnusOrder::Z4;
-            let a1_mul = |x: &V6| match z4 {
-                true => x * (0.5 * h) + coad_mul(&xi2, x) * k,
-                false => x * h,
-            };
-            let a2_mul = |x: &V6| match z4 {
-                true => x * (0.5 * h) - coad_mul(&xi1, x) * k,
-                false => V6::zeros(),
+            let local_mats = (nc > STEP_MATRIX_COLUMNS).then(|| {
+                let (a1, a2) = match z4 {
+                    true => (
+                        M6::identity() * (0.5 * h) + coad(&xi2) * k,
+                        M6::identity() * (0.5 * h) - coad(&xi1) * k,
+                    ),
+                    false => (M6::identity() * h, M6::zeros()),
+                };
+                let cbv = if z4 { coadbar(&v) * k } else { M6::zeros() };
+                (a1, a2, cbv, et.d_ttf(&fbar))
+            });
+            let sweep_mats = (tb.max(c.end) > STEP_MATRIX_COLUMNS).then(|| {
+                (
+                    et.g.adjoint_inv().transpose(),
+                    coadbar(&fbar),
+                    load_derivative(&w1, &ws.wg[i + 1]),
+                )
+            });
+            let d_vec = match local_mats {
+                Some(_) => None,
+                None => Some(et.d_ttf_vectors(&fbar)),
             };
             // H = [G | Ψ_q1ᵀ | Ψ_q2ᵀ] (|c| × 18, column-major in gbuf), Gᵀ = T (A₁ᵀ Ψ_q1 + A₂ᵀ Ψ_q2)
             {
                 let (p1, p2) = (ws.ev.psi_q_at(s1, &c), ws.ev.psi_q_at(s2, &c));
+                let lt = local_mats.map(|(a1, a2, _, _)| (a1.transpose(), a2.transpose()));
                 for r in 0..nc {
                     let (p1r, p2r): (V6, V6) =
                         (p1.column(r).into_owned(), p2.column(r).into_owned());
-                    let atp = match z4 {
-                        true => {
+                    let atp = match (&lt, z4) {
+                        (Some((a1t, a2t)), _) => a1t * p1r + a2t * p2r,
+                        (None, true) => {
                             (p1r + p2r) * (0.5 * h) + (ad_mul(&xi1, &p2r) - ad_mul(&xi2, &p1r)) * k
                         }
-                        false => p1r * h,
+                        (None, false) => p1r * h,
                     };
-                    let g = et.t_mul(&atp);
+                    // (T formed on a wide step, see forward_jacobians)
+                    let g = match lt {
+                        Some(_) => et.t * atp,
+                        None => et.t_mul(&atp),
+                    };
                     for a in 0..6 {
                         ws.gbuf[a * nc + r] = g[a];
                         ws.gbuf[(6 + a) * nc + r] = p1r[a];
@@ -665,14 +696,28 @@ impl<P: StrainParam> Model<P> {
             }
             // Local terms on the step's columns (j ∈ c): Ψ_q1ᵀ x₁ + Ψ_q2ᵀ x₂ with
             // x₁ = A₁ D Z_j + k coadbar(v) Ψ_q2,j, x₂ = A₂ D Z_j − k coadbar(v) Ψ_q1,j
-            // (D = ∂(TᵀF̄)/∂Ω; Z2: no coadbar term). D as a matrix when it serves enough
-            // columns to repay its products, else by its vectors.
-            let d_vec = et.d_ttf_vectors(&fbar);
-            let d_mat = (nc > D_TTF_MATRIX_COLUMNS).then(|| et.d_ttf(&fbar));
+            // (D = ∂(TᵀF̄)/∂Ω; Z2: no coadbar term; coadbar(v) p = coad_p v).
+            let local = |zj: &V6, p1j: &V6, p2j: &V6| -> (V6, V6) {
+                match (&local_mats, &d_vec) {
+                    (Some((a1, a2, cbv, d)), _) => {
+                        let dz = d * zj;
+                        (a1 * dz + cbv * p2j, a2 * dz - cbv * p1j)
+                    }
+                    (None, Some(dv)) => {
+                        let dz = dv.mul(zj);
+                        match z4 {
+                            true => (
+                                dz * (0.5 * h) + (coad_mul(&xi2, &dz) + coad_mul(p2j, &v)) * k,
+                                dz * (0.5 * h) - (coad_mul(&xi1, &dz) + coad_mul(p1j, &v)) * k,
+                            ),
+                            false => (dz * h, V6::zeros()),
+                        }
+                    }
+                    (None, None) => unreachable!("D is kept in one form or the other"),
+                }
+            };
             // one pass: Ū_j ← coAd (Ū_j + C_w J_{i+1,j}); t = Ū_j − coadbar(F̄) J_{i,j};
             // out[c, j] += G t (+ the local terms)
-            let hj = if fbar == V6::zeros() { 0 } else { ws.jac_hi[i] };
-            let tb = ub.max(hj);
             let hm = &ws.gbuf[..18 * nc];
             let zi = ws.z.columns(i * n, n);
             let wg1 = ws.wg[i + 1];
@@ -681,34 +726,31 @@ impl<P: StrainParam> Model<P> {
                 if j < ub {
                     let mut u: V6 = ws.ubar.fixed_columns::<1>(j).into_owned();
                     if j < h1 {
-                        u += load_derivative_mul(
-                            &w1,
-                            &wg1,
-                            &ws.jac.fixed_columns::<1>((i + 1) * n + j).into_owned(),
-                        );
+                        let jj: V6 = ws.jac.fixed_columns::<1>((i + 1) * n + j).into_owned();
+                        u += match &sweep_mats {
+                            Some((_, _, cw)) => cw * jj,
+                            None => load_derivative_mul(&w1, &wg1, &jj),
+                        };
                     }
-                    u = et.g.coadjoint_mul(&u);
+                    u = match &sweep_mats {
+                        Some((coadj, _, _)) => coadj * u,
+                        None => et.g.coadjoint_mul(&u),
+                    };
                     ws.ubar.fixed_columns_mut::<1>(j).copy_from(&u);
                     t = u;
                 }
                 if j < hj {
-                    // coadbar(F̄) J = coad_J F̄
-                    t -= coad_mul(&ws.jac.fixed_columns::<1>(i * n + j).into_owned(), &fbar);
+                    let jj: V6 = ws.jac.fixed_columns::<1>(i * n + j).into_owned();
+                    t -= match &sweep_mats {
+                        Some((_, bf, _)) => bf * jj,
+                        None => coad_mul(&jj, &fbar),
+                    };
                 }
                 if c.contains(&j) {
                     let zj: V6 = zi.fixed_columns::<1>(j).into_owned();
                     let p1j: V6 = ws.ev.psi_q_at(s1, &c).column(j - c.start).into_owned();
                     let p2j: V6 = ws.ev.psi_q_at(s2, &c).column(j - c.start).into_owned();
-                    let dz = match &d_mat {
-                        Some(d) => d * zj,
-                        None => d_vec.mul(&zj),
-                    };
-                    let (mut x1, mut x2) = (a1_mul(&dz), a2_mul(&dz));
-                    if z4 {
-                        // k coadbar(v) p = k coad_p v
-                        x1 += coad_mul(&p2j, &v) * k;
-                        x2 -= coad_mul(&p1j, &v) * k;
-                    }
+                    let (x1, x2) = local(&zj, &p1j, &p2j);
                     add_h_times(out, &c, j, hm, &t, &x1, &x2);
                 } else if j < tb {
                     add_g_times(out, &c, j, &hm[..6 * nc], &t);
@@ -852,6 +894,17 @@ pub(crate) fn zeros6_lazy(cols: usize) -> Matrix6xX<f64> {
     Matrix6xX::from_vec(vec![0.0; 6 * cols])
 }
 
+/// `C_w = coadbar(w) + [m̃_g 0; f̃_g 0]`: `∂w/∂J` of a point wrench, the second term from its
+/// world-fixed part `wg = [m_g; f_g]` (gravity, global wrenches; spec §7.5).
+fn load_derivative(w: &V6, wg: &V6) -> M6 {
+    let mut c = coadbar(w);
+    c.fixed_view_mut::<3, 3>(0, 0)
+        .add_assign(&tilde(&V3::new(wg[0], wg[1], wg[2])));
+    c.fixed_view_mut::<3, 3>(3, 0)
+        .add_assign(&tilde(&V3::new(wg[3], wg[4], wg[5])));
+    c
+}
+
 /// `C_w x` for `C_w = coadbar(w) + [m̃_g 0; f̃_g 0]`: `∂w/∂J` of a point wrench, the second term
 /// from its world-fixed part `wg = [m_g; f_g]` (gravity, global wrenches; spec §7.5), applied to
 /// a Jacobian column `x = [δθ; δp]`: `coad_x w + [m_g × δθ; f_g × δθ]`.
@@ -863,14 +916,13 @@ fn load_derivative_mul(w: &V6, wg: &V6, x: &V6) -> V6 {
     coad_mul(x, w) + V6::new(m[0], m[1], m[2], f[0], f[1], f[2])
 }
 
-/// Columns of a step beyond which the Jacobian passes complete a lean Magnus step (form `T(Ω)`
-/// and the powers of `ad_Ω`, three 6×6 products) instead of applying `T` by `ad` products: `T` is
-/// applied twice per column (forward `T Z`, backward `G`).
-const T_MATRIX_COLUMNS: usize = 6;
-
-/// Columns of a step beyond which the backward pass forms `∂(TᵀF̄)/∂Ω` as a 6×6 matrix (three
-/// 6×6 products) rather than applying it by its vectors (seven `coad` products per column).
-const D_TTF_MATRIX_COLUMNS: usize = 4;
+/// Columns of a step beyond which the Jacobian passes form its 6×6 maps as matrices rather than
+/// applying them by 6-vector products: `T(Ω)` (completing a lean Magnus step: the powers of `ad_Ω`,
+/// three 6×6 products) and `Ad⁻¹` in the forward pass; `coAd`, `coadbar(F̄)`, `C_w` for the sweep
+/// over the columns and `A₁`, `A₂`, `coadbar(v)`, `∂(TᵀF̄)/∂Ω` for the step's own in the backward
+/// pass. A matrix–vector product is the cheapest per column; a reduced model's step has one or two
+/// columns, where forming the matrices would cost more than all the products.
+const STEP_MATRIX_COLUMNS: usize = 4;
 
 /// `out[c, j] += G t` for the `|c| × 6` column-major `g`: six axpys down column j of `out`.
 #[inline]

@@ -4,8 +4,7 @@
 //! rows of the Jacobian), whatever the support of the basis.
 
 use super::*;
-use crate::lie::{ad, coad, coadbar, M6};
-use std::ops::AddAssign;
+use crate::lie::ad;
 
 impl<P: StrainParam> Model<P> {
     fn dense_forward_jacobians(&self, ws: &mut Workspace) {
