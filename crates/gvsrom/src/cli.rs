@@ -286,9 +286,11 @@ pub struct SimulateArgs {
     #[arg(long)]
     pub max_order: Option<usize>,
 
-    /// NDF error test: `componentwise` (ode15s) or `mass` (positions and velocities in the norm of
-    /// the mass matrix: modes that move little mass do not limit the step). Default:
-    /// componentwise, or mass for a lightly damped rod (see `--max-order`).
+    /// Error test of the adaptive methods: `componentwise` (ode15s) or `mass` (positions and
+    /// velocities in the norm of the mass matrix: modes that move little mass do not limit the
+    /// step). Default: componentwise, or with the NDF mass for a lightly damped rod (see
+    /// `--max-order`). With `--method galpha`, `mass` is what makes it usable on a lightly damped
+    /// rod.
     #[arg(long, value_enum)]
     pub error_norm: Option<ErrorNormChoice>,
 
@@ -716,6 +718,10 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
             rtol: args.rtol,
             atol: args.atol,
             rho_inf: args.rho_inf,
+            error_norm: match args.error_norm {
+                Some(ErrorNormChoice::Mass) => gvs::solve::ode::ErrorNorm::Mass,
+                _ => gvs::solve::ode::ErrorNorm::Componentwise,
+            },
             ..GeneralizedAlphaOptions::default()
         }),
         (None, MethodChoice::Ndf) => {
