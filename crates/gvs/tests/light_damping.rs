@@ -111,6 +111,10 @@ fn damping_regime_flags_the_undamped_rod_and_finds_the_stiffest_mode() {
 /// The release of issue 8 on 6 elements: from the equilibrium under the tip force, the force is
 /// removed (`λ = 0`) and the rod swings freely for 1.5 s.
 fn release(m: &Model<LinearBasis>, ndf: NdfOptions) -> gvs::solve::dynamics::Simulation {
+    release_with(m, Method::Ndf(ndf))
+}
+
+fn release_with(m: &Model<LinearBasis>, method: Method) -> gvs::solve::dynamics::Simulation {
     simulate(
         m,
         &Signal::constant(&[]),
@@ -121,9 +125,25 @@ fn release(m: &Model<LinearBasis>, ndf: NdfOptions) -> gvs::solve::dynamics::Sim
             loads: tip_load(),
         },
         &samples(1.5, 150),
-        &options(ndf),
+        &IntegratorOptions {
+            method,
+            jacobian: OdeJacobian::Structured,
+        },
     )
     .unwrap()
+}
+
+/// Largest distance between the tips of two runs at the same samples, in rod lengths.
+fn max_tip_distance(
+    a: &gvs::solve::dynamics::Simulation,
+    b: &gvs::solve::dynamics::Simulation,
+) -> f64 {
+    a.trajectory
+        .tip
+        .iter()
+        .zip(&b.trajectory.tip)
+        .map(|(a, b)| (a.pos - b.pos).norm() / L)
+        .fold(0.0, f64::max)
 }
 
 #[test]
@@ -155,13 +175,7 @@ fn undamped_release_with_the_automatic_method_keeps_its_energy_and_tracks_a_tigh
         .iter()
         .map(|e| (e - e0).abs() / e0)
         .fold(0.0, f64::max);
-    let tip_err = fast
-        .trajectory
-        .tip
-        .iter()
-        .zip(&tight.trajectory.tip)
-        .map(|(a, b)| (a.pos - b.pos).norm() / L)
-        .fold(0.0, f64::max);
+    let tip_err = max_tip_distance(&fast, &tight);
     println!(
         "automatic method: {} steps, energy drift {:.3} %, tip within {:.4} % L of the tight run ({} steps)",
         fast.stats.steps,
@@ -236,29 +250,14 @@ fn small_free_vibration_has_the_first_linearized_period() {
 fn generalized_alpha_with_the_mass_norm_tracks_a_tight_run_in_few_steps() {
     use gvs::solve::ode::GeneralizedAlphaOptions;
     let m = cantilever(0.0, 6);
-    let run = |method: Method| {
-        simulate(
-            &m,
-            &Signal::constant(&[]),
-            &tip_load(),
-            Some(&Signal::constant(&[0.0])),
-            &InitialState::Equilibrium {
-                u: vec![],
-                loads: tip_load(),
-            },
-            &samples(1.5, 150),
-            &IntegratorOptions {
-                method,
-                jacobian: OdeJacobian::Structured,
-            },
-        )
-        .unwrap()
-    };
-    let ga = run(Method::GeneralizedAlpha(GeneralizedAlphaOptions {
-        rtol: 1e-5,
-        error_norm: ErrorNorm::Mass,
-        ..GeneralizedAlphaOptions::default()
-    }));
+    let ga = release_with(
+        &m,
+        Method::GeneralizedAlpha(GeneralizedAlphaOptions {
+            rtol: 1e-5,
+            error_norm: ErrorNorm::Mass,
+            ..GeneralizedAlphaOptions::default()
+        }),
+    );
     assert!(ga.error.is_none(), "{:?}", ga.error);
     let tight = release(
         &m,
@@ -268,13 +267,7 @@ fn generalized_alpha_with_the_mass_norm_tracks_a_tight_run_in_few_steps() {
             ..NdfOptions::default()
         },
     );
-    let tip_err = ga
-        .trajectory
-        .tip
-        .iter()
-        .zip(&tight.trajectory.tip)
-        .map(|(a, b)| (a.pos - b.pos).norm() / L)
-        .fold(0.0, f64::max);
+    let tip_err = max_tip_distance(&ga, &tight);
     println!(
         "generalized-α, mass norm: {} steps ({} failed), tip within {:.4} % L of the tight run",
         ga.stats.steps,
