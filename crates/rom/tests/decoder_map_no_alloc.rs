@@ -52,3 +52,32 @@ fn eval_rate_and_weighted_hessian_do_not_allocate() {
         .chain(&hess)
         .all(|v| v.is_finite()));
 }
+
+/// The same at the paper's IV-A size (306 point strains, 7 hidden layers halving to r = 1, folded
+/// onto 33 coefficients), where the layer products take faer's blocked kernels: after the first
+/// call on a thread, which allocates the kernels' thread-local packing buffer once, no call
+/// allocates.
+#[test]
+fn paper_sized_decoder_does_not_allocate() {
+    let (r, m) = (1, 33);
+    let mut rng = SplitMix64::new(3);
+    let decoder = Mlp::glorot(&[r, 38, 76, 153, 306], &mut rng).unwrap();
+    let a: Vec<f64> = (0..m * 306).map(|_| rng.range(-1.0, 1.0)).collect();
+    let map = DecoderMap::new(&decoder, &Scaling::identity(306), &a, m).unwrap();
+    let (z, zd, g) = (vec![0.3], vec![1.0], vec![0.1; m]);
+    let (mut c, mut c_z, mut c_z_dot) = (vec![0.0; m], vec![0.0; m * r], vec![0.0; m * r]);
+    let (mut hess, mut scratch) = (vec![0.0; r * r], vec![0.0; map.scratch_len()]);
+    let first = ALLOCATIONS.with(Cell::get);
+    map.eval(&z, &mut c, &mut c_z, &mut scratch);
+    map.eval_rate(&z, &zd, &mut c_z_dot, &mut scratch);
+    map.add_weighted_hessian(&z, &g, &mut hess, &mut scratch);
+    assert!(ALLOCATIONS.with(Cell::get) - first <= 1);
+    let before = ALLOCATIONS.with(Cell::get);
+    for _ in 0..3 {
+        map.eval(&z, &mut c, &mut c_z, &mut scratch);
+        map.eval_rate(&z, &zd, &mut c_z_dot, &mut scratch);
+        map.add_weighted_hessian(&z, &g, &mut hess, &mut scratch);
+    }
+    assert_eq!(ALLOCATIONS.with(Cell::get) - before, 0);
+    assert!(c.iter().chain(&c_z).chain(&hess).all(|v| v.is_finite()));
+}
