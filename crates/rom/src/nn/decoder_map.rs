@@ -18,8 +18,9 @@
 //!   maps have no curvature, so `∇²φ = Σ_k P_kᵀ diag(μ_k ⊙ σ''(a_k)) P_k` with the adjoints
 //!   `μ_{L−1} = W_Lᵀ g`, `μ_{k−1} = W_kᵀ (σ'(a_k) ⊙ μ_k)` — `O(Σ n_k r²)`, no third-order tensor.
 //!
-//! No call allocates. The weights are kept column-major, so every product is one faer call
-//! (value and tangents together; no packing `dgemm`).
+//! The weights are kept column-major, so every product is one faer call (value and tangents
+//! together). No call allocates, but a thread's first, where faer allocates its thread-local
+//! packing buffer once (`tests/decoder_map_no_alloc.rs`).
 
 use super::mlp::{Layer, Mlp};
 use super::{NnError, Scaling};
