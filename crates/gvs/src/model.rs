@@ -24,8 +24,8 @@ use crate::actuation::{
 use crate::discretize::{Discretization, MagnusOrder};
 use crate::error::ModelError;
 use crate::lie::{
-    ad_mul, coad, coad_mul, coadbar, exp_tangent, exp_tangent_lean, tilde, ExpTangent, Pose, M6,
-    V3, V6,
+    ad_mul, coad, coad_mul, coadbar, exp_tangent, exp_tangent_lean, tilde, DTtf, ExpTangent, Pose,
+    M6, V3, V6,
 };
 use crate::loads::{Frame, Loads};
 use crate::rod::{Rod, SectionProps};
@@ -646,7 +646,7 @@ impl<P: StrainParam> Model<P> {
             // A₁ = h/2 + k coad_ξ₂, A₂ = h/2 − k coad_ξ₁ (Z2: A₁ = h, A₂ = 0), coadᵀ = −ad.
             let (xi1, xi2) = (ws.xi[s1], ws.xi[s2]);
             let z4 = self.disc.order == MagnusOrder::Z4;
-            let local_mats = (nc > STEP_MATRIX_COLUMNS).then(|| {
+            let local_maps = if nc > STEP_MATRIX_COLUMNS {
                 let (a1, a2) = match z4 {
                     true => (
                         M6::identity() * (0.5 * h) + coad(&xi2) * k,
@@ -655,8 +655,15 @@ impl<P: StrainParam> Model<P> {
                     false => (M6::identity() * h, M6::zeros()),
                 };
                 let cbv = if z4 { coadbar(&v) * k } else { M6::zeros() };
-                (a1, a2, cbv, et.d_ttf(&fbar))
-            });
+                LocalMaps::Matrices {
+                    a1,
+                    a2,
+                    cbv,
+                    d: et.d_ttf(&fbar),
+                }
+            } else {
+                LocalMaps::Products(et.d_ttf_vectors(&fbar))
+            };
             let sweep_mats = (tb.max(c.end) > STEP_MATRIX_COLUMNS).then(|| {
                 (
                     et.g.adjoint_inv().transpose(),
@@ -664,14 +671,13 @@ impl<P: StrainParam> Model<P> {
                     load_derivative(&w1, &ws.wg[i + 1]),
                 )
             });
-            let d_vec = match local_mats {
-                Some(_) => None,
-                None => Some(et.d_ttf_vectors(&fbar)),
-            };
             // H = [G | Ψ_q1ᵀ | Ψ_q2ᵀ] (|c| × 18, column-major in gbuf), Gᵀ = T (A₁ᵀ Ψ_q1 + A₂ᵀ Ψ_q2)
             {
                 let (p1, p2) = (ws.ev.psi_q_at(s1, &c), ws.ev.psi_q_at(s2, &c));
-                let lt = local_mats.map(|(a1, a2, _, _)| (a1.transpose(), a2.transpose()));
+                let lt = match &local_maps {
+                    LocalMaps::Matrices { a1, a2, .. } => Some((a1.transpose(), a2.transpose())),
+                    LocalMaps::Products(_) => None,
+                };
                 for r in 0..nc {
                     let (p1r, p2r): (V6, V6) =
                         (p1.column(r).into_owned(), p2.column(r).into_owned());
@@ -698,12 +704,12 @@ impl<P: StrainParam> Model<P> {
             // x₁ = A₁ D Z_j + k coadbar(v) Ψ_q2,j, x₂ = A₂ D Z_j − k coadbar(v) Ψ_q1,j
             // (D = ∂(TᵀF̄)/∂Ω; Z2: no coadbar term; coadbar(v) p = coad_p v).
             let local = |zj: &V6, p1j: &V6, p2j: &V6| -> (V6, V6) {
-                match (&local_mats, &d_vec) {
-                    (Some((a1, a2, cbv, d)), _) => {
+                match &local_maps {
+                    LocalMaps::Matrices { a1, a2, cbv, d } => {
                         let dz = d * zj;
                         (a1 * dz + cbv * p2j, a2 * dz - cbv * p1j)
                     }
-                    (None, Some(dv)) => {
+                    LocalMaps::Products(dv) => {
                         let dz = dv.mul(zj);
                         match z4 {
                             true => (
@@ -713,7 +719,6 @@ impl<P: StrainParam> Model<P> {
                             false => (dz * h, V6::zeros()),
                         }
                     }
-                    (None, None) => unreachable!("D is kept in one form or the other"),
                 }
             };
             // one pass: Ū_j ← coAd (Ū_j + C_w J_{i+1,j}); t = Ū_j − coadbar(F̄) J_{i,j};
@@ -914,6 +919,16 @@ fn load_derivative_mul(w: &V6, wg: &V6, x: &V6) -> V6 {
     let m = V3::new(wg[0], wg[1], wg[2]).cross(&dth);
     let f = V3::new(wg[3], wg[4], wg[5]).cross(&dth);
     coad_mul(x, w) + V6::new(m[0], m[1], m[2], f[0], f[1], f[2])
+}
+
+/// The backward pass's maps of one step on its own columns: `A₁`, `A₂`, `k coadbar(v)` and
+/// `D = ∂(TᵀF̄)/∂Ω` as matrices (wide steps), or `D` by its vectors and the rest by 6-vector
+/// products (narrow steps; see [`STEP_MATRIX_COLUMNS`]). A stack value per step: boxing the large
+/// variant would allocate in the pass.
+#[allow(clippy::large_enum_variant)]
+enum LocalMaps {
+    Matrices { a1: M6, a2: M6, cbv: M6, d: M6 },
+    Products(DTtf),
 }
 
 /// Columns of a step beyond which the Jacobian passes form its 6×6 maps as matrices rather than
