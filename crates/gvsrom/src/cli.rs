@@ -17,6 +17,7 @@ use std::ops::ControlFlow;
 pub enum MethodChoice {
     Ndf,
     Galpha,
+    Sdirk,
 }
 
 /// `simulate --error-norm`.
@@ -649,7 +650,7 @@ fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
 fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
     use gvs::inputs::Interpolation;
     use gvs::solve::dynamics::{IntegratorOptions, Method, OdeJacobian};
-    use gvs::solve::ode::{FixedStepOptions, GeneralizedAlphaOptions, NdfOptions};
+    use gvs::solve::ode::{FixedStepOptions, GeneralizedAlphaOptions, NdfOptions, SdirkOptions};
     use gvsrom::simulate::{self, InputSource, SimulateOptions};
     use std::io::IsTerminal;
     let (scenario, mut built) = load(&args.scenario)?;
@@ -723,6 +724,15 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
                 _ => gvs::solve::ode::ErrorNorm::Componentwise,
             },
             ..GeneralizedAlphaOptions::default()
+        }),
+        (None, MethodChoice::Sdirk) => Method::Sdirk(SdirkOptions {
+            rtol: args.rtol,
+            atol: args.atol,
+            error_norm: match args.error_norm {
+                Some(ErrorNormChoice::Componentwise) => gvs::solve::ode::ErrorNorm::Componentwise,
+                _ => gvs::solve::ode::ErrorNorm::Mass,
+            },
+            ..SdirkOptions::default()
         }),
         (None, MethodChoice::Ndf) => {
             let base = NdfOptions {

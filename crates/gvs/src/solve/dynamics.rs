@@ -11,6 +11,7 @@
 
 use super::ode::{
     integrate_fixed, integrate_generalized_alpha, integrate_ndf, integrate_ndf_second_order,
+    integrate_sdirk, SdirkOptions,
     FixedStepOptions, GeneralizedAlphaOptions, MechanicalSystem, NdfOptions, OdeError, OdeStats,
     OdeSystem, RhsError,
 };
@@ -34,6 +35,8 @@ pub enum Method {
     Fixed(FixedStepOptions),
     /// Adaptive generalized-α in second-order form (lightly damped rods).
     GeneralizedAlpha(GeneralizedAlphaOptions),
+    /// Adaptive L-stable SDIRK of order 4 in second-order form (lightly damped rods).
+    Sdirk(SdirkOptions),
 }
 
 /// Integrator and Jacobian choice.
@@ -437,6 +440,9 @@ pub fn simulate_streaming<P: StrainParam>(
         Method::Fixed(o) => integrate_fixed(&mut sys, t0, &y0, t_out, &breaks, o, &mut record),
         Method::GeneralizedAlpha(o) => {
             integrate_generalized_alpha(&mut sys, t0, &q0, &qd0, t_out, &breaks, o, &mut record)
+        }
+        Method::Sdirk(o) => {
+            integrate_sdirk(&mut sys, t0, &q0, &qd0, t_out, &breaks, o, &mut record)
         }
     };
     let wall_time_s = start.elapsed().as_secs_f64();

@@ -106,6 +106,7 @@ mod fixed;
 mod galpha;
 mod mass_norm;
 mod ndf;
+mod sdirk;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]
@@ -116,6 +117,8 @@ mod tests_fixed;
 mod tests_galpha;
 #[cfg(test)]
 mod tests_ndf_second_order;
+#[cfg(test)]
+mod tests_sdirk;
 
 pub use fixed::integrate_fixed;
 pub use galpha::{integrate_generalized_alpha, GeneralizedAlphaOptions, MechanicalSystem};
@@ -124,6 +127,7 @@ pub use galpha::{integrate_generalized_alpha, GeneralizedAlphaOptions, Mechanica
 /// `ControlFlow::Break(reason)` stops the integration with [`OdeError::Stopped`].
 pub type Output<'a> = dyn FnMut(f64, &DVector<f64>) -> ControlFlow<String> + 'a;
 pub use ndf::{integrate_ndf, integrate_ndf_second_order};
+pub use sdirk::{integrate_sdirk, SdirkOptions};
 
 /// An error reported by the right-hand side (or its Jacobian); it stops the integration.
 #[derive(Debug, Clone, thiserror::Error, PartialEq)]

@@ -7,12 +7,12 @@ use std::f64::consts::PI;
 use std::ops::ControlFlow;
 
 /// `m q̈ + c q̇ + k q = f(t)` per coordinate (decoupled), `f` a step at `t_step`.
-struct Oscillators {
-    m: f64,
-    c: f64,
-    k: Vec<f64>,
-    f_after: f64,
-    t_step: f64,
+pub(super) struct Oscillators {
+    pub(super) m: f64,
+    pub(super) c: f64,
+    pub(super) k: Vec<f64>,
+    pub(super) f_after: f64,
+    pub(super) t_step: f64,
 }
 
 impl Oscillators {
