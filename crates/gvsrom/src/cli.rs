@@ -15,6 +15,7 @@ use std::ops::ControlFlow;
 /// `simulate --method`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum MethodChoice {
+    Auto,
     Ndf,
     Galpha,
     Sdirk,
@@ -265,11 +266,12 @@ pub struct SimulateArgs {
     #[arg(long)]
     pub from_equilibrium: bool,
 
-    /// Relative tolerance of the NDF integrator (ode15s default 1e-3).
-    #[arg(long, default_value_t = 1e-3)]
-    pub rtol: f64,
+    /// Relative tolerance of the adaptive integrator. Default 1e-3 (ode15s), or 1e-4 when the
+    /// automatic method is SDIRK4 for a lightly damped rod (see `--method`).
+    #[arg(long)]
+    pub rtol: Option<f64>,
 
-    /// Absolute tolerance of the NDF integrator (ode15s default 1e-6).
+    /// Absolute tolerance of the adaptive integrator (ode15s default 1e-6).
     #[arg(long, default_value_t = 1e-6)]
     pub atol: f64,
 
@@ -277,9 +279,12 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "H")]
     pub fixed_step: Option<f64>,
 
-    /// Adaptive integrator: `ndf` (variable order, ode15s class) or `galpha` (generalized-α in
-    /// second-order form with numerical dissipation `--rho-inf`, Newton on n unknowns).
-    #[arg(long, value_enum, default_value_t = MethodChoice::Ndf)]
+    /// Adaptive integrator: `auto` (default: the NDF for a damped rod; SDIRK4 with the mass-norm
+    /// error test at rtol 1e-4 for a lightly damped one, whose stiffest mode is underdamped),
+    /// `ndf` (variable order, ode15s class; orders ≤ 2 with the mass-norm test for a lightly damped
+    /// rod), `sdirk` (L-stable, order 4, in second-order form: Newton on n unknowns per stage) or
+    /// `galpha` (generalized-α in second-order form with numerical dissipation `--rho-inf`).
+    #[arg(long, value_enum, default_value_t = MethodChoice::Auto)]
     pub method: MethodChoice,
 
     /// Highest order of the NDF, 1–5 (orders ≤ 2 are A-stable). Default: 5, or 2 for a lightly
@@ -709,54 +714,77 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
     } else {
         OdeJacobian::Structured
     };
+    // the note printed when the rod's damping chose the method
     let mut light = None;
+    let rtol = args.rtol.unwrap_or(NdfOptions::default().rtol);
+    let error_norm = |default: gvs::solve::ode::ErrorNorm| match args.error_norm {
+        Some(ErrorNormChoice::Mass) => gvs::solve::ode::ErrorNorm::Mass,
+        Some(ErrorNormChoice::Componentwise) => gvs::solve::ode::ErrorNorm::Componentwise,
+        None => default,
+    };
+    // the rod's damping chooses for `auto` and `ndf` unless the NDF's order or norm is given
+    let ndf_choice = args.max_order.is_some() || args.error_norm.is_some();
+    let regime = if args.fixed_step.is_none()
+        && matches!(args.method, MethodChoice::Auto | MethodChoice::Ndf)
+        && !ndf_choice
+        && jacobian == OdeJacobian::Structured
+    {
+        Some(match &built.reduced {
+            Some(r) => gvs::solve::dynamics::damping_regime(&r.model)?,
+            None => gvs::solve::dynamics::damping_regime(&built.model)?,
+        })
+    } else {
+        None
+    };
     let method = match (args.fixed_step, args.method) {
         (Some(h), _) => Method::Fixed(FixedStepOptions {
             h,
             ..FixedStepOptions::default()
         }),
         (None, MethodChoice::Galpha) => Method::GeneralizedAlpha(GeneralizedAlphaOptions {
-            rtol: args.rtol,
+            rtol,
             atol: args.atol,
             rho_inf: args.rho_inf,
-            error_norm: match args.error_norm {
-                Some(ErrorNormChoice::Mass) => gvs::solve::ode::ErrorNorm::Mass,
-                _ => gvs::solve::ode::ErrorNorm::Componentwise,
-            },
+            error_norm: error_norm(gvs::solve::ode::ErrorNorm::Componentwise),
             ..GeneralizedAlphaOptions::default()
         }),
         (None, MethodChoice::Sdirk) => Method::Sdirk(SdirkOptions {
-            rtol: args.rtol,
+            rtol,
             atol: args.atol,
-            error_norm: match args.error_norm {
-                Some(ErrorNormChoice::Componentwise) => gvs::solve::ode::ErrorNorm::Componentwise,
-                _ => gvs::solve::ode::ErrorNorm::Mass,
-            },
+            error_norm: error_norm(gvs::solve::ode::ErrorNorm::Mass),
             ..SdirkOptions::default()
         }),
-        (None, MethodChoice::Ndf) => {
+        (None, MethodChoice::Auto) if regime.is_some_and(|r| r.is_light()) => {
+            let zeta = regime.map_or(0.0, |r| r.zeta_max);
+            let rtol = args
+                .rtol
+                .unwrap_or(gvs::solve::dynamics::LIGHT_DAMPING_RTOL);
+            light = Some(format!(
+                "integrator SDIRK4 (order 4, L-stable) with the mass-norm error test at rtol {rtol:e}: lightly damped (stiffest mode ζ = {zeta:.3}; --method or --rtol to choose)"
+            ));
+            Method::Sdirk(SdirkOptions {
+                rtol,
+                atol: args.atol,
+                error_norm: gvs::solve::ode::ErrorNorm::Mass,
+                ..SdirkOptions::default()
+            })
+        }
+        (None, MethodChoice::Ndf | MethodChoice::Auto) => {
             let base = NdfOptions {
-                rtol: args.rtol,
+                rtol,
                 atol: args.atol,
                 max_order: args.max_order.unwrap_or(5),
-                error_norm: match args.error_norm {
-                    Some(ErrorNormChoice::Mass) => gvs::solve::ode::ErrorNorm::Mass,
-                    _ => gvs::solve::ode::ErrorNorm::Componentwise,
-                },
+                error_norm: error_norm(gvs::solve::ode::ErrorNorm::Componentwise),
                 ..NdfOptions::default()
             };
-            if args.max_order.is_none()
-                && args.error_norm.is_none()
-                && jacobian == OdeJacobian::Structured
-            {
-                let (o, regime) = match &built.reduced {
-                    Some(r) => gvs::solve::dynamics::ndf_for_rod(&r.model, &base),
-                    None => gvs::solve::dynamics::ndf_for_rod(&built.model, &base),
-                }?;
+            if let Some(regime) = regime {
                 if regime.is_light() {
-                    light = Some(regime);
+                    light = Some(format!(
+                        "integrator NDF orders ≤ 2 with the mass-norm error test: lightly damped (stiffest mode ζ = {:.3}; --max-order or --error-norm to choose)",
+                        regime.zeta_max
+                    ));
                 }
-                Method::Ndf(o)
+                Method::Ndf(gvs::solve::dynamics::ndf_for_regime(&base, &regime))
             } else {
                 Method::Ndf(base)
             }
@@ -780,12 +808,8 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
         None => None,
     };
     print_model(&scenario, &built, out)?;
-    if let Some(r) = light {
-        writeln!(
-            out,
-            "integrator NDF orders ≤ 2 with the mass-norm error test: lightly damped (stiffest mode ζ = {:.3}; --max-order or --error-norm to choose)",
-            r.zeta_max
-        )?;
+    if let Some(note) = light {
+        writeln!(out, "{note}")?;
     }
     let signal = interrupt_flag();
     let tty = std::io::stderr().is_terminal();

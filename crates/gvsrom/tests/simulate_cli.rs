@@ -328,7 +328,7 @@ fn semicolon_input_file_keeps_its_rows_and_mixed_delimiters_name_the_line() {
 }
 
 #[test]
-fn lightly_damped_rod_gets_the_a_stable_orders_and_says_so() {
+fn lightly_damped_rod_gets_an_l_stable_method_and_says_so() {
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples");
     let scenario = format!("{root}/undamped-release.toml");
     let schedule = format!("{root}/release-zero.csv");
@@ -354,12 +354,27 @@ fn lightly_damped_rod_gets_the_a_stable_orders_and_says_so() {
     };
     let auto = run(&[]);
     assert!(
-        auto.contains("integrator NDF orders ≤ 2 with the mass-norm error test: lightly damped (stiffest mode ζ = 0.000"),
+        auto.contains("integrator SDIRK4 (order 4, L-stable) with the mass-norm error test at rtol 1e-4: lightly damped (stiffest mode ζ = 0.000"),
         "{auto}"
     );
+    // a tolerance given is used
+    let given = run(&["--rtol", "3e-4"]);
+    assert!(given.contains("at rtol 3e-4: lightly damped"), "{given}");
+    // the NDF by name gets its A-stable orders
+    let ndf = run(&["--method", "ndf"]);
+    assert!(
+        ndf.contains("integrator NDF orders ≤ 2 with the mass-norm error test: lightly damped (stiffest mode ζ = 0.000"),
+        "{ndf}"
+    );
     // a choice by hand is kept, and not announced
-    for extra in [["--max-order", "5"], ["--error-norm", "componentwise"]] {
-        let manual = run(&extra);
+    for extra in [
+        &["--max-order", "5"][..],
+        &["--error-norm", "componentwise"],
+        &["--method", "sdirk"],
+        &["--method", "galpha"],
+        &["--method", "ndf", "--max-order", "5"],
+    ] {
+        let manual = run(extra);
         assert!(!manual.contains("integrator "), "{extra:?}: {manual}");
     }
     // a damped preset keeps the default NDF

@@ -12,10 +12,7 @@ use crate::build::Built;
 use crate::error::ScenarioError;
 use crate::output::OutputDir;
 use crate::simulate::{self, InputSource, SimulateOptions};
-use gvs::solve::dynamics::{
-    simulate_streaming, IntegratorOptions, Method, OdeJacobian, SimulationError,
-};
-use gvs::solve::ode::NdfOptions;
+use gvs::solve::dynamics::{simulate_streaming, IntegratorOptions, OdeJacobian, SimulationError};
 use serde::{Deserialize, Serialize};
 use std::io::Write;
 use std::ops::ControlFlow;
@@ -30,6 +27,10 @@ pub struct DynamicInfo {
     /// The input as given (`babble=-15,0,0.5,1`, `steps=…`, `csv FILE`, `constant`).
     pub input: String,
     pub from_equilibrium: bool,
+    /// The integrator the rod's damping chose (`ndf` or `sdirk`; empty in files written before
+    /// it was recorded, which used the NDF).
+    #[serde(default)]
+    pub method: String,
     pub rtol: f64,
     pub atol: f64,
     /// Time of the last sample stored.
@@ -82,17 +83,16 @@ pub fn run(
         _ => "constant".into(),
     };
     let duration = args.duration.unwrap_or(0.0);
+    // as `simulate`'s automatic choice: the NDF, or SDIRK4 for a lightly damped rod
+    let (method, _) = gvs::solve::dynamics::method_for_rod(&built.model, args.rtol, args.atol)
+        .map_err(|e| DatasetError::Plan(e.to_string()))?;
     let opts = SimulateOptions {
         duration,
         sample_rate: args.sample_rate.unwrap_or(100.0),
         input,
         start_at_equilibrium: args.from_equilibrium,
         integrator: IntegratorOptions {
-            method: Method::Ndf(NdfOptions {
-                rtol: args.rtol,
-                atol: args.atol,
-                ..NdfOptions::default()
-            }),
+            method: method.clone(),
             jacobian: OdeJacobian::Structured,
         },
         load_schedule: None,
@@ -182,7 +182,10 @@ pub fn run(
             sample_rate: opts.sample_rate,
             input: input_text,
             from_equilibrium: args.from_equilibrium,
-            rtol: args.rtol,
+            method: method.name().into(),
+            rtol: method
+                .rtol()
+                .unwrap_or(gvs::solve::ode::NdfOptions::default().rtol),
             atol: args.atol,
             t_reached: summary_run.t_last,
             steps: summary_run.stats.steps,

@@ -75,11 +75,16 @@ pub(super) const A: [[f64; STAGES]; STAGES] = [
     [25.0 / 24.0, -49.0 / 48.0, 125.0 / 16.0, -85.0 / 12.0, 0.0],
 ];
 /// The weights of the embedded third-order solution.
-pub(super) const B_HAT: [f64; STAGES] = [59.0 / 48.0, -17.0 / 96.0, 225.0 / 32.0, -85.0 / 12.0, 0.0];
+pub(super) const B_HAT: [f64; STAGES] =
+    [59.0 / 48.0, -17.0 / 96.0, 225.0 / 32.0, -85.0 / 12.0, 0.0];
 
 /// `b_j − b̂_j` (`b_5 = γ`).
 fn error_weight(j: usize) -> f64 {
-    let b = if j + 1 == STAGES { GAMMA } else { A[STAGES - 1][j] };
+    let b = if j + 1 == STAGES {
+        GAMMA
+    } else {
+        A[STAGES - 1][j]
+    };
     b - B_HAT[j]
 }
 
@@ -188,7 +193,13 @@ impl Work {
     }
 
     /// `‖v‖ / (rtol·max(‖x‖, ‖y‖) + atol)`, componentwise or in the mass norm.
-    fn weighted(&self, v: &DVector<f64>, x: &DVector<f64>, y: &DVector<f64>, tol: (f64, f64)) -> f64 {
+    fn weighted(
+        &self,
+        v: &DVector<f64>,
+        x: &DVector<f64>,
+        y: &DVector<f64>,
+        tol: (f64, f64),
+    ) -> f64 {
         let (rtol, atol) = tol;
         match &self.mnorm {
             None => v
@@ -556,14 +567,7 @@ fn integrate_piece<S: MechanicalSystem>(
                 let (b, db) = quintic_hermite(s);
                 let hh = h * h;
                 for i in 0..n {
-                    let nodes = [
-                        q0[i],
-                        h * v0[i],
-                        hh * a0[i],
-                        q1[i],
-                        h * v1[i],
-                        hh * a1[i],
-                    ];
+                    let nodes = [q0[i], h * v0[i], hh * a0[i], q1[i], h * v1[i], hh * a1[i]];
                     let (mut x, mut dx) = (0.0, 0.0);
                     for k in 0..6 {
                         x += b[k] * nodes[k];

@@ -63,7 +63,10 @@ fn tableau_is_fourth_order_with_a_third_order_embedding_and_l_stable() {
         });
         let x = m
             .lu()
-            .solve(&DVector::from_element(STAGES, nalgebra::Complex::new(1.0, 0.0)))
+            .solve(&DVector::from_element(
+                STAGES,
+                nalgebra::Complex::new(1.0, 0.0),
+            ))
             .unwrap();
         nalgebra::Complex::new(1.0, 0.0) + z * b.map(|v| nalgebra::Complex::new(v, 0.0)).dot(&x)
     };
