@@ -2,7 +2,8 @@
 //! NDF/BDF method of the class of MATLAB's `ode15s` ([`integrate_ndf`]; for mechanical systems
 //! `M(q) q̈ = τ` the same method with an `n × n` Newton iteration on the residual `M q̈ − τ`,
 //! [`integrate_ndf_second_order`], see `corrector`), a cheap fixed-step BDF2 method for real-time
-//! use ([`integrate_fixed`]) and adaptive generalized-α ([`integrate_generalized_alpha`]).
+//! use ([`integrate_fixed`]), adaptive generalized-α ([`integrate_generalized_alpha`]) and an
+//! adaptive L-stable SDIRK of order 4 in second-order form ([`integrate_sdirk`]).
 //!
 //! Reference: L. F. Shampine and M. W. Reichelt, *The MATLAB ODE Suite*, SIAM J. Sci. Comput. 18(1),
 //! 1–22, 1997 (§2: the NDFs, their quasi-constant step size implementation and the step/order
