@@ -2,7 +2,9 @@
 //! residual `M q̈ − τ`, the mass matrix, the statics Jacobian and the iteration parts `M, D, K` —
 //! allocate nothing once the
 //! workspace exists (issue 8), checked with a counting global allocator in this test binary, on a
-//! FEM (local-support) and a Legendre (global) basis, with a friction tendon, damping and gravity.
+//! FEM (local-support) and a Legendre (global) basis, with a friction tendon, damping and gravity;
+//! and the steps of the second-order integrators (SDIRK4, generalized-α, the NDF in second-order
+//! form) allocate nothing either.
 
 use gvs::actuation::{Tendon, DEFAULT_FRICTION_SMOOTHING};
 use gvs::discretize::{Discretization, MagnusOrder, Quadrature};
@@ -137,5 +139,163 @@ fn residuals_mass_matrix_and_statics_jacobian_do_not_allocate() {
             dd.iter().all(|v| v.is_finite()) && (&dd - dd.transpose()).amax() < 1e-12 * dd.amax()
         );
         assert!(r.iter().chain(jac.iter()).all(|v| v.is_finite()));
+    }
+}
+
+/// A chain of unit masses between springs (`k = 100`, fixed ends) with a cubic spring to ground
+/// and light damping: `M q̈ = τ` in second-order form, evaluated without allocating.
+struct Chain {
+    n: usize,
+}
+
+impl Chain {
+    fn force(&self, q: &DVector<f64>, qd: &DVector<f64>, i: usize) -> f64 {
+        let left = if i > 0 { q[i - 1] } else { 0.0 };
+        let right = if i + 1 < self.n { q[i + 1] } else { 0.0 };
+        100.0 * (left - 2.0 * q[i] + right) - 50.0 * q[i].powi(3) - 0.01 * qd[i]
+    }
+}
+
+impl gvs::solve::ode::MechanicalSystem for Chain {
+    fn dim(&self) -> usize {
+        self.n
+    }
+    fn residual(
+        &mut self,
+        _t: f64,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        qdd: &DVector<f64>,
+        eps: &mut DVector<f64>,
+    ) -> Result<(), gvs::solve::ode::RhsError> {
+        for i in 0..self.n {
+            eps[i] = qdd[i] - self.force(q, qd, i);
+        }
+        Ok(())
+    }
+    fn accelerations(
+        &mut self,
+        _t: f64,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        qdd: &mut DVector<f64>,
+    ) -> Result<(), gvs::solve::ode::RhsError> {
+        for i in 0..self.n {
+            qdd[i] = self.force(q, qd, i);
+        }
+        Ok(())
+    }
+    fn mass(
+        &mut self,
+        _t: f64,
+        _q: &DVector<f64>,
+        m: &mut DMatrix<f64>,
+    ) -> Result<(), gvs::solve::ode::RhsError> {
+        m.fill_with_identity();
+        Ok(())
+    }
+    fn iteration_parts(
+        &mut self,
+        _t: f64,
+        q: &DVector<f64>,
+        _qd: &DVector<f64>,
+        m: &mut DMatrix<f64>,
+        d: &mut DMatrix<f64>,
+        k: &mut DMatrix<f64>,
+    ) -> Result<(), gvs::solve::ode::RhsError> {
+        m.fill_with_identity();
+        d.fill_with_identity();
+        *d *= 0.01;
+        k.fill(0.0);
+        for i in 0..self.n {
+            k[(i, i)] = 200.0 + 150.0 * q[i] * q[i];
+            if i > 0 {
+                k[(i, i - 1)] = -100.0;
+                k[(i - 1, i)] = -100.0;
+            }
+        }
+        Ok(())
+    }
+}
+
+#[test]
+fn integrator_steps_do_not_allocate() {
+    use gvs::solve::ode::{
+        integrate_generalized_alpha, integrate_ndf_second_order, integrate_sdirk, ErrorNorm,
+        GeneralizedAlphaOptions, NdfOptions, SdirkOptions,
+    };
+    use std::ops::ControlFlow;
+    let n = 12;
+    let q0 = DVector::from_fn(n, |i, _| 0.3 * ((i as f64) * 0.9).sin());
+    let qd0 = DVector::zeros(n);
+    // allocations of one integration over [0, t_end] with 11 outputs and a breakpoint at 0.5:
+    // the set-up allocates, the steps must not, so a run 8 times as long allocates as many
+    let count = |method: usize, t_end: f64| -> (usize, usize) {
+        let t_out: Vec<f64> = (0..=10).map(|k| t_end * k as f64 / 10.0).collect();
+        let mut sys = Chain { n };
+        let mut last = 0.0;
+        let mut out = |t: f64, _: &DVector<f64>| {
+            last = t;
+            ControlFlow::<String>::Continue(())
+        };
+        let before = allocations();
+        let stats = match method {
+            0 => integrate_sdirk(
+                &mut sys,
+                0.0,
+                &q0,
+                &qd0,
+                &t_out,
+                &[0.5],
+                &SdirkOptions {
+                    error_norm: ErrorNorm::Mass,
+                    ..SdirkOptions::default()
+                },
+                &mut out,
+            ),
+            1 => integrate_generalized_alpha(
+                &mut sys,
+                0.0,
+                &q0,
+                &qd0,
+                &t_out,
+                &[0.5],
+                &GeneralizedAlphaOptions {
+                    error_norm: ErrorNorm::Mass,
+                    ..GeneralizedAlphaOptions::default()
+                },
+                &mut out,
+            ),
+            _ => integrate_ndf_second_order(
+                &mut sys,
+                0.0,
+                &q0,
+                &qd0,
+                &t_out,
+                &[0.5],
+                &NdfOptions::default(),
+                &mut out,
+            ),
+        }
+        .unwrap();
+        let allocated = allocations() - before;
+        assert_eq!(last, t_end);
+        (allocated, stats.steps)
+    };
+    for (method, name) in [
+        (0, "SDIRK4"),
+        (1, "generalized-α"),
+        (2, "NDF (second order)"),
+    ] {
+        let (short, steps_short) = count(method, 1.0);
+        let (long, steps_long) = count(method, 8.0);
+        assert!(
+            steps_long > 4 * steps_short,
+            "{name}: {steps_short} and {steps_long} steps"
+        );
+        assert_eq!(
+            short, long,
+            "{name}: {short} allocations over {steps_short} steps, {long} over {steps_long}"
+        );
     }
 }

@@ -93,19 +93,16 @@ fn release(c: &mut Criterion) {
             load_schedule: Some(format!("{root}/release-zero.csv").into()),
         };
         let plan = plan(&built, &opts).unwrap();
-        c.bench_function(
-            &format!("dynamics/undamped release 6s ({label})"),
-            |b| {
-                b.iter(|| {
-                    black_box(
-                        run(&built, &plan, &opts.integrator, None, &mut |_| {
-                            ControlFlow::Continue(())
-                        })
-                        .unwrap(),
-                    )
-                })
-            },
-        );
+        c.bench_function(&format!("dynamics/undamped release 6s ({label})"), |b| {
+            b.iter(|| {
+                black_box(
+                    run(&built, &plan, &opts.integrator, None, &mut |_| {
+                        ControlFlow::Continue(())
+                    })
+                    .unwrap(),
+                )
+            })
+        });
     }
 }
 

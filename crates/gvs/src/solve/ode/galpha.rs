@@ -53,7 +53,7 @@
 use super::mass_norm::MassNorm;
 use super::{
     check_common, deliver, invalid, mechanical_state, next_down, next_up, rhs_err, ulp, ErrorNorm,
-    OdeError, OdeStats, Output, RhsError,
+    Lu, OdeError, OdeStats, Output, RhsError,
 };
 use nalgebra::{DMatrix, DVector};
 
@@ -174,6 +174,8 @@ struct Work {
     m: DMatrix<f64>,
     d: DMatrix<f64>,
     k: DMatrix<f64>,
+    /// The factored iteration matrix `S`.
+    lu: Lu,
     out: DVector<f64>,
     /// `‖·‖_M̂` of the `M` in `m` (with [`ErrorNorm::Mass`]) and the count of `M` evaluations.
     mnorm: Option<MassNorm>,
@@ -200,6 +202,7 @@ impl Work {
             m: mat(),
             d: mat(),
             k: mat(),
+            lu: Lu::new(n),
             out: DVector::zeros(2 * n),
             mnorm: None,
             m_count: 0,
@@ -367,7 +370,7 @@ fn integrate_piece<S: MechanicalSystem>(
     stats.jacobian_evals += 1;
     w.parts(sys, clamp(t)).map_err(rhs_err(t))?;
     let mut parts_current = true;
-    let mut lu: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>> = None;
+    let mut factored = false;
     let mut lu_h = f64::NAN;
 
     let span = piece.b - piece.a;
@@ -410,13 +413,15 @@ fn integrate_piece<S: MechanicalSystem>(
         let t1 = if h == piece.b - t { piece.b } else { t + h };
         let scale = (1.0 - c.alpha_f) / (1.0 - c.alpha_m);
         let (cq, cv) = (h * h * c.beta * scale, h * c.gamma * scale);
-        if lu.is_none() || (h / lu_h - 1.0).abs() > 0.2 {
-            let s = &w.m + &w.d * cv + &w.k * cq;
-            stats.lu_decompositions += 1;
-            lu = Some(s.lu());
+        if !factored || (h / lu_h - 1.0).abs() > 0.2 {
+            let (m, d, k) = (&w.m, &w.d, &w.k);
+            factored = w.lu.factor_with(stats, |s| {
+                for (((s, m), d), k) in s.iter_mut().zip(m.iter()).zip(d.iter()).zip(k.iter()) {
+                    *s = m + cv * d + cq * k;
+                }
+            });
             lu_h = h;
         }
-        let factor = lu.as_ref().expect("factored above");
 
         // simplified Newton on q̈_{n+1}, predictor: q̈ extrapolated linearly from the last two
         // steps of this piece (q̈_n on its first step)
@@ -427,43 +432,44 @@ fn integrate_piece<S: MechanicalSystem>(
             w.qdd1.axpy(-r, &w.qdd_prev, 1.0);
         }
         let mut converged = false;
-        let mut prev = f64::NAN;
-        for it in 0..MAX_NEWTON {
-            w.update(c, h);
-            stats.rhs_evals += 1;
-            stats.newton_iterations += 1;
-            sys.residual(clamp(t1), &w.q1, &w.qd1, &w.qdd1, &mut w.eps)
-                .map_err(rhs_err(t))?;
-            if w.eps.iter().any(|v| !v.is_finite()) {
-                break;
-            }
-            w.eps.neg_mut();
-            if !factor.solve_mut(&mut w.eps) {
-                break;
-            }
-            w.qdd1 += &w.eps;
-            let dq = w.weighted(&w.eps, &w.q, &w.q1, rtol, atol) * cq;
-            let dv = w.weighted(&w.eps, &w.qd, &w.qd1, rtol, atol) * cv;
-            let norm = dq.max(dv);
-            if !norm.is_finite() {
-                break;
-            }
-            if it == 0 {
-                if norm <= 0.1 * KAPPA {
-                    converged = true;
+        // a singular (or non-finite) S fails the attempt as a diverged Newton iteration would
+        if factored {
+            let mut prev = f64::NAN;
+            for it in 0..MAX_NEWTON {
+                w.update(c, h);
+                stats.rhs_evals += 1;
+                stats.newton_iterations += 1;
+                sys.residual(clamp(t1), &w.q1, &w.qd1, &w.qdd1, &mut w.eps)
+                    .map_err(rhs_err(t))?;
+                if w.eps.iter().any(|v| !v.is_finite()) {
                     break;
                 }
-            } else {
-                let rate = norm / prev;
-                if rate > 0.9 {
+                w.eps.neg_mut();
+                w.lu.solve(&mut w.eps);
+                w.qdd1 += &w.eps;
+                let dq = w.weighted(&w.eps, &w.q, &w.q1, rtol, atol) * cq;
+                let dv = w.weighted(&w.eps, &w.qd, &w.qd1, rtol, atol) * cv;
+                let norm = dq.max(dv);
+                if !norm.is_finite() {
                     break;
                 }
-                if rate / (1.0 - rate) * norm <= KAPPA {
-                    converged = true;
-                    break;
+                if it == 0 {
+                    if norm <= 0.1 * KAPPA {
+                        converged = true;
+                        break;
+                    }
+                } else {
+                    let rate = norm / prev;
+                    if rate > 0.9 {
+                        break;
+                    }
+                    if rate / (1.0 - rate) * norm <= KAPPA {
+                        converged = true;
+                        break;
+                    }
                 }
+                prev = norm;
             }
-            prev = norm;
         }
         if !converged {
             stats.failed_steps += 1;
@@ -472,7 +478,7 @@ fn integrate_piece<S: MechanicalSystem>(
                 stats.jacobian_evals += 1;
                 w.parts(sys, clamp(t)).map_err(rhs_err(t))?;
                 parts_current = true;
-                lu = None;
+                factored = false;
             } else {
                 h *= 0.25;
             }
@@ -490,7 +496,7 @@ fn integrate_piece<S: MechanicalSystem>(
         w.e.copy_from(&w.qdd1);
         w.e -= &w.qdd;
         w.me.gemv(ce, &w.m, &w.e, 0.0);
-        factor.solve_mut(&mut w.me);
+        w.lu.solve(&mut w.me);
         let err = w.weighted(&w.me, &w.q, &w.q1, rtol, atol);
         if err > 1.0 {
             stats.failed_steps += 1;

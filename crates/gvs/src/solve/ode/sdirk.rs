@@ -506,11 +506,13 @@ fn integrate_piece<S: MechanicalSystem>(
                 }
             });
             h_lu = h;
-            if !factored {
-                return Err(OdeError::NewtonFailure { t });
-            }
         }
-        let attempt = stages(sys, w, t, h, tol, &clamp, stats)?;
+        // a singular (or non-finite) S fails the attempt as a diverged Newton iteration would
+        let attempt = if factored {
+            stages(sys, w, t, h, tol, &clamp, stats)?
+        } else {
+            Attempt::Diverged
+        };
         let Attempt::Converged(iterations) = attempt else {
             stats.failed_steps += 1;
             fails_here += 1;
