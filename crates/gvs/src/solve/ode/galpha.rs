@@ -50,10 +50,13 @@
 //! evaluations stay strictly inside, and the next piece restarts with consistent accelerations
 //! `M q̈ = τ` (the input may jump there).
 
-use super::mass_norm::MassNorm;
+use super::one_step::{
+    begin_attempt, check_step_options, first_step, newton_test, next_step, pieces, shrink, Newton,
+    Parts, Piece,
+};
 use super::{
-    check_common, deliver, invalid, mechanical_state, next_down, next_up, rhs_err, ulp, ErrorNorm,
-    Lu, OdeError, OdeStats, Output, RhsError,
+    check_common, deliver, invalid, mechanical_state, rhs_err, ErrorNorm, OdeError, OdeStats,
+    Output, RhsError,
 };
 use nalgebra::{DMatrix, DVector};
 
@@ -171,21 +174,13 @@ struct Work {
     /// Error estimate and `M e`.
     e: DVector<f64>,
     me: DVector<f64>,
-    m: DMatrix<f64>,
-    d: DMatrix<f64>,
-    k: DMatrix<f64>,
-    /// The factored iteration matrix `S`.
-    lu: Lu,
+    parts: Parts,
     out: DVector<f64>,
-    /// `‖·‖_M̂` of the `M` in `m` (with [`ErrorNorm::Mass`]) and the count of `M` evaluations.
-    mnorm: Option<MassNorm>,
-    m_count: usize,
 }
 
 impl Work {
-    fn new(n: usize) -> Self {
+    fn new(n: usize, norm: ErrorNorm) -> Self {
         let v = || DVector::zeros(n);
-        let mat = || DMatrix::zeros(n, n);
         Work {
             q: v(),
             qd: v(),
@@ -199,42 +194,8 @@ impl Work {
             eps: v(),
             e: v(),
             me: v(),
-            m: mat(),
-            d: mat(),
-            k: mat(),
-            lu: Lu::new(n),
+            parts: Parts::new(n, norm),
             out: DVector::zeros(2 * n),
-            mnorm: None,
-            m_count: 0,
-        }
-    }
-
-    /// `M, D, K` at `(t, q, q̇)` (and the mass norm of the new `M`).
-    fn parts<S: MechanicalSystem>(&mut self, sys: &mut S, t: f64) -> Result<(), RhsError> {
-        sys.iteration_parts(t, &self.q, &self.qd, &mut self.m, &mut self.d, &mut self.k)?;
-        self.m_count += 1;
-        if let Some(mn) = &mut self.mnorm {
-            mn.set(&self.m, self.m_count);
-        }
-        Ok(())
-    }
-
-    /// `‖v‖ / (rtol·max(‖x‖, ‖y‖) + atol)`: componentwise (max over `i` of the weighted entries) or
-    /// in the mass norm (`‖·‖_M̂`, with `atol` the largest entry's).
-    fn weighted(
-        &self,
-        v: &DVector<f64>,
-        x: &DVector<f64>,
-        y: &DVector<f64>,
-        rtol: f64,
-        atol: f64,
-    ) -> f64 {
-        match &self.mnorm {
-            None => weighted(v, x, y, rtol, atol),
-            Some(mn) => {
-                let s = mn.half(x.as_slice()).max(mn.half(y.as_slice()));
-                mn.half(v.as_slice()) / (rtol * s + atol)
-            }
         }
     }
 
@@ -272,33 +233,8 @@ pub fn integrate_generalized_alpha<S: MechanicalSystem>(
             format!("{} (accepted: a number in [0, 1])", opts.rho_inf),
         ));
     }
-    if !(opts.rtol > 0.0 && opts.rtol < 1.0) {
-        return Err(invalid("rtol", format!("{} (accepted: (0, 1))", opts.rtol)));
-    }
-    if !(opts.atol > 0.0 && opts.atol.is_finite()) {
-        return Err(invalid("atol", format!("{} (accepted: > 0)", opts.atol)));
-    }
-    if opts.max_step.is_nan() || opts.max_step <= 0.0 {
-        return Err(invalid(
-            "max_step",
-            format!("{} (accepted: > 0)", opts.max_step),
-        ));
-    }
-    if let Some(h) = opts.initial_step {
-        if !(h > 0.0 && h.is_finite()) {
-            return Err(invalid("initial_step", format!("{h} (accepted: > 0)")));
-        }
-    }
-    let tf = *bounds.last().unwrap_or(&t0);
-    let hmax = if opts.max_step.is_finite() {
-        opts.max_step
-    } else {
-        0.1 * (tf - t0).abs().max(f64::MIN_POSITIVE)
-    };
-    let mut w = Work::new(n);
-    if opts.error_norm == ErrorNorm::Mass {
-        w.mnorm = Some(MassNorm::new(n));
-    }
+    check_step_options(opts.rtol, opts.atol, opts.max_step, opts.initial_step)?;
+    let mut w = Work::new(n, opts.error_norm);
     w.q.copy_from(q0);
     w.qd.copy_from(qd0);
     let mut next = 0;
@@ -306,40 +242,14 @@ pub fn integrate_generalized_alpha<S: MechanicalSystem>(
         b.copy_from(&y0)
     })?;
     let mut stats = OdeStats::default();
-    let pieces = bounds.len().saturating_sub(1);
     let c = Coefficients::new(opts.rho_inf);
-    for p in 0..pieces {
-        let (a, b) = (bounds[p], bounds[p + 1]);
-        let lo = if p > 0 { next_up(a) } else { f64::NEG_INFINITY };
-        let hi = if p + 1 < pieces {
-            next_down(b)
-        } else {
-            f64::INFINITY
-        };
-        let piece = Piece { a, b, lo, hi, hmax };
+    for (p, piece) in pieces(&bounds, opts.max_step).iter().enumerate() {
         let h0 = if p == 0 { opts.initial_step } else { None };
         integrate_piece(
-            sys, &mut w, &c, opts, &piece, h0, t_out, &mut next, output, &mut stats,
+            sys, &mut w, &c, opts, piece, h0, t_out, &mut next, output, &mut stats,
         )?;
     }
     Ok(stats)
-}
-
-struct Piece {
-    a: f64,
-    b: f64,
-    /// Evaluation times are clamped to `[lo, hi]`.
-    lo: f64,
-    hi: f64,
-    hmax: f64,
-}
-
-/// `max_i |v_i| / (rtol·max(|x_i|, |y_i|) + atol)`.
-fn weighted(v: &DVector<f64>, x: &DVector<f64>, y: &DVector<f64>, rtol: f64, atol: f64) -> f64 {
-    v.iter()
-        .zip(x.iter().zip(y.iter()))
-        .map(|(v, (x, y))| v.abs() / (rtol * x.abs().max(y.abs()) + atol))
-        .fold(0.0, f64::max)
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -357,71 +267,30 @@ fn integrate_piece<S: MechanicalSystem>(
 ) -> Result<(), OdeError> {
     let n = w.q.len();
     let (rtol, atol) = (opts.rtol, opts.atol);
-    let clamp = |t: f64| t.max(piece.lo).min(piece.hi);
     let mut t = piece.a;
     // consistent accelerations at the start of the piece
     stats.rhs_evals += 1;
-    sys.accelerations(clamp(t), &w.q, &w.qd, &mut w.qdd)
+    sys.accelerations(piece.clamp(t), &w.q, &w.qd, &mut w.qdd)
         .map_err(rhs_err(t))?;
     if w.qdd.iter().any(|v| !v.is_finite()) {
         return Err(OdeError::NonFinite { t });
     }
     w.a.copy_from(&w.qdd);
-    stats.jacobian_evals += 1;
-    w.parts(sys, clamp(t)).map_err(rhs_err(t))?;
-    let mut parts_current = true;
-    let mut factored = false;
-    let mut lu_h = f64::NAN;
-
+    w.parts.eval(sys, piece.clamp(t), &w.q, &w.qd, stats)?;
     let span = piece.b - piece.a;
-    let mut h = match h0 {
-        Some(h) => h,
-        None => {
-            // half a tolerance unit of displacement in the first step, by velocity and acceleration
-            let zero = DVector::zeros(n);
-            let vel = w.weighted(&w.qd, &w.q, &zero, rtol, atol);
-            let acc = w.weighted(&w.qdd, &w.q, &zero, rtol, atol);
-            let mut h = span.min(piece.hmax);
-            if vel > 0.0 {
-                h = h.min(0.5 / vel);
-            }
-            if acc > 0.0 {
-                h = h.min((1.0 / acc).sqrt());
-            }
-            h
-        }
-    }
-    .min(piece.hmax)
-    .min(span);
+    let mut h = h0
+        .unwrap_or_else(|| first_step(&w.parts, &w.q, &w.qd, &w.qdd, rtol, atol, span, piece.hmax))
+        .min(piece.hmax)
+        .min(span);
     let mut fails_here = 0usize;
     let mut h_prev: Option<f64> = None;
+    // `q` and `q̇` move with `q̈_{n+1}` at the rates `c_q`, `c_v` (module doc)
+    let scale = (1.0 - c.alpha_f) / (1.0 - c.alpha_m);
+    let rates = |h: f64| (h * c.gamma * scale, h * h * c.beta * scale);
     while t < piece.b {
-        let hmin = 16.0 * ulp(t);
-        if h < hmin {
-            return Err(OdeError::StepSizeUnderflow { t, h, h_min: hmin });
-        }
-        if stats.steps >= opts.max_steps {
-            return Err(OdeError::TooManySteps {
-                t,
-                max_steps: opts.max_steps,
-            });
-        }
-        // land on the end of the piece (stretching by up to 10 %)
-        if t + 1.1 * h >= piece.b {
-            h = piece.b - t;
-        }
-        let t1 = if h == piece.b - t { piece.b } else { t + h };
-        let scale = (1.0 - c.alpha_f) / (1.0 - c.alpha_m);
-        let (cq, cv) = (h * h * c.beta * scale, h * c.gamma * scale);
-        if !factored || (h / lu_h - 1.0).abs() > 0.2 {
-            let (m, d, k) = (&w.m, &w.d, &w.k);
-            factored = w.lu.factor_with(stats, |s| {
-                for (((s, m), d), k) in s.iter_mut().zip(m.iter()).zip(d.iter()).zip(k.iter()) {
-                    *s = m + cv * d + cq * k;
-                }
-            });
-            lu_h = h;
-        }
+        let t1 = begin_attempt(t, &mut h, piece, stats.steps, opts.max_steps)?;
+        let (cv, cq) = rates(h);
+        let factored = w.parts.factor_for(h, rates, stats).is_some();
 
         // simplified Newton on q̈_{n+1}, predictor: q̈ extrapolated linearly from the last two
         // steps of this piece (q̈_n on its first step)
@@ -431,60 +300,46 @@ fn integrate_piece<S: MechanicalSystem>(
             w.qdd1.axpy(r, &w.qdd, 1.0);
             w.qdd1.axpy(-r, &w.qdd_prev, 1.0);
         }
-        let mut converged = false;
         // a singular (or non-finite) S fails the attempt as a diverged Newton iteration would
+        let mut converged = false;
         if factored {
             let mut prev = f64::NAN;
             for it in 0..MAX_NEWTON {
                 w.update(c, h);
                 stats.rhs_evals += 1;
                 stats.newton_iterations += 1;
-                sys.residual(clamp(t1), &w.q1, &w.qd1, &w.qdd1, &mut w.eps)
+                sys.residual(piece.clamp(t1), &w.q1, &w.qd1, &w.qdd1, &mut w.eps)
                     .map_err(rhs_err(t))?;
                 if w.eps.iter().any(|v| !v.is_finite()) {
                     break;
                 }
                 w.eps.neg_mut();
-                w.lu.solve(&mut w.eps);
+                w.parts.solve(&mut w.eps);
                 w.qdd1 += &w.eps;
-                let dq = w.weighted(&w.eps, &w.q, &w.q1, rtol, atol) * cq;
-                let dv = w.weighted(&w.eps, &w.qd, &w.qd1, rtol, atol) * cv;
-                let norm = dq.max(dv);
-                if !norm.is_finite() {
-                    break;
-                }
-                if it == 0 {
-                    if norm <= 0.1 * KAPPA {
+                let dq = w.parts.weighted(&w.eps, &w.q, &w.q1, rtol, atol) * cq;
+                let dv = w.parts.weighted(&w.eps, &w.qd, &w.qd1, rtol, atol) * cv;
+                match newton_test(it, dq.max(dv), prev, KAPPA) {
+                    Newton::Converged => {
                         converged = true;
                         break;
                     }
-                } else {
-                    let rate = norm / prev;
-                    if rate > 0.9 {
-                        break;
-                    }
-                    if rate / (1.0 - rate) * norm <= KAPPA {
-                        converged = true;
-                        break;
-                    }
+                    Newton::Failed => break,
+                    Newton::Continue => prev = dq.max(dv),
                 }
-                prev = norm;
             }
         }
         if !converged {
-            stats.failed_steps += 1;
-            fails_here += 1;
-            if !parts_current {
-                stats.jacobian_evals += 1;
-                w.parts(sys, clamp(t)).map_err(rhs_err(t))?;
-                parts_current = true;
-                factored = false;
-            } else {
-                h *= 0.25;
-            }
-            if fails_here > 40 {
-                return Err(OdeError::NewtonFailure { t });
-            }
+            let (q, qd) = (&w.q, &w.qd);
+            w.parts.after_failure(
+                sys,
+                t,
+                piece.clamp(t),
+                q,
+                qd,
+                &mut h,
+                &mut fails_here,
+                stats,
+            )?;
             continue;
         }
         w.update(c, h);
@@ -495,13 +350,13 @@ fn integrate_piece<S: MechanicalSystem>(
         let ce = (c.beta - 1.0 / 6.0) * h * h;
         w.e.copy_from(&w.qdd1);
         w.e -= &w.qdd;
-        w.me.gemv(ce, &w.m, &w.e, 0.0);
-        w.lu.solve(&mut w.me);
-        let err = w.weighted(&w.me, &w.q, &w.q1, rtol, atol);
-        if err > 1.0 {
+        w.me.gemv(ce, &w.parts.m, &w.e, 0.0);
+        w.parts.solve(&mut w.me);
+        let err = w.parts.weighted(&w.me, &w.q, &w.q1, rtol, atol);
+        if err.is_nan() || err > 1.0 {
             stats.failed_steps += 1;
             fails_here += 1;
-            h *= (0.9 * err.powf(-1.0 / 3.0)).clamp(0.2, 0.9);
+            h *= shrink(err, 1.0 / 3.0);
             continue;
         }
         // accepted: outputs in (t, t1] by cubic Hermite interpolation
@@ -537,12 +392,8 @@ fn integrate_piece<S: MechanicalSystem>(
         h_prev = Some(h);
         std::mem::swap(&mut w.qdd, &mut w.qdd1);
         std::mem::swap(&mut w.a, &mut w.a1);
-        parts_current = false;
-        let ratio = (0.9 * err.max(1e-12).powf(-1.0 / 3.0)).clamp(0.2, 2.0);
-        if !(1.0..=1.2).contains(&ratio) {
-            h *= ratio;
-        }
-        h = h.min(piece.hmax);
+        w.parts.current = false;
+        h = next_step(h, err, 1.0 / 3.0, piece.hmax);
     }
     Ok(())
 }

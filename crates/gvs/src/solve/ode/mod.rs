@@ -107,6 +107,7 @@ mod fixed;
 mod galpha;
 mod mass_norm;
 mod ndf;
+mod one_step;
 mod sdirk;
 #[cfg(test)]
 mod tests;

@@ -53,12 +53,14 @@
 //! consistent accelerations `M q̈ = τ`.
 
 use super::galpha::MechanicalSystem;
-use super::mass_norm::MassNorm;
-use super::{
-    check_common, deliver, invalid, mechanical_state, next_down, next_up, rhs_err, ulp, ErrorNorm,
-    Lu, OdeError, OdeStats, Output, RhsError,
+use super::one_step::{
+    begin_attempt, check_step_options, first_step, newton_test, next_step, pieces, shrink, Newton,
+    Parts, Piece,
 };
-use nalgebra::{DMatrix, DVector};
+use super::{
+    check_common, deliver, mechanical_state, rhs_err, ErrorNorm, OdeError, OdeStats, Output,
+};
+use nalgebra::DVector;
 
 /// The diagonal `γ` of the tableau.
 pub(super) const GAMMA: f64 = 0.25;
@@ -144,19 +146,13 @@ struct Work {
     eq: DVector<f64>,
     ev: DVector<f64>,
     tmp: DVector<f64>,
-    m: DMatrix<f64>,
-    d: DMatrix<f64>,
-    k: DMatrix<f64>,
-    lu: Lu,
+    parts: Parts,
     out: DVector<f64>,
-    mnorm: Option<MassNorm>,
-    m_count: usize,
 }
 
 impl Work {
-    fn new(n: usize) -> Self {
+    fn new(n: usize, norm: ErrorNorm) -> Self {
         let v = || DVector::zeros(n);
-        let mat = || DMatrix::zeros(n, n);
         Work {
             q: v(),
             qd: v(),
@@ -172,45 +168,8 @@ impl Work {
             eq: v(),
             ev: v(),
             tmp: v(),
-            m: mat(),
-            d: mat(),
-            k: mat(),
-            lu: Lu::new(n),
+            parts: Parts::new(n, norm),
             out: DVector::zeros(2 * n),
-            mnorm: None,
-            m_count: 0,
-        }
-    }
-
-    /// `M, D, K` at `(t, q, q̇)` (and the mass norm of the new `M`).
-    fn parts<S: MechanicalSystem>(&mut self, sys: &mut S, t: f64) -> Result<(), RhsError> {
-        sys.iteration_parts(t, &self.q, &self.qd, &mut self.m, &mut self.d, &mut self.k)?;
-        self.m_count += 1;
-        if let Some(mn) = &mut self.mnorm {
-            mn.set(&self.m, self.m_count);
-        }
-        Ok(())
-    }
-
-    /// `‖v‖ / (rtol·max(‖x‖, ‖y‖) + atol)`, componentwise or in the mass norm.
-    fn weighted(
-        &self,
-        v: &DVector<f64>,
-        x: &DVector<f64>,
-        y: &DVector<f64>,
-        tol: (f64, f64),
-    ) -> f64 {
-        let (rtol, atol) = tol;
-        match &self.mnorm {
-            None => v
-                .iter()
-                .zip(x.iter().zip(y.iter()))
-                .map(|(v, (x, y))| v.abs() / (rtol * x.abs().max(y.abs()) + atol))
-                .fold(0.0, f64::max),
-            Some(mn) => {
-                let s = mn.half(x.as_slice()).max(mn.half(y.as_slice()));
-                mn.half(v.as_slice()) / (rtol * s + atol)
-            }
         }
     }
 
@@ -288,33 +247,8 @@ pub fn integrate_sdirk<S: MechanicalSystem>(
     let n = sys.dim();
     let y0 = mechanical_state(n, q0, qd0)?;
     let bounds = check_common(2 * n, t0, &y0, t_out, breakpoints)?;
-    if !(opts.rtol > 0.0 && opts.rtol < 1.0) {
-        return Err(invalid("rtol", format!("{} (accepted: (0, 1))", opts.rtol)));
-    }
-    if !(opts.atol > 0.0 && opts.atol.is_finite()) {
-        return Err(invalid("atol", format!("{} (accepted: > 0)", opts.atol)));
-    }
-    if opts.max_step.is_nan() || opts.max_step <= 0.0 {
-        return Err(invalid(
-            "max_step",
-            format!("{} (accepted: > 0)", opts.max_step),
-        ));
-    }
-    if let Some(h) = opts.initial_step {
-        if !(h > 0.0 && h.is_finite()) {
-            return Err(invalid("initial_step", format!("{h} (accepted: > 0)")));
-        }
-    }
-    let tf = *bounds.last().unwrap_or(&t0);
-    let hmax = if opts.max_step.is_finite() {
-        opts.max_step
-    } else {
-        0.1 * (tf - t0).abs().max(f64::MIN_POSITIVE)
-    };
-    let mut w = Work::new(n);
-    if opts.error_norm == ErrorNorm::Mass {
-        w.mnorm = Some(MassNorm::new(n));
-    }
+    check_step_options(opts.rtol, opts.atol, opts.max_step, opts.initial_step)?;
+    let mut w = Work::new(n, opts.error_norm);
     w.q.copy_from(q0);
     w.qd.copy_from(qd0);
     let mut next = 0;
@@ -322,31 +256,13 @@ pub fn integrate_sdirk<S: MechanicalSystem>(
         b.copy_from(&y0)
     })?;
     let mut stats = OdeStats::default();
-    let pieces = bounds.len().saturating_sub(1);
-    for p in 0..pieces {
-        let (a, b) = (bounds[p], bounds[p + 1]);
-        let lo = if p > 0 { next_up(a) } else { f64::NEG_INFINITY };
-        let hi = if p + 1 < pieces {
-            next_down(b)
-        } else {
-            f64::INFINITY
-        };
-        let piece = Piece { a, b, lo, hi, hmax };
+    for (p, piece) in pieces(&bounds, opts.max_step).iter().enumerate() {
         let h0 = if p == 0 { opts.initial_step } else { None };
         integrate_piece(
-            sys, &mut w, opts, &piece, h0, t_out, &mut next, output, &mut stats,
+            sys, &mut w, opts, piece, h0, t_out, &mut next, output, &mut stats,
         )?;
     }
     Ok(stats)
-}
-
-struct Piece {
-    a: f64,
-    b: f64,
-    /// Evaluation times are clamped to `[lo, hi]`.
-    lo: f64,
-    hi: f64,
-    hmax: f64,
 }
 
 /// The outcome of the stages of a step attempt.
@@ -364,7 +280,7 @@ fn stages<S: MechanicalSystem>(
     t: f64,
     h: f64,
     tol: (f64, f64),
-    clamp: &impl Fn(f64) -> f64,
+    piece: &Piece,
     stats: &mut OdeStats,
 ) -> Result<Attempt, OdeError> {
     let hg = h * GAMMA;
@@ -375,7 +291,7 @@ fn stages<S: MechanicalSystem>(
     for i in 0..STAGES {
         w.stage_base(i, h);
         w.predict(i, h);
-        let ti = clamp(t + C[i] * h);
+        let ti = piece.clamp(t + C[i] * h);
         let mut converged = false;
         let mut prev = f64::NAN;
         for it in 0..MAX_NEWTON {
@@ -388,29 +304,18 @@ fn stages<S: MechanicalSystem>(
                 return Ok(Attempt::Diverged);
             }
             w.eps.neg_mut();
-            w.lu.solve(&mut w.eps);
+            w.parts.solve(&mut w.eps);
             w.acc[i] += &w.eps;
-            let norm = w.weighted(&w.eps, &w.q, &w.qs, tol) * cq;
-            if !norm.is_finite() {
-                return Ok(Attempt::Diverged);
-            }
+            let norm = w.parts.weighted(&w.eps, &w.q, &w.qs, tol.0, tol.1) * cq;
             most = most.max(it + 1);
-            if it == 0 {
-                if norm <= 0.1 * KAPPA {
+            match newton_test(it, norm, prev, KAPPA) {
+                Newton::Converged => {
                     converged = true;
                     break;
                 }
-            } else {
-                let rate = norm / prev;
-                if rate > 0.9 {
-                    break;
-                }
-                if rate / (1.0 - rate) * norm <= KAPPA {
-                    converged = true;
-                    break;
-                }
+                Newton::Failed => break,
+                Newton::Continue => prev = norm,
             }
-            prev = norm;
         }
         if !converged {
             return Ok(Attempt::Diverged);
@@ -434,99 +339,54 @@ fn integrate_piece<S: MechanicalSystem>(
 ) -> Result<(), OdeError> {
     let n = w.q.len();
     let tol = (opts.rtol, opts.atol);
-    let clamp = |t: f64| t.max(piece.lo).min(piece.hi);
     let mut t = piece.a;
     // consistent accelerations at the start of the piece
     stats.rhs_evals += 1;
-    sys.accelerations(clamp(t), &w.q, &w.qd, &mut w.qdd)
+    sys.accelerations(piece.clamp(t), &w.q, &w.qd, &mut w.qdd)
         .map_err(rhs_err(t))?;
     if w.qdd.iter().any(|v| !v.is_finite()) {
         return Err(OdeError::NonFinite { t });
     }
     w.h_prev = None;
-    stats.jacobian_evals += 1;
-    w.parts(sys, clamp(t)).map_err(rhs_err(t))?;
-    let mut parts_current = true;
+    w.parts.eval(sys, piece.clamp(t), &w.q, &w.qd, stats)?;
     // renew M, D, K before the next step (its Newton was slow)
     let mut refresh = false;
-    let mut factored = false;
-    let mut h_lu = f64::NAN;
-
     let span = piece.b - piece.a;
-    let mut h = match h0 {
-        Some(h) => h,
-        None => {
-            // a tolerance unit of displacement in the first step, by velocity and acceleration
-            let zero = DVector::zeros(n);
-            let vel = w.weighted(&w.qd, &w.q, &zero, tol);
-            let acc = w.weighted(&w.qdd, &w.q, &zero, tol);
-            let mut h = span.min(piece.hmax);
-            if vel > 0.0 {
-                h = h.min(0.5 / vel);
-            }
-            if acc > 0.0 {
-                h = h.min((1.0 / acc).sqrt());
-            }
-            h
-        }
-    }
-    .min(piece.hmax)
-    .min(span);
+    let mut h = h0
+        .unwrap_or_else(|| {
+            first_step(
+                &w.parts, &w.q, &w.qd, &w.qdd, tol.0, tol.1, span, piece.hmax,
+            )
+        })
+        .min(piece.hmax)
+        .min(span);
     let mut fails_here = 0usize;
+    let rates = |h: f64| (h * GAMMA, (h * GAMMA).powi(2));
     while t < piece.b {
-        let hmin = 16.0 * ulp(t);
-        if h < hmin {
-            return Err(OdeError::StepSizeUnderflow { t, h, h_min: hmin });
-        }
-        if stats.steps >= opts.max_steps {
-            return Err(OdeError::TooManySteps {
-                t,
-                max_steps: opts.max_steps,
-            });
-        }
-        // land on the end of the piece (stretching by up to 10 %)
-        if t + 1.1 * h >= piece.b {
-            h = piece.b - t;
-        }
-        let t1 = if h == piece.b - t { piece.b } else { t + h };
-        if refresh && !parts_current {
+        let t1 = begin_attempt(t, &mut h, piece, stats.steps, opts.max_steps)?;
+        if refresh && !w.parts.current {
             // the last step's Newton was slow: M, D, K at the current point
-            stats.jacobian_evals += 1;
-            w.parts(sys, clamp(t)).map_err(rhs_err(t))?;
-            parts_current = true;
-            factored = false;
+            w.parts.eval(sys, piece.clamp(t), &w.q, &w.qd, stats)?;
         }
         refresh = false;
-        if !factored || (h / h_lu - 1.0).abs() > 0.2 {
-            let hg = h * GAMMA;
-            let (m, d, k) = (&w.m, &w.d, &w.k);
-            factored = w.lu.factor_with(stats, |s| {
-                for (((s, m), d), k) in s.iter_mut().zip(m.iter()).zip(d.iter()).zip(k.iter()) {
-                    *s = m + hg * d + hg * hg * k;
-                }
-            });
-            h_lu = h;
-        }
+        let h_lu = w.parts.factor_for(h, rates, stats);
         // a singular (or non-finite) S fails the attempt as a diverged Newton iteration would
-        let attempt = if factored {
-            stages(sys, w, t, h, tol, &clamp, stats)?
-        } else {
-            Attempt::Diverged
+        let attempt = match h_lu {
+            Some(_) => stages(sys, w, t, h, tol, piece, stats)?,
+            None => Attempt::Diverged,
         };
-        let Attempt::Converged(iterations) = attempt else {
-            stats.failed_steps += 1;
-            fails_here += 1;
-            if !parts_current {
-                stats.jacobian_evals += 1;
-                w.parts(sys, clamp(t)).map_err(rhs_err(t))?;
-                parts_current = true;
-                factored = false;
-            } else {
-                h *= 0.25;
-            }
-            if fails_here > 40 {
-                return Err(OdeError::NewtonFailure { t });
-            }
+        let (Attempt::Converged(iterations), Some(h_lu)) = (attempt, h_lu) else {
+            let (q, qd) = (&w.q, &w.qd);
+            w.parts.after_failure(
+                sys,
+                t,
+                piece.clamp(t),
+                q,
+                qd,
+                &mut h,
+                &mut fails_here,
+                stats,
+            )?;
             continue;
         };
         let last = STAGES - 1;
@@ -542,20 +402,15 @@ fn integrate_piece<S: MechanicalSystem>(
             w.ev.axpy(c, &w.acc[j], 1.0);
         }
         let hg = h_lu * GAMMA;
-        w.tmp.gemv(1.0, &w.m, &w.ev, 0.0);
-        w.tmp.gemv(-hg, &w.k, &w.eq, 1.0);
-        w.lu.solve(&mut w.tmp);
+        w.tmp.gemv(1.0, &w.parts.m, &w.ev, 0.0);
+        w.tmp.gemv(-hg, &w.parts.k, &w.eq, 1.0);
+        w.parts.solve(&mut w.tmp);
         w.eq.axpy(hg, &w.tmp, 1.0);
-        let err = w.weighted(&w.eq, &w.q, &w.qs, tol);
+        let err = w.parts.weighted(&w.eq, &w.q, &w.qs, tol.0, tol.1);
         if err.is_nan() || err > 1.0 {
             stats.failed_steps += 1;
             fails_here += 1;
-            let r = if err.is_finite() {
-                (0.9 * err.powf(-0.25)).clamp(0.2, 0.9)
-            } else {
-                0.25
-            };
-            h *= r;
+            h *= shrink(err, 0.25);
             continue;
         }
         // accepted: outputs in (t, t1] by quintic Hermite interpolation
@@ -586,13 +441,9 @@ fn integrate_piece<S: MechanicalSystem>(
         std::mem::swap(&mut w.qdd_prev, &mut w.qdd);
         w.qdd.copy_from(&w.acc[last]);
         w.h_prev = Some(h);
-        parts_current = false;
+        w.parts.current = false;
         refresh = iterations > SLOW_NEWTON;
-        let ratio = (0.9 * err.max(1e-12).powf(-0.25)).clamp(0.2, 2.0);
-        if !(1.0..=1.2).contains(&ratio) {
-            h *= ratio;
-        }
-        h = h.min(piece.hmax);
+        h = next_step(h, err, 0.25, piece.hmax);
     }
     Ok(())
 }

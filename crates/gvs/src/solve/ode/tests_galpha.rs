@@ -78,23 +78,34 @@ impl MechanicalSystem for Oscillators {
     }
 }
 
-fn run(
+/// An integrator of `M q̈ = τ` with its options bound: `(sys, t0, q0, q̇0, t_out, breakpoints, output)`.
+pub(super) type Integrator<'a> = &'a dyn Fn(
+    &mut Oscillators,
+    f64,
+    &DVector<f64>,
+    &DVector<f64>,
+    &[f64],
+    &[f64],
+    &mut Output<'_>,
+) -> Result<OdeStats, OdeError>;
+
+/// Runs `integrate` on `sys` from `q = q0` (every coordinate) at rest; the outputs at `t_out`.
+pub(super) fn run_from_rest(
+    integrate: Integrator<'_>,
     sys: &mut Oscillators,
     q0: f64,
     t_out: &[f64],
     breaks: &[f64],
-    opts: &GeneralizedAlphaOptions,
 ) -> (Vec<DVector<f64>>, OdeStats) {
     let n = sys.dim();
     let mut ys = Vec::new();
-    let stats = integrate_generalized_alpha(
+    let stats = integrate(
         sys,
         t_out[0],
         &DVector::from_element(n, q0),
         &DVector::zeros(n),
         t_out,
         breaks,
-        opts,
         &mut |_, y| {
             ys.push(y.clone());
             ControlFlow::Continue(())
@@ -102,6 +113,19 @@ fn run(
     )
     .unwrap();
     (ys, stats)
+}
+
+fn run(
+    sys: &mut Oscillators,
+    q0: f64,
+    t_out: &[f64],
+    breaks: &[f64],
+    opts: &GeneralizedAlphaOptions,
+) -> (Vec<DVector<f64>>, OdeStats) {
+    let integrate: Integrator<'_> = &|s, t0, q, qd, t_out, b, out| {
+        integrate_generalized_alpha(s, t0, q, qd, t_out, b, opts, out)
+    };
+    run_from_rest(integrate, sys, q0, t_out, breaks)
 }
 
 #[test]
@@ -164,44 +188,65 @@ fn tolerance_tenfold_tighter_lowers_the_error() {
     assert!(e5 < 0.2 * e3, "rtol 1e-3: {e3:e}, rtol 1e-5: {e5:e}");
 }
 
-#[test]
-fn damped_oscillators_with_a_step_force_match_the_closed_form() {
-    // two oscillators (ω = 3 and 40 rad/s, c = 0.6), a unit force switched on at t = 0.5
-    let (m, c) = (1.0, 0.6);
-    let ks = [9.0, 1600.0];
-    let mut sys = Oscillators {
-        m,
-        c,
-        k: ks.to_vec(),
+/// The two damped oscillators of [`damped_oscillators_with_a_step_force_match_the_closed_form`]
+/// (ω = 3 and 40 rad/s, c = 0.6, a unit force switched on at t = 0.5) and their outputs at
+/// `t = 0, 0.05, …, 3`.
+pub(super) fn damped_oscillators() -> (Oscillators, Vec<f64>) {
+    let sys = Oscillators {
+        m: 1.0,
+        c: 0.6,
+        k: vec![9.0, 1600.0],
         f_after: 1.0,
         t_step: 0.5,
     };
-    let t_out: Vec<f64> = (0..=60).map(|i| i as f64 * 0.05).collect();
+    (sys, (0..=60).map(|i| i as f64 * 0.05).collect())
+}
+
+/// Per oscillator of `sys`, the largest error of `ys` (outputs at `t_out`) against the closed-form
+/// step response, in units of the static deflection `1/k`.
+pub(super) fn step_response_errors(
+    sys: &Oscillators,
+    t_out: &[f64],
+    ys: &[DVector<f64>],
+) -> Vec<f64> {
+    let (m, c) = (sys.m, sys.c);
+    sys.k
+        .iter()
+        .enumerate()
+        .map(|(j, &k)| {
+            let w0 = (k / m).sqrt();
+            let zeta = c / (2.0 * m * w0);
+            let wd = w0 * (1.0 - zeta * zeta).sqrt();
+            let exact = |t: f64| {
+                if t < sys.t_step {
+                    return 0.0;
+                }
+                let s = t - sys.t_step;
+                (1.0 - (-zeta * w0 * s).exp() * ((wd * s).cos() + zeta * w0 / wd * (wd * s).sin()))
+                    / k
+            };
+            t_out
+                .iter()
+                .zip(ys)
+                .map(|(t, y)| (y[j] - exact(*t)).abs() * k)
+                .fold(0.0, f64::max)
+        })
+        .collect()
+}
+
+#[test]
+fn damped_oscillators_with_a_step_force_match_the_closed_form() {
+    let (mut sys, t_out) = damped_oscillators();
     let opts = GeneralizedAlphaOptions {
         rtol: 1e-7,
         atol: 1e-10,
         ..Default::default()
     };
     let (ys, _) = run(&mut sys, 0.0, &t_out, &[0.5], &opts);
-    for (j, &k) in ks.iter().enumerate() {
-        let w0 = (k / m).sqrt();
-        let zeta = c / (2.0 * m * w0);
-        let wd = w0 * (1.0 - zeta * zeta).sqrt();
-        let exact = |t: f64| {
-            if t < 0.5 {
-                return 0.0;
-            }
-            let s = t - 0.5;
-            (1.0 - (-zeta * w0 * s).exp() * ((wd * s).cos() + zeta * w0 / wd * (wd * s).sin())) / k
-        };
-        let worst = t_out
-            .iter()
-            .zip(&ys)
-            .map(|(t, y)| (y[j] - exact(*t)).abs() * k)
-            .fold(0.0, f64::max);
+    for (j, worst) in step_response_errors(&sys, &t_out, &ys).iter().enumerate() {
         // 0.3 % of the static deflection over 16 periods of the stiffer one (phase drift, see above)
         assert!(
-            worst < 3e-3,
+            *worst < 3e-3,
             "oscillator {j}: max error {worst:e} of the static deflection"
         );
     }

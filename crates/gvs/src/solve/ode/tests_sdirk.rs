@@ -2,7 +2,9 @@
 //! closed forms of free and damped oscillators with a breakpoint, and invalid options.
 
 use super::sdirk::{A, B_HAT, C, GAMMA, STAGES};
-use super::tests_galpha::Oscillators;
+use super::tests_galpha::{
+    damped_oscillators, run_from_rest, step_response_errors, Integrator, Oscillators,
+};
 use super::*;
 use nalgebra::{DMatrix, DVector};
 use std::f64::consts::PI;
@@ -86,23 +88,9 @@ fn run(
     breaks: &[f64],
     opts: &SdirkOptions,
 ) -> (Vec<DVector<f64>>, OdeStats) {
-    let n = sys.dim();
-    let mut ys = Vec::new();
-    let stats = integrate_sdirk(
-        sys,
-        t_out[0],
-        &DVector::from_element(n, q0),
-        &DVector::zeros(n),
-        t_out,
-        breaks,
-        opts,
-        &mut |_, y| {
-            ys.push(y.clone());
-            ControlFlow::Continue(())
-        },
-    )
-    .unwrap();
-    (ys, stats)
+    let integrate: Integrator<'_> =
+        &|s, t0, q, qd, t_out, b, out| integrate_sdirk(s, t0, q, qd, t_out, b, opts, out);
+    run_from_rest(integrate, sys, q0, t_out, breaks)
 }
 
 /// `ω = 2π` from `q = 1` at rest: `q = cos 2πt`.
@@ -186,41 +174,16 @@ fn tolerance_tenfold_tighter_lowers_the_error() {
 
 #[test]
 fn damped_oscillators_with_a_step_force_match_the_closed_form() {
-    // two oscillators (ω = 3 and 40 rad/s, c = 0.6), a unit force switched on at t = 0.5
-    let (m, c) = (1.0, 0.6);
-    let ks = [9.0, 1600.0];
-    let mut sys = Oscillators {
-        m,
-        c,
-        k: ks.to_vec(),
-        f_after: 1.0,
-        t_step: 0.5,
-    };
-    let t_out: Vec<f64> = (0..=60).map(|i| i as f64 * 0.05).collect();
+    let (mut sys, t_out) = damped_oscillators();
     let opts = SdirkOptions {
         rtol: 1e-7,
         atol: 1e-10,
         ..Default::default()
     };
     let (ys, _) = run(&mut sys, 0.0, &t_out, &[0.5], &opts);
-    for (j, &k) in ks.iter().enumerate() {
-        let w0 = (k / m).sqrt();
-        let zeta = c / (2.0 * m * w0);
-        let wd = w0 * (1.0 - zeta * zeta).sqrt();
-        let exact = |t: f64| {
-            if t < 0.5 {
-                return 0.0;
-            }
-            let s = t - 0.5;
-            (1.0 - (-zeta * w0 * s).exp() * ((wd * s).cos() + zeta * w0 / wd * (wd * s).sin())) / k
-        };
-        let worst = t_out
-            .iter()
-            .zip(&ys)
-            .map(|(t, y)| (y[j] - exact(*t)).abs() * k)
-            .fold(0.0, f64::max);
+    for (j, worst) in step_response_errors(&sys, &t_out, &ys).iter().enumerate() {
         assert!(
-            worst < 1e-5,
+            *worst < 1e-5,
             "oscillator {j}: max error {worst:e} of the static deflection"
         );
     }
