@@ -42,22 +42,38 @@ pub struct Reduced {
 
 impl Reduced {
     /// Errors if `q` lies outside the training encodings' range by more than half its width in
-    /// some coordinate: the decoder is extrapolating there (tanh layers saturate, `Ψ_q → 0`, and
-    /// spurious equilibria appear), so the result is not to be trusted.
+    /// some coordinate ([`Self::range_violation`]): the decoder is extrapolating there (tanh layers
+    /// saturate, `Ψ_q → 0`, and spurious equilibria appear), so the result is not to be trusted.
     pub fn check_range(&self, q: &[f64]) -> Result<(), ScenarioError> {
-        for (d, (v, [lo, hi])) in q.iter().zip(&self.latent_range).enumerate() {
-            let margin = 0.5 * (hi - lo).max(1e-12);
-            if *v < lo - margin || *v > hi + margin || !v.is_finite() {
-                return Err(invalid(
-                    "--model",
-                    format!(
-                        "the reduced solution q_r[{d}] = {v:.6} lies far outside the range of the training data [{lo:.6}, {hi:.6}] of `{}`: the decoder is extrapolating (the load is outside the dataset, or the model is poor)",
-                        self.path.display()
-                    ),
-                ));
-            }
+        match self.range_violation(q) {
+            None => Ok(()),
+            Some(v) => Err(invalid(
+                "--model",
+                format!(
+                    "the reduced solution {v}: the decoder is extrapolating (the load is outside the dataset, or the model is poor)"
+                ),
+            )),
         }
-        Ok(())
+    }
+
+    /// The first coordinate of `q` outside the training encodings' range widened by half its
+    /// width on each side (or not finite), described as "`q_r[d] = v` lies far outside the range
+    /// of the training data `[lo, hi]` of `MODEL`"; `None` inside (always, for models without a
+    /// recorded range).
+    pub fn range_violation(&self, q: &[f64]) -> Option<String> {
+        q.iter()
+            .zip(&self.latent_range)
+            .enumerate()
+            .find(|(_, (v, [lo, hi]))| {
+                let margin = 0.5 * (hi - lo).max(1e-12);
+                !(**v >= lo - margin && **v <= hi + margin)
+            })
+            .map(|(d, (v, [lo, hi]))| {
+                format!(
+                    "q_r[{d}] = {v:.6} lies far outside the range of the training data [{lo:.6}, {hi:.6}] of `{}`",
+                    self.path.display()
+                )
+            })
     }
 }
 

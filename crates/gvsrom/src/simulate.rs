@@ -360,6 +360,7 @@ pub fn run(
     let mut last_tip = None;
     let mut write_error: Option<std::io::Error> = None;
     let mut interrupted = None;
+    let mut off_manifold = None;
     let mut sink = |s: &Sample<'_>| {
         last_tip = Some(*s.tip);
         if let Some(w) = writer.as_deref_mut() {
@@ -368,6 +369,17 @@ pub fn run(
                 write_error = Some(e);
                 return ControlFlow::Break(msg);
             }
+        }
+        // A reduced trajectory far outside its training encodings is off the learned manifold
+        // (the decoder saturates, `Ψ_q → 0`, `M → 0`): stop there with the reason rather than
+        // integrating a spurious motion until Newton fails.
+        if let Some(v) = built.reduced.as_ref().and_then(|r| r.range_violation(s.q)) {
+            let msg = format!(
+                "the reduced trajectory left the training region at t = {:.4} s: {v}; the decoder extrapolates there (an input outside the dataset, or a poor model)",
+                s.t
+            );
+            off_manifold = Some(msg.clone());
+            return ControlFlow::Break(msg);
         }
         let flow = control(s.t);
         if let ControlFlow::Break(reason) = &flow {
@@ -418,10 +430,11 @@ pub fn run(
             ),
         ));
     }
-    let ending = match (&summary.error, interrupted) {
-        (None, _) => Ending::Complete,
-        (Some(_), Some(reason)) => Ending::Interrupted { reason },
-        (Some(e), None) => Ending::Failed {
+    let ending = match (&summary.error, off_manifold, interrupted) {
+        (None, _, _) => Ending::Complete,
+        (Some(_), Some(error), _) => Ending::Failed { error },
+        (Some(_), None, Some(reason)) => Ending::Interrupted { reason },
+        (Some(e), None, None) => Ending::Failed {
             error: e.to_string(),
         },
     };
@@ -568,6 +581,8 @@ impl TrajectoryWriter {
                 Some(error.clone()),
             ),
         };
+        // the integrators report their work counts only for a run that reached its end
+        let counted = |n: usize| sm.error.is_none().then_some(n);
         let meta = Meta {
             scenario: &built.name,
             complete,
@@ -580,11 +595,11 @@ impl TrajectoryWriter {
             n_actuators: built.model.n_actuators(),
             wall_time_s: sm.wall_time_s,
             real_time_factor: outcome.real_time_factor(),
-            steps: sm.stats.steps,
-            failed_steps: sm.stats.failed_steps,
-            rhs_evaluations: sm.stats.rhs_evals,
-            jacobian_evaluations: sm.stats.jacobian_evals,
-            lu_decompositions: sm.stats.lu_decompositions,
+            steps: counted(sm.stats.steps),
+            failed_steps: counted(sm.stats.failed_steps),
+            rhs_evaluations: counted(sm.stats.rhs_evals),
+            jacobian_evaluations: counted(sm.stats.jacobian_evals),
+            lu_decompositions: counted(sm.stats.lu_decompositions),
             error,
         };
         dir.commit(meta)
@@ -608,11 +623,12 @@ struct Meta<'a> {
     n_actuators: usize,
     wall_time_s: f64,
     real_time_factor: f64,
-    steps: usize,
-    failed_steps: usize,
-    rhs_evaluations: usize,
-    jacobian_evaluations: usize,
-    lu_decompositions: usize,
+    /// Work counts of the integrator (`null` for a run that stopped early: not reported then).
+    steps: Option<usize>,
+    failed_steps: Option<usize>,
+    rhs_evaluations: Option<usize>,
+    jacobian_evaluations: Option<usize>,
+    lu_decompositions: Option<usize>,
     /// The integrator's error if it failed.
     error: Option<String>,
 }

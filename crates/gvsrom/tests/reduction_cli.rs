@@ -327,6 +327,61 @@ fn a_model_from_another_scenario_is_refused_naming_the_layout() {
     );
 }
 
+#[test]
+fn a_reduced_trajectory_leaving_the_training_region_stops_with_the_reason() {
+    // The small autoencoder with its recorded training range narrowed to ±1e-3 about the
+    // straight rod's encoding: a release from straight under -3 N leaves it within milliseconds.
+    let dir = copy_dir(ae_small(), "red-ae-narrow");
+    let mut meta = json(&dir.join("meta.json"));
+    let rest = meta["rest"][0].as_f64().unwrap();
+    meta["latent_range"] = serde_json::json!([[rest - 1e-3, rest + 1e-3]]);
+    std::fs::write(
+        dir.join("meta.json"),
+        serde_json::to_string_pretty(&meta).unwrap(),
+    )
+    .unwrap();
+    let out = scratch("red-sim-narrow");
+    let msg = expect_error(
+        &[
+            "simulate",
+            "single-tendon",
+            "--duration",
+            "0.5",
+            "--tension=-3",
+            "--model",
+            s(&dir),
+            "--out",
+            s(&out),
+        ],
+        &[
+            "left the training region at t = ",
+            "q_r[0] = ",
+            "marked partial",
+        ],
+    );
+    // the samples before it are kept, and the run is marked partial
+    let (shape, _) = npy(&out.join("t.npy"));
+    assert!(shape[0] >= 1 && shape[0] < 51, "{shape:?}: {msg}");
+    let meta = json(&out.join("meta.json"));
+    assert_eq!(meta["complete"], false, "{msg}");
+    assert!(
+        meta["error"]
+            .as_str()
+            .is_some_and(|e| e.contains("left the training region")),
+        "{meta}"
+    );
+    // the full range lets the same run finish
+    run_ok(&[
+        "simulate",
+        "single-tendon",
+        "--duration",
+        "0.5",
+        "--tension=-3",
+        "--model",
+        s(ae_small()),
+    ]);
+}
+
 /// A copy of `model` whose `weights.safetensors` lacks the tensor `drop`.
 fn without_tensor(model: &Path, name: &str, drop: &str) -> PathBuf {
     use safetensors::tensor::{SafeTensors, TensorView};
