@@ -340,19 +340,27 @@ fn a_reduced_trajectory_leaving_the_training_region_stops_with_the_reason() {
         serde_json::to_string_pretty(&meta).unwrap(),
     )
     .unwrap();
-    let out = scratch("red-sim-narrow");
-    let msg = expect_error(
-        &[
+    let release = |model: &Path| {
+        let m = s(model).to_string();
+        [
             "simulate",
             "single-tendon",
             "--duration",
             "0.5",
             "--tension=-3",
             "--model",
-            s(&dir),
-            "--out",
-            s(&out),
-        ],
+        ]
+        .map(String::from)
+        .into_iter()
+        .chain([m])
+        .collect::<Vec<_>>()
+    };
+    let out = scratch("red-sim-narrow");
+    let mut args = release(&dir);
+    args.extend(["--out".to_string(), s(&out).to_string()]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let msg = expect_error(
+        &args,
         &[
             "left the training region at t = ",
             "q_r[0] = ",
@@ -371,15 +379,8 @@ fn a_reduced_trajectory_leaving_the_training_region_stops_with_the_reason() {
         "{meta}"
     );
     // the full range lets the same run finish
-    run_ok(&[
-        "simulate",
-        "single-tendon",
-        "--duration",
-        "0.5",
-        "--tension=-3",
-        "--model",
-        s(ae_small()),
-    ]);
+    let args = release(ae_small());
+    run_ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
 }
 
 /// A copy of `model` whose `weights.safetensors` lacks the tensor `drop`.
