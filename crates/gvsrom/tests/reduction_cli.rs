@@ -340,25 +340,16 @@ fn a_reduced_trajectory_leaving_the_training_region_stops_with_the_reason() {
         serde_json::to_string_pretty(&meta).unwrap(),
     )
     .unwrap();
-    let release = |model: &Path| {
-        let m = s(model).to_string();
-        [
-            "simulate",
-            "single-tendon",
-            "--duration",
-            "0.5",
-            "--tension=-3",
-            "--model",
-        ]
-        .map(String::from)
-        .into_iter()
-        .chain([m])
-        .collect::<Vec<_>>()
-    };
+    let release = [
+        "simulate",
+        "single-tendon",
+        "--duration",
+        "0.5",
+        "--tension=-3",
+        "--model",
+    ];
     let out = scratch("red-sim-narrow");
-    let mut args = release(&dir);
-    args.extend(["--out".to_string(), s(&out).to_string()]);
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let args = [&release[..], &[s(&dir), "--out", s(&out)]].concat();
     let msg = expect_error(
         &args,
         &[
@@ -379,8 +370,7 @@ fn a_reduced_trajectory_leaving_the_training_region_stops_with_the_reason() {
         "{meta}"
     );
     // the full range lets the same run finish
-    let args = release(ae_small());
-    run_ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    run_ok(&[&release[..], &[s(ae_small())]].concat());
 }
 
 /// A copy of `model` whose `weights.safetensors` lacks the tensor `drop`.
