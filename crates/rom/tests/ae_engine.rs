@@ -454,6 +454,31 @@ fn coriolis_matrix_agrees_with_force_path_with_ae_param() {
 }
 
 #[test]
+fn dynamics_residual_is_m_qdd_minus_tau_with_ae_param() {
+    // the recursive residual of the second-order integrators, ε(q, q̇, q̈), against M(q) q̈ − τ(q, q̇)
+    // from the mass matrix and the force path, with damping and gravity
+    let fx = fixture();
+    for r in [1, 2] {
+        let m = fx.rom(r, 1e4);
+        let n = m.n_dof();
+        let loads = m.prepare_loads(&gravity()).unwrap();
+        let mut ws = m.workspace();
+        for (k, q) in latent_points(fx, r).iter().enumerate() {
+            let qd = latent_velocity(fx, r, k);
+            let qdd = latent_velocity(fx, r, k + 1) * 30.0;
+            let mut tau = DVector::zeros(n);
+            m.dynamic_forces(q, &qd, &[-1.0], &loads, &mut ws, &mut tau);
+            let expected = m.mass_matrix(q, &mut ws) * &qdd - &tau;
+            let mut eps = DVector::zeros(n);
+            m.dynamics_residual(q, &qd, &qdd, &[-1.0], &loads, &mut ws, &mut eps);
+            let err = (&eps - &expected).amax() / expected.amax();
+            eprintln!("r = {r}: ε vs M q̈ − τ {err:.3e}");
+            assert!(err < 1e-10, "r = {r}: ε vs M q̈ − τ {err:e}");
+        }
+    }
+}
+
+#[test]
 fn velocity_and_jdot_recursions_match_finite_differences_with_ae_param() {
     // η_i = J_i q̇ and ζ_i = J̇_i q̇ with J̇ from central differences of J along q̇
     let fx = fixture();
