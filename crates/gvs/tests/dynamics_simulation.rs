@@ -389,6 +389,14 @@ fn streaming_sink_sees_the_same_samples_and_can_stop_the_run() {
         }
         ref other => panic!("expected Stopped, got {other:?}"),
     }
+    // the work up to the stop is counted: fewer steps than the whole run, but some
+    assert!(
+        summary.stats.steps > 0 && summary.stats.steps < full.stats.steps,
+        "{:?} of {:?}",
+        summary.stats,
+        full.stats
+    );
+    assert!(summary.stats.rhs_evals > summary.stats.steps);
     // the samples before the stop are those of the uninterrupted run, bit for bit
     for (k, (t, q)) in seen.iter().enumerate() {
         assert_eq!(*t, full.trajectory.t[k]);

@@ -841,20 +841,15 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
     }
     let sm = &outcome.summary;
     let t_last = sm.t_last.unwrap_or(0.0);
-    // the integrators report their work counts only for a run that reached its end
-    let counts = if sm.error.is_none() {
-        format!(
-            ", {} steps ({} failed), {} RHS and {} Jacobian evaluations",
-            sm.stats.steps, sm.stats.failed_steps, sm.stats.rhs_evals, sm.stats.jacobian_evals
-        )
-    } else {
-        String::new()
-    };
     writeln!(
         out,
-        "simulated  {t_last:.3} s in {:.3} s wall time (real-time factor {:.1}){counts}",
+        "simulated  {t_last:.3} s in {:.3} s wall time (real-time factor {:.1}), {} steps ({} failed), {} RHS and {} Jacobian evaluations",
         sm.wall_time_s,
         outcome.real_time_factor(),
+        sm.stats.steps,
+        sm.stats.failed_steps,
+        sm.stats.rhs_evals,
+        sm.stats.jacobian_evals
     )?;
     if let Some(g) = &outcome.last_tip {
         writeln!(

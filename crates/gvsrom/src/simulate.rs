@@ -581,8 +581,6 @@ impl TrajectoryWriter {
                 Some(error.clone()),
             ),
         };
-        // the integrators report their work counts only for a run that reached its end
-        let counted = |n: usize| sm.error.is_none().then_some(n);
         let meta = Meta {
             scenario: &built.name,
             complete,
@@ -595,11 +593,11 @@ impl TrajectoryWriter {
             n_actuators: built.model.n_actuators(),
             wall_time_s: sm.wall_time_s,
             real_time_factor: outcome.real_time_factor(),
-            steps: counted(sm.stats.steps),
-            failed_steps: counted(sm.stats.failed_steps),
-            rhs_evaluations: counted(sm.stats.rhs_evals),
-            jacobian_evaluations: counted(sm.stats.jacobian_evals),
-            lu_decompositions: counted(sm.stats.lu_decompositions),
+            steps: sm.stats.steps,
+            failed_steps: sm.stats.failed_steps,
+            rhs_evaluations: sm.stats.rhs_evals,
+            jacobian_evaluations: sm.stats.jacobian_evals,
+            lu_decompositions: sm.stats.lu_decompositions,
             error,
         };
         dir.commit(meta)
@@ -623,12 +621,12 @@ struct Meta<'a> {
     n_actuators: usize,
     wall_time_s: f64,
     real_time_factor: f64,
-    /// Work counts of the integrator (`null` for a run that stopped early: not reported then).
-    steps: Option<usize>,
-    failed_steps: Option<usize>,
-    rhs_evaluations: Option<usize>,
-    jacobian_evaluations: Option<usize>,
-    lu_decompositions: Option<usize>,
+    /// Work counts of the integrator (up to the end of the run, or to where it stopped).
+    steps: usize,
+    failed_steps: usize,
+    rhs_evaluations: usize,
+    jacobian_evaluations: usize,
+    lu_decompositions: usize,
     /// The integrator's error if it failed.
     error: Option<String>,
 }

@@ -363,6 +363,8 @@ fn a_reduced_trajectory_leaving_the_training_region_stops_with_the_reason() {
     assert!(shape[0] >= 1 && shape[0] < 51, "{shape:?}: {msg}");
     let meta = json(&out.join("meta.json"));
     assert_eq!(meta["complete"], false, "{msg}");
+    // the integrator's work up to the stop is counted
+    assert!(meta["steps"].as_u64().is_some_and(|n| n > 0), "{meta}");
     assert!(
         meta["error"]
             .as_str()

@@ -120,6 +120,7 @@ pub struct Trajectory {
 #[derive(Debug)]
 pub struct Simulation {
     pub trajectory: Trajectory,
+    /// The integrator's work, up to the end or to where it stopped.
     pub stats: OdeStats,
     pub wall_time_s: f64,
     /// `Some` if the integration stopped early; the trajectory holds the samples before it.
@@ -298,6 +299,7 @@ pub struct RunSummary {
     pub samples: usize,
     /// Time of the last sample delivered (`None` if none was).
     pub t_last: Option<f64>,
+    /// The integrator's work, up to the end or to where it stopped.
     pub stats: OdeStats,
     pub wall_time_s: f64,
     /// `Some` if the integration stopped before the last output time: a failure of the method, or
@@ -469,7 +471,7 @@ pub fn simulate_streaming<P: StrainParam>(
     let wall_time_s = start.elapsed().as_secs_f64();
     let (stats, error) = match result {
         Ok(s) => (s, None),
-        Err(e) => (OdeStats::default(), Some(e)),
+        Err(e) => (e.stats, Some(e.error)),
     };
     Ok(RunSummary {
         samples,

@@ -4,7 +4,7 @@
 
 use super::{
     check_common, deliver, invalid, ulp, Clamp, Counted, FixedStepOptions, JacWork, Lu, OdeError,
-    OdeStats, OdeSystem, Output,
+    OdeFailure, OdeStats, OdeSystem, Output,
 };
 use nalgebra::{DMatrix, DVector};
 
@@ -84,31 +84,30 @@ pub fn integrate_fixed<S: OdeSystem>(
     breakpoints: &[f64],
     opts: &FixedStepOptions,
     output: &mut Output<'_>,
-) -> Result<OdeStats, OdeError> {
+) -> Result<OdeStats, OdeFailure> {
     let n = sys.dim();
     let bounds = check_common(n, t0, y0, t_out, breakpoints)?;
     let tf = *bounds.last().unwrap_or(&t0);
     let h = opts.h;
     if !(h > 0.0 && h.is_finite()) {
-        return Err(invalid(
-            "h",
-            format!("must be positive and finite, got {h}"),
-        ));
+        return Err(invalid("h", format!("must be positive and finite, got {h}")).into());
     }
     if h < 4.0 * ulp(t0.abs().max(tf.abs())) {
         return Err(invalid(
             "h",
             format!("{h:e} is below the time resolution at t = {tf}"),
-        ));
+        )
+        .into());
     }
     if !(opts.newton_tol > 0.0 && opts.newton_tol.is_finite()) {
         return Err(invalid(
             "newton_tol",
             format!("must be positive and finite, got {}", opts.newton_tol),
-        ));
+        )
+        .into());
     }
     if opts.max_newton == 0 {
-        return Err(invalid("max_newton", "must be at least 1"));
+        return Err(invalid("max_newton", "must be at least 1").into());
     }
     let v = || DVector::zeros(n);
     let mut w = Work {
@@ -140,27 +139,31 @@ pub fn integrate_fixed<S: OdeSystem>(
         rate: None,
     };
     let pieces = bounds.len().saturating_sub(1);
-    if pieces > 0 {
-        cs.clamp = Clamp::piece(bounds[0], false, bounds[1], pieces > 1);
-        if !cs.jacobian(t0, &w.y, &w.thresh, &mut w.jac, &mut w.jw)? {
-            return Err(OdeError::NonFinite { t: t0 });
+    let mut run = || -> Result<(), OdeError> {
+        if pieces > 0 {
+            cs.clamp = Clamp::piece(bounds[0], false, bounds[1], pieces > 1);
+            if !cs.jacobian(t0, &w.y, &w.thresh, &mut w.jac, &mut w.jw)? {
+                return Err(OdeError::NonFinite { t: t0 });
+            }
+            st.jac_fresh = true;
         }
-        st.jac_fresh = true;
-    }
-    for p in 0..pieces {
-        let (a, b) = (bounds[p], bounds[p + 1]);
-        cs.clamp = Clamp::piece(a, p > 0, b, p + 1 < pieces);
-        st.have_prev = false;
-        // Number of steps: the last one is in [0.1h, 1.1h].
-        let nsteps = ((b - a) / h - 0.1).ceil().max(1.0) as usize;
-        for i in 1..=nsteps {
-            let target = if i == nsteps { b } else { a + i as f64 * h };
-            advance(
-                &mut cs, &mut w, &mut st, opts, target, t_out, &mut next, output,
-            )?;
+        for p in 0..pieces {
+            let (a, b) = (bounds[p], bounds[p + 1]);
+            cs.clamp = Clamp::piece(a, p > 0, b, p + 1 < pieces);
+            st.have_prev = false;
+            // Number of steps: the last one is in [0.1h, 1.1h].
+            let nsteps = ((b - a) / h - 0.1).ceil().max(1.0) as usize;
+            for i in 1..=nsteps {
+                let target = if i == nsteps { b } else { a + i as f64 * h };
+                advance(
+                    &mut cs, &mut w, &mut st, opts, target, t_out, &mut next, output,
+                )?;
+            }
         }
-    }
-    Ok(cs.stats)
+        Ok(())
+    };
+    let result = run();
+    OdeFailure::with(result, &cs.stats)
 }
 
 /// Steps from `st.t` to `target` (one step, or halves of it if Newton fails).

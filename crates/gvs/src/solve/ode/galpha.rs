@@ -55,8 +55,8 @@ use super::one_step::{
     Parts, Piece,
 };
 use super::{
-    check_common, deliver, invalid, mechanical_state, rhs_err, ErrorNorm, OdeError, OdeStats,
-    Output, RhsError,
+    check_common, deliver, invalid, mechanical_state, rhs_err, ErrorNorm, OdeError, OdeFailure,
+    OdeStats, Output, RhsError,
 };
 use nalgebra::{DMatrix, DVector};
 
@@ -223,7 +223,7 @@ pub fn integrate_generalized_alpha<S: MechanicalSystem>(
     breakpoints: &[f64],
     opts: &GeneralizedAlphaOptions,
     output: &mut Output<'_>,
-) -> Result<OdeStats, OdeError> {
+) -> Result<OdeStats, OdeFailure> {
     let n = sys.dim();
     let y0 = mechanical_state(n, q0, qd0)?;
     let bounds = check_common(2 * n, t0, &y0, t_out, breakpoints)?;
@@ -231,7 +231,8 @@ pub fn integrate_generalized_alpha<S: MechanicalSystem>(
         return Err(invalid(
             "rho_inf",
             format!("{} (accepted: a number in [0, 1])", opts.rho_inf),
-        ));
+        )
+        .into());
     }
     check_step_options(opts.rtol, opts.atol, opts.max_step, opts.initial_step)?;
     let mut w = Work::new(n, opts.error_norm);
@@ -243,13 +244,16 @@ pub fn integrate_generalized_alpha<S: MechanicalSystem>(
     })?;
     let mut stats = OdeStats::default();
     let c = Coefficients::new(opts.rho_inf);
-    for (p, piece) in pieces(&bounds, opts.max_step).iter().enumerate() {
-        let h0 = if p == 0 { opts.initial_step } else { None };
-        integrate_piece(
-            sys, &mut w, &c, opts, piece, h0, t_out, &mut next, output, &mut stats,
-        )?;
-    }
-    Ok(stats)
+    let result = pieces(&bounds, opts.max_step)
+        .iter()
+        .enumerate()
+        .try_for_each(|(p, piece)| {
+            let h0 = if p == 0 { opts.initial_step } else { None };
+            integrate_piece(
+                sys, &mut w, &c, opts, piece, h0, t_out, &mut next, output, &mut stats,
+            )
+        });
+    OdeFailure::with(result, &stats)
 }
 
 #[allow(clippy::too_many_arguments)]

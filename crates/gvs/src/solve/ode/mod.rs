@@ -284,6 +284,38 @@ pub enum OdeError {
     },
 }
 
+/// An integration that stopped before its last output time: why, and the work done until then.
+#[derive(Debug, Clone, thiserror::Error)]
+#[error("{error}")]
+pub struct OdeFailure {
+    pub error: OdeError,
+    /// The counts up to the failure (zero for errors found before the first step: invalid input).
+    pub stats: OdeStats,
+}
+
+impl OdeFailure {
+    /// The outcome of an integration whose work is counted in `stats`.
+    fn with(result: Result<(), OdeError>, stats: &OdeStats) -> Result<OdeStats, OdeFailure> {
+        match result {
+            Ok(()) => Ok(stats.clone()),
+            Err(error) => Err(OdeFailure {
+                error,
+                stats: stats.clone(),
+            }),
+        }
+    }
+}
+
+/// An error found before any step (invalid input, the first output): nothing counted yet.
+impl From<OdeError> for OdeFailure {
+    fn from(error: OdeError) -> Self {
+        OdeFailure {
+            error,
+            stats: OdeStats::default(),
+        }
+    }
+}
+
 impl OdeError {
     /// The last time the solution reached (the last accepted step), `None` for invalid input.
     pub fn t_reached(&self) -> Option<f64> {

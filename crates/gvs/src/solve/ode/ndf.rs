@@ -6,7 +6,7 @@ use super::corrector::{Corrector, FirstOrder, SecondOrder};
 use super::mass_norm::MassNorm;
 use super::{
     check_common, deliver, invalid, mechanical_state, ulp, wnorm, Clamp, ErrorNorm,
-    MechanicalSystem, NdfOptions, OdeError, OdeStats, OdeSystem, Output,
+    MechanicalSystem, NdfOptions, OdeError, OdeFailure, OdeStats, OdeSystem, Output,
 };
 use nalgebra::{DMatrix, DVector};
 
@@ -317,7 +317,7 @@ pub fn integrate_ndf<S: OdeSystem>(
     breakpoints: &[f64],
     opts: &NdfOptions,
     output: &mut Output<'_>,
-) -> Result<OdeStats, OdeError> {
+) -> Result<OdeStats, OdeFailure> {
     let n = sys.dim();
     integrate(
         &mut FirstOrder::new(sys),
@@ -346,7 +346,7 @@ pub fn integrate_ndf_second_order<S: MechanicalSystem>(
     breakpoints: &[f64],
     opts: &NdfOptions,
     output: &mut Output<'_>,
-) -> Result<OdeStats, OdeError> {
+) -> Result<OdeStats, OdeFailure> {
     let n = sys.dim();
     let y0 = mechanical_state(n, q0, qd0)?;
     integrate(
@@ -371,7 +371,7 @@ fn integrate<C: Corrector>(
     breakpoints: &[f64],
     opts: &NdfOptions,
     output: &mut Output<'_>,
-) -> Result<OdeStats, OdeError> {
+) -> Result<OdeStats, OdeFailure> {
     let bounds = check_common(n, t0, y0, t_out, breakpoints)?;
     let tf = *bounds.last().unwrap_or(&t0);
     let mut w = Work::new(n);
@@ -381,7 +381,8 @@ fn integrate<C: Corrector>(
             return Err(invalid(
                 "error_norm",
                 "the mass norm needs a mechanical system (integrate_ndf_second_order)",
-            ));
+            )
+            .into());
         }
         w.mass_norm = true;
         w.mnorm = MassNorm::new(n / 2);
@@ -392,13 +393,13 @@ fn integrate<C: Corrector>(
         b.copy_from(y0)
     })?;
     let pieces = bounds.len().saturating_sub(1);
-    for p in 0..pieces {
+    let result = (0..pieces).try_for_each(|p| {
         let (a, b) = (bounds[p], bounds[p + 1]);
         cs.set_clamp(Clamp::piece(a, p > 0, b, p + 1 < pieces));
         let h0 = if p == 0 { cfg.h0 } else { None };
-        integrate_piece(cs, &mut w, &cfg, a, b, h0, t_out, &mut next, output)?;
-    }
-    Ok(cs.stats().clone())
+        integrate_piece(cs, &mut w, &cfg, a, b, h0, t_out, &mut next, output)
+    });
+    OdeFailure::with(result, cs.stats())
 }
 
 /// Integrates the piece `[a, b]` from `w.y` (at `a`) to `b`, leaving `y(b)` in `w.y`.

@@ -58,7 +58,8 @@ use super::one_step::{
     Parts, Piece,
 };
 use super::{
-    check_common, deliver, mechanical_state, rhs_err, ErrorNorm, OdeError, OdeStats, Output,
+    check_common, deliver, mechanical_state, rhs_err, ErrorNorm, OdeError, OdeFailure, OdeStats,
+    Output,
 };
 use nalgebra::DVector;
 
@@ -243,7 +244,7 @@ pub fn integrate_sdirk<S: MechanicalSystem>(
     breakpoints: &[f64],
     opts: &SdirkOptions,
     output: &mut Output<'_>,
-) -> Result<OdeStats, OdeError> {
+) -> Result<OdeStats, OdeFailure> {
     let n = sys.dim();
     let y0 = mechanical_state(n, q0, qd0)?;
     let bounds = check_common(2 * n, t0, &y0, t_out, breakpoints)?;
@@ -256,13 +257,16 @@ pub fn integrate_sdirk<S: MechanicalSystem>(
         b.copy_from(&y0)
     })?;
     let mut stats = OdeStats::default();
-    for (p, piece) in pieces(&bounds, opts.max_step).iter().enumerate() {
-        let h0 = if p == 0 { opts.initial_step } else { None };
-        integrate_piece(
-            sys, &mut w, opts, piece, h0, t_out, &mut next, output, &mut stats,
-        )?;
-    }
-    Ok(stats)
+    let result = pieces(&bounds, opts.max_step)
+        .iter()
+        .enumerate()
+        .try_for_each(|(p, piece)| {
+            let h0 = if p == 0 { opts.initial_step } else { None };
+            integrate_piece(
+                sys, &mut w, opts, piece, h0, t_out, &mut next, output, &mut stats,
+            )
+        });
+    OdeFailure::with(result, &stats)
 }
 
 /// The outcome of the stages of a step attempt.

@@ -75,7 +75,7 @@ pub(super) fn ndf<S: OdeSystem>(
             std::ops::ControlFlow::Continue(())
         },
     );
-    (out, r)
+    (out, r.map_err(|f| f.error))
 }
 
 pub(super) fn linspace(a: f64, b: f64, m: usize) -> Vec<f64> {

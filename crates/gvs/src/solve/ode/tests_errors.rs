@@ -75,6 +75,7 @@ fn bad_input_is_rejected_without_panic() {
             std::ops::ControlFlow::Continue(())
         })
         .unwrap_err()
+        .error
     };
     let cases: Vec<(&str, OdeError)> = vec![
         (

@@ -24,7 +24,7 @@ fn fixed<S: OdeSystem>(
             std::ops::ControlFlow::Continue(())
         },
     );
-    (out, r)
+    (out, r.map_err(|f| f.error))
 }
 
 fn opts(h: f64) -> FixedStepOptions {
@@ -204,6 +204,7 @@ fn fixed_step_failures_and_bad_options() {
             std::ops::ControlFlow::Continue(())
         })
         .unwrap_err()
+        .error
     };
     let good = FixedStepOptions::default();
     for (field, e) in [

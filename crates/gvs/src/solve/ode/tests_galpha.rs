@@ -87,7 +87,7 @@ pub(super) type Integrator<'a> = &'a dyn Fn(
     &[f64],
     &[f64],
     &mut Output<'_>,
-) -> Result<OdeStats, OdeError>;
+) -> Result<OdeStats, OdeFailure>;
 
 /// Runs `integrate` on `sys` from `q = q0` (every coordinate) at rest; the outputs at `t_out`.
 pub(super) fn run_from_rest(

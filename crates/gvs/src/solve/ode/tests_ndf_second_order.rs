@@ -286,7 +286,7 @@ fn bad_initial_state_is_an_error_naming_it() {
     )
     .unwrap_err();
     assert!(
-        matches!(err, OdeError::Invalid { field: "y0", .. }),
+        matches!(err.error, OdeError::Invalid { field: "y0", .. }),
         "{err}"
     );
     // the generalized-α method checks the same way (it used to check q̇0 only)
@@ -302,7 +302,7 @@ fn bad_initial_state_is_an_error_naming_it() {
     )
     .unwrap_err();
     assert!(
-        matches!(err, OdeError::Invalid { field: "y0", .. }),
+        matches!(err.error, OdeError::Invalid { field: "y0", .. }),
         "{err}"
     );
 }
