@@ -51,8 +51,8 @@
 //! `M q̈ = τ` (the input may jump there).
 
 use super::one_step::{
-    begin_attempt, check_step_options, first_step, newton_test, next_step, pieces, shrink, Newton,
-    Parts, Piece,
+    begin_attempt, check_step_options, first_step, newton_test, next_step, over_pieces, shrink,
+    Newton, Parts, Piece,
 };
 use super::{
     check_common, deliver, invalid, mechanical_state, rhs_err, ErrorNorm, OdeError, OdeFailure,
@@ -242,18 +242,17 @@ pub fn integrate_generalized_alpha<S: MechanicalSystem>(
     deliver(t_out, &mut next, t0, &mut w.out, output, |_, b| {
         b.copy_from(&y0)
     })?;
-    let mut stats = OdeStats::default();
     let c = Coefficients::new(opts.rho_inf);
-    let result = pieces(&bounds, opts.max_step)
-        .iter()
-        .enumerate()
-        .try_for_each(|(p, piece)| {
-            let h0 = if p == 0 { opts.initial_step } else { None };
+    over_pieces(
+        &bounds,
+        opts.max_step,
+        opts.initial_step,
+        |piece, h0, stats| {
             integrate_piece(
-                sys, &mut w, &c, opts, piece, h0, t_out, &mut next, output, &mut stats,
+                sys, &mut w, &c, opts, piece, h0, t_out, &mut next, output, stats,
             )
-        });
-    OdeFailure::with(result, &stats)
+        },
+    )
 }
 
 #[allow(clippy::too_many_arguments)]

@@ -295,7 +295,10 @@ pub struct OdeFailure {
 
 impl OdeFailure {
     /// The outcome of an integration whose work is counted in `stats`.
-    fn with(result: Result<(), OdeError>, stats: &OdeStats) -> Result<OdeStats, OdeFailure> {
+    pub(super) fn with(
+        result: Result<(), OdeError>,
+        stats: &OdeStats,
+    ) -> Result<OdeStats, OdeFailure> {
         match result {
             Ok(()) => Ok(stats.clone()),
             Err(error) => Err(OdeFailure {

@@ -6,7 +6,7 @@
 
 use super::galpha::MechanicalSystem;
 use super::mass_norm::MassNorm;
-use super::{invalid, next_down, next_up, rhs_err, ErrorNorm, Lu, OdeError, OdeStats};
+use super::{invalid, next_down, next_up, rhs_err, ErrorNorm, Lu, OdeError, OdeFailure, OdeStats};
 use nalgebra::{DMatrix, DVector};
 
 /// Checks the step options both methods take.
@@ -76,6 +76,25 @@ pub(super) fn pieces(bounds: &[f64], max_step: f64) -> Vec<Piece> {
             hmax,
         })
         .collect()
+}
+
+/// Integrates the pieces between `bounds` in order with `piece_fn(piece, h0, stats)` (`h0` the
+/// first step: `initial_step` on the first piece, automatic on the others); the outcome with the
+/// work counted up to its end or its failure.
+pub(super) fn over_pieces(
+    bounds: &[f64],
+    max_step: f64,
+    initial_step: Option<f64>,
+    mut piece_fn: impl FnMut(&Piece, Option<f64>, &mut OdeStats) -> Result<(), OdeError>,
+) -> Result<OdeStats, OdeFailure> {
+    let mut stats = OdeStats::default();
+    let result = pieces(bounds, max_step)
+        .iter()
+        .enumerate()
+        .try_for_each(|(p, piece)| {
+            piece_fn(piece, if p == 0 { initial_step } else { None }, &mut stats)
+        });
+    OdeFailure::with(result, &stats)
 }
 
 /// `M`, `D`, `K` of the iteration matrix, its factorization, and the error norm.

@@ -54,8 +54,8 @@
 
 use super::galpha::MechanicalSystem;
 use super::one_step::{
-    begin_attempt, check_step_options, first_step, newton_test, next_step, pieces, shrink, Newton,
-    Parts, Piece,
+    begin_attempt, check_step_options, first_step, newton_test, next_step, over_pieces, shrink,
+    Newton, Parts, Piece,
 };
 use super::{
     check_common, deliver, mechanical_state, rhs_err, ErrorNorm, OdeError, OdeFailure, OdeStats,
@@ -256,17 +256,16 @@ pub fn integrate_sdirk<S: MechanicalSystem>(
     deliver(t_out, &mut next, t0, &mut w.out, output, |_, b| {
         b.copy_from(&y0)
     })?;
-    let mut stats = OdeStats::default();
-    let result = pieces(&bounds, opts.max_step)
-        .iter()
-        .enumerate()
-        .try_for_each(|(p, piece)| {
-            let h0 = if p == 0 { opts.initial_step } else { None };
+    over_pieces(
+        &bounds,
+        opts.max_step,
+        opts.initial_step,
+        |piece, h0, stats| {
             integrate_piece(
-                sys, &mut w, opts, piece, h0, t_out, &mut next, output, &mut stats,
+                sys, &mut w, opts, piece, h0, t_out, &mut next, output, stats,
             )
-        });
-    OdeFailure::with(result, &stats)
+        },
+    )
 }
 
 /// The outcome of the stages of a step attempt.
