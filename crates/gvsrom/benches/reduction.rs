@@ -4,13 +4,24 @@
 //! does) and the POD-ROM with 7 modes (from the straight rod). Single thread. The paper's MATLAB:
 //! HOM 670 ms, AE 42 ms, POD-7 165 ms.
 //!
+//! Dynamics in the same run: 2 s of random steps (new tensions uniform in [−6, 0] N every second,
+//! seed 1, 100 samples/s) from rest in the equilibrium under gravity alone (the straight rod is
+//! not on a decoder's manifold: the data all sag under gravity) with the HOM (second-order NDF, structured
+//! iteration parts), the AE-ROM (first-order NDF with a finite-difference Jacobian, as
+//! `simulate --model` runs decoders) and POD-7 (structured), all at rtol 1e-3 / atol 1e-6.
+//!
 //! The setup solves 200 training equilibria (tensions evenly in [−6, 3] N) and trains the AE for at
 //! most 300 epochs, a few seconds.
 //!
 //! Run with `cargo bench -p gvsrom --bench reduction`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use gvs::inputs::random_steps;
 use gvs::model::Model;
+use gvs::solve::dynamics::{
+    simulate, InitialState, IntegratorOptions, Method, OdeJacobian, Simulation,
+};
+use gvs::solve::ode::NdfOptions;
 use gvs::solve::statics::{StaticsOptions, StaticsSolver};
 use gvs::strain::StrainParam;
 use nalgebra::DVector;
@@ -96,6 +107,91 @@ fn reduction(c: &mut Criterion) {
     c.bench_function("reduction/POD-ROM 7 modes equilibrium u=-2.7N", |b| {
         b.iter(|| black_box(pod_solver.solve(&u, &built.loads, None).expect("pod")))
     });
+
+    // dynamics: the AE-ROM from the straight rod's coordinates (the encoder of zero strain, refined)
+    let zero = vec![0.0; features];
+    let z_guess = DVector::from_vec(ae.encode(&zero).expect("encode"));
+    let map = ae
+        .decoder_map(p.as_slice(), p.nrows())
+        .expect("decoder map");
+    let (z_rest, rest_norm) = ReducedParam::find_rest(&map, &z_guess);
+    eprintln!(
+        "AE rest z = {:?}, ‖c(z)‖ = {rest_norm:.3e}",
+        z_rest.as_slice()
+    );
+    let ae_rest_model = rom_model(
+        &built,
+        ReducedParam::new(&hom.param, map, z_rest).expect("reduced"),
+    );
+    let hom_run = random_steps_run(hom, &built.loads, OdeJacobian::Structured);
+    for (label, run) in [
+        (
+            "AE-ROM",
+            random_steps_run(&ae_rest_model, &built.loads, OdeJacobian::FiniteDifference),
+        ),
+        (
+            "POD-7",
+            random_steps_run(&pod_model, &built.loads, OdeJacobian::Structured),
+        ),
+    ] {
+        let (a, b) = (&hom_run.trajectory.tip, &run.trajectory.tip);
+        let worst = a
+            .iter()
+            .zip(b)
+            .map(|(a, b)| (a.pos - b.pos).norm())
+            .fold(0.0, f64::max);
+        eprintln!(
+            "{label}: {} steps (HOM {}), tip within {:.3} % L of the HOM's over 2 s (start {:.3} %, end {:.3} %)",
+            run.stats.steps,
+            hom_run.stats.steps,
+            100.0 * worst / hom.rod.length(),
+            100.0 * (a[0].pos - b[0].pos).norm() / hom.rod.length(),
+            100.0 * (a[a.len() - 1].pos - b[b.len() - 1].pos).norm() / hom.rod.length()
+        );
+    }
+    c.bench_function("reduction/HOM 33 DOF 2 s random steps", |b| {
+        b.iter(|| black_box(random_steps_run(hom, &built.loads, OdeJacobian::Structured)))
+    });
+    c.bench_function("reduction/AE-ROM r=1 2 s random steps", |b| {
+        b.iter(|| {
+            black_box(random_steps_run(
+                &ae_rest_model,
+                &built.loads,
+                OdeJacobian::FiniteDifference,
+            ))
+        })
+    });
+    c.bench_function("reduction/POD-ROM 7 modes 2 s random steps", |b| {
+        b.iter(|| {
+            black_box(random_steps_run(
+                &pod_model,
+                &built.loads,
+                OdeJacobian::Structured,
+            ))
+        })
+    });
+}
+
+/// 2 s of random steps (uniform in [−6, 0] N every second, seed 1) from rest in the equilibrium
+/// under gravity alone, sampled at 100 Hz, NDF at its default tolerances.
+fn random_steps_run<P: StrainParam>(
+    m: &Model<P>,
+    loads: &gvs::loads::Loads,
+    jacobian: OdeJacobian,
+) -> Simulation {
+    let steps = random_steps(1, -6.0, 0.0, 1.0, 2.0, 1);
+    let t_out: Vec<f64> = (0..=200).map(|k| k as f64 * 0.01).collect();
+    let options = IntegratorOptions {
+        method: Method::Ndf(NdfOptions::default()),
+        jacobian,
+    };
+    let initial = InitialState::Equilibrium {
+        u: vec![0.0],
+        loads: loads.clone(),
+    };
+    let s = simulate(m, &steps, loads, None, &initial, &t_out, &options).expect("simulate");
+    assert!(s.error.is_none(), "{:?}", s.error);
+    s
 }
 
 fn rom_model<P: StrainParam>(built: &gvsrom::Built, param: P) -> Model<P> {
