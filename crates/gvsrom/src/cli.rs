@@ -811,6 +811,15 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
     if let Some(note) = light {
         writeln!(out, "{note}")?;
     }
+    if let (Some(r), false) = (&built.reduced, args.from_equilibrium) {
+        let off = r.rest_strain_offset();
+        if off > 1e-6 {
+            writeln!(
+                out,
+                "start      the reduced model's rest coordinates decode to max |ξ − ξ*| = {off:.3e} at the points, not to the straight rod the full model starts from (--from-equilibrium starts both at the scenario's equilibrium)"
+            )?;
+        }
+    }
     let signal = interrupt_flag();
     let tty = std::io::stderr().is_terminal();
     let mut last_pct = usize::MAX;

@@ -56,6 +56,21 @@ impl Reduced {
         }
     }
 
+    /// How far the rest coordinates ([`StrainParam::rest_coordinates`], where a simulation from
+    /// rest starts) are from the straight rod: the largest `|ξ − ξ*|` over the computational points
+    /// and strain components. Zero for POD (`q_r = 0`); for an autoencoder, its reconstruction error
+    /// of the straight rod, large when the training data lack it (e.g. all sag under gravity).
+    pub fn rest_strain_offset(&self) -> f64 {
+        let m = &self.model;
+        let mut ws = m.workspace();
+        m.forward(&m.param.rest_coordinates(), &mut ws, false);
+        m.point_strains(&ws)
+            .iter()
+            .enumerate()
+            .map(|(j, xi)| (xi - m.xi_star(j)).amax())
+            .fold(0.0, f64::max)
+    }
+
     /// The first coordinate of `q` outside the training encodings' range widened by half its
     /// width on each side (or not finite), described as "`q_r[d] = v` lies far outside the range
     /// of the training data `[lo, hi]` of `MODEL`"; `None` inside (always, for models without a

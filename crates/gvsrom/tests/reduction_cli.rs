@@ -375,6 +375,31 @@ fn a_reduced_trajectory_leaving_the_training_region_stops_with_the_reason() {
     run_ok(&[&release[..], &[s(ae_small())]].concat());
 }
 
+#[test]
+fn a_reduced_start_off_the_straight_rod_is_reported() {
+    // The single-tendon data all sag under gravity: the autoencoder's rest decodes to a bent rod,
+    // POD's `q_r = 0` is the straight rod, and a start at equilibrium is shared by both models.
+    let run = |model: &Path, extra: &[&str]| {
+        let args = [
+            &[
+                "simulate",
+                "single-tendon",
+                "--duration",
+                "0.05",
+                "--model",
+                s(model),
+            ][..],
+            extra,
+        ]
+        .concat();
+        run_ok(&args)
+    };
+    let note = "start      the reduced model's rest coordinates decode to max |ξ − ξ*| = ";
+    assert!(run(ae_small(), &[]).contains(note));
+    assert!(!run(ae_small(), &["--from-equilibrium"]).contains(note));
+    assert!(!run(pod33(), &[]).contains(note));
+}
+
 /// A copy of `model` whose `weights.safetensors` lacks the tensor `drop`.
 fn without_tensor(model: &Path, name: &str, drop: &str) -> PathBuf {
     use safetensors::tensor::{SafeTensors, TensorView};
