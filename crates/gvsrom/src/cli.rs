@@ -60,6 +60,10 @@ pub enum Command {
     /// Train a tanh autoencoder on a dataset's strain snapshots; its decoder becomes a nonlinear
     /// reduced model (`--model` on `statics` and `simulate`).
     Train(TrainArgs),
+    /// Compare a trajectory with a reference one (e.g. `simulate --model` against the full model):
+    /// tip and strain errors over the common samples, and the speed ratio (simulated time per wall
+    /// time).
+    Compare(CompareArgs),
     /// Validate a preset or scenario file and print the model's size, without solving.
     Check(ScenarioArgs),
     /// List the built-in presets.
@@ -69,6 +73,15 @@ pub enum Command {
         /// Preset name (see `gvsrom presets`).
         preset: String,
     },
+}
+
+/// Two trajectories to compare.
+#[derive(Debug, Args)]
+pub struct CompareArgs {
+    /// The reference trajectory (a `simulate --out` directory), e.g. the full model's
+    pub reference: PathBuf,
+    /// The trajectory to measure against it, e.g. a reduced model's (same sample times)
+    pub run: PathBuf,
 }
 
 /// Which scenario, with overrides.
@@ -339,6 +352,7 @@ pub fn run(cli: Cli, out: &mut impl Write) -> Result<()> {
         Command::Dataset(args) => dataset_cmd(&args, out),
         Command::Pod(args) => pod_cmd(&args, out),
         Command::Train(args) => train_cmd(&args, out),
+        Command::Compare(args) => compare_cmd(&args, out),
         Command::Check(args) => check_cmd(&args, out),
         Command::Presets => presets_cmd(out),
         Command::Show { preset } => {
@@ -384,6 +398,68 @@ fn presets_cmd(out: &mut impl Write) -> Result<()> {
         out,
         "Run one with `gvsrom statics NAME`; print its TOML with `gvsrom show NAME`."
     )?;
+    Ok(())
+}
+
+fn compare_cmd(args: &CompareArgs, out: &mut impl Write) -> Result<()> {
+    use gvsrom::compare::{compare, Trajectory};
+    let reference = Trajectory::load(&args.reference, "REFERENCE")?;
+    let run = Trajectory::load(&args.run, "RUN")?;
+    let c = compare(&reference, &run)?;
+    let describe = |tr: &Trajectory| {
+        format!(
+            "{}: {}, {} DOF, {} samples to t = {} s{}, {:.3} s wall",
+            tr.dir.display(),
+            tr.scenario,
+            tr.n_dof,
+            tr.samples(),
+            tr.t.last().copied().unwrap_or(0.0),
+            if tr.complete { "" } else { " (partial)" },
+            tr.wall_time_s
+        )
+    };
+    writeln!(out, "reference  {}", describe(&reference))?;
+    // simulated time per wall time, so that a partial run compares fairly
+    let rate = |tr: &Trajectory| tr.t.last().copied().unwrap_or(0.0) / tr.wall_time_s;
+    let ratio = rate(&run) / rate(&reference);
+    let speed = if ratio >= 1.0 {
+        format!("{ratio:.1}× faster")
+    } else {
+        format!("{:.1}× slower", 1.0 / ratio)
+    };
+    writeln!(out, "run        {}: {speed}", describe(&run))?;
+    if reference.scenario != run.scenario {
+        writeln!(
+            out,
+            "note       the scenarios differ (`{}`, `{}`)",
+            reference.scenario, run.scenario
+        )?;
+    }
+    writeln!(
+        out,
+        "compared   {} samples, t = {} … {} s",
+        c.samples,
+        reference.t[0],
+        reference.t[c.samples - 1]
+    )?;
+    writeln!(
+        out,
+        "tip error  mean {:.3} %, max {:.3} % at t = {} s, last {:.3} % of the length {} m",
+        c.tip_mean, c.tip_max, c.tip_max_t, c.tip_end, reference.length
+    )?;
+    let active: Vec<&str> = c
+        .active
+        .iter()
+        .map(|&i| gvsrom::scenario::StrainMode::ALL[i].name())
+        .collect();
+    match (c.strain_mean, c.strain_max) {
+        (Some(mean), Some(max)) => writeln!(
+            out,
+            "strain     error mean {mean:.3} %, max {max:.3} % (per sample: MAE over the points and {} / the reference's peak |ξ − ξ*|)",
+            active.join(", ")
+        )?,
+        _ => writeln!(out, "strain     the reference is straight at every sample")?,
+    }
     Ok(())
 }
 

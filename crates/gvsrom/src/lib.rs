@@ -7,6 +7,7 @@
 //! and prints.
 
 pub mod build;
+pub mod compare;
 pub mod csv_input;
 pub mod dataset;
 pub mod error;

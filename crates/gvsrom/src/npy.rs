@@ -1,10 +1,82 @@
 //! NumPy `.npy` arrays (little-endian f64, C order, written by npyz) inside an [`OutputDir`]:
-//! whole arrays, and arrays streamed row by row whose number of rows is known only at the end.
+//! whole arrays, and arrays streamed row by row whose number of rows is known only at the end; and
+//! reading an array back checked against the dtype and shape its `meta.json` gives.
 
 use crate::output::OutputDir;
 use npyz::WriterBuilder;
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
+use std::path::Path;
+
+/// A `.npy` file that is missing, unreadable, or not the array its `meta.json` describes.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{file}: {message}")]
+pub struct NpyError {
+    pub file: String,
+    pub message: String,
+}
+
+fn npy_error(file: &str, message: impl Into<String>) -> NpyError {
+    NpyError {
+        file: file.into(),
+        message: message.into(),
+    }
+}
+
+/// Reads `dir/name` as a C-order array of dtype `descr` and shape `shape`, with no byte missing or
+/// extra.
+pub fn read_checked<T: npyz::Deserialize>(
+    dir: &Path,
+    name: &str,
+    descr: &str,
+    shape: &[usize],
+) -> Result<Vec<T>, NpyError> {
+    let path = dir.join(name);
+    let shown = path.display().to_string();
+    let bytes = std::fs::read(&path).map_err(|e| match e.kind() {
+        std::io::ErrorKind::NotFound => npy_error(&shown, "missing array"),
+        _ => npy_error(&shown, format!("cannot read it: {e}")),
+    })?;
+    let npy = npyz::NpyFile::new(&bytes[..])
+        .map_err(|e| npy_error(&shown, format!("not a valid .npy file: {e}")))?;
+    let dtype = npy.dtype().descr();
+    if dtype != format!("'{descr}'") {
+        return Err(npy_error(
+            &shown,
+            format!("dtype {dtype}, expected '{descr}'"),
+        ));
+    }
+    if npy.order() != npyz::Order::C {
+        return Err(npy_error(&shown, "Fortran order, expected C order"));
+    }
+    let got: Vec<usize> = npy.shape().iter().map(|&d| d as usize).collect();
+    if got != shape {
+        return Err(npy_error(
+            &shown,
+            format!("shape {got:?}, expected {shape:?} from meta.json"),
+        ));
+    }
+    let n: usize = shape.iter().product();
+    let size = std::mem::size_of::<T>();
+    let data_len = npy.into_inner().len();
+    if data_len != n * size {
+        return Err(npy_error(
+            &shown,
+            format!(
+                "{} ({data_len} data bytes, expected {} for shape {shape:?})",
+                if data_len < n * size {
+                    "truncated"
+                } else {
+                    "has trailing bytes"
+                },
+                n * size
+            ),
+        ));
+    }
+    npyz::NpyFile::new(&bytes[..])
+        .and_then(|f| f.into_vec::<T>())
+        .map_err(|e| npy_error(&shown, format!("cannot read the data: {e}")))
+}
 
 fn shape_u64(shape: &[usize]) -> Vec<u64> {
     shape.iter().map(|&d| d as u64).collect()

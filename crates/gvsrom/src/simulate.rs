@@ -591,6 +591,7 @@ impl TrajectoryWriter {
             n_dof: built.n_dof(),
             n_points: built.model.disc.n_points(),
             n_actuators: built.model.n_actuators(),
+            length: built.model.rod.length(),
             wall_time_s: sm.wall_time_s,
             real_time_factor: outcome.real_time_factor(),
             steps: sm.stats.steps,
@@ -619,6 +620,8 @@ struct Meta<'a> {
     n_dof: usize,
     n_points: usize,
     n_actuators: usize,
+    /// Rod length [m].
+    length: f64,
     wall_time_s: f64,
     real_time_factor: f64,
     /// Work counts of the integrator (up to the end of the run, or to where it stopped).

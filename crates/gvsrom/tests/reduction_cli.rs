@@ -194,7 +194,7 @@ fn a_pod_rom_with_all_modes_reproduces_the_hom_equilibrium() {
 #[test]
 fn a_pod_rom_trajectory_follows_the_hom() {
     let model = pod33();
-    let run = |name: &str, model: Option<&Path>| -> (Vec<usize>, Vec<f64>) {
+    let run = |name: &str, model: Option<&Path>| -> (PathBuf, Vec<usize>, Vec<f64>) {
         let dir = scratch(name);
         // the release from straight under -3 N: the first 0.05 s hold the fast transient (about
         // 3000 steps at these tolerances; later steps are long, so a longer run adds little)
@@ -217,10 +217,11 @@ fn a_pod_rom_trajectory_follows_the_hom() {
             args.extend(["--model", s(m)]);
         }
         run_ok(&args);
-        npy(&dir.join("tip_position.npy"))
+        let (shape, tips) = npy(&dir.join("tip_position.npy"));
+        (dir, shape, tips)
     };
-    let (shape_h, hom) = run("red-sim-hom", None);
-    let (shape_r, rom) = run("red-sim-rom", Some(model));
+    let (dir_h, shape_h, hom) = run("red-sim-hom", None);
+    let (dir_r, shape_r, rom) = run("red-sim-rom", Some(model));
     assert_eq!(shape_h, [21, 3]);
     assert_eq!(shape_r, shape_h);
     // Both runs keep the local error per step below rtol·|y| + atol (1e-6 relative); the HOM
@@ -242,6 +243,36 @@ fn a_pod_rom_trajectory_follows_the_hom() {
     eprintln!(
         "POD-33 vs HOM trajectory: max tip difference {:e} L",
         worst / L
+    );
+    // `gvsrom compare` measures the same: its largest tip error (printed in % of L to 3 decimals)
+    // rounds to zero, and it names both runs
+    let report = run_ok(&["compare", s(&dir_h), s(&dir_r)]);
+    assert!(report.contains("compared   21 samples"), "{report}");
+    assert!(
+        report.contains("tip error  mean 0.000 %, max 0.000 %"),
+        "{report}"
+    );
+    assert!(
+        report.contains("33 DOF") && (report.contains("faster") || report.contains("slower")),
+        "{report}"
+    );
+    assert!(report.contains("strain     error mean 0.000 %"), "{report}");
+    // the other way round with another sample rate is refused
+    let coarse = scratch("red-sim-hom-coarse");
+    run_ok(&[
+        "simulate",
+        "single-tendon",
+        "--duration",
+        "0.05",
+        "--sample-rate",
+        "200",
+        "--tension=-3",
+        "--out",
+        s(&coarse),
+    ]);
+    expect_error(
+        &["compare", s(&dir_h), s(&coarse)],
+        &["RUN", "--sample-rate"],
     );
 }
 

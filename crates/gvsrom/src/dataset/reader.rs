@@ -37,59 +37,14 @@ fn file_error(file: &str, message: impl Into<String>) -> DatasetError {
     }
 }
 
-/// Reads `dir/name` as a C-order array of dtype `descr` and shape `shape`, with no byte missing or
-/// extra.
+/// [`crate::npy::read_checked`] with its error as a dataset file error.
 fn read_npy<T: npyz::Deserialize>(
     dir: &Path,
     name: &str,
     descr: &str,
     shape: &[usize],
 ) -> Result<Vec<T>, DatasetError> {
-    let path = dir.join(name);
-    let shown = path.display().to_string();
-    let bytes = std::fs::read(&path).map_err(|e| match e.kind() {
-        std::io::ErrorKind::NotFound => file_error(&shown, "missing array"),
-        _ => file_error(&shown, format!("cannot read it: {e}")),
-    })?;
-    let npy = npyz::NpyFile::new(&bytes[..])
-        .map_err(|e| file_error(&shown, format!("not a valid .npy file: {e}")))?;
-    let dtype = npy.dtype().descr();
-    if dtype != format!("'{descr}'") {
-        return Err(file_error(
-            &shown,
-            format!("dtype {dtype}, expected '{descr}'"),
-        ));
-    }
-    if npy.order() != npyz::Order::C {
-        return Err(file_error(&shown, "Fortran order, expected C order"));
-    }
-    let got: Vec<usize> = npy.shape().iter().map(|&d| d as usize).collect();
-    if got != shape {
-        return Err(file_error(
-            &shown,
-            format!("shape {got:?}, expected {shape:?} from meta.json"),
-        ));
-    }
-    let n: usize = shape.iter().product();
-    let size = std::mem::size_of::<T>();
-    let data_len = npy.into_inner().len();
-    if data_len != n * size {
-        return Err(file_error(
-            &shown,
-            format!(
-                "{} ({data_len} data bytes, expected {} for shape {shape:?})",
-                if data_len < n * size {
-                    "truncated"
-                } else {
-                    "has trailing bytes"
-                },
-                n * size
-            ),
-        ));
-    }
-    npyz::NpyFile::new(&bytes[..])
-        .and_then(|f| f.into_vec::<T>())
-        .map_err(|e| file_error(&shown, format!("cannot read the data: {e}")))
+    crate::npy::read_checked(dir, name, descr, shape).map_err(|e| file_error(&e.file, e.message))
 }
 
 impl Dataset {
