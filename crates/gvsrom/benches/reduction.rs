@@ -13,6 +13,8 @@
 //! The setup solves 200 training equilibria (tensions evenly in [−6, 3] N) and trains the AE for at
 //! most 300 epochs, a few seconds.
 //!
+//! Also the HOM from the nearest training sample's coordinates, the start the AE-ROM gets.
+//!
 //! Run with `cargo bench -p gvsrom --bench reduction`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
@@ -45,11 +47,13 @@ fn reduction(c: &mut Criterion) {
     let tensions: Vec<f64> = (0..200).map(|i| -6.0 + 9.0 * i as f64 / 199.0).collect();
     let mut solver = StaticsSolver::new(hom, built.options.clone());
     let mut rows = Vec::new();
+    let mut qs = Vec::new();
     for &u in &tensions {
         let sol = solver
             .solve(&[u], &built.loads, None)
             .expect("training solve");
         rows.extend((&pm * &sol.q).iter());
+        qs.push(sol.q);
     }
     let features = layout.len();
 
@@ -99,6 +103,20 @@ fn reduction(c: &mut Criterion) {
         ramp_steps: 1,
         ..built.options.clone()
     };
+    // the HOM from the same training sample the AE-ROM starts from
+    let mut hom_warm = StaticsSolver::new(hom, one_stage.clone());
+    c.bench_function(
+        "reduction/HOM 33 DOF equilibrium u=-2.7N from the nearest sample",
+        |b| {
+            b.iter(|| {
+                black_box(
+                    hom_warm
+                        .solve(&u, &built.loads, Some(&qs[nearest]))
+                        .expect("hom"),
+                )
+            })
+        },
+    );
     let mut ae_solver = StaticsSolver::new(&ae_model, one_stage);
     c.bench_function("reduction/AE-ROM r=1 equilibrium u=-2.7N", |b| {
         b.iter(|| black_box(ae_solver.solve(&u, &built.loads, Some(&z0)).expect("ae")))
