@@ -1,12 +1,15 @@
 //! The mass-matrix norm of mechanical states ([`super::ErrorNorm::Mass`]): `‖x‖_M̂ = √(xᵀ M̂ x)` with
 //! `M̂ = M·m/tr M` (unit mean diagonal), by the Cholesky factor of `M̂`.
 
+use crate::dynamics::cholesky_factor_in_place;
 use nalgebra::DMatrix;
 
 /// `‖·‖_M̂` for one half (`q` or `q̇`, `m` entries) of a mechanical state.
 pub(super) struct MassNorm {
-    /// `L` of `M̂ = L Lᵀ` (row `i` of `Lᵀ` is the contiguous column `i` of `L` from the diagonal
-    /// down), or `M̂` itself if it is not positive definite (`chol` false).
+    /// `L` of `M̂ = L Lᵀ` in the lower triangle (row `i` of `Lᵀ` is the contiguous column `i` of `L`
+    /// from the diagonal down; the strict upper triangle is scratch), by
+    /// [`cholesky_factor_in_place`] (pivots of a semi-definite `M̂` raised to its floor), or `M̂`
+    /// itself if it is indefinite (`chol` false).
     l: DMatrix<f64>,
     chol: bool,
     /// Evaluation count of the `M` it was made from.
@@ -39,10 +42,9 @@ impl MassNorm {
         }
         self.l.copy_from(mass);
         self.l *= mass.nrows() as f64 / tr;
-        self.chol = cholesky_upper_in_place(&mut self.l);
-        if self.chol {
-            self.l.transpose_mut();
-        } else {
+        // the mass matrix's own (blocked) factorization: `L` in the lower triangle
+        self.chol = cholesky_factor_in_place(&mut self.l).is_ok();
+        if !self.chol {
             self.l.copy_from(mass);
             self.l *= mass.nrows() as f64 / tr;
         }
@@ -81,31 +83,41 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     (s[0] + s[1]) + (s[2] + s[3]) + tail
 }
 
-/// `A = RᵀR` in place (upper triangle `R`, lower triangle zeroed) for a symmetric positive
-/// definite `A`; `false` (with `A` overwritten) if it is not.
-fn cholesky_upper_in_place(a: &mut DMatrix<f64>) -> bool {
-    let m = a.nrows();
-    let s = a.as_mut_slice();
-    for j in 0..m {
-        // R_ij = (A_ij − Σ_{k<i} R_ki R_kj) / R_ii for i < j; R_jj = √(A_jj − Σ_k R_kj²)
-        for i in 0..j {
-            let mut v = s[i + j * m];
-            for k in 0..i {
-                v -= s[k + i * m] * s[k + j * m];
-            }
-            s[i + j * m] = v / s[i + i * m];
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `√(xᵀ M̂ x)` directly, `M̂ = M·m/tr M`.
+    fn direct(mass: &DMatrix<f64>, x: &[f64]) -> f64 {
+        let m = mass.nrows();
+        let scale = m as f64 / mass.trace();
+        let x = nalgebra::DVector::from_column_slice(x);
+        (scale * x.dot(&(mass * &x))).max(0.0).sqrt()
+    }
+
+    #[test]
+    fn the_norm_is_the_quadratic_form_of_the_scaled_mass_across_cholesky_blocks() {
+        // SPD, larger than one factorization block, with entries of mixed sizes
+        for m in [5, 100] {
+            let b = DMatrix::from_fn(m, m, |i, j| ((i * 7 + j * 3) % 11) as f64 - 5.0);
+            let mass = &b * b.transpose() + DMatrix::from_diagonal_element(m, m, 0.5);
+            let mut mn = MassNorm::new(m);
+            mn.set(&mass, 0);
+            assert!(mn.chol && mn.of() == 0);
+            let x: Vec<f64> = (0..m).map(|i| (i as f64 * 0.37).sin()).collect();
+            let (got, want) = (mn.half(&x), direct(&mass, &x));
+            assert!(
+                (got - want).abs() <= 1e-12 * want,
+                "m = {m}: {got} vs {want}"
+            );
         }
-        let mut d = s[j + j * m];
-        for k in 0..j {
-            d -= s[k + j * m] * s[k + j * m];
-        }
-        if !(d > 0.0 && d.is_finite()) {
-            return false;
-        }
-        s[j + j * m] = d.sqrt();
-        for i in j + 1..m {
-            s[i + j * m] = 0.0;
+        // an indefinite matrix falls back to the quadratic form, clipped at zero
+        let mass = DMatrix::from_row_slice(2, 2, &[1.0, 2.0, 2.0, 1.0]);
+        let mut mn = MassNorm::new(2);
+        mn.set(&mass, 1);
+        assert!(!mn.chol);
+        for x in [[1.0, 1.0], [1.0, -1.0]] {
+            assert!((mn.half(&x) - direct(&mass, &x)).abs() < 1e-14, "{x:?}");
         }
     }
-    true
 }
