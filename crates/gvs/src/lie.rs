@@ -192,69 +192,149 @@ pub struct ExpCoeffs {
     pub phi: [f64; 4],
 }
 
+/// `Σ_k c_k x^k` in Horner form.
+#[inline(always)]
+fn horner<const N: usize>(x: f64, c: &[f64; N]) -> f64 {
+    let mut acc = c[N - 1];
+    for k in (0..N - 1).rev() {
+        acc = acc * x + c[k];
+    }
+    acc
+}
+
+/// Taylor coefficients of [`exp_coeffs`] in powers of `θ²` (entry k multiplies `θ²ᵏ`), stored as
+/// reciprocals so that a series costs multiplications only.
+mod series {
+    pub const A2: [f64; 7] = [
+        1.0 / 2.0,
+        -1.0 / 24.0,
+        1.0 / 720.0,
+        -1.0 / 40320.0,
+        1.0 / 3628800.0,
+        -1.0 / 479001600.0,
+        1.0 / 87178291200.0,
+    ];
+    pub const A3: [f64; 7] = [
+        1.0 / 6.0,
+        -1.0 / 120.0,
+        1.0 / 5040.0,
+        -1.0 / 362880.0,
+        1.0 / 39916800.0,
+        -1.0 / 6227020800.0,
+        1.0 / 1307674368000.0,
+    ];
+    pub const F: [[f64; 7]; 4] = [
+        [
+            1.0 / 2.0,
+            0.0,
+            -1.0 / 720.0,
+            1.0 / 20160.0,
+            -1.0 / 1209600.0,
+            1.0 / 119750400.0,
+            -1.0 / 17435658240.0,
+        ],
+        [
+            1.0 / 6.0,
+            0.0,
+            -1.0 / 5040.0,
+            1.0 / 181440.0,
+            -1.0 / 13305600.0,
+            1.0 / 1556755200.0,
+            -1.0 / 261534873600.0,
+        ],
+        [
+            1.0 / 24.0,
+            -1.0 / 360.0,
+            1.0 / 13440.0,
+            -1.0 / 907200.0,
+            1.0 / 95800320.0,
+            -1.0 / 14529715200.0,
+            1.0 / 2988969984000.0,
+        ],
+        [
+            1.0 / 120.0,
+            -1.0 / 2520.0,
+            1.0 / 120960.0,
+            -1.0 / 9979200.0,
+            1.0 / 1245404160.0,
+            -1.0 / 217945728000.0,
+            1.0 / 50812489728000.0,
+        ],
+    ];
+    pub const PHI: [[f64; 6]; 4] = [
+        [
+            0.0,
+            -1.0 / 180.0,
+            1.0 / 3360.0,
+            -1.0 / 151200.0,
+            1.0 / 11975040.0,
+            -1.0 / 1452971520.0,
+        ],
+        [
+            0.0,
+            -1.0 / 1260.0,
+            1.0 / 30240.0,
+            -1.0 / 1663200.0,
+            1.0 / 155675520.0,
+            -1.0 / 21794572800.0,
+        ],
+        [
+            -1.0 / 180.0,
+            1.0 / 3360.0,
+            -1.0 / 151200.0,
+            1.0 / 11975040.0,
+            -1.0 / 1452971520.0,
+            1.0 / 249080832000.0,
+        ],
+        [
+            -1.0 / 1260.0,
+            1.0 / 30240.0,
+            -1.0 / 1663200.0,
+            1.0 / 155675520.0,
+            -1.0 / 21794572800.0,
+            1.0 / 4234374144000.0,
+        ],
+    ];
+}
+
 /// Closed forms above [`SMALL_ANGLE`], Taylor series below (spec §2.3–2.4, extended to θ¹²).
+///
+/// The series run in Horner form in `θ²`; the closed forms take one division (`1/θ`) and its powers.
 pub fn exp_coeffs(theta: f64) -> ExpCoeffs {
     let t = theta;
+    let t2 = t * t;
     if t < SMALL_ANGLE {
-        let t2 = t * t;
-        let t4 = t2 * t2;
-        let t6 = t4 * t2;
-        let t8 = t4 * t4;
-        let t10 = t8 * t2;
-        let t12 = t6 * t6;
         ExpCoeffs {
-            a2: 0.5 - t2 / 24.0 + t4 / 720.0 - t6 / 40320.0 + t8 / 3628800.0 - t10 / 479001600.0
-                + t12 / 87178291200.0,
-            a3: 1.0 / 6.0 - t2 / 120.0 + t4 / 5040.0 - t6 / 362880.0 + t8 / 39916800.0
-                - t10 / 6227020800.0
-                + t12 / 1307674368000.0,
-            f: [
-                0.5 - t4 / 720.0 + t6 / 20160.0 - t8 / 1209600.0 + t10 / 119750400.0
-                    - t12 / 17435658240.0,
-                1.0 / 6.0 - t4 / 5040.0 + t6 / 181440.0 - t8 / 13305600.0 + t10 / 1556755200.0
-                    - t12 / 261534873600.0,
-                1.0 / 24.0 - t2 / 360.0 + t4 / 13440.0 - t6 / 907200.0 + t8 / 95800320.0
-                    - t10 / 14529715200.0
-                    + t12 / 2988969984000.0,
-                1.0 / 120.0 - t2 / 2520.0 + t4 / 120960.0 - t6 / 9979200.0 + t8 / 1245404160.0
-                    - t10 / 217945728000.0
-                    + t12 / 50812489728000.0,
-            ],
-            phi: [
-                -t2 / 180.0 + t4 / 3360.0 - t6 / 151200.0 + t8 / 11975040.0 - t10 / 1452971520.0,
-                -t2 / 1260.0 + t4 / 30240.0 - t6 / 1663200.0 + t8 / 155675520.0
-                    - t10 / 21794572800.0,
-                -1.0 / 180.0 + t2 / 3360.0 - t4 / 151200.0 + t6 / 11975040.0 - t8 / 1452971520.0
-                    + t10 / 249080832000.0,
-                -1.0 / 1260.0 + t2 / 30240.0 - t4 / 1663200.0 + t6 / 155675520.0
-                    - t8 / 21794572800.0
-                    + t10 / 4234374144000.0,
-            ],
+            a2: horner(t2, &series::A2),
+            a3: horner(t2, &series::A3),
+            f: series::F.map(|c| horner(t2, &c)),
+            phi: series::PHI.map(|c| horner(t2, &c)),
         }
     } else {
         let (s, c) = t.sin_cos();
-        let t2 = t * t;
-        let t3 = t2 * t;
-        let t4 = t2 * t2;
-        let t5 = t4 * t;
-        let t6 = t3 * t3;
-        let t7 = t6 * t;
+        let i1 = 1.0 / t;
+        let i2 = i1 * i1;
+        let i3 = i2 * i1;
+        let i4 = i2 * i2;
+        let i5 = i4 * i1;
+        let i6 = i3 * i3;
+        let i7 = i6 * i1;
         let u3 = -8.0 + (8.0 - t2) * c + 5.0 * t * s;
         let u4 = -8.0 * t + (15.0 - t2) * s - 7.0 * t * c;
         ExpCoeffs {
-            a2: (1.0 - c) / t2,
-            a3: (t - s) / t3,
+            a2: (1.0 - c) * i2,
+            a3: (t - s) * i3,
             f: [
-                (4.0 - 4.0 * c - t * s) / (2.0 * t2),
-                (4.0 * t - 5.0 * s + t * c) / (2.0 * t3),
-                (2.0 - 2.0 * c - t * s) / (2.0 * t4),
-                (2.0 * t - 3.0 * s + t * c) / (2.0 * t5),
+                (4.0 - 4.0 * c - t * s) * (0.5 * i2),
+                (4.0 * t - 5.0 * s + t * c) * (0.5 * i3),
+                (2.0 - 2.0 * c - t * s) * (0.5 * i4),
+                (2.0 * t - 3.0 * s + t * c) * (0.5 * i5),
             ],
             phi: [
-                u3 / (2.0 * t4),
-                u4 / (2.0 * t5),
-                u3 / (2.0 * t6),
-                u4 / (2.0 * t7),
+                u3 * (0.5 * i4),
+                u4 * (0.5 * i5),
+                u3 * (0.5 * i6),
+                u4 * (0.5 * i7),
             ],
         }
     }
@@ -342,6 +422,22 @@ pub fn exp_tangent_lean(omega: &V6) -> ExpTangent {
         pow: [M6::from_element(f64::NAN); 4],
         omega: *omega,
         full: false,
+    }
+}
+
+impl ExpTangent {
+    /// Makes `self` the lean step of `omega` ([`exp_tangent_lean`]) in place: `g`, the coefficients
+    /// and `Ω`, with `full = false`. `t` and `pow` keep stale values (never read while `full` is
+    /// false: [`ExpTangent::complete`] recomputes them) instead of being overwritten with NaN, so a
+    /// hot forward pass writes 22 numbers per step instead of moving the whole 1.5 kB struct.
+    #[inline]
+    pub fn set_lean(&mut self, omega: &V6) {
+        let k = ang(omega);
+        let theta = k.norm();
+        self.coeffs = exp_coeffs(theta);
+        self.g = exp_with(&k, &lin(omega), theta, &self.coeffs);
+        self.omega = *omega;
+        self.full = false;
     }
 }
 

@@ -24,8 +24,7 @@ use crate::actuation::{
 use crate::discretize::{Discretization, MagnusOrder};
 use crate::error::ModelError;
 use crate::lie::{
-    ad_mul, coad, coad_mul, coadbar, exp_tangent, exp_tangent_lean, tilde, DTtf, ExpTangent, Pose,
-    M6, V3, V6,
+    ad_mul, coad, coad_mul, coadbar, exp_tangent, tilde, DTtf, ExpTangent, Pose, M6, V3, V6,
 };
 use crate::loads::{Frame, Loads};
 use crate::rod::{Rod, SectionProps};
@@ -338,13 +337,12 @@ impl<P: StrainParam> Model<P> {
                 }
                 MagnusOrder::Z2 => ws.xi[s1] * h,
             };
-            let et = if jacobians {
-                exp_tangent(&omega)
+            if jacobians {
+                ws.et[i] = exp_tangent(&omega);
             } else {
-                exp_tangent_lean(&omega)
-            };
-            ws.g[i + 1] = ws.g[i].compose(&et.g);
-            ws.et[i] = et;
+                ws.et[i].set_lean(&omega);
+            }
+            ws.g[i + 1] = ws.g[i].compose(&ws.et[i].g);
         }
         if jacobians {
             self.forward_jacobians(ws);
