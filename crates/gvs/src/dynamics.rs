@@ -195,6 +195,7 @@ impl<P: StrainParam> Model<P> {
             }
             start = end;
         }
+        crate::cpu::clear_upper_state();
     }
 
     /// The smallest ratio `Ds/Es` over the sections and the strain components with `Es > 0` [s]
@@ -637,6 +638,7 @@ pub fn cholesky_factor_in_place(a: &mut DMatrix<f64>) -> Result<(), DynamicsErro
                 -1.0,
                 Par::Seq,
             );
+            crate::cpu::clear_upper_state();
             if a21.rb().has_nan() {
                 return Err(DynamicsError::MassNotPositiveDefinite {
                     pivot: j0 + nb,

@@ -12,6 +12,7 @@
 //! shear-y, shear-z]`; the rod runs along its local x-axis; SI units.
 
 pub mod actuation;
+pub mod cpu;
 pub mod discretize;
 pub mod dynamics;
 pub mod error;

@@ -57,6 +57,7 @@ pub(crate) fn mul_cols((rows, k, n): (usize, usize, usize), a: &[f64], b: &[f64]
     let b = MatRef::from_column_major_slice(&b[..k * n], k, n);
     let y = MatMut::from_column_major_slice_mut(&mut y[..rows * n], rows, n);
     matmul(y, Accum::Replace, a, b, 1.0, Par::Seq);
+    gvs::cpu::clear_upper_state();
 }
 
 /// `Y = Aᵀ·B` for column-major `A` (`rows × k`), `B` (`rows × n`) and `Y` (`k × n`), as
@@ -71,4 +72,5 @@ pub(crate) fn mul_tr_cols(
     let b = MatRef::from_column_major_slice(&b[..rows * n], rows, n);
     let y = MatMut::from_column_major_slice_mut(&mut y[..k * n], k, n);
     matmul(y, Accum::Replace, a.transpose(), b, 1.0, Par::Seq);
+    gvs::cpu::clear_upper_state();
 }

@@ -229,6 +229,7 @@ impl Stacked {
             let yb = MatMut::from_column_major_slice_mut(yb, ns, k);
             matmul(yb, Accum::Replace, phi, xb, 1.0, Par::Seq);
         }
+        gvs::cpu::clear_upper_state();
     }
 
     /// `g = Σ_i Φ_iᵀ w_i` (`g` of length m) with `w_i` the component `a_i` of `w` at every site,
@@ -245,6 +246,7 @@ impl Stacked {
             let gb = MatMut::from_column_major_slice_mut(&mut g[b.cols.clone()], b.cols.len(), 1);
             matmul(gb, Accum::Add, phi.transpose(), wb, 1.0, Par::Seq);
         }
+        gvs::cpu::clear_upper_state();
     }
 }
 

@@ -231,6 +231,7 @@ impl Lu {
                 stack,
                 params,
             );
+            crate::cpu::clear_upper_state();
             let tol = amax * n as f64 * f64::EPSILON;
             (0..n).all(|k| self.factors[(k, k)].abs() > tol)
         };
@@ -246,6 +247,7 @@ impl Lu {
         let rhs = MatMut::from_column_major_slice_mut(b.as_mut_slice(), n, 1);
         let stack = MemStack::new(&mut self.mem);
         lu_solve_faer::solve_in_place(lu, lu, perm, rhs, Par::Seq, stack);
+        crate::cpu::clear_upper_state();
         for (i, s) in self.sigma.iter().enumerate() {
             let c = self.v.column(i).dot(b) / s;
             b.axpy(-c, &self.w.column(i), 1.0);

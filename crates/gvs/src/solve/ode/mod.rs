@@ -698,6 +698,7 @@ impl Lu {
             MemStack::new(&mut self.mem),
             Default::default(),
         );
+        crate::cpu::clear_upper_state();
         (0..n).all(|k| {
             let p = self.a[(k, k)];
             p != 0.0 && p.is_finite()
@@ -711,6 +712,7 @@ impl Lu {
         let perm = PermRef::new_checked(&self.perm, &self.perm_inv, n);
         let rhs = MatMut::from_column_major_slice_mut(b.as_mut_slice(), n, 1);
         lu_solve::solve_in_place(lu, lu, perm, rhs, Par::Seq, MemStack::new(&mut self.mem));
+        crate::cpu::clear_upper_state();
     }
 }
 
