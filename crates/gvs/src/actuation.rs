@@ -274,6 +274,18 @@ pub fn turning_angle(a: &V3, b: &V3) -> (f64, V3, V3) {
 /// get zero gradients, as in [`turning_angle`].
 #[inline]
 pub fn smoothed_turning_angle(a: &V3, b: &V3, eps: f64) -> (f64, V3, V3) {
+    smoothed_turning_angle_with(a, b, eps, true)
+}
+
+/// The value of [`smoothed_turning_angle`] alone (what a residual needs): the same operations up to
+/// `φ_ε`, so the same bits, without the gradients' divisions and cross products.
+#[inline]
+pub fn smoothed_turning_angle_value(a: &V3, b: &V3, eps: f64) -> f64 {
+    smoothed_turning_angle_with(a, b, eps, false).0
+}
+
+#[inline(always)]
+fn smoothed_turning_angle_with(a: &V3, b: &V3, eps: f64, gradients: bool) -> (f64, V3, V3) {
     if eps <= 0.0 {
         return turning_angle(a, b);
     }
@@ -282,10 +294,16 @@ pub fn smoothed_turning_angle(a: &V3, b: &V3, eps: f64) -> (f64, V3, V3) {
     let c = a.dot(b);
     let phi = s.atan2(c);
     let z = phi / eps;
-    let th = z.tanh();
-    let ch = z.cosh();
-    let sech2 = 1.0 / (ch * ch);
+    // tanh z and sech² z from one exponential: with m = e^{−2z} − 1 (z ≥ 0, m ∈ (−1, 0]),
+    // tanh z = −m/(2 + m), sech² z = 4(1 + m)/(2 + m)² (expm1 keeps tanh's relative precision at small z)
+    let m = (-2.0 * z).exp_m1();
+    let inv = 1.0 / (2.0 + m);
+    let th = -m * inv;
+    let sech2 = 4.0 * (1.0 + m) * inv * inv;
     let value = phi * th + 0.5 * eps * z * z * sech2;
+    if !gradients {
+        return (value, V3::zeros(), V3::zeros());
+    }
     // φ/s, with its limit 1/c at s = 0 (φ = atan(s/c) = s/c (1 − (s/c)²/3 + …))
     let phi_over_s = if s > 1e-150 {
         phi / s

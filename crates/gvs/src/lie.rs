@@ -352,13 +352,27 @@ pub fn exp_se3(omega: &V6) -> Pose {
     exp_with(&k, &nu, theta, &c)
 }
 
+/// [`exp_se3`] from its coefficients. With `k̃² = k kᵀ − θ² I`: `R = (1 − a₂θ²) I + a₁' k̃ + a₂ k kᵀ` and
+/// `p = ν + a₂ k × ν + a₃ k × (k × ν)` (no 3×3 products).
 #[inline]
 fn exp_with(k: &V3, nu: &V3, theta: f64, c: &ExpCoeffs) -> Pose {
-    let kt = tilde(k);
-    let kt2 = kt * kt;
-    let a1 = 1.0 - c.a3 * theta * theta; // sin θ / θ
-    let rot = M3::identity() + kt * a1 + kt2 * c.a2;
-    let pos = nu + kt * nu * c.a2 + kt2 * nu * c.a3;
+    let t2 = theta * theta;
+    let a1 = 1.0 - c.a3 * t2; // sin θ / θ
+    let d = 1.0 - c.a2 * t2; // cos θ
+    let (a2k, a1k) = (k * c.a2, k * a1);
+    let rot = M3::new(
+        d + a2k[0] * k[0],
+        a2k[0] * k[1] - a1k[2],
+        a2k[0] * k[2] + a1k[1],
+        a2k[1] * k[0] + a1k[2],
+        d + a2k[1] * k[1],
+        a2k[1] * k[2] - a1k[0],
+        a2k[2] * k[0] - a1k[1],
+        a2k[2] * k[1] + a1k[0],
+        d + a2k[2] * k[2],
+    );
+    let kxnu = k.cross(nu);
+    let pos = nu + kxnu * c.a2 + k.cross(&kxnu) * c.a3;
     Pose { rot, pos }
 }
 

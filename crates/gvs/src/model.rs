@@ -19,7 +19,8 @@
 //! of spec §8.2; the friction factor's derivative `∂α/∂q` is included, so the Jacobian is exact.
 
 use crate::actuation::{
-    smoothed_turning_angle, tangent_jacobian, tendon_local, wrench_jacobian, Tendon,
+    smoothed_turning_angle, smoothed_turning_angle_value, tangent_jacobian, tendon_local,
+    wrench_jacobian, Tendon,
 };
 use crate::discretize::{Discretization, MagnusOrder};
 use crate::error::ModelError;
@@ -539,11 +540,13 @@ impl<P: StrainParam> Model<P> {
                     if m > 0 {
                         let x_prev = self.disc.points[self.tendon_points[k][m - 1]].x;
                         let eps = td.smoothing_angle(p.x - x_prev);
-                        let (phi, ga, gb) = smoothed_turning_angle(&tau_prev, &tau, eps);
-                        theta += phi;
                         if jac {
+                            let (phi, ga, gb) = smoothed_turning_angle(&tau_prev, &tau, eps);
+                            theta += phi;
                             ws.dtheta.gemv_tr(1.0, &ws.dtau_prev, &ga, 1.0);
                             ws.dtheta.gemv_tr(1.0, &ws.dtau, &gb, 1.0);
+                        } else {
+                            theta += smoothed_turning_angle_value(&tau_prev, &tau, eps);
                         }
                     }
                     tau_prev = tau;

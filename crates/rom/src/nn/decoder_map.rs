@@ -187,7 +187,7 @@ impl CoefficientMap for DecoderMap {
             if k < last {
                 let st = &mut stored[off..off + n_out * cols];
                 for i in 0..n_out {
-                    let sigma = y[i].tanh();
+                    let sigma = super::activation::tanh(y[i]);
                     let d1 = 1.0 - sigma * sigma;
                     st[i] = sigma;
                     for l in 0..r {

@@ -9,6 +9,7 @@
 //! - [`autoencoder`]: the symmetric architecture, encode/decode, training entry point.
 //! - [`decoder_map`]: the decoder folded with an output projection; value, Jacobian, eq. (17), Hessians.
 
+pub mod activation;
 pub mod autoencoder;
 pub mod batch;
 pub mod decoder_map;
