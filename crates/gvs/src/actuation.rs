@@ -296,7 +296,8 @@ fn smoothed_turning_angle_with(a: &V3, b: &V3, eps: f64, gradients: bool) -> (f6
     let z = phi / eps;
     // tanh z and sech² z from one exponential: with m = e^{−2z} − 1 (z ≥ 0, m ∈ (−1, 0]),
     // tanh z = −m/(2 + m), sech² z = 4(1 + m)/(2 + m)² (expm1 keeps tanh's relative precision at small z)
-    let m = (-2.0 * z).exp_m1();
+    // (above z = 19, e^{−2z} < 2⁻⁵⁴ and m is −1 exactly: the exact value without the call)
+    let m = if z < 19.0 { (-2.0 * z).exp_m1() } else { -1.0 };
     let inv = 1.0 / (2.0 + m);
     let th = -m * inv;
     let sech2 = 4.0 * (1.0 + m) * inv * inv;
