@@ -1,8 +1,10 @@
 //! Reduced models against the full one (issue 7, paper IV-A): one equilibrium of the single-tendon
 //! arm at u = −2.7 N (not a training tension) with the HOM (33 DOF, from the straight rod), the
 //! AE-ROM (r = 1, 7 hidden layers, from the nearest training sample's encoding, as `statics --model`
-//! does) and the POD-ROM with 7 modes (from the straight rod). Single thread. The paper's MATLAB:
-//! HOM 670 ms, AE 42 ms, POD-7 165 ms.
+//! does) and the POD-ROM with 7 modes (from the straight rod), and, as the floor of any one-DOF
+//! reduced model on this engine, POD-1 (a constant strain column: no decoder cost). Each solver as
+//! `statics` runs it (`solver.jacobian = auto`: forward differences at one coordinate). Single thread.
+//! The paper's MATLAB: HOM 670 ms, AE 42 ms, POD-7 165 ms.
 //!
 //! Dynamics in the same run: 2 s of random steps (new tensions uniform in [−6, 0] N every second,
 //! seed 1, 100 samples/s) from rest in the equilibrium under gravity alone (the straight rod is
@@ -57,10 +59,15 @@ fn reduction(c: &mut Criterion) {
     }
     let features = layout.len();
 
-    // POD-7 on the HOM basis
+    // POD-7 and POD-1 on the HOM basis
     let pod = Pod::compute(&rows, features, 7).expect("pod");
     let pod_basis = hom.param.compose(&(&p * &pod.modes)).expect("compose");
     let pod_model = rom_model(&built, pod_basis);
+    let pod1 = Pod::compute(&rows, features, 1).expect("pod");
+    let pod1_model = rom_model(
+        &built,
+        hom.param.compose(&(&p * &pod1.modes)).expect("compose"),
+    );
 
     // AE r = 1, 7 hidden layers
     let options = TrainOptions {
@@ -124,6 +131,26 @@ fn reduction(c: &mut Criterion) {
     let mut pod_solver = StaticsSolver::new(&pod_model, built.options.clone());
     c.bench_function("reduction/POD-ROM 7 modes equilibrium u=-2.7N", |b| {
         b.iter(|| black_box(pod_solver.solve(&u, &built.loads, None).expect("pod")))
+    });
+    let mut pod1_solver = StaticsSolver::new(&pod1_model, built.options.clone());
+    for (label, sol) in [
+        ("HOM", hom_solver.solve(&u, &built.loads, None)),
+        (
+            "HOM from the nearest sample",
+            hom_warm.solve(&u, &built.loads, Some(&qs[nearest])),
+        ),
+        ("AE-ROM", ae_solver.solve(&u, &built.loads, Some(&z0))),
+        ("POD-7", pod_solver.solve(&u, &built.loads, None)),
+        ("POD-1", pod1_solver.solve(&u, &built.loads, None)),
+    ] {
+        let sol = sol.expect("solve");
+        eprintln!(
+            "{label}: {} iterations, {} residuals, {} Jacobians",
+            sol.iterations, sol.residual_evaluations, sol.jacobian_evaluations
+        );
+    }
+    c.bench_function("reduction/POD-ROM 1 mode equilibrium u=-2.7N", |b| {
+        b.iter(|| black_box(pod1_solver.solve(&u, &built.loads, None).expect("pod1")))
     });
 
     // dynamics: the AE-ROM from the straight rod's coordinates (the encoder of zero strain, refined)
