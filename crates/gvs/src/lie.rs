@@ -396,7 +396,8 @@ pub struct ExpTangent {
     /// `ad_Ωʳ`, r = 1..4.
     pub pow: [M6; 4],
     pub omega: V6,
-    /// Whether `t` and `pow` are computed ([`exp_tangent_lean`] leaves them NaN).
+    /// Whether `t` and `pow` are computed ([`exp_tangent_lean`] leaves them NaN, [`ExpTangent::set_lean`]
+    /// stale; [`ExpTangent::t_dot`] and [`ExpTangent::d_ty`] assert it in debug builds).
     pub full: bool,
 }
 
@@ -507,6 +508,7 @@ impl ExpTangent {
     /// Time derivative `Ṫ = Σ_r [φ_r (Ω_k·Ω̇_k) Aʳ + f_r Σ_{u=1}^{r} A^{u−1} Ȧ A^{r−u}]`, `A = ad_Ω`,
     /// `Ȧ = ad_Ω̇` (spec §2.5).
     pub fn t_dot(&self, omega_dot: &V6) -> M6 {
+        debug_assert!(self.full, "t_dot needs the powers of a full step");
         let a = &self.pow[0];
         let ad_ = ad(omega_dot);
         let kk = ang(&self.omega).dot(&ang(omega_dot));
@@ -541,6 +543,7 @@ impl ExpTangent {
 
     /// `∂(T y)/∂Ω = Σ_r [φ_r (Aʳy) [Ω_kᵀ, 0] − f_r Σ_{u=1}^{r} A^{u−1} ad_{(A^{r−u} y)}]` (spec §2.5).
     pub fn d_ty(&self, y: &V6) -> M6 {
+        debug_assert!(self.full, "d_ty needs the powers of a full step");
         let a = &self.pow[0];
         // A^{m} y for m = 0..4
         let mut ay = [*y; 5];
