@@ -426,18 +426,22 @@ pub fn exp_tangent(omega: &V6) -> ExpTangent {
 /// [`ExpTangent::complete`]): what a pass that only needs `exp Ω`, `T y` and `Tᵀ y`
 /// ([`ExpTangent::t_mul`], [`ExpTangent::t_tr_mul`]) pays — no 6×6 products.
 pub fn exp_tangent_lean(omega: &V6) -> ExpTangent {
-    let k = ang(omega);
-    let theta = k.norm();
-    let coeffs = exp_coeffs(theta);
-    let g = exp_with(&k, &lin(omega), theta, &coeffs);
-    ExpTangent {
-        g,
-        t: M6::from_element(f64::NAN),
-        coeffs,
-        pow: [M6::from_element(f64::NAN); 4],
+    let nan = f64::NAN;
+    let mut et = ExpTangent {
+        g: Pose::identity(),
+        t: M6::from_element(nan),
+        coeffs: ExpCoeffs {
+            a2: nan,
+            a3: nan,
+            f: [nan; 4],
+            phi: [nan; 4],
+        },
+        pow: [M6::from_element(nan); 4],
         omega: *omega,
         full: false,
-    }
+    };
+    et.set_lean(omega);
+    et
 }
 
 impl ExpTangent {
