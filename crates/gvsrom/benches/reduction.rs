@@ -1,7 +1,8 @@
 //! Reduced models against the full one (issue 7, paper IV-A): one equilibrium of the single-tendon
 //! arm at u = −2.7 N (not a training tension) with the HOM (33 DOF, from the straight rod), the
-//! AE-ROM (r = 1, 7 hidden layers, from the nearest training sample's encoding, as `statics --model`
-//! does) and the POD-ROM with 7 modes (from the straight rod), and, as the floor of any one-DOF
+//! AE-ROM (r = 1, 7 hidden layers, from its anchors as `statics --model` starts: its own equilibria
+//! at the training tensions, solved as `gvsrom train` does and interpolated at u) and the POD-ROM
+//! with 7 modes (from the straight rod), and, as the floor of any one-DOF
 //! reduced model on this engine, POD-1 (a constant strain column: no decoder cost). Each solver as
 //! `statics` runs it (`solver.jacobian = auto`: forward differences at one coordinate). Single thread.
 //! The paper's MATLAB: HOM 670 ms, AE 42 ms, POD-7 165 ms.
@@ -15,7 +16,9 @@
 //! The setup solves 200 training equilibria (tensions evenly in [−6, 3] N) and trains the AE for at
 //! most 300 epochs, a few seconds.
 //!
-//! Also the HOM from the nearest training sample's coordinates, the start the AE-ROM gets.
+//! Also, for equal starts, the HOM from its own training solutions interpolated at u the same way,
+//! and the AE-ROM from the nearest training sample's encoding (the start before anchors held
+//! equilibria).
 //!
 //! Run with `cargo bench -p gvsrom --bench reduction`.
 
@@ -28,6 +31,7 @@ use gvs::solve::dynamics::{
 use gvs::solve::ode::NdfOptions;
 use gvs::solve::statics::{StaticsOptions, StaticsSolver};
 use gvs::strain::StrainParam;
+use gvsrom::reduce::{anchor_guess, solve_anchors};
 use nalgebra::DVector;
 use rom::nn::{Autoencoder, TrainOptions};
 use rom::pod::Pod;
@@ -91,17 +95,34 @@ fn reduction(c: &mut Criterion) {
         })
         .map(|(i, _)| i)
         .unwrap();
-    let z0 = DVector::from_vec(
-        ae.encode(&rows[nearest * features..(nearest + 1) * features])
-            .expect("encode"),
-    );
     let map = ae
         .decoder_map(p.as_slice(), p.nrows())
         .expect("decoder map");
-    let ae_param = ReducedParam::new(&hom.param, map, z0.clone()).expect("reduced");
+    let mut latent: Vec<f64> = rows
+        .chunks_exact(features)
+        .flat_map(|row| ae.encode(row).expect("encode"))
+        .collect();
+    let z_enc = DVector::from_column_slice(&latent[nearest..nearest + 1]);
+    let ae_param = ReducedParam::new(&hom.param, map, z_enc.clone()).expect("reduced");
     let ae_model = rom_model(&built, ae_param);
-
+    // anchors as `gvsrom train` makes them: the AE-ROM's own equilibria at the training tensions
+    let solved = solve_anchors(
+        &ae_model,
+        &built.options,
+        &built.u,
+        &built.loads,
+        &[0],
+        &tensions,
+        &mut latent,
+        &|_| true,
+    );
+    assert_eq!(solved, tensions.len(), "anchor equilibria");
     let u = [TEST_TENSION];
+    let z0 = anchor_guess(&tensions, &latent, 1, 1, &u).expect("anchor guess");
+    // the HOM's counterpart: its training solutions, interpolated the same way
+    let q_flat: Vec<f64> = qs.iter().flat_map(|q| q.iter().copied()).collect();
+    let q_guess = anchor_guess(&tensions, &q_flat, 1, hom.n_dof(), &u).expect("hom guess");
+
     let mut hom_solver = StaticsSolver::new(hom, built.options.clone());
     c.bench_function("reduction/HOM 33 DOF equilibrium u=-2.7N", |b| {
         b.iter(|| black_box(hom_solver.solve(&u, &built.loads, None).expect("hom")))
@@ -110,15 +131,15 @@ fn reduction(c: &mut Criterion) {
         ramp_steps: 1,
         ..built.options.clone()
     };
-    // the HOM from the same training sample the AE-ROM starts from
+    // the HOM from its training solutions interpolated at u, as the AE-ROM starts from its anchors
     let mut hom_warm = StaticsSolver::new(hom, one_stage.clone());
     c.bench_function(
-        "reduction/HOM 33 DOF equilibrium u=-2.7N from the nearest sample",
+        "reduction/HOM 33 DOF equilibrium u=-2.7N from the training solutions",
         |b| {
             b.iter(|| {
                 black_box(
                     hom_warm
-                        .solve(&u, &built.loads, Some(&qs[nearest]))
+                        .solve(&u, &built.loads, Some(&q_guess))
                         .expect("hom"),
                 )
             })
@@ -128,6 +149,10 @@ fn reduction(c: &mut Criterion) {
     c.bench_function("reduction/AE-ROM r=1 equilibrium u=-2.7N", |b| {
         b.iter(|| black_box(ae_solver.solve(&u, &built.loads, Some(&z0)).expect("ae")))
     });
+    c.bench_function(
+        "reduction/AE-ROM r=1 equilibrium u=-2.7N from the nearest encoding",
+        |b| b.iter(|| black_box(ae_solver.solve(&u, &built.loads, Some(&z_enc)).expect("ae"))),
+    );
     let mut pod_solver = StaticsSolver::new(&pod_model, built.options.clone());
     c.bench_function("reduction/POD-ROM 7 modes equilibrium u=-2.7N", |b| {
         b.iter(|| black_box(pod_solver.solve(&u, &built.loads, None).expect("pod")))
@@ -136,10 +161,14 @@ fn reduction(c: &mut Criterion) {
     for (label, sol) in [
         ("HOM", hom_solver.solve(&u, &built.loads, None)),
         (
-            "HOM from the nearest sample",
-            hom_warm.solve(&u, &built.loads, Some(&qs[nearest])),
+            "HOM from the training solutions",
+            hom_warm.solve(&u, &built.loads, Some(&q_guess)),
         ),
         ("AE-ROM", ae_solver.solve(&u, &built.loads, Some(&z0))),
+        (
+            "AE-ROM from the nearest encoding",
+            ae_solver.solve(&u, &built.loads, Some(&z_enc)),
+        ),
         ("POD-7", pod_solver.solve(&u, &built.loads, None)),
         ("POD-1", pod1_solver.solve(&u, &built.loads, None)),
     ] {

@@ -714,6 +714,13 @@ fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
         s.rest_residual,
         s.projection_residual
     )?;
+    if s.anchor_equilibria > 0 {
+        writeln!(
+            out,
+            "anchors    {} of {} training inputs hold the reduced model's own equilibrium (solved in {:.2} s): statics --model starts there",
+            s.anchor_equilibria, s.rows, s.anchor_time_s
+        )?;
+    }
     writeln!(out, "model      {}", s.path.display())?;
     if signal.load(Ordering::SeqCst) != 0 {
         return Err(Interrupted {

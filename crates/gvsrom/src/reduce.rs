@@ -18,6 +18,7 @@ use crate::reduced_model::{
 };
 use crate::scenario::Scenario;
 use gvs::model::Model;
+use gvs::solve::statics::{StaticsOptions, StaticsSolver};
 use gvs::strain::{LinearBasis, StrainParam};
 use nalgebra::{DMatrix, DVector};
 use rom::nn::{Autoencoder, TrainOptions, TrainReport};
@@ -33,8 +34,8 @@ pub struct Reduced {
     /// `"pod"` or `"autoencoder"`.
     pub kind: String,
     pub path: PathBuf,
-    /// Initial guess of a statics solve: the encoding of the training sample nearest to this
-    /// scenario's inputs (autoencoders whose dataset inputs the scenario defines).
+    /// Initial guess of a statics solve: the model's anchors at this scenario's inputs
+    /// ([`anchor_guess`]; autoencoders whose dataset inputs the scenario defines).
     pub initial: Option<DVector<f64>>,
     /// The training encodings' range per coordinate (autoencoders).
     pub latent_range: Vec<[f64; 2]>,
@@ -76,33 +77,32 @@ impl Reduced {
     /// of the training data `[lo, hi]` of `MODEL`"; `None` inside (always, for models without a
     /// recorded range).
     pub fn range_violation(&self, q: &[f64]) -> Option<String> {
-        q.iter()
-            .zip(&self.latent_range)
-            .enumerate()
-            .find(|(_, (v, [lo, hi]))| {
-                let margin = 0.5 * (hi - lo).max(1e-12);
-                !(**v >= lo - margin && **v <= hi + margin)
-            })
-            .map(|(d, (v, [lo, hi]))| {
-                format!(
-                    "q_r[{d}] = {v:.6} lies far outside the range of the training data [{lo:.6}, {hi:.6}] of `{}`",
-                    self.path.display()
-                )
-            })
+        outside_range(&self.latent_range, q).map(|d| {
+            let (v, [lo, hi]) = (q[d], self.latent_range[d]);
+            format!(
+                "q_r[{d}] = {v:.6} lies far outside the range of the training data [{lo:.6}, {hi:.6}] of `{}`",
+                self.path.display()
+            )
+        })
     }
+}
+
+/// The first coordinate of `q` outside `range` widened by half its width on each side, or not
+/// finite (see [`Reduced::range_violation`]).
+fn outside_range(range: &[[f64; 2]], q: &[f64]) -> Option<usize> {
+    q.iter().zip(range).position(|(v, [lo, hi])| {
+        let margin = 0.5 * (hi - lo).max(1e-12);
+        !(*v >= lo - margin && *v <= hi + margin)
+    })
 }
 
 /// The value of a dataset input `path` in the scenario being run: tensions from `built` (they
 /// include `--tension`), anything else from the scenario table.
 fn input_value(built: &Built, table: Option<&toml::Table>, path: &str) -> Option<f64> {
-    let segs = crate::scenario::parse_path(path).ok()?;
-    if let [crate::scenario::Seg::Key(t), crate::scenario::Seg::Index(k), crate::scenario::Seg::Key(f)] =
-        segs.as_slice()
-    {
-        if t == "tendons" && f == "tension" {
-            return built.u.get(*k).copied();
-        }
+    if let Some(k) = tendon_input(path) {
+        return built.u.get(k).copied();
     }
+    let segs = crate::scenario::parse_path(path).ok()?;
     match crate::scenario::lookup(table?, &segs)? {
         toml::Value::Float(v) => Some(*v),
         toml::Value::Integer(v) => Some(*v as f64),
@@ -110,7 +110,8 @@ fn input_value(built: &Built, table: Option<&toml::Table>, path: &str) -> Option
     }
 }
 
-/// The encoding of the anchor nearest to the scenario's inputs (each input scaled by its range).
+/// The initial guess of a reduced statics solve at the scenario's inputs, from the model's anchors
+/// ([`anchor_guess`]).
 fn nearest_anchor(
     built: &Built,
     table: Option<&toml::Table>,
@@ -118,26 +119,63 @@ fn nearest_anchor(
 ) -> Option<DVector<f64>> {
     let a = model.anchors.as_ref()?;
     let names = &model.meta.anchor_parameters;
-    let k = names.len();
-    if a.n == 0 || k == 0 {
-        return None;
-    }
     let x: Vec<f64> = names
         .iter()
         .map(|p| input_value(built, table, p))
         .collect::<Option<_>>()?;
+    anchor_guess(&a.inputs, &a.latent, names.len(), model.meta.latent, &x)
+}
+
+/// An initial guess at the inputs `x` (k values) from anchors: `inputs` (`n × k`) and their reduced
+/// coordinates `latent` (`n × r`), both row-major.
+///
+/// With one input and anchors on both sides of `x`, the linear interpolation between the nearest
+/// anchor below and the nearest above: for anchors that are the reduced model's own equilibria
+/// (see [`solve_anchors`]) its error is second order in their spacing, where the nearest anchor's
+/// is first order, and one Newton step usually reaches the tolerance (IV-A: 3 residuals instead of
+/// 4). Otherwise the nearest anchor, each input scaled by its largest magnitude. `None` without
+/// anchors or inputs.
+pub fn anchor_guess(
+    inputs: &[f64],
+    latent: &[f64],
+    k: usize,
+    r: usize,
+    x: &[f64],
+) -> Option<DVector<f64>> {
+    let n = inputs.len().checked_div(k).unwrap_or(0);
+    if n == 0 || x.len() != k || latent.len() != n * r {
+        return None;
+    }
+    let row = |i: usize| DVector::from_column_slice(&latent[i * r..(i + 1) * r]);
+    if k == 1 {
+        let x = x[0];
+        // nearest anchor at or below x, nearest at or above (first of equal inputs)
+        let below = (0..n)
+            .filter(|&i| inputs[i] <= x)
+            .min_by(|&a, &b| (x - inputs[a]).total_cmp(&(x - inputs[b])).then(a.cmp(&b)));
+        let above = (0..n)
+            .filter(|&i| inputs[i] >= x)
+            .min_by(|&a, &b| (inputs[a] - x).total_cmp(&(inputs[b] - x)).then(a.cmp(&b)));
+        if let (Some(lo), Some(hi)) = (below, above) {
+            let (xl, xh) = (inputs[lo], inputs[hi]);
+            if xh > xl {
+                let w = (x - xl) / (xh - xl);
+                return Some(row(lo) * (1.0 - w) + row(hi) * w);
+            }
+            return Some(row(lo));
+        }
+    }
     let mut scale = vec![0.0f64; k];
-    for row in a.inputs.chunks_exact(k) {
-        for (d, v) in row.iter().enumerate() {
+    for a in inputs.chunks_exact(k) {
+        for (d, v) in a.iter().enumerate() {
             scale[d] = scale[d].max(v.abs());
         }
     }
-    let best = a
-        .inputs
+    let best = inputs
         .chunks_exact(k)
-        .map(|row| {
-            row.iter()
-                .zip(&x)
+        .map(|a| {
+            a.iter()
+                .zip(x)
                 .zip(&scale)
                 .map(|((v, w), s)| ((v - w) / s.max(1e-300)).powi(2))
                 .sum::<f64>()
@@ -145,10 +183,83 @@ fn nearest_anchor(
         .enumerate()
         .min_by(|a, b| a.1.total_cmp(&b.1))?
         .0;
-    let r = model.meta.latent;
-    Some(DVector::from_column_slice(
-        &a.latent[best * r..(best + 1) * r],
-    ))
+    Some(row(best))
+}
+
+/// Index `K` of a dataset input `tendons.K.tension`; `None` for any other input.
+fn tendon_input(path: &str) -> Option<usize> {
+    let segs = crate::scenario::parse_path(path).ok()?;
+    match segs.as_slice() {
+        [crate::scenario::Seg::Key(t), crate::scenario::Seg::Index(k), crate::scenario::Seg::Key(f)]
+            if t == "tendons" && f == "tension" =>
+        {
+            Some(*k)
+        }
+        _ => None,
+    }
+}
+
+/// Largest number of dogleg iterations of an anchor's solve ([`solve_anchors`]).
+const ANCHOR_MAX_ITERATIONS: usize = 50;
+
+/// Replaces anchors' reduced coordinates by the reduced model's own statics equilibria at their
+/// inputs, where one is found; returns how many were replaced.
+///
+/// Anchor `i` has the tensions `inputs[i·k..(i+1)·k]` on the tendons `tendons` (the other tensions
+/// and the loads as in `u` and `loads`), and its solve starts from `latent[i·r..(i+1)·r]` (the
+/// training sample's encoding) at the full load, at most [`ANCHOR_MAX_ITERATIONS`] iterations. A
+/// solution is kept if `accept` takes it (e.g. inside the training encodings' range); otherwise the
+/// encoding stays. An encoding lies off the reduced model's equilibrium by the encoder's error (IV-A:
+/// 2e-3 in `q_r`, three times what a 1.5e-3 N change of tension moves it), so equilibria are the
+/// better starts, and between two of them [`anchor_guess`] interpolates to second order.
+///
+/// The anchors are solved in parallel (rayon), each from its own encoding: the result does not
+/// depend on the thread count.
+#[allow(clippy::too_many_arguments)]
+pub fn solve_anchors<P: StrainParam>(
+    model: &Model<P>,
+    options: &StaticsOptions,
+    u: &[f64],
+    loads: &gvs::loads::Loads,
+    tendons: &[usize],
+    inputs: &[f64],
+    latent: &mut [f64],
+    accept: &(dyn Fn(&DVector<f64>) -> bool + Sync),
+) -> usize {
+    use rayon::prelude::*;
+    let (k, r) = (tendons.len(), model.n_dof());
+    if k == 0 || r == 0 || inputs.len() / k != latent.len() / r {
+        return 0;
+    }
+    let options = StaticsOptions {
+        ramp_steps: 1,
+        min_increment: 1.0,
+        max_iterations: options.max_iterations.min(ANCHOR_MAX_ITERATIONS),
+        ..options.clone()
+    };
+    const CHUNK: usize = 32;
+    latent
+        .par_chunks_mut(CHUNK * r)
+        .zip(inputs.par_chunks(CHUNK * k))
+        .map(|(z, x)| {
+            let mut solver = StaticsSolver::new(model, options.clone());
+            let mut uk = u.to_vec();
+            let mut replaced = 0;
+            for (z, x) in z.chunks_exact_mut(r).zip(x.chunks_exact(k)) {
+                for (&t, &v) in tendons.iter().zip(x) {
+                    uk[t] = v;
+                }
+                let z0 = DVector::from_column_slice(z);
+                if let Ok(sol) = solver.solve(&uk, loads, Some(&z0)) {
+                    if sol.q.iter().all(|v| v.is_finite()) && accept(&sol.q) {
+                        z.copy_from_slice(sol.q.as_slice());
+                        replaced += 1;
+                    }
+                }
+            }
+            replaced
+        })
+        .sum()
 }
 
 fn invalid(field: &str, message: impl Into<String>) -> ScenarioError {
@@ -241,6 +352,7 @@ pub fn pod(
         rest: vec![0.0; modes],
         latent_range: vec![],
         anchor_parameters: vec![],
+        anchor_equilibria: 0,
         captured_energy: Some(energy[modes - 1]),
         training: None,
         projection_residual: 0.0,
@@ -282,6 +394,10 @@ pub struct TrainSummary {
     pub rest: Vec<f64>,
     pub rest_residual: f64,
     pub projection_residual: f64,
+    /// How many of the `rows` anchors are the reduced model's own equilibria, and the time their
+    /// solves took.
+    pub anchor_equilibria: usize,
+    pub anchor_time_s: f64,
 }
 
 /// Trains an autoencoder on a dataset's snapshots and saves it at `out`. `progress(epoch, train,
@@ -341,6 +457,7 @@ pub fn train(
         rest: rest.iter().copied().collect(),
         latent_range: range,
         anchor_parameters: ds.meta.parameters.clone(),
+        anchor_equilibria: 0,
         captured_energy: None,
         training: Some(TrainingMeta {
             hidden_layers: options.hidden_layers,
@@ -366,7 +483,7 @@ pub fn train(
         crate_version: env!("CARGO_PKG_VERSION").into(),
     };
     let encoder_sizes = ae.encoder().layer_sizes().to_vec();
-    let model = ReducedModel {
+    let mut model = ReducedModel {
         meta,
         weights: ModelWeights::Autoencoder(ae),
         anchors: Some(crate::reduced_model::Anchors {
@@ -375,6 +492,13 @@ pub fn train(
             latent,
         }),
     };
+    let t_anchors = std::time::Instant::now();
+    // (an interrupted run is saved at once, with the encodings)
+    if report.stop != rom::nn::StopReason::Interrupted {
+        model.meta.anchor_equilibria = equilibrium_anchors(&built, &ds, &mut model)?;
+    }
+    let anchor_time_s = t_anchors.elapsed().as_secs_f64();
+    let anchor_equilibria = model.meta.anchor_equilibria;
     let path = model.save(
         dir,
         &[
@@ -391,7 +515,50 @@ pub fn train(
         rest: rest.iter().copied().collect(),
         rest_residual,
         projection_residual: worst,
+        anchor_equilibria,
+        anchor_time_s,
     })
+}
+
+/// For a static dataset whose inputs are all tendon tensions: the reduced model's own equilibria in
+/// place of the anchors' encodings where found ([`solve_anchors`], inside the training encodings'
+/// range); returns their number (0 for other datasets, whose anchors keep the encodings).
+fn equilibrium_anchors(
+    built: &Built,
+    ds: &Dataset,
+    model: &mut ReducedModel,
+) -> Result<usize, ScenarioError> {
+    let tendons: Option<Vec<usize>> = model
+        .meta
+        .anchor_parameters
+        .iter()
+        .map(|p| tendon_input(p))
+        .collect();
+    let (Some(tendons), None) = (tendons, &ds.meta.dynamic) else {
+        return Ok(0);
+    };
+    if tendons.is_empty() || model.anchors.is_none() {
+        return Ok(0);
+    }
+    let param = parameterization(built, model)?;
+    let m = &built.model;
+    let reduced = Model::new(m.rod.clone(), m.disc.clone(), param, m.tendons.clone())
+        .map_err(ScenarioError::from)?
+        .with_base(m.base);
+    let range = model.meta.latent_range.clone();
+    let Some(a) = model.anchors.as_mut() else {
+        return Ok(0);
+    };
+    Ok(solve_anchors(
+        &reduced,
+        &built.options,
+        &built.u,
+        &built.loads,
+        &tendons,
+        &a.inputs,
+        &mut a.latent,
+        &|q| outside_range(&range, q.as_slice()).is_none(),
+    ))
 }
 
 /// A training error named by the command-line option it comes from.
@@ -492,4 +659,65 @@ pub fn attach(
         latent_range: model.meta.latent_range.clone(),
     });
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn anchor_guess_interpolates_between_the_bracketing_anchors_of_one_input() {
+        // unsorted anchors; latent r = 2
+        let inputs = [1.0, -1.0, 0.0, 3.0];
+        let latent = [10.0, 1.0, -10.0, -1.0, 0.0, 0.0, 30.0, 3.0];
+        let g = anchor_guess(&inputs, &latent, 1, 2, &[0.25]).unwrap();
+        assert_eq!(g.as_slice(), &[2.5, 0.25]);
+        // between 1 and 3: w = 0.5
+        let g = anchor_guess(&inputs, &latent, 1, 2, &[2.0]).unwrap();
+        assert_eq!(g.as_slice(), &[20.0, 2.0]);
+        // on an anchor: that anchor, exactly
+        let g = anchor_guess(&inputs, &latent, 1, 2, &[-1.0]).unwrap();
+        assert_eq!(g.as_slice(), &[-10.0, -1.0]);
+    }
+
+    #[test]
+    fn anchor_guess_takes_the_nearest_anchor_outside_the_span_and_for_several_inputs() {
+        let inputs = [1.0, -1.0, 0.0, 3.0];
+        let latent = [10.0, -10.0, 0.0, 30.0];
+        assert_eq!(
+            anchor_guess(&inputs, &latent, 1, 1, &[5.0]).unwrap()[0],
+            30.0
+        );
+        assert_eq!(
+            anchor_guess(&inputs, &latent, 1, 1, &[-7.0]).unwrap()[0],
+            -10.0
+        );
+        // two inputs, the second 100× larger: distances are taken in units of each input's scale
+        let inputs = [0.0, 0.0, 1.0, 0.0, 0.0, 100.0];
+        let latent = [1.0, 2.0, 3.0];
+        // (0.6, 0) is 0.6 from anchor 1 in input 0; (0, 40) is 0.4 of the scale from anchor 0
+        assert_eq!(
+            anchor_guess(&inputs, &latent, 2, 1, &[0.6, 0.0]).unwrap()[0],
+            2.0
+        );
+        assert_eq!(
+            anchor_guess(&inputs, &latent, 2, 1, &[0.0, 40.0]).unwrap()[0],
+            1.0
+        );
+    }
+
+    #[test]
+    fn anchor_guess_without_usable_anchors_is_none() {
+        assert!(anchor_guess(&[], &[], 1, 1, &[0.0]).is_none());
+        assert!(anchor_guess(&[1.0, 2.0], &[1.0], 1, 1, &[0.0]).is_none());
+        assert!(anchor_guess(&[1.0, 2.0], &[1.0, 2.0], 1, 1, &[0.0, 1.0]).is_none());
+        assert!(anchor_guess(&[1.0, 2.0], &[1.0, 2.0], 0, 1, &[]).is_none());
+    }
+
+    #[test]
+    fn tendon_inputs_are_recognised_by_their_path() {
+        assert_eq!(tendon_input("tendons.3.tension"), Some(3));
+        assert_eq!(tendon_input("tendons.0.friction"), None);
+        assert_eq!(tendon_input("loads.distributed.0.magnitude"), None);
+    }
 }

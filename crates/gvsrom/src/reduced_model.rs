@@ -110,9 +110,15 @@ pub struct ModelMeta {
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub latent_range: Vec<[f64; 2]>,
     /// Names of the dataset inputs stored as anchors (`anchors.inputs` in the weights): the
-    /// nearest training sample's encoding is the initial guess of a reduced statics solve.
+    /// anchors near the scenario's inputs give the initial guess of a reduced statics solve.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub anchor_parameters: Vec<String>,
+    /// How many anchors hold the reduced model's own statics equilibrium at their inputs (the
+    /// others, the training sample's encoding): static datasets whose inputs are all tendon
+    /// tensions get equilibria wherever the solve from the encoding converges inside the
+    /// training encodings' range.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub anchor_equilibria: usize,
     /// POD: fraction of the snapshot energy the kept modes capture.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub captured_energy: Option<f64>,
@@ -135,7 +141,13 @@ pub enum ModelWeights {
     Autoencoder(Autoencoder),
 }
 
-/// Training samples as (inputs, encoding) pairs: initial guesses for reduced solves.
+fn is_zero(n: &usize) -> bool {
+    *n == 0
+}
+
+/// Training samples as (inputs, reduced coordinates) pairs: initial guesses for reduced solves. The
+/// coordinates are the reduced model's equilibrium at the inputs or the sample's encoding
+/// ([`ModelMeta::anchor_equilibria`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Anchors {
     pub n: usize,

@@ -80,8 +80,9 @@ pub fn solve_repeated(built: &Built, repeat: u32) -> Result<StaticsReport, Stati
 
 /// [`solve`] on `model`: the scenario's own or a reduced one with the same rod, points and tendons.
 ///
-/// With an initial guess `q0` (a reduced model's nearest training sample), the full load is first
-/// solved from `q0` in one stage; if that fails, the scenario's load ramp from rest follows.
+/// With an initial guess `q0` (a reduced model's, from its anchors: `reduce::anchor_guess`), the full
+/// load is first solved from `q0` in one stage; if that fails, the scenario's load ramp from rest
+/// follows.
 fn solve_on<P: StrainParam>(
     built: &Built,
     model: &Model<P>,

@@ -324,6 +324,25 @@ fn an_autoencoder_model_is_repeatable_and_loads_back_identically() {
 }
 
 #[test]
+fn statics_at_a_training_tension_starts_on_the_reduced_models_own_equilibrium() {
+    let m = ae_small();
+    // every anchor of a tension sweep is solved at training time
+    let meta = json(&m.join("meta.json"));
+    assert_eq!(meta["anchor_equilibria"], 40, "{meta}");
+    // −3 N = −6 + 9·13/39 is a training tension: the guess is its anchor, already in equilibrium
+    let at = statics("red-anchor-at", -3.0, Some(m));
+    assert_eq!(at["iterations"], 0, "{at}");
+    let model = ReducedModel::load(m).unwrap();
+    let a = model.anchors.as_ref().unwrap();
+    let k = a
+        .inputs
+        .iter()
+        .position(|&x| x == -3.0)
+        .expect("anchor at -3 N");
+    assert_eq!(at["q"][0].as_f64().unwrap(), a.latent[k]);
+}
+
+#[test]
 fn a_model_from_another_scenario_is_refused_naming_the_layout() {
     let (model, _) = pod_full();
     for model in [model.as_path(), ae_small()] {
