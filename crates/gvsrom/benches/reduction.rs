@@ -2,8 +2,9 @@
 //! arm at u = −2.7 N (not a training tension) with the HOM (33 DOF, from the straight rod), the
 //! AE-ROM (r = 1, 7 hidden layers, from its anchors as `statics --model` starts: its own equilibria
 //! at the training tensions, solved as `gvsrom train` does and interpolated at u) and the POD-ROM
-//! with 7 modes (from the straight rod), and, as the floor of any one-DOF
-//! reduced model on this engine, POD-1 (a constant strain column: no decoder cost). Each solver as
+//! with 7 modes (from its anchors likewise, and from the straight rod), and, as the floor of any
+//! one-DOF reduced model on this engine, POD-1 (a constant strain column: no decoder cost; from its
+//! anchors). Each solver as
 //! `statics` runs it (`solver.jacobian = auto`: forward differences at one coordinate). Single thread.
 //! The paper's MATLAB: HOM 670 ms, AE 42 ms, POD-7 165 ms.
 //!
@@ -145,7 +146,7 @@ fn reduction(c: &mut Criterion) {
             })
         },
     );
-    let mut ae_solver = StaticsSolver::new(&ae_model, one_stage);
+    let mut ae_solver = StaticsSolver::new(&ae_model, one_stage.clone());
     c.bench_function("reduction/AE-ROM r=1 equilibrium u=-2.7N", |b| {
         b.iter(|| black_box(ae_solver.solve(&u, &built.loads, Some(&z0)).expect("ae")))
     });
@@ -153,11 +154,40 @@ fn reduction(c: &mut Criterion) {
         "reduction/AE-ROM r=1 equilibrium u=-2.7N from the nearest encoding",
         |b| b.iter(|| black_box(ae_solver.solve(&u, &built.loads, Some(&z_enc)).expect("ae"))),
     );
+    // POD anchors as `gvsrom pod` makes them: Vᵀx of each sample, then the POD-ROM's equilibria
+    let pod_guess = |pod: &Pod, model: &Model<gvs::strain::LinearBasis>| {
+        let k = pod.modes.ncols();
+        let mut latent = pod.encode_rows(&rows);
+        let solved = solve_anchors(
+            model,
+            &built.options,
+            &built.u,
+            &built.loads,
+            &[0],
+            &tensions,
+            &mut latent,
+            &|_| true,
+        );
+        assert_eq!(solved, tensions.len(), "POD anchor equilibria");
+        anchor_guess(&tensions, &latent, 1, k, &u).expect("pod guess")
+    };
+    let (pod7_z0, pod1_z0) = (pod_guess(&pod, &pod_model), pod_guess(&pod1, &pod1_model));
     let mut pod_solver = StaticsSolver::new(&pod_model, built.options.clone());
+    c.bench_function(
+        "reduction/POD-ROM 7 modes equilibrium u=-2.7N from the straight rod",
+        |b| b.iter(|| black_box(pod_solver.solve(&u, &built.loads, None).expect("pod"))),
+    );
+    let mut pod_anchored = StaticsSolver::new(&pod_model, one_stage.clone());
     c.bench_function("reduction/POD-ROM 7 modes equilibrium u=-2.7N", |b| {
-        b.iter(|| black_box(pod_solver.solve(&u, &built.loads, None).expect("pod")))
+        b.iter(|| {
+            black_box(
+                pod_anchored
+                    .solve(&u, &built.loads, Some(&pod7_z0))
+                    .expect("pod"),
+            )
+        })
     });
-    let mut pod1_solver = StaticsSolver::new(&pod1_model, built.options.clone());
+    let mut pod1_solver = StaticsSolver::new(&pod1_model, one_stage.clone());
     for (label, sol) in [
         ("HOM", hom_solver.solve(&u, &built.loads, None)),
         (
@@ -169,8 +199,15 @@ fn reduction(c: &mut Criterion) {
             "AE-ROM from the nearest encoding",
             ae_solver.solve(&u, &built.loads, Some(&z_enc)),
         ),
-        ("POD-7", pod_solver.solve(&u, &built.loads, None)),
-        ("POD-1", pod1_solver.solve(&u, &built.loads, None)),
+        (
+            "POD-7",
+            pod_anchored.solve(&u, &built.loads, Some(&pod7_z0)),
+        ),
+        (
+            "POD-7 from the straight rod",
+            pod_solver.solve(&u, &built.loads, None),
+        ),
+        ("POD-1", pod1_solver.solve(&u, &built.loads, Some(&pod1_z0))),
     ] {
         let sol = sol.expect("solve");
         eprintln!(
@@ -179,7 +216,13 @@ fn reduction(c: &mut Criterion) {
         );
     }
     c.bench_function("reduction/POD-ROM 1 mode equilibrium u=-2.7N", |b| {
-        b.iter(|| black_box(pod1_solver.solve(&u, &built.loads, None).expect("pod1")))
+        b.iter(|| {
+            black_box(
+                pod1_solver
+                    .solve(&u, &built.loads, Some(&pod1_z0))
+                    .expect("pod1"),
+            )
+        })
     });
 
     // dynamics: the AE-ROM from the straight rod's coordinates (the encoder of zero strain, refined)

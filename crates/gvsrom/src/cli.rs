@@ -631,6 +631,7 @@ fn pod_cmd(args: &PodArgs, out: &mut impl Write) -> Result<()> {
         "modes      {} capture {:.8} of the snapshot energy",
         s.modes, s.captured_energy
     )?;
+    anchors_line(out, s.anchor_equilibria, s.rows, s.anchor_time_s)?;
     writeln!(out, "model      {}", s.path.display())?;
     Ok(())
 }
@@ -714,13 +715,7 @@ fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
         s.rest_residual,
         s.projection_residual
     )?;
-    if s.anchor_equilibria > 0 {
-        writeln!(
-            out,
-            "anchors    {} of {} training inputs hold the reduced model's own equilibrium (solved in {:.2} s): statics --model starts there",
-            s.anchor_equilibria, s.rows, s.anchor_time_s
-        )?;
-    }
+    anchors_line(out, s.anchor_equilibria, s.rows, s.anchor_time_s)?;
     writeln!(out, "model      {}", s.path.display())?;
     if signal.load(Ordering::SeqCst) != 0 {
         return Err(Interrupted {
@@ -1134,4 +1129,20 @@ fn print_solution(r: &StaticsReport, out: &mut impl Write) -> Result<()> {
         writeln!(out, "           {label} {}", fmt_vec(row, 6))?;
     }
     Ok(())
+}
+
+/// The `anchors` line of `pod` and `train` (nothing when no anchor is an equilibrium).
+fn anchors_line(
+    out: &mut dyn Write,
+    equilibria: usize,
+    rows: usize,
+    seconds: f64,
+) -> std::io::Result<()> {
+    if equilibria == 0 {
+        return Ok(());
+    }
+    writeln!(
+        out,
+        "anchors    {equilibria} of {rows} training inputs hold the reduced model's own equilibrium (solved in {seconds:.2} s): statics --model starts there"
+    )
 }

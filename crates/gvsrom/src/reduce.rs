@@ -327,6 +327,9 @@ pub struct PodSummary {
     pub captured_energy: f64,
     pub singular_values: Vec<f64>,
     pub numerical_rank: usize,
+    /// As [`TrainSummary::anchor_equilibria`] and [`TrainSummary::anchor_time_s`].
+    pub anchor_equilibria: usize,
+    pub anchor_time_s: f64,
 }
 
 /// POD of a dataset's strain snapshots, `modes` modes, saved as a model at `out`.
@@ -344,6 +347,8 @@ pub fn pod(
     let dir = OutputDir::create("--out", out, crate::reduced_model::MODEL_FORMAT, force)?;
     let pod = Pod::compute(&x, features, modes).map_err(|e| invalid("--modes", e.to_string()))?;
     let energy = pod.captured_energy();
+    // anchors: each sample's POD coordinates Vᵀx, then the POD-ROM's own equilibria
+    let latent = pod.encode_rows(&x);
     let meta = ModelMeta {
         kind: "pod".into(),
         latent: modes,
@@ -351,21 +356,28 @@ pub fn pod(
         dataset: dataset_ref(dataset, rows)?,
         rest: vec![0.0; modes],
         latent_range: vec![],
-        anchor_parameters: vec![],
+        anchor_parameters: ds.meta.parameters.clone(),
         anchor_equilibria: 0,
         captured_energy: Some(energy[modes - 1]),
         training: None,
         projection_residual: 0.0,
         crate_version: env!("CARGO_PKG_VERSION").into(),
     };
-    let model = ReducedModel {
+    let mut model = ReducedModel {
         meta,
         weights: ModelWeights::Pod {
             modes: pod.modes.clone(),
             singular_values: pod.singular_values.clone(),
         },
-        anchors: None,
+        anchors: Some(crate::reduced_model::Anchors {
+            n: rows,
+            inputs: sample_inputs(&ds),
+            latent,
+        }),
     };
+    let t_anchors = std::time::Instant::now();
+    model.meta.anchor_equilibria = equilibrium_anchors(&built, &ds, &mut model)?;
+    let anchor_time_s = t_anchors.elapsed().as_secs_f64();
     let path = model.save(
         dir,
         &[
@@ -381,6 +393,8 @@ pub fn pod(
         captured_energy: energy[modes - 1],
         numerical_rank: pod.rank(1e-12),
         singular_values: pod.singular_values,
+        anchor_equilibria: model.meta.anchor_equilibria,
+        anchor_time_s,
     })
 }
 
@@ -422,13 +436,10 @@ pub fn train(
     // to the straight rod), and what the HOM basis cannot represent of the reconstructions
     let mut worst = 0.0f64;
     let r = options.latent;
-    let ok = ds.ok_rows();
-    let k_in = ds.meta.parameters.len();
     let mut latent = Vec::with_capacity(rows * r);
-    let mut inputs = Vec::with_capacity(rows * k_in);
     let mut range = vec![[f64::INFINITY, f64::NEG_INFINITY]; r];
     let (mut rest, mut rest_norm) = (vec![0.0; r], f64::INFINITY);
-    for (i, row) in x.chunks_exact(features).enumerate() {
+    for row in x.chunks_exact(features) {
         let z = ae
             .encode(row)
             .map_err(|e| invalid("train", e.to_string()))?;
@@ -444,8 +455,6 @@ pub fn train(
             rest = z.clone();
         }
         latent.extend_from_slice(&z);
-        let sample = ok[i];
-        inputs.extend_from_slice(&ds.inputs[sample * k_in..(sample + 1) * k_in]);
     }
     let rest = DVector::from_vec(rest);
     let rest_residual = rest_norm.sqrt();
@@ -488,7 +497,7 @@ pub fn train(
         weights: ModelWeights::Autoencoder(ae),
         anchors: Some(crate::reduced_model::Anchors {
             n: rows,
-            inputs,
+            inputs: sample_inputs(&ds),
             latent,
         }),
     };
@@ -518,6 +527,15 @@ pub fn train(
         anchor_equilibria,
         anchor_time_s,
     })
+}
+
+/// The inputs of the usable samples (status ok), row-major (`n × k`): the anchors' inputs.
+fn sample_inputs(ds: &Dataset) -> Vec<f64> {
+    let k = ds.meta.parameters.len();
+    ds.ok_rows()
+        .iter()
+        .flat_map(|&i| ds.inputs[i * k..(i + 1) * k].iter().copied())
+        .collect()
 }
 
 /// For a static dataset whose inputs are all tendon tensions: the reduced model's own equilibria in

@@ -325,21 +325,32 @@ fn an_autoencoder_model_is_repeatable_and_loads_back_identically() {
 
 #[test]
 fn statics_at_a_training_tension_starts_on_the_reduced_models_own_equilibrium() {
-    let m = ae_small();
-    // every anchor of a tension sweep is solved at training time
-    let meta = json(&m.join("meta.json"));
-    assert_eq!(meta["anchor_equilibria"], 40, "{meta}");
-    // −3 N = −6 + 9·13/39 is a training tension: the guess is its anchor, already in equilibrium
-    let at = statics("red-anchor-at", -3.0, Some(m));
-    assert_eq!(at["iterations"], 0, "{at}");
-    let model = ReducedModel::load(m).unwrap();
-    let a = model.anchors.as_ref().unwrap();
-    let k = a
-        .inputs
-        .iter()
-        .position(|&x| x == -3.0)
-        .expect("anchor at -3 N");
-    assert_eq!(at["q"][0].as_f64().unwrap(), a.latent[k]);
+    for (m, name) in [(ae_small(), "ae"), (pod_full().0.as_path(), "pod")] {
+        // every anchor of a tension sweep is solved when the model is made
+        let meta = json(&m.join("meta.json"));
+        assert_eq!(meta["anchor_equilibria"], 40, "{name}: {meta}");
+        // −3 N = −6 + 9·13/39 is a training tension: the guess is its anchor, already in equilibrium
+        let at = statics(&format!("red-anchor-at-{name}"), -3.0, Some(m));
+        assert_eq!(at["iterations"], 0, "{name}: {at}");
+        let model = ReducedModel::load(m).unwrap();
+        let a = model.anchors.as_ref().unwrap();
+        let k = a
+            .inputs
+            .iter()
+            .position(|&x| x == -3.0)
+            .expect("anchor at -3 N");
+        let r = model.meta.latent;
+        let q: Vec<f64> = at["q"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        // (the JSON text round-trip may move the last bit)
+        for (v, w) in q.iter().zip(&a.latent[k * r..(k + 1) * r]) {
+            assert!((v - w).abs() <= 1e-15 * w.abs(), "{name}: {q:?}");
+        }
+    }
 }
 
 #[test]

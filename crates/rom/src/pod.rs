@@ -107,6 +107,20 @@ impl Pod {
         self.modes.tr_mul(x)
     }
 
+    /// [`Pod::encode`] of the snapshots stored row-major in `rows` (each as long as a mode): their
+    /// coordinates `Vᵀ x`, row-major (`n_rows × K`).
+    pub fn encode_rows(&self, rows: &[f64]) -> Vec<f64> {
+        let l = self.modes.nrows();
+        rows.chunks_exact(l)
+            .flat_map(|x| {
+                self.modes
+                    .column_iter()
+                    .map(|v| v.iter().zip(x).map(|(a, b)| a * b).sum::<f64>())
+                    .collect::<Vec<_>>()
+            })
+            .collect()
+    }
+
     /// `V q_r`.
     pub fn decode(&self, q_r: &DVector<f64>) -> DVector<f64> {
         &self.modes * q_r
@@ -116,6 +130,20 @@ impl Pod {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn encode_rows_is_encode_of_each_row() {
+        let (rows, _, _) = rank_two(5, 12);
+        let pod = Pod::compute(&rows, 12, 2).unwrap();
+        let all = pod.encode_rows(&rows);
+        assert_eq!(all.len(), 10);
+        for (i, x) in rows.chunks_exact(12).enumerate() {
+            let z = pod.encode(&DVector::from_column_slice(x));
+            for k in 0..2 {
+                assert!((all[2 * i + k] - z[k]).abs() <= 1e-15 * (1.0 + z[k].abs()));
+            }
+        }
+    }
 
     /// Rows `x(θ) = a(θ) u + b(θ) w` with orthonormal `u`, `w`: rank 2, modes span {u, w}.
     fn rank_two(n: usize, l: usize) -> (Vec<f64>, DVector<f64>, DVector<f64>) {
