@@ -203,7 +203,8 @@ fn tendon_input(path: &str) -> Option<usize> {
 const ANCHOR_MAX_ITERATIONS: usize = 50;
 
 /// Replaces anchors' reduced coordinates by the reduced model's own statics equilibria at their
-/// inputs, where one is found; returns how many were replaced.
+/// inputs, where one is found; returns how many were replaced (none if the lengths do not match
+/// or a tendon index is not one of `u`'s).
 ///
 /// Anchor `i` has the tensions `inputs[i·k..(i+1)·k]` on the tendons `tendons` (the other tensions
 /// and the loads as in `u` and `loads`), and its solve starts from `latent[i·r..(i+1)·r]` (the
@@ -228,7 +229,11 @@ pub fn solve_anchors<P: StrainParam>(
 ) -> usize {
     use rayon::prelude::*;
     let (k, r) = (tendons.len(), model.n_dof());
-    if k == 0 || r == 0 || inputs.len() / k != latent.len() / r {
+    if k == 0
+        || r == 0
+        || inputs.len() / k != latent.len() / r
+        || tendons.iter().any(|&t| t >= u.len())
+    {
         return 0;
     }
     let options = StaticsOptions {
