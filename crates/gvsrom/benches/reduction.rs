@@ -32,7 +32,7 @@ use gvs::solve::dynamics::{
 use gvs::solve::ode::NdfOptions;
 use gvs::solve::statics::{StaticsOptions, StaticsSolver};
 use gvs::strain::StrainParam;
-use gvsrom::reduce::{anchor_guess, solve_anchors};
+use gvsrom::reduce::{anchor_guess, solve_anchors, AnchorInput, AnchorProblem};
 use nalgebra::DVector;
 use rom::nn::{Autoencoder, TrainOptions};
 use rom::pod::Pod;
@@ -107,12 +107,17 @@ fn reduction(c: &mut Criterion) {
     let ae_param = ReducedParam::new(&hom.param, map, z_enc.clone()).expect("reduced");
     let ae_model = rom_model(&built, ae_param);
     // anchors as `gvsrom train` makes them: the AE-ROM's own equilibria at the training tensions
+    let problem = AnchorProblem {
+        u: &built.u,
+        loads: &built.loads,
+        inputs: &[AnchorInput::Tension(0)],
+        table: None,
+        length: hom.rod.length(),
+    };
     let solved = solve_anchors(
         &ae_model,
         &built.options,
-        &built.u,
-        &built.loads,
-        &[0],
+        &problem,
         &tensions,
         &mut latent,
         &|_| true,
@@ -161,9 +166,7 @@ fn reduction(c: &mut Criterion) {
         let solved = solve_anchors(
             model,
             &built.options,
-            &built.u,
-            &built.loads,
-            &[0],
+            &problem,
             &tensions,
             &mut latent,
             &|_| true,

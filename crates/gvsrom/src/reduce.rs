@@ -199,41 +199,93 @@ fn tendon_input(path: &str) -> Option<usize> {
     }
 }
 
+/// How a dataset input enters an anchor's statics problem ([`solve_anchors`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum AnchorInput {
+    /// `tendons.K.tension`: the tension of tendon `K`.
+    Tension(usize),
+    /// A load value that does not move computational points (`loads.…`, except a point load's
+    /// abscissa `loads.point.K.x`): set in the scenario table, whose loads are built again.
+    Load(String),
+}
+
+impl AnchorInput {
+    /// The kind of the dataset input `path`; `None` for inputs that change the model itself
+    /// (geometry, material, basis, a point load's abscissa).
+    pub fn of(path: &str) -> Option<AnchorInput> {
+        if let Some(k) = tendon_input(path) {
+            return Some(AnchorInput::Tension(k));
+        }
+        let moves_points = path.starts_with("loads.point.") && path.ends_with(".x");
+        (path.starts_with("loads.") && !moves_points).then(|| AnchorInput::Load(path.to_string()))
+    }
+}
+
+/// The statics problem of the anchors: the scenario's tensions `u` and `loads`, changed at each
+/// anchor by its inputs ([`AnchorInput`], one per input column). `table` (the scenario's TOML) and
+/// `length` (the rod's) are needed for load inputs only.
+pub struct AnchorProblem<'a> {
+    pub u: &'a [f64],
+    pub loads: &'a gvs::loads::Loads,
+    pub inputs: &'a [AnchorInput],
+    pub table: Option<&'a toml::Table>,
+    pub length: f64,
+}
+
+impl AnchorProblem<'_> {
+    /// Tensions and (if load inputs change them) loads at the inputs `x`; `None` if the loads
+    /// cannot be built from these values.
+    fn at(&self, x: &[f64]) -> Option<(Vec<f64>, Option<gvs::loads::Loads>)> {
+        let mut u = self.u.to_vec();
+        let mut table = None;
+        for (input, &v) in self.inputs.iter().zip(x) {
+            match input {
+                AnchorInput::Tension(t) => *u.get_mut(*t)? = v,
+                AnchorInput::Load(path) => {
+                    let t = table.get_or_insert_with(|| self.table.cloned().unwrap_or_default());
+                    crate::scenario::apply_override(t, &format!("{path}={v}")).ok()?;
+                }
+            }
+        }
+        let loads = match table {
+            None => None,
+            Some(t) => {
+                let scenario = crate::scenario::from_table(t).ok()?;
+                Some(crate::build::loads(&scenario, self.length).ok()?)
+            }
+        };
+        Some((u, loads))
+    }
+}
+
 /// Largest number of dogleg iterations of an anchor's solve ([`solve_anchors`]).
 const ANCHOR_MAX_ITERATIONS: usize = 50;
 
 /// Replaces anchors' reduced coordinates by the reduced model's own statics equilibria at their
 /// inputs, where one is found; returns how many were replaced (none if the lengths do not match
-/// or a tendon index is not one of `u`'s).
+/// the problem's inputs).
 ///
-/// Anchor `i` has the tensions `inputs[i·k..(i+1)·k]` on the tendons `tendons` (the other tensions
-/// and the loads as in `u` and `loads`), and its solve starts from `latent[i·r..(i+1)·r]` (the
-/// training sample's encoding) at the full load, at most [`ANCHOR_MAX_ITERATIONS`] iterations. A
-/// solution is kept if `accept` takes it (e.g. inside the training encodings' range); otherwise the
-/// encoding stays. An encoding lies off the reduced model's equilibrium by the encoder's error (IV-A:
-/// 2e-3 in `q_r`, three times what a 1.5e-3 N change of tension moves it), so equilibria are the
-/// better starts, and between two of them [`anchor_guess`] interpolates to second order.
+/// Anchor `i` has the inputs `inputs[i·k..(i+1)·k]` (`k = problem.inputs.len()`), and its solve
+/// starts from `latent[i·r..(i+1)·r]` (the training sample's encoding) at the full load, at most
+/// [`ANCHOR_MAX_ITERATIONS`] iterations. A solution is kept if `accept` takes it (e.g. inside the
+/// training encodings' range); otherwise the encoding stays. An encoding lies off the reduced
+/// model's equilibrium by the encoder's error (IV-A: 2e-3 in `q_r`, three times what a 1.5e-3 N
+/// change of tension moves it), so equilibria are the better starts, and between two of them
+/// [`anchor_guess`] interpolates to second order.
 ///
 /// The anchors are solved in parallel (rayon), each from its own encoding: the result does not
 /// depend on the thread count.
-#[allow(clippy::too_many_arguments)]
 pub fn solve_anchors<P: StrainParam>(
     model: &Model<P>,
     options: &StaticsOptions,
-    u: &[f64],
-    loads: &gvs::loads::Loads,
-    tendons: &[usize],
+    problem: &AnchorProblem<'_>,
     inputs: &[f64],
     latent: &mut [f64],
     accept: &(dyn Fn(&DVector<f64>) -> bool + Sync),
 ) -> usize {
     use rayon::prelude::*;
-    let (k, r) = (tendons.len(), model.n_dof());
-    if k == 0
-        || r == 0
-        || inputs.len() / k != latent.len() / r
-        || tendons.iter().any(|&t| t >= u.len())
-    {
+    let (k, r) = (problem.inputs.len(), model.n_dof());
+    if k == 0 || r == 0 || inputs.len() / k != latent.len() / r {
         return 0;
     }
     let options = StaticsOptions {
@@ -248,14 +300,14 @@ pub fn solve_anchors<P: StrainParam>(
         .zip(inputs.par_chunks(CHUNK * k))
         .map(|(z, x)| {
             let mut solver = StaticsSolver::new(model, options.clone());
-            let mut uk = u.to_vec();
             let mut replaced = 0;
             for (z, x) in z.chunks_exact_mut(r).zip(x.chunks_exact(k)) {
-                for (&t, &v) in tendons.iter().zip(x) {
-                    uk[t] = v;
-                }
+                let Some((u, loads)) = problem.at(x) else {
+                    continue;
+                };
                 let z0 = DVector::from_column_slice(z);
-                if let Ok(sol) = solver.solve(&uk, loads, Some(&z0)) {
+                let loads = loads.as_ref().unwrap_or(problem.loads);
+                if let Ok(sol) = solver.solve(&u, loads, Some(&z0)) {
                     if sol.q.iter().all(|v| v.is_finite()) && accept(&sol.q) {
                         z.copy_from_slice(sol.q.as_slice());
                         replaced += 1;
@@ -543,26 +595,34 @@ fn sample_inputs(ds: &Dataset) -> Vec<f64> {
         .collect()
 }
 
-/// For a static dataset whose inputs are all tendon tensions: the reduced model's own equilibria in
-/// place of the anchors' encodings where found ([`solve_anchors`], inside the training encodings'
-/// range); returns their number (0 for other datasets, whose anchors keep the encodings).
+/// For a static dataset whose inputs are all tendon tensions or loads ([`AnchorInput`]): the reduced
+/// model's own equilibria in place of the anchors' encodings where found ([`solve_anchors`], inside
+/// the training encodings' range); returns their number (0 for other datasets, whose anchors keep
+/// the encodings).
 fn equilibrium_anchors(
     built: &Built,
     ds: &Dataset,
     model: &mut ReducedModel,
 ) -> Result<usize, ScenarioError> {
-    let tendons: Option<Vec<usize>> = model
+    let inputs: Option<Vec<AnchorInput>> = model
         .meta
         .anchor_parameters
         .iter()
-        .map(|p| tendon_input(p))
+        .map(|p| AnchorInput::of(p))
         .collect();
-    let (Some(tendons), None) = (tendons, &ds.meta.dynamic) else {
+    let (Some(inputs), None) = (inputs, &ds.meta.dynamic) else {
         return Ok(0);
     };
-    if tendons.is_empty() || model.anchors.is_none() {
+    if inputs.is_empty() || model.anchors.is_none() {
         return Ok(0);
     }
+    let table = match inputs.iter().any(|i| matches!(i, AnchorInput::Load(_))) {
+        true => Some(crate::scenario::parse_table(
+            &ds.meta.scenario,
+            &ds.meta.scenario_toml,
+        )?),
+        false => None,
+    };
     let param = parameterization(built, model)?;
     let m = &built.model;
     let reduced = Model::new(m.rod.clone(), m.disc.clone(), param, m.tendons.clone())
@@ -572,12 +632,17 @@ fn equilibrium_anchors(
     let Some(a) = model.anchors.as_mut() else {
         return Ok(0);
     };
+    let problem = AnchorProblem {
+        u: &built.u,
+        loads: &built.loads,
+        inputs: &inputs,
+        table: table.as_ref(),
+        length: m.rod.length(),
+    };
     Ok(solve_anchors(
         &reduced,
         &built.options,
-        &built.u,
-        &built.loads,
-        &tendons,
+        &problem,
         &a.inputs,
         &mut a.latent,
         &|q| outside_range(&range, q.as_slice()).is_none(),
@@ -738,9 +803,22 @@ mod tests {
     }
 
     #[test]
-    fn tendon_inputs_are_recognised_by_their_path() {
-        assert_eq!(tendon_input("tendons.3.tension"), Some(3));
-        assert_eq!(tendon_input("tendons.0.friction"), None);
-        assert_eq!(tendon_input("loads.distributed.0.magnitude"), None);
+    fn anchor_inputs_are_recognised_by_their_path() {
+        assert_eq!(
+            AnchorInput::of("tendons.3.tension"),
+            Some(AnchorInput::Tension(3))
+        );
+        assert_eq!(AnchorInput::of("tendons.0.friction"), None);
+        assert_eq!(
+            AnchorInput::of("loads.distributed.0.magnitude"),
+            Some(AnchorInput::Load("loads.distributed.0.magnitude".into()))
+        );
+        assert_eq!(
+            AnchorInput::of("loads.point.0.force.2"),
+            Some(AnchorInput::Load("loads.point.0.force.2".into()))
+        );
+        // a point load's abscissa moves the computational points; geometry changes the model
+        assert_eq!(AnchorInput::of("loads.point.0.x"), None);
+        assert_eq!(AnchorInput::of("divisions.0.length"), None);
     }
 }

@@ -354,6 +354,39 @@ fn statics_at_a_training_tension_starts_on_the_reduced_models_own_equilibrium() 
 }
 
 #[test]
+fn a_load_input_anchor_is_the_reduced_models_equilibrium_too() {
+    // soft-beam: the distributed load's magnitude swept over −5, −4, …, 5 N·m/m
+    let ds = scratch("red-beam-ds");
+    run_ok(&[
+        "dataset",
+        "soft-beam",
+        "--sweep",
+        "loads.distributed.0.magnitude=-5:5",
+        "--samples",
+        "11",
+        "--out",
+        s(&ds),
+    ]);
+    let pod = scratch("red-beam-pod");
+    let out = run_ok(&["pod", s(&ds), "--modes", "2", "--out", s(&pod)]);
+    assert!(out.contains("anchors    11 of 11"), "{out}");
+    assert_eq!(json(&pod.join("meta.json"))["anchor_equilibria"], 11);
+    let file = scratch("red-beam-statics.json");
+    run_ok(&[
+        "statics",
+        "soft-beam",
+        "--set",
+        "loads.distributed.0.magnitude=2",
+        "--model",
+        s(&pod),
+        "--json",
+        s(&file),
+    ]);
+    let at = json(&file);
+    assert_eq!(at["iterations"], 0, "{at}");
+}
+
+#[test]
 fn a_model_from_another_scenario_is_refused_naming_the_layout() {
     let (model, _) = pod_full();
     for model in [model.as_path(), ae_small()] {
