@@ -133,8 +133,9 @@ fn nearest_anchor(
 /// anchor below and the nearest above: for anchors that are the reduced model's own equilibria
 /// (see [`solve_anchors`]) its error is second order in their spacing, where the nearest anchor's
 /// is first order, and one Newton step usually reaches the tolerance (IV-A: 3 residuals instead of
-/// 4). Otherwise the nearest anchor, each input scaled by its largest magnitude. `None` without
-/// anchors or inputs.
+/// 4). With several inputs, the local linear fit to the nearest anchors where it is defined
+/// (`local_linear`), else the nearest anchor; distances with each input scaled by its largest
+/// magnitude. `None` without anchors or inputs.
 pub fn anchor_guess(
     inputs: &[f64],
     latent: &[f64],
@@ -168,22 +169,68 @@ pub fn anchor_guess(
     let mut scale = vec![0.0f64; k];
     for a in inputs.chunks_exact(k) {
         for (d, v) in a.iter().enumerate() {
-            scale[d] = scale[d].max(v.abs());
+            scale[d] = scale[d].max(v.abs()).max(1e-300);
         }
     }
-    let best = inputs
+    let dist: Vec<f64> = inputs
         .chunks_exact(k)
         .map(|a| {
             a.iter()
                 .zip(x)
                 .zip(&scale)
-                .map(|((v, w), s)| ((v - w) / s.max(1e-300)).powi(2))
+                .map(|((v, w), s)| ((v - w) / s).powi(2))
                 .sum::<f64>()
         })
-        .enumerate()
-        .min_by(|a, b| a.1.total_cmp(&b.1))?
-        .0;
-    Some(row(best))
+        .collect();
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| dist[a].total_cmp(&dist[b]).then(a.cmp(&b)));
+    let nearest = *order.first()?;
+    if k > 1 {
+        if let Some(z) = local_linear(inputs, latent, k, r, x, &scale, &order) {
+            return Some(z);
+        }
+    }
+    Some(row(nearest))
+}
+
+/// The value at `x` of the least-squares linear fit `z ≈ z₀ + G (x' − x)` to the `2(k + 1)`
+/// anchors nearest to `x` (`order`: anchors by distance): a first-order prediction, as the
+/// one-input interpolation. `None` if there are too few anchors, if `x` lies outside their bounding
+/// box (no extrapolation) or if they do not span the inputs (rank < k + 1).
+fn local_linear(
+    inputs: &[f64],
+    latent: &[f64],
+    k: usize,
+    r: usize,
+    x: &[f64],
+    scale: &[f64],
+    order: &[usize],
+) -> Option<DVector<f64>> {
+    let m = 2 * (k + 1);
+    let near = order.get(..m)?;
+    for d in 0..k {
+        let (lo, hi) = near
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &i| {
+                (lo.min(inputs[i * k + d]), hi.max(inputs[i * k + d]))
+            });
+        if !(lo <= x[d] && x[d] <= hi) {
+            return None;
+        }
+    }
+    let a = DMatrix::from_fn(m, k + 1, |row, col| match col {
+        0 => 1.0,
+        _ => (inputs[near[row] * k + col - 1] - x[col - 1]) / scale[col - 1],
+    });
+    let z = DMatrix::from_fn(m, r, |row, col| latent[near[row] * r + col]);
+    let svd = a.svd(true, true);
+    let smax = svd.singular_values.max();
+    if svd.rank(1e-8 * smax) < k + 1 {
+        return None;
+    }
+    let beta = svd.solve(&z, 1e-8 * smax).ok()?;
+    let z0 = beta.row(0).transpose();
+    z0.iter().all(|v| v.is_finite()).then_some(z0)
 }
 
 /// Index `K` of a dataset input `tendons.K.tension`; `None` for any other input.
@@ -792,6 +839,29 @@ mod tests {
             anchor_guess(&inputs, &latent, 2, 1, &[0.0, 40.0]).unwrap()[0],
             1.0
         );
+    }
+
+    #[test]
+    fn anchor_guess_fits_several_inputs_linearly_inside_the_nearest_anchors() {
+        // a 5 × 5 grid of two inputs, latent (r = 2) linear in them: the fit reproduces it
+        let (mut inputs, mut latent) = (vec![], vec![]);
+        let f = |a: f64, b: f64| [1.0 + 2.0 * a - 0.5 * b, -3.0 + 0.25 * a + 4.0 * b];
+        for i in 0..5 {
+            for j in 0..5 {
+                let (a, b) = (i as f64, 10.0 * j as f64);
+                inputs.extend([a, b]);
+                latent.extend(f(a, b));
+            }
+        }
+        let g = anchor_guess(&inputs, &latent, 2, 2, &[1.3, 27.0]).unwrap();
+        let e = f(1.3, 27.0);
+        assert!(
+            (g[0] - e[0]).abs() < 1e-12 && (g[1] - e[1]).abs() < 1e-12,
+            "{g} vs {e:?}"
+        );
+        // outside the anchors: the nearest one, no extrapolation
+        let g = anchor_guess(&inputs, &latent, 2, 2, &[6.0, 45.0]).unwrap();
+        assert_eq!(g.as_slice(), &f(4.0, 40.0));
     }
 
     #[test]
