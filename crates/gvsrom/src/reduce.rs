@@ -35,7 +35,7 @@ pub struct Reduced {
     pub kind: String,
     pub path: PathBuf,
     /// Initial guess of a statics solve: the model's anchors at this scenario's inputs
-    /// ([`anchor_guess`]; autoencoders whose dataset inputs the scenario defines).
+    /// ([`anchor_guess`]; models whose dataset inputs the scenario defines).
     pub initial: Option<DVector<f64>>,
     /// The training encodings' range per coordinate (autoencoders).
     pub latent_range: Vec<[f64; 2]>,
@@ -112,7 +112,7 @@ fn input_value(built: &Built, table: Option<&toml::Table>, path: &str) -> Option
 
 /// The initial guess of a reduced statics solve at the scenario's inputs, from the model's anchors
 /// ([`anchor_guess`]).
-fn nearest_anchor(
+fn initial_guess(
     built: &Built,
     table: Option<&toml::Table>,
     model: &ReducedModel,
@@ -316,7 +316,7 @@ const ANCHOR_MAX_ITERATIONS: usize = 50;
 /// starts from `latent[i·r..(i+1)·r]` (the training sample's encoding) at the full load, at most
 /// [`ANCHOR_MAX_ITERATIONS`] iterations. A solution is kept if `accept` takes it (e.g. inside the
 /// training encodings' range); otherwise the encoding stays. An encoding lies off the reduced
-/// model's equilibrium by the encoder's error (IV-A: 2e-3 in `q_r`, three times what a 1.5e-3 N
+/// model's equilibrium by the encoder's error (IV-A: 2e-3 in `q_r`, twice what a 1.5e-3 N
 /// change of tension moves it), so equilibria are the better starts, and between two of them
 /// [`anchor_guess`] interpolates to second order.
 ///
@@ -785,7 +785,7 @@ pub fn attach(
     let reduced = Model::new(m.rod.clone(), m.disc.clone(), param, m.tendons.clone())
         .map_err(ScenarioError::from)?
         .with_base(m.base);
-    let initial = nearest_anchor(built, table, &model);
+    let initial = initial_guess(built, table, &model);
     built.reduced = Some(Reduced {
         model: reduced,
         kind: model.meta.kind.clone(),
