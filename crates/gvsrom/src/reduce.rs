@@ -182,8 +182,15 @@ pub fn anchor_guess(
                 .sum::<f64>()
         })
         .collect();
+    // the 2(k + 1) nearest anchors in order (local_linear's), without sorting all n
+    let by_dist = |a: &usize, b: &usize| dist[*a].total_cmp(&dist[*b]).then(a.cmp(b));
     let mut order: Vec<usize> = (0..n).collect();
-    order.sort_by(|&a, &b| dist[a].total_cmp(&dist[b]).then(a.cmp(&b)));
+    let m = (2 * (k + 1)).min(n);
+    if m < n {
+        order.select_nth_unstable_by(m, by_dist);
+        order.truncate(m);
+    }
+    order.sort_by(by_dist);
     let nearest = *order.first()?;
     if k > 1 {
         if let Some(z) = local_linear(inputs, latent, k, r, x, &scale, &order) {
@@ -670,11 +677,7 @@ fn equilibrium_anchors(
         )?),
         false => None,
     };
-    let param = parameterization(built, model)?;
-    let m = &built.model;
-    let reduced = Model::new(m.rod.clone(), m.disc.clone(), param, m.tendons.clone())
-        .map_err(ScenarioError::from)?
-        .with_base(m.base);
+    let reduced = reduced_model(built, model)?;
     let range = model.meta.latent_range.clone();
     let Some(a) = model.anchors.as_mut() else {
         return Ok(0);
@@ -684,7 +687,7 @@ fn equilibrium_anchors(
         loads: &built.loads,
         inputs: &inputs,
         table: table.as_ref(),
-        length: m.rod.length(),
+        length: built.model.rod.length(),
     };
     Ok(solve_anchors(
         &reduced,
@@ -770,6 +773,20 @@ pub fn parameterization(
     })
 }
 
+/// The scenario's rod, points and tendons with the parameterization of `model` ([`parameterization`]).
+fn reduced_model(
+    built: &Built,
+    model: &ReducedModel,
+) -> Result<Model<Box<dyn StrainParam>>, ScenarioError> {
+    let param = parameterization(built, model)?;
+    let m = &built.model;
+    Ok(
+        Model::new(m.rod.clone(), m.disc.clone(), param, m.tendons.clone())
+            .map_err(ScenarioError::from)?
+            .with_base(m.base),
+    )
+}
+
 /// `--model DIR`: loads the model, checks it against the scenario and attaches it to `built`.
 /// `table` (the scenario's TOML after `--set`) supplies the values of non-tension dataset inputs
 /// for the initial guess.
@@ -780,11 +797,7 @@ pub fn attach(
 ) -> Result<(), anyhow::Error> {
     let model = ReducedModel::load(dir)?;
     check_layout(built, &model, dir)?;
-    let param = parameterization(built, &model)?;
-    let m = &built.model;
-    let reduced = Model::new(m.rod.clone(), m.disc.clone(), param, m.tendons.clone())
-        .map_err(ScenarioError::from)?
-        .with_base(m.base);
+    let reduced = reduced_model(built, &model)?;
     let initial = initial_guess(built, table, &model);
     built.reduced = Some(Reduced {
         model: reduced,
