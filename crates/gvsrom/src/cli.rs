@@ -64,6 +64,10 @@ pub enum Command {
     /// tip and strain errors over the common samples, and the speed ratio (simulated time per wall
     /// time).
     Compare(CompareArgs),
+    /// Reproduce the paper's studies end to end (data, training, reduced models, evaluation) with
+    /// their tables beside the paper's, figures and one HTML page `OUT/index.html`; finished steps
+    /// are kept and reused by the next run.
+    Reproduce(ReproduceArgs),
     /// Validate a preset or scenario file and print the model's size, without solving.
     Check(ScenarioArgs),
     /// List the built-in presets.
@@ -82,6 +86,24 @@ pub struct CompareArgs {
     pub reference: PathBuf,
     /// The trajectory to measure against it, e.g. a reduced model's (same sample times)
     pub run: PathBuf,
+}
+
+/// `gvsrom reproduce`.
+#[derive(Debug, Args)]
+pub struct ReproduceArgs {
+    /// The paper's cases to run: `iv-a`, `iv-b`, `v`, or `all`.
+    #[arg(required = true, value_enum)]
+    pub cases: Vec<gvsrom::reproduce::Case>,
+    /// Reduced sizes (fewer samples, epochs, POD modes): every case in minutes, the paper's trends
+    /// but not its numbers.
+    #[arg(long)]
+    pub quick: bool,
+    /// The run directory: created, or an earlier `reproduce` run whose finished steps are reused.
+    #[arg(long, value_name = "DIR", default_value = "results")]
+    pub out: PathBuf,
+    /// Worker threads (default: one per core).
+    #[arg(long, value_name = "N")]
+    pub jobs: Option<usize>,
 }
 
 /// Which scenario, with overrides.
@@ -353,6 +375,7 @@ pub fn run(cli: Cli, out: &mut impl Write) -> Result<()> {
         Command::Pod(args) => pod_cmd(&args, out),
         Command::Train(args) => train_cmd(&args, out),
         Command::Compare(args) => compare_cmd(&args, out),
+        Command::Reproduce(args) => reproduce_cmd(&args, out),
         Command::Check(args) => check_cmd(&args, out),
         Command::Presets => presets_cmd(out),
         Command::Show { preset } => {
@@ -981,6 +1004,33 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
             message: format!("{reason} at t = {t_last} s; {kept}"),
         }
         .into()),
+    }
+}
+
+fn reproduce_cmd(args: &ReproduceArgs, out: &mut impl Write) -> Result<()> {
+    use gvsrom::reproduce;
+    let jobs = args.jobs.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
+    let opts = reproduce::Options {
+        cases: args.cases.clone(),
+        quick: args.quick,
+        out: args.out.clone(),
+        jobs,
+    };
+    let signal = interrupt_flag();
+    match reproduce::run(&opts, signal.clone(), out) {
+        Ok(_) => Ok(()),
+        Err(e) => match e.downcast_ref::<reproduce::Interrupted>() {
+            Some(i) => Err(Interrupted {
+                signal: i.signal as i32,
+                message: i.to_string(),
+            }
+            .into()),
+            None => Err(e),
+        },
     }
 }
 

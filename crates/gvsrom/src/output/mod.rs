@@ -25,6 +25,9 @@
 //!    A killed process (SIGKILL, power loss) can leave a hidden `.P.gvsrom-staging-*` directory or
 //!    `.P.gvsrom-old-*`; they are never taken for a complete result and can be deleted by hand.
 
+mod run_dir;
+pub use run_dir::{RunDir, RUN_FORMAT};
+
 use serde::Serialize;
 use serde_json::{Map, Value};
 use std::fs::{self, File, OpenOptions};

@@ -1,0 +1,265 @@
+//! Case IV-B: the soft beam under a triangular moment pulse (paper Section IV-B, Table I bottom,
+//! Figs. 5–6, Table III).
+//!
+//! The paper's magnitudes are the pulse's total moment in N·m (`convention = "total"`): 5000
+//! equilibria at random centres in [0, L] and magnitudes in [−5, 5] N·m. Models: autoencoders
+//! r = 1, 2, 3 × 3, 5, 7 hidden layers and POD with 1 … 40 modes. Test: 4 N·m at X/L = 0.25 and
+//! 2 N·m at X/L = 0.75 (Fig. 6).
+
+use super::iv_a::{accuracy_table, fewest_pod_below, strain_series, table_i, table_iii};
+use super::report::{figure, CaseReport, Cell, Finding, RenderedFigure};
+use super::tasks::{self, AeConfig, DatasetSpec, EvalModel, Evaluation, ScenarioSpec};
+use super::{iv_common, new_report, paper, Case, Options, Run};
+use crate::plot::{palette, Figure, LineChart, Series, SeriesStyle};
+use serde_json::json;
+
+struct Sizes {
+    samples: usize,
+    epochs: usize,
+    max_pod: usize,
+    repeat: u32,
+}
+
+fn sizes(quick: bool) -> Sizes {
+    if quick {
+        Sizes {
+            samples: 800,
+            epochs: 150,
+            max_pod: 24,
+            repeat: 2,
+        }
+    } else {
+        Sizes {
+            samples: 5000,
+            epochs: 1000,
+            max_pod: 40,
+            repeat: 5,
+        }
+    }
+}
+
+/// The two loads of Fig. 6: (total moment [N·m], centre [m]) on the 0.8 m beam.
+const TEST_LOADS: [(f64, f64); 2] = [(4.0, 0.2), (2.0, 0.6)];
+
+/// Runs case IV-B.
+pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<RenderedFigure>)> {
+    let s = sizes(opts.quick);
+    let scenario = ScenarioSpec::new("soft-beam", &["loads.distributed.0.convention=\"total\""]);
+    let plan = DatasetSpec {
+        random: vec![
+            "loads.distributed.0.center=0:0.8".into(),
+            "loads.distributed.0.magnitude=-5:5".into(),
+        ],
+        samples: Some(s.samples),
+        seed: 1,
+        ..DatasetSpec::default()
+    };
+    let data = tasks::dataset(run, "iv-b/dataset", &scenario, &plan, opts.jobs)?;
+    let configs: Vec<AeConfig> = paper::TABLE_I_LAYERS
+        .iter()
+        .flat_map(|&h| (1..=3).map(move |r| (h, r)))
+        .map(|(h, r)| AeConfig::new(r, h, s.epochs))
+        .collect();
+    let trained = tasks::parallel(&configs, |c| {
+        tasks::train(
+            run,
+            &format!("iv-b/ae-r{}-h{}", c.latent, c.hidden_layers),
+            &data,
+            c,
+        )
+    })?;
+    let aes: Vec<Vec<_>> = trained.chunks(3).map(<[_]>::to_vec).collect();
+    let modes: Vec<usize> = (1..=s.max_pod).collect();
+    let pods = tasks::parallel(&modes, |&k| {
+        tasks::pod(run, &format!("iv-b/pod-{k}"), &data, k)
+    })?;
+
+    let mut report = new_report(
+        Case::IvB,
+        "soft beam under an external moment (paper Section IV-B)",
+    );
+    report.setup = vec![
+        "scenario: preset `soft-beam` with `loads.distributed.0.convention = \"total\"`: the magnitude is the pulse's total moment in N·m, as the paper gives it (0.8 m beam, radius 1.5 cm, E = 1 MPa, follower moment about local y as a triangular pulse of base 0.1 L, no gravity, 50-DOF linear FEM-like bend-y basis, 148 points)".into(),
+        format!("data: {} equilibria at random centres in [0, 0.8] m and magnitudes in [−5, 5] N·m, seed 1 (`gvsrom dataset soft-beam --set 'loads.distributed.0.convention=\"total\"' --random loads.distributed.0.center=0:0.8 --random loads.distributed.0.magnitude=-5:5 --samples {} --seed 1`); {} solved, {} failed", data.value.samples, data.value.samples, data.value.ok, data.value.failed),
+        format!("autoencoders: r = 1, 2, 3 × 3, 5, 7 hidden layers, tanh, λ = 1e-4, Adam ≤ {} epochs with early stopping, then L-BFGS", s.epochs),
+        format!("POD: 1 … {} modes", s.max_pod),
+        format!("test: 4 N·m at X/L = 0.25 and 2 N·m at X/L = 0.75 (Fig. 6); each equilibrium solved {} times, mean time", s.repeat),
+    ];
+    report.tables.push(table_i(
+        "table-i",
+        "Table I (bottom): RMS reconstruction error over the full dataset",
+        &aes,
+        &paper::TABLE_I_IV_B,
+        "RMS of x̂ − x over every entry of every snapshot, x = bend-y curvature deviation at the 148 points [1/m]. Columns: ours, the paper's, ours / paper.",
+    ));
+    let mut models = vec![EvalModel::hom(), EvalModel::of("AE-2", &aes[2][1])];
+    for (k, p) in pods.iter().enumerate() {
+        models.push(EvalModel::of(&format!("POD-{}", k + 1), p));
+    }
+    let inputs: Vec<Vec<String>> = TEST_LOADS
+        .iter()
+        .map(|(m, c)| {
+            vec![
+                format!("loads.distributed.0.magnitude={m}"),
+                format!("loads.distributed.0.center={c}"),
+            ]
+        })
+        .collect();
+    let ev = tasks::statics_eval(run, "iv-b/eval", &scenario, &inputs, &models, s.repeat)?;
+    let ev = &ev.value;
+    let k = fewest_pod_below(ev, pods.len(), 1.0);
+    report.tables.push(accuracy_table(ev, &models));
+    let (ae_err, ae_max) = ev.stats("AE-2", |s| s.strain_error_percent);
+    let (pod2_err, _) = ev.stats("POD-2", |s| s.strain_error_percent);
+    let (hom_t, _) = ev.stats("HOM", |s| s.time_s);
+    let (ae_t, _) = ev.stats("AE-2", |s| s.time_s);
+    let pod_k = k.map(|k| format!("POD-{k}"));
+    let (pod_t, _) = pod_k
+        .as_deref()
+        .map(|l| ev.stats(l, |s| s.time_s))
+        .unwrap_or((f64::NAN, f64::NAN));
+    report
+        .tables
+        .push(table_iii(&paper::TABLE_III_IV_B, k, pod_t, 2, ae_t, hom_t));
+    report.findings = vec![
+        Finding {
+            claim: "the AE-ROM is more accurate than the POD-ROM of equal DOF (r = 2)".into(),
+            holds: ae_err < pod2_err,
+            evidence: format!(
+                "mean strain error {} % (AE-2) against {} % (POD-2)",
+                Cell::sig(ae_err, 3).render(),
+                Cell::sig(pod2_err, 3).render()
+            ),
+        },
+        Finding {
+            claim: "the AE-ROM reaches < 1 % strain error with 2 DOF".into(),
+            holds: ae_max < 1.0,
+            evidence: format!(
+                "largest strain error at the two test loads {} %",
+                Cell::sig(ae_max, 3).render()
+            ),
+        },
+        Finding {
+            claim: "at equal accuracy (< 1 %) the AE-ROM is faster than the POD-ROM".into(),
+            holds: ae_max < 1.0 && ae_t < pod_t,
+            evidence: match &pod_k {
+                Some(l) => format!(
+                    "AE-2 {} ms against {l} {} ms per equilibrium{}",
+                    Cell::sig(ae_t * 1e3, 3).render(),
+                    Cell::sig(pod_t * 1e3, 3).render(),
+                    if ae_max < 1.0 {
+                        ""
+                    } else {
+                        "; but the AE-ROM itself is not below 1 %"
+                    }
+                ),
+                None => format!("no POD model up to {} modes reaches < 1 %", pods.len()),
+            },
+        },
+        Finding {
+            claim: "both ROMs are faster than the HOM".into(),
+            holds: ae_t < hom_t && pod_t < hom_t,
+            evidence: format!(
+                "HOM {} ms, AE-2 {} ms, POD-k {} ms",
+                Cell::sig(hom_t * 1e3, 3).render(),
+                Cell::sig(ae_t * 1e3, 3).render(),
+                Cell::sig(pod_t * 1e3, 3).render()
+            ),
+        },
+    ];
+    let latent = iv_common::latent_and_dimension(
+        &data.path,
+        &[&aes[0][1], &aes[0][2]],
+        &aes[2],
+        1,
+        "magnitude [N·m]",
+    )?;
+    report.tables.push(latent.table.clone());
+    report.notes = vec![
+        "Table I's bottom half is measured in the paper's convention (total moment in N·m); the preset's default (`convention = \"peak\"`, the peak line density) gives 25× smaller strains.".into(),
+        "Known gap: on this problem gvsrom's autoencoder trainer reaches 3–7× the paper's RMSE at 7 hidden layers (a plain scikit-learn MLPRegressor of the same architecture does 40 % better at r = 2); the trainer, not the data, is the gap.".into(),
+        "Times: gvsrom on this machine against the paper's MATLAB: compare the ratios.".into(),
+    ];
+    report.settings =
+        json!({ "scenario": scenario, "plan": plan, "autoencoders": configs, "pod_modes": modes });
+    report.values = json!({
+        "table_i": aes.iter().map(|row| row.iter().map(|a| &a.value).collect::<Vec<_>>()).collect::<Vec<_>>(),
+        "pod_k_below_1_percent": k,
+        "evaluation": ev,
+        "intrinsic_dimension": latent.values,
+    });
+    let figures = vec![
+        fig6(ev, pod_k.as_deref())?,
+        figure("fig5-latent", "Fig. 5: latent coordinates of the training samples, AE with r = 2 (left) and r = 3 (right), 3 hidden layers, coloured by the moment's magnitude", &latent.figure, 1400, 620)?,
+    ];
+    Ok((report, figures))
+}
+
+/// Fig. 6: bend-y strain along the beam at the two test loads (HOM, AE-2, POD-2, POD-k) and the
+/// configurations of the HOM and the AE-ROM.
+fn fig6(ev: &Evaluation, pod_k: Option<&str>) -> anyhow::Result<RenderedFigure> {
+    let mut labels = vec![
+        ("HOM", palette::HOM, SeriesStyle::Line),
+        ("AE-2", palette::AE, SeriesStyle::Dashed),
+        ("POD-2", palette::POD, SeriesStyle::Dashed),
+    ];
+    if let Some(l) = pod_k {
+        labels.push((l, palette::POD_ALT, SeriesStyle::Dashed));
+    }
+    let mut panels = vec![];
+    for ((m, c), p) in TEST_LOADS.iter().zip(&ev.points) {
+        panels.push(Figure::Line(LineChart {
+            title: format!("{m} N·m at X/L = {:.2}", c / 0.8),
+            x_label: "X [m]".into(),
+            y_label: "bend-y strain ξ₂ [1/m]".into(),
+            series: labels
+                .iter()
+                .filter_map(|(l, col, st)| {
+                    let s = p
+                        .models
+                        .iter()
+                        .find(|s| s.label == *l && s.error.is_none())?;
+                    Some(strain_series(ev, s, "bend_y", l, *col, *st))
+                })
+                .collect(),
+            log_y: false,
+            equal_aspect: false,
+        }));
+    }
+    let mut shapes = vec![];
+    for (n, p) in ev.points.iter().enumerate() {
+        for (label, color, style) in [
+            ("HOM", palette::HOM, SeriesStyle::Line),
+            ("AE-2", palette::AE, SeriesStyle::Dashed),
+        ] {
+            if let Some(s) = p
+                .models
+                .iter()
+                .find(|s| s.label == label && s.error.is_none())
+            {
+                shapes.push(Series {
+                    label: if n == 0 { label.into() } else { String::new() },
+                    x: s.centerline.iter().map(|c| c[0]).collect(),
+                    y: s.centerline.iter().map(|c| c[2]).collect(),
+                    style,
+                    color: Some(color),
+                });
+            }
+        }
+    }
+    panels.push(Figure::Line(LineChart {
+        title: "configurations at both loads".into(),
+        x_label: "x [m]".into(),
+        y_label: "z [m]".into(),
+        series: shapes,
+        log_y: false,
+        equal_aspect: true,
+    }));
+    figure(
+        "fig6-strain",
+        "Fig. 6: bend-y strain of the HOM, the AE-ROM (r = 2) and POD-ROMs with 2 and k modes (k: the fewest reaching < 1 %) at 4 N·m @ X/L = 0.25 and 2 N·m @ X/L = 0.75, and the configurations (x–z)",
+        &Figure::Grid { title: "IV-B: strain profiles and configurations".into(), cols: 3, panels },
+        1800,
+        600,
+    )
+}

@@ -1,0 +1,265 @@
+//! Pipeline steps that are saved, keyed and skipped (`gvsrom reproduce`).
+//!
+//! A step has a name (its place under `<out>/steps/`) and a *key*: the FNV-1a hash of its name, its
+//! configuration and the keys of its inputs, as canonical JSON. Its output (a dataset, a model) is an
+//! ordinary gvsrom output at `<out>/steps/<name>/`; its value (the numbers it measured) and its key
+//! are recorded in `<out>/steps/<name>.step.json`, written *after* the output is in place. A step whose
+//! record holds the same key, and whose output still loads, is reused; anything else is computed
+//! again and replaces what the run wrote before. So an interrupted run resumes where it stopped (a
+//! step killed half-way left at most a hidden staging directory and no record), and changing one
+//! option recomputes only the steps whose keys it enters.
+
+use crate::output::{OutputError, OutputFile, RunDir};
+use crate::reduced_model::fnv1a64;
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+/// The run was stopped by a signal (SIGINT, SIGTERM) between or inside steps; the steps finished
+/// before it are kept. The CLI exits with `128 + signal`.
+#[derive(Debug, thiserror::Error)]
+#[error("interrupted by {}; the finished steps are kept in `{}` and a new run with the same options reuses them", signal_name(*.signal), .out.display())]
+pub struct Interrupted {
+    pub signal: usize,
+    pub out: PathBuf,
+}
+
+fn signal_name(sig: usize) -> &'static str {
+    match sig {
+        2 => "SIGINT",
+        15 => "SIGTERM",
+        _ => "a signal",
+    }
+}
+
+/// How one step went, for the reports.
+#[derive(Debug, Clone, Serialize, Deserialize, PartialEq)]
+pub struct StepRecord {
+    pub name: String,
+    pub key: String,
+    /// Wall time of the computation when it ran [s] (a reused step shows the time it took then).
+    pub wall_time_s: f64,
+    /// Reused from an earlier run (same key, output present).
+    pub reused: bool,
+}
+
+/// A finished step: its value, where its output is, and its record.
+#[derive(Debug, Clone)]
+pub struct Step<T> {
+    pub value: T,
+    pub path: PathBuf,
+    pub record: StepRecord,
+}
+
+impl<T> Step<T> {
+    pub fn key(&self) -> &str {
+        &self.record.key
+    }
+}
+
+/// The state of one `reproduce` run: its directory (locked), the interrupt flag and the steps done.
+pub struct Run {
+    dir: RunDir,
+    interrupt: Arc<AtomicUsize>,
+    records: Mutex<Vec<StepRecord>>,
+}
+
+impl Run {
+    pub fn new(dir: RunDir, interrupt: Arc<AtomicUsize>) -> Run {
+        Run {
+            dir,
+            interrupt,
+            records: Mutex::new(vec![]),
+        }
+    }
+
+    /// The run directory.
+    pub fn path(&self) -> &Path {
+        self.dir.path()
+    }
+
+    /// The run directory, to write loose files such as `index.html`.
+    pub fn dir_mut(&mut self) -> &mut RunDir {
+        &mut self.dir
+    }
+
+    /// The interrupt flag (a signal number once SIGINT/SIGTERM arrived).
+    pub fn interrupt(&self) -> &Arc<AtomicUsize> {
+        &self.interrupt
+    }
+
+    /// An error if a signal arrived.
+    pub fn check_interrupt(&self) -> Result<(), Interrupted> {
+        match self.interrupt.load(Ordering::SeqCst) {
+            0 => Ok(()),
+            signal => Err(Interrupted {
+                signal,
+                out: self.path().to_path_buf(),
+            }),
+        }
+    }
+
+    /// Where step `name`'s output goes: `<out>/steps/<name>`.
+    pub fn step_path(&self, name: &str) -> PathBuf {
+        self.path().join("steps").join(name)
+    }
+
+    /// The records of the steps run or reused so far, in order.
+    pub fn records(&self) -> Vec<StepRecord> {
+        self.records.lock().map(|r| r.clone()).unwrap_or_default()
+    }
+
+    /// The records of the steps whose names start with `prefix`.
+    pub fn records_of(&self, names: &[&str]) -> Vec<StepRecord> {
+        self.records()
+            .into_iter()
+            .filter(|r| names.iter().any(|n| r.name == *n))
+            .collect()
+    }
+
+    /// Runs (or reuses) step `name` with configuration `config` (which must include the keys of its
+    /// inputs). `valid(path)` says whether an earlier output at the step's path is still usable;
+    /// `compute(path)` writes the output there (through the output module, replacing an earlier
+    /// gvsrom output) and returns the step's value.
+    pub fn step<T, C>(
+        &self,
+        name: &str,
+        config: &C,
+        valid: impl Fn(&Path) -> bool,
+        compute: impl FnOnce(&Path) -> anyhow::Result<T>,
+    ) -> anyhow::Result<Step<T>>
+    where
+        T: Serialize + DeserializeOwned,
+        C: Serialize + ?Sized,
+    {
+        self.check_interrupt()?;
+        let key = step_key(name, config)?;
+        let path = self.step_path(name);
+        let record_path = self.record_path(name);
+        if let Some(value) = read_record::<T>(&record_path, &key) {
+            if valid(&path) {
+                let wall_time_s = read_time(&record_path).unwrap_or(0.0);
+                return Ok(self.finish(name, key, wall_time_s, true, value, path));
+            }
+        }
+        // the record goes first: a record without its output is never trusted (key checked above,
+        // `valid` below), an output without its record is recomputed
+        let record = OutputFile::create("--out", &record_path, "reproduce-step", true)?;
+        let t0 = Instant::now();
+        let value = compute(&path)?;
+        let wall_time_s = t0.elapsed().as_secs_f64();
+        self.check_interrupt()?;
+        record.commit_json(json!({
+            "step": name,
+            "key": key,
+            "wall_time_s": wall_time_s,
+            "value": serde_json::to_value(&value)?,
+        }))?;
+        Ok(self.finish(name, key, wall_time_s, false, value, path))
+    }
+
+    fn record_path(&self, name: &str) -> PathBuf {
+        self.path().join("steps").join(format!("{name}.step.json"))
+    }
+
+    fn finish<T>(
+        &self,
+        name: &str,
+        key: String,
+        wall_time_s: f64,
+        reused: bool,
+        value: T,
+        path: PathBuf,
+    ) -> Step<T> {
+        let record = StepRecord {
+            name: name.to_string(),
+            key,
+            wall_time_s,
+            reused,
+        };
+        if let Ok(mut r) = self.records.lock() {
+            r.push(record.clone());
+        }
+        Step {
+            value,
+            path,
+            record,
+        }
+    }
+}
+
+/// The key of a step: FNV-1a of `{"step": name, "config": config, "version": crate version}` as
+/// canonical JSON (object keys sorted).
+pub fn step_key<C: Serialize + ?Sized>(name: &str, config: &C) -> Result<String, OutputError> {
+    let value = json!({
+        "step": name,
+        "config": serde_json::to_value(config).map_err(|e| io_err(name, e))?,
+        "version": env!("CARGO_PKG_VERSION"),
+    });
+    Ok(fnv1a64(canonical(&value).as_bytes()))
+}
+
+fn io_err(name: &str, e: serde_json::Error) -> OutputError {
+    OutputError::Refused {
+        option: "reproduce".into(),
+        path: PathBuf::from(name),
+        reason: format!("the step's configuration cannot be serialized: {e}"),
+    }
+}
+
+/// JSON text with object keys sorted at every level (serde_json keeps insertion order here).
+fn canonical(v: &Value) -> String {
+    match v {
+        Value::Object(m) => {
+            let mut keys: Vec<&String> = m.keys().collect();
+            keys.sort();
+            let items: Vec<String> = keys
+                .iter()
+                .map(|k| format!("{}:{}", Value::from(k.as_str()), canonical(&m[*k])))
+                .collect();
+            format!("{{{}}}", items.join(","))
+        }
+        Value::Array(a) => format!(
+            "[{}]",
+            a.iter().map(canonical).collect::<Vec<_>>().join(",")
+        ),
+        other => other.to_string(),
+    }
+}
+
+fn read_json(path: &Path) -> Option<Value> {
+    serde_json::from_str(&std::fs::read_to_string(path).ok()?).ok()
+}
+
+/// The value of a step record at `path` if it holds `key`.
+fn read_record<T: DeserializeOwned>(path: &Path, key: &str) -> Option<T> {
+    let v = read_json(path)?;
+    if v.get("key")?.as_str()? != key {
+        return None;
+    }
+    serde_json::from_value(v.get("value")?.clone()).ok()
+}
+
+fn read_time(path: &Path) -> Option<f64> {
+    read_json(path)?.get("wall_time_s")?.as_f64()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_key_ignores_key_order_and_changes_with_any_value() {
+        let a = step_key("s", &json!({"a": 1, "b": [1.5, 2]})).unwrap();
+        let b = step_key("s", &json!({"b": [1.5, 2], "a": 1})).unwrap();
+        let c = step_key("s", &json!({"a": 1, "b": [1.5, 3]})).unwrap();
+        let d = step_key("t", &json!({"a": 1, "b": [1.5, 2]})).unwrap();
+        assert_eq!(a, b);
+        assert_ne!(a, c);
+        assert_ne!(a, d);
+    }
+}

@@ -1,0 +1,481 @@
+//! The steps the cases are made of, each one call of the library function a command also calls:
+//! a dataset (`gvsrom dataset`), a POD model (`gvsrom pod`), an autoencoder (`gvsrom train`) and
+//! statics of the HOM and reduced models at test inputs (`gvsrom statics [--model]`).
+
+use super::step::{Interrupted, Run, Step};
+use crate::dataset::{Dataset, DatasetArgs, Layout};
+use crate::reduced_model::{ModelWeights, ReducedModel};
+use crate::{build, presets, reduce, scenario, statics, Built};
+use serde::{Deserialize, Serialize};
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::Ordering;
+
+/// A scenario: a preset (or file) with `--set` overrides.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ScenarioSpec {
+    pub preset: String,
+    pub set: Vec<String>,
+}
+
+impl ScenarioSpec {
+    pub fn new(preset: &str, set: &[&str]) -> ScenarioSpec {
+        ScenarioSpec {
+            preset: preset.into(),
+            set: set.iter().map(|s| s.to_string()).collect(),
+        }
+    }
+
+    /// The same scenario with more overrides.
+    pub fn with(&self, more: &[String]) -> ScenarioSpec {
+        let mut s = self.clone();
+        s.set.extend(more.iter().cloned());
+        s
+    }
+
+    /// The built scenario and its TOML table after the overrides (the table supplies non-tension
+    /// inputs to a reduced model's initial guess, as `--set` does on the command line).
+    pub fn build(&self) -> anyhow::Result<(Built, toml::Table)> {
+        let s = presets::load(&self.preset, &self.set)?;
+        let built = build(&s)?;
+        let src = presets::source(&self.preset)?;
+        let mut table = scenario::parse_table(&src.origin, &src.text)?;
+        for spec in &self.set {
+            scenario::apply_override(&mut table, spec)?;
+        }
+        Ok((built, table))
+    }
+}
+
+/// A sampling plan of `gvsrom dataset` (static: sweep/grid/random; dynamic: babbling).
+#[derive(Debug, Clone, Serialize, Deserialize, Default)]
+pub struct DatasetSpec {
+    pub sweep: Vec<String>,
+    pub grid: Vec<String>,
+    pub random: Vec<String>,
+    pub samples: Option<usize>,
+    pub seed: u64,
+    pub duration: Option<f64>,
+    pub babble: Option<Vec<f64>>,
+    pub sample_rate: Option<f64>,
+}
+
+/// What a dataset step reports.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct DatasetInfo {
+    pub samples: usize,
+    pub ok: usize,
+    pub failed: usize,
+    pub features: usize,
+    pub parameters: Vec<String>,
+}
+
+/// `gvsrom dataset` on `scenario` with `plan`, at `<out>/steps/<name>`.
+pub fn dataset(
+    run: &Run,
+    name: &str,
+    scenario: &ScenarioSpec,
+    plan: &DatasetSpec,
+    jobs: usize,
+) -> anyhow::Result<Step<DatasetInfo>> {
+    let config = serde_json::json!({ "scenario": scenario, "plan": plan });
+    run.step(
+        name,
+        &config,
+        |p| Dataset::load(p).is_ok_and(|d| d.meta.complete),
+        |path| {
+            let args = DatasetArgs {
+                scenario: scenario.preset.clone(),
+                set: scenario.set.clone(),
+                sweep: plan.sweep.clone(),
+                grid: plan.grid.clone(),
+                random: plan.random.clone(),
+                samples: plan.samples,
+                seed: plan.seed,
+                chunk_size: crate::dataset::DEFAULT_CHUNK_SIZE,
+                threads: Some(jobs),
+                out: path.to_path_buf(),
+                force: true,
+                resume: false,
+                duration: plan.duration,
+                sample_rate: plan.sample_rate,
+                input: None,
+                interpolate: false,
+                steps: None,
+                babble: plan.babble.clone(),
+                from_equilibrium: false,
+                rtol: None,
+                atol: 1e-6,
+                stop_after_chunks: None,
+            };
+            let outcome = crate::dataset::run(&args, run.interrupt(), &mut std::io::sink())?;
+            if outcome.interrupted.is_some() {
+                run.check_interrupt()?;
+                anyhow::bail!("the dataset `{}` stopped early", path.display());
+            }
+            let m = &outcome.meta;
+            Ok(DatasetInfo {
+                samples: m.samples,
+                ok: m.counts.ok,
+                failed: m.counts.failed,
+                features: m.strain_x.len() * m.components.len(),
+                parameters: m.parameters.clone(),
+            })
+        },
+    )
+}
+
+/// What a model step reports.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ModelInfo {
+    pub latent: usize,
+    /// RMS reconstruction error over every solved sample of the dataset (Table I), strain units.
+    pub rmse_full: f64,
+    /// POD: captured energy of the kept modes.
+    pub captured_energy: Option<f64>,
+    /// Autoencoder: training and validation RMSE, epochs, wall time of the training alone.
+    pub train_rmse: Option<f64>,
+    pub val_rmse: Option<f64>,
+    pub epochs_run: Option<usize>,
+    pub anchor_equilibria: usize,
+}
+
+/// `gvsrom pod DATASET --modes K` at `<out>/steps/<name>`.
+pub fn pod(
+    run: &Run,
+    name: &str,
+    data: &Step<DatasetInfo>,
+    modes: usize,
+) -> anyhow::Result<Step<ModelInfo>> {
+    let config = serde_json::json!({ "dataset": data.key(), "modes": modes });
+    run.step(
+        name,
+        &config,
+        |p| ReducedModel::load(p).is_ok(),
+        |path| {
+            let s = reduce::pod(&data.path, modes, path, true)?;
+            let model = ReducedModel::load(path)?;
+            Ok(ModelInfo {
+                latent: modes,
+                rmse_full: reconstruction_rmse(&data.path, &model)?,
+                captured_energy: Some(s.captured_energy),
+                train_rmse: None,
+                val_rmse: None,
+                epochs_run: None,
+                anchor_equilibria: s.anchor_equilibria,
+            })
+        },
+    )
+}
+
+/// The settings of one autoencoder (`gvsrom train` options).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct AeConfig {
+    pub latent: usize,
+    pub hidden_layers: usize,
+    pub epochs: usize,
+    pub patience: usize,
+    pub lambda: f64,
+    pub batch_size: usize,
+    pub learning_rate: f64,
+    pub seed: u64,
+}
+
+impl AeConfig {
+    /// `gvsrom train`'s defaults (λ = 1e-4 as in the paper) with `epochs`.
+    pub fn new(latent: usize, hidden_layers: usize, epochs: usize) -> AeConfig {
+        let d = rom::nn::TrainOptions::default();
+        AeConfig {
+            latent,
+            hidden_layers,
+            epochs,
+            patience: d.patience.unwrap_or(0),
+            lambda: d.lambda,
+            batch_size: d.batch_size,
+            learning_rate: d.learning_rate,
+            seed: d.seed,
+        }
+    }
+}
+
+/// `gvsrom train DATASET …` at `<out>/steps/<name>`; Ctrl-C stops the training and the run (the
+/// partial model is not recorded as a finished step).
+pub fn train(
+    run: &Run,
+    name: &str,
+    data: &Step<DatasetInfo>,
+    c: &AeConfig,
+) -> anyhow::Result<Step<ModelInfo>> {
+    let config = serde_json::json!({ "dataset": data.key(), "ae": c });
+    run.step(
+        name,
+        &config,
+        |p| ReducedModel::load(p).is_ok(),
+        |path| {
+            let options = rom::nn::TrainOptions {
+                latent: c.latent,
+                hidden_layers: c.hidden_layers,
+                lambda: c.lambda,
+                epochs: c.epochs,
+                batch_size: c.batch_size,
+                learning_rate: c.learning_rate,
+                patience: (c.patience > 0).then_some(c.patience),
+                seed: c.seed,
+                ..rom::nn::TrainOptions::default()
+            };
+            let interrupt = run.interrupt().clone();
+            let mut progress =
+                |_: usize, _: f64, _: Option<f64>| match interrupt.load(Ordering::SeqCst) {
+                    0 => ControlFlow::Continue(()),
+                    _ => ControlFlow::Break(()),
+                };
+            let s = reduce::train(&data.path, &options, path, true, &mut progress)?;
+            run.check_interrupt()?;
+            let model = ReducedModel::load(path)?;
+            Ok(ModelInfo {
+                latent: c.latent,
+                rmse_full: reconstruction_rmse(&data.path, &model)?,
+                captured_energy: None,
+                train_rmse: Some(s.report.final_train_rmse),
+                val_rmse: s.report.final_val_rmse,
+                epochs_run: Some(s.report.epochs_run),
+                anchor_equilibria: s.anchor_equilibria,
+            })
+        },
+    )
+}
+
+/// Table I's measure: `sqrt(mean (x̂ − x)²)` over every entry of every solved snapshot of the
+/// dataset (training and validation rows alike), x̂ the model's reconstruction (AE: `D(E(x))`; POD:
+/// `V Vᵀ x`), in the snapshots' units (1/m for curvatures).
+pub fn reconstruction_rmse(dataset: &Path, model: &ReducedModel) -> anyhow::Result<f64> {
+    let ds = Dataset::load(dataset)?;
+    let (mut sum, mut count) = (0.0, 0usize);
+    for k in ds.ok_rows() {
+        let x = ds.strain_row(k);
+        let rec: Vec<f64> = match &model.weights {
+            ModelWeights::Autoencoder(ae) => ae.reconstruct(x)?,
+            ModelWeights::Pod { modes, .. } => {
+                let v = nalgebra::DVector::from_column_slice(x);
+                (modes * (modes.transpose() * v)).iter().copied().collect()
+            }
+        };
+        sum += x
+            .iter()
+            .zip(&rec)
+            .map(|(a, b)| (a - b) * (a - b))
+            .sum::<f64>();
+        count += x.len();
+    }
+    anyhow::ensure!(count > 0, "`{}` has no solved samples", dataset.display());
+    Ok((sum / count as f64).sqrt())
+}
+
+/// One model of an evaluation: a label, and a reduced model's directory (None: the HOM).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct EvalModel {
+    pub label: String,
+    pub path: Option<PathBuf>,
+    /// The key of the step that made it (so the evaluation is redone when the model changes).
+    pub key: String,
+}
+
+impl EvalModel {
+    pub fn hom() -> EvalModel {
+        EvalModel {
+            label: "HOM".into(),
+            path: None,
+            key: String::new(),
+        }
+    }
+    pub fn of(label: &str, step: &Step<ModelInfo>) -> EvalModel {
+        EvalModel {
+            label: label.into(),
+            path: Some(step.path.clone()),
+            key: step.key().to_string(),
+        }
+    }
+}
+
+/// One model's equilibrium at one test input.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Solved {
+    pub label: String,
+    pub dof: usize,
+    /// `None` when the solve failed (then `error` says why).
+    pub error: Option<String>,
+    pub q: Vec<f64>,
+    pub tip: [f64; 3],
+    /// ξ − ξ* at the points, active components, point-major.
+    pub strain: Vec<f64>,
+    pub centerline: Vec<[f64; 3]>,
+    /// Mean solve time over the repetitions [s].
+    pub time_s: f64,
+    pub iterations: usize,
+    /// Against the HOM at the same input (0 for the HOM itself).
+    pub strain_error_percent: f64,
+    pub tip_error_percent: f64,
+}
+
+/// All models at one test input.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct EvalPoint {
+    /// The overrides that make the input (e.g. `tendons.0.tension=-2.7`).
+    pub set: Vec<String>,
+    pub models: Vec<Solved>,
+}
+
+/// An evaluation: the points' abscissae and components, and every model at every input.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Evaluation {
+    pub strain_x: Vec<f64>,
+    pub components: Vec<String>,
+    pub length: f64,
+    pub points: Vec<EvalPoint>,
+}
+
+impl Evaluation {
+    /// The solutions of model `label` over the inputs.
+    pub fn of<'a>(&'a self, label: &'a str) -> impl Iterator<Item = &'a Solved> + 'a {
+        self.points
+            .iter()
+            .filter_map(move |p| p.models.iter().find(|m| m.label == label))
+    }
+    /// Mean and max of `f` over the inputs for model `label` (NaN if it failed anywhere).
+    pub fn stats(&self, label: &str, f: impl Fn(&Solved) -> f64) -> (f64, f64) {
+        let v: Vec<f64> = self
+            .of(label)
+            .map(|s| if s.error.is_some() { f64::NAN } else { f(s) })
+            .collect();
+        if v.is_empty() || v.iter().any(|x| !x.is_finite()) {
+            return (f64::NAN, f64::NAN);
+        }
+        let mean = v.iter().sum::<f64>() / v.len() as f64;
+        (mean, v.iter().copied().fold(f64::MIN, f64::max))
+    }
+}
+
+/// `gvsrom statics [--model M]` of every model at every input (each input: `scenario` with the
+/// overrides `inputs[i]`), sequentially on one thread so that the times compare. Each solve is
+/// repeated `repeat` times and its mean time kept (`statics --repeat`).
+pub fn statics_eval(
+    run: &Run,
+    name: &str,
+    scenario: &ScenarioSpec,
+    inputs: &[Vec<String>],
+    models: &[EvalModel],
+    repeat: u32,
+) -> anyhow::Result<Step<Evaluation>> {
+    let config = serde_json::json!({
+        "scenario": scenario, "inputs": inputs, "models": models, "repeat": repeat,
+    });
+    run.step(
+        name,
+        &config,
+        |_| true,
+        |_| {
+            let mut points = vec![];
+            let (base, _) = scenario.build()?;
+            let layout = Layout::of(&base);
+            for set in inputs {
+                run.check_interrupt()?;
+                let spec = scenario.with(set);
+                let mut solved = vec![];
+                let mut hom_report = None;
+                for m in models {
+                    let (mut built, table) = spec.build()?;
+                    if let Some(dir) = &m.path {
+                        reduce::attach(&mut built, Some(&table), dir)?;
+                    }
+                    let result = statics::solve_repeated(&built, repeat)
+                        .map_err(anyhow::Error::from)
+                        .and_then(|r| match &built.reduced {
+                            Some(red) => red.check_range(&r.q).map(|_| r).map_err(Into::into),
+                            None => Ok(r),
+                        });
+                    solved.push(match result {
+                        Ok(r) => {
+                            let (se, te) = match &hom_report {
+                                Some(h) => {
+                                    let c = statics::compare(&built, h, &r);
+                                    (c.strain_error_percent, c.tip_error_percent)
+                                }
+                                None => (0.0, 0.0),
+                            };
+                            let s = Solved {
+                                label: m.label.clone(),
+                                dof: r.n_dof,
+                                error: None,
+                                q: r.q.clone(),
+                                tip: r.tip_position,
+                                strain: statics::active_deviations(&built, &r),
+                                centerline: r.centerline.clone(),
+                                time_s: r.solve_time_s,
+                                iterations: r.iterations,
+                                strain_error_percent: se,
+                                tip_error_percent: te,
+                            };
+                            if m.path.is_none() {
+                                hom_report = Some(r);
+                            }
+                            s
+                        }
+                        Err(e) => {
+                            anyhow::ensure!(
+                                m.path.is_some(),
+                                "the full model's statics failed at {}: {e:#}",
+                                set.join(" ")
+                            );
+                            Solved {
+                                label: m.label.clone(),
+                                dof: built.n_dof(),
+                                error: Some(format!("{e:#}")),
+                                q: vec![],
+                                tip: [f64::NAN; 3],
+                                strain: vec![],
+                                centerline: vec![],
+                                time_s: f64::NAN,
+                                iterations: 0,
+                                strain_error_percent: f64::NAN,
+                                tip_error_percent: f64::NAN,
+                            }
+                        }
+                    });
+                }
+                points.push(EvalPoint {
+                    set: set.clone(),
+                    models: solved,
+                });
+            }
+            Ok(Evaluation {
+                strain_x: layout.strain_x.clone(),
+                components: layout.component_names(),
+                length: base.model.disc.length(),
+                points,
+            })
+        },
+    )
+}
+
+/// Runs `f` over `items` on the run's thread pool (in parallel), keeping the order; the first
+/// interrupt or error wins.
+pub fn parallel<I: Sync, T: Send>(
+    items: &[I],
+    f: impl Fn(&I) -> anyhow::Result<T> + Sync + Send,
+) -> anyhow::Result<Vec<T>> {
+    use rayon::prelude::*;
+    let results: Vec<anyhow::Result<T>> = items.par_iter().map(&f).collect();
+    // an interrupt anywhere is reported as the interrupt, not as the error it caused elsewhere
+    if let Some(i) = results.iter().find_map(|r| {
+        r.as_ref()
+            .err()
+            .and_then(|e| e.downcast_ref::<Interrupted>())
+    }) {
+        return Err(Interrupted {
+            signal: i.signal,
+            out: i.out.clone(),
+        }
+        .into());
+    }
+    results.into_iter().collect()
+}
