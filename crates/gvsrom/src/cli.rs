@@ -12,26 +12,12 @@ use gvsrom::{build, Built, Scenario};
 use std::io::Write;
 use std::ops::ControlFlow;
 
-/// `simulate --method`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum MethodChoice {
-    Auto,
-    Ndf,
-    Galpha,
-    Sdirk,
-}
-
-/// `simulate --error-norm`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum ErrorNormChoice {
-    /// Every coordinate to its own tolerance (ode15s).
-    Componentwise,
-    /// Positions and velocities in the mass-matrix norm (mass-weighted displacement).
-    Mass,
-}
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;
+
+/// `simulate --method` and `--error-norm` (the library chooses the integrator from them).
+pub use gvsrom::simulate::{ErrorNormChoice, MethodChoice};
 
 /// Simulate slender soft robots with the Geometric Variable Strain (GVS) Cosserat-rod model.
 #[derive(Debug, Parser)]
@@ -104,6 +90,12 @@ pub struct ReproduceArgs {
     /// Worker threads (default: one per core).
     #[arg(long, value_name = "N")]
     pub jobs: Option<usize>,
+    /// Testing aid: the smallest sizes that still run every step (implies --quick).
+    #[arg(long, hide = true)]
+    pub test_sizes: bool,
+    /// The noise study's Gaussian noise, σ relative to the RMS of the snapshots.
+    #[arg(long, value_name = "LEVEL", default_value_t = gvsrom::reproduce::DEFAULT_NOISE)]
+    pub noise: f64,
 }
 
 /// Which scenario, with overrides.
@@ -755,8 +747,6 @@ fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
 
 fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
     use gvs::inputs::Interpolation;
-    use gvs::solve::dynamics::{IntegratorOptions, Method, OdeJacobian};
-    use gvs::solve::ode::{FixedStepOptions, GeneralizedAlphaOptions, NdfOptions, SdirkOptions};
     use gvsrom::simulate::{self, InputSource, SimulateOptions};
     use std::io::IsTerminal;
     let (scenario, mut built) = load(&args.scenario)?;
@@ -801,102 +791,24 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
     } else {
         InputSource::Constant
     };
-    // The structured Jacobian drops ∂M/∂q q̈ and the velocity terms; for a decoder, whose M(q)
-    // varies strongly, that costs many rejected steps, while finite differences cost only 2r
-    // right-hand sides (r small): measured on IV-C2, 2780 steps (477 failed) against 5429 (2054
-    // failed).
-    let jacobian = if args.fd_jacobian
-        || built
-            .reduced
-            .as_ref()
-            .is_some_and(|r| !r.model.param.is_linear())
-    {
-        OdeJacobian::FiniteDifference
-    } else {
-        OdeJacobian::Structured
+    let choice = simulate::IntegratorChoice {
+        method: args.method,
+        rtol: args.rtol,
+        atol: args.atol,
+        max_order: args.max_order,
+        error_norm: args.error_norm,
+        rho_inf: args.rho_inf,
+        fixed_step: args.fixed_step,
+        fd_jacobian: args.fd_jacobian,
     };
     // the note printed when the rod's damping chose the method
-    let mut light = None;
-    let rtol = args.rtol.unwrap_or(NdfOptions::default().rtol);
-    let error_norm = |default: gvs::solve::ode::ErrorNorm| match args.error_norm {
-        Some(ErrorNormChoice::Mass) => gvs::solve::ode::ErrorNorm::Mass,
-        Some(ErrorNormChoice::Componentwise) => gvs::solve::ode::ErrorNorm::Componentwise,
-        None => default,
-    };
-    // the rod's damping chooses for `auto` and `ndf` unless the NDF's order or norm is given
-    let ndf_choice = args.max_order.is_some() || args.error_norm.is_some();
-    let regime = if args.fixed_step.is_none()
-        && matches!(args.method, MethodChoice::Auto | MethodChoice::Ndf)
-        && !ndf_choice
-        && jacobian == OdeJacobian::Structured
-    {
-        Some(match &built.reduced {
-            Some(r) => gvs::solve::dynamics::damping_regime(&r.model)?,
-            None => gvs::solve::dynamics::damping_regime(&built.model)?,
-        })
-    } else {
-        None
-    };
-    let method = match (args.fixed_step, args.method) {
-        (Some(h), _) => Method::Fixed(FixedStepOptions {
-            h,
-            ..FixedStepOptions::default()
-        }),
-        (None, MethodChoice::Galpha) => Method::GeneralizedAlpha(GeneralizedAlphaOptions {
-            rtol,
-            atol: args.atol,
-            rho_inf: args.rho_inf,
-            error_norm: error_norm(gvs::solve::ode::ErrorNorm::Componentwise),
-            ..GeneralizedAlphaOptions::default()
-        }),
-        (None, MethodChoice::Sdirk) => Method::Sdirk(SdirkOptions {
-            rtol,
-            atol: args.atol,
-            error_norm: error_norm(gvs::solve::ode::ErrorNorm::Mass),
-            ..SdirkOptions::default()
-        }),
-        (None, MethodChoice::Auto) if regime.is_some_and(|r| r.is_light()) => {
-            let zeta = regime.map_or(0.0, |r| r.zeta_max);
-            let rtol = args
-                .rtol
-                .unwrap_or(gvs::solve::dynamics::LIGHT_DAMPING_RTOL);
-            light = Some(format!(
-                "integrator SDIRK4 (order 4, L-stable) with the mass-norm error test at rtol {rtol:e}: lightly damped (stiffest mode ζ = {zeta:.3}; --method or --rtol to choose)"
-            ));
-            Method::Sdirk(SdirkOptions {
-                rtol,
-                atol: args.atol,
-                error_norm: gvs::solve::ode::ErrorNorm::Mass,
-                ..SdirkOptions::default()
-            })
-        }
-        (None, MethodChoice::Ndf | MethodChoice::Auto) => {
-            let base = NdfOptions {
-                rtol,
-                atol: args.atol,
-                max_order: args.max_order.unwrap_or(5),
-                error_norm: error_norm(gvs::solve::ode::ErrorNorm::Componentwise),
-                ..NdfOptions::default()
-            };
-            if let Some(regime) = regime {
-                if regime.is_light() {
-                    light = Some(format!(
-                        "integrator NDF orders ≤ 2 with the mass-norm error test: lightly damped (stiffest mode ζ = {:.3}; --max-order or --error-norm to choose)",
-                        regime.zeta_max
-                    ));
-                }
-                Method::Ndf(gvs::solve::dynamics::ndf_for_regime(&base, &regime))
-            } else {
-                Method::Ndf(base)
-            }
-        }
-    };
+    let (integrator, light) = simulate::choose_integrator(&built, &choice)?;
     let opts = SimulateOptions {
         duration: args.duration,
         sample_rate: args.sample_rate,
         input,
         start_at_equilibrium: args.from_equilibrium,
-        integrator: IntegratorOptions { method, jacobian },
+        integrator,
         load_schedule: args.load_schedule.clone(),
     };
     // everything is checked, and the output staged, before the computation starts
@@ -1016,9 +928,11 @@ fn reproduce_cmd(args: &ReproduceArgs, out: &mut impl Write) -> Result<()> {
     });
     let opts = reproduce::Options {
         cases: args.cases.clone(),
-        quick: args.quick,
+        quick: args.quick || args.test_sizes,
+        tiny: args.test_sizes,
         out: args.out.clone(),
         jobs,
+        noise: args.noise,
     };
     let signal = interrupt_flag();
     match reproduce::run(&opts, signal.clone(), out) {

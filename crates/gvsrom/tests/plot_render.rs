@@ -503,3 +503,60 @@ fn write_look_pngs() {
         std::fs::write(dir.join(format!("{name}.svg")), &out.svg).unwrap();
     }
 }
+
+#[test]
+fn extreme_values_and_tiny_sizes_do_not_panic_or_hang() {
+    // Data spanning the whole f64 range, subnormals and infinities, at the smallest accepted size and
+    // at a normal one: each render returns (Ok or a PlotError) quickly.
+    let weird = vec![
+        vec![0.0, f64::MAX],
+        vec![-f64::MAX, f64::MAX],
+        vec![1e-320, 2e-320],
+        vec![f64::INFINITY, 1.0, f64::NEG_INFINITY, 2.0],
+        vec![1e300, -1e300, 0.0],
+    ];
+    let start = std::time::Instant::now();
+    for (w, h) in [(64, 64), (300, 200)] {
+        for ys in &weird {
+            let x: Vec<f64> = (0..ys.len()).map(|i| i as f64).collect();
+            for (log_y, equal_aspect) in [(false, false), (true, false), (false, true)] {
+                let c = LineChart {
+                    title: "weird".into(),
+                    x_label: "x".into(),
+                    y_label: "y".into(),
+                    series: vec![Series::new(
+                        "s",
+                        x.clone(),
+                        ys.clone(),
+                        SeriesStyle::LineMarkers,
+                    )],
+                    log_y,
+                    equal_aspect,
+                };
+                let _ = render(&Figure::Line(c), w, h);
+            }
+            let s = Scatter2 {
+                title: "weird".into(),
+                x: x.clone(),
+                y: ys.clone(),
+                color: Some(ys.clone()),
+                ..Default::default()
+            };
+            let _ = render(&Figure::Scatter2(s), w, h);
+            let points = ys.iter().map(|&v| [v, 1.0, v]).collect();
+            let s = Scatter3 {
+                title: "weird".into(),
+                points,
+                color: Some(ys.clone()),
+                ..Default::default()
+            };
+            let _ = render(&Figure::Scatter3(s), w, h);
+        }
+        let _ = render(&grid(), w, h);
+    }
+    assert!(
+        start.elapsed().as_secs_f64() < 20.0,
+        "took {:?}",
+        start.elapsed()
+    );
+}

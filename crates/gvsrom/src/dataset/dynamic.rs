@@ -211,6 +211,7 @@ pub fn run(
         q_order: gvs::strain::COORDINATE_ORDER.into(),
         wall_time_s: t0.elapsed().as_secs_f64(),
         threads: 1,
+        noise: None,
     };
     write_arrays(&mut dir, &mut meta, &layout, &inputs, &rows, Some(&t))?;
     let path = dir.commit(&meta)?;

@@ -21,6 +21,7 @@
 
 pub mod dynamic;
 pub mod generate;
+pub mod noise;
 pub mod plan;
 pub mod reader;
 mod resume;
@@ -255,6 +256,9 @@ pub struct Meta {
     /// Wall time of this run (a resumed run: of its own part).
     pub wall_time_s: f64,
     pub threads: usize,
+    /// A dataset made from another by adding noise to its snapshots ([`noise::with_noise`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub noise: Option<noise::NoiseInfo>,
 }
 
 /// The result of [`run`].
@@ -414,6 +418,7 @@ pub fn run(
         threads: 0,
         plan: Some(plan.clone()),
         dynamic: None,
+        noise: None,
     };
     // the output is checked, locked and staged before the computation
     let mut dir = OutputDir::create("--out", &args.out, "dataset", args.force || args.resume)?;

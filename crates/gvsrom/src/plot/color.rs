@@ -3,6 +3,7 @@
 
 use plotters::style::RGBColor;
 
+use super::validate::plottable;
 use super::{palette, Rgb};
 
 /// Colour of points whose scalar is not finite.
@@ -52,9 +53,9 @@ pub(crate) struct ColorScale {
 }
 
 impl ColorScale {
-    /// The scale spanning the finite values, or `None` when there are none.
+    /// The scale spanning the plottable values (finite, |v| ≤ 1e300), or `None` when there are none.
     pub fn from_values(values: &[f64]) -> Option<Self> {
-        let mut finite = values.iter().copied().filter(|v| v.is_finite());
+        let mut finite = values.iter().copied().filter(|&v| plottable(v));
         let first = finite.next()?;
         let (lo, hi) = finite.fold((first, first), |(lo, hi), v| (lo.min(v), hi.max(v)));
         Some(Self { lo, hi })
@@ -69,9 +70,9 @@ impl ColorScale {
         }
     }
 
-    /// The colour of `v` (grey when `v` is not finite).
+    /// The colour of `v` (grey when `v` is not plottable).
     pub fn color(&self, v: f64) -> RGBColor {
-        if v.is_finite() {
+        if plottable(v) {
             viridis(self.fraction(v))
         } else {
             MISSING

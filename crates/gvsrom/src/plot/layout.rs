@@ -108,13 +108,16 @@ pub(crate) fn label_count(len: u32, spacing: f64, theme: &Theme) -> usize {
     ((len as f64 / (spacing * theme.scale)).floor() as usize).clamp(2, 10)
 }
 
+/// A tick-label formatter.
+pub(crate) type TickFormat<'a> = &'a dyn Fn(&f64) -> String;
+
 /// Draws the light mesh, the axes, the tick labels (`n` = at most (x, y) labels, formatted by `fmt`)
 /// and the axis descriptions `desc` (left out when empty) of a 2-D chart.
 pub(crate) fn draw_mesh<DB, X, Y>(
     chart: &mut ChartContext<'_, DB, Cartesian2d<X, Y>>,
     theme: &Theme,
     n: (usize, usize),
-    fmt: (&dyn Fn(&f64) -> String, &dyn Fn(&f64) -> String),
+    fmt: (TickFormat<'_>, TickFormat<'_>),
     desc: (&str, &str),
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>>
 where

@@ -32,7 +32,8 @@ pub enum SeriesStyle {
     LineMarkers,
 }
 
-/// One data series of a chart: `(x[i], y[i])` pairs; a pair with a non-finite value is a gap.
+/// One data series of a chart: `(x[i], y[i])` pairs; a pair with a value that is NaN, infinite or
+/// beyond ±1e300 (or, on a log axis, y < 1e-300) is left out and breaks the line there.
 ///
 /// `color: None` takes the next colour of [`palette::EXTRA`] (by the series' index in the chart); an empty
 /// `label` keeps the series out of the legend.

@@ -6,11 +6,13 @@ use std::ops::Range;
 use plotters::coord::ranged1d::Ranged;
 use plotters::coord::types::RangedCoordf64;
 
+use super::validate::plottable;
+
 /// `(min, max)` of the finite values, `None` when there are none.
 pub(crate) fn extent(values: impl IntoIterator<Item = f64>) -> Option<(f64, f64)> {
     values
         .into_iter()
-        .filter(|v| v.is_finite())
+        .filter(|&v| plottable(v))
         .fold(None, |acc, v| match acc {
             None => Some((v, v)),
             Some((lo, hi)) => Some((lo.min(v), hi.max(v))),
@@ -18,22 +20,22 @@ pub(crate) fn extent(values: impl IntoIterator<Item = f64>) -> Option<(f64, f64)
 }
 
 /// A linear axis over `[lo, hi]` with `margin` × span added on each side. A (near-)degenerate extent
-/// is widened by ±10 % of its value (±1 around zero).
+/// is widened by ±10 % of its value (±1 around zero). Inputs are plottable (|v| ≤ 1e300), so the
+/// span stays finite.
 pub(crate) fn linear((lo, hi): (f64, f64), margin: f64) -> Range<f64> {
-    // Keep clear of overflow: spans beyond ~1e307 are clamped (such data is not plottable anyway).
-    let (lo, hi) = (lo.max(-1e307), hi.min(1e307));
     let scale = lo.abs().max(hi.abs());
     let span = hi - lo;
-    if span <= 1e-12 * scale || span == 0.0 {
+    if span <= 1e-12 * scale || span < 1e-280 {
         let c = 0.5 * (lo + hi);
-        let half = if c.abs() > 1e-300 { 0.1 * c.abs() } else { 1.0 };
+        let half = if c.abs() > 1e-280 { 0.1 * c.abs() } else { 1.0 };
         return (c - half)..(c + half);
     }
     (lo - margin * span)..(hi + margin * span)
 }
 
 /// A log axis over positive `[lo, hi]` with `margin` of the decades on each side, extended down to
-/// the next power of ten when none lies inside (so the axis always has a labelled tick).
+/// the next power of ten when none lies inside (so the axis always has a labelled tick). The ends
+/// stay within 10^±305, normal and finite (plotters' log ticks loop forever on an infinite end).
 pub(crate) fn log((lo, hi): (f64, f64), margin: f64) -> Range<f64> {
     let (l0, l1) = (lo.log10(), hi.log10());
     let span = l1 - l0;
@@ -45,7 +47,8 @@ pub(crate) fn log((lo, hi): (f64, f64), margin: f64) -> Range<f64> {
     if a.ceil() > b {
         a = a.floor();
     }
-    10f64.powf(a)..10f64.powf(b)
+    let (a, b) = (a.clamp(-305.0, 305.0), b.clamp(-305.0, 305.0));
+    10f64.powf(a)..10f64.powf(b.max(a + 0.5))
 }
 
 /// Expands `x` or `y` about its centre so that one data unit has the same length in pixels on both

@@ -16,7 +16,11 @@ use super::layout::{self, OrPlotError};
 use super::range::{self, LinearFormat};
 use super::scatter::point_radius;
 use super::theme::Theme;
+use super::validate::plottable;
 use super::{PlotError, Scatter3};
+
+/// A point in plotters' 3-D coordinates (x, y up, z depth) and its pixel on the backend.
+type Projected = ((f64, f64, f64), (i32, i32));
 
 /// Draws `s` into `area`. Data axis `labels[0]` is plotters' x, `labels[1]` its depth axis z and
 /// `labels[2]` its vertical axis y, so the third coordinate points up.
@@ -28,7 +32,7 @@ pub(crate) fn draw<DB: DrawingBackend>(
     let title = s.title.as_str();
     let area = layout::titled(area, title, &theme.title_font(), theme)?;
     let finite: Vec<usize> = (0..s.points.len())
-        .filter(|&i| s.points[i].iter().all(|v| v.is_finite()))
+        .filter(|&i| s.points[i].iter().all(|&v| plottable(v)))
         .collect();
     let no_data = || PlotError::NoFiniteData {
         title: title.to_string(),
@@ -66,7 +70,7 @@ pub(crate) fn draw<DB: DrawingBackend>(
 
     // The two horizontal axes meet at the lowest bottom corner, where their end labels would collide:
     // the depth axis leaves out its label within 15 % of its span of that corner.
-    let corners: Vec<((f64, f64, f64), (i32, i32))> = [r0.start, r0.end]
+    let corners: Vec<Projected> = [r0.start, r0.end]
         .iter()
         .flat_map(|&x| [r2.start, r2.end].map(move |y| (x, y)))
         .flat_map(|(x, y)| [r1.start, r1.end].map(move |z| (x, y, z)))
@@ -116,7 +120,7 @@ pub(crate) fn draw<DB: DrawingBackend>(
             )
         })
         .collect();
-    order.sort_by(|a, b| b.0.cmp(&a.0));
+    order.sort_by_key(|a| std::cmp::Reverse(a.0));
     let r = point_radius(theme, finite.len());
     let color_of = |i: usize| match (&scale, &s.color) {
         (Some(sc), Some(c)) => sc.color(c[i]),
@@ -162,7 +166,7 @@ fn draw_axis_names<DB: DrawingBackend>(
             continue;
         }
         let (a, b) = ((k + 1) % 3, (k + 2) % 3);
-        let mut best: Option<((f64, f64, f64), (i32, i32))> = None;
+        let mut best: Option<Projected> = None;
         for ia in 0..2 {
             for ib in 0..2 {
                 let mut p = [0.0; 3];

@@ -3,9 +3,18 @@
 
 use super::{Figure, LineChart, PlotError, Scatter2, Scatter3};
 
-/// Whether the point `(x, y)` is drawn: both finite and, on a log y axis, `y > 0`.
+/// Largest magnitude drawn; beyond it (and for NaN, ±∞) a value counts as missing, which keeps
+/// every span and pixel computation finite.
+pub(crate) const LIMIT: f64 = 1e300;
+
+/// Whether `v` can be drawn: finite and |v| ≤ [`LIMIT`].
+pub(crate) fn plottable(v: f64) -> bool {
+    v.abs() <= LIMIT
+}
+
+/// Whether the point `(x, y)` is drawn: both plottable and, on a log y axis, `y ≥ 1/LIMIT` (> 0).
 pub(crate) fn usable(x: f64, y: f64, log_y: bool) -> bool {
-    x.is_finite() && y.is_finite() && (!log_y || y > 0.0)
+    plottable(x) && plottable(y) && (!log_y || y >= 1.0 / LIMIT)
 }
 
 /// The name of series `index` in messages: its label, or `#n` (1-based) when the label is empty.
@@ -124,7 +133,7 @@ fn scatter3(s: &Scatter3) -> Result<(), PlotError> {
             title: s.title.clone(),
         });
     }
-    if !s.points.iter().any(|p| p.iter().all(|v| v.is_finite())) {
+    if !s.points.iter().any(|p| p.iter().all(|&v| plottable(v))) {
         return Err(PlotError::NoFiniteData {
             title: s.title.clone(),
             log_y: false,

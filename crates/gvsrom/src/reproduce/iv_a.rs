@@ -6,6 +6,7 @@
 //! equilibrium is solved as `gvsrom statics [--model]` solves it.
 
 use super::report::{figure, ratio, CaseReport, Cell, Finding, RenderedFigure, Table};
+use super::step::Step;
 use super::tasks::{self, AeConfig, DatasetSpec, EvalModel, Evaluation, ModelInfo, ScenarioSpec};
 use super::{new_report, paper, Case, Options, Run};
 use crate::plot::{palette, Figure, LineChart, Series, SeriesStyle};
@@ -30,8 +31,15 @@ struct Sizes {
     repeat: u32,
 }
 
-fn sizes(quick: bool) -> Sizes {
-    if quick {
+fn sizes(opts: &Options) -> Sizes {
+    if opts.tiny {
+        Sizes {
+            samples: 40,
+            epochs: 15,
+            max_pod: 3,
+            repeat: 1,
+        }
+    } else if opts.quick {
         Sizes {
             samples: 200,
             epochs: 150,
@@ -48,36 +56,65 @@ fn sizes(quick: bool) -> Sizes {
     }
 }
 
+/// The IV-A scenario: the preset as it is (gravity, friction 0.88).
+pub fn scenario() -> ScenarioSpec {
+    ScenarioSpec::new("single-tendon", &[])
+}
+
+fn plan(opts: &Options) -> DatasetSpec {
+    DatasetSpec {
+        sweep: vec!["tendons.0.tension=-6:3".into()],
+        samples: Some(sizes(opts).samples),
+        ..DatasetSpec::default()
+    }
+}
+
+/// The IV-A dataset (step `iv-a/dataset`).
+pub fn dataset(run: &Run, opts: &Options) -> anyhow::Result<Step<tasks::DatasetInfo>> {
+    tasks::dataset(run, "iv-a/dataset", &scenario(), &plan(opts), opts.jobs)
+}
+
+/// The settings of the IV-A autoencoder with `r` latent coordinates and `h` hidden layers.
+pub fn ae_config(opts: &Options, r: usize, h: usize) -> AeConfig {
+    let mut c = AeConfig::new(r, h, sizes(opts).epochs);
+    if opts.tiny {
+        c.lbfgs_iterations = 10;
+    }
+    c
+}
+
+/// The name of the step that trains the IV-A autoencoder `c` on `data`.
+pub fn ae_step(
+    run: &Run,
+    data: &Step<tasks::DatasetInfo>,
+    c: &AeConfig,
+) -> anyhow::Result<Step<ModelInfo>> {
+    tasks::train(
+        run,
+        &format!("iv-a/ae-r{}-h{}", c.latent, c.hidden_layers),
+        data,
+        c,
+    )
+}
+
 /// The IV-A data and every model trained on it (steps shared with case V).
 pub fn models(run: &Run, opts: &Options) -> anyhow::Result<Models> {
-    let s = sizes(opts.quick);
-    let scenario = ScenarioSpec::new("single-tendon", &[]);
-    let plan = DatasetSpec {
-        sweep: vec!["tendons.0.tension=-6:3".into()],
-        samples: Some(s.samples),
-        ..DatasetSpec::default()
-    };
-    let data = tasks::dataset(run, "iv-a/dataset", &scenario, &plan, opts.jobs)?;
+    let s = sizes(opts);
+    let scenario = scenario();
+    let data = dataset(run, opts)?;
     let configs: Vec<AeConfig> = paper::TABLE_I_LAYERS
         .iter()
         .flat_map(|&h| (1..=3).map(move |r| (h, r)))
-        .map(|(h, r)| AeConfig::new(r, h, s.epochs))
+        .map(|(h, r)| ae_config(opts, r, h))
         .collect();
-    let trained = tasks::parallel(&configs, |c| {
-        tasks::train(
-            run,
-            &format!("iv-a/ae-r{}-h{}", c.latent, c.hidden_layers),
-            &data,
-            c,
-        )
-    })?;
+    let trained = tasks::parallel(&configs, |c| ae_step(run, &data, c))?;
     let aes = trained.chunks(3).map(<[_]>::to_vec).collect();
     let modes: Vec<usize> = (1..=s.max_pod).collect();
     let pods = tasks::parallel(&modes, |&k| {
         tasks::pod(run, &format!("iv-a/pod-{k}"), &data, k)
     })?;
     let settings = json!({
-        "scenario": scenario, "plan": plan, "autoencoders": configs, "pod_modes": modes,
+        "scenario": scenario, "plan": plan(opts), "autoencoders": configs, "pod_modes": modes,
     });
     Ok(Models {
         scenario,
@@ -97,7 +134,7 @@ pub fn test_tensions() -> Vec<f64> {
 
 /// Runs case IV-A.
 pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<RenderedFigure>)> {
-    let s = sizes(opts.quick);
+    let s = sizes(opts);
     let m = models(run, opts)?;
     let mut report = new_report(
         Case::IvA,
@@ -129,7 +166,8 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         .collect();
     let ev = tasks::statics_eval(run, "iv-a/eval", &m.scenario, &inputs, &models, s.repeat)?;
     let ev = &ev.value;
-    let k = fewest_pod_below(ev, m.pods.len(), 1.0);
+    let modes: Vec<usize> = (1..=m.pods.len()).collect();
+    let k = fewest_pod_below(ev, &modes, 1.0);
     report.tables.push(accuracy_table(ev, &models));
     let (ae_err, ae_max) = ev.stats("AE-1", |s| s.strain_error_percent);
     let (hom_t, _) = ev.stats("HOM", |s| s.time_s);
@@ -213,9 +251,13 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     Ok((report, figures))
 }
 
-/// The fewest POD modes whose largest strain error over the test inputs is below `limit` %.
-pub fn fewest_pod_below(ev: &Evaluation, max: usize, limit: f64) -> Option<usize> {
-    (1..=max).find(|k| ev.stats(&format!("POD-{k}"), |s| s.strain_error_percent).1 < limit)
+/// The fewest POD modes among `modes` (ascending) whose largest strain error over the test inputs
+/// is below `limit` %.
+pub fn fewest_pod_below(ev: &Evaluation, modes: &[usize], limit: f64) -> Option<usize> {
+    modes
+        .iter()
+        .copied()
+        .find(|k| ev.stats(&format!("POD-{k}"), |s| s.strain_error_percent).1 < limit)
 }
 
 /// Table I for one case: ours, the paper's and the ratio per r, one row per depth.

@@ -3,11 +3,12 @@
 //!
 //! The paper's magnitudes are the pulse's total moment in N·m (`convention = "total"`): 5000
 //! equilibria at random centres in [0, L] and magnitudes in [−5, 5] N·m. Models: autoencoders
-//! r = 1, 2, 3 × 3, 5, 7 hidden layers and POD with 1 … 40 modes. Test: 4 N·m at X/L = 0.25 and
+//! r = 1, 2, 3 × 3, 5, 7 hidden layers and POD with 1 … 30 modes. Test: 4 N·m at X/L = 0.25 and
 //! 2 N·m at X/L = 0.75 (Fig. 6).
 
 use super::iv_a::{accuracy_table, fewest_pod_below, strain_series, table_i, table_iii};
 use super::report::{figure, CaseReport, Cell, Finding, RenderedFigure};
+use super::step::Step;
 use super::tasks::{self, AeConfig, DatasetSpec, EvalModel, Evaluation, ScenarioSpec};
 use super::{iv_common, new_report, paper, Case, Options, Run};
 use crate::plot::{palette, Figure, LineChart, Series, SeriesStyle};
@@ -16,23 +17,31 @@ use serde_json::json;
 struct Sizes {
     samples: usize,
     epochs: usize,
-    max_pod: usize,
+    /// The POD models tried, ascending (the fewest below 1 % is searched among them).
+    pod_modes: Vec<usize>,
     repeat: u32,
 }
 
-fn sizes(quick: bool) -> Sizes {
-    if quick {
+fn sizes(opts: &Options) -> Sizes {
+    if opts.tiny {
         Sizes {
-            samples: 800,
-            epochs: 150,
-            max_pod: 24,
+            samples: 60,
+            epochs: 15,
+            pod_modes: vec![1, 2, 4],
+            repeat: 1,
+        }
+    } else if opts.quick {
+        Sizes {
+            samples: 500,
+            epochs: 100,
+            pod_modes: vec![1, 2, 3, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 28],
             repeat: 2,
         }
     } else {
         Sizes {
             samples: 5000,
             epochs: 1000,
-            max_pod: 40,
+            pod_modes: (1..=30).collect(),
             repeat: 5,
         }
     }
@@ -41,35 +50,78 @@ fn sizes(quick: bool) -> Sizes {
 /// The two loads of Fig. 6: (total moment [N·m], centre [m]) on the 0.8 m beam.
 const TEST_LOADS: [(f64, f64); 2] = [(4.0, 0.2), (2.0, 0.6)];
 
-/// Runs case IV-B.
-pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<RenderedFigure>)> {
-    let s = sizes(opts.quick);
-    let scenario = ScenarioSpec::new("soft-beam", &["loads.distributed.0.convention=\"total\""]);
-    let plan = DatasetSpec {
+/// The IV-B scenario: the preset in the paper's convention (total moment in N·m).
+pub fn scenario() -> ScenarioSpec {
+    ScenarioSpec::new("soft-beam", &["loads.distributed.0.convention=\"total\""])
+}
+
+fn plan(opts: &Options) -> DatasetSpec {
+    DatasetSpec {
         random: vec![
             "loads.distributed.0.center=0:0.8".into(),
             "loads.distributed.0.magnitude=-5:5".into(),
         ],
-        samples: Some(s.samples),
+        samples: Some(sizes(opts).samples),
         seed: 1,
         ..DatasetSpec::default()
-    };
-    let data = tasks::dataset(run, "iv-b/dataset", &scenario, &plan, opts.jobs)?;
+    }
+}
+
+/// The IV-B dataset (step `iv-b/dataset`).
+pub fn dataset(run: &Run, opts: &Options) -> anyhow::Result<Step<tasks::DatasetInfo>> {
+    tasks::dataset(run, "iv-b/dataset", &scenario(), &plan(opts), opts.jobs)
+}
+
+/// The settings of the IV-B autoencoder with `r` latent coordinates and `h` hidden layers.
+pub fn ae_config(opts: &Options, r: usize, h: usize) -> AeConfig {
+    let mut c = AeConfig::new(r, h, sizes(opts).epochs);
+    if opts.tiny {
+        c.lbfgs_iterations = 10;
+    }
+    c
+}
+
+/// Trains the IV-B autoencoder `c` on `data` (step `iv-b/ae-r<r>-h<h>`).
+pub fn ae_step(
+    run: &Run,
+    data: &Step<tasks::DatasetInfo>,
+    c: &AeConfig,
+) -> anyhow::Result<Step<tasks::ModelInfo>> {
+    tasks::train(
+        run,
+        &format!("iv-b/ae-r{}-h{}", c.latent, c.hidden_layers),
+        data,
+        c,
+    )
+}
+
+/// The two test inputs of Fig. 6 as overrides.
+pub fn test_inputs() -> Vec<Vec<String>> {
+    TEST_LOADS
+        .iter()
+        .map(|(m, c)| {
+            vec![
+                format!("loads.distributed.0.magnitude={m}"),
+                format!("loads.distributed.0.center={c}"),
+            ]
+        })
+        .collect()
+}
+
+/// Runs case IV-B.
+pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<RenderedFigure>)> {
+    let s = sizes(opts);
+    let scenario = scenario();
+    let plan = plan(opts);
+    let data = dataset(run, opts)?;
     let configs: Vec<AeConfig> = paper::TABLE_I_LAYERS
         .iter()
         .flat_map(|&h| (1..=3).map(move |r| (h, r)))
-        .map(|(h, r)| AeConfig::new(r, h, s.epochs))
+        .map(|(h, r)| ae_config(opts, r, h))
         .collect();
-    let trained = tasks::parallel(&configs, |c| {
-        tasks::train(
-            run,
-            &format!("iv-b/ae-r{}-h{}", c.latent, c.hidden_layers),
-            &data,
-            c,
-        )
-    })?;
+    let trained = tasks::parallel(&configs, |c| ae_step(run, &data, c))?;
     let aes: Vec<Vec<_>> = trained.chunks(3).map(<[_]>::to_vec).collect();
-    let modes: Vec<usize> = (1..=s.max_pod).collect();
+    let modes = s.pod_modes.clone();
     let pods = tasks::parallel(&modes, |&k| {
         tasks::pod(run, &format!("iv-b/pod-{k}"), &data, k)
     })?;
@@ -82,7 +134,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         "scenario: preset `soft-beam` with `loads.distributed.0.convention = \"total\"`: the magnitude is the pulse's total moment in N·m, as the paper gives it (0.8 m beam, radius 1.5 cm, E = 1 MPa, follower moment about local y as a triangular pulse of base 0.1 L, no gravity, 50-DOF linear FEM-like bend-y basis, 148 points)".into(),
         format!("data: {} equilibria at random centres in [0, 0.8] m and magnitudes in [−5, 5] N·m, seed 1 (`gvsrom dataset soft-beam --set 'loads.distributed.0.convention=\"total\"' --random loads.distributed.0.center=0:0.8 --random loads.distributed.0.magnitude=-5:5 --samples {} --seed 1`); {} solved, {} failed", data.value.samples, data.value.samples, data.value.ok, data.value.failed),
         format!("autoencoders: r = 1, 2, 3 × 3, 5, 7 hidden layers, tanh, λ = 1e-4, Adam ≤ {} epochs with early stopping, then L-BFGS", s.epochs),
-        format!("POD: 1 … {} modes", s.max_pod),
+        format!("POD: {:?} modes", s.pod_modes),
         format!("test: 4 N·m at X/L = 0.25 and 2 N·m at X/L = 0.75 (Fig. 6); each equilibrium solved {} times, mean time", s.repeat),
     ];
     report.tables.push(table_i(
@@ -93,8 +145,8 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         "RMS of x̂ − x over every entry of every snapshot, x = bend-y curvature deviation at the 148 points [1/m]. Columns: ours, the paper's, ours / paper.",
     ));
     let mut models = vec![EvalModel::hom(), EvalModel::of("AE-2", &aes[2][1])];
-    for (k, p) in pods.iter().enumerate() {
-        models.push(EvalModel::of(&format!("POD-{}", k + 1), p));
+    for (k, p) in modes.iter().zip(&pods) {
+        models.push(EvalModel::of(&format!("POD-{k}"), p));
     }
     let inputs: Vec<Vec<String>> = TEST_LOADS
         .iter()
@@ -107,7 +159,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         .collect();
     let ev = tasks::statics_eval(run, "iv-b/eval", &scenario, &inputs, &models, s.repeat)?;
     let ev = &ev.value;
-    let k = fewest_pod_below(ev, pods.len(), 1.0);
+    let k = fewest_pod_below(ev, &modes, 1.0);
     report.tables.push(accuracy_table(ev, &models));
     let (ae_err, ae_max) = ev.stats("AE-2", |s| s.strain_error_percent);
     let (pod2_err, _) = ev.stats("POD-2", |s| s.strain_error_percent);
@@ -153,7 +205,10 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
                         "; but the AE-ROM itself is not below 1 %"
                     }
                 ),
-                None => format!("no POD model up to {} modes reaches < 1 %", pods.len()),
+                None => format!(
+                    "no POD model up to {} modes reaches < 1 %",
+                    modes.last().copied().unwrap_or(0)
+                ),
             },
         },
         Finding {

@@ -12,7 +12,10 @@ pub mod html;
 pub mod intrinsic;
 pub mod iv_a;
 pub mod iv_b;
+pub mod iv_c1;
+pub mod iv_c2;
 pub mod iv_common;
+pub mod noise;
 pub mod paper;
 pub mod report;
 pub mod step;
@@ -37,9 +40,20 @@ pub enum Case {
     /// IV-B: soft beam under a moment pulse, Table I (bottom), Figs. 5–6, Table III row.
     #[value(name = "iv-b")]
     IvB,
+    /// IV-C1: six-tendon manipulator under gravity, statics: AE r = 6 against POD-6 (Fig. 7),
+    /// grid against random sampling (Fig. 8), Table III row.
+    #[value(name = "iv-c1")]
+    IvC1,
+    /// IV-C2: six-tendon manipulator, dynamics: babbling data, AE- and POD-ROMs with r = 1 … 8 on a
+    /// new 10 s input (Fig. 9), Table III row.
+    #[value(name = "iv-c2")]
+    IvC2,
     /// V: the prototype's four tensions, AE-ROM and POD-ROM with one DOF (Fig. 10b).
     #[value(name = "v")]
     V,
+    /// The IV-A and IV-B autoencoders retrained on snapshots with Gaussian noise.
+    #[value(name = "noise")]
+    Noise,
     /// Every case above.
     #[value(name = "all")]
     All,
@@ -51,13 +65,23 @@ impl Case {
         match self {
             Case::IvA => "iv-a",
             Case::IvB => "iv-b",
+            Case::IvC1 => "iv-c1",
+            Case::IvC2 => "iv-c2",
             Case::V => "v",
+            Case::Noise => "noise",
             Case::All => "all",
         }
     }
 
     /// Every case, in the paper's order.
-    pub const EVERY: [Case; 3] = [Case::IvA, Case::IvB, Case::V];
+    pub const EVERY: [Case; 6] = [
+        Case::IvA,
+        Case::IvB,
+        Case::IvC1,
+        Case::IvC2,
+        Case::V,
+        Case::Noise,
+    ];
 }
 
 /// What `gvsrom reproduce` is asked to do.
@@ -66,10 +90,18 @@ pub struct Options {
     pub cases: Vec<Case>,
     /// Reduced sizes (samples, epochs, architectures): the whole run in minutes.
     pub quick: bool,
+    /// The smallest sizes that still exercise every step (tests; implies `quick`). The cases that
+    /// do not know them run their quick sizes.
+    pub tiny: bool,
     pub out: PathBuf,
     /// Worker threads (dataset generation, training several models at once, anchors).
     pub jobs: usize,
+    /// The noise study's σ relative to the snapshots' RMS.
+    pub noise: f64,
 }
+
+/// The noise study's level unless `--noise` says otherwise.
+pub const DEFAULT_NOISE: f64 = 0.02;
 
 impl Options {
     /// The cases to run, `all` expanded, each once, in the paper's order.
@@ -106,6 +138,11 @@ pub fn run(
         "--jobs {}: expected an integer in [1, 256]",
         opts.jobs
     );
+    anyhow::ensure!(
+        opts.noise.is_finite() && (0.0..=1.0).contains(&opts.noise),
+        "--noise {}: expected a number in [0, 1] (σ relative to the snapshots' RMS)",
+        opts.noise
+    );
     let cases = opts.case_list();
     anyhow::ensure!(!cases.is_empty(), "no case to reproduce");
     let dir = crate::output::RunDir::open("--out", &opts.out)?;
@@ -125,14 +162,20 @@ pub fn run(
                 Case::IvA => "single-tendon manipulator: data, Table I, POD and AE ROMs, Fig. 3–4",
                 Case::IvB =>
                     "soft beam under a moment pulse: data, Table I, POD and AE ROMs, Fig. 5–6",
+                Case::IvC1 => "six-tendon manipulator under gravity, statics: AE-6 against POD-6, grid against random data (Fig. 7–8)",
+                Case::IvC2 => "six-tendon manipulator, dynamics: babbling data, ROMs with r = 1 … 8 on a new input (Fig. 9)",
                 Case::V => "prototype tensions with 1-DOF ROMs (Fig. 10b)",
+                Case::Noise => "IV-A and IV-B autoencoders trained on noisy snapshots",
                 Case::All => "",
             }
         )?;
         let (mut report, figures) = pool.install(|| match case {
             Case::IvA => iv_a::run(&run, opts),
             Case::IvB => iv_b::run(&run, opts),
+            Case::IvC1 => iv_c1::run(&run, opts),
+            Case::IvC2 => iv_c2::run(&run, opts),
             Case::V => v::run(&run, opts),
+            Case::Noise => noise::run(&run, opts),
             Case::All => unreachable!("expanded by case_list"),
         })?;
         report.wall_time_s = t0.elapsed().as_secs_f64();

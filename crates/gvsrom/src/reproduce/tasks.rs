@@ -130,6 +130,7 @@ pub fn dataset(
 pub struct ModelInfo {
     pub latent: usize,
     /// RMS reconstruction error over every solved sample of the dataset (Table I), strain units.
+    #[serde(with = "nan_as_null")]
     pub rmse_full: f64,
     /// POD: captured energy of the kept modes.
     pub captured_energy: Option<f64>,
@@ -179,6 +180,8 @@ pub struct AeConfig {
     pub batch_size: usize,
     pub learning_rate: f64,
     pub seed: u64,
+    /// Iterations of the final full-batch L-BFGS phase (0: none).
+    pub lbfgs_iterations: usize,
 }
 
 impl AeConfig {
@@ -194,6 +197,10 @@ impl AeConfig {
             batch_size: d.batch_size,
             learning_rate: d.learning_rate,
             seed: d.seed,
+            lbfgs_iterations: match d.fine_tune {
+                rom::nn::FineTune::Lbfgs { iterations, .. } => iterations,
+                _ => 0,
+            },
         }
     }
 }
@@ -221,6 +228,13 @@ pub fn train(
                 learning_rate: c.learning_rate,
                 patience: (c.patience > 0).then_some(c.patience),
                 seed: c.seed,
+                fine_tune: match c.lbfgs_iterations {
+                    0 => rom::nn::FineTune::None,
+                    iterations => rom::nn::FineTune::Lbfgs {
+                        iterations,
+                        memory: 10,
+                    },
+                },
                 ..rom::nn::TrainOptions::default()
             };
             let interrupt = run.interrupt().clone();
@@ -305,16 +319,46 @@ pub struct Solved {
     /// `None` when the solve failed (then `error` says why).
     pub error: Option<String>,
     pub q: Vec<f64>,
+    #[serde(with = "nan_as_null::array3")]
     pub tip: [f64; 3],
     /// ξ − ξ* at the points, active components, point-major.
     pub strain: Vec<f64>,
     pub centerline: Vec<[f64; 3]>,
     /// Mean solve time over the repetitions [s].
+    #[serde(with = "nan_as_null")]
     pub time_s: f64,
     pub iterations: usize,
     /// Against the HOM at the same input (0 for the HOM itself).
+    #[serde(with = "nan_as_null")]
     pub strain_error_percent: f64,
+    #[serde(with = "nan_as_null")]
     pub tip_error_percent: f64,
+}
+
+/// NaN (a failed solve's numbers) as JSON `null` and back: JSON has no NaN, and a step record must
+/// read back exactly what it stored.
+mod nan_as_null {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    pub fn serialize<S: Serializer>(v: &f64, s: S) -> Result<S::Ok, S::Error> {
+        v.is_finite().then_some(*v).serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+    }
+
+    pub mod array3 {
+        use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+        pub fn serialize<S: Serializer>(v: &[f64; 3], s: S) -> Result<S::Ok, S::Error> {
+            v.map(|x| x.is_finite().then_some(x)).serialize(s)
+        }
+
+        pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 3], D::Error> {
+            Ok(<[Option<f64>; 3]>::deserialize(d)?.map(|x| x.unwrap_or(f64::NAN)))
+        }
+    }
 }
 
 /// All models at one test input.
@@ -457,14 +501,23 @@ pub fn statics_eval(
     )
 }
 
-/// Runs `f` over `items` on the run's thread pool (in parallel), keeping the order; the first
-/// interrupt or error wins.
+/// Runs `f` over `items` on the run's thread pool (in parallel), keeping the order, with a progress
+/// bar on a terminal; the first interrupt or error wins.
 pub fn parallel<I: Sync, T: Send>(
     items: &[I],
     f: impl Fn(&I) -> anyhow::Result<T> + Sync + Send,
 ) -> anyhow::Result<Vec<T>> {
     use rayon::prelude::*;
-    let results: Vec<anyhow::Result<T>> = items.par_iter().map(&f).collect();
+    let bar = crate::dataset::progress_bar_of(items.len() as u64, "models");
+    let results: Vec<anyhow::Result<T>> = items
+        .par_iter()
+        .map(|i| {
+            let r = f(i);
+            bar.inc(1);
+            r
+        })
+        .collect();
+    bar.finish_and_clear();
     // an interrupt anywhere is reported as the interrupt, not as the error it caused elsewhere
     if let Some(i) = results.iter().find_map(|r| {
         r.as_ref()

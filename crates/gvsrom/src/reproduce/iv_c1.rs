@@ -1,0 +1,734 @@
+//! Case IV-C1: the six-tendon manipulator's statics under gravity (paper Section IV-C1, Figs. 7–8,
+//! Table III same-DOF row).
+//!
+//! Data: 20 000 equilibria at uniform random tensions in [−30, 30] N on all six tendons (seed 0).
+//! Models: an autoencoder with r = 6 latent coordinates and 7 hidden layers, and POD with 6 modes.
+//! Test: five random tension vectors (fixed seed), where the HOM, the AE-ROM and the POD-ROM are
+//! solved as `gvsrom statics [--model]` solves them (Fig. 7, Table III). Fig. 8: two more r = 6
+//! autoencoders, trained on equal counts of grid and random samples, and the first three principal
+//! components of their training codes.
+
+use super::iv_a::accuracy_table;
+use super::report::{figure, ratio, CaseReport, Cell, Digits, Finding, RenderedFigure, Table};
+use super::step::Step;
+use super::tasks::{
+    self, AeConfig, DatasetInfo, DatasetSpec, EvalModel, Evaluation, ModelInfo, ScenarioSpec,
+};
+use super::{new_report, paper, Case, Options, Run};
+use crate::dataset::Dataset;
+use crate::plot::{palette, Figure, LineChart, Scatter3, Series, SeriesStyle};
+use crate::reduced_model::{ModelWeights, ReducedModel};
+use serde_json::json;
+use std::path::Path;
+
+/// The reduced models' size: one coordinate per tendon (paper: r = 6, POD with 6 modes).
+const R: usize = 6;
+/// Hidden layers of every autoencoder of the case (the paper's deepest, as in Table I).
+const HIDDEN_LAYERS: usize = 7;
+/// Tension range of the data and of the test inputs [N].
+const U_RANGE: (f64, f64) = (-30.0, 30.0);
+/// Seed of the five test tension vectors (the datasets use seed 0: other draws).
+const TEST_SEED: u64 = 7;
+/// Number of test inputs (Fig. 7).
+const TESTS: usize = 5;
+/// Fig. 8's finding: how much larger the random-trained codes' occupied share of their PC box must
+/// be than the grid-trained codes' to count as "more evenly charted" (a difference of a few % is
+/// within what another seed or bin count changes).
+const CLEARLY_MORE: f64 = 1.1;
+/// Centreline samples of the evaluation's solutions (the preset's 21 draw the bent arm as a
+/// polygon; output only, the computational points and the solve are unchanged).
+const CENTERLINE_POINTS: usize = 61;
+
+/// Sizes of the full and the quick run.
+struct Sizes {
+    samples: usize,
+    /// Grid values per tendon of Fig. 8's grid dataset (samples: `per_axis⁶`).
+    per_axis: usize,
+    epochs: usize,
+    repeat: u32,
+}
+
+fn sizes(quick: bool) -> Sizes {
+    if quick {
+        Sizes {
+            samples: 2000,
+            per_axis: 3,
+            epochs: 300,
+            repeat: 2,
+        }
+    } else {
+        Sizes {
+            samples: 20_000,
+            per_axis: 4,
+            epochs: 1000,
+            repeat: 5,
+        }
+    }
+}
+
+/// The five test tension vectors [N]: uniform in [−30, 30) N from SplitMix64 with [`TEST_SEED`],
+/// rounded to 0.1 N so that the inputs print exactly.
+pub fn test_tensions() -> Vec<[f64; 6]> {
+    let mut rng = gvs::inputs::SplitMix64::new(TEST_SEED);
+    (0..TESTS)
+        .map(|_| std::array::from_fn(|_| (rng.range(U_RANGE.0, U_RANGE.1) * 10.0).round() / 10.0))
+        .collect()
+}
+
+fn tension_spec() -> String {
+    format!("tendons.*.tension={}:{}", U_RANGE.0, U_RANGE.1)
+}
+
+/// Runs case IV-C1.
+pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<RenderedFigure>)> {
+    let s = sizes(opts.quick);
+    let scenario = ScenarioSpec::new("six-tendon", &["loads.gravity=[0,0,-9.81]"]);
+    let plan = DatasetSpec {
+        random: vec![tension_spec()],
+        samples: Some(s.samples),
+        seed: 0,
+        ..DatasetSpec::default()
+    };
+    let fig8_samples = s.per_axis.pow(6);
+    let grid_plan = DatasetSpec {
+        grid: vec![tension_spec()],
+        samples: Some(fig8_samples),
+        ..DatasetSpec::default()
+    };
+    let random_plan = DatasetSpec {
+        random: vec![tension_spec()],
+        samples: Some(fig8_samples),
+        seed: 0,
+        ..DatasetSpec::default()
+    };
+    let data = tasks::dataset(run, "iv-c1/dataset", &scenario, &plan, opts.jobs)?;
+    let grid = tasks::dataset(run, "iv-c1/fig8-grid", &scenario, &grid_plan, opts.jobs)?;
+    let random = tasks::dataset(run, "iv-c1/fig8-random", &scenario, &random_plan, opts.jobs)?;
+
+    // the three autoencoders at once (the big one first: rayon gives it a thread of its own)
+    let ae_config = AeConfig::new(R, HIDDEN_LAYERS, s.epochs);
+    let jobs: [(&str, &Step<DatasetInfo>); 3] = [
+        ("iv-c1/ae-6", &data),
+        ("iv-c1/fig8-ae-grid", &grid),
+        ("iv-c1/fig8-ae-random", &random),
+    ];
+    let mut trained = tasks::parallel(&jobs, |(name, d)| tasks::train(run, name, d, &ae_config))?;
+    let ae_random = trained.pop().expect("three autoencoders");
+    let ae_grid = trained.pop().expect("three autoencoders");
+    let ae = trained.pop().expect("three autoencoders");
+    let pod = tasks::pod(run, "iv-c1/pod-6", &data, R)?;
+
+    let tensions = test_tensions();
+    let inputs: Vec<Vec<String>> = tensions
+        .iter()
+        .map(|u| {
+            u.iter()
+                .enumerate()
+                .map(|(k, v)| format!("tendons.{k}.tension={v}"))
+                .collect()
+        })
+        .collect();
+    let models = [
+        EvalModel::hom(),
+        EvalModel::of("AE-6", &ae),
+        EvalModel::of("POD-6", &pod),
+    ];
+    let eval_scenario = scenario.with(&[format!("output.centerline_points={CENTERLINE_POINTS}")]);
+    let ev = tasks::statics_eval(
+        run,
+        "iv-c1/eval",
+        &eval_scenario,
+        &inputs,
+        &models,
+        s.repeat,
+    )?;
+    let ev = &ev.value;
+
+    let fig8 = [
+        Sampling::measure("grid", &grid, &ae_grid)?,
+        Sampling::measure("random", &random, &ae_random)?,
+    ];
+
+    let mut report = new_report(
+        Case::IvC1,
+        "six-tendon multisection manipulator, statics (paper Section IV-C1)",
+    );
+    let hom_dof = ev.of("HOM").next().map_or(0, |h| h.dof);
+    report.setup = vec![
+        format!("scenario: preset `six-tendon` with `loads.gravity=[0,0,-9.81]` (0.6 m arm in two 0.3 m divisions, radius 2 → 1 cm, E = 1 MPa; base along +x, gravity along −z: a horizontal cantilever that sags under its own weight, as IV-A; six frictionless tendons 60° apart on the surface, alternating full and half length; {hom_dof}-DOF Legendre basis, {} computational points, 6 active strain components)", ev.strain_x.len()),
+        format!("data: {} equilibria at uniform random tensions in [−30, 30] N on all six tendons, seed 0 (`gvsrom dataset six-tendon --set 'loads.gravity=[0,0,-9.81]' --random 'tendons.*.tension=-30:30' --samples {} --seed 0`); solved and failed counts in the table below", s.samples, s.samples),
+        format!("autoencoder: r = {R}, {HIDDEN_LAYERS} hidden layers, tanh, λ = 1e-4, Adam ≤ {} epochs with early stopping (patience {}), then L-BFGS (`gvsrom train` defaults)", s.epochs, ae_config.patience),
+        format!("POD: {R} modes of the uncentred snapshots"),
+        format!("test: {TESTS} tension vectors uniform in [−30, 30) N (SplitMix64, seed {TEST_SEED}, rounded to 0.1 N; listed below); each equilibrium solved {} times, mean time, one thread; the HOM from the straight rod, the ROMs from their anchors (as `gvsrom statics [--model]`); centrelines sampled at {CENTERLINE_POINTS} points for Fig. 7", s.repeat),
+        format!("Fig. 8: two more r = {R} autoencoders (same settings) trained on {} equilibria each: a grid of {}⁶ tensions over [−30, 30] N (`--grid 'tendons.*.tension=-30:30' --samples {}`) and uniform random tensions (`--random … --samples {} --seed 0`)", fig8_samples, s.per_axis, fig8_samples, fig8_samples),
+    ];
+
+    report.tables.push(datasets_table([
+        ("training (random)", &data.value),
+        ("Fig. 8 grid", &grid.value),
+        ("Fig. 8 random", &random.value),
+    ]));
+    report.tables.push(models_table(&ae, &pod));
+    let mut accuracy = accuracy_table(ev, &models);
+    accuracy.title = "Accuracy and time at the five test inputs (Fig. 7's models)".into();
+    report.tables.push(accuracy);
+    report.tables.push(inputs_table(ev, &tensions));
+    let (ae_tip, _) = ev.stats("AE-6", |s| s.tip_error_percent);
+    let (pod_tip, _) = ev.stats("POD-6", |s| s.tip_error_percent);
+    let (ae_strain, _) = ev.stats("AE-6", |s| s.strain_error_percent);
+    let (pod_strain, _) = ev.stats("POD-6", |s| s.strain_error_percent);
+    let (hom_t, _) = ev.stats("HOM", |s| s.time_s);
+    let (ae_t, _) = ev.stats("AE-6", |s| s.time_s);
+    let (pod_t, _) = ev.stats("POD-6", |s| s.time_s);
+    let times = Times {
+        hom: hom_t,
+        ae: ae_t,
+        pod: pod_t,
+    };
+    report
+        .tables
+        .push(table_iii(hom_dof, ae_tip, pod_tip, ev.length, &times));
+    report.tables.push(fig8_table(&fig8));
+
+    let ms = |t: f64| Cell::sig(t * 1e3, 3).render();
+    let failed = |label: &str| ev.of(label).filter(|s| s.error.is_some()).count();
+    let failures = match (failed("AE-6"), failed("POD-6")) {
+        (0, 0) => String::new(),
+        (a, p) => format!(
+            " (failed solves, which make a mean –: AE-6 at {a}, POD-6 at {p} of the {TESTS} inputs)"
+        ),
+    };
+    report.findings = vec![
+        Finding {
+            claim: "at equal DOF (6) the AE-ROM is more accurate than the POD-ROM".into(),
+            holds: ae_tip < pod_tip,
+            evidence: format!(
+                "mean tip error {} % L (AE-6) against {} % L (POD-6); mean strain error {} % against {} %{failures}",
+                Cell::sig(ae_tip, 3).render(),
+                Cell::sig(pod_tip, 3).render(),
+                Cell::sig(ae_strain, 3).render(),
+                Cell::sig(pod_strain, 3).render()
+            ),
+        },
+        Finding {
+            claim: "both ROMs are faster than the HOM".into(),
+            holds: ae_t < hom_t && pod_t < hom_t,
+            evidence: format!(
+                "HOM {} ms, AE-6 {} ms, POD-6 {} ms per equilibrium{failures}",
+                ms(hom_t),
+                ms(ae_t),
+                ms(pod_t)
+            ),
+        },
+        Finding {
+            claim: "at equal DOF the POD-ROM is faster than the AE-ROM".into(),
+            holds: pod_t < ae_t,
+            evidence: format!(
+                "POD-6 {} ms against AE-6 {} ms{failures}",
+                ms(pod_t),
+                ms(ae_t)
+            ),
+        },
+        Finding {
+            claim: format!("random sampling charts the latent space more evenly than grid sampling (Fig. 8); measured: the random-trained codes occupy at least {}× the share of their PC₁–PC₃ box that the grid-trained codes occupy", Cell::sig(CLEARLY_MORE, 2).render()),
+            holds: fig8[1].occupied >= CLEARLY_MORE * fig8[0].occupied,
+            evidence: format!(
+                "occupied cells: {} % (random) against {} % (grid), ratio {}",
+                Cell::sig(fig8[1].occupied * 100.0, 3).render(),
+                Cell::sig(fig8[0].occupied * 100.0, 3).render(),
+                Cell::sig(fig8[1].occupied / fig8[0].occupied, 3).render()
+            ),
+        },
+    ];
+    report.notes = vec![
+        "Gravity: the paper's IV-C text does not say whether gravity acts; the preset's default is none (actuation only). Here it acts along −z with the base along +x, as in IV-A, so the unloaded arm is a sagging horizontal cantilever; a few random equilibria then fail (limit points of the heavy arm with pushing tendons), counted in the dataset table and left out of the training.".into(),
+        format!("The HOM has {hom_dof} DOF as the paper's, but only {} computational points (two divisions × 5 Gauss points + ends): one HOM equilibrium costs well under a millisecond, so the ROMs have little to save; the paper's MATLAB times (0.1–0.3 s) are three orders of magnitude above ours. Compare the ratios between models, not the absolute times.", ev.strain_x.len()),
+        "The five test inputs are random draws from a fixed seed; the paper's five \"arbitrary actuation inputs\" are not listed, so per-input errors are not comparable one by one, only their mean.".into(),
+        "Fig. 8's coverage number is ours, a crude proxy of the paper's visual reading: the fraction of the cells of an n × n × n grid over the bounding box of the codes' first three principal components that hold at least one code (n = round((N/4)^(1/3)), 4 codes per cell if spread evenly).".into(),
+    ];
+    if ae.value.rmse_full > pod.value.rmse_full && ae_tip < pod_tip {
+        report.notes.push(format!(
+            "The autoencoder reconstructs the training snapshots worse than POD-6 (RMS {} against {}, table \"Reduced models\"), yet its ROM is the more accurate at the test inputs: the ROM's error is that of the equilibrium found on the decoder's manifold, not of the reconstruction D(E(x)) of the HOM's strain.",
+            Cell::sig(ae.value.rmse_full, 3).render(),
+            Cell::sig(pod.value.rmse_full, 3).render()
+        ));
+    }
+    report.settings = json!({
+        "scenario": scenario,
+        "eval_scenario": eval_scenario,
+        "plan": plan,
+        "fig8_grid_plan": grid_plan,
+        "fig8_random_plan": random_plan,
+        "autoencoder": ae_config,
+        "pod_modes": R,
+        "test_seed": TEST_SEED,
+        "test_tensions": tensions,
+        "repeat": s.repeat,
+    });
+    report.values = json!({
+        "datasets": {
+            "training": &data.value,
+            "fig8_grid": &grid.value,
+            "fig8_random": &random.value,
+            "training_failures": failed_samples(&data.path),
+        },
+        "models": { "ae": &ae.value, "pod": &pod.value, "fig8_ae_grid": &ae_grid.value, "fig8_ae_random": &ae_random.value },
+        "tip_error_mean_percent": { "ae": ae_tip, "pod": pod_tip },
+        "time_mean_s": { "hom": hom_t, "ae": ae_t, "pod": pod_t },
+        "fig8": fig8.iter().map(Sampling::values).collect::<Vec<_>>(),
+        "evaluation": ev,
+    });
+    let figures = vec![fig7(ev, &tensions)?, fig8_figure(&fig8)?];
+    Ok((report, figures))
+}
+
+/// Samples, solved and failed equilibria of each dataset.
+fn datasets_table(rows: [(&str, &DatasetInfo); 3]) -> Table {
+    Table {
+        id: "datasets".into(),
+        title: "Datasets".into(),
+        columns: ["dataset", "samples", "solved", "failed"]
+            .map(String::from)
+            .to_vec(),
+        rows: rows
+            .iter()
+            .map(|(name, d)| {
+                vec![
+                    Cell::text(*name),
+                    Cell::int(d.samples),
+                    Cell::int(d.ok),
+                    Cell::int(d.failed),
+                ]
+            })
+            .collect(),
+        note: "A failed sample is an equilibrium the HOM's Newton solver (with its load ramp) did not reach; it is recorded as failed and left out of the snapshots.".into(),
+    }
+}
+
+/// The two reduced models: reconstruction error, training outcome.
+fn models_table(ae: &Step<ModelInfo>, pod: &Step<ModelInfo>) -> Table {
+    let opt = |v: Option<f64>| Cell::sig(v.unwrap_or(f64::NAN), 3);
+    Table {
+        id: "models".into(),
+        title: "Reduced models".into(),
+        columns: [
+            "model",
+            "DOF",
+            "RMS reconstruction error",
+            "validation RMSE",
+            "epochs run",
+            "POD captured energy",
+        ]
+        .map(String::from)
+        .to_vec(),
+        rows: vec![
+            vec![
+                Cell::text("AE-6"),
+                Cell::int(ae.value.latent),
+                Cell::sig(ae.value.rmse_full, 3),
+                opt(ae.value.val_rmse),
+                ae.value
+                    .epochs_run
+                    .map_or(Cell::num(f64::NAN, Digits::Fixed(0)), Cell::int),
+                Cell::num(f64::NAN, Digits::Sig(3)),
+            ],
+            vec![
+                Cell::text("POD-6"),
+                Cell::int(pod.value.latent),
+                Cell::sig(pod.value.rmse_full, 3),
+                Cell::num(f64::NAN, Digits::Sig(3)),
+                Cell::num(f64::NAN, Digits::Fixed(0)),
+                opt(pod.value.captured_energy),
+            ],
+        ],
+        note: "RMS of x̂ − x over every entry of every solved snapshot of the training data, x = ξ − ξ* at the computational points, six components (curvatures in 1/m, elongation and shears unitless). Epochs: Adam epochs plus L-BFGS iterations. Captured energy: Σ of the kept squared singular values / Σ of all.".into(),
+    }
+}
+
+/// Fig. 7's annotations: each test input's tensions and the ROMs' tip errors against the HOM.
+fn inputs_table(ev: &Evaluation, tensions: &[[f64; 6]]) -> Table {
+    let mut columns = vec!["input".to_string()];
+    columns.extend((1..=6).map(|k| format!("u{k} [N]")));
+    columns.extend(
+        [
+            "AE-6 tip error [cm]",
+            "AE-6 tip error [% L]",
+            "POD-6 tip error [cm]",
+            "POD-6 tip error [% L]",
+        ]
+        .map(String::from),
+    );
+    let rows = ev
+        .points
+        .iter()
+        .zip(tensions)
+        .enumerate()
+        .map(|(i, (p, u))| {
+            let mut row = vec![Cell::int(i + 1)];
+            row.extend(u.iter().map(|&v| Cell::fixed(v, 1)));
+            for label in ["AE-6", "POD-6"] {
+                let (cm, pct) = tip_error(p, label);
+                row.extend([Cell::sig(cm, 3), Cell::sig(pct, 3)]);
+            }
+            row
+        })
+        .collect();
+    Table {
+        id: "inputs".into(),
+        title: "Test inputs and tip errors (Fig. 7's annotations)".into(),
+        columns,
+        rows,
+        note: "u_k: tension of tendon k (negative pulls; odd k full length, even k half length, numbering from 1). Tip error: ‖p_ROM − p_HOM‖, and in % of the length L = 0.6 m. – : the ROM's solve failed.".into(),
+    }
+}
+
+/// Model `label`'s tip error at point `p`: ‖p_ROM − p_HOM‖ [cm] and in % of the length (NaN if a
+/// solve failed).
+fn tip_error(p: &tasks::EvalPoint, label: &str) -> (f64, f64) {
+    let find = |l: &str| p.models.iter().find(|m| m.label == l && m.error.is_none());
+    match (find("HOM"), find(label)) {
+        (Some(h), Some(m)) => {
+            let d = (0..3).map(|i| (m.tip[i] - h.tip[i]).powi(2)).sum::<f64>();
+            (d.sqrt() * 100.0, m.tip_error_percent)
+        }
+        _ => (f64::NAN, f64::NAN),
+    }
+}
+
+/// Mean times per equilibrium [s].
+struct Times {
+    hom: f64,
+    ae: f64,
+    pod: f64,
+}
+
+/// Table III's same-DOF row: tip errors and times of POD-6 and AE-6, the HOM's time, beside the
+/// paper's.
+fn table_iii(hom_dof: usize, ae_tip: f64, pod_tip: f64, length: f64, t: &Times) -> Table {
+    let p = &paper::TABLE_III_IV_C1;
+    let (p_pod_err, p_ae_err) = (
+        p.pod_error.unwrap_or(f64::NAN),
+        p.ae_error.unwrap_or(f64::NAN),
+    );
+    let cm = |pct: f64| pct / 100.0 * length * 100.0;
+    let row = |q: &str, ours: Cell, paper: Cell, r: Cell| vec![Cell::text(q), ours, paper, r];
+    let num = |q: &str, ours: f64, paper: f64| {
+        row(
+            q,
+            Cell::sig(ours, 3),
+            Cell::sig(paper, 3),
+            ratio(ours, paper),
+        )
+    };
+    let int = |q: &str, ours: usize, paper: usize| {
+        row(
+            q,
+            Cell::int(ours),
+            Cell::int(paper),
+            ratio(ours as f64, paper as f64),
+        )
+    };
+    let rows = vec![
+        int("HOM DOF", hom_dof, paper::IV_C_HOM_DOF),
+        int("ROM DOF (POD modes = AE latent size)", R, p.ae_dof),
+        num("POD-ROM tip error [% L]", pod_tip, p_pod_err),
+        num("AE-ROM tip error [% L]", ae_tip, p_ae_err),
+        num(
+            "POD-ROM tip error [cm]",
+            cm(pod_tip),
+            paper::IV_C1_POD_TIP_ERROR_CM,
+        ),
+        num(
+            "AE-ROM tip error [cm]",
+            cm(ae_tip),
+            paper::IV_C1_AE_TIP_ERROR_CM,
+        ),
+        num("POD-ROM time [s]", t.pod, p.pod_time_s),
+        num("AE-ROM time [s]", t.ae, p.ae_time_s),
+        num("HOM time [s]", t.hom, p.hom_time_s),
+        num(
+            "POD-ROM tip error / AE-ROM tip error",
+            pod_tip / ae_tip,
+            p_pod_err / p_ae_err,
+        ),
+        num(
+            "AE-ROM time / POD-ROM time",
+            t.ae / t.pod,
+            p.ae_time_s / p.pod_time_s,
+        ),
+        num(
+            "AE-ROM speed-up over the HOM",
+            t.hom / t.ae,
+            p.hom_time_s / p.ae_time_s,
+        ),
+        num(
+            "POD-ROM speed-up over the HOM",
+            t.hom / t.pod,
+            p.hom_time_s / p.pod_time_s,
+        ),
+    ];
+    Table {
+        id: "table-iii".into(),
+        title: "Table III row (same DOF study: 6 DOF)".into(),
+        columns: ["quantity", "ours", "paper", "ratio"].map(String::from).to_vec(),
+        rows,
+        note: "Tip errors: mean over the five test inputs of ‖p_ROM − p_HOM‖ (the paper's cm values are from its text). Times: mean wall time of one static equilibrium over the test inputs. Ours: gvsrom, one thread, this machine; the paper's: MATLAB on an i9-13900HX.".into(),
+    }
+}
+
+/// The labels of the failed training samples and why (at most 50).
+fn failed_samples(data: &Path) -> serde_json::Value {
+    match Dataset::load(data) {
+        Ok(d) => json!(d.meta.failures.iter().take(50).collect::<Vec<_>>()),
+        Err(e) => json!(format!("{e}")),
+    }
+}
+
+/// One sampling strategy of Fig. 8: its training codes on their first three principal components.
+struct Sampling {
+    name: &'static str,
+    samples: usize,
+    val_rmse: f64,
+    /// PC₁–PC₃ of each solved sample's code.
+    pcs: Vec<[f64; 3]>,
+    /// Share of the codes' variance on PC₁–PC₃.
+    explained: f64,
+    /// Occupied share of the cells of an n³ grid over the PC₁–PC₃ bounding box.
+    occupied: f64,
+    bins: usize,
+}
+
+impl Sampling {
+    fn measure(
+        name: &'static str,
+        data: &Step<DatasetInfo>,
+        ae: &Step<ModelInfo>,
+    ) -> anyhow::Result<Sampling> {
+        let z = encodings(&data.path, &ae.path)?;
+        let (pcs, explained) = principal_components(&z)?;
+        let bins = ((pcs.len() as f64 / 4.0).cbrt().round() as usize).max(2);
+        Ok(Sampling {
+            name,
+            samples: data.value.samples,
+            val_rmse: ae.value.val_rmse.unwrap_or(f64::NAN),
+            occupied: occupied_fraction(&pcs, bins),
+            explained,
+            pcs,
+            bins,
+        })
+    }
+
+    fn values(&self) -> serde_json::Value {
+        json!({
+            "sampling": self.name, "samples": self.samples, "val_rmse": self.val_rmse,
+            "explained_variance_pc1_3": self.explained, "occupied_fraction": self.occupied,
+            "bins": self.bins,
+        })
+    }
+}
+
+/// The encodings `E(x)` of every solved sample of the dataset at `data` by the autoencoder at
+/// `model` (as `iv_common`'s private helper of the same name, without the colour input).
+fn encodings(data: &Path, model: &Path) -> anyhow::Result<Vec<Vec<f64>>> {
+    let ds = Dataset::load(data)?;
+    let m = ReducedModel::load(model)?;
+    let ModelWeights::Autoencoder(ae) = &m.weights else {
+        anyhow::bail!("`{}` is not an autoencoder", model.display());
+    };
+    ds.ok_rows()
+        .into_iter()
+        .map(|i| Ok(ae.encode(ds.strain_row(i))?))
+        .collect()
+}
+
+/// The codes `z_i` on their first three principal components, `p_i = Vₖᵀ (z_i − z̄)`, k = 1 … 3,
+/// from the SVD `Z − 1 z̄ᵀ = U Σ Vᵀ` (singular values sorted here, descending), and the share of
+/// the variance they carry, `(σ₁² + σ₂² + σ₃²) / Σ σ²`.
+fn principal_components(z: &[Vec<f64>]) -> anyhow::Result<(Vec<[f64; 3]>, f64)> {
+    let n = z.len();
+    let d = z.first().map_or(0, Vec::len);
+    anyhow::ensure!(
+        n >= 3 && d >= 3,
+        "{n} codes of size {d}: too few for three principal components"
+    );
+    let mean: Vec<f64> = (0..d)
+        .map(|j| z.iter().map(|r| r[j]).sum::<f64>() / n as f64)
+        .collect();
+    let c = nalgebra::DMatrix::from_fn(n, d, |i, j| z[i][j] - mean[j]);
+    let svd = c.clone().svd(false, true);
+    let v_t = svd
+        .v_t
+        .ok_or_else(|| anyhow::anyhow!("the SVD of the codes gave no right singular vectors"))?;
+    let sv = &svd.singular_values;
+    let mut order: Vec<usize> = (0..sv.len()).collect();
+    order.sort_by(|&a, &b| sv[b].total_cmp(&sv[a]));
+    let total: f64 = sv.iter().map(|s| s * s).sum();
+    let explained = order[..3].iter().map(|&k| sv[k] * sv[k]).sum::<f64>() / total;
+    let pcs = (0..n)
+        .map(|i| {
+            std::array::from_fn(|a| {
+                let k = order[a];
+                (0..d).map(|j| c[(i, j)] * v_t[(k, j)]).sum()
+            })
+        })
+        .collect();
+    Ok((pcs, explained))
+}
+
+/// The share of the `bins³` cells of the points' bounding box that hold at least one point.
+fn occupied_fraction(p: &[[f64; 3]], bins: usize) -> f64 {
+    let lo: [f64; 3] = std::array::from_fn(|a| p.iter().map(|x| x[a]).fold(f64::MAX, f64::min));
+    let hi: [f64; 3] = std::array::from_fn(|a| p.iter().map(|x| x[a]).fold(f64::MIN, f64::max));
+    let mut occupied = vec![false; bins.pow(3)];
+    for x in p {
+        let cell: [usize; 3] = std::array::from_fn(|a| {
+            let w = hi[a] - lo[a];
+            let f = if w > 0.0 { (x[a] - lo[a]) / w } else { 0.0 };
+            ((f * bins as f64) as usize).min(bins - 1)
+        });
+        occupied[(cell[0] * bins + cell[1]) * bins + cell[2]] = true;
+    }
+    occupied.iter().filter(|&&o| o).count() as f64 / occupied.len() as f64
+}
+
+/// Fig. 8's numbers: per sampling, the codes' spread over PC₁–PC₃.
+fn fig8_table(s: &[Sampling; 2]) -> Table {
+    Table {
+        id: "fig8".into(),
+        title: "Fig. 8: grid against random sampling, r = 6 autoencoders".into(),
+        columns: [
+            "sampling",
+            "samples",
+            "AE validation RMSE",
+            "variance on PC₁–PC₃ [%]",
+            "grid cells n",
+            "occupied cells of the PC₁–PC₃ box [%]",
+        ]
+        .map(String::from)
+        .to_vec(),
+        rows: s
+            .iter()
+            .map(|x| {
+                vec![
+                    Cell::text(x.name),
+                    Cell::int(x.samples),
+                    Cell::sig(x.val_rmse, 3),
+                    Cell::sig(x.explained * 100.0, 3),
+                    Cell::int(x.bins),
+                    Cell::sig(x.occupied * 100.0, 3),
+                ]
+            })
+            .collect(),
+        note: "Each autoencoder encodes its own training samples; the codes are centred and projected on their first three principal components. Occupied cells: of an n × n × n grid over the bounding box of the projections (a higher share: the codes chart the box more evenly).".into(),
+    }
+}
+
+/// Fig. 7: the HOM's, AE-6's and POD-6's centrelines at the five test inputs, side view (x–z, top
+/// row) and top view (x–y, bottom row), the inputs and the ROMs' tip errors in the titles.
+fn fig7(ev: &Evaluation, tensions: &[[f64; 6]]) -> anyhow::Result<RenderedFigure> {
+    let styles = [
+        ("HOM", palette::HOM, SeriesStyle::Line),
+        ("AE-6", palette::AE, SeriesStyle::Dashed),
+        ("POD-6", palette::POD, SeriesStyle::Dashed),
+    ];
+    let views: [(usize, &str); 2] = [(2, "z [m]"), (1, "y [m]")];
+    let mut panels = vec![];
+    for (v, (axis, y_label)) in views.iter().enumerate() {
+        // each model enters the legend once per row, in the first panel where it solved
+        let mut in_legend = [false; 3];
+        for (i, (p, u)) in ev.points.iter().zip(tensions).enumerate() {
+            let mut series = vec![];
+            for ((label, color, style), shown) in styles.iter().zip(in_legend.iter_mut()) {
+                let Some(s) = p
+                    .models
+                    .iter()
+                    .find(|m| m.label == *label && m.error.is_none())
+                else {
+                    continue;
+                };
+                let first = !std::mem::replace(shown, true);
+                series.push(Series {
+                    label: if first {
+                        label.to_string()
+                    } else {
+                        String::new()
+                    },
+                    x: s.centerline.iter().map(|c| c[0]).collect(),
+                    y: s.centerline.iter().map(|c| c[*axis]).collect(),
+                    style: *style,
+                    color: Some(*color),
+                });
+                // the tip, whose distance from the HOM's is the annotated error
+                series.push(Series {
+                    label: String::new(),
+                    x: vec![s.tip[0]],
+                    y: vec![s.tip[*axis]],
+                    style: SeriesStyle::Markers,
+                    color: Some(*color),
+                });
+            }
+            let title = if v == 0 {
+                let u: Vec<String> = u.iter().map(|x| Cell::fixed(*x, 1).render()).collect();
+                format!("#{}: u = [{}] N", i + 1, u.join(", "))
+            } else {
+                let err = |label: &str| match tip_error(p, label).0 {
+                    e if e.is_finite() => format!("{} cm", Cell::sig(e, 3).render()),
+                    _ => "failed".to_string(),
+                };
+                format!(
+                    "#{}: tip error AE {}, POD {}",
+                    i + 1,
+                    err("AE-6"),
+                    err("POD-6")
+                )
+            };
+            panels.push(Figure::Line(LineChart {
+                title,
+                x_label: "x [m]".into(),
+                y_label: y_label.to_string(),
+                series,
+                log_y: false,
+                equal_aspect: true,
+            }));
+        }
+    }
+    figure(
+        "fig7-configurations",
+        "Fig. 7: configurations of the HOM (green), the AE-ROM with r = 6 (gold) and the POD-ROM with 6 modes (red) at the five test inputs; top row side view (x–z, gravity along −z) with the tensions, bottom row top view (x–y) with the ROMs' tip errors against the HOM",
+        &Figure::Grid {
+            title: "IV-C1: six-tendon manipulator under gravity, HOM against 6-DOF ROMs".into(),
+            cols: TESTS,
+            panels,
+        },
+        2600,
+        1150,
+    )
+}
+
+/// Fig. 8: the training codes of the grid- and the random-sampled autoencoders on PC₁–PC₃,
+/// coloured by PC₃.
+fn fig8_figure(s: &[Sampling; 2]) -> anyhow::Result<RenderedFigure> {
+    let panels = s
+        .iter()
+        .map(|x| {
+            Figure::Scatter3(Scatter3 {
+                title: format!("{} sampling ({} samples)", x.name, x.samples),
+                labels: ["PC₁".into(), "PC₂".into(), "PC₃".into()],
+                points: x.pcs.clone(),
+                color: Some(x.pcs.iter().map(|p| p[2]).collect()),
+                color_label: "PC₃".into(),
+            })
+        })
+        .collect();
+    figure(
+        "fig8-sampling",
+        "Fig. 8: the 6-D latent codes of the training samples on their first three principal components, for an autoencoder (r = 6) trained on grid-sampled (left) and one trained on random-sampled tensions (right), equal sample counts; colour: PC₃",
+        &Figure::Grid {
+            title: "IV-C1: latent codes, grid against random sampling".into(),
+            cols: 2,
+            panels,
+        },
+        1400,
+        650,
+    )
+}
