@@ -5,11 +5,12 @@
 //! 1 … 10 modes. Test: 20 tensions between the training ones (−5.85 + 0.45 i N), where every model's
 //! equilibrium is solved as `gvsrom statics [--model]` solves it.
 
+use super::figures;
 use super::report::{figure, ratio, CaseReport, Cell, Finding, RenderedFigure, Table};
 use super::step::Step;
 use super::tasks::{self, AeConfig, DatasetSpec, EvalModel, Evaluation, ModelInfo, ScenarioSpec};
 use super::{new_report, paper, Case, Options, Run};
-use crate::plot::{palette, Figure, LineChart, Series, SeriesStyle};
+use crate::plot::{palette, Figure, SeriesStyle};
 use serde_json::json;
 
 /// The setup shared by IV-A and V: scenario, data and the models both use.
@@ -416,65 +417,31 @@ pub fn table_iii(
 /// Fig. 4: bend-y strain along the rod at three test tensions (HOM, AE-1, POD-2, POD-k) and the
 /// AE-ROM's configurations at six.
 fn fig4(ev: &Evaluation, pod_k: Option<&str>) -> anyhow::Result<RenderedFigure> {
-    let mut labels = vec![
+    let mut looks = vec![
         ("HOM", palette::HOM, SeriesStyle::Line),
         ("AE-1", palette::AE, SeriesStyle::Dashed),
         ("POD-2", palette::POD, SeriesStyle::Dashed),
     ];
     if let Some(l) = pod_k {
-        labels.push((l, palette::POD_ALT, SeriesStyle::Dashed));
+        looks.push((l, palette::POD_ALT, SeriesStyle::Dashed));
     }
-    let mut panels = vec![];
-    for &i in &[0usize, 7, 16] {
-        let p = &ev.points[i];
-        panels.push(Figure::Line(LineChart {
-            title: p.set.join(" ").replace("tendons.0.tension=", "u = ") + " N",
-            x_label: "X [m]".into(),
-            y_label: "bend-y strain ξ₂ [1/m]".into(),
-            series: labels
-                .iter()
-                .filter_map(|(l, c, st)| {
-                    let s = p
-                        .models
-                        .iter()
-                        .find(|m| m.label == *l && m.error.is_none())?;
-                    Some(strain_series(ev, s, "bend_y", l, *c, *st))
-                })
-                .collect(),
-            log_y: false,
-            equal_aspect: false,
-        }));
-    }
-    let mut shapes = vec![];
-    for (n, &i) in [0usize, 4, 8, 12, 16, 19].iter().enumerate() {
-        let p = &ev.points[i];
-        for (label, color, style) in [
-            ("HOM", palette::HOM, SeriesStyle::Line),
-            ("AE-1", palette::AE, SeriesStyle::Dashed),
-        ] {
-            if let Some(s) = p
-                .models
-                .iter()
-                .find(|m| m.label == label && m.error.is_none())
-            {
-                shapes.push(Series {
-                    label: if n == 0 { label.into() } else { String::new() },
-                    x: s.centerline.iter().map(|c| c[0]).collect(),
-                    y: s.centerline.iter().map(|c| c[2]).collect(),
-                    style,
-                    color: Some(color),
-                });
-            }
-        }
-    }
-    panels.push(Figure::Line(LineChart {
-        title: "configurations, u = −5.85 … 2.7 N".into(),
-        x_label: "x [m]".into(),
-        y_label: "z [m]".into(),
-        series: shapes,
-        log_y: false,
-        equal_aspect: true,
-    }));
+    let mut panels: Vec<Figure> = [0usize, 7, 16]
+        .iter()
+        .map(|&i| {
+            let title = ev.points[i]
+                .set
+                .join(" ")
+                .replace("tendons.0.tension=", "u = ")
+                + " N";
+            figures::strain_panel(ev, i, "bend_y", "bend-y strain ξ₂ [1/m]", title, &looks)
+        })
+        .collect();
+    panels.push(Figure::Line(figures::configurations(
+        ev,
+        &[0, 4, 8, 12, 16, 19],
+        &looks[..2],
+        "configurations, u = −5.85 … 2.7 N",
+    )));
     figure(
         "fig4-strain",
         "Fig. 4: bend-y strain along the rod of the HOM, the AE-ROM (r = 1) and POD-ROMs with 2 and k modes (k: the fewest reaching < 1 %) at three test tensions, and the HOM and AE-ROM configurations (side view x–z) at six",
@@ -482,30 +449,4 @@ fn fig4(ev: &Evaluation, pod_k: Option<&str>) -> anyhow::Result<RenderedFigure> 
         1400,
         1000,
     )
-}
-
-/// One model's strain component `component` along the rod as a series.
-pub fn strain_series(
-    ev: &Evaluation,
-    s: &tasks::Solved,
-    component: &str,
-    label: &str,
-    color: crate::plot::Rgb,
-    style: SeriesStyle,
-) -> Series {
-    let a = ev.components.len();
-    let c = ev
-        .components
-        .iter()
-        .position(|n| n == component)
-        .unwrap_or(0);
-    Series {
-        label: label.into(),
-        x: ev.strain_x.clone(),
-        y: (0..ev.strain_x.len())
-            .map(|j| s.strain.get(j * a + c).copied().unwrap_or(f64::NAN))
-            .collect(),
-        style,
-        color: Some(color),
-    }
 }

@@ -6,12 +6,13 @@
 //! r = 1, 2, 3 × 3, 5, 7 hidden layers and POD with 1 … 30 modes. Test: 4 N·m at X/L = 0.25 and
 //! 2 N·m at X/L = 0.75 (Fig. 6).
 
-use super::iv_a::{accuracy_table, fewest_pod_below, strain_series, table_i, table_iii};
+use super::figures;
+use super::iv_a::{accuracy_table, fewest_pod_below, table_i, table_iii};
 use super::report::{figure, CaseReport, Cell, Finding, RenderedFigure};
 use super::step::Step;
 use super::tasks::{self, AeConfig, DatasetSpec, EvalModel, Evaluation, ScenarioSpec};
 use super::{iv_common, new_report, paper, Case, Options, Run};
-use crate::plot::{palette, Figure, LineChart, Series, SeriesStyle};
+use crate::plot::{palette, Figure, SeriesStyle};
 use serde_json::json;
 
 struct Sizes {
@@ -253,63 +254,28 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
 /// Fig. 6: bend-y strain along the beam at the two test loads (HOM, AE-2, POD-2, POD-k) and the
 /// configurations of the HOM and the AE-ROM.
 fn fig6(ev: &Evaluation, pod_k: Option<&str>) -> anyhow::Result<RenderedFigure> {
-    let mut labels = vec![
+    let mut looks = vec![
         ("HOM", palette::HOM, SeriesStyle::Line),
         ("AE-2", palette::AE, SeriesStyle::Dashed),
         ("POD-2", palette::POD, SeriesStyle::Dashed),
     ];
     if let Some(l) = pod_k {
-        labels.push((l, palette::POD_ALT, SeriesStyle::Dashed));
+        looks.push((l, palette::POD_ALT, SeriesStyle::Dashed));
     }
-    let mut panels = vec![];
-    for ((m, c), p) in TEST_LOADS.iter().zip(&ev.points) {
-        panels.push(Figure::Line(LineChart {
-            title: format!("{m} N·m at X/L = {:.2}", c / 0.8),
-            x_label: "X [m]".into(),
-            y_label: "bend-y strain ξ₂ [1/m]".into(),
-            series: labels
-                .iter()
-                .filter_map(|(l, col, st)| {
-                    let s = p
-                        .models
-                        .iter()
-                        .find(|s| s.label == *l && s.error.is_none())?;
-                    Some(strain_series(ev, s, "bend_y", l, *col, *st))
-                })
-                .collect(),
-            log_y: false,
-            equal_aspect: false,
-        }));
-    }
-    let mut shapes = vec![];
-    for (n, p) in ev.points.iter().enumerate() {
-        for (label, color, style) in [
-            ("HOM", palette::HOM, SeriesStyle::Line),
-            ("AE-2", palette::AE, SeriesStyle::Dashed),
-        ] {
-            if let Some(s) = p
-                .models
-                .iter()
-                .find(|s| s.label == label && s.error.is_none())
-            {
-                shapes.push(Series {
-                    label: if n == 0 { label.into() } else { String::new() },
-                    x: s.centerline.iter().map(|c| c[0]).collect(),
-                    y: s.centerline.iter().map(|c| c[2]).collect(),
-                    style,
-                    color: Some(color),
-                });
-            }
-        }
-    }
-    panels.push(Figure::Line(LineChart {
-        title: "configurations at both loads".into(),
-        x_label: "x [m]".into(),
-        y_label: "z [m]".into(),
-        series: shapes,
-        log_y: false,
-        equal_aspect: true,
-    }));
+    let mut panels: Vec<Figure> = TEST_LOADS
+        .iter()
+        .enumerate()
+        .map(|(i, (m, c))| {
+            let title = format!("{m} N·m at X/L = {:.2}", c / 0.8);
+            figures::strain_panel(ev, i, "bend_y", "bend-y strain ξ₂ [1/m]", title, &looks)
+        })
+        .collect();
+    panels.push(Figure::Line(figures::configurations(
+        ev,
+        &[0, 1],
+        &looks[..2],
+        "configurations at both loads",
+    )));
     figure(
         "fig6-strain",
         "Fig. 6: bend-y strain of the HOM, the AE-ROM (r = 2) and POD-ROMs with 2 and k modes (k: the fewest reaching < 1 %) at 4 N·m @ X/L = 0.25 and 2 N·m @ X/L = 0.75, and the configurations (x–z)",
