@@ -7,7 +7,6 @@ use super::step::Step;
 use super::tasks::ModelInfo;
 use crate::dataset::Dataset;
 use crate::plot::{Figure, Scatter2, Scatter3};
-use crate::reduced_model::{ModelWeights, ReducedModel};
 use serde_json::json;
 use std::path::Path;
 
@@ -22,27 +21,23 @@ pub struct Latent {
 /// dataset input `color_input` of each.
 fn encodings(
     dataset: &Dataset,
+    data: &Path,
     model: &Path,
     color_input: usize,
 ) -> anyhow::Result<(Vec<Vec<f64>>, Vec<f64>)> {
-    let m = ReducedModel::load(model)?;
-    let ModelWeights::Autoencoder(ae) = &m.weights else {
-        anyhow::bail!("`{}` is not an autoencoder", model.display());
-    };
     let k = dataset.meta.parameters.len();
-    let mut z = vec![];
-    let mut c = vec![];
-    for i in dataset.ok_rows() {
-        z.push(ae.encode(dataset.strain_row(i))?);
-        c.push(
+    let c = dataset
+        .ok_rows()
+        .iter()
+        .map(|&i| {
             dataset
                 .inputs
                 .get(i * k + color_input)
                 .copied()
-                .unwrap_or(f64::NAN),
-        );
-    }
-    Ok((z, c))
+                .unwrap_or(f64::NAN)
+        })
+        .collect();
+    Ok((super::latent::encodings(data, model)?, c))
 }
 
 /// Fig. 3 / Fig. 5: the training samples' encodings by `vis[0]` (r = 2) and `vis[1]` (r = 3),
@@ -56,8 +51,8 @@ pub fn latent_and_dimension(
     color_label: &str,
 ) -> anyhow::Result<Latent> {
     let ds = Dataset::load(data)?;
-    let (z2, c2) = encodings(&ds, &vis[0].path, color_input)?;
-    let (z3, c3) = encodings(&ds, &vis[1].path, color_input)?;
+    let (z2, c2) = encodings(&ds, data, &vis[0].path, color_input)?;
+    let (z3, c3) = encodings(&ds, data, &vis[1].path, color_input)?;
     let figure = Figure::Grid {
         title: "latent coordinates of the training samples".into(),
         cols: 2,

@@ -16,6 +16,7 @@ pub mod iv_b;
 pub mod iv_c1;
 pub mod iv_c2;
 pub mod iv_common;
+pub mod latent;
 pub mod noise;
 pub mod paper;
 pub mod report;

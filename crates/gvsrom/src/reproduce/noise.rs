@@ -37,6 +37,11 @@ fn noisy(
     )
 }
 
+/// Trains the study's autoencoder `(data, r, hidden layers, step-name prefix)`: an empty prefix
+/// names the study's own (clean) step, so it is shared with the study's case.
+type TrainFn<'a> =
+    dyn Fn(&Step<DatasetInfo>, usize, usize, &str) -> anyhow::Result<Step<ModelInfo>> + Sync + 'a;
+
 /// One study's clean and noisy models, measured.
 struct Study {
     label: &'static str,
@@ -58,8 +63,7 @@ fn study(
     data: &Step<DatasetInfo>,
     level: f64,
     rom: (usize, usize),
-    train: &(dyn Fn(&Step<DatasetInfo>, usize, usize, &str) -> anyhow::Result<Step<ModelInfo>>
-          + Sync),
+    train: &TrainFn<'_>,
     scenario: &ScenarioSpec,
     inputs: &[Vec<String>],
     color: (usize, &str),
