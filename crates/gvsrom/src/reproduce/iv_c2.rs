@@ -3,11 +3,11 @@
 //!
 //! Data: 180 s of actuator babbling under gravity (each tendon holds a uniform tension in
 //! [−15, 0] N for 0.5–1 s), sampled at 100 Hz: 18 001 snapshots (`gvsrom dataset --duration
-//! --babble`). Models: for r = 1 … 8 an autoencoder with 7 hidden layers and POD with r modes, and
-//! one control autoencoder at the paper's λ. Test: a new 10 s input, new random tensions in
-//! [−15, 0] N every second, sampled at 100 Hz; the HOM and every ROM simulated with it one after the
-//! other (`gvsrom simulate [--model]`), each ROM's trajectory compared with the HOM's
-//! (`gvsrom compare`: mean tip error in % of the length) and timed.
+//! --babble`). Models: for r = 1 … 8 an autoencoder with 7 hidden layers and POD with r modes; at
+//! r = 7 more autoencoders (other seeds, the paper's λ) for the choice of λ. Test: a new 10 s input,
+//! new random tensions in [−15, 0] N every second, sampled at 100 Hz; the HOM and every ROM
+//! simulated with it one after the other (`gvsrom simulate [--model]`), each ROM's trajectory
+//! compared with the HOM's (`gvsrom compare`: mean tip error in % of the length) and timed.
 
 use super::report::{figure, ratio, CaseReport, Cell, Finding, RenderedFigure, Table};
 use super::step::Step;
@@ -25,10 +25,10 @@ use std::sync::atomic::Ordering;
 /// Hidden layers of every autoencoder (the paper's deepest, as in Table I).
 const HIDDEN_LAYERS: usize = 7;
 /// Weight decay of the autoencoders that become ROMs. The paper's (and `gvsrom train`'s) 1e-4
-/// leaves AE-ROMs that run out of their training region on this data (README, "Reduced models"):
-/// a weaker decay lets the decoder keep the range of the data; the control model measures it again.
+/// left AE-ROMs that run out of their training region on this test (README, "Reduced models"); the
+/// λ table measures both again at the inset's r, over [`Sizes::seeds`].
 const LAMBDA: f64 = 1e-6;
-/// The paper's weight decay, trained once at the inset's r as the control.
+/// The paper's weight decay.
 const LAMBDA_PAPER: f64 = 1e-4;
 /// Babbling of the data: tensions in [lo, hi] N held for [hold_min, hold_max] s (paper IV-C2).
 const BABBLE: [f64; 4] = [-15.0, 0.0, 0.5, 1.0];
@@ -51,6 +51,8 @@ struct Sizes {
     test_s: f64,
     /// Runs of each test simulation; the smallest wall time is kept.
     repeat: usize,
+    /// Training seeds of the λ comparison at the inset's r (the ROMs of every r use the first).
+    seeds: Vec<u64>,
 }
 
 fn sizes(opts: &Options) -> Sizes {
@@ -61,6 +63,7 @@ fn sizes(opts: &Options) -> Sizes {
             epochs: 5,
             test_s: 2.0,
             repeat: 1,
+            seeds: vec![0],
         }
     } else if opts.quick {
         Sizes {
@@ -69,6 +72,7 @@ fn sizes(opts: &Options) -> Sizes {
             epochs: 40,
             test_s: 10.0,
             repeat: 1,
+            seeds: vec![0],
         }
     } else {
         Sizes {
@@ -77,6 +81,7 @@ fn sizes(opts: &Options) -> Sizes {
             epochs: 300,
             test_s: 10.0,
             repeat: 3,
+            seeds: vec![0, 1, 2],
         }
     }
 }
@@ -192,7 +197,7 @@ fn simulate_test(
     hom: Option<&Step<SimRun>>,
 ) -> anyhow::Result<Step<SimRun>> {
     let config = json!({
-        "scenario": scenario, "test": test,
+        "label": label, "scenario": scenario, "test": test,
         "model": model.map(Step::key), "hom": hom.map(Step::key),
     });
     run.step(
@@ -282,6 +287,27 @@ struct Dof {
     pod_run: SimRun,
 }
 
+/// An autoencoder of the λ comparison at the inset's r: its weight decay and seed, and its run.
+struct Variant {
+    lambda: f64,
+    seed: u64,
+    model: ModelInfo,
+    run: SimRun,
+}
+
+/// The step name of an AE (`ae-…`) or its test (`test-ae-…`) with r, λ and seed: `…-r7` for the
+/// ROMs of Fig. 9 (λ = [`LAMBDA`], the first seed), `…-r7-lambda-1e-4-seed1` for another.
+fn ae_name(prefix: &str, r: usize, lambda: f64, seed: u64, first_seed: u64) -> String {
+    let mut name = format!("iv-c2/{prefix}-r{r}");
+    if lambda != LAMBDA {
+        name += &format!("-lambda-{lambda:e}");
+    }
+    if seed != first_seed {
+        name += &format!("-seed{seed}");
+    }
+    name
+}
+
 /// Runs case IV-C2.
 pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<RenderedFigure>)> {
     let s = sizes(opts);
@@ -301,23 +327,33 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     } else {
         *s.dofs.last().expect("at least one r")
     };
-    let ae_config = |r: usize, lambda: f64| AeConfig {
+    let first_seed = s.seeds[0];
+    let ae_config = |r: usize, lambda: f64, seed: u64| AeConfig {
         lambda,
+        seed,
         ..AeConfig::new(r, HIDDEN_LAYERS, s.epochs)
     };
-    // every autoencoder at once (they cost about the same: r changes only the innermost layers),
-    // the control last
+    // every autoencoder at once (they cost about the same: r changes only the innermost layers):
+    // the ROMs of every r, then the other λ and seeds at the inset's r
     let mut jobs: Vec<(String, AeConfig)> = s
         .dofs
         .iter()
-        .map(|&r| (format!("iv-c2/ae-r{r}"), ae_config(r, LAMBDA)))
+        .map(|&r| {
+            let name = ae_name("ae", r, LAMBDA, first_seed, first_seed);
+            (name, ae_config(r, LAMBDA, first_seed))
+        })
         .collect();
-    jobs.push((
-        format!("iv-c2/ae-r{inset}-lambda-1e-4"),
-        ae_config(inset, LAMBDA_PAPER),
-    ));
+    let variants: Vec<(f64, u64)> = [LAMBDA, LAMBDA_PAPER]
+        .iter()
+        .flat_map(|&l| s.seeds.iter().map(move |&seed| (l, seed)))
+        .filter(|&(l, seed)| !(l == LAMBDA && seed == first_seed))
+        .collect();
+    for &(l, seed) in &variants {
+        let name = ae_name("ae", inset, l, seed, first_seed);
+        jobs.push((name, ae_config(inset, l, seed)));
+    }
     let mut trained = tasks::parallel(&jobs, |(name, c)| tasks::train(run, name, &data, c))?;
-    let control = trained.pop().expect("the control autoencoder");
+    let variant_models = trained.split_off(s.dofs.len());
     let pods = tasks::parallel(&s.dofs, |&r| {
         tasks::pod(run, &format!("iv-c2/pod-{r}"), &data, r)
     })?;
@@ -367,19 +403,37 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
             pod_run: pod_run.value,
         });
     }
-    let control_run = simulate_test(
-        run,
-        &format!("iv-c2/test-ae-r{inset}-lambda-1e-4"),
-        &format!("AE-{inset} (λ = 1e-4)"),
-        &scenario,
-        &test,
-        Some(&control),
-        Some(&hom),
-    )?;
+    let mut lambdas = vec![];
+    for (&(lambda, seed), model) in variants.iter().zip(variant_models) {
+        let test_run = simulate_test(
+            run,
+            &ae_name("test-ae", inset, lambda, seed, first_seed),
+            &format!("AE-{inset} (λ = {lambda:e}, seed {seed})"),
+            &scenario,
+            &test,
+            Some(&model),
+            Some(&hom),
+        )?;
+        lambdas.push(Variant {
+            lambda,
+            seed,
+            model: model.value,
+            run: test_run.value,
+        });
+    }
     let inset_dof = dofs
         .iter()
         .find(|d| d.r == inset)
         .expect("the inset's r is tried");
+    lambdas.insert(
+        0,
+        Variant {
+            lambda: LAMBDA,
+            seed: first_seed,
+            model: inset_dof.ae.value.clone(),
+            run: inset_dof.ae_run.clone(),
+        },
+    );
     let (ae, pod) = inset_runs.expect("the inset's r is tried");
     let trajectories = Inset {
         r: inset,
@@ -404,19 +458,23 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     report.setup = vec![
         format!("scenario: `ScenarioSpec::new(\"six-tendon\", &[\"loads.gravity=[0,0,-9.81]\"])`, as IV-C1: the preset `six-tendon` with gravity along −z (0.6 m arm in two 0.3 m divisions, radius 2 → 1 cm, E = 1 MPa, Kelvin–Voigt damping η = 10 kPa·s; base along +x, so a horizontal cantilever that sags; six frictionless tendons 60° apart, alternating full and half length; {}-DOF Legendre basis, {} values per snapshot)", hom.dof, data.value.features),
         format!("data: {} s of actuator babbling, each tendon holding a uniform tension in [{lo}, {hi}] N for a uniform {hmin}–{hmax} s, from the straight rod at rest, sampled at {SAMPLE_RATE} Hz, seed {DATA_SEED} (`gvsrom dataset six-tendon --set 'loads.gravity=[0,0,-9.81]' --duration {} --babble={lo},{hi},{hmin},{hmax} --sample-rate {SAMPLE_RATE} --seed {DATA_SEED}`): {} snapshots, {} of them computed ({} failed)", s.data_s, s.data_s, data.value.samples, data.value.ok, data.value.failed),
-        format!("autoencoders: r = {dof_list}, {HIDDEN_LAYERS} hidden layers, tanh, λ = {LAMBDA:e} (not the paper's 1e-4: see the λ table), Adam ≤ {} epochs with early stopping (patience {}), then L-BFGS; one control AE with r = {inset} at λ = {LAMBDA_PAPER:e}, otherwise the same", s.epochs, AeConfig::new(1, HIDDEN_LAYERS, s.epochs).patience),
+        format!("autoencoders: r = {dof_list}, {HIDDEN_LAYERS} hidden layers, tanh, λ = {LAMBDA:e} (not the paper's {LAMBDA_PAPER:e}: see the λ table), Adam ≤ {} epochs with early stopping (patience {}), then L-BFGS, seed {first_seed}; at r = {inset} also λ = {LAMBDA:e} and {LAMBDA_PAPER:e} with seeds {}, otherwise the same", s.epochs, AeConfig::new(1, HIDDEN_LAYERS, s.epochs).patience, s.seeds.iter().map(u64::to_string).collect::<Vec<_>>().join(", ")),
         format!("POD: r = {dof_list} modes of the uncentred snapshots"),
         format!("test: {} s of new uniform random tensions in [{tlo}, {thi}] N on every tendon every {period} s, seed {TEST_SEED}, sampled at {SAMPLE_RATE} Hz (`gvsrom simulate six-tendon --set 'loads.gravity=[0,0,-9.81]' --duration {} --steps={tlo},{thi},{period} --seed {TEST_SEED} [--model M] --out DIR`, then `gvsrom compare HOM-DIR DIR`); every model starts at rest (the HOM and POD from the straight rod, an AE from its rest point, the encoding of the straight rod, as the data start there), with `simulate`'s automatic integrator", s.test_s, s.test_s),
         format!("timing: the simulations run one after the other on one thread, each {} time(s), the smallest wall time of the integration kept; error: mean over the samples of ‖p_ROM − p_HOM‖ / L (`gvsrom compare`'s tip mean)", s.repeat),
     ];
     report.tables.push(fig9_table(&dofs, &hom));
     report.tables.push(table_iii(inset_dof, &hom));
-    report
-        .tables
-        .push(lambda_table(inset_dof, &control, &control_run));
+    report.tables.push(lambda_table(inset, &lambdas));
     report.tables.push(models_table(&dofs));
     report.findings = findings(&dofs, &hom, inset_dof);
-    report.notes = notes(&dofs, &hom, inset_dof, &control_run);
+    let context = Context {
+        data_s: s.data_s,
+        swing: tip_travel(&trajectories.hom, 1.0),
+        length: trajectories.hom.length,
+        lambdas: &lambdas,
+    };
+    report.notes = notes(&dofs, &hom, inset_dof, &context);
     report.settings = json!({
         "scenario": scenario,
         "plan": plan,
@@ -428,11 +486,14 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     report.values = json!({
         "dataset": data.value,
         "hom": hom,
+        "hom_tip_travel_within_1s_m": context.swing,
         "dofs": dofs.iter().map(|d| json!({
             "r": d.r, "ae_model": d.ae.value, "pod_model": d.pod.value,
             "ae": d.ae_run, "pod": d.pod_run,
         })).collect::<Vec<_>>(),
-        "lambda_control": { "model": control.value, "run": control_run.value },
+        "lambda": lambdas.iter().map(|v| json!({
+            "lambda": v.lambda, "seed": v.seed, "model": v.model, "run": v.run,
+        })).collect::<Vec<_>>(),
     });
     let figures = vec![fig9(&dofs, &hom, &trajectories)?];
     Ok((report, figures))
@@ -443,7 +504,10 @@ fn fig9_table(dofs: &[Dof], hom: &SimRun) -> Table {
     let reached = |x: &SimRun| Cell::sig(x.t_reached, 3);
     Table {
         id: "fig9".into(),
-        title: "Fig. 9: mean tip error and wall time of the 10 s test per DOF".into(),
+        title: format!(
+            "Fig. 9: mean tip error and wall time of the {} s test per DOF",
+            hom.t_reached
+        ),
         columns: [
             "DOF r",
             "AE-ROM tip error [% L]",
@@ -530,33 +594,28 @@ fn table_iii(d: &Dof, hom: &SimRun) -> Table {
         columns: ["quantity", "ours", "paper", "ratio"].map(String::from).to_vec(),
         rows,
         note: format!(
-            "Tip errors: mean over the 10 s test of ‖p_ROM − p_HOM‖ / L. Times: wall time of the whole 10 s simulation. Ours: gvsrom, one thread, this machine; the paper's: MATLAB on an i9-13900HX. AE-{}: {}; POD-{}: {}.",
+            "Tip errors: mean over the {} s test of ‖p_ROM − p_HOM‖ / L. Times: wall time of the whole simulation. Ours: gvsrom, one thread, this machine; the paper's: MATLAB on an i9-13900HX. A run that stopped early has its error and time up to where it stopped: AE-{}: {}; POD-{}: {}. Other seeds of AE-{}: the λ table.",
+            hom.t_reached,
             d.r,
             ae.status(),
             d.r,
-            pod.status()
+            pod.status(),
+            d.r
         ),
     }
 }
 
-/// The weight decay: the AE-ROM at the inset's r with λ = 1e-6 (used) and 1e-4 (the paper's).
-fn lambda_table(d: &Dof, control: &Step<ModelInfo>, control_run: &Step<SimRun>) -> Table {
-    let row = |lambda: f64, m: &ModelInfo, x: &SimRun| {
-        vec![
-            Cell::sig(lambda, 1),
-            Cell::sig(m.rmse_full, 3),
-            Cell::sig(x.t_reached, 3),
-            Cell::sig(x.tip_mean(), 3),
-            Cell::sig(x.wall_time_s, 3),
-            Cell::text(x.status()),
-        ]
-    };
+/// The weight decay: the AE-ROMs at the inset's r with λ = 1e-6 (used) and 1e-4 (the paper's),
+/// one row per training seed.
+fn lambda_table(r: usize, lambdas: &[Variant]) -> Table {
     Table {
         id: "lambda".into(),
-        title: format!("Weight decay λ of the AE-ROM with r = {}", d.r),
+        title: format!("Weight decay λ and training seed of the AE-ROM with r = {r}"),
         columns: [
             "λ",
+            "seed",
             "RMSE over the dataset",
+            "validation RMSE",
             "reached [s]",
             "tip error [% L]",
             "time [s]",
@@ -564,11 +623,22 @@ fn lambda_table(d: &Dof, control: &Step<ModelInfo>, control_run: &Step<SimRun>) 
         ]
         .map(String::from)
         .to_vec(),
-        rows: vec![
-            row(LAMBDA, &d.ae.value, &d.ae_run),
-            row(LAMBDA_PAPER, &control.value, &control_run.value),
-        ],
-        note: "Same data, architecture, epochs and seed; only λ differs. RMSE: of the reconstruction D(E(x)) − x over every entry of every snapshot. A run that leaves the training region (q_r beyond the range of the training encodings by more than half its width) is stopped there: the decoder would extrapolate.".into(),
+        rows: lambdas
+            .iter()
+            .map(|v| {
+                vec![
+                    Cell::sig(v.lambda, 1),
+                    Cell::int(v.seed as usize),
+                    Cell::sig(v.model.rmse_full, 3),
+                    Cell::sig(v.model.val_rmse.unwrap_or(f64::NAN), 3),
+                    Cell::sig(v.run.t_reached, 3),
+                    Cell::sig(v.run.tip_mean(), 3),
+                    Cell::sig(v.run.wall_time_s, 3),
+                    Cell::text(v.run.status()),
+                ]
+            })
+            .collect(),
+        note: "Same data, architecture and epochs; λ and the seed (initial weights, train/validation split, mini-batch order) differ. The first row is the AE-ROM of Fig. 9 and Table III. RMSE: of the reconstruction D(E(x)) − x over every entry of every snapshot. A run that leaves the training region (q_r beyond the range of the training encodings by more than half its width) is stopped there: the decoder would extrapolate. Tip error and time up to where the run stopped.".into(),
     }
 }
 
@@ -708,8 +778,50 @@ fn findings(dofs: &[Dof], hom: &SimRun, inset: &Dof) -> Vec<Finding> {
     ]
 }
 
+/// The largest distance the tip travels within `window` seconds over the trajectory [m].
+fn tip_travel(t: &Trajectory, window: f64) -> f64 {
+    let p = |k: usize| [t.tip[3 * k], t.tip[3 * k + 1], t.tip[3 * k + 2]];
+    let mut best = 0.0f64;
+    for i in 0..t.samples() {
+        for j in i + 1..t.samples() {
+            if t.t[j] - t.t[i] > window + 1e-9 {
+                break;
+            }
+            let (a, b) = (p(i), p(j));
+            best = best.max((0..3).map(|c| (a[c] - b[c]).powi(2)).sum::<f64>().sqrt());
+        }
+    }
+    best
+}
+
+/// "ndf (r = 3, 4), sdirk (r = 1, 2)": the integrators `simulate` chose for a kind of ROM.
+fn methods(dofs: &[Dof], run: impl Fn(&Dof) -> &SimRun) -> String {
+    let mut by: Vec<(String, Vec<String>)> = vec![];
+    for d in dofs {
+        let m = &run(d).method;
+        match by.iter_mut().find(|(name, _)| name == m) {
+            Some((_, rs)) => rs.push(d.r.to_string()),
+            None => by.push((m.clone(), vec![d.r.to_string()])),
+        }
+    }
+    by.iter()
+        .map(|(m, rs)| format!("{m} (r = {})", rs.join(", ")))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// What the notes are made of besides the runs.
+struct Context<'a> {
+    data_s: f64,
+    /// The HOM tip's largest travel within one second [m].
+    swing: f64,
+    /// Rod length [m].
+    length: f64,
+    lambdas: &'a [Variant],
+}
+
 /// Where and why the results differ from the paper's.
-fn notes(dofs: &[Dof], hom: &SimRun, inset: &Dof, control: &Step<SimRun>) -> Vec<String> {
+fn notes(dofs: &[Dof], hom: &SimRun, inset: &Dof, c: &Context) -> Vec<String> {
     let (ae, pod) = (&inset.ae_run, &inset.pod_run);
     let p = &paper::TABLE_III_IV_C2;
     let start = dofs
@@ -722,18 +834,26 @@ fn notes(dofs: &[Dof], hom: &SimRun, inset: &Dof, control: &Step<SimRun>) -> Vec
         .max_by(|a, b| a.wall_time_s.total_cmp(&b.wall_time_s));
     vec![
         format!(
-            "Accuracy: at r = {} the AE-ROM's mean tip error is {} % L and POD's {} % L; the paper's (r = {}) are {} % and {} %. The README measured 5.7 % (AE-7) against 15.5 % (POD-7) without gravity and with 720 s of babbling; here gravity acts (as in IV-C1) and the data are the paper's 180 s. The arm swings under the steps (the tip travels half a metre within a second), so the snapshots vary with the velocity as well as the position and r coordinates hold less of them than in statics.",
+            "Accuracy: at r = {} the AE-ROM's mean tip error is {} % L and POD's {} % L; the paper's (r = {}) are {} % and {} %. The README measured 5.7 % (AE-7) against 15.5 % (POD-7) without gravity and with 720 s of babbling; here gravity acts (as in IV-C1) and the data are {} s of babbling. The arm swings under the steps (the HOM's tip travels up to {} m within a second of the test, the arm being {} m long), so the snapshots vary with the velocity as well as the position, and r coordinates hold less of them than in statics (POD's captured energy, models table).",
             inset.r,
             Cell::sig(ae.tip_mean(), 3).render(),
             Cell::sig(pod.tip_mean(), 3).render(),
             p.ae_dof,
             Cell::sig(p.ae_error.unwrap_or(f64::NAN), 2).render(),
             Cell::sig(p.pod_error.unwrap_or(f64::NAN), 2).render(),
+            c.data_s,
+            Cell::sig(c.swing, 2).render(),
+            Cell::sig(c.length, 2).render(),
         ),
         format!(
-            "Speed: our HOM runs the 10 s test in {} s (the paper's MATLAB HOM: {} s): a 28-DOF model with 14 computational points, integrated in second-order form with its analytic iteration matrix. A ROM saves little on such a model: POD-ROMs run on the same structured integrator with fewer unknowns, an AE-ROM on the first-order form with a finite-difference Jacobian (`simulate` chooses it for decoders) and a decoder's Jacobian at each of its points, so it can be slower than the HOM{}. Compare the ratios between models, not the absolute times; on this shared 2-core machine times of runs under a second vary by tens of per cent.",
+            "Speed: our HOM runs the {} s test in {} s (the paper's MATLAB HOM: {} s): {} DOF, 14 computational points, integrated by `{}` in second-order form with its analytic iteration matrix. A ROM saves little on such a model. The POD-ROMs use the same structured Jacobian with fewer unknowns: {}. The AE-ROMs use the first-order form with a finite-difference Jacobian (`simulate`'s choice for decoders) and the decoder's Jacobian at every evaluation: {}; so they can be slower than the HOM{}. Compare the ratios between models, not the absolute times; on this shared 2-core machine times of runs under a second vary by tens of per cent.",
+            hom.t_reached,
             Cell::sig(hom.wall_time_s, 3).render(),
             Cell::sig(p.hom_time_s, 4).render(),
+            hom.dof,
+            hom.method,
+            methods(dofs, |d| &d.pod_run),
+            methods(dofs, |d| &d.ae_run),
             slowest_ae.map_or(String::new(), |a| format!(
                 " (the slowest AE-ROM here, {}, took {} s)",
                 a.label,
@@ -741,17 +861,54 @@ fn notes(dofs: &[Dof], hom: &SimRun, inset: &Dof, control: &Step<SimRun>) -> Vec
             )),
         ),
         format!(
-            "Weight decay: the AE-ROMs use λ = {LAMBDA:e}, not the paper's 1e-4. The README found that λ = 1e-4 AEs leave their training region on this test; measured again here with one control AE at r = {}: {} (the λ = {LAMBDA:e} one: {}).",
+            "Weight decay: the AE-ROMs use λ = {LAMBDA:e}, not the paper's {LAMBDA_PAPER:e}. The README found that λ = 1e-4 AEs leave their training region on this test and a λ = 1e-6 one did not; measured again here at r = {} (λ table): {}. The training seed matters as much: an AE-ROM of either λ may run through or leave its region depending on it, and Fig. 9 shows one seed per r.",
             inset.r,
-            control.value.status(),
-            ae.status()
+            [LAMBDA, LAMBDA_PAPER]
+                .iter()
+                .map(|&l| lambda_summary(l, c.lambdas))
+                .collect::<Vec<_>>()
+                .join("; "),
         ),
         format!(
-            "Start: every model starts at rest, as the data do (the dataset starts from the straight rod and the arm falls under gravity first). An AE-ROM starts from its rest point, which decodes to the straight rod only up to its reconstruction error: the largest max |ξ − ξ*| of the AE starts is {} (models table), so the AE-ROMs carry that offset into the first samples.",
+            "Start: every model starts at rest, as the data do (the dataset starts from the straight rod, and the arm first falls under gravity): the HOM's start is no problem. An AE-ROM starts from its rest point, the encoding of that straight sample, which decodes to the straight rod only up to the autoencoder's error: up to max |ξ − ξ*| = {} here (models table), so the AE-ROMs do not start quite where the HOM does, and that offset counts in their mean error. Starting every model from the static equilibrium instead (`gvsrom simulate six-tendon --set 'loads.gravity=[0,0,-9.81]' --set tendons.0.tension=0 --from-equilibrium … --model M`) is worse: the AE-ROMs' own equilibria under gravity lie far outside their training region (r = 5, 7, 8 of the full run) or are not found (r = 2).",
             Cell::sig(start, 3).render()
         ),
         "A ROM run that stops early (its trajectory leaves the range of the training encodings, where the decoder extrapolates, or the integrator fails) is not an error of the case: it is recorded as partial, with its reason, and its error and time are those up to where it stopped (Fig. 9 table, \"reached\"); the findings count it as neither more accurate nor faster.".into(),
     ]
+}
+
+/// "λ = …: k of n runs complete (mean tip error …)" over the seeds of the λ table.
+fn lambda_summary(lambda: f64, lambdas: &[Variant]) -> String {
+    let of: Vec<&SimRun> = lambdas
+        .iter()
+        .filter(|v| v.lambda == lambda)
+        .map(|v| &v.run)
+        .collect();
+    let complete: Vec<String> = of
+        .iter()
+        .filter(|x| x.complete)
+        .map(|x| Cell::sig(x.tip_mean(), 3).render() + " % L")
+        .collect();
+    let stopped: Vec<String> = of
+        .iter()
+        .filter(|x| !x.complete)
+        .map(|x| format!("{} s", Cell::sig(x.t_reached, 3).render()))
+        .collect();
+    format!(
+        "λ = {lambda:e}: {} of {} runs complete{}{}",
+        complete.len(),
+        of.len(),
+        if complete.is_empty() {
+            String::new()
+        } else {
+            format!(" (mean tip error {})", complete.join(", "))
+        },
+        if stopped.is_empty() {
+            String::new()
+        } else {
+            format!(", the others stopped at t = {}", stopped.join(", "))
+        }
+    )
 }
 
 /// The trajectories of the inset (HOM, AE-r, POD-r).
@@ -894,7 +1051,7 @@ fn fig9(dofs: &[Dof], hom: &SimRun, inset: &Inset) -> anyhow::Result<RenderedFig
             equal_aspect: false,
         }),
         Figure::Line(LineChart {
-            title: "wall time of the 10 s test".into(),
+            title: format!("wall time of the {} s test", hom.t_reached),
             x_label: "DOF r".into(),
             y_label: "wall time [s]".into(),
             series: time_series,
@@ -915,7 +1072,7 @@ fn fig9(dofs: &[Dof], hom: &SimRun, inset: &Inset) -> anyhow::Result<RenderedFig
     ];
     figure(
         "fig9-dof",
-        &format!("Fig. 9: mean tip error (% of the length) and wall time of the 10 s test against the number of DOFs for the AE-ROM (gold) and the POD-ROM (red), the HOM's time as the green dashed line (log scales where the values span two powers of ten; black dots: runs that stopped early, measured up to where they stopped); the tip traces of the HOM, AE-{r} and POD-{r} (r = {r}, the paper's inset): the path seen along the arm (y–z, gravity along −z) and the tip's x, y, z over time", r = inset.r),
+        &format!("Fig. 9: mean tip error (% of the length) and wall time of the {d} s test against the number of DOFs for the AE-ROM (gold) and the POD-ROM (red), the HOM's time as the green dashed line (log scales where the values span two powers of ten; black dots: runs that stopped early, measured up to where they stopped); the tip traces of the HOM, AE-{r} and POD-{r} (r = {r}, the paper's inset): the path seen along the arm (y–z, gravity along −z) and the tip's x, y, z over time", r = inset.r, d = hom.t_reached),
         &Figure::Grid {
             title: "IV-C2: six-tendon manipulator dynamics, ROMs against the HOM".into(),
             cols: 3,
