@@ -225,15 +225,45 @@ pub struct TrainArgs {
     /// Epochs without a better validation loss before stopping (0: never stop early).
     #[arg(long, default_value_t = 50)]
     pub patience: usize,
+    /// Learning-rate reductions (× 0.3 each, from the best weights so far) at validation plateaus of
+    /// `--patience` epochs before Adam stops.
+    #[arg(long, default_value_t = 4)]
+    pub lr_reductions: usize,
+    /// Iterations of the full-batch L-BFGS phase that follows Adam from its best weights (0: none).
+    #[arg(long, default_value_t = 300)]
+    pub lbfgs_iterations: usize,
     /// Seed of the initialization, the split and the shuffles (same seed, same model).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// How each strain value's error weighs in the loss: `standardized` (each point and component
+    /// by its own spread), `physical` (plain squared error, the RMSE of Table I) or `energy`
+    /// (weighted by the section stiffness: the strain-energy norm).
+    #[arg(long, value_enum, default_value_t = LossArg::Standardized)]
+    pub loss: LossArg,
     /// The new model directory.
     #[arg(long, value_name = "MODEL")]
     pub out: PathBuf,
     /// Replace MODEL if it is an earlier gvsrom output.
     #[arg(long)]
     pub force: bool,
+}
+
+/// `--loss` of `gvsrom train` (see [`reduce::Loss`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum LossArg {
+    Standardized,
+    Physical,
+    Energy,
+}
+
+impl From<LossArg> for reduce::Loss {
+    fn from(l: LossArg) -> Self {
+        match l {
+            LossArg::Standardized => reduce::Loss::Standardized,
+            LossArg::Physical => reduce::Loss::Physical,
+            LossArg::Energy => reduce::Loss::Energy,
+        }
+    }
 }
 
 #[derive(Debug, Args)]
@@ -663,6 +693,14 @@ fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
         validation_fraction: args.validation_fraction,
         patience: (args.patience > 0).then_some(args.patience),
         seed: args.seed,
+        lr_reductions: args.lr_reductions,
+        fine_tune: match args.lbfgs_iterations {
+            0 => rom::nn::FineTune::None,
+            iterations => rom::nn::FineTune::Lbfgs {
+                iterations,
+                memory: 10,
+            },
+        },
         ..TrainOptions::default()
     };
     let signal = interrupt_flag();
@@ -685,6 +723,7 @@ fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
     let s = reduce::train(
         &args.dataset,
         &options,
+        args.loss.into(),
         &args.out,
         args.force,
         &mut progress,

@@ -525,21 +525,70 @@ pub struct TrainSummary {
     pub anchor_time_s: f64,
 }
 
+/// How a snapshot feature's error weighs in the autoencoder's training loss (`gvsrom train --loss`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Loss {
+    /// Each feature standardized by its own spread: every point and component weighs the same
+    /// relative to its own variation, whatever its physical magnitude.
+    #[default]
+    Standardized,
+    /// The physical mean squared error, every feature with weight 1 (the RMSE of Table I).
+    Physical,
+    /// The strain-energy norm: feature (point j, component a) weighted by the section stiffness
+    /// `Σ_s,aa` at point j (not by the quadrature weight, under which the kinematic points would
+    /// weigh nothing). Errors in stiff shear and elongation weigh what they cost in elastic force.
+    Energy,
+}
+
+impl Loss {
+    /// The name used on the command line and in `meta.json`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Loss::Standardized => "standardized",
+            Loss::Physical => "physical",
+            Loss::Energy => "energy",
+        }
+    }
+
+    /// The per-feature weighting of the point layout `layout` of `built`.
+    fn weighting(self, built: &Built, layout: &PointLayout) -> rom::nn::Weighting {
+        use rom::nn::Weighting;
+        match self {
+            Loss::Standardized => Weighting::Standardize,
+            Loss::Physical => Weighting::Physical(vec![1.0; layout.len()]),
+            Loss::Energy => Weighting::Physical(
+                (0..layout.n_points)
+                    .flat_map(|i| {
+                        let es = built.model.section(i).es;
+                        layout.active.iter().map(move |&a| es[a])
+                    })
+                    .collect(),
+            ),
+        }
+    }
+}
+
 /// Trains an autoencoder on a dataset's snapshots and saves it at `out`. `progress(epoch, train,
 /// validation)` is called after every epoch; `Break` stops training early (the best weights so far
 /// are kept and saved, marked by the stop reason).
 pub fn train(
     dataset: &Path,
     options: &TrainOptions,
+    loss: Loss,
     out: &Path,
     force: bool,
     progress: &mut dyn FnMut(usize, f64, Option<f64>) -> ControlFlow<()>,
 ) -> Result<TrainSummary, anyhow::Error> {
     let ds = Dataset::load(dataset)?;
     let built = dataset_scenario(&ds)?;
-    let (_, pm, p) = projection_of(&built)?;
+    let (layout, pm, p) = projection_of(&built)?;
     let (x, rows) = snapshot_rows(&ds, "DATASET")?;
     let features = ds.row_len();
+    let options = &TrainOptions {
+        weighting: loss.weighting(&built, &layout),
+        ..options.clone()
+    };
     let dir = OutputDir::create("--out", out, crate::reduced_model::MODEL_FORMAT, force)?;
     let (ae, report) =
         Autoencoder::train(&x, features, options, progress).map_err(|e| train_error(&e))?;
@@ -590,6 +639,12 @@ pub fn train(
             validation_fraction: options.validation_fraction,
             patience: options.patience,
             seed: options.seed,
+            loss: Some(loss.name().into()),
+            lr_reductions: Some(options.lr_reductions),
+            lbfgs_iterations: Some(match options.fine_tune {
+                rom::nn::FineTune::Lbfgs { iterations, .. } => iterations,
+                _ => 0,
+            }),
             epochs_run: report.epochs_run,
             best_epoch: report.best_epoch,
             stop: format!("{:?}", report.stop),

@@ -81,6 +81,16 @@ pub struct TrainingMeta {
     pub validation_fraction: f64,
     pub patience: Option<usize>,
     pub seed: u64,
+    /// The loss weighting (`standardized`, `physical`, `energy`); absent in models from before the
+    /// choice existed, which were trained standardized.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub loss: Option<String>,
+    /// Learning-rate reductions at plateaus (absent: from before they existed, none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lr_reductions: Option<usize>,
+    /// Iterations allowed to the final L-BFGS phase (absent: from before the option, 300).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lbfgs_iterations: Option<usize>,
     pub epochs_run: usize,
     pub best_epoch: usize,
     pub stop: String,

@@ -164,6 +164,7 @@ fn train(x: &[f64], nf: usize, latent: usize) -> Trained {
             memory: 10,
         },
         seed: 7 + latent as u64,
+        ..TrainOptions::default()
     };
     let (ae, report) = Autoencoder::train(x, nf, &opts, &mut |_, _, _| {
         std::ops::ControlFlow::Continue(())

@@ -182,6 +182,10 @@ pub struct AeConfig {
     pub seed: u64,
     /// Iterations of the final full-batch L-BFGS phase (0: none).
     pub lbfgs_iterations: usize,
+    /// The loss weighting (`gvsrom train --loss`).
+    pub loss: reduce::Loss,
+    /// Learning-rate reductions at plateaus (`--lr-reductions`).
+    pub lr_reductions: usize,
 }
 
 impl AeConfig {
@@ -201,6 +205,8 @@ impl AeConfig {
                 rom::nn::FineTune::Lbfgs { iterations, .. } => iterations,
                 _ => 0,
             },
+            loss: reduce::Loss::default(),
+            lr_reductions: d.lr_reductions,
         }
     }
 }
@@ -228,6 +234,7 @@ pub fn train(
                 learning_rate: c.learning_rate,
                 patience: (c.patience > 0).then_some(c.patience),
                 seed: c.seed,
+                lr_reductions: c.lr_reductions,
                 fine_tune: match c.lbfgs_iterations {
                     0 => rom::nn::FineTune::None,
                     iterations => rom::nn::FineTune::Lbfgs {
@@ -243,7 +250,7 @@ pub fn train(
                     0 => ControlFlow::Continue(()),
                     _ => ControlFlow::Break(()),
                 };
-            let s = reduce::train(&data.path, &options, path, true, &mut progress)?;
+            let s = reduce::train(&data.path, &options, c.loss, path, true, &mut progress)?;
             run.check_interrupt()?;
             let model = ReducedModel::load(path)?;
             Ok(ModelInfo {

@@ -100,13 +100,14 @@ impl Autoencoder {
         opts.validate()?;
         let sizes = Self::architecture(n_features, opts.latent, opts.hidden_layers)?;
         let rows = check_data(data, n_features)?;
+        opts.weighting.check(n_features)?;
         let mut rng = SplitMix64::new(opts.seed);
         let mut layers: Vec<Layer> = sizes
             .windows(2)
             .map(|s| Layer::glorot(s[0], s[1], &mut rng))
             .collect();
         let (train, val) = split_rows(rows, opts.validation_fraction, &mut rng);
-        let scaling = Scaling::from_rows(data, n_features, &train);
+        let scaling = Scaling::from_rows(data, n_features, &train, &opts.weighting);
         let mut scaled = data.to_vec();
         scaling.to_scaled(&mut scaled);
         let tanh = chain_tanh_flags(opts.hidden_layers);

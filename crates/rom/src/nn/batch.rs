@@ -290,4 +290,78 @@ mod tests {
             }
         }
     }
+
+    #[test]
+    fn weighted_physical_loss_gradient_matches_central_differences() {
+        // The physical weighting is applied through the scaling: the scaled MSE's gradient must be
+        // the gradient of (1/(c²·B·n)) Σ_b Σ_j w_j (x̂_bj − x_bj)² with x̂ = s ⊙ chain((x − μ)/s) + μ
+        // and c² = (1/n) Σ_j w_j σ_j², written here in physical units without the scaling's code.
+        use crate::nn::scaling::{Scaling, Weighting};
+        let sizes = [4, 3, 1, 3, 4];
+        let tanh = [true, false, true, false];
+        let mut rng = SplitMix64::new(11);
+        let mut layers: Vec<Layer> = sizes
+            .windows(2)
+            .map(|s| Layer::glorot(s[0], s[1], &mut rng))
+            .collect();
+        let rows = 6;
+        // features of very different magnitudes, as bending (≈ 10 1/m) against elongation (≈ 1e-3)
+        let mag = [10.0, 3.0, 1e-3, 0.5];
+        let x: Vec<f64> = (0..rows * 4)
+            .map(|i| mag[i % 4] * rng.range(-1.0, 1.0))
+            .collect();
+        let w = vec![1.0, 2.0, 5e4, 0.3];
+        let all: Vec<usize> = (0..rows).collect();
+        let scaling = Scaling::from_rows(&x, 4, &all, &Weighting::Physical(w.clone()));
+        let mean: Vec<f64> = (0..4)
+            .map(|j| (0..rows).map(|b| x[b * 4 + j]).sum::<f64>() / rows as f64)
+            .collect();
+        let var: Vec<f64> = (0..4)
+            .map(|j| {
+                (0..rows)
+                    .map(|b| (x[b * 4 + j] - mean[j]).powi(2))
+                    .sum::<f64>()
+                    / rows as f64
+            })
+            .collect();
+        let c2 = (0..4).map(|j| w[j] * var[j]).sum::<f64>() / 4.0;
+        let scale: Vec<f64> = w.iter().map(|w| (c2 / w).sqrt()).collect();
+        let mut y = x.clone();
+        scaling.to_scaled(&mut y);
+        let mut ws = Workspace::new(&sizes, 8);
+        let physical_loss = |layers: &[Layer], ws: &mut Workspace| {
+            for b in 0..rows {
+                for j in 0..4 {
+                    ws.acts[0][b * 4 + j] = (x[b * 4 + j] - mean[j]) / scale[j];
+                }
+            }
+            forward_batch(layers, &tanh, ws, rows);
+            let out = ws.output(rows);
+            let mut sum = 0.0;
+            for b in 0..rows {
+                for j in 0..4 {
+                    let xhat = scale[j] * out[b * 4 + j] + mean[j];
+                    sum += w[j] * (xhat - x[b * 4 + j]).powi(2);
+                }
+            }
+            sum / (c2 * (rows * 4) as f64)
+        };
+        ws.acts[0][..rows * 4].copy_from_slice(&y);
+        forward_batch(&layers, &tanh, &mut ws, rows);
+        backward_batch(&layers, &tanh, &mut ws, rows, 0.0);
+        let gw = ws.grad_w.clone();
+        let h = 1e-6;
+        for k in 0..layers.len() {
+            for i in 0..gw[k].len() {
+                layers[k].w[i] += h;
+                let up = physical_loss(&layers, &mut ws);
+                layers[k].w[i] -= 2.0 * h;
+                let down = physical_loss(&layers, &mut ws);
+                layers[k].w[i] += h;
+                let fd = (up - down) / (2.0 * h);
+                let err = (fd - gw[k][i]).abs() / gw[k][i].abs().max(1e-3);
+                assert!(err <= 1e-6, "layer {k} W[{i}]: fd {fd} vs {}", gw[k][i]);
+            }
+        }
+    }
 }

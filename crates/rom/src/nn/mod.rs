@@ -21,7 +21,7 @@ pub mod train;
 pub use autoencoder::Autoencoder;
 pub use decoder_map::DecoderMap;
 pub use mlp::Mlp;
-pub use scaling::Scaling;
+pub use scaling::{Scaling, Weighting};
 pub use train::{FineTune, Progress, StopReason, TrainOptions, TrainReport};
 
 use thiserror::Error;

@@ -1,12 +1,20 @@
-//! Mini-batch Adam on the loss of eq. (15) with early stopping on the validation loss.
+//! Mini-batch Adam on the loss of eq. (15) with learning-rate reductions on plateaus and early
+//! stopping on the validation loss.
 //!
 //! Per epoch: the training rows are shuffled (Fisher–Yates driven by `SplitMix64`), cut into batches
 //! of `batch_size` rows (the last one may be smaller), and each batch takes one Adam step
 //! (Kingma & Ba 2015: `m ← β₁m + (1−β₁)g`, `v ← β₂v + (1−β₂)g²`,
 //! `θ ← θ − η m̂/(√v̂ + ε)`, `m̂ = m/(1−β₁ᵗ)`, `v̂ = v/(1−β₂ᵗ)`) on the gradient of
-//! `(1/(B·n)) Σ‖x̂ − x‖² + λ Σ‖W‖²` (see [`crate::nn::batch`]). The monitored loss is the validation
+//! `(1/(B·n)) Σ‖x̂ − x‖² + (λ/n) Σ‖W‖²` (see [`crate::nn::batch`]). That is eq. (15) —
+//! `‖x̂ − x‖² + λ Σ‖W‖²`, the squared norm of a whole snapshot, averaged over the batch — divided by
+//! the number of features `n`: the penalty weighs against a snapshot's error, not against one
+//! entry's. (Applied against the per-entry mean, λ = 1e-4 is n times stronger; on the 148-value soft
+//! beam snapshots it then outweighs the reconstruction term and caps Table I's RMSE near 4 instead
+//! of 0.6.) The monitored loss is the validation
 //! reconstruction MSE (scaled units, no penalty), or the epoch's training MSE without validation rows;
-//! the weights with the lowest monitored loss are kept. An optional fine-tuning phase ([`FineTune`]:
+//! the weights with the lowest monitored loss are kept. After `patience` epochs without a lower
+//! monitored loss the phase goes back to the best weights and continues with the rate times
+//! [`LR_REDUCTION_FACTOR`], up to [`TrainOptions::lr_reductions`] times, then stops. An optional fine-tuning phase ([`FineTune`]:
 //! Adam with a smaller rate, or full-batch L-BFGS, which converges much further on smooth small
 //! problems) restarts from the best weights and only changes the result if it lowers the monitored
 //! loss. Everything runs on one thread in a fixed order: the same seed and data give bit-identical
@@ -15,6 +23,7 @@
 use super::batch::{backward_batch, dataset_mse, forward_batch, reconstruction_mse, Workspace};
 use super::lbfgs::{Lbfgs, Objective};
 use super::mlp::Layer;
+use super::scaling::Weighting;
 use super::NnError;
 use gvs::inputs::SplitMix64;
 use std::ops::ControlFlow;
@@ -27,7 +36,8 @@ pub struct TrainOptions {
     pub latent: usize,
     /// Number of hidden layers, odd (paper: 3, 5, 7); see [`crate::nn::Autoencoder::architecture`].
     pub hidden_layers: usize,
-    /// L2 weight penalty `λ` of eq. (15) (paper: 1e-4).
+    /// L2 weight penalty `λ` of eq. (15) (paper: 1e-4), against the squared error of a whole
+    /// snapshot (module docs).
     pub lambda: f64,
     /// Maximum number of epochs of the main phase.
     pub epochs: usize,
@@ -40,10 +50,16 @@ pub struct TrainOptions {
     /// Stop a phase after this many (≥ 1) epochs without a lower monitored loss; `None` never stops
     /// early.
     pub patience: Option<usize>,
+    /// Learning-rate reductions of the Adam phases: after `patience` epochs without improvement the
+    /// weights go back to the best ones and the rate is multiplied by [`LR_REDUCTION_FACTOR`], up to
+    /// this many times, before the phase stops (0: stop at the first plateau).
+    pub lr_reductions: usize,
     /// The final phase after the main Adam phase.
     pub fine_tune: FineTune,
     /// Seed of the initialisation, the train/validation split and the shuffles.
     pub seed: u64,
+    /// How each feature's error weighs in the loss (through the data scaling).
+    pub weighting: Weighting,
 }
 
 impl Default for TrainOptions {
@@ -57,11 +73,13 @@ impl Default for TrainOptions {
             learning_rate: 1e-3,
             validation_fraction: 0.1,
             patience: Some(50),
+            lr_reductions: 4,
             fine_tune: FineTune::Lbfgs {
                 iterations: 300,
                 memory: 10,
             },
             seed: 0,
+            weighting: Weighting::Standardize,
         }
     }
 }
@@ -175,6 +193,9 @@ struct Adam {
     v_b: Vec<Vec<f64>>,
     t: i32,
 }
+
+/// The factor applied to the Adam learning rate at each plateau ([`TrainOptions::lr_reductions`]).
+pub const LR_REDUCTION_FACTOR: f64 = 0.3;
 
 const BETA1: f64 = 0.9;
 const BETA2: f64 = 0.999;
@@ -334,6 +355,8 @@ pub(crate) fn fit(
         .collect();
     // Batches never exceed the training rows; the validation pass reuses the same buffers.
     let mut ws = Workspace::new(&sizes, opts.batch_size.min(p.train.len()));
+    // eq. (15) over n: the mean squared error per entry plus λ/n Σ‖W‖² (module docs)
+    let lambda = opts.lambda / sizes[0].max(1) as f64;
     let mut t = Tracker {
         best: p.layers.to_vec(),
         best_loss: f64::INFINITY,
@@ -354,7 +377,7 @@ pub(crate) fn fit(
         &mut ws,
         &mut t,
         rng,
-        (opts.epochs, opts.learning_rate, opts.lambda),
+        (opts.epochs, opts.learning_rate, lambda, opts.lr_reductions),
         false,
     );
     let resumable =
@@ -371,11 +394,11 @@ pub(crate) fn fit(
                 &mut ws,
                 &mut t,
                 rng,
-                (epochs, opts.learning_rate * f, opts.lambda),
+                (epochs, opts.learning_rate * f, lambda, opts.lr_reductions),
                 true,
             ),
             FineTune::Lbfgs { iterations, memory } => {
-                lbfgs_phase(&mut p, &mut ws, &mut t, (iterations, memory), opts.lambda)
+                lbfgs_phase(&mut p, &mut ws, &mut t, (iterations, memory), lambda)
             }
             FineTune::None => stop,
         };
@@ -387,17 +410,19 @@ pub(crate) fn fit(
     t.out
 }
 
-/// Up to `epochs` epochs of mini-batch Adam with a fresh optimiser state.
+/// Up to `epochs` epochs of mini-batch Adam with a fresh optimiser state; at each of up to
+/// `reductions` plateaus the best weights come back and the rate drops by [`LR_REDUCTION_FACTOR`].
 fn adam_phase(
     p: &mut Problem,
     ws: &mut Workspace,
     t: &mut Tracker,
     rng: &mut SplitMix64,
-    (epochs, lr, lambda): (usize, f64, f64),
+    (epochs, lr, lambda, reductions): (usize, f64, f64, usize),
     fine: bool,
 ) -> StopReason {
     let mut adam = Adam::new(p.layers);
     let mut order = p.train.to_vec();
+    let (mut lr, mut reductions) = (lr, reductions);
     for _ in 0..epochs {
         shuffle(&mut order, rng);
         let train = run_epoch(
@@ -409,8 +434,14 @@ fn adam_phase(
             &mut adam,
             (lr, lambda),
         );
-        if let Some(stop) = t.record(p, ws, train, fine) {
-            return stop;
+        match t.record(p, ws, train, fine) {
+            Some(StopReason::EarlyStopping) if reductions > 0 && t.out.best_epoch > 0 => {
+                // a plateau: back to the best weights with a smaller step
+                copy_layers(p.layers, &t.best);
+                (lr, reductions, t.since_best) = (lr * LR_REDUCTION_FACTOR, reductions - 1, 0);
+            }
+            Some(stop) => return stop,
+            None => {}
         }
     }
     StopReason::EpochLimit

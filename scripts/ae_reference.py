@@ -1,0 +1,159 @@
+#!/usr/bin/env python3
+"""Independent reference trainer for gvsrom's autoencoders (JAX + optax, float64).
+
+The same network, loss and data as `gvsrom train`, written from the paper (Section III, eq. 15)
+and not from gvsrom's code, to judge the Rust trainer against a standard stack:
+
+- architecture: n → n/2 → … → r → … → n (the encoder halves the width per layer, the decoder
+  mirrors it), tanh on every hidden layer, linear latent and output layers, Glorot-uniform weights,
+  zero biases;
+- loss: mean squared reconstruction error over the batch and the features in scaled units plus
+  λ Σ‖W‖² (biases not regularised), λ = 1e-4;
+- scaling: `standardized` (each feature by its own standard deviation) or `physical` (one common
+  scale: the plain physical MSE);
+- Adam (optax defaults β = 0.9/0.999, ε = 1e-8), shuffled mini-batches, a fixed epoch budget and
+  the weights with the lowest validation loss kept.
+
+It prints the RMSE over the whole dataset in physical units (Table I's metric) and the mean wall
+time of an epoch after the first (compiled) one.
+
+    python -m venv .venv && .venv/bin/pip install numpy jax optax
+    .venv/bin/python scripts/ae_reference.py DATASET --latent 2 --hidden-layers 7 --epochs 200
+"""
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+
+import jax
+
+jax.config.update("jax_enable_x64", True)
+import jax.numpy as jnp  # noqa: E402
+import optax  # noqa: E402
+
+
+def load(dataset: Path) -> np.ndarray:
+    """The solved snapshots (status 0) of a gvsrom dataset, rows × features."""
+    x = np.load(dataset / "strain.npy")
+    status = np.load(dataset / "status.npy")
+    x = x.reshape(x.shape[0], -1)[status == 0]
+    if not np.isfinite(x).all():
+        raise SystemExit(f"{dataset}: non-finite strain in solved rows")
+    return x
+
+
+def architecture(n: int, r: int, hidden: int) -> list[int]:
+    if hidden % 2 == 0:
+        raise SystemExit(f"--hidden-layers {hidden}: expected odd")
+    enc = [n] + [max(n >> k, r + 1) for k in range(1, (hidden - 1) // 2 + 1)]
+    return enc + [r] + enc[::-1]
+
+
+def init(sizes: list[int], key) -> list[tuple]:
+    params = []
+    for a, b in zip(sizes[:-1], sizes[1:]):
+        key, sub = jax.random.split(key)
+        lim = np.sqrt(6.0 / (a + b))
+        params.append((jax.random.uniform(sub, (a, b), minval=-lim, maxval=lim), jnp.zeros(b)))
+    return params
+
+
+def forward(params, x, tanh_flags):
+    h = x
+    for (w, b), t in zip(params, tanh_flags):
+        h = h @ w + b
+        if t:
+            h = jnp.tanh(h)
+    return h
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("dataset", type=Path)
+    ap.add_argument("--latent", type=int, default=1)
+    ap.add_argument("--hidden-layers", type=int, default=7)
+    ap.add_argument("--epochs", type=int, default=200)
+    ap.add_argument("--batch-size", type=int, default=64)
+    ap.add_argument("--learning-rate", type=float, default=1e-3)
+    ap.add_argument("--lambda", dest="lam", type=float, default=1e-4)
+    ap.add_argument("--validation-fraction", type=float, default=0.1)
+    ap.add_argument("--loss", choices=["standardized", "physical"], default="standardized")
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--json", action="store_true", help="print one JSON line instead of text")
+    args = ap.parse_args()
+
+    x = load(args.dataset)
+    rows, n = x.shape
+    rng = np.random.default_rng(args.seed)
+    order = rng.permutation(rows)
+    n_val = int(rows * args.validation_fraction)
+    val, train = order[:n_val], order[n_val:]
+    mu = x[train].mean(0)
+    sd = x[train].std(0)
+    if args.loss == "standardized":
+        s = np.where(sd <= 1e-12 * (1 + np.abs(mu)), 1.0, sd)
+    else:
+        c = np.sqrt(np.mean(sd**2))
+        s = np.full(n, c if c > 0 else 1.0)
+    y = jnp.asarray((x - mu) / s)
+
+    sizes = architecture(n, args.latent, args.hidden_layers)
+    half = (args.hidden_layers + 1) // 2
+    flags = [k + 1 < half for k in range(half)] * 2
+    params = init(sizes, jax.random.PRNGKey(args.seed))
+
+    def loss(p, batch):
+        rec = jnp.mean((forward(p, batch, flags) - batch) ** 2)
+        return rec + args.lam * sum(jnp.sum(w * w) for w, _ in p)
+
+    opt = optax.adam(args.learning_rate)
+    state = opt.init(params)
+
+    @jax.jit
+    def step(p, st, batch):
+        g = jax.grad(loss)(p, batch)
+        upd, st = opt.update(g, st, p)
+        return optax.apply_updates(p, upd), st
+
+    @jax.jit
+    def mse(p, data):
+        return jnp.mean((forward(p, data, flags) - data) ** 2)
+
+    best, best_val, times = params, np.inf, []
+    y_train, y_val = y[train], y[val] if n_val else y[train]
+    for epoch in range(args.epochs):
+        t0 = time.perf_counter()
+        perm = rng.permutation(len(train))
+        for k in range(0, len(train), args.batch_size):
+            params, state = step(params, state, y_train[perm[k : k + args.batch_size]])
+        v = float(mse(params, y_val))
+        times.append(time.perf_counter() - t0)
+        if v < best_val:
+            best, best_val = params, v
+    rec = np.asarray(forward(best, y, flags)) * s + mu
+    rmse = float(np.sqrt(np.mean((rec - x) ** 2)))
+    epoch_s = float(np.mean(times[1:])) if len(times) > 1 else float(times[0])
+    out = {
+        "dataset": str(args.dataset),
+        "rows": rows,
+        "features": n,
+        "sizes": sizes,
+        "loss": args.loss,
+        "epochs": args.epochs,
+        "rmse_full": rmse,
+        "epoch_s": epoch_s,
+        "backend": jax.default_backend(),
+    }
+    if args.json:
+        print(json.dumps(out))
+    else:
+        print(f"network    {'-'.join(map(str, sizes))}, loss {args.loss}, {args.epochs} epochs")
+        print(f"RMSE       {rmse:.4e} over all {rows} snapshots (physical units)")
+        print(f"epoch      {epoch_s * 1e3:.1f} ms mean after the first ({jax.default_backend()})")
+
+
+if __name__ == "__main__":
+    main()
