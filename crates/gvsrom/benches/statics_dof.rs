@@ -1,8 +1,8 @@
-//! Statics cost vs the number of DOF (issue 8): one equilibrium of the soft beam (IV-B load) with a
-//! rich FEM-like basis — all six strain modes, quadratic elements, `E` elements and 3 Gauss points
-//! per element, `n = 6 (2E + 1)` DOF — from the straight rod, single thread. The solve converges in
-//! one dogleg iteration at every size, so this measures the residual, the analytic Jacobian and the
-//! LU of one Newton step.
+//! Statics cost vs the number of DOF (issue 8): one equilibrium of the soft beam (IV-B load in the
+//! peak reading, preset `soft-beam-peak`: 4 N·m/m peak) with a rich FEM-like basis — all six strain
+//! modes, quadratic elements, `E` elements and 3 Gauss points per element, `n = 6 (2E + 1)` DOF —
+//! from the straight rod, single thread. The solve converges in one dogleg iteration at every size,
+//! so this measures the residual, the analytic Jacobian and the LU of one Newton step.
 //!
 //! Run with `cargo bench -p gvsrom --bench statics_dof` (the largest size takes a few seconds per
 //! sample group; `STATICS_DOF_ELEMENTS=4,10,20` selects the sizes).
@@ -33,7 +33,7 @@ fn statics_dof(c: &mut Criterion) {
             ),
             format!("divisions.0.quadrature={{ gauss_per_element = 3, elements = {e} }}"),
         ];
-        let scenario = gvsrom::presets::load("soft-beam", &overrides).expect("preset");
+        let scenario = gvsrom::presets::load("soft-beam-peak", &overrides).expect("preset");
         let built = gvsrom::build(&scenario).expect("build");
         let n = built.model.n_dof();
         let mut solver = StaticsSolver::new(&built.model, built.options.clone());

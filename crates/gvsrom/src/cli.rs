@@ -208,7 +208,7 @@ pub struct TrainArgs {
     #[arg(long, value_name = "N", default_value_t = 7)]
     pub hidden_layers: usize,
     /// Maximum Adam epochs.
-    #[arg(long, default_value_t = 1000)]
+    #[arg(long, default_value_t = 2000)]
     pub epochs: usize,
     /// Mini-batch size.
     #[arg(long, default_value_t = 64)]
@@ -237,8 +237,9 @@ pub struct TrainArgs {
     pub seed: u64,
     /// How each strain value's error weighs in the loss: `standardized` (each point and component
     /// by its own spread), `physical` (plain squared error, the RMSE of Table I) or `energy`
-    /// (weighted by the section stiffness: the strain-energy norm).
-    #[arg(long, value_enum, default_value_t = LossArg::Standardized)]
+    /// (weighted by the section stiffness: the strain-energy norm, which the reduced model's
+    /// elastic force feels).
+    #[arg(long, value_enum, default_value_t = LossArg::Energy)]
     pub loss: LossArg,
     /// The new model directory.
     #[arg(long, value_name = "MODEL")]
@@ -764,8 +765,12 @@ fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
     )?;
     writeln!(
         out,
-        "rest       q_r = {} (the sample closest to the straight rod, ‖ξ − ξ*‖ = {:.3e}); projection residual ≤ {:.1e}",
+        "rest       q_r = {} ({}; it decodes to ‖ξ − ξ*‖ = {:.3e}); projection residual ≤ {:.1e}",
         fmt_vec(&s.rest, 6),
+        match s.zero_anchor_rows {
+            0 => "the encoding of the sample closest to the straight rod".to_string(),
+            k => format!("the encoding of the straight rod, trained in as {k} zero-strain rows"),
+        },
         s.rest_residual,
         s.projection_residual
     )?;

@@ -27,9 +27,10 @@
 //!
 //! A load is rejected when `θ > MAX_BENDING` (200 rad, about 30 turns) or `ε > MAX_STRAIN` (1: an
 //! axial strain of −1 is the elongation ν₁ = 0, a section squeezed to nothing). The paper's presets
-//! stay far inside: single-tendon at ±30 N implies about 24 rad and an axial strain of 0.62,
-//! six-tendon's full-length tendons at ±30 N about 8.6 rad and 0.095 each, the soft beam at a peak
-//! of 5 N·m/m at most about 4 rad, its "total" reading of 4 N·m (the coiled beam) about 20 rad.
+//! stay inside: single-tendon at ±30 N implies about 24 rad and an axial strain of 0.62,
+//! six-tendon's full-length tendons at ±30 N about 8.6 rad and 0.095 each, the soft beam at a total
+//! moment of 5 N·m (its preset's reading; the coiled beam) at most about 96 rad, at a peak of
+//! 5 N·m/m (`soft-beam-peak`) at most about 4 rad.
 //!
 //! Every product is formed so that an overflow gives `inf` (never `0 · inf = NaN`) and every
 //! comparison rejects `inf` and NaN.
@@ -544,25 +545,22 @@ mod tests {
                 .collect();
             built("six-tendon", &alternating).unwrap();
         }
-        for m in [-5.0, 5.0] {
-            for i in 0..=8 {
-                built(
-                    "soft-beam",
-                    &[
-                        format!("loads.distributed.0.magnitude={m}"),
-                        format!("loads.distributed.0.center={}", i as f64 * 0.1),
-                    ],
-                )
-                .unwrap();
+        // the paper's IV-B range, ±5 N·m in total (the coiled beam), and its peak reading ±5 N·m/m
+        for preset in ["soft-beam", "soft-beam-peak"] {
+            for m in [-5.0, 5.0] {
+                for i in 0..=8 {
+                    built(
+                        preset,
+                        &[
+                            format!("loads.distributed.0.magnitude={m}"),
+                            format!("loads.distributed.0.center={}", i as f64 * 0.1),
+                        ],
+                    )
+                    .unwrap();
+                }
             }
         }
-        // the coiled beam: the pulse's magnitude read as a total of 4 N·m
-        built(
-            "soft-beam",
-            &["loads.distributed.0.convention=total".into()],
-        )
-        .unwrap();
-        // with a margin: single-tendon at ±30 N is the tightest, at ~24 rad and strain 0.62
+        // with a margin: single-tendon at ±30 N, the tightest in strain, at ~24 rad and strain 0.62
         let b = built("single-tendon", &["tendons.0.tension=-30".into()]).unwrap();
         let e = &estimates(&b, &b.u, 1.0, false)[0];
         assert!(
@@ -570,6 +568,23 @@ mod tests {
             "{} {}",
             e.bending,
             e.strain
+        );
+        // the tightest in bending: 5 N·m in total reaching the tip (X₀ = L − w/2 = 0.76 m) implies
+        // θ = M X₀ / EI ≈ 96 rad (the symmetric pulse's closed form above), under half the bound
+        let b = built(
+            "soft-beam",
+            &[
+                "loads.distributed.0.magnitude=5".into(),
+                "loads.distributed.0.center=0.76".into(),
+            ],
+        )
+        .unwrap();
+        let e = only_estimate(&b);
+        let theta = 5.0 * 0.76 / (1e6 * PI * 0.015f64.powi(4) / 4.0);
+        assert!(
+            (e.bending - theta).abs() < 1e-3 * theta && e.bending < MAX_BENDING / 2.0,
+            "{} vs {theta}",
+            e.bending
         );
     }
 

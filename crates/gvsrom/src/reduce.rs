@@ -516,8 +516,14 @@ pub struct TrainSummary {
     pub features: usize,
     pub report: TrainReport,
     pub encoder_sizes: Vec<usize>,
+    /// The rest coordinates: the encoding of the straight rod (`ξ = ξ*`) when it was trained in
+    /// ([`zero_anchor_rows`]), else of the sample closest to it.
     pub rest: Vec<f64>,
+    /// `‖D(rest)‖`: how far the rest coordinates decode from the straight rod (all points and
+    /// components, strain units).
     pub rest_residual: f64,
+    /// Copies of the zero-strain snapshot among the training rows.
+    pub zero_anchor_rows: usize,
     pub projection_residual: f64,
     /// How many of the `rows` anchors are the reduced model's own equilibria, and the time their
     /// solves took.
@@ -531,13 +537,14 @@ pub struct TrainSummary {
 pub enum Loss {
     /// Each feature standardized by its own spread: every point and component weighs the same
     /// relative to its own variation, whatever its physical magnitude.
-    #[default]
     Standardized,
     /// The physical mean squared error, every feature with weight 1 (the RMSE of Table I).
     Physical,
     /// The strain-energy norm: feature (point j, component a) weighted by the section stiffness
     /// `Σ_s,aa` at point j (not by the quadrature weight, under which the kinematic points would
     /// weigh nothing). Errors in stiff shear and elongation weigh what they cost in elastic force.
+    /// The default: the reduced model feels strain errors through exactly this norm.
+    #[default]
     Energy,
 }
 
@@ -590,15 +597,20 @@ pub fn train(
         ..options.clone()
     };
     let dir = OutputDir::create("--out", out, crate::reduced_model::MODEL_FORMAT, force)?;
+    // the zero-strain anchor of trajectory data: the straight rod, where simulations from rest
+    // start, joins the training rows so that a latent point decodes to it
+    let anchor_rows = zero_anchor_rows(rows, ds.meta.dynamic.is_some());
+    let mut training = x.clone();
+    training.resize((rows + anchor_rows) * features, 0.0);
     let (ae, report) =
-        Autoencoder::train(&x, features, options, progress).map_err(|e| train_error(&e))?;
-    // one encoding per usable sample: its range, the anchors, the rest point (the sample closest
-    // to the straight rod), and what the HOM basis cannot represent of the reconstructions
+        Autoencoder::train(&training, features, options, progress).map_err(|e| train_error(&e))?;
+    drop(training);
+    // one encoding per usable sample: its range, the anchors, and what the HOM basis cannot
+    // represent of the reconstructions
     let mut worst = 0.0f64;
     let r = options.latent;
     let mut latent = Vec::with_capacity(rows * r);
     let mut range = vec![[f64::INFINITY, f64::NEG_INFINITY]; r];
-    let (mut rest, mut rest_norm) = (vec![0.0; r], f64::INFINITY);
     for row in x.chunks_exact(features) {
         let z = ae
             .encode(row)
@@ -609,15 +621,27 @@ pub fn train(
             range[d][0] = range[d][0].min(*v);
             range[d][1] = range[d][1].max(*v);
         }
-        let norm = row.iter().map(|v| v * v).sum::<f64>();
-        if norm < rest_norm {
-            rest_norm = norm;
-            rest = z.clone();
-        }
         latent.extend_from_slice(&z);
     }
+    // the rest coordinates: with the zero-strain anchor the encoding of the straight rod, else
+    // that of the sample closest to it (equilibria under gravity: the straight rod is off their
+    // manifold and its encoding may lie outside the data's range); and how far they decode from it
+    let straightest = x
+        .chunks_exact(features)
+        .min_by(|a, b| {
+            let n = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>();
+            n(a).total_cmp(&n(b))
+        })
+        .expect("at least one usable row");
+    let zero = vec![0.0; features];
+    let rest = ae
+        .encode(if anchor_rows > 0 { &zero } else { straightest })
+        .map_err(|e| invalid("train", e.to_string()))?;
+    let rest_decoded = ae
+        .decode(&rest)
+        .map_err(|e| invalid("train", e.to_string()))?;
+    let rest_residual = rest_decoded.iter().map(|v| v * v).sum::<f64>().sqrt();
     let rest = DVector::from_vec(rest);
-    let rest_residual = rest_norm.sqrt();
     let meta = ModelMeta {
         kind: "autoencoder".into(),
         latent: options.latent,
@@ -641,6 +665,7 @@ pub fn train(
             seed: options.seed,
             loss: Some(loss.name().into()),
             lr_reductions: Some(options.lr_reductions),
+            zero_anchor_rows: Some(anchor_rows),
             lbfgs_iterations: Some(match options.fine_tune {
                 rom::nn::FineTune::Lbfgs { iterations, .. } => iterations,
                 _ => 0,
@@ -689,10 +714,24 @@ pub fn train(
         encoder_sizes,
         rest: rest.iter().copied().collect(),
         rest_residual,
+        zero_anchor_rows: anchor_rows,
         projection_residual: worst,
         anchor_equilibria,
         anchor_time_s,
     })
+}
+
+/// Copies of the zero-strain snapshot added to `rows` training rows: for trajectory data (which
+/// start from the straight rod at rest, as every simulation from rest does) 1 % of the rows and at
+/// least 10, so that the straight rod is a point of the learned manifold and not just one sample
+/// among thousands; none for equilibria, whose manifold need not contain the straight rod (under
+/// gravity no equilibrium is straight, and a 1-D decoder forced through it bends away from the data).
+pub fn zero_anchor_rows(rows: usize, dynamic: bool) -> usize {
+    if dynamic {
+        (rows / 100).max(10)
+    } else {
+        0
+    }
 }
 
 /// The inputs of the usable samples (status ok), row-major (`n × k`): the anchors' inputs.

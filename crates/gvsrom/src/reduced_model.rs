@@ -88,6 +88,9 @@ pub struct TrainingMeta {
     /// Learning-rate reductions at plateaus (absent: from before they existed, none).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lr_reductions: Option<usize>,
+    /// Copies of the zero-strain snapshot trained with the data (absent: none, from before).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub zero_anchor_rows: Option<usize>,
     /// Iterations allowed to the final L-BFGS phase (absent: from before the option, 300).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lbfgs_iterations: Option<usize>,

@@ -124,7 +124,10 @@ fn unknown_key_is_named_in_a_file_and_in_an_override() {
 fn unknown_preset_or_missing_file_lists_the_presets() {
     expect_error(
         &["statics", "two-tendon"],
-        &["two-tendon", "single-tendon, soft-beam, six-tendon"],
+        &[
+            "two-tendon",
+            "single-tendon, soft-beam, six-tendon, soft-beam-peak, six-tendon-no-gravity",
+        ],
     );
     expect_error(&["statics", "no/such/file.toml"], &["no/such/file.toml"]);
     expect_error(&["show", "two-tendon"], &["unknown preset `two-tendon`"]);
@@ -316,7 +319,13 @@ fn presets_lists_all_and_check_validates_without_solving() {
     let out = gvsrom(&["presets"]);
     let s = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success());
-    for name in ["single-tendon", "soft-beam", "six-tendon"] {
+    for name in [
+        "single-tendon",
+        "soft-beam",
+        "six-tendon",
+        "soft-beam-peak",
+        "six-tendon-no-gravity",
+    ] {
         assert!(s.contains(name), "{s}");
     }
     let out = gvsrom(&["check", "soft-beam"]);
@@ -472,10 +481,11 @@ fn loads_far_beyond_the_elastic_range_are_rejected_naming_the_load() {
             ],
         );
     }
+    // the peak reading, whose unit the message names: N·m/m
     expect_error(
         &[
             "statics",
-            "soft-beam",
+            "soft-beam-peak",
             "--set",
             "loads.distributed.0.magnitude=-1e6",
         ],

@@ -414,7 +414,10 @@ fn bad_count_scenario_and_values_are_one_line_errors() {
     }
     expect_error(
         &["modes", "two-tendon"],
-        &["two-tendon", "single-tendon, soft-beam, six-tendon"],
+        &[
+            "two-tendon",
+            "single-tendon, soft-beam, six-tendon, soft-beam-peak, six-tendon-no-gravity",
+        ],
     );
     expect_error(
         &["modes", "six-tendon", "--set", "material.density=-1"],

@@ -1,8 +1,10 @@
 //! Physics checks on the built-in presets: the analytic statics Jacobian against central finite
-//! differences at each preset's equilibrium (gvs-spec §10.3.9, relative error ≤ 1e-6), and the
-//! six-tendon symmetry (gvs-spec §10.2): pulling a tendon or the one 120° away gives configurations
-//! related by a 120° rotation about the rod axis.
+//! differences at each preset's equilibrium (gvs-spec §10.3.9, relative error ≤ 1e-6), the
+//! six-tendon symmetry without gravity (gvs-spec §10.2): pulling a tendon or the one 120° away gives
+//! configurations related by a 120° rotation about the rod axis, and the loads the paper's setups
+//! state: the soft beam's pulse integrates to its total moment, the six-tendon arm hangs in gravity.
 
+use gvs::loads::DistributedWrench;
 use gvs::solve::statics::solve_statics;
 use nalgebra::{DMatrix, DVector, Rotation3, Vector3};
 
@@ -41,9 +43,15 @@ fn statics_jacobian_matches_finite_differences_for_every_preset() {
         ("single-tendon", vec!["tendons.0.tension=-3"]),
         ("single-tendon", vec!["tendons.0.tension=-6"]),
         ("soft-beam", vec![]),
+        ("soft-beam-peak", vec![]),
         ("six-tendon", vec![]),
         (
             "six-tendon",
+            vec!["tendons.1.tension=-8", "tendons.4.tension=-3"],
+        ),
+        ("six-tendon-no-gravity", vec![]),
+        (
+            "six-tendon-no-gravity",
             vec!["tendons.1.tension=-8", "tendons.4.tension=-3"],
         ),
     ] {
@@ -66,14 +74,15 @@ fn tip(b: &gvsrom::Built) -> Vector3<f64> {
 
 #[test]
 fn six_tendon_pulls_120_degrees_apart_give_rotated_configurations() {
+    // gravity along −z would break the rotational symmetry: the preset without it
     let rot = Rotation3::from_axis_angle(&Vector3::x_axis(), 120f64.to_radians());
     for (a, b) in [(0usize, 2usize), (1, 3), (2, 4)] {
         let ta = tip(&built(
-            "six-tendon",
+            "six-tendon-no-gravity",
             &["tendons.0.tension=0", &format!("tendons.{a}.tension=-10")],
         ));
         let tb = tip(&built(
-            "six-tendon",
+            "six-tendon-no-gravity",
             &["tendons.0.tension=0", &format!("tendons.{b}.tension=-10")],
         ));
         let err = (rot * ta - tb).norm();
@@ -83,4 +92,65 @@ fn six_tendon_pulls_120_degrees_apart_give_rotated_configurations() {
         );
         assert!(ta.y.abs() + ta.z.abs() > 0.05, "the pull bends the arm");
     }
+}
+
+/// `(∫₀ᴸ ‖m(X)‖ dX, X₀/L)` of the built scenario's single distributed load, a triangular pulse
+/// centred at `X₀`: the trapezoid rule on the pulse's breakpoints `0, X₀ − w/2, X₀, X₀ + w/2, L`
+/// (clipped to `[0, L]`), exact for a density linear between them; each piece is split in 64 so
+/// that a density that is not would differ.
+fn pulse_total_moment(b: &gvsrom::Built) -> (f64, f64) {
+    assert_eq!(b.loads.distributed.len(), 1, "one distributed load");
+    let (center, width) = match b.loads.distributed[0] {
+        DistributedWrench::TriangularPulse { center, width, .. } => (center, width),
+        other => panic!("not a triangular pulse: {other:?}"),
+    };
+    let l = b.model.disc.length();
+    let mut breaks: Vec<f64> = [0.0, center - width / 2.0, center, center + width / 2.0, l]
+        .into_iter()
+        .map(|x| x.clamp(0.0, l))
+        .collect();
+    breaks.sort_by(f64::total_cmp);
+    let density = |x: f64| {
+        b.loads.distributed[0]
+            .density_at(x)
+            .0
+            .fixed_rows::<3>(0)
+            .norm()
+    };
+    let mut total = 0.0;
+    for w in breaks.windows(2) {
+        let h = (w[1] - w[0]) / 64.0;
+        for i in 0..64 {
+            let (a, c) = (w[0] + i as f64 * h, w[0] + (i + 1) as f64 * h);
+            total += 0.5 * h * (density(a) + density(c));
+        }
+    }
+    (total, center / l)
+}
+
+#[test]
+fn soft_beam_pulse_integrates_to_the_papers_4_newton_metres() {
+    // the paper's first IV-B load: 4 N·m in total at X/L = 0.25 (the preset reads it as the total)
+    let (total, at) = pulse_total_moment(&built("soft-beam", &[]));
+    assert!((total - 4.0).abs() < 1e-12 * 4.0, "∫ m dX = {total} N·m");
+    assert!((at - 0.25).abs() < 1e-12, "X₀/L = {at}");
+}
+
+#[test]
+fn soft_beam_peak_pulse_integrates_to_peak_times_half_width() {
+    // peak 4 N·m/m over a base of w = 0.1 L = 0.08 m: ∫ m dX = 4 · 0.5 · 0.08 = 0.16 N·m
+    let (total, _) = pulse_total_moment(&built("soft-beam-peak", &[]));
+    assert!(
+        (total - 4.0 * 0.5 * 0.08).abs() < 1e-12 * 0.16,
+        "∫ m dX = {total} N·m"
+    );
+}
+
+#[test]
+fn six_tendon_hangs_in_gravity_along_minus_z_and_its_variant_has_none() {
+    assert_eq!(built("six-tendon", &[]).loads.gravity, [0.0, 0.0, -9.81]);
+    assert_eq!(
+        built("six-tendon-no-gravity", &[]).loads.gravity,
+        [0.0, 0.0, 0.0]
+    );
 }

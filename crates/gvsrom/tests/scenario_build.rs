@@ -111,9 +111,9 @@ fn uniform_distributed_force_matches_gravity_of_same_weight() {
 #[test]
 fn pulse_total_convention_equals_peak_of_twice_the_mean() {
     // total = peak · w/2: 4 N·m/m peak over w = 0.08 m is 0.16 N·m in total
-    let peak = run_preset("soft-beam", &[]);
+    let peak = run_preset("soft-beam-peak", &[]);
     let total = run_preset(
-        "soft-beam",
+        "soft-beam-peak",
         &[
             "loads.distributed.0.magnitude=0.16",
             "loads.distributed.0.convention=total",
@@ -127,9 +127,9 @@ fn pulse_total_convention_equals_peak_of_twice_the_mean() {
 #[test]
 fn rotating_the_base_rotates_the_equilibrium() {
     // no gravity: a rigid motion of the base moves the whole solution with it
-    let a = run_preset("six-tendon", &["tendons.1.tension=-4"]);
+    let a = run_preset("six-tendon-no-gravity", &["tendons.1.tension=-4"]);
     let b = run_preset(
-        "six-tendon",
+        "six-tendon-no-gravity",
         &[
             "tendons.1.tension=-4",
             "base.axis=[1, 1, 0]",
@@ -163,7 +163,7 @@ fn rotating_the_base_rotates_the_equilibrium() {
         m[(2, 2)]
     );
     let c = run_preset(
-        "six-tendon",
+        "six-tendon-no-gravity",
         &[
             "tendons.1.tension=-4",
             &rows,

@@ -50,7 +50,7 @@ fn sizes(opts: &Options) -> Sizes {
     } else {
         Sizes {
             samples: 1000,
-            epochs: 1000,
+            epochs: 2000,
             max_pod: 10,
             repeat: 5,
         }

@@ -68,7 +68,7 @@ impl Default for TrainOptions {
             latent: 1,
             hidden_layers: 7,
             lambda: 1e-4,
-            epochs: 1000,
+            epochs: 2000,
             batch_size: 64,
             learning_rate: 1e-3,
             validation_fraction: 0.1,

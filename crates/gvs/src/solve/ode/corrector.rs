@@ -23,9 +23,9 @@
 //!   evaluated at the start and when Newton fails, as the Jacobian of the first-order form. `M`
 //!   goes stale faster: unlike `I − c J`, whose leading term is exact, `S`'s leading term is `M`
 //!   itself, so with an `M` kept from earlier steps the iteration contracts only as fast as
-//!   `M_old⁻¹ M(q)` is close to `I` (on the six-tendon arm's large rotations, 10 s: 9 286 failed
-//!   of 14 414 steps with `M` renewed only with `D` and `K`, 79 of 2 368 with `M` renewed at
-//!   every attempt). So `M` alone is renewed ([`MechanicalSystem::mass`], one forward pass with
+//!   `M_old⁻¹ M(q)` is close to `I` (on the six-tendon arm's large rotations without gravity,
+//!   `six-tendon-no-gravity`, 10 s: 9 286 failed of 14 414 steps with `M` renewed only with `D` and
+//!   `K`, 79 of 2 368 with `M` renewed at every attempt). So `M` alone is renewed ([`MechanicalSystem::mass`], one forward pass with
 //!   Jacobians and a blocked product: far cheaper than `K`) at the predicted configuration of the
 //!   next attempt when Newton fails, before `D` and `K` are, and of the next step when the last
 //!   one contracted slower than `ρ = 0.2`; `S` is refactored with it. The
