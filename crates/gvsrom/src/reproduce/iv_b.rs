@@ -232,7 +232,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     )?;
     report.tables.push(latent.table.clone());
     report.notes = vec![
-        "Table I's bottom half is measured in the paper's convention (total moment in N·m); the preset's default (`convention = \"peak\"`, the peak line density) gives 25× smaller strains.".into(),
+        "Table I's bottom half is measured in the paper's convention (total moment in N·m); the variant `soft-beam-peak` (`convention = \"peak\"`, the magnitude read as the peak line density) gives 25× smaller strains.".into(),
         "Known gap: on this problem gvsrom's autoencoder trainer reaches 3–7× the paper's RMSE at 7 hidden layers (a plain scikit-learn MLPRegressor of the same architecture does 40 % better at r = 2); the trainer, not the data, is the gap.".into(),
         "Times: gvsrom on this machine against the paper's MATLAB: compare the ratios.".into(),
     ];
