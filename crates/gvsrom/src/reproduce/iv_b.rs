@@ -50,6 +50,24 @@ fn sizes(opts: &Options) -> Sizes {
 
 /// The two loads of Fig. 6: (total moment [N·m], centre [m]) on the 0.8 m beam.
 const TEST_LOADS: [(f64, f64); 2] = [(4.0, 0.2), (2.0, 0.6)];
+/// Random test loads beyond the paper's two, and the seed that draws them (not the data's).
+const RANDOM_LOADS: usize = 5;
+const RANDOM_SEED: u64 = 7;
+
+/// `RANDOM_LOADS` loads drawn like the data (centre uniform in [0, L], magnitude uniform in
+/// [−5, 5] N·m) with another seed, as overrides.
+fn random_inputs() -> Vec<Vec<String>> {
+    let mut rng = gvs::inputs::SplitMix64::new(RANDOM_SEED);
+    (0..RANDOM_LOADS)
+        .map(|_| {
+            let (c, m) = (rng.range(0.0, 0.8), rng.range(-5.0, 5.0));
+            vec![
+                format!("loads.distributed.0.magnitude={m:.4}"),
+                format!("loads.distributed.0.center={c:.4}"),
+            ]
+        })
+        .collect()
+}
 
 /// The IV-B scenario: the preset in the paper's convention (total moment in N·m).
 pub fn scenario() -> ScenarioSpec {
@@ -174,6 +192,30 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     report
         .tables
         .push(table_iii(&paper::TABLE_III_IV_B, k, pod_t, 2, ae_t, hom_t));
+    // beyond the paper: five random loads, the AE-2 against POD-2 and POD-k
+    let random_models: Vec<EvalModel> = models
+        .iter()
+        .filter(|m| {
+            ["HOM", "AE-2", "POD-2"].contains(&m.label.as_str()) || Some(&m.label) == pod_k.as_ref()
+        })
+        .cloned()
+        .collect();
+    let ev_random = tasks::statics_eval(
+        run,
+        "iv-b/eval-random",
+        &scenario,
+        &random_inputs(),
+        &random_models,
+        1,
+    )?;
+    let ev_random = &ev_random.value;
+    let mut random_table = accuracy_table(ev_random, &random_models);
+    random_table.id = "accuracy-random".into();
+    random_table.title = format!("Accuracy at {RANDOM_LOADS} random loads (centre in [0, L], magnitude in [−5, 5] N·m, seed {RANDOM_SEED}; not in the paper)");
+    random_table.columns[6] = "time per equilibrium [ms] (one solve)".into();
+    report.tables.push(random_table);
+    let (ae_rand, ae_rand_max) = ev_random.stats("AE-2", |s| s.strain_error_percent);
+    let (pod2_rand, _) = ev_random.stats("POD-2", |s| s.strain_error_percent);
     report.findings = vec![
         Finding {
             claim: "the AE-ROM is more accurate than the POD-ROM of equal DOF (r = 2)".into(),
@@ -190,6 +232,16 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
             evidence: format!(
                 "largest strain error at the two test loads {} %",
                 Cell::sig(ae_max, 3).render()
+            ),
+        },
+        Finding {
+            claim: format!("the AE-2 ROM stays below 1 % strain error, and below POD-2, at {RANDOM_LOADS} random loads (beyond the paper)"),
+            holds: ae_rand_max < 1.0 && ae_rand < pod2_rand,
+            evidence: format!(
+                "AE-2 mean {} %, largest {} %; POD-2 mean {} %",
+                Cell::sig(ae_rand, 3).render(),
+                Cell::sig(ae_rand_max, 3).render(),
+                Cell::sig(pod2_rand, 3).render()
             ),
         },
         Finding {
@@ -233,7 +285,12 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     report.tables.push(latent.table.clone());
     report.notes = vec![
         "Table I's bottom half is measured in the paper's convention (total moment in N·m); the variant `soft-beam-peak` (`convention = \"peak\"`, the magnitude read as the peak line density) gives 25× smaller strains.".into(),
-        "Known gap: on this problem gvsrom's autoencoder trainer reaches 3–7× the paper's RMSE at 7 hidden layers (a plain scikit-learn MLPRegressor of the same architecture does 40 % better at r = 2); the trainer, not the data, is the gap.".into(),
+        format!(
+            "Table I at 7 hidden layers, ours / the paper's: r = 1 {}, r = 2 {}, r = 3 {}. The weight penalty weighs against a whole snapshot's squared error, as eq. (15) writes it; against the per-entry mean it is 148× stronger here and held the r = 2 error at 3.9 (docs/assumptions.md). A 1-D code of this 2-D family is a hard, non-convex fit: training stops at its first plateaus.",
+            ratio_at_7(&aes, 0),
+            ratio_at_7(&aes, 1),
+            ratio_at_7(&aes, 2)
+        ),
         "Times: gvsrom on this machine against the paper's MATLAB: compare the ratios.".into(),
     ];
     report.settings =
@@ -242,6 +299,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         "table_i": aes.iter().map(|row| row.iter().map(|a| &a.value).collect::<Vec<_>>()).collect::<Vec<_>>(),
         "pod_k_below_1_percent": k,
         "evaluation": ev,
+        "evaluation_random": ev_random,
         "intrinsic_dimension": latent.values,
     });
     let figures = vec![
@@ -283,4 +341,14 @@ fn fig6(ev: &Evaluation, pod_k: Option<&str>) -> anyhow::Result<RenderedFigure> 
         1800,
         600,
     )
+}
+
+/// "x.xx×": the RMSE of the 7-hidden-layer AE with latent index `r` (0-based) over the paper's.
+fn ratio_at_7(aes: &[Vec<Step<tasks::ModelInfo>>], r: usize) -> String {
+    let ours = aes
+        .last()
+        .and_then(|row| row.get(r))
+        .map_or(f64::NAN, |a| a.value.rmse_full);
+    let paper = paper::TABLE_I_IV_B.last().map_or(f64::NAN, |row| row[r]);
+    format!("{}×", Cell::sig(ours / paper, 3).render())
 }
