@@ -152,7 +152,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     report.setup = vec![
         "scenario: preset `soft-beam` (`convention = \"total\"`: the magnitude is the pulse's total moment in N·m, as the paper gives it; 0.8 m beam, radius 1.5 cm, E = 1 MPa, follower moment about local y as a triangular pulse of base 0.1 L, no gravity, 50-DOF linear FEM-like bend-y basis, 148 points)".into(),
         format!("data: {} equilibria at random centres in [0, 0.8] m and magnitudes in [−5, 5] N·m, seed 1 (`gvsrom dataset soft-beam --random loads.distributed.0.center=0:0.8 --random loads.distributed.0.magnitude=-5:5 --samples {} --seed 1`); {} solved, {} failed", data.value.samples, data.value.samples, data.value.ok, data.value.failed),
-        format!("autoencoders: r = 1, 2, 3 × 3, 5, 7 hidden layers, tanh, λ = 1e-4, Adam ≤ {} epochs with early stopping, then L-BFGS", s.epochs),
+        format!("autoencoders: r = 1, 2, 3 × 3, 5, 7 hidden layers, tanh, λ = 1e-4 against a whole snapshot's squared error (eq. 15), loss in the strain-energy norm, Adam ≤ {} epochs with learning-rate reductions at plateaus and early stopping, then L-BFGS", s.epochs),
         format!("POD: {:?} modes", s.pod_modes),
         format!("test: 4 N·m at X/L = 0.25 and 2 N·m at X/L = 0.75 (Fig. 6); each equilibrium solved {} times, mean time", s.repeat),
     ];
