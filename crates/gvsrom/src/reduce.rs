@@ -600,8 +600,15 @@ pub fn train(
     // the zero-strain anchor of trajectory data: the straight rod, where simulations from rest
     // start, joins the training rows so that a latent point decodes to it
     let anchor_rows = zero_anchor_rows(rows, ds.meta.dynamic.is_some());
-    let mut training = x.clone();
-    training.resize((rows + anchor_rows) * features, 0.0);
+    let training: std::borrow::Cow<[f64]> = match anchor_rows {
+        0 => (&x[..]).into(),
+        k => {
+            let mut t = Vec::with_capacity((rows + k) * features);
+            t.extend_from_slice(&x);
+            t.resize((rows + k) * features, 0.0);
+            t.into()
+        }
+    };
     let (ae, report) =
         Autoencoder::train(&training, features, options, progress).map_err(|e| train_error(&e))?;
     drop(training);
