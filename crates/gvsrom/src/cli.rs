@@ -93,7 +93,7 @@ pub struct ReproduceArgs {
     /// Testing aid: the smallest sizes that still run every step (implies --quick).
     #[arg(long, hide = true)]
     pub test_sizes: bool,
-    /// The noise study's Gaussian noise, σ relative to the RMS of the snapshots.
+    /// The noise study's Gaussian noise, σ relative to the RMS of each strain component of the snapshots.
     #[arg(long, value_name = "LEVEL", default_value_t = gvsrom::reproduce::DEFAULT_NOISE)]
     pub noise: f64,
 }

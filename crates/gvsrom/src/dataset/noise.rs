@@ -1,8 +1,10 @@
 //! A dataset with Gaussian noise on its strain snapshots (paper Section IV-B, last paragraph: the
-//! autoencoders "trained on noisy strain data"): `x̃ = x + σ n`, `n ~ N(0, 1)` independently per
-//! entry, `σ = level · RMS(x)` over every entry of every solved sample. Failed and missing rows stay
-//! as they are; every other array is copied unchanged, and `meta.json` records the source, its
-//! strain hash, the level, σ and the seed.
+//! autoencoders "trained on noisy strain data"): `x̃ = x + σ_c n`, `n ~ N(0, 1)` independently per
+//! entry, `σ_c = level · RMS(x_c)` for each strain component `c` over its values at every point of
+//! every solved sample. Per component, because the components differ by orders of magnitude
+//! (bending ~10 1/m, shear and elongation ~1e-4): one σ for all would bury the small ones in noise.
+//! Failed and missing rows stay as they are; every other array is copied unchanged, and `meta.json`
+//! records the source, its strain hash, the level, the σ_c and the seed.
 
 use super::generate::{Layout, SampleResult};
 use super::{Dataset, DatasetError, Meta};
@@ -17,10 +19,11 @@ pub struct NoiseInfo {
     /// The clean dataset's path and the FNV-1a hash of its `strain.npy`.
     pub source: String,
     pub source_strain_hash: String,
-    /// σ relative to the RMS of the clean snapshots.
+    /// σ relative to the RMS of each component of the clean snapshots.
     pub level: f64,
-    /// The absolute standard deviation added, in strain units.
-    pub sigma: f64,
+    /// The absolute standard deviation added to each component (in `components` order), in strain
+    /// units.
+    pub sigma: Vec<f64>,
     pub seed: u64,
 }
 
@@ -63,13 +66,15 @@ pub fn with_noise(
     let ds = Dataset::load(src)?;
     let ok = ds.ok_rows();
     let width = ds.row_len();
-    let (sum, count) = ok.iter().fold((0.0, 0usize), |(s, c), &k| {
-        (
-            s + ds.strain_row(k).iter().map(|v| v * v).sum::<f64>(),
-            c + width,
-        )
-    });
-    let sigma = level * (sum / count.max(1) as f64).sqrt();
+    let a = ds.meta.components.len().max(1);
+    let mut sum = vec![0.0; a];
+    for &k in &ok {
+        for (j, v) in ds.strain_row(k).iter().enumerate() {
+            sum[j % a] += v * v;
+        }
+    }
+    let count = (ok.len() * width / a).max(1) as f64;
+    let sigma: Vec<f64> = sum.iter().map(|s| level * (s / count).sqrt()).collect();
     let bytes = std::fs::read(src.join(super::FILES[1])).map_err(|e| DatasetError::File {
         file: src.join(super::FILES[1]).display().to_string(),
         message: format!("cannot read it: {e}"),
@@ -78,7 +83,7 @@ pub fn with_noise(
         source: src.display().to_string(),
         source_strain_hash: crate::reduced_model::fnv1a64(&bytes),
         level,
-        sigma,
+        sigma: sigma.clone(),
         seed,
     };
     let mut normal = Normal {
@@ -90,8 +95,8 @@ pub fn with_noise(
         .map(|k| {
             let mut strain = ds.strain_row(k).to_vec();
             if ds.status[k] == super::generate::STATUS_OK {
-                for v in &mut strain {
-                    *v += sigma * normal.next();
+                for (j, v) in strain.iter_mut().enumerate() {
+                    *v += sigma[j % a] * normal.next();
                 }
             }
             let mut tip_rotation = [0.0; 9];

@@ -98,7 +98,7 @@ pub struct Options {
     pub out: PathBuf,
     /// Worker threads (dataset generation, training several models at once, anchors).
     pub jobs: usize,
-    /// The noise study's σ relative to the snapshots' RMS.
+    /// The noise study's σ relative to the RMS of each strain component of the snapshots.
     pub noise: f64,
 }
 
@@ -142,7 +142,7 @@ pub fn run(
     );
     anyhow::ensure!(
         opts.noise.is_finite() && (0.0..=1.0).contains(&opts.noise),
-        "--noise {}: expected a number in [0, 1] (σ relative to the snapshots' RMS)",
+        "--noise {}: expected a number in [0, 1] (σ relative to each strain component's RMS)",
         opts.noise
     );
     let cases = opts.case_list();

@@ -2,7 +2,7 @@
 //! paragraph: noise "locally introduces an additional dimension to the manifold" but "the
 //! performance of the AE as a strain parameterization remains almost unaffected").
 //!
-//! For each study: Gaussian noise of `--noise` times the snapshots' RMS is added to its dataset
+//! For each study: Gaussian noise of `--noise` times each strain component's RMS is added to its dataset
 //! ([`crate::dataset::noise::with_noise`]); the ROM autoencoder (IV-A r = 1, IV-B r = 2, 7 hidden
 //! layers) and the visualisation autoencoders (r = 2 and 3, 3 hidden layers) are trained again on
 //! it with the same settings; the reconstruction error is measured against the clean snapshots and
@@ -25,7 +25,8 @@ fn noisy(
     data: &Step<DatasetInfo>,
     level: f64,
 ) -> anyhow::Result<Step<DatasetInfo>> {
-    let config = json!({ "dataset": data.key(), "level": level, "seed": NOISE_SEED });
+    let config =
+        json!({ "dataset": data.key(), "level": level, "per_component": true, "seed": NOISE_SEED });
     run.step(
         name,
         &config,
@@ -172,7 +173,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         "autoencoders trained on noisy snapshots (paper Section IV-B, last paragraph)",
     );
     report.setup = vec![
-        format!("noise: Gaussian, independent per snapshot entry, σ = {level} × the RMS of the clean snapshots (`--noise`; the paper does not give its level), seed {NOISE_SEED}"),
+        format!("noise: Gaussian, independent per snapshot entry, σ_c = {level} × the RMS of each strain component c of the clean snapshots (`--noise`; the paper does not give its level), seed {NOISE_SEED}"),
         "IV-A: its dataset and test tensions; ROM autoencoder r = 1, 7 hidden layers; latent plots r = 2 and 3, 3 hidden layers — trained again on the noisy snapshots with the same settings".into(),
         "IV-B: its dataset (total moment in N·m) and the two Fig. 6 loads; ROM autoencoder r = 2, 7 hidden layers; latent plots as IV-A".into(),
     ];
