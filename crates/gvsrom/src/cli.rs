@@ -239,32 +239,14 @@ pub struct TrainArgs {
     /// by its own spread), `physical` (plain squared error, the RMSE of Table I) or `energy`
     /// (weighted by the section stiffness: the strain-energy norm, which the reduced model's
     /// elastic force feels).
-    #[arg(long, value_enum, default_value_t = LossArg::Energy)]
-    pub loss: LossArg,
+    #[arg(long, value_enum, default_value_t = reduce::Loss::Energy)]
+    pub loss: reduce::Loss,
     /// The new model directory.
     #[arg(long, value_name = "MODEL")]
     pub out: PathBuf,
     /// Replace MODEL if it is an earlier gvsrom output.
     #[arg(long)]
     pub force: bool,
-}
-
-/// `--loss` of `gvsrom train` (see [`reduce::Loss`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum LossArg {
-    Standardized,
-    Physical,
-    Energy,
-}
-
-impl From<LossArg> for reduce::Loss {
-    fn from(l: LossArg) -> Self {
-        match l {
-            LossArg::Standardized => reduce::Loss::Standardized,
-            LossArg::Physical => reduce::Loss::Physical,
-            LossArg::Energy => reduce::Loss::Energy,
-        }
-    }
 }
 
 #[derive(Debug, Args)]
@@ -695,13 +677,7 @@ fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
         patience: (args.patience > 0).then_some(args.patience),
         seed: args.seed,
         lr_reductions: args.lr_reductions,
-        fine_tune: match args.lbfgs_iterations {
-            0 => rom::nn::FineTune::None,
-            iterations => rom::nn::FineTune::Lbfgs {
-                iterations,
-                memory: 10,
-            },
-        },
+        fine_tune: rom::nn::FineTune::lbfgs(args.lbfgs_iterations),
         ..TrainOptions::default()
     };
     let signal = interrupt_flag();
@@ -724,7 +700,7 @@ fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
     let s = reduce::train(
         &args.dataset,
         &options,
-        args.loss.into(),
+        args.loss,
         &args.out,
         args.force,
         &mut progress,

@@ -532,7 +532,17 @@ pub struct TrainSummary {
 }
 
 /// How a snapshot feature's error weighs in the autoencoder's training loss (`gvsrom train --loss`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Default,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum Loss {
     /// Each feature standardized by its own spread: every point and component weighs the same
@@ -633,16 +643,21 @@ pub fn train(
     // the rest coordinates: with the zero-strain anchor the encoding of the straight rod, else
     // that of the sample closest to it (equilibria under gravity: the straight rod is off their
     // manifold and its encoding may lie outside the data's range); and how far they decode from it
-    let straightest = x
-        .chunks_exact(features)
-        .min_by(|a, b| {
-            let n = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>();
-            n(a).total_cmp(&n(b))
-        })
-        .expect("at least one usable row");
     let zero = vec![0.0; features];
+    let straightest = || {
+        x.chunks_exact(features)
+            .min_by(|a, b| {
+                let n = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>();
+                n(a).total_cmp(&n(b))
+            })
+            .expect("at least one usable row")
+    };
     let rest = ae
-        .encode(if anchor_rows > 0 { &zero } else { straightest })
+        .encode(if anchor_rows > 0 {
+            &zero
+        } else {
+            straightest()
+        })
         .map_err(|e| invalid("train", e.to_string()))?;
     let rest_decoded = ae
         .decode(&rest)
@@ -673,10 +688,7 @@ pub fn train(
             loss: Some(loss.name().into()),
             lr_reductions: Some(options.lr_reductions),
             zero_anchor_rows: Some(anchor_rows),
-            lbfgs_iterations: Some(match options.fine_tune {
-                rom::nn::FineTune::Lbfgs { iterations, .. } => iterations,
-                _ => 0,
-            }),
+            lbfgs_iterations: Some(options.fine_tune.lbfgs_iterations()),
             epochs_run: report.epochs_run,
             best_epoch: report.best_epoch,
             stop: format!("{:?}", report.stop),

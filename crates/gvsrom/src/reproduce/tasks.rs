@@ -201,10 +201,7 @@ impl AeConfig {
             batch_size: d.batch_size,
             learning_rate: d.learning_rate,
             seed: d.seed,
-            lbfgs_iterations: match d.fine_tune {
-                rom::nn::FineTune::Lbfgs { iterations, .. } => iterations,
-                _ => 0,
-            },
+            lbfgs_iterations: d.fine_tune.lbfgs_iterations(),
             loss: reduce::Loss::default(),
             lr_reductions: d.lr_reductions,
         }
@@ -235,13 +232,7 @@ pub fn train(
                 patience: (c.patience > 0).then_some(c.patience),
                 seed: c.seed,
                 lr_reductions: c.lr_reductions,
-                fine_tune: match c.lbfgs_iterations {
-                    0 => rom::nn::FineTune::None,
-                    iterations => rom::nn::FineTune::Lbfgs {
-                        iterations,
-                        memory: 10,
-                    },
-                },
+                fine_tune: rom::nn::FineTune::lbfgs(c.lbfgs_iterations),
                 ..rom::nn::TrainOptions::default()
             };
             let interrupt = run.interrupt().clone();

@@ -74,10 +74,7 @@ impl Default for TrainOptions {
             validation_fraction: 0.1,
             patience: Some(50),
             lr_reductions: 4,
-            fine_tune: FineTune::Lbfgs {
-                iterations: 300,
-                memory: 10,
-            },
+            fine_tune: FineTune::lbfgs(300),
             seed: 0,
             weighting: Weighting::Standardize,
         }
@@ -135,6 +132,27 @@ pub enum FineTune {
     },
     /// Full-batch L-BFGS ([`crate::nn::lbfgs`]) for up to `iterations`, each counted as an epoch.
     Lbfgs { iterations: usize, memory: usize },
+}
+
+impl FineTune {
+    /// L-BFGS for `iterations` with a memory of 10 pairs, or no final phase for 0.
+    pub fn lbfgs(iterations: usize) -> Self {
+        match iterations {
+            0 => FineTune::None,
+            iterations => FineTune::Lbfgs {
+                iterations,
+                memory: 10,
+            },
+        }
+    }
+
+    /// The L-BFGS iterations allowed (0 for no or an Adam phase).
+    pub fn lbfgs_iterations(&self) -> usize {
+        match self {
+            FineTune::Lbfgs { iterations, .. } => *iterations,
+            _ => 0,
+        }
+    }
 }
 
 /// Why training stopped.
