@@ -350,7 +350,7 @@ pub struct SimulateArgs {
     pub load_schedule: Option<PathBuf>,
 
     /// Use finite differences of the right-hand side for the integrator's Jacobian instead of the
-    /// structured analytic one (automatic with an autoencoder `--model`).
+    /// structured analytic one.
     #[arg(long)]
     pub fd_jacobian: bool,
 
@@ -885,11 +885,12 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
     let t_last = sm.t_last.unwrap_or(0.0);
     writeln!(
         out,
-        "simulated  {t_last:.3} s in {:.3} s wall time (real-time factor {:.1}), {} steps ({} failed), {} RHS and {} Jacobian evaluations",
+        "simulated  {t_last:.3} s in {:.3} s wall time (real-time factor {:.1}), {} steps ({} failed, {} of them in Newton), {} RHS and {} Jacobian evaluations",
         sm.wall_time_s,
         outcome.real_time_factor(),
         sm.stats.steps,
         sm.stats.failed_steps,
+        sm.stats.newton_failures,
         sm.stats.rhs_evals,
         sm.stats.jacobian_evals
     )?;

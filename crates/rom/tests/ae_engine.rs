@@ -624,3 +624,111 @@ fn rom_statics_with_ae_param_matches_the_hom_inside_the_training_range() {
         }
     }
 }
+
+/// Central differences of `q̈ ↦ ε(q + c_q q̈, q̇ + c_v q̈, q̈)` at `q̈ = 0`: the exact `c ∂ε/∂d_v` of
+/// the NDF corrector (`c_v = c`, `c_q = c²`), column by column.
+#[allow(clippy::too_many_arguments)]
+fn exact_iteration_matrix(
+    m: &AeModel,
+    q: &DVector<f64>,
+    qd: &DVector<f64>,
+    (cv, cq): (f64, f64),
+    u: &[f64],
+    loads: &gvs::model::PreparedLoads,
+) -> DMatrix<f64> {
+    let n = m.n_dof();
+    let mut ws = m.workspace();
+    let mut fd = DMatrix::zeros(n, n);
+    let (mut ep, mut em) = (DVector::zeros(n), DVector::zeros(n));
+    for j in 0..n {
+        let e = 1e-3;
+        let mut a = DVector::zeros(n);
+        a[j] = e;
+        m.dynamics_residual(
+            &(q + &a * cq),
+            &(qd + &a * cv),
+            &a,
+            u,
+            loads,
+            &mut ws,
+            &mut ep,
+        );
+        a[j] = -e;
+        m.dynamics_residual(
+            &(q + &a * cq),
+            &(qd + &a * cv),
+            &a,
+            u,
+            loads,
+            &mut ws,
+            &mut em,
+        );
+        fd.set_column(j, &((&ep - &em) / (2.0 * e)));
+    }
+    fd
+}
+
+/// The structured iteration matrix `S = M + c D + c² K_T` of the second-order NDF
+/// ([`Model::iteration_parts`], `K_T` with the decoder's Hessian term) against central differences
+/// of the recursive residual: exact at an equilibrium at rest of the reduced model; away from rest
+/// it drops only terms that vanish with the velocity (`∂(C q̇)/∂q̇`, `∂(C q̇)/∂q`), so its error
+/// shrinks with `q̇`.
+#[test]
+fn iteration_matrix_matches_finite_differences_of_the_residual_with_ae_param() {
+    let fx = fixture();
+    let u = [-2.5];
+    for r in [1, 2] {
+        let m = fx.rom(r, 1e4);
+        let n = m.n_dof();
+        let loads = m.prepare_loads(&gravity()).unwrap();
+        let z0 = fx.z(r, 20);
+        let qe = StaticsSolver::new(&m, StaticsOptions::default())
+            .solve(&u, &gravity(), Some(&z0))
+            .unwrap_or_else(|e| panic!("r = {r}: ROM statics: {e}"))
+            .q;
+        let mut ws = m.workspace();
+        let (mut mm, mut dd, mut kk) = (
+            DMatrix::zeros(n, n),
+            DMatrix::zeros(n, n),
+            DMatrix::zeros(n, n),
+        );
+        m.iteration_parts(&qe, &u, &loads, &mut ws, &mut mm, &mut dd, &mut kk);
+        // c of a 2 ms step and of a 20 ms one: the stiffness part matters in the second
+        for c in [2e-3, 2e-2] {
+            let s = &mm + &dd * c + &kk * (c * c);
+            let zero = DVector::zeros(n);
+            let fd = exact_iteration_matrix(&m, &qe, &zero, (c, c * c), &u, &loads);
+            let err = (&s - &fd).amax() / fd.amax();
+            eprintln!("r = {r}, c = {c}: S vs central differences at rest {err:.3e}");
+            assert!(err < 1e-6, "r = {r}, c = {c}: S at rest {err:e}");
+            // the K_T part alone is visible: dropping it must be seen
+            let without_k = &mm + &dd * c;
+            let err_k = (&without_k - &fd).amax() / fd.amax();
+            assert!(
+                err_k > 1e3 * err,
+                "r = {r}, c = {c}: K_T invisible ({err_k:e})"
+            );
+        }
+        // moving: the error is first order in q̇
+        let c = 2e-2;
+        let s = &mm + &dd * c + &kk * (c * c);
+        let qd = latent_velocity(fx, r, 0);
+        let errs: Vec<f64> = [1.0, 0.1]
+            .iter()
+            .map(|&scale| {
+                let fd = exact_iteration_matrix(&m, &qe, &(&qd * scale), (c, c * c), &u, &loads);
+                (&s - &fd).amax() / fd.amax()
+            })
+            .collect();
+        eprintln!(
+            "r = {r}: S vs central differences moving, q̇ and q̇/10: {:.3e} and {:.3e}",
+            errs[0], errs[1]
+        );
+        assert!(
+            errs[1] < 0.2 * errs[0] && errs[1] > 1e-6,
+            "r = {r}: the dropped velocity terms do not scale with q̇: {:e}, {:e}",
+            errs[0],
+            errs[1]
+        );
+    }
+}

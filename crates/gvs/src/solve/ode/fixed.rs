@@ -246,6 +246,7 @@ fn advance<S: OdeSystem>(
             }
             Newton::Stalled if !st.jac_fresh => {
                 cs.stats.failed_steps += 1;
+                cs.stats.newton_failures += 1;
                 if !cs.jacobian(t, &w.y, &w.thresh, &mut w.jac, &mut w.jw)? {
                     return Err(OdeError::NonFinite { t });
                 }
@@ -254,6 +255,7 @@ fn advance<S: OdeSystem>(
             }
             failure => {
                 cs.stats.failed_steps += 1;
+                cs.stats.newton_failures += 1;
                 if halvings >= MAX_HALVINGS {
                     return Err(match failure {
                         Newton::NonFinite => OdeError::NonFinite { t },

@@ -180,6 +180,24 @@ pub struct NdfOptions {
     /// How local errors (and Newton corrections) are measured (default componentwise, as
     /// `ode15s`).
     pub error_norm: ErrorNorm,
+    /// When the second-order form renews the mass matrix of its iteration matrix (default
+    /// [`MassRenewal::WhenSlow`]; the first-order form ignores it).
+    pub mass_renewal: MassRenewal,
+}
+
+/// When [`integrate_ndf_second_order`] renews `M` in its iteration matrix `M + c D + c² K`
+/// (`D`, `K` are renewed only when Newton fails with them stale).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum MassRenewal {
+    /// After a Newton failure, and for the step after one that contracted slower than `ρ = 0.2`:
+    /// for a model whose `M` costs as much as a few residuals (the HOM: one forward pass with
+    /// Jacobians on all `n` coordinates).
+    #[default]
+    WhenSlow,
+    /// At every attempt, at the predicted configuration: for a model whose `M(q)` changes fast
+    /// and costs little against the failed steps a stale one causes (a decoder's reduced model:
+    /// `r ≪ n` coordinates, `M = Jᵀ Ms J` with the decoder's Jacobian inside `J`).
+    EveryAttempt,
 }
 
 /// The norm of the NDF's error test.
@@ -211,6 +229,7 @@ impl Default for NdfOptions {
             max_step: f64::INFINITY,
             max_steps: 1_000_000,
             error_norm: ErrorNorm::Componentwise,
+            mass_renewal: MassRenewal::WhenSlow,
         }
     }
 }
@@ -247,6 +266,9 @@ pub struct OdeStats {
     pub steps: usize,
     /// Rejected attempts (error test failures and Newton failures).
     pub failed_steps: usize,
+    /// Of `failed_steps`, those whose Newton iteration did not converge (too slow, singular
+    /// iteration matrix or non-finite values); the rest failed the error test.
+    pub newton_failures: usize,
     /// Right-hand side evaluations (including those for finite-difference Jacobians).
     pub rhs_evals: usize,
     /// Jacobian evaluations (analytic or by finite differences).

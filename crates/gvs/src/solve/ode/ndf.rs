@@ -350,7 +350,7 @@ pub fn integrate_ndf_second_order<S: MechanicalSystem>(
     let n = sys.dim();
     let y0 = mechanical_state(n, q0, qd0)?;
     integrate(
-        &mut SecondOrder::new(sys),
+        &mut SecondOrder::new(sys, opts.mass_renewal),
         2 * n,
         t0,
         &y0,
@@ -604,6 +604,7 @@ fn integrate_piece<C: Corrector>(
                 // Too slow (or singular iteration matrix, or non-finite values): new Jacobian if
                 // the current one is stale, else a smaller step.
                 cs.stats().failed_steps += 1;
+                cs.stats().newton_failures += 1;
                 if !nonfinite && cs.renew_cheaply() {
                     // retry the step with the cheap remedy first
                 } else if !nonfinite && !jcurrent {

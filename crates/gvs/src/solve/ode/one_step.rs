@@ -216,6 +216,7 @@ impl Parts {
         stats: &mut OdeStats,
     ) -> Result<(), OdeError> {
         stats.failed_steps += 1;
+        stats.newton_failures += 1;
         *fails += 1;
         if *fails > 40 {
             return Err(OdeError::NewtonFailure { t });
