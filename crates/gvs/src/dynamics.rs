@@ -262,6 +262,29 @@ impl<P: StrainParam> Model<P> {
         r.neg_mut();
     }
 
+    /// [`Self::dynamics_residual`] and the mass matrix `M(q)` (into `ws.mass`) from one forward
+    /// pass (with Jacobians, which the residual does not need but `M` does): for an integrator
+    /// that renews `M` where it evaluates its first residual of a step.
+    #[allow(clippy::too_many_arguments)]
+    pub fn dynamics_residual_and_mass(
+        &self,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        qdd: &DVector<f64>,
+        u: &[f64],
+        loads: &PreparedLoads,
+        ws: &mut Workspace,
+        r: &mut DVector<f64>,
+    ) {
+        self.forward(q, ws, true);
+        self.assemble_mass(ws);
+        self.velocities_with(q, qd, Some(qdd), ws);
+        self.point_wrenches(loads, ws);
+        self.subtract_inertial_wrenches(ws);
+        self.assemble_forces(u, Some(qd), ws, r);
+        r.neg_mut();
+    }
+
     /// Iteration matrix of an implicit integrator in second-order form,
     /// `S = M + c_v D + c_q K_T ≈ ∂ε/∂q̈ + c_v ∂ε/∂q̇ + c_q ∂ε/∂q` for `ε` of
     /// [`Self::dynamics_residual`] when `q̇` and `q` move with `q̈` at the rates `c_v`, `c_q`

@@ -325,3 +325,32 @@ fn linearized_frequencies_of_clamped_rod_match_beam_theory() {
         "no mode within 1 % of axial {axial} Hz: {f:?}"
     );
 }
+
+/// The merged pass of the second-order NDF's first residual of an attempt gives the residual of
+/// [`Model::dynamics_residual`] and the mass matrix of [`Model::mass_matrix`] exactly.
+#[test]
+fn residual_and_mass_from_one_pass_equal_the_separate_evaluations() {
+    let m = linear_model(MagnusOrder::Z4, 2e4);
+    let n = m.n_dof();
+    let loads = Loads {
+        gravity: [0.0, 0.0, -9.81],
+        ..Default::default()
+    };
+    let pl = m.prepare_loads(&loads).unwrap();
+    let q = pseudo_random(n, 3, 0.8);
+    let qd = pseudo_random(n, 4, 2.0);
+    let qdd = pseudo_random(n, 5, 20.0);
+    let u = [-1.5];
+    let mut ws = m.workspace();
+    let (mut e1, mut e2) = (DVector::zeros(n), DVector::zeros(n));
+    m.dynamics_residual(&q, &qd, &qdd, &u, &pl, &mut ws, &mut e1);
+    let mass = m.mass_matrix(&q, &mut ws);
+    let mut ws2 = m.workspace();
+    m.dynamics_residual_and_mass(&q, &qd, &qdd, &u, &pl, &mut ws2, &mut e2);
+    assert!(e1.amax() > 0.0 && mass.amax() > 0.0);
+    assert!((&e1 - &e2).amax() <= 1e-12 * e1.amax(), "residuals differ");
+    assert!(
+        (&mass - &ws2.mass).amax() <= 1e-12 * mass.amax(),
+        "masses differ"
+    );
+}

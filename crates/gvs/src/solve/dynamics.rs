@@ -262,6 +262,22 @@ impl<P: StrainParam> MechanicalSystem for RodOde<'_, P> {
         Ok(())
     }
 
+    fn residual_and_mass(
+        &mut self,
+        t: f64,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        qdd: &DVector<f64>,
+        eps: &mut DVector<f64>,
+        m: &mut nalgebra::DMatrix<f64>,
+    ) -> Result<(), RhsError> {
+        self.inputs_at(t);
+        self.model
+            .dynamics_residual_and_mass(q, qd, qdd, &self.u, &self.loads, &mut self.ws, eps);
+        m.copy_from(&self.ws.mass);
+        Ok(())
+    }
+
     fn iteration_parts(
         &mut self,
         t: f64,

@@ -83,6 +83,20 @@ pub trait MechanicalSystem {
     ) -> Result<(), RhsError>;
     /// The mass matrix `M(q)` at time `t`.
     fn mass(&mut self, t: f64, q: &DVector<f64>, m: &mut DMatrix<f64>) -> Result<(), RhsError>;
+    /// [`Self::residual`] and [`Self::mass`] at the same `(t, q)`; a system that gets both from one
+    /// pass over its structure overrides it.
+    fn residual_and_mass(
+        &mut self,
+        t: f64,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        qdd: &DVector<f64>,
+        eps: &mut DVector<f64>,
+        m: &mut DMatrix<f64>,
+    ) -> Result<(), RhsError> {
+        self.mass(t, q, m)?;
+        self.residual(t, q, qd, qdd, eps)
+    }
     /// `M`, `D ≈ −∂τ/∂q̇` and `K ≈ ∂(M q̈ − τ)/∂q` at `(t, q, q̇)` for the iteration matrix
     /// `S = M + c_v D + c_q K`.
     #[allow(clippy::too_many_arguments)]
