@@ -20,6 +20,7 @@ pub mod latent;
 pub mod noise;
 pub mod paper;
 pub mod report;
+pub mod sim_test;
 pub mod step;
 pub mod tasks;
 pub mod v;

@@ -1,507 +1,14 @@
-//! Case IV-C2: the six-tendon manipulator's dynamics (paper Section IV-C2, Fig. 9, Table III
-//! same-DOF row).
-//!
-//! Data: 180 s of actuator babbling under gravity (each tendon holds a uniform tension in
-//! [−15, 0] N for 0.5–1 s), sampled at 100 Hz: 18 001 snapshots (`gvsrom dataset --duration
-//! --babble`). Models: for r = 1 … 8 an autoencoder with 7 hidden layers and POD with r modes; at
-//! r = 7 more autoencoders (other seeds, the paper's λ) for the choice of λ. Test: a new 10 s input,
-//! new random tensions in [−15, 0] N every second, sampled at 100 Hz; the HOM and every ROM
-//! simulated with it one after the other (`gvsrom simulate [--model]`), each ROM's trajectory
-//! compared with the HOM's (`gvsrom compare`: mean tip error in % of the length) and timed.
+//! IV-C2's report: Fig. 9's table and figure, the Table III row, the λ and models tables, the
+//! paper's conclusions as measured and the differences from the paper.
 
-use super::report::{figure, ratio, CaseReport, Cell, Finding, RenderedFigure, Table};
-use super::step::Step;
-use super::tasks::{self, AeConfig, DatasetSpec, ModelInfo, ScenarioSpec};
-use super::{new_report, paper, Case, Options, Run};
-use crate::compare::{compare, Trajectory};
+use super::super::paper;
+use super::super::report::{figure, ratio, Cell, Finding, RenderedFigure, Table};
+use super::super::sim_test::SimRun;
+use super::{Dof, Variant, LAMBDA, LAMBDA_OTHER};
+use crate::compare::Trajectory;
 use crate::plot::{palette, Figure, LineChart, Series, SeriesStyle};
-use crate::simulate::{self, Ending, InputSource, IntegratorChoice, SimulateOptions};
-use crate::{reduce, Built};
-use serde::{Deserialize, Serialize};
-use serde_json::json;
-use std::ops::ControlFlow;
-use std::sync::atomic::Ordering;
-
-/// Hidden layers of every autoencoder (the paper's deepest, as in Table I).
-const HIDDEN_LAYERS: usize = 7;
-/// Weight decay of the autoencoders that become ROMs: the paper's, against the squared error of a
-/// whole snapshot as in eq. (15) (`rom::nn::train`). (Applied against the per-entry error, as
-/// `gvsrom train` did before, 1e-4 was hundreds of times stronger and its AE-ROMs left their
-/// training region on this test.) The λ table compares it with [`LAMBDA_OTHER`] at the inset's r.
-const LAMBDA: f64 = 1e-4;
-/// The other weight decay of the λ table: 100 times weaker.
-const LAMBDA_OTHER: f64 = 1e-6;
-/// Babbling of the data: tensions in [lo, hi] N held for [hold_min, hold_max] s (paper IV-C2).
-const BABBLE: [f64; 4] = [-15.0, 0.0, 0.5, 1.0];
-/// Samples per second of the data and of the test trajectories (paper: 100 Hz).
-const SAMPLE_RATE: f64 = 100.0;
-/// Seed of the babbling (the test input draws with [`TEST_SEED`]: another signal).
-const DATA_SEED: u64 = 0;
-/// The test input: new tensions uniform in [lo, hi] N on every tendon every `period` s.
-const TEST_STEPS: [f64; 3] = [-15.0, 0.0, 1.0];
-const TEST_SEED: u64 = 2;
-
-/// Sizes of the full, the quick and the tiny run.
-struct Sizes {
-    /// Babbling time [s].
-    data_s: f64,
-    /// The reduced sizes r (AE latent size = POD modes).
-    dofs: Vec<usize>,
-    epochs: usize,
-    /// Test duration [s].
-    test_s: f64,
-    /// Runs of each test simulation; the smallest wall time is kept.
-    repeat: usize,
-    /// Training seeds of the λ comparison at the inset's r (the ROMs of every r use the first).
-    seeds: Vec<u64>,
-}
-
-fn sizes(opts: &Options) -> Sizes {
-    if opts.tiny {
-        Sizes {
-            data_s: 10.0,
-            dofs: vec![2, 3],
-            epochs: 5,
-            test_s: 2.0,
-            repeat: 1,
-            seeds: vec![0],
-        }
-    } else if opts.quick {
-        Sizes {
-            data_s: 30.0,
-            dofs: vec![2, 4, 7],
-            epochs: 40,
-            test_s: 10.0,
-            repeat: 1,
-            seeds: vec![0],
-        }
-    } else {
-        Sizes {
-            data_s: 180.0,
-            dofs: (1..=8).collect(),
-            epochs: 300,
-            test_s: 10.0,
-            repeat: 3,
-            seeds: vec![0, 1, 2],
-        }
-    }
-}
-
-/// The test of every model: the input, its length and the integrator (the CLI's automatic
-/// choice).
-#[derive(Debug, Clone, Serialize)]
-struct Test {
-    duration: f64,
-    sample_rate: f64,
-    steps: [f64; 3],
-    seed: u64,
-    integrator: IntegratorChoice,
-    repeat: usize,
-}
-
-impl Test {
-    fn options(&self, built: &Built) -> anyhow::Result<(SimulateOptions, Option<String>)> {
-        let (integrator, note) = simulate::choose_integrator(built, &self.integrator)?;
-        let [lo, hi, period] = self.steps;
-        Ok((
-            SimulateOptions {
-                duration: self.duration,
-                sample_rate: self.sample_rate,
-                input: InputSource::Steps {
-                    lo,
-                    hi,
-                    period,
-                    seed: self.seed,
-                },
-                start_at_equilibrium: false,
-                integrator,
-                load_schedule: None,
-            },
-            note,
-        ))
-    }
-}
-
-/// A ROM's trajectory against the HOM's over their common samples (`gvsrom compare`), in %.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-struct Errors {
-    samples: usize,
-    tip_mean: f64,
-    tip_max: f64,
-    tip_max_t: f64,
-    tip_end: f64,
-    strain_mean: Option<f64>,
-    strain_max: Option<f64>,
-}
-
-/// One simulation of the test: how it ended, what it cost, and (for a ROM) its error against the
-/// HOM.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-struct SimRun {
-    label: String,
-    dof: usize,
-    complete: bool,
-    /// Why the run ended early, in full.
-    reason: Option<String>,
-    /// The run ended early because it left the training region (else: the integrator failed).
-    left_training_region: bool,
-    /// Time of the last sample [s].
-    t_reached: f64,
-    samples: usize,
-    /// The smallest wall time of the integration over the repetitions [s].
-    wall_time_s: f64,
-    wall_times_s: Vec<f64>,
-    method: String,
-    /// The integrator line `simulate` prints when the rod's damping chose the method.
-    integrator_note: Option<String>,
-    steps: usize,
-    failed_steps: usize,
-    rhs_evaluations: usize,
-    jacobian_evaluations: usize,
-    /// Largest `|ξ − ξ*|` at the points of the model's start (a decoder's rest point; 0 for the
-    /// HOM and POD, which start from the straight rod).
-    start_offset: f64,
-    /// `None` for the HOM.
-    error: Option<Errors>,
-}
-
-impl SimRun {
-    fn tip_mean(&self) -> f64 {
-        self.error.as_ref().map_or(f64::NAN, |e| e.tip_mean)
-    }
-    /// "complete", or where and why it stopped, in short (the full reason is in `reason`).
-    fn status(&self) -> String {
-        if self.complete {
-            return "complete".into();
-        }
-        let why = if self.left_training_region {
-            "left its training region"
-        } else {
-            "the integrator failed"
-        };
-        format!("stopped at t = {:.2} s ({why})", self.t_reached)
-    }
-}
-
-/// The test simulated with the HOM (`model: None`) or a reduced model, written as a trajectory to
-/// the step's path (`gvsrom simulate … [--model M] --out DIR`) and, for a ROM, compared with the
-/// HOM's (`gvsrom compare`). The simulation is repeated `test.repeat` times without output and the
-/// smallest wall time kept. A ROM run that ends early is recorded as partial with its reason; the
-/// HOM's must complete.
-fn simulate_test(
-    run: &Run,
-    name: &str,
-    label: &str,
-    scenario: &ScenarioSpec,
-    test: &Test,
-    model: Option<&Step<ModelInfo>>,
-    hom: Option<&Step<SimRun>>,
-) -> anyhow::Result<Step<SimRun>> {
-    let config = json!({
-        "label": label, "scenario": scenario, "test": test,
-        "model": model.map(Step::key), "hom": hom.map(Step::key),
-    });
-    run.step(
-        name,
-        &config,
-        |p| Trajectory::load(p, "RUN").is_ok(),
-        |path| {
-            let (mut built, table) = scenario.build()?;
-            if let Some(m) = model {
-                reduce::attach(&mut built, Some(&table), &m.path)?;
-            }
-            let (opts, note) = test.options(&built)?;
-            let interrupt = run.interrupt().clone();
-            let mut control = |_: f64| match interrupt.load(Ordering::SeqCst) {
-                0 => ControlFlow::Continue(()),
-                _ => ControlFlow::Break("interrupted".to_string()),
-            };
-            let written = simulate::run_to_dir(&built, &opts, path, true, &mut control)?;
-            run.check_interrupt()?;
-            let outcome = &written.outcome;
-            let reason = match &outcome.ending {
-                Ending::Complete => None,
-                Ending::Failed { error } => Some(error.clone()),
-                Ending::Interrupted { reason } => Some(reason.clone()),
-            };
-            if let (None, Some(r)) = (model, &reason) {
-                anyhow::bail!("the HOM's simulation of the test failed: {r}");
-            }
-            let mut wall_times_s = vec![outcome.summary.wall_time_s];
-            for _ in 1..test.repeat {
-                let plan = simulate::plan(&built, &opts)?;
-                let again = simulate::run(&built, &plan, &opts.integrator, None, &mut control)?;
-                run.check_interrupt()?;
-                wall_times_s.push(again.summary.wall_time_s);
-            }
-            let error = match hom {
-                Some(h) => {
-                    let c = compare(
-                        &Trajectory::load(&h.path, "REFERENCE")?,
-                        &Trajectory::load(&written.dir, "RUN")?,
-                    )?;
-                    Some(Errors {
-                        samples: c.samples,
-                        tip_mean: c.tip_mean,
-                        tip_max: c.tip_max,
-                        tip_max_t: c.tip_max_t,
-                        tip_end: c.tip_end,
-                        strain_mean: c.strain_mean,
-                        strain_max: c.strain_max,
-                    })
-                }
-                None => None,
-            };
-            let sm = &outcome.summary;
-            Ok(SimRun {
-                label: label.into(),
-                dof: built.n_dof(),
-                complete: outcome.ending == Ending::Complete,
-                reason,
-                left_training_region: outcome.left_training_region,
-                t_reached: sm.t_last.unwrap_or(0.0),
-                samples: written.samples,
-                wall_time_s: wall_times_s.iter().copied().fold(f64::INFINITY, f64::min),
-                wall_times_s,
-                method: opts.integrator.method.name().into(),
-                integrator_note: note,
-                steps: sm.stats.steps,
-                failed_steps: sm.stats.failed_steps,
-                rhs_evaluations: sm.stats.rhs_evals,
-                jacobian_evaluations: sm.stats.jacobian_evals,
-                start_offset: built
-                    .reduced
-                    .as_ref()
-                    .map_or(0.0, |r| r.rest_strain_offset()),
-                error,
-            })
-        },
-    )
-}
-
-/// One reduced size: its models and their test runs.
-struct Dof {
-    r: usize,
-    ae: Step<ModelInfo>,
-    pod: Step<ModelInfo>,
-    ae_run: SimRun,
-    pod_run: SimRun,
-}
-
-/// An autoencoder of the λ comparison at the inset's r: its weight decay and seed, and its run.
-struct Variant {
-    lambda: f64,
-    seed: u64,
-    model: ModelInfo,
-    run: SimRun,
-}
-
-/// The step name of an AE (`ae-…`) or its test (`test-ae-…`) with r, λ and seed: `…-r7` for the
-/// ROMs of Fig. 9 (λ = [`LAMBDA`], the first seed), `…-r7-lambda-1e-4-seed1` for another.
-fn ae_name(prefix: &str, r: usize, lambda: f64, seed: u64, first_seed: u64) -> String {
-    let mut name = format!("iv-c2/{prefix}-r{r}");
-    if lambda != LAMBDA {
-        name += &format!("-lambda-{lambda:e}");
-    }
-    if seed != first_seed {
-        name += &format!("-seed{seed}");
-    }
-    name
-}
-
-/// Runs case IV-C2.
-pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<RenderedFigure>)> {
-    let s = sizes(opts);
-    let scenario = ScenarioSpec::new("six-tendon", &[]);
-    let plan = DatasetSpec {
-        duration: Some(s.data_s),
-        babble: Some(BABBLE.to_vec()),
-        sample_rate: Some(SAMPLE_RATE),
-        seed: DATA_SEED,
-        ..DatasetSpec::default()
-    };
-    let data = tasks::dataset(run, "iv-c2/dataset", &scenario, &plan, opts.jobs)?;
-
-    // the inset's r: the paper's 7 when tried, else the largest
-    let inset = if s.dofs.contains(&paper::TABLE_III_IV_C2.ae_dof) {
-        paper::TABLE_III_IV_C2.ae_dof
-    } else {
-        *s.dofs.last().expect("at least one r")
-    };
-    let first_seed = s.seeds[0];
-    let ae_config = |r: usize, lambda: f64, seed: u64| AeConfig {
-        lambda,
-        seed,
-        ..AeConfig::new(r, HIDDEN_LAYERS, s.epochs)
-    };
-    // every autoencoder at once (they cost about the same: r changes only the innermost layers):
-    // the ROMs of every r, then the other λ and seeds at the inset's r
-    let mut jobs: Vec<(String, AeConfig)> = s
-        .dofs
-        .iter()
-        .map(|&r| {
-            let name = ae_name("ae", r, LAMBDA, first_seed, first_seed);
-            (name, ae_config(r, LAMBDA, first_seed))
-        })
-        .collect();
-    let variants: Vec<(f64, u64)> = [LAMBDA, LAMBDA_OTHER]
-        .iter()
-        .flat_map(|&l| s.seeds.iter().map(move |&seed| (l, seed)))
-        .filter(|&(l, seed)| !(l == LAMBDA && seed == first_seed))
-        .collect();
-    for &(l, seed) in &variants {
-        let name = ae_name("ae", inset, l, seed, first_seed);
-        jobs.push((name, ae_config(inset, l, seed)));
-    }
-    let mut trained = tasks::parallel(&jobs, |(name, c)| tasks::train(run, name, &data, c))?;
-    let variant_models = trained.split_off(s.dofs.len());
-    let pods = tasks::parallel(&s.dofs, |&r| {
-        tasks::pod(run, &format!("iv-c2/pod-{r}"), &data, r)
-    })?;
-
-    // the test runs, one after the other so that their wall times compare
-    let test = Test {
-        duration: s.test_s,
-        sample_rate: SAMPLE_RATE,
-        steps: TEST_STEPS,
-        seed: TEST_SEED,
-        integrator: IntegratorChoice::default(),
-        repeat: s.repeat,
-    };
-    let hom = simulate_test(run, "iv-c2/test-hom", "HOM", &scenario, &test, None, None)?;
-    let mut dofs = vec![];
-    let mut inset_runs = None;
-    for ((&r, ae), pod) in s.dofs.iter().zip(trained).zip(pods) {
-        let ae_run = simulate_test(
-            run,
-            &format!("iv-c2/test-ae-r{r}"),
-            &format!("AE-{r}"),
-            &scenario,
-            &test,
-            Some(&ae),
-            Some(&hom),
-        )?;
-        let pod_run = simulate_test(
-            run,
-            &format!("iv-c2/test-pod-{r}"),
-            &format!("POD-{r}"),
-            &scenario,
-            &test,
-            Some(&pod),
-            Some(&hom),
-        )?;
-        if r == inset {
-            inset_runs = Some((
-                Trajectory::load(&ae_run.path, "AE")?,
-                Trajectory::load(&pod_run.path, "POD")?,
-            ));
-        }
-        dofs.push(Dof {
-            r,
-            ae,
-            pod,
-            ae_run: ae_run.value,
-            pod_run: pod_run.value,
-        });
-    }
-    let mut lambdas = vec![];
-    for (&(lambda, seed), model) in variants.iter().zip(variant_models) {
-        let test_run = simulate_test(
-            run,
-            &ae_name("test-ae", inset, lambda, seed, first_seed),
-            &format!("AE-{inset} (λ = {lambda:e}, seed {seed})"),
-            &scenario,
-            &test,
-            Some(&model),
-            Some(&hom),
-        )?;
-        lambdas.push(Variant {
-            lambda,
-            seed,
-            model: model.value,
-            run: test_run.value,
-        });
-    }
-    let inset_dof = dofs
-        .iter()
-        .find(|d| d.r == inset)
-        .expect("the inset's r is tried");
-    lambdas.insert(
-        0,
-        Variant {
-            lambda: LAMBDA,
-            seed: first_seed,
-            model: inset_dof.ae.value.clone(),
-            run: inset_dof.ae_run.clone(),
-        },
-    );
-    let (ae, pod) = inset_runs.expect("the inset's r is tried");
-    let trajectories = Inset {
-        r: inset,
-        hom: Trajectory::load(&hom.path, "HOM")?,
-        ae,
-        pod,
-    };
-    let hom = hom.value;
-
-    let mut report = new_report(
-        Case::IvC2,
-        "six-tendon multisection manipulator, dynamics (paper Section IV-C2)",
-    );
-    let dof_list = s
-        .dofs
-        .iter()
-        .map(usize::to_string)
-        .collect::<Vec<_>>()
-        .join(", ");
-    let [lo, hi, hmin, hmax] = BABBLE;
-    let [tlo, thi, period] = TEST_STEPS;
-    report.setup = vec![
-        format!("scenario: `ScenarioSpec::new(\"six-tendon\", &[])`, as IV-C1: the preset `six-tendon`, with gravity along −z (0.6 m arm in two 0.3 m divisions, radius 2 → 1 cm, E = 1 MPa, Kelvin–Voigt damping η = 10 kPa·s; base along +x, so a horizontal cantilever that sags; six frictionless tendons 60° apart, alternating full and half length; {}-DOF Legendre basis, {} values per snapshot)", hom.dof, data.value.features),
-        format!("data: {} s of actuator babbling, each tendon holding a uniform tension in [{lo}, {hi}] N for a uniform {hmin}–{hmax} s, from the straight rod at rest, sampled at {SAMPLE_RATE} Hz, seed {DATA_SEED} (`gvsrom dataset six-tendon --duration {} --babble={lo},{hi},{hmin},{hmax} --sample-rate {SAMPLE_RATE} --seed {DATA_SEED}`): {} snapshots, {} of them computed ({} failed)", s.data_s, s.data_s, data.value.samples, data.value.ok, data.value.failed),
-        format!("autoencoders: one per r = {dof_list}, each with {HIDDEN_LAYERS} hidden layers, tanh, λ = {LAMBDA:e} (the paper's, against a whole snapshot's squared error), loss weighted by the section stiffness (strain-energy norm), 1 % zero-strain rows (the straight rod the simulations start from), Adam ≤ {} epochs with early stopping (patience {}) and learning-rate reductions, then L-BFGS, seed {first_seed}; at r = {inset} also λ = {LAMBDA:e} and {LAMBDA_OTHER:e} with seeds {}, otherwise the same", s.epochs, AeConfig::new(1, HIDDEN_LAYERS, s.epochs).patience, s.seeds.iter().map(u64::to_string).collect::<Vec<_>>().join(", ")),
-        format!("POD: r = {dof_list} modes of the uncentred snapshots"),
-        format!("test: {} s of new uniform random tensions in [{tlo}, {thi}] N on every tendon every {period} s, seed {TEST_SEED}, sampled at {SAMPLE_RATE} Hz (`gvsrom simulate six-tendon --duration {} --steps={tlo},{thi},{period} --seed {TEST_SEED} [--model M] --out DIR`, then `gvsrom compare HOM-DIR DIR`); every model starts at rest (the HOM and POD from the straight rod, an AE from its rest point, the encoding of the straight rod, as the data start there), with `simulate`'s automatic integrator", s.test_s, s.test_s),
-        format!("timing: the simulations run one after the other on one thread, each {} time(s) (the trajectory written once), the smallest wall time of the integration kept; error: mean over the samples of ‖p_ROM − p_HOM‖ / L (`gvsrom compare`'s tip mean)", s.repeat),
-    ];
-    report.tables.push(fig9_table(&dofs, &hom));
-    report.tables.push(table_iii(inset_dof, &hom));
-    report.tables.push(lambda_table(inset, &lambdas));
-    report.tables.push(models_table(&dofs));
-    report.findings = findings(&dofs, &hom, inset_dof);
-    let context = Context {
-        data_s: s.data_s,
-        swing: tip_travel(&trajectories.hom, 1.0),
-        length: trajectories.hom.length,
-        lambdas: &lambdas,
-    };
-    report.notes = notes(&dofs, &hom, inset_dof, &context);
-    report.settings = json!({
-        "scenario": scenario,
-        "plan": plan,
-        "autoencoders": jobs.iter().map(|(n, c)| json!({ "step": n, "config": c })).collect::<Vec<_>>(),
-        "pod_modes": s.dofs,
-        "test": test,
-        "inset_r": inset,
-    });
-    report.values = json!({
-        "dataset": data.value,
-        "hom": hom,
-        "hom_tip_travel_within_1s_m": context.swing,
-        "dofs": dofs.iter().map(|d| json!({
-            "r": d.r, "ae_model": d.ae.value, "pod_model": d.pod.value,
-            "ae": d.ae_run, "pod": d.pod_run,
-        })).collect::<Vec<_>>(),
-        "lambda": lambdas.iter().map(|v| json!({
-            "lambda": v.lambda, "seed": v.seed, "model": v.model, "run": v.run,
-        })).collect::<Vec<_>>(),
-    });
-    let figures = vec![fig9(&dofs, &hom, &trajectories)?];
-    Ok((report, figures))
-}
-
 /// Fig. 9's numbers: per r, both ROMs' mean tip error and wall time, and the HOM's time.
-fn fig9_table(dofs: &[Dof], hom: &SimRun) -> Table {
+pub(super) fn fig9_table(dofs: &[Dof], hom: &SimRun) -> Table {
     let reached = |x: &SimRun| Cell::sig(x.t_reached, 3);
     Table {
         id: "fig9".into(),
@@ -541,7 +48,7 @@ fn fig9_table(dofs: &[Dof], hom: &SimRun) -> Table {
 }
 
 /// Table III's same-DOF row (r = 7 in the full run) beside the paper's.
-fn table_iii(d: &Dof, hom: &SimRun) -> Table {
+pub(super) fn table_iii(d: &Dof, hom: &SimRun) -> Table {
     let p = &paper::TABLE_III_IV_C2;
     let (p_pod, p_ae) = (
         p.pod_error.unwrap_or(f64::NAN),
@@ -608,7 +115,7 @@ fn table_iii(d: &Dof, hom: &SimRun) -> Table {
 
 /// The weight decay: the AE-ROMs at the inset's r with λ = 1e-6 (used) and 1e-4 (the paper's),
 /// one row per training seed.
-fn lambda_table(r: usize, lambdas: &[Variant]) -> Table {
+pub(super) fn lambda_table(r: usize, lambdas: &[Variant]) -> Table {
     Table {
         id: "lambda".into(),
         title: format!("Weight decay λ and training seed of the AE-ROM with r = {r}"),
@@ -644,7 +151,7 @@ fn lambda_table(r: usize, lambdas: &[Variant]) -> Table {
 }
 
 /// The models per r: the autoencoders' reconstruction and epochs, POD's captured energy.
-fn models_table(dofs: &[Dof]) -> Table {
+pub(super) fn models_table(dofs: &[Dof]) -> Table {
     Table {
         id: "models".into(),
         title: "The reduced models".into(),
@@ -679,7 +186,7 @@ fn models_table(dofs: &[Dof]) -> Table {
 }
 
 /// The paper's conclusions on Fig. 9, as measured.
-fn findings(dofs: &[Dof], hom: &SimRun, inset: &Dof) -> Vec<Finding> {
+pub(super) fn findings(dofs: &[Dof], hom: &SimRun, inset: &Dof) -> Vec<Finding> {
     let list = |f: &dyn Fn(&Dof) -> bool| {
         let v: Vec<String> = dofs
             .iter()
@@ -795,7 +302,7 @@ fn faster(a: &SimRun, b: &SimRun) -> Option<bool> {
 }
 
 /// The largest distance the tip travels within `window` seconds over the trajectory [m].
-fn tip_travel(t: &Trajectory, window: f64) -> f64 {
+pub(super) fn tip_travel(t: &Trajectory, window: f64) -> f64 {
     let p = |k: usize| [t.tip[3 * k], t.tip[3 * k + 1], t.tip[3 * k + 2]];
     let mut best = 0.0f64;
     for i in 0..t.samples() {
@@ -827,17 +334,17 @@ fn methods(dofs: &[Dof], run: impl Fn(&Dof) -> &SimRun) -> String {
 }
 
 /// What the notes are made of besides the runs.
-struct Context<'a> {
-    data_s: f64,
+pub(super) struct Context<'a> {
+    pub(super) data_s: f64,
     /// The HOM tip's largest travel within one second [m].
-    swing: f64,
+    pub(super) swing: f64,
     /// Rod length [m].
-    length: f64,
-    lambdas: &'a [Variant],
+    pub(super) length: f64,
+    pub(super) lambdas: &'a [Variant],
 }
 
 /// Where and why the results differ from the paper's.
-fn notes(dofs: &[Dof], hom: &SimRun, inset: &Dof, c: &Context) -> Vec<String> {
+pub(super) fn notes(dofs: &[Dof], hom: &SimRun, inset: &Dof, c: &Context) -> Vec<String> {
     let (ae, pod) = (&inset.ae_run, &inset.pod_run);
     let p = &paper::TABLE_III_IV_C2;
     let start = dofs
@@ -928,16 +435,16 @@ fn lambda_summary(lambda: f64, lambdas: &[Variant]) -> String {
 }
 
 /// The trajectories of the inset (HOM, AE-r, POD-r).
-struct Inset {
-    r: usize,
-    hom: Trajectory,
-    ae: Trajectory,
-    pod: Trajectory,
+pub(super) struct Inset {
+    pub(super) r: usize,
+    pub(super) hom: Trajectory,
+    pub(super) ae: Trajectory,
+    pub(super) pod: Trajectory,
 }
 
 /// Fig. 9: mean tip error and wall time against the DOF for both ROMs (and the HOM's time), and the
 /// inset's tip traces: the tip's path seen along the arm (y–z) and its coordinates over time.
-fn fig9(dofs: &[Dof], hom: &SimRun, inset: &Inset) -> anyhow::Result<RenderedFigure> {
+pub(super) fn fig9(dofs: &[Dof], hom: &SimRun, inset: &Inset) -> anyhow::Result<RenderedFigure> {
     let r: Vec<f64> = dofs.iter().map(|d| d.r as f64).collect();
     let over_r = |label: &str, f: &dyn Fn(&Dof) -> f64, color, style| Series {
         label: label.into(),
