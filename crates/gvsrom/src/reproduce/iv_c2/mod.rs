@@ -9,6 +9,7 @@
 //! simulated with it one after the other (`gvsrom simulate [--model]`), each ROM's trajectory
 //! compared with the HOM's (`gvsrom compare`: mean tip error in % of the length) and timed.
 
+mod more_tests;
 mod report;
 
 use super::report::{CaseReport, RenderedFigure};
@@ -18,6 +19,7 @@ use super::tasks::{self, AeConfig, DatasetSpec, ModelInfo, ScenarioSpec};
 use super::{new_report, paper, Case, Options, Run};
 use crate::compare::Trajectory;
 use crate::simulate::IntegratorChoice;
+use more_tests::{more_tests_findings, more_tests_table, run_more_tests, TestRuns};
 use report::{
     fig9, fig9_table, findings, lambda_table, models_table, notes, table_iii, tip_travel, Context,
     Inset,
@@ -56,6 +58,8 @@ struct Sizes {
     repeat: usize,
     /// Training seeds of the λ comparison at the inset's r (the ROMs of every r use the first).
     seeds: Vec<u64>,
+    /// Seeds of more test inputs for the inset's ROMs (besides [`TEST_SEED`]).
+    more_tests: Vec<u64>,
 }
 
 fn sizes(opts: &Options) -> Sizes {
@@ -67,6 +71,7 @@ fn sizes(opts: &Options) -> Sizes {
             test_s: 2.0,
             repeat: 1,
             seeds: vec![0],
+            more_tests: vec![],
         }
     } else if opts.quick {
         Sizes {
@@ -76,6 +81,7 @@ fn sizes(opts: &Options) -> Sizes {
             test_s: 10.0,
             repeat: 1,
             seeds: vec![0],
+            more_tests: vec![3],
         }
     } else {
         Sizes {
@@ -85,6 +91,7 @@ fn sizes(opts: &Options) -> Sizes {
             test_s: 10.0,
             repeat: 3,
             seeds: vec![0, 1, 2],
+            more_tests: vec![3, 4, 5, 6],
         }
     }
 }
@@ -244,6 +251,21 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
             run: inset_dof.ae_run.clone(),
         },
     );
+    let mut tests = vec![TestRuns {
+        seed: TEST_SEED,
+        hom: hom.value.clone(),
+        ae: inset_dof.ae_run.clone(),
+        pod: inset_dof.pod_run.clone(),
+    }];
+    tests.extend(run_more_tests(
+        run,
+        &scenario,
+        &test,
+        &s.more_tests,
+        inset,
+        &inset_dof.ae,
+        &inset_dof.pod,
+    )?);
     let (ae, pod) = inset_runs.expect("the inset's r is tried");
     let trajectories = Inset {
         r: inset,
@@ -270,14 +292,16 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         format!("data: {} s of actuator babbling, each tendon holding a uniform tension in [{lo}, {hi}] N for a uniform {hmin}–{hmax} s, from the straight rod at rest, sampled at {SAMPLE_RATE} Hz, seed {DATA_SEED} (`gvsrom dataset six-tendon --duration {} --babble={lo},{hi},{hmin},{hmax} --sample-rate {SAMPLE_RATE} --seed {DATA_SEED}`): {} snapshots, {} of them computed ({} failed)", s.data_s, s.data_s, data.value.samples, data.value.ok, data.value.failed),
         format!("autoencoders: one per r = {dof_list}, each with {HIDDEN_LAYERS} hidden layers, tanh, λ = {LAMBDA:e} (the paper's, against a whole snapshot's squared error), loss weighted by the section stiffness (strain-energy norm), 1 % zero-strain rows (the straight rod the simulations start from), Adam ≤ {} epochs with early stopping (patience {}) and learning-rate reductions, then L-BFGS, seed {first_seed}; at r = {inset} also λ = {LAMBDA:e} and {LAMBDA_OTHER:e} with seeds {}, otherwise the same", s.epochs, AeConfig::new(1, HIDDEN_LAYERS, s.epochs).patience, s.seeds.iter().map(u64::to_string).collect::<Vec<_>>().join(", ")),
         format!("POD: r = {dof_list} modes of the uncentred snapshots"),
-        format!("test: {} s of new uniform random tensions in [{tlo}, {thi}] N on every tendon every {period} s, seed {TEST_SEED}, sampled at {SAMPLE_RATE} Hz (`gvsrom simulate six-tendon --duration {} --steps={tlo},{thi},{period} --seed {TEST_SEED} [--model M] --out DIR`, then `gvsrom compare HOM-DIR DIR`); every model starts at rest (the HOM and POD from the straight rod, an AE from its rest point, the encoding of the straight rod, as the data start there), with `simulate`'s automatic integrator", s.test_s, s.test_s),
+        format!("test: {} s of new uniform random tensions in [{tlo}, {thi}] N on every tendon every {period} s, seed {TEST_SEED}, sampled at {SAMPLE_RATE} Hz (`gvsrom simulate six-tendon --duration {} --steps={tlo},{thi},{period} --seed {TEST_SEED} [--model M] --out DIR`, then `gvsrom compare HOM-DIR DIR`); every model starts at rest (the HOM and POD from the straight rod, an AE from its rest point, the encoding of the straight rod, as the data start there), with `simulate`'s automatic integrator{}", s.test_s, s.test_s, if s.more_tests.is_empty() { String::new() } else { format!("; the r = {inset} ROMs also on {} more inputs of the same kind, seeds {}", s.more_tests.len(), s.more_tests.iter().map(u64::to_string).collect::<Vec<_>>().join(", ")) }),
         format!("timing: the simulations run one after the other on one thread, each {} time(s) (the trajectory written once), the smallest wall time of the integration kept; error: mean over the samples of ‖p_ROM − p_HOM‖ / L (`gvsrom compare`'s tip mean)", s.repeat),
     ];
     report.tables.push(fig9_table(&dofs, &hom));
     report.tables.push(table_iii(inset_dof, &hom));
+    report.tables.push(more_tests_table(inset, &tests));
     report.tables.push(lambda_table(inset, &lambdas));
     report.tables.push(models_table(&dofs));
     report.findings = findings(&dofs, &hom, inset_dof);
+    report.findings.extend(more_tests_findings(inset, &tests));
     let context = Context {
         data_s: s.data_s,
         swing: tip_travel(&trajectories.hom, 1.0),
@@ -301,6 +325,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
             "r": d.r, "ae_model": d.ae.value, "pod_model": d.pod.value,
             "ae": d.ae_run, "pod": d.pod_run,
         })).collect::<Vec<_>>(),
+        "more_tests": tests,
         "lambda": lambdas.iter().map(|v| json!({
             "lambda": v.lambda, "seed": v.seed, "model": v.model, "run": v.run,
         })).collect::<Vec<_>>(),

@@ -1,0 +1,205 @@
+//! IV-C2's inset ROMs (r = 7 in the full run) on more test inputs than the paper's one: the same
+//! kind of input (new random tensions every second) drawn with other seeds, each simulated with
+//! the HOM, the AE-ROM and the POD-ROM (`gvsrom simulate --seed S [--model M]`, `gvsrom compare`).
+//! One test input can flatter or wrong a model; the table gives the spread, the findings the
+//! paper's accuracy claim on every input.
+
+use super::super::paper;
+use super::super::report::{Cell, Finding, Table};
+use super::super::sim_test::{simulate_test, SimRun, Test};
+use super::super::step::Step;
+use super::super::tasks::{ModelInfo, ScenarioSpec};
+use super::super::Run;
+use serde::Serialize;
+
+/// One test input: its seed and the three runs.
+#[derive(Debug, Clone, Serialize)]
+pub(super) struct TestRuns {
+    pub(super) seed: u64,
+    pub(super) hom: SimRun,
+    pub(super) ae: SimRun,
+    pub(super) pod: SimRun,
+}
+
+/// Simulates `test` with each of `seeds` (instead of its own) with the HOM and the models `ae` and
+/// `pod` of size `r`, one after the other (their wall times compare).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn run_more_tests(
+    run: &Run,
+    scenario: &ScenarioSpec,
+    test: &Test,
+    seeds: &[u64],
+    r: usize,
+    ae: &Step<ModelInfo>,
+    pod: &Step<ModelInfo>,
+) -> anyhow::Result<Vec<TestRuns>> {
+    seeds
+        .iter()
+        .map(|&seed| {
+            let t = Test {
+                seed,
+                ..test.clone()
+            };
+            let tag = format!("test seed {seed}");
+            let hom = simulate_test(
+                run,
+                &format!("iv-c2/test-hom-seed{seed}"),
+                &format!("HOM ({tag})"),
+                scenario,
+                &t,
+                None,
+                None,
+            )?;
+            let ae_run = simulate_test(
+                run,
+                &format!("iv-c2/test-ae-r{r}-test-seed{seed}"),
+                &format!("AE-{r} ({tag})"),
+                scenario,
+                &t,
+                Some(ae),
+                Some(&hom),
+            )?;
+            let pod_run = simulate_test(
+                run,
+                &format!("iv-c2/test-pod-{r}-test-seed{seed}"),
+                &format!("POD-{r} ({tag})"),
+                scenario,
+                &t,
+                Some(pod),
+                Some(&hom),
+            )?;
+            Ok(TestRuns {
+                seed,
+                hom: hom.value,
+                ae: ae_run.value,
+                pod: pod_run.value,
+            })
+        })
+        .collect()
+}
+
+/// Per test input: both ROMs' mean tip error, wall time and status, and the HOM's time; the mean
+/// over the inputs last.
+pub(super) fn more_tests_table(r: usize, tests: &[TestRuns]) -> Table {
+    let mean =
+        |f: &dyn Fn(&TestRuns) -> f64| tests.iter().map(f).sum::<f64>() / tests.len().max(1) as f64;
+    let mut rows: Vec<Vec<Cell>> = tests
+        .iter()
+        .map(|t| {
+            vec![
+                Cell::int(t.seed as usize),
+                Cell::sig(t.ae.tip_mean(), 3),
+                Cell::sig(t.pod.tip_mean(), 3),
+                Cell::sig(t.ae.wall_time_s, 3),
+                Cell::sig(t.pod.wall_time_s, 3),
+                Cell::sig(t.hom.wall_time_s, 3),
+                Cell::text(t.ae.status()),
+                Cell::text(t.pod.status()),
+            ]
+        })
+        .collect();
+    rows.push(vec![
+        Cell::text("mean"),
+        Cell::sig(mean(&|t| t.ae.tip_mean()), 3),
+        Cell::sig(mean(&|t| t.pod.tip_mean()), 3),
+        Cell::sig(mean(&|t| t.ae.wall_time_s), 3),
+        Cell::sig(mean(&|t| t.pod.wall_time_s), 3),
+        Cell::sig(mean(&|t| t.hom.wall_time_s), 3),
+        Cell::text(""),
+        Cell::text(""),
+    ]);
+    Table {
+        id: "more-tests".into(),
+        title: format!("AE-{r} and POD-{r} on {} test inputs", tests.len()),
+        columns: [
+            "test seed",
+            "AE-ROM tip error [% L]",
+            "POD-ROM tip error [% L]",
+            "AE-ROM time [s]",
+            "POD-ROM time [s]",
+            "HOM time [s]",
+            "AE-ROM run",
+            "POD-ROM run",
+        ]
+        .map(String::from)
+        .to_vec(),
+        rows,
+        note: "Each row is a test input of the same kind (new uniform random tensions on every tendon every second) drawn with its seed; the first is the paper's test above. Tip error: mean over the samples of ‖p_ROM − p_HOM‖ / L against the HOM on the same input; times: smallest wall time of the integration, one thread, the three runs of a row one after the other.".into(),
+    }
+}
+
+/// The paper's accuracy and speed claims at r on every test input.
+pub(super) fn more_tests_findings(r: usize, tests: &[TestRuns]) -> Vec<Finding> {
+    let p = &paper::TABLE_III_IV_C2;
+    let target = p.ae_error.unwrap_or(f64::NAN);
+    let n = tests.len();
+    let list = |f: &dyn Fn(&TestRuns) -> bool| {
+        let seeds: Vec<String> = tests
+            .iter()
+            .filter(|t| f(t))
+            .map(|t| t.seed.to_string())
+            .collect();
+        (seeds.len(), seeds.join(", "))
+    };
+    let errors = tests
+        .iter()
+        .map(|t| Cell::sig(t.ae.tip_mean(), 3).render())
+        .collect::<Vec<_>>()
+        .join(", ");
+    let (k_target, _) = list(&|t| t.ae.complete && t.ae.tip_mean() <= target);
+    let (k_better, better_at) =
+        list(&|t| t.ae.complete && t.pod.complete && t.ae.tip_mean() < t.pod.tip_mean());
+    let (k_left, left_at) = list(&|t| t.ae.left_training_region || t.pod.left_training_region);
+    let (k_fast, _) = list(&|t| t.ae.complete && t.ae.wall_time_s <= t.hom.wall_time_s);
+    let ratios = tests
+        .iter()
+        .map(|t| {
+            let ratio = Cell::sig(t.ae.wall_time_s / t.hom.wall_time_s, 2).render();
+            if t.ae.complete {
+                ratio
+            } else {
+                format!("{ratio} (stopped early)")
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
+    vec![
+        Finding {
+            claim: format!(
+                "AE-{r}'s mean tip error is at most the paper's {target} % L on every test input"
+            ),
+            holds: n > 0 && k_target == n,
+            evidence: format!(
+                "{k_target} of {n} inputs; AE-{r} errors {errors} % L (seeds {})",
+                seeds(tests)
+            ),
+        },
+        Finding {
+            claim: format!("AE-{r} is more accurate than POD-{r} on every test input"),
+            holds: n > 0 && k_better == n,
+            evidence: format!("{k_better} of {n} inputs (seeds {better_at})"),
+        },
+        Finding {
+            claim: format!("no AE-{r} or POD-{r} run leaves its training region"),
+            holds: k_left == 0,
+            evidence: if k_left == 0 {
+                format!("every run of the {n} inputs stayed inside")
+            } else {
+                format!("{k_left} of {n} inputs had a run that left (seeds {left_at})")
+            },
+        },
+        Finding {
+            claim: format!("the AE-{r}-ROM takes no more wall time than the HOM on the same input"),
+            holds: n > 0 && k_fast == n,
+            evidence: format!("{k_fast} of {n} inputs; AE-ROM / HOM time {ratios}"),
+        },
+    ]
+}
+
+fn seeds(tests: &[TestRuns]) -> String {
+    tests
+        .iter()
+        .map(|t| t.seed.to_string())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
