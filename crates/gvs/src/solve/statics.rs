@@ -11,13 +11,21 @@
 //!
 //! **Load ramping**: the loads and tensions are scaled by `λ_m = m/N` and each solve is warm-started
 //! from the previous one; if a stage fails, the increment is halved (down to `min_increment`) before
-//! the failure is reported.
+//! the failure is reported. When the increment cannot be halved further in a solve from the
+//! straight rod (no `q0`, `min_increment < 1`), pseudo-arc-length continuation
+//! ([`super::continuation`]) follows the equilibria from the straight rod at λ = 0 (the one
+//! equilibrium without load) through any folds to λ = 1, and a last dogleg stage at λ = 1 polishes
+//! its solution. It starts from the straight rod, not from the ramp's last converged stage: the
+//! ramp's large increments can converge onto another branch (on the six-tendon arm, loops of
+//! equilibria folding back and forth below λ = 1, which continuation from there circles without
+//! reaching λ = 1).
 //!
 //! **Bounded work**: the options are capped ([`MAX_RAMP_STEPS`], [`MAX_ITERATIONS`],
 //! [`MIN_INCREMENT_FLOOR`]) and one solve stops with [`StaticsError::NotConverged`] after
 //! [`MAX_LOAD_STAGES`] load stages or [`MAX_TOTAL_ITERATIONS`] dogleg iterations in all, so that no
 //! input makes a solve run unbounded (e.g. ramping by a halved increment of 1e-6 for 1e6 stages).
 
+use super::continuation::{self, ContinuationStats};
 use super::dogleg::{
     self, DoglegError, DoglegOptions, DoglegWorkspace, EvalError, NonlinearSystem,
 };
@@ -137,7 +145,7 @@ impl StaticsOptions {
 #[derive(Debug, Clone)]
 pub struct StaticsSolution {
     pub q: DVector<f64>,
-    /// Dogleg iterations summed over load stages.
+    /// Dogleg iterations summed over load stages (and the continuation's, if it ran).
     pub iterations: usize,
     /// Residual evaluations, those of forward-difference Jacobians included.
     pub residual_evaluations: usize,
@@ -146,6 +154,8 @@ pub struct StaticsSolution {
     pub residual_norm: f64,
     /// Load stages solved (including retries after halving).
     pub load_stages: usize,
+    /// The continuation from the straight rod, if the ramp stalled (its q was then polished at λ = 1).
+    pub continuation: Option<ContinuationStats>,
 }
 
 #[derive(Debug, Error)]
@@ -312,6 +322,7 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
             jacobian_evaluations: 0,
             residual_norm: f64::NAN,
             load_stages: 0,
+            continuation: None,
         };
         let differences = match self.options.jacobian {
             StaticsJacobian::Auto => n <= DIFFERENCE_MAX_DOF,
@@ -383,16 +394,39 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                     total.iterations += iterations;
                     total.residual_norm = residual_norm;
                     last_tolerance = tolerance;
-                    if inc / 2.0 >= self.options.min_increment * (1.0 - 1e-12) {
+                    if inc / 2.0 >= self.options.min_increment * (1.0 - 1e-12)
+                        && total.continuation.is_none()
+                    {
                         inc /= 2.0;
                         continue;
+                    }
+                    let mut reason = format!("{reason} (load increment already reduced to {inc})");
+                    // only from the straight rod (a warm start's caller has its own fallback) and
+                    // with ramping allowed (min_increment = 1 asks for one stage)
+                    let may_continue = q0.is_none() && self.options.min_increment < 1.0;
+                    if may_continue && total.continuation.is_none() {
+                        let ws = &mut self.ws;
+                        match continuation::follow_statics(self.model, ws, u, loads, &opts) {
+                            Ok((path, residuals, jacobians)) => {
+                                total.iterations += path.stats.iterations;
+                                total.residual_evaluations += residuals;
+                                total.jacobian_evaluations += jacobians;
+                                total.continuation = Some(path.stats);
+                                q = path.x;
+                                inc = 1.0; // a last stage at λ = 1 polishes q
+                                continue;
+                            }
+                            Err(e) => reason = format!("{reason}; then from the straight rod, {e}"),
+                        }
+                    } else if total.continuation.is_some() {
+                        reason = format!("{reason}, at λ = 1 after the continuation");
                     }
                     return Err(StaticsError::NotConverged {
                         load_factor: target,
                         iterations: total.iterations,
                         residual_norm,
                         tolerance,
-                        reason: format!("{reason} (load increment already reduced to {inc})"),
+                        reason,
                     });
                 }
             }
