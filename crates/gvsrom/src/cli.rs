@@ -1101,6 +1101,22 @@ fn print_solution(r: &StaticsReport, out: &mut impl Write) -> Result<()> {
         r.residual_norm,
         r.solve_time_s * 1e3
     )?;
+    if let Some(c) = &r.continuation {
+        let folds = c
+            .folds
+            .iter()
+            .map(|l| format!("{l:.4}"))
+            .collect::<Vec<_>>()
+            .join(", ");
+        writeln!(
+            out,
+            "continued  the load ramp stalled: followed the equilibria from the straight rod by arc-length continuation in {} ({} rejected), through {}{}",
+            plural(c.steps, "step"),
+            c.rejected_steps,
+            plural(c.folds.len(), "fold"),
+            if folds.is_empty() { String::new() } else { format!(" at load factor {folds}") }
+        )?;
+    }
     writeln!(out, "tip        position {} m", fmt_vec(&r.tip_position, 6))?;
     let (axis, angle) = r.tip_axis_angle();
     writeln!(

@@ -42,6 +42,21 @@ pub struct StaticsReport {
     pub residual_norm: f64,
     /// Wall-clock time of the solve alone [s].
     pub solve_time_s: f64,
+    /// Set when the load ramp stalled and the equilibrium was reached by arc-length continuation
+    /// from the straight rod.
+    pub continuation: Option<ContinuationSummary>,
+}
+
+/// How the arc-length continuation reached the equilibrium ([`gvs::solve::continuation`]).
+#[derive(Debug, Clone, Serialize)]
+pub struct ContinuationSummary {
+    /// Accepted and rejected arc-length steps.
+    pub steps: usize,
+    pub rejected_steps: usize,
+    /// The load factor at each fold passed, in order.
+    pub folds: Vec<f64>,
+    /// The largest load factor on the path before it reached 1.
+    pub lambda_max: f64,
 }
 
 impl StaticsReport {
@@ -140,6 +155,12 @@ fn solve_on<P: StrainParam>(
         jacobian_evaluations: sol.jacobian_evaluations,
         residual_norm: sol.residual_norm,
         solve_time_s,
+        continuation: sol.continuation.as_ref().map(|c| ContinuationSummary {
+            steps: c.steps,
+            rejected_steps: c.rejected,
+            folds: c.folds.clone(),
+            lambda_max: c.lambda_max,
+        }),
     })
 }
 

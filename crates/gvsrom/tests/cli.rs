@@ -545,3 +545,35 @@ fn solver_options_beyond_their_limits_are_rejected_before_solving() {
         &["solver.min_increment", "1e-300", "[1e-6, 1]"],
     );
 }
+
+/// A six-tendon input under gravity that the load ramp alone cannot solve (sample 7371 of
+/// `dataset six-tendon --random 'tendons.*.tension=-30:30' --samples 20000 --seed 0`): `statics`
+/// reaches it by arc-length continuation through two folds, says so, and records it in the JSON.
+#[test]
+fn an_input_beyond_the_load_ramp_is_solved_by_continuation_and_reported() {
+    let json = scratch("continuation.json");
+    let out = gvsrom(&[
+        "statics",
+        "six-tendon",
+        "--tension=14.443131761064372,-23.659122666412333,2.0695427183255006,7.619300609702577,10.53722237180915,10.791231360008751",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.contains("continued") && stdout.contains("through 2 folds at load factor 0.59"),
+        "{stdout}"
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let folds = v["continuation"]["folds"]
+        .as_array()
+        .expect("continuation.folds");
+    assert_eq!(folds.len(), 2, "{v}");
+    assert!(v["residual_norm"].as_f64().unwrap() < 1e-8);
+}
