@@ -1,52 +1,8 @@
-//! Matrix products of the network passes: a safe bounds-checked wrapper of `matrixmultiply::dgemm`
-//! for the mini-batches of training, and faer products for the narrow right-hand sides of one
-//! evaluation (the decoder and the stacked strain basis).
+//! faer products for the narrow right-hand sides of one evaluation (the decoder and the stacked
+//! strain basis); the mini-batches of training call faer directly ([`crate::nn::batch`]).
 
 use faer::linalg::matmul::matmul;
 use faer::{Accum, MatMut, MatRef, Par};
-
-/// `C = A·B + β·C` for `A` (`m × k`), `B` (`k × n`), `C` (`m × n`) with explicit (row, column)
-/// strides; checks that every addressed element lies inside its slice.
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn gemm(
-    (m, k, n): (usize, usize, usize),
-    a: &[f64],
-    (rsa, csa): (usize, usize),
-    b: &[f64],
-    (rsb, csb): (usize, usize),
-    beta: f64,
-    c: &mut [f64],
-    (rsc, csc): (usize, usize),
-) {
-    if m == 0 || n == 0 {
-        return;
-    }
-    let last = |rows: usize, cols: usize, rs: usize, cs: usize| {
-        (rows - 1) * rs + cols.saturating_sub(1) * cs
-    };
-    assert!(k == 0 || (last(m, k, rsa, csa) < a.len() && last(k, n, rsb, csb) < b.len()));
-    assert!(last(m, n, rsc, csc) < c.len());
-    // SAFETY: the assertions above bound every element the kernel reads or writes; `c` is a unique
-    // borrow and cannot alias `a` or `b`.
-    unsafe {
-        matrixmultiply::dgemm(
-            m,
-            k,
-            n,
-            1.0,
-            a.as_ptr(),
-            rsa as isize,
-            csa as isize,
-            b.as_ptr(),
-            rsb as isize,
-            csb as isize,
-            beta,
-            c.as_mut_ptr(),
-            rsc as isize,
-            csc as isize,
-        );
-    }
-}
 
 /// `Y = A·B` for column-major `A` (`rows × k`), `B` (`k × n`) and `Y` (`rows × n`), on faer's
 /// runtime-dispatched SIMD kernels: the narrow products of one evaluation (a value and a few

@@ -13,7 +13,7 @@
 //! halves are therefore plain [`Mlp`]s. The networks work in scaled units (see [`Scaling`]):
 //! `E(x) = enc((x − μ)/s)`, `D(z) = s ⊙ dec(z) + μ`.
 
-use super::batch::{dataset_mse, forward_batch, Workspace};
+use super::batch::{dataset_mse, forward_batch, in_pool, Workspace};
 use super::decoder_map::DecoderMap;
 use super::mlp::{Layer, Mlp};
 use super::train::{fit, shuffle, Problem, Progress, TrainOptions, TrainReport};
@@ -122,11 +122,11 @@ impl Autoencoder {
 
         let mut ws = Workspace::new(&sizes, opts.batch_size.min(rows));
         let mut errors = |index: &[usize]| {
-            let mse = dataset_mse(&layers, &tanh, &scaled, index, &mut ws);
-            (
-                mse,
-                physical_rmse(&layers, &tanh, &scaled, index, &scaling, &mut ws),
-            )
+            let (layers, tanh, scaled, scaling, ws) = (&layers, &tanh, &scaled, &scaling, &mut ws);
+            in_pool(|| {
+                let mse = dataset_mse(layers, tanh, scaled, index, ws);
+                (mse, physical_rmse(layers, tanh, scaled, index, scaling, ws))
+            })
         };
         let (final_train_loss, final_train_rmse) = errors(&train);
         let final_val = (!val.is_empty()).then(|| errors(&val));

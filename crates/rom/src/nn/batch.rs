@@ -1,4 +1,4 @@
-//! Batched forward and backward passes of a layer chain on `matrixmultiply::dgemm`.
+//! Batched forward and backward passes of a layer chain on faer's matrix products.
 //!
 //! A batch of `B` samples is stored row-major, one sample per row: `H_k` is `B × n_k`. Layer `k`
 //! computes `A_{k+1} = H_k W_kᵀ + 1 b_kᵀ`, `H_{k+1} = σ_k(A_{k+1})` (tanh or identity per layer).
@@ -13,10 +13,53 @@
 //! `Δ_k = (Δ_{k+1} W_k) ⊙ σ'_{k−1}` with `σ' = 1 − H_k²` for tanh and 1 for identity.
 //!
 //! All buffers live in a [`Workspace`] sized once for the largest batch, so a training epoch allocates
-//! nothing of its own (`dgemm` may use its internal packing cache).
+//! nothing of its own (faer reuses its thread-local packing buffers).
+//!
+//! Parallelism (rayon's current pool, through [`in_pool`]): a layer with at least
+//! [`PARALLEL_MIN_MACS`] multiply-adds per pass runs as two tasks — in the forward pass the two
+//! halves of its output units; in the backward pass `∂L/∂W_k` beside `Δ_k` (the same work each),
+//! and for the first layer the two halves of `∂L/∂W_0`'s rows. The split depends on the sizes only,
+//! never on the number of threads, and every output element is computed by one task in a fixed
+//! order, so results are bit-identical whatever the pool (one thread runs both tasks in turn).
 
+use super::activation::add_bias_and_activate;
 use super::mlp::Layer;
-use crate::gemm::gemm;
+use faer::linalg::matmul::matmul;
+use faer::reborrow::ReborrowMut;
+use faer::{Accum, MatMut, MatRef, Par};
+
+/// A layer's pass runs as two parallel tasks from this many multiply-adds (rows × weights): ~10 µs
+/// of work, against ~1 µs for a rayon join between running workers.
+pub(crate) const PARALLEL_MIN_MACS: usize = 1 << 17;
+
+/// Runs `f` on a worker of rayon's current pool (directly when this thread is one), so that the
+/// joins inside it are cheap: from outside the pool every join would hand its work to the pool and
+/// wait.
+pub(crate) fn in_pool<R: Send>(f: impl FnOnce() -> R + Send) -> R {
+    rayon::scope(|_| f())
+}
+
+/// Where `n` units are cut into two tasks: about half, on a multiple of 4 (the SIMD width).
+fn half(n: usize) -> usize {
+    n.div_ceil(2).next_multiple_of(4).min(n)
+}
+
+/// The first `rows × cols` values of `s` as a row-major matrix.
+fn row_major(s: &[f64], rows: usize, cols: usize) -> MatRef<'_, f64> {
+    MatRef::from_row_major_slice(&s[..rows * cols], rows, cols)
+}
+
+/// The first `rows × cols` values of `s` as a mutable row-major matrix.
+fn row_major_mut(s: &mut [f64], rows: usize, cols: usize) -> MatMut<'_, f64> {
+    MatMut::from_row_major_slice_mut(&mut s[..rows * cols], rows, cols)
+}
+
+/// `C = A·B` (`Accum::Replace`) or `C += A·B` (`Accum::Add`) on this thread.
+fn product(c: MatMut<'_, f64>, accum: Accum, a: MatRef<'_, f64>, b: MatRef<'_, f64>) {
+    matmul(c, accum, a, b, 1.0, Par::Seq);
+    // faer leaves the upper vector registers dirty; the baseline SSE code after it would pay
+    gvs::cpu::clear_upper_state();
+}
 
 /// Buffers for batches of up to `capacity` rows: activations, backpropagated errors, gradients.
 #[derive(Debug, Clone)]
@@ -69,24 +112,24 @@ impl Workspace {
 pub(crate) fn forward_batch(layers: &[Layer], tanh: &[bool], ws: &mut Workspace, rows: usize) {
     for (k, layer) in layers.iter().enumerate() {
         let (head, tail) = ws.acts.split_at_mut(k + 1);
-        let (h, out) = (&head[k], &mut tail[0]);
         let (n_in, n_out) = (layer.n_in, layer.n_out);
-        for row in out[..rows * n_out].chunks_exact_mut(n_out) {
-            row.copy_from_slice(&layer.b);
-        }
-        // W_kᵀ as a (n_in × n_out) matrix: element (p, j) = W[j, p] at j·n_in + p.
-        gemm(
-            (rows, n_in, n_out),
-            h,
-            (n_in, 1),
-            &layer.w,
-            (1, n_in),
-            1.0,
-            out,
-            (n_out, 1),
-        );
-        if tanh[k] {
-            out[..rows * n_out].iter_mut().for_each(|a| *a = a.tanh());
+        let h = row_major(&head[k], rows, n_in);
+        // W_kᵀ (n_in × n_out): element (p, j) = W[j, p] at j·n_in + p.
+        let w_t = row_major(&layer.w, n_out, n_in).transpose();
+        let out = row_major_mut(&mut tail[0], rows, n_out);
+        // output units j0.. (the columns of `out` and `w_t`, the biases `b`)
+        let units = |mut out: MatMut<'_, f64>, w_t: MatRef<'_, f64>, b: &[f64]| {
+            product(out.rb_mut(), Accum::Replace, h, w_t);
+            add_bias_and_activate(out, b, tanh[k]);
+        };
+        if rows * layer.w.len() >= PARALLEL_MIN_MACS {
+            let j = half(n_out);
+            let (out_0, out_1) = out.split_at_col_mut(j);
+            let (w_t_0, w_t_1) = w_t.split_at_col(j);
+            let (b_0, b_1) = layer.b.split_at(j);
+            rayon::join(|| units(out_0, w_t_0, b_0), || units(out_1, w_t_1, b_1));
+        } else {
+            units(out, w_t, &layer.b);
         }
     }
 }
@@ -113,70 +156,124 @@ pub(crate) fn backward_batch(
     rows: usize,
     lambda: f64,
 ) {
+    backward(layers, tanh, ws, rows, Some(lambda));
+}
+
+/// As [`backward_batch`] without the penalty: `ws.grad_w` holds `Δ_{k+1}ᵀ H_k` only, and the
+/// optimiser adds `2λ W_k` (as `(2λ)·W_k`, rounding as [`backward_batch`] does) as it reads it,
+/// which saves a pass over the weights and the gradients.
+pub(crate) fn backward_batch_without_penalty(
+    layers: &[Layer],
+    tanh: &[bool],
+    ws: &mut Workspace,
+    rows: usize,
+) {
+    backward(layers, tanh, ws, rows, None);
+}
+
+fn backward(layers: &[Layer], tanh: &[bool], ws: &mut Workspace, rows: usize, lambda: Option<f64>) {
     let n_layers = layers.len();
     let n = layers[n_layers - 1].n_out;
     let scale = 2.0 / (rows * n) as f64;
-    let [d_cur, d_prev] = &mut ws.delta;
-    for (d, (y, x)) in d_cur.iter_mut().zip(
-        ws.acts[n_layers][..rows * n]
-            .iter()
-            .zip(&ws.acts[0][..rows * n]),
-    ) {
-        *d = scale * (y - x);
-    }
+    let Workspace {
+        acts,
+        delta: [d_cur, d_prev],
+        grad_w,
+        grad_b,
+        ..
+    } = ws;
+    output_delta(
+        &mut d_cur[..rows * n],
+        &acts[n_layers][..rows * n],
+        &acts[0][..rows * n],
+        scale,
+    );
     if tanh[n_layers - 1] {
-        apply_tanh_derivative(&mut d_cur[..rows * n], &ws.acts[n_layers][..rows * n]);
+        apply_tanh_derivative(&mut d_cur[..rows * n], &acts[n_layers][..rows * n]);
     }
     for k in (0..n_layers).rev() {
         let layer = &layers[k];
         let (n_in, n_out) = (layer.n_in, layer.n_out);
-        let (delta, h) = (&d_cur[..rows * n_out], &ws.acts[k][..rows * n_in]);
-        // ∂L/∂W_k = Δᵀ H_k + 2λ W_k: Δᵀ is (n_out × B) with element (j, b) at b·n_out + j.
-        let gw = &mut ws.grad_w[k];
-        for (g, w) in gw.iter_mut().zip(&layer.w) {
-            *g = 2.0 * lambda * w;
-        }
-        gemm(
-            (n_out, rows, n_in),
-            delta,
-            (1, n_out),
-            h,
-            (n_in, 1),
-            1.0,
-            gw,
-            (n_in, 1),
-        );
-        column_sums(delta, n_out, &mut ws.grad_b[k]);
-        if k > 0 {
-            // Δ_k = (Δ_{k+1} W_k) ⊙ σ'_{k−1}(H_k).
-            gemm(
-                (rows, n_out, n_in),
-                delta,
-                (n_out, 1),
-                &layer.w,
-                (n_in, 1),
-                0.0,
-                d_prev,
-                (n_in, 1),
+        let (delta, h) = (&d_cur[..rows * n_out], &acts[k][..rows * n_in]);
+        // rows j0.. of ∂L/∂W_k = Δᵀ H_k + 2λ W_k (into `gw`) and of ∂L/∂b_k = Δᵀ 1 (into `gb`)
+        let gradients = |gw: &mut [f64], gb: &mut [f64], j0: usize| {
+            let units = gb.len();
+            if let Some(lambda) = lambda {
+                let w = &layer.w[j0 * n_in..(j0 + units) * n_in];
+                for (g, w) in gw.iter_mut().zip(w) {
+                    *g = 2.0 * lambda * w;
+                }
+            }
+            let accum = if lambda.is_some() {
+                Accum::Add
+            } else {
+                Accum::Replace
+            };
+            let delta_t = row_major(delta, rows, n_out).transpose().subrows(j0, units);
+            product(
+                row_major_mut(gw, units, n_in),
+                accum,
+                delta_t,
+                row_major(h, rows, n_in),
+            );
+            column_sums(delta, n_out, j0, gb);
+        };
+        // Δ_k = (Δ_{k+1} W_k) ⊙ σ'_{k−1}(H_k)
+        let back = |d_prev: &mut [f64]| {
+            product(
+                row_major_mut(d_prev, rows, n_in),
+                Accum::Replace,
+                row_major(delta, rows, n_out),
+                row_major(&layer.w, n_out, n_in),
             );
             if tanh[k - 1] {
                 apply_tanh_derivative(&mut d_prev[..rows * n_in], h);
             }
+        };
+        let (gw, gb) = (&mut grad_w[k][..], &mut grad_b[k][..]);
+        let parallel = rows * layer.w.len() >= PARALLEL_MIN_MACS;
+        if k > 0 {
+            if parallel {
+                rayon::join(|| gradients(gw, gb, 0), || back(d_prev));
+            } else {
+                gradients(gw, gb, 0);
+                back(d_prev);
+            }
             std::mem::swap(d_cur, d_prev);
+        } else if parallel {
+            let j = half(n_out);
+            let (gw_0, gw_1) = gw.split_at_mut(j * n_in);
+            let (gb_0, gb_1) = gb.split_at_mut(j);
+            rayon::join(|| gradients(gw_0, gb_0, 0), || gradients(gw_1, gb_1, j));
+        } else {
+            gradients(gw, gb, 0);
         }
     }
 }
 
-/// `d ← d ⊙ (1 − h²)`, the tanh derivative expressed through its output `h = tanh(a)`.
-fn apply_tanh_derivative(d: &mut [f64], h: &[f64]) {
-    d.iter_mut().zip(h).for_each(|(d, h)| *d *= 1.0 - h * h);
+simd_fn! {
+    /// `d = scale · (y − x)`, the loss gradient with respect to the output.
+    fn output_delta(d: &mut [f64], y: &[f64], x: &[f64], scale: f64) {
+        for (d, (y, x)) in d.iter_mut().zip(y.iter().zip(x)) {
+            *d = scale * (y - x);
+        }
+    }
 }
 
-/// `out_j = Σ_b m[b, j]` for a row-major `B × n` matrix.
-fn column_sums(m: &[f64], n: usize, out: &mut [f64]) {
-    out.iter_mut().for_each(|o| *o = 0.0);
-    for row in m.chunks_exact(n) {
-        out.iter_mut().zip(row).for_each(|(o, v)| *o += v);
+simd_fn! {
+    /// `d ← d ⊙ (1 − h²)`, the tanh derivative expressed through its output `h = tanh(a)`.
+    fn apply_tanh_derivative(d: &mut [f64], h: &[f64]) {
+        d.iter_mut().zip(h).for_each(|(d, h)| *d *= 1.0 - h * h);
+    }
+}
+
+simd_fn! {
+    /// `out_j = Σ_b m[b, j0 + j]` for a row-major `B × n` matrix `m`.
+    fn column_sums(m: &[f64], n: usize, j0: usize, out: &mut [f64]) {
+        out.iter_mut().for_each(|o| *o = 0.0);
+        for row in m.chunks_exact(n) {
+            out.iter_mut().zip(&row[j0..]).for_each(|(o, v)| *o += v);
+        }
     }
 }
 
@@ -190,6 +287,10 @@ pub(crate) fn forward_rows(
     ws: &mut Workspace,
     out: &mut [f64],
 ) {
+    let weights: usize = layers.iter().map(|l| l.w.len()).sum();
+    if rows * weights >= PARALLEL_MIN_MACS && rayon::current_thread_index().is_none() {
+        return in_pool(|| forward_rows(layers, tanh, x, rows, ws, out));
+    }
     let n_in = layers[0].n_in;
     let n_out = layers[layers.len() - 1].n_out;
     let mut start = 0;

@@ -3,11 +3,43 @@
 //!
 //! - [`mlp`]: dense layers `h_{k+1} = tanh(W_k h_k + b_k)` with a linear last layer; plain-data access.
 //! - [`scaling`]: the per-feature affine map between physical snapshots and network units.
-//! - [`batch`]: batched forward/backward passes on `matrixmultiply::dgemm` with a reusable workspace.
+//! - [`batch`]: batched forward/backward passes on faer's products with a reusable workspace.
 //! - [`train`]: options, Adam, early stopping, the training report.
 //! - [`lbfgs`]: full-batch L-BFGS, the optional final training phase.
 //! - [`autoencoder`]: the symmetric architecture, encode/decode, training entry point.
 //! - [`decoder_map`]: the decoder folded with an output projection; value, Jacobian, eq. (17), Hessians.
+
+/// `simd_fn! { fn name(args) -> R { body } }` defines `name` whose body is compiled twice, for
+/// AVX2 + FMA and for the baseline target, and runs the AVX2 build when the CPU has them (a cached
+/// run-time test). The elementwise kernels of training are plain loops that the compiler vectorises;
+/// without fast-math both builds round identically (`mul_add` is exactly rounded on either), so the
+/// results do not depend on the path taken.
+macro_rules! simd_fn {
+    (
+        $(#[$meta:meta])*
+        $vis:vis fn $name:ident($($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)? $body:block
+    ) => {
+        $(#[$meta])*
+        $vis fn $name($($arg: $ty),*) $(-> $ret)? {
+            #[inline(always)]
+            fn imp($($arg: $ty),*) $(-> $ret)? $body
+            #[cfg(target_arch = "x86_64")]
+            {
+                #[target_feature(enable = "avx2,fma")]
+                unsafe fn avx2($($arg: $ty),*) $(-> $ret)? {
+                    imp($($arg),*)
+                }
+                if std::arch::is_x86_feature_detected!("avx2")
+                    && std::arch::is_x86_feature_detected!("fma")
+                {
+                    // SAFETY: the CPU has AVX2 and FMA, checked just above.
+                    return unsafe { avx2($($arg),*) };
+                }
+            }
+            imp($($arg),*)
+        }
+    };
+}
 
 pub mod activation;
 pub mod autoencoder;

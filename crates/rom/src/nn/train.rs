@@ -17,10 +17,15 @@
 //! [`LR_REDUCTION_FACTOR`], up to [`TrainOptions::lr_reductions`] times, then stops. An optional fine-tuning phase ([`FineTune`]:
 //! Adam with a smaller rate, or full-batch L-BFGS, which converges much further on smooth small
 //! problems) restarts from the best weights and only changes the result if it lowers the monitored
-//! loss. Everything runs on one thread in a fixed order: the same seed and data give bit-identical
-//! weights.
+//! loss. The passes and the Adam step run as pairs of tasks on rayon's current pool (the caller's, or
+//! the global one: all cores unless `RAYON_NUM_THREADS` says otherwise), split by the layer sizes
+//! alone ([`crate::nn::batch`]): the same seed and data give bit-identical weights whatever the
+//! number of threads (`weights_do_not_depend_on_the_number_of_threads`).
 
-use super::batch::{backward_batch, dataset_mse, forward_batch, reconstruction_mse, Workspace};
+use super::batch::{
+    backward_batch_without_penalty, dataset_mse, forward_batch, in_pool, reconstruction_mse,
+    Workspace, PARALLEL_MIN_MACS,
+};
 use super::lbfgs::{Lbfgs, Objective};
 use super::mlp::Layer;
 use super::scaling::Weighting;
@@ -205,11 +210,16 @@ pub type Progress<'a> = &'a mut dyn FnMut(usize, f64, Option<f64>) -> ControlFlo
 
 /// Adam moments for every weight and bias.
 struct Adam {
-    m_w: Vec<Vec<f64>>,
-    v_w: Vec<Vec<f64>>,
-    m_b: Vec<Vec<f64>>,
-    v_b: Vec<Vec<f64>>,
+    layers: Vec<Moments>,
     t: i32,
+}
+
+/// First and second moments of one layer's weights and biases.
+struct Moments {
+    m_w: Vec<f64>,
+    v_w: Vec<f64>,
+    m_b: Vec<f64>,
+    v_b: Vec<f64>,
 }
 
 /// The factor applied to the Adam learning rate at each plateau ([`TrainOptions::lr_reductions`]).
@@ -221,59 +231,101 @@ const EPS: f64 = 1e-8;
 
 impl Adam {
     fn new(layers: &[Layer]) -> Self {
-        let zeros =
-            |f: fn(&Layer) -> usize| layers.iter().map(|l| vec![0.0; f(l)]).collect::<Vec<_>>();
         Adam {
-            m_w: zeros(|l| l.w.len()),
-            v_w: zeros(|l| l.w.len()),
-            m_b: zeros(|l| l.b.len()),
-            v_b: zeros(|l| l.b.len()),
+            layers: layers
+                .iter()
+                .map(|l| Moments {
+                    m_w: vec![0.0; l.w.len()],
+                    v_w: vec![0.0; l.w.len()],
+                    m_b: vec![0.0; l.b.len()],
+                    v_b: vec![0.0; l.b.len()],
+                })
+                .collect(),
             t: 0,
         }
     }
 
-    /// One step `θ ← θ − η m̂/(√v̂ + ε)` on every layer with the gradients in `ws`.
-    fn step(&mut self, layers: &mut [Layer], ws: &Workspace, lr: f64) {
+    /// One step `θ ← θ − η m̂/(√v̂ + ε)` on every layer with the gradients in `ws`, which lack the
+    /// penalty's `2λ W` ([`backward_batch_without_penalty`]); it is added here. Two tasks (rayon)
+    /// update the layers before and after the middle of the parameters (the encoder and the decoder
+    /// of an autoencoder); the update is elementwise, so the result does not depend on the split.
+    fn step(&mut self, layers: &mut [Layer], ws: &Workspace, lr: f64, lambda: f64) {
         self.t = self.t.saturating_add(1);
-        let c1 = 1.0 - BETA1.powi(self.t);
-        let c2 = 1.0 - BETA2.powi(self.t);
-        for (k, layer) in layers.iter_mut().enumerate() {
-            adam_update(
-                &mut layer.w,
-                &ws.grad_w[k],
-                &mut self.m_w[k],
-                &mut self.v_w[k],
-                lr,
-                c1,
-                c2,
-            );
-            adam_update(
-                &mut layer.b,
-                &ws.grad_b[k],
-                &mut self.m_b[k],
-                &mut self.v_b[k],
-                lr,
-                c1,
-                c2,
-            );
+        let rates = AdamRates::new(lr, self.t);
+        let update = |layers: &mut [Layer], moments: &mut [Moments], k0: usize| {
+            for (k, (layer, m)) in layers.iter_mut().zip(moments).enumerate() {
+                let (gw, gb) = (&ws.grad_w[k0 + k], &ws.grad_b[k0 + k]);
+                adam_update(
+                    &mut layer.w,
+                    gw,
+                    &mut m.m_w,
+                    &mut m.v_w,
+                    rates,
+                    2.0 * lambda,
+                );
+                adam_update(&mut layer.b, gb, &mut m.m_b, &mut m.v_b, rates, 0.0);
+            }
+        };
+        let sizes = layers.iter().map(|l| l.w.len() + l.b.len());
+        let total: usize = sizes.clone().sum();
+        if total < PARALLEL_MIN_MACS / 8 {
+            update(layers, &mut self.layers, 0);
+            return;
+        }
+        // cut after the layers whose running count of parameters stays within half of them
+        let mut seen = 0;
+        let middle = sizes
+            .take_while(|n| {
+                seen += n;
+                2 * seen <= total
+            })
+            .count()
+            .max(1);
+        let (first, second) = layers.split_at_mut(middle);
+        let (m_first, m_second) = self.layers.split_at_mut(middle);
+        rayon::join(
+            || update(first, m_first, 0),
+            || update(second, m_second, middle),
+        );
+    }
+}
+
+/// The factors of step `t`: `θ ← θ − (η/c₁) m / (√(v · (1/c₂)) + ε)` with the bias corrections
+/// `c₁ = 1 − β₁ᵗ`, `c₂ = 1 − β₂ᵗ`, which is `η m̂/(√v̂ + ε)` up to rounding with one division and one
+/// square root per parameter (instead of three divider operations, the bound of the update).
+#[derive(Debug, Clone, Copy)]
+struct AdamRates {
+    lr_over_c1: f64,
+    inv_c2: f64,
+}
+
+impl AdamRates {
+    fn new(lr: f64, t: i32) -> Self {
+        AdamRates {
+            lr_over_c1: lr / (1.0 - BETA1.powi(t)),
+            inv_c2: 1.0 / (1.0 - BETA2.powi(t)),
         }
     }
 }
 
-/// Elementwise Adam update with bias corrections `c1 = 1 − β₁ᵗ`, `c2 = 1 − β₂ᵗ`.
-fn adam_update(
-    theta: &mut [f64],
-    g: &[f64],
-    m: &mut [f64],
-    v: &mut [f64],
-    lr: f64,
-    c1: f64,
-    c2: f64,
-) {
-    for i in 0..theta.len() {
-        m[i] = BETA1 * m[i] + (1.0 - BETA1) * g[i];
-        v[i] = BETA2 * v[i] + (1.0 - BETA2) * g[i] * g[i];
-        theta[i] -= lr * (m[i] / c1) / ((v[i] / c2).sqrt() + EPS);
+simd_fn! {
+    /// Elementwise Adam update ([`AdamRates`]) on the gradient `g + two_lambda·θ` (the penalty's
+    /// term, summed as [`crate::nn::batch::backward_batch`] does).
+    fn adam_update(
+        theta: &mut [f64],
+        g: &[f64],
+        m: &mut [f64],
+        v: &mut [f64],
+        rates: AdamRates,
+        two_lambda: f64,
+    ) {
+        let AdamRates { lr_over_c1, inv_c2 } = rates;
+        for (((theta, g), m), v) in theta.iter_mut().zip(g).zip(m.iter_mut()).zip(v.iter_mut()) {
+            let g = two_lambda * *theta + g;
+            *m = BETA1 * *m + (1.0 - BETA1) * g;
+            *v = BETA2 * *v + (1.0 - BETA2) * g * g;
+            *theta -= lr_over_c1 * *m / ((*v * inv_c2).sqrt() + EPS);
+        }
     }
 }
 
@@ -332,8 +384,10 @@ impl Tracker<'_, '_> {
         train: f64,
         fine: bool,
     ) -> Option<StopReason> {
-        let val =
-            (!self.val.is_empty()).then(|| dataset_mse(p.layers, p.tanh, p.data, self.val, ws));
+        let val = (!self.val.is_empty()).then(|| {
+            let (layers, val) = (&*p.layers, self.val);
+            in_pool(|| dataset_mse(layers, p.tanh, p.data, val, ws))
+        });
         self.out.train_loss.push(train);
         self.out.val_loss.extend(val);
         self.out.fine_tune_epochs_run += usize::from(fine);
@@ -443,15 +497,8 @@ fn adam_phase(
     let (mut lr, mut reductions) = (lr, reductions);
     for _ in 0..epochs {
         shuffle(&mut order, rng);
-        let train = run_epoch(
-            p.layers,
-            p.tanh,
-            p.data,
-            &order,
-            ws,
-            &mut adam,
-            (lr, lambda),
-        );
+        let (layers, order, adam) = (&mut *p.layers, &order, &mut adam);
+        let train = in_pool(|| run_epoch(layers, p.tanh, p.data, order, ws, adam, (lr, lambda)));
         match t.record(p, ws, train, fine) {
             Some(StopReason::EarlyStopping) if reductions > 0 && t.out.best_epoch > 0 => {
                 // a plateau: back to the best weights with a smaller step
@@ -479,9 +526,10 @@ fn lbfgs_phase(
         rows: p.train,
         lambda,
     };
-    let mut lbfgs = Lbfgs::new(p.layers, memory, &obj, ws);
+    let mut lbfgs = in_pool(|| Lbfgs::new(p.layers, memory, &obj, ws));
     for _ in 0..iterations {
-        let Some(train) = lbfgs.step(p.layers, &obj, ws) else {
+        let (layers, lbfgs, obj) = (&mut *p.layers, &mut lbfgs, &obj);
+        let Some(train) = in_pool(|| lbfgs.step(layers, obj, ws)) else {
             return StopReason::Converged;
         };
         if let Some(stop) = t.record(p, ws, train, true) {
@@ -507,8 +555,83 @@ fn run_epoch(
         ws.load_rows(data, n, batch);
         forward_batch(layers, tanh, ws, batch.len());
         sum += reconstruction_mse(ws, batch.len()) * batch.len() as f64;
-        backward_batch(layers, tanh, ws, batch.len(), lambda);
-        adam.step(layers, ws, lr);
+        backward_batch_without_penalty(layers, tanh, ws, batch.len());
+        adam.step(layers, ws, lr, lambda);
     }
     sum / order.len().max(1) as f64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::nn::batch::backward_batch;
+
+    #[test]
+    fn adam_step_adds_the_penalty_as_backward_batch_does() {
+        // Two Adam steps with the penalty added in the update equal, bit for bit, the update on the
+        // full gradient of `backward_batch`; and the textbook update to rounding.
+        let sizes = [9, 5, 2, 5, 9];
+        let tanh = [true, false, true, false];
+        let mut rng = SplitMix64::new(5);
+        let mut layers: Vec<Layer> = sizes
+            .windows(2)
+            .map(|s| Layer::glorot(s[0], s[1], &mut rng))
+            .collect();
+        layers
+            .iter_mut()
+            .flat_map(|l| l.b.iter_mut())
+            .for_each(|b| *b = rng.range(-0.5, 0.5));
+        let (rows, lambda, lr) = (7, 0.02, 1e-2);
+        let x: Vec<f64> = (0..rows * 9).map(|_| rng.range(-1.0, 1.0)).collect();
+        let mut ws = Workspace::new(&sizes, rows);
+        let mut reference = layers.clone();
+        let mut m: Vec<Vec<f64>> = layers.iter().map(|l| vec![0.0; l.w.len()]).collect();
+        let mut v = m.clone();
+        let mut mb: Vec<Vec<f64>> = layers.iter().map(|l| vec![0.0; l.b.len()]).collect();
+        let mut vb = mb.clone();
+        let mut adam = Adam::new(&layers);
+        let mut textbook = layers.clone();
+        let (mut m_t, mut v_t) = (m.clone(), v.clone());
+        for t in 1..=2 {
+            ws.acts[0][..rows * 9].copy_from_slice(&x);
+            forward_batch(&reference, &tanh, &mut ws, rows);
+            backward_batch(&reference, &tanh, &mut ws, rows, lambda);
+            let (c1, c2) = (1.0 - BETA1.powi(t), 1.0 - BETA2.powi(t));
+            let AdamRates { lr_over_c1, inv_c2 } = AdamRates::new(lr, t);
+            for (k, layer) in textbook.iter_mut().enumerate() {
+                let (theta, g) = (&mut layer.w, &ws.grad_w[k]);
+                let (m, v) = (&mut m_t[k], &mut v_t[k]);
+                for i in 0..theta.len() {
+                    m[i] = BETA1 * m[i] + (1.0 - BETA1) * g[i];
+                    v[i] = BETA2 * v[i] + (1.0 - BETA2) * g[i] * g[i];
+                    theta[i] -= lr * (m[i] / c1) / ((v[i] / c2).sqrt() + EPS);
+                }
+            }
+            for (k, layer) in reference.iter_mut().enumerate() {
+                for (theta, g, m, v) in [
+                    (&mut layer.w, &ws.grad_w[k], &mut m[k], &mut v[k]),
+                    (&mut layer.b, &ws.grad_b[k], &mut mb[k], &mut vb[k]),
+                ] {
+                    for i in 0..theta.len() {
+                        m[i] = BETA1 * m[i] + (1.0 - BETA1) * g[i];
+                        v[i] = BETA2 * v[i] + (1.0 - BETA2) * g[i] * g[i];
+                        theta[i] -= lr_over_c1 * m[i] / ((v[i] * inv_c2).sqrt() + EPS);
+                    }
+                }
+            }
+            ws.acts[0][..rows * 9].copy_from_slice(&x);
+            forward_batch(&layers, &tanh, &mut ws, rows);
+            backward_batch_without_penalty(&layers, &tanh, &mut ws, rows);
+            adam.step(&mut layers, &ws, lr, lambda);
+            assert_eq!(layers, reference, "step {t}");
+            for (a, b) in layers.iter().zip(&textbook) {
+                for (a, b) in a.w.iter().zip(&b.w) {
+                    assert!(
+                        (a - b).abs() <= 1e-15 * (b.abs() + lr),
+                        "step {t}: {a} vs {b}"
+                    );
+                }
+            }
+        }
+    }
 }

@@ -177,6 +177,45 @@ fn same_seed_gives_bit_identical_weights() {
 }
 
 #[test]
+fn weights_do_not_depend_on_the_number_of_threads() {
+    // Layers large enough for the two-task passes and the split Adam step (batch.rs, train.rs),
+    // with Adam, L-BFGS and a ragged last batch: one, two and three threads agree bit for bit.
+    let n = 128;
+    let data = one_parameter_family(150, n, 8);
+    let opts = TrainOptions {
+        latent: 1,
+        hidden_layers: 3,
+        epochs: 3,
+        batch_size: 64,
+        fine_tune: FineTune::lbfgs(3),
+        ..TrainOptions::default()
+    };
+    let sizes = Autoencoder::architecture(n, 1, 3).unwrap();
+    let weights: usize = sizes.windows(2).map(|s| s[0] * s[1]).sum();
+    assert!(64 * sizes[0] * sizes[1] >= crate::nn::batch::PARALLEL_MIN_MACS);
+    assert!(weights >= crate::nn::batch::PARALLEL_MIN_MACS / 8);
+    let train = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| Autoencoder::train(&data, n, &opts, &mut quiet()).unwrap())
+    };
+    let (one, report_one) = train(1);
+    for threads in [2, 3] {
+        let (many, report_many) = train(threads);
+        assert_eq!(many, one, "{threads} threads");
+        assert_eq!(report_many.train_loss, report_one.train_loss);
+        assert_eq!(report_many.val_loss, report_one.val_loss);
+    }
+    // and on the calling thread (the global pool)
+    assert_eq!(
+        Autoencoder::train(&data, n, &opts, &mut quiet()).unwrap().0,
+        one
+    );
+}
+
+#[test]
 fn progress_callback_break_stops_training_and_keeps_best_weights() {
     let data = one_parameter_family(30, 8, 4);
     let opts = TrainOptions {
