@@ -322,6 +322,21 @@ pub(crate) fn dataset_mse(
     sum / index.len().max(1) as f64
 }
 
+/// Glorot weights and random biases in [−0.5, 0.5) for the layers of `sizes` (tests of the passes
+/// and of the optimiser: non-zero biases exercise their gradients).
+#[cfg(test)]
+pub(crate) fn test_layers(sizes: &[usize], rng: &mut gvs::inputs::SplitMix64) -> Vec<Layer> {
+    let mut layers: Vec<Layer> = sizes
+        .windows(2)
+        .map(|s| Layer::glorot(s[0], s[1], rng))
+        .collect();
+    layers
+        .iter_mut()
+        .flat_map(|l| l.b.iter_mut())
+        .for_each(|b| *b = rng.range(-0.5, 0.5));
+    layers
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -346,14 +361,7 @@ mod tests {
         let sizes = [4, 3, 2, 3, 4];
         let tanh = [true, false, true, false];
         let mut rng = SplitMix64::new(7);
-        let mut layers: Vec<Layer> = sizes
-            .windows(2)
-            .map(|s| Layer::glorot(s[0], s[1], &mut rng))
-            .collect();
-        layers
-            .iter_mut()
-            .flat_map(|l| l.b.iter_mut())
-            .for_each(|b| *b = rng.range(-0.5, 0.5));
+        let mut layers = test_layers(&sizes, &mut rng);
         let (rows, lambda) = (5, 0.03);
         let mut ws = Workspace::new(&sizes, 8);
         let x: Vec<f64> = (0..rows * 4).map(|_| rng.range(-1.0, 1.0)).collect();

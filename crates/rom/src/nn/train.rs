@@ -564,7 +564,7 @@ fn run_epoch(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::nn::batch::backward_batch;
+    use crate::nn::batch::{backward_batch, test_layers};
 
     #[test]
     fn adam_step_adds_the_penalty_as_backward_batch_does() {
@@ -573,14 +573,7 @@ mod tests {
         let sizes = [9, 5, 2, 5, 9];
         let tanh = [true, false, true, false];
         let mut rng = SplitMix64::new(5);
-        let mut layers: Vec<Layer> = sizes
-            .windows(2)
-            .map(|s| Layer::glorot(s[0], s[1], &mut rng))
-            .collect();
-        layers
-            .iter_mut()
-            .flat_map(|l| l.b.iter_mut())
-            .for_each(|b| *b = rng.range(-0.5, 0.5));
+        let mut layers = test_layers(&sizes, &mut rng);
         let (rows, lambda, lr) = (7, 0.02, 1e-2);
         let x: Vec<f64> = (0..rows * 9).map(|_| rng.range(-1.0, 1.0)).collect();
         let mut ws = Workspace::new(&sizes, rows);
