@@ -255,11 +255,7 @@ impl<P: StrainParam> Model<P> {
         r: &mut DVector<f64>,
     ) {
         self.forward(q, ws, false);
-        self.velocities_with(q, qd, Some(qdd), ws);
-        self.point_wrenches(loads, ws);
-        self.subtract_inertial_wrenches(ws);
-        self.assemble_forces(u, Some(qd), ws, r);
-        r.neg_mut();
+        self.residual_after_forward(q, qd, qdd, u, loads, ws, r);
     }
 
     /// [`Self::dynamics_residual`] and the mass matrix `M(q)` (into `ws.mass`) from one forward
@@ -278,6 +274,21 @@ impl<P: StrainParam> Model<P> {
     ) {
         self.forward(q, ws, true);
         self.assemble_mass(ws);
+        self.residual_after_forward(q, qd, qdd, u, loads, ws, r);
+    }
+
+    /// The part of [`Self::dynamics_residual`] after the forward pass at `q`.
+    #[allow(clippy::too_many_arguments)]
+    fn residual_after_forward(
+        &self,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        qdd: &DVector<f64>,
+        u: &[f64],
+        loads: &PreparedLoads,
+        ws: &mut Workspace,
+        r: &mut DVector<f64>,
+    ) {
         self.velocities_with(q, qd, Some(qdd), ws);
         self.point_wrenches(loads, ws);
         self.subtract_inertial_wrenches(ws);
