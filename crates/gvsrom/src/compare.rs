@@ -99,7 +99,7 @@ impl Trajectory {
 }
 
 /// What [`compare`] measures (percentages; see the module documentation).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Comparison {
     /// Common samples compared.
     pub samples: usize,
@@ -112,6 +112,7 @@ pub struct Comparison {
     pub strain_mean: Option<f64>,
     pub strain_max: Option<f64>,
     /// Strain components (0 torsion … 5 shear z) compared.
+    #[serde(default)]
     pub active: Vec<usize>,
 }
 

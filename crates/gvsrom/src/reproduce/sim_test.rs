@@ -4,7 +4,7 @@
 use super::step::Step;
 use super::tasks::{ModelInfo, ScenarioSpec};
 use super::Run;
-use crate::compare::{compare, Trajectory};
+use crate::compare::{compare, Comparison, Trajectory};
 use crate::simulate::{self, Ending, InputSource, IntegratorChoice, SimulateOptions};
 use crate::{reduce, Built};
 use serde::{Deserialize, Serialize};
@@ -47,18 +47,6 @@ impl Test {
     }
 }
 
-/// A ROM's trajectory against the HOM's over their common samples (`gvsrom compare`), in %.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct Errors {
-    pub samples: usize,
-    pub tip_mean: f64,
-    pub tip_max: f64,
-    pub tip_max_t: f64,
-    pub tip_end: f64,
-    pub strain_mean: Option<f64>,
-    pub strain_max: Option<f64>,
-}
-
 /// One simulation of the test: how it ended, what it cost, and (for a ROM) its error against the
 /// HOM.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -86,8 +74,8 @@ pub struct SimRun {
     /// Largest `|ξ − ξ*|` at the points of the model's start (a decoder's rest point; 0 for the
     /// HOM and POD, which start from the straight rod).
     pub start_offset: f64,
-    /// `None` for the HOM.
-    pub error: Option<Errors>,
+    /// Against the HOM over their common samples (`gvsrom compare`, in %); `None` for the HOM.
+    pub error: Option<Comparison>,
 }
 
 impl SimRun {
@@ -160,21 +148,10 @@ pub fn simulate_test(
                 wall_times_s.push(again.summary.wall_time_s);
             }
             let error = match hom {
-                Some(h) => {
-                    let c = compare(
-                        &Trajectory::load(&h.path, "REFERENCE")?,
-                        &Trajectory::load(&written.dir, "RUN")?,
-                    )?;
-                    Some(Errors {
-                        samples: c.samples,
-                        tip_mean: c.tip_mean,
-                        tip_max: c.tip_max,
-                        tip_max_t: c.tip_max_t,
-                        tip_end: c.tip_end,
-                        strain_mean: c.strain_mean,
-                        strain_max: c.strain_max,
-                    })
-                }
+                Some(h) => Some(compare(
+                    &Trajectory::load(&h.path, "REFERENCE")?,
+                    &Trajectory::load(&written.dir, "RUN")?,
+                )?),
                 None => None,
             };
             let sm = &outcome.summary;
