@@ -134,6 +134,50 @@ fn split_target(n: &Named) -> Result<(PathBuf, String), OutputError> {
     Ok((parent, name))
 }
 
+/// Refuses an output path (`out_option` = `out`) that equals or contains one of the command's
+/// `inputs` (`(option, path)` pairs; compared by canonical path, so `./d`, `d/` and a link to `d` are
+/// the same): with `--force` such an output would replace the command's own input. Call it before
+/// the output is created. Inputs that do not exist are skipped (reading them fails on its own).
+pub fn refuse_overlap(
+    out_option: &str,
+    out: &Path,
+    inputs: &[(&str, &Path)],
+) -> Result<(), OutputError> {
+    let named = Named {
+        option: out_option.into(),
+        path: out.to_path_buf(),
+    };
+    let Some(Component::Normal(name)) = out.components().next_back() else {
+        return Ok(()); // refused later by split_target, with its own reason
+    };
+    let parent = match out.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let Ok(target) = fs::canonicalize(parent).map(|p| p.join(name)) else {
+        return Ok(()); // the parent does not exist yet: nothing in it can be an input
+    };
+    // the target itself may be a link to an input
+    let target = fs::canonicalize(&target).unwrap_or(target);
+    for (option, input) in inputs {
+        let Ok(input_c) = fs::canonicalize(input) else {
+            continue;
+        };
+        if input_c.starts_with(&target) {
+            let how = if input_c == target {
+                "is"
+            } else {
+                "contains"
+            };
+            return Err(named.refused(format!(
+                "{how} the input {option} `{}`; an output never replaces the command's own input: choose another path",
+                input.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// Refuses the home directory and the current directory or its ancestors (by canonical path).
 fn refuse_special(n: &Named, parent: &Path, name: &str) -> Result<(), OutputError> {
     let Ok(target) = fs::canonicalize(parent).map(|p| p.join(name)) else {
@@ -755,6 +799,33 @@ mod tests {
             let _f = OutputFile::create("--json", &d.join("x.json"), "test", false).unwrap();
         }
         assert!(names(&d).is_empty(), "left behind: {:?}", names(&d));
+    }
+
+    #[test]
+    fn an_output_that_is_or_contains_an_input_is_refused_by_any_spelling() {
+        let d = sandbox("overlap");
+        let data = d.join("data");
+        fs::create_dir_all(data.join("inner")).unwrap();
+        let other = d.join("other");
+        for (out, inputs) in [
+            (data.clone(), vec![("DATASET", data.as_path())]),
+            (d.join("data/"), vec![("DATASET", data.as_path())]),
+            (d.join("./data"), vec![("DATASET", data.as_path())]),
+            (data.clone(), vec![("--model", data.join("inner").as_path())]),
+        ] {
+            let err = refuse_overlap("--out", &out, &inputs).unwrap_err().to_string();
+            assert!(err.contains("input") && err.contains("--out"), "{err}");
+        }
+        #[cfg(unix)]
+        {
+            let link = d.join("link");
+            std::os::unix::fs::symlink(&data, &link).unwrap();
+            assert!(refuse_overlap("--out", &link, &[("DATASET", &data)]).is_err());
+        }
+        // distinct paths, an input inside nothing, and a missing input pass
+        refuse_overlap("--out", &other, &[("DATASET", &data)]).unwrap();
+        refuse_overlap("--out", &data.join("inner/new"), &[("DATASET", &data)]).unwrap();
+        refuse_overlap("--out", &other, &[("DATASET", &d.join("missing"))]).unwrap();
     }
 
     #[test]
