@@ -1,0 +1,183 @@
+//! `--model MODEL`: a reduced model bound to a scenario: its parameterization in place of the
+//! scenario's basis, the layout check, and the latent range the model may be trusted in.
+
+use super::{anchors::initial_guess, invalid, projection_of};
+use crate::build::Built;
+use crate::dataset::Layout;
+use crate::error::ScenarioError;
+use crate::reduced_model::{ModelWeights, ReducedModel};
+use gvs::model::Model;
+use gvs::strain::{LinearBasis, StrainParam};
+use nalgebra::DVector;
+use rom::reduced::ReducedParam;
+use std::path::{Path, PathBuf};
+
+/// A reduced model bound to a scenario.
+pub struct Reduced {
+    /// The scenario's rod, points, tendons and loads with the reduced parameterization.
+    pub model: Model<Box<dyn StrainParam>>,
+    /// `"pod"` or `"autoencoder"`.
+    pub kind: String,
+    pub path: PathBuf,
+    /// Initial guess of a statics solve: the model's anchors at this scenario's inputs
+    /// ([`anchor_guess`]; models whose dataset inputs the scenario defines).
+    pub initial: Option<DVector<f64>>,
+    /// The training encodings' range per coordinate (autoencoders).
+    pub latent_range: Vec<[f64; 2]>,
+}
+
+impl Reduced {
+    /// Errors if `q` lies outside the training encodings' range by more than half its width in
+    /// some coordinate ([`Self::range_violation`]): the decoder is extrapolating there (tanh layers
+    /// saturate, `Ψ_q → 0`, and spurious equilibria appear), so the result is not to be trusted.
+    pub fn check_range(&self, q: &[f64]) -> Result<(), ScenarioError> {
+        match self.range_violation(q) {
+            None => Ok(()),
+            Some(v) => Err(invalid(
+                "--model",
+                format!(
+                    "the reduced solution {v}: the decoder is extrapolating (the load is outside the dataset, or the model is poor)"
+                ),
+            )),
+        }
+    }
+
+    /// How far the rest coordinates ([`StrainParam::rest_coordinates`], where a simulation from
+    /// rest starts) are from the straight rod: the largest `|ξ − ξ*|` over the computational points
+    /// and strain components. Zero for POD (`q_r = 0`); for an autoencoder, its reconstruction error
+    /// of the straight rod, large when the training data lack it (e.g. all sag under gravity).
+    pub fn rest_strain_offset(&self) -> f64 {
+        let m = &self.model;
+        let mut ws = m.workspace();
+        m.forward(&m.param.rest_coordinates(), &mut ws, false);
+        m.point_strains(&ws)
+            .iter()
+            .enumerate()
+            .map(|(j, xi)| (xi - m.xi_star(j)).amax())
+            .fold(0.0, f64::max)
+    }
+
+    /// The first coordinate of `q` outside the training encodings' range widened by half its
+    /// width on each side (or not finite), described as "`q_r[d] = v` lies far outside the range
+    /// of the training data `[lo, hi]` of `MODEL`"; `None` inside (always, for models without a
+    /// recorded range).
+    pub fn range_violation(&self, q: &[f64]) -> Option<String> {
+        outside_range(&self.latent_range, q).map(|d| {
+            let (v, [lo, hi]) = (q[d], self.latent_range[d]);
+            format!(
+                "q_r[{d}] = {v:.6} lies far outside the range of the training data [{lo:.6}, {hi:.6}] of `{}`",
+                self.path.display()
+            )
+        })
+    }
+}
+
+/// The first coordinate of `q` outside `range` widened by half its width on each side, or not
+/// finite (see [`Reduced::range_violation`]).
+pub(super) fn outside_range(range: &[[f64; 2]], q: &[f64]) -> Option<usize> {
+    q.iter().zip(range).position(|(v, [lo, hi])| {
+        let margin = 0.5 * (hi - lo).max(1e-12);
+        !(*v >= lo - margin && *v <= hi + margin)
+    })
+}
+
+/// Checks that `model` was learned on the layout of `built` (points, active components, HOM size).
+pub(super) fn check_layout(
+    built: &Built,
+    model: &ReducedModel,
+    path: &Path,
+) -> Result<(), ScenarioError> {
+    let l = Layout::of(built);
+    let ml = &model.meta.layout;
+    let names = l.component_names();
+    let length = built.model.disc.length();
+    let same_points = ml.strain_x.len() == l.strain_x.len()
+        && ml
+            .strain_x
+            .iter()
+            .zip(&l.strain_x)
+            .all(|(a, b)| (a - b).abs() <= 1e-12 * length.max(1.0));
+    if !same_points || ml.active != names || ml.hom_dof != built.model.n_dof() {
+        return Err(invalid(
+            "--model",
+            format!(
+                "`{}` was learned on {} points × [{}] with a {}-DOF basis (scenario `{}`); this scenario has {} points × [{}] with {} DOF{}",
+                path.display(),
+                ml.strain_x.len(),
+                ml.active.join(", "),
+                ml.hom_dof,
+                ml.scenario,
+                l.strain_x.len(),
+                names.join(", "),
+                built.model.n_dof(),
+                if ml.strain_x.len() == l.strain_x.len() && !same_points {
+                    " (the points are at other abscissae)"
+                } else {
+                    ""
+                }
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The reduced parameterization of `model` on the sites of `built`.
+pub fn parameterization(
+    built: &Built,
+    model: &ReducedModel,
+) -> Result<Box<dyn StrainParam>, ScenarioError> {
+    let (_, _, p) = projection_of(built)?;
+    let basis: &LinearBasis = &built.model.param;
+    Ok(match &model.weights {
+        ModelWeights::Pod { modes, .. } => {
+            let b = &p * modes;
+            Box::new(basis.compose(&b)?)
+        }
+        ModelWeights::Autoencoder(ae) => {
+            let map = ae
+                .decoder_map(p.as_slice(), p.nrows())
+                .map_err(|e| invalid("--model", e.to_string()))?;
+            let rest = DVector::from_vec(model.meta.rest.clone());
+            Box::new(
+                ReducedParam::new(basis, map, rest)
+                    .map_err(|e| invalid("--model", e.to_string()))?,
+            )
+        }
+    })
+}
+
+/// The scenario's rod, points and tendons with the parameterization of `model` ([`parameterization`]).
+pub(super) fn reduced_model(
+    built: &Built,
+    model: &ReducedModel,
+) -> Result<Model<Box<dyn StrainParam>>, ScenarioError> {
+    let param = parameterization(built, model)?;
+    let m = &built.model;
+    Ok(
+        Model::new(m.rod.clone(), m.disc.clone(), param, m.tendons.clone())
+            .map_err(ScenarioError::from)?
+            .with_base(m.base),
+    )
+}
+
+/// `--model DIR`: loads the model, checks it against the scenario and attaches it to `built`.
+/// `table` (the scenario's TOML after `--set`) supplies the values of non-tension dataset inputs
+/// for the initial guess.
+pub fn attach(
+    built: &mut Built,
+    table: Option<&toml::Table>,
+    dir: &Path,
+) -> Result<(), anyhow::Error> {
+    let model = ReducedModel::load(dir)?;
+    check_layout(built, &model, dir)?;
+    let reduced = reduced_model(built, &model)?;
+    let initial = initial_guess(built, table, &model);
+    built.reduced = Some(Reduced {
+        model: reduced,
+        kind: model.meta.kind.clone(),
+        path: dir.to_path_buf(),
+        initial,
+        latent_range: model.meta.latent_range.clone(),
+    });
+    Ok(())
+}

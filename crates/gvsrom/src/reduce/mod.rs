@@ -1,0 +1,152 @@
+//! Reduction commands and reduced models on a scenario (paper Sections III–IV):
+//!
+//! - [`pod`]: `gvsrom pod DATASET --modes K --out MODEL`;
+//! - [`train`]: `gvsrom train DATASET --latent R --hidden-layers 3|5|7 --out MODEL`;
+//! - [`attach`]: `--model MODEL` on `statics` and `simulate`: the scenario's engine with the model's
+//!   strain parameterization in place of its basis (no physics re-implemented).
+//!
+//! POD and decoders alike act on the HOM's own basis through the least-squares projection `P` of
+//! point strains onto its coefficients (`rom::reduced`): `Ψ_s(q_r) = Φ_s P V q_r` (POD, a constant
+//! linear basis) or `Φ_s P D(q_r)` (autoencoder).
+//!
+//! Files: [`pod`](pod()) and [`train`](train()) build models from a dataset (`pod.rs`, `train.rs`);
+//! `anchors.rs` holds the training samples kept as initial guesses; `attach.rs` binds a model to a
+//! scenario; this file the steps both commands share.
+
+mod anchors;
+mod attach;
+mod pod;
+mod train;
+
+pub use anchors::{anchor_guess, solve_anchors, AnchorInput, AnchorProblem};
+pub use attach::{attach, parameterization, Reduced};
+pub use pod::{pod, PodSummary};
+pub use train::{train, zero_anchor_rows, Loss, TrainSummary};
+
+use crate::build::{build, Built};
+use crate::dataset::Dataset;
+use crate::error::ScenarioError;
+use crate::reduced_model::{fnv1a64, DatasetRef, ModelLayout, ReducedModel};
+use crate::scenario::Scenario;
+use attach::{outside_range, reduced_model};
+use nalgebra::DMatrix;
+use rom::reduced::{point_matrix, projection, PointLayout};
+use std::path::Path;
+
+pub(super) fn invalid(field: &str, message: impl Into<String>) -> ScenarioError {
+    ScenarioError::invalid(field, message)
+}
+
+/// The HOM a dataset was generated on (its scenario TOML, as stored).
+pub fn dataset_scenario(ds: &Dataset) -> Result<Built, ScenarioError> {
+    let s = Scenario::from_toml(&ds.meta.scenario, &ds.meta.scenario_toml, &[])?;
+    build(&s)
+}
+
+/// The point layout of `built` in `rom`'s terms, and `Φ̄` and `P` of its basis.
+pub(super) fn projection_of(
+    built: &Built,
+) -> Result<(PointLayout, DMatrix<f64>, DMatrix<f64>), ScenarioError> {
+    let layout = PointLayout::active_in(&built.model.param, &built.model.disc);
+    let pm = point_matrix(&built.model.param, &layout);
+    let p = projection(&pm).map_err(|e| invalid("basis", e.to_string()))?;
+    Ok((layout, pm, p))
+}
+
+/// The usable rows of a dataset (status ok), row-major, and their count; an error if none.
+pub(super) fn snapshot_rows(
+    ds: &Dataset,
+    option: &str,
+) -> Result<(Vec<f64>, usize), ScenarioError> {
+    let rows = ds.ok_rows();
+    if rows.is_empty() {
+        return Err(invalid(
+            option,
+            "the dataset has no solved samples (every status is failed or not computed)",
+        ));
+    }
+    let mut x = Vec::with_capacity(rows.len() * ds.row_len());
+    for &k in &rows {
+        x.extend_from_slice(ds.strain_row(k));
+    }
+    Ok((x, rows.len()))
+}
+
+pub(super) fn model_layout(ds: &Dataset, built: &Built) -> ModelLayout {
+    ModelLayout {
+        scenario: ds.meta.scenario.clone(),
+        scenario_toml: ds.meta.scenario_toml.clone(),
+        strain_x: ds.meta.strain_x.clone(),
+        active: ds.meta.components.clone(),
+        hom_dof: built.model.n_dof(),
+    }
+}
+
+pub(super) fn dataset_ref(dir: &Path, rows: usize) -> Result<DatasetRef, ScenarioError> {
+    let bytes = std::fs::read(dir.join("strain.npy"))
+        .map_err(|e| invalid("DATASET", format!("cannot read strain.npy: {e}")))?;
+    Ok(DatasetRef {
+        path: dir.display().to_string(),
+        strain_hash: fnv1a64(&bytes),
+        rows,
+    })
+}
+
+/// The inputs of the usable samples (status ok), row-major (`n × k`): the anchors' inputs.
+pub(super) fn sample_inputs(ds: &Dataset) -> Vec<f64> {
+    let k = ds.meta.parameters.len();
+    ds.ok_rows()
+        .iter()
+        .flat_map(|&i| ds.inputs[i * k..(i + 1) * k].iter().copied())
+        .collect()
+}
+
+/// For a static dataset whose inputs are all tendon tensions or loads ([`AnchorInput`]): the reduced
+/// model's own equilibria in place of the anchors' encodings where found ([`solve_anchors`], inside
+/// the training encodings' range); returns their number (0 for other datasets, whose anchors keep
+/// the encodings).
+pub(super) fn equilibrium_anchors(
+    built: &Built,
+    ds: &Dataset,
+    model: &mut ReducedModel,
+) -> Result<usize, ScenarioError> {
+    let inputs: Option<Vec<AnchorInput>> = model
+        .meta
+        .anchor_parameters
+        .iter()
+        .map(|p| AnchorInput::of(p))
+        .collect();
+    let (Some(inputs), None) = (inputs, &ds.meta.dynamic) else {
+        return Ok(0);
+    };
+    if inputs.is_empty() || model.anchors.is_none() {
+        return Ok(0);
+    }
+    let table = match inputs.iter().any(|i| matches!(i, AnchorInput::Load(_))) {
+        true => Some(crate::scenario::parse_table(
+            &ds.meta.scenario,
+            &ds.meta.scenario_toml,
+        )?),
+        false => None,
+    };
+    let reduced = reduced_model(built, model)?;
+    let range = model.meta.latent_range.clone();
+    let Some(a) = model.anchors.as_mut() else {
+        return Ok(0);
+    };
+    let problem = AnchorProblem {
+        u: &built.u,
+        loads: &built.loads,
+        inputs: &inputs,
+        table: table.as_ref(),
+        length: built.model.rod.length(),
+    };
+    Ok(solve_anchors(
+        &reduced,
+        &built.options,
+        &problem,
+        &a.inputs,
+        &mut a.latent,
+        &|q| outside_range(&range, q.as_slice()).is_none(),
+    ))
+}

@@ -1,0 +1,92 @@
+//! `gvsrom pod DATASET --modes K --out MODEL`: proper orthogonal decomposition of a dataset's
+//! strain snapshots as a linear reduced model.
+
+use super::{
+    dataset_ref, dataset_scenario, equilibrium_anchors, invalid, model_layout, projection_of,
+    sample_inputs, snapshot_rows,
+};
+use crate::dataset::Dataset;
+use crate::output::OutputDir;
+use crate::reduced_model::{ModelMeta, ModelWeights, ReducedModel};
+use rom::pod::Pod;
+use std::path::{Path, PathBuf};
+
+/// What `gvsrom pod` reports.
+pub struct PodSummary {
+    pub path: PathBuf,
+    pub rows: usize,
+    pub features: usize,
+    pub modes: usize,
+    pub captured_energy: f64,
+    pub singular_values: Vec<f64>,
+    pub numerical_rank: usize,
+    /// As [`TrainSummary::anchor_equilibria`] and [`TrainSummary::anchor_time_s`].
+    pub anchor_equilibria: usize,
+    pub anchor_time_s: f64,
+}
+
+/// POD of a dataset's strain snapshots, `modes` modes, saved as a model at `out`.
+pub fn pod(
+    dataset: &Path,
+    modes: usize,
+    out: &Path,
+    force: bool,
+) -> Result<PodSummary, anyhow::Error> {
+    let ds = Dataset::load(dataset)?;
+    let built = dataset_scenario(&ds)?;
+    projection_of(&built)?; // the HOM basis must be recoverable from point strains
+    let (x, rows) = snapshot_rows(&ds, "DATASET")?;
+    let features = ds.row_len();
+    let dir = OutputDir::create("--out", out, crate::reduced_model::MODEL_FORMAT, force)?;
+    let pod = Pod::compute(&x, features, modes).map_err(|e| invalid("--modes", e.to_string()))?;
+    let energy = pod.captured_energy();
+    // anchors: each sample's POD coordinates Vᵀx, then the POD-ROM's own equilibria
+    let latent = pod.encode_rows(&x);
+    let meta = ModelMeta {
+        kind: "pod".into(),
+        latent: modes,
+        layout: model_layout(&ds, &built),
+        dataset: dataset_ref(dataset, rows)?,
+        rest: vec![0.0; modes],
+        latent_range: vec![],
+        anchor_parameters: ds.meta.parameters.clone(),
+        anchor_equilibria: 0,
+        captured_energy: Some(energy[modes - 1]),
+        training: None,
+        projection_residual: 0.0,
+        crate_version: env!("CARGO_PKG_VERSION").into(),
+    };
+    let mut model = ReducedModel {
+        meta,
+        weights: ModelWeights::Pod {
+            modes: pod.modes.clone(),
+            singular_values: pod.singular_values.clone(),
+        },
+        anchors: Some(crate::reduced_model::Anchors {
+            n: rows,
+            inputs: sample_inputs(&ds),
+            latent,
+        }),
+    };
+    let t_anchors = std::time::Instant::now();
+    model.meta.anchor_equilibria = equilibrium_anchors(&built, &ds, &mut model)?;
+    let anchor_time_s = t_anchors.elapsed().as_secs_f64();
+    let path = model.save(
+        dir,
+        &[
+            ("singular_values", &pod.singular_values),
+            ("captured_energy", &energy),
+        ],
+    )?;
+    Ok(PodSummary {
+        path,
+        rows,
+        features,
+        modes,
+        captured_energy: energy[modes - 1],
+        numerical_rank: pod.rank(1e-12),
+        singular_values: pod.singular_values,
+        anchor_equilibria: model.meta.anchor_equilibria,
+        anchor_time_s,
+    })
+}

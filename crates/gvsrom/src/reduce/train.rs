@@ -1,0 +1,274 @@
+//! `gvsrom train DATASET --latent R --hidden-layers N --out MODEL`: a tanh autoencoder learned
+//! from a dataset's strain snapshots, whose decoder becomes a nonlinear reduced model.
+
+use super::{
+    dataset_ref, dataset_scenario, equilibrium_anchors, invalid, model_layout, projection_of,
+    sample_inputs, snapshot_rows,
+};
+use crate::build::Built;
+use crate::dataset::Dataset;
+use crate::error::ScenarioError;
+use crate::output::OutputDir;
+use crate::reduced_model::{ModelMeta, ModelWeights, ReducedModel, TrainingMeta};
+use nalgebra::DVector;
+use rom::nn::{Autoencoder, TrainOptions, TrainReport};
+use rom::reduced::{projection_residual, PointLayout};
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
+
+/// What `gvsrom train` reports.
+pub struct TrainSummary {
+    pub path: PathBuf,
+    pub rows: usize,
+    pub features: usize,
+    pub report: TrainReport,
+    pub encoder_sizes: Vec<usize>,
+    /// The rest coordinates: the encoding of the straight rod (`ξ = ξ*`) when it was trained in
+    /// ([`zero_anchor_rows`]), else of the sample closest to it.
+    pub rest: Vec<f64>,
+    /// `‖D(rest)‖`: how far the rest coordinates decode from the straight rod (all points and
+    /// components, strain units).
+    pub rest_residual: f64,
+    /// Copies of the zero-strain snapshot among the training rows.
+    pub zero_anchor_rows: usize,
+    pub projection_residual: f64,
+    /// How many of the `rows` anchors are the reduced model's own equilibria, and the time their
+    /// solves took.
+    pub anchor_equilibria: usize,
+    pub anchor_time_s: f64,
+}
+
+/// How a snapshot feature's error weighs in the autoencoder's training loss (`gvsrom train --loss`).
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Default,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
+#[serde(rename_all = "kebab-case")]
+pub enum Loss {
+    /// Each feature standardized by its own spread: every point and component weighs the same
+    /// relative to its own variation, whatever its physical magnitude.
+    Standardized,
+    /// The physical mean squared error, every feature with weight 1 (the RMSE of Table I).
+    Physical,
+    /// The strain-energy norm: feature (point j, component a) weighted by the section stiffness
+    /// `Σ_s,aa` at point j (not by the quadrature weight, under which the kinematic points would
+    /// weigh nothing). Errors in stiff shear and elongation weigh what they cost in elastic force.
+    /// The default: the reduced model feels strain errors through exactly this norm.
+    #[default]
+    Energy,
+}
+
+impl Loss {
+    /// The name used on the command line and in `meta.json`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Loss::Standardized => "standardized",
+            Loss::Physical => "physical",
+            Loss::Energy => "energy",
+        }
+    }
+
+    /// The per-feature weighting of the point layout `layout` of `built`.
+    fn weighting(self, built: &Built, layout: &PointLayout) -> rom::nn::Weighting {
+        use rom::nn::Weighting;
+        match self {
+            Loss::Standardized => Weighting::Standardize,
+            Loss::Physical => Weighting::Physical(vec![1.0; layout.len()]),
+            Loss::Energy => Weighting::Physical(
+                (0..layout.n_points)
+                    .flat_map(|i| {
+                        let es = built.model.section(i).es;
+                        layout.active.iter().map(move |&a| es[a])
+                    })
+                    .collect(),
+            ),
+        }
+    }
+}
+
+/// Trains an autoencoder on a dataset's snapshots and saves it at `out`. `progress(epoch, train,
+/// validation)` is called after every epoch; `Break` stops training early (the best weights so far
+/// are kept and saved, marked by the stop reason).
+pub fn train(
+    dataset: &Path,
+    options: &TrainOptions,
+    loss: Loss,
+    out: &Path,
+    force: bool,
+    progress: &mut dyn FnMut(usize, f64, Option<f64>) -> ControlFlow<()>,
+) -> Result<TrainSummary, anyhow::Error> {
+    let ds = Dataset::load(dataset)?;
+    let built = dataset_scenario(&ds)?;
+    let (layout, pm, p) = projection_of(&built)?;
+    let (x, rows) = snapshot_rows(&ds, "DATASET")?;
+    let features = ds.row_len();
+    let options = &TrainOptions {
+        weighting: loss.weighting(&built, &layout),
+        ..options.clone()
+    };
+    let dir = OutputDir::create("--out", out, crate::reduced_model::MODEL_FORMAT, force)?;
+    // the zero-strain anchor of trajectory data: the straight rod, where simulations from rest
+    // start, joins the training rows so that a latent point decodes to it
+    let anchor_rows = zero_anchor_rows(rows, ds.meta.dynamic.is_some());
+    let training: std::borrow::Cow<[f64]> = match anchor_rows {
+        0 => (&x[..]).into(),
+        k => {
+            let mut t = Vec::with_capacity((rows + k) * features);
+            t.extend_from_slice(&x);
+            t.resize((rows + k) * features, 0.0);
+            t.into()
+        }
+    };
+    let (ae, report) =
+        Autoencoder::train(&training, features, options, progress).map_err(|e| train_error(&e))?;
+    drop(training);
+    // one encoding per usable sample: its range, the anchors, and what the HOM basis cannot
+    // represent of the reconstructions
+    let mut worst = 0.0f64;
+    let r = options.latent;
+    let mut latent = Vec::with_capacity(rows * r);
+    let mut range = vec![[f64::INFINITY, f64::NEG_INFINITY]; r];
+    for row in x.chunks_exact(features) {
+        let z = ae
+            .encode(row)
+            .map_err(|e| invalid("train", e.to_string()))?;
+        let rec = ae.decode(&z).map_err(|e| invalid("train", e.to_string()))?;
+        worst = worst.max(projection_residual(&pm, &p, &DVector::from_vec(rec)));
+        for (d, v) in z.iter().enumerate() {
+            range[d][0] = range[d][0].min(*v);
+            range[d][1] = range[d][1].max(*v);
+        }
+        latent.extend_from_slice(&z);
+    }
+    // the rest coordinates: with the zero-strain anchor the encoding of the straight rod, else
+    // that of the sample closest to it (equilibria under gravity: the straight rod is off their
+    // manifold and its encoding may lie outside the data's range); and how far they decode from it
+    let zero = vec![0.0; features];
+    let straightest = || {
+        x.chunks_exact(features)
+            .min_by(|a, b| {
+                let n = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>();
+                n(a).total_cmp(&n(b))
+            })
+            .expect("at least one usable row")
+    };
+    let rest = ae
+        .encode(if anchor_rows > 0 {
+            &zero
+        } else {
+            straightest()
+        })
+        .map_err(|e| invalid("train", e.to_string()))?;
+    let rest_decoded = ae
+        .decode(&rest)
+        .map_err(|e| invalid("train", e.to_string()))?;
+    let rest_residual = rest_decoded.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let rest = DVector::from_vec(rest);
+    let meta = ModelMeta {
+        kind: "autoencoder".into(),
+        latent: options.latent,
+        layout: model_layout(&ds, &built),
+        dataset: dataset_ref(dataset, rows)?,
+        rest: rest.iter().copied().collect(),
+        latent_range: range,
+        anchor_parameters: ds.meta.parameters.clone(),
+        anchor_equilibria: 0,
+        captured_energy: None,
+        training: Some(TrainingMeta {
+            hidden_layers: options.hidden_layers,
+            encoder_sizes: ae.encoder().layer_sizes().to_vec(),
+            decoder_sizes: ae.decoder().layer_sizes().to_vec(),
+            lambda: options.lambda,
+            epochs: options.epochs,
+            batch_size: options.batch_size,
+            learning_rate: options.learning_rate,
+            validation_fraction: options.validation_fraction,
+            patience: options.patience,
+            seed: options.seed,
+            loss: Some(loss.name().into()),
+            lr_reductions: Some(options.lr_reductions),
+            zero_anchor_rows: Some(anchor_rows),
+            lbfgs_iterations: Some(options.fine_tune.lbfgs_iterations()),
+            epochs_run: report.epochs_run,
+            best_epoch: report.best_epoch,
+            stop: format!("{:?}", report.stop),
+            final_train_loss: report.final_train_loss,
+            final_val_loss: report.final_val_loss,
+            final_train_rmse: report.final_train_rmse,
+            final_val_rmse: report.final_val_rmse,
+            wall_time_s: report.wall_time.as_secs_f64(),
+        }),
+        projection_residual: worst,
+        crate_version: env!("CARGO_PKG_VERSION").into(),
+    };
+    let encoder_sizes = ae.encoder().layer_sizes().to_vec();
+    let mut model = ReducedModel {
+        meta,
+        weights: ModelWeights::Autoencoder(ae),
+        anchors: Some(crate::reduced_model::Anchors {
+            n: rows,
+            inputs: sample_inputs(&ds),
+            latent,
+        }),
+    };
+    let t_anchors = std::time::Instant::now();
+    // (an interrupted run is saved at once, with the encodings)
+    if report.stop != rom::nn::StopReason::Interrupted {
+        model.meta.anchor_equilibria = equilibrium_anchors(&built, &ds, &mut model)?;
+    }
+    let anchor_time_s = t_anchors.elapsed().as_secs_f64();
+    let anchor_equilibria = model.meta.anchor_equilibria;
+    let path = model.save(
+        dir,
+        &[
+            ("train_loss", &report.train_loss),
+            ("val_loss", &report.val_loss),
+        ],
+    )?;
+    Ok(TrainSummary {
+        path,
+        rows,
+        features,
+        report,
+        encoder_sizes,
+        rest: rest.iter().copied().collect(),
+        rest_residual,
+        zero_anchor_rows: anchor_rows,
+        projection_residual: worst,
+        anchor_equilibria,
+        anchor_time_s,
+    })
+}
+
+/// Copies of the zero-strain snapshot added to `rows` training rows: for trajectory data (which
+/// start from the straight rod at rest, as every simulation from rest does) 1 % of the rows and at
+/// least 10, so that the straight rod is a point of the learned manifold and not just one sample
+/// among thousands; none for equilibria, whose manifold need not contain the straight rod (under
+/// gravity no equilibrium is straight, and a 1-D decoder forced through it bends away from the data).
+pub fn zero_anchor_rows(rows: usize, dynamic: bool) -> usize {
+    if dynamic {
+        (rows / 100).max(10)
+    } else {
+        0
+    }
+}
+
+/// A training error named by the command-line option it comes from.
+pub(super) fn train_error(e: &rom::nn::NnError) -> ScenarioError {
+    use rom::nn::NnError;
+    let option = match e {
+        NnError::InvalidLatent { .. } => "--latent".to_string(),
+        NnError::InvalidHiddenLayers { .. } => "--hidden-layers".to_string(),
+        NnError::InvalidOption { field, .. } => format!("--{}", field.replace('_', "-")),
+        NnError::EmptyData | NnError::NonFiniteData { .. } => "DATASET".to_string(),
+        _ => "train".to_string(),
+    };
+    invalid(&option, e.to_string())
+}
