@@ -125,6 +125,12 @@ pub struct ScenarioArgs {
     /// `output.centerline_points`, default 21).
     #[arg(long, value_name = "N")]
     pub centerline_points: Option<usize>,
+
+    /// Use `--model` even where the scenario lies outside what the model was trained on (an input
+    /// outside the training range, other physics). Without it such a scenario is refused; with it
+    /// every difference is printed as a warning and recorded in the outputs.
+    #[arg(long)]
+    pub extrapolate: bool,
 }
 
 #[derive(Debug, Args)]
@@ -413,7 +419,11 @@ fn attach_model(built: &mut Built, args: &ScenarioArgs, dir: &std::path::Path) -
     for spec in &args.set {
         gvsrom::scenario::apply_override(&mut table, spec)?;
     }
-    reduce::attach(built, Some(&table), dir)
+    reduce::attach(built, &table, dir, args.extrapolate)?;
+    for w in built.reduced.iter().flat_map(|r| &r.warnings) {
+        eprintln!("warning: {w}");
+    }
+    Ok(())
 }
 
 fn presets_cmd(out: &mut impl Write) -> Result<()> {

@@ -68,6 +68,15 @@ pub struct DatasetRef {
     pub rows: usize,
 }
 
+/// The range of one training input over the usable samples (see `reduce::validity`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct InputRange {
+    /// The dataset input's scenario path, e.g. `tendons.0.tension`.
+    pub parameter: String,
+    pub min: f64,
+    pub max: f64,
+}
+
 /// The autoencoder's training record.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TrainingMeta {
@@ -122,6 +131,11 @@ pub struct ModelMeta {
     /// solution far outside it is off the learned manifold and is reported as an error.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub latent_range: Vec<[f64; 2]>,
+    /// Per training input, its range over the usable samples: `--model` refuses a scenario whose
+    /// inputs lie outside (`reduce::validity`). Empty in models from before it was recorded, which
+    /// are refused too.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub input_range: Vec<InputRange>,
     /// Names of the dataset inputs stored as anchors (`anchors.inputs` in the weights): the
     /// anchors near the scenario's inputs give the initial guess of a reduced statics solve.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]

@@ -12,12 +12,12 @@ use gvs::discretize::MagnusOrder;
 use gvs::loads::{Frame, PulseMagnitude};
 use gvs::solve::statics::StaticsOptions;
 use gvs::strain::FemDegree;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use toml::{Table, Value};
 
 /// A complete scenario: a rod, its discretization and strain basis, tendons, loads, solver and
 /// output options.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Scenario {
     /// Short name shown in summaries and written to the JSON output (default: the preset name or the
@@ -44,7 +44,7 @@ pub struct Scenario {
 }
 
 /// Isotropic material (gvs-spec §3.2).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialSpec {
     /// E [Pa].
@@ -64,7 +64,7 @@ fn default_damping() -> f64 {
 
 /// Base pose `g(0)`: position and rotation of the first cross-section in the world frame. The
 /// rotation is either a matrix (`rotation`, rows) or an axis and an angle in degrees; default identity.
-#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BaseSpec {
     #[serde(default)]
@@ -78,7 +78,7 @@ pub struct BaseSpec {
 }
 
 /// One division of the rod: geometry, strain basis, quadrature.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DivisionSpec {
     /// ℓ_j [m].
@@ -98,7 +98,7 @@ pub struct DivisionSpec {
 }
 
 /// A strain component, in the engine's order `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum StrainMode {
     Torsion,
@@ -141,7 +141,7 @@ impl StrainMode {
 /// `kind = "fem"`: FEM-like local (nodal) basis on `elements` equal elements per active mode, of
 /// `degree` linear (default) or quadratic. (One flat table rather than a tagged enum, so that every
 /// error can name its key.)
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BasisSpec {
     pub kind: BasisKind,
@@ -156,7 +156,7 @@ pub struct BasisSpec {
     pub degree: Option<FemDegree>,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum BasisKind {
     Legendre,
@@ -164,7 +164,7 @@ pub enum BasisKind {
 }
 
 /// Per-mode Legendre orders (override `order`).
-#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ModeOrders {
     pub torsion: Option<usize>,
@@ -191,7 +191,7 @@ impl ModeOrders {
 /// Computational points of a division (gvs-spec §5.1): `gauss` Gauss points over the whole
 /// division plus its two ends, or `gauss_per_element` Gauss points in each of `elements` equal
 /// elements plus the element ends.
-#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct QuadratureSpec {
     pub gauss: Option<usize>,
@@ -202,7 +202,7 @@ pub struct QuadratureSpec {
 /// A tendon (gvs-spec §7.6–7.7). Its offset `d(X) = [0, y, z]` is interpolated linearly from
 /// `offset_start` at `x_start` to `offset_end` at `x_end`; or, with `angle_deg`, the two end
 /// offsets are `radial_fraction · r(X) · (cos θ, sin θ)` (on the surface for fraction 1).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TendonSpec {
     #[serde(default)]
@@ -231,7 +231,7 @@ pub struct TendonSpec {
 }
 
 /// Gravity, point wrenches and distributed wrenches.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LoadsSpec {
     /// World gravitational acceleration [m/s²].
@@ -258,7 +258,7 @@ fn default_gravity() -> [f64; 3] {
 }
 
 /// A concentrated wrench at abscissa `x` (which becomes a computational point).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PointLoadSpec {
     pub x: f64,
@@ -275,7 +275,7 @@ pub struct PointLoadSpec {
 /// follower moment about the local `axis` (default local y), line density
 /// `m(X) = m̂ max(0, 1 − |X − center|/(width/2))` with `m̂ = magnitude` (`convention = "peak"`,
 /// default) or `2 magnitude / width` (`"total"`).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DistributedLoadSpec {
     pub kind: DistributedKind,
@@ -303,7 +303,7 @@ pub struct DistributedLoadSpec {
     pub convention: Option<PulseMagnitude>,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum DistributedKind {
     Uniform,
@@ -316,7 +316,7 @@ pub fn default_pulse_axis() -> [f64; 3] {
 }
 
 /// What the statics command reports.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OutputSpec {
     /// Number of equally spaced centreline samples in the JSON output (≥ 2).
@@ -349,6 +349,18 @@ impl Scenario {
             apply_override(&mut table, spec)?;
         }
         from_table(table)
+    }
+
+    /// The resolved scenario as a TOML table: every field, defaults filled in, `--set` overrides
+    /// applied. Parsing it back gives the same scenario.
+    pub fn to_table(&self) -> Result<Table, ScenarioError> {
+        Table::try_from(self).map_err(|e| ScenarioError::invalid("scenario", e.to_string()))
+    }
+
+    /// [`Self::to_table`] as TOML text.
+    pub fn to_toml(&self) -> Result<String, ScenarioError> {
+        toml::to_string(&self.to_table()?)
+            .map_err(|e| ScenarioError::invalid("scenario", e.to_string()))
     }
 
     /// The tensions `u` of the tendons, in order.
@@ -673,6 +685,22 @@ fn one_line(s: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_preset_round_trips_through_its_resolved_toml() {
+        for p in crate::presets::PRESETS {
+            let s = crate::presets::load(p.name, &[]).unwrap();
+            let text = s.to_toml().unwrap();
+            let back = Scenario::from_toml(p.name, &text, &[]).unwrap();
+            assert_eq!(back.to_table().unwrap(), s.to_table().unwrap(), "{}", p.name);
+            // every default is written out: the resolved text names the solver and the output
+            let table = s.to_table().unwrap();
+            for key in ["material", "divisions", "loads", "solver", "output", "magnus"] {
+                assert!(table.contains_key(key), "{}: no `{key}` in\n{text}", p.name);
+            }
+            assert_eq!(format!("{back:?}"), format!("{s:?}"), "{}", p.name);
+        }
+    }
 
     const MINIMAL: &str = r#"
         [material]

@@ -22,8 +22,14 @@ pub struct Reduced {
     /// Initial guess of a statics solve: the model's anchors at this scenario's inputs
     /// ([`anchor_guess`]; models whose dataset inputs the scenario defines).
     pub initial: Option<DVector<f64>>,
-    /// The training encodings' range per coordinate (autoencoders).
+    /// The training encodings' range per coordinate.
     pub latent_range: Vec<[f64; 2]>,
+    /// How the scenario lies outside what the model was trained on, when used with
+    /// `--extrapolate` (empty: inside; see [`super::validity`]).
+    pub extrapolated: Vec<String>,
+    /// What a front-end should tell the user about this model (an interrupted training, an
+    /// extrapolation).
+    pub warnings: Vec<String>,
 }
 
 impl Reduced {
@@ -162,22 +168,62 @@ pub(super) fn reduced_model(
 
 /// `--model DIR`: loads the model, checks it against the scenario and attaches it to `built`.
 /// `table` (the scenario's TOML after `--set`) supplies the values of non-tension dataset inputs
-/// for the initial guess.
+/// (for the initial guess and the validity check) and the physics compared with the model's.
+///
+/// A scenario outside what the model was trained on ([`super::validity::check`]) is refused with
+/// every reason, unless `extrapolate`: then the reasons become [`Reduced::extrapolated`] and
+/// warnings. A model whose training was interrupted is used with a warning.
 pub fn attach(
     built: &mut Built,
-    table: Option<&toml::Table>,
+    table: &toml::Table,
     dir: &Path,
+    extrapolate: bool,
 ) -> Result<(), anyhow::Error> {
     let model = ReducedModel::load(dir)?;
     check_layout(built, &model, dir)?;
+    let outside = super::validity::check(built, table, &model)?;
+    if !outside.is_empty() && !extrapolate {
+        return Err(invalid(
+            "--model",
+            format!(
+                "`{}` was not trained for this scenario: {}; pass --extrapolate to use it anyway (its answer is then an extrapolation, and is marked so)",
+                dir.display(),
+                outside.join("; ")
+            ),
+        )
+        .into());
+    }
+    let mut warnings = vec![];
+    if let Some(t) = &model.meta.training {
+        if t.stop == format!("{:?}", rom::nn::StopReason::Interrupted) {
+            warnings.push(format!(
+                "`{}` holds the best weights of an interrupted training ({} of up to {} epochs)",
+                dir.display(),
+                t.epochs_run,
+                t.epochs
+            ));
+        }
+    }
+    warnings.extend(
+        outside
+            .iter()
+            .map(|o| format!("extrapolating (--extrapolate): {o}")),
+    );
     let reduced = reduced_model(built, &model)?;
-    let initial = initial_guess(built, table, &model);
+    let initial = initial_guess(built, Some(table), &model);
     built.reduced = Some(Reduced {
         model: reduced,
         kind: model.meta.kind.clone(),
         path: dir.to_path_buf(),
         initial,
-        latent_range: model.meta.latent_range.clone(),
+        // a decoder saturates outside its training encodings; a POD basis is linear and is
+        // bounded by its training inputs only
+        latent_range: match &model.weights {
+            ModelWeights::Autoencoder(_) => model.meta.latent_range.clone(),
+            ModelWeights::Pod { .. } => vec![],
+        },
+        extrapolated: outside,
+        warnings,
     });
     Ok(())
 }

@@ -17,6 +17,7 @@ mod anchors;
 mod attach;
 mod pod;
 mod train;
+pub mod validity;
 
 pub use anchors::{anchor_guess, solve_anchors, AnchorInput, AnchorProblem};
 pub use attach::{attach, parameterization, Reduced};
@@ -37,10 +38,38 @@ pub(super) fn invalid(field: &str, message: impl Into<String>) -> ScenarioError 
     ScenarioError::invalid(field, message)
 }
 
-/// The HOM a dataset was generated on (its scenario TOML, as stored).
+/// The HOM a dataset was generated on (its scenario TOML, as stored), checked against the dataset's
+/// arrays: the points, active components and coordinates that scenario has must be the dataset's
+/// (metadata naming another scenario would otherwise fail deep inside a matrix product).
 pub fn dataset_scenario(ds: &Dataset) -> Result<Built, ScenarioError> {
     let s = Scenario::from_toml(&ds.meta.scenario, &ds.meta.scenario_toml, &[])?;
-    build(&s)
+    let built = build(&s)?;
+    let l = crate::dataset::Layout::of(&built);
+    let m = &ds.meta;
+    let length = built.model.disc.length().max(1.0);
+    let same_x = l.strain_x.len() == m.strain_x.len()
+        && l.strain_x.iter().zip(&m.strain_x).all(|(a, b)| (a - b).abs() <= 1e-12 * length);
+    if !same_x || l.component_names() != m.components || l.n_dof != m.n_dof {
+        return Err(invalid(
+            "DATASET",
+            format!(
+                "its meta.json is inconsistent: the scenario it names (`{}`) has {} points × [{}] and {} coordinates, the dataset records {} points × [{}] and {} coordinates{}",
+                m.scenario,
+                l.strain_x.len(),
+                l.component_names().join(", "),
+                l.n_dof,
+                m.strain_x.len(),
+                m.components.join(", "),
+                m.n_dof,
+                if l.strain_x.len() == m.strain_x.len() && !same_x {
+                    " (at other abscissae)"
+                } else {
+                    ""
+                }
+            ),
+        ));
+    }
+    Ok(built)
 }
 
 /// The point layout of `built` in `rom`'s terms, and `Φ̄` and `P` of its basis.
@@ -58,6 +87,17 @@ pub(super) fn snapshot_rows(
     ds: &Dataset,
     option: &str,
 ) -> Result<(Vec<f64>, usize), ScenarioError> {
+    let c = &ds.meta.counts;
+    if c.not_computed > 0 {
+        return Err(invalid(
+            option,
+            format!(
+                "the dataset is incomplete: {} of its {} samples were not computed (its run was interrupted); finish it first by running the same `gvsrom dataset` command again with `--resume`",
+                c.not_computed,
+                ds.samples()
+            ),
+        ));
+    }
     let rows = ds.ok_rows();
     if rows.is_empty() {
         return Err(invalid(
@@ -149,4 +189,15 @@ pub(super) fn equilibrium_anchors(
         &mut a.latent,
         &|q| outside_range(&range, q.as_slice()).is_none(),
     ))
+}
+
+/// Per coordinate, the `[min, max]` of `latent` (`n × r`, row-major).
+pub(super) fn latent_range(latent: &[f64], r: usize) -> Vec<[f64; 2]> {
+    let mut range = vec![[f64::INFINITY, f64::NEG_INFINITY]; r];
+    for z in latent.chunks_exact(r.max(1)) {
+        for (d, v) in z.iter().enumerate() {
+            range[d] = [range[d][0].min(*v), range[d][1].max(*v)];
+        }
+    }
+    range
 }

@@ -8,7 +8,8 @@ use super::{
 use crate::dataset::Dataset;
 use crate::output::OutputDir;
 use crate::reduced_model::{ModelMeta, ModelWeights, ReducedModel};
-use rom::pod::Pod;
+use crate::error::ScenarioError;
+use rom::pod::{Pod, PodError};
 use std::path::{Path, PathBuf};
 
 /// What `gvsrom pod` reports.
@@ -38,17 +39,19 @@ pub fn pod(
     let (x, rows) = snapshot_rows(&ds, "DATASET")?;
     let features = ds.row_len();
     let dir = OutputDir::create("--out", out, crate::reduced_model::MODEL_FORMAT, force)?;
-    let pod = Pod::compute(&x, features, modes).map_err(|e| invalid("--modes", e.to_string()))?;
+    let pod = Pod::compute(&x, features, modes).map_err(|e| pod_error(e, &ds, &x, features))?;
     let energy = pod.captured_energy();
     // anchors: each sample's POD coordinates Vᵀx, then the POD-ROM's own equilibria
     let latent = pod.encode_rows(&x);
+    let latent_range = super::latent_range(&latent, modes);
     let meta = ModelMeta {
         kind: "pod".into(),
         latent: modes,
         layout: model_layout(&ds, &built),
         dataset: dataset_ref(dataset, rows)?,
         rest: vec![0.0; modes],
-        latent_range: vec![],
+        latent_range,
+        input_range: super::validity::input_ranges(&ds),
         anchor_parameters: ds.meta.parameters.clone(),
         anchor_equilibria: 0,
         captured_energy: Some(energy[modes - 1]),
@@ -89,4 +92,32 @@ pub fn pod(
         anchor_equilibria: model.meta.anchor_equilibria,
         anchor_time_s,
     })
+}
+
+/// A POD error named by its cause: the number of modes, or the dataset (for a failed SVD, with the
+/// largest strain value and its sample: a pathological value, not an option, makes it fail).
+fn pod_error(e: PodError, ds: &Dataset, x: &[f64], features: usize) -> ScenarioError {
+    match e {
+        PodError::Modes { .. } => invalid("--modes", e.to_string()),
+        PodError::Data(_) => invalid("DATASET", e.to_string()),
+        PodError::Svd => {
+            let (i, v) = x
+                .iter()
+                .enumerate()
+                .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+                .map(|(i, v)| (i, *v))
+                .unwrap_or((0, 0.0));
+            let sample = ds
+                .ok_rows()
+                .get(i / features.max(1))
+                .copied()
+                .unwrap_or(0);
+            invalid(
+                "DATASET",
+                format!(
+                    "{e}: its largest strain value is {v:e} (sample {sample}); a value that large is not a strain the model can hold — check that sample"
+                ),
+            )
+        }
+    }
 }

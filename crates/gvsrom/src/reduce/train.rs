@@ -178,6 +178,7 @@ pub fn train(
         dataset: dataset_ref(dataset, rows)?,
         rest: rest.iter().copied().collect(),
         latent_range: range,
+        input_range: super::validity::input_ranges(&ds),
         anchor_parameters: ds.meta.parameters.clone(),
         anchor_equilibria: 0,
         captured_energy: None,
@@ -268,6 +269,7 @@ pub(super) fn train_error(e: &rom::nn::NnError) -> ScenarioError {
         NnError::InvalidHiddenLayers { .. } => "--hidden-layers".to_string(),
         NnError::InvalidOption { field, .. } => format!("--{}", field.replace('_', "-")),
         NnError::EmptyData | NnError::NonFiniteData { .. } => "DATASET".to_string(),
+        NnError::Diverged { .. } => "--learning-rate".to_string(),
         _ => "train".to_string(),
     };
     invalid(&option, e.to_string())

@@ -121,7 +121,7 @@ pub fn simulate_test(
         |path| {
             let (mut built, table) = scenario.build()?;
             if let Some(m) = model {
-                reduce::attach(&mut built, Some(&table), &m.path)?;
+                reduce::attach(&mut built, &table, &m.path, false)?;
             }
             let (opts, note) = test.options(&built)?;
             let interrupt = run.interrupt().clone();

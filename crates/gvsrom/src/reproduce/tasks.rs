@@ -152,7 +152,8 @@ pub fn pod(
     run.step(
         name,
         &config,
-        |p| ReducedModel::load(p).is_ok(),
+        // (a model without a recorded validity range is from an earlier build: made again)
+        |p| ReducedModel::load(p).is_ok_and(|m| !m.meta.input_range.is_empty()),
         |path| {
             let s = reduce::pod(&data.path, modes, path, true)?;
             let model = ReducedModel::load(path)?;
@@ -220,7 +221,8 @@ pub fn train(
     run.step(
         name,
         &config,
-        |p| ReducedModel::load(p).is_ok(),
+        // (a model without a recorded validity range is from an earlier build: made again)
+        |p| ReducedModel::load(p).is_ok_and(|m| !m.meta.input_range.is_empty()),
         |path| {
             let options = rom::nn::TrainOptions {
                 latent: c.latent,
@@ -427,7 +429,7 @@ pub fn statics_eval(
                 for m in models {
                     let (mut built, table) = spec.build()?;
                     if let Some(dir) = &m.path {
-                        reduce::attach(&mut built, Some(&table), dir)?;
+                        reduce::attach(&mut built, &table, dir, false)?;
                     }
                     let result = statics::solve_repeated(&built, repeat)
                         .map_err(anyhow::Error::from)

@@ -16,7 +16,7 @@
 use super::batch::{dataset_mse, forward_batch, in_pool, Workspace};
 use super::decoder_map::DecoderMap;
 use super::mlp::{Layer, Mlp};
-use super::train::{fit, shuffle, Problem, Progress, TrainOptions, TrainReport};
+use super::train::{fit, shuffle, Problem, Progress, StopReason, TrainOptions, TrainReport};
 use super::{NnError, Scaling};
 use gvs::inputs::SplitMix64;
 use std::time::Instant;
@@ -119,6 +119,21 @@ impl Autoencoder {
             val: &val,
         };
         let outcome = fit(problem, opts, &mut rng, progress);
+        // a diverged run or one that never beat its initial weights is no model
+        if outcome.stop == StopReason::Diverged {
+            return Err(NnError::Diverged {
+                epoch: outcome.train_loss.len(),
+                loss: outcome.train_loss.last().copied().unwrap_or(f64::NAN),
+                initial: outcome.initial_train_loss,
+                learning_rate: opts.learning_rate,
+            });
+        }
+        if outcome.best_epoch == 0 {
+            return Err(NnError::NoProgress {
+                epochs: outcome.train_loss.len(),
+                initial: outcome.initial_loss,
+            });
+        }
 
         let mut ws = Workspace::new(&sizes, opts.batch_size.min(rows));
         let mut errors = |index: &[usize]| {

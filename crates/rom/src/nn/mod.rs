@@ -54,7 +54,7 @@ pub use autoencoder::Autoencoder;
 pub use decoder_map::DecoderMap;
 pub use mlp::Mlp;
 pub use scaling::{Scaling, Weighting};
-pub use train::{FineTune, Progress, StopReason, TrainOptions, TrainReport};
+pub use train::{FineTune, Progress, StopReason, TrainOptions, TrainReport, EXPLODED};
 
 use thiserror::Error;
 
@@ -120,6 +120,19 @@ pub enum NnError {
         value: f64,
         expected: &'static str,
     },
+    #[error(
+        "the training diverged at epoch {epoch}: its loss became {loss:e} (the initial weights' was {initial:.3e}); lower the learning rate (it was {learning_rate}); no model is kept"
+    )]
+    Diverged {
+        epoch: usize,
+        loss: f64,
+        initial: f64,
+        learning_rate: f64,
+    },
+    #[error(
+        "the training did not lower the loss in {epochs} epochs (the initial weights' {initial:.3e} was never beaten); nothing was learned: check the learning rate and the data"
+    )]
+    NoProgress { epochs: usize, initial: f64 },
     #[error("{what}: {got} does not match {expected}")]
     Mismatch {
         what: &'static str,

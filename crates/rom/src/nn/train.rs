@@ -96,6 +96,9 @@ impl TrainOptions {
                 expected,
             })
         };
+        if self.epochs == 0 {
+            return bad("epochs", 0.0, "≥ 1 (zero epochs would keep the random initial weights)");
+        }
         if self.batch_size == 0 {
             return bad("batch_size", 0.0, "≥ 1");
         }
@@ -224,6 +227,9 @@ struct Moments {
 
 /// The factor applied to the Adam learning rate at each plateau ([`TrainOptions::lr_reductions`]).
 pub const LR_REDUCTION_FACTOR: f64 = 0.3;
+/// An epoch whose training loss exceeds the initial weights' by this factor has diverged (a loss
+/// that explodes while staying finite, e.g. with a far too large learning rate).
+pub const EXPLODED: f64 = 1e4;
 
 const BETA1: f64 = 0.9;
 const BETA2: f64 = 0.999;
@@ -356,6 +362,10 @@ pub(crate) struct Problem<'a> {
 
 /// What [`fit`] observed; the chain ends with the best weights.
 pub(crate) struct FitOutcome {
+    /// Training-set loss of the initial weights.
+    pub initial_train_loss: f64,
+    /// Monitored loss (validation, else training) of the initial weights: a kept epoch beats it.
+    pub initial_loss: f64,
     pub train_loss: Vec<f64>,
     pub val_loss: Vec<f64>,
     pub best_epoch: usize,
@@ -392,7 +402,8 @@ impl Tracker<'_, '_> {
         self.out.val_loss.extend(val);
         self.out.fine_tune_epochs_run += usize::from(fine);
         let monitored = val.unwrap_or(train);
-        if !train.is_finite() || !monitored.is_finite() {
+        let exploded = train > EXPLODED * self.out.initial_train_loss;
+        if !train.is_finite() || !monitored.is_finite() || exploded {
             return Some(StopReason::Diverged);
         }
         if monitored < self.best_loss {
@@ -429,12 +440,20 @@ pub(crate) fn fit(
     let mut ws = Workspace::new(&sizes, opts.batch_size.min(p.train.len()));
     // eq. (15) over n: the mean squared error per entry plus λ/n Σ‖W‖² (module docs)
     let lambda = opts.lambda / sizes[0].max(1) as f64;
+    let initial_train_loss = in_pool(|| dataset_mse(p.layers, p.tanh, p.data, p.train, &mut ws));
+    let initial_loss = match p.val.is_empty() {
+        true => initial_train_loss,
+        false => in_pool(|| dataset_mse(p.layers, p.tanh, p.data, p.val, &mut ws)),
+    };
     let mut t = Tracker {
         best: p.layers.to_vec(),
-        best_loss: f64::INFINITY,
+        // an epoch is kept only if it beats the initial weights
+        best_loss: initial_loss,
         since_best: 0,
         patience: opts.patience,
         out: FitOutcome {
+            initial_train_loss,
+            initial_loss,
             train_loss: Vec::new(),
             val_loss: Vec::new(),
             best_epoch: 0,

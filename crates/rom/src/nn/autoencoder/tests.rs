@@ -289,3 +289,69 @@ fn one_latent_coordinate_learns_one_parameter_family() {
         ((report.final_train_rmse.powi(2) * 180.0 + val_rmse.powi(2) * 20.0) / 200.0).sqrt();
     assert!((pooled - rmse).abs() <= 1e-9 * rmse, "{pooled} vs {rmse}");
 }
+
+#[test]
+fn zero_epochs_are_refused_rather_than_saving_the_random_initial_weights() {
+    let data = one_parameter_family(20, 12, 1);
+    let opts = TrainOptions {
+        epochs: 0,
+        ..TrainOptions::default()
+    };
+    let err = Autoencoder::train(&data, 12, &opts, &mut quiet()).unwrap_err();
+    assert!(
+        matches!(err, NnError::InvalidOption { field: "epochs", .. }),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_diverging_training_is_an_error_and_no_model() {
+    // a learning rate 10⁶× the default: the loss explodes (finite or not) within a few epochs
+    let data = one_parameter_family(200, 12, 2);
+    let opts = TrainOptions {
+        latent: 1,
+        hidden_layers: 3,
+        epochs: 200,
+        learning_rate: 1e3,
+        fine_tune: FineTune::None,
+        ..TrainOptions::default()
+    };
+    match Autoencoder::train(&data, 12, &opts, &mut quiet()) {
+        Err(NnError::Diverged {
+            epoch,
+            loss,
+            initial,
+            learning_rate,
+        }) => {
+            assert!(epoch >= 1 && epoch < 200, "stopped at epoch {epoch}");
+            assert!(!(loss <= crate::nn::EXPLODED * initial), "{loss} vs {initial}");
+            assert_eq!(learning_rate, 1e3);
+        }
+        other => panic!("expected a divergence error, got {:?}", other.map(|r| r.1)),
+    }
+}
+
+#[test]
+fn a_training_that_never_beats_its_initial_weights_is_an_error() {
+    // a learning rate so small the weights cannot move: no epoch beats the initial loss
+    let data = one_parameter_family(50, 12, 3);
+    let opts = TrainOptions {
+        latent: 1,
+        hidden_layers: 3,
+        epochs: 3,
+        learning_rate: 1e-300,
+        fine_tune: FineTune::None,
+        ..TrainOptions::default()
+    };
+    let err = Autoencoder::train(&data, 12, &opts, &mut quiet()).unwrap_err();
+    assert!(
+        matches!(err, NnError::NoProgress { epochs: 3, initial } if initial > 0.0),
+        "{err}"
+    );
+    // the same data with the default rate learns: the check does not refuse a real training
+    let opts = TrainOptions {
+        learning_rate: TrainOptions::default().learning_rate,
+        ..opts
+    };
+    Autoencoder::train(&data, 12, &opts, &mut quiet()).unwrap();
+}

@@ -1,0 +1,292 @@
+//! Reduced models refuse what they cannot answer: failed trainings leave no model, incomplete or
+//! inconsistent datasets are refused, and `--model` refuses a scenario outside what the model was
+//! trained on (its inputs' ranges, its scenario's physics) unless `--extrapolate` is given.
+
+mod common;
+
+use common::{expect_error, gvsrom, scratch};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::sync::OnceLock;
+use std::time::Duration;
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn run_ok(args: &[&str]) -> (String, String) {
+    let out = gvsrom(args);
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout).to_string(),
+        String::from_utf8_lossy(&out.stderr).to_string(),
+    );
+    assert!(out.status.success(), "gvsrom {args:?} failed: {stderr}");
+    (stdout, stderr)
+}
+
+/// 12 single-tendon equilibria at tensions in [-6, 3] N.
+fn dataset12() -> &'static Path {
+    static D: OnceLock<PathBuf> = OnceLock::new();
+    D.get_or_init(|| {
+        let dir = scratch("val-ds12");
+        run_ok(&[
+            "dataset",
+            "single-tendon",
+            "--sweep",
+            "tendons.0.tension=-6:3",
+            "--samples",
+            "12",
+            "--out",
+            s(&dir),
+        ]);
+        dir
+    })
+}
+
+/// POD-2 of [`dataset12`].
+fn pod2() -> &'static Path {
+    static M: OnceLock<PathBuf> = OnceLock::new();
+    M.get_or_init(|| {
+        let dir = scratch("val-pod2");
+        run_ok(&["pod", s(dataset12()), "--modes", "2", "--out", s(&dir)]);
+        dir
+    })
+}
+
+#[test]
+fn zero_epochs_and_a_diverging_training_leave_no_model() {
+    let out = scratch("val-ae-failed");
+    let train = |extra: &[&str], needles: &[&str]| {
+        let args = [
+            &[
+                "train",
+                s(dataset12()),
+                "--hidden-layers",
+                "3",
+                "--out",
+                s(&out),
+            ][..],
+            extra,
+        ]
+        .concat();
+        expect_error(&args, needles);
+        assert!(!out.exists(), "a failed training wrote a model");
+    };
+    train(&["--epochs", "0"], &["--epochs", "≥ 1"]);
+    // a learning rate 10⁶× the default: the loss explodes
+    train(
+        &["--epochs", "200", "--learning-rate", "1000"],
+        &["--learning-rate", "diverged", "lower the learning rate"],
+    );
+    // a rate too small to move any weight: the loss never falls below the initial weights'
+    train(
+        &[
+            "--epochs",
+            "3",
+            "--learning-rate",
+            "1e-300",
+            "--lbfgs-iterations",
+            "0",
+        ],
+        &["did not lower the loss"],
+    );
+}
+
+#[test]
+fn an_incomplete_dataset_is_refused_by_pod_and_train() {
+    let dir = scratch("val-ds-incomplete");
+    let out = gvsrom(&[
+        "dataset",
+        "single-tendon",
+        "--sweep",
+        "tendons.0.tension=-6:3",
+        "--samples",
+        "12",
+        "--chunk-size",
+        "4",
+        "--threads",
+        "1",
+        "--stop-after-chunks",
+        "1",
+        "--out",
+        s(&dir),
+    ]);
+    assert_eq!(out.status.code(), Some(130));
+    let model = scratch("val-ds-incomplete-model");
+    for args in [
+        vec!["pod", s(&dir), "--modes", "1", "--out", s(&model)],
+        vec!["train", s(&dir), "--epochs", "2", "--out", s(&model)],
+    ] {
+        expect_error(&args, &["incomplete", "8 of its 12 samples", "--resume"]);
+        assert!(!model.exists());
+    }
+}
+
+#[test]
+fn a_model_refuses_inputs_outside_its_training_range_unless_extrapolating() {
+    let m = pod2();
+    // inside [-6, 3] N (and its 2 % margin): answered
+    run_ok(&[
+        "statics",
+        "single-tendon",
+        "--tension=-6.1",
+        "--model",
+        s(m),
+    ]);
+    // outside: refused, naming the input, its value and the range
+    expect_error(
+        &["statics", "single-tendon", "--tension=-9", "--model", s(m)],
+        &[
+            "--model",
+            "tendons.0.tension = -9",
+            "outside the training inputs [-6, 3]",
+            "--extrapolate",
+        ],
+    );
+    // on purpose: answered, with a warning naming the extrapolation
+    let (stdout, stderr) = run_ok(&[
+        "statics",
+        "single-tendon",
+        "--tension=-9",
+        "--model",
+        s(m),
+        "--extrapolate",
+    ]);
+    assert!(stdout.contains("tip"), "{stdout}");
+    assert!(
+        stderr.contains("warning: extrapolating (--extrapolate): tendons.0.tension = -9"),
+        "{stderr}"
+    );
+    // the same for simulate and modes
+    expect_error(
+        &[
+            "simulate",
+            "single-tendon",
+            "--tension=-9",
+            "--duration",
+            "0.01",
+            "--model",
+            s(m),
+        ],
+        &["tendons.0.tension = -9"],
+    );
+    expect_error(
+        &["modes", "single-tendon", "--tension=-9", "--model", s(m)],
+        &["tendons.0.tension = -9"],
+    );
+}
+
+#[test]
+fn a_model_refuses_a_scenario_with_other_physics_naming_the_field() {
+    let m = pod2();
+    expect_error(
+        &[
+            "statics",
+            "single-tendon",
+            "--tension=-3",
+            "--set",
+            "loads.gravity=[0,0,0]",
+            "--model",
+            s(m),
+        ],
+        &[
+            "--model",
+            "loads.gravity[2] differs",
+            "-9.81",
+            "single-tendon",
+        ],
+    );
+    expect_error(
+        &[
+            "statics",
+            "single-tendon",
+            "--tension=-3",
+            "--set",
+            "tendons.0.friction=0",
+            "--model",
+            s(m),
+        ],
+        &["tendons[0].friction differs", "0.88"],
+    );
+    expect_error(
+        &[
+            "statics",
+            "single-tendon",
+            "--tension=-3",
+            "--set",
+            "material.youngs_modulus=2e6",
+            "--model",
+            s(m),
+        ],
+        &["material.youngs_modulus differs"],
+    );
+    // what is not physics may change: solver settings, output, the name
+    run_ok(&[
+        "statics",
+        "single-tendon",
+        "--tension=-3",
+        "--set",
+        "solver.max_iterations=80",
+        "--set",
+        "name=renamed",
+        "--set",
+        "output.centerline_points=5",
+        "--model",
+        s(m),
+    ]);
+}
+
+#[test]
+fn a_model_from_an_interrupted_training_is_used_with_a_warning() {
+    let dir = scratch("val-ae-interrupted");
+    let child = Command::new(env!("CARGO_BIN_EXE_gvsrom"))
+        .args([
+            "train",
+            s(dataset12()),
+            "--hidden-layers",
+            "3",
+            "--epochs",
+            "1000000",
+            "--patience",
+            "0",
+            "--out",
+            s(&dir),
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1500));
+    assert!(Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap()
+        .success());
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(130),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (_, stderr) = run_ok(&[
+        "statics",
+        "single-tendon",
+        "--tension=-3",
+        "--model",
+        s(&dir),
+    ]);
+    assert!(
+        stderr.contains("warning:") && stderr.contains("interrupted training"),
+        "{stderr}"
+    );
+    // a model trained to its end carries no such warning
+    let (_, stderr) = run_ok(&[
+        "statics",
+        "single-tendon",
+        "--tension=-3",
+        "--model",
+        s(pod2()),
+    ]);
+    assert!(!stderr.contains("warning"), "{stderr}");
+}
