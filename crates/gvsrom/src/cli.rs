@@ -551,6 +551,11 @@ fn statics_cmd(args: &StaticsArgs, out: &mut impl Write) -> Result<()> {
         let doc = statics::StaticsJson {
             report: &report,
             model: args.model.as_ref().map(|p| p.display().to_string()),
+            model_extrapolated: built
+                .reduced
+                .as_ref()
+                .map(|r| r.extrapolated.clone())
+                .unwrap_or_default(),
             comparison,
         };
         let path = json.commit_json(&doc)?;

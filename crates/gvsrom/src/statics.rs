@@ -171,6 +171,9 @@ pub struct StaticsJson<'a> {
     pub report: &'a StaticsReport,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub model: Option<String>,
+    /// How the scenario lies outside what the model was trained on (`--extrapolate`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub model_extrapolated: Vec<String>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub comparison: Option<Comparison>,
 }

@@ -143,7 +143,8 @@ fn a_model_refuses_inputs_outside_its_training_range_unless_extrapolating() {
             "--extrapolate",
         ],
     );
-    // on purpose: answered, with a warning naming the extrapolation
+    // on purpose: answered, with a warning naming the extrapolation, recorded in the JSON
+    let json = scratch("val-extrapolated.json");
     let (stdout, stderr) = run_ok(&[
         "statics",
         "single-tendon",
@@ -151,7 +152,17 @@ fn a_model_refuses_inputs_outside_its_training_range_unless_extrapolating() {
         "--model",
         s(m),
         "--extrapolate",
+        "--json",
+        s(&json),
     ]);
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert!(
+        doc["model_extrapolated"][0]
+            .as_str()
+            .is_some_and(|e| e.contains("tendons.0.tension = -9")),
+        "{doc}"
+    );
     assert!(stdout.contains("tip"), "{stdout}");
     assert!(
         stderr.contains("warning: extrapolating (--extrapolate): tendons.0.tension = -9"),

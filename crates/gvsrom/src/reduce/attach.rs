@@ -36,16 +36,22 @@ impl Reduced {
     /// Errors if `q` lies outside the training encodings' range by more than half its width in
     /// some coordinate ([`Self::range_violation`]): the decoder is extrapolating there (tanh layers
     /// saturate, `Ψ_q → 0`, and spurious equilibria appear), so the result is not to be trusted.
+    /// The message names the likely cause: the inputs were checked when the model was attached.
     pub fn check_range(&self, q: &[f64]) -> Result<(), ScenarioError> {
-        match self.range_violation(q) {
-            None => Ok(()),
-            Some(v) => Err(invalid(
-                "--model",
-                format!(
-                    "the reduced solution {v}: the decoder is extrapolating (the load is outside the dataset, or the model is poor)"
-                ),
-            )),
-        }
+        let Some(v) = self.range_violation(q) else {
+            return Ok(());
+        };
+        let cause = if !self.extrapolated.is_empty() {
+            "the model is extrapolating (--extrapolate) and its decoder has left its data"
+        } else if self.initial.is_none() {
+            "the inputs lie inside the training range, but the model has no anchors to start the solve from, and from its rest coordinates the solve reached a spurious equilibrium off the learned manifold: re-create the model with this build (it stores anchors)"
+        } else {
+            "the inputs lie inside the training range, yet the solve reached a spurious equilibrium off the learned manifold: the model is poor here (more data, or more training)"
+        };
+        Err(invalid(
+            "--model",
+            format!("the reduced solution {v}: {cause}"),
+        ))
     }
 
     /// How far the rest coordinates ([`StrainParam::rest_coordinates`], where a simulation from
