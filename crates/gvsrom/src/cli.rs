@@ -508,7 +508,27 @@ fn check_cmd(args: &ScenarioArgs, out: &mut impl Write) -> Result<()> {
     Ok(())
 }
 
+/// The command's input files and directories that an output must not replace: the scenario file
+/// (not a preset name, which is resolved first) and `model`, with their option names.
+fn scenario_inputs<'a>(
+    args: &'a ScenarioArgs,
+    model: Option<&'a PathBuf>,
+) -> Vec<(&'static str, &'a std::path::Path)> {
+    let mut inputs = vec![];
+    if presets::find(&args.scenario).is_none() {
+        inputs.push(("SCENARIO", std::path::Path::new(&args.scenario)));
+    }
+    if let Some(m) = model {
+        inputs.push(("--model", m.as_path()));
+    }
+    inputs
+}
+
 fn statics_cmd(args: &StaticsArgs, out: &mut impl Write) -> Result<()> {
+    if let Some(path) = &args.json {
+        let inputs = scenario_inputs(&args.scenario, args.model.as_ref());
+        gvsrom::output::refuse_overlap("--json", path, &inputs)?;
+    }
     let (scenario, mut built) = load(&args.scenario)?;
     if let Some(dir) = &args.model {
         attach_model(&mut built, &args.scenario, dir)?;
@@ -566,6 +586,10 @@ fn statics_cmd(args: &StaticsArgs, out: &mut impl Write) -> Result<()> {
 
 fn modes_cmd(args: &ModesArgs, out: &mut impl Write) -> Result<()> {
     use gvsrom::modes;
+    if let Some(path) = &args.json {
+        let inputs = scenario_inputs(&args.scenario, args.model.as_ref());
+        gvsrom::output::refuse_overlap("--json", path, &inputs)?;
+    }
     let (scenario, mut built) = load(&args.scenario)?;
     if let Some(dir) = &args.model {
         attach_model(&mut built, &args.scenario, dir)?;
@@ -648,6 +672,9 @@ fn modes_cmd(args: &ModesArgs, out: &mut impl Write) -> Result<()> {
 
 fn pod_cmd(args: &PodArgs, out: &mut impl Write) -> Result<()> {
     let s = reduce::pod(&args.dataset, args.modes, &args.out, args.force)?;
+    for w in &s.warnings {
+        eprintln!("warning: {w}");
+    }
     writeln!(
         out,
         "snapshots  {} × {} (failed samples skipped), numerical rank {}",
@@ -721,6 +748,9 @@ fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
         &mut progress,
     )?;
     bar.finish_and_clear();
+    for w in &s.warnings {
+        eprintln!("warning: {w}");
+    }
     let r = &s.report;
     writeln!(
         out,
@@ -784,6 +814,16 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
     use gvs::inputs::Interpolation;
     use gvsrom::simulate::{self, InputSource, SimulateOptions};
     use std::io::IsTerminal;
+    if let Some(dir) = &args.out {
+        let mut inputs = scenario_inputs(&args.scenario, args.model.as_ref());
+        if let Some(p) = &args.input {
+            inputs.push(("--input", p.as_path()));
+        }
+        if let Some(p) = &args.load_schedule {
+            inputs.push(("--load-schedule", p.as_path()));
+        }
+        gvsrom::output::refuse_overlap("--out", dir, &inputs)?;
+    }
     let (scenario, mut built) = load(&args.scenario)?;
     if let Some(dir) = &args.model {
         attach_model(&mut built, &args.scenario, dir)?;

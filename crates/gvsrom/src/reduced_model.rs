@@ -11,11 +11,13 @@
 //! - training curves (`train_loss.npy`, `val_loss.npy`) or the POD spectrum (`singular_values.npy`,
 //!   `captured_energy.npy`).
 //!
-//! Loading checks every tensor's name, dtype and shape against the metadata: a truncated or edited
-//! file is an error naming it, never a different model. Saved and loaded models are bit-identical.
+//! Loading first checks every file and the metadata against the SHA-256 hashes recorded when the
+//! model was written (`output::integrity`), then every tensor's name, dtype and shape against the
+//! metadata: a truncated or edited file is an error naming it, never a different model. Saved and
+//! loaded models are bit-identical.
 
 use crate::npy::write_array;
-use crate::output::{OutputDir, OutputError, MANIFEST_KEY};
+use crate::output::{Integrity, OutputDir, OutputError, MANIFEST_KEY};
 use rom::nn::{Autoencoder, Mlp, Scaling};
 use safetensors::tensor::{Dtype, SafeTensors, TensorView};
 use serde::{Deserialize, Serialize};
@@ -190,6 +192,9 @@ pub struct ReducedModel {
     pub meta: ModelMeta,
     pub weights: ModelWeights,
     pub anchors: Option<Anchors>,
+    /// Whether its files were checked against their recorded hashes when loaded (a new model:
+    /// [`Integrity::Checked`]; `Unhashed` if written before hashes were recorded).
+    pub integrity: Integrity,
 }
 
 /// FNV-1a 64-bit hash, as 16 hex digits.
@@ -300,6 +305,12 @@ impl ReducedModel {
             path: dir.to_path_buf(),
             message,
         };
+        // every listed file and the metadata as written, before anything is parsed
+        let integrity = crate::output::verify_dir(dir, MODEL_FORMAT).map_err(|e| {
+            bad(format!(
+                "{e}; an edited model is not the model that was trained — re-create it"
+            ))
+        })?;
         let meta_path = dir.join("meta.json");
         let text = std::fs::read_to_string(&meta_path)
             .map_err(|e| bad(format!("cannot read meta.json: {e}")))?;
@@ -423,6 +434,7 @@ impl ReducedModel {
             meta,
             weights,
             anchors,
+            integrity,
         })
     }
 }

@@ -301,3 +301,94 @@ fn a_model_from_an_interrupted_training_is_used_with_a_warning() {
     ]);
     assert!(!stderr.contains("warning"), "{stderr}");
 }
+
+/// A copy of a gvsrom directory output (flat) at a fresh scratch path.
+fn copy_dir(from: &Path, name: &str) -> PathBuf {
+    let to = scratch(name);
+    std::fs::create_dir_all(&to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let e = e.unwrap();
+        std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
+    }
+    to
+}
+
+fn read_json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+fn write_json(path: &Path, v: &serde_json::Value) {
+    std::fs::write(path, serde_json::to_string_pretty(v).unwrap()).unwrap();
+}
+
+/// Byte offset of the data of a version-1 `.npy` file.
+fn npy_data_offset(bytes: &[u8]) -> usize {
+    assert_eq!(&bytes[..6], b"\x93NUMPY");
+    10 + u16::from_le_bytes([bytes[8], bytes[9]]) as usize
+}
+
+#[test]
+fn edited_weights_with_their_shapes_intact_are_refused() {
+    let m = copy_dir(pod2(), "val-pod2-edited");
+    let w = m.join("weights.safetensors");
+    let mut bytes = std::fs::read(&w).unwrap();
+    // one mantissa byte of the last value: same shapes, a slightly different model
+    let n = bytes.len();
+    bytes[n - 3] ^= 0x01;
+    std::fs::write(&w, &bytes).unwrap();
+    expect_error(
+        &["statics", "single-tendon", "--tension=-3", "--model", s(&m)],
+        &[
+            "weights.safetensors",
+            "differs from the hash",
+            "re-create it",
+        ],
+    );
+}
+
+#[test]
+fn dataset_metadata_inconsistent_with_its_arrays_is_refused_not_a_panic() {
+    let out = scratch("val-ds-inconsistent-model");
+    // the component names reordered (hashes re-recorded, as by a writer with a bug)
+    let ds = copy_dir(dataset12(), "val-ds-renamed");
+    let mut meta = read_json(&ds.join("meta.json"));
+    meta["components"].as_array_mut().unwrap().reverse();
+    write_json(&ds.join("meta.json"), &meta);
+    common::reseal::reseal(&ds);
+    for cmd in [
+        vec!["pod", s(&ds), "--modes", "1", "--out", s(&out)],
+        vec!["train", s(&ds), "--epochs", "2", "--out", s(&out)],
+    ] {
+        expect_error(&cmd, &["DATASET", "meta.json is inconsistent"]);
+        assert!(!out.exists());
+    }
+    // meta.json naming another scenario (a two-mode rod) over the single tendon's arrays
+    let ds = copy_dir(dataset12(), "val-ds-other-scenario");
+    let mut meta = read_json(&ds.join("meta.json"));
+    let text = "[material]\nyoungs_modulus = 1e6\npoisson_ratio = 0.5\ndensity = 1000\n[[divisions]]\nlength = 0.5\nradius = 0.01\nbasis = { kind = \"legendre\", modes = [\"bend_y\", \"bend_z\"], order = 3 }\n";
+    meta["scenario_toml"] = text.into();
+    write_json(&ds.join("meta.json"), &meta);
+    common::reseal::reseal(&ds);
+    expect_error(
+        &["pod", s(&ds), "--modes", "1", "--out", s(&out)],
+        &["DATASET", "meta.json is inconsistent", "coordinates"],
+    );
+}
+
+#[test]
+fn a_pathological_strain_is_blamed_on_the_dataset_not_on_an_option() {
+    let ds = copy_dir(dataset12(), "val-ds-huge");
+    let f = ds.join("strain.npy");
+    let mut bytes = std::fs::read(&f).unwrap();
+    let at = npy_data_offset(&bytes) + 8 * 5;
+    bytes[at..at + 8].copy_from_slice(&1e300f64.to_le_bytes());
+    std::fs::write(&f, &bytes).unwrap();
+    common::reseal::reseal(&ds);
+    let out = scratch("val-ds-huge-model");
+    let msg = expect_error(
+        &["pod", s(&ds), "--modes", "1", "--out", s(&out)],
+        &["DATASET", "sample 0", "1e300", "corrupt sample"],
+    );
+    assert!(!msg.contains("--modes"), "{msg}");
+    assert!(!out.exists());
+}

@@ -348,6 +348,15 @@ pub fn run(
     out: &mut dyn Write,
 ) -> Result<Outcome, DatasetError> {
     let t0 = Instant::now();
+    // `--resume` reads the dataset at --out itself, on purpose; the other inputs must stay apart
+    let mut inputs = vec![];
+    if crate::presets::find(&args.scenario).is_none() {
+        inputs.push(("SCENARIO", Path::new(&args.scenario)));
+    }
+    if let Some(p) = &args.input {
+        inputs.push(("--input", p.as_path()));
+    }
+    crate::output::refuse_overlap("--out", &args.out, &inputs)?;
     let (table, built, scenario_toml) = load_scenario(args)?;
     if args.duration.is_some() {
         return dynamic::run(args, &built, scenario_toml, interrupt, out, t0);

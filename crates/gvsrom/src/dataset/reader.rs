@@ -1,10 +1,15 @@
-//! Reading a dataset back: every array is checked against `meta.json` (dtype, shape, exact byte
-//! length) so a truncated, corrupted or missing file is an error naming the file, never a wrong
-//! dataset.
+//! Reading a dataset back: its files are first checked against the hashes recorded when it was
+//! written ([`crate::output::verify_dir`]), then every array against `meta.json` (dtype, shape, exact
+//! byte length), so an edited, truncated, corrupted or missing file is an error naming the file,
+//! never a wrong dataset.
 
 use super::generate::{STATUS_FAILED, STATUS_NOT_COMPUTED, STATUS_OK};
 use super::{DatasetError, Meta, FILES, T_FILE};
+use crate::output::integrity::{Integrity, IntegrityError, Problem};
 use std::path::Path;
+
+/// The manifest format of a dataset directory.
+pub const DATASET_FORMAT: &str = "dataset";
 
 /// A dataset loaded from its directory. Arrays are row-major; see the module documentation of
 /// [`crate::dataset`] for the files.
@@ -28,6 +33,9 @@ pub struct Dataset {
     pub strain_x: Vec<f64>,
     /// Sample times of a dynamic dataset.
     pub t: Option<Vec<f64>>,
+    /// Whether the files were checked against recorded hashes ([`Integrity::Unhashed`]: a dataset
+    /// written before gvsrom recorded them; a front-end may warn).
+    pub integrity: Integrity,
 }
 
 fn file_error(file: &str, message: impl Into<String>) -> DatasetError {
@@ -47,9 +55,30 @@ fn read_npy<T: npyz::Deserialize>(
     crate::npy::read_checked(dir, name, descr, shape).map_err(|e| file_error(&e.file, e.message))
 }
 
+/// An integrity error as a dataset error. For a file changed since it was written, what reading it
+/// finds is added when that fails too (e.g. "truncated"): the hash says *that* it changed, the
+/// reader *how*.
+fn integrity_error(dir: &Path, e: IntegrityError) -> DatasetError {
+    let mut message = e.problem.to_string();
+    if matches!(e.problem, Problem::Changed | Problem::MetaEdited) {
+        if let Err(found) = Dataset::read(dir, Integrity::Unhashed) {
+            message = format!("{message}; as read now: {found}");
+        }
+    }
+    file_error(&e.path.display().to_string(), message)
+}
+
 impl Dataset {
-    /// Loads and validates the dataset in `dir`.
+    /// Loads and validates the dataset in `dir`: its files against the hashes in its manifest, then
+    /// its arrays against `meta.json`.
     pub fn load(dir: &Path) -> Result<Dataset, DatasetError> {
+        let integrity =
+            crate::output::verify_dir(dir, DATASET_FORMAT).map_err(|e| integrity_error(dir, e))?;
+        Dataset::read(dir, integrity)
+    }
+
+    /// Reads and validates the arrays of the dataset in `dir` (its integrity checked or not).
+    fn read(dir: &Path, integrity: Integrity) -> Result<Dataset, DatasetError> {
         let meta_path = dir.join(crate::output::MANIFEST_FILE);
         let shown = meta_path.display().to_string();
         let text = std::fs::read_to_string(&meta_path).map_err(|e| match e.kind() {
@@ -62,7 +91,7 @@ impl Dataset {
             .get(crate::output::MANIFEST_KEY)
             .and_then(|m| m.get("format"))
             .and_then(|f| f.as_str());
-        if format != Some("dataset") {
+        if format != Some(DATASET_FORMAT) {
             return Err(file_error(
                 &shown,
                 "not a gvsrom dataset (its manifest does not say format \"dataset\")",
@@ -110,6 +139,7 @@ impl Dataset {
                 _ => None,
             },
             meta,
+            integrity,
         };
         ds.check_consistency(dir)?;
         Ok(ds)

@@ -17,15 +17,26 @@
 //! 4. **Staging beside the target.** Results are written into a fresh, uniquely named
 //!    `.P.gvsrom-staging-<pid>-<n>` in `P`'s directory (same file system, so the final move is an atomic
 //!    rename). It is created before the computation starts, which also proves the location writable.
-//! 5. **Commit.** Every file is fsynced, then the staging is renamed to `P`. Replacing (with `--force`)
-//!    first renames the old output aside to `.P.gvsrom-old-<pid>-<n>`, moves the new one in, and only
-//!    then deletes the old one's manifest-listed files. The target is re-checked under the lock at
-//!    commit time. If the commit cannot complete, the staging is kept and the error names it.
+//! 5. **Commit.** Every file is fsynced and its SHA-256 recorded in the manifest with that of
+//!    meta.json's other values ([`integrity`]; loaders check them with [`verify_dir`]), then the
+//!    staging is renamed to `P`. Replacing (with `--force`) exchanges the staging and the old output
+//!    in one step on Linux (`renameat2` with `RENAME_EXCHANGE`: `P` always holds a complete output),
+//!    then deletes the old one's manifest-listed files from where the staging was. Where the exchange
+//!    is unavailable (other systems; `ENOSYS`, `EINVAL`, `EOPNOTSUPP`, `EPERM` from old kernels, some
+//!    file systems and sandboxes) it takes two renames, the old output aside to
+//!    `.P.gvsrom-old-<pid>-<n>` and the new one in: between them `P` holds nothing, and a kill there
+//!    leaves the old output complete under the `-old-` name ([`replace`]). The target is re-checked
+//!    under the lock at commit time. If the commit cannot complete, the staging is kept and the error
+//!    names it.
 //! 6. A run that ends without committing (an error before the results exist) removes its staging.
-//!    A killed process (SIGKILL, power loss) can leave a hidden `.P.gvsrom-staging-*` directory or
-//!    `.P.gvsrom-old-*`; they are never taken for a complete result and can be deleted by hand.
+//!    A killed process (SIGKILL, power loss) can leave a hidden `.P.gvsrom-staging-*` directory (the
+//!    unfinished new output, or after an exchange the old one being deleted) or `.P.gvsrom-old-*`;
+//!    they are never taken for a complete result and can be deleted by hand.
 
+pub mod integrity;
+mod replace;
 mod run_dir;
+pub use integrity::{verify_dir, Integrity, IntegrityError};
 pub use run_dir::{RunDir, RUN_FORMAT};
 
 use serde::Serialize;
@@ -164,11 +175,7 @@ pub fn refuse_overlap(
             continue;
         };
         if input_c.starts_with(&target) {
-            let how = if input_c == target {
-                "is"
-            } else {
-                "contains"
-            };
+            let how = if input_c == target { "is" } else { "contains" };
             return Err(named.refused(format!(
                 "{how} the input {option} `{}`; an output never replaces the command's own input: choose another path",
                 input.display()
@@ -198,18 +205,20 @@ fn refuse_special(n: &Named, parent: &Path, name: &str) -> Result<(), OutputErro
     Ok(())
 }
 
-/// Reads the manifest of an existing output: the `"gvsrom"` object of `json_path`, and its `files`.
-fn read_manifest(json_path: &Path) -> Option<(String, Vec<String>)> {
+/// Reads the manifest of an existing output: the `"gvsrom"` object of `json_path`, and its `files`
+/// (only a directory output's manifest has them).
+fn read_manifest(json_path: &Path) -> Option<(String, Option<Vec<String>>)> {
     let text = fs::read_to_string(json_path).ok()?;
     let value: Value = serde_json::from_str(&text).ok()?;
     let m = value.get(MANIFEST_KEY)?.as_object()?;
     let format = m.get("format")?.as_str()?.to_string();
     let files = match m.get("files") {
-        Some(Value::Array(a)) => a
-            .iter()
-            .map(|f| f.as_str().map(str::to_string))
-            .collect::<Option<Vec<_>>>()?,
-        None => vec![],
+        Some(Value::Array(a)) => Some(
+            a.iter()
+                .map(|f| f.as_str().map(str::to_string))
+                .collect::<Option<Vec<_>>>()?,
+        ),
+        None => None,
         Some(_) => return None,
     };
     Some((format, files))
@@ -255,6 +264,13 @@ fn inspect(n: &Named, target: &Path, kind: Kind, force: bool) -> Result<Existing
             if kind == Kind::Dir { " in meta.json" } else { "" }
         )));
     };
+    if kind == Kind::File && files.is_some() {
+        // e.g. `--json MODEL/meta.json`: replacing it would break the directory output around it
+        return Err(n.refused(format!(
+            "is the meta.json of a gvsrom {format} directory, not a file output; gvsrom never replaces part of an output: choose another path"
+        )));
+    }
+    let files = files.unwrap_or_default();
     if !force {
         return Err(n.refused(format!(
             "exists (a gvsrom {format} output); pass --force to replace it, or choose another path"
@@ -611,10 +627,15 @@ impl OutputDir {
                 source,
             },
         };
-        let meta = with_manifest(meta, manifest(&self.format, Some(&self.files)))
+        let mut meta = with_manifest(meta, manifest(&self.format, Some(&self.files)))
             .map_err(named.io("write meta.json"))?;
         let staging = self.staging.clone();
         (|| -> io::Result<()> {
+            for f in &self.files {
+                File::open(staging.join(f))?.sync_all()?;
+            }
+            // the hashes of the files as they are on disk, read back
+            integrity::record_hashes(&staging, &self.files, &mut meta)?;
             let mut w = BufWriter::new(
                 OpenOptions::new()
                     .write(true)
@@ -624,9 +645,6 @@ impl OutputDir {
             serde_json::to_writer_pretty(&mut w, &meta)?;
             w.write_all(b"\n")?;
             w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
-            for f in &self.files {
-                File::open(staging.join(f))?.sync_all()?;
-            }
             sync_dir(&staging)
         })()
         .map_err(named.io("write its files"))?;
@@ -640,18 +658,15 @@ impl OutputDir {
                     .map_err(|e| keep(named.io("move the results into place")(e), &staging))?;
             }
             Existing::Previous { files } => {
-                let aside = unique_sibling(&self.parent, &self.name, "old");
-                fs::rename(&self.target, &aside)
-                    .map_err(|e| keep(named.io("set the previous output aside")(e), &staging))?;
-                if let Err(e) = fs::rename(&staging, &self.target) {
-                    let _ = fs::rename(&aside, &self.target);
-                    return Err(keep(named.io("move the results into place")(e), &staging));
-                }
+                let old = replace::swap_in(&staging, &self.target, || {
+                    unique_sibling(&self.parent, &self.name, "old")
+                })
+                .map_err(|(op, e)| keep(named.io(op)(e), &staging))?;
                 // The new output is in place; the old one goes only by its own manifest.
-                if let Err(e) = remove_previous_dir(&aside, &files) {
+                if let Err(e) = remove_previous_dir(&old, &files) {
                     eprintln!(
                         "warning: the replaced output was kept in `{}`: {e}",
-                        aside.display()
+                        old.display()
                     );
                 }
             }
@@ -811,9 +826,14 @@ mod tests {
             (data.clone(), vec![("DATASET", data.as_path())]),
             (d.join("data/"), vec![("DATASET", data.as_path())]),
             (d.join("./data"), vec![("DATASET", data.as_path())]),
-            (data.clone(), vec![("--model", data.join("inner").as_path())]),
+            (
+                data.clone(),
+                vec![("--model", data.join("inner").as_path())],
+            ),
         ] {
-            let err = refuse_overlap("--out", &out, &inputs).unwrap_err().to_string();
+            let err = refuse_overlap("--out", &out, &inputs)
+                .unwrap_err()
+                .to_string();
             assert!(err.contains("input") && err.contains("--out"), "{err}");
         }
         #[cfg(unix)]

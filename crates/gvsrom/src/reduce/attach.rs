@@ -200,6 +200,12 @@ pub fn attach(
         .into());
     }
     let mut warnings = vec![];
+    if model.integrity == crate::output::Integrity::Unhashed {
+        warnings.push(format!(
+            "`{}` was written before gvsrom recorded content hashes: its files could not be checked for edits",
+            dir.display()
+        ));
+    }
     if let Some(t) = &model.meta.training {
         if t.stop == format!("{:?}", rom::nn::StopReason::Interrupted) {
             warnings.push(format!(

@@ -82,10 +82,15 @@ pub(super) fn projection_of(
     Ok((layout, pm, p))
 }
 
-/// The usable rows of a dataset (status ok), row-major, and their count; an error if none.
+/// Bound on a snapshot value times the rod length (see [`snapshot_rows`]).
+const MAX_STRAIN_TIMES_LENGTH: f64 = 1e6;
+
+/// The usable rows of a dataset (status ok), row-major, and their count; an error if none, if the
+/// dataset is incomplete, or if a value is beyond any strain a rod of `length` can hold.
 pub(super) fn snapshot_rows(
     ds: &Dataset,
     option: &str,
+    length: f64,
 ) -> Result<(Vec<f64>, usize), ScenarioError> {
     let c = &ds.meta.counts;
     if c.not_computed > 0 {
@@ -108,6 +113,23 @@ pub(super) fn snapshot_rows(
     let mut x = Vec::with_capacity(rows.len() * ds.row_len());
     for &k in &rows {
         x.extend_from_slice(ds.strain_row(k));
+    }
+    // a value no rod of this length can hold: a bent rod of curvature κ turns κL/2π times, a
+    // stretched one by a factor of its elongation; 10⁶ of either is a corrupt sample, not physics
+    let (i, v) = x
+        .iter()
+        .enumerate()
+        .map(|(i, v)| (i, v.abs()))
+        .fold((0, 0.0f64), |a, b| if b.1 > a.1 { b } else { a });
+    if v * length.max(1.0) > MAX_STRAIN_TIMES_LENGTH {
+        let sample = rows[i / ds.row_len().max(1)];
+        return Err(invalid(
+            option,
+            format!(
+                "sample {sample} holds the strain value {:e}, which no rod of length {length} m can hold (|ξ − ξ*| · max(L, 1 m) > {MAX_STRAIN_TIMES_LENGTH:e}): a corrupt sample; remove it or re-create the dataset",
+                x[i]
+            ),
+        ));
     }
     Ok((x, rows.len()))
 }
@@ -200,4 +222,16 @@ pub(super) fn latent_range(latent: &[f64], r: usize) -> Vec<[f64; 2]> {
         }
     }
     range
+}
+
+/// What a front-end should tell the user about the dataset `ds` read from `dir` (one written before
+/// content hashes could not be checked for edits).
+pub(super) fn dataset_warnings(ds: &Dataset, dir: &Path) -> Vec<String> {
+    match ds.integrity {
+        crate::output::Integrity::Checked => vec![],
+        crate::output::Integrity::Unhashed => vec![format!(
+            "dataset `{}` was written before gvsrom recorded content hashes: its files could not be checked for edits",
+            dir.display()
+        )],
+    }
 }

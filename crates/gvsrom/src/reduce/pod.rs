@@ -24,6 +24,8 @@ pub struct PodSummary {
     /// As [`TrainSummary::anchor_equilibria`] and [`TrainSummary::anchor_time_s`].
     pub anchor_equilibria: usize,
     pub anchor_time_s: f64,
+    /// Warnings for the user (a dataset without content hashes).
+    pub warnings: Vec<String>,
 }
 
 /// POD of a dataset's strain snapshots, `modes` modes, saved as a model at `out`.
@@ -36,7 +38,7 @@ pub fn pod(
     let ds = Dataset::load(dataset)?;
     let built = dataset_scenario(&ds)?;
     projection_of(&built)?; // the HOM basis must be recoverable from point strains
-    let (x, rows) = snapshot_rows(&ds, "DATASET")?;
+    let (x, rows) = snapshot_rows(&ds, "DATASET", built.model.rod.length())?;
     let features = ds.row_len();
     let dir = OutputDir::create("--out", out, crate::reduced_model::MODEL_FORMAT, force)?;
     let pod = Pod::compute(&x, features, modes).map_err(|e| pod_error(e, &ds, &x, features))?;
@@ -65,6 +67,8 @@ pub fn pod(
             modes: pod.modes.clone(),
             singular_values: pod.singular_values.clone(),
         },
+        // written by this run: as its files will be hashed
+        integrity: crate::output::Integrity::Checked,
         anchors: Some(crate::reduced_model::Anchors {
             n: rows,
             inputs: sample_inputs(&ds),
@@ -82,6 +86,7 @@ pub fn pod(
         ],
     )?;
     Ok(PodSummary {
+        warnings: super::dataset_warnings(&ds, dataset),
         path,
         rows,
         features,

@@ -36,6 +36,8 @@ pub struct TrainSummary {
     /// solves took.
     pub anchor_equilibria: usize,
     pub anchor_time_s: f64,
+    /// Warnings for the user (a dataset without content hashes).
+    pub warnings: Vec<String>,
 }
 
 /// How a snapshot feature's error weighs in the autoencoder's training loss (`gvsrom train --loss`).
@@ -107,7 +109,7 @@ pub fn train(
     let ds = Dataset::load(dataset)?;
     let built = dataset_scenario(&ds)?;
     let (layout, pm, p) = projection_of(&built)?;
-    let (x, rows) = snapshot_rows(&ds, "DATASET")?;
+    let (x, rows) = snapshot_rows(&ds, "DATASET", built.model.rod.length())?;
     let features = ds.row_len();
     let options = &TrainOptions {
         weighting: loss.weighting(&built, &layout),
@@ -213,6 +215,8 @@ pub fn train(
     let mut model = ReducedModel {
         meta,
         weights: ModelWeights::Autoencoder(ae),
+        // written by this run: as its files will be hashed
+        integrity: crate::output::Integrity::Checked,
         anchors: Some(crate::reduced_model::Anchors {
             n: rows,
             inputs: sample_inputs(&ds),
@@ -234,6 +238,7 @@ pub fn train(
         ],
     )?;
     Ok(TrainSummary {
+        warnings: super::dataset_warnings(&ds, dataset),
         path,
         rows,
         features,

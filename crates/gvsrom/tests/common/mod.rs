@@ -2,6 +2,8 @@
 //! one-line user error.
 #![allow(dead_code)]
 
+pub mod reseal;
+
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
