@@ -392,3 +392,93 @@ fn a_pathological_strain_is_blamed_on_the_dataset_not_on_an_option() {
     assert!(!msg.contains("--modes"), "{msg}");
     assert!(!out.exists());
 }
+
+/// The 1-latent, 3-hidden-layer autoencoder of [`dataset12`] (30 epochs).
+fn ae1() -> &'static Path {
+    static M: OnceLock<PathBuf> = OnceLock::new();
+    M.get_or_init(|| {
+        let dir = scratch("val-ae1");
+        run_ok(&[
+            "train",
+            s(dataset12()),
+            "--latent",
+            "1",
+            "--hidden-layers",
+            "3",
+            "--epochs",
+            "30",
+            "--seed",
+            "3",
+            "--out",
+            s(&dir),
+        ]);
+        dir
+    })
+}
+
+#[test]
+fn a_solution_off_the_learned_manifold_names_its_cause() {
+    use safetensors::tensor::{SafeTensors, TensorView};
+    // the autoencoder with its training range narrowed to ±1e-6 about its rest coordinates: every
+    // loaded equilibrium lies "off the manifold", an in-range load included
+    let narrowed = |name: &str, drop_anchors: bool| {
+        let dir = copy_dir(ae1(), name);
+        let mut meta = read_json(&dir.join("meta.json"));
+        let rest = meta["rest"][0].as_f64().unwrap();
+        meta["latent_range"] = serde_json::json!([[rest - 1e-6, rest + 1e-6]]);
+        write_json(&dir.join("meta.json"), &meta);
+        if drop_anchors {
+            let w = dir.join("weights.safetensors");
+            let bytes = std::fs::read(&w).unwrap();
+            let st = SafeTensors::deserialize(&bytes).unwrap();
+            let kept: Vec<(String, TensorView<'_>)> = st
+                .tensors()
+                .into_iter()
+                .filter(|(n, _)| !n.starts_with("anchors."))
+                .collect();
+            assert_eq!(kept.len() + 2, st.len());
+            let out = safetensors::serialize(kept, None).unwrap();
+            std::fs::write(&w, out).unwrap();
+        }
+        common::reseal::reseal(&dir);
+        dir
+    };
+    let statics = |m: &Path, tension: &str, extra: &[&str], needles: &[&str]| {
+        let t = format!("--tension={tension}");
+        let args = [
+            &["statics", "single-tendon", &t, "--model", s(m)][..],
+            extra,
+        ]
+        .concat();
+        expect_error(&args, needles)
+    };
+    // with anchors: the inputs were in range, so the model is poor there
+    let m = narrowed("val-ae1-narrow", false);
+    let msg = statics(
+        &m,
+        "-4",
+        &[],
+        &["inputs lie inside the training range", "poor"],
+    );
+    assert!(!msg.contains("outside the dataset"), "{msg}");
+    // without anchors: that is named
+    let m = narrowed("val-ae1-narrow-noanchors", true);
+    statics(&m, "-4", &[], &["no anchors", "re-create the model"]);
+    // extrapolating on purpose: that is named
+    let m = narrowed("val-ae1-narrow-x", false);
+    let out = gvsrom(&[
+        "statics",
+        "single-tendon",
+        "--tension=-9",
+        "--model",
+        s(&m),
+        "--extrapolate",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    let last = err.lines().last().unwrap_or_default();
+    assert!(
+        last.starts_with("error: ") && last.contains("the model is extrapolating"),
+        "{err}"
+    );
+}
