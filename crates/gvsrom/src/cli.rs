@@ -46,9 +46,9 @@ pub enum Command {
     /// Train a tanh autoencoder on a dataset's strain snapshots; its decoder becomes a nonlinear
     /// reduced model (`--model` on `statics` and `simulate`).
     Train(TrainArgs),
-    /// Compare a trajectory with a reference one (e.g. `simulate --model` against the full model):
-    /// tip and strain errors over the common samples, and the speed ratio (simulated time per wall
-    /// time).
+    /// Compare a trajectory with a reference one (e.g. `simulate --model` against the full model)
+    /// of the same scenario, input and sample times: tip and strain errors over the common samples,
+    /// and the speed ratio (simulated time per wall time).
     Compare(CompareArgs),
     /// Reproduce the paper's studies end to end (data, training, reduced models, evaluation) with
     /// their tables beside the paper's, figures and one HTML page `OUT/index.html`; finished steps
@@ -70,8 +70,14 @@ pub enum Command {
 pub struct CompareArgs {
     /// The reference trajectory (a `simulate --out` directory), e.g. the full model's
     pub reference: PathBuf,
-    /// The trajectory to measure against it, e.g. a reduced model's (same sample times)
+    /// The trajectory to measure against it, e.g. a reduced model's (same scenario, input and
+    /// sample times)
     pub run: PathBuf,
+    /// Compare the runs even if their scenario, physics, input or duration differ (or their
+    /// meta.json cannot tell): the output then says how they differ. Without it such runs are
+    /// refused, since one does not approximate the other.
+    #[arg(long)]
+    pub allow_different: bool,
 }
 
 /// `gvsrom reproduce`.
@@ -312,13 +318,13 @@ pub struct SimulateArgs {
     #[arg(long)]
     pub from_equilibrium: bool,
 
-    /// Relative tolerance of the adaptive integrator. Default 1e-3 (ode15s), or 1e-4 when the
-    /// automatic method is SDIRK4 for a lightly damped rod (see `--method`).
-    #[arg(long)]
+    /// Relative tolerance of the adaptive integrator, in [1e-12, 1). Default 1e-3 (ode15s), or
+    /// 1e-4 when the automatic method is SDIRK4 for a lightly damped rod (see `--method`).
+    #[arg(long, allow_hyphen_values = true)]
     pub rtol: Option<f64>,
 
-    /// Absolute tolerance of the adaptive integrator (ode15s default 1e-6).
-    #[arg(long, default_value_t = 1e-6)]
+    /// Absolute tolerance of the adaptive integrator, at least 1e-14 (ode15s default 1e-6).
+    #[arg(long, default_value_t = 1e-6, allow_hyphen_values = true)]
     pub atol: f64,
 
     /// Use the fixed-step implicit method with step H [s] instead of the adaptive NDF (real time).
@@ -413,13 +419,22 @@ fn load(args: &ScenarioArgs) -> Result<(Scenario, Built)> {
 
 /// `--model DIR`: attaches a reduced model to `built` (the scenario table supplies the dataset
 /// inputs of the model's initial guess).
-fn attach_model(built: &mut Built, args: &ScenarioArgs, dir: &std::path::Path) -> Result<()> {
+fn attach_model(
+    built: &mut Built,
+    args: &ScenarioArgs,
+    dir: &std::path::Path,
+    tensions_from_signal: bool,
+) -> Result<()> {
     let src = presets::source(&args.scenario)?;
     let mut table = gvsrom::scenario::parse_table(&src.origin, &src.text)?;
     for spec in &args.set {
         gvsrom::scenario::apply_override(&mut table, spec)?;
     }
-    reduce::attach(built, &table, dir, args.extrapolate)?;
+    let options = reduce::AttachOptions {
+        extrapolate: args.extrapolate,
+        tensions_from_signal,
+    };
+    reduce::attach(built, &table, dir, options)?;
     for w in built.reduced.iter().flat_map(|r| &r.warnings) {
         eprintln!("warning: {w}");
     }
@@ -440,38 +455,56 @@ fn presets_cmd(out: &mut impl Write) -> Result<()> {
 }
 
 fn compare_cmd(args: &CompareArgs, out: &mut impl Write) -> Result<()> {
-    use gvsrom::compare::{compare, Trajectory};
+    use gvsrom::compare::{compare, differences, speed_ratio, Trajectory};
     let reference = Trajectory::load(&args.reference, "REFERENCE")?;
     let run = Trajectory::load(&args.run, "RUN")?;
+    // only like with like: the same scenario, physics, input and sample times
+    let diffs = differences(&reference, &run);
+    if !args.allow_different && !diffs.none() {
+        let mut reasons = diffs.differ.clone();
+        reasons.extend(diffs.unknown.iter().map(|u| format!("cannot tell {u}")));
+        return Err(gvsrom::ScenarioError::invalid(
+            "RUN",
+            format!(
+                "{}; a run approximates a reference only under the same scenario, input and sample times (--allow-different compares them anyway)",
+                reasons.join("; ")
+            ),
+        )
+        .into());
+    }
     let c = compare(&reference, &run)?;
     let describe = |tr: &Trajectory| {
+        let wall = tr.wall_time_s;
         format!(
-            "{}: {}, {} DOF, {} samples to t = {} s{}, {:.3} s wall",
+            "{}: {}, {} DOF, {} samples to t = {} s{}, {}",
             tr.dir.display(),
             tr.scenario,
             tr.n_dof,
             tr.samples(),
             tr.t.last().copied().unwrap_or(0.0),
             if tr.complete { "" } else { " (partial)" },
-            tr.wall_time_s
+            if wall.is_finite() && wall > 0.0 {
+                format!("{wall:.3} s wall")
+            } else {
+                "wall time n/a".to_string()
+            }
         )
     };
     writeln!(out, "reference  {}", describe(&reference))?;
     // simulated time per wall time, so that a partial run compares fairly
-    let rate = |tr: &Trajectory| tr.t.last().copied().unwrap_or(0.0) / tr.wall_time_s;
-    let ratio = rate(&run) / rate(&reference);
-    let speed = if ratio >= 1.0 {
-        format!("{ratio:.1}× faster")
-    } else {
-        format!("{:.1}× slower", 1.0 / ratio)
+    let speed = match speed_ratio(&reference, &run) {
+        Some(ratio) if ratio >= 1.0 => format!("{ratio:.1}× faster"),
+        Some(ratio) => format!("{:.1}× slower", 1.0 / ratio),
+        None => {
+            "speed n/a (a wall time is zero or not recorded, or a run has no time span)".to_string()
+        }
     };
     writeln!(out, "run        {}: {speed}", describe(&run))?;
-    if reference.scenario != run.scenario {
-        writeln!(
-            out,
-            "note       the scenarios differ (`{}`, `{}`)",
-            reference.scenario, run.scenario
-        )?;
+    for d in &diffs.differ {
+        writeln!(out, "differ     {d} (compared anyway: --allow-different)")?;
+    }
+    for u in &diffs.unknown {
+        writeln!(out, "unknown    {u} (compared anyway: --allow-different)")?;
     }
     writeln!(
         out,
@@ -531,7 +564,7 @@ fn statics_cmd(args: &StaticsArgs, out: &mut impl Write) -> Result<()> {
     }
     let (scenario, mut built) = load(&args.scenario)?;
     if let Some(dir) = &args.model {
-        attach_model(&mut built, &args.scenario, dir)?;
+        attach_model(&mut built, &args.scenario, dir, false)?;
     }
     // the output is checked, locked and staged before the solve, so a bad path fails at once
     let json = match &args.json {
@@ -592,7 +625,7 @@ fn modes_cmd(args: &ModesArgs, out: &mut impl Write) -> Result<()> {
     }
     let (scenario, mut built) = load(&args.scenario)?;
     if let Some(dir) = &args.model {
-        attach_model(&mut built, &args.scenario, dir)?;
+        attach_model(&mut built, &args.scenario, dir, false)?;
     }
     let n_dof = built.n_dof();
     let (count, clipped) = modes::parse_count(args.count.as_deref(), n_dof)?;
@@ -826,7 +859,9 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
     }
     let (scenario, mut built) = load(&args.scenario)?;
     if let Some(dir) = &args.model {
-        attach_model(&mut built, &args.scenario, dir)?;
+        // an input signal's tensions are checked against the model once the signal is built
+        let signal_driven = args.input.is_some() || args.steps.is_some() || args.babble.is_some();
+        attach_model(&mut built, &args.scenario, dir, signal_driven)?;
     }
     let input = if let Some(path) = &args.input {
         let interpolation = if args.interpolate {
@@ -888,6 +923,9 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
     };
     // everything is checked, and the output staged, before the computation starts
     let plan = simulate::plan(&built, &opts)?;
+    for o in &plan.model_extrapolated {
+        eprintln!("warning: extrapolating (--extrapolate): {o}");
+    }
     let mut writer = match &args.out {
         Some(dir) => {
             simulate::check_output_size(&built, &plan)?;
@@ -959,7 +997,7 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
     let written = match writer {
         Some(w) => {
             let samples = w.samples();
-            let dir = w.finish(&built, &outcome, *plan.t_out.last().unwrap())?;
+            let dir = w.finish(&built, &plan, &outcome)?;
             let partial = if outcome.ending == Ending::Complete {
                 ""
             } else {

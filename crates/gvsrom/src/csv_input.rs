@@ -75,6 +75,7 @@ pub fn read_csv_signal(
     interpolation: Interpolation,
 ) -> Result<Signal, ScenarioError> {
     let file = path.display().to_string();
+    crate::scenario::check_regular_file(&file, path)?;
     let text = std::fs::read_to_string(path)
         .map_err(|e| ScenarioError::invalid(&file, format!("cannot read the input file: {e}")))?;
     let expected = n_values + 1;
@@ -180,6 +181,20 @@ pub fn read_csv_signal(
     };
     s.validate(&file, n_values).map_err(ScenarioError::from)?;
     Ok(s)
+}
+
+/// The SHA-256 of the file at `path` (option `field`), in hex: what a trajectory records of its
+/// CSV input, so that two runs can be told to have had the same input.
+pub fn file_sha256(field: &str, path: &Path) -> Result<String, ScenarioError> {
+    use sha2::{Digest, Sha256};
+    crate::scenario::check_regular_file(field, path)?;
+    let bytes = std::fs::read(path).map_err(|e| {
+        ScenarioError::invalid(field, format!("cannot read `{}`: {e}", path.display()))
+    })?;
+    Ok(Sha256::digest(&bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect())
 }
 
 /// The largest |value| of each channel over the signal's knots: `max_k |values[k][j]|`, which is
@@ -308,6 +323,27 @@ mod tests {
             .to_string();
         assert!(
             e.contains("/nonexistent/in.csv") && e.contains("cannot read"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_directory_or_device_is_refused_before_it_is_read() {
+        let dir = std::env::temp_dir().join(format!("gvsrom-csv-dir-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let e = read_csv_signal(&dir, 1, Interpolation::Hold)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("a directory, not a regular file"), "{e}");
+        let e = read_csv_signal(Path::new("/dev/zero"), 1, Interpolation::Hold)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("a character device"), "{e}");
+        let e = file_sha256("--input", Path::new("/dev/zero"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("--input") && e.contains("a character device"),
             "{e}"
         );
     }

@@ -91,6 +91,7 @@ pub fn source(arg: &str) -> Result<Source, ScenarioError> {
             available: names(),
         });
     }
+    crate::scenario::check_regular_file("SCENARIO", path)?;
     let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Io {
         path: arg.to_string(),
         error: e,

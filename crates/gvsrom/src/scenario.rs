@@ -393,6 +393,50 @@ impl Scenario {
     }
 }
 
+/// Refuses `path` (given as `field`, e.g. `SCENARIO` or `--input`) if it is something other than a
+/// regular file (or a link to one), before anything opens it: opening a FIFO blocks until a writer
+/// appears, a device reads forever, a directory cannot be read. The error says what it is. A path
+/// whose metadata cannot be read (missing, no permission) passes: the reader reports that itself.
+pub fn check_regular_file(field: &str, path: &std::path::Path) -> Result<(), ScenarioError> {
+    let Ok(meta) = std::fs::metadata(path) else {
+        return Ok(());
+    };
+    let ft = meta.file_type();
+    if ft.is_file() {
+        return Ok(());
+    }
+    let what = if ft.is_dir() {
+        "a directory"
+    } else {
+        special_file_kind(&ft)
+    };
+    Err(ScenarioError::invalid(
+        field,
+        format!("`{}` is {what}, not a regular file", path.display()),
+    ))
+}
+
+#[cfg(unix)]
+fn special_file_kind(ft: &std::fs::FileType) -> &'static str {
+    use std::os::unix::fs::FileTypeExt;
+    if ft.is_fifo() {
+        "a FIFO (named pipe)"
+    } else if ft.is_char_device() {
+        "a character device"
+    } else if ft.is_block_device() {
+        "a block device"
+    } else if ft.is_socket() {
+        "a socket"
+    } else {
+        "a special file"
+    }
+}
+
+#[cfg(not(unix))]
+fn special_file_kind(_ft: &std::fs::FileType) -> &'static str {
+    "a special file"
+}
+
 /// TOML text → table; syntax errors carry line and column.
 pub fn parse_table(source_name: &str, text: &str) -> Result<Table, ScenarioError> {
     text.parse::<Table>().map_err(|e| ScenarioError::Syntax {

@@ -16,7 +16,7 @@
 //! | `tip_rotation.npy` | (N, 3, 3) | tip rotation matrices (section → world) |
 //! | `strain.npy` | (N, p, 6) | ξ at the p computational points, `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]` |
 //! | `strain_x.npy` | (p,) | abscissae of the computational points [m] |
-//! | `meta.json` | | manifest (`gvsrom`: format, version, files), scenario, `complete`, `reason`, `t_reached`, sizes, integrator statistics, wall time, real-time factor, error |
+//! | `meta.json` | | manifest (`gvsrom`: format, version, files), scenario, `complete`, `reason`, `t_reached`, `t_requested`, `sample_rate`, sizes, integrator statistics, wall time, real-time factor, error, `input` ([`input_record`]), `physics` (material, geometry, base, tendon routing, loads) |
 //!
 //! The integrator is chosen here too ([`choose_integrator`]): by the rod's damping unless named,
 //! as `gvsrom simulate` and `gvsrom reproduce` both do.
@@ -28,8 +28,8 @@ use crate::output::{OutputDir, OutputError};
 use gvs::inputs::{babble, random_steps, Interpolation, Signal};
 use gvs::lie::Pose;
 use gvs::solve::dynamics::{
-    simulate_streaming, InitialState, IntegratorOptions, Method, OdeJacobian, RunSummary, Sample,
-    SimulationError,
+    simulate_streaming_interruptible, InitialState, IntegratorOptions, Method, OdeJacobian,
+    RunSummary, Sample, SimulationError,
 };
 use gvs::solve::ode::{
     ErrorNorm, FixedStepOptions, GeneralizedAlphaOptions, MassRenewal, NdfOptions, SdirkOptions,
@@ -210,6 +210,7 @@ pub fn choose_integrator(
     built: &Built,
     choice: &IntegratorChoice,
 ) -> Result<(IntegratorOptions, Option<String>), ScenarioError> {
+    check_tolerances(choice)?;
     let decoder = built
         .reduced
         .as_ref()
@@ -301,6 +302,44 @@ pub fn choose_integrator(
     Ok((IntegratorOptions { method, jacobian }, note))
 }
 
+/// Smallest `--atol` accepted: `1e-14 ≈ 45 ε`. The coordinates of a rod (strain coefficients
+/// in 1/m, reduced coordinates, and their rates) are of order 1e-3 … 1e2 in the presets and carry
+/// a round-off of `ε` times their scale; a run from rest starts at `q = 0`, where the absolute
+/// tolerance alone bounds the error, so below about `10 ε` the error test and Newton's ask for
+/// digits no iteration delivers (measured on the single-tendon arm at `--rtol 1e-12`: SDIRK4 took
+/// 1371 steps for the first millisecond at `--atol 1e-16`, made no progress in 10 minutes at
+/// `--rtol 1e-30 --atol 1e-30`; the NDF failed in Newton at `--atol 1e-30`). The library takes
+/// any `atol > 0` (its units are the problem's); `--rtol` is bounded as the library bounds it,
+/// [[`gvs::solve::ode::MIN_RTOL`], [`gvs::solve::ode::MAX_RTOL`]).
+pub const MIN_ATOL: f64 = 1e-14;
+
+/// `--rtol` in [[`gvs::solve::ode::MIN_RTOL`], [`gvs::solve::ode::MAX_RTOL`]) and `--atol` finite
+/// and at least [`MIN_ATOL`].
+fn check_tolerances(choice: &IntegratorChoice) -> Result<(), ScenarioError> {
+    use gvs::solve::ode::{MAX_RTOL, MIN_RTOL};
+    if let Some(rtol) = choice.rtol {
+        if !(MIN_RTOL..MAX_RTOL).contains(&rtol) {
+            return Err(ScenarioError::value(
+                "--rtol",
+                rtol,
+                format!(
+                    "a number in [{MIN_RTOL:e}, {MAX_RTOL}); below {MIN_RTOL:e} the error estimates are round-off"
+                ),
+            ));
+        }
+    }
+    if !(choice.atol >= MIN_ATOL && choice.atol.is_finite()) {
+        return Err(ScenarioError::value(
+            "--atol",
+            choice.atol,
+            format!(
+                "a finite number >= {MIN_ATOL:e}; below it the coordinates' round-off exceeds the tolerance"
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Options of a dynamics run.
 #[derive(Debug, Clone)]
 pub struct SimulateOptions {
@@ -337,7 +376,12 @@ pub fn input_signal(built: &Built, opts: &SimulateOptions) -> Result<Signal, Sce
         InputSource::Csv {
             path,
             interpolation,
-        } => crate::csv_input::read_csv_signal(path, na, *interpolation)?,
+        } => {
+            crate::scenario::check_regular_file("--input", path)?;
+            let signal = crate::csv_input::read_csv_signal(path, na, *interpolation)?;
+            covers_start("--input", path, &signal, RUN_START)?;
+            signal
+        }
         InputSource::Steps {
             lo,
             hi,
@@ -373,6 +417,27 @@ pub fn input_signal(built: &Built, opts: &SimulateOptions) -> Result<Signal, Sce
             babble(na, *lo, *hi, *hold_min, *hold_max, d, *seed)
         }
     })
+}
+
+/// Every run starts at t = 0 (its first sample).
+const RUN_START: f64 = 0.0;
+
+/// Refuses a signal read from `path` (option `field`) whose first row comes after the run's start
+/// `t0`: before its first row the signal would silently hold that row's values.
+fn covers_start(field: &str, path: &Path, signal: &Signal, t0: f64) -> Result<(), ScenarioError> {
+    match signal.times.first() {
+        Some(&first) if first > t0 => Err(ScenarioError::invalid(
+            field,
+            format!(
+                "`{}` starts at t = {} s, after the run's start t = {} s; the input before its first row is not given (add a row at t = {})",
+                path.display(),
+                gvs::error::fmt_value(first),
+                gvs::error::fmt_value(t0),
+                gvs::error::fmt_value(t0)
+            ),
+        )),
+        _ => Ok(()),
+    }
 }
 
 fn range_check(field: &str, lo: f64, hi: f64) -> Result<(), ScenarioError> {
@@ -431,6 +496,13 @@ pub struct Plan {
     pub signal: Signal,
     pub schedule: Option<Signal>,
     pub initial: InitialState,
+    /// Output samples per second.
+    pub sample_rate: f64,
+    /// What `meta.json` records of the run's input ([`input_record`]).
+    pub input: serde_json::Value,
+    /// How the input signal lies outside a reduced model's training inputs, when used with
+    /// `--extrapolate` (`Reduced::check_signal`; without it such a signal is refused).
+    pub model_extrapolated: Vec<String>,
 }
 
 /// Validates `opts` against `built` and builds the [`Plan`] of the run.
@@ -472,12 +544,34 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
         }
     }
     let signal = input_signal(built, opts)?;
+    // a reduced model answers only for tensions it was trained on: the signal's, at its knots
+    // (where a held or linear signal takes its extremes) and at both ends of the run
+    let model_extrapolated = match (&built.reduced, &opts.input) {
+        (Some(r), input) if !matches!(input, InputSource::Constant) => {
+            let end = t_out.last().copied().unwrap_or(0.0);
+            let mut times: Vec<f64> = signal
+                .times
+                .iter()
+                .copied()
+                .filter(|t| (0.0..=end).contains(t))
+                .chain([0.0, end])
+                .collect();
+            times.sort_by(f64::total_cmp);
+            let mut u = vec![0.0; signal.channels()];
+            r.check_signal(&times, |t| {
+                signal.eval(t, &mut u);
+                u.clone()
+            })?
+        }
+        _ => vec![],
+    };
     let schedule = match &opts.load_schedule {
-        Some(path) => Some(crate::csv_input::read_csv_signal(
-            path,
-            1,
-            Interpolation::Linear,
-        )?),
+        Some(path) => {
+            crate::scenario::check_regular_file("--load-schedule", path)?;
+            let s = crate::csv_input::read_csv_signal(path, 1, Interpolation::Linear)?;
+            covers_start("--load-schedule", path, &s, t_out[0])?;
+            Some(s)
+        }
         None => None,
     };
     let u_max = crate::csv_input::max_abs_per_column(&signal);
@@ -494,11 +588,95 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
     } else {
         InitialState::Rest
     };
+    let input = input_record(built, opts)?;
     Ok(Plan {
         t_out,
         signal,
         schedule,
         initial,
+        sample_rate: opts.sample_rate,
+        input,
+        model_extrapolated,
+    })
+}
+
+/// The run's input as `meta.json` records it (`"input"`), for `gvsrom compare` to tell runs with
+/// other inputs apart: the signal's specification — `"constant"` with the tensions, `"csv"` with
+/// the file, its SHA-256 and the interpolation, `"steps"` or `"babble"` with their parameters and
+/// seed —, the start (`"rest"`, or `"equilibrium"` with the tensions it is solved under) and the
+/// load schedule (file and SHA-256, or null).
+pub fn input_record(
+    built: &Built,
+    opts: &SimulateOptions,
+) -> Result<serde_json::Value, ScenarioError> {
+    use serde_json::json;
+    let file = |field: &str, path: &Path| -> Result<serde_json::Value, ScenarioError> {
+        Ok(json!({
+            "file": path.display().to_string(),
+            "sha256": crate::csv_input::file_sha256(field, path)?,
+        }))
+    };
+    let mut signal = match &opts.input {
+        InputSource::Constant => json!({"signal": "constant", "tensions": built.u}),
+        InputSource::Csv {
+            path,
+            interpolation,
+        } => {
+            let mut v = file("--input", path)?;
+            v["signal"] = json!("csv");
+            v["interpolation"] = json!(match interpolation {
+                Interpolation::Hold => "hold",
+                Interpolation::Linear => "linear",
+            });
+            v
+        }
+        InputSource::Steps {
+            lo,
+            hi,
+            period,
+            seed,
+        } => json!({
+            "signal": "steps", "lo": lo, "hi": hi, "period": period, "seed": seed,
+        }),
+        InputSource::Babble {
+            lo,
+            hi,
+            hold_min,
+            hold_max,
+            seed,
+        } => json!({
+            "signal": "babble", "lo": lo, "hi": hi, "hold_min": hold_min, "hold_max": hold_max,
+            "seed": seed,
+        }),
+    };
+    if opts.start_at_equilibrium {
+        signal["start"] = json!("equilibrium");
+        signal["start_tensions"] = json!(built.u);
+    } else {
+        signal["start"] = json!("rest");
+    }
+    signal["load_schedule"] = match &opts.load_schedule {
+        Some(path) => file("--load-schedule", path)?,
+        None => serde_json::Value::Null,
+    };
+    Ok(signal)
+}
+
+/// The scenario's physics as `meta.json` records it (`"physics"`), for `gvsrom compare`: the
+/// material, the divisions' geometry, the base pose, the tendons' routing and friction, and the
+/// loads (gravity, point and distributed wrenches). Not the tensions (the input), not the strain
+/// basis nor the computational points (the discretization, which a reduced model replaces).
+fn physics_record(built: &Built) -> serde_json::Value {
+    let m = &built.model;
+    let rot: Vec<[f64; 3]> = (0..3)
+        .map(|i| [m.base.rot[(i, 0)], m.base.rot[(i, 1)], m.base.rot[(i, 2)]])
+        .collect();
+    serde_json::json!({
+        "material": m.rod.material,
+        "divisions": m.rod.divisions,
+        "base": {"position": [m.base.pos[0], m.base.pos[1], m.base.pos[2]], "rotation": rot},
+        "tendons": m.tendons,
+        "loads": built.loads,
     })
 }
 
@@ -533,8 +711,10 @@ impl Outcome {
 }
 
 /// Runs the planned simulation, streaming each sample to `writer` (if any) and calling
-/// `control(t)` after each: returning `ControlFlow::Break(reason)` interrupts the run (the samples so
-/// far are kept). A failed write stops the run with an error.
+/// `control(t)` after each and before every step attempt of the integrator (with `t` the last
+/// sample's time): returning `ControlFlow::Break(reason)` interrupts the run within one step (the
+/// samples so far are kept), however far the next sample is. A failed write stops the run with an
+/// error.
 pub fn run(
     built: &Built,
     plan: &Plan,
@@ -544,9 +724,24 @@ pub fn run(
 ) -> Result<Outcome, ScenarioError> {
     let mut last_tip = None;
     let mut write_error: Option<std::io::Error> = None;
-    let mut interrupted = None;
     let mut off_manifold = None;
+    // `control` is called from the sink and from the integrator's per-attempt poll, never nested
+    let control = std::cell::RefCell::new(control);
+    let interrupted = std::cell::RefCell::new(None::<String>);
+    let last_t = std::cell::Cell::new(plan.t_out.first().copied().unwrap_or(0.0));
+    let check = |t: f64| {
+        let flow = (*control.borrow_mut())(t);
+        if let ControlFlow::Break(reason) = &flow {
+            *interrupted.borrow_mut() = Some(reason.clone());
+        }
+        flow
+    };
+    let stop = || match check(last_t.get()) {
+        ControlFlow::Break(reason) => Some(reason),
+        ControlFlow::Continue(()) => None,
+    };
     let mut sink = |s: &Sample<'_>| {
+        last_t.set(s.t);
         last_tip = Some(*s.tip);
         if let Some(w) = writer.as_deref_mut() {
             if let Err(e) = w.push(s) {
@@ -566,14 +761,10 @@ pub fn run(
             off_manifold = Some(msg.clone());
             return ControlFlow::Break(msg);
         }
-        let flow = control(s.t);
-        if let ControlFlow::Break(reason) = &flow {
-            interrupted = Some(reason.clone());
-        }
-        flow
+        check(s.t)
     };
     let summary = match &built.reduced {
-        Some(r) => simulate_streaming(
+        Some(r) => simulate_streaming_interruptible(
             &r.model,
             &plan.signal,
             &built.loads,
@@ -582,8 +773,9 @@ pub fn run(
             &plan.t_out,
             integrator,
             &mut sink,
+            &stop,
         ),
-        None => simulate_streaming(
+        None => simulate_streaming_interruptible(
             &built.model,
             &plan.signal,
             &built.loads,
@@ -592,6 +784,7 @@ pub fn run(
             &plan.t_out,
             integrator,
             &mut sink,
+            &stop,
         ),
     }
     .map_err(|e| match e {
@@ -616,7 +809,7 @@ pub fn run(
         ));
     }
     let left_training_region = summary.error.is_some() && off_manifold.is_some();
-    let ending = match (&summary.error, off_manifold, interrupted) {
+    let ending = match (&summary.error, off_manifold, interrupted.into_inner()) {
         (None, _, _) => Ending::Complete,
         (Some(_), Some(error), _) => Ending::Failed { error },
         (Some(_), None, Some(reason)) => Ending::Interrupted { reason },
@@ -667,8 +860,7 @@ pub fn run_to_dir(
     let mut writer = TrajectoryWriter::create(out, force, built)?;
     let outcome = run(built, &plan, &opts.integrator, Some(&mut writer), control)?;
     let samples = writer.samples();
-    let end = plan.t_out.last().copied().unwrap_or(opts.duration);
-    let dir = writer.finish(built, &outcome, end)?;
+    let dir = writer.finish(built, &plan, &outcome)?;
     Ok(Written {
         outcome,
         dir,
@@ -764,14 +956,16 @@ impl TrajectoryWriter {
         self.t.rows()
     }
 
-    /// Completes the arrays, writes `meta.json` (with `"complete"`, the reason for an early end and
-    /// the last time reached) and moves the directory into place.
+    /// Completes the arrays, writes `meta.json` (with `"complete"`, the reason for an early end,
+    /// the last time reached, and the plan's sample rate and input record) and moves the directory
+    /// into place.
     pub fn finish(
         self,
         built: &Built,
+        plan: &Plan,
         outcome: &Outcome,
-        requested_end: f64,
     ) -> Result<PathBuf, OutputError> {
+        let requested_end = plan.t_out.last().copied().unwrap_or(0.0);
         let TrajectoryWriter {
             mut dir,
             t,
@@ -818,6 +1012,7 @@ impl TrajectoryWriter {
             reason,
             t_reached: sm.t_last,
             t_requested: requested_end,
+            sample_rate: plan.sample_rate,
             samples,
             n_dof: built.n_dof(),
             n_points: built.model.disc.n_points(),
@@ -832,6 +1027,15 @@ impl TrajectoryWriter {
             jacobian_evaluations: sm.stats.jacobian_evals,
             lu_decompositions: sm.stats.lu_decompositions,
             error,
+            input: &plan.input,
+            physics: physics_record(built),
+            model_extrapolated: built
+                .reduced
+                .iter()
+                .flat_map(|r| r.extrapolated.iter())
+                .chain(&plan.model_extrapolated)
+                .cloned()
+                .collect(),
         };
         dir.commit(meta)
     }
@@ -848,6 +1052,8 @@ struct Meta<'a> {
     /// Time of the last sample written.
     t_reached: Option<f64>,
     t_requested: f64,
+    /// Output samples per second.
+    sample_rate: f64,
     samples: usize,
     n_dof: usize,
     n_points: usize,
@@ -866,4 +1072,12 @@ struct Meta<'a> {
     lu_decompositions: usize,
     /// The integrator's error if it failed.
     error: Option<String>,
+    /// The input signal, start and load schedule ([`input_record`]).
+    input: &'a serde_json::Value,
+    /// The scenario's physics besides the inputs ([`physics_record`]).
+    physics: serde_json::Value,
+    /// How the run lies outside its reduced model's training (`--extrapolate`): the scenario's and
+    /// the input signal's differences.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    model_extrapolated: Vec<String>,
 }

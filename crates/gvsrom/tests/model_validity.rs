@@ -482,3 +482,59 @@ fn a_solution_off_the_learned_manifold_names_its_cause() {
         "{err}"
     );
 }
+
+#[test]
+fn a_simulation_input_signal_is_checked_against_the_training_inputs() {
+    let m = pod2();
+    let out = scratch("val-sim-extrapolated");
+    // random steps in [-30, -20] N lie outside the training range [-6, 3] N
+    let sim = |extra: &[&'static str]| -> Vec<String> {
+        [
+            &[
+                "simulate",
+                "single-tendon",
+                "--duration",
+                "0.02",
+                "--steps=-30,-20,0.005",
+                "--model",
+                s(m),
+            ][..],
+            extra,
+        ]
+        .concat()
+        .iter()
+        .map(|a| a.to_string())
+        .collect()
+    };
+    let args = sim(&[]);
+    expect_error(
+        &args.iter().map(String::as_str).collect::<Vec<_>>(),
+        &[
+            "--model",
+            "input signal's tendons.0.tension reaches",
+            "[-6, 3]",
+        ],
+    );
+    // inside: answered (the scenario's own tension, 0 N, is not what drives the run)
+    run_ok(&[
+        "simulate",
+        "single-tendon",
+        "--duration",
+        "0.02",
+        "--steps=-5,2,0.005",
+        "--model",
+        s(m),
+    ]);
+    // on purpose: a warning, and the record in the trajectory's meta.json
+    let mut args = sim(&["--extrapolate", "--out"]);
+    args.push(s(&out).to_string());
+    let (_, stderr) = run_ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(stderr.contains("warning: extrapolating"), "{stderr}");
+    let meta = read_json(&out.join("meta.json"));
+    assert!(
+        meta["model_extrapolated"][0]
+            .as_str()
+            .is_some_and(|e| e.contains("tendons.0.tension reaches")),
+        "{meta}"
+    );
+}

@@ -160,9 +160,19 @@ struct RodOde<'m, P: StrainParam> {
     qd: DVector<f64>,
     qdd: DVector<f64>,
     jacobian: OdeJacobian,
+    /// Polled before every step attempt ([`simulate_streaming_interruptible`]).
+    stop: &'m StopCheck<'m>,
 }
 
+/// A check polled before every step attempt of a simulation: `Some(reason)` stops it (e.g. an
+/// interrupt flag set by SIGINT/SIGTERM; keep it as cheap as an atomic load).
+pub type StopCheck<'a> = dyn Fn() -> Option<String> + 'a;
+
 impl<P: StrainParam> OdeSystem for RodOde<'_, P> {
+    fn stop_requested(&mut self) -> Option<String> {
+        (self.stop)()
+    }
+
     fn jacobian(
         &mut self,
         t: f64,
@@ -220,6 +230,10 @@ impl<P: StrainParam> RodOde<'_, P> {
 impl<P: StrainParam> MechanicalSystem for RodOde<'_, P> {
     fn dim(&self) -> usize {
         self.model.n_dof()
+    }
+
+    fn stop_requested(&mut self) -> Option<String> {
+        (self.stop)()
     }
 
     fn residual(
@@ -377,6 +391,35 @@ pub fn simulate_streaming<P: StrainParam>(
     options: &IntegratorOptions,
     sink: &mut dyn FnMut(&Sample<'_>) -> ControlFlow<String>,
 ) -> Result<RunSummary, SimulationError> {
+    simulate_streaming_interruptible(
+        model,
+        actuation,
+        loads,
+        load_scale,
+        initial,
+        t_out,
+        options,
+        sink,
+        &|| None,
+    )
+}
+
+/// [`simulate_streaming`] that also polls `stop` before every step attempt of the integrator, so
+/// an interrupt stops the run within one step even when the next sample is far away (tight
+/// tolerances, a stiff transient); the summary then reports [`OdeError::Stopped`] with `stop`'s
+/// reason, and the samples before it were delivered.
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_streaming_interruptible<P: StrainParam>(
+    model: &Model<P>,
+    actuation: &Signal,
+    loads: &Loads,
+    load_scale: Option<&Signal>,
+    initial: &InitialState,
+    t_out: &[f64],
+    options: &IntegratorOptions,
+    sink: &mut dyn FnMut(&Sample<'_>) -> ControlFlow<String>,
+    stop: &StopCheck<'_>,
+) -> Result<RunSummary, SimulationError> {
     let n = model.n_dof();
     actuation.validate("actuation", model.n_actuators())?;
     if let Some(s) = load_scale {
@@ -436,6 +479,7 @@ pub fn simulate_streaming<P: StrainParam>(
         qd: DVector::zeros(n),
         qdd: DVector::zeros(n),
         jacobian: options.jacobian,
+        stop,
     };
     let mut y0 = DVector::zeros(2 * n);
     y0.rows_mut(0, n).copy_from(&q0);

@@ -48,6 +48,16 @@ pub const MIN_INCREMENT_FLOOR: f64 = 1e-6;
 pub const MAX_LOAD_STAGES: usize = 2 * MAX_RAMP_STEPS;
 /// Largest number of dogleg iterations over all load stages of one solve.
 pub const MAX_TOTAL_ITERATIONS: usize = 100_000;
+/// Smallest `solver.ftol` accepted: `1e-14 ≈ 45 ε`. The residual is a sum over the points whose
+/// round-off is a few `ε` of its scale (measured on the presets at their equilibria: `‖R‖∞` of
+/// 2e-16 … 9e-16 for a scale ≥ 1); a tolerance below it can never be met, and the solve then
+/// fails after its ramp and continuation with a misleading hint (`solver.ftol = 1e-30`: "try
+/// solver.ramp_steps = 10").
+pub const MIN_FTOL: f64 = 1e-14;
+/// Largest `solver.ftol` accepted: a residual of 0.1 % of the forces is not an equilibrium.
+pub const MAX_FTOL: f64 = 1e-3;
+/// Smallest `solver.xtol` accepted: `ε`; a step below `ε (1 + ‖q‖∞)` does not change `q`.
+pub const MIN_XTOL: f64 = f64::EPSILON;
 
 /// Largest number of coordinates for which [`StaticsJacobian::Auto`] takes forward differences.
 ///
@@ -111,8 +121,8 @@ impl Default for StaticsOptions {
 
 impl StaticsOptions {
     /// Checks every option against its accepted range: `ramp_steps` in [1, [`MAX_RAMP_STEPS`]],
-    /// `min_increment` in [[`MIN_INCREMENT_FLOOR`], 1], `ftol`, `xtol` > 0, `max_iterations` in
-    /// [1, [`MAX_ITERATIONS`]].
+    /// `min_increment` in [[`MIN_INCREMENT_FLOOR`], 1], `ftol` in [[`MIN_FTOL`], [`MAX_FTOL`]],
+    /// `xtol` ≥ [`MIN_XTOL`], `max_iterations` in [1, [`MAX_ITERATIONS`]].
     pub fn validate(&self) -> Result<(), ModelError> {
         if !(1..=MAX_RAMP_STEPS).contains(&self.ramp_steps) {
             return Err(ModelError::value(
@@ -128,8 +138,20 @@ impl StaticsOptions {
             Some((1.0, true)),
             &format!("a number in [{MIN_INCREMENT_FLOOR:e}, 1]"),
         )?;
-        crate::error::check_positive("solver.ftol", self.ftol, "")?;
-        crate::error::check_positive("solver.xtol", self.xtol, "")?;
+        crate::error::check_range(
+            "solver.ftol",
+            self.ftol,
+            Some((MIN_FTOL, true)),
+            Some((MAX_FTOL, true)),
+            &format!("a number in [{MIN_FTOL:e}, {MAX_FTOL:e}]: below it the residual test asks for less than its round-off"),
+        )?;
+        crate::error::check_range(
+            "solver.xtol",
+            self.xtol,
+            Some((MIN_XTOL, true)),
+            None,
+            &format!("a finite number >= {MIN_XTOL:e} (the machine epsilon)"),
+        )?;
         if !(1..=MAX_ITERATIONS).contains(&self.max_iterations) {
             return Err(ModelError::value(
                 "solver.max_iterations",
@@ -546,6 +568,38 @@ mod tests {
             e.contains("solver.min_increment") && e.contains("1e-9") && e.contains("[1e-6, 1]"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn tolerances_below_the_round_off_or_absurdly_loose_are_rejected_with_the_range() {
+        for (ftol, xtol) in [(MIN_FTOL, MIN_XTOL), (MAX_FTOL, 1.0)] {
+            let ok = StaticsOptions {
+                ftol,
+                xtol,
+                ..StaticsOptions::default()
+            };
+            assert!(ok.validate().is_ok(), "ftol {ftol}, xtol {xtol}");
+        }
+        for ftol in [1e-30, 1e-15, 0.0, 0.1, f64::NAN] {
+            let e = rejected(StaticsOptions {
+                ftol,
+                ..StaticsOptions::default()
+            });
+            assert!(
+                e.contains("solver.ftol") && e.contains("[1e-14, 1e-3]") && e.contains("round-off"),
+                "{e}"
+            );
+        }
+        for xtol in [1e-300, 0.0, f64::INFINITY] {
+            let e = rejected(StaticsOptions {
+                xtol,
+                ..StaticsOptions::default()
+            });
+            assert!(
+                e.contains("solver.xtol") && e.contains(">= 2.220446049250313e-16"),
+                "{e}"
+            );
+        }
     }
 
     #[test]

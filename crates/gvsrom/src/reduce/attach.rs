@@ -12,6 +12,16 @@ use nalgebra::DVector;
 use rom::reduced::ReducedParam;
 use std::path::{Path, PathBuf};
 
+/// How [`attach`] checks the scenario against what the model was trained for.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct AttachOptions {
+    /// Use the model outside its training inputs or physics, recording how (`--extrapolate`).
+    pub extrapolate: bool,
+    /// The tendon tensions come from an input signal (a simulation): the scenario's static
+    /// tensions are not checked, the signal is ([`Reduced::check_signal`]).
+    pub tensions_from_signal: bool,
+}
+
 /// A reduced model bound to a scenario.
 pub struct Reduced {
     /// The scenario's rod, points, tendons and loads with the reduced parameterization.
@@ -30,9 +40,38 @@ pub struct Reduced {
     /// What a front-end should tell the user about this model (an interrupted training, an
     /// extrapolation).
     pub warnings: Vec<String>,
+    /// The training inputs' ranges ([`super::validity`]).
+    pub input_range: Vec<crate::reduced_model::InputRange>,
+    /// [`AttachOptions::extrapolate`], for the checks that come later (an input signal's).
+    pub extrapolate: bool,
 }
 
 impl Reduced {
+    /// Checks an input signal's tensions (`u_at(t)` at `times`) against the training ranges
+    /// ([`super::validity::check_signal`]): an error listing how it lies outside, or with
+    /// `--extrapolate` those sentences, to be printed and recorded with the run.
+    pub fn check_signal(
+        &self,
+        times: &[f64],
+        u_at: impl FnMut(f64) -> Vec<f64>,
+    ) -> Result<Vec<String>, ScenarioError> {
+        let outside = super::validity::check_signal(&self.input_range, times, u_at);
+        if outside.is_empty() {
+            return Ok(vec![]);
+        }
+        if !self.extrapolate {
+            return Err(invalid(
+                "--model",
+                format!(
+                    "`{}` was not trained for this input: {}; pass --extrapolate to use it anyway (its answer is then an extrapolation, and is marked so)",
+                    self.path.display(),
+                    outside.join("; ")
+                ),
+            ));
+        }
+        Ok(outside)
+    }
+
     /// Errors if `q` lies outside the training encodings' range by more than half its width in
     /// some coordinate ([`Self::range_violation`]): the decoder is extrapolating there (tanh layers
     /// saturate, `Ψ_q → 0`, and spurious equilibria appear), so the result is not to be trusted.
@@ -183,11 +222,15 @@ pub fn attach(
     built: &mut Built,
     table: &toml::Table,
     dir: &Path,
-    extrapolate: bool,
+    options: AttachOptions,
 ) -> Result<(), anyhow::Error> {
+    let AttachOptions {
+        extrapolate,
+        tensions_from_signal,
+    } = options;
     let model = ReducedModel::load(dir)?;
     check_layout(built, &model, dir)?;
-    let outside = super::validity::check(built, table, &model)?;
+    let outside = super::validity::check(built, table, &model, tensions_from_signal)?;
     if !outside.is_empty() && !extrapolate {
         return Err(invalid(
             "--model",
@@ -236,6 +279,8 @@ pub fn attach(
         },
         extrapolated: outside,
         warnings,
+        input_range: model.meta.input_range.clone(),
+        extrapolate,
     });
     Ok(())
 }

@@ -67,10 +67,14 @@ fn inside(r: &InputRange, v: f64) -> bool {
 /// was trained on, one sentence each: an input outside its training range, a tendon tension that
 /// training held fixed at another value, a physics field that differs. Empty: the model may answer.
 /// An error only if the model's own scenario cannot be read.
+///
+/// With `tensions_from_signal` (a simulation driven by an input signal) the scenario's own
+/// tensions are not checked: the signal's are, by [`check_signal`].
 pub fn check(
     built: &Built,
     table: &Table,
     model: &ReducedModel,
+    tensions_from_signal: bool,
 ) -> Result<Vec<String>, ScenarioError> {
     let meta = &model.meta;
     let mut outside = vec![];
@@ -79,7 +83,13 @@ pub fn check(
             "it records no range of training inputs (it was written before gvsrom recorded them): re-create it with `gvsrom pod` or `gvsrom train` from its dataset".to_string(),
         );
     }
+    let signal_driven = |p: &str| {
+        tensions_from_signal && p.starts_with("tendons.") && p.ends_with(".tension")
+    };
     for r in &meta.input_range {
+        if signal_driven(&r.parameter) {
+            continue;
+        }
         match input_value(built, Some(table), &r.parameter) {
             Some(v) if inside(r, v) => {}
             Some(v) => outside.push(format!(
@@ -103,7 +113,7 @@ pub fn check(
     let is_input = |p: &str| meta.input_range.iter().any(|r| r.parameter == p);
     for (k, t) in trained.tendons.iter().enumerate() {
         let path = format!("tendons.{k}.tension");
-        if is_input(&path) {
+        if is_input(&path) || tensions_from_signal {
             continue;
         }
         match built.u.get(k) {
@@ -147,6 +157,54 @@ pub fn check(
         )
     }));
     Ok(outside)
+}
+
+/// The tendon tensions of an input signal against the model's training ranges: `u_at(t)` gives
+/// the tensions at time `t`, sampled at `times`. One sentence per tendon whose signal leaves its
+/// range (its extreme value and when), or whose training held it fixed at another value.
+pub fn check_signal(
+    ranges: &[InputRange],
+    times: &[f64],
+    mut u_at: impl FnMut(f64) -> Vec<f64>,
+) -> Vec<String> {
+    let mut worst: Vec<Option<(f64, f64)>> = vec![];
+    for &t in times {
+        let u = u_at(t);
+        worst.resize(worst.len().max(u.len()), None);
+        for (k, &v) in u.iter().enumerate() {
+            let Some(r) = ranges
+                .iter()
+                .find(|r| r.parameter == format!("tendons.{k}.tension"))
+            else {
+                continue;
+            };
+            // distance outside the range (0 inside); keep the farthest
+            let d = if inside(r, v) {
+                0.0
+            } else {
+                (r.min - v).max(v - r.max).max(f64::MIN_POSITIVE)
+            };
+            let d = if v.is_finite() { d } else { f64::INFINITY };
+            if d > 0.0 && worst[k].is_none_or(|(dw, _)| d > dw) {
+                worst[k] = Some((d, t));
+            }
+        }
+    }
+    let mut out = vec![];
+    for (k, w) in worst.iter().enumerate() {
+        if let Some((_, t)) = w {
+            let r = ranges
+                .iter()
+                .find(|r| r.parameter == format!("tendons.{k}.tension"))
+                .expect("a range was found for it");
+            let v = u_at(*t)[k];
+            out.push(format!(
+                "the input signal's tendons.{k}.tension reaches {v} at t = {t} s, outside the training inputs [{}, {}]",
+                r.min, r.max
+            ));
+        }
+    }
+    out
 }
 
 /// Removes the value at `path` from `table`, if present (an array entry is replaced by a marker,

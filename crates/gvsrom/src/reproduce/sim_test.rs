@@ -121,7 +121,11 @@ pub fn simulate_test(
         |path| {
             let (mut built, table) = scenario.build()?;
             if let Some(m) = model {
-                reduce::attach(&mut built, &table, &m.path, false)?;
+                let options = reduce::AttachOptions {
+                    extrapolate: false,
+                    tensions_from_signal: true,
+                };
+                reduce::attach(&mut built, &table, &m.path, options)?;
             }
             let (opts, note) = test.options(&built)?;
             let interrupt = run.interrupt().clone();

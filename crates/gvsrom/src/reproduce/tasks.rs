@@ -429,7 +429,7 @@ pub fn statics_eval(
                 for m in models {
                     let (mut built, table) = spec.build()?;
                     if let Some(dir) = &m.path {
-                        reduce::attach(&mut built, &table, dir, false)?;
+                        reduce::attach(&mut built, &table, dir, Default::default())?;
                     }
                     let result = statics::solve_repeated(&built, repeat)
                         .map_err(anyhow::Error::from)

@@ -86,6 +86,9 @@ pub(super) trait Corrector {
     }
     /// After a converged Newton iteration, with its contraction rate estimate.
     fn converged(&mut self, _rate: f64) {}
+    /// The system's [`OdeSystem::stop_requested`] (or [`MechanicalSystem::stop_requested`]),
+    /// polled before every attempt.
+    fn stop_requested(&mut self) -> Option<String>;
     /// Whether the system has a mass matrix ([`Corrector::mass`]).
     fn has_mass(&self) -> bool {
         false
@@ -135,6 +138,10 @@ impl<'a, S: OdeSystem> FirstOrder<'a, S> {
 impl<S: OdeSystem> Corrector for FirstOrder<'_, S> {
     fn stats(&mut self) -> &mut OdeStats {
         &mut self.cs.stats
+    }
+
+    fn stop_requested(&mut self) -> Option<String> {
+        self.cs.sys.stop_requested()
     }
 
     fn set_clamp(&mut self, clamp: Clamp) {
@@ -253,6 +260,10 @@ impl<'a, S: MechanicalSystem> SecondOrder<'a, S> {
 impl<S: MechanicalSystem> Corrector for SecondOrder<'_, S> {
     fn stats(&mut self) -> &mut OdeStats {
         &mut self.stats
+    }
+
+    fn stop_requested(&mut self) -> Option<String> {
+        self.sys.stop_requested()
     }
 
     fn set_clamp(&mut self, clamp: Clamp) {

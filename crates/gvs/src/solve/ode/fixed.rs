@@ -183,6 +183,9 @@ fn advance<S: OdeSystem>(
     let mut hs_max = f64::INFINITY;
     while st.t < target {
         let t = st.t;
+        if let Some(reason) = cs.sys.stop_requested() {
+            return Err(OdeError::Stopped { t, reason });
+        }
         let tn = if target - t <= hs_max {
             target
         } else {
@@ -259,7 +262,10 @@ fn advance<S: OdeSystem>(
                 if halvings >= MAX_HALVINGS {
                     return Err(match failure {
                         Newton::NonFinite => OdeError::NonFinite { t },
-                        _ => OdeError::NewtonFailure { t },
+                        _ => OdeError::NewtonFailure {
+                            t,
+                            tolerances: None,
+                        },
                     });
                 }
                 halvings += 1;

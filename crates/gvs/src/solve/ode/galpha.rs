@@ -109,6 +109,11 @@ pub trait MechanicalSystem {
         d: &mut DMatrix<f64>,
         k: &mut DMatrix<f64>,
     ) -> Result<(), RhsError>;
+    /// Polled before every step attempt, as [`super::OdeSystem::stop_requested`]: `Some(reason)`
+    /// stops the integration at once with [`super::OdeError::Stopped`]. Default: never.
+    fn stop_requested(&mut self) -> Option<String> {
+        None
+    }
 }
 
 /// Options of [`integrate_generalized_alpha`].
@@ -117,7 +122,8 @@ pub struct GeneralizedAlphaOptions {
     /// Spectral radius at infinite frequency, in `[0, 1]`: 1 keeps every frequency (no numerical
     /// dissipation), 0 annihilates the unresolved ones in one step. Default 0.8.
     pub rho_inf: f64,
-    /// Relative tolerance of the position error per step (default `1e-3`).
+    /// Relative tolerance of the position error per step (default `1e-3`), in
+    /// [[`super::MIN_RTOL`], [`super::MAX_RTOL`]).
     pub rtol: f64,
     /// Absolute tolerance (default `1e-6`).
     pub atol: f64,
@@ -305,7 +311,15 @@ fn integrate_piece<S: MechanicalSystem>(
     let scale = (1.0 - c.alpha_f) / (1.0 - c.alpha_m);
     let rates = |h: f64| (h * c.gamma * scale, h * h * c.beta * scale);
     while t < piece.b {
-        let t1 = begin_attempt(t, &mut h, piece, stats.steps, opts.max_steps)?;
+        let t1 = begin_attempt(
+            sys,
+            t,
+            &mut h,
+            piece,
+            stats.steps,
+            opts.max_steps,
+            (rtol, atol),
+        )?;
         let (cv, cq) = rates(h);
         let factored = w.parts.factor_for(h, rates, stats).is_some();
 
@@ -349,6 +363,7 @@ fn integrate_piece<S: MechanicalSystem>(
             let (q, qd) = (&w.q, &w.qd);
             w.parts.after_failure(
                 sys,
+                (rtol, atol),
                 t,
                 piece.clamp(t),
                 q,

@@ -118,6 +118,8 @@ mod tests_fixed;
 #[cfg(test)]
 mod tests_galpha;
 #[cfg(test)]
+mod tests_limits;
+#[cfg(test)]
 mod tests_ndf_second_order;
 #[cfg(test)]
 mod tests_sdirk;
@@ -130,6 +132,44 @@ pub use galpha::{integrate_generalized_alpha, GeneralizedAlphaOptions, Mechanica
 pub type Output<'a> = dyn FnMut(f64, &DVector<f64>) -> ControlFlow<String> + 'a;
 pub use ndf::{integrate_ndf, integrate_ndf_second_order};
 pub use sdirk::{integrate_sdirk, SdirkOptions};
+
+/// Smallest relative tolerance the adaptive integrators accept: `1e-12 ≈ 4.5e3 ε`. The error
+/// estimates are differences of states that carry a round-off of a few `ε` relative to their size,
+/// amplified by the Newton solves (whose convergence test asks for `rtol/2`, after one iteration
+/// `rtol/20`), so below about `1e3 ε` the step control steers by round-off: the steps shrink
+/// without bound or Newton never meets its test (`ode15s` floors it at `100 ε`, silently).
+pub const MIN_RTOL: f64 = 1e-12;
+/// Relative tolerances must be below 1: at `rtol = 1` (100 %) every step passes the error test.
+pub const MAX_RTOL: f64 = 1.0;
+/// Checks the tolerances of an adaptive integrator: `rtol` in [[`MIN_RTOL`], [`MAX_RTOL`]) and
+/// `atol` finite and positive (`atol_field` names it in the error: `atol` or `atol_components`).
+/// `atol` has the units of the state, so no floor fits every problem: a caller that knows its
+/// coordinates' scale bounds it further (the CLI does for a rod's strain coordinates).
+pub(super) fn check_tolerances(
+    rtol: f64,
+    atol: f64,
+    atol_field: &'static str,
+) -> Result<(), OdeError> {
+    if !(MIN_RTOL..MAX_RTOL).contains(&rtol) {
+        return Err(invalid(
+            "rtol",
+            format!(
+                "{} (accepted: a number in [{MIN_RTOL:e}, {MAX_RTOL}))",
+                crate::error::fmt_value(rtol)
+            ),
+        ));
+    }
+    if !(atol > 0.0 && atol.is_finite()) {
+        return Err(invalid(
+            atol_field,
+            format!(
+                "{} (accepted: a finite number > 0)",
+                crate::error::fmt_value(atol)
+            ),
+        ));
+    }
+    Ok(())
+}
 
 /// An error reported by the right-hand side (or its Jacobian); it stops the integration.
 #[derive(Debug, Clone, thiserror::Error, PartialEq)]
@@ -154,14 +194,21 @@ pub trait OdeSystem {
     ) -> Result<bool, RhsError> {
         Ok(false)
     }
+    /// Polled before every step attempt (an atomic load's worth of work, e.g. an interrupt flag
+    /// set by SIGINT/SIGTERM): `Some(reason)` stops the integration at once with
+    /// [`OdeError::Stopped`] at the last accepted time, without waiting for the next output time,
+    /// which tight tolerances can put out of reach. Default: never.
+    fn stop_requested(&mut self) -> Option<String> {
+        None
+    }
 }
 
 /// Options of [`integrate_ndf`].
 #[derive(Debug, Clone)]
 pub struct NdfOptions {
-    /// Relative tolerance (default `1e-3`, as `ode15s`); values below `100·eps` are raised to it.
+    /// Relative tolerance (default `1e-3`, as `ode15s`), in [[`MIN_RTOL`], [`MAX_RTOL`]).
     pub rtol: f64,
-    /// Absolute tolerance for every component (default `1e-6`).
+    /// Absolute tolerance for every component (default `1e-6`), finite and > 0.
     pub atol: f64,
     /// Per-component absolute tolerances (length `dim`); when `Some`, used instead of `atol`.
     pub atol_components: Option<Vec<f64>>,
@@ -283,10 +330,31 @@ pub struct OdeStats {
 /// [`OdeError::t_reached`] has been delivered.
 #[derive(Debug, Clone, thiserror::Error)]
 pub enum OdeError {
-    #[error("integration stopped at t = {t}: step size {h:e} below the minimum {h_min:e}")]
-    StepSizeUnderflow { t: f64, h: f64, h_min: f64 },
-    #[error("integration stopped at t = {t}: Newton iteration failed to converge repeatedly")]
-    NewtonFailure { t: f64 },
+    /// The error test (or Newton, for the one-step methods) failed at the smallest step the time
+    /// resolution allows; the tolerances in use are named, since too tight ones are a cause.
+    #[error("integration stopped at t = {t}: step size {h:e} below the minimum {h_min:e} with rtol = {rtol:e}, atol = {atol:e} (tolerances too tight for the problem, or a singularity)")]
+    StepSizeUnderflow {
+        t: f64,
+        h: f64,
+        h_min: f64,
+        rtol: f64,
+        /// The absolute tolerance (the smallest, for per-component tolerances).
+        atol: f64,
+    },
+    /// Newton failed at the smallest step (the adaptive methods: its test asks for a fraction of
+    /// `rtol`, so too tight tolerances are a cause, and `tolerances` names them) or after its
+    /// retries (the fixed step: `tolerances` is `None`).
+    #[error(
+        "integration stopped at t = {t}: Newton iteration failed to converge repeatedly{}",
+        tolerances.map_or(String::new(), |(rtol, atol)| format!(
+            " with rtol = {rtol:e}, atol = {atol:e} (tolerances too tight for the problem, or a singularity)"
+        ))
+    )]
+    NewtonFailure {
+        t: f64,
+        /// `(rtol, atol)` of an adaptive method (the smallest `atol` for per-component ones).
+        tolerances: Option<(f64, f64)>,
+    },
     #[error(
         "integration stopped at t = {t}: non-finite value (NaN or infinity) in the solution or the right-hand side"
     )]
@@ -296,7 +364,8 @@ pub enum OdeError {
     #[error("integration stopped at t = {t}: maximum number of steps {max_steps} reached")]
     TooManySteps { t: f64, max_steps: usize },
     /// The output callback asked to stop after delivering the sample at `t` (an interrupt, a full
-    /// disk): not a failure of the method.
+    /// disk), or the system did ([`OdeSystem::stop_requested`]) after the step that reached `t`:
+    /// not a failure of the method.
     #[error("integration stopped at t = {t}: {reason}")]
     Stopped { t: f64, reason: String },
     #[error("invalid input `{field}`: {message}")]
@@ -346,7 +415,7 @@ impl OdeError {
     pub fn t_reached(&self) -> Option<f64> {
         match self {
             OdeError::StepSizeUnderflow { t, .. }
-            | OdeError::NewtonFailure { t }
+            | OdeError::NewtonFailure { t, .. }
             | OdeError::NonFinite { t }
             | OdeError::Rhs { t, .. }
             | OdeError::TooManySteps { t, .. }

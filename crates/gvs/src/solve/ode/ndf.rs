@@ -5,8 +5,8 @@
 use super::corrector::{Corrector, FirstOrder, SecondOrder};
 use super::mass_norm::MassNorm;
 use super::{
-    check_common, deliver, invalid, mechanical_state, ulp, wnorm, Clamp, ErrorNorm,
-    MechanicalSystem, NdfOptions, OdeError, OdeFailure, OdeStats, OdeSystem, Output,
+    check_common, check_tolerances, deliver, invalid, mechanical_state, ulp, wnorm, Clamp,
+    ErrorNorm, MechanicalSystem, NdfOptions, OdeError, OdeFailure, OdeStats, OdeSystem, Output,
 };
 use nalgebra::{DMatrix, DVector};
 
@@ -28,6 +28,8 @@ const MAX_IT: usize = 4;
 /// Validated options.
 struct Config {
     rtol: f64,
+    /// The absolute tolerance (the smallest of per-component ones), for messages.
+    atol: f64,
     maxk: usize,
     hmax: f64,
     h0: Option<f64>,
@@ -45,14 +47,8 @@ fn check_options(
     tf: f64,
     thresh: &mut DVector<f64>,
 ) -> Result<Config, OdeError> {
-    if !(o.rtol > 0.0 && o.rtol.is_finite()) {
-        return Err(invalid(
-            "rtol",
-            format!("must be positive and finite, got {}", o.rtol),
-        ));
-    }
-    let rtol = o.rtol.max(100.0 * f64::EPSILON);
-    match &o.atol_components {
+    let rtol = o.rtol;
+    let atol = match &o.atol_components {
         Some(v) => {
             if v.len() != n {
                 return Err(invalid(
@@ -61,25 +57,22 @@ fn check_options(
                 ));
             }
             for (i, &a) in v.iter().enumerate() {
-                if !(a > 0.0 && a.is_finite()) {
-                    return Err(invalid(
-                        "atol_components",
-                        format!("entry {i} must be positive and finite, got {a}"),
-                    ));
-                }
+                check_tolerances(rtol, a, "atol_components").map_err(|e| match e {
+                    OdeError::Invalid { field, message } if field == "atol_components" => {
+                        invalid(field, format!("entry {i}: {message}"))
+                    }
+                    e => e,
+                })?;
                 thresh[i] = a / rtol;
             }
+            v.iter().copied().fold(f64::INFINITY, f64::min)
         }
         None => {
-            if !(o.atol > 0.0 && o.atol.is_finite()) {
-                return Err(invalid(
-                    "atol",
-                    format!("must be positive and finite, got {}", o.atol),
-                ));
-            }
+            check_tolerances(rtol, o.atol, "atol")?;
             thresh.fill(o.atol / rtol);
+            o.atol
         }
-    }
+    };
     if !(1..=5).contains(&o.max_order) {
         return Err(invalid(
             "max_order",
@@ -114,6 +107,7 @@ fn check_options(
     let (inv_ga, erconst) = coefficients(o.bdf);
     Ok(Config {
         rtol,
+        atol,
         maxk: o.max_order,
         hmax,
         h0: o.initial_step,
@@ -511,6 +505,9 @@ fn integrate_piece<C: Corrector>(
         let (tnew, h, err) = loop {
             // Solve the corrector for ynew (retrying with a new Jacobian or a smaller step).
             let (tnew, h) = loop {
+                if let Some(reason) = cs.stop_requested() {
+                    return Err(OdeError::Stopped { t, reason });
+                }
                 let tnew = if done { b } else { t + absh };
                 let h = tnew - t;
                 {
@@ -616,7 +613,10 @@ fn integrate_piece<C: Corrector>(
                     return Err(if nonfinite {
                         OdeError::NonFinite { t }
                     } else {
-                        OdeError::NewtonFailure { t }
+                        OdeError::NewtonFailure {
+                            t,
+                            tolerances: Some((rtol, cfg.atol)),
+                        }
                     });
                 } else {
                     abshlast = absh;
@@ -641,6 +641,8 @@ fn integrate_piece<C: Corrector>(
                     t,
                     h: absh,
                     h_min: hmin,
+                    rtol,
+                    atol: cfg.atol,
                 });
             }
             abshlast = absh;

@@ -16,12 +16,7 @@ pub(super) fn check_step_options(
     max_step: f64,
     initial_step: Option<f64>,
 ) -> Result<(), OdeError> {
-    if !(rtol > 0.0 && rtol < 1.0) {
-        return Err(invalid("rtol", format!("{rtol} (accepted: (0, 1))")));
-    }
-    if !(atol > 0.0 && atol.is_finite()) {
-        return Err(invalid("atol", format!("{atol} (accepted: > 0)")));
-    }
+    super::check_tolerances(rtol, atol, "atol")?;
     if max_step.is_nan() || max_step <= 0.0 {
         return Err(invalid("max_step", format!("{max_step} (accepted: > 0)")));
     }
@@ -202,11 +197,13 @@ impl Parts {
     }
 
     /// After a failed attempt (Newton diverged, or `S` singular): renews `M, D, K` at the current
-    /// point `(t, q, q̇)` if they are stale, else cuts `h` by 4; stops after 40 failures in a row.
+    /// point `(t, q, q̇)` if they are stale, else cuts `h` by 4; stops after 40 failures in a row,
+    /// naming the tolerances `tol = (rtol, atol)`.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn after_failure<S: MechanicalSystem>(
         &mut self,
         sys: &mut S,
+        tol: (f64, f64),
         t: f64,
         t_eval: f64,
         q: &DVector<f64>,
@@ -219,7 +216,10 @@ impl Parts {
         stats.newton_failures += 1;
         *fails += 1;
         if *fails > 40 {
-            return Err(OdeError::NewtonFailure { t });
+            return Err(OdeError::NewtonFailure {
+                t,
+                tolerances: Some(tol),
+            });
         }
         if self.current {
             *h *= 0.25;
@@ -288,22 +288,31 @@ pub(super) fn first_step(
     h
 }
 
-/// Before an attempt from `t` with step `h` on `piece`: errors if `h` fell below `16 ulp(t)` or the
-/// step budget is spent, lands on the end of the piece (stretching `h` by up to 10 %), and returns
-/// the end of the step.
-pub(super) fn begin_attempt(
+/// Before an attempt from `t` with step `h` on `piece`: errors if `h` fell below `16 ulp(t)` (naming
+/// the tolerances `tol = (rtol, atol)`), the step budget is spent or `sys` asks to stop
+/// ([`MechanicalSystem::stop_requested`]); lands on the end of the piece (stretching `h` by up to
+/// 10 %), and returns the end of the step.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn begin_attempt<S: MechanicalSystem>(
+    sys: &mut S,
     t: f64,
     h: &mut f64,
     piece: &Piece,
     steps: usize,
     max_steps: usize,
+    tol: (f64, f64),
 ) -> Result<f64, OdeError> {
+    if let Some(reason) = sys.stop_requested() {
+        return Err(OdeError::Stopped { t, reason });
+    }
     let hmin = 16.0 * super::ulp(t);
     if *h < hmin {
         return Err(OdeError::StepSizeUnderflow {
             t,
             h: *h,
             h_min: hmin,
+            rtol: tol.0,
+            atol: tol.1,
         });
     }
     if steps >= max_steps {

@@ -99,7 +99,8 @@ const MAX_NEWTON: usize = 7;
 /// Options of [`integrate_sdirk`].
 #[derive(Debug, Clone)]
 pub struct SdirkOptions {
-    /// Relative tolerance of the local error per step (default `1e-3`).
+    /// Relative tolerance of the local error per step (default `1e-3`), in
+    /// [[`super::MIN_RTOL`], [`super::MAX_RTOL`]).
     pub rtol: f64,
     /// Absolute tolerance (default `1e-6`).
     pub atol: f64,
@@ -366,7 +367,7 @@ fn integrate_piece<S: MechanicalSystem>(
     let mut fails_here = 0usize;
     let rates = |h: f64| (h * GAMMA, (h * GAMMA).powi(2));
     while t < piece.b {
-        let t1 = begin_attempt(t, &mut h, piece, stats.steps, opts.max_steps)?;
+        let t1 = begin_attempt(sys, t, &mut h, piece, stats.steps, opts.max_steps, tol)?;
         if refresh && !w.parts.current {
             // the last step's Newton was slow: M, D, K at the current point
             w.parts.eval(sys, piece.clamp(t), &w.q, &w.qd, stats)?;
@@ -382,6 +383,7 @@ fn integrate_piece<S: MechanicalSystem>(
             let (q, qd) = (&w.q, &w.qd);
             w.parts.after_failure(
                 sys,
+                tol,
                 t,
                 piece.clamp(t),
                 q,
