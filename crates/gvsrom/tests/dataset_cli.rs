@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{expect_error, gvsrom, scratch};
+use common::{copy_dir, expect_error, gvsrom, scratch};
 use gvsrom::dataset::Dataset;
 use std::path::Path;
 
@@ -130,17 +130,6 @@ fn a_dataset_read_back_holds_exactly_the_bytes_written() {
     assert_eq!(ds.status, vec![0u8; 9]);
     // and loading twice gives the same dataset
     assert_eq!(Dataset::load(&dir).unwrap(), ds);
-}
-
-/// A copy of `src` in a fresh scratch directory.
-fn copy_dir(src: &Path, name: &str) -> std::path::PathBuf {
-    let dst = scratch(name);
-    std::fs::create_dir_all(&dst).unwrap();
-    for e in std::fs::read_dir(src).unwrap() {
-        let e = e.unwrap();
-        std::fs::copy(e.path(), dst.join(e.file_name())).unwrap();
-    }
-    dst
 }
 
 #[test]

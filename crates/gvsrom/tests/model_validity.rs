@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{expect_error, gvsrom, scratch};
+use common::{copy_dir, expect_error, gvsrom, scratch};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::sync::OnceLock;
@@ -300,17 +300,6 @@ fn a_model_from_an_interrupted_training_is_used_with_a_warning() {
         s(pod2()),
     ]);
     assert!(!stderr.contains("warning"), "{stderr}");
-}
-
-/// A copy of a gvsrom directory output (flat) at a fresh scratch path.
-fn copy_dir(from: &Path, name: &str) -> PathBuf {
-    let to = scratch(name);
-    std::fs::create_dir_all(&to).unwrap();
-    for e in std::fs::read_dir(from).unwrap() {
-        let e = e.unwrap();
-        std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
-    }
-    to
 }
 
 fn read_json(path: &Path) -> serde_json::Value {

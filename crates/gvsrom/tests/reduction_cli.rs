@@ -9,7 +9,7 @@
 
 mod common;
 
-use common::{expect_error, gvsrom, scratch};
+use common::{copy_dir, expect_error, gvsrom, scratch};
 use gvsrom::reduced_model::ReducedModel;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -124,17 +124,6 @@ fn statics(name: &str, tension: f64, model: Option<&Path>) -> serde_json::Value 
     }
     run_ok(&args);
     json(&file)
-}
-
-/// Copies a model or dataset directory (flat) to a fresh scratch path.
-fn copy_dir(from: &Path, name: &str) -> PathBuf {
-    let to = scratch(name);
-    std::fs::create_dir_all(&to).unwrap();
-    for e in std::fs::read_dir(from).unwrap() {
-        let e = e.unwrap();
-        std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
-    }
-    to
 }
 
 /// The trained 1-latent, 3-hidden-layer autoencoder of [`dataset40`] (30 epochs, seed 3).

@@ -57,3 +57,14 @@ pub fn expect_error(args: &[&str], needles: &[&str]) -> String {
     }
     stderr
 }
+
+/// A copy of a gvsrom directory output (flat) at the fresh scratch path `name`.
+pub fn copy_dir(from: &std::path::Path, name: &str) -> PathBuf {
+    let to = scratch(name);
+    std::fs::create_dir_all(&to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let e = e.unwrap();
+        std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
+    }
+    to
+}
