@@ -37,6 +37,16 @@ pub fn read_checked<T: npyz::Deserialize>(
         std::io::ErrorKind::NotFound => npy_error(&shown, "missing array"),
         _ => npy_error(&shown, format!("cannot read it: {e}")),
     })?;
+    // npyz multiplies the shape's dimensions in u64 without checking, so a header whose numbers
+    // could overflow that product is refused before npyz reads it
+    if let Some(bits) = header_number_bits(&bytes).filter(|&b| b > 64) {
+        return Err(npy_error(
+            &shown,
+            format!(
+                "not a valid .npy file: its header holds numbers of up to {bits} bits together, more than the 64 bits any array shape (product of dimensions) can take"
+            ),
+        ));
+    }
     let npy = npyz::NpyFile::new(&bytes[..])
         .map_err(|e| npy_error(&shown, format!("not a valid .npy file: {e}")))?;
     let dtype = npy.dtype().descr();
@@ -56,26 +66,65 @@ pub fn read_checked<T: npyz::Deserialize>(
             format!("shape {got:?}, expected {shape:?} from meta.json"),
         ));
     }
-    let n: usize = shape.iter().product();
     let size = std::mem::size_of::<T>();
+    let expected = shape
+        .iter()
+        .try_fold(size, |a, &d| a.checked_mul(d))
+        .ok_or_else(|| {
+            npy_error(
+                &shown,
+                format!("shape {shape:?} of {size}-byte values holds more bytes than any file"),
+            )
+        })?;
     let data_len = npy.into_inner().len();
-    if data_len != n * size {
+    if data_len != expected {
         return Err(npy_error(
             &shown,
             format!(
-                "{} ({data_len} data bytes, expected {} for shape {shape:?})",
-                if data_len < n * size {
+                "{} ({data_len} data bytes, expected {expected} for shape {shape:?})",
+                if data_len < expected {
                     "truncated"
                 } else {
                     "has trailing bytes"
                 },
-                n * size
             ),
         ));
     }
     npyz::NpyFile::new(&bytes[..])
         .and_then(|f| f.into_vec::<T>())
         .map_err(|e| npy_error(&shown, format!("cannot read the data: {e}")))
+}
+
+/// An upper bound of log₂ of the product of all integers written in the header of the `.npy` file
+/// `bytes` (`None`: no header where npyz would read one; npyz then refuses the file itself).
+///
+/// The header is a Python literal, where an integer is a token starting with a digit (decimal,
+/// `0x…`, `0o…`, `0b…`, with `_` between digits): one of k characters is below 16ᵏ, and a sum
+/// `a + b` of such tokens below the product of their bounds. So 4 bits per character of every such
+/// token bound the product of any dimensions (and of any of their prefixes) the header can give.
+fn header_number_bits(bytes: &[u8]) -> Option<u64> {
+    if bytes.get(..6)? != b"\x93NUMPY" {
+        return None;
+    }
+    // version 1.0: a u16 header length; 2.0 and 3.0: a u32
+    let (len, at): (usize, usize) = match bytes.get(6)? {
+        1 => (
+            u16::from_le_bytes([*bytes.get(8)?, *bytes.get(9)?]).into(),
+            10,
+        ),
+        2 | 3 => (
+            u32::from_le_bytes(bytes.get(8..12)?.try_into().ok()?) as usize,
+            12,
+        ),
+        _ => return None,
+    };
+    let text = bytes.get(at..at.checked_add(len)?)?;
+    Some(
+        text.split(|c| !(c.is_ascii_alphanumeric() || *c == b'_'))
+            .filter(|t| t.first().is_some_and(u8::is_ascii_digit))
+            .map(|t| 4 * t.len() as u64)
+            .sum(),
+    )
 }
 
 fn shape_u64(shape: &[usize]) -> Vec<u64> {

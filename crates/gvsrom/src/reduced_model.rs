@@ -225,6 +225,29 @@ fn mlp_tensors(prefix: &str, mlp: &Mlp, out: &mut BTreeMap<String, (Vec<usize>, 
     }
 }
 
+/// The first tensor of the safetensors file `bytes` whose `data_offsets` end past its data,
+/// described; `None` if there is none or the header cannot be read (safetensors then refuses it).
+///
+/// safetensors (0.8) adds the last tensor's end to the header length unchecked: offsets near 2⁶⁴
+/// (tensors that fit nowhere, yet consistent with their shapes) overflow there, a panic in a build
+/// with overflow checks (a wrapped sum, refused as an incomplete file, without).
+fn offsets_beyond_data(bytes: &[u8]) -> Option<String> {
+    let n = usize::try_from(u64::from_le_bytes(bytes.get(..8)?.try_into().ok()?)).ok()?;
+    let header = bytes.get(8..8usize.checked_add(n)?)?;
+    let data = bytes.len() - 8 - n;
+    let serde_json::Value::Object(tensors) = serde_json::from_slice(header).ok()? else {
+        return None;
+    };
+    tensors.iter().find_map(|(name, info)| {
+        let end = info.get("data_offsets")?.get(1)?.as_u64()?;
+        (end > data as u64).then(|| {
+            format!(
+                "tensor `{name}` ends at byte {end} of data, but the file holds {data} data bytes"
+            )
+        })
+    })
+}
+
 impl ReducedModel {
     fn tensors(&self) -> BTreeMap<String, (Vec<usize>, Vec<u8>)> {
         let mut t = BTreeMap::new();
@@ -337,6 +360,9 @@ impl ReducedModel {
         }
         let bytes = std::fs::read(dir.join(WEIGHTS_FILE))
             .map_err(|e| bad(format!("cannot read {WEIGHTS_FILE}: {e}")))?;
+        if let Some(message) = offsets_beyond_data(&bytes) {
+            return Err(bad(format!("{WEIGHTS_FILE} is damaged: {message}")));
+        }
         let st = SafeTensors::deserialize(&bytes)
             .map_err(|e| bad(format!("{WEIGHTS_FILE} is damaged: {e}")))?;
         let get = |name: &str, shape: &[usize]| -> Result<Vec<f64>, ModelFileError> {
@@ -350,10 +376,18 @@ impl ReducedModel {
                     t.shape()
                 )));
             }
-            Ok(t.data()
+            let values: Vec<f64> = t
+                .data()
                 .chunks_exact(8)
                 .map(|c| f64::from_le_bytes(c.try_into().expect("chunks of 8")))
-                .collect())
+                .collect();
+            // modes, singular values, weights, scalings and anchors are all finite when written
+            if let Some((i, v)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+                return Err(bad(format!(
+                    "{WEIGHTS_FILE}: tensor `{name}` holds {v} at index {i} (expected finite values)"
+                )));
+            }
+            Ok(values)
         };
         let features = meta.layout.features();
         let weights = match meta.kind.as_str() {

@@ -148,11 +148,14 @@ impl Dataset {
     fn check_consistency(&self, dir: &Path) -> Result<(), DatasetError> {
         let at = |f: &str| dir.join(f).display().to_string();
         let m = &self.meta;
-        for (a, b) in self.strain_x.iter().zip(&m.strain_x) {
-            if (a - b).abs() > 1e-12 * (1.0 + b.abs()) {
+        for (j, (a, b)) in self.strain_x.iter().zip(&m.strain_x).enumerate() {
+            let close = (a - b).abs() <= 1e-12 * (1.0 + b.abs()); // false for a NaN
+            if !close {
                 return Err(file_error(
                     &at(FILES[8]),
-                    "differs from strain_x in meta.json",
+                    format!(
+                        "differs from strain_x in meta.json: point {j} at {a}, meta.json says {b}"
+                    ),
                 ));
             }
         }
@@ -180,6 +183,16 @@ impl Dataset {
                 return Err(file_error(
                     &at(FILES[1]),
                     format!("row {k} has status ok but holds NaN or infinite values"),
+                ));
+            }
+            let d = m.parameters.len();
+            let inputs = &self.inputs[k * d..(k + 1) * d];
+            if let Some(v) = inputs.iter().find(|v| s == STATUS_OK && !v.is_finite()) {
+                return Err(file_error(
+                    &at(FILES[0]),
+                    format!(
+                        "row {k} has status ok but holds the input {v} (expected finite values)"
+                    ),
                 ));
             }
         }
