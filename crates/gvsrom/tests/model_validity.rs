@@ -527,3 +527,29 @@ fn a_simulation_input_signal_is_checked_against_the_training_inputs() {
         "{meta}"
     );
 }
+
+#[test]
+fn a_model_without_a_recorded_range_is_refused_and_one_without_hashes_warns() {
+    // written before ranges were recorded: no `input_range` (hashes re-recorded)
+    let m = copy_dir(pod2(), "val-pod2-norange");
+    let mut meta = read_json(&m.join("meta.json"));
+    meta.as_object_mut().unwrap().remove("input_range").unwrap();
+    write_json(&m.join("meta.json"), &meta);
+    common::reseal::reseal(&m);
+    expect_error(
+        &["statics", "single-tendon", "--tension=-3", "--model", s(&m)],
+        &["records no range of training inputs", "re-create it"],
+    );
+    // written before hashes were recorded: used, with a warning that it could not be checked
+    let m = copy_dir(pod2(), "val-pod2-nohash");
+    let mut meta = read_json(&m.join("meta.json"));
+    let manifest = meta["gvsrom"].as_object_mut().unwrap();
+    manifest.shift_remove("sha256").unwrap();
+    manifest.shift_remove("meta_sha256").unwrap();
+    write_json(&m.join("meta.json"), &meta);
+    let (_, stderr) = run_ok(&["statics", "single-tendon", "--tension=-3", "--model", s(&m)]);
+    assert!(
+        stderr.contains("warning:") && stderr.contains("before gvsrom recorded content hashes"),
+        "{stderr}"
+    );
+}
