@@ -12,7 +12,9 @@ use crate::build::Built;
 use crate::error::ScenarioError;
 use crate::output::OutputDir;
 use crate::simulate::{self, InputSource, SimulateOptions};
-use gvs::solve::dynamics::{simulate_streaming, IntegratorOptions, OdeJacobian, SimulationError};
+use gvs::solve::dynamics::{
+    simulate_streaming_interruptible, IntegratorOptions, OdeJacobian, SimulationError,
+};
 use serde::{Deserialize, Serialize};
 use std::io::Write;
 use std::ops::ControlFlow;
@@ -116,7 +118,13 @@ pub fn run(
     let mut inputs: Vec<f64> = Vec::with_capacity(n_max * na);
     let mut t: Vec<f64> = Vec::with_capacity(n_max);
     let mut stopped = None;
-    let summary_run = simulate_streaming(
+    // polled before every step attempt too, not only at samples: with tight tolerances the next
+    // sample may be far away
+    let stop = || match interrupt.load(Ordering::SeqCst) {
+        0 => None,
+        sig => Some(format!("interrupted by {}", super::signal_name(sig))),
+    };
+    let summary_run = simulate_streaming_interruptible(
         model,
         &plan.signal,
         &built.loads,
@@ -153,6 +161,7 @@ pub fn run(
                 }
             }
         },
+        &stop,
     )
     .map_err(|e| match e {
         SimulationError::Model(m) => DatasetError::Scenario(ScenarioError::from(m)),
@@ -162,6 +171,9 @@ pub fn run(
         )),
     })?;
     bar.finish_and_clear();
+    if stopped.is_none() {
+        stopped = stop(); // stopped between samples
+    }
     let n = rows.len();
     let failed = match (&summary_run.error, &stopped) {
         (Some(e), None) => Some(e.to_string()),
