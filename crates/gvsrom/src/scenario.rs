@@ -736,10 +736,22 @@ mod tests {
             let s = crate::presets::load(p.name, &[]).unwrap();
             let text = s.to_toml().unwrap();
             let back = Scenario::from_toml(p.name, &text, &[]).unwrap();
-            assert_eq!(back.to_table().unwrap(), s.to_table().unwrap(), "{}", p.name);
+            assert_eq!(
+                back.to_table().unwrap(),
+                s.to_table().unwrap(),
+                "{}",
+                p.name
+            );
             // every default is written out: the resolved text names the solver and the output
             let table = s.to_table().unwrap();
-            for key in ["material", "divisions", "loads", "solver", "output", "magnus"] {
+            for key in [
+                "material",
+                "divisions",
+                "loads",
+                "solver",
+                "output",
+                "magnus",
+            ] {
                 assert!(table.contains_key(key), "{}: no `{key}` in\n{text}", p.name);
             }
             assert_eq!(format!("{back:?}"), format!("{s:?}"), "{}", p.name);

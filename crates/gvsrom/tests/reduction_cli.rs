@@ -527,7 +527,10 @@ fn a_damaged_model_or_dataset_is_an_error_not_a_wrong_model() {
         let w = dir.join("weights.safetensors");
         let bytes = std::fs::read(&w).unwrap();
         std::fs::write(&w, &bytes[..bytes.len() / 2]).unwrap();
-        use_model(&dir, &["weights.safetensors", "differs from the hash", s(&dir)]);
+        use_model(
+            &dir,
+            &["weights.safetensors", "differs from the hash", s(&dir)],
+        );
         reseal(&dir);
         use_model(&dir, &["weights.safetensors", "damaged", s(&dir)]);
         // the weights file deleted

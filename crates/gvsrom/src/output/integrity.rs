@@ -318,12 +318,7 @@ mod tests {
     use std::io::Write;
 
     fn sandbox(name: &str) -> PathBuf {
-        let d = std::env::temp_dir()
-            .join(format!("gvsrom-integrity-unit-{}", std::process::id()))
-            .join(name);
-        let _ = fs::remove_dir_all(&d);
-        fs::create_dir_all(&d).unwrap();
-        d
+        super::super::test_util::sandbox("integrity", name)
     }
 
     /// A committed output of format "test" with `a.bin`, `b.bin` (same length) and meta values.

@@ -36,6 +36,8 @@
 pub mod integrity;
 mod replace;
 mod run_dir;
+#[cfg(test)]
+mod test_util;
 pub use integrity::{verify_dir, Integrity, IntegrityError};
 pub use run_dir::{RunDir, RUN_FORMAT};
 
@@ -785,24 +787,11 @@ mod tests {
     use super::*;
     use serde_json::json;
 
-    /// A fresh empty directory in the system's temporary directory (never the current directory).
     fn sandbox(name: &str) -> PathBuf {
-        let d = std::env::temp_dir()
-            .join(format!("gvsrom-output-unit-{}", std::process::id()))
-            .join(name);
-        let _ = fs::remove_dir_all(&d);
-        fs::create_dir_all(&d).unwrap();
-        d
+        super::test_util::sandbox("output", name)
     }
 
-    fn names(dir: &Path) -> Vec<String> {
-        let mut v: Vec<String> = fs::read_dir(dir)
-            .unwrap()
-            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-            .collect();
-        v.sort();
-        v
-    }
+    use super::test_util::names;
 
     #[test]
     fn dropping_an_uncommitted_output_leaves_nothing_behind() {

@@ -108,22 +108,10 @@ mod tests {
     use std::fs;
 
     fn sandbox(name: &str) -> PathBuf {
-        let d = std::env::temp_dir()
-            .join(format!("gvsrom-replace-unit-{}", std::process::id()))
-            .join(name);
-        let _ = fs::remove_dir_all(&d);
-        fs::create_dir_all(&d).unwrap();
-        d
+        super::super::test_util::sandbox("replace", name)
     }
 
-    fn names(dir: &Path) -> Vec<String> {
-        let mut v: Vec<String> = fs::read_dir(dir)
-            .unwrap()
-            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-            .collect();
-        v.sort();
-        v
-    }
+    use super::super::test_util::names;
 
     #[test]
     fn a_forced_replace_leaves_the_new_output_and_nothing_of_the_old_one() {

@@ -168,12 +168,7 @@ mod tests {
     use super::*;
 
     fn sandbox(name: &str) -> PathBuf {
-        let d = std::env::temp_dir()
-            .join(format!("gvsrom-run-dir-unit-{}", std::process::id()))
-            .join(name);
-        let _ = fs::remove_dir_all(&d);
-        fs::create_dir_all(&d).unwrap();
-        d
+        super::super::test_util::sandbox("run-dir", name)
     }
 
     #[test]

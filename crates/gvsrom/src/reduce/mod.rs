@@ -48,7 +48,10 @@ pub fn dataset_scenario(ds: &Dataset) -> Result<Built, ScenarioError> {
     let m = &ds.meta;
     let length = built.model.disc.length().max(1.0);
     let same_x = l.strain_x.len() == m.strain_x.len()
-        && l.strain_x.iter().zip(&m.strain_x).all(|(a, b)| (a - b).abs() <= 1e-12 * length);
+        && l.strain_x
+            .iter()
+            .zip(&m.strain_x)
+            .all(|(a, b)| (a - b).abs() <= 1e-12 * length);
     if !same_x || l.component_names() != m.components || l.n_dof != m.n_dof {
         return Err(invalid(
             "DATASET",

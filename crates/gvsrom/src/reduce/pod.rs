@@ -6,9 +6,9 @@ use super::{
     sample_inputs, snapshot_rows,
 };
 use crate::dataset::Dataset;
+use crate::error::ScenarioError;
 use crate::output::OutputDir;
 use crate::reduced_model::{ModelMeta, ModelWeights, ReducedModel};
-use crate::error::ScenarioError;
 use rom::pod::{Pod, PodError};
 use std::path::{Path, PathBuf};
 
@@ -112,11 +112,7 @@ fn pod_error(e: PodError, ds: &Dataset, x: &[f64], features: usize) -> ScenarioE
                 .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
                 .map(|(i, v)| (i, *v))
                 .unwrap_or((0, 0.0));
-            let sample = ds
-                .ok_rows()
-                .get(i / features.max(1))
-                .copied()
-                .unwrap_or(0);
+            let sample = ds.ok_rows().get(i / features.max(1)).copied().unwrap_or(0);
             invalid(
                 "DATASET",
                 format!(

@@ -83,9 +83,8 @@ pub fn check(
             "it records no range of training inputs (it was written before gvsrom recorded them): re-create it with `gvsrom pod` or `gvsrom train` from its dataset".to_string(),
         );
     }
-    let signal_driven = |p: &str| {
-        tensions_from_signal && p.starts_with("tendons.") && p.ends_with(".tension")
-    };
+    let signal_driven =
+        |p: &str| tensions_from_signal && p.starts_with("tendons.") && p.ends_with(".tension");
     for r in &meta.input_range {
         if signal_driven(&r.parameter) {
             continue;

@@ -97,7 +97,11 @@ impl TrainOptions {
             })
         };
         if self.epochs == 0 {
-            return bad("epochs", 0.0, "≥ 1 (zero epochs would keep the random initial weights)");
+            return bad(
+                "epochs",
+                0.0,
+                "≥ 1 (zero epochs would keep the random initial weights)",
+            );
         }
         if self.batch_size == 0 {
             return bad("batch_size", 0.0, "≥ 1");

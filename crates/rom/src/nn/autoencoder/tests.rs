@@ -299,7 +299,13 @@ fn zero_epochs_are_refused_rather_than_saving_the_random_initial_weights() {
     };
     let err = Autoencoder::train(&data, 12, &opts, &mut quiet()).unwrap_err();
     assert!(
-        matches!(err, NnError::InvalidOption { field: "epochs", .. }),
+        matches!(
+            err,
+            NnError::InvalidOption {
+                field: "epochs",
+                ..
+            }
+        ),
         "{err}"
     );
 }
@@ -324,7 +330,10 @@ fn a_diverging_training_is_an_error_and_no_model() {
             learning_rate,
         }) => {
             assert!(epoch >= 1 && epoch < 200, "stopped at epoch {epoch}");
-            assert!(!(loss <= crate::nn::EXPLODED * initial), "{loss} vs {initial}");
+            assert!(
+                !(loss <= crate::nn::EXPLODED * initial),
+                "{loss} vs {initial}"
+            );
             assert_eq!(learning_rate, 1e3);
         }
         other => panic!("expected a divergence error, got {:?}", other.map(|r| r.1)),
