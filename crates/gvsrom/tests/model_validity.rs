@@ -6,7 +6,6 @@ mod common;
 
 use common::{copy_dir, expect_error, gvsrom, scratch};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
 use std::sync::OnceLock;
 use std::time::Duration;
 
@@ -250,8 +249,8 @@ fn a_model_refuses_a_scenario_with_other_physics_naming_the_field() {
 #[test]
 fn a_model_from_an_interrupted_training_is_used_with_a_warning() {
     let dir = scratch("val-ae-interrupted");
-    let child = Command::new(env!("CARGO_BIN_EXE_gvsrom"))
-        .args([
+    let out = common::interrupted(
+        &[
             "train",
             s(dataset12()),
             "--hidden-layers",
@@ -262,18 +261,10 @@ fn a_model_from_an_interrupted_training_is_used_with_a_warning() {
             "0",
             "--out",
             s(&dir),
-        ])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(Duration::from_millis(1500));
-    assert!(Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap()
-        .success());
-    let out = child.wait_with_output().unwrap();
+        ],
+        // a few hundred epochs of the small network
+        Duration::from_millis(1500),
+    );
     assert_eq!(
         out.status.code(),
         Some(130),

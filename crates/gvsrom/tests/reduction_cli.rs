@@ -12,7 +12,6 @@ mod common;
 use common::{copy_dir, expect_error, gvsrom, scratch};
 use gvsrom::reduced_model::ReducedModel;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
@@ -674,8 +673,8 @@ fn an_ae_rom_equilibrium_is_within_one_percent_strain_error() {
 #[test]
 fn interrupted_training_keeps_the_best_weights() {
     let dir = scratch("red-ae-interrupted");
-    let child = Command::new(env!("CARGO_BIN_EXE_gvsrom"))
-        .args([
+    let out = common::interrupted(
+        &[
             "train",
             s(dataset40()),
             "--hidden-layers",
@@ -686,20 +685,10 @@ fn interrupted_training_keeps_the_best_weights() {
             "0",
             "--out",
             s(&dir),
-        ])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    // a few hundred epochs of the small network
-    std::thread::sleep(Duration::from_millis(1500));
-    let ok = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap()
-        .success();
-    assert!(ok);
-    let out = child.wait_with_output().unwrap();
+        ],
+        // a few hundred epochs of the small network
+        Duration::from_millis(1500),
+    );
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(130), "{err}");
     assert!(

@@ -68,3 +68,21 @@ pub fn copy_dir(from: &std::path::Path, name: &str) -> PathBuf {
     }
     to
 }
+
+/// Runs `gvsrom args`, sends it SIGINT after `after` and returns its output once it exits.
+pub fn interrupted(args: &[&str], after: std::time::Duration) -> Output {
+    use std::process::Stdio;
+    let child = Command::new(env!("CARGO_BIN_EXE_gvsrom"))
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the gvsrom binary runs");
+    std::thread::sleep(after);
+    let sent = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(sent.success(), "SIGINT could not be sent");
+    child.wait_with_output().expect("gvsrom exits")
+}
