@@ -52,6 +52,7 @@
 //! reached, the largest λ, the steps and the folds ([`ContinuationError`]).
 
 use super::dogleg::{self, DoglegOptions, DoglegWorkspace, EvalError, NonlinearSystem};
+use super::StopCheck;
 use crate::error::ModelError;
 use crate::loads::Loads;
 use crate::model::{Model, PreparedLoads, Workspace};
@@ -73,6 +74,11 @@ pub trait ParametrizedSystem {
     ) -> f64;
     /// `∂R/∂x(x, λ)` into `jac` (called after [`Self::residual`] at the same point).
     fn jacobian(&mut self, x: &DVector<f64>, lambda: f64, jac: &mut DMatrix<f64>);
+    /// Polled before every continuation step: `Some(reason)` stops [`follow`] with
+    /// [`Stop::Requested`] (an interrupt; [`super::StopCheck`]).
+    fn stop_requested(&mut self) -> Option<String> {
+        None
+    }
 }
 
 /// Options of [`follow`]; step sizes in units of λ at the initial slope (see the module doc).
@@ -183,7 +189,7 @@ pub enum ContinuationError {
 }
 
 /// Why [`follow`] stopped short of the target.
-#[derive(Debug, Clone, Copy, PartialEq, Error)]
+#[derive(Debug, Clone, PartialEq, Error)]
 pub enum Stop {
     #[error("the step limit ({0})")]
     MaxSteps(usize),
@@ -193,6 +199,9 @@ pub enum Stop {
         "the arc step fell below {0:e} (a singular point, or a corrector that cannot converge)"
     )]
     StepCollapsed(f64),
+    /// The caller asked to stop ([`ParametrizedSystem::stop_requested`]), with its reason.
+    #[error("{0}")]
+    Requested(String),
 }
 
 /// Scratch of [`follow`]: residual, `∂R/∂λ`, `∂R/∂x` and the bordered matrix.
@@ -395,6 +404,9 @@ pub fn follow<S: ParametrizedSystem>(
         if stats.steps >= opts.max_steps {
             return Err(stopped(Stop::MaxSteps(opts.max_steps), lambda, &stats));
         }
+        if let Some(reason) = sys.stop_requested() {
+            return Err(stopped(Stop::Requested(reason), lambda, &stats));
+        }
         stats.steps += 1;
         let xp = &x + t.rows(0, n) * ds;
         let mup = mu + t[n] * ds;
@@ -503,6 +515,8 @@ pub struct StaticsPath<'a, 'm, P: StrainParam> {
     /// Model residual and Jacobian evaluations so far.
     pub residual_evaluations: usize,
     pub jacobian_evaluations: usize,
+    /// Polled before every step ([`ParametrizedSystem::stop_requested`]).
+    stop: &'a StopCheck<'a>,
 }
 
 impl<'a, 'm, P: StrainParam> StaticsPath<'a, 'm, P> {
@@ -511,6 +525,7 @@ impl<'a, 'm, P: StrainParam> StaticsPath<'a, 'm, P> {
         ws: &'a mut Workspace,
         u: &[f64],
         loads: &Loads,
+        stop: &'a StopCheck<'a>,
     ) -> Result<Self, ModelError> {
         let full = model.prepare_loads(loads)?;
         let mut none = full.clone();
@@ -528,6 +543,7 @@ impl<'a, 'm, P: StrainParam> StaticsPath<'a, 'm, P> {
             at: None,
             residual_evaluations: 0,
             jacobian_evaluations: 0,
+            stop,
         })
     }
 }
@@ -568,17 +584,22 @@ impl<P: StrainParam> ParametrizedSystem for StaticsPath<'_, '_, P> {
         self.at = None;
         self.jacobian_evaluations += 1;
     }
+    fn stop_requested(&mut self) -> Option<String> {
+        (self.stop)()
+    }
 }
 
 /// Follows the statics of `model` under `u`, `loads` from the straight rod
 /// ([`StrainParam::rest_coordinates`], the equilibrium at λ = 0) to λ = 1, landing with the dogleg
-/// options `landing`. Returns the report and the model's residual and Jacobian evaluations.
+/// options `landing`, polling `stop` before every step. Returns the report and the model's residual
+/// and Jacobian evaluations.
 pub fn follow_statics<P: StrainParam>(
     model: &Model<P>,
     ws: &mut Workspace,
     u: &[f64],
     loads: &Loads,
     landing: &DoglegOptions,
+    stop: &StopCheck<'_>,
 ) -> Result<(ContinuationReport, usize, usize), ContinuationError> {
     let opts = ContinuationOptions {
         corrector_ftol: landing
@@ -587,7 +608,7 @@ pub fn follow_statics<P: StrainParam>(
         landing: landing.clone(),
         ..ContinuationOptions::default()
     };
-    let mut sys = StaticsPath::new(model, ws, u, loads)?;
+    let mut sys = StaticsPath::new(model, ws, u, loads, stop)?;
     let rep = follow(&mut sys, &model.param.rest_coordinates(), 0.0, &opts)?;
     Ok((rep, sys.residual_evaluations, sys.jacobian_evaluations))
 }

@@ -164,9 +164,7 @@ struct RodOde<'m, P: StrainParam> {
     stop: &'m StopCheck<'m>,
 }
 
-/// A check polled before every step attempt of a simulation: `Some(reason)` stops it (e.g. an
-/// interrupt flag set by SIGINT/SIGTERM; keep it as cheap as an atomic load).
-pub type StopCheck<'a> = dyn Fn() -> Option<String> + 'a;
+pub use super::StopCheck;
 
 impl<P: StrainParam> OdeSystem for RodOde<'_, P> {
     fn stop_requested(&mut self) -> Option<String> {
@@ -461,7 +459,7 @@ pub fn simulate_streaming_interruptible<P: StrainParam>(
                     ..Default::default()
                 },
             )
-            .solve(u, loads, None)?;
+            .solve_interruptible(u, loads, None, stop)?;
             (sol.q, DVector::zeros(n))
         }
     };

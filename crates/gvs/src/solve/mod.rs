@@ -8,5 +8,15 @@ pub mod dynamics;
 pub mod ode;
 pub mod statics;
 
+/// A check polled by long solver loops (before every step attempt of a simulation, every load stage
+/// of a statics ramp and every continuation step): `Some(reason)` stops the solver with that reason
+/// (e.g. an interrupt flag set by SIGINT/SIGTERM; keep it as cheap as an atomic load).
+pub type StopCheck<'a> = dyn Fn() -> Option<String> + 'a;
+
+/// The check that never stops.
+pub fn never_stop() -> Option<String> {
+    None
+}
+
 #[cfg(test)]
 mod tests_continuation;

@@ -29,6 +29,7 @@ use super::continuation::{self, ContinuationStats};
 use super::dogleg::{
     self, DoglegError, DoglegOptions, DoglegWorkspace, EvalError, NonlinearSystem,
 };
+use super::{never_stop, StopCheck};
 use crate::error::ModelError;
 use crate::loads::Loads;
 use crate::model::{Model, PreparedLoads, Workspace};
@@ -194,6 +195,10 @@ pub enum StaticsError {
         tolerance: f64,
         reason: String,
     },
+    /// The caller's [`StopCheck`] asked to stop (an interrupt) before the load stage at
+    /// `load_factor` or a continuation step.
+    #[error("statics stopped at load factor {load_factor:.4}: {reason}")]
+    Stopped { load_factor: f64, reason: String },
 }
 
 /// A statics solver bound to one model, owning its workspaces so repeated solves do not allocate.
@@ -296,7 +301,27 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
         loads: &Loads,
         q0: Option<&DVector<f64>>,
     ) -> Result<StaticsSolution, StaticsError> {
-        self.solve_within(u, loads, q0, MAX_LOAD_STAGES, MAX_TOTAL_ITERATIONS)
+        self.solve_within(
+            u,
+            loads,
+            q0,
+            MAX_LOAD_STAGES,
+            MAX_TOTAL_ITERATIONS,
+            &never_stop,
+        )
+    }
+
+    /// [`Self::solve`] that polls `stop` before every load stage and every continuation step: a
+    /// `Some(reason)` ends the solve with [`StaticsError::Stopped`] within one stage (one dogleg
+    /// solve), however many stages the ramp still has.
+    pub fn solve_interruptible(
+        &mut self,
+        u: &[f64],
+        loads: &Loads,
+        q0: Option<&DVector<f64>>,
+        stop: &StopCheck<'_>,
+    ) -> Result<StaticsSolution, StaticsError> {
+        self.solve_within(u, loads, q0, MAX_LOAD_STAGES, MAX_TOTAL_ITERATIONS, stop)
     }
 
     /// [`Self::solve`] with explicit caps on the load stages and total iterations of the solve.
@@ -307,6 +332,7 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
         q0: Option<&DVector<f64>>,
         max_stages: usize,
         max_total_iterations: usize,
+        stop: &StopCheck<'_>,
     ) -> Result<StaticsSolution, StaticsError> {
         self.options.validate()?;
         let n = self.model.n_dof();
@@ -356,6 +382,12 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
         // ‖R‖∞ and its tolerance at the end of the last stage (converged or not)
         let mut last_tolerance = f64::NAN;
         while lambda < 1.0 {
+            if let Some(reason) = stop() {
+                return Err(StaticsError::Stopped {
+                    load_factor: lambda,
+                    reason,
+                });
+            }
             if total.load_stages >= max_stages || total.iterations >= max_total_iterations {
                 return Err(StaticsError::NotConverged {
                     load_factor: lambda,
@@ -428,7 +460,7 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                     let may_continue = q0.is_none() && self.options.min_increment < 1.0;
                     if may_continue && total.continuation.is_none() {
                         let ws = &mut self.ws;
-                        match continuation::follow_statics(self.model, ws, u, loads, &opts) {
+                        match continuation::follow_statics(self.model, ws, u, loads, &opts, stop) {
                             Ok((path, residuals, jacobians)) => {
                                 total.iterations += path.stats.iterations;
                                 total.residual_evaluations += residuals;
@@ -437,6 +469,16 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                                 q = path.x;
                                 inc = 1.0; // a last stage at λ = 1 polishes q
                                 continue;
+                            }
+                            Err(continuation::ContinuationError::Stopped {
+                                why: continuation::Stop::Requested(reason),
+                                lambda,
+                                ..
+                            }) => {
+                                return Err(StaticsError::Stopped {
+                                    load_factor: lambda,
+                                    reason,
+                                })
                             }
                             Err(e) => reason = format!("{reason}; then from the straight rod, {e}"),
                         }
@@ -612,7 +654,7 @@ mod tests {
         };
         let mut solver = StaticsSolver::new(&model, options.clone());
         let e = solver
-            .solve_within(&[], &gravity(), None, 3, MAX_TOTAL_ITERATIONS)
+            .solve_within(&[], &gravity(), None, 3, MAX_TOTAL_ITERATIONS, &never_stop)
             .unwrap_err();
         match &e {
             StaticsError::NotConverged {
@@ -639,6 +681,66 @@ mod tests {
     }
 
     #[test]
+    fn a_stop_request_ends_the_ramp_before_the_next_stage() {
+        // a 10-stage ramp whose stop check answers on its 5th poll: 4 stages solved, λ = 0.4
+        let model = rod_model();
+        let options = StaticsOptions {
+            ramp_steps: 10,
+            ..StaticsOptions::default()
+        };
+        let polls = std::cell::Cell::new(0);
+        let stop = || {
+            polls.set(polls.get() + 1);
+            (polls.get() == 5).then(|| "interrupted by SIGINT".to_string())
+        };
+        let e = StaticsSolver::new(&model, options.clone())
+            .solve_interruptible(&[], &gravity(), None, &stop)
+            .unwrap_err();
+        match &e {
+            StaticsError::Stopped {
+                load_factor,
+                reason,
+            } => {
+                assert!((load_factor - 0.4).abs() < 1e-12, "{e}");
+                assert_eq!(reason, "interrupted by SIGINT");
+            }
+            other => panic!("expected Stopped, got {other}"),
+        }
+        assert_eq!(polls.get(), 5);
+        // a check that never answers leaves the solve as it was: the same q as `solve`
+        let a = StaticsSolver::new(&model, options.clone())
+            .solve_interruptible(&[], &gravity(), None, &|| None)
+            .unwrap();
+        let b = StaticsSolver::new(&model, options)
+            .solve(&[], &gravity(), None)
+            .unwrap();
+        assert_eq!(a.q, b.q);
+    }
+
+    #[test]
+    fn a_stop_request_ends_the_continuation_before_its_next_step() {
+        let model = rod_model();
+        let mut ws = model.workspace();
+        let e = continuation::follow_statics(
+            &model,
+            &mut ws,
+            &[],
+            &gravity(),
+            &DoglegOptions::default(),
+            &|| Some("interrupted by SIGTERM".into()),
+        )
+        .unwrap_err();
+        match &e {
+            continuation::ContinuationError::Stopped {
+                why: continuation::Stop::Requested(reason),
+                steps: 0,
+                ..
+            } => assert_eq!(reason, "interrupted by SIGTERM"),
+            other => panic!("expected a requested stop before the first step, got {other}"),
+        }
+    }
+
+    #[test]
     fn a_solve_stops_at_its_iteration_cap() {
         let model = rod_model();
         let options = StaticsOptions {
@@ -646,7 +748,7 @@ mod tests {
             ..StaticsOptions::default()
         };
         let e = StaticsSolver::new(&model, options)
-            .solve_within(&[], &gravity(), None, MAX_LOAD_STAGES, 1)
+            .solve_within(&[], &gravity(), None, MAX_LOAD_STAGES, 1, &never_stop)
             .unwrap_err()
             .to_string();
         assert!(

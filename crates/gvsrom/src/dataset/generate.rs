@@ -13,7 +13,8 @@ use super::plan::Plan;
 use crate::build::Built;
 use crate::scenario::{apply_override, from_table};
 use gvs::model::Model;
-use gvs::solve::statics::{StaticsOptions, StaticsSolution, StaticsSolver};
+use gvs::solve::statics::{StaticsError, StaticsOptions, StaticsSolution, StaticsSolver};
+use gvs::solve::StopCheck;
 use gvs::strain::LinearBasis;
 use nalgebra::DVector;
 use toml::Table;
@@ -214,8 +215,9 @@ impl Generator<'_> {
         order
     }
 
-    /// Solves chunk `c`; results in plan order.
-    pub fn chunk(&self, c: usize) -> Vec<SampleResult> {
+    /// Solves chunk `c`; results in plan order. `stop` is polled before every load stage of every
+    /// solve: `None` if it asked to stop (the chunk is then not done and none of its results kept).
+    pub fn chunk(&self, c: usize, stop: &StopCheck<'_>) -> Option<Vec<SampleResult>> {
         let range = self.chunk_range(c);
         let params = &self.plan.parameters;
         // normalised coordinates for distances, and the distance to zero for the chain's start
@@ -268,16 +270,17 @@ impl Generator<'_> {
             let result = match self.setup(k) {
                 Err(reason) => SampleResult::missing(self.layout, STATUS_FAILED, Some(reason)),
                 Ok(Setup::Shared(u)) => {
-                    let r = solve(&mut shared, &self.base.options, &u, &self.base.loads, warm);
+                    let options = &self.base.options;
+                    let r = solve(&mut shared, options, &u, &self.base.loads, warm, stop)?;
                     record(base, &mut ws, self.layout, r)
                 }
                 Ok(Setup::Loads(u, loads)) => {
-                    let r = solve(&mut shared, &self.base.options, &u, &loads, warm);
+                    let r = solve(&mut shared, &self.base.options, &u, &loads, warm, stop)?;
                     record(base, &mut ws, self.layout, r)
                 }
                 Ok(Setup::Rebuilt(b)) => {
                     let mut solver = StaticsSolver::new(&b.model, b.options.clone());
-                    let r = solve(&mut solver, &b.options, &b.u, &b.loads, warm);
+                    let r = solve(&mut solver, &b.options, &b.u, &b.loads, warm, stop)?;
                     let mut ws = b.model.workspace();
                     record(&b.model, &mut ws, self.layout, r)
                 }
@@ -287,11 +290,15 @@ impl Generator<'_> {
             }
             out[i] = Some(result);
         }
-        out.into_iter()
-            .map(|r| {
-                r.unwrap_or_else(|| SampleResult::missing(self.layout, STATUS_NOT_COMPUTED, None))
-            })
-            .collect()
+        Some(
+            out.into_iter()
+                .map(|r| {
+                    r.unwrap_or_else(|| {
+                        SampleResult::missing(self.layout, STATUS_NOT_COMPUTED, None)
+                    })
+                })
+                .collect(),
+        )
     }
 }
 
@@ -300,14 +307,16 @@ fn dist(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// A warm-started full-load solve from `warm` if given, else (or if it fails) the scenario's solve
-/// from straight. Returns the solution and whether the warm start was used.
+/// from straight. Returns the solution and whether the warm start was used, or the failure's
+/// reason; `None` if `stop` asked to stop (polled before every load stage).
 fn solve(
     solver: &mut StaticsSolver<'_, LinearBasis>,
     options: &StaticsOptions,
     u: &[f64],
     loads: &gvs::loads::Loads,
     warm: Option<&DVector<f64>>,
-) -> Result<(StaticsSolution, bool), String> {
+    stop: &StopCheck<'_>,
+) -> Option<Result<(StaticsSolution, bool), String>> {
     if let Some(q0) = warm {
         solver.options = StaticsOptions {
             ramp_steps: 1,
@@ -315,15 +324,18 @@ fn solve(
             max_iterations: options.max_iterations.min(WARM_MAX_ITERATIONS),
             ..options.clone()
         };
-        if let Ok(s) = solver.solve(u, loads, Some(q0)) {
-            return Ok((s, true));
+        match solver.solve_interruptible(u, loads, Some(q0), stop) {
+            Ok(s) => return Some(Ok((s, true))),
+            Err(StaticsError::Stopped { .. }) => return None,
+            Err(_) => {}
         }
     }
     solver.options = options.clone();
-    solver
-        .solve(u, loads, None)
-        .map(|s| (s, false))
-        .map_err(|e| e.to_string())
+    match solver.solve_interruptible(u, loads, None, stop) {
+        Ok(s) => Some(Ok((s, false))),
+        Err(StaticsError::Stopped { .. }) => None,
+        Err(e) => Some(Err(e.to_string())),
+    }
 }
 
 /// The sample's row values at a solution (forward kinematics at `q`).

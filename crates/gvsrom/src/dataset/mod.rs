@@ -456,6 +456,12 @@ pub fn run(
     let bar = progress_bar(todo_samples as u64);
     let started = AtomicUsize::new(0);
     let stop_after = args.stop_after_chunks.unwrap_or(usize::MAX);
+    // polled before every load stage of every solve: an interrupt ends the chunks under way (they
+    // are then not done) within one stage, however long their ramps
+    let stop = || match interrupt.load(Ordering::SeqCst) {
+        0 => None,
+        sig => Some(format!("interrupted by {}", signal_name(sig))),
+    };
     let computed: Vec<(usize, Option<Vec<SampleResult>>)> = pool.install(|| {
         use rayon::prelude::*;
         todo.par_iter()
@@ -465,9 +471,11 @@ pub fn run(
                 {
                     return (c, None);
                 }
-                let r = gen.chunk(c);
-                bar.inc(r.len() as u64);
-                (c, Some(r))
+                let r = gen.chunk(c, &stop);
+                if let Some(r) = &r {
+                    bar.inc(r.len() as u64);
+                }
+                (c, r)
             })
             .collect()
     });
