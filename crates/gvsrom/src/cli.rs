@@ -1157,10 +1157,10 @@ fn print_model(scenario: &Scenario, built: &Built, out: &mut impl Write) -> Resu
     if let Some(r) = &built.reduced {
         writeln!(
             out,
-            "reduced    {} model `{}`: {} coordinates on the {}-DOF basis",
+            "reduced    {} model `{}`: {} on the {}-DOF basis",
             r.kind,
             r.path.display(),
-            r.model.n_dof(),
+            plural(r.model.n_dof(), "coordinate"),
             m.n_dof()
         )?;
     }
