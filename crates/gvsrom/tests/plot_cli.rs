@@ -390,3 +390,47 @@ fn bad_inputs_are_one_line_errors_naming_the_file() {
     );
     assert!(!out.exists(), "a failed plot wrote its output");
 }
+
+/// Writes the figures of every kind to /tmp/plot-samples/KIND/ for a person to look at, with the
+/// first, middle and last frames of the rod animation as PNGs (`cargo test --test plot_cli --
+/// --ignored`).
+#[test]
+#[ignore]
+fn write_samples() {
+    use image::AnimationDecoder;
+    let root = Path::new("/tmp/plot-samples");
+    let inputs: [(&str, &Path); 5] = [
+        ("statics", statics_json()),
+        ("trajectory", trajectory_with_centerlines()),
+        ("dataset", dataset()),
+        ("pod", pod()),
+        ("autoencoder", autoencoder()),
+    ];
+    for (kind, input) in inputs {
+        let (dir, _) = plot(input, &format!("plot-samples-{kind}"), &[]);
+        let to = root.join(kind);
+        std::fs::create_dir_all(&to).unwrap();
+        for e in std::fs::read_dir(&dir).unwrap() {
+            let p = e.unwrap().path();
+            let name = p.file_name().unwrap().to_str().unwrap().to_string();
+            if name.ends_with(".png") || name.ends_with(".gif") {
+                std::fs::copy(&p, to.join(&name)).unwrap();
+            }
+            if name.ends_with(".gif") {
+                let bytes = std::fs::read(&p).unwrap();
+                let dec = image::codecs::gif::GifDecoder::new(&bytes[..]).unwrap();
+                let frames = dec.into_frames().collect_frames().unwrap();
+                for (tag, k) in [
+                    ("first", 0),
+                    ("middle", frames.len() / 2),
+                    ("last", frames.len() - 1),
+                ] {
+                    frames[k]
+                        .buffer()
+                        .save(to.join(format!("{name}.{tag}.png")))
+                        .unwrap();
+                }
+            }
+        }
+    }
+}

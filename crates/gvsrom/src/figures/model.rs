@@ -52,7 +52,7 @@ fn pod_spectrum(
         Some(s) if !s.is_empty() => s,
         _ => sigma.to_vec(),
     };
-    if sigma.is_empty() || !(sigma[0] > 0.0) {
+    if sigma.first().is_none_or(|&s| s.is_nan() || s <= 0.0) {
         return Err(input_error(
             dir,
             "the POD model holds no positive singular value to plot",
