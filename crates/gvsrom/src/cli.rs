@@ -56,6 +56,10 @@ pub enum Command {
     Reproduce(ReproduceArgs),
     /// Validate a preset or scenario file and print the model's size, without solving.
     Check(ScenarioArgs),
+    /// Figures (SVG and PNG) of a gvsrom output: a `statics --json` file, or a `simulate --out`,
+    /// `dataset`, `pod` or `train` directory (rod shapes, tip paths, strain, an animation of the
+    /// rod, input coverage, POD spectra, training curves, reduced coordinates).
+    Plot(PlotArgs),
     /// List the built-in presets.
     Presets,
     /// Print a preset's TOML (save it with `gvsrom show NAME > my.toml` to start your own).
@@ -394,6 +398,7 @@ pub fn run(cli: Cli, out: &mut impl Write) -> Result<()> {
         Command::Compare(args) => compare_cmd(&args, out),
         Command::Reproduce(args) => reproduce_cmd(&args, out),
         Command::Check(args) => check_cmd(&args, out),
+        Command::Plot(args) => plot_cmd(&args, out),
         Command::Presets => presets_cmd(out),
         Command::Show { preset } => {
             let p = presets::find(&preset).ok_or_else(|| {
@@ -1239,4 +1244,43 @@ fn anchors_line(
         out,
         "anchors    {equilibria} of {rows} training inputs hold the reduced model's own equilibrium (solved in {seconds:.2} s): statics --model starts there"
     )
+}
+
+// ---- gvsrom plot ---------------------------------------------------------------------------------
+
+/// `gvsrom plot INPUT --out DIR`.
+#[derive(Debug, Args)]
+pub struct PlotArgs {
+    /// A `statics --json` file, or a directory written by `simulate --out`, `dataset`, `pod` or
+    /// `train`
+    pub input: PathBuf,
+    /// New directory for the figures
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Image formats, comma-separated
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "svg,png")]
+    pub format: Vec<gvsrom::figures::FigureFormat>,
+    /// Replace DIR if it is an earlier gvsrom output
+    #[arg(long)]
+    pub force: bool,
+}
+
+fn plot_cmd(args: &PlotArgs, out: &mut impl Write) -> Result<()> {
+    let s = gvsrom::figures::plot_outputs(&args.input, &args.out, &args.format, args.force)?;
+    for note in &s.notes {
+        writeln!(out, "note: {note}")?;
+    }
+    writeln!(
+        out,
+        "{} figures of the {} `{}` in {} ({:.1} s):",
+        s.written.len(),
+        s.kind.name(),
+        args.input.display(),
+        s.out.display(),
+        s.wall_time_s
+    )?;
+    for w in &s.written {
+        writeln!(out, "  {:<28} {:>9} bytes", w.name, w.bytes)?;
+    }
+    Ok(())
 }

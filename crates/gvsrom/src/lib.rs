@@ -11,6 +11,7 @@ pub mod compare;
 pub mod csv_input;
 pub mod dataset;
 pub mod error;
+pub mod figures;
 pub mod modes;
 pub mod npy;
 pub mod output;

@@ -95,6 +95,29 @@ pub fn read_checked<T: npyz::Deserialize>(
         .map_err(|e| npy_error(&shown, format!("cannot read the data: {e}")))
 }
 
+/// Reads `dir/name` as a 1-D little-endian f64 array of whatever length its header gives (a curve
+/// such as a model's `train_loss.npy`), checked like [`read_checked`].
+pub fn read_vector(dir: &Path, name: &str) -> Result<Vec<f64>, NpyError> {
+    let path = dir.join(name);
+    let shown = path.display().to_string();
+    let bytes = std::fs::read(&path).map_err(|e| match e.kind() {
+        std::io::ErrorKind::NotFound => npy_error(&shown, "missing array"),
+        _ => npy_error(&shown, format!("cannot read it: {e}")),
+    })?;
+    let len = header_number_bits(&bytes)
+        .filter(|&b| b <= 64)
+        .and_then(|_| npyz::NpyFile::new(&bytes[..]).ok())
+        .map(|npy| npy.shape().to_vec());
+    match len.as_deref() {
+        Some(&[n]) => read_checked(dir, name, "<f8", &[n as usize]),
+        Some(shape) => Err(npy_error(
+            &shown,
+            format!("shape {shape:?}, expected a 1-D array"),
+        )),
+        None => Err(npy_error(&shown, "not a valid .npy file")),
+    }
+}
+
 /// An upper bound of log₂ of the product of all integers written in the header of the `.npy` file
 /// `bytes` (`None`: no header where npyz would read one; npyz then refuses the file itself).
 ///

@@ -560,3 +560,66 @@ fn extreme_values_and_tiny_sizes_do_not_panic_or_hang() {
         start.elapsed()
     );
 }
+
+/// A helix and its axis as 3-D lines, equal scales.
+fn line3() -> gvsrom::plot::Line3 {
+    use gvsrom::plot::Series3;
+    let s = linspace(0.0, 1.0, 80);
+    let helix = s
+        .iter()
+        .map(|&t| [0.05 * (12.0 * t).cos(), 0.05 * (12.0 * t).sin(), 0.2 * t])
+        .collect();
+    gvsrom::plot::Line3 {
+        title: "Helix".into(),
+        labels: ["x [m]".into(), "y [m]".into(), "z [m]".into()],
+        series: vec![
+            Series3::new("helix", helix, SeriesStyle::Line).with_color(palette::HOM),
+            Series3::new(
+                "axis",
+                vec![[0.0, 0.0, 0.0], [0.0, 0.0, 0.2]],
+                SeriesStyle::Dashed,
+            )
+            .with_color(palette::POD),
+            Series3::new(
+                "box",
+                vec![[-1.0, -1.0, -1.0], [1.0, 1.0, 1.0]],
+                SeriesStyle::Bounds,
+            ),
+        ],
+        equal_aspect: true,
+    }
+}
+
+#[test]
+fn line3_draws_its_series_legend_and_axis_names_but_not_bounds() {
+    let out = render(&Figure::Line3(line3()), 900, 700).unwrap();
+    let img = decode(&out.png, 900, 700);
+    assert!(count(&img, is(palette::HOM)) > 100, "helix not drawn");
+    assert!(count(&img, is(palette::POD)) > 20, "axis not drawn");
+    for text in ["Helix", "helix", "axis", "x [m]", "z [m]"] {
+        assert!(svg_has_text(&out.svg, text), "SVG lacks {text:?}");
+    }
+    // a Bounds series has no legend entry; it widens the box to ±1 m
+    assert!(!svg_has_text(&out.svg, "box"));
+    assert!(svg_has_text(&out.svg, "-1.0") || svg_has_text(&out.svg, "-1"));
+}
+
+#[test]
+fn gif_animation_has_one_frame_per_figure_and_refuses_no_frames() {
+    use image::AnimationDecoder;
+    let frames: Vec<Figure> = (0..3)
+        .map(|k| {
+            let mut c = rod_chart();
+            c.series.truncate(k + 1);
+            Figure::Line(c)
+        })
+        .collect();
+    let gif = gvsrom::plot::animation::render_gif(&frames, 320, 240, 100).unwrap();
+    let dec = image::codecs::gif::GifDecoder::new(&gif[..]).unwrap();
+    let decoded = dec.into_frames().collect_frames().unwrap();
+    assert_eq!(decoded.len(), 3);
+    assert_eq!(decoded[0].buffer().dimensions(), (320, 240));
+    assert_ne!(decoded[0].buffer(), decoded[2].buffer());
+    let err = gvsrom::plot::animation::render_gif(&[], 320, 240, 100).unwrap_err();
+    assert!(matches!(err, PlotError::Empty { .. }), "{err}");
+}

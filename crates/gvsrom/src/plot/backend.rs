@@ -6,7 +6,7 @@ use plotters::prelude::*;
 
 use super::layout::{self, OrPlotError};
 use super::theme::Theme;
-use super::{chart, scatter, scatter3, Figure, PlotError};
+use super::{chart, line3, scatter, scatter3, Figure, PlotError};
 
 /// Draws `fig` into `area`: white background, then the chart, or for a grid the overall title and
 /// the panels in `cols` columns, row-major.
@@ -21,6 +21,7 @@ pub(crate) fn draw<DB: DrawingBackend>(
         Figure::Line(c) => chart::draw(area, c, &theme),
         Figure::Scatter2(s) => scatter::draw(area, s, &theme),
         Figure::Scatter3(s) => scatter3::draw(area, s, &theme),
+        Figure::Line3(c) => line3::draw(area, c, &theme),
         Figure::Grid {
             title,
             cols,
@@ -49,14 +50,20 @@ pub(crate) fn render_svg(fig: &Figure, width: u32, height: u32) -> Result<String
     Ok(svg)
 }
 
-/// `fig` as PNG bytes of `width × height` pixels (8-bit RGB).
-pub(crate) fn render_png(fig: &Figure, width: u32, height: u32) -> Result<Vec<u8>, PlotError> {
+/// `fig` as packed 8-bit RGB pixels, `width × height`, row-major.
+pub(crate) fn render_rgb(fig: &Figure, width: u32, height: u32) -> Result<Vec<u8>, PlotError> {
     let mut rgb = vec![255u8; width as usize * height as usize * 3];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, (width, height)).into_drawing_area();
         draw(&root, fig)?;
         root.present().or_plot(fig.title())?;
     }
+    Ok(rgb)
+}
+
+/// `fig` as PNG bytes of `width × height` pixels (8-bit RGB).
+pub(crate) fn render_png(fig: &Figure, width: u32, height: u32) -> Result<Vec<u8>, PlotError> {
+    let rgb = render_rgb(fig, width, height)?;
     encode_png(&rgb, width, height).map_err(|e| PlotError::Encode {
         title: fig.title().to_string(),
         message: e.to_string(),

@@ -155,7 +155,7 @@ where
     let labels: Vec<String> = c
         .series
         .iter()
-        .filter(|s| !s.label.trim().is_empty())
+        .filter(|s| s.style != SeriesStyle::Bounds && !s.label.trim().is_empty())
         .map(|s| s.label.clone())
         .collect();
     if !labels.is_empty() {
@@ -168,6 +168,7 @@ where
             .series
             .iter()
             .zip(runs)
+            .filter(|(s, _)| s.style != SeriesStyle::Bounds)
             .flat_map(|(s, rs)| {
                 rs.iter()
                     .map(move |r| (r.as_slice(), s.style != SeriesStyle::Markers))
@@ -214,13 +215,13 @@ where
             SeriesStyle::Dashed => {
                 chart.draw_series(DashedLineSeries::new(run.iter().copied(), dash, gap, line))?;
             }
-            SeriesStyle::Markers => {}
+            SeriesStyle::Markers | SeriesStyle::Bounds => {}
         }
         if matches!(s.style, SeriesStyle::Markers | SeriesStyle::LineMarkers) {
             chart.draw_series(run.iter().map(|&p| Circle::new(p, r, dot)))?;
         }
     }
-    if s.label.trim().is_empty() {
+    if s.style == SeriesStyle::Bounds || s.label.trim().is_empty() {
         return Ok(());
     }
     // The legend entry hangs on an empty series, so it shows even when the data has no usable point.
@@ -237,6 +238,7 @@ where
             EmptyElement::at((x, y)) + seg(0, 8) + seg(12, 20) + seg(24, 28)
         }),
         SeriesStyle::Markers => anno.legend(move |(x, y)| Circle::new((x + gw / 2, y), r, dot)),
+        SeriesStyle::Bounds => anno,
         SeriesStyle::LineMarkers => anno.legend(move |(x, y)| {
             EmptyElement::at((x, y))
                 + PathElement::new(vec![(0, 0), (gw, 0)], line)

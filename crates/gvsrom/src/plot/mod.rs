@@ -6,12 +6,15 @@
 //! Data are never trusted: non-finite values leave gaps, empty or mismatched data give a [`PlotError`]
 //! naming the figure title and the series, and no input makes the renderer panic.
 
+pub mod animation;
+mod axes3;
 mod backend;
 mod chart;
 mod color;
 mod colorbar;
 mod layout;
 mod legend;
+mod line3;
 pub mod palette;
 mod range;
 mod scatter;
@@ -19,17 +22,22 @@ mod scatter3;
 mod theme;
 mod validate;
 
+pub(crate) use range::extent;
+
 /// An sRGB colour, 8 bits per channel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Rgb(pub u8, pub u8, pub u8);
 
-/// How a series is drawn: a solid line, a dashed line, filled circle markers, or a line with markers.
+/// How a series is drawn: a solid line, a dashed line, filled circle markers, or a line with markers;
+/// or not at all (`Bounds`): its points only extend the axes, e.g. to keep the axes of every frame of
+/// an animation the same. A `Bounds` series never shows in the legend.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SeriesStyle {
     Line,
     Dashed,
     Markers,
     LineMarkers,
+    Bounds,
 }
 
 /// One data series of a chart: `(x[i], y[i])` pairs; a pair with a value that is NaN, infinite or
@@ -104,12 +112,54 @@ pub struct Scatter3 {
     pub color_label: String,
 }
 
+/// One polyline of a [`Line3`] chart: points `[x, y, z]` (a point with a coordinate that is not
+/// plottable breaks the line there), drawn in `style` (markers and `Bounds` as in [`SeriesStyle`]);
+/// `color: None` takes the next colour of [`palette::EXTRA`], an empty `label` keeps it out of the
+/// legend.
+#[derive(Clone, Debug)]
+pub struct Series3 {
+    pub label: String,
+    pub points: Vec<[f64; 3]>,
+    pub style: SeriesStyle,
+    pub color: Option<Rgb>,
+}
+
+impl Series3 {
+    /// A series of the given style with the default colour.
+    pub fn new(label: impl Into<String>, points: Vec<[f64; 3]>, style: SeriesStyle) -> Self {
+        Self {
+            label: label.into(),
+            points,
+            style,
+            color: None,
+        }
+    }
+
+    /// The same series drawn in `color`.
+    pub fn with_color(mut self, color: Rgb) -> Self {
+        self.color = Some(color);
+        self
+    }
+}
+
+/// Polylines in 3-D (rod centrelines, tip paths) in the box and projection of [`Scatter3`], with a
+/// legend in the upper left when any series has a label. `labels[2]` names the vertical axis.
+/// `equal_aspect` gives the three axes the same span, so a rod keeps its shape.
+#[derive(Clone, Debug, Default)]
+pub struct Line3 {
+    pub title: String,
+    pub labels: [String; 3],
+    pub series: Vec<Series3>,
+    pub equal_aspect: bool,
+}
+
 /// A figure: one chart, or several in a grid.
 #[derive(Clone, Debug)]
 pub enum Figure {
     Line(LineChart),
     Scatter2(Scatter2),
     Scatter3(Scatter3),
+    Line3(Line3),
     /// Panels in a grid of `cols` columns, filled row-major, under an overall `title` (may be empty).
     Grid {
         title: String,
@@ -125,6 +175,7 @@ impl Figure {
             Figure::Line(c) => &c.title,
             Figure::Scatter2(s) => &s.title,
             Figure::Scatter3(s) => &s.title,
+            Figure::Line3(c) => &c.title,
             Figure::Grid { title, .. } => title,
         }
     }

@@ -1,7 +1,7 @@
 //! Checks a figure's data before anything is drawn, so both images fail alike and the error names the
 //! figure and the series: lengths agree, something is there, and some of it is finite.
 
-use super::{Figure, LineChart, PlotError, Scatter2, Scatter3};
+use super::{Figure, Line3, LineChart, PlotError, Scatter2, Scatter3};
 
 /// Largest magnitude drawn; beyond it (and for NaN, ±∞) a value counts as missing, which keeps
 /// every span and pixel computation finite.
@@ -32,6 +32,7 @@ pub(crate) fn figure(fig: &Figure) -> Result<(), PlotError> {
         Figure::Line(c) => line(c),
         Figure::Scatter2(s) => scatter2(s),
         Figure::Scatter3(s) => scatter3(s),
+        Figure::Line3(c) => line3(c),
         Figure::Grid {
             title,
             cols,
@@ -136,6 +137,23 @@ fn scatter3(s: &Scatter3) -> Result<(), PlotError> {
     if !s.points.iter().any(|p| p.iter().all(|&v| plottable(v))) {
         return Err(PlotError::NoFiniteData {
             title: s.title.clone(),
+            log_y: false,
+        });
+    }
+    Ok(())
+}
+
+/// A 3-D line chart: some series has a point finite in all three coordinates.
+fn line3(c: &Line3) -> Result<(), PlotError> {
+    if c.series.iter().all(|s| s.points.is_empty()) {
+        return Err(PlotError::Empty {
+            title: c.title.clone(),
+        });
+    }
+    let finite = |p: &[f64; 3]| p.iter().all(|&v| plottable(v));
+    if !c.series.iter().any(|s| s.points.iter().any(finite)) {
+        return Err(PlotError::NoFiniteData {
+            title: c.title.clone(),
             log_y: false,
         });
     }

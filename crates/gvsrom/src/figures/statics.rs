@@ -1,0 +1,116 @@
+//! Figures of a `gvsrom statics --json` result: the rod's shape in 3-D (`rod_3d`) and in side views
+//! x–z and x–y (`rod_side`), and the strain along the rod (`strain`: curvatures in 1/m, stretch and
+//! shears dimensionless).
+
+use super::views::{self, AXES, XI_STAR};
+use super::{input_error, FiguresError, Sink};
+use crate::plot::{palette, Figure, Line3, Series3, SeriesStyle};
+use serde::Deserialize;
+use std::path::Path;
+
+/// The fields of a `statics --json` document the figures use.
+#[derive(Debug, Clone, Deserialize)]
+pub struct StaticsDoc {
+    pub scenario: String,
+    #[serde(default)]
+    pub u: Vec<f64>,
+    pub tip_position: [f64; 3],
+    pub centerline_x: Vec<f64>,
+    pub centerline: Vec<[f64; 3]>,
+    pub strain_x: Vec<f64>,
+    /// ξ at the points, `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]`.
+    pub strain: Vec<[f64; 6]>,
+    #[serde(default)]
+    pub model: Option<String>,
+}
+
+impl StaticsDoc {
+    /// Reads and checks the document at `path`: sizes agree, something to draw.
+    pub fn load(path: &Path) -> Result<StaticsDoc, FiguresError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| input_error(path, format!("cannot read it: {e}")))?;
+        let doc: StaticsDoc = serde_json::from_str(&text).map_err(|e| {
+            input_error(
+                path,
+                format!("not a `statics --json` result the figures can read: {e}"),
+            )
+        })?;
+        let mismatch = |what: &str, a: usize, b: usize| {
+            input_error(path, format!("{what}: {a} abscissae but {b} values"))
+        };
+        if doc.centerline.len() != doc.centerline_x.len() {
+            return Err(mismatch(
+                "centerline",
+                doc.centerline_x.len(),
+                doc.centerline.len(),
+            ));
+        }
+        if doc.strain.len() != doc.strain_x.len() {
+            return Err(mismatch("strain", doc.strain_x.len(), doc.strain.len()));
+        }
+        if doc.centerline.len() < 2 {
+            return Err(input_error(
+                path,
+                format!(
+                    "centerline has {} points (at least 2 are needed to draw the rod)",
+                    doc.centerline.len()
+                ),
+            ));
+        }
+        Ok(doc)
+    }
+
+    /// The figure titles' description of the solve: scenario, tensions and model.
+    fn caption(&self) -> String {
+        let mut s = self.scenario.clone();
+        if !self.u.is_empty() {
+            let u: Vec<String> = self.u.iter().map(|v| format!("{v:.3}")).collect();
+            s.push_str(&format!(", u = [{}] N", u.join(", ")));
+        }
+        if let Some(m) = &self.model {
+            let name = Path::new(m)
+                .file_name()
+                .map_or(m.clone(), |n| n.to_string_lossy().into_owned());
+            s.push_str(&format!(", model {name}"));
+        }
+        s
+    }
+}
+
+/// The rod's centreline and tip as 3-D series.
+fn rod_series(doc: &StaticsDoc) -> Vec<Series3> {
+    vec![
+        Series3::new("centreline", doc.centerline.clone(), SeriesStyle::Line)
+            .with_color(palette::HOM),
+        Series3::new("base", vec![doc.centerline[0]], SeriesStyle::Markers)
+            .with_color(palette::EXTRA[6]),
+        Series3::new("tip", vec![doc.tip_position], SeriesStyle::Markers).with_color(palette::POD),
+    ]
+}
+
+/// `rod_3d`, `rod_side` and `strain` of the statics result at `path`.
+pub(crate) fn figures(path: &Path, sink: &mut Sink) -> Result<(), FiguresError> {
+    let doc = StaticsDoc::load(path)?;
+    let caption = doc.caption();
+    let rod = rod_series(&doc);
+    let rod_3d = Figure::Line3(Line3 {
+        title: format!("Rod at equilibrium — {caption}"),
+        labels: AXES.map(String::from),
+        series: rod.clone(),
+        equal_aspect: true,
+    });
+    sink.figure("rod_3d", &rod_3d, (900, 700))?;
+    let side = views::side_views(&format!("Rod at equilibrium — {caption}"), &rod, &[]);
+    sink.figure("rod_side", &side, (1400, 600))?;
+    if doc.strain.is_empty() {
+        sink.note("strain: the result holds no computational points");
+        return Ok(());
+    }
+    let panels = views::strain_panels(&doc.strain_x, |c, j| doc.strain[j][c] - XI_STAR[c]);
+    let strain = Figure::Grid {
+        title: format!("Strain along the rod — {caption}"),
+        cols: 1,
+        panels,
+    };
+    sink.figure("strain", &strain, (1000, 900))
+}

@@ -1,0 +1,296 @@
+//! Figures of a `gvsrom simulate --out` trajectory: the tip's path in 3-D (`tip_path_3d`) and in side
+//! views (`tip_path_side`), the tip's coordinates over time (`tip_position`), the strain over time
+//! at a few points along the rod (`strain_time`), and, when the trajectory stores its centrelines
+//! (`centerline.npy`, shape `[samples, N, 3]`, with `centerline_x` in `meta.json`), the rod at a
+//! few instants (`rod_3d`, `rod_side`) and an animation of it (`rod_animation.gif`).
+
+use super::views::{self, AXES, XI_STAR};
+use super::{input_error, FiguresError, Sink};
+use crate::compare::Trajectory;
+use crate::plot::{palette, Figure, Line3, LineChart, Series, Series3, SeriesStyle};
+use std::path::Path;
+
+/// The file of per-sample centrelines in a trajectory.
+pub const CENTERLINE_FILE: &str = "centerline.npy";
+
+/// Frames of the animation at most.
+pub const MAX_FRAMES: usize = 36;
+
+/// Rod shapes drawn in `rod_3d` and `rod_side`.
+const SNAPSHOTS: usize = 6;
+
+/// Points along the rod whose strain `strain_time` follows.
+const STRAIN_POINTS: usize = 4;
+
+/// The centrelines of a trajectory: abscissae and, per sample, the points.
+#[derive(Debug, Clone)]
+pub struct Centerlines {
+    pub x: Vec<f64>,
+    /// `samples`, each `x.len()` points [m].
+    pub shapes: Vec<Vec<[f64; 3]>>,
+}
+
+/// Reads `dir/centerline.npy` if there is one: `None` for an older trajectory without it; an error
+/// naming the file when it is there but `meta.json` gives no `centerline_x` or the array is not
+/// `[samples, len(centerline_x), 3]` finite f64.
+pub fn load_centerlines(dir: &Path, samples: usize) -> Result<Option<Centerlines>, FiguresError> {
+    let file = dir.join(CENTERLINE_FILE);
+    if !file.exists() {
+        return Ok(None);
+    }
+    let meta_path = dir.join(crate::output::MANIFEST_FILE);
+    let meta: serde_json::Value = std::fs::read_to_string(&meta_path)
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok())
+        .unwrap_or_default();
+    let x: Option<Vec<f64>> = meta["centerline_x"]
+        .as_array()
+        .and_then(|a| a.iter().map(|v| v.as_f64()).collect());
+    let x = x.filter(|x| x.len() >= 2).ok_or_else(|| {
+        input_error(
+            &meta_path,
+            format!("{CENTERLINE_FILE} is there but `centerline_x` (at least 2 abscissae [m]) is missing"),
+        )
+    })?;
+    let n = x.len();
+    let v = crate::npy::read_checked::<f64>(dir, CENTERLINE_FILE, "<f8", &[samples, n, 3])
+        .map_err(|e| input_error(&file, e.message))?;
+    if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+        return Err(input_error(
+            &file,
+            format!("entry {i} is {}, not a finite number", v[i]),
+        ));
+    }
+    let shapes = v
+        .chunks_exact(3 * n)
+        .map(|s| s.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect())
+        .collect();
+    Ok(Some(Centerlines { x, shapes }))
+}
+
+/// The tip position of sample `k`.
+fn tip(tr: &Trajectory, k: usize) -> [f64; 3] {
+    [tr.tip[3 * k], tr.tip[3 * k + 1], tr.tip[3 * k + 2]]
+}
+
+/// All figures of the trajectory in `dir`.
+pub(crate) fn figures(dir: &Path, sink: &mut Sink) -> Result<(), FiguresError> {
+    let tr = Trajectory::load(dir, "INPUT").map_err(|e| input_error(dir, e.to_string()))?;
+    let n = tr.samples();
+    if n == 0 {
+        return Err(input_error(dir, "the trajectory has no samples"));
+    }
+    let caption = format!(
+        "{}, t = {:.3}–{:.3} s{}",
+        tr.scenario,
+        tr.t[0],
+        tr.t[n - 1],
+        if tr.complete { "" } else { " (incomplete run)" }
+    );
+    let centerlines = load_centerlines(dir, n)?;
+    tip_figures(&tr, &caption, sink)?;
+    strain_time(&tr, &caption, sink)?;
+    match &centerlines {
+        Some(c) => rod_figures(&tr, c, &caption, sink)?,
+        None => sink.note(format!(
+            "rod_3d, rod_side, rod_animation: the trajectory has no {CENTERLINE_FILE} (written by an earlier gvsrom); only the tip is drawn"
+        )),
+    }
+    Ok(())
+}
+
+/// `tip_path_3d`, `tip_path_side` and `tip_position`.
+fn tip_figures(tr: &Trajectory, caption: &str, sink: &mut Sink) -> Result<(), FiguresError> {
+    let n = tr.samples();
+    let path: Vec<[f64; 3]> = (0..n).map(|k| tip(tr, k)).collect();
+    let series = vec![
+        Series3::new("tip path", path.clone(), SeriesStyle::Line).with_color(palette::POD_ALT),
+        Series3::new("start", vec![path[0]], SeriesStyle::Markers).with_color(palette::HOM),
+        Series3::new("end", vec![path[n - 1]], SeriesStyle::Markers).with_color(palette::POD),
+    ];
+    let fig = Figure::Line3(Line3 {
+        title: format!("Tip path — {caption}"),
+        labels: AXES.map(String::from),
+        series: series.clone(),
+        equal_aspect: true,
+    });
+    sink.figure("tip_path_3d", &fig, (900, 700))?;
+    let side = views::side_views(&format!("Tip path — {caption}"), &series, &[]);
+    sink.figure("tip_path_side", &side, (1400, 600))?;
+    let panels = (0..3)
+        .map(|i| {
+            Figure::Line(LineChart {
+                title: String::new(),
+                x_label: if i == 2 {
+                    "t [s]".into()
+                } else {
+                    String::new()
+                },
+                y_label: format!("tip {}", AXES[i]),
+                series: vec![Series::new(
+                    "",
+                    tr.t.clone(),
+                    path.iter().map(|p| p[i]).collect(),
+                    SeriesStyle::Line,
+                )
+                .with_color(palette::EXTRA[i])],
+                log_y: false,
+                equal_aspect: false,
+            })
+        })
+        .collect();
+    let fig = Figure::Grid {
+        title: format!("Tip position — {caption}"),
+        cols: 1,
+        panels,
+    };
+    sink.figure("tip_position", &fig, (1000, 900))
+}
+
+/// `strain_time`: each strain component that moves, at a few points along the rod, over time.
+fn strain_time(tr: &Trajectory, caption: &str, sink: &mut Sink) -> Result<(), FiguresError> {
+    let (n, p) = (tr.samples(), tr.strain_x.len());
+    if p == 0 {
+        sink.note("strain_time: the trajectory has no computational points");
+        return Ok(());
+    }
+    let dev = |k: usize, j: usize, c: usize| tr.strain[(k * p + j) * 6 + c] - XI_STAR[c];
+    let active: Vec<usize> = (0..6)
+        .filter(|&c| {
+            views::nonzero(
+                (0..n)
+                    .flat_map(|k| (0..p).map(move |j| (k, j)))
+                    .map(|(k, j)| dev(k, j, c)),
+            )
+        })
+        .collect();
+    if active.is_empty() {
+        sink.note("strain_time: the rod stays straight (every strain deviation is zero)");
+        return Ok(());
+    }
+    let points = views::spread(p, STRAIN_POINTS);
+    let panels: Vec<Figure> = active
+        .iter()
+        .map(|&c| {
+            Figure::Line(LineChart {
+                title: views::component_label(c).into(),
+                x_label: "t [s]".into(),
+                y_label: format!("ξ − ξ* [{}]", views::component_unit(c)),
+                series: points
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &j)| {
+                        Series::new(
+                            format!("X = {:.3} m", tr.strain_x[j]),
+                            tr.t.clone(),
+                            (0..n).map(|k| dev(k, j, c)).collect(),
+                            SeriesStyle::Line,
+                        )
+                        .with_color(palette::EXTRA[i % palette::EXTRA.len()])
+                    })
+                    .collect(),
+                log_y: false,
+                equal_aspect: false,
+            })
+        })
+        .collect();
+    let cols = if panels.len() > 1 { 2 } else { 1 };
+    let rows = panels.len().div_ceil(cols) as u32;
+    let fig = Figure::Grid {
+        title: format!("Strain over time — {caption}"),
+        cols,
+        panels,
+    };
+    sink.figure("strain_time", &fig, (700 * cols as u32, 60 + 450 * rows))
+}
+
+/// The corners of the box holding every centreline and tip of the run.
+fn run_bounds(tr: &Trajectory, c: &Centerlines) -> Vec<[f64; 3]> {
+    let all = || {
+        c.shapes
+            .iter()
+            .flatten()
+            .copied()
+            .chain((0..tr.samples()).map(|k| tip(tr, k)))
+    };
+    let ext = |i: usize| crate::plot::extent(all().map(|p| p[i])).unwrap_or((0.0, 0.0));
+    let (x, y, z) = (ext(0), ext(1), ext(2));
+    vec![[x.0, y.0, z.0], [x.1, y.1, z.1]]
+}
+
+/// `rod_3d`, `rod_side` (the rod at a few instants) and `rod_animation.gif`.
+fn rod_figures(
+    tr: &Trajectory,
+    c: &Centerlines,
+    caption: &str,
+    sink: &mut Sink,
+) -> Result<(), FiguresError> {
+    let n = tr.samples();
+    let shots = views::spread(n, SNAPSHOTS);
+    let series: Vec<Series3> = shots
+        .iter()
+        .enumerate()
+        .map(|(i, &k)| {
+            Series3::new(
+                format!("t = {:.3} s", tr.t[k]),
+                c.shapes[k].clone(),
+                SeriesStyle::Line,
+            )
+            .with_color(palette::EXTRA[i % palette::EXTRA.len()])
+        })
+        .collect();
+    let fig = Figure::Line3(Line3 {
+        title: format!("Rod shapes — {caption}"),
+        labels: AXES.map(String::from),
+        series: series.clone(),
+        equal_aspect: true,
+    });
+    sink.figure("rod_3d", &fig, (900, 700))?;
+    let side = views::side_views(&format!("Rod shapes — {caption}"), &series, &[]);
+    sink.figure("rod_side", &side, (1400, 600))?;
+
+    let bounds = run_bounds(tr, c);
+    let frames_at = views::spread(n, MAX_FRAMES);
+    let frames: Vec<Figure> = frames_at
+        .iter()
+        .map(|&k| animation_frame(tr, c, k, &bounds))
+        .collect();
+    // about real time, between 50 ms and 250 ms a frame
+    let dt = if frames_at.len() > 1 {
+        (tr.t[n - 1] - tr.t[0]) / (frames_at.len() - 1) as f64
+    } else {
+        0.0
+    };
+    let delay_ms = (dt * 1000.0).clamp(50.0, 250.0).round() as u32;
+    sink.animation("rod_animation", &frames, (960, 440), delay_ms)
+}
+
+/// One frame: the rod at sample `k` in 3-D and seen from the side (with the tip's path so far), on
+/// the axes of the whole run.
+fn animation_frame(tr: &Trajectory, c: &Centerlines, k: usize, bounds: &[[f64; 3]]) -> Figure {
+    let rod = Series3::new("", c.shapes[k].clone(), SeriesStyle::Line).with_color(palette::HOM);
+    let trace = Series3::new(
+        "",
+        (0..=k).map(|i| tip(tr, i)).collect(),
+        SeriesStyle::Dashed,
+    )
+    .with_color(palette::EXTRA[6]);
+    let tip_now = Series3::new("", vec![tip(tr, k)], SeriesStyle::Markers).with_color(palette::POD);
+    let box3 = Series3::new("", bounds.to_vec(), SeriesStyle::Bounds);
+    let series = vec![trace, rod, tip_now];
+    let mut in_3d = series.clone();
+    in_3d.push(box3);
+    Figure::Grid {
+        title: format!("{} — t = {:.3} s", tr.scenario, tr.t[k]),
+        cols: 2,
+        panels: vec![
+            Figure::Line3(Line3 {
+                title: String::new(),
+                labels: AXES.map(String::from),
+                series: in_3d,
+                equal_aspect: true,
+            }),
+            Figure::Line(views::side_view("", &series, (0, 2), bounds)),
+        ],
+    }
+}

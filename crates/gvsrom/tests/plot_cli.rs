@@ -1,0 +1,436 @@
+//! `gvsrom plot` end to end (issue 22): figures of a statics result, a trajectory (with and without
+//! per-sample centrelines), a dataset, a POD model and an autoencoder. Every SVG must be well-formed
+//! XML, every PNG must decode to a picture of several distinct colours, the rod animation must be a
+//! GIF of more than one frame; bad inputs are one-line errors naming the file.
+//!
+//! The inputs are built once per run of this file with the CLI itself, as small as the commands
+//! allow ([`OnceLock`]).
+
+mod common;
+
+use common::{copy_dir, expect_error, gvsrom, reseal::reseal, scratch};
+use npyz::WriterBuilder;
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+fn run_ok(args: &[&str]) -> String {
+    let out = gvsrom(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "gvsrom {args:?} failed: {stderr}");
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// `statics single-tendon --tension=-4 --json F`.
+fn statics_json() -> &'static Path {
+    static F: OnceLock<PathBuf> = OnceLock::new();
+    F.get_or_init(|| {
+        let f = scratch("plot-statics.json");
+        run_ok(&["statics", "single-tendon", "--tension=-4", "--json", s(&f)]);
+        f
+    })
+}
+
+/// A 0.2 s single-tendon trajectory under random steps (21 samples), as `simulate` writes it.
+fn trajectory() -> &'static Path {
+    static D: OnceLock<PathBuf> = OnceLock::new();
+    D.get_or_init(|| {
+        let d = scratch("plot-traj");
+        run_ok(&[
+            "simulate",
+            "single-tendon",
+            "--duration",
+            "0.2",
+            "--steps=-6,0,0.1",
+            "--out",
+            s(&d),
+        ]);
+        d
+    })
+}
+
+/// Rod length of the single-tendon preset [m].
+const L: f64 = 0.25;
+/// Centreline points of the synthetic centrelines.
+const N: usize = 11;
+
+/// [`trajectory`] with a synthetic `centerline.npy` ([samples, N, 3]: circular arcs in the x–z
+/// plane whose curvature grows over the run) and `centerline_x` in meta.json, resealed: the layout
+/// `simulate` writes them in.
+fn trajectory_with_centerlines() -> &'static Path {
+    static D: OnceLock<PathBuf> = OnceLock::new();
+    D.get_or_init(|| {
+        let d = copy_dir(trajectory(), "plot-traj-cl");
+        let mut meta = json(&d.join("meta.json"));
+        let n = meta["samples"].as_u64().unwrap() as usize;
+        let x: Vec<f64> = (0..N).map(|i| L * i as f64 / (N - 1) as f64).collect();
+        let mut data = Vec::with_capacity(n * N * 3);
+        for k in 0..n {
+            let kappa = 0.5 + 10.0 * k as f64 / n as f64;
+            for &s in &x {
+                data.extend([
+                    (kappa * s).sin() / kappa,
+                    0.0,
+                    -(1.0 - (kappa * s).cos()) / kappa,
+                ]);
+            }
+        }
+        let mut bytes = vec![];
+        {
+            let mut w = npyz::WriteOptions::<f64>::new()
+                .default_dtype()
+                .shape(&[n as u64, N as u64, 3])
+                .writer(&mut bytes)
+                .begin_nd()
+                .unwrap();
+            w.extend(data.iter().copied()).unwrap();
+            w.finish().unwrap();
+        }
+        std::fs::write(d.join("centerline.npy"), bytes).unwrap();
+        meta["centerline_x"] = serde_json::json!(x);
+        meta["gvsrom"]["files"]
+            .as_array_mut()
+            .unwrap()
+            .push("centerline.npy".into());
+        std::fs::write(
+            d.join("meta.json"),
+            serde_json::to_string_pretty(&meta).unwrap(),
+        )
+        .unwrap();
+        reseal(&d);
+        d
+    })
+}
+
+/// A 12-sample tension sweep.
+fn dataset() -> &'static Path {
+    static D: OnceLock<PathBuf> = OnceLock::new();
+    D.get_or_init(|| {
+        let d = scratch("plot-ds");
+        run_ok(&[
+            "dataset",
+            "single-tendon",
+            "--sweep",
+            "tendons.0.tension=-6:3",
+            "--samples",
+            "12",
+            "--out",
+            s(&d),
+        ]);
+        d
+    })
+}
+
+fn pod() -> &'static Path {
+    static D: OnceLock<PathBuf> = OnceLock::new();
+    D.get_or_init(|| {
+        let d = scratch("plot-pod");
+        run_ok(&["pod", s(dataset()), "--modes", "2", "--out", s(&d)]);
+        d
+    })
+}
+
+fn autoencoder() -> &'static Path {
+    static D: OnceLock<PathBuf> = OnceLock::new();
+    D.get_or_init(|| {
+        let d = scratch("plot-ae");
+        run_ok(&[
+            "train",
+            s(dataset()),
+            "--hidden-layers",
+            "3",
+            "--epochs",
+            "20",
+            "--lbfgs-iterations",
+            "0",
+            "--out",
+            s(&d),
+        ]);
+        d
+    })
+}
+
+/// Runs `gvsrom plot INPUT --out DIR extra…` and returns DIR and stdout.
+fn plot(input: &Path, name: &str, extra: &[&str]) -> (PathBuf, String) {
+    let out = scratch(name);
+    let args = [&["plot", s(input), "--out", s(&out)][..], extra].concat();
+    let stdout = run_ok(&args);
+    (out, stdout)
+}
+
+/// Distinct colours of a decoded image.
+fn colours(img: &image::RgbaImage) -> usize {
+    img.pixels().map(|p| p.0).collect::<HashSet<_>>().len()
+}
+
+/// Checks every figure in `dir`: the listed ones are there (and printed), SVGs parse as XML with
+/// text, PNGs decode to pictures of several colours, GIFs decode to several frames.
+fn check_figures(dir: &Path, stdout: &str, expected: &[&str]) {
+    let meta = json(&dir.join("meta.json"));
+    assert_eq!(meta["gvsrom"]["format"], "figures");
+    let files: Vec<String> = meta["gvsrom"]["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f.as_str().unwrap().to_string())
+        .collect();
+    for e in expected {
+        assert!(files.iter().any(|f| f == e), "{e} missing from {files:?}");
+    }
+    for f in &files {
+        assert!(stdout.contains(f.as_str()), "stdout lacks {f}: {stdout}");
+        let path = dir.join(f);
+        let bytes = std::fs::read(&path).unwrap();
+        match f.rsplit('.').next() {
+            Some("svg") => {
+                let text = String::from_utf8(bytes).unwrap();
+                let doc = roxmltree::Document::parse(&text)
+                    .unwrap_or_else(|e| panic!("{f} is not well-formed XML: {e}"));
+                assert_eq!(doc.root_element().tag_name().name(), "svg", "{f}");
+                let texts = doc
+                    .descendants()
+                    .filter(|n| n.tag_name().name() == "text")
+                    .count();
+                assert!(texts >= 5, "{f}: only {texts} text elements");
+            }
+            Some("png") => {
+                let img = image::load_from_memory(&bytes)
+                    .unwrap_or_else(|e| panic!("{f} does not decode: {e}"))
+                    .to_rgba8();
+                assert!(img.width() >= 600 && img.height() >= 400, "{f}");
+                let n = colours(&img);
+                assert!(n >= 8, "{f}: only {n} distinct colours (blank?)");
+            }
+            Some("gif") => {
+                use image::AnimationDecoder;
+                let dec = image::codecs::gif::GifDecoder::new(&bytes[..]).unwrap();
+                let frames = dec.into_frames().collect_frames().unwrap();
+                assert!(frames.len() > 1, "{f}: {} frame(s)", frames.len());
+                assert!(colours(frames[0].buffer()) >= 8, "{f}: blank first frame");
+                let (a, b) = (frames[0].buffer(), frames[frames.len() - 1].buffer());
+                assert_ne!(a, b, "{f}: the first and last frames are the same");
+            }
+            other => panic!("unexpected figure file {f} ({other:?})"),
+        }
+    }
+}
+
+/// Both formats of each stem.
+fn both(stems: &[&str]) -> Vec<String> {
+    stems
+        .iter()
+        .flat_map(|s| [format!("{s}.svg"), format!("{s}.png")])
+        .collect()
+}
+
+fn refs(v: &[String]) -> Vec<&str> {
+    v.iter().map(String::as_str).collect()
+}
+
+#[test]
+fn statics_result_gives_rod_views_and_strain_profiles() {
+    let (dir, stdout) = plot(statics_json(), "plot-out-statics", &[]);
+    let expected = both(&["rod_3d", "rod_side", "strain"]);
+    check_figures(&dir, &stdout, &refs(&expected));
+    assert!(stdout.contains("statics result"), "{stdout}");
+    // units on the strain panels
+    let svg = std::fs::read_to_string(dir.join("strain.svg")).unwrap();
+    assert!(
+        svg.contains("[1/m]") && svg.contains("[–]"),
+        "strain.svg lacks units"
+    );
+}
+
+#[test]
+fn trajectory_with_centerlines_gives_tip_strain_rod_figures_and_animation() {
+    let (dir, stdout) = plot(trajectory_with_centerlines(), "plot-out-traj-cl", &[]);
+    let mut expected = both(&[
+        "tip_path_3d",
+        "tip_path_side",
+        "tip_position",
+        "strain_time",
+        "rod_3d",
+        "rod_side",
+    ]);
+    expected.push("rod_animation.gif".into());
+    check_figures(&dir, &stdout, &refs(&expected));
+    let gif = std::fs::metadata(dir.join("rod_animation.gif"))
+        .unwrap()
+        .len();
+    assert!(gif < 3_000_000, "rod_animation.gif is {gif} bytes");
+}
+
+#[test]
+fn trajectory_without_centerlines_draws_the_tip_and_says_why_not_the_rod() {
+    let (dir, stdout) = plot(trajectory(), "plot-out-traj", &[]);
+    let expected = both(&[
+        "tip_path_3d",
+        "tip_path_side",
+        "tip_position",
+        "strain_time",
+    ]);
+    check_figures(&dir, &stdout, &refs(&expected));
+    assert!(
+        stdout.contains("note:") && stdout.contains("centerline.npy"),
+        "{stdout}"
+    );
+    assert!(!dir.join("rod_animation.gif").exists());
+}
+
+#[test]
+fn dataset_gives_input_coverage_strain_envelope_and_tip_workspace() {
+    let (dir, stdout) = plot(dataset(), "plot-out-ds", &[]);
+    let expected = both(&["input_coverage", "strain_envelope", "tip_workspace"]);
+    check_figures(&dir, &stdout, &refs(&expected));
+}
+
+#[test]
+fn pod_model_gives_spectrum_and_latent_coordinates() {
+    let (dir, stdout) = plot(pod(), "plot-out-pod", &[]);
+    let expected = both(&["pod_spectrum", "latent"]);
+    check_figures(&dir, &stdout, &refs(&expected));
+}
+
+#[test]
+fn autoencoder_gives_training_curves_and_latent_coordinates() {
+    let (dir, stdout) = plot(autoencoder(), "plot-out-ae", &[]);
+    let expected = both(&["training_curves", "latent"]);
+    check_figures(&dir, &stdout, &refs(&expected));
+}
+
+#[test]
+fn format_option_selects_the_image_formats() {
+    let (dir, stdout) = plot(statics_json(), "plot-out-svg", &["--format", "svg"]);
+    check_figures(&dir, &stdout, &["rod_3d.svg", "strain.svg"]);
+    assert!(!dir.join("rod_3d.png").exists());
+    let (dir, stdout) = plot(pod(), "plot-out-png", &["--format", "png"]);
+    check_figures(&dir, &stdout, &["pod_spectrum.png"]);
+    assert!(!dir.join("pod_spectrum.svg").exists());
+}
+
+#[test]
+fn an_existing_output_is_replaced_only_with_force() {
+    let (dir, _) = plot(statics_json(), "plot-out-force", &["--format", "svg"]);
+    let args = [
+        "plot",
+        s(statics_json()),
+        "--out",
+        s(&dir),
+        "--format",
+        "png",
+    ];
+    expect_error(&args, &["--out", "--force"]);
+    run_ok(&[&args[..], &["--force"]].concat());
+    assert!(dir.join("rod_3d.png").exists() && !dir.join("rod_3d.svg").exists());
+}
+
+#[test]
+fn bad_inputs_are_one_line_errors_naming_the_file() {
+    let out = scratch("plot-out-bad");
+    // missing
+    let missing = scratch("plot-no-such-input");
+    expect_error(
+        &["plot", s(&missing), "--out", s(&out)],
+        &["plot-no-such-input", "no such file"],
+    );
+    // a JSON file that is not a gvsrom output
+    let foreign = scratch("plot-foreign.json");
+    std::fs::write(&foreign, "{\"a\": 1}").unwrap();
+    expect_error(
+        &["plot", s(&foreign), "--out", s(&out)],
+        &["plot-foreign.json", "accepted", "statics --json"],
+    );
+    // a binary file
+    let binary = scratch("plot-binary.bin");
+    std::fs::write(&binary, [0xff, 0xfe, 0x00, 0x01]).unwrap();
+    expect_error(
+        &["plot", s(&binary), "--out", s(&out)],
+        &["plot-binary.bin"],
+    );
+    // a directory that is not a gvsrom output
+    let plain = scratch("plot-plain-dir");
+    std::fs::create_dir_all(&plain).unwrap();
+    expect_error(
+        &["plot", s(&plain), "--out", s(&out)],
+        &["plot-plain-dir", "meta.json", "accepted"],
+    );
+    // a gvsrom output without figures: a figures directory itself
+    let (figs, _) = plot(statics_json(), "plot-out-figs", &["--format", "svg"]);
+    expect_error(
+        &["plot", s(&figs), "--out", s(&out)],
+        &["plot-out-figs", "\"figures\"", "accepted"],
+    );
+    // a statics result without its centreline
+    let empty = scratch("plot-empty-statics.json");
+    let mut v = json(statics_json());
+    v["centerline"] = serde_json::json!([]);
+    v["centerline_x"] = serde_json::json!([]);
+    std::fs::write(&empty, v.to_string()).unwrap();
+    expect_error(
+        &["plot", s(&empty), "--out", s(&out)],
+        &["plot-empty-statics.json", "centerline"],
+    );
+    // a centerline.npy of the wrong shape
+    let bad = copy_dir(trajectory_with_centerlines(), "plot-traj-bad-cl");
+    let mut meta = json(&bad.join("meta.json"));
+    meta["centerline_x"] = serde_json::json!([0.0, 0.25]);
+    std::fs::write(bad.join("meta.json"), meta.to_string()).unwrap();
+    reseal(&bad);
+    expect_error(
+        &["plot", s(&bad), "--out", s(&out)],
+        &["centerline.npy", "shape"],
+    );
+    assert!(!out.exists(), "a failed plot wrote its output");
+}
+
+/// Writes the figures of every kind to /tmp/plot-samples/KIND/ for a person to look at, with the
+/// first, middle and last frames of the rod animation as PNGs (`cargo test --test plot_cli --
+/// --ignored`).
+#[test]
+#[ignore]
+fn write_samples() {
+    use image::AnimationDecoder;
+    let root = Path::new("/tmp/plot-samples");
+    let inputs: [(&str, &Path); 5] = [
+        ("statics", statics_json()),
+        ("trajectory", trajectory_with_centerlines()),
+        ("dataset", dataset()),
+        ("pod", pod()),
+        ("autoencoder", autoencoder()),
+    ];
+    for (kind, input) in inputs {
+        let (dir, _) = plot(input, &format!("plot-samples-{kind}"), &[]);
+        let to = root.join(kind);
+        std::fs::create_dir_all(&to).unwrap();
+        for e in std::fs::read_dir(&dir).unwrap() {
+            let p = e.unwrap().path();
+            let name = p.file_name().unwrap().to_str().unwrap().to_string();
+            if name.ends_with(".png") || name.ends_with(".gif") {
+                std::fs::copy(&p, to.join(&name)).unwrap();
+            }
+            if name.ends_with(".gif") {
+                let bytes = std::fs::read(&p).unwrap();
+                let dec = image::codecs::gif::GifDecoder::new(&bytes[..]).unwrap();
+                let frames = dec.into_frames().collect_frames().unwrap();
+                for (tag, k) in [
+                    ("first", 0),
+                    ("middle", frames.len() / 2),
+                    ("last", frames.len() - 1),
+                ] {
+                    frames[k]
+                        .buffer()
+                        .save(to.join(format!("{name}.{tag}.png")))
+                        .unwrap();
+                }
+            }
+        }
+    }
+}
