@@ -1,7 +1,8 @@
 //! Reading a dataset back: its files are first checked against the hashes recorded when it was
 //! written ([`crate::output::verify_dir`]), then every array against `meta.json` (dtype, shape, exact
 //! byte length), so an edited, truncated, corrupted or missing file is an error naming the file,
-//! never a wrong dataset.
+//! never a wrong dataset. Only regular files are opened ([`crate::output::read`]): a FIFO, device or
+//! directory in place of a file is refused by name, never waited on.
 
 use super::generate::{STATUS_FAILED, STATUS_NOT_COMPUTED, STATUS_OK};
 use super::{DatasetError, Meta, FILES, T_FILE};
@@ -81,10 +82,13 @@ impl Dataset {
     fn read(dir: &Path, integrity: Integrity) -> Result<Dataset, DatasetError> {
         let meta_path = dir.join(crate::output::MANIFEST_FILE);
         let shown = meta_path.display().to_string();
-        let text = std::fs::read_to_string(&meta_path).map_err(|e| match e.kind() {
-            std::io::ErrorKind::NotFound => file_error(&shown, "missing (not a gvsrom dataset)"),
-            _ => file_error(&shown, format!("cannot read it: {e}")),
-        })?;
+        let text =
+            crate::output::read_regular_to_string(&meta_path).map_err(|e| match e.kind() {
+                std::io::ErrorKind::NotFound => {
+                    file_error(&shown, "missing (not a gvsrom dataset)")
+                }
+                _ => file_error(&shown, format!("cannot read it: {e}")),
+            })?;
         let value: serde_json::Value = serde_json::from_str(&text)
             .map_err(|e| file_error(&shown, format!("not valid JSON: {e}")))?;
         let format = value

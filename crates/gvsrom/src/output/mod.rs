@@ -38,6 +38,7 @@ mod file;
 pub mod integrity;
 mod lock;
 mod manifest;
+pub mod read;
 mod replace;
 mod run_dir;
 mod staging;
@@ -47,6 +48,7 @@ mod test_util;
 pub use dir::OutputDir;
 pub use file::OutputFile;
 pub use integrity::{verify_dir, Integrity, IntegrityError};
+pub use read::{read_regular, read_regular_to_string};
 pub use run_dir::{RunDir, RUN_FORMAT};
 pub use target::refuse_overlap;
 
