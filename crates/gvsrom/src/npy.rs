@@ -33,7 +33,7 @@ pub fn read_checked<T: npyz::Deserialize>(
 ) -> Result<Vec<T>, NpyError> {
     let path = dir.join(name);
     let shown = path.display().to_string();
-    let bytes = std::fs::read(&path).map_err(|e| match e.kind() {
+    let bytes = crate::output::read_regular(&path).map_err(|e| match e.kind() {
         std::io::ErrorKind::NotFound => npy_error(&shown, "missing array"),
         _ => npy_error(&shown, format!("cannot read it: {e}")),
     })?;

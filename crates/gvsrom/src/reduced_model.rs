@@ -13,7 +13,9 @@
 //!
 //! Loading first checks every file and the metadata against the SHA-256 hashes recorded when the
 //! model was written (`output::integrity`), then every tensor's name, dtype and shape against the
-//! metadata: a truncated or edited file is an error naming it, never a different model. Saved and
+//! metadata: a truncated or edited file is an error naming it, never a different model. Only
+//! regular files are opened ([`crate::output::read`]): a FIFO or device in place of a file is refused
+//! by name, never waited on. Saved and
 //! loaded models are bit-identical.
 
 use crate::npy::write_array;
@@ -335,7 +337,7 @@ impl ReducedModel {
             ))
         })?;
         let meta_path = dir.join("meta.json");
-        let text = std::fs::read_to_string(&meta_path)
+        let text = crate::output::read_regular_to_string(&meta_path)
             .map_err(|e| bad(format!("cannot read meta.json: {e}")))?;
         let value: serde_json::Value =
             serde_json::from_str(&text).map_err(|e| bad(format!("meta.json: {e}")))?;
@@ -358,7 +360,7 @@ impl ReducedModel {
                 meta.rest.len()
             )));
         }
-        let bytes = std::fs::read(dir.join(WEIGHTS_FILE))
+        let bytes = crate::output::read_regular(&dir.join(WEIGHTS_FILE))
             .map_err(|e| bad(format!("cannot read {WEIGHTS_FILE}: {e}")))?;
         if let Some(message) = offsets_beyond_data(&bytes) {
             return Err(bad(format!("{WEIGHTS_FILE} is damaged: {message}")));

@@ -75,9 +75,11 @@ pub fn with_noise(
     }
     let count = (ok.len() * width / a).max(1) as f64;
     let sigma: Vec<f64> = sum.iter().map(|s| level * (s / count).sqrt()).collect();
-    let bytes = std::fs::read(src.join(super::FILES[1])).map_err(|e| DatasetError::File {
-        file: src.join(super::FILES[1]).display().to_string(),
-        message: format!("cannot read it: {e}"),
+    let bytes = crate::output::read_regular(&src.join(super::FILES[1])).map_err(|e| {
+        DatasetError::File {
+            file: src.join(super::FILES[1]).display().to_string(),
+            message: format!("cannot read it: {e}"),
+        }
     })?;
     let info = NoiseInfo {
         source: src.display().to_string(),

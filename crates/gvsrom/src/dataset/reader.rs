@@ -1,7 +1,8 @@
 //! Reading a dataset back: its files are first checked against the hashes recorded when it was
 //! written ([`crate::output::verify_dir`]), then every array against `meta.json` (dtype, shape, exact
 //! byte length), so an edited, truncated, corrupted or missing file is an error naming the file,
-//! never a wrong dataset.
+//! never a wrong dataset. Only regular files are opened ([`crate::output::read`]): a FIFO, device or
+//! directory in place of a file is refused by name, never waited on.
 
 use super::generate::{STATUS_FAILED, STATUS_NOT_COMPUTED, STATUS_OK};
 use super::{DatasetError, Meta, FILES, T_FILE};
@@ -68,6 +69,24 @@ fn integrity_error(dir: &Path, e: IntegrityError) -> DatasetError {
     file_error(&e.path.display().to_string(), message)
 }
 
+/// Largest ‖RᵀR − I‖_F of a stored tip rotation. A solved tip rotation is a product of exponential
+/// maps, each orthogonal to rounding (~1e-16), so its error stays many orders below this; a matrix
+/// with an entry changed by more than about 1e-6 is refused.
+pub const ROTATION_TOL: f64 = 1e-6;
+
+/// `Ok` if the row-major 3×3 `r` is a rotation: ‖RᵀR − I‖_F ≤ [`ROTATION_TOL`] and det R > 0;
+/// otherwise `Err((‖RᵀR − I‖_F, det R))`.
+pub fn is_rotation(r: &[f64]) -> Result<(), (f64, f64)> {
+    let m = nalgebra::Matrix3::from_row_slice(r);
+    let orthogonality = (m.transpose() * m - nalgebra::Matrix3::identity()).norm();
+    let det = m.determinant();
+    if orthogonality <= ROTATION_TOL && det > 0.0 {
+        Ok(())
+    } else {
+        Err((orthogonality, det))
+    }
+}
+
 impl Dataset {
     /// Loads and validates the dataset in `dir`: its files against the hashes in its manifest, then
     /// its arrays against `meta.json`.
@@ -81,10 +100,13 @@ impl Dataset {
     fn read(dir: &Path, integrity: Integrity) -> Result<Dataset, DatasetError> {
         let meta_path = dir.join(crate::output::MANIFEST_FILE);
         let shown = meta_path.display().to_string();
-        let text = std::fs::read_to_string(&meta_path).map_err(|e| match e.kind() {
-            std::io::ErrorKind::NotFound => file_error(&shown, "missing (not a gvsrom dataset)"),
-            _ => file_error(&shown, format!("cannot read it: {e}")),
-        })?;
+        let text =
+            crate::output::read_regular_to_string(&meta_path).map_err(|e| match e.kind() {
+                std::io::ErrorKind::NotFound => {
+                    file_error(&shown, "missing (not a gvsrom dataset)")
+                }
+                _ => file_error(&shown, format!("cannot read it: {e}")),
+            })?;
         let value: serde_json::Value = serde_json::from_str(&text)
             .map_err(|e| file_error(&shown, format!("not valid JSON: {e}")))?;
         let format = value
@@ -179,20 +201,15 @@ impl Dataset {
                     format!("row {k} has status {s}, inconsistent with chunk_done in meta.json"),
                 ));
             }
-            if s == STATUS_OK && self.strain_row(k).iter().any(|v| !v.is_finite()) {
-                return Err(file_error(
-                    &at(FILES[1]),
-                    format!("row {k} has status ok but holds NaN or infinite values"),
-                ));
+            if s == STATUS_OK {
+                self.check_ok_row(dir, k)?;
             }
-            let d = m.parameters.len();
-            let inputs = &self.inputs[k * d..(k + 1) * d];
-            if let Some(v) = inputs.iter().find(|v| s == STATUS_OK && !v.is_finite()) {
+            // ‖R‖∞ is a norm whatever the status (NaN where nothing was solved)
+            let r = self.residual[k];
+            if r < 0.0 {
                 return Err(file_error(
-                    &at(FILES[0]),
-                    format!(
-                        "row {k} has status ok but holds the input {v} (expected finite values)"
-                    ),
+                    &at(FILES[7]),
+                    format!("row {k} holds the residual {r}, a norm ‖R‖∞ (accepted: ≥ 0)"),
                 ));
             }
         }
@@ -210,6 +227,60 @@ impl Dataset {
             return Err(file_error(
                 &at(crate::output::MANIFEST_FILE),
                 "chunk_done does not have one entry per chunk",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The values of the row `k` of status ok: finite strain, inputs, coordinates, tip position and
+    /// rotation (and residual of a static dataset, sample time of a dynamic one), and a tip rotation
+    /// that is one ([`is_rotation`]).
+    fn check_ok_row(&self, dir: &Path, k: usize) -> Result<(), DatasetError> {
+        let at = |f: &str| dir.join(f).display().to_string();
+        if self.strain_row(k).iter().any(|v| !v.is_finite()) {
+            return Err(file_error(
+                &at(FILES[1]),
+                format!("row {k} has status ok but holds NaN or infinite values"),
+            ));
+        }
+        let d = self.meta.parameters.len();
+        if let Some(v) = self.inputs[k * d..(k + 1) * d]
+            .iter()
+            .find(|v| !v.is_finite())
+        {
+            return Err(file_error(
+                &at(FILES[0]),
+                format!("row {k} has status ok but holds the input {v} (expected finite values)"),
+            ));
+        }
+        let n = self.meta.n_dof;
+        let rotation = &self.tip_rotation[9 * k..9 * (k + 1)];
+        let mut rows: Vec<(&str, &[f64])> = vec![
+            (FILES[2], &self.q[k * n..(k + 1) * n]),
+            (FILES[3], &self.tip_position[3 * k..3 * (k + 1)]),
+            (FILES[4], rotation),
+        ];
+        match &self.t {
+            // a dynamic dataset's samples are not solves: no residual (NaN)
+            Some(t) => rows.push((T_FILE, &t[k..=k])),
+            None => rows.push((FILES[7], &self.residual[k..=k])),
+        }
+        for (file, values) in rows {
+            if let Some((j, v)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+                return Err(file_error(
+                    &at(file),
+                    format!(
+                        "row {k} has status ok but holds {v} at index {j} of the row (expected finite values)"
+                    ),
+                ));
+            }
+        }
+        if let Err((orthogonality, det)) = is_rotation(rotation) {
+            return Err(file_error(
+                &at(FILES[4]),
+                format!(
+                    "row {k} is not a rotation: ‖RᵀR − I‖_F = {orthogonality:e} (accepted ≤ {ROTATION_TOL:e}), det R = {det} (accepted > 0)"
+                ),
             ));
         }
         Ok(())

@@ -15,11 +15,12 @@
 //! Files in `DIR` that the manifest does not list are neither checked nor an error: loaders read only
 //! listed files.
 
+use super::read::{file_kind, open_regular, read_regular};
 use super::{MANIFEST_FILE, MANIFEST_KEY};
 use serde::ser::{Serialize, SerializeMap, Serializer};
 use serde_json::{Map, Value};
 use sha2::{Digest, Sha256};
-use std::fs::{self, File};
+use std::fs;
 use std::io::{self, Read};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -71,7 +72,7 @@ fn hex(digest: &[u8]) -> String {
 
 /// The SHA-256 of the file at `path`, read in blocks (any size).
 pub(super) fn file_sha256(path: &Path) -> io::Result<String> {
-    let mut file = File::open(path)?;
+    let mut file = open_regular(path)?;
     let mut hasher = Sha256::new();
     let mut buf = vec![0u8; 1 << 16];
     loop {
@@ -174,9 +175,10 @@ pub fn verify_dir(dir: &Path, expected_format: &str) -> Result<Integrity, Integr
     let not_ours = format!("not a gvsrom {expected_format} output");
     match fs::symlink_metadata(&meta_path) {
         Ok(m) if m.is_file() => {}
-        Ok(_) => {
+        Ok(m) => {
             return Err(bad_meta(format!(
-                "not a regular file ({not_ours}: gvsrom writes meta.json as a plain file)"
+                "is {}, not a regular file ({not_ours}: gvsrom writes meta.json as a plain file)",
+                file_kind(&m.file_type())
             )))
         }
         Err(e) if e.kind() == io::ErrorKind::NotFound => {
@@ -184,7 +186,7 @@ pub fn verify_dir(dir: &Path, expected_format: &str) -> Result<Integrity, Integr
         }
         Err(e) => return Err(bad_meta(format!("cannot read it: {e}"))),
     }
-    let bytes = fs::read(&meta_path).map_err(|e| bad_meta(format!("cannot read it: {e}")))?;
+    let bytes = read_regular(&meta_path).map_err(|e| bad_meta(format!("cannot read it: {e}")))?;
     let value: Value =
         serde_json::from_slice(&bytes).map_err(|e| bad_meta(format!("not valid JSON: {e}")))?;
     let Value::Object(meta) = value else {
@@ -274,11 +276,11 @@ pub fn verify_dir(dir: &Path, expected_format: &str) -> Result<Integrity, Integr
         };
         match fs::symlink_metadata(&path) {
             Ok(m) if m.is_file() => {}
-            Ok(_) => {
-                return Err(bad_file(
-                    "not a regular file (a directory, link or special file) where gvsrom wrote one"
-                        .into(),
-                ))
+            Ok(m) => {
+                return Err(bad_file(format!(
+                    "is {}, not a regular file (gvsrom wrote a regular file here)",
+                    file_kind(&m.file_type())
+                )))
             }
             Err(e) if e.kind() == io::ErrorKind::NotFound => {
                 return Err(bad_file(
@@ -499,7 +501,7 @@ mod tests {
         fs::create_dir(dir.join("b.bin")).unwrap();
         let (file, p) = problem(&dir);
         assert_eq!(file, "b.bin");
-        assert!(matches!(p, Problem::File(m) if m.contains("not a regular file")));
+        assert!(matches!(p, Problem::File(m) if m.contains("is a directory, not a regular file")));
         fs::remove_dir(dir.join("b.bin")).unwrap();
         let (file, p) = problem(&dir);
         assert_eq!(file, "b.bin");

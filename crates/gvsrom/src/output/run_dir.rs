@@ -9,10 +9,11 @@
 //!   [`RunDir::write_file`] (e.g. `index.html`) are staged, fsynced and renamed into place, and are
 //!   listed in the manifest: a file the manifest does not list is never replaced.
 
-use super::{
-    manifest, refuse_special, split_target, sync_dir, unique_sibling, with_manifest, Named,
-    OutputError, TargetLock, MANIFEST_FILE, MANIFEST_KEY,
-};
+use super::lock::TargetLock;
+use super::manifest::{manifest, with_manifest};
+use super::staging::{sync_dir, unique_sibling};
+use super::target::{refuse_special, split_target};
+use super::{Named, OutputError, MANIFEST_FILE, MANIFEST_KEY};
 use serde_json::{json, Value};
 use std::fs::{self, OpenOptions};
 use std::io::{self, Write};

@@ -148,7 +148,7 @@ pub(super) fn model_layout(ds: &Dataset, built: &Built) -> ModelLayout {
 }
 
 pub(super) fn dataset_ref(dir: &Path, rows: usize) -> Result<DatasetRef, ScenarioError> {
-    let bytes = std::fs::read(dir.join("strain.npy"))
+    let bytes = crate::output::read_regular(&dir.join("strain.npy"))
         .map_err(|e| invalid("DATASET", format!("cannot read strain.npy: {e}")))?;
     Ok(DatasetRef {
         path: dir.display().to_string(),

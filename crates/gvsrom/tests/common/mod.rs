@@ -4,8 +4,9 @@
 
 pub mod reseal;
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
 
 pub fn gvsrom(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_gvsrom"))
@@ -31,7 +32,34 @@ pub fn scratch(name: &str) -> PathBuf {
 /// Runs `args`, expects a user error (exit code 1, one stderr line starting with `error:`, no
 /// panic) containing every string of `needles`; returns the message.
 pub fn expect_error(args: &[&str], needles: &[&str]) -> String {
-    let out = gvsrom(args);
+    user_error(args, &gvsrom(args), needles)
+}
+
+/// [`expect_error`] with a deadline: a run still going after `limit` is killed and the test fails
+/// (e.g. a reader waiting on a FIFO that no one writes), instead of hanging the test suite.
+pub fn expect_error_within(limit: Duration, args: &[&str], needles: &[&str]) -> String {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_gvsrom"))
+        .args(args)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the gvsrom binary runs");
+    let start = Instant::now();
+    while child.try_wait().expect("waiting for gvsrom").is_none() {
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("gvsrom {args:?} did not finish within {limit:?} (killed)");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let out = child.wait_with_output().expect("gvsrom exits");
+    user_error(args, &out, needles)
+}
+
+/// Checks that `out` of `gvsrom args` is a user error (see [`expect_error`]); returns the message.
+fn user_error(args: &[&str], out: &Output, needles: &[&str]) -> String {
     let stderr = String::from_utf8_lossy(&out.stderr).to_string();
     assert_eq!(
         out.status.code(),
@@ -58,6 +86,19 @@ pub fn expect_error(args: &[&str], needles: &[&str]) -> String {
     stderr
 }
 
+/// Replaces the file at `path` (if any) by a FIFO that no process writes: opening it for reading
+/// waits forever.
+pub fn fifo_at(path: &Path) {
+    if path.symlink_metadata().is_ok() {
+        std::fs::remove_file(path).unwrap();
+    }
+    let made = Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .expect("mkfifo runs");
+    assert!(made.success(), "mkfifo {path:?}");
+}
+
 /// A copy of a gvsrom directory output (flat) at the fresh scratch path `name`.
 pub fn copy_dir(from: &std::path::Path, name: &str) -> PathBuf {
     let to = scratch(name);
@@ -70,8 +111,7 @@ pub fn copy_dir(from: &std::path::Path, name: &str) -> PathBuf {
 }
 
 /// Runs `gvsrom args`, sends it SIGINT after `after` and returns its output once it exits.
-pub fn interrupted(args: &[&str], after: std::time::Duration) -> Output {
-    use std::process::Stdio;
+pub fn interrupted(args: &[&str], after: Duration) -> Output {
     let child = Command::new(env!("CARGO_BIN_EXE_gvsrom"))
         .args(args)
         .stdout(Stdio::piped())
