@@ -128,8 +128,8 @@ pub struct ScenarioArgs {
     )]
     pub tension: Option<Vec<f64>>,
 
-    /// Number of equally spaced centreline samples in the JSON output (overrides
-    /// `output.centerline_points`, default 21).
+    /// Number of centreline samples, equally spaced in arc length, in the JSON output and per
+    /// sample of a trajectory (`centerline.npy`); overrides `output.centerline_points`, default 21.
     #[arg(long, value_name = "N")]
     pub centerline_points: Option<usize>,
 
@@ -367,9 +367,9 @@ pub struct SimulateArgs {
     #[arg(long)]
     pub fd_jacobian: bool,
 
-    /// Write the trajectory (t, q, q̇, u, tip pose, strains) as .npy files and meta.json into the new
-    /// directory DIR, streamed as it is computed. An interrupted (Ctrl-C, SIGTERM) or failed run
-    /// still writes what it has, marked `"complete": false`.
+    /// Write the trajectory (t, q, q̇, u, tip pose, strains, centreline) as .npy files and
+    /// meta.json into the new directory DIR, streamed as it is computed. An interrupted (Ctrl-C,
+    /// SIGTERM) or failed run still writes what it has, marked `"complete": false`.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
 
@@ -631,10 +631,12 @@ fn modes_cmd(args: &ModesArgs, out: &mut impl Write) -> Result<()> {
         let inputs = scenario_inputs(&args.scenario, args.model.as_ref());
         gvsrom::output::refuse_overlap("--json", path, &inputs)?;
     }
-    let (scenario, mut built, _) = load(&args.scenario)?;
+    let (scenario, mut built, mut provenance) = load(&args.scenario)?;
     if let Some(dir) = &args.model {
         attach_model(&mut built, &args.scenario, dir, false)?;
+        provenance = provenance.model(dir)?;
     }
+    let provenance = provenance.solver(&built.options);
     let n_dof = built.n_dof();
     let (count, clipped) = modes::parse_count(args.count.as_deref(), n_dof)?;
     // the output is checked, locked and staged before the solve, so a bad path fails at once
@@ -704,6 +706,7 @@ fn modes_cmd(args: &ModesArgs, out: &mut impl Write) -> Result<()> {
         let doc = modes::ModesJson {
             report: &report,
             model: args.model.as_ref().map(|p| p.display().to_string()),
+            provenance: Some(&provenance),
         };
         let path = json.commit_json(&doc)?;
         writeln!(out, "json       {}", path.display())?;
