@@ -941,6 +941,7 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
     let provenance = provenance
         .seed("input", args.seed)
         .input(plan.input.clone())
+        .sampling(opts.duration, opts.sample_rate)
         .integrator(simulate::integrator_record(&opts.integrator, &choice));
     let mut writer = match &args.out {
         Some(dir) => {

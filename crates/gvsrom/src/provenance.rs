@@ -11,6 +11,7 @@
 //! | `scenario_toml` | the scenario as run (after `--set`, `--tension`, `--centerline-points`): `gvsrom statics FILE` on this text alone solves the same problem |
 //! | `seeds` | every seed, by what it seeds (`{"input": 1}`, `{"plan": 0}`, `{"training": 0}`) |
 //! | `input` | a run's actuation ([`crate::simulate::input_record`]) |
+//! | `sampling` | a dynamics run's `duration` [s] and `sample_rate` [Hz] |
 //! | `integrator` | a dynamics run's method and tolerances ([`crate::simulate::integrator_record`]) |
 //! | `solver` | a statics run's solver options (the scenario's `[solver]`) |
 //! | `model`, `dataset` | an input directory: its path and the hashes its manifest records (`meta_sha256`, `sha256` per file) |
@@ -43,6 +44,8 @@ pub struct Provenance {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub input: Option<Value>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sampling: Option<Sampling>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub integrator: Option<Value>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub solver: Option<Value>,
@@ -50,6 +53,15 @@ pub struct Provenance {
     pub model: Option<DirOrigin>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dataset: Option<DirOrigin>,
+}
+
+/// The time span and output rate of a dynamics run.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Sampling {
+    /// Simulated time [s] (`--duration`).
+    pub duration: f64,
+    /// Output samples per second [Hz] (`--sample-rate`).
+    pub sample_rate: f64,
 }
 
 /// Where a scenario's text came from.
@@ -110,6 +122,7 @@ impl Provenance {
             scenario_toml: None,
             seeds: BTreeMap::new(),
             input: None,
+            sampling: None,
             integrator: None,
             solver: None,
             model: None,
@@ -125,6 +138,15 @@ impl Provenance {
 
     pub fn input(mut self, input: Value) -> Self {
         self.input = Some(input);
+        self
+    }
+
+    /// A dynamics run's `duration` [s] and `sample_rate` [Hz].
+    pub fn sampling(mut self, duration: f64, sample_rate: f64) -> Self {
+        self.sampling = Some(Sampling {
+            duration,
+            sample_rate,
+        });
         self
     }
 

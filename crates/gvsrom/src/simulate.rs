@@ -891,8 +891,8 @@ pub struct Written {
 /// `gvsrom simulate … --out DIR` without the printing: plans the run ([`plan`], the output size),
 /// stages the trajectory at `out` (`force`: replacing an earlier gvsrom output there), runs it
 /// ([`run`], `control` as there) and moves it into place. A run that ended early is written too,
-/// marked partial; `outcome.ending` says why. `provenance` (without the input, which is added
-/// here) is recorded in `meta.json`.
+/// marked partial; `outcome.ending` says why. `provenance` (without the input and sampling, which
+/// are added here) is recorded in `meta.json`.
 pub fn run_to_dir(
     built: &Built,
     opts: &SimulateOptions,
@@ -905,7 +905,10 @@ pub fn run_to_dir(
     check_output_size(built, &plan)?;
     let mut writer = TrajectoryWriter::create(out, force, built)?;
     if let Some(p) = provenance {
-        writer.set_provenance(&p.input(plan.input.clone()));
+        let p = p
+            .input(plan.input.clone())
+            .sampling(opts.duration, opts.sample_rate);
+        writer.set_provenance(&p);
     }
     let outcome = run(built, &plan, &opts.integrator, Some(&mut writer), control)?;
     let samples = writer.samples();
