@@ -5,6 +5,7 @@ use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 use gvsrom::output::OutputFile;
 use gvsrom::presets::{self, PRESETS};
+use gvsrom::provenance::Provenance;
 use gvsrom::reduce;
 use gvsrom::simulate::{Ending, TrajectoryWriter};
 use gvsrom::statics::{self, StaticsReport};
@@ -131,8 +132,8 @@ pub struct ScenarioArgs {
     )]
     pub tension: Option<Vec<f64>>,
 
-    /// Number of equally spaced centreline samples in the JSON output (overrides
-    /// `output.centerline_points`, default 21).
+    /// Number of centreline samples, equally spaced in arc length, in the JSON output and per
+    /// sample of a trajectory (`centerline.npy`); overrides `output.centerline_points`, default 21.
     #[arg(long, value_name = "N")]
     pub centerline_points: Option<usize>,
 
@@ -370,9 +371,9 @@ pub struct SimulateArgs {
     #[arg(long)]
     pub fd_jacobian: bool,
 
-    /// Write the trajectory (t, q, q̇, u, tip pose, strains) as .npy files and meta.json into the new
-    /// directory DIR, streamed as it is computed. An interrupted (Ctrl-C, SIGTERM) or failed run
-    /// still writes what it has, marked `"complete": false`.
+    /// Write the trajectory (t, q, q̇, u, tip pose, strains, centreline) as .npy files and
+    /// meta.json into the new directory DIR, streamed as it is computed. An interrupted (Ctrl-C,
+    /// SIGTERM) or failed run still writes what it has, marked `"complete": false`.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
 
@@ -410,8 +411,11 @@ pub fn run(cli: Cli, out: &mut impl Write) -> Result<()> {
     }
 }
 
-fn load(args: &ScenarioArgs) -> Result<(Scenario, Built)> {
-    let mut scenario = presets::load(&args.scenario, &args.set)?;
+/// The scenario after `--set`, `--tension` and `--centerline-points`, built, and the provenance of
+/// a run of it (started now).
+fn load(args: &ScenarioArgs) -> Result<(Scenario, Built, Provenance)> {
+    let src = presets::source(&args.scenario)?;
+    let mut scenario = presets::load_from(&src, &args.set)?;
     if let Some(u) = &args.tension {
         scenario.set_tensions(u).context("--tension")?;
     }
@@ -419,7 +423,8 @@ fn load(args: &ScenarioArgs) -> Result<(Scenario, Built)> {
         scenario.output.centerline_points = n;
     }
     let built = build(&scenario)?;
-    Ok((scenario, built))
+    let provenance = Provenance::of_scenario(&src, &args.set, scenario.to_toml()?);
+    Ok((scenario, built, provenance))
 }
 
 /// `--model DIR`: attaches a reduced model to `built` (the scenario table supplies the dataset
@@ -540,8 +545,8 @@ fn compare_cmd(args: &CompareArgs, out: &mut impl Write) -> Result<()> {
 }
 
 fn check_cmd(args: &ScenarioArgs, out: &mut impl Write) -> Result<()> {
-    let (scenario, built) = load(args)?;
-    print_model(&scenario, &built, out)?;
+    let (scenario, built, _) = load(args)?;
+    print_model(&scenario, args, &built, out)?;
     writeln!(out, "ok         the scenario is valid")?;
     Ok(())
 }
@@ -567,16 +572,18 @@ fn statics_cmd(args: &StaticsArgs, out: &mut impl Write) -> Result<()> {
         let inputs = scenario_inputs(&args.scenario, args.model.as_ref());
         gvsrom::output::refuse_overlap("--json", path, &inputs)?;
     }
-    let (scenario, mut built) = load(&args.scenario)?;
+    let (scenario, mut built, mut provenance) = load(&args.scenario)?;
     if let Some(dir) = &args.model {
         attach_model(&mut built, &args.scenario, dir, false)?;
+        provenance = provenance.model(dir)?;
     }
+    let provenance = provenance.solver(&built.options);
     // the output is checked, locked and staged before the solve, so a bad path fails at once
     let json = match &args.json {
         Some(path) => Some(OutputFile::create("--json", path, "statics", args.force)?),
         None => None,
     };
-    print_model(&scenario, &built, out)?;
+    print_model(&scenario, &args.scenario, &built, out)?;
     let report = statics::solve_repeated(&built, args.repeat)?;
     print_solution(&report, out)?;
     if let Some(r) = &built.reduced {
@@ -615,6 +622,7 @@ fn statics_cmd(args: &StaticsArgs, out: &mut impl Write) -> Result<()> {
                 .map(|r| r.extrapolated.clone())
                 .unwrap_or_default(),
             comparison,
+            provenance: Some(&provenance),
         };
         let path = json.commit_json(&doc)?;
         writeln!(out, "json       {}", path.display())?;
@@ -628,10 +636,12 @@ fn modes_cmd(args: &ModesArgs, out: &mut impl Write) -> Result<()> {
         let inputs = scenario_inputs(&args.scenario, args.model.as_ref());
         gvsrom::output::refuse_overlap("--json", path, &inputs)?;
     }
-    let (scenario, mut built) = load(&args.scenario)?;
+    let (scenario, mut built, mut provenance) = load(&args.scenario)?;
     if let Some(dir) = &args.model {
         attach_model(&mut built, &args.scenario, dir, false)?;
+        provenance = provenance.model(dir)?;
     }
+    let provenance = provenance.solver(&built.options);
     let n_dof = built.n_dof();
     let (count, clipped) = modes::parse_count(args.count.as_deref(), n_dof)?;
     // the output is checked, locked and staged before the solve, so a bad path fails at once
@@ -639,7 +649,7 @@ fn modes_cmd(args: &ModesArgs, out: &mut impl Write) -> Result<()> {
         Some(path) => Some(OutputFile::create("--json", path, "modes", args.force)?),
         None => None,
     };
-    print_model(&scenario, &built, out)?;
+    print_model(&scenario, &args.scenario, &built, out)?;
     if clipped {
         writeln!(
             out,
@@ -701,6 +711,7 @@ fn modes_cmd(args: &ModesArgs, out: &mut impl Write) -> Result<()> {
         let doc = modes::ModesJson {
             report: &report,
             model: args.model.as_ref().map(|p| p.display().to_string()),
+            provenance: Some(&provenance),
         };
         let path = json.commit_json(&doc)?;
         writeln!(out, "json       {}", path.display())?;
@@ -862,11 +873,12 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
         }
         gvsrom::output::refuse_overlap("--out", dir, &inputs)?;
     }
-    let (scenario, mut built) = load(&args.scenario)?;
+    let (scenario, mut built, mut provenance) = load(&args.scenario)?;
     if let Some(dir) = &args.model {
         // an input signal's tensions are checked against the model once the signal is built
         let signal_driven = args.input.is_some() || args.steps.is_some() || args.babble.is_some();
         attach_model(&mut built, &args.scenario, dir, signal_driven)?;
+        provenance = provenance.model(dir)?;
     }
     let input = if let Some(path) = &args.input {
         let interpolation = if args.interpolate {
@@ -931,14 +943,21 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
     for o in &plan.model_extrapolated {
         eprintln!("warning: extrapolating (--extrapolate): {o}");
     }
+    let provenance = provenance
+        .seed("input", args.seed)
+        .input(plan.input.clone())
+        .sampling(opts.duration, opts.sample_rate)
+        .integrator(simulate::integrator_record(&opts.integrator, &choice));
     let mut writer = match &args.out {
         Some(dir) => {
             simulate::check_output_size(&built, &plan)?;
-            Some(TrajectoryWriter::create(dir, args.force, &built)?)
+            let mut w = TrajectoryWriter::create(dir, args.force, &built)?;
+            w.set_provenance(&provenance);
+            Some(w)
         }
         None => None,
     };
-    print_model(&scenario, &built, out)?;
+    print_model(&scenario, &args.scenario, &built, out)?;
     if let Some(note) = light {
         writeln!(out, "{note}")?;
     }
@@ -1142,14 +1161,25 @@ fn plural(n: usize, word: &str) -> String {
     }
 }
 
-fn print_model(scenario: &Scenario, built: &Built, out: &mut impl Write) -> Result<()> {
+/// The summary of the model that runs. The scenario line is derived from the scenario as built;
+/// the file's own `description` follows only when no `--set` or `--tension` changed the scenario
+/// (its text may no longer hold then).
+fn print_model(
+    scenario: &Scenario,
+    args: &ScenarioArgs,
+    built: &Built,
+    out: &mut impl Write,
+) -> Result<()> {
     let m = &built.model;
-    let desc = scenario
-        .description
-        .as_deref()
-        .map(|d| format!(" — {d}"))
-        .unwrap_or_default();
-    writeln!(out, "scenario   {}{desc}", built.name)?;
+    writeln!(
+        out,
+        "scenario   {} — {}",
+        built.name,
+        gvsrom::build::describe(scenario, built)
+    )?;
+    if let (Some(d), true, None) = (&scenario.description, args.set.is_empty(), &args.tension) {
+        writeln!(out, "           {d}")?;
+    }
     writeln!(
         out,
         "model      {} DOF, {} computational points, {}, length {} m, Magnus {:?}",

@@ -57,6 +57,14 @@ pub struct Trajectory {
     pub input: Option<Value>,
     /// The physics record (`physics`), if recorded.
     pub physics: Option<Value>,
+    /// Abscissae of the centreline samples [m] (`centerline_x`; trajectories written before the
+    /// centreline was recorded have none).
+    pub centerline_x: Option<Vec<f64>>,
+    /// `samples × centerline_x.len() × 3`: the centreline positions [m] (`centerline.npy`), with
+    /// `centerline_x`.
+    pub centerline: Option<Vec<f64>>,
+    /// How the run was made (`provenance`), if recorded.
+    pub provenance: Option<Value>,
 }
 
 impl Trajectory {
@@ -112,6 +120,24 @@ impl Trajectory {
                 meta_path.display()
             )));
         }
+        let centerline_x = match meta.get("centerline_x") {
+            None => None,
+            Some(v) => Some(
+                serde_json::from_value::<Vec<f64>>(v.clone())
+                    .ok()
+                    .filter(|x| x.len() >= 2 && x.iter().all(|x| x.is_finite()))
+                    .ok_or_else(|| {
+                        bad(format!(
+                            "{}: `centerline_x` is not a list of at least 2 finite numbers",
+                            meta_path.display()
+                        ))
+                    })?,
+            ),
+        };
+        let centerline = match &centerline_x {
+            Some(x) => Some(read("centerline.npy", &[n, x.len(), 3])?),
+            None => None,
+        };
         Ok(Trajectory {
             dir: dir.to_path_buf(),
             scenario: meta["scenario"].as_str().unwrap_or("?").to_string(),
@@ -127,6 +153,9 @@ impl Trajectory {
             sample_rate: meta["sample_rate"].as_f64(),
             input: meta.get("input").filter(|v| v.is_object()).cloned(),
             physics: meta.get("physics").filter(|v| v.is_object()).cloned(),
+            centerline_x,
+            centerline,
+            provenance: meta.get("provenance").filter(|v| v.is_object()).cloned(),
         })
     }
 
@@ -493,6 +522,9 @@ mod tests {
             physics: Some(
                 serde_json::json!({"material": {"damping": 1e4}, "loads": {"gravity": [0.0, 0.0, -9.81]}}),
             ),
+            centerline_x: None,
+            centerline: None,
+            provenance: None,
         }
     }
 

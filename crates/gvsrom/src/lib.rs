@@ -18,6 +18,7 @@ pub mod output;
 pub mod plausibility;
 pub mod plot;
 pub mod presets;
+pub mod provenance;
 pub mod reduce;
 pub mod reduced_model;
 pub mod reproduce;

@@ -383,6 +383,9 @@ pub struct ModesJson<'a> {
     pub report: &'a ModesReport,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub model: Option<String>,
+    /// How the result was made ([`crate::provenance`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub provenance: Option<&'a crate::provenance::Provenance>,
 }
 
 #[cfg(test)]

@@ -67,6 +67,8 @@ pub struct Source {
     /// Name used when the scenario sets none: the preset name or the file stem.
     pub default_name: String,
     pub text: String,
+    /// A built-in preset (else a file).
+    pub preset: bool,
 }
 
 /// Resolves `arg` as a preset name first, then as a file path.
@@ -76,6 +78,7 @@ pub fn source(arg: &str) -> Result<Source, ScenarioError> {
             origin: format!("preset `{}`", p.name),
             default_name: p.name.to_string(),
             text: p.toml.to_string(),
+            preset: true,
         });
     }
     let path = Path::new(arg);
@@ -103,16 +106,21 @@ pub fn source(arg: &str) -> Result<Source, ScenarioError> {
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_else(|| "scenario".into()),
         text,
+        preset: false,
     })
 }
 
 /// Loads a preset or a file and applies `--set` overrides; the scenario's name defaults to the
 /// preset name or file stem.
 pub fn load(arg: &str, overrides: &[String]) -> Result<Scenario, ScenarioError> {
-    let src = source(arg)?;
+    load_from(&source(arg)?, overrides)
+}
+
+/// [`load`] of a scenario text already read.
+pub fn load_from(src: &Source, overrides: &[String]) -> Result<Scenario, ScenarioError> {
     let mut s = Scenario::from_toml(&src.origin, &src.text, overrides)?;
     if s.name.is_none() {
-        s.name = Some(src.default_name);
+        s.name = Some(src.default_name.clone());
     }
     Ok(s)
 }

@@ -159,6 +159,9 @@ pub struct ModelMeta {
     /// `max ‖x − Φ̄Px‖/‖x‖` (see `rom::reduced`).
     pub projection_residual: f64,
     pub crate_version: String,
+    /// How the model was made ([`crate::provenance`]; absent in models from before).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub provenance: Option<crate::provenance::Provenance>,
 }
 
 /// The numbers of a model.

@@ -16,7 +16,8 @@
 //! | `tip_rotation.npy` | (N, 3, 3) | tip rotation matrices (section → world) |
 //! | `strain.npy` | (N, p, 6) | ξ at the p computational points, `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]` |
 //! | `strain_x.npy` | (p,) | abscissae of the computational points [m] |
-//! | `meta.json` | | manifest (`gvsrom`: format, version, files), scenario, `complete`, `reason`, `t_reached`, `t_requested`, `sample_rate`, sizes, integrator statistics, wall time, real-time factor, error, `input` ([`input_record`]), `physics` (material, geometry, base, tendon routing, loads) |
+//! | `centerline.npy` | (N, c, 3) | centreline positions [m] at the `c` abscissae `centerline_x` of `meta.json`, equally spaced in arc length from base to tip (`output.centerline_points`, `--centerline-points`), in the world frame as `statics --json` |
+//! | `meta.json` | | manifest (`gvsrom`: format, version, files), scenario, `complete`, `reason`, `t_reached`, `t_requested`, `sample_rate`, sizes, integrator statistics, wall time, real-time factor, error, `input` ([`input_record`]), `physics` (material, geometry, base, tendon routing, loads), `centerline_x`, `provenance` ([`crate::provenance`]) |
 //!
 //! The integrator is chosen here too ([`choose_integrator`]): by the rod's damping unless named,
 //! as `gvsrom simulate` and `gvsrom reproduce` both do.
@@ -300,6 +301,49 @@ pub fn choose_integrator(
         }
     };
     Ok((IntegratorOptions { method, jacobian }, note))
+}
+
+/// The integrator of a run as its provenance records it (`"integrator"`): the method that ran
+/// with its tolerances and options (as [`choose_integrator`] resolved them) and what was
+/// `requested` (the command's options).
+pub fn integrator_record(
+    options: &IntegratorOptions,
+    requested: &IntegratorChoice,
+) -> serde_json::Value {
+    use serde_json::json;
+    let norm = |n: ErrorNorm| match n {
+        ErrorNorm::Componentwise => "componentwise",
+        ErrorNorm::Mass => "mass",
+    };
+    let mut v = match &options.method {
+        Method::Ndf(o) => json!({
+            "rtol": o.rtol, "atol": o.atol, "max_order": o.max_order, "bdf": o.bdf,
+            "error_norm": norm(o.error_norm),
+            "mass_renewal": match o.mass_renewal {
+                MassRenewal::WhenSlow => "when_slow",
+                MassRenewal::EveryAttempt => "every_attempt",
+            },
+            "max_steps": o.max_steps,
+        }),
+        Method::Fixed(o) => {
+            json!({"h": o.h, "newton_tol": o.newton_tol, "max_newton": o.max_newton})
+        }
+        Method::GeneralizedAlpha(o) => json!({
+            "rtol": o.rtol, "atol": o.atol, "rho_inf": o.rho_inf,
+            "error_norm": norm(o.error_norm), "max_steps": o.max_steps,
+        }),
+        Method::Sdirk(o) => json!({
+            "rtol": o.rtol, "atol": o.atol, "error_norm": norm(o.error_norm),
+            "max_steps": o.max_steps,
+        }),
+    };
+    v["method"] = json!(options.method.name());
+    v["jacobian"] = json!(match options.jacobian {
+        OdeJacobian::FiniteDifference => "finite_difference",
+        OdeJacobian::Structured => "structured",
+    });
+    v["requested"] = serde_json::to_value(requested).unwrap_or(serde_json::Value::Null);
+    v
 }
 
 /// Smallest `--atol` accepted: `1e-14 ≈ 45 ε`. The coordinates of a rod (strain coefficients
@@ -744,7 +788,7 @@ pub fn run(
         last_t.set(s.t);
         last_tip = Some(*s.tip);
         if let Some(w) = writer.as_deref_mut() {
-            if let Err(e) = w.push(s) {
+            if let Err(e) = w.push(built, s) {
                 let msg = format!("cannot write the trajectory: {e}");
                 write_error = Some(e);
                 return ControlFlow::Break(msg);
@@ -847,17 +891,25 @@ pub struct Written {
 /// `gvsrom simulate … --out DIR` without the printing: plans the run ([`plan`], the output size),
 /// stages the trajectory at `out` (`force`: replacing an earlier gvsrom output there), runs it
 /// ([`run`], `control` as there) and moves it into place. A run that ended early is written too,
-/// marked partial; `outcome.ending` says why.
+/// marked partial; `outcome.ending` says why. `provenance` (without the input and sampling, which
+/// are added here) is recorded in `meta.json`.
 pub fn run_to_dir(
     built: &Built,
     opts: &SimulateOptions,
     out: &Path,
     force: bool,
+    provenance: Option<crate::provenance::Provenance>,
     control: &mut dyn FnMut(f64) -> ControlFlow<String>,
 ) -> Result<Written, TrajectoryError> {
     let plan = plan(built, opts)?;
     check_output_size(built, &plan)?;
     let mut writer = TrajectoryWriter::create(out, force, built)?;
+    if let Some(p) = provenance {
+        let p = p
+            .input(plan.input.clone())
+            .sampling(opts.duration, opts.sample_rate);
+        writer.set_provenance(&p);
+    }
     let outcome = run(built, &plan, &opts.integrator, Some(&mut writer), control)?;
     let samples = writer.samples();
     let dir = writer.finish(built, &plan, &outcome)?;
@@ -868,10 +920,12 @@ pub fn run_to_dir(
     })
 }
 
-/// Bytes written per sample: `t`, `q`, `q̇`, `u`, tip position and rotation, strains (f64 each).
+/// Bytes written per sample: `t`, `q`, `q̇`, `u`, tip position and rotation, strains, centreline
+/// (f64 each).
 fn bytes_per_sample(built: &Built) -> f64 {
     let m = &built.model;
-    8.0 * (1 + 2 * built.n_dof() + m.n_actuators() + 3 + 9 + 6 * m.disc.n_points()) as f64
+    let c = built.centerline_points.max(2);
+    8.0 * (1 + 2 * built.n_dof() + m.n_actuators() + 3 + 9 + 6 * m.disc.n_points() + 3 * c) as f64
 }
 
 /// Refuses a trajectory larger than [`MAX_OUTPUT_BYTES`] before anything is computed.
@@ -903,6 +957,54 @@ pub struct TrajectoryWriter {
     tip_position: NpyRows,
     tip_rotation: NpyRows,
     strain: NpyRows,
+    centerline: NpyRows,
+    shape: Centerline,
+    provenance: Option<serde_json::Value>,
+}
+
+/// The centreline of each sample: the forward kinematics of the model that runs (the reduced one
+/// shares the scenario's rod and points) at `q`, sampled at `x` — buffers allocated once, before
+/// the run.
+struct Centerline {
+    /// Abscissae `x_k = L k / (c − 1)`, `k = 0 … c − 1` [m].
+    x: Vec<f64>,
+    q: nalgebra::DVector<f64>,
+    ws: gvs::model::Workspace,
+    /// `c × 3` positions of the current sample.
+    points: Vec<f64>,
+}
+
+impl Centerline {
+    fn new(built: &Built) -> Self {
+        let (n, ws) = match &built.reduced {
+            Some(r) => (r.model.n_dof(), r.model.workspace()),
+            None => (built.model.n_dof(), built.model.workspace()),
+        };
+        let c = built.centerline_points.max(2);
+        Centerline {
+            x: crate::statics::centerline_abscissae(built.model.disc.length(), c),
+            q: nalgebra::DVector::zeros(n),
+            ws,
+            points: vec![0.0; 3 * c],
+        }
+    }
+
+    /// The centreline at `q` into [`Self::points`].
+    fn sample(&mut self, built: &Built, q: &[f64]) {
+        self.q.as_mut_slice().copy_from_slice(q);
+        match &built.reduced {
+            Some(r) => self.fill(&r.model),
+            None => self.fill(&built.model),
+        }
+    }
+
+    fn fill<P: gvs::strain::StrainParam>(&mut self, model: &gvs::model::Model<P>) {
+        model.forward(&self.q, &mut self.ws, false);
+        for (k, &x) in self.x.iter().enumerate() {
+            let p = model.position_at(&self.ws, x);
+            self.points[3 * k..3 * k + 3].copy_from_slice(&[p[0], p[1], p[2]]);
+        }
+    }
 }
 
 impl TrajectoryWriter {
@@ -912,6 +1014,8 @@ impl TrajectoryWriter {
         let mut dir = OutputDir::create("--out", path, "trajectory", force)?;
         let m = &built.model;
         let (n, na, np) = (built.n_dof(), m.n_actuators(), m.disc.n_points());
+        let shape = Centerline::new(built);
+        let nc = shape.x.len();
         let open = |dir: &mut OutputDir| -> std::io::Result<_> {
             Ok((
                 NpyRows::new(dir, "t.npy", &[])?,
@@ -921,9 +1025,10 @@ impl TrajectoryWriter {
                 NpyRows::new(dir, "tip_position.npy", &[3])?,
                 NpyRows::new(dir, "tip_rotation.npy", &[3, 3])?,
                 NpyRows::new(dir, "strain.npy", &[np, 6])?,
+                NpyRows::new(dir, "centerline.npy", &[nc, 3])?,
             ))
         };
-        let (t, q, qd, u, tip_position, tip_rotation, strain) =
+        let (t, q, qd, u, tip_position, tip_rotation, strain, centerline) =
             open(&mut dir).map_err(|e| dir.io_error("create the trajectory files", e))?;
         Ok(TrajectoryWriter {
             dir,
@@ -934,11 +1039,31 @@ impl TrajectoryWriter {
             tip_position,
             tip_rotation,
             strain,
+            centerline,
+            shape,
+            provenance: None,
         })
     }
 
-    /// Appends one sample.
-    pub fn push(&mut self, s: &Sample<'_>) -> std::io::Result<()> {
+    /// Records how the run was made in `meta.json` (`"provenance"`, [`crate::provenance`]).
+    pub fn set_provenance(&mut self, provenance: &crate::provenance::Provenance) {
+        self.provenance = serde_json::to_value(provenance).ok();
+    }
+
+    /// Appends one sample of the run of `built` (the model that runs computes its centreline).
+    pub fn push(&mut self, built: &Built, s: &Sample<'_>) -> std::io::Result<()> {
+        if s.q.len() != self.shape.q.len() {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                format!(
+                    "a sample of {} coordinates for a trajectory of {}",
+                    s.q.len(),
+                    self.shape.q.len()
+                ),
+            ));
+        }
+        self.shape.sample(built, s.q);
+        self.centerline.push(self.shape.points.iter().copied())?;
         self.t.push([s.t])?;
         self.q.push(s.q.iter().copied())?;
         self.qd.push(s.qd.iter().copied())?;
@@ -975,9 +1100,12 @@ impl TrajectoryWriter {
             tip_position,
             tip_rotation,
             strain,
+            centerline,
+            shape,
+            provenance,
         } = self;
         let samples = t.rows();
-        let arrays = [t, q, qd, u, tip_position, tip_rotation, strain];
+        let arrays = [t, q, qd, u, tip_position, tip_rotation, strain, centerline];
         (|| -> std::io::Result<()> {
             for a in arrays {
                 a.finish(&mut dir)?;
@@ -1036,6 +1164,8 @@ impl TrajectoryWriter {
                 .chain(&plan.model_extrapolated)
                 .cloned()
                 .collect(),
+            centerline_x: shape.x,
+            provenance,
         };
         dir.commit(meta)
     }
@@ -1080,4 +1210,9 @@ struct Meta<'a> {
     /// the input signal's differences.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     model_extrapolated: Vec<String>,
+    /// Abscissae of the centreline samples in `centerline.npy` [m].
+    centerline_x: Vec<f64>,
+    /// How the run was made ([`crate::provenance::Provenance`]), when the caller recorded it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    provenance: Option<serde_json::Value>,
 }

@@ -126,8 +126,7 @@ fn solve_on<P: StrainParam>(
     model.forward(&sol.q, &mut ws, false);
     let tip = &ws.g[model.disc.tip()];
     let length = model.disc.length();
-    let n = built.centerline_points.max(2);
-    let centerline_x: Vec<f64> = (0..n).map(|i| length * i as f64 / (n - 1) as f64).collect();
+    let centerline_x = centerline_abscissae(length, built.centerline_points);
     let centerline = centerline_x
         .iter()
         .map(|&x| arr3(&model.position_at(&ws, x)))
@@ -176,6 +175,9 @@ pub struct StaticsJson<'a> {
     pub model_extrapolated: Vec<String>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub comparison: Option<Comparison>,
+    /// How the solution was made ([`crate::provenance`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub provenance: Option<&'a crate::provenance::Provenance>,
 }
 
 /// A reduced equilibrium against the full model's (`statics --model --compare`), see `rom::metrics`.
@@ -240,6 +242,13 @@ fn failure(built: &Built, error: StaticsError) -> StaticsFailure {
         }
     }
     StaticsFailure { error, hint }
+}
+
+/// `c` abscissae equally spaced in arc length on `[0, L]`, both ends included (`c ≥ 2`): the
+/// centreline samples of `statics --json` and of a trajectory.
+pub fn centerline_abscissae(length: f64, c: usize) -> Vec<f64> {
+    let c = c.max(2);
+    (0..c).map(|i| length * i as f64 / (c - 1) as f64).collect()
 }
 
 fn arr3(v: &V3) -> [f64; 3] {

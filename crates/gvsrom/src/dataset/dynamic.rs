@@ -57,6 +57,7 @@ pub fn run(
     scenario_toml: String,
     interrupt: &AtomicUsize,
     out: &mut dyn Write,
+    provenance: crate::provenance::Provenance,
     t0: Instant,
 ) -> Result<Outcome, DatasetError> {
     let static_opts = [
@@ -224,6 +225,19 @@ pub fn run(
         wall_time_s: t0.elapsed().as_secs_f64(),
         threads: 1,
         noise: None,
+        provenance: Some(
+            provenance
+                .input(plan.input.clone())
+                .sampling(duration, opts.sample_rate)
+                .integrator(simulate::integrator_record(
+                    &opts.integrator,
+                    &simulate::IntegratorChoice {
+                        rtol: args.rtol,
+                        atol: args.atol,
+                        ..simulate::IntegratorChoice::default()
+                    },
+                )),
+        ),
     };
     write_arrays(&mut dir, &mut meta, &layout, &inputs, &rows, Some(&t))?;
     let path = dir.commit(&meta)?;

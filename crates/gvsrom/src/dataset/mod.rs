@@ -259,6 +259,9 @@ pub struct Meta {
     /// A dataset made from another by adding noise to its snapshots ([`noise::with_noise`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub noise: Option<noise::NoiseInfo>,
+    /// How the dataset was made ([`crate::provenance`]; absent in datasets from before).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub provenance: Option<crate::provenance::Provenance>,
 }
 
 /// The result of [`run`].
@@ -280,20 +283,24 @@ fn plan_err(e: String) -> DatasetError {
     DatasetError::Plan(e)
 }
 
-/// The scenario table after `--set`, the scenario built from it, and its TOML text.
-fn load_scenario(args: &DatasetArgs) -> Result<(toml::Table, Built, String), DatasetError> {
+/// The scenario table after `--set`, the scenario built from it, its TOML text, and the
+/// provenance of the dataset (started now).
+fn load_scenario(
+    args: &DatasetArgs,
+) -> Result<(toml::Table, Built, String, crate::provenance::Provenance), DatasetError> {
     let src = crate::presets::source(&args.scenario)?;
     let mut table = crate::scenario::parse_table(&src.origin, &src.text)?;
     for spec in &args.set {
         crate::scenario::apply_override(&mut table, spec)?;
     }
     if !table.contains_key("name") {
-        table.insert("name".into(), toml::Value::String(src.default_name));
+        table.insert("name".into(), toml::Value::String(src.default_name.clone()));
     }
     let scenario = crate::scenario::from_table(table.clone())?;
     let built = crate::build(&scenario)?;
     let text = toml::to_string(&table).map_err(|e| plan_err(format!("scenario: {e}")))?;
-    Ok((table, built, text))
+    let provenance = crate::provenance::Provenance::of_scenario(&src, &args.set, text.clone());
+    Ok((table, built, text, provenance))
 }
 
 /// Checks the extremes of the plan before computing: the tensions against the rod's elastic range
@@ -357,9 +364,10 @@ pub fn run(
         inputs.push(("--input", p.as_path()));
     }
     crate::output::refuse_overlap("--out", &args.out, &inputs)?;
-    let (table, built, scenario_toml) = load_scenario(args)?;
+    let (table, built, scenario_toml, provenance) = load_scenario(args)?;
     if args.duration.is_some() {
-        return dynamic::run(args, &built, scenario_toml, interrupt, out, t0);
+        let provenance = provenance.seed("input", args.seed);
+        return dynamic::run(args, &built, scenario_toml, interrupt, out, provenance, t0);
     }
     let plan = Plan::new(
         &args.sweep,
@@ -428,6 +436,7 @@ pub fn run(
         plan: Some(plan.clone()),
         dynamic: None,
         noise: None,
+        provenance: Some(provenance.seed("plan", args.seed)),
     };
     // the output is checked, locked and staged before the computation
     let mut dir = OutputDir::create("--out", &args.out, "dataset", args.force || args.resume)?;

@@ -35,7 +35,9 @@ pub fn pod(
     out: &Path,
     force: bool,
 ) -> Result<PodSummary, anyhow::Error> {
+    let provenance = crate::provenance::Provenance::of_command();
     let ds = Dataset::load(dataset)?;
+    let provenance = provenance.dataset("DATASET", dataset)?;
     let built = dataset_scenario(&ds)?;
     projection_of(&built)?; // the HOM basis must be recoverable from point strains
     let (x, rows) = snapshot_rows(&ds, "DATASET", built.model.rod.length())?;
@@ -60,6 +62,7 @@ pub fn pod(
         training: None,
         projection_residual: 0.0,
         crate_version: env!("CARGO_PKG_VERSION").into(),
+        provenance: Some(provenance),
     };
     let mut model = ReducedModel {
         meta,

@@ -106,7 +106,11 @@ pub fn train(
     force: bool,
     progress: &mut dyn FnMut(usize, f64, Option<f64>) -> ControlFlow<()>,
 ) -> Result<TrainSummary, anyhow::Error> {
+    let provenance = crate::provenance::Provenance::of_command();
     let ds = Dataset::load(dataset)?;
+    let provenance = provenance
+        .dataset("DATASET", dataset)?
+        .seed("training", options.seed);
     let built = dataset_scenario(&ds)?;
     let (layout, pm, p) = projection_of(&built)?;
     let (x, rows) = snapshot_rows(&ds, "DATASET", built.model.rod.length())?;
@@ -210,6 +214,7 @@ pub fn train(
         }),
         projection_residual: worst,
         crate_version: env!("CARGO_PKG_VERSION").into(),
+        provenance: Some(provenance),
     };
     let encoder_sizes = ae.encoder().layer_sizes().to_vec();
     let mut model = ReducedModel {

@@ -133,7 +133,14 @@ pub fn simulate_test(
                 0 => ControlFlow::Continue(()),
                 _ => ControlFlow::Break("interrupted".to_string()),
             };
-            let written = simulate::run_to_dir(&built, &opts, path, true, &mut control)?;
+            let mut provenance = scenario.provenance()?.seed("input", test.seed).integrator(
+                simulate::integrator_record(&opts.integrator, &test.integrator),
+            );
+            if let Some(m) = model {
+                provenance = provenance.model(&m.path)?;
+            }
+            let written =
+                simulate::run_to_dir(&built, &opts, path, true, Some(provenance), &mut control)?;
             run.check_interrupt()?;
             let outcome = &written.outcome;
             let reason = match &outcome.ending {

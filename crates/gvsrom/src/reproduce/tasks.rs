@@ -45,6 +45,17 @@ impl ScenarioSpec {
         }
         Ok((built, table))
     }
+
+    /// The provenance of a run of this scenario ([`crate::provenance`]), started now.
+    pub fn provenance(&self) -> anyhow::Result<crate::provenance::Provenance> {
+        let src = presets::source(&self.preset)?;
+        let s = presets::load_from(&src, &self.set)?;
+        Ok(crate::provenance::Provenance::of_scenario(
+            &src,
+            &self.set,
+            s.to_toml()?,
+        ))
+    }
 }
 
 /// A sampling plan of `gvsrom dataset` (static: sweep/grid/random; dynamic: babbling).
