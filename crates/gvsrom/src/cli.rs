@@ -83,6 +83,12 @@ pub struct CompareArgs {
     /// refused, since one does not approximate the other.
     #[arg(long)]
     pub allow_different: bool,
+    /// Also write the comparison as JSON, with both runs' hashes (`provenance`).
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+    /// Let `--json` replace an earlier gvsrom output at that path.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// `gvsrom reproduce`.
@@ -465,7 +471,18 @@ fn presets_cmd(out: &mut impl Write) -> Result<()> {
 }
 
 fn compare_cmd(args: &CompareArgs, out: &mut impl Write) -> Result<()> {
-    use gvsrom::compare::{compare, differences, speed_ratio, Trajectory};
+    use gvsrom::compare::{compare, differences, speed_ratio, Report, Side, Trajectory};
+    let json = match &args.json {
+        Some(path) => {
+            let inputs = [
+                ("REFERENCE", args.reference.as_path()),
+                ("RUN", args.run.as_path()),
+            ];
+            gvsrom::output::refuse_overlap("--json", path, &inputs)?;
+            Some(OutputFile::create("--json", path, "compare", args.force)?)
+        }
+        None => None,
+    };
     let reference = Trajectory::load(&args.reference, "REFERENCE")?;
     let run = Trajectory::load(&args.run, "RUN")?;
     // only like with like: the same scenario, physics, input and sample times
@@ -540,6 +557,20 @@ fn compare_cmd(args: &CompareArgs, out: &mut impl Write) -> Result<()> {
             active.join(", ")
         )?,
         _ => writeln!(out, "strain     the reference is straight at every sample")?,
+    }
+    if let Some(json) = json {
+        let report = Report {
+            reference: Side::of(&reference),
+            run: Side::of(&run),
+            speed_ratio: speed_ratio(&reference, &run),
+            comparison: c,
+            differ: diffs.differ,
+            unknown: diffs.unknown,
+            provenance: gvsrom::provenance::Provenance::of_command()
+                .compared(&args.reference, &args.run)?,
+        };
+        let path = json.commit_json(&report)?;
+        writeln!(out, "json       {}", path.display())?;
     }
     Ok(())
 }

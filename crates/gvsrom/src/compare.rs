@@ -406,6 +406,49 @@ pub struct Comparison {
     pub active: Vec<usize>,
 }
 
+/// One trajectory of a [`Report`], as `compare` describes it.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Side {
+    pub path: String,
+    pub scenario: String,
+    pub n_dof: usize,
+    pub samples: usize,
+    /// The last sample's time [s].
+    pub t_last: Option<f64>,
+    pub complete: bool,
+    /// Wall time of the run [s], if recorded.
+    pub wall_time_s: Option<f64>,
+}
+
+impl Side {
+    pub fn of(tr: &Trajectory) -> Side {
+        Side {
+            path: tr.dir.display().to_string(),
+            scenario: tr.scenario.clone(),
+            n_dof: tr.n_dof,
+            samples: tr.samples(),
+            t_last: tr.t.last().copied(),
+            complete: tr.complete,
+            wall_time_s: (tr.wall_time_s.is_finite() && tr.wall_time_s > 0.0)
+                .then_some(tr.wall_time_s),
+        }
+    }
+}
+
+/// What `gvsrom compare --json` writes: both runs, the measured errors, the speed ratio
+/// ([`speed_ratio`], `null` if it cannot be told), the differences compared anyway
+/// (`--allow-different`) and how the report was made.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Report {
+    pub reference: Side,
+    pub run: Side,
+    pub comparison: Comparison,
+    pub speed_ratio: Option<f64>,
+    pub differ: Vec<String>,
+    pub unknown: Vec<String>,
+    pub provenance: crate::provenance::Provenance,
+}
+
 /// `run` against `reference` over their common samples.
 pub fn compare(reference: &Trajectory, run: &Trajectory) -> Result<Comparison, ScenarioError> {
     let n = reference.samples().min(run.samples());

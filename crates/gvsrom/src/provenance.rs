@@ -14,7 +14,7 @@
 //! | `sampling` | a dynamics run's `duration` [s] and `sample_rate` [Hz] |
 //! | `integrator` | a dynamics run's method and tolerances ([`crate::simulate::integrator_record`]) |
 //! | `solver` | a statics run's solver options (the scenario's `[solver]`) |
-//! | `model`, `dataset` | an input directory: its path and the hashes its manifest records (`meta_sha256`, `sha256` per file) |
+//! | `model`, `dataset`, `reference`, `run` | an input directory (`compare`'s trajectories for the last two): its path and the hashes its manifest records (`meta_sha256`, `sha256` per file) |
 //!
 //! Keys that do not apply are left out. One struct, [`Provenance`], builds them all.
 
@@ -53,6 +53,11 @@ pub struct Provenance {
     pub model: Option<DirOrigin>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dataset: Option<DirOrigin>,
+    /// `compare`'s two trajectories.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference: Option<DirOrigin>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub run: Option<DirOrigin>,
 }
 
 /// The time span and output rate of a dynamics run.
@@ -127,6 +132,8 @@ impl Provenance {
             solver: None,
             model: None,
             dataset: None,
+            reference: None,
+            run: None,
         }
     }
 
@@ -164,6 +171,13 @@ impl Provenance {
     /// The reduced model in `dir` (`--model`), by its manifest's hashes.
     pub fn model(mut self, dir: &Path) -> Result<Self, ScenarioError> {
         self.model = Some(DirOrigin::of("--model", dir)?);
+        Ok(self)
+    }
+
+    /// `compare`'s reference and run trajectories, by their manifests' hashes.
+    pub fn compared(mut self, reference: &Path, run: &Path) -> Result<Self, ScenarioError> {
+        self.reference = Some(DirOrigin::of("REFERENCE", reference)?);
+        self.run = Some(DirOrigin::of("RUN", run)?);
         Ok(self)
     }
 

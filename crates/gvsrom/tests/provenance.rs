@@ -466,3 +466,111 @@ fn datasets_models_and_model_runs_record_where_they_came_from() {
     );
     assert_eq!(doc["n_dof"], 2);
 }
+
+#[test]
+fn an_autoencoder_modes_and_a_comparison_record_where_they_came_from() {
+    let t0 = now_s();
+    let ds = scratch("prov-ae-ds");
+    run_ok(&[
+        "dataset",
+        "single-tendon",
+        "--sweep",
+        "tendons.0.tension=-5:0",
+        "--samples",
+        "12",
+        "--out",
+        s(&ds),
+    ]);
+    let ds_meta = json(&ds.join("meta.json"));
+    let model = scratch("prov-ae");
+    let train_args = [
+        "train",
+        s(&ds),
+        "--latent",
+        "1",
+        "--hidden-layers",
+        "3",
+        "--epochs",
+        "30",
+        "--seed",
+        "4",
+        "--out",
+        s(&model),
+    ];
+    run_ok(&train_args);
+    let m_meta = json(&model.join("meta.json"));
+    let p = &m_meta["provenance"];
+    check_common(p, &train_args, t0);
+    assert_eq!(p["seeds"], serde_json::json!({"training": 4}));
+    assert_eq!(p["dataset"]["path"], s(&ds));
+    assert_eq!(p["dataset"]["sha256"], ds_meta["gvsrom"]["sha256"]);
+
+    // modes about an equilibrium: the scenario as run, the solver
+    let modes = scratch("prov-modes.json");
+    let modes_args = [
+        "modes",
+        "single-tendon",
+        "--tension=-2",
+        "--count",
+        "2",
+        "--json",
+        s(&modes),
+    ];
+    run_ok(&modes_args);
+    let doc = json(&modes);
+    let p = &doc["provenance"];
+    check_common(p, &modes_args, t0);
+    assert_eq!(p["scenario"]["sha256"], sha256_hex(PRESET_TEXT.as_bytes()));
+    let toml: toml::Table = p["scenario_toml"].as_str().unwrap().parse().unwrap();
+    assert_eq!(toml["tendons"][0]["tension"].as_float(), Some(-2.0));
+    assert!(p["solver"].is_object(), "{p}");
+
+    // a comparison: both trajectories by their manifests' hashes (a POD-ROM: a 30-epoch
+    // autoencoder is too rough to follow the motion)
+    let pod = scratch("prov-cmp-pod");
+    run_ok(&["pod", s(&ds), "--modes", "3", "--out", s(&pod)]);
+    let hom = scratch("prov-cmp-hom");
+    let rom = scratch("prov-cmp-rom");
+    let sim = |out: &Path, model: Option<&Path>| {
+        let mut a = vec![
+            "simulate",
+            "single-tendon",
+            "--duration",
+            "0.2",
+            "--from-equilibrium",
+            "--out",
+            s(out),
+        ];
+        if let Some(m) = model {
+            a.extend(["--model", s(m)]);
+        }
+        run_ok(&a);
+    };
+    sim(&hom, None);
+    sim(&rom, Some(&pod));
+    let report = scratch("prov-compare.json");
+    let cmp_args = ["compare", s(&hom), s(&rom), "--json", s(&report)];
+    run_ok(&cmp_args);
+    let doc = json(&report);
+    let p = &doc["provenance"];
+    check_common(p, &cmp_args, t0);
+    for (key, dir) in [("reference", &hom), ("run", &rom)] {
+        let meta = json(&dir.join("meta.json"));
+        assert_eq!(p[key]["path"], s(dir), "{p}");
+        assert_eq!(p[key]["meta_sha256"], meta["gvsrom"]["meta_sha256"]);
+        assert_eq!(p[key]["sha256"], meta["gvsrom"]["sha256"]);
+    }
+    assert_eq!(doc["reference"]["n_dof"], 33);
+    assert_eq!(doc["run"]["n_dof"], 3);
+    let tip_max = doc["comparison"]["tip_max"].as_f64().unwrap();
+    assert!(tip_max.is_finite() && tip_max >= 0.0, "{doc}");
+    // the report is an output of its own: replaced only with --force, never over an input
+    let again = gvsrom(&cmp_args);
+    assert!(!again.status.success());
+    let over_input = gvsrom(&["compare", s(&hom), s(&rom), "--json", s(&hom), "--force"]);
+    let stderr = String::from_utf8_lossy(&over_input.stderr);
+    assert!(
+        !over_input.status.success() && stderr.contains("--json"),
+        "{stderr}"
+    );
+}

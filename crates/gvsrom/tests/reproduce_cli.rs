@@ -103,6 +103,27 @@ fn check_case(dir: &Path, case: &str) {
     }
     assert!(!results["findings"].as_array().unwrap().is_empty());
     assert!(results["setup"].as_array().unwrap().len() >= 2);
+    // how the report was made: this version and the command that ran it
+    let p = &results["provenance"];
+    assert_eq!(
+        p["gvsrom_version"],
+        env!("CARGO_PKG_VERSION"),
+        "{case}: {p}"
+    );
+    let command: Vec<&str> = p["command"]
+        .as_array()
+        .unwrap_or_else(|| panic!("{case}: no provenance command: {p}"))
+        .iter()
+        .filter_map(Value::as_str)
+        .collect();
+    assert!(
+        command.get(1) == Some(&"reproduce") && command.contains(&case),
+        "{case}: {command:?}"
+    );
+    assert!(
+        p["started"].as_str().is_some_and(|t| t.ends_with('Z')),
+        "{p}"
+    );
 }
 
 #[test]

@@ -156,6 +156,7 @@ pub fn run(
     let mut done = vec![];
     for case in cases {
         let t0 = Instant::now();
+        let provenance = crate::provenance::Provenance::of_command();
         let before = run.records().len();
         writeln!(
             log,
@@ -185,6 +186,7 @@ pub fn run(
         report.steps = run.records()[before..].to_vec();
         report.crate_version = env!("CARGO_PKG_VERSION").into();
         report.quick = opts.quick;
+        report.provenance = Some(provenance);
         let path = report::write_case(&run.path().join(case.name()), &mut report, figures)?;
         let steps = &run.records()[before..];
         let reused = steps.iter().filter(|r| r.reused).count();
@@ -238,5 +240,6 @@ pub(crate) fn new_report(case: Case, title: &str) -> CaseReport {
         quick: false,
         crate_version: String::new(),
         wall_time_s: 0.0,
+        provenance: None,
     }
 }

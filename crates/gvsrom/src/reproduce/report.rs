@@ -122,6 +122,10 @@ pub struct CaseReport {
     pub quick: bool,
     pub crate_version: String,
     pub wall_time_s: f64,
+    /// How the report was made: the version, the command line and the start time (the steps'
+    /// own settings and keys are in `settings` and `steps`).
+    #[serde(default)]
+    pub provenance: Option<crate::provenance::Provenance>,
 }
 
 impl CaseReport {
