@@ -36,10 +36,10 @@ pub enum Command {
     /// write the trajectory as NumPy arrays.
     Simulate(SimulateArgs),
     /// Natural frequencies and mode shapes about the static equilibrium under the scenario's loads
-    /// and tensions (undamped, linearized; see README "Natural frequencies and mode shapes").
+    /// and tensions (undamped, linearized; see docs/modes.md).
     Modes(ModesArgs),
     /// Generate a strain snapshot dataset: solve the statics over a sampling plan (`--sweep`,
-    /// `--grid`, `--random`) in parallel and write NumPy arrays (see README "Datasets").
+    /// `--grid`, `--random`) in parallel and write NumPy arrays (see docs/datasets.md).
     Dataset(gvsrom::dataset::DatasetArgs),
     /// POD of a dataset's strain snapshots: K modes become a reduced model (`--model` on `statics`
     /// and `simulate`).

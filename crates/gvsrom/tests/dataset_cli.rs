@@ -629,31 +629,11 @@ fn load_and_material_parameters_match_statics_with_set() {
     }
 }
 
-#[test]
-fn an_interrupt_stops_a_long_load_ramp_within_one_stage_not_at_the_next_sample() {
-    // one sample with a 10 000-stage ramp takes seconds (≈ 8 s here); SIGINT during it must end
-    // the run at the next stage, not after the sample (nor after the chunk)
-    let dir = scratch("ds-interrupted-ramp");
+/// Runs `gvsrom args` (writing `dir`), sends SIGINT after 1 s and checks that it exits with 130
+/// within 4 s of its start, marking the dataset incomplete.
+fn interrupted_soon(args: &[&str], dir: &Path) {
     let t0 = std::time::Instant::now();
-    let out = common::interrupted(
-        &[
-            "dataset",
-            "six-tendon",
-            "--set",
-            "solver.ramp_steps=10000",
-            "--random",
-            "tendons.*.tension=-30:30",
-            "--samples",
-            "2",
-            "--chunk-size",
-            "1",
-            "--threads",
-            "1",
-            "--out",
-            dir.to_str().unwrap(),
-        ],
-        std::time::Duration::from_millis(1000),
-    );
+    let out = common::interrupted(args, std::time::Duration::from_millis(1000));
     let elapsed = t0.elapsed().as_secs_f64();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(130), "{stderr}");
@@ -663,7 +643,6 @@ fn an_interrupt_stops_a_long_load_ramp_within_one_stage_not_at_the_next_sample()
     );
     let meta = json(&dir.join("meta.json"));
     assert_eq!(meta["complete"], false);
-    assert_eq!(meta["counts"]["ok"], 0, "{meta}");
     assert!(
         meta["reason"]
             .as_str()
@@ -673,38 +652,52 @@ fn an_interrupt_stops_a_long_load_ramp_within_one_stage_not_at_the_next_sample()
 }
 
 #[test]
+fn an_interrupt_stops_a_long_load_ramp_within_one_stage_not_at_the_next_sample() {
+    // one sample with a 10 000-stage ramp takes seconds (≈ 8 s here); SIGINT during it must end
+    // the run at the next stage, not after the sample (nor after the chunk)
+    let dir = scratch("ds-interrupted-ramp");
+    let args = [
+        "dataset",
+        "six-tendon",
+        "--set",
+        "solver.ramp_steps=10000",
+        "--random",
+        "tendons.*.tension=-30:30",
+        "--samples",
+        "2",
+        "--chunk-size",
+        "1",
+        "--threads",
+        "1",
+        "--out",
+        dir.to_str().unwrap(),
+    ];
+    interrupted_soon(&args, &dir);
+    assert_eq!(json(&dir.join("meta.json"))["counts"]["ok"], 0);
+}
+
+#[test]
 fn an_interrupt_stops_a_dynamic_dataset_between_integrator_steps_not_at_the_next_sample() {
     // tight tolerances and one sample every 2 s: the first interval takes far longer than 30 s
     // here, so only the per-step poll can end the run soon after SIGINT
     let dir = scratch("ds-interrupted-steps");
-    let t0 = std::time::Instant::now();
-    let out = common::interrupted(
-        &[
-            "dataset",
-            "six-tendon",
-            "--duration",
-            "4",
-            "--babble=-15,0,0.05,0.1",
-            "--sample-rate",
-            "0.5",
-            "--rtol",
-            "1e-12",
-            "--atol",
-            "1e-14",
-            "--out",
-            dir.to_str().unwrap(),
-        ],
-        std::time::Duration::from_millis(1000),
-    );
-    let elapsed = t0.elapsed().as_secs_f64();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(130), "{stderr}");
-    assert!(
-        elapsed < 4.0,
-        "the run ended {elapsed:.1} s after its start, 1 s after SIGINT: {stderr}"
-    );
-    let ds = Dataset::load(&dir).unwrap();
-    assert!(!ds.meta.complete);
+    let args = [
+        "dataset",
+        "six-tendon",
+        "--duration",
+        "4",
+        "--babble=-15,0,0.05,0.1",
+        "--sample-rate",
+        "0.5",
+        "--rtol",
+        "1e-12",
+        "--atol",
+        "1e-14",
+        "--out",
+        dir.to_str().unwrap(),
+    ];
+    interrupted_soon(&args, &dir);
     // the initial sample only
+    let ds = Dataset::load(&dir).unwrap();
     assert_eq!(ds.t.as_deref(), Some(&[0.0][..]));
 }
