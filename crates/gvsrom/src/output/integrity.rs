@@ -65,9 +65,14 @@ pub enum Problem {
     MetaEdited,
 }
 
-/// The SHA-256 of `bytes` as 64 lowercase hex digits.
+/// A digest as lowercase hex digits.
 fn hex(digest: &[u8]) -> String {
     digest.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// The SHA-256 of `bytes` as 64 lowercase hex digits, as the manifest records a file's.
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    hex(&Sha256::digest(bytes))
 }
 
 /// The SHA-256 of the file at `path`, read in blocks (any size).
