@@ -350,13 +350,8 @@ mod tests {
     #[cfg(target_os = "linux")]
     #[test]
     fn a_fifo_is_refused_naming_it_without_waiting_for_a_writer() {
-        let dir = std::env::temp_dir().join(format!("gvsrom-csv-fifo-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let pipe = dir.join("in.csv");
-        let _ = std::fs::remove_file(&pipe);
-        let c = std::ffi::CString::new(pipe.to_str().unwrap()).unwrap();
-        // SAFETY: a valid NUL-terminated path
-        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+        let pipe = crate::output::test_util::sandbox("csv", "fifo").join("in.csv");
+        crate::output::test_util::fifo(&pipe);
         // no writer ever opens it: a reader that opened it plainly would block this test forever
         let e = read_csv_signal(&pipe, 1, Interpolation::Hold)
             .unwrap_err()

@@ -408,19 +408,9 @@ mod tests {
         bytes
     }
 
-    fn sandbox(name: &str) -> std::path::PathBuf {
-        let d = std::env::temp_dir().join(format!(
-            "gvsrom-dataset-reader-{}-{name}",
-            std::process::id()
-        ));
-        let _ = std::fs::remove_dir_all(&d);
-        std::fs::create_dir_all(&d).unwrap();
-        d
-    }
-
     #[test]
     fn an_array_is_used_only_with_the_hash_its_manifest_records() {
-        let dir = sandbox("hashed");
+        let dir = crate::output::test_util::sandbox("dataset-reader", "hashed");
         let bytes = write_array(&dir);
         // the hash of the bytes written, computed here independently of the reader
         let sha = {

@@ -142,9 +142,7 @@ mod tests {
     fn a_fifo_is_refused_without_waiting_for_a_writer() {
         let d = sandbox("fifo");
         let pipe = d.join("p");
-        let c = std::ffi::CString::new(pipe.to_str().unwrap()).unwrap();
-        // SAFETY: a valid NUL-terminated path
-        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+        super::super::test_util::fifo(&pipe);
         // no writer ever opens it: a plain open would block this test forever
         let e = read_regular(&pipe).unwrap_err();
         assert_eq!(

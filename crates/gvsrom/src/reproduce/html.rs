@@ -144,17 +144,15 @@ figure{margin:1em 0}figure img{max-width:100%;border:1px solid #ddd}
 figcaption{font-size:.9em;color:#444}pre{background:#f6f6f6;padding:.5em;overflow:auto;font-size:.8em}
 ";
 
-#[cfg(test)]
+#[cfg(all(test, target_os = "linux"))]
 mod tests {
     use super::super::report::FigureRef;
     use super::super::{new_report, Case};
     use super::*;
 
-    #[cfg(target_os = "linux")]
     #[test]
     fn a_figure_that_is_a_fifo_is_an_error_naming_it_not_a_wait() {
-        let dir = std::env::temp_dir().join(format!("gvsrom-html-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
+        let dir = crate::output::test_util::sandbox("html", "fifo-figure");
         let mut report = new_report(Case::EVERY[0], "t");
         report.figures.push(FigureRef {
             stem: "fig".into(),
@@ -163,9 +161,7 @@ mod tests {
         let case_dir = dir.join(&report.case);
         std::fs::create_dir_all(&case_dir).unwrap();
         let pipe = case_dir.join("fig.png");
-        let c = std::ffi::CString::new(pipe.to_str().unwrap()).unwrap();
-        // SAFETY: a valid NUL-terminated path
-        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+        crate::output::test_util::fifo(&pipe);
         // no writer ever opens it: a plain read would block this test forever
         let e = format!("{:#}", index(&[report], &dir).unwrap_err());
         assert!(

@@ -263,9 +263,7 @@ mod tests {
 
     #[test]
     fn a_record_is_reused_only_with_its_key_and_a_fifo_in_its_place_is_not_waited_on() {
-        let dir = std::env::temp_dir().join(format!("gvsrom-step-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::output::test_util::sandbox("step", "record");
         let record = dir.join("s.step.json");
         let text = json!({"step": "s", "key": "k1", "wall_time_s": 2.5, "value": [1, 2]});
         std::fs::write(&record, text.to_string()).unwrap();
@@ -277,9 +275,7 @@ mod tests {
         #[cfg(target_os = "linux")]
         {
             let pipe = dir.join("p.step.json");
-            let c = std::ffi::CString::new(pipe.to_str().unwrap()).unwrap();
-            // SAFETY: a valid NUL-terminated path
-            assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+            crate::output::test_util::fifo(&pipe);
             // no writer ever opens it: a plain read would block this test forever
             assert_eq!(read_record::<Vec<u32>>(&pipe, "k1"), None);
         }
