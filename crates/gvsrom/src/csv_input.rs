@@ -75,9 +75,11 @@ pub fn read_csv_signal(
     interpolation: Interpolation,
 ) -> Result<Signal, ScenarioError> {
     let file = path.display().to_string();
-    crate::scenario::check_regular_file(&file, path)?;
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| ScenarioError::invalid(&file, format!("cannot read the input file: {e}")))?;
+    let text = crate::output::read_regular_to_string(path).map_err(|e| {
+        crate::scenario::read_error(&file, path, e, |e| {
+            ScenarioError::invalid(&file, format!("cannot read the input file: {e}"))
+        })
+    })?;
     let expected = n_values + 1;
     let mut times: Vec<f64> = vec![];
     let mut values = vec![];
@@ -186,15 +188,12 @@ pub fn read_csv_signal(
 /// The SHA-256 of the file at `path` (option `field`), in hex: what a trajectory records of its
 /// CSV input, so that two runs can be told to have had the same input.
 pub fn file_sha256(field: &str, path: &Path) -> Result<String, ScenarioError> {
-    use sha2::{Digest, Sha256};
-    crate::scenario::check_regular_file(field, path)?;
-    let bytes = std::fs::read(path).map_err(|e| {
-        ScenarioError::invalid(field, format!("cannot read `{}`: {e}", path.display()))
+    let bytes = crate::output::read_regular(path).map_err(|e| {
+        crate::scenario::read_error(field, path, e, |e| {
+            ScenarioError::invalid(field, format!("cannot read `{}`: {e}", path.display()))
+        })
     })?;
-    Ok(Sha256::digest(&bytes)
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect())
+    Ok(crate::output::integrity::sha256_hex(&bytes))
 }
 
 /// The largest |value| of each channel over the signal's knots: `max_k |values[k][j]|`, which is
@@ -346,6 +345,24 @@ mod tests {
             e.contains("--input") && e.contains("a character device"),
             "{e}"
         );
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_fifo_is_refused_naming_it_without_waiting_for_a_writer() {
+        let pipe = crate::output::test_util::sandbox("csv", "fifo").join("in.csv");
+        crate::output::test_util::fifo(&pipe);
+        // no writer ever opens it: a reader that opened it plainly would block this test forever
+        let e = read_csv_signal(&pipe, 1, Interpolation::Hold)
+            .unwrap_err()
+            .to_string();
+        let shown = format!(
+            "`{}` is a FIFO (named pipe), not a regular file",
+            pipe.display()
+        );
+        assert!(e.contains(&shown), "{e}");
+        let e = file_sha256("--input", &pipe).unwrap_err().to_string();
+        assert!(e.contains("--input") && e.contains(&shown), "{e}");
     }
 
     #[test]

@@ -31,38 +31,58 @@ pub fn read_checked<T: npyz::Deserialize>(
     descr: &str,
     shape: &[usize],
 ) -> Result<Vec<T>, NpyError> {
+    let (bytes, shown) = read_file(dir, name)?;
+    parse_checked(&bytes, &shown, descr, shape)
+}
+
+/// The bytes of the array file `dir/name` and its path as errors show it. Only a regular file is
+/// read ([`crate::output::read`]).
+pub fn read_file(dir: &Path, name: &str) -> Result<(Vec<u8>, String), NpyError> {
     let path = dir.join(name);
     let shown = path.display().to_string();
-    let bytes = crate::output::read_regular(&path).map_err(|e| match e.kind() {
-        std::io::ErrorKind::NotFound => npy_error(&shown, "missing array"),
-        _ => npy_error(&shown, format!("cannot read it: {e}")),
-    })?;
+    match crate::output::read_regular(&path) {
+        Ok(bytes) => Ok((bytes, shown)),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            Err(npy_error(&shown, "missing array"))
+        }
+        Err(e) => Err(npy_error(&shown, format!("cannot read it: {e}"))),
+    }
+}
+
+/// The array held by `bytes` (of the file shown as `shown` in errors), which must be a C-order
+/// `.npy` array of dtype `descr` and shape `shape`, with no byte missing or extra.
+pub fn parse_checked<T: npyz::Deserialize>(
+    bytes: &[u8],
+    shown: &str,
+    descr: &str,
+    shape: &[usize],
+) -> Result<Vec<T>, NpyError> {
     // npyz multiplies the shape's dimensions in u64 without checking, so a header whose numbers
     // could overflow that product is refused before npyz reads it
-    if let Some(bits) = header_number_bits(&bytes).filter(|&b| b > 64) {
+    if let Some(bits) = header_number_bits(bytes).filter(|&b| b > 64) {
         return Err(npy_error(
-            &shown,
+            shown,
             format!(
                 "not a valid .npy file: its header holds numbers of up to {bits} bits together, more than the 64 bits any array shape (product of dimensions) can take"
             ),
         ));
     }
-    let npy = npyz::NpyFile::new(&bytes[..])
-        .map_err(|e| npy_error(&shown, format!("not a valid .npy file: {e}")))?;
+    let npy = npyz::NpyFile::new(bytes)
+        .map_err(|e| npy_error(shown, format!("not a valid .npy file: {e}")))?;
     let dtype = npy.dtype().descr();
     if dtype != format!("'{descr}'") {
         return Err(npy_error(
-            &shown,
+            shown,
             format!("dtype {dtype}, expected '{descr}'"),
         ));
     }
     if npy.order() != npyz::Order::C {
-        return Err(npy_error(&shown, "Fortran order, expected C order"));
+        return Err(npy_error(shown, "Fortran order, expected C order"));
     }
     let got: Vec<usize> = npy.shape().iter().map(|&d| d as usize).collect();
     if got != shape {
         return Err(npy_error(
-            &shown,
+            shown,
             format!("shape {got:?}, expected {shape:?} from meta.json"),
         ));
     }
@@ -72,14 +92,14 @@ pub fn read_checked<T: npyz::Deserialize>(
         .try_fold(size, |a, &d| a.checked_mul(d))
         .ok_or_else(|| {
             npy_error(
-                &shown,
+                shown,
                 format!("shape {shape:?} of {size}-byte values holds more bytes than any file"),
             )
         })?;
     let data_len = npy.into_inner().len();
     if data_len != expected {
         return Err(npy_error(
-            &shown,
+            shown,
             format!(
                 "{} ({data_len} data bytes, expected {expected} for shape {shape:?})",
                 if data_len < expected {
@@ -90,26 +110,21 @@ pub fn read_checked<T: npyz::Deserialize>(
             ),
         ));
     }
-    npyz::NpyFile::new(&bytes[..])
+    npyz::NpyFile::new(bytes)
         .and_then(|f| f.into_vec::<T>())
-        .map_err(|e| npy_error(&shown, format!("cannot read the data: {e}")))
+        .map_err(|e| npy_error(shown, format!("cannot read the data: {e}")))
 }
 
 /// Reads `dir/name` as a 1-D little-endian f64 array of whatever length its header gives (a curve
 /// such as a model's `train_loss.npy`), checked like [`read_checked`].
 pub fn read_vector(dir: &Path, name: &str) -> Result<Vec<f64>, NpyError> {
-    let path = dir.join(name);
-    let shown = path.display().to_string();
-    let bytes = std::fs::read(&path).map_err(|e| match e.kind() {
-        std::io::ErrorKind::NotFound => npy_error(&shown, "missing array"),
-        _ => npy_error(&shown, format!("cannot read it: {e}")),
-    })?;
+    let (bytes, shown) = read_file(dir, name)?;
     let len = header_number_bits(&bytes)
         .filter(|&b| b <= 64)
         .and_then(|_| npyz::NpyFile::new(&bytes[..]).ok())
         .map(|npy| npy.shape().to_vec());
     match len.as_deref() {
-        Some(&[n]) => read_checked(dir, name, "<f8", &[n as usize]),
+        Some(&[n]) => parse_checked(&bytes, &shown, "<f8", &[n as usize]),
         Some(shape) => Err(npy_error(
             &shown,
             format!("shape {shape:?}, expected a 1-D array"),

@@ -94,10 +94,11 @@ pub fn source(arg: &str) -> Result<Source, ScenarioError> {
             available: names(),
         });
     }
-    crate::scenario::check_regular_file("SCENARIO", path)?;
-    let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Io {
-        path: arg.to_string(),
-        error: e,
+    let text = crate::output::read_regular_to_string(path).map_err(|e| {
+        crate::scenario::read_error("SCENARIO", path, e, |error| ScenarioError::Io {
+            path: arg.to_string(),
+            error,
+        })
     })?;
     Ok(Source {
         origin: arg.to_string(),

@@ -66,7 +66,8 @@ impl ModelLayout {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DatasetRef {
     pub path: String,
-    /// FNV-1a 64 of the dataset's `strain.npy` bytes (a change detector, not a signature).
+    /// The SHA-256 of the `strain.npy` bytes the model was made from, as the dataset's manifest
+    /// records it (16 hex digits of FNV-1a 64 in models made by earlier versions).
     pub strain_hash: String,
     /// Rows used (failed samples skipped).
     pub rows: usize,

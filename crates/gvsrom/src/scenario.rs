@@ -13,6 +13,7 @@ use gvs::loads::{Frame, PulseMagnitude};
 use gvs::solve::statics::StaticsOptions;
 use gvs::strain::FemDegree;
 use serde::{Deserialize, Serialize};
+use std::path::Path;
 use toml::{Table, Value};
 
 /// A complete scenario: a rod, its discretization and strain basis, tendons, loads, solver and
@@ -393,48 +394,44 @@ impl Scenario {
     }
 }
 
-/// Refuses `path` (given as `field`, e.g. `SCENARIO` or `--input`) if it is something other than a
-/// regular file (or a link to one), before anything opens it: opening a FIFO blocks until a writer
-/// appears, a device reads forever, a directory cannot be read. The error says what it is. A path
-/// whose metadata cannot be read (missing, no permission) passes: the reader reports that itself.
-pub fn check_regular_file(field: &str, path: &std::path::Path) -> Result<(), ScenarioError> {
-    let Ok(meta) = std::fs::metadata(path) else {
-        return Ok(());
-    };
-    let ft = meta.file_type();
-    if ft.is_file() {
-        return Ok(());
-    }
-    let what = if ft.is_dir() {
-        "a directory"
-    } else {
-        special_file_kind(&ft)
-    };
-    Err(ScenarioError::invalid(
+/// The error of `path` (given as `field`, e.g. `SCENARIO` or `--input`) that is `kind` ("a FIFO
+/// (named pipe)", "a directory", …: [`crate::output::read::file_kind`]) instead of a regular file.
+fn not_a_regular_file(field: &str, path: &Path, kind: &str) -> ScenarioError {
+    ScenarioError::invalid(
         field,
-        format!("`{}` is {what}, not a regular file", path.display()),
-    ))
+        format!("`{}` is {kind}, not a regular file", path.display()),
+    )
 }
 
-#[cfg(unix)]
-fn special_file_kind(ft: &std::fs::FileType) -> &'static str {
-    use std::os::unix::fs::FileTypeExt;
-    if ft.is_fifo() {
-        "a FIFO (named pipe)"
-    } else if ft.is_char_device() {
-        "a character device"
-    } else if ft.is_block_device() {
-        "a block device"
-    } else if ft.is_socket() {
-        "a socket"
-    } else {
-        "a special file"
+/// An error of [`crate::output::read`] reading the input `path` (given as `field`) as a scenario
+/// error: a path that is not a regular file is refused naming `field`, the path and what it is; any
+/// other error (missing, no permission, not UTF-8) goes through `other`.
+pub fn read_error(
+    field: &str,
+    path: &Path,
+    e: std::io::Error,
+    other: impl FnOnce(std::io::Error) -> ScenarioError,
+) -> ScenarioError {
+    match crate::output::read::not_regular_kind(&e) {
+        Some(kind) => not_a_regular_file(field, path, kind),
+        None => other(e),
     }
 }
 
-#[cfg(not(unix))]
-fn special_file_kind(_ft: &std::fs::FileType) -> &'static str {
-    "a special file"
+/// Refuses `path` (given as `field`) if it is something other than a regular file (or a link to
+/// one); the error says what it is. A path whose metadata cannot be read (missing, no permission)
+/// passes: the reader reports that itself. A check before opening leaves a window in which the path
+/// can be replaced: read with [`crate::output::read`] (and [`read_error`]) instead, which also
+/// checks the opened file.
+pub fn check_regular_file(field: &str, path: &Path) -> Result<(), ScenarioError> {
+    match std::fs::metadata(path) {
+        Ok(meta) if !meta.is_file() => Err(not_a_regular_file(
+            field,
+            path,
+            crate::output::read::file_kind(&meta.file_type()),
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// TOML text → table; syntax errors carry line and column.

@@ -151,6 +151,26 @@ fn ae_small() -> &'static Path {
 }
 
 #[test]
+fn a_model_records_the_strain_hash_its_dataset_manifest_records() {
+    use sha2::{Digest, Sha256};
+    let ds = dataset40();
+    // the hash of the file's bytes, computed here, not by gvsrom
+    let bytes = std::fs::read(ds.join("strain.npy")).unwrap();
+    let sha: String = Sha256::digest(&bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    assert_eq!(
+        json(&ds.join("meta.json"))["gvsrom"]["sha256"]["strain.npy"],
+        sha.as_str()
+    );
+    for model in [pod33(), ae_small()] {
+        let meta = json(&model.join("meta.json"));
+        assert_eq!(meta["dataset"]["strain_hash"], sha.as_str(), "{model:?}");
+    }
+}
+
+#[test]
 fn a_pod_rom_with_all_modes_reproduces_the_hom_equilibrium() {
     let (model, rank) = pod_full();
     // sample k = 13 of the sweep: -6 + 9·13/39 = -3 N

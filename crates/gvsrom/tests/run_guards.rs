@@ -7,54 +7,14 @@
 
 mod common;
 
-use common::{gvsrom, scratch};
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, ExitStatus, Output, Stdio};
+use common::{expect_error_within, fifo_at, gvsrom, scratch, spawn, wait_within};
+use std::path::Path;
 use std::time::{Duration, Instant};
 
-/// Waits for `child` up to `limit`; kills it (SIGKILL) and returns `None` past the deadline.
-fn wait_at_most(mut child: Child, limit: Duration) -> Option<(ExitStatus, Output)> {
-    let start = Instant::now();
-    loop {
-        if let Some(status) = child.try_wait().unwrap() {
-            let out = child.wait_with_output().unwrap();
-            return Some((status, out));
-        }
-        if start.elapsed() > limit {
-            let _ = child.kill();
-            let _ = child.wait();
-            return None;
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-}
-
-fn spawn(args: &[&str]) -> Child {
-    Command::new(env!("CARGO_BIN_EXE_gvsrom"))
-        .args(args)
-        .stdin(Stdio::null())
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("the gvsrom binary runs")
-}
-
-/// Runs `args` with a 5 s deadline and expects a one-line user error (exit code 1) containing
-/// every string of `needles`; returns the message.
+/// Runs `args` with a 5 s deadline and expects a one-line user error containing every string of
+/// `needles` ([`expect_error_within`]); returns the message.
 fn expect_error_fast(args: &[&str], needles: &[&str]) -> String {
-    let (status, out) = wait_at_most(spawn(args), Duration::from_secs(5))
-        .unwrap_or_else(|| panic!("gvsrom {args:?} did not finish within 5 s"));
-    let stderr = String::from_utf8_lossy(&out.stderr).to_string();
-    assert_eq!(status.code(), Some(1), "gvsrom {args:?}: {stderr}");
-    assert!(!stderr.contains("panicked"), "{stderr}");
-    assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
-    for n in needles {
-        assert!(
-            stderr.contains(n),
-            "gvsrom {args:?}: error lacks `{n}`: {stderr}"
-        );
-    }
-    stderr
+    expect_error_within(Duration::from_secs(5), args, needles)
 }
 
 fn path(p: &Path) -> &str {
@@ -133,8 +93,9 @@ fn sigterm_stops_a_slow_simulation_within_a_step_and_writes_the_partial_trajecto
         unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGTERM) },
         0
     );
-    let (status, out) = wait_at_most(child, Duration::from_secs(4))
+    let out = wait_within(child, Duration::from_secs(4))
         .expect("gvsrom simulate did not stop within 4 s of SIGTERM");
+    let status = out.status;
     let stderr = String::from_utf8_lossy(&out.stderr);
     println!(
         "stopped {:.3} s after SIGTERM",
@@ -149,22 +110,11 @@ fn sigterm_stops_a_slow_simulation_within_a_step_and_writes_the_partial_trajecto
     assert_eq!(meta["samples"], 1, "{meta}");
 }
 
-/// A FIFO at scratch `name` (no writer ever opens it: reading it would block forever).
-fn fifo(name: &str) -> PathBuf {
-    let p = scratch(name);
-    let c = std::ffi::CString::new(path(&p)).unwrap();
-    // SAFETY: a valid NUL-terminated path
-    assert_eq!(
-        unsafe { libc::mkfifo(c.as_ptr(), 0o600) },
-        0,
-        "mkfifo {p:?}"
-    );
-    p
-}
-
 #[test]
 fn a_fifo_or_directory_given_as_a_file_input_fails_at_once_saying_what_it_is() {
-    let pipe = fifo("input.fifo");
+    // no writer ever opens it: reading it would block forever
+    let pipe = scratch("input.fifo");
+    fifo_at(&pipe);
     let pipe = path(&pipe);
     expect_error_fast(
         &["statics", pipe],
@@ -193,9 +143,7 @@ fn a_fifo_or_directory_given_as_a_file_input_fails_at_once_saying_what_it_is() {
     // a trajectory whose meta.json is a FIFO
     let traj = scratch("fifo-trajectory");
     std::fs::create_dir_all(&traj).unwrap();
-    let c = std::ffi::CString::new(path(&traj.join("meta.json"))).unwrap();
-    // SAFETY: a valid NUL-terminated path
-    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+    fifo_at(&traj.join("meta.json"));
     expect_error_fast(
         &["compare", path(&traj), path(&traj)],
         &["REFERENCE", "meta.json", "a FIFO"],

@@ -16,7 +16,8 @@ use std::path::{Path, PathBuf};
 /// How a noisy dataset was made (in its `meta.json`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct NoiseInfo {
-    /// The clean dataset's path and the FNV-1a hash of its `strain.npy`.
+    /// The clean dataset's path and the SHA-256 of the `strain.npy` bytes the noise was added to
+    /// (as its manifest records it; 16 hex digits of FNV-1a 64 in datasets made by earlier versions).
     pub source: String,
     pub source_strain_hash: String,
     /// σ relative to the RMS of each component of the clean snapshots.
@@ -75,15 +76,9 @@ pub fn with_noise(
     }
     let count = (ok.len() * width / a).max(1) as f64;
     let sigma: Vec<f64> = sum.iter().map(|s| level * (s / count).sqrt()).collect();
-    let bytes = crate::output::read_regular(&src.join(super::FILES[1])).map_err(|e| {
-        DatasetError::File {
-            file: src.join(super::FILES[1]).display().to_string(),
-            message: format!("cannot read it: {e}"),
-        }
-    })?;
     let info = NoiseInfo {
         source: src.display().to_string(),
-        source_strain_hash: crate::reduced_model::fnv1a64(&bytes),
+        source_strain_hash: ds.strain_sha256.clone(),
         level,
         sigma: sigma.clone(),
         seed,

@@ -6,7 +6,8 @@
 
 use super::generate::{STATUS_FAILED, STATUS_NOT_COMPUTED, STATUS_OK};
 use super::{DatasetError, Meta, FILES, T_FILE};
-use crate::output::integrity::{Integrity, IntegrityError, Problem};
+use crate::output::integrity::{recorded_hashes, sha256_hex, Integrity, IntegrityError, Problem};
+use std::collections::BTreeMap;
 use std::path::Path;
 
 /// The manifest format of a dataset directory.
@@ -37,6 +38,9 @@ pub struct Dataset {
     /// Whether the files were checked against recorded hashes ([`Integrity::Unhashed`]: a dataset
     /// written before gvsrom recorded them; a front-end may warn).
     pub integrity: Integrity,
+    /// The SHA-256 (hex) of the `strain.npy` bytes `strain` was read from: for a checked dataset,
+    /// the hash its manifest records. What a model or a noisy copy records of its source.
+    pub strain_sha256: String,
 }
 
 fn file_error(file: &str, message: impl Into<String>) -> DatasetError {
@@ -46,14 +50,58 @@ fn file_error(file: &str, message: impl Into<String>) -> DatasetError {
     }
 }
 
-/// [`crate::npy::read_checked`] with its error as a dataset file error.
-fn read_npy<T: npyz::Deserialize>(
-    dir: &Path,
-    name: &str,
-    descr: &str,
-    shape: &[usize],
-) -> Result<Vec<T>, DatasetError> {
-    crate::npy::read_checked(dir, name, descr, shape).map_err(|e| file_error(&e.file, e.message))
+/// Reads the arrays of a dataset directory, each file once: the bytes parsed are the bytes hashed.
+struct Arrays<'a> {
+    dir: &'a Path,
+    /// For a checked dataset, the hashes its manifest records: each file read must still have its
+    /// own, so a file replaced after [`crate::output::verify_dir`] checked it is refused, not used.
+    recorded: Option<BTreeMap<String, String>>,
+}
+
+impl Arrays<'_> {
+    /// The array `name` ([`crate::npy::parse_checked`]) and the SHA-256 of the bytes it was read
+    /// from.
+    fn read_hashed<T: npyz::Deserialize>(
+        &self,
+        name: &str,
+        descr: &str,
+        shape: &[usize],
+    ) -> Result<(Vec<T>, String), DatasetError> {
+        let npy = |e: crate::npy::NpyError| file_error(&e.file, e.message);
+        let (bytes, shown) = crate::npy::read_file(self.dir, name).map_err(npy)?;
+        let sha256 = sha256_hex(&bytes);
+        match self.recorded.as_ref().map(|r| r.get(name)) {
+            None => {}
+            Some(Some(recorded)) if *recorded == sha256 => {}
+            Some(Some(_)) => {
+                return Err(file_error(
+                    &shown,
+                    format!(
+                        "{}; it changed while the dataset was being read (is another process writing it?)",
+                        Problem::Changed
+                    ),
+                ))
+            }
+            Some(None) => {
+                return Err(file_error(
+                    &shown,
+                    "meta.json records no hash for it (gvsrom lists and hashes every file of a dataset)",
+                ))
+            }
+        }
+        let v = crate::npy::parse_checked(&bytes, &shown, descr, shape).map_err(npy)?;
+        Ok((v, sha256))
+    }
+
+    /// The array `name`, read as [`Arrays::read_hashed`].
+    fn read<T: npyz::Deserialize>(
+        &self,
+        name: &str,
+        descr: &str,
+        shape: &[usize],
+    ) -> Result<Vec<T>, DatasetError> {
+        Ok(self.read_hashed(name, descr, shape)?.0)
+    }
 }
 
 /// An integrity error as a dataset error. For a file changed since it was written, what reading it
@@ -119,6 +167,13 @@ impl Dataset {
                 "not a gvsrom dataset (its manifest does not say format \"dataset\")",
             ));
         }
+        let arrays = Arrays {
+            dir,
+            recorded: match integrity {
+                Integrity::Checked => Some(recorded_hashes(&value)),
+                Integrity::Unhashed => None,
+            },
+        };
         let meta: Meta = serde_json::from_value(value)
             .map_err(|e| file_error(&shown, format!("does not describe a dataset: {e}")))?;
         let kind_ok = match meta.kind.as_str() {
@@ -146,22 +201,26 @@ impl Dataset {
         }
         let row = p * meta.components.len();
         let f8 = "<f8";
+        // in the files' order: the first file found wrong is the one named
+        let inputs = arrays.read(FILES[0], f8, &[n, d])?;
+        let (strain, strain_sha256) = arrays.read_hashed(FILES[1], f8, &[n, row])?;
         let ds = Dataset {
-            inputs: read_npy(dir, FILES[0], f8, &[n, d])?,
-            strain: read_npy(dir, FILES[1], f8, &[n, row])?,
-            q: read_npy(dir, FILES[2], f8, &[n, meta.n_dof])?,
-            tip_position: read_npy(dir, FILES[3], f8, &[n, 3])?,
-            tip_rotation: read_npy(dir, FILES[4], f8, &[n, 3, 3])?,
-            status: read_npy(dir, FILES[5], "|u1", &[n])?,
-            iterations: read_npy(dir, FILES[6], "<u4", &[n])?,
-            residual: read_npy(dir, FILES[7], f8, &[n])?,
-            strain_x: read_npy(dir, FILES[8], f8, &[p])?,
+            inputs,
+            strain,
+            q: arrays.read(FILES[2], f8, &[n, meta.n_dof])?,
+            tip_position: arrays.read(FILES[3], f8, &[n, 3])?,
+            tip_rotation: arrays.read(FILES[4], f8, &[n, 3, 3])?,
+            status: arrays.read(FILES[5], "|u1", &[n])?,
+            iterations: arrays.read(FILES[6], "<u4", &[n])?,
+            residual: arrays.read(FILES[7], f8, &[n])?,
+            strain_x: arrays.read(FILES[8], f8, &[p])?,
             t: match meta.kind.as_str() {
-                "dynamics" => Some(read_npy(dir, T_FILE, f8, &[n])?),
+                "dynamics" => Some(arrays.read(T_FILE, f8, &[n])?),
                 _ => None,
             },
             meta,
             integrity,
+            strain_sha256,
         };
         ds.check_consistency(dir)?;
         Ok(ds)
@@ -326,5 +385,67 @@ impl Dataset {
             }
         }
         v
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use npyz::WriterBuilder;
+
+    /// `dir/a.npy`: the f64 array [1, 2]; returns its bytes.
+    fn write_array(dir: &Path) -> Vec<u8> {
+        let mut bytes = vec![];
+        let mut npy = npyz::WriteOptions::<f64>::new()
+            .default_dtype()
+            .shape(&[2])
+            .writer(&mut bytes)
+            .begin_nd()
+            .unwrap();
+        npy.extend([1.0, 2.0]).unwrap();
+        npy.finish().unwrap();
+        std::fs::write(dir.join("a.npy"), &bytes).unwrap();
+        bytes
+    }
+
+    #[test]
+    fn an_array_is_used_only_with_the_hash_its_manifest_records() {
+        let dir = crate::output::test_util::sandbox("dataset-reader", "hashed");
+        let bytes = write_array(&dir);
+        // the hash of the bytes written, computed here independently of the reader
+        let sha = {
+            use sha2::{Digest, Sha256};
+            let d = Sha256::digest(&bytes);
+            d.iter().map(|b| format!("{b:02x}")).collect::<String>()
+        };
+        let with = |recorded: Option<&[(&str, &str)]>| Arrays {
+            dir: &dir,
+            recorded: recorded.map(|r| {
+                r.iter()
+                    .map(|(f, h)| (f.to_string(), h.to_string()))
+                    .collect()
+            }),
+        };
+        // unhashed: read, and its hash given
+        let (v, h) = with(None).read_hashed::<f64>("a.npy", "<f8", &[2]).unwrap();
+        assert_eq!((v, &h), (vec![1.0, 2.0], &sha));
+        // the recorded hash: read
+        let (v, h) = with(Some(&[("a.npy", &sha)]))
+            .read_hashed::<f64>("a.npy", "<f8", &[2])
+            .unwrap();
+        assert_eq!((v, h), (vec![1.0, 2.0], sha));
+        // another hash recorded (the file replaced after the check): refused, naming the file
+        let other = "0".repeat(64);
+        let e = with(Some(&[("a.npy", &other)]))
+            .read::<f64>("a.npy", "<f8", &[2])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("a.npy") && e.contains("changed while"), "{e}");
+        // no hash recorded for it in a hashed dataset: refused
+        let e = with(Some(&[]))
+            .read::<f64>("a.npy", "<f8", &[2])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("a.npy") && e.contains("records no hash"), "{e}");
     }
 }

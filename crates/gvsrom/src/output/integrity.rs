@@ -20,6 +20,7 @@ use super::{MANIFEST_FILE, MANIFEST_KEY};
 use serde::ser::{Serialize, SerializeMap, Serializer};
 use serde_json::{Map, Value};
 use sha2::{Digest, Sha256};
+use std::collections::BTreeMap;
 use std::fs;
 use std::io::{self, Read};
 use std::path::{Path, PathBuf};
@@ -65,9 +66,14 @@ pub enum Problem {
     MetaEdited,
 }
 
-/// The SHA-256 of `bytes` as 64 lowercase hex digits.
+/// A digest as lowercase hex digits.
 fn hex(digest: &[u8]) -> String {
     digest.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// The SHA-256 of `bytes` as 64 lowercase hex digits, as the manifest records a file's.
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    hex(&Sha256::digest(bytes))
 }
 
 /// The SHA-256 of the file at `path`, read in blocks (any size).
@@ -160,6 +166,19 @@ fn plain(name: &str) -> bool {
 fn recorded(v: &Value) -> Option<String> {
     let s = v.as_str()?;
     (s.len() == 64 && s.bytes().all(|b| b.is_ascii_hexdigit())).then(|| s.to_ascii_lowercase())
+}
+
+/// The file hashes recorded in the manifest of `meta` (a parsed meta.json), by file name: the
+/// well-formed ones (64 hexadecimal digits), lower case. Empty for an output without hashes.
+pub fn recorded_hashes(meta: &Value) -> BTreeMap<String, String> {
+    let hashes = meta.get(MANIFEST_KEY).and_then(|m| m.get(SHA256_KEY));
+    match hashes {
+        Some(Value::Object(h)) => h
+            .iter()
+            .filter_map(|(f, v)| Some((f.clone(), recorded(v)?)))
+            .collect(),
+        _ => BTreeMap::new(),
+    }
 }
 
 /// Checks the directory output `dir` against its manifest before it is read: `meta.json` holds a

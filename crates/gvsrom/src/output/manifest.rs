@@ -4,7 +4,6 @@
 use super::MANIFEST_KEY;
 use serde::Serialize;
 use serde_json::{Map, Value};
-use std::fs;
 use std::io;
 use std::path::Path;
 
@@ -38,7 +37,7 @@ pub(super) fn with_manifest(value: impl Serialize, manifest: Value) -> io::Resul
 /// Reads the manifest of an existing output: the `"gvsrom"` object of `json_path`, and its `files`
 /// (only a directory output's manifest has them).
 pub(super) fn read_manifest(json_path: &Path) -> Option<(String, Option<Vec<String>>)> {
-    let text = fs::read_to_string(json_path).ok()?;
+    let text = super::read::read_regular_to_string(json_path).ok()?;
     let value: Value = serde_json::from_str(&text).ok()?;
     let m = value.get(MANIFEST_KEY)?.as_object()?;
     let format = m.get("format")?.as_str()?.to_string();

@@ -44,7 +44,7 @@ mod run_dir;
 mod staging;
 mod target;
 #[cfg(test)]
-mod test_util;
+pub(crate) mod test_util;
 pub use dir::OutputDir;
 pub use file::OutputFile;
 pub use integrity::{verify_dir, Integrity, IntegrityError};

@@ -42,12 +42,29 @@ fn special_kind(_ft: &FileType) -> &'static str {
     "a special file"
 }
 
+/// Why [`open_regular`] refused a path: what it is instead of a regular file ([`file_kind`]). The
+/// payload of its [`io::ErrorKind::InvalidInput`] error; [`not_regular_kind`] gets it back.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct NotRegular(pub &'static str);
+
+impl std::fmt::Display for NotRegular {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "it is {}, not a regular file", self.0)
+    }
+}
+
+impl std::error::Error for NotRegular {}
+
 /// The error of a path that is not a regular file: `it is a FIFO (named pipe), not a regular file`.
 fn not_regular(ft: &FileType) -> io::Error {
-    io::Error::new(
-        io::ErrorKind::InvalidInput,
-        format!("it is {}, not a regular file", file_kind(ft)),
-    )
+    io::Error::new(io::ErrorKind::InvalidInput, NotRegular(file_kind(ft)))
+}
+
+/// What the path was ("a FIFO (named pipe)", "a directory", …) if `e` is the refusal of
+/// [`open_regular`] (or the readers built on it) of a path that is not a regular file; `None` for
+/// any other error (missing, no permission, …).
+pub fn not_regular_kind(e: &io::Error) -> Option<&'static str> {
+    e.get_ref()?.downcast_ref::<NotRegular>().map(|n| n.0)
 }
 
 /// Opens `path` (a link followed) for reading if it is a regular file; otherwise an
@@ -106,8 +123,10 @@ mod tests {
         let e = read_regular(&d).unwrap_err();
         assert_eq!(e.kind(), io::ErrorKind::InvalidInput);
         assert_eq!(e.to_string(), "it is a directory, not a regular file");
+        assert_eq!(not_regular_kind(&e), Some("a directory"));
         let e = read_regular(&d.join("missing")).unwrap_err();
         assert_eq!(e.kind(), io::ErrorKind::NotFound);
+        assert_eq!(not_regular_kind(&e), None);
         #[cfg(unix)]
         {
             let e = read_regular(Path::new("/dev/null")).unwrap_err();
@@ -123,14 +142,13 @@ mod tests {
     fn a_fifo_is_refused_without_waiting_for_a_writer() {
         let d = sandbox("fifo");
         let pipe = d.join("p");
-        let c = std::ffi::CString::new(pipe.to_str().unwrap()).unwrap();
-        // SAFETY: a valid NUL-terminated path
-        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+        super::super::test_util::fifo(&pipe);
         // no writer ever opens it: a plain open would block this test forever
         let e = read_regular(&pipe).unwrap_err();
         assert_eq!(
             e.to_string(),
             "it is a FIFO (named pipe), not a regular file"
         );
+        assert_eq!(not_regular_kind(&e), Some("a FIFO (named pipe)"));
     }
 }

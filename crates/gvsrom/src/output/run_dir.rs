@@ -152,7 +152,8 @@ fn write_atomically(dir: &Path, name: &str, bytes: &[u8]) -> io::Result<()> {
 
 /// The files listed by a run directory's manifest, if `path` is one.
 fn read_run_manifest(path: &Path) -> Option<Vec<String>> {
-    let value: Value = serde_json::from_str(&fs::read_to_string(path).ok()?).ok()?;
+    let value: Value =
+        serde_json::from_str(&super::read::read_regular_to_string(path).ok()?).ok()?;
     let m = value.get(MANIFEST_KEY)?.as_object()?;
     if m.get("format")?.as_str()? != RUN_FORMAT {
         return None;

@@ -27,7 +27,7 @@ pub use train::{train, zero_anchor_rows, Loss, TrainSummary};
 use crate::build::{build, Built};
 use crate::dataset::Dataset;
 use crate::error::ScenarioError;
-use crate::reduced_model::{fnv1a64, DatasetRef, ModelLayout, ReducedModel};
+use crate::reduced_model::{DatasetRef, ModelLayout, ReducedModel};
 use crate::scenario::Scenario;
 use attach::{outside_range, reduced_model};
 use nalgebra::DMatrix;
@@ -147,14 +147,14 @@ pub(super) fn model_layout(ds: &Dataset, built: &Built) -> ModelLayout {
     }
 }
 
-pub(super) fn dataset_ref(dir: &Path, rows: usize) -> Result<DatasetRef, ScenarioError> {
-    let bytes = crate::output::read_regular(&dir.join("strain.npy"))
-        .map_err(|e| invalid("DATASET", format!("cannot read strain.npy: {e}")))?;
-    Ok(DatasetRef {
+/// What a model records of the dataset `ds` loaded from `dir`, `rows` of it used: the hash of the
+/// very `strain.npy` bytes the snapshots were read from ([`Dataset::strain_sha256`]).
+pub(super) fn dataset_ref(dir: &Path, ds: &Dataset, rows: usize) -> DatasetRef {
+    DatasetRef {
         path: dir.display().to_string(),
-        strain_hash: fnv1a64(&bytes),
+        strain_hash: ds.strain_sha256.clone(),
         rows,
-    })
+    }
 }
 
 /// The inputs of the usable samples (status ok), row-major (`n × k`): the anchors' inputs.

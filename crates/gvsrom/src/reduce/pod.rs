@@ -52,7 +52,7 @@ pub fn pod(
         kind: "pod".into(),
         latent: modes,
         layout: model_layout(&ds, &built),
-        dataset: dataset_ref(dataset, rows)?,
+        dataset: dataset_ref(dataset, &ds, rows),
         rest: vec![0.0; modes],
         latent_range,
         input_range: super::validity::input_ranges(&ds),

@@ -181,7 +181,7 @@ pub fn train(
         kind: "autoencoder".into(),
         latent: options.latent,
         layout: model_layout(&ds, &built),
-        dataset: dataset_ref(dataset, rows)?,
+        dataset: dataset_ref(dataset, &ds, rows),
         rest: rest.iter().copied().collect(),
         latent_range: range,
         input_range: super::validity::input_ranges(&ds),

@@ -2,6 +2,7 @@
 //! with every case's setup, tables, findings, notes, figures, settings and step times.
 
 use super::report::{format_number, CaseReport, Cell, Digits};
+use anyhow::Context;
 use base64::Engine;
 use std::path::Path;
 
@@ -12,7 +13,8 @@ fn esc(s: &str) -> String {
         .replace('"', "&quot;")
 }
 
-/// The page over `reports`, reading each case's figures from `<dir>/<case>/<stem>.png`.
+/// The page over `reports`, reading each case's figures from `<dir>/<case>/<stem>.png` (regular
+/// files only: [`crate::output::read`]).
 pub fn index(reports: &[CaseReport], dir: &Path) -> anyhow::Result<String> {
     let mut h = String::new();
     h.push_str("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>gvsrom — the paper reproduced</title>\n<style>\n");
@@ -100,7 +102,10 @@ pub fn index(reports: &[CaseReport], dir: &Path) -> anyhow::Result<String> {
             h.push_str("</ul>\n");
         }
         for f in &r.figures {
-            let png = std::fs::read(dir.join(&r.case).join(format!("{}.png", f.stem)))?;
+            let path = dir.join(&r.case).join(format!("{}.png", f.stem));
+            let png = crate::output::read_regular(&path).with_context(|| {
+                format!("{}: cannot read the figure (a PNG file)", path.display())
+            })?;
             h.push_str(&format!(
                 "<figure><img alt=\"{}\" src=\"data:image/png;base64,{}\"><figcaption>{}</figcaption></figure>\n",
                 esc(&f.stem),
@@ -138,3 +143,30 @@ th{background:#f2f5f3}td.n{text-align:right;font-variant-numeric:tabular-nums}
 figure{margin:1em 0}figure img{max-width:100%;border:1px solid #ddd}
 figcaption{font-size:.9em;color:#444}pre{background:#f6f6f6;padding:.5em;overflow:auto;font-size:.8em}
 ";
+
+#[cfg(all(test, target_os = "linux"))]
+mod tests {
+    use super::super::report::FigureRef;
+    use super::super::{new_report, Case};
+    use super::*;
+
+    #[test]
+    fn a_figure_that_is_a_fifo_is_an_error_naming_it_not_a_wait() {
+        let dir = crate::output::test_util::sandbox("html", "fifo-figure");
+        let mut report = new_report(Case::EVERY[0], "t");
+        report.figures.push(FigureRef {
+            stem: "fig".into(),
+            caption: "c".into(),
+        });
+        let case_dir = dir.join(&report.case);
+        std::fs::create_dir_all(&case_dir).unwrap();
+        let pipe = case_dir.join("fig.png");
+        crate::output::test_util::fifo(&pipe);
+        // no writer ever opens it: a plain read would block this test forever
+        let e = format!("{:#}", index(&[report], &dir).unwrap_err());
+        assert!(
+            e.contains(&pipe.display().to_string()) && e.contains("a FIFO (named pipe)"),
+            "{e}"
+        );
+    }
+}

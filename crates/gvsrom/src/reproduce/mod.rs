@@ -214,11 +214,14 @@ pub fn run(
 }
 
 /// The case reports present in run directory `dir` (`<case>/results.json`), in the paper's order.
+/// Only regular files are read ([`crate::output::read`]): a FIFO in a report's place is passed
+/// over, not waited on.
 pub fn read_reports(dir: &std::path::Path) -> Vec<CaseReport> {
     Case::EVERY
         .iter()
         .filter_map(|c| {
-            let text = std::fs::read_to_string(dir.join(c.name()).join("results.json")).ok()?;
+            let path = dir.join(c.name()).join("results.json");
+            let text = crate::output::read_regular_to_string(&path).ok()?;
             serde_json::from_str(&text).ok()
         })
         .collect()

@@ -140,9 +140,8 @@ impl Run {
         let key = step_key(name, config)?;
         let path = self.step_path(name);
         let record_path = self.record_path(name);
-        if let Some(value) = read_record::<T>(&record_path, &key) {
+        if let Some((value, wall_time_s)) = read_record::<T>(&record_path, &key) {
             if valid(&path) {
-                let wall_time_s = read_time(&record_path).unwrap_or(0.0);
                 return Ok(self.finish(name, key, wall_time_s, true, value, path));
             }
         }
@@ -231,21 +230,20 @@ fn canonical(v: &Value) -> String {
     }
 }
 
-fn read_json(path: &Path) -> Option<Value> {
-    serde_json::from_str(&std::fs::read_to_string(path).ok()?).ok()
-}
-
-/// The value of a step record at `path` if it holds `key`.
-fn read_record<T: DeserializeOwned>(path: &Path, key: &str) -> Option<T> {
-    let v = read_json(path)?;
+/// The value of the step record at `path` and its wall time (0 if not recorded), if the record
+/// holds `key`. A record that cannot be used (missing, not a regular file, not JSON, another key)
+/// is `None`: the step is computed again.
+fn read_record<T: DeserializeOwned>(path: &Path, key: &str) -> Option<(T, f64)> {
+    let mut v: Value =
+        serde_json::from_str(&crate::output::read_regular_to_string(path).ok()?).ok()?;
     if v.get("key")?.as_str()? != key {
         return None;
     }
-    serde_json::from_value(v.get("value")?.clone()).ok()
-}
-
-fn read_time(path: &Path) -> Option<f64> {
-    read_json(path)?.get("wall_time_s")?.as_f64()
+    let wall_time_s = v.get("wall_time_s").and_then(Value::as_f64).unwrap_or(0.0);
+    Some((
+        serde_json::from_value(v.get_mut("value")?.take()).ok()?,
+        wall_time_s,
+    ))
 }
 
 #[cfg(test)]
@@ -261,5 +259,25 @@ mod tests {
         assert_eq!(a, b);
         assert_ne!(a, c);
         assert_ne!(a, d);
+    }
+
+    #[test]
+    fn a_record_is_reused_only_with_its_key_and_a_fifo_in_its_place_is_not_waited_on() {
+        let dir = crate::output::test_util::sandbox("step", "record");
+        let record = dir.join("s.step.json");
+        let text = json!({"step": "s", "key": "k1", "wall_time_s": 2.5, "value": [1, 2]});
+        std::fs::write(&record, text.to_string()).unwrap();
+        assert_eq!(
+            read_record::<Vec<u32>>(&record, "k1"),
+            Some((vec![1, 2], 2.5))
+        );
+        assert_eq!(read_record::<Vec<u32>>(&record, "k2"), None);
+        #[cfg(target_os = "linux")]
+        {
+            let pipe = dir.join("p.step.json");
+            crate::output::test_util::fifo(&pipe);
+            // no writer ever opens it: a plain read would block this test forever
+            assert_eq!(read_record::<Vec<u32>>(&pipe, "k1"), None);
+        }
     }
 }

@@ -5,7 +5,7 @@
 pub mod reseal;
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 pub fn gvsrom(args: &[&str]) -> Output {
@@ -35,26 +35,37 @@ pub fn expect_error(args: &[&str], needles: &[&str]) -> String {
     user_error(args, &gvsrom(args), needles)
 }
 
-/// [`expect_error`] with a deadline: a run still going after `limit` is killed and the test fails
-/// (e.g. a reader waiting on a FIFO that no one writes), instead of hanging the test suite.
-pub fn expect_error_within(limit: Duration, args: &[&str], needles: &[&str]) -> String {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_gvsrom"))
+/// Starts `gvsrom args` (stdin empty, stdout and stderr captured).
+pub fn spawn(args: &[&str]) -> Child {
+    Command::new(env!("CARGO_BIN_EXE_gvsrom"))
         .args(args)
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
-        .expect("the gvsrom binary runs");
+        .expect("the gvsrom binary runs")
+}
+
+/// Waits for `child` up to `limit` and returns its output; past the deadline kills it (SIGKILL)
+/// and returns `None`.
+pub fn wait_within(mut child: Child, limit: Duration) -> Option<Output> {
     let start = Instant::now();
     while child.try_wait().expect("waiting for gvsrom").is_none() {
         if start.elapsed() > limit {
             let _ = child.kill();
             let _ = child.wait();
-            panic!("gvsrom {args:?} did not finish within {limit:?} (killed)");
+            return None;
         }
         std::thread::sleep(Duration::from_millis(20));
     }
-    let out = child.wait_with_output().expect("gvsrom exits");
+    Some(child.wait_with_output().expect("gvsrom exits"))
+}
+
+/// [`expect_error`] with a deadline: a run still going after `limit` is killed and the test fails
+/// (e.g. a reader waiting on a FIFO that no one writes), instead of hanging the test suite.
+pub fn expect_error_within(limit: Duration, args: &[&str], needles: &[&str]) -> String {
+    let out = wait_within(spawn(args), limit)
+        .unwrap_or_else(|| panic!("gvsrom {args:?} did not finish within {limit:?} (killed)"));
     user_error(args, &out, needles)
 }
 
@@ -112,12 +123,7 @@ pub fn copy_dir(from: &std::path::Path, name: &str) -> PathBuf {
 
 /// Runs `gvsrom args`, sends it SIGINT after `after` and returns its output once it exits.
 pub fn interrupted(args: &[&str], after: Duration) -> Output {
-    let child = Command::new(env!("CARGO_BIN_EXE_gvsrom"))
-        .args(args)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("the gvsrom binary runs");
+    let child = spawn(args);
     std::thread::sleep(after);
     let sent = Command::new("kill")
         .args(["-INT", &child.id().to_string()])
