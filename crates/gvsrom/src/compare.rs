@@ -72,8 +72,7 @@ impl Trajectory {
     pub fn load(dir: &Path, field: &str) -> Result<Trajectory, ScenarioError> {
         let bad = |message: String| ScenarioError::invalid(field, message);
         let meta_path = dir.join("meta.json");
-        crate::scenario::check_regular_file(field, &meta_path)?;
-        let text = std::fs::read_to_string(&meta_path)
+        let text = crate::output::read::read_regular_to_string(&meta_path)
             .map_err(|e| bad(format!("cannot read {}: {e}", meta_path.display())))?;
         let meta: serde_json::Value = serde_json::from_str(&text)
             .map_err(|e| bad(format!("{} is not valid JSON: {e}", meta_path.display())))?;
@@ -98,7 +97,6 @@ impl Trajectory {
         let (n, points) = (count("samples")?, count("n_points")?);
         let f8 = "<f8";
         let read = |name: &str, shape: &[usize]| {
-            crate::scenario::check_regular_file(field, &dir.join(name))?;
             let v = read_checked::<f64>(dir, name, f8, shape).map_err(|e| bad(e.to_string()))?;
             match v.iter().position(|x| !x.is_finite()) {
                 Some(i) => Err(bad(format!(

@@ -198,7 +198,7 @@ impl DirOrigin {
                 format!("cannot record `{}` in the provenance: {why}", dir.display()),
             )
         };
-        let text = std::fs::read(&meta_path)
+        let text = crate::output::read::read_regular(&meta_path)
             .map_err(|e| bad(format!("cannot read {}: {e}", meta_path.display())))?;
         let meta: Value = serde_json::from_slice(&text)
             .map_err(|e| bad(format!("{} is not valid JSON: {e}", meta_path.display())))?;

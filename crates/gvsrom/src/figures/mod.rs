@@ -79,7 +79,7 @@ impl InputKind {
 /// of `meta.json` in the directory).
 fn manifest_format(path: &Path, json: &Path) -> Result<String, FiguresError> {
     let not_ours = |what: &str| input_error(path, format!("{what}; accepted: {ACCEPTED}"));
-    let text = std::fs::read_to_string(json).map_err(|e| match e.kind() {
+    let text = crate::output::read::read_regular_to_string(json).map_err(|e| match e.kind() {
         std::io::ErrorKind::NotFound => not_ours(&format!(
             "has no {MANIFEST_FILE} (not a gvsrom output directory)"
         )),

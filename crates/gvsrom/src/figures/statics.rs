@@ -27,7 +27,7 @@ pub struct StaticsDoc {
 impl StaticsDoc {
     /// Reads and checks the document at `path`: sizes agree, something to draw.
     pub fn load(path: &Path) -> Result<StaticsDoc, FiguresError> {
-        let text = std::fs::read_to_string(path)
+        let text = crate::output::read::read_regular_to_string(path)
             .map_err(|e| input_error(path, format!("cannot read it: {e}")))?;
         let doc: StaticsDoc = serde_json::from_str(&text).map_err(|e| {
             input_error(

@@ -39,7 +39,7 @@ pub fn load_centerlines(dir: &Path, samples: usize) -> Result<Option<Centerlines
         return Ok(None);
     }
     let meta_path = dir.join(crate::output::MANIFEST_FILE);
-    let meta: serde_json::Value = std::fs::read_to_string(&meta_path)
+    let meta: serde_json::Value = crate::output::read::read_regular_to_string(&meta_path)
         .ok()
         .and_then(|t| serde_json::from_str(&t).ok())
         .unwrap_or_default();
