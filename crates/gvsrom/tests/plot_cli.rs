@@ -9,7 +9,6 @@
 mod common;
 
 use common::{copy_dir, expect_error, gvsrom, reseal::reseal, scratch};
-use npyz::WriterBuilder;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -57,49 +56,19 @@ fn trajectory() -> &'static Path {
     })
 }
 
-/// Rod length of the single-tendon preset [m].
-const L: f64 = 0.25;
-/// Centreline points of the synthetic centrelines.
-const N: usize = 11;
-
-/// [`trajectory`] with a synthetic `centerline.npy` ([samples, N, 3]: circular arcs in the x–z
-/// plane whose curvature grows over the run) and `centerline_x` in meta.json, resealed: the layout
-/// `simulate` writes them in.
-fn trajectory_with_centerlines() -> &'static Path {
+/// [`trajectory`] as an older gvsrom wrote it, without `centerline.npy` and `centerline_x`
+/// (resealed, so only the missing centreline differs).
+fn trajectory_without_centerlines() -> &'static Path {
     static D: OnceLock<PathBuf> = OnceLock::new();
     D.get_or_init(|| {
-        let d = copy_dir(trajectory(), "plot-traj-cl");
+        let d = copy_dir(trajectory(), "plot-traj-old");
         let mut meta = json(&d.join("meta.json"));
-        let n = meta["samples"].as_u64().unwrap() as usize;
-        let x: Vec<f64> = (0..N).map(|i| L * i as f64 / (N - 1) as f64).collect();
-        let mut data = Vec::with_capacity(n * N * 3);
-        for k in 0..n {
-            let kappa = 0.5 + 10.0 * k as f64 / n as f64;
-            for &s in &x {
-                data.extend([
-                    (kappa * s).sin() / kappa,
-                    0.0,
-                    -(1.0 - (kappa * s).cos()) / kappa,
-                ]);
-            }
-        }
-        let mut bytes = vec![];
-        {
-            let mut w = npyz::WriteOptions::<f64>::new()
-                .default_dtype()
-                .shape(&[n as u64, N as u64, 3])
-                .writer(&mut bytes)
-                .begin_nd()
-                .unwrap();
-            w.extend(data.iter().copied()).unwrap();
-            w.finish().unwrap();
-        }
-        std::fs::write(d.join("centerline.npy"), bytes).unwrap();
-        meta["centerline_x"] = serde_json::json!(x);
+        std::fs::remove_file(d.join("centerline.npy")).unwrap();
+        meta.as_object_mut().unwrap().remove("centerline_x");
         meta["gvsrom"]["files"]
             .as_array_mut()
             .unwrap()
-            .push("centerline.npy".into());
+            .retain(|f| f != "centerline.npy");
         std::fs::write(
             d.join("meta.json"),
             serde_json::to_string_pretty(&meta).unwrap(),
@@ -251,7 +220,7 @@ fn statics_result_gives_rod_views_and_strain_profiles() {
 
 #[test]
 fn trajectory_with_centerlines_gives_tip_strain_rod_figures_and_animation() {
-    let (dir, stdout) = plot(trajectory_with_centerlines(), "plot-out-traj-cl", &[]);
+    let (dir, stdout) = plot(trajectory(), "plot-out-traj-cl", &[]);
     let mut expected = both(&[
         "tip_path_3d",
         "tip_path_side",
@@ -270,7 +239,7 @@ fn trajectory_with_centerlines_gives_tip_strain_rod_figures_and_animation() {
 
 #[test]
 fn trajectory_without_centerlines_draws_the_tip_and_says_why_not_the_rod() {
-    let (dir, stdout) = plot(trajectory(), "plot-out-traj", &[]);
+    let (dir, stdout) = plot(trajectory_without_centerlines(), "plot-out-traj", &[]);
     let expected = both(&[
         "tip_path_3d",
         "tip_path_side",
@@ -379,7 +348,7 @@ fn bad_inputs_are_one_line_errors_naming_the_file() {
         &["plot-empty-statics.json", "centerline"],
     );
     // a centerline.npy of the wrong shape
-    let bad = copy_dir(trajectory_with_centerlines(), "plot-traj-bad-cl");
+    let bad = copy_dir(trajectory(), "plot-traj-bad-cl");
     let mut meta = json(&bad.join("meta.json"));
     meta["centerline_x"] = serde_json::json!([0.0, 0.25]);
     std::fs::write(bad.join("meta.json"), meta.to_string()).unwrap();
@@ -401,7 +370,7 @@ fn write_samples() {
     let root = Path::new("/tmp/plot-samples");
     let inputs: [(&str, &Path); 5] = [
         ("statics", statics_json()),
-        ("trajectory", trajectory_with_centerlines()),
+        ("trajectory", trajectory()),
         ("dataset", dataset()),
         ("pod", pod()),
         ("autoencoder", autoencoder()),
