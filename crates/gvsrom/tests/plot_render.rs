@@ -623,3 +623,86 @@ fn gif_animation_has_one_frame_per_figure_and_refuses_no_frames() {
     let err = gvsrom::plot::animation::render_gif(&[], 320, 240, 100).unwrap_err();
     assert!(matches!(err, PlotError::Empty { .. }), "{err}");
 }
+
+#[test]
+fn gif_of_a_rod_animation_stays_small_enough_to_commit() {
+    use gvsrom::plot::{Line3, Series3};
+    // The layout of `gvsrom plot`'s rod_animation.gif: 36 frames of 960 × 440, the rod in 3-D and
+    // from the side with the tip's dashed path so far, on the axes of the whole run.
+    let tip = |t: f64| {
+        let k = 4.0 + 3.0 * (1.3 * t).sin();
+        let phi = 0.9 * t;
+        let (x, z) = ((k * L).sin() / k, -(1.0 - (k * L).cos()) / k);
+        (k, phi, [x * phi.cos(), x * phi.sin(), z])
+    };
+    let times = linspace(0.0, 10.0, 36);
+    let frames: Vec<Figure> = times
+        .iter()
+        .map(|&t| {
+            let (k, phi, end) = tip(t);
+            let rod: Vec<[f64; 3]> = linspace(0.0, L, 50)
+                .iter()
+                .map(|&s| {
+                    let x = (k * s).sin() / k;
+                    [x * phi.cos(), x * phi.sin(), -(1.0 - (k * s).cos()) / k]
+                })
+                .collect();
+            let trace = linspace(0.0, t, 200).iter().map(|&u| tip(u).2).collect();
+            let bounds = vec![[-L, -L, -L], [L, L, 0.05]];
+            let s3 = vec![
+                Series3::new("", trace, SeriesStyle::Dashed).with_color(palette::EXTRA[6]),
+                Series3::new("", rod, SeriesStyle::Line).with_color(palette::HOM),
+                Series3::new("", vec![end], SeriesStyle::Markers).with_color(palette::POD),
+                Series3::new("", bounds, SeriesStyle::Bounds),
+            ];
+            let side: Vec<Series> = s3
+                .iter()
+                .map(|s| {
+                    let x = s.points.iter().map(|p| p[0]).collect();
+                    let z = s.points.iter().map(|p| p[2]).collect();
+                    let mut c = Series::new("", x, z, s.style);
+                    c.color = s.color;
+                    c
+                })
+                .collect();
+            Figure::Grid {
+                title: format!("rod — t = {t:.3} s"),
+                cols: 2,
+                panels: vec![
+                    Figure::Line3(Line3 {
+                        title: String::new(),
+                        labels: ["x [m]".into(), "y [m]".into(), "z [m]".into()],
+                        series: s3,
+                        equal_aspect: true,
+                    }),
+                    Figure::Line(LineChart {
+                        x_label: "x [m]".into(),
+                        y_label: "z [m]".into(),
+                        series: side,
+                        equal_aspect: true,
+                        ..Default::default()
+                    }),
+                ],
+            }
+        })
+        .collect();
+    let gif = gvsrom::plot::animation::render_gif(&frames, 960, 440, 280).unwrap();
+    // 300 kB is what a README figure may weigh; a frame per file with a palette of its own made
+    // ~1 MB of this (1.05 MB for `gvsrom plot` of a 10 s six-tendon run, now 118 kB).
+    assert!(gif.len() < 300_000, "{} bytes", gif.len());
+    let dec = image::codecs::gif::GifDecoder::new(&gif[..]).unwrap();
+    use image::AnimationDecoder;
+    let decoded = dec.into_frames().collect_frames().unwrap();
+    assert_eq!(decoded.len(), 36);
+    // the last frame, composed over the earlier ones, shows the rod and the tip marker in full colour
+    let last = decoded[35].buffer();
+    let n = |c: Rgb| {
+        last.pixels()
+            .filter(|p| p.0[..3] == [c.0, c.1, c.2])
+            .count()
+    };
+    assert!(
+        n(palette::HOM) > 100 && n(palette::POD) > 10,
+        "rod or tip lost"
+    );
+}

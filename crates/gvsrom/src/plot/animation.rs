@@ -1,11 +1,12 @@
 //! Animations: a sequence of figures (e.g. a rod's shape at successive times, on the same axes) as
 //! the frames of one looping animated GIF, which every browser and image viewer plays without a
-//! video codec. Frames are drawn like [`super::render`]'s PNG and reduced to a 256-colour palette
-//! per frame by the GIF encoder.
+//! video codec. Frames are drawn like [`super::render`]'s PNG, mapped to one colour table shared by
+//! all frames ([`super::gif_palette`]), and each frame after the first stores only the rectangle
+//! that changed, its unchanged pixels transparent over the previous frame (disposal "keep").
 
-use image::codecs::gif::{GifEncoder, Repeat};
-use image::{Delay, RgbaImage};
+use std::borrow::Cow;
 
+use super::gif_palette::{Quantizer, TRANSPARENT};
 use super::{backend, theme, validate, Figure, PlotError};
 
 /// Most frames an animation may have: a GIF of more frames grows large and slow to encode for
@@ -48,30 +49,83 @@ pub fn render_gif(
     }
     frames.iter().try_for_each(validate::figure)?;
     theme::register_font();
-    let encode_error = |e: image::ImageError| PlotError::Encode {
+    let encode_error = |e: gif::EncodingError| PlotError::Encode {
         title: title.clone(),
         message: e.to_string(),
     };
+    let mut quantizer = Quantizer::for_frames(frames);
+    let table = quantizer.table_rgb();
+    // GIF delays are in centiseconds
+    let delay = (delay_ms.div_ceil(10)).min(u16::MAX as u32) as u16;
     let mut gif = Vec::new();
     {
-        // speed 30 of 1..=30: the fastest palette search, ample for flat plot colours
-        let mut encoder = GifEncoder::new_with_speed(&mut gif, 30);
-        encoder.set_repeat(Repeat::Infinite).map_err(encode_error)?;
+        let mut encoder = gif::Encoder::new(&mut gif, width as u16, height as u16, &table)
+            .map_err(encode_error)?;
+        encoder
+            .set_repeat(gif::Repeat::Infinite)
+            .map_err(encode_error)?;
+        let mut shown: Option<Vec<u8>> = None;
         for fig in frames {
-            let rgb = backend::render_rgb(fig, width, height)?;
-            let rgba: Vec<u8> = rgb
-                .chunks_exact(3)
-                .flat_map(|p| [p[0], p[1], p[2], 255])
-                .collect();
-            let img =
-                RgbaImage::from_raw(width, height, rgba).ok_or_else(|| PlotError::Encode {
-                    title: fig.title().to_string(),
-                    message: "frame buffer of the wrong size".into(),
-                })?;
-            let frame =
-                image::Frame::from_parts(img, 0, 0, Delay::from_numer_denom_ms(delay_ms, 1));
-            encoder.encode_frame(frame).map_err(encode_error)?;
+            let now = quantizer.indices(&backend::render_rgb(fig, width, height)?);
+            let mut frame = match &shown {
+                None => full_frame(&now, width, height),
+                Some(before) => changed_frame(before, &now, width),
+            };
+            frame.delay = delay;
+            frame.dispose = gif::DisposalMethod::Keep;
+            encoder.write_frame(&frame).map_err(encode_error)?;
+            shown = Some(now);
         }
     }
     Ok(gif)
+}
+
+/// The whole picture `now` (`width × height` indices) as a frame.
+fn full_frame(now: &[u8], width: u32, height: u32) -> gif::Frame<'static> {
+    gif::Frame {
+        width: width as u16,
+        height: height as u16,
+        buffer: Cow::Owned(now.to_vec()),
+        ..gif::Frame::default()
+    }
+}
+
+/// The smallest rectangle holding every pixel where `now` differs from `before`, those pixels with
+/// their index and the others [`TRANSPARENT`] (a single transparent pixel when nothing changed).
+fn changed_frame(before: &[u8], now: &[u8], width: u32) -> gif::Frame<'static> {
+    let w = width as usize;
+    let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
+    for (i, _) in before
+        .iter()
+        .zip(now)
+        .enumerate()
+        .filter(|(_, (a, b))| a != b)
+    {
+        let (x, y) = (i % w, i / w);
+        (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x), y1.max(y));
+    }
+    let mut frame = gif::Frame {
+        transparent: Some(TRANSPARENT),
+        ..gif::Frame::default()
+    };
+    if x0 == usize::MAX {
+        (frame.width, frame.height) = (1, 1);
+        frame.buffer = Cow::Owned(vec![TRANSPARENT]);
+        return frame;
+    }
+    let mut buffer = Vec::with_capacity((x1 - x0 + 1) * (y1 - y0 + 1));
+    for y in y0..=y1 {
+        let row = y * w;
+        buffer.extend((row + x0..=row + x1).map(|i| {
+            if now[i] == before[i] {
+                TRANSPARENT
+            } else {
+                now[i]
+            }
+        }));
+    }
+    (frame.left, frame.top) = (x0 as u16, y0 as u16);
+    (frame.width, frame.height) = ((x1 - x0 + 1) as u16, (y1 - y0 + 1) as u16);
+    frame.buffer = Cow::Owned(buffer);
+    frame
 }

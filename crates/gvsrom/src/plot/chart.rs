@@ -77,7 +77,17 @@ pub(crate) fn draw<DB: DrawingBackend>(
             has_y,
         );
         let fy = move |v: &f64| yfmt.format(*v);
-        return plot(&area, c, theme, &runs, frame, xr, yr.log_scale(), ny, &fy);
+        return plot(
+            &area,
+            c,
+            theme,
+            &runs,
+            frame,
+            xr,
+            range::LogAxis::new(yr),
+            ny,
+            &fy,
+        );
     }
 
     let yr0 = range::linear(ye, 0.05);

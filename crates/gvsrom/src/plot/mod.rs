@@ -12,6 +12,7 @@ mod backend;
 mod chart;
 mod color;
 mod colorbar;
+mod gif_palette;
 mod layout;
 mod legend;
 mod line3;
