@@ -56,6 +56,9 @@ pub enum InputSource {
         period: f64,
         seed: u64,
     },
+    /// A signal given in memory (Python's `input=` array of rows `t, u_1, …, u_na`), checked
+    /// as a CSV file's rows are.
+    Rows(Signal),
     /// Actuator babbling: each actuator holds a uniform random value in `[lo, hi]` for a uniform random
     /// time in `[hold_min, hold_max]` (paper IV-C2).
     Babble {
@@ -426,6 +429,11 @@ pub fn input_signal(built: &Built, opts: &SimulateOptions) -> Result<Signal, Sce
             covers_start("--input", path, &signal, RUN_START)?;
             signal
         }
+        InputSource::Rows(signal) => {
+            signal.validate("input", na)?;
+            covers_start("input", Path::new("input"), signal, RUN_START)?;
+            signal.clone()
+        }
         InputSource::Steps {
             lo,
             hi,
@@ -674,6 +682,14 @@ pub fn input_record(
             });
             v
         }
+        InputSource::Rows(signal) => json!({
+            "signal": "rows",
+            "rows": signal.times.len(),
+            "interpolation": match signal.interpolation {
+                Interpolation::Hold => "hold",
+                Interpolation::Linear => "linear",
+            },
+        }),
         InputSource::Steps {
             lo,
             hi,
