@@ -18,11 +18,12 @@ use pyo3::prelude::*;
 
 /// The built-in presets: `{name: summary}` (`gvsrom presets`).
 #[pyfunction]
-fn presets() -> Vec<(&'static str, &'static str)> {
-    gvsrom::presets::PRESETS
-        .iter()
-        .map(|p| (p.name, p.summary))
-        .collect()
+fn presets(py: Python<'_>) -> PyResult<Bound<'_, pyo3::types::PyDict>> {
+    let d = pyo3::types::PyDict::new(py);
+    for p in gvsrom::presets::PRESETS {
+        d.set_item(p.name, p.summary)?;
+    }
+    Ok(d)
 }
 
 #[pymodule]
