@@ -23,10 +23,13 @@ use std::path::PathBuf;
 #[pyclass(module = "gvsrom", frozen)]
 pub struct Model {
     pub dir: PathBuf,
+    /// `"pod"` or `"autoencoder"`.
     #[pyo3(get)]
     kind: String,
+    /// Number of reduced coordinates r.
     #[pyo3(get)]
     latent: usize,
+    /// Whether it may be used outside its training inputs (`--extrapolate`).
     #[pyo3(get)]
     pub extrapolate: bool,
 }

@@ -33,12 +33,14 @@ pub fn forward(built: &Built, q: &DVector<f64>) -> (Vec<f64>, Vec<f64>) {
 }
 
 fn poses(ws: &Workspace) -> (Vec<f64>, Vec<f64>) {
-    let pos = ws.g.iter().flat_map(|g| [g.pos[0], g.pos[1], g.pos[2]]).collect();
-    let rot = ws
-        .g
-        .iter()
-        .flat_map(|g| (0..3).flat_map(move |i| (0..3).map(move |j| g.rot[(i, j)])))
-        .collect();
+    let pos =
+        ws.g.iter()
+            .flat_map(|g| [g.pos[0], g.pos[1], g.pos[2]])
+            .collect();
+    let rot =
+        ws.g.iter()
+            .flat_map(|g| (0..3).flat_map(move |i| (0..3).map(move |j| g.rot[(i, j)])))
+            .collect();
     (pos, rot)
 }
 
@@ -79,7 +81,11 @@ pub fn mass_matrix(built: &Built, q: &DVector<f64>) -> DMatrix<f64> {
 }
 
 /// `R(q)` under tensions `u` and the scenario's loads.
-pub fn statics_residual(built: &Built, q: &DVector<f64>, u: &[f64]) -> Result<DVector<f64>, ScenarioError> {
+pub fn statics_residual(
+    built: &Built,
+    q: &DVector<f64>,
+    u: &[f64],
+) -> Result<DVector<f64>, ScenarioError> {
     on_model!(built, m => residual_on(m, built, q, u))
 }
 
@@ -97,7 +103,11 @@ fn residual_on<P: StrainParam>(
 }
 
 /// `∂R/∂q` under tensions `u` and the scenario's loads (the analytic Jacobian of the solver).
-pub fn statics_jacobian(built: &Built, q: &DVector<f64>, u: &[f64]) -> Result<DMatrix<f64>, ScenarioError> {
+pub fn statics_jacobian(
+    built: &Built,
+    q: &DVector<f64>,
+    u: &[f64],
+) -> Result<DMatrix<f64>, ScenarioError> {
     on_model!(built, m => jacobian_on(m, built, q, u))
 }
 

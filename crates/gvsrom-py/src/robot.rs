@@ -4,13 +4,13 @@
 use crate::arrays::{self, In1, In2};
 use crate::errors::{self, invalid, scenario as err};
 use crate::models::Model;
+use crate::quantities;
 use crate::scenario::Scenario;
 use crate::statics::{Statics, StaticsBatch};
 use gvsrom::reduce::{self, AttachOptions};
 use gvsrom::statics::{self, StaticsReport};
 use gvsrom::Built;
 use pyo3::exceptions::PyUserWarning;
-use crate::quantities;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
@@ -52,7 +52,13 @@ pub fn build_with(
                     extrapolate: a.extrapolate,
                     tensions_from_signal,
                 };
-                reduce::attach_source(&mut built, &scenario.src, &scenario.overrides, &a.dir, options)?;
+                reduce::attach_source(
+                    &mut built,
+                    &scenario.src,
+                    &scenario.overrides,
+                    &a.dir,
+                    options,
+                )?;
             }
             Ok(built)
         })
@@ -81,7 +87,12 @@ impl Robot {
 
     /// The scenario with tensions `u` (`--tension`), built with the model attached: for the runs
     /// whose reduced model needs its initial guess at `u`.
-    fn rebuilt_with(&self, py: Python<'_>, u: Option<&[f64]>, attached: &Attached) -> PyResult<Built> {
+    fn rebuilt_with(
+        &self,
+        py: Python<'_>,
+        u: Option<&[f64]>,
+        attached: &Attached,
+    ) -> PyResult<Built> {
         let mut scenario = self.scenario.clone();
         if let Some(u) = u {
             scenario.scenario.set_tensions(u).map_err(err)?;
@@ -93,14 +104,21 @@ impl Robot {
     fn quantity_tensions(&self, u: Option<In1<'_>>) -> PyResult<Vec<f64>> {
         match u {
             None => Ok(self.built.u.clone()),
-            Some(u) => gvsrom::scenario::tensions_for(self.built.model.n_actuators(), &arrays::vec1(&u))
-                .map_err(err),
+            Some(u) => {
+                gvsrom::scenario::tensions_for(self.built.model.n_actuators(), &arrays::vec1(&u))
+                    .map_err(err)
+            }
         }
     }
 
     /// The equilibrium under `u` (the scenario's tensions if `None`) with `attached` (else this
     /// robot's model): `gvsrom statics [--tension u] [--model DIR]`.
-    fn solve(&self, py: Python<'_>, u: Option<Vec<f64>>, attached: Option<&Attached>) -> PyResult<StaticsReport> {
+    fn solve(
+        &self,
+        py: Python<'_>,
+        u: Option<Vec<f64>>,
+        attached: Option<&Attached>,
+    ) -> PyResult<StaticsReport> {
         match attached.or(self.attached.as_ref()) {
             None => {
                 let u = match u {
@@ -186,7 +204,14 @@ impl Robot {
     /// shape ``(n_points,)``: integrals over the rod are ``Σ W_i f(X_i)``.
     #[getter]
     fn point_weights<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        let w: Vec<f64> = self.built.model.disc.points.iter().map(|p| p.weight).collect();
+        let w: Vec<f64> = self
+            .built
+            .model
+            .disc
+            .points
+            .iter()
+            .map(|p| p.weight)
+            .collect();
         arrays::vector(py, &w)
     }
 
@@ -228,7 +253,12 @@ impl Robot {
     ///     If the model was not learned on this scenario's points, or the scenario lies outside
     ///     its training (without ``extrapolate``).
     #[pyo3(signature = (model, extrapolate=false))]
-    fn with_model(&self, py: Python<'_>, model: PyRef<'_, Model>, extrapolate: bool) -> PyResult<Robot> {
+    fn with_model(
+        &self,
+        py: Python<'_>,
+        model: PyRef<'_, Model>,
+        extrapolate: bool,
+    ) -> PyResult<Robot> {
         let attached = Attached {
             dir: model.dir.clone(),
             extrapolate,
@@ -364,7 +394,12 @@ impl Robot {
     /// numpy.ndarray
     ///     Shape (6, n_dof), or (n_points, 6, n_dof) for all points.
     #[pyo3(signature = (q, point=None))]
-    fn jacobian<'py>(&self, py: Python<'py>, q: In1<'_>, point: Option<isize>) -> PyResult<Bound<'py, PyAny>> {
+    fn jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        q: In1<'_>,
+        point: Option<isize>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let n = self.built.n_dof();
         let q = arrays::dvec("q", &q, n)?;
         let p = self.built.model.disc.n_points();
@@ -373,7 +408,9 @@ impl Robot {
             Some(i) => {
                 let j = if i < 0 { i + p as isize } else { i };
                 if !(0..p as isize).contains(&j) {
-                    return Err(invalid(format!("`point` = {i} is out of range: the rod has {p} points")));
+                    return Err(invalid(format!(
+                        "`point` = {i} is out of range: the rod has {p} points"
+                    )));
                 }
                 vec![j as usize]
             }
@@ -392,7 +429,12 @@ impl Robot {
     /// -------
     /// numpy.ndarray
     ///     Shape (n_points, 6).
-    fn point_velocities<'py>(&self, py: Python<'py>, q: In1<'_>, qd: In1<'_>) -> PyResult<Bound<'py, PyAny>> {
+    fn point_velocities<'py>(
+        &self,
+        py: Python<'py>,
+        q: In1<'_>,
+        qd: In1<'_>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let n = self.built.n_dof();
         let (q, qd) = (arrays::dvec("q", &q, n)?, arrays::dvec("qd", &qd, n)?);
         let flat = py.detach(|| quantities::velocities(&self.built, &q, &qd));
@@ -415,19 +457,33 @@ impl Robot {
     /// u : array_like of float, optional
     ///     Tensions [N], one per tendon or one for all; default: the scenario's.
     #[pyo3(signature = (q, u=None))]
-    fn statics_residual<'py>(&self, py: Python<'py>, q: In1<'_>, u: Option<In1<'_>>) -> PyResult<Bound<'py, PyAny>> {
+    fn statics_residual<'py>(
+        &self,
+        py: Python<'py>,
+        q: In1<'_>,
+        u: Option<In1<'_>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let q = arrays::dvec("q", &q, self.built.n_dof())?;
         let u = self.quantity_tensions(u)?;
-        let r = py.detach(|| quantities::statics_residual(&self.built, &q, &u)).map_err(err)?;
+        let r = py
+            .detach(|| quantities::statics_residual(&self.built, &q, &u))
+            .map_err(err)?;
         Ok(arrays::vector(py, r.as_slice()))
     }
 
     /// The analytic Jacobian ``∂R/∂q`` of :meth:`statics_residual`, shape (n_dof, n_dof).
     #[pyo3(signature = (q, u=None))]
-    fn statics_jacobian<'py>(&self, py: Python<'py>, q: In1<'_>, u: Option<In1<'_>>) -> PyResult<Bound<'py, PyAny>> {
+    fn statics_jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        q: In1<'_>,
+        u: Option<In1<'_>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let q = arrays::dvec("q", &q, self.built.n_dof())?;
         let u = self.quantity_tensions(u)?;
-        let j = py.detach(|| quantities::statics_jacobian(&self.built, &q, &u)).map_err(err)?;
+        let j = py
+            .detach(|| quantities::statics_jacobian(&self.built, &q, &u))
+            .map_err(err)?;
         arrays::matrix(py, &j)
     }
 

@@ -54,7 +54,10 @@ fn toml_value(value: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
     if let Ok(s) = value.cast::<PyString>() {
         return Ok(toml::Value::String(s.to_str()?.to_string()));
     }
-    if value.is_instance_of::<PyList>() || value.is_instance_of::<PyTuple>() || value.hasattr("tolist")? {
+    if value.is_instance_of::<PyList>()
+        || value.is_instance_of::<PyTuple>()
+        || value.hasattr("tolist")?
+    {
         // NumPy arrays and scalars through `tolist()`
         let v = if value.hasattr("tolist")? {
             value.call_method0("tolist")?

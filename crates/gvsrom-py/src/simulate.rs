@@ -61,7 +61,12 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
     };
     // a reduced model checks a signal's tensions, not the scenario's (`simulate --model`)
     let rebuilt = match &robot.attached {
-        Some(att) if a.input.is_some() => Some(crate::robot::build_with(py, &robot.scenario, Some(att), true)?),
+        Some(att) if a.input.is_some() => Some(crate::robot::build_with(
+            py,
+            &robot.scenario,
+            Some(att),
+            true,
+        )?),
         _ => None,
     };
     let built = rebuilt.as_ref().unwrap_or(&robot.built);
@@ -101,7 +106,13 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
                 }
             }
         };
-        simulate::run_into(built, &plan, &opts.integrator, Some(&mut buffer), &mut control)
+        simulate::run_into(
+            built,
+            &plan,
+            &opts.integrator,
+            Some(&mut buffer),
+            &mut control,
+        )
     });
     if let Some(e) = interrupt {
         return Err(e);
@@ -137,7 +148,10 @@ fn trajectory<'py>(
     d.set_item("qd", shaped(py, b.qd.clone(), [k, n])?)?;
     d.set_item("u", shaped(py, b.u.clone(), [k, na])?)?;
     d.set_item("tip_position", shaped(py, b.tip_position.clone(), [k, 3])?)?;
-    d.set_item("tip_rotation", shaped(py, b.tip_rotation.clone(), [k, 3, 3])?)?;
+    d.set_item(
+        "tip_rotation",
+        shaped(py, b.tip_rotation.clone(), [k, 3, 3])?,
+    )?;
     d.set_item("strain", shaped(py, b.strain.clone(), [k, p, 6])?)?;
     let x: Vec<f64> = built.model.disc.points.iter().map(|pt| pt.x).collect();
     d.set_item("strain_x", vector(py, &x))?;

@@ -38,22 +38,39 @@ use pyo3::types::PyDict;
 ///     Wall-clock time of the solve [s].
 #[pyclass(module = "gvsrom", frozen, get_all)]
 pub struct Statics {
+    /// The scenario's name.
     scenario: String,
+    /// Generalized coordinates n.
     n_dof: usize,
+    /// Computational points p.
     n_points: usize,
+    /// Tendon tensions u [N].
     u: Py<PyAny>,
+    /// Generalized coordinates at equilibrium.
     q: Py<PyAny>,
+    /// Tip position in the world frame [m].
     tip_position: Py<PyAny>,
+    /// Tip rotation matrix, section frame → world.
     tip_rotation: Py<PyAny>,
+    /// Abscissae of the centreline samples [m].
     centerline_x: Py<PyAny>,
+    /// Centreline positions [m] at `centerline_x`.
     centerline: Py<PyAny>,
+    /// Abscissae of the computational points [m].
     strain_x: Py<PyAny>,
+    /// ξ at the points, `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]`.
     strain: Py<PyAny>,
+    /// Dogleg iterations over all load stages.
     iterations: usize,
+    /// Load stages of the ramp.
     load_stages: usize,
+    /// Residual evaluations.
     residual_evaluations: usize,
+    /// Jacobian evaluations.
     jacobian_evaluations: usize,
+    /// `‖R(q)‖∞` at the solution.
     residual_norm: f64,
+    /// Wall-clock time of the solve [s].
     solve_time_s: f64,
 }
 
@@ -141,27 +158,43 @@ impl Statics {
 ///     Each solve's own wall-clock time [s] (the solves run in parallel).
 #[pyclass(module = "gvsrom", frozen, get_all)]
 pub struct StaticsBatch {
+    /// Tendon tensions u [N].
     u: Py<PyAny>,
+    /// Generalized coordinates at equilibrium.
     q: Py<PyAny>,
+    /// Tip position in the world frame [m].
     tip_position: Py<PyAny>,
+    /// Tip rotation matrix, section frame → world.
     tip_rotation: Py<PyAny>,
+    /// Abscissae of the centreline samples [m].
     centerline_x: Py<PyAny>,
+    /// Centreline positions [m] at `centerline_x`.
     centerline: Py<PyAny>,
+    /// Abscissae of the computational points [m].
     strain_x: Py<PyAny>,
+    /// ξ at the points, `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]`.
     strain: Py<PyAny>,
+    /// Dogleg iterations over all load stages.
     iterations: Py<PyAny>,
+    /// `‖R(q)‖∞` at the solution.
     residual_norm: Py<PyAny>,
+    /// Wall-clock time of the solve [s].
     solve_time_s: Py<PyAny>,
 }
 
 impl StaticsBatch {
     pub fn new(py: Python<'_>, rs: &[StaticsReport], built: &Built) -> PyResult<StaticsBatch> {
         let m = rs.len();
-        let cat = |f: &dyn Fn(&StaticsReport) -> Vec<f64>| -> Vec<f64> { rs.iter().flat_map(f).collect() };
+        let cat = |f: &dyn Fn(&StaticsReport) -> Vec<f64>| -> Vec<f64> {
+            rs.iter().flat_map(f).collect()
+        };
         let na = built.model.n_actuators();
         let n = built.n_dof();
         let x: Vec<f64> = built.model.disc.points.iter().map(|p| p.x).collect();
-        let c = gvsrom::statics::centerline_abscissae(built.model.disc.length(), built.centerline_points);
+        let c = gvsrom::statics::centerline_abscissae(
+            built.model.disc.length(),
+            built.centerline_points,
+        );
         let iterations: Vec<i64> = rs.iter().map(|r| r.iterations as i64).collect();
         Ok(StaticsBatch {
             u: shaped(py, cat(&|r| r.u.clone()), [m, na])?.unbind(),
@@ -173,8 +206,10 @@ impl StaticsBatch {
             strain_x: vector(py, &x).unbind(),
             strain: shaped(py, cat(&|r| flat(&r.strain)), [m, x.len(), 6])?.unbind(),
             iterations: PyArray::from_vec(py, iterations).into_any().unbind(),
-            residual_norm: vector(py, &rs.iter().map(|r| r.residual_norm).collect::<Vec<_>>()).unbind(),
-            solve_time_s: vector(py, &rs.iter().map(|r| r.solve_time_s).collect::<Vec<_>>()).unbind(),
+            residual_norm: vector(py, &rs.iter().map(|r| r.residual_norm).collect::<Vec<_>>())
+                .unbind(),
+            solve_time_s: vector(py, &rs.iter().map(|r| r.solve_time_s).collect::<Vec<_>>())
+                .unbind(),
         })
     }
 }
