@@ -38,5 +38,6 @@ fn _gvsrom(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<models::Model>()?;
     m.add_function(wrap_pyfunction!(models::load_model, m)?)?;
     m.add_function(wrap_pyfunction!(models::pod, m)?)?;
+    m.add_function(wrap_pyfunction!(models::train, m)?)?;
     Ok(())
 }

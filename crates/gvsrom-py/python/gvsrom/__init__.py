@@ -20,6 +20,7 @@ from ._gvsrom import (
     load_model,
     pod,
     presets,
+    train,
 )
 
 __all__ = [
@@ -34,4 +35,5 @@ __all__ = [
     "load_model",
     "pod",
     "presets",
+    "train",
 ]

@@ -21,6 +21,7 @@ __all__ = [
     "load_model",
     "pod",
     "presets",
+    "train",
 ]
 
 _F = NDArray[np.float64]
@@ -141,6 +142,23 @@ class Model:
 
 def load_model(path: _Path, extrapolate: bool = False) -> Model: ...
 def pod(dataset: _Path, modes: int, out: _Path, force: bool = False) -> Model: ...
+def train(
+    dataset: _Path,
+    out: _Path,
+    latent: int = 1,
+    hidden_layers: int = 7,
+    epochs: int = 2000,
+    batch_size: int = 64,
+    learning_rate: float = 0.001,
+    lambda_: float = 0.0001,
+    validation_fraction: float = 0.1,
+    patience: int = 50,
+    lr_reductions: int = 4,
+    lbfgs_iterations: int = 300,
+    seed: int = 0,
+    loss: str = "energy",
+    force: bool = False,
+) -> Model: ...
 
 @final
 class Robot:
