@@ -64,6 +64,20 @@ impl Built {
             None => self.model.n_dof(),
         }
     }
+
+    /// Tensions `u` [N] for a run in place of the scenario's, checked as a scenario built with
+    /// them (`--tension`) would be: one value for every tendon or one per tendon
+    /// ([`crate::scenario::tensions_for`]), finite, and plausible with the loads
+    /// ([`crate::plausibility::check`]). Returns one value per tendon.
+    pub fn tensions(&self, u: &[f64]) -> Result<Vec<f64>, ScenarioError> {
+        let u = crate::scenario::tensions_for(self.model.n_actuators(), u)?;
+        for (k, v) in u.iter().enumerate() {
+            finite(&format!("tendons[{k}].tension"), *v)?;
+        }
+        let u_abs: Vec<f64> = u.iter().map(|v| v.abs()).collect();
+        crate::plausibility::check(self, &u_abs, 1.0)?;
+        Ok(u)
+    }
 }
 
 /// A one-line description of the scenario as built (after `--set` and `--tension`), for the

@@ -442,15 +442,11 @@ fn attach_model(
     tensions_from_signal: bool,
 ) -> Result<()> {
     let src = presets::source(&args.scenario)?;
-    let mut table = gvsrom::scenario::parse_table(&src.origin, &src.text)?;
-    for spec in &args.set {
-        gvsrom::scenario::apply_override(&mut table, spec)?;
-    }
     let options = reduce::AttachOptions {
         extrapolate: args.extrapolate,
         tensions_from_signal,
     };
-    reduce::attach(built, &table, dir, options)?;
+    reduce::attach_source(built, &src, &args.set, dir, options)?;
     for w in built.reduced.iter().flat_map(|r| &r.warnings) {
         eprintln!("warning: {w}");
     }

@@ -371,27 +371,34 @@ impl Scenario {
 
     /// Sets the tendon tensions: one value for every tendon, or one value per tendon.
     pub fn set_tensions(&mut self, u: &[f64]) -> Result<(), ScenarioError> {
-        let n = self.tendons.len();
-        if n == 0 {
-            return Err(ScenarioError::invalid(
-                "tendons",
-                "the scenario has no tendons to set a tension on",
-            ));
-        }
-        if u.len() != 1 && u.len() != n {
-            return Err(ScenarioError::invalid(
-                "tendons",
-                format!(
-                    "{} tensions given for {n} tendons (give 1 value for all, or {n})",
-                    u.len()
-                ),
-            ));
-        }
-        for (k, t) in self.tendons.iter_mut().enumerate() {
-            t.tension = if u.len() == 1 { u[0] } else { u[k] };
+        let u = tensions_for(self.tendons.len(), u)?;
+        for (t, u) in self.tendons.iter_mut().zip(u) {
+            t.tension = u;
         }
         Ok(())
     }
+}
+
+/// The tensions of `n` tendons from `u`: one value for every tendon, or one value per tendon.
+pub fn tensions_for(n: usize, u: &[f64]) -> Result<Vec<f64>, ScenarioError> {
+    if n == 0 {
+        return Err(ScenarioError::invalid(
+            "tendons",
+            "the scenario has no tendons to set a tension on",
+        ));
+    }
+    if u.len() != 1 && u.len() != n {
+        return Err(ScenarioError::invalid(
+            "tendons",
+            format!(
+                "{} tensions given for {n} tendons (give 1 value for all, or {n})",
+                u.len()
+            ),
+        ));
+    }
+    Ok((0..n)
+        .map(|k| if u.len() == 1 { u[0] } else { u[k] })
+        .collect())
 }
 
 /// The error of `path` (given as `field`, e.g. `SCENARIO` or `--input`) that is `kind` ("a FIFO

@@ -56,6 +56,9 @@ pub enum InputSource {
         period: f64,
         seed: u64,
     },
+    /// A signal given in memory (Python's `input=` array of rows `t, u_1, …, u_na`), checked
+    /// as a CSV file's rows are.
+    Rows(Signal),
     /// Actuator babbling: each actuator holds a uniform random value in `[lo, hi]` for a uniform random
     /// time in `[hold_min, hold_max]` (paper IV-C2).
     Babble {
@@ -426,6 +429,11 @@ pub fn input_signal(built: &Built, opts: &SimulateOptions) -> Result<Signal, Sce
             covers_start("--input", path, &signal, RUN_START)?;
             signal
         }
+        InputSource::Rows(signal) => {
+            signal.validate("input", na)?;
+            covers_start("input", Path::new("input"), signal, RUN_START)?;
+            signal.clone()
+        }
         InputSource::Steps {
             lo,
             hi,
@@ -674,6 +682,14 @@ pub fn input_record(
             });
             v
         }
+        InputSource::Rows(signal) => json!({
+            "signal": "rows",
+            "rows": signal.times.len(),
+            "interpolation": match signal.interpolation {
+                Interpolation::Hold => "hold",
+                Interpolation::Linear => "linear",
+            },
+        }),
         InputSource::Steps {
             lo,
             hi,
@@ -763,7 +779,32 @@ pub fn run(
     built: &Built,
     plan: &Plan,
     integrator: &IntegratorOptions,
-    mut writer: Option<&mut TrajectoryWriter>,
+    writer: Option<&mut TrajectoryWriter>,
+    control: &mut dyn FnMut(f64) -> ControlFlow<String>,
+) -> Result<Outcome, ScenarioError> {
+    let sink = writer.map(|w| w as &mut dyn SampleSink);
+    run_into(built, plan, integrator, sink, control)
+}
+
+/// Where [`run_into`] delivers the samples: a [`TrajectoryWriter`] (files) or a
+/// [`TrajectoryBuffer`] (memory).
+pub trait SampleSink {
+    /// Appends one sample of the run of `built`.
+    fn push(&mut self, built: &Built, s: &Sample<'_>) -> std::io::Result<()>;
+}
+
+impl SampleSink for TrajectoryWriter {
+    fn push(&mut self, built: &Built, s: &Sample<'_>) -> std::io::Result<()> {
+        TrajectoryWriter::push(self, built, s)
+    }
+}
+
+/// [`run`] with the samples delivered to any [`SampleSink`].
+pub fn run_into(
+    built: &Built,
+    plan: &Plan,
+    integrator: &IntegratorOptions,
+    mut writer: Option<&mut dyn SampleSink>,
     control: &mut dyn FnMut(f64) -> ControlFlow<String>,
 ) -> Result<Outcome, ScenarioError> {
     let mut last_tip = None;
@@ -867,6 +908,72 @@ pub fn run(
         last_tip,
         left_training_region,
     })
+}
+
+/// A trajectory kept in memory (the arrays of the files a [`TrajectoryWriter`] writes, row-major,
+/// one row per sample): what the Python binding returns.
+pub struct TrajectoryBuffer {
+    pub t: Vec<f64>,
+    /// `samples × n`.
+    pub q: Vec<f64>,
+    pub qd: Vec<f64>,
+    /// `samples × n_a`.
+    pub u: Vec<f64>,
+    /// `samples × 3`.
+    pub tip_position: Vec<f64>,
+    /// `samples × 3 × 3`.
+    pub tip_rotation: Vec<f64>,
+    /// `samples × p × 6`.
+    pub strain: Vec<f64>,
+    /// `samples × c × 3`, at [`Self::centerline_x`].
+    pub centerline: Vec<f64>,
+    shape: Centerline,
+}
+
+impl TrajectoryBuffer {
+    /// An empty trajectory of the run of `built`.
+    pub fn new(built: &Built) -> Self {
+        TrajectoryBuffer {
+            t: vec![],
+            q: vec![],
+            qd: vec![],
+            u: vec![],
+            tip_position: vec![],
+            tip_rotation: vec![],
+            strain: vec![],
+            centerline: vec![],
+            shape: Centerline::new(built),
+        }
+    }
+
+    /// Abscissae of the centreline samples [m].
+    pub fn centerline_x(&self) -> &[f64] {
+        &self.shape.x
+    }
+}
+
+impl SampleSink for TrajectoryBuffer {
+    fn push(&mut self, built: &Built, s: &Sample<'_>) -> std::io::Result<()> {
+        if s.q.len() != self.shape.q.len() {
+            return Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "a sample of another model's coordinates",
+            ));
+        }
+        self.shape.sample(built, s.q);
+        self.centerline.extend_from_slice(&self.shape.points);
+        self.t.push(s.t);
+        self.q.extend_from_slice(s.q);
+        self.qd.extend_from_slice(s.qd);
+        self.u.extend_from_slice(s.u);
+        self.tip_position.extend(s.tip.pos.iter().copied());
+        let r = &s.tip.rot;
+        self.tip_rotation
+            .extend((0..3).flat_map(|i| (0..3).map(move |j| r[(i, j)])));
+        self.strain
+            .extend(s.strain.iter().flat_map(|xi| xi.iter().copied()));
+        Ok(())
+    }
 }
 
 /// Why [`run_to_dir`] could not run or write a trajectory.

@@ -76,9 +76,17 @@ impl StaticsReport {
 /// non-convergence names the scenario's largest load ([`crate::plausibility::largest_load`]) and
 /// suggests more ramp steps.
 pub fn solve(built: &Built) -> Result<StaticsReport, StaticsFailure> {
+    solve_under(built, &built.u)
+}
+
+/// [`solve`] under the tensions `u` [N] in place of the scenario's, one per tendon: the same
+/// equilibrium as a scenario built with these tensions (`--tension`), without building it again.
+/// Check `u` first with [`Built::tensions`]. A reduced model attached starts from its initial
+/// guess at the scenario's own tensions.
+pub fn solve_under(built: &Built, u: &[f64]) -> Result<StaticsReport, StaticsFailure> {
     match &built.reduced {
-        Some(r) => solve_on(built, &r.model, r.initial.as_ref()),
-        None => solve_on(built, &built.model, None),
+        Some(r) => solve_on(built, &r.model, u, r.initial.as_ref()),
+        None => solve_on(built, &built.model, u, None),
     }
 }
 
@@ -101,6 +109,7 @@ pub fn solve_repeated(built: &Built, repeat: u32) -> Result<StaticsReport, Stati
 fn solve_on<P: StrainParam>(
     built: &Built,
     model: &Model<P>,
+    u: &[f64],
     q0: Option<&DVector<f64>>,
 ) -> Result<StaticsReport, StaticsFailure> {
     let t0 = Instant::now();
@@ -111,14 +120,14 @@ fn solve_on<P: StrainParam>(
             ..built.options.clone()
         };
         StaticsSolver::new(model, options)
-            .solve(&built.u, &built.loads, Some(q0))
+            .solve(u, &built.loads, Some(q0))
             .ok()
     });
     let sol = match warm {
         Some(sol) => sol,
         None => StaticsSolver::new(model, built.options.clone())
-            .solve(&built.u, &built.loads, None)
-            .map_err(|error| failure(built, error))?,
+            .solve(u, &built.loads, None)
+            .map_err(|error| failure(built, u, error))?,
     };
     let solve_time_s = t0.elapsed().as_secs_f64();
 
@@ -138,7 +147,7 @@ fn solve_on<P: StrainParam>(
         .collect();
     Ok(StaticsReport {
         scenario: built.name.clone(),
-        u: built.u.clone(),
+        u: u.to_vec(),
         n_dof: model.n_dof(),
         n_points: model.disc.n_points(),
         q: sol.q.iter().copied().collect(),
@@ -227,10 +236,10 @@ pub fn compare(built: &Built, hom: &StaticsReport, rom: &StaticsReport) -> Compa
 }
 
 /// The engine's error with, for a non-convergence, the largest load and a remedy.
-fn failure(built: &Built, error: StaticsError) -> StaticsFailure {
+fn failure(built: &Built, u: &[f64], error: StaticsError) -> StaticsFailure {
     let mut hint = String::new();
     if let StaticsError::NotConverged { .. } = error {
-        if let Some(load) = crate::plausibility::largest_load(built, &built.u, 1.0) {
+        if let Some(load) = crate::plausibility::largest_load(built, u, 1.0) {
             hint.push_str(&format!("; {load}"));
         }
         let steps = built.options.ramp_steps;

@@ -284,3 +284,19 @@ pub fn attach(
     });
     Ok(())
 }
+
+/// [`attach`] for a scenario given as its source and `--set` overrides (the table the command line
+/// reads): parses the source's TOML, applies the overrides and attaches the model in `dir`.
+pub fn attach_source(
+    built: &mut Built,
+    src: &crate::presets::Source,
+    overrides: &[String],
+    dir: &Path,
+    options: AttachOptions,
+) -> Result<(), anyhow::Error> {
+    let mut table = crate::scenario::parse_table(&src.origin, &src.text)?;
+    for spec in overrides {
+        crate::scenario::apply_override(&mut table, spec)?;
+    }
+    attach(built, &table, dir, options)
+}

@@ -20,7 +20,7 @@ mod train;
 pub mod validity;
 
 pub use anchors::{anchor_guess, solve_anchors, AnchorInput, AnchorProblem};
-pub use attach::{attach, parameterization, AttachOptions, Reduced};
+pub use attach::{attach, attach_source, parameterization, AttachOptions, Reduced};
 pub use pod::{pod, PodSummary};
 pub use train::{train, zero_anchor_rows, Loss, TrainSummary};
 

@@ -1,0 +1,39 @@
+"""gvsrom: GVS Cosserat-rod simulation of soft robots and their reduced-order models.
+
+The same library the ``gvsrom`` command line calls, with NumPy arrays in and out::
+
+    import gvsrom
+    robot = gvsrom.Scenario.preset("single-tendon").set("tendons.0.tension", -5).build()
+    eq = robot.statics()
+    eq.tip_position          # numpy array, [m]
+"""
+
+from ._gvsrom import (
+    ConvergenceError,
+    GvsromError,
+    Model,
+    Robot,
+    Scenario,
+    Statics,
+    StaticsBatch,
+    __version__,
+    load_model,
+    pod,
+    presets,
+    train,
+)
+
+__all__ = [
+    "ConvergenceError",
+    "GvsromError",
+    "Model",
+    "Robot",
+    "Scenario",
+    "Statics",
+    "StaticsBatch",
+    "__version__",
+    "load_model",
+    "pod",
+    "presets",
+    "train",
+]

@@ -1,0 +1,68 @@
+//! NumPy conversions: array-likes (arrays of any real dtype, lists) in, `float64` arrays out.
+
+use crate::errors::invalid;
+use nalgebra::{DMatrix, DVector};
+use numpy::{AllowTypeChange, PyArray, PyArrayLike1, PyArrayLike2, PyArrayMethods};
+use pyo3::prelude::*;
+
+/// A 1-D input (`float64` after conversion).
+pub type In1<'py> = PyArrayLike1<'py, f64, AllowTypeChange>;
+/// A 2-D input (`float64` after conversion).
+pub type In2<'py> = PyArrayLike2<'py, f64, AllowTypeChange>;
+
+/// The values of a 1-D input.
+pub fn vec1(a: &In1<'_>) -> Vec<f64> {
+    a.as_array().iter().copied().collect()
+}
+
+/// A 1-D input of length `n` as a vector; else a `GvsromError` naming `name`.
+pub fn dvec(name: &str, a: &In1<'_>, n: usize) -> PyResult<DVector<f64>> {
+    let v = a.as_array();
+    if v.len() != n {
+        return Err(invalid(format!(
+            "`{name}` has {} entries, the model has {n} coordinates",
+            v.len()
+        )));
+    }
+    Ok(DVector::from_iterator(n, v.iter().copied()))
+}
+
+/// The rows of a 2-D input, each of length `cols`; else a `GvsromError` naming `name`.
+pub fn rows(name: &str, a: &In2<'_>, cols: usize, what: &str) -> PyResult<Vec<Vec<f64>>> {
+    let v = a.as_array();
+    if v.ncols() != cols {
+        return Err(invalid(format!(
+            "`{name}` has {} columns, expected {cols} ({what})",
+            v.ncols()
+        )));
+    }
+    Ok(v.rows().into_iter().map(|r| r.to_vec()).collect())
+}
+
+/// A flat row-major buffer as an array of `shape`.
+pub fn shaped<'py, const D: usize>(
+    py: Python<'py>,
+    flat: Vec<f64>,
+    shape: [usize; D],
+) -> PyResult<Bound<'py, PyAny>>
+where
+    [usize; D]: numpy::ndarray::IntoDimension,
+{
+    Ok(PyArray::from_vec(py, flat).reshape(shape)?.into_any())
+}
+
+/// A 1-D array.
+pub fn vector<'py>(py: Python<'py>, v: &[f64]) -> Bound<'py, PyAny> {
+    PyArray::from_slice(py, v).into_any()
+}
+
+/// A dense matrix as a 2-D array (nalgebra is column-major, NumPy row-major).
+pub fn matrix<'py>(py: Python<'py>, m: &DMatrix<f64>) -> PyResult<Bound<'py, PyAny>> {
+    let flat: Vec<f64> = m.transpose().as_slice().to_vec();
+    shaped(py, flat, [m.nrows(), m.ncols()])
+}
+
+/// Row-major flattening of fixed-size rows.
+pub fn flat<const N: usize>(rows: &[[f64; N]]) -> Vec<f64> {
+    rows.iter().flatten().copied().collect()
+}

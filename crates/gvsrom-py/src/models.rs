@@ -1,0 +1,218 @@
+//! Reduced models: `gvsrom.load_model(path)` and `gvsrom.pod(dataset, modes, out)` (the library's
+//! `gvsrom pod`).
+
+use crate::errors::{self, invalid};
+use gvsrom::reduced_model::ReducedModel;
+use pyo3::prelude::*;
+use std::path::PathBuf;
+
+/// A reduced model directory (from ``gvsrom pod``, ``gvsrom train`` or :func:`pod`), checked
+/// against its recorded hashes when loaded. Pass it as ``model=`` to :meth:`Robot.statics` or to
+/// :meth:`Robot.with_model`.
+///
+/// Attributes
+/// ----------
+/// path : pathlib.Path
+///     The model directory.
+/// kind : str
+///     ``"pod"`` or ``"autoencoder"``.
+/// latent : int
+///     Number of reduced coordinates r.
+/// extrapolate : bool
+///     Whether it may be used outside its training inputs (``--extrapolate``).
+#[pyclass(module = "gvsrom", frozen)]
+pub struct Model {
+    pub dir: PathBuf,
+    /// `"pod"` or `"autoencoder"`.
+    #[pyo3(get)]
+    kind: String,
+    /// Number of reduced coordinates r.
+    #[pyo3(get)]
+    latent: usize,
+    /// Whether it may be used outside its training inputs (`--extrapolate`).
+    #[pyo3(get)]
+    pub extrapolate: bool,
+}
+
+#[pymethods]
+impl Model {
+    /// The model directory.
+    #[getter]
+    fn path(&self) -> PathBuf {
+        self.dir.clone()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Model(path={:?}, kind={:?}, latent={})",
+            self.dir.display().to_string(),
+            self.kind,
+            self.latent
+        )
+    }
+}
+
+/// Loads a reduced model directory.
+///
+/// Parameters
+/// ----------
+/// path : str or os.PathLike
+///     A model directory.
+/// extrapolate : bool
+///     Allow using it outside its training inputs (``--extrapolate``).
+///
+/// Raises
+/// ------
+/// GvsromError
+///     If it is not a model directory, or its files were edited.
+#[pyfunction]
+#[pyo3(signature = (path, extrapolate=false))]
+pub fn load_model(py: Python<'_>, path: PathBuf, extrapolate: bool) -> PyResult<Model> {
+    let m = py
+        .detach(|| ReducedModel::load(&path))
+        .map_err(|e| invalid(e.to_string()))?;
+    Ok(Model {
+        dir: path,
+        kind: m.meta.kind.clone(),
+        latent: m.meta.latent,
+        extrapolate,
+    })
+}
+
+/// POD of a dataset's strain snapshots (``gvsrom pod DATASET --modes K --out MODEL``).
+///
+/// Parameters
+/// ----------
+/// dataset : str or os.PathLike
+///     A dataset directory (``gvsrom dataset``).
+/// modes : int
+///     POD modes kept (reduced coordinates).
+/// out : str or os.PathLike
+///     The new model directory.
+/// force : bool
+///     Replace ``out`` if it is an earlier gvsrom output.
+///
+/// Returns
+/// -------
+/// Model
+///     The new model.
+#[pyfunction]
+#[pyo3(signature = (dataset, modes, out, force=false))]
+pub fn pod(
+    py: Python<'_>,
+    dataset: PathBuf,
+    modes: usize,
+    out: PathBuf,
+    force: bool,
+) -> PyResult<Model> {
+    let summary = py
+        .detach(|| gvsrom::reduce::pod(&dataset, modes, &out, force))
+        .map_err(errors::any)?;
+    for w in &summary.warnings {
+        crate::robot::warn(py, w)?;
+    }
+    load_model(py, summary.path, false)
+}
+
+/// How often training looks for Ctrl-C.
+const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(100);
+
+/// Trains a tanh autoencoder on a dataset's strain snapshots; its decoder becomes a nonlinear
+/// reduced model (``gvsrom train DATASET … --out MODEL``, with the same defaults). Ctrl-C stops
+/// training, saves the best weights so far and raises ``KeyboardInterrupt``.
+///
+/// Parameters
+/// ----------
+/// dataset : str or os.PathLike
+///     A dataset directory (``gvsrom dataset``).
+/// out : str or os.PathLike
+///     The new model directory.
+/// latent : int
+///     Latent size r (reduced coordinates).
+/// hidden_layers : int
+///     Hidden layers of the whole autoencoder (odd: 3, 5, 7…).
+/// epochs, batch_size, learning_rate, lambda_, validation_fraction, patience, lr_reductions,
+/// lbfgs_iterations, seed
+///     As the ``gvsrom train`` options of the same names (``lambda_`` is ``--lambda``; patience 0:
+///     never stop early).
+/// loss : str
+///     ``"energy"``, ``"physical"`` or ``"standardized"``.
+/// force : bool
+///     Replace ``out`` if it is an earlier gvsrom output.
+///
+/// Returns
+/// -------
+/// Model
+///     The new model.
+#[pyfunction]
+#[pyo3(signature = (dataset, out, latent=1, hidden_layers=7, epochs=2000, batch_size=64, learning_rate=1e-3, lambda_=1e-4, validation_fraction=0.1, patience=50, lr_reductions=4, lbfgs_iterations=300, seed=0, loss="energy", force=false))]
+#[allow(clippy::too_many_arguments)]
+pub fn train(
+    py: Python<'_>,
+    dataset: PathBuf,
+    out: PathBuf,
+    latent: usize,
+    hidden_layers: usize,
+    epochs: usize,
+    batch_size: usize,
+    learning_rate: f64,
+    lambda_: f64,
+    validation_fraction: f64,
+    patience: usize,
+    lr_reductions: usize,
+    lbfgs_iterations: usize,
+    seed: u64,
+    loss: &str,
+    force: bool,
+) -> PyResult<Model> {
+    use gvsrom::reduce::Loss;
+    use rom::nn::TrainOptions;
+    let loss = [Loss::Energy, Loss::Physical, Loss::Standardized]
+        .into_iter()
+        .find(|l| l.name() == loss)
+        .ok_or_else(|| {
+            invalid(format!(
+                "invalid `loss`: `{loss}` (accepted: energy, physical, standardized)"
+            ))
+        })?;
+    let options = TrainOptions {
+        latent,
+        hidden_layers,
+        lambda: lambda_,
+        epochs,
+        batch_size,
+        learning_rate,
+        validation_fraction,
+        patience: (patience > 0).then_some(patience),
+        seed,
+        lr_reductions,
+        fine_tune: rom::nn::FineTune::lbfgs(lbfgs_iterations),
+        ..TrainOptions::default()
+    };
+    let mut interrupt: Option<PyErr> = None;
+    let summary = py.detach(|| {
+        let mut last_poll = std::time::Instant::now();
+        let mut progress = |_epoch: usize, _train: f64, _val: Option<f64>| {
+            if last_poll.elapsed() < SIGNAL_POLL {
+                return std::ops::ControlFlow::Continue(());
+            }
+            last_poll = std::time::Instant::now();
+            match Python::attach(|py| py.check_signals()) {
+                Ok(()) => std::ops::ControlFlow::Continue(()),
+                Err(e) => {
+                    interrupt = Some(e);
+                    std::ops::ControlFlow::Break(())
+                }
+            }
+        };
+        gvsrom::reduce::train(&dataset, &options, loss, &out, force, &mut progress)
+    });
+    let summary = summary.map_err(errors::any)?;
+    for w in &summary.warnings {
+        crate::robot::warn(py, w)?;
+    }
+    if let Some(e) = interrupt {
+        return Err(e);
+    }
+    load_model(py, summary.path, false)
+}

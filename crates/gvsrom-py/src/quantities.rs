@@ -1,0 +1,126 @@
+//! Model quantities at a given state, for the model that runs (the HOM, or the reduced model
+//! attached): forward kinematics, the geometric Jacobians, the point velocities, `M(q)`, the
+//! static residual `R(q) = −K₁(q) + F(q) + B(q)u` and its Jacobian. Each is one engine call.
+
+use gvs::model::{Model, Workspace};
+use gvs::strain::StrainParam;
+use gvsrom::{Built, ScenarioError};
+use nalgebra::{DMatrix, DVector};
+
+/// `$body` with `$m` bound to the model that runs (generic over its parameterization).
+macro_rules! on_model {
+    ($built:expr, $m:ident => $body:expr) => {
+        match &$built.reduced {
+            Some(r) => {
+                let $m = &r.model;
+                $body
+            }
+            None => {
+                let $m = &$built.model;
+                $body
+            }
+        }
+    };
+}
+
+/// Poses at the points: positions (p × 3, row-major) and rotations (p × 3 × 3, row-major).
+pub fn forward(built: &Built, q: &DVector<f64>) -> (Vec<f64>, Vec<f64>) {
+    on_model!(built, m => {
+        let mut ws = m.workspace();
+        m.forward(q, &mut ws, false);
+        poses(&ws)
+    })
+}
+
+fn poses(ws: &Workspace) -> (Vec<f64>, Vec<f64>) {
+    let pos =
+        ws.g.iter()
+            .flat_map(|g| [g.pos[0], g.pos[1], g.pos[2]])
+            .collect();
+    let rot =
+        ws.g.iter()
+            .flat_map(|g| (0..3).flat_map(move |i| (0..3).map(move |j| g.rot[(i, j)])))
+            .collect();
+    (pos, rot)
+}
+
+/// The geometric (body) Jacobians `J_i` (`η_i = J_i q̇`) at the points `which`, each 6 × n,
+/// stacked row-major into (points × 6 × n).
+pub fn jacobians(built: &Built, q: &DVector<f64>, which: &[usize]) -> Vec<f64> {
+    on_model!(built, m => {
+        let n = m.n_dof();
+        let mut ws = m.workspace();
+        m.forward(q, &mut ws, true);
+        let mut out = Vec::with_capacity(which.len() * 6 * n);
+        for &i in which {
+            let j = ws.jac.columns(i * n, n);
+            for a in 0..6 {
+                out.extend(j.row(a).iter().copied());
+            }
+        }
+        out
+    })
+}
+
+/// Body twists `η_i` (p × 6, row-major) at `(q, q̇)` by the engine's velocity recursion.
+pub fn velocities(built: &Built, q: &DVector<f64>, qd: &DVector<f64>) -> Vec<f64> {
+    on_model!(built, m => {
+        let mut ws = m.workspace();
+        m.forward(q, &mut ws, false);
+        m.velocities(q, qd, &mut ws);
+        ws.eta.iter().flat_map(|e| e.iter().copied().collect::<Vec<_>>()).collect()
+    })
+}
+
+/// The mass matrix `M(q)`.
+pub fn mass_matrix(built: &Built, q: &DVector<f64>) -> DMatrix<f64> {
+    on_model!(built, m => {
+        let mut ws = m.workspace();
+        m.mass_matrix(q, &mut ws)
+    })
+}
+
+/// `R(q)` under tensions `u` and the scenario's loads.
+pub fn statics_residual(
+    built: &Built,
+    q: &DVector<f64>,
+    u: &[f64],
+) -> Result<DVector<f64>, ScenarioError> {
+    on_model!(built, m => residual_on(m, built, q, u))
+}
+
+fn residual_on<P: StrainParam>(
+    m: &Model<P>,
+    built: &Built,
+    q: &DVector<f64>,
+    u: &[f64],
+) -> Result<DVector<f64>, ScenarioError> {
+    let loads = m.prepare_loads(&built.loads)?;
+    let mut ws = m.workspace();
+    let mut r = DVector::zeros(m.n_dof());
+    m.statics_residual(q, u, &loads, &mut ws, &mut r);
+    Ok(r)
+}
+
+/// `∂R/∂q` under tensions `u` and the scenario's loads (the analytic Jacobian of the solver).
+pub fn statics_jacobian(
+    built: &Built,
+    q: &DVector<f64>,
+    u: &[f64],
+) -> Result<DMatrix<f64>, ScenarioError> {
+    on_model!(built, m => jacobian_on(m, built, q, u))
+}
+
+fn jacobian_on<P: StrainParam>(
+    m: &Model<P>,
+    built: &Built,
+    q: &DVector<f64>,
+    u: &[f64],
+) -> Result<DMatrix<f64>, ScenarioError> {
+    let loads = m.prepare_loads(&built.loads)?;
+    let mut ws = m.workspace();
+    let n = m.n_dof();
+    let mut jac = DMatrix::zeros(n, n);
+    m.statics_jacobian(q, u, &loads, &mut ws, &mut jac);
+    Ok(jac)
+}

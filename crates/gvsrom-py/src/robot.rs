@@ -1,0 +1,562 @@
+//! `gvsrom.Robot`: a built scenario (the engine's model, loads, tensions and solver options), with
+//! a reduced model attached or not; its statics, dynamics and model quantities.
+
+use crate::arrays::{self, In1, In2};
+use crate::errors::{self, invalid, scenario as err};
+use crate::models::Model;
+use crate::quantities;
+use crate::scenario::Scenario;
+use crate::statics::{Statics, StaticsBatch};
+use gvsrom::reduce::{self, AttachOptions};
+use gvsrom::statics::{self, StaticsReport};
+use gvsrom::Built;
+use pyo3::exceptions::PyUserWarning;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use rayon::prelude::*;
+use std::ffi::CString;
+use std::path::PathBuf;
+
+/// A reduced model to attach: its directory and whether it may extrapolate (`--extrapolate`).
+#[derive(Clone)]
+pub struct Attached {
+    pub dir: PathBuf,
+    pub extrapolate: bool,
+}
+
+/// A built scenario: the engine's model of the rod with its loads, tendon tensions and solver
+/// options, and, if :meth:`with_model` attached one, a reduced model that replaces the scenario's
+/// strain basis in statics, dynamics and every model quantity.
+///
+/// Made by :meth:`Scenario.build`.
+#[pyclass(module = "gvsrom", frozen)]
+pub struct Robot {
+    pub scenario: Scenario,
+    pub built: Built,
+    pub attached: Option<Attached>,
+}
+
+/// Builds `scenario` and attaches `attached` as `gvsrom … --model DIR` does, warning in Python
+/// what the command line prints as warnings.
+pub fn build_with(
+    py: Python<'_>,
+    scenario: &Scenario,
+    attached: Option<&Attached>,
+    tensions_from_signal: bool,
+) -> PyResult<Built> {
+    let built = py
+        .detach(|| -> anyhow::Result<Built> {
+            let mut built = gvsrom::build(&scenario.scenario)?;
+            if let Some(a) = attached {
+                let options = AttachOptions {
+                    extrapolate: a.extrapolate,
+                    tensions_from_signal,
+                };
+                reduce::attach_source(
+                    &mut built,
+                    &scenario.src,
+                    &scenario.overrides,
+                    &a.dir,
+                    options,
+                )?;
+            }
+            Ok(built)
+        })
+        .map_err(errors::any)?;
+    for w in built.reduced.iter().flat_map(|r| &r.warnings) {
+        warn(py, w)?;
+    }
+    Ok(built)
+}
+
+/// A `UserWarning` in Python.
+pub fn warn(py: Python<'_>, message: &str) -> PyResult<()> {
+    let text = CString::new(message.replace('\0', " ")).unwrap_or_default();
+    PyErr::warn(py, &py.get_type::<PyUserWarning>(), &text, 1)
+}
+
+impl Robot {
+    pub fn new(py: Python<'_>, scenario: Scenario, attached: Option<Attached>) -> PyResult<Robot> {
+        let built = build_with(py, &scenario, attached.as_ref(), false)?;
+        Ok(Robot {
+            scenario,
+            built,
+            attached,
+        })
+    }
+
+    /// The scenario with tensions `u` (`--tension`), built with the model attached: for the runs
+    /// whose reduced model needs its initial guess at `u`.
+    fn rebuilt_with(
+        &self,
+        py: Python<'_>,
+        u: Option<&[f64]>,
+        attached: &Attached,
+    ) -> PyResult<Built> {
+        let mut scenario = self.scenario.clone();
+        if let Some(u) = u {
+            scenario.scenario.set_tensions(u).map_err(err)?;
+        }
+        build_with(py, &scenario, Some(attached), false)
+    }
+
+    /// Tensions of a model quantity: the scenario's, or `u` (one per tendon or one for all).
+    fn quantity_tensions(&self, u: Option<In1<'_>>) -> PyResult<Vec<f64>> {
+        match u {
+            None => Ok(self.built.u.clone()),
+            Some(u) => {
+                gvsrom::scenario::tensions_for(self.built.model.n_actuators(), &arrays::vec1(&u))
+                    .map_err(err)
+            }
+        }
+    }
+
+    /// The equilibrium under `u` (the scenario's tensions if `None`) with `attached` (else this
+    /// robot's model): `gvsrom statics [--tension u] [--model DIR]`.
+    fn solve(
+        &self,
+        py: Python<'_>,
+        u: Option<Vec<f64>>,
+        attached: Option<&Attached>,
+    ) -> PyResult<StaticsReport> {
+        match attached.or(self.attached.as_ref()) {
+            None => {
+                let u = match u {
+                    Some(u) => self.built.tensions(&u).map_err(err)?,
+                    None => self.built.u.clone(),
+                };
+                py.detach(|| statics::solve_under(&self.built, &u))
+                    .map_err(|f| errors::statics(py, f))
+            }
+            Some(a) => {
+                let built = self.rebuilt_with(py, u.as_deref(), a)?;
+                py.detach(|| -> anyhow::Result<StaticsReport> {
+                    let report = statics::solve(&built)?;
+                    if let Some(r) = &built.reduced {
+                        r.check_range(&report.q)?;
+                    }
+                    Ok(report)
+                })
+                .map_err(errors::any)
+            }
+        }
+    }
+}
+
+#[pymethods]
+impl Robot {
+    /// The scenario's name.
+    #[getter]
+    fn name(&self) -> String {
+        self.built.name.clone()
+    }
+
+    /// A copy of the scenario this robot was built from.
+    #[getter]
+    fn scenario(&self) -> Scenario {
+        self.scenario.clone()
+    }
+
+    /// The attached reduced model's directory, or ``None``.
+    #[getter]
+    fn model(&self) -> Option<PathBuf> {
+        self.attached.as_ref().map(|a| a.dir.clone())
+    }
+
+    /// Generalized coordinates n of the model that runs (the reduced model's if attached).
+    #[getter]
+    fn n_dof(&self) -> usize {
+        self.built.n_dof()
+    }
+
+    /// Number of tendons (actuators).
+    #[getter]
+    fn n_actuators(&self) -> usize {
+        self.built.model.n_actuators()
+    }
+
+    /// Number of computational points.
+    #[getter]
+    fn n_points(&self) -> usize {
+        self.built.model.disc.n_points()
+    }
+
+    /// Rod length L [m].
+    #[getter]
+    fn length(&self) -> f64 {
+        self.built.model.disc.length()
+    }
+
+    /// The scenario's tendon tensions u [N].
+    #[getter]
+    fn tensions<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        arrays::vector(py, &self.built.u)
+    }
+
+    /// Abscissae X of the computational points [m], shape ``(n_points,)``.
+    #[getter]
+    fn point_x<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        let x: Vec<f64> = self.built.model.disc.points.iter().map(|p| p.x).collect();
+        arrays::vector(py, &x)
+    }
+
+    /// Quadrature weights W of the computational points [m] (0 at the ends and extra points),
+    /// shape ``(n_points,)``: integrals over the rod are ``Σ W_i f(X_i)``.
+    #[getter]
+    fn point_weights<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        let w: Vec<f64> = self
+            .built
+            .model
+            .disc
+            .points
+            .iter()
+            .map(|p| p.weight)
+            .collect();
+        arrays::vector(py, &w)
+    }
+
+    /// Diagonal of the cross-section inertia ``Ms`` per unit length at each point
+    /// ``[ρJ, ρI_y, ρI_z, ρA, ρA, ρA]``, shape ``(n_points, 6)``.
+    #[getter]
+    fn section_inertia<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let m = &self.built.model;
+        let rows: Vec<[f64; 6]> = (0..m.disc.n_points())
+            .map(|i| std::array::from_fn(|a| m.section(i).ms[a]))
+            .collect();
+        arrays::shaped(py, arrays::flat(&rows), [rows.len(), 6])
+    }
+
+    /// Diagonal of the cross-section stiffness ``Es`` at each point
+    /// ``[GJ, EI_y, EI_z, EA, GA, GA]``, shape ``(n_points, 6)``.
+    #[getter]
+    fn section_stiffness<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let m = &self.built.model;
+        let rows: Vec<[f64; 6]> = (0..m.disc.n_points())
+            .map(|i| std::array::from_fn(|a| m.section(i).es[a]))
+            .collect();
+        arrays::shaped(py, arrays::flat(&rows), [rows.len(), 6])
+    }
+
+    /// This scenario with a reduced model in place of its strain basis (``--model DIR``).
+    ///
+    /// Parameters
+    /// ----------
+    /// model : Model
+    ///     From :func:`load_model`.
+    /// extrapolate : bool
+    ///     Use the model where the scenario lies outside what it was trained on (``--extrapolate``);
+    ///     the reasons are then warned about.
+    ///
+    /// Raises
+    /// ------
+    /// GvsromError
+    ///     If the model was not learned on this scenario's points, or the scenario lies outside
+    ///     its training (without ``extrapolate``).
+    #[pyo3(signature = (model, extrapolate=false))]
+    fn with_model(
+        &self,
+        py: Python<'_>,
+        model: PyRef<'_, Model>,
+        extrapolate: bool,
+    ) -> PyResult<Robot> {
+        let attached = Attached {
+            dir: model.dir.clone(),
+            extrapolate,
+        };
+        Robot::new(py, self.scenario.clone(), Some(attached))
+    }
+
+    /// Static equilibrium under tendon tensions ``u``, as ``gvsrom statics`` solves it (same
+    /// numbers as its ``--json``).
+    ///
+    /// Parameters
+    /// ----------
+    /// u : array_like of float, optional
+    ///     Tensions [N] (negative pulls): one per tendon, or one for all. Default: the scenario's.
+    /// model : Model, optional
+    ///     A reduced model to solve with (``--model``); default: this robot's.
+    ///
+    /// Returns
+    /// -------
+    /// Statics
+    ///     ``q``, the tip pose, the centreline, the strains and the solver statistics.
+    ///
+    /// Raises
+    /// ------
+    /// GvsromError
+    ///     For tensions of the wrong count, not finite or implausible with the loads.
+    /// ConvergenceError
+    ///     If the solve does not converge (with its iterations and residual).
+    #[pyo3(signature = (u=None, model=None))]
+    fn statics(
+        &self,
+        py: Python<'_>,
+        u: Option<In1<'_>>,
+        model: Option<PyRef<'_, Model>>,
+    ) -> PyResult<Statics> {
+        let u = u.map(|a| arrays::vec1(&a));
+        let attached = model.map(|m| Attached {
+            dir: m.dir.clone(),
+            extrapolate: m.extrapolate,
+        });
+        let report = self.solve(py, u, attached.as_ref())?;
+        Statics::new(py, &report)
+    }
+
+    /// Static equilibria under many tensions, solved in parallel (all cores, the GIL released).
+    /// Row ``k`` equals ``statics(U[k])``.
+    ///
+    /// Parameters
+    /// ----------
+    /// U : array_like of float, shape (m, n_actuators)
+    ///     One row of tensions [N] per equilibrium.
+    ///
+    /// Returns
+    /// -------
+    /// StaticsBatch
+    ///     The solutions' arrays stacked along a first axis of length m.
+    ///
+    /// Raises
+    /// ------
+    /// GvsromError, ConvergenceError
+    ///     For the first row that fails, named ``U[k]``.
+    #[allow(non_snake_case)]
+    #[pyo3(signature = (U,))]
+    fn statics_batch(&self, py: Python<'_>, U: In2<'_>) -> PyResult<StaticsBatch> {
+        if self.attached.is_some() {
+            return Err(invalid(
+                "statics_batch solves the full model; call statics(u) per row with a reduced model",
+            ));
+        }
+        let na = self.built.model.n_actuators();
+        let rows = arrays::rows("U", &U, na, "one tension per tendon")?;
+        let rows = rows
+            .iter()
+            .enumerate()
+            .map(|(k, u)| {
+                self.built
+                    .tensions(u)
+                    .map_err(|e| invalid(format!("U[{k}]: {e}")))
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        let built = &self.built;
+        let results: Vec<_> = py.detach(|| {
+            rows.par_iter()
+                .map(|u| statics::solve_under(built, u))
+                .collect()
+        });
+        let mut reports = Vec::with_capacity(results.len());
+        for (k, r) in results.into_iter().enumerate() {
+            match r {
+                Ok(report) => reports.push(report),
+                Err(f) => {
+                    let message = format!("U[{k}]: {f}");
+                    return Err(errors::statics_with_message(py, &f, &message));
+                }
+            }
+        }
+        StaticsBatch::new(py, &reports, built)
+    }
+
+    /// Forward kinematics: the poses of the cross-sections at the computational points.
+    ///
+    /// Parameters
+    /// ----------
+    /// q : array_like of float, shape (n_dof,)
+    ///
+    /// Returns
+    /// -------
+    /// dict
+    ///     ``x`` (p,) abscissae [m], ``position`` (p, 3) [m], ``rotation`` (p, 3, 3) (section →
+    ///     world).
+    fn forward<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyDict>> {
+        let q = arrays::dvec("q", &q, self.built.n_dof())?;
+        let (pos, rot) = py.detach(|| quantities::forward(&self.built, &q));
+        let p = self.built.model.disc.n_points();
+        let d = PyDict::new(py);
+        d.set_item("x", self.point_x(py))?;
+        d.set_item("position", arrays::shaped(py, pos, [p, 3])?)?;
+        d.set_item("rotation", arrays::shaped(py, rot, [p, 3, 3])?)?;
+        Ok(d)
+    }
+
+    /// Geometric (body) Jacobian ``J_i`` of point ``i``: the section's twist is
+    /// ``η_i = J_i q̇`` (angular velocity first, then linear, both in the section frame).
+    ///
+    /// Parameters
+    /// ----------
+    /// q : array_like of float, shape (n_dof,)
+    /// point : int, optional
+    ///     Point index (negative counts from the tip); default: all points.
+    ///
+    /// Returns
+    /// -------
+    /// numpy.ndarray
+    ///     Shape (6, n_dof), or (n_points, 6, n_dof) for all points.
+    #[pyo3(signature = (q, point=None))]
+    fn jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        q: In1<'_>,
+        point: Option<isize>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let n = self.built.n_dof();
+        let q = arrays::dvec("q", &q, n)?;
+        let p = self.built.model.disc.n_points();
+        let which: Vec<usize> = match point {
+            None => (0..p).collect(),
+            Some(i) => {
+                let j = if i < 0 { i + p as isize } else { i };
+                if !(0..p as isize).contains(&j) {
+                    return Err(invalid(format!(
+                        "`point` = {i} is out of range: the rod has {p} points"
+                    )));
+                }
+                vec![j as usize]
+            }
+        };
+        let flat = py.detach(|| quantities::jacobians(&self.built, &q, &which));
+        match point {
+            None => arrays::shaped(py, flat, [p, 6, n]),
+            Some(_) => arrays::shaped(py, flat, [6, n]),
+        }
+    }
+
+    /// Section twists ``η_i`` at the points (angular then linear velocity, section frame) at
+    /// ``(q, q̇)``, by the engine's velocity recursion.
+    ///
+    /// Returns
+    /// -------
+    /// numpy.ndarray
+    ///     Shape (n_points, 6).
+    fn point_velocities<'py>(
+        &self,
+        py: Python<'py>,
+        q: In1<'_>,
+        qd: In1<'_>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let n = self.built.n_dof();
+        let (q, qd) = (arrays::dvec("q", &q, n)?, arrays::dvec("qd", &qd, n)?);
+        let flat = py.detach(|| quantities::velocities(&self.built, &q, &qd));
+        arrays::shaped(py, flat, [self.built.model.disc.n_points(), 6])
+    }
+
+    /// The mass matrix ``M(q)`` (symmetric positive definite), shape (n_dof, n_dof).
+    fn mass_matrix<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyAny>> {
+        let q = arrays::dvec("q", &q, self.built.n_dof())?;
+        let m = py.detach(|| quantities::mass_matrix(&self.built, &q));
+        arrays::matrix(py, &m)
+    }
+
+    /// The static residual ``R(q) = −K₁(q) + F(q) + B(q)u`` (paper eq. 9) under the scenario's
+    /// loads: zero at an equilibrium.
+    ///
+    /// Parameters
+    /// ----------
+    /// q : array_like of float, shape (n_dof,)
+    /// u : array_like of float, optional
+    ///     Tensions [N], one per tendon or one for all; default: the scenario's.
+    #[pyo3(signature = (q, u=None))]
+    fn statics_residual<'py>(
+        &self,
+        py: Python<'py>,
+        q: In1<'_>,
+        u: Option<In1<'_>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let q = arrays::dvec("q", &q, self.built.n_dof())?;
+        let u = self.quantity_tensions(u)?;
+        let r = py
+            .detach(|| quantities::statics_residual(&self.built, &q, &u))
+            .map_err(err)?;
+        Ok(arrays::vector(py, r.as_slice()))
+    }
+
+    /// The analytic Jacobian ``∂R/∂q`` of :meth:`statics_residual`, shape (n_dof, n_dof).
+    #[pyo3(signature = (q, u=None))]
+    fn statics_jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        q: In1<'_>,
+        u: Option<In1<'_>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let q = arrays::dvec("q", &q, self.built.n_dof())?;
+        let u = self.quantity_tensions(u)?;
+        let j = py
+            .detach(|| quantities::statics_jacobian(&self.built, &q, &u))
+            .map_err(err)?;
+        arrays::matrix(py, &j)
+    }
+
+    /// Simulates the dynamics as ``gvsrom simulate`` does (stiff adaptive integrator), keeping the
+    /// samples in memory. Ctrl-C interrupts it (``KeyboardInterrupt``).
+    ///
+    /// Parameters
+    /// ----------
+    /// duration : float
+    ///     Simulated time [s].
+    /// sample_rate : float
+    ///     Output samples per second [Hz].
+    /// input : array_like of float, shape (k, 1 + n_actuators), optional
+    ///     Rows ``t, u_1, …, u_na`` (times ascending from 0), held piecewise constant (or linear
+    ///     with ``interpolate``); default: the scenario's tensions, constant.
+    /// interpolate : bool
+    ///     Interpolate ``input`` linearly between its rows.
+    /// from_equilibrium : bool
+    ///     Start at the static equilibrium under the scenario's tensions (else straight at rest).
+    /// method : str
+    ///     ``"auto"``, ``"ndf"``, ``"sdirk"`` or ``"galpha"`` (``--method``).
+    /// rtol, atol : float
+    ///     Tolerances of the adaptive integrator (default rtol: chosen by ``method``).
+    ///
+    /// Returns
+    /// -------
+    /// dict
+    ///     ``t`` (k,), ``q``/``qd`` (k, n), ``u`` (k, n_a), ``tip_position`` (k, 3),
+    ///     ``tip_rotation`` (k, 3, 3), ``strain`` (k, p, 6), ``strain_x`` (p,), ``centerline``
+    ///     (k, c, 3), ``centerline_x`` (c,), and ``steps``, ``failed_steps``, ``wall_time_s``.
+    ///
+    /// Raises
+    /// ------
+    /// GvsromError
+    ///     For bad options or input, or an integrator failure (with the samples computed).
+    #[pyo3(signature = (duration, sample_rate=100.0, input=None, interpolate=false, from_equilibrium=false, method="auto", rtol=None, atol=1e-6))]
+    #[allow(clippy::too_many_arguments)]
+    fn simulate<'py>(
+        &self,
+        py: Python<'py>,
+        duration: f64,
+        sample_rate: f64,
+        input: Option<In2<'_>>,
+        interpolate: bool,
+        from_equilibrium: bool,
+        method: &str,
+        rtol: Option<f64>,
+        atol: f64,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let args = crate::simulate::Args {
+            duration,
+            sample_rate,
+            input,
+            interpolate,
+            from_equilibrium,
+            method,
+            rtol,
+            atol,
+        };
+        crate::simulate::run(self, py, args)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Robot(name={:?}, n_dof={}, n_actuators={}, length={}{})",
+            self.built.name,
+            self.built.n_dof(),
+            self.built.model.n_actuators(),
+            self.built.model.disc.length(),
+            match &self.attached {
+                Some(a) => format!(", model={:?}", a.dir.display().to_string()),
+                None => String::new(),
+            }
+        )
+    }
+}

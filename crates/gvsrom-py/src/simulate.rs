@@ -1,0 +1,165 @@
+//! `Robot.simulate`: a dynamics run as `gvsrom simulate` plans and runs it, its samples kept in
+//! memory and returned as NumPy arrays; Ctrl-C interrupts it within one integrator step.
+
+use crate::arrays::{self, shaped, vector};
+use crate::errors::{invalid, scenario as err};
+use crate::robot::{warn, Robot};
+use gvs::inputs::{Interpolation, Signal};
+use gvsrom::simulate::{
+    self, Ending, InputSource, IntegratorChoice, MethodChoice, SimulateOptions, TrajectoryBuffer,
+};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::ops::ControlFlow;
+use std::time::{Duration, Instant};
+
+/// How often the run looks for Ctrl-C (a signal handler needs the GIL).
+const SIGNAL_POLL: Duration = Duration::from_millis(20);
+
+/// The arguments of [`run`] (the options of `gvsrom simulate`).
+pub struct Args<'a> {
+    pub duration: f64,
+    pub sample_rate: f64,
+    pub input: Option<arrays::In2<'a>>,
+    pub interpolate: bool,
+    pub from_equilibrium: bool,
+    pub method: &'a str,
+    pub rtol: Option<f64>,
+    pub atol: f64,
+}
+
+fn method(name: &str) -> PyResult<MethodChoice> {
+    Ok(match name {
+        "auto" => MethodChoice::Auto,
+        "ndf" => MethodChoice::Ndf,
+        "sdirk" => MethodChoice::Sdirk,
+        "galpha" => MethodChoice::Galpha,
+        other => {
+            return Err(invalid(format!(
+                "invalid `method`: `{other}` (accepted: auto, ndf, sdirk, galpha)"
+            )))
+        }
+    })
+}
+
+pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'py, PyDict>> {
+    let na = robot.built.model.n_actuators();
+    let input = match &a.input {
+        None => InputSource::Constant,
+        Some(rows) => {
+            let rows = arrays::rows("input", rows, 1 + na, "t, then one tension per tendon")?;
+            InputSource::Rows(Signal {
+                times: rows.iter().map(|r| r[0]).collect(),
+                values: rows.iter().map(|r| r[1..].to_vec()).collect(),
+                interpolation: if a.interpolate {
+                    Interpolation::Linear
+                } else {
+                    Interpolation::Hold
+                },
+            })
+        }
+    };
+    // a reduced model checks a signal's tensions, not the scenario's (`simulate --model`)
+    let rebuilt = match &robot.attached {
+        Some(att) if a.input.is_some() => Some(crate::robot::build_with(
+            py,
+            &robot.scenario,
+            Some(att),
+            true,
+        )?),
+        _ => None,
+    };
+    let built = rebuilt.as_ref().unwrap_or(&robot.built);
+    let choice = IntegratorChoice {
+        method: method(a.method)?,
+        rtol: a.rtol,
+        atol: a.atol,
+        ..IntegratorChoice::default()
+    };
+    let (integrator, _note) = simulate::choose_integrator(built, &choice).map_err(err)?;
+    let opts = SimulateOptions {
+        duration: a.duration,
+        sample_rate: a.sample_rate,
+        input,
+        start_at_equilibrium: a.from_equilibrium,
+        integrator,
+        load_schedule: None,
+    };
+    let plan = simulate::plan(built, &opts).map_err(err)?;
+    for o in &plan.model_extrapolated {
+        warn(py, &format!("extrapolating (--extrapolate): {o}"))?;
+    }
+    let mut buffer = TrajectoryBuffer::new(built);
+    let mut interrupt: Option<PyErr> = None;
+    let outcome = py.detach(|| {
+        let mut last_poll = Instant::now();
+        let mut control = |_t: f64| {
+            if last_poll.elapsed() < SIGNAL_POLL {
+                return ControlFlow::Continue(());
+            }
+            last_poll = Instant::now();
+            match Python::attach(|py| py.check_signals()) {
+                Ok(()) => ControlFlow::Continue(()),
+                Err(e) => {
+                    interrupt = Some(e);
+                    ControlFlow::Break("interrupted".to_string())
+                }
+            }
+        };
+        simulate::run_into(
+            built,
+            &plan,
+            &opts.integrator,
+            Some(&mut buffer),
+            &mut control,
+        )
+    });
+    if let Some(e) = interrupt {
+        return Err(e);
+    }
+    let outcome = outcome.map_err(err)?;
+    match &outcome.ending {
+        Ending::Complete => {}
+        Ending::Failed { error } => {
+            return Err(invalid(format!(
+                "{error} ({} samples computed)",
+                buffer.t.len()
+            )))
+        }
+        Ending::Interrupted { reason } => return Err(invalid(reason.clone())),
+    }
+    trajectory(py, built, &buffer, &outcome)
+}
+
+fn trajectory<'py>(
+    py: Python<'py>,
+    built: &gvsrom::Built,
+    b: &TrajectoryBuffer,
+    outcome: &simulate::Outcome,
+) -> PyResult<Bound<'py, PyDict>> {
+    let k = b.t.len();
+    let n = built.n_dof();
+    let na = built.model.n_actuators();
+    let p = built.model.disc.n_points();
+    let c = b.centerline_x().len();
+    let d = PyDict::new(py);
+    d.set_item("t", vector(py, &b.t))?;
+    d.set_item("q", shaped(py, b.q.clone(), [k, n])?)?;
+    d.set_item("qd", shaped(py, b.qd.clone(), [k, n])?)?;
+    d.set_item("u", shaped(py, b.u.clone(), [k, na])?)?;
+    d.set_item("tip_position", shaped(py, b.tip_position.clone(), [k, 3])?)?;
+    d.set_item(
+        "tip_rotation",
+        shaped(py, b.tip_rotation.clone(), [k, 3, 3])?,
+    )?;
+    d.set_item("strain", shaped(py, b.strain.clone(), [k, p, 6])?)?;
+    let x: Vec<f64> = built.model.disc.points.iter().map(|pt| pt.x).collect();
+    d.set_item("strain_x", vector(py, &x))?;
+    d.set_item("centerline", shaped(py, b.centerline.clone(), [k, c, 3])?)?;
+    d.set_item("centerline_x", vector(py, b.centerline_x()))?;
+    let s = &outcome.summary;
+    d.set_item("steps", s.stats.steps)?;
+    d.set_item("failed_steps", s.stats.failed_steps)?;
+    d.set_item("wall_time_s", s.wall_time_s)?;
+    Ok(d)
+}

@@ -1,0 +1,227 @@
+//! `gvsrom.Statics` and `gvsrom.StaticsBatch`: a statics report (`gvsrom statics --json`) as NumPy
+//! arrays, one solution or many stacked.
+
+use crate::arrays::{flat, shaped, vector};
+use gvsrom::statics::StaticsReport;
+use gvsrom::Built;
+use numpy::PyArray;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// A static equilibrium (the fields of ``gvsrom statics --json``).
+///
+/// Attributes
+/// ----------
+/// scenario : str
+///     The scenario's name.
+/// u : numpy.ndarray, shape (n_actuators,)
+///     Tendon tensions [N].
+/// q : numpy.ndarray, shape (n_dof,)
+///     Generalized coordinates at equilibrium.
+/// tip_position : numpy.ndarray, shape (3,)
+///     Tip position in the world frame [m].
+/// tip_rotation : numpy.ndarray, shape (3, 3)
+///     Tip rotation matrix, section frame → world.
+/// centerline_x : numpy.ndarray, shape (c,)
+///     Abscissae of the centreline samples [m].
+/// centerline : numpy.ndarray, shape (c, 3)
+///     Centreline positions [m].
+/// strain_x : numpy.ndarray, shape (p,)
+///     Abscissae of the computational points [m].
+/// strain : numpy.ndarray, shape (p, 6)
+///     ξ at the points, ``[torsion, bend-y, bend-z, elongation, shear-y, shear-z]``.
+/// iterations, load_stages, residual_evaluations, jacobian_evaluations : int
+///     Solver statistics.
+/// residual_norm : float
+///     ``‖R(q)‖∞`` at the solution.
+/// solve_time_s : float
+///     Wall-clock time of the solve [s].
+#[pyclass(module = "gvsrom", frozen, get_all)]
+pub struct Statics {
+    /// The scenario's name.
+    scenario: String,
+    /// Generalized coordinates n.
+    n_dof: usize,
+    /// Computational points p.
+    n_points: usize,
+    /// Tendon tensions u [N].
+    u: Py<PyAny>,
+    /// Generalized coordinates at equilibrium.
+    q: Py<PyAny>,
+    /// Tip position in the world frame [m].
+    tip_position: Py<PyAny>,
+    /// Tip rotation matrix, section frame → world.
+    tip_rotation: Py<PyAny>,
+    /// Abscissae of the centreline samples [m].
+    centerline_x: Py<PyAny>,
+    /// Centreline positions [m] at `centerline_x`.
+    centerline: Py<PyAny>,
+    /// Abscissae of the computational points [m].
+    strain_x: Py<PyAny>,
+    /// ξ at the points, `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]`.
+    strain: Py<PyAny>,
+    /// Dogleg iterations over all load stages.
+    iterations: usize,
+    /// Load stages of the ramp.
+    load_stages: usize,
+    /// Residual evaluations.
+    residual_evaluations: usize,
+    /// Jacobian evaluations.
+    jacobian_evaluations: usize,
+    /// `‖R(q)‖∞` at the solution.
+    residual_norm: f64,
+    /// Wall-clock time of the solve [s].
+    solve_time_s: f64,
+}
+
+impl Statics {
+    pub fn new(py: Python<'_>, r: &StaticsReport) -> PyResult<Statics> {
+        Ok(Statics {
+            scenario: r.scenario.clone(),
+            n_dof: r.n_dof,
+            n_points: r.n_points,
+            u: vector(py, &r.u).unbind(),
+            q: vector(py, &r.q).unbind(),
+            tip_position: vector(py, &r.tip_position).unbind(),
+            tip_rotation: shaped(py, flat(&r.tip_rotation), [3, 3])?.unbind(),
+            centerline_x: vector(py, &r.centerline_x).unbind(),
+            centerline: shaped(py, flat(&r.centerline), [r.centerline.len(), 3])?.unbind(),
+            strain_x: vector(py, &r.strain_x).unbind(),
+            strain: shaped(py, flat(&r.strain), [r.strain.len(), 6])?.unbind(),
+            iterations: r.iterations,
+            load_stages: r.load_stages,
+            residual_evaluations: r.residual_evaluations,
+            jacobian_evaluations: r.jacobian_evaluations,
+            residual_norm: r.residual_norm,
+            solve_time_s: r.solve_time_s,
+        })
+    }
+}
+
+#[pymethods]
+impl Statics {
+    /// The fields as a ``dict`` (arrays not copied).
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("scenario", &self.scenario)?;
+        d.set_item("n_dof", self.n_dof)?;
+        d.set_item("n_points", self.n_points)?;
+        for (k, v) in [
+            ("u", &self.u),
+            ("q", &self.q),
+            ("tip_position", &self.tip_position),
+            ("tip_rotation", &self.tip_rotation),
+            ("centerline_x", &self.centerline_x),
+            ("centerline", &self.centerline),
+            ("strain_x", &self.strain_x),
+            ("strain", &self.strain),
+        ] {
+            d.set_item(k, v.bind(py))?;
+        }
+        d.set_item("iterations", self.iterations)?;
+        d.set_item("load_stages", self.load_stages)?;
+        d.set_item("residual_evaluations", self.residual_evaluations)?;
+        d.set_item("jacobian_evaluations", self.jacobian_evaluations)?;
+        d.set_item("residual_norm", self.residual_norm)?;
+        d.set_item("solve_time_s", self.solve_time_s)?;
+        Ok(d)
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> String {
+        format!(
+            "Statics(scenario={:?}, n_dof={}, tip_position={}, iterations={}, residual_norm={:.3e})",
+            self.scenario,
+            self.n_dof,
+            self.tip_position.bind(py),
+            self.iterations,
+            self.residual_norm
+        )
+    }
+}
+
+/// Many static equilibria (:meth:`Robot.statics_batch`): the fields of :class:`Statics` stacked
+/// along a first axis of length m.
+///
+/// Attributes
+/// ----------
+/// u : numpy.ndarray, shape (m, n_actuators)
+/// q : numpy.ndarray, shape (m, n_dof)
+/// tip_position : numpy.ndarray, shape (m, 3)
+/// tip_rotation : numpy.ndarray, shape (m, 3, 3)
+/// centerline_x : numpy.ndarray, shape (c,)
+/// centerline : numpy.ndarray, shape (m, c, 3)
+/// strain_x : numpy.ndarray, shape (p,)
+/// strain : numpy.ndarray, shape (m, p, 6)
+/// iterations : numpy.ndarray of int64, shape (m,)
+/// residual_norm : numpy.ndarray, shape (m,)
+/// solve_time_s : numpy.ndarray, shape (m,)
+///     Each solve's own wall-clock time [s] (the solves run in parallel).
+#[pyclass(module = "gvsrom", frozen, get_all)]
+pub struct StaticsBatch {
+    /// Tendon tensions u [N].
+    u: Py<PyAny>,
+    /// Generalized coordinates at equilibrium.
+    q: Py<PyAny>,
+    /// Tip position in the world frame [m].
+    tip_position: Py<PyAny>,
+    /// Tip rotation matrix, section frame → world.
+    tip_rotation: Py<PyAny>,
+    /// Abscissae of the centreline samples [m].
+    centerline_x: Py<PyAny>,
+    /// Centreline positions [m] at `centerline_x`.
+    centerline: Py<PyAny>,
+    /// Abscissae of the computational points [m].
+    strain_x: Py<PyAny>,
+    /// ξ at the points, `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]`.
+    strain: Py<PyAny>,
+    /// Dogleg iterations over all load stages.
+    iterations: Py<PyAny>,
+    /// `‖R(q)‖∞` at the solution.
+    residual_norm: Py<PyAny>,
+    /// Wall-clock time of the solve [s].
+    solve_time_s: Py<PyAny>,
+}
+
+impl StaticsBatch {
+    pub fn new(py: Python<'_>, rs: &[StaticsReport], built: &Built) -> PyResult<StaticsBatch> {
+        let m = rs.len();
+        let cat = |f: &dyn Fn(&StaticsReport) -> Vec<f64>| -> Vec<f64> {
+            rs.iter().flat_map(f).collect()
+        };
+        let na = built.model.n_actuators();
+        let n = built.n_dof();
+        let x: Vec<f64> = built.model.disc.points.iter().map(|p| p.x).collect();
+        let c = gvsrom::statics::centerline_abscissae(
+            built.model.disc.length(),
+            built.centerline_points,
+        );
+        let iterations: Vec<i64> = rs.iter().map(|r| r.iterations as i64).collect();
+        Ok(StaticsBatch {
+            u: shaped(py, cat(&|r| r.u.clone()), [m, na])?.unbind(),
+            q: shaped(py, cat(&|r| r.q.clone()), [m, n])?.unbind(),
+            tip_position: shaped(py, cat(&|r| r.tip_position.to_vec()), [m, 3])?.unbind(),
+            tip_rotation: shaped(py, cat(&|r| flat(&r.tip_rotation)), [m, 3, 3])?.unbind(),
+            centerline_x: vector(py, &c).unbind(),
+            centerline: shaped(py, cat(&|r| flat(&r.centerline)), [m, c.len(), 3])?.unbind(),
+            strain_x: vector(py, &x).unbind(),
+            strain: shaped(py, cat(&|r| flat(&r.strain)), [m, x.len(), 6])?.unbind(),
+            iterations: PyArray::from_vec(py, iterations).into_any().unbind(),
+            residual_norm: vector(py, &rs.iter().map(|r| r.residual_norm).collect::<Vec<_>>())
+                .unbind(),
+            solve_time_s: vector(py, &rs.iter().map(|r| r.solve_time_s).collect::<Vec<_>>())
+                .unbind(),
+        })
+    }
+}
+
+#[pymethods]
+impl StaticsBatch {
+    /// Number of equilibria m.
+    fn __len__(&self, py: Python<'_>) -> PyResult<usize> {
+        self.q.bind(py).len()
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> PyResult<String> {
+        Ok(format!("StaticsBatch(m={})", self.__len__(py)?))
+    }
+}

@@ -1,0 +1,41 @@
+"""Shared fixtures: the `gvsrom` binary the Python results are compared with (GVSROM_BIN)."""
+
+import json
+import os
+import subprocess
+from pathlib import Path
+
+import pytest
+
+PRESETS = ["single-tendon", "soft-beam", "six-tendon", "soft-beam-peak", "six-tendon-no-gravity"]
+
+
+@pytest.fixture(scope="session")
+def gvsrom_bin() -> Path:
+    """The command-line binary (`cargo build -p gvsrom`), from GVSROM_BIN."""
+    path = os.environ.get("GVSROM_BIN")
+    if not path or not Path(path).is_file():
+        pytest.skip("GVSROM_BIN is not set to the gvsrom binary")
+    return Path(path)
+
+
+def run_cli(bin_path: Path, *args: str) -> subprocess.CompletedProcess:
+    """Runs `gvsrom ARGS`, returning the completed process (not checked)."""
+    return subprocess.run([str(bin_path), *args], capture_output=True, text=True, timeout=600)
+
+
+def cli_error(bin_path: Path, *args: str) -> str:
+    """The message of a failing `gvsrom ARGS`: its stderr without the `error: ` prefix."""
+    p = run_cli(bin_path, *args)
+    assert p.returncode == 1, p.stdout + p.stderr
+    line = p.stderr.strip().splitlines()[-1]
+    assert line.startswith("error: "), line
+    return line[len("error: "):]
+
+
+def cli_statics(bin_path: Path, tmp_path: Path, *args: str) -> dict:
+    """`gvsrom statics ARGS --json F`, read back."""
+    out = tmp_path / "statics.json"
+    p = run_cli(bin_path, "statics", *args, "--json", str(out), "--force")
+    assert p.returncode == 0, p.stderr
+    return json.loads(out.read_text())

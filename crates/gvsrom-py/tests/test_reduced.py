@@ -1,0 +1,75 @@
+"""A tiny dataset (CLI) → POD and autoencoder (Python) → reduced statics, equal to the CLI's
+`statics --model`; the reduced model's quantities checked as the full model's are."""
+
+import numpy as np
+import pytest
+
+import gvsrom
+from conftest import cli_statics, run_cli
+
+
+@pytest.fixture(scope="module")
+def dataset(gvsrom_bin, tmp_path_factory):
+    out = tmp_path_factory.mktemp("ds") / "sweep"
+    p = run_cli(gvsrom_bin, "dataset", "single-tendon", "--sweep", "tendons.0.tension=-6:0",
+                "--samples", "7", "--out", str(out))
+    assert p.returncode == 0, p.stderr
+    return out
+
+
+@pytest.fixture(scope="module")
+def pod_model(dataset, tmp_path_factory):
+    return gvsrom.pod(dataset, 2, tmp_path_factory.mktemp("pod") / "model")
+
+
+@pytest.fixture(scope="module")
+def ae_model(dataset, tmp_path_factory):
+    return gvsrom.train(dataset, tmp_path_factory.mktemp("ae") / "model", latent=1, hidden_layers=3,
+                        epochs=40, patience=0, lbfgs_iterations=20, seed=3)
+
+
+def test_pod_model_loads_with_its_size(pod_model):
+    assert (pod_model.kind, pod_model.latent) == ("pod", 2)
+    again = gvsrom.load_model(pod_model.path)
+    assert (again.kind, again.latent) == ("pod", 2)
+
+
+@pytest.mark.parametrize("which", ["pod_model", "ae_model"])
+def test_reduced_statics_equals_the_cli_with_model(gvsrom_bin, tmp_path, request, which):
+    model = request.getfixturevalue(which)
+    cli = cli_statics(gvsrom_bin, tmp_path, "single-tendon", "--tension=-3", "--model", str(model.path))
+    robot = gvsrom.Scenario.preset("single-tendon").build()
+    eq = robot.statics(u=[-3.0], model=model)
+    assert eq.n_dof == model.latent
+    np.testing.assert_allclose(eq.q, cli["q"], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(eq.tip_position, cli["tip_position"], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(eq.strain, cli["strain"], rtol=0, atol=1e-12)
+    same = robot.with_model(model).statics(u=[-3.0])
+    np.testing.assert_array_equal(same.q, eq.q)
+
+
+def test_reduced_model_quantities_hold_as_the_full_models(ae_model):
+    robot = gvsrom.Scenario.preset("single-tendon").build().with_model(ae_model)
+    assert robot.n_dof == 1 and robot.model == ae_model.path
+    q = robot.statics(u=[-3.0]).q + 0.01
+    M = robot.mass_matrix(q)
+    assert M.shape == (1, 1) and M[0, 0] > 0
+    # the decoder's second derivatives enter ∂R/∂q: compare with central differences
+    h = 1e-6
+    fd = (robot.statics_residual(q + h, [-3.0]) - robot.statics_residual(q - h, [-3.0])) / (2 * h)
+    jac = robot.statics_jacobian(q, [-3.0])
+    np.testing.assert_allclose(jac[:, 0], fd, rtol=1e-5, atol=1e-8 * np.abs(jac).max())
+
+
+def test_a_model_outside_its_training_is_refused_with_the_cli_message(gvsrom_bin, pod_model):
+    p = run_cli(gvsrom_bin, "statics", "single-tendon", "--tension=-20", "--model", str(pod_model.path))
+    assert p.returncode == 1
+    expected = p.stderr.strip().splitlines()[-1].removeprefix("error: ")
+    with pytest.raises(gvsrom.GvsromError) as e:
+        gvsrom.Scenario.preset("single-tendon").build().statics(u=[-20.0], model=pod_model)
+    assert str(e.value) == expected
+
+
+def test_load_model_of_a_non_model_is_a_value_error(tmp_path):
+    with pytest.raises(ValueError):
+        gvsrom.load_model(tmp_path)

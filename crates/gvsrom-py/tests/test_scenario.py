@@ -1,0 +1,82 @@
+"""Scenario: presets, TOML text and files, `set` with the paths and errors of `--set`."""
+
+import pytest
+
+import gvsrom
+from conftest import cli_error
+
+
+def test_presets_lists_the_built_in_scenarios():
+    names = gvsrom.presets()
+    assert "single-tendon" in names and "six-tendon" in names
+    assert all(isinstance(v, str) and v for v in names.values())
+
+
+def test_preset_builds_the_paper_robot_with_its_sizes():
+    robot = gvsrom.Scenario.preset("single-tendon").build()
+    assert (robot.n_dof, robot.n_actuators, robot.length) == (33, 1, 0.25)
+    assert robot.point_x.shape == (robot.n_points,)
+    assert robot.section_inertia.shape == (robot.n_points, 6)
+
+
+def test_unknown_preset_is_a_value_error_naming_the_presets():
+    with pytest.raises(ValueError, match="unknown preset `nope`.*single-tendon"):
+        gvsrom.Scenario.preset("nope")
+
+
+def test_set_uses_the_paths_and_toml_values_of_the_command_line():
+    s = gvsrom.Scenario.preset("six-tendon")
+    s.set("tendons.0.tension", -2).set("tendons.1.tension", "-3.5").set("loads.gravity", [0, 0, -1.5])
+    assert s.tensions[:2] == [-2.0, -3.5]
+    assert s.overrides == ["tendons.0.tension=-2", "tendons.1.tension=-3.5", "loads.gravity=[0, 0, -1.5]"]
+    tomllib = pytest.importorskip("tomllib")
+    assert tomllib.loads(s.to_toml())["loads"]["gravity"] == [0.0, 0.0, -1.5]
+
+
+def test_a_rejected_set_leaves_the_scenario_unchanged():
+    s = gvsrom.Scenario.preset("single-tendon")
+    before = s.to_toml()
+    with pytest.raises(gvsrom.GvsromError):
+        s.set("tendons.5.tension", 1.0)
+    assert s.to_toml() == before and s.overrides == []
+
+
+def test_to_toml_parses_back_to_the_same_scenario():
+    text = gvsrom.Scenario.preset("soft-beam").set("divisions.0.basis.elements", 10).to_toml()
+    assert gvsrom.Scenario.from_toml(text).to_toml() == text
+
+
+def test_from_toml_reads_a_file_given_as_path_or_str(tmp_path):
+    text = gvsrom.Scenario.preset("single-tendon").to_toml()
+    f = tmp_path / "arm.toml"
+    f.write_text(text)
+    assert gvsrom.Scenario.from_toml(f).to_toml() == text
+    assert gvsrom.Scenario.from_toml(str(f)).to_toml() == text
+
+
+def test_missing_file_is_a_value_error():
+    with pytest.raises(ValueError, match="not found"):
+        gvsrom.Scenario.from_toml("no/such/file.toml")
+
+
+@pytest.mark.parametrize(
+    "path, value, spec",
+    [
+        ("tendons.5.tension", 1.0, "tendons.5.tension=1.0"),
+        ("material.colour", "red", "material.colour=red"),
+        ("divisions.0.basis.order", "x", "divisions.0.basis.order=x"),
+    ],
+)
+def test_set_errors_carry_the_message_of_the_command_line(gvsrom_bin, path, value, spec):
+    expected = cli_error(gvsrom_bin, "check", "single-tendon", "--set", spec)
+    with pytest.raises(gvsrom.GvsromError) as e:
+        gvsrom.Scenario.preset("single-tendon").set(path, value)
+    assert str(e.value) == expected
+
+
+def test_build_errors_carry_the_message_of_the_command_line(gvsrom_bin):
+    expected = cli_error(gvsrom_bin, "check", "single-tendon", "--set", "material.youngs_modulus=-1")
+    s = gvsrom.Scenario.preset("single-tendon").set("material.youngs_modulus", -1)
+    with pytest.raises(ValueError) as e:
+        s.build()
+    assert str(e.value) == expected

@@ -1,0 +1,87 @@
+"""Statics from Python equals `gvsrom statics --json` on every preset, bit for bit."""
+
+import numpy as np
+import pytest
+
+import gvsrom
+from conftest import PRESETS, cli_error, cli_statics
+
+# the same code on the same inputs: identical up to the JSON round trip of f64 (exact with
+# serde_json's float_roundtrip); 1e-12 leaves room for nothing else
+TOL = 1e-12
+
+TENSIONS = {
+    "single-tendon": [-5.0],
+    "six-tendon": [-4.0, 0.0, -2.0, 0.0, -1.0, 0.0],
+    "six-tendon-no-gravity": [-3.0, -1.0, 0.0, 0.0, -2.0, 0.0],
+}
+
+
+def assert_same(py: gvsrom.Statics, cli: dict) -> None:
+    np.testing.assert_allclose(py.q, cli["q"], rtol=0, atol=TOL)
+    np.testing.assert_allclose(py.u, cli["u"], rtol=0, atol=0)
+    np.testing.assert_allclose(py.tip_position, cli["tip_position"], rtol=0, atol=TOL)
+    np.testing.assert_allclose(py.tip_rotation, cli["tip_rotation"], rtol=0, atol=TOL)
+    np.testing.assert_allclose(py.centerline_x, cli["centerline_x"], rtol=0, atol=TOL)
+    np.testing.assert_allclose(py.centerline, cli["centerline"], rtol=0, atol=TOL)
+    np.testing.assert_allclose(py.strain_x, cli["strain_x"], rtol=0, atol=TOL)
+    np.testing.assert_allclose(py.strain, cli["strain"], rtol=0, atol=TOL)
+    assert py.iterations == cli["iterations"]
+    assert py.load_stages == cli["load_stages"]
+    assert py.residual_norm == pytest.approx(cli["residual_norm"], rel=0, abs=TOL)
+    assert py.scenario == cli["scenario"]
+
+
+@pytest.mark.parametrize("name", PRESETS)
+def test_statics_equals_the_cli_json_on_each_preset(gvsrom_bin, tmp_path, name):
+    cli = cli_statics(gvsrom_bin, tmp_path, name)
+    eq = gvsrom.Scenario.preset(name).build().statics()
+    assert_same(eq, cli)
+    assert eq.q.shape == (eq.n_dof,) and eq.strain.shape == (eq.n_points, 6)
+    assert eq.solve_time_s > 0
+
+
+@pytest.mark.parametrize("name", sorted(TENSIONS))
+def test_statics_under_tensions_equals_the_cli_with_tension(gvsrom_bin, tmp_path, name):
+    u = TENSIONS[name]
+    cli = cli_statics(gvsrom_bin, tmp_path, name, "--tension=" + ",".join(map(str, u)))
+    eq = gvsrom.Scenario.preset(name).build().statics(u=np.array(u))
+    assert_same(eq, cli)
+
+
+def test_statics_after_set_equals_the_cli_with_set(gvsrom_bin, tmp_path):
+    sets = ["tendons.0.tension=-7", "solver.ramp_steps=3"]
+    cli = cli_statics(gvsrom_bin, tmp_path, "single-tendon", *[a for s in sets for a in ("--set", s)])
+    s = gvsrom.Scenario.preset("single-tendon").set("tendons.0.tension", -7).set("solver.ramp_steps", 3)
+    assert_same(s.build().statics(), cli)
+
+
+def test_one_tension_is_given_to_every_tendon():
+    robot = gvsrom.Scenario.preset("six-tendon-no-gravity").build()
+    a = robot.statics(u=[-1.5])
+    b = robot.statics(u=[-1.5] * 6)
+    np.testing.assert_array_equal(a.q, b.q)
+
+
+def test_wrong_tension_count_is_a_value_error(gvsrom_bin):
+    robot = gvsrom.Scenario.preset("six-tendon").build()
+    expected = cli_error(gvsrom_bin, "statics", "six-tendon", "--tension=-1,-2")
+    with pytest.raises(ValueError) as e:
+        robot.statics(u=[-1.0, -2.0])
+    # the command line names its option first
+    assert expected == "--tension: " + str(e.value)
+
+
+def test_non_convergence_raises_with_iterations_and_residual(gvsrom_bin):
+    sets = ["solver.max_iterations=1", "solver.ramp_steps=1", "tendons.0.tension=-10"]
+    expected = cli_error(gvsrom_bin, "statics", "single-tendon", *[a for s in sets for a in ("--set", s)])
+    s = gvsrom.Scenario.preset("single-tendon")
+    for spec in sets:
+        path, value = spec.split("=")
+        s.set(path, value)
+    with pytest.raises(gvsrom.ConvergenceError) as e:
+        s.build().statics()
+    assert str(e.value) == expected
+    assert e.value.iterations >= 1 and e.value.residual_norm > 0
+    assert f"after {e.value.iterations} iterations" in str(e.value)
+    assert isinstance(e.value, ValueError)
