@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{copy_dir, expect_error, gvsrom, scratch};
+use common::{copy_dir, expect_error, gvsrom, json, run_ok, scratch, sweep_dataset};
 use gvsrom::dataset::Dataset;
 use std::path::Path;
 
@@ -20,31 +20,9 @@ const ARRAYS: [&str; 9] = [
     "strain_x.npy",
 ];
 
-fn run_ok(args: &[&str]) -> String {
-    let out = gvsrom(args);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "gvsrom {args:?} failed: {stderr}");
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-fn json(path: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
-}
-
 /// A 9-sample single-tendon sweep over [-6, 3] N (one chunk).
 fn sweep9(name: &str) -> std::path::PathBuf {
-    let dir = scratch(name);
-    run_ok(&[
-        "dataset",
-        "single-tendon",
-        "--sweep",
-        "tendons.0.tension=-6:3",
-        "--samples",
-        "9",
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
-    dir
+    sweep_dataset(name, "-6:3", 9)
 }
 
 #[test]

@@ -7,7 +7,7 @@
 mod common;
 
 use common::reseal::reseal;
-use common::{gvsrom, scratch};
+use common::sweep_dataset;
 use gvsrom::dataset::Dataset;
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -15,25 +15,7 @@ use std::path::{Path, PathBuf};
 /// A 3-sample single-tendon sweep (all samples ok), made once.
 fn dataset() -> &'static Path {
     static D: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
-    D.get_or_init(|| {
-        let dir = scratch("values-ds");
-        let out = gvsrom(&[
-            "dataset",
-            "single-tendon",
-            "--sweep",
-            "tendons.0.tension=-3:0",
-            "--samples",
-            "3",
-            "--out",
-            dir.to_str().unwrap(),
-        ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        dir
-    })
+    D.get_or_init(|| sweep_dataset("values-ds", "-3:0", 3))
 }
 
 /// The values of the f64 array `file` of `dir` (flat, C order), and the byte offset of its data.

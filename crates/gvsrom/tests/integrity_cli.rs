@@ -4,36 +4,14 @@
 
 mod common;
 
-use common::{expect_error, gvsrom, scratch};
+use common::{expect_error, gvsrom, s, scratch, sweep_dataset};
 use std::fs;
 use std::path::{Path, PathBuf};
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
 
 /// A 3-sample single-tendon sweep (one chunk), made once.
 fn dataset() -> &'static Path {
     static D: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
-    D.get_or_init(|| {
-        let dir = scratch("integ-ds");
-        let out = gvsrom(&[
-            "dataset",
-            "single-tendon",
-            "--sweep",
-            "tendons.0.tension=-3:0",
-            "--samples",
-            "3",
-            "--out",
-            s(&dir),
-        ]);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        dir
-    })
+    D.get_or_init(|| sweep_dataset("integ-ds", "-3:0", 3))
 }
 
 /// A copy of the dataset in a fresh scratch directory.

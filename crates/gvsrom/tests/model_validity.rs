@@ -4,42 +4,17 @@
 
 mod common;
 
-use common::{copy_dir, expect_error, gvsrom, scratch};
+use common::{
+    copy_dir, expect_error, gvsrom, json, run_ok, run_ok_with_stderr, s, scratch, sweep_dataset,
+};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 use std::time::Duration;
 
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-fn run_ok(args: &[&str]) -> (String, String) {
-    let out = gvsrom(args);
-    let (stdout, stderr) = (
-        String::from_utf8_lossy(&out.stdout).to_string(),
-        String::from_utf8_lossy(&out.stderr).to_string(),
-    );
-    assert!(out.status.success(), "gvsrom {args:?} failed: {stderr}");
-    (stdout, stderr)
-}
-
 /// 12 single-tendon equilibria at tensions in [-6, 3] N.
 fn dataset12() -> &'static Path {
     static D: OnceLock<PathBuf> = OnceLock::new();
-    D.get_or_init(|| {
-        let dir = scratch("val-ds12");
-        run_ok(&[
-            "dataset",
-            "single-tendon",
-            "--sweep",
-            "tendons.0.tension=-6:3",
-            "--samples",
-            "12",
-            "--out",
-            s(&dir),
-        ]);
-        dir
-    })
+    D.get_or_init(|| sweep_dataset("val-ds12", "-6:3", 12))
 }
 
 /// POD-2 of [`dataset12`].
@@ -144,7 +119,7 @@ fn a_model_refuses_inputs_outside_its_training_range_unless_extrapolating() {
     );
     // on purpose: answered, with a warning naming the extrapolation, recorded in the JSON
     let json = scratch("val-extrapolated.json");
-    let (stdout, stderr) = run_ok(&[
+    let (stdout, stderr) = run_ok_with_stderr(&[
         "statics",
         "single-tendon",
         "--tension=-9",
@@ -271,7 +246,7 @@ fn a_model_from_an_interrupted_training_is_used_with_a_warning() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let (_, stderr) = run_ok(&[
+    let (_, stderr) = run_ok_with_stderr(&[
         "statics",
         "single-tendon",
         "--tension=-3",
@@ -283,7 +258,7 @@ fn a_model_from_an_interrupted_training_is_used_with_a_warning() {
         "{stderr}"
     );
     // a model trained to its end carries no such warning
-    let (_, stderr) = run_ok(&[
+    let (_, stderr) = run_ok_with_stderr(&[
         "statics",
         "single-tendon",
         "--tension=-3",
@@ -291,10 +266,6 @@ fn a_model_from_an_interrupted_training_is_used_with_a_warning() {
         s(pod2()),
     ]);
     assert!(!stderr.contains("warning"), "{stderr}");
-}
-
-fn read_json(path: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
 fn write_json(path: &Path, v: &serde_json::Value) {
@@ -331,7 +302,7 @@ fn dataset_metadata_inconsistent_with_its_arrays_is_refused_not_a_panic() {
     let out = scratch("val-ds-inconsistent-model");
     // the component names reordered (hashes re-recorded, as by a writer with a bug)
     let ds = copy_dir(dataset12(), "val-ds-renamed");
-    let mut meta = read_json(&ds.join("meta.json"));
+    let mut meta = json(&ds.join("meta.json"));
     meta["components"].as_array_mut().unwrap().reverse();
     write_json(&ds.join("meta.json"), &meta);
     common::reseal::reseal(&ds);
@@ -344,7 +315,7 @@ fn dataset_metadata_inconsistent_with_its_arrays_is_refused_not_a_panic() {
     }
     // meta.json naming another scenario (a two-mode rod) over the single tendon's arrays
     let ds = copy_dir(dataset12(), "val-ds-other-scenario");
-    let mut meta = read_json(&ds.join("meta.json"));
+    let mut meta = json(&ds.join("meta.json"));
     let text = "[material]\nyoungs_modulus = 1e6\npoisson_ratio = 0.5\ndensity = 1000\n[[divisions]]\nlength = 0.5\nradius = 0.01\nbasis = { kind = \"legendre\", modes = [\"bend_y\", \"bend_z\"], order = 3 }\n";
     meta["scenario_toml"] = text.into();
     write_json(&ds.join("meta.json"), &meta);
@@ -403,7 +374,7 @@ fn a_solution_off_the_learned_manifold_names_its_cause() {
     // loaded equilibrium lies "off the manifold", an in-range load included
     let narrowed = |name: &str, drop_anchors: bool| {
         let dir = copy_dir(ae1(), name);
-        let mut meta = read_json(&dir.join("meta.json"));
+        let mut meta = json(&dir.join("meta.json"));
         let rest = meta["rest"][0].as_f64().unwrap();
         meta["latent_range"] = serde_json::json!([[rest - 1e-6, rest + 1e-6]]);
         write_json(&dir.join("meta.json"), &meta);
@@ -508,9 +479,9 @@ fn a_simulation_input_signal_is_checked_against_the_training_inputs() {
     // on purpose: a warning, and the record in the trajectory's meta.json
     let mut args = sim(&["--extrapolate", "--out"]);
     args.push(s(&out).to_string());
-    let (_, stderr) = run_ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    let (_, stderr) = run_ok_with_stderr(&args.iter().map(String::as_str).collect::<Vec<_>>());
     assert!(stderr.contains("warning: extrapolating"), "{stderr}");
-    let meta = read_json(&out.join("meta.json"));
+    let meta = json(&out.join("meta.json"));
     assert!(
         meta["model_extrapolated"][0]
             .as_str()
@@ -523,7 +494,7 @@ fn a_simulation_input_signal_is_checked_against_the_training_inputs() {
 fn a_model_without_a_recorded_range_is_refused_and_one_without_hashes_warns() {
     // written before ranges were recorded: no `input_range` (hashes re-recorded)
     let m = copy_dir(pod2(), "val-pod2-norange");
-    let mut meta = read_json(&m.join("meta.json"));
+    let mut meta = json(&m.join("meta.json"));
     meta.as_object_mut().unwrap().remove("input_range").unwrap();
     write_json(&m.join("meta.json"), &meta);
     common::reseal::reseal(&m);
@@ -533,12 +504,13 @@ fn a_model_without_a_recorded_range_is_refused_and_one_without_hashes_warns() {
     );
     // written before hashes were recorded: used, with a warning that it could not be checked
     let m = copy_dir(pod2(), "val-pod2-nohash");
-    let mut meta = read_json(&m.join("meta.json"));
+    let mut meta = json(&m.join("meta.json"));
     let manifest = meta["gvsrom"].as_object_mut().unwrap();
     manifest.shift_remove("sha256").unwrap();
     manifest.shift_remove("meta_sha256").unwrap();
     write_json(&m.join("meta.json"), &meta);
-    let (_, stderr) = run_ok(&["statics", "single-tendon", "--tension=-3", "--model", s(&m)]);
+    let (_, stderr) =
+        run_ok_with_stderr(&["statics", "single-tendon", "--tension=-3", "--model", s(&m)]);
     assert!(
         stderr.contains("warning:") && stderr.contains("before gvsrom recorded content hashes"),
         "{stderr}"

@@ -5,10 +5,10 @@
 
 mod common;
 
-use common::{expect_error, gvsrom, scratch};
+use common::{expect_error, gvsrom, s, scratch};
 use nalgebra::{DMatrix, DVector};
 use std::f64::consts::PI;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// A uniform clamped–free rod, L = 0.5 m, r = 5 mm (L/r = 100), E = 1 MPa, ν = 0.5, ρ = 1000 kg/m³,
 /// no gravity and no loads (gvs-spec §10.5), all six strain components in Legendre order 6 with 12
@@ -38,10 +38,6 @@ fn rod_file(name: &str, text: &str) -> PathBuf {
     let path = scratch(&format!("{name}.toml"));
     std::fs::write(&path, text).unwrap();
     path
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
 }
 
 /// Runs `gvsrom modes ARGS --json FILE`, expects success; returns stdout and the JSON.

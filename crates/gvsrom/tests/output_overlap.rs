@@ -4,23 +4,10 @@
 
 mod common;
 
-use common::{expect_error, gvsrom, scratch};
+use common::{expect_error, gvsrom, run_ok, s, scratch, sweep_dataset};
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::Command;
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-fn run_ok(args: &[&str]) {
-    let out = gvsrom(args);
-    assert!(
-        out.status.success(),
-        "gvsrom {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
 
 /// Every file below `dir` (or `dir` itself if it is a file) with its bytes, sorted by path.
 fn snapshot(path: &Path) -> Vec<(PathBuf, Vec<u8>)> {
@@ -51,17 +38,7 @@ fn with_scenario(name: &str) -> (PathBuf, PathBuf) {
 fn model() -> &'static Path {
     static M: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
     M.get_or_init(|| {
-        let ds = scratch("overlap-ds");
-        run_ok(&[
-            "dataset",
-            "single-tendon",
-            "--sweep",
-            "tendons.0.tension=-3:0",
-            "--samples",
-            "3",
-            "--out",
-            s(&ds),
-        ]);
+        let ds = sweep_dataset("overlap-ds", "-3:0", 3);
         let m = scratch("overlap-model");
         run_ok(&["pod", s(&ds), "--modes", "1", "--out", s(&m)]);
         m

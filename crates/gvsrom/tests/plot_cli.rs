@@ -8,25 +8,10 @@
 
 mod common;
 
-use common::{copy_dir, expect_error, gvsrom, reseal::reseal, scratch};
+use common::{copy_dir, expect_error, json, reseal::reseal, run_ok, s, scratch, sweep_dataset};
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
-
-fn run_ok(args: &[&str]) -> String {
-    let out = gvsrom(args);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "gvsrom {args:?} failed: {stderr}");
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-fn json(path: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
-}
 
 /// `statics single-tendon --tension=-4 --json F`.
 fn statics_json() -> &'static Path {
@@ -82,20 +67,7 @@ fn trajectory_without_centerlines() -> &'static Path {
 /// A 12-sample tension sweep.
 fn dataset() -> &'static Path {
     static D: OnceLock<PathBuf> = OnceLock::new();
-    D.get_or_init(|| {
-        let d = scratch("plot-ds");
-        run_ok(&[
-            "dataset",
-            "single-tendon",
-            "--sweep",
-            "tendons.0.tension=-6:3",
-            "--samples",
-            "12",
-            "--out",
-            s(&d),
-        ]);
-        d
-    })
+    D.get_or_init(|| sweep_dataset("plot-ds", "-6:3", 12))
 }
 
 fn pod() -> &'static Path {

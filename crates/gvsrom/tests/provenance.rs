@@ -4,35 +4,12 @@
 
 mod common;
 
-use common::{gvsrom, scratch};
+use common::{gvsrom, json, npy, run_ok, s, scratch};
 use serde_json::Value;
 use std::path::Path;
 
 /// Length of the single-tendon rod [m] (`examples/single-tendon.toml`: one division of 0.25 m).
 const L: f64 = 0.25;
-
-fn run_ok(args: &[&str]) -> String {
-    let out = gvsrom(args);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "gvsrom {args:?} failed: {stderr}");
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-fn json(path: &Path) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-/// Shape and values of a little-endian f64 `.npy` file (read with npyz, as numpy would).
-fn npy(path: &Path) -> (Vec<usize>, Vec<f64>) {
-    let bytes = std::fs::read(path).unwrap();
-    let file = npyz::NpyFile::new(&bytes[..]).unwrap();
-    let shape = file.shape().iter().map(|&d| d as usize).collect();
-    (shape, file.into_vec::<f64>().unwrap())
-}
 
 fn sha256_hex(bytes: &[u8]) -> String {
     use sha2::{Digest, Sha256};

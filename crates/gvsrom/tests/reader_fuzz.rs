@@ -21,7 +21,7 @@
 
 mod common;
 
-use common::{gvsrom, scratch};
+use common::{run_ok, s, scratch, sweep_dataset};
 use gvsrom::dataset::Dataset;
 use gvsrom::reduced_model::{ModelWeights, ReducedModel};
 use proptest::prelude::*;
@@ -39,36 +39,10 @@ use std::time::Duration;
 /// in a debug build): longer is reported as a hang.
 const LIMIT: Duration = Duration::from_secs(60);
 
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-fn run_ok(args: &[&str]) {
-    let out = gvsrom(args);
-    assert!(
-        out.status.success(),
-        "gvsrom {args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
-
 /// Six single-tendon equilibria at tensions in [-6, 3] N.
 fn dataset() -> &'static Path {
     static D: OnceLock<PathBuf> = OnceLock::new();
-    D.get_or_init(|| {
-        let dir = scratch("rfuzz-ds");
-        run_ok(&[
-            "dataset",
-            "single-tendon",
-            "--sweep",
-            "tendons.0.tension=-6:3",
-            "--samples",
-            "6",
-            "--out",
-            s(&dir),
-        ]);
-        dir
-    })
+    D.get_or_init(|| sweep_dataset("rfuzz-ds", "-6:3", 6))
 }
 
 /// A two-mode POD of [`dataset`].

@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{expect_error_within, fifo_at, gvsrom, scratch};
+use common::{expect_error_within, fifo_at, run_ok, s, scratch, sweep_dataset};
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -14,36 +14,10 @@ use std::time::Duration;
 /// Longer than any of these runs takes when it ends (well under a second), short enough to fail.
 const DEADLINE: Duration = Duration::from_secs(20);
 
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-fn ok(args: &[&str]) {
-    let out = gvsrom(args);
-    assert!(
-        out.status.success(),
-        "gvsrom {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
-
 /// A 3-sample single-tendon sweep, made once.
 fn dataset() -> &'static Path {
     static D: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
-    D.get_or_init(|| {
-        let dir = scratch("special-ds");
-        ok(&[
-            "dataset",
-            "single-tendon",
-            "--sweep",
-            "tendons.0.tension=-3:0",
-            "--samples",
-            "3",
-            "--out",
-            s(&dir),
-        ]);
-        dir
-    })
+    D.get_or_init(|| sweep_dataset("special-ds", "-3:0", 3))
 }
 
 /// A one-mode POD model of [`dataset`], made once.
@@ -51,7 +25,7 @@ fn model() -> &'static Path {
     static M: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
     M.get_or_init(|| {
         let dir = scratch("special-model");
-        ok(&["pod", s(dataset()), "--modes", "1", "--out", s(&dir)]);
+        run_ok(&["pod", s(dataset()), "--modes", "1", "--out", s(&dir)]);
         dir
     })
 }
@@ -105,7 +79,7 @@ fn statics_refused(model: &Path, needles: &[&str]) -> String {
 fn an_older_dataset_whose_manifest_lists_no_files_is_still_read() {
     // the copies below differ from this one only by the special file
     let dir = copy(dataset(), "special-ds-unlisted", true);
-    ok(&[
+    run_ok(&[
         "pod",
         s(&dir),
         "--modes",

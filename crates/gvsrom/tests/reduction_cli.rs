@@ -9,7 +9,7 @@
 
 mod common;
 
-use common::{copy_dir, expect_error, gvsrom, scratch};
+use common::{copy_dir, expect_error, json, npy, run_ok, s, scratch, sweep_dataset};
 use gvsrom::reduced_model::ReducedModel;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -17,29 +17,6 @@ use std::time::{Duration, Instant};
 
 /// Length of the single-tendon rod [m].
 const L: f64 = 0.25;
-
-fn run_ok(args: &[&str]) -> String {
-    let out = gvsrom(args);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "gvsrom {args:?} failed: {stderr}");
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-fn json(path: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-/// Shape and values of a little-endian f64 `.npy` file (read with npyz, as numpy would).
-fn npy(path: &Path) -> (Vec<usize>, Vec<f64>) {
-    let bytes = std::fs::read(path).unwrap();
-    let file = npyz::NpyFile::new(&bytes[..]).unwrap();
-    let shape = file.shape().iter().map(|&d| d as usize).collect();
-    (shape, file.into_vec::<f64>().unwrap())
-}
 
 fn tip(v: &serde_json::Value) -> [f64; 3] {
     let t = v.as_array().unwrap();
@@ -56,18 +33,7 @@ fn dist(a: &[f64], b: &[f64]) -> f64 {
 
 /// `gvsrom dataset single-tendon --sweep tendons.0.tension=LO:HI --samples N --out DIR`.
 fn sweep(name: &str, lo: f64, hi: f64, samples: usize) -> PathBuf {
-    let dir = scratch(name);
-    run_ok(&[
-        "dataset",
-        "single-tendon",
-        "--sweep",
-        &format!("tendons.0.tension={lo}:{hi}"),
-        "--samples",
-        &samples.to_string(),
-        "--out",
-        s(&dir),
-    ]);
-    dir
+    sweep_dataset(name, &format!("{lo}:{hi}"), samples)
 }
 
 /// The 40-sample sweep over [-6, 3] N shared by the POD and autoencoder tests: tensions

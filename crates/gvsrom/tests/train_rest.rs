@@ -9,17 +9,8 @@
 
 mod common;
 
-use common::{gvsrom, scratch};
+use common::{run_ok, scratch};
 use gvsrom::reduced_model::{ModelWeights, ReducedModel};
-
-fn run_ok(args: &[&str]) {
-    let out = gvsrom(args);
-    assert!(
-        out.status.success(),
-        "gvsrom {args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-}
 
 fn npy(path: &std::path::Path) -> Vec<f64> {
     let bytes = std::fs::read(path).unwrap();

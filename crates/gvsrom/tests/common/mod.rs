@@ -1,5 +1,5 @@
-//! Helpers shared by the command-line tests: run the binary, scratch paths, and the check of a
-//! one-line user error.
+//! Helpers shared by the command-line tests: run the binary (and expect success), scratch paths,
+//! small single-tendon sweep datasets, and the check of a one-line user error.
 #![allow(dead_code)]
 
 pub mod reseal;
@@ -13,6 +13,55 @@ pub fn gvsrom(args: &[&str]) -> Output {
         .args(args)
         .output()
         .expect("the gvsrom binary runs")
+}
+
+/// A test path as the `&str` of a command-line argument (scratch paths are UTF-8).
+pub fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// Runs `gvsrom args`, expects success (panics with its stderr otherwise); returns stdout.
+pub fn run_ok(args: &[&str]) -> String {
+    run_ok_with_stderr(args).0
+}
+
+/// [`run_ok`] that also returns stderr (warnings): `(stdout, stderr)`.
+pub fn run_ok_with_stderr(args: &[&str]) -> (String, String) {
+    let out = gvsrom(args);
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "gvsrom {args:?} failed: {stderr}");
+    (String::from_utf8_lossy(&out.stdout).into_owned(), stderr)
+}
+
+/// The JSON document of the file at `path`.
+pub fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// Shape and values of a little-endian f64 `.npy` file (read with npyz, as numpy would).
+pub fn npy(path: &Path) -> (Vec<usize>, Vec<f64>) {
+    let bytes = std::fs::read(path).unwrap();
+    let file = npyz::NpyFile::new(&bytes[..]).unwrap();
+    let shape = file.shape().iter().map(|&d| d as usize).collect();
+    (shape, file.into_vec::<f64>().unwrap())
+}
+
+/// `gvsrom dataset single-tendon --sweep tendons.0.tension=RANGE --samples SAMPLES --out DIR` at
+/// the fresh scratch path `name` (`range` is `LO:HI` in N); returns DIR. A file that uses one
+/// sweep in several tests caches it in its own `OnceLock`.
+pub fn sweep_dataset(name: &str, range: &str, samples: usize) -> PathBuf {
+    let dir = scratch(name);
+    run_ok(&[
+        "dataset",
+        "single-tendon",
+        "--sweep",
+        &format!("tendons.0.tension={range}"),
+        "--samples",
+        &samples.to_string(),
+        "--out",
+        s(&dir),
+    ]);
+    dir
 }
 
 /// A scratch path unique to one test (files of all tests share one folder), cleared of what an
