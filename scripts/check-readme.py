@@ -9,7 +9,8 @@ exceptions are stated here and nowhere else:
 - `export PATH=…` lines only put the binary on the PATH, which this script does.
 - `scripts/check-readme.py` is this check.
 
-Every ```python block is run with the Python interpreter given by `--python` (default: this one)
+Every ```python block is run with the Python interpreter given by `--python` (default: this one;
+CI passes the venv of the Python package, which has NumPy and `gvsrom`)
 after the shell blocks before it, in the same directory. If that interpreter has no NumPy the
 Python blocks are reported as not run and the check fails, unless `--skip-python` is given.
 
