@@ -129,6 +129,10 @@ def main():
     args = ap.parse_args()
 
     binary = find_binary(args.bin)
+    # the blocks run in the scratch directory: a relative interpreter path is made absolute (not
+    # resolved: a venv's python is a link that must stay the venv's)
+    if os.sep in args.python:
+        args.python = os.path.abspath(args.python)
     readme = Path(args.readme).read_text()
     if args.keep:
         work = Path(args.keep).resolve()
