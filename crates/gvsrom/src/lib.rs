@@ -12,6 +12,7 @@ pub mod csv_input;
 pub mod dataset;
 pub mod error;
 pub mod figures;
+pub mod layout;
 pub mod modes;
 pub mod npy;
 pub mod output;

@@ -206,7 +206,7 @@ pub struct Comparison {
 
 /// Strain deviations `ξ − ξ*` of a report at its points, the active components of `built` only.
 pub fn active_deviations(built: &Built, report: &StaticsReport) -> Vec<f64> {
-    let active = crate::dataset::Layout::of(built).active;
+    let active = crate::layout::Layout::of(built).active;
     let star = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0];
     report
         .strain

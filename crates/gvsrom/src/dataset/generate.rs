@@ -11,6 +11,7 @@
 
 use super::plan::Plan;
 use crate::build::Built;
+pub use crate::layout::Layout;
 use crate::scenario::{apply_override, from_table};
 use gvs::model::Model;
 use gvs::solve::statics::{StaticsError, StaticsOptions, StaticsSolution, StaticsSolver};
@@ -26,40 +27,6 @@ pub const STATUS_NOT_COMPUTED: u8 = 2;
 
 /// Iteration limit of a warm-started solve before falling back to the ramp from straight.
 const WARM_MAX_ITERATIONS: usize = 50;
-
-/// What every sample row holds: the computational points and the strain components stored.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Layout {
-    pub n_dof: usize,
-    pub strain_x: Vec<f64>,
-    /// Indices (0..6) of the active strain components.
-    pub active: Vec<usize>,
-}
-
-impl Layout {
-    /// The layout of `built`: a strain component is active if the basis can excite it at any site.
-    pub fn of(built: &Built) -> Layout {
-        let m = &built.model;
-        Layout {
-            n_dof: m.n_dof(),
-            strain_x: m.disc.points.iter().map(|p| p.x).collect(),
-            active: rom::reduced::PointLayout::active_in(&m.param, &m.disc).active,
-        }
-    }
-
-    /// Names of the active components (`bend_y`, …), in column order within a point.
-    pub fn component_names(&self) -> Vec<String> {
-        self.active
-            .iter()
-            .map(|&a| crate::scenario::StrainMode::ALL[a].name().to_string())
-            .collect()
-    }
-
-    /// Values per strain row: points × active components.
-    pub fn row_len(&self) -> usize {
-        self.strain_x.len() * self.active.len()
-    }
-}
 
 /// One solved (or failed) sample.
 #[derive(Debug, Clone)]
