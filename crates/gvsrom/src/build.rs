@@ -937,3 +937,13 @@ pub fn loads(s: &Scenario, l: f64) -> Result<Loads, ScenarioError> {
         distributed,
     })
 }
+
+impl<'a> From<&'a Built> for crate::plausibility::Subject<'a> {
+    fn from(b: &'a Built) -> Self {
+        crate::plausibility::Subject {
+            model: &b.model,
+            u: &b.u,
+            loads: &b.loads,
+        }
+    }
+}

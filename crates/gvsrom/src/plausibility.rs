@@ -35,11 +35,12 @@
 //! Every product is formed so that an overflow gives `inf` (never `0 · inf = NaN`) and every
 //! comparison rejects `inf` and NaN.
 
-use crate::build::Built;
 use crate::error::ScenarioError;
 use gvs::error::fmt_value;
 use gvs::lie::V3;
-use gvs::loads::{DistributedWrench, PulseMagnitude};
+use gvs::loads::{DistributedWrench, Loads, PulseMagnitude};
+use gvs::model::Model;
+use gvs::strain::LinearBasis;
 use std::f64::consts::PI;
 
 /// Largest implied bending angle `θ` accepted [rad] (about 30 turns).
@@ -49,9 +50,23 @@ pub const MAX_STRAIN: f64 = 1.0;
 /// Grid intervals per division of the estimate (fewer when the rod has many divisions, at least 4).
 pub const GRID_POINTS: usize = 64;
 
+/// What the check reads of a built scenario (`crate::build::Built` converts into it): the model, the
+/// scenario's own tensions and its loads. The check depends on the engine only, not on `build`.
+#[derive(Clone, Copy)]
+pub struct Subject<'a> {
+    pub model: &'a Model<LinearBasis>,
+    pub u: &'a [f64],
+    pub loads: &'a Loads,
+}
+
 /// Checks the loads and tensions a run will see. `u_max[k]` is the largest |tension| of tendon k over the run,
 /// `load_scale_max` the largest |λ| applied to the external loads and gravity (1.0 for statics).
-pub fn check(built: &Built, u_max: &[f64], load_scale_max: f64) -> Result<(), ScenarioError> {
+pub fn check<'a>(
+    subject: impl Into<Subject<'a>>,
+    u_max: &[f64],
+    load_scale_max: f64,
+) -> Result<(), ScenarioError> {
+    let built = subject.into();
     let n_a = built.model.n_actuators();
     if u_max.len() != n_a {
         return Err(ScenarioError::invalid(
@@ -62,7 +77,7 @@ pub fn check(built: &Built, u_max: &[f64], load_scale_max: f64) -> Result<(), Sc
             ),
         ));
     }
-    let worst = estimates(built, u_max, load_scale_max, true)
+    let worst = estimates(&built, u_max, load_scale_max, true)
         .into_iter()
         .filter(|e| !(e.bending <= MAX_BENDING && e.strain <= MAX_STRAIN))
         .max_by(|a, b| a.severity().total_cmp(&b.severity()));
@@ -88,8 +103,12 @@ pub fn check(built: &Built, u_max: &[f64], load_scale_max: f64) -> Result<(), Sc
 }
 
 /// One phrase naming the load with the largest implied strain, e.g. "the largest load is tendons[0].tension = -40 N (implied bending ~12 rad)", or None without loads.
-pub fn largest_load(built: &Built, u: &[f64], load_scale: f64) -> Option<String> {
-    let e = estimates(built, u, load_scale, false)
+pub fn largest_load<'a>(
+    subject: impl Into<Subject<'a>>,
+    u: &[f64],
+    load_scale: f64,
+) -> Option<String> {
+    let e = estimates(&subject.into(), u, load_scale, false)
         .into_iter()
         .filter(|e| e.severity() > 0.0)
         .max_by(|a, b| a.severity().total_cmp(&b.severity()))?;
@@ -171,7 +190,7 @@ struct Interval {
     area: [f64; 2],
 }
 
-fn grid(built: &Built) -> Vec<Interval> {
+fn grid(built: &Subject<'_>) -> Vec<Interval> {
     let rod = &built.model.rod;
     let e = rod.material.youngs_modulus;
     let g = rod.material.shear_modulus();
@@ -233,7 +252,7 @@ fn tri_tail(s: f64, c: f64, h: f64) -> f64 {
 /// Estimates of every load: tendons (with `u[k]`, signed or a bound), point and distributed
 /// wrenches and gravity (scaled by `scale`). `bound` phrases tensions as bounds over a run when
 /// they are not the scenario's own.
-fn estimates(built: &Built, u: &[f64], scale: f64, bound: bool) -> Vec<Estimate> {
+fn estimates(built: &Subject<'_>, u: &[f64], scale: f64, bound: bool) -> Vec<Estimate> {
     let grid = grid(built);
     let model = &built.model;
     let l = model.rod.length();
@@ -269,7 +288,7 @@ fn estimates(built: &Built, u: &[f64], scale: f64, bound: bool) -> Vec<Estimate>
         });
     }
 
-    let loads = &built.loads;
+    let loads = built.loads;
     for (k, p) in loads.point.iter().enumerate() {
         let m = V3::from_row_slice(&p.wrench[..3]).norm();
         let f = V3::from_row_slice(&p.wrench[3..]).norm();
@@ -417,6 +436,7 @@ fn wrench_name(field: &str, w: &[f64; 6], force_unit: &str, moment_unit: &str) -
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::build::Built;
     use crate::presets;
     use crate::scenario::Scenario;
 
@@ -444,7 +464,7 @@ mod tests {
     }
 
     fn only_estimate(b: &Built) -> Estimate {
-        let mut e = estimates(b, &b.u, 1.0, false);
+        let mut e = estimates(&b.into(), &b.u, 1.0, false);
         e.retain(|e| e.severity() > 0.0);
         assert_eq!(e.len(), 1);
         e.pop().unwrap()
@@ -562,7 +582,7 @@ mod tests {
         }
         // with a margin: single-tendon at ±30 N, the tightest in strain, at ~24 rad and strain 0.62
         let b = built("single-tendon", &["tendons.0.tension=-30".into()]).unwrap();
-        let e = &estimates(&b, &b.u, 1.0, false)[0];
+        let e = &estimates(&(&b).into(), &b.u, 1.0, false)[0];
         assert!(
             e.bending < MAX_BENDING / 5.0 && e.strain < 0.7,
             "{} {}",
