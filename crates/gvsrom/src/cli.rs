@@ -429,7 +429,7 @@ fn load(args: &ScenarioArgs) -> Result<(Scenario, Built, Provenance)> {
         scenario.output.centerline_points = n;
     }
     let built = build(&scenario)?;
-    let provenance = Provenance::of_scenario(&src, &args.set, scenario.to_toml()?);
+    let provenance = src.provenance(&args.set, scenario.to_toml()?);
     Ok((scenario, built, provenance))
 }
 

@@ -28,7 +28,7 @@ pub enum ScenarioError {
     /// A structural problem (conflicting or missing keys, counts).
     #[error("invalid `{field}`: {message}")]
     Invalid { field: String, message: String },
-    /// A load far beyond the rod's elastic range (see [`crate::plausibility`]); `load` names it by its
+    /// A load far beyond the rod's elastic range (see the `plausibility` module); `load` names it by its
     /// scenario path and value.
     #[error("{load} {message}")]
     Implausible { load: String, message: String },

@@ -50,7 +50,7 @@ pub const MAX_STRAIN: f64 = 1.0;
 /// Grid intervals per division of the estimate (fewer when the rod has many divisions, at least 4).
 pub const GRID_POINTS: usize = 64;
 
-/// What the check reads of a built scenario (`crate::build::Built` converts into it): the model, the
+/// What the check reads of a built scenario (the build layer's `Built` converts into it): the model, the
 /// scenario's own tensions and its loads. The check depends on the engine only, not on `build`.
 #[derive(Clone, Copy)]
 pub struct Subject<'a> {

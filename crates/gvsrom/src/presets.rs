@@ -4,6 +4,7 @@
 //! and `six-tendon-no-gravity` are milder variants, kept for the gvs-spec §10.4 anchors.
 
 use crate::error::ScenarioError;
+use crate::provenance::{sha256_hex, Provenance, ScenarioOrigin};
 use crate::scenario::Scenario;
 use std::path::Path;
 
@@ -69,6 +70,24 @@ pub struct Source {
     pub text: String,
     /// A built-in preset (else a file).
     pub preset: bool,
+}
+
+impl Source {
+    /// Where the text came from, as provenance records it (with its SHA-256).
+    pub fn origin_record(&self) -> ScenarioOrigin {
+        ScenarioOrigin {
+            source: if self.preset { "preset" } else { "file" }.into(),
+            name: self.preset.then(|| self.default_name.clone()),
+            path: (!self.preset).then(|| self.origin.clone()),
+            sha256: sha256_hex(self.text.as_bytes()),
+        }
+    }
+
+    /// The provenance of a run of this scenario with the `--set` `overrides`, run as
+    /// `scenario_toml` (the resolved TOML), started now.
+    pub fn provenance(&self, overrides: &[String], scenario_toml: String) -> Provenance {
+        Provenance::of_scenario(self.origin_record(), overrides, scenario_toml)
+    }
 }
 
 /// Resolves `arg` as a preset name first, then as a file path.

@@ -10,9 +10,9 @@
 //! | `overrides` | every `--set PATH=VALUE`, in order |
 //! | `scenario_toml` | the scenario as run (after `--set`, `--tension`, `--centerline-points`): `gvsrom statics FILE` on this text alone solves the same problem |
 //! | `seeds` | every seed, by what it seeds (`{"input": 1}`, `{"plan": 0}`, `{"training": 0}`) |
-//! | `input` | a run's actuation ([`crate::simulate::input_record`]) |
+//! | `input` | a run's actuation (`simulate::input_record`) |
 //! | `sampling` | a dynamics run's `duration` [s] and `sample_rate` [Hz] |
-//! | `integrator` | a dynamics run's method and tolerances ([`crate::simulate::integrator_record`]) |
+//! | `integrator` | a dynamics run's method and tolerances (`simulate::integrator_record`) |
 //! | `solver` | a statics run's solver options (the scenario's `[solver]`) |
 //! | `model`, `dataset`, `reference`, `run` | an input directory (`compare`'s trajectories for the last two): its path and the hashes its manifest records (`meta_sha256`, `sha256` per file) |
 //!
@@ -20,7 +20,6 @@
 
 use crate::error::ScenarioError;
 use crate::output::{MANIFEST_FILE, MANIFEST_KEY};
-use crate::presets::Source;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::collections::BTreeMap;
@@ -98,16 +97,15 @@ pub struct DirOrigin {
 }
 
 impl Provenance {
-    /// A run of the scenario read from `source` with the `--set` `overrides`, run as
+    /// A run of the scenario read from `origin` with the `--set` `overrides`, run as
     /// `scenario_toml`; started now, by this process's command line.
-    pub fn of_scenario(source: &Source, overrides: &[String], scenario_toml: String) -> Provenance {
+    pub fn of_scenario(
+        origin: ScenarioOrigin,
+        overrides: &[String],
+        scenario_toml: String,
+    ) -> Provenance {
         let mut p = Provenance::of_command();
-        p.scenario = Some(ScenarioOrigin {
-            source: if source.preset { "preset" } else { "file" }.into(),
-            name: source.preset.then(|| source.default_name.clone()),
-            path: (!source.preset).then(|| source.origin.clone()),
-            sha256: sha256_hex(source.text.as_bytes()),
-        });
+        p.scenario = Some(origin);
         p.overrides = overrides.to_vec();
         p.scenario_toml = Some(scenario_toml);
         p

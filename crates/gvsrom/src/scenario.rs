@@ -4,8 +4,8 @@
 //! The format is documented key by key in `docs/scenario-format.md`. Every table rejects unknown keys.
 //! Reading goes TOML text → `toml::Table` (syntax errors with line and column) → overrides → a check
 //! that no number is NaN or infinite → [`Scenario`] (type errors name the key's path, e.g.
-//! `divisions[0].basis.order`). Physical validation and conversion to the engine's types are in
-//! [`crate::build`].
+//! `divisions[0].basis.order`). Physical validation and conversion to the engine's types are the build
+//! layer's (`build`, above this module).
 
 use crate::error::ScenarioError;
 use gvs::discretize::MagnusOrder;

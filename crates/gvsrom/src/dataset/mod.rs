@@ -299,7 +299,7 @@ fn load_scenario(
     let scenario = crate::scenario::from_table(table.clone())?;
     let built = crate::build(&scenario)?;
     let text = toml::to_string(&table).map_err(|e| plan_err(format!("scenario: {e}")))?;
-    let provenance = crate::provenance::Provenance::of_scenario(&src, &args.set, text.clone());
+    let provenance = src.provenance(&args.set, text.clone());
     Ok((table, built, text, provenance))
 }
 

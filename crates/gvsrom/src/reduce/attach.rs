@@ -2,7 +2,7 @@
 //! scenario's basis, the layout check, and the latent range the model may be trusted in.
 
 use super::{anchors::initial_guess, invalid, projection_of};
-use crate::build::Built;
+use crate::build::{Built, Reduced};
 use crate::dataset::Layout;
 use crate::error::ScenarioError;
 use crate::reduced_model::{ModelWeights, ReducedModel};
@@ -10,7 +10,7 @@ use gvs::model::Model;
 use gvs::strain::{LinearBasis, StrainParam};
 use nalgebra::DVector;
 use rom::reduced::ReducedParam;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// How [`attach`] checks the scenario against what the model was trained for.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -20,116 +20,6 @@ pub struct AttachOptions {
     /// The tendon tensions come from an input signal (a simulation): the scenario's static
     /// tensions are not checked, the signal is ([`Reduced::check_signal`]).
     pub tensions_from_signal: bool,
-}
-
-/// A reduced model bound to a scenario.
-pub struct Reduced {
-    /// The scenario's rod, points, tendons and loads with the reduced parameterization.
-    pub model: Model<Box<dyn StrainParam>>,
-    /// `"pod"` or `"autoencoder"`.
-    pub kind: String,
-    pub path: PathBuf,
-    /// Initial guess of a statics solve: the model's anchors at this scenario's inputs
-    /// ([`anchor_guess`]; models whose dataset inputs the scenario defines).
-    pub initial: Option<DVector<f64>>,
-    /// The training encodings' range per coordinate.
-    pub latent_range: Vec<[f64; 2]>,
-    /// How the scenario lies outside what the model was trained on, when used with
-    /// `--extrapolate` (empty: inside; see [`super::validity`]).
-    pub extrapolated: Vec<String>,
-    /// What a front-end should tell the user about this model (an interrupted training, an
-    /// extrapolation).
-    pub warnings: Vec<String>,
-    /// The training inputs' ranges ([`super::validity`]).
-    pub input_range: Vec<crate::reduced_model::InputRange>,
-    /// [`AttachOptions::extrapolate`], for the checks that come later (an input signal's).
-    pub extrapolate: bool,
-}
-
-impl Reduced {
-    /// Checks an input signal's tensions (`u_at(t)` at `times`) against the training ranges
-    /// ([`super::validity::check_signal`]): an error listing how it lies outside, or with
-    /// `--extrapolate` those sentences, to be printed and recorded with the run.
-    pub fn check_signal(
-        &self,
-        times: &[f64],
-        u_at: impl FnMut(f64) -> Vec<f64>,
-    ) -> Result<Vec<String>, ScenarioError> {
-        let outside = super::validity::check_signal(&self.input_range, times, u_at);
-        if outside.is_empty() {
-            return Ok(vec![]);
-        }
-        if !self.extrapolate {
-            return Err(invalid(
-                "--model",
-                format!(
-                    "`{}` was not trained for this input: {}; pass --extrapolate to use it anyway (its answer is then an extrapolation, and is marked so)",
-                    self.path.display(),
-                    outside.join("; ")
-                ),
-            ));
-        }
-        Ok(outside)
-    }
-
-    /// Errors if `q` lies outside the training encodings' range by more than half its width in
-    /// some coordinate ([`Self::range_violation`]): the decoder is extrapolating there (tanh layers
-    /// saturate, `Ψ_q → 0`, and spurious equilibria appear), so the result is not to be trusted.
-    /// The message names the likely cause: the inputs were checked when the model was attached.
-    pub fn check_range(&self, q: &[f64]) -> Result<(), ScenarioError> {
-        let Some(v) = self.range_violation(q) else {
-            return Ok(());
-        };
-        let cause = if !self.extrapolated.is_empty() {
-            "the model is extrapolating (--extrapolate) and its decoder has left its data"
-        } else if self.initial.is_none() {
-            "the inputs lie inside the training range, but the model has no anchors to start the solve from, and from its rest coordinates the solve reached a spurious equilibrium off the learned manifold: re-create the model with this build (it stores anchors)"
-        } else {
-            "the inputs lie inside the training range, yet the solve reached a spurious equilibrium off the learned manifold: the model is poor here (more data, or more training)"
-        };
-        Err(invalid(
-            "--model",
-            format!("the reduced solution {v}: {cause}"),
-        ))
-    }
-
-    /// How far the rest coordinates ([`StrainParam::rest_coordinates`], where a simulation from
-    /// rest starts) are from the straight rod: the largest `|ξ − ξ*|` over the computational points
-    /// and strain components. Zero for POD (`q_r = 0`); for an autoencoder, its reconstruction error
-    /// of the straight rod, large when the training data lack it (e.g. all sag under gravity).
-    pub fn rest_strain_offset(&self) -> f64 {
-        let m = &self.model;
-        let mut ws = m.workspace();
-        m.forward(&m.param.rest_coordinates(), &mut ws, false);
-        m.point_strains(&ws)
-            .iter()
-            .enumerate()
-            .map(|(j, xi)| (xi - m.xi_star(j)).amax())
-            .fold(0.0, f64::max)
-    }
-
-    /// The first coordinate of `q` outside the training encodings' range widened by half its
-    /// width on each side (or not finite), described as "`q_r[d] = v` lies far outside the range
-    /// of the training data `[lo, hi]` of `MODEL`"; `None` inside (always, for models without a
-    /// recorded range).
-    pub fn range_violation(&self, q: &[f64]) -> Option<String> {
-        outside_range(&self.latent_range, q).map(|d| {
-            let (v, [lo, hi]) = (q[d], self.latent_range[d]);
-            format!(
-                "q_r[{d}] = {v:.6} lies far outside the range of the training data [{lo:.6}, {hi:.6}] of `{}`",
-                self.path.display()
-            )
-        })
-    }
-}
-
-/// The first coordinate of `q` outside `range` widened by half its width on each side, or not
-/// finite (see [`Reduced::range_violation`]).
-pub(super) fn outside_range(range: &[[f64; 2]], q: &[f64]) -> Option<usize> {
-    q.iter().zip(range).position(|(v, [lo, hi])| {
-        let margin = 0.5 * (hi - lo).max(1e-12);
-        !(*v >= lo - margin && *v <= hi + margin)
-    })
 }
 
 /// Checks that `model` was learned on the layout of `built` (points, active components, HOM size).

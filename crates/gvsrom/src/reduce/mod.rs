@@ -19,17 +19,19 @@ mod pod;
 mod train;
 pub mod validity;
 
+pub use crate::build::Reduced;
 pub use anchors::{anchor_guess, solve_anchors, AnchorInput, AnchorProblem};
-pub use attach::{attach, attach_source, parameterization, AttachOptions, Reduced};
+pub use attach::{attach, attach_source, parameterization, AttachOptions};
 pub use pod::{pod, PodSummary};
 pub use train::{train, zero_anchor_rows, Loss, TrainSummary};
 
+use crate::build::reduced::outside_range;
 use crate::build::{build, Built};
 use crate::dataset::Dataset;
 use crate::error::ScenarioError;
 use crate::reduced_model::{DatasetRef, ModelLayout, ReducedModel};
 use crate::scenario::Scenario;
-use attach::{outside_range, reduced_model};
+use attach::reduced_model;
 use nalgebra::DMatrix;
 use rom::reduced::{point_matrix, projection, PointLayout};
 use std::path::Path;

@@ -4,7 +4,7 @@
 //! of per cent of the length off). So every model records
 //!
 //! - the **range of each training input** (`tendons.K.tension`, `loads.…`): the usable samples'
-//!   `[min, max]`, widened by [`INPUT_MARGIN`] of its width on each side;
+//!   `[min, max]`, widened by [`INPUT_MARGIN`](crate::build::reduced::INPUT_MARGIN) of its width on each side;
 //! - the **scenario it was trained on** (its TOML, in the layout), whose physics — everything but
 //!   the inputs, the tendon tensions, `name`, `description`, `solver` and `output` — must be the
 //!   scenario's it is used on;
@@ -15,17 +15,13 @@
 //! scenario unless `--extrapolate` is given, which is then printed and recorded.
 
 use super::anchors::input_value;
+use crate::build::reduced::inside;
 use crate::build::Built;
 use crate::dataset::Dataset;
 use crate::error::ScenarioError;
 use crate::reduced_model::{InputRange, ReducedModel};
 use crate::scenario::{parse_path, Scenario, Seg};
 use toml::{Table, Value};
-
-/// The observed range of a training input is widened by this fraction of its width on each side:
-/// a test signal drawn like the training one (IV-C2's babbling with another seed) reaches a little
-/// beyond the extremes the training samples happened to hit.
-pub const INPUT_MARGIN: f64 = 0.02;
 
 /// Keys of a scenario that are not physics: a model may be used whatever their value.
 const NOT_PHYSICS: &[&str] = &["name", "description", "solver", "output"];
@@ -54,22 +50,13 @@ pub fn input_ranges(ds: &Dataset) -> Vec<InputRange> {
         .collect()
 }
 
-/// Whether `v` lies in `r` widened by [`INPUT_MARGIN`] of its width (and at least a relative
-/// 1e-9 of its magnitude, for a single-valued range).
-fn inside(r: &InputRange, v: f64) -> bool {
-    let slack = (INPUT_MARGIN * (r.max - r.min))
-        .max(1e-9 * r.min.abs().max(r.max.abs()))
-        .max(1e-12);
-    v.is_finite() && v >= r.min - slack && v <= r.max + slack
-}
-
 /// Every way the scenario of `built` (its TOML `table`, after `--set`) lies outside what `model`
 /// was trained on, one sentence each: an input outside its training range, a tendon tension that
 /// training held fixed at another value, a physics field that differs. Empty: the model may answer.
 /// An error only if the model's own scenario cannot be read.
 ///
 /// With `tensions_from_signal` (a simulation driven by an input signal) the scenario's own
-/// tensions are not checked: the signal's are, by [`check_signal`].
+/// tensions are not checked: the signal's are, by `Reduced::check_signal`.
 pub fn check(
     built: &Built,
     table: &Table,
@@ -156,54 +143,6 @@ pub fn check(
         )
     }));
     Ok(outside)
-}
-
-/// The tendon tensions of an input signal against the model's training ranges: `u_at(t)` gives
-/// the tensions at time `t`, sampled at `times`. One sentence per tendon whose signal leaves its
-/// range (its extreme value and when), or whose training held it fixed at another value.
-pub fn check_signal(
-    ranges: &[InputRange],
-    times: &[f64],
-    mut u_at: impl FnMut(f64) -> Vec<f64>,
-) -> Vec<String> {
-    let mut worst: Vec<Option<(f64, f64)>> = vec![];
-    for &t in times {
-        let u = u_at(t);
-        worst.resize(worst.len().max(u.len()), None);
-        for (k, &v) in u.iter().enumerate() {
-            let Some(r) = ranges
-                .iter()
-                .find(|r| r.parameter == format!("tendons.{k}.tension"))
-            else {
-                continue;
-            };
-            // distance outside the range (0 inside); keep the farthest
-            let d = if inside(r, v) {
-                0.0
-            } else {
-                (r.min - v).max(v - r.max).max(f64::MIN_POSITIVE)
-            };
-            let d = if v.is_finite() { d } else { f64::INFINITY };
-            if d > 0.0 && worst[k].is_none_or(|(dw, _)| d > dw) {
-                worst[k] = Some((d, t));
-            }
-        }
-    }
-    let mut out = vec![];
-    for (k, w) in worst.iter().enumerate() {
-        if let Some((_, t)) = w {
-            let r = ranges
-                .iter()
-                .find(|r| r.parameter == format!("tendons.{k}.tension"))
-                .expect("a range was found for it");
-            let v = u_at(*t)[k];
-            out.push(format!(
-                "the input signal's tendons.{k}.tension reaches {v} at t = {t} s, outside the training inputs [{}, {}]",
-                r.min, r.max
-            ));
-        }
-    }
-    out
 }
 
 /// Removes the value at `path` from `table`, if present (an array entry is replaced by a marker,

@@ -50,11 +50,7 @@ impl ScenarioSpec {
     pub fn provenance(&self) -> anyhow::Result<crate::provenance::Provenance> {
         let src = presets::source(&self.preset)?;
         let s = presets::load_from(&src, &self.set)?;
-        Ok(crate::provenance::Provenance::of_scenario(
-            &src,
-            &self.set,
-            s.to_toml()?,
-        ))
+        Ok(src.provenance(&self.set, s.to_toml()?))
     }
 }
 

@@ -1,0 +1,184 @@
+//! Each division's strain basis (Legendre or FEM-like, with its active modes) and quadrature.
+
+use super::limits::*;
+use crate::error::ScenarioError;
+use crate::scenario::{BasisKind, DivisionSpec, StrainMode};
+use gvs::discretize::Quadrature;
+use gvs::strain::{DivisionBasis, FemDegree};
+
+/// The six active flags of a mode list; rejects an empty list and repeated modes.
+pub(super) fn mode_flags(field: &str, modes: &[StrainMode]) -> Result<[bool; 6], ScenarioError> {
+    if modes.is_empty() {
+        return Err(ScenarioError::invalid(
+            field,
+            "the basis is empty: list at least one strain mode of torsion, bend_y, bend_z, elongation, shear_y, shear_z",
+        ));
+    }
+    let mut flags = [false; 6];
+    for m in modes {
+        if flags[m.index()] {
+            return Err(ScenarioError::invalid(
+                field,
+                format!("mode `{}` is listed twice", m.name()),
+            ));
+        }
+        flags[m.index()] = true;
+    }
+    Ok(flags)
+}
+
+pub(super) fn basis(j: usize, d: &DivisionSpec) -> Result<DivisionBasis, ScenarioError> {
+    let f = |n: &str| format!("divisions[{j}].basis.{n}");
+    let b = &d.basis;
+    let flags = mode_flags(&f("modes"), &b.modes)?;
+    let not_for = |key: &str, kind: &str| {
+        Err(ScenarioError::invalid(
+            f(key),
+            format!("not used by a {kind} basis (kind = \"{kind}\")"),
+        ))
+    };
+    match b.kind {
+        BasisKind::Legendre => {
+            if b.elements.is_some() {
+                return not_for("elements", "legendre");
+            }
+            if b.degree.is_some() {
+                return not_for("degree", "legendre");
+            }
+            let mut ords = [0usize; 6];
+            for m in StrainMode::ALL {
+                let explicit = b.orders.get(m);
+                if !flags[m.index()] {
+                    if explicit.is_some() {
+                        return Err(ScenarioError::invalid(
+                            f(&format!("orders.{}", m.name())),
+                            format!("mode `{}` is not in `modes`", m.name()),
+                        ));
+                    }
+                    continue;
+                }
+                let (field, k) = match (explicit, b.order) {
+                    (Some(k), _) => (f(&format!("orders.{}", m.name())), k),
+                    (None, Some(k)) => (f("order"), k),
+                    (None, None) => {
+                        return Err(ScenarioError::invalid(
+                            f("order"),
+                            format!("missing: give `order` (all modes) or `orders.{}`", m.name()),
+                        ))
+                    }
+                };
+                if k > MAX_LEGENDRE_ORDER {
+                    return Err(ScenarioError::value(
+                        field,
+                        k as f64,
+                        format!("an integer in [0, {MAX_LEGENDRE_ORDER}]"),
+                    ));
+                }
+                ords[m.index()] = k;
+            }
+            Ok(DivisionBasis::Legendre {
+                modes: flags,
+                orders: ords,
+            })
+        }
+        BasisKind::Fem => {
+            if b.order.is_some() {
+                return not_for("order", "fem");
+            }
+            if let Some(m) = StrainMode::ALL
+                .into_iter()
+                .find(|&m| b.orders.get(m).is_some())
+            {
+                return not_for(&format!("orders.{}", m.name()), "fem");
+            }
+            let Some(elements) = b.elements else {
+                return Err(ScenarioError::invalid(
+                    f("elements"),
+                    format!(
+                        "missing: a fem basis needs `elements`, an integer in [1, {MAX_POINTS}]"
+                    ),
+                ));
+            };
+            if !(1..=MAX_POINTS).contains(&elements) {
+                return Err(ScenarioError::value(
+                    f("elements"),
+                    elements as f64,
+                    format!("an integer in [1, {MAX_POINTS}]"),
+                ));
+            }
+            Ok(DivisionBasis::Fem {
+                modes: flags,
+                elements,
+                degree: b.degree.unwrap_or(FemDegree::Linear),
+            })
+        }
+    }
+}
+
+/// The division's quadrature; defaults follow SoRoSim (gvs-spec §5.1): Legendre → `max order + 1`
+/// Gauss points, at least 5; FEM → per element, 2 (linear) or 3 (quadratic) points.
+pub(super) fn quadrature(
+    j: usize,
+    d: &DivisionSpec,
+    basis: &DivisionBasis,
+) -> Result<Quadrature, ScenarioError> {
+    let f = |n: &str| format!("divisions[{j}].quadrature.{n}");
+    let check = |field: String, v: usize, max: usize| {
+        if (1..=max).contains(&v) {
+            Ok(v)
+        } else {
+            Err(ScenarioError::value(
+                field,
+                v as f64,
+                format!("an integer in [1, {max}]"),
+            ))
+        }
+    };
+    let q = d.quadrature.clone().unwrap_or_default();
+    match (q.gauss, q.elements, q.gauss_per_element) {
+        (None, None, None) => Ok(match basis {
+            DivisionBasis::Fem {
+                elements, degree, ..
+            } => Quadrature::Elements {
+                elements: *elements,
+                gauss_per_element: match degree {
+                    FemDegree::Linear => 2,
+                    FemDegree::Quadratic => 3,
+                },
+            },
+            DivisionBasis::Legendre { modes, orders } => {
+                let max = (0..6).filter(|&i| modes[i]).map(|i| orders[i]).max().unwrap_or(0);
+                Quadrature::Gauss {
+                    n: (max + 1).max(5),
+                }
+            }
+        }),
+        (Some(n), None, None) => Ok(Quadrature::Gauss {
+            n: check(f("gauss"), n, MAX_POINTS)?,
+        }),
+        (None, elements, Some(g)) => {
+            let elements = match (elements, basis) {
+                (Some(e), _) => check(f("elements"), e, MAX_POINTS)?,
+                (None, DivisionBasis::Fem { elements, .. }) => *elements,
+                (None, DivisionBasis::Legendre { .. }) => {
+                    return Err(ScenarioError::invalid(
+                        f("elements"),
+                        "missing: per-element quadrature on a Legendre basis needs `elements`",
+                    ))
+                }
+            };
+            Ok(Quadrature::Elements {
+                elements,
+                gauss_per_element: check(f("gauss_per_element"), g, MAX_GAUSS_PER_ELEMENT)?,
+            })
+        }
+        (Some(_), _, _) => Err(ScenarioError::invalid(
+            f("gauss"),
+            "give either `gauss` (points over the whole division) or `gauss_per_element` (with optional `elements`), not both",
+        )),
+        (None, Some(_), None) => Err(ScenarioError::invalid(
+            f("gauss_per_element"),
+            "missing: `elements` needs `gauss_per_element`",
+        )),
+    }
+}

@@ -1,0 +1,74 @@
+//! The one-line description of a built scenario printed by the summaries.
+
+use super::Built;
+use crate::scenario::{BasisKind, Scenario};
+use gvs::strain::FemDegree;
+
+/// A one-line description of the scenario as built (after `--set` and `--tension`), for the
+/// summaries: `0.25 m tapered rod, gravity 9.81 m/s², 1 tendon (friction 0.88), 33-DOF Legendre
+/// basis`. Derived from the model, never from the scenario's free-text `description`, so that it
+/// cannot contradict the run.
+pub fn describe(s: &Scenario, built: &Built) -> String {
+    let m = &built.model;
+    let g = &m.rod.divisions;
+    let tapered = g.iter().any(|d| d.radius_start != d.radius_end)
+        || g.windows(2).any(|w| w[0].radius_end != w[1].radius_start);
+    let mut parts = vec![format!(
+        "{} m {} rod{}",
+        m.rod.length(),
+        if tapered { "tapered" } else { "uniform" },
+        match g.len() {
+            1 => String::new(),
+            n => format!(" in {n} divisions"),
+        }
+    )];
+    let gravity = built
+        .loads
+        .gravity
+        .iter()
+        .map(|v| v * v)
+        .sum::<f64>()
+        .sqrt();
+    parts.push(if gravity > 0.0 {
+        format!("gravity {gravity} m/s²")
+    } else {
+        "no gravity".into()
+    });
+    let tendons = &m.tendons;
+    parts.push(match tendons.len() {
+        0 => "no tendons".into(),
+        n => {
+            let (lo, hi) = tendons
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), t| {
+                    (lo.min(t.friction), hi.max(t.friction))
+                });
+            let friction = if lo == hi {
+                format!("friction {lo}")
+            } else {
+                format!("friction {lo} to {hi}")
+            };
+            format!("{n} tendon{} ({friction})", if n == 1 { "" } else { "s" })
+        }
+    });
+    let count = |n: usize, what: &str| match n {
+        0 => None,
+        1 => Some(format!("1 {what}")),
+        n => Some(format!("{n} {what}es")),
+    };
+    parts.extend(count(built.loads.point.len(), "point wrench"));
+    parts.extend(count(built.loads.distributed.len(), "distributed wrench"));
+    let mut kinds: Vec<&str> = vec![];
+    for d in &s.divisions {
+        let kind = match (d.basis.kind, d.basis.degree) {
+            (BasisKind::Legendre, _) => "Legendre",
+            (BasisKind::Fem, Some(FemDegree::Quadratic)) => "quadratic FEM-like",
+            (BasisKind::Fem, _) => "linear FEM-like",
+        };
+        if !kinds.contains(&kind) {
+            kinds.push(kind);
+        }
+    }
+    parts.push(format!("{}-DOF {} basis", m.n_dof(), kinds.join(" + ")));
+    parts.join(", ")
+}

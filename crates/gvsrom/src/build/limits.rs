@@ -1,0 +1,89 @@
+//! The accepted ranges of a scenario's values, and the checks that name the field when one lies
+//! outside.
+
+use crate::error::ScenarioError;
+
+/// Largest Legendre order per mode accepted (higher orders are numerically pointless here).
+pub const MAX_LEGENDRE_ORDER: usize = 50;
+/// Largest number of Gauss points per division, or of elements per division.
+pub const MAX_POINTS: usize = 5000;
+/// Largest number of Gauss points per element.
+pub const MAX_GAUSS_PER_ELEMENT: usize = 20;
+/// Largest `n_dof × strain sites`: the tabulated basis and Jacobians are 6 × n·sites matrices
+/// (5e6 ≈ 240 MB each).
+pub const MAX_BASIS_SIZE: usize = 5_000_000;
+/// Largest number of generalized coordinates (DOF). Statics factorizes a dense n × n Jacobian per
+/// iteration (O(n³)): 2000 DOF is about a second per iteration on one core.
+pub const MAX_DOF: usize = 2000;
+/// Accepted Young's modulus E [Pa]: from the softest hydrogels (≈ 1 kPa) with three decades of
+/// room below, to stiffer than diamond (1.2e12 Pa).
+pub const YOUNGS_MODULUS_RANGE: (f64, f64) = (1.0, 1e13);
+/// Accepted density ρ [kg/m³]: 0 (massless) to 1e5, five times the densest element (osmium 2.26e4).
+pub const DENSITY_RANGE: (f64, f64) = (0.0, 1e5);
+/// Largest gravitational acceleration |g| [m/s²] (1000 g).
+pub const MAX_GRAVITY: f64 = 1e4;
+/// Accepted division length ℓ_j [m]: 1 µm to 1 km.
+pub const DIVISION_LENGTH_RANGE: (f64, f64) = (1e-6, 1e3);
+/// Smallest radius [m] (0.1 µm); the largest is the rod's total length L (a rod is slender).
+pub const MIN_RADIUS: f64 = 1e-7;
+/// Largest number of centreline samples.
+pub const MAX_CENTERLINE_POINTS: usize = 100_000;
+
+pub(super) fn finite(field: &str, v: f64) -> Result<f64, ScenarioError> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(ScenarioError::value(field, v, "a finite number"))
+    }
+}
+
+/// A bound for a message: plain in [1e-3, 1e4), else in exponent form (`1e13`).
+pub(crate) fn num(v: f64) -> String {
+    if v == 0.0 || (1e-3..1e4).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
+/// `v` in the closed range `[lo, hi]`, else an error naming `field` and the range.
+pub(super) fn in_range(
+    field: &str,
+    v: f64,
+    (lo, hi): (f64, f64),
+    unit: &str,
+) -> Result<f64, ScenarioError> {
+    if v.is_finite() && v >= lo && v <= hi {
+        Ok(v)
+    } else {
+        Err(ScenarioError::value(
+            field,
+            v,
+            format!("a number in [{}, {}] {unit}", num(lo), num(hi)),
+        ))
+    }
+}
+
+pub(super) fn positive(field: &str, v: f64, unit: &str) -> Result<f64, ScenarioError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(ScenarioError::value(
+            field,
+            v,
+            format!("a finite number > 0 {unit}"),
+        ))
+    }
+}
+
+pub(super) fn non_negative(field: &str, v: f64, unit: &str) -> Result<f64, ScenarioError> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(ScenarioError::value(
+            field,
+            v,
+            format!("a finite number >= 0 {unit}"),
+        ))
+    }
+}

@@ -1,0 +1,176 @@
+//! Scenario → engine: validates every value against its accepted range (naming the TOML field) and
+//! builds the rod, discretization, strain basis, tendons, loads and solver options of the engine.
+//!
+//! The engine validates too; the checks here come first so that messages use the scenario's own key
+//! paths, and they add what the engine cannot know (conflicting shorthand keys, sizes).
+
+mod basis;
+mod describe;
+mod limits;
+mod loads;
+pub mod reduced;
+mod rod;
+mod tendons;
+
+pub use describe::describe;
+pub use limits::*;
+pub use loads::loads;
+pub use reduced::Reduced;
+
+use basis::{basis, quadrature};
+use rod::{base_pose, geometry, material, radius_range};
+use tendons::tendon;
+
+use crate::error::ScenarioError;
+use crate::scenario::Scenario;
+use gvs::discretize::Discretization;
+use gvs::loads::Loads;
+use gvs::model::Model;
+use gvs::rod::Rod;
+use gvs::solve::statics::StaticsOptions;
+use gvs::strain::{DivisionBasis, LinearBasis};
+
+/// Everything a statics run needs, built and validated.
+pub struct Built {
+    pub name: String,
+    pub model: Model<LinearBasis>,
+    pub loads: Loads,
+    /// Tendon tensions u [N], in tendon order.
+    pub u: Vec<f64>,
+    pub options: StaticsOptions,
+    pub centerline_points: usize,
+    /// A reduced model (`--model`) that replaces the scenario's basis in statics and dynamics.
+    pub reduced: Option<Reduced>,
+}
+
+impl Built {
+    /// Generalized coordinates of the model that runs: the reduced one if attached.
+    pub fn n_dof(&self) -> usize {
+        match &self.reduced {
+            Some(r) => r.model.n_dof(),
+            None => self.model.n_dof(),
+        }
+    }
+
+    /// Tensions `u` [N] for a run in place of the scenario's, checked as a scenario built with
+    /// them (`--tension`) would be: one value for every tendon or one per tendon
+    /// ([`crate::scenario::tensions_for`]), finite, and plausible with the loads
+    /// ([`crate::plausibility::check`]). Returns one value per tendon.
+    pub fn tensions(&self, u: &[f64]) -> Result<Vec<f64>, ScenarioError> {
+        let u = crate::scenario::tensions_for(self.model.n_actuators(), u)?;
+        for (k, v) in u.iter().enumerate() {
+            finite(&format!("tendons[{k}].tension"), *v)?;
+        }
+        let u_abs: Vec<f64> = u.iter().map(|v| v.abs()).collect();
+        crate::plausibility::check(self, &u_abs, 1.0)?;
+        Ok(u)
+    }
+}
+
+/// Validates `s` and builds the engine's model, loads, tensions and solver options; the loads must
+/// pass [`crate::plausibility::check`] with the scenario's tensions and load factor 1.
+pub fn build(s: &Scenario) -> Result<Built, ScenarioError> {
+    let material = material(s)?;
+    if s.divisions.is_empty() {
+        return Err(ScenarioError::invalid(
+            "divisions",
+            "at least one [[divisions]] entry is required",
+        ));
+    }
+    let geometry = s
+        .divisions
+        .iter()
+        .enumerate()
+        .map(|(j, d)| geometry(j, d))
+        .collect::<Result<Vec<_>, _>>()?;
+    let rod = Rod {
+        material,
+        divisions: geometry,
+    };
+    let length = rod.length();
+    for (j, d) in s.divisions.iter().enumerate() {
+        radius_range(j, d, length)?;
+    }
+    let bases = s
+        .divisions
+        .iter()
+        .enumerate()
+        .map(|(j, d)| basis(j, d))
+        .collect::<Result<Vec<_>, _>>()?;
+    let n_dof: usize = bases.iter().map(DivisionBasis::dofs).sum();
+    if n_dof > MAX_DOF {
+        return Err(ScenarioError::invalid(
+            "divisions",
+            format!(
+                "the basis has {n_dof} DOF (accepted <= {MAX_DOF}): statics factorizes a dense {n_dof} × {n_dof} Jacobian per iteration; lower the basis orders or elements"
+            ),
+        ));
+    }
+    let quads = s
+        .divisions
+        .iter()
+        .zip(&bases)
+        .enumerate()
+        .map(|(j, (d, b))| quadrature(j, d, b))
+        .collect::<Result<Vec<_>, _>>()?;
+    let base = base_pose(s)?;
+    let tendons = s
+        .tendons
+        .iter()
+        .enumerate()
+        .map(|(k, t)| tendon(k, t, &rod))
+        .collect::<Result<Vec<_>, _>>()?;
+    let u = s
+        .tendons
+        .iter()
+        .enumerate()
+        .map(|(k, t)| finite(&format!("tendons[{k}].tension"), t.tension))
+        .collect::<Result<Vec<_>, _>>()?;
+    let loads = loads(s, length)?;
+    s.solver.validate()?;
+    let centerline_points = s.output.centerline_points;
+    if !(2..=MAX_CENTERLINE_POINTS).contains(&centerline_points) {
+        return Err(ScenarioError::value(
+            "output.centerline_points",
+            centerline_points as f64,
+            format!("an integer in [2, {MAX_CENTERLINE_POINTS}]"),
+        ));
+    }
+
+    let extra_x = loads.point_abscissae();
+    let disc = Discretization::new(&rod, &quads, s.magnus, &extra_x)?;
+    if n_dof.saturating_mul(disc.n_sites()) > MAX_BASIS_SIZE {
+        return Err(ScenarioError::invalid(
+            "divisions",
+            format!(
+                "the model is too large: {n_dof} DOF × {} strain sites = {} (accepted <= {MAX_BASIS_SIZE}); lower the basis orders/elements or the quadrature points",
+                disc.n_sites(),
+                n_dof * disc.n_sites()
+            ),
+        ));
+    }
+    let basis = LinearBasis::per_division(&disc, &bases)?;
+    let model = Model::new(rod, disc, basis, tendons)?.with_base(base);
+    let built = Built {
+        name: s.name.clone().unwrap_or_else(|| "scenario".to_string()),
+        model,
+        loads,
+        u,
+        options: s.solver.clone(),
+        centerline_points,
+        reduced: None,
+    };
+    let u_abs: Vec<f64> = built.u.iter().map(|v| v.abs()).collect();
+    crate::plausibility::check(&built, &u_abs, 1.0)?;
+    Ok(built)
+}
+
+impl<'a> From<&'a Built> for crate::plausibility::Subject<'a> {
+    fn from(b: &'a Built) -> Self {
+        crate::plausibility::Subject {
+            model: &b.model,
+            u: &b.u,
+            loads: &b.loads,
+        }
+    }
+}

@@ -1,0 +1,182 @@
+//! A reduced model attached to a built scenario: its parameterization in place of the scenario's
+//! basis, and what every run checks against what the model was trained on — the inputs' ranges
+//! and the latent range. The reduction layer attaches one (its `attach`); the runs only read it.
+
+use crate::error::ScenarioError;
+use crate::reduced_model::InputRange;
+use gvs::model::Model;
+use gvs::strain::StrainParam;
+use nalgebra::DVector;
+use std::path::PathBuf;
+
+/// The observed range of a training input is widened by this fraction of its width on each side:
+/// a test signal drawn like the training one (IV-C2's babbling with another seed) reaches a little
+/// beyond the extremes the training samples happened to hit.
+pub const INPUT_MARGIN: f64 = 0.02;
+
+/// Whether `v` lies in `r` widened by [`INPUT_MARGIN`] of its width (and at least a relative
+/// 1e-9 of its magnitude, for a single-valued range).
+pub fn inside(r: &InputRange, v: f64) -> bool {
+    let slack = (INPUT_MARGIN * (r.max - r.min))
+        .max(1e-9 * r.min.abs().max(r.max.abs()))
+        .max(1e-12);
+    v.is_finite() && v >= r.min - slack && v <= r.max + slack
+}
+
+/// A reduced model bound to a scenario.
+pub struct Reduced {
+    /// The scenario's rod, points, tendons and loads with the reduced parameterization.
+    pub model: Model<Box<dyn StrainParam>>,
+    /// `"pod"` or `"autoencoder"`.
+    pub kind: String,
+    pub path: PathBuf,
+    /// Initial guess of a statics solve: the model's anchors at this scenario's inputs
+    /// ([`anchor_guess`]; models whose dataset inputs the scenario defines).
+    pub initial: Option<DVector<f64>>,
+    /// The training encodings' range per coordinate.
+    pub latent_range: Vec<[f64; 2]>,
+    /// How the scenario lies outside what the model was trained on, when used with
+    /// `--extrapolate` (empty: inside; see [`InputRange`]).
+    pub extrapolated: Vec<String>,
+    /// What a front-end should tell the user about this model (an interrupted training, an
+    /// extrapolation).
+    pub warnings: Vec<String>,
+    /// The training inputs' ranges ([`InputRange`]).
+    pub input_range: Vec<InputRange>,
+    /// [`AttachOptions::extrapolate`], for the checks that come later (an input signal's).
+    pub extrapolate: bool,
+}
+
+impl Reduced {
+    /// Checks an input signal's tensions (`u_at(t)` at `times`) against the training ranges
+    /// ([`signal_outside`]): an error listing how it lies outside, or with
+    /// `--extrapolate` those sentences, to be printed and recorded with the run.
+    pub fn check_signal(
+        &self,
+        times: &[f64],
+        u_at: impl FnMut(f64) -> Vec<f64>,
+    ) -> Result<Vec<String>, ScenarioError> {
+        let outside = signal_outside(&self.input_range, times, u_at);
+        if outside.is_empty() {
+            return Ok(vec![]);
+        }
+        if !self.extrapolate {
+            return Err(ScenarioError::invalid(
+                "--model",
+                format!(
+                    "`{}` was not trained for this input: {}; pass --extrapolate to use it anyway (its answer is then an extrapolation, and is marked so)",
+                    self.path.display(),
+                    outside.join("; ")
+                ),
+            ));
+        }
+        Ok(outside)
+    }
+
+    /// Errors if `q` lies outside the training encodings' range by more than half its width in
+    /// some coordinate ([`Self::range_violation`]): the decoder is extrapolating there (tanh layers
+    /// saturate, `Ψ_q → 0`, and spurious equilibria appear), so the result is not to be trusted.
+    /// The message names the likely cause: the inputs were checked when the model was attached.
+    pub fn check_range(&self, q: &[f64]) -> Result<(), ScenarioError> {
+        let Some(v) = self.range_violation(q) else {
+            return Ok(());
+        };
+        let cause = if !self.extrapolated.is_empty() {
+            "the model is extrapolating (--extrapolate) and its decoder has left its data"
+        } else if self.initial.is_none() {
+            "the inputs lie inside the training range, but the model has no anchors to start the solve from, and from its rest coordinates the solve reached a spurious equilibrium off the learned manifold: re-create the model with this build (it stores anchors)"
+        } else {
+            "the inputs lie inside the training range, yet the solve reached a spurious equilibrium off the learned manifold: the model is poor here (more data, or more training)"
+        };
+        Err(ScenarioError::invalid(
+            "--model",
+            format!("the reduced solution {v}: {cause}"),
+        ))
+    }
+
+    /// How far the rest coordinates ([`StrainParam::rest_coordinates`], where a simulation from
+    /// rest starts) are from the straight rod: the largest `|ξ − ξ*|` over the computational points
+    /// and strain components. Zero for POD (`q_r = 0`); for an autoencoder, its reconstruction error
+    /// of the straight rod, large when the training data lack it (e.g. all sag under gravity).
+    pub fn rest_strain_offset(&self) -> f64 {
+        let m = &self.model;
+        let mut ws = m.workspace();
+        m.forward(&m.param.rest_coordinates(), &mut ws, false);
+        m.point_strains(&ws)
+            .iter()
+            .enumerate()
+            .map(|(j, xi)| (xi - m.xi_star(j)).amax())
+            .fold(0.0, f64::max)
+    }
+
+    /// The first coordinate of `q` outside the training encodings' range widened by half its
+    /// width on each side (or not finite), described as "`q_r[d] = v` lies far outside the range
+    /// of the training data `[lo, hi]` of `MODEL`"; `None` inside (always, for models without a
+    /// recorded range).
+    pub fn range_violation(&self, q: &[f64]) -> Option<String> {
+        outside_range(&self.latent_range, q).map(|d| {
+            let (v, [lo, hi]) = (q[d], self.latent_range[d]);
+            format!(
+                "q_r[{d}] = {v:.6} lies far outside the range of the training data [{lo:.6}, {hi:.6}] of `{}`",
+                self.path.display()
+            )
+        })
+    }
+}
+
+/// The first coordinate of `q` outside `range` widened by half its width on each side, or not
+/// finite (see [`Reduced::range_violation`]).
+pub fn outside_range(range: &[[f64; 2]], q: &[f64]) -> Option<usize> {
+    q.iter().zip(range).position(|(v, [lo, hi])| {
+        let margin = 0.5 * (hi - lo).max(1e-12);
+        !(*v >= lo - margin && *v <= hi + margin)
+    })
+}
+
+/// The tendon tensions of an input signal against the model's training ranges: `u_at(t)` gives
+/// the tensions at time `t`, sampled at `times`. One sentence per tendon whose signal leaves its
+/// range (its extreme value and when), or whose training held it fixed at another value.
+pub fn signal_outside(
+    ranges: &[InputRange],
+    times: &[f64],
+    mut u_at: impl FnMut(f64) -> Vec<f64>,
+) -> Vec<String> {
+    let mut worst: Vec<Option<(f64, f64)>> = vec![];
+    for &t in times {
+        let u = u_at(t);
+        worst.resize(worst.len().max(u.len()), None);
+        for (k, &v) in u.iter().enumerate() {
+            let Some(r) = ranges
+                .iter()
+                .find(|r| r.parameter == format!("tendons.{k}.tension"))
+            else {
+                continue;
+            };
+            // distance outside the range (0 inside); keep the farthest
+            let d = if inside(r, v) {
+                0.0
+            } else {
+                (r.min - v).max(v - r.max).max(f64::MIN_POSITIVE)
+            };
+            let d = if v.is_finite() { d } else { f64::INFINITY };
+            if d > 0.0 && worst[k].is_none_or(|(dw, _)| d > dw) {
+                worst[k] = Some((d, t));
+            }
+        }
+    }
+    let mut out = vec![];
+    for (k, w) in worst.iter().enumerate() {
+        if let Some((_, t)) = w {
+            let r = ranges
+                .iter()
+                .find(|r| r.parameter == format!("tendons.{k}.tension"))
+                .expect("a range was found for it");
+            let v = u_at(*t)[k];
+            out.push(format!(
+                "the input signal's tendons.{k}.tension reaches {v} at t = {t} s, outside the training inputs [{}, {}]",
+                r.min, r.max
+            ));
+        }
+    }
+    out
+}

@@ -1,0 +1,160 @@
+//! The rod: material, the divisions' geometry and the base pose.
+
+use super::limits::*;
+use crate::error::ScenarioError;
+use crate::scenario::{DivisionSpec, Scenario};
+use gvs::lie::{Pose, M3, V3};
+use gvs::rod::{DivisionGeometry, Material};
+
+pub(super) fn material(s: &Scenario) -> Result<Material, ScenarioError> {
+    let m = &s.material;
+    in_range(
+        "material.youngs_modulus",
+        m.youngs_modulus,
+        YOUNGS_MODULUS_RANGE,
+        "Pa",
+    )?;
+    if !(m.poisson_ratio.is_finite() && m.poisson_ratio > -1.0 && m.poisson_ratio <= 0.5) {
+        return Err(ScenarioError::value(
+            "material.poisson_ratio",
+            m.poisson_ratio,
+            "a number in (-1, 0.5]",
+        ));
+    }
+    in_range("material.density", m.density, DENSITY_RANGE, "kg/m^3")?;
+    non_negative("material.damping", m.damping, "Pa*s")?;
+    Ok(Material {
+        youngs_modulus: m.youngs_modulus,
+        poisson_ratio: m.poisson_ratio,
+        density: m.density,
+        damping: m.damping,
+    })
+}
+
+pub(super) fn geometry(j: usize, d: &DivisionSpec) -> Result<DivisionGeometry, ScenarioError> {
+    let f = |n: &str| format!("divisions[{j}].{n}");
+    positive(&f("length"), d.length, "m")?;
+    let length = in_range(&f("length"), d.length, DIVISION_LENGTH_RANGE, "m")?;
+    let (r0, r1) = match (d.radius, d.radius_start, d.radius_end) {
+        (Some(r), None, None) => (
+            positive(&f("radius"), r, "m")?,
+            positive(&f("radius"), r, "m")?,
+        ),
+        (None, Some(a), Some(b)) => (
+            positive(&f("radius_start"), a, "m")?,
+            positive(&f("radius_end"), b, "m")?,
+        ),
+        (Some(_), _, _) => return Err(ScenarioError::invalid(
+            f("radius"),
+            "give either `radius` (uniform) or `radius_start` and `radius_end` (tapered), not both",
+        )),
+        (None, Some(_), None) => {
+            return Err(ScenarioError::invalid(
+                f("radius_end"),
+                "missing: `radius_start` needs `radius_end`",
+            ))
+        }
+        (None, None, Some(_)) => {
+            return Err(ScenarioError::invalid(
+                f("radius_start"),
+                "missing: `radius_end` needs `radius_start`",
+            ))
+        }
+        (None, None, None) => {
+            return Err(ScenarioError::invalid(
+                f("radius"),
+                "missing: give `radius` or `radius_start` and `radius_end` [m]",
+            ))
+        }
+    };
+    Ok(DivisionGeometry {
+        length,
+        radius_start: r0,
+        radius_end: r1,
+    })
+}
+
+/// Checks the radii of division `j` lie in `[MIN_RADIUS, L]`, `L` the rod's total length.
+pub(super) fn radius_range(j: usize, d: &DivisionSpec, l: f64) -> Result<(), ScenarioError> {
+    let pairs = [
+        ("radius", d.radius),
+        ("radius_start", d.radius_start),
+        ("radius_end", d.radius_end),
+    ];
+    for (name, r) in pairs {
+        if let Some(r) = r {
+            if !(r >= MIN_RADIUS && r <= l) {
+                return Err(ScenarioError::value(
+                    format!("divisions[{j}].{name}"),
+                    r,
+                    format!(
+                        "a number in [{}, {l}] m (at most the rod's length)",
+                        num(MIN_RADIUS)
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+pub(super) fn base_pose(s: &Scenario) -> Result<Pose, ScenarioError> {
+    let b = &s.base;
+    for (i, v) in b.position.iter().enumerate() {
+        finite(&format!("base.position[{i}]"), *v)?;
+    }
+    let rot = match (b.rotation, b.axis, b.angle_deg) {
+        (None, None, None) => M3::identity(),
+        (Some(r), None, None) => {
+            let m = M3::from_fn(|i, j| r[i][j]);
+            for (i, row) in r.iter().enumerate() {
+                for (j, v) in row.iter().enumerate() {
+                    finite(&format!("base.rotation[{i}][{j}]"), *v)?;
+                }
+            }
+            let orth = (m.transpose() * m - M3::identity()).abs().max();
+            let det = m.determinant();
+            if orth > 1e-6 || det <= 0.0 {
+                return Err(ScenarioError::invalid(
+                    "base.rotation",
+                    format!(
+                        "not a rotation matrix (‖RᵀR − I‖max = {orth:.2e}, det = {det:.6}); expected orthonormal rows with det = +1 (to 1e-6)"
+                    ),
+                ));
+            }
+            m
+        }
+        (None, Some(axis), Some(angle)) => {
+            let a = V3::from_row_slice(&axis);
+            let n = a.norm();
+            if !(n.is_finite() && n > 0.0) {
+                return Err(ScenarioError::value(
+                    "base.axis",
+                    n,
+                    "a finite non-zero axis vector (its norm is shown)",
+                ));
+            }
+            let angle = finite("base.angle_deg", angle)?.to_radians();
+            *nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(a), angle).matrix()
+        }
+        (None, Some(_), None) => {
+            return Err(ScenarioError::invalid(
+                "base.angle_deg",
+                "missing: `axis` needs `angle_deg`",
+            ))
+        }
+        (None, None, Some(_)) => {
+            return Err(ScenarioError::invalid(
+                "base.axis",
+                "missing: `angle_deg` needs `axis`",
+            ))
+        }
+        (Some(_), _, _) => {
+            return Err(ScenarioError::invalid(
+                "base.rotation",
+                "give either `rotation` or `axis` and `angle_deg`, not both",
+            ))
+        }
+    };
+    Ok(Pose::new(rot, V3::from_row_slice(&b.position)))
+}

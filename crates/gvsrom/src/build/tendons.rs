@@ -1,0 +1,149 @@
+//! Tendons: routing, termination and friction, checked against the rod they run along.
+
+use super::limits::*;
+use crate::error::ScenarioError;
+use crate::scenario::TendonSpec;
+use gvs::actuation::{Tendon, DEFAULT_FRICTION_SMOOTHING};
+use gvs::rod::Rod;
+
+/// Radius at `x` on the side given: `after = true` takes the division starting at `x` at a junction.
+pub(super) fn radius_at(rod: &Rod, x: f64, after: bool) -> f64 {
+    let starts = rod.division_starts();
+    let tol = 1e-12 * rod.length();
+    let mut found = None;
+    for (j, d) in rod.divisions.iter().enumerate() {
+        let (x0, x1) = (starts[j], starts[j] + d.length);
+        if x >= x0 - tol && x <= x1 + tol {
+            let r = d.radius_at(((x - x0) / d.length).clamp(0.0, 1.0));
+            found = Some(r);
+            if !after {
+                break;
+            }
+        }
+    }
+    found.unwrap_or(f64::NAN)
+}
+
+pub(super) fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, ScenarioError> {
+    let f = |n: &str| format!("tendons[{k}].{n}");
+    let l = rod.length();
+    let x_start = finite(&f("x_start"), t.x_start)?;
+    if !(0.0..l).contains(&x_start) {
+        return Err(ScenarioError::value(
+            f("x_start"),
+            x_start,
+            format!("an abscissa in [0, {l}) m"),
+        ));
+    }
+    let x_end = finite(&f("x_end"), t.x_end.unwrap_or(l))?;
+    if !(x_end > x_start && x_end <= l * (1.0 + 1e-12)) {
+        return Err(ScenarioError::value(
+            f("x_end"),
+            x_end,
+            format!("an abscissa in ({x_start}, {l}] m (after x_start)"),
+        ));
+    }
+    let x_end = x_end.min(l);
+    let friction = non_negative(&f("friction"), t.friction, "")?;
+    let friction_smoothing = non_negative(
+        &f("friction_smoothing"),
+        t.friction_smoothing.unwrap_or(DEFAULT_FRICTION_SMOOTHING),
+        "rad/m (a curvature scale; 0 = no smoothing)",
+    )?;
+    let explicit = t.offset_start.is_some() || t.offset_end.is_some();
+    let polar = t.angle_deg.is_some() || t.radial_fraction.is_some();
+    let (offset_start, offset_end) = match (explicit, polar) {
+        (true, true) => {
+            return Err(ScenarioError::invalid(
+                f("angle_deg"),
+                "give either `offset_start` and `offset_end`, or `angle_deg` (with optional `radial_fraction`), not both",
+            ))
+        }
+        (false, false) => {
+            return Err(ScenarioError::invalid(
+                f("offset_start"),
+                "missing: give `offset_start` and `offset_end` ([y, z] in m), or `angle_deg`",
+            ))
+        }
+        (true, false) => {
+            let (Some(a), Some(b)) = (t.offset_start, t.offset_end) else {
+                let missing = if t.offset_start.is_none() { "offset_start" } else { "offset_end" };
+                return Err(ScenarioError::invalid(
+                    f(missing),
+                    "missing: a tendon needs both `offset_start` and `offset_end` ([y, z] in m)",
+                ));
+            };
+            for (name, v) in [("offset_start", a), ("offset_end", b)] {
+                for (i, c) in v.iter().enumerate() {
+                    finite(&f(&format!("{name}[{i}]")), *c)?;
+                }
+            }
+            (a, b)
+        }
+        (false, true) => {
+            let Some(angle) = t.angle_deg else {
+                return Err(ScenarioError::invalid(
+                    f("angle_deg"),
+                    "missing: `radial_fraction` needs `angle_deg`",
+                ));
+            };
+            let theta = finite(&f("angle_deg"), angle)?.to_radians();
+            let c = t.radial_fraction.unwrap_or(1.0);
+            if !(c.is_finite() && (0.0..=1.0).contains(&c)) {
+                return Err(ScenarioError::value(
+                    f("radial_fraction"),
+                    c,
+                    "a number in [0, 1] (1 = on the surface)",
+                ));
+            }
+            let (s, co) = theta.sin_cos();
+            let r0 = radius_at(rod, x_start, true) * c;
+            let r1 = radius_at(rod, x_end, false) * c;
+            ([r0 * co, r0 * s], [r1 * co, r1 * s])
+        }
+    };
+    let tendon = Tendon {
+        offset_start,
+        offset_end,
+        x_start,
+        x_end,
+        friction,
+        friction_smoothing,
+    };
+    // |d(X)| is convex along the span and r(X) linear per division: checking the span's ends and
+    // the division junctions inside it covers the whole path.
+    let mut checks = vec![(x_start, radius_at(rod, x_start, true), "offset_start", "")];
+    let starts = rod.division_starts();
+    for &xj in starts.iter().skip(1) {
+        if xj > x_start && xj < x_end {
+            let r = radius_at(rod, xj, true).min(radius_at(rod, xj, false));
+            checks.push((
+                xj,
+                r,
+                "offset_end",
+                " (a division junction inside the span)",
+            ));
+        }
+    }
+    checks.push((x_end, radius_at(rod, x_end, false), "offset_end", ""));
+    for (x, r, which, note) in checks {
+        let dn = tendon.offset(x).norm();
+        if dn > r * (1.0 + 1e-9) {
+            let (field, how) = if polar {
+                (
+                    f("angle_deg"),
+                    "the straight path between the surface points at x_start and x_end",
+                )
+            } else {
+                (f(which), "the tendon")
+            };
+            return Err(ScenarioError::invalid(
+                field,
+                format!(
+                    "{how} leaves the cross-section at X = {x} m{note}: offset norm {dn} m > radius {r} m (accepted: |offset| <= r(X) along the whole span)"
+                ),
+            ));
+        }
+    }
+    Ok(tendon)
+}

@@ -1,0 +1,208 @@
+//! The library's layering (`docs/architecture.md`): every module of `src/` uses only modules of
+//! its own layer listed before it or of a lower layer — never a higher one — so no two modules
+//! import each other. Read from the source text: every `crate::module` path in library code
+//! (`use` lines, paths, intra-doc links; test modules excepted) is an edge.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::fs;
+use std::path::{Path, PathBuf};
+
+/// The modules of `src/`, bottom first: a module may use only those before it.
+const ORDER: &[(&str, &[&str])] = &[
+    (
+        "files",
+        &["error", "output", "npy", "provenance", "reduced_model"],
+    ),
+    (
+        "scenario",
+        &["scenario", "presets", "csv_input", "plausibility"],
+    ),
+    ("build", &["build", "layout"]),
+    (
+        "runs",
+        &["statics", "simulate", "modes", "dataset", "compare"],
+    ),
+    ("reduction", &["reduce"]),
+    ("figures", &["plot", "figures"]),
+    ("studies", &["reproduce"]),
+    ("front-end", &["cli"]),
+];
+
+fn src() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("src")
+}
+
+/// Every `.rs` file under `dir`, recursively.
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for e in fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            rust_files(&p, out);
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            out.push(p);
+        }
+    }
+}
+
+/// The top-level module a file of `src/` belongs to (`build/loads.rs` → `build`).
+fn module_of(rel: &Path) -> String {
+    let first = rel
+        .components()
+        .next()
+        .unwrap()
+        .as_os_str()
+        .to_str()
+        .unwrap();
+    first.trim_end_matches(".rs").to_string()
+}
+
+/// The library code of a file: its text without `#[cfg(test)]` items (a test module may use
+/// anything: it is not part of the library).
+fn library_code(text: &str) -> String {
+    let mut out = String::new();
+    let mut skip_depth: Option<i64> = None;
+    let mut depth = 0i64;
+    let mut pending_test = false;
+    for line in text.lines() {
+        let trimmed = line.trim_start();
+        if skip_depth.is_none() && trimmed.starts_with("#[cfg(test)]") {
+            pending_test = true;
+            continue;
+        }
+        let opens = line.matches('{').count() as i64;
+        let closes = line.matches('}').count() as i64;
+        if pending_test {
+            // the item after the attribute: skip to its closing brace (or its `;`)
+            pending_test = false;
+            if opens > closes {
+                skip_depth = Some(depth);
+                depth += opens - closes;
+            }
+            continue;
+        }
+        depth += opens - closes;
+        if let Some(d) = skip_depth {
+            if depth <= d {
+                skip_depth = None;
+            }
+            continue;
+        }
+        out.push_str(line);
+        out.push('\n');
+    }
+    out
+}
+
+/// The modules named by `crate::NAME` paths in `code`, including grouped `use crate::{a, b::c}`.
+fn crate_paths(code: &str, modules: &BTreeSet<String>) -> BTreeSet<String> {
+    let mut found = BTreeSet::new();
+    let mut rest = code;
+    while let Some(i) = rest.find("crate::") {
+        rest = &rest[i + "crate::".len()..];
+        if let Some(group) = rest.strip_prefix('{') {
+            let end = group.find('}').unwrap_or(group.len());
+            for item in group[..end].split(',') {
+                let name: String = item
+                    .trim()
+                    .chars()
+                    .take_while(|c| c.is_alphanumeric() || *c == '_')
+                    .collect();
+                if modules.contains(&name) {
+                    found.insert(name);
+                }
+            }
+        } else {
+            let name: String = rest
+                .chars()
+                .take_while(|c| c.is_alphanumeric() || *c == '_')
+                .collect();
+            if modules.contains(&name) {
+                found.insert(name);
+            }
+        }
+    }
+    found
+}
+
+/// module → (file, module it names) for every edge of the library code.
+fn edges() -> BTreeMap<String, BTreeSet<(String, String)>> {
+    let root = src();
+    let mut files = vec![];
+    rust_files(&root, &mut files);
+    let modules: BTreeSet<String> = files
+        .iter()
+        .map(|f| module_of(f.strip_prefix(&root).unwrap()))
+        .filter(|m| m != "lib" && m != "main")
+        .collect();
+    let mut out: BTreeMap<String, BTreeSet<(String, String)>> = BTreeMap::new();
+    for f in &files {
+        let rel = f.strip_prefix(&root).unwrap();
+        let from = module_of(rel);
+        if from == "lib" || from == "main" {
+            continue;
+        }
+        let code = library_code(&fs::read_to_string(f).unwrap());
+        let entry = out.entry(from.clone()).or_default();
+        for to in crate_paths(&code, &modules) {
+            if to != from {
+                entry.insert((rel.display().to_string(), to));
+            }
+        }
+    }
+    out
+}
+
+fn rank(module: &str) -> Option<usize> {
+    ORDER
+        .iter()
+        .flat_map(|(_, ms)| ms.iter())
+        .position(|m| *m == module)
+}
+
+#[test]
+fn every_module_of_the_library_has_its_place_in_the_layering() {
+    let unplaced: Vec<String> = edges()
+        .keys()
+        .filter(|m| rank(m).is_none())
+        .cloned()
+        .collect();
+    assert!(
+        unplaced.is_empty(),
+        "modules missing from ORDER (place each in its layer, here and in docs/architecture.md): {unplaced:?}"
+    );
+}
+
+#[test]
+fn no_library_module_uses_a_module_above_it() {
+    let mut upward = vec![];
+    for (from, tos) in edges() {
+        let Some(r) = rank(&from) else { continue };
+        for (file, to) in tos {
+            if rank(&to).is_none_or(|t| t > r) {
+                upward.push(format!(
+                    "{file} uses `crate::{to}`, which is above `{from}`"
+                ));
+            }
+        }
+    }
+    assert!(upward.is_empty(), "upward imports:\n{}", upward.join("\n"));
+}
+
+#[test]
+fn the_edge_finder_sees_grouped_paths_and_skips_test_modules() {
+    let modules: BTreeSet<String> = ["build", "scenario", "reduce"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let code = library_code(
+        "use crate::{build::Built, scenario};\nfn f() {}\n#[cfg(test)]\nmod tests {\n    use crate::reduce;\n    fn g() { if true { } }\n}\nfn h() { crate::reduce::x(); }\n",
+    );
+    let found = crate_paths(&code, &modules);
+    assert_eq!(
+        found.into_iter().collect::<Vec<_>>(),
+        vec!["build", "reduce", "scenario"],
+        "the grouped use and the call after the test module count; {code}"
+    );
+    let only_test = library_code("#[cfg(test)]\nmod tests {\n    use crate::reduce;\n}\n");
+    assert!(crate_paths(&only_test, &modules).is_empty());
+}
