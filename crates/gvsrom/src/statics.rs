@@ -3,6 +3,7 @@
 
 use crate::build::Built;
 use crate::error::StaticsFailure;
+use crate::provenance::Provenance;
 use gvs::lie::V3;
 use gvs::model::Model;
 use gvs::solve::statics::{StaticsError, StaticsOptions, StaticsSolver, MAX_RAMP_STEPS};
@@ -99,6 +100,71 @@ pub fn solve_repeated(built: &Built, repeat: u32) -> Result<StaticsReport, Stati
     }
     report.solve_time_s = total / repeat.max(1) as f64;
     Ok(report)
+}
+
+/// The full model's equilibrium under the scenario's tensions, whether or not a reduced model
+/// is attached: the reference of `statics --model --compare`.
+pub fn solve_full(built: &Built, repeat: u32) -> Result<StaticsReport, StaticsFailure> {
+    let mut report = solve_on(built, &built.model, &built.u, None)?;
+    let mut total = report.solve_time_s;
+    for _ in 1..repeat {
+        total += solve_on(built, &built.model, &built.u, None)?.solve_time_s;
+    }
+    report.solve_time_s = total / repeat.max(1) as f64;
+    Ok(report)
+}
+
+/// A `statics` run ([`run`]): the equilibrium of the model that runs and, with `compare`, the
+/// full model's with the reduced one's errors against it.
+pub struct StaticsRun {
+    pub report: StaticsReport,
+    /// The full model's equilibrium (`--compare` with a reduced model).
+    pub full: Option<StaticsReport>,
+    pub comparison: Option<Comparison>,
+}
+
+/// `gvsrom statics`: the equilibrium of `built` ([`solve_repeated`], `repeat` solves timed). For
+/// an attached reduced model, its solution must lie where the model was trained
+/// (`Reduced::check_range`), and with `compare` the full model is solved too and compared.
+pub fn run(built: &Built, repeat: u32, compare_full: bool) -> anyhow::Result<StaticsRun> {
+    let report = solve_repeated(built, repeat)?;
+    let Some(r) = &built.reduced else {
+        return Ok(StaticsRun {
+            report,
+            full: None,
+            comparison: None,
+        });
+    };
+    r.check_range(&report.q)?;
+    let (full, comparison) = if compare_full {
+        let full = solve_full(built, repeat)?;
+        let c = compare(built, &full, &report);
+        (Some(full), Some(c))
+    } else {
+        (None, None)
+    };
+    Ok(StaticsRun {
+        report,
+        full,
+        comparison,
+    })
+}
+
+impl StaticsRun {
+    /// The `--json` document of this run of `built`, made as `provenance` records.
+    pub fn json<'a>(&'a self, built: &Built, provenance: &'a Provenance) -> StaticsJson<'a> {
+        StaticsJson {
+            report: &self.report,
+            model: built.reduced.as_ref().map(|r| r.path.display().to_string()),
+            model_extrapolated: built
+                .reduced
+                .as_ref()
+                .map(|r| r.extrapolated.clone())
+                .unwrap_or_default(),
+            comparison: self.comparison.clone(),
+            provenance: Some(provenance),
+        }
+    }
 }
 
 /// [`solve`] on `model`: the scenario's own or a reduced one with the same rod, points and tendons.

@@ -9,6 +9,7 @@ mod describe;
 mod limits;
 mod loads;
 pub mod reduced;
+mod resolve;
 mod rod;
 mod tendons;
 
@@ -16,6 +17,7 @@ pub use describe::describe;
 pub use limits::*;
 pub use loads::loads;
 pub use reduced::Reduced;
+pub use resolve::{resolve, Request, Resolved};
 
 use basis::{basis, quadrature};
 use rod::{base_pose, geometry, material, radius_range};

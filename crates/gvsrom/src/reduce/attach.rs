@@ -2,7 +2,7 @@
 //! scenario's basis, the layout check, and the latent range the model may be trusted in.
 
 use super::{anchors::initial_guess, invalid, projection_of};
-use crate::build::{Built, Reduced};
+use crate::build::{Built, Reduced, Resolved};
 use crate::dataset::Layout;
 use crate::error::ScenarioError;
 use crate::reduced_model::{ModelWeights, ReducedModel};
@@ -189,4 +189,16 @@ pub fn attach_source(
         crate::scenario::apply_override(&mut table, spec)?;
     }
     attach(built, &table, dir, options)
+}
+
+/// `--model DIR` on a resolved scenario: attaches the model in `dir` to its built scenario
+/// ([`attach_source`]) and records the model in the run's provenance.
+pub fn attach_resolved(
+    r: &mut Resolved,
+    dir: &Path,
+    options: AttachOptions,
+) -> Result<(), anyhow::Error> {
+    attach_source(&mut r.built, &r.source, &r.overrides, dir, options)?;
+    r.provenance = r.provenance.clone().model(dir)?;
+    Ok(())
 }

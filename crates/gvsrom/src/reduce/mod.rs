@@ -21,7 +21,7 @@ pub mod validity;
 
 pub use crate::build::Reduced;
 pub use anchors::{anchor_guess, solve_anchors, AnchorInput, AnchorProblem};
-pub use attach::{attach, attach_source, parameterization, AttachOptions};
+pub use attach::{attach, attach_resolved, attach_source, parameterization, AttachOptions};
 pub use pod::{pod, PodSummary};
 pub use train::{train, zero_anchor_rows, Loss, TrainSummary};
 

@@ -25,353 +25,17 @@
 //! and what it cannot decide because a file written by an earlier gvsrom does not record it. The
 //! strain basis and the reduced model are not compared: they are what a comparison measures.
 
+mod differences;
+mod trajectory;
+
+pub use differences::{differences, Differences};
+pub use trajectory::Trajectory;
+
 use crate::error::ScenarioError;
-use crate::npy::read_checked;
-use serde_json::Value;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// The straight, unstretched rod's strain.
 const XI_STAR: [f64; 6] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0];
-
-/// A trajectory directory written by `gvsrom simulate --out`.
-#[derive(Debug, Clone)]
-pub struct Trajectory {
-    pub dir: PathBuf,
-    pub scenario: String,
-    pub n_dof: usize,
-    pub complete: bool,
-    pub wall_time_s: f64,
-    /// Rod length [m].
-    pub length: f64,
-    pub t: Vec<f64>,
-    /// `samples × 3`.
-    pub tip: Vec<f64>,
-    /// `samples × points × 6`: `ξ` at the computational points.
-    pub strain: Vec<f64>,
-    pub strain_x: Vec<f64>,
-    /// The requested end time (`t_requested`), if recorded.
-    pub t_requested: Option<f64>,
-    /// Output samples per second (`sample_rate`), if recorded.
-    pub sample_rate: Option<f64>,
-    /// The input record (`input`), if recorded.
-    pub input: Option<Value>,
-    /// The physics record (`physics`), if recorded.
-    pub physics: Option<Value>,
-    /// Abscissae of the centreline samples [m] (`centerline_x`; trajectories written before the
-    /// centreline was recorded have none).
-    pub centerline_x: Option<Vec<f64>>,
-    /// `samples × centerline_x.len() × 3`: the centreline positions [m] (`centerline.npy`), with
-    /// `centerline_x`.
-    pub centerline: Option<Vec<f64>>,
-    /// How the run was made (`provenance`), if recorded.
-    pub provenance: Option<Value>,
-}
-
-impl Trajectory {
-    /// Loads and checks the trajectory in `dir`; `field` names it in errors (`REFERENCE`, `RUN`).
-    pub fn load(dir: &Path, field: &str) -> Result<Trajectory, ScenarioError> {
-        let bad = |message: String| ScenarioError::invalid(field, message);
-        let meta_path = dir.join("meta.json");
-        let text = crate::output::read::read_regular_to_string(&meta_path)
-            .map_err(|e| bad(format!("cannot read {}: {e}", meta_path.display())))?;
-        let meta: serde_json::Value = serde_json::from_str(&text)
-            .map_err(|e| bad(format!("{} is not valid JSON: {e}", meta_path.display())))?;
-        if meta["gvsrom"]["format"] != "trajectory" {
-            return Err(bad(format!(
-                "{} is not a trajectory (a directory written by `gvsrom simulate --out`)",
-                dir.display()
-            )));
-        }
-        // its files as written (an older trajectory without hashes is read unchecked)
-        crate::output::verify_dir(dir, "trajectory").map_err(|e| {
-            bad(format!(
-                "{e}; an edited trajectory is not the run that was simulated"
-            ))
-        })?;
-        let count = |key: &str| {
-            meta[key]
-                .as_u64()
-                .map(|v| v as usize)
-                .ok_or_else(|| bad(format!("{}: `{key}` is missing", meta_path.display())))
-        };
-        let (n, points) = (count("samples")?, count("n_points")?);
-        let f8 = "<f8";
-        let read = |name: &str, shape: &[usize]| {
-            let v = read_checked::<f64>(dir, name, f8, shape).map_err(|e| bad(e.to_string()))?;
-            match v.iter().position(|x| !x.is_finite()) {
-                Some(i) => Err(bad(format!(
-                    "{}: entry {i} is {}, not a finite number",
-                    dir.join(name).display(),
-                    v[i]
-                ))),
-                None => Ok(v),
-            }
-        };
-        let strain_x = read("strain_x.npy", &[points])?;
-        let length = match meta["length"].as_f64() {
-            Some(l) => l,
-            None => *strain_x.last().unwrap_or(&0.0),
-        };
-        if !(length > 0.0 && length.is_finite()) {
-            return Err(bad(format!(
-                "{}: rod length {length} (expected > 0)",
-                meta_path.display()
-            )));
-        }
-        let centerline_x = match meta.get("centerline_x") {
-            None => None,
-            Some(v) => Some(
-                serde_json::from_value::<Vec<f64>>(v.clone())
-                    .ok()
-                    .filter(|x| x.len() >= 2 && x.iter().all(|x| x.is_finite()))
-                    .ok_or_else(|| {
-                        bad(format!(
-                            "{}: `centerline_x` is not a list of at least 2 finite numbers",
-                            meta_path.display()
-                        ))
-                    })?,
-            ),
-        };
-        let centerline = match &centerline_x {
-            Some(x) => Some(read("centerline.npy", &[n, x.len(), 3])?),
-            None => None,
-        };
-        Ok(Trajectory {
-            dir: dir.to_path_buf(),
-            scenario: meta["scenario"].as_str().unwrap_or("?").to_string(),
-            n_dof: count("n_dof")?,
-            complete: meta["complete"].as_bool().unwrap_or(false),
-            wall_time_s: meta["wall_time_s"].as_f64().unwrap_or(f64::NAN),
-            length,
-            t: read("t.npy", &[n])?,
-            tip: read("tip_position.npy", &[n, 3])?,
-            strain: read("strain.npy", &[n, points, 6])?,
-            strain_x,
-            t_requested: meta["t_requested"].as_f64(),
-            sample_rate: meta["sample_rate"].as_f64(),
-            input: meta.get("input").filter(|v| v.is_object()).cloned(),
-            physics: meta.get("physics").filter(|v| v.is_object()).cloned(),
-            centerline_x,
-            centerline,
-            provenance: meta.get("provenance").filter(|v| v.is_object()).cloned(),
-        })
-    }
-
-    pub fn samples(&self) -> usize {
-        self.t.len()
-    }
-}
-
-/// How two trajectories differ besides what a comparison measures ([`differences`]).
-#[derive(Debug, Clone, Default, PartialEq)]
-pub struct Differences {
-    /// One sentence per aspect that differs, naming the fields and both values: "the runs have
-    /// different inputs: `tendons[0].tension` = -10 in REFERENCE, -5 in RUN".
-    pub differ: Vec<String>,
-    /// One sentence per aspect that cannot be decided because a `meta.json` does not record it.
-    pub unknown: Vec<String>,
-}
-
-impl Differences {
-    /// Both lists empty: the runs are known to have run the same scenario, input and sample times.
-    pub fn none(&self) -> bool {
-        self.differ.is_empty() && self.unknown.is_empty()
-    }
-}
-
-/// Listed differences per aspect before "and N more".
-const SHOWN: usize = 4;
-
-/// How `run` differs from `reference` in what both must share for one to approximate the other:
-/// the scenario's name, its physics, the input and the requested duration and sample rate (see
-/// the module documentation).
-pub fn differences(reference: &Trajectory, run: &Trajectory) -> Differences {
-    let mut d = Differences::default();
-    let old = |tr: &Trajectory, label: &str, what: &str| {
-        format!(
-            "{label}'s meta.json ({}) does not record {what} (written by an earlier gvsrom; simulate again to record it)",
-            tr.dir.display()
-        )
-    };
-    let (r, u) = ("REFERENCE", "RUN");
-    if reference.scenario == "?" || run.scenario == "?" {
-        d.unknown.push(format!(
-            "the scenario names: {}",
-            if reference.scenario == "?" {
-                old(reference, r, "it")
-            } else {
-                old(run, u, "it")
-            }
-        ));
-    } else if reference.scenario != run.scenario {
-        d.differ.push(format!(
-            "the runs are of different scenarios: `{}` in REFERENCE, `{}` in RUN",
-            reference.scenario, run.scenario
-        ));
-    }
-    let mut aspect = |what: &str,
-                      differ: &str,
-                      a: &Option<Value>,
-                      b: &Option<Value>,
-                      name: fn(&str) -> String| {
-        match (a, b) {
-            (Some(a), Some(b)) => {
-                let mut out = vec![];
-                diff(a, b, &mut String::new(), &mut out);
-                if !out.is_empty() {
-                    d.differ.push(format!("{differ}: {}", listed(&out, name)));
-                }
-            }
-            (None, _) => d.unknown.push(format!(
-                "whether the {what} are the same: {}",
-                old(reference, r, &format!("its {what}"))
-            )),
-            (_, None) => d.unknown.push(format!(
-                "whether the {what} are the same: {}",
-                old(run, u, &format!("its {what}"))
-            )),
-        }
-    };
-    aspect(
-        "physics",
-        "the runs have different physics",
-        &reference.physics,
-        &run.physics,
-        |p| p.to_string(),
-    );
-    // signals of different kinds: the kind, not each parameter one of them lacks
-    let (mut a, mut b) = (reference.input.clone(), run.input.clone());
-    if let (Some(Value::Object(x)), Some(Value::Object(y))) = (&mut a, &mut b) {
-        if x.get("signal") != y.get("signal") {
-            let shared = ["signal", "start", "start_tensions", "load_schedule"];
-            x.retain(|k, _| shared.contains(&k.as_str()));
-            y.retain(|k, _| shared.contains(&k.as_str()));
-        }
-    }
-    aspect(
-        "inputs",
-        "the runs have different inputs",
-        &a,
-        &b,
-        input_name,
-    );
-    let mut times = vec![];
-    let near = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs());
-    match (reference.t_requested, run.t_requested) {
-        (Some(a), Some(b)) if !near(a, b) => {
-            times.push(("--duration".to_string(), format!("{a} s"), format!("{b} s")))
-        }
-        (Some(_), Some(_)) => {}
-        (None, _) => d.unknown.push(format!(
-            "whether the durations are the same: {}",
-            old(reference, r, "its requested duration")
-        )),
-        (_, None) => d.unknown.push(format!(
-            "whether the durations are the same: {}",
-            old(run, u, "its requested duration")
-        )),
-    }
-    if let (Some(a), Some(b)) = (reference.sample_rate, run.sample_rate) {
-        if !near(a, b) {
-            times.push((
-                "--sample-rate".to_string(),
-                format!("{a} Hz"),
-                format!("{b} Hz"),
-            ));
-        }
-    }
-    if !times.is_empty() {
-        d.differ.push(format!(
-            "the runs have different sample times: {}",
-            listed(&times, |p| p.to_string())
-        ));
-    }
-    d
-}
-
-/// `` `name` = a in REFERENCE, b in RUN; … `` for the first [`SHOWN`] differences, then how many
-/// more; `name` renders a path.
-fn listed(items: &[(String, String, String)], name: fn(&str) -> String) -> String {
-    let mut parts: Vec<String> = items
-        .iter()
-        .take(SHOWN)
-        .map(|(path, a, b)| format!("`{}` = {a} in REFERENCE, {b} in RUN", name(path)))
-        .collect();
-    if items.len() > SHOWN {
-        parts.push(format!("and {} more", items.len() - SHOWN));
-    }
-    parts.join("; ")
-}
-
-/// An input record's path as the user knows it: the tensions as the scenario's
-/// `tendons[k].tension`, the rest under `input`.
-fn input_name(path: &str) -> String {
-    let index = |rest: &str| {
-        rest.strip_prefix('[')
-            .and_then(|r| r.strip_suffix(']'))
-            .map(str::to_string)
-    };
-    if let Some(k) = path.strip_prefix("tensions").and_then(index) {
-        return format!("tendons[{k}].tension");
-    }
-    if let Some(k) = path.strip_prefix("start_tensions").and_then(index) {
-        return format!("tendons[{k}].tension (the starting equilibrium's)");
-    }
-    format!("input.{path}")
-}
-
-/// Appends `(path, a, b)` for every leaf where the JSON values `a` and `b` differ (numbers to a
-/// relative 1e-12); a key, or a list of another length, on one side only is a difference of its own.
-fn diff(a: &Value, b: &Value, path: &mut String, out: &mut Vec<(String, String, String)>) {
-    match (a, b) {
-        (Value::Object(x), Value::Object(y)) => {
-            let mut keys: Vec<&String> = x.keys().chain(y.keys()).collect();
-            keys.sort();
-            keys.dedup();
-            for k in keys {
-                let len = path.len();
-                if !path.is_empty() {
-                    path.push('.');
-                }
-                path.push_str(k);
-                match (x.get(k), y.get(k)) {
-                    (Some(va), Some(vb)) => diff(va, vb, path, out),
-                    (va, vb) => out.push((path.clone(), shown(va), shown(vb))),
-                }
-                path.truncate(len);
-            }
-        }
-        (Value::Array(x), Value::Array(y)) if x.len() == y.len() => {
-            for (i, (va, vb)) in x.iter().zip(y).enumerate() {
-                let len = path.len();
-                path.push_str(&format!("[{i}]"));
-                diff(va, vb, path, out);
-                path.truncate(len);
-            }
-        }
-        (Value::Number(x), Value::Number(y)) => {
-            let (x, y) = (
-                x.as_f64().unwrap_or(f64::NAN),
-                y.as_f64().unwrap_or(f64::NAN),
-            );
-            let same = (x - y).abs() <= 1e-12 * x.abs().max(y.abs()); // false for NaN
-            if !same {
-                out.push((path.clone(), shown(Some(a)), shown(Some(b))));
-            }
-        }
-        _ if a == b => {}
-        _ => out.push((path.clone(), shown(Some(a)), shown(Some(b)))),
-    }
-}
-
-fn shown(v: Option<&Value>) -> String {
-    match v {
-        None => "absent".into(),
-        Some(Value::Array(a)) => format!("a list of {}", a.len()),
-        Some(Value::Object(_)) => "a table".into(),
-        Some(v) => v.to_string(),
-    }
-}
 
 /// Simulated time per wall time of `run` over that of `reference` (> 1: `run` is faster), or
 /// `None` when it cannot be told: a wall time that is zero, negative or not recorded, or a
@@ -445,6 +109,62 @@ pub struct Report {
     pub differ: Vec<String>,
     pub unknown: Vec<String>,
     pub provenance: crate::provenance::Provenance,
+}
+
+/// Two trajectories compared as `gvsrom compare` compares them ([`run`]).
+pub struct Compared {
+    pub reference: Trajectory,
+    pub run: Trajectory,
+    /// How they differ (empty unless compared anyway, `allow_different`).
+    pub differences: Differences,
+    pub comparison: Comparison,
+    /// [`speed_ratio`] of the run over the reference.
+    pub speed_ratio: Option<f64>,
+}
+
+/// `gvsrom compare REFERENCE RUN`: loads both trajectories, refuses them unless they ran the same
+/// scenario, input and sample times ([`differences`]; `allow_different` compares them anyway) and
+/// measures the run against the reference ([`compare`]).
+pub fn run(reference: &Path, run: &Path, allow_different: bool) -> Result<Compared, ScenarioError> {
+    let reference = Trajectory::load(reference, "REFERENCE")?;
+    let run = Trajectory::load(run, "RUN")?;
+    let diffs = differences(&reference, &run);
+    if !allow_different && !diffs.none() {
+        let mut reasons = diffs.differ.clone();
+        reasons.extend(diffs.unknown.iter().map(|u| format!("cannot tell {u}")));
+        return Err(ScenarioError::invalid(
+            "RUN",
+            format!(
+                "{}; a run approximates a reference only under the same scenario, input and sample times (--allow-different compares them anyway)",
+                reasons.join("; ")
+            ),
+        ));
+    }
+    let comparison = compare(&reference, &run)?;
+    let speed_ratio = speed_ratio(&reference, &run);
+    Ok(Compared {
+        reference,
+        run,
+        differences: diffs,
+        comparison,
+        speed_ratio,
+    })
+}
+
+impl Compared {
+    /// The `--json` report of this comparison, its provenance made now.
+    pub fn report(&self) -> Result<Report, ScenarioError> {
+        Ok(Report {
+            reference: Side::of(&self.reference),
+            run: Side::of(&self.run),
+            speed_ratio: self.speed_ratio,
+            comparison: self.comparison.clone(),
+            differ: self.differences.differ.clone(),
+            unknown: self.differences.unknown.clone(),
+            provenance: crate::provenance::Provenance::of_command()
+                .compared(&self.reference.dir, &self.run.dir)?,
+        })
+    }
 }
 
 /// `run` against `reference` over their common samples.

@@ -1,0 +1,137 @@
+//! The text the commands print: the model summary, a solution, number formats.
+
+use super::*;
+
+pub(super) fn fmt_vec(v: &[f64], prec: usize) -> String {
+    let items: Vec<String> = v.iter().map(|x| format!("{x:.prec$}")).collect();
+    format!("[{}]", items.join(", "))
+}
+
+/// `[a, b, c]` with each number in its shortest exact form.
+pub(super) fn fmt_g(v: &[f64]) -> String {
+    let items: Vec<String> = v.iter().map(|x| format!("{x}")).collect();
+    format!("[{}]", items.join(", "))
+}
+
+pub(super) fn plural(n: usize, word: &str) -> String {
+    if n == 1 {
+        format!("{n} {word}")
+    } else {
+        format!("{n} {word}s")
+    }
+}
+
+/// The summary of the model that runs. The scenario line is derived from the scenario as built;
+/// the file's own `description` follows only when no `--set` or `--tension` changed the scenario
+/// (its text may no longer hold then).
+pub(super) fn print_model(
+    scenario: &Scenario,
+    args: &ScenarioArgs,
+    built: &Built,
+    out: &mut impl Write,
+) -> Result<()> {
+    let m = &built.model;
+    writeln!(
+        out,
+        "scenario   {} — {}",
+        built.name,
+        gvsrom::build::describe(scenario, built)
+    )?;
+    if let (Some(d), true, None) = (&scenario.description, args.set.is_empty(), &args.tension) {
+        writeln!(out, "           {d}")?;
+    }
+    writeln!(
+        out,
+        "model      {} DOF, {} computational points, {}, length {} m, Magnus {:?}",
+        m.n_dof(),
+        m.disc.n_points(),
+        plural(m.rod.divisions.len(), "division"),
+        m.rod.length(),
+        m.disc.order
+    )?;
+    if let Some(r) = &built.reduced {
+        writeln!(
+            out,
+            "reduced    {} model `{}`: {} on the {}-DOF basis",
+            r.kind,
+            r.path.display(),
+            plural(r.model.n_dof(), "coordinate"),
+            m.n_dof()
+        )?;
+    }
+    if built.u.is_empty() {
+        writeln!(out, "tendons    none")?;
+    } else {
+        writeln!(
+            out,
+            "tendons    {}, u = {} N",
+            built.u.len(),
+            fmt_g(&built.u)
+        )?;
+    }
+    let l = &built.loads;
+    writeln!(
+        out,
+        "loads      gravity {} m/s², {}, {}",
+        fmt_g(&l.gravity),
+        plural(l.point.len(), "point wrench").replace("wrenchs", "wrenches"),
+        plural(l.distributed.len(), "distributed wrench").replace("wrenchs", "wrenches"),
+    )?;
+    Ok(())
+}
+
+pub(super) fn print_solution(r: &StaticsReport, out: &mut impl Write) -> Result<()> {
+    writeln!(
+        out,
+        "solved     {} in {}, ‖R‖∞ = {:.3e}, {:.2} ms",
+        plural(r.iterations, "iteration"),
+        plural(r.load_stages, "load stage"),
+        r.residual_norm,
+        r.solve_time_s * 1e3
+    )?;
+    if let Some(c) = &r.continuation {
+        let folds = c
+            .folds
+            .iter()
+            .map(|l| format!("{l:.4}"))
+            .collect::<Vec<_>>()
+            .join(", ");
+        writeln!(
+            out,
+            "continued  the load ramp stalled: followed the equilibria from the straight rod by arc-length continuation in {} ({} rejected), through {}{}",
+            plural(c.steps, "step"),
+            c.rejected_steps,
+            plural(c.folds.len(), "fold"),
+            if folds.is_empty() { String::new() } else { format!(" at load factor {folds}") }
+        )?;
+    }
+    writeln!(out, "tip        position {} m", fmt_vec(&r.tip_position, 6))?;
+    let (axis, angle) = r.tip_axis_angle();
+    writeln!(
+        out,
+        "           rotation axis {}, angle {:.4}°",
+        fmt_vec(&axis, 6),
+        angle.to_degrees()
+    )?;
+    for (i, row) in r.tip_rotation.iter().enumerate() {
+        let label = if i == 0 { "R =" } else { "   " };
+        writeln!(out, "           {label} {}", fmt_vec(row, 6))?;
+    }
+    Ok(())
+}
+
+/// The `anchors` line of `pod` and `train` (nothing when no anchor is an equilibrium).
+pub(super) fn anchors_line(
+    out: &mut dyn Write,
+    equilibria: usize,
+    rows: usize,
+    seconds: f64,
+) -> std::io::Result<()> {
+    if equilibria == 0 {
+        return Ok(());
+    }
+    writeln!(
+        out,
+        "anchors    {equilibria} of {rows} training inputs hold the reduced model's own equilibrium (solved in {seconds:.2} s): statics --model starts there"
+    )
+}

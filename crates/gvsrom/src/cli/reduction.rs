@@ -1,0 +1,211 @@
+//! `gvsrom pod` and `gvsrom train`.
+
+use super::*;
+
+#[derive(Debug, Args)]
+pub struct PodArgs {
+    /// A dataset directory (from `gvsrom dataset`).
+    pub dataset: PathBuf,
+    /// Number of POD modes kept (reduced coordinates).
+    #[arg(long, value_name = "K")]
+    pub modes: usize,
+    /// The new model directory.
+    #[arg(long, value_name = "MODEL")]
+    pub out: PathBuf,
+    /// Replace MODEL if it is an earlier gvsrom output.
+    #[arg(long)]
+    pub force: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct TrainArgs {
+    /// A dataset directory (from `gvsrom dataset`).
+    pub dataset: PathBuf,
+    /// Latent size r (reduced coordinates).
+    #[arg(long, value_name = "R", default_value_t = 1)]
+    pub latent: usize,
+    /// Hidden layers of the whole autoencoder (odd: 3, 5, 7…); layer sizes halve from the snapshot
+    /// size towards the latent size (paper Section III).
+    #[arg(long, value_name = "N", default_value_t = 7)]
+    pub hidden_layers: usize,
+    /// Maximum Adam epochs.
+    #[arg(long, default_value_t = 2000)]
+    pub epochs: usize,
+    /// Mini-batch size.
+    #[arg(long, default_value_t = 64)]
+    pub batch_size: usize,
+    /// Adam learning rate.
+    #[arg(long, default_value_t = 1e-3)]
+    pub learning_rate: f64,
+    /// L2 weight regularization λ of eq. (15) (paper: 1e-4).
+    #[arg(long, default_value_t = 1e-4)]
+    pub lambda: f64,
+    /// Fraction of the snapshots held out for validation and early stopping.
+    #[arg(long, default_value_t = 0.1)]
+    pub validation_fraction: f64,
+    /// Epochs without a better validation loss before stopping (0: never stop early).
+    #[arg(long, default_value_t = 50)]
+    pub patience: usize,
+    /// Learning-rate reductions (× 0.3 each, from the best weights so far) at validation plateaus of
+    /// `--patience` epochs before Adam stops.
+    #[arg(long, default_value_t = 4)]
+    pub lr_reductions: usize,
+    /// Iterations of the full-batch L-BFGS phase that follows Adam from its best weights (0: none).
+    #[arg(long, default_value_t = 300)]
+    pub lbfgs_iterations: usize,
+    /// Seed of the initialization, the split and the shuffles (same seed, same model).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// How each strain value's error weighs in the loss: `standardized` (each point and component
+    /// by its own spread), `physical` (plain squared error, the RMSE of Table I) or `energy`
+    /// (weighted by the section stiffness: the strain-energy norm, which the reduced model's
+    /// elastic force feels).
+    #[arg(long, value_enum, default_value_t = reduce::Loss::Energy)]
+    pub loss: reduce::Loss,
+    /// The new model directory.
+    #[arg(long, value_name = "MODEL")]
+    pub out: PathBuf,
+    /// Replace MODEL if it is an earlier gvsrom output.
+    #[arg(long)]
+    pub force: bool,
+}
+
+pub(super) fn pod_cmd(args: &PodArgs, out: &mut impl Write) -> Result<()> {
+    let s = reduce::pod(&args.dataset, args.modes, &args.out, args.force)?;
+    for w in &s.warnings {
+        eprintln!("warning: {w}");
+    }
+    writeln!(
+        out,
+        "snapshots  {} × {} (failed samples skipped), numerical rank {}",
+        s.rows, s.features, s.numerical_rank
+    )?;
+    let shown: Vec<String> = s
+        .singular_values
+        .iter()
+        .take(10)
+        .map(|v| format!("{v:.4e}"))
+        .collect();
+    writeln!(
+        out,
+        "σ          {}{}",
+        shown.join(" "),
+        if s.singular_values.len() > 10 {
+            " …"
+        } else {
+            ""
+        }
+    )?;
+    writeln!(
+        out,
+        "modes      {} capture {:.8} of the snapshot energy",
+        s.modes, s.captured_energy
+    )?;
+    anchors_line(out, s.anchor_equilibria, s.rows, s.anchor_time_s)?;
+    writeln!(out, "model      {}", s.path.display())?;
+    Ok(())
+}
+
+pub(super) fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
+    use rom::nn::TrainOptions;
+    let options = TrainOptions {
+        latent: args.latent,
+        hidden_layers: args.hidden_layers,
+        lambda: args.lambda,
+        epochs: args.epochs,
+        batch_size: args.batch_size,
+        learning_rate: args.learning_rate,
+        validation_fraction: args.validation_fraction,
+        patience: (args.patience > 0).then_some(args.patience),
+        seed: args.seed,
+        lr_reductions: args.lr_reductions,
+        fine_tune: rom::nn::FineTune::lbfgs(args.lbfgs_iterations),
+        ..TrainOptions::default()
+    };
+    let signal = interrupt_flag();
+    let bar = gvsrom::dataset::progress_bar_of(args.epochs as u64, "epochs");
+    let mut progress = |epoch: usize, train: f64, val: Option<f64>| {
+        // the fine-tuning phase runs past --epochs
+        if epoch as u64 > bar.length().unwrap_or(0) {
+            bar.set_length(epoch as u64);
+        }
+        bar.set_position(epoch as u64);
+        bar.set_message(match val {
+            Some(v) => format!("loss {train:.3e} / validation {v:.3e}"),
+            None => format!("loss {train:.3e}"),
+        });
+        match signal.load(Ordering::SeqCst) {
+            0 => ControlFlow::Continue(()),
+            _ => ControlFlow::Break(()),
+        }
+    };
+    let s = reduce::train(
+        &args.dataset,
+        &options,
+        args.loss,
+        &args.out,
+        args.force,
+        &mut progress,
+    )?;
+    bar.finish_and_clear();
+    for w in &s.warnings {
+        eprintln!("warning: {w}");
+    }
+    let r = &s.report;
+    writeln!(
+        out,
+        "snapshots  {} × {} ({} training, {} validation)",
+        s.rows, s.features, r.n_train, r.n_val
+    )?;
+    writeln!(
+        out,
+        "network    {} (encoder; the decoder mirrors it), tanh hidden layers, linear output",
+        s.encoder_sizes
+            .iter()
+            .map(|v| v.to_string())
+            .collect::<Vec<_>>()
+            .join("-")
+    )?;
+    writeln!(
+        out,
+        "trained    {} Adam epochs + {} fine-tuning iterations in {:.1} s (best at {} of {}; last phase ended by {:?})",
+        r.epochs_run - r.fine_tune_epochs_run,
+        r.fine_tune_epochs_run,
+        r.wall_time.as_secs_f64(),
+        r.best_epoch,
+        r.epochs_run,
+        r.stop
+    )?;
+    writeln!(
+        out,
+        "RMSE       {:.4e} training{}",
+        r.final_train_rmse,
+        r.final_val_rmse
+            .map(|v| format!(", {v:.4e} validation"))
+            .unwrap_or_default()
+    )?;
+    writeln!(
+        out,
+        "rest       q_r = {} ({}; it decodes to ‖ξ − ξ*‖ = {:.3e}); projection residual ≤ {:.1e}",
+        fmt_vec(&s.rest, 6),
+        match s.zero_anchor_rows {
+            0 => "the encoding of the sample closest to the straight rod".to_string(),
+            k => format!("the encoding of the straight rod, trained in as {k} zero-strain rows"),
+        },
+        s.rest_residual,
+        s.projection_residual
+    )?;
+    anchors_line(out, s.anchor_equilibria, s.rows, s.anchor_time_s)?;
+    writeln!(out, "model      {}", s.path.display())?;
+    if signal.load(Ordering::SeqCst) != 0 {
+        return Err(Interrupted {
+            signal: signal.load(Ordering::SeqCst) as i32,
+            message: format!(
+                "training interrupted; the best weights so far were saved to `{}`",
+                s.path.display()
+            ),
+        }
+        .into());
+    }
+    Ok(())
+}

@@ -1,0 +1,292 @@
+//! `gvsrom simulate`.
+
+use super::*;
+
+#[derive(Debug, Args)]
+pub struct SimulateArgs {
+    #[command(flatten)]
+    pub scenario: ScenarioArgs,
+
+    /// Simulated time [s].
+    #[arg(long, value_name = "T", allow_hyphen_values = true)]
+    pub duration: f64,
+
+    /// Output samples per second [Hz].
+    #[arg(
+        long,
+        value_name = "HZ",
+        default_value_t = 100.0,
+        allow_hyphen_values = true
+    )]
+    pub sample_rate: f64,
+
+    /// Actuation from a CSV file with columns `t, u_1, …, u_na` (held piecewise constant; see
+    /// `--interpolate`). Without an input option the scenario's tensions are held constant.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["steps", "babble"])]
+    pub input: Option<PathBuf>,
+
+    /// Interpolate the CSV input linearly between its rows instead of holding each row.
+    #[arg(long, requires = "input")]
+    pub interpolate: bool,
+
+    /// Random step actuation: every actuator draws a new tension uniformly in [LO, HI] every PERIOD
+    /// seconds (the paper's IV-C test: `--steps=-15,0,1`).
+    #[arg(
+        long,
+        value_name = "LO,HI,PERIOD",
+        value_delimiter = ',',
+        allow_hyphen_values = true,
+        conflicts_with = "babble"
+    )]
+    pub steps: Option<Vec<f64>>,
+
+    /// Actuator babbling: each actuator holds a tension uniform in [LO, HI] for a time uniform in
+    /// [HOLD_MIN, HOLD_MAX] seconds (the paper's IV-C2 data: `--babble=-15,0,0.5,1`).
+    #[arg(
+        long,
+        value_name = "LO,HI,HOLD_MIN,HOLD_MAX",
+        value_delimiter = ',',
+        allow_hyphen_values = true
+    )]
+    pub babble: Option<Vec<f64>>,
+
+    /// Seed of the random inputs (same seed, same signal).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+
+    /// Start at the static equilibrium under the scenario's tensions and loads, then switch to the
+    /// input at t = 0 (a release test when the input differs).
+    #[arg(long)]
+    pub from_equilibrium: bool,
+
+    /// Relative tolerance of the adaptive integrator, in [1e-12, 1). Default 1e-3 (ode15s), or
+    /// 1e-4 when the automatic method is SDIRK4 for a lightly damped rod (see `--method`).
+    #[arg(long, allow_hyphen_values = true)]
+    pub rtol: Option<f64>,
+
+    /// Absolute tolerance of the adaptive integrator, at least 1e-14 (ode15s default 1e-6).
+    #[arg(long, default_value_t = 1e-6, allow_hyphen_values = true)]
+    pub atol: f64,
+
+    /// Use the fixed-step implicit method with step H [s] instead of the adaptive NDF (real time).
+    #[arg(long, value_name = "H")]
+    pub fixed_step: Option<f64>,
+
+    /// Adaptive integrator: `auto` (default: the NDF for a damped rod; SDIRK4 with the mass-norm
+    /// error test at rtol 1e-4 for a lightly damped one, whose stiffest mode is underdamped),
+    /// `ndf` (variable order, ode15s class; orders ≤ 2 with the mass-norm test for a lightly damped
+    /// rod), `sdirk` (L-stable, order 4, in second-order form: Newton on n unknowns per stage) or
+    /// `galpha` (generalized-α in second-order form with numerical dissipation `--rho-inf`).
+    #[arg(long, value_enum, default_value_t = MethodChoice::Auto)]
+    pub method: MethodChoice,
+
+    /// Highest order of the NDF, 1–5 (orders ≤ 2 are A-stable). Default: 5, or 2 for a lightly
+    /// damped rod (its stiffest mode underdamped), which also gets `--error-norm mass`.
+    #[arg(long)]
+    pub max_order: Option<usize>,
+
+    /// Error test of the adaptive methods: `componentwise` (ode15s) or `mass` (positions and
+    /// velocities in the norm of the mass matrix: modes that move little mass do not limit the
+    /// step). Default: componentwise, or with the NDF mass for a lightly damped rod (see
+    /// `--max-order`). With `--method galpha`, `mass` is what makes it usable on a lightly damped
+    /// rod.
+    #[arg(long, value_enum)]
+    pub error_norm: Option<ErrorNormChoice>,
+
+    /// Generalized-α: spectral radius at infinite frequency in [0, 1] (1: no numerical dissipation).
+    #[arg(long, default_value_t = 0.8)]
+    pub rho_inf: f64,
+
+    /// Time-varying external loads: a CSV file with columns `t, λ` that scales every external load and
+    /// gravity, linearly interpolated between rows (e.g. a load applied then removed).
+    #[arg(long, value_name = "FILE")]
+    pub load_schedule: Option<PathBuf>,
+
+    /// Use finite differences of the right-hand side for the integrator's Jacobian instead of the
+    /// structured analytic one.
+    #[arg(long)]
+    pub fd_jacobian: bool,
+
+    /// Write the trajectory (t, q, q̇, u, tip pose, strains, centreline) as .npy files and
+    /// meta.json into the new directory DIR, streamed as it is computed. An interrupted (Ctrl-C,
+    /// SIGTERM) or failed run still writes what it has, marked `"complete": false`.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+
+    /// Replace DIR if it is an earlier gvsrom output holding only its own files (never anything else).
+    #[arg(long, requires = "out")]
+    pub force: bool,
+
+    /// Simulate with the reduced model in directory MODEL (from `gvsrom pod` or `gvsrom train`) in
+    /// place of the scenario's basis.
+    #[arg(long, value_name = "MODEL")]
+    pub model: Option<PathBuf>,
+}
+
+pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
+    use gvsrom::simulate::{self, InputSource, SimulateOptions};
+    use std::io::IsTerminal;
+    if let Some(dir) = &args.out {
+        let mut inputs = scenario_inputs(&args.scenario, args.model.as_ref());
+        if let Some(p) = &args.input {
+            inputs.push(("--input", p.as_path()));
+        }
+        if let Some(p) = &args.load_schedule {
+            inputs.push(("--load-schedule", p.as_path()));
+        }
+        gvsrom::output::refuse_overlap("--out", dir, &inputs)?;
+    }
+    let mut r = load(&args.scenario)?;
+    if let Some(dir) = &args.model {
+        // an input signal's tensions are checked against the model once the signal is built
+        let signal_driven = args.input.is_some() || args.steps.is_some() || args.babble.is_some();
+        attach_model(&mut r, &args.scenario, dir, signal_driven)?;
+    }
+    let (scenario, built) = (&r.scenario, &r.built);
+    let input = InputSource::from_options(
+        args.input.as_deref(),
+        args.interpolate,
+        args.steps.as_deref(),
+        args.babble.as_deref(),
+        args.seed,
+    )?;
+    let choice = simulate::IntegratorChoice {
+        method: args.method,
+        rtol: args.rtol,
+        atol: args.atol,
+        max_order: args.max_order,
+        error_norm: args.error_norm,
+        rho_inf: args.rho_inf,
+        fixed_step: args.fixed_step,
+        fd_jacobian: args.fd_jacobian,
+    };
+    // the note printed when the rod's damping chose the method
+    let (integrator, light) = simulate::choose_integrator(built, &choice)?;
+    let opts = SimulateOptions {
+        duration: args.duration,
+        sample_rate: args.sample_rate,
+        input,
+        start_at_equilibrium: args.from_equilibrium,
+        integrator,
+        load_schedule: args.load_schedule.clone(),
+    };
+    // everything is checked, and the output staged, before the computation starts
+    let plan = simulate::plan(built, &opts)?;
+    for o in &plan.model_extrapolated {
+        eprintln!("warning: extrapolating (--extrapolate): {o}");
+    }
+    let provenance = r
+        .provenance
+        .clone()
+        .seed("input", args.seed)
+        .input(plan.input.clone())
+        .sampling(opts.duration, opts.sample_rate)
+        .integrator(simulate::integrator_record(&opts.integrator, &choice));
+    let mut writer = match &args.out {
+        Some(dir) => {
+            simulate::check_output_size(built, &plan)?;
+            let mut w = TrajectoryWriter::create(dir, args.force, built)?;
+            w.set_provenance(&provenance);
+            Some(w)
+        }
+        None => None,
+    };
+    print_model(scenario, &args.scenario, built, out)?;
+    if let Some(note) = light {
+        writeln!(out, "{note}")?;
+    }
+    if let (Some(r), false) = (&built.reduced, args.from_equilibrium) {
+        let off = r.rest_strain_offset();
+        if off > 1e-6 {
+            writeln!(
+                out,
+                "start      the reduced model's rest coordinates decode to max |ξ − ξ*| = {off:.3e} at the points, not to the straight rod the full model starts from (--from-equilibrium starts both at the scenario's equilibrium)"
+            )?;
+        }
+    }
+    let signal = interrupt_flag();
+    let tty = std::io::stderr().is_terminal();
+    let mut last_pct = usize::MAX;
+    let duration = args.duration;
+    let mut control = |t: f64| {
+        if tty {
+            let pct = ((t / duration) * 100.0).clamp(0.0, 100.0) as usize;
+            if pct != last_pct {
+                last_pct = pct;
+                let bar = "#".repeat(pct / 4) + &".".repeat(25 - pct / 4);
+                eprint!("\r[{bar}] {pct:3}%  t = {t:.2} s");
+            }
+        }
+        match signal.load(Ordering::SeqCst) {
+            0 => ControlFlow::Continue(()),
+            s => ControlFlow::Break(format!("interrupted by {}", signal_name(s))),
+        }
+    };
+    let outcome = simulate::run(
+        built,
+        &plan,
+        &opts.integrator,
+        writer.as_mut(),
+        &mut control,
+    )?;
+    if tty {
+        eprintln!();
+    }
+    let sm = &outcome.summary;
+    let t_last = sm.t_last.unwrap_or(0.0);
+    writeln!(
+        out,
+        "simulated  {t_last:.3} s in {:.3} s wall time (real-time factor {:.1}), {} steps ({} failed, {} of them in Newton), {} RHS and {} Jacobian evaluations",
+        sm.wall_time_s,
+        outcome.real_time_factor(),
+        sm.stats.steps,
+        sm.stats.failed_steps,
+        sm.stats.newton_failures,
+        sm.stats.rhs_evals,
+        sm.stats.jacobian_evals
+    )?;
+    if let Some(g) = &outcome.last_tip {
+        writeln!(
+            out,
+            "tip        position {} m at t = {t_last:.3} s",
+            fmt_vec(&[g.pos[0], g.pos[1], g.pos[2]], 6),
+        )?;
+    }
+    let written = match writer {
+        Some(w) => {
+            let samples = w.samples();
+            let dir = w.finish(built, &plan, &outcome)?;
+            let partial = if outcome.ending == Ending::Complete {
+                ""
+            } else {
+                ", marked partial"
+            };
+            writeln!(
+                out,
+                "trajectory {} ({samples} samples{partial})",
+                dir.display()
+            )?;
+            Some((dir, samples))
+        }
+        None => None,
+    };
+    let kept = match &written {
+        Some((dir, n)) => format!(
+            "the {n} samples before it were written to `{}`, marked partial",
+            dir.display()
+        ),
+        None => format!(
+            "{} samples computed; nothing was written (no --out)",
+            sm.samples
+        ),
+    };
+    match &outcome.ending {
+        Ending::Complete => Ok(()),
+        Ending::Failed { error } => anyhow::bail!("{error} ({kept})"),
+        Ending::Interrupted { reason } => Err(Interrupted {
+            signal: signal.load(Ordering::SeqCst) as i32,
+            message: format!("{reason} at t = {t_last} s; {kept}"),
+        }
+        .into()),
+    }
+}

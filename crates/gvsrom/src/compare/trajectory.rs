@@ -1,0 +1,135 @@
+//! A trajectory directory written by `gvsrom simulate --out`, read for a comparison.
+
+use crate::error::ScenarioError;
+use crate::npy::read_checked;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+
+/// A trajectory directory written by `gvsrom simulate --out`.
+#[derive(Debug, Clone)]
+pub struct Trajectory {
+    pub dir: PathBuf,
+    pub scenario: String,
+    pub n_dof: usize,
+    pub complete: bool,
+    pub wall_time_s: f64,
+    /// Rod length [m].
+    pub length: f64,
+    pub t: Vec<f64>,
+    /// `samples × 3`.
+    pub tip: Vec<f64>,
+    /// `samples × points × 6`: `ξ` at the computational points.
+    pub strain: Vec<f64>,
+    pub strain_x: Vec<f64>,
+    /// The requested end time (`t_requested`), if recorded.
+    pub t_requested: Option<f64>,
+    /// Output samples per second (`sample_rate`), if recorded.
+    pub sample_rate: Option<f64>,
+    /// The input record (`input`), if recorded.
+    pub input: Option<Value>,
+    /// The physics record (`physics`), if recorded.
+    pub physics: Option<Value>,
+    /// Abscissae of the centreline samples [m] (`centerline_x`; trajectories written before the
+    /// centreline was recorded have none).
+    pub centerline_x: Option<Vec<f64>>,
+    /// `samples × centerline_x.len() × 3`: the centreline positions [m] (`centerline.npy`), with
+    /// `centerline_x`.
+    pub centerline: Option<Vec<f64>>,
+    /// How the run was made (`provenance`), if recorded.
+    pub provenance: Option<Value>,
+}
+
+impl Trajectory {
+    /// Loads and checks the trajectory in `dir`; `field` names it in errors (`REFERENCE`, `RUN`).
+    pub fn load(dir: &Path, field: &str) -> Result<Trajectory, ScenarioError> {
+        let bad = |message: String| ScenarioError::invalid(field, message);
+        let meta_path = dir.join("meta.json");
+        let text = crate::output::read::read_regular_to_string(&meta_path)
+            .map_err(|e| bad(format!("cannot read {}: {e}", meta_path.display())))?;
+        let meta: serde_json::Value = serde_json::from_str(&text)
+            .map_err(|e| bad(format!("{} is not valid JSON: {e}", meta_path.display())))?;
+        if meta["gvsrom"]["format"] != "trajectory" {
+            return Err(bad(format!(
+                "{} is not a trajectory (a directory written by `gvsrom simulate --out`)",
+                dir.display()
+            )));
+        }
+        // its files as written (an older trajectory without hashes is read unchecked)
+        crate::output::verify_dir(dir, "trajectory").map_err(|e| {
+            bad(format!(
+                "{e}; an edited trajectory is not the run that was simulated"
+            ))
+        })?;
+        let count = |key: &str| {
+            meta[key]
+                .as_u64()
+                .map(|v| v as usize)
+                .ok_or_else(|| bad(format!("{}: `{key}` is missing", meta_path.display())))
+        };
+        let (n, points) = (count("samples")?, count("n_points")?);
+        let f8 = "<f8";
+        let read = |name: &str, shape: &[usize]| {
+            let v = read_checked::<f64>(dir, name, f8, shape).map_err(|e| bad(e.to_string()))?;
+            match v.iter().position(|x| !x.is_finite()) {
+                Some(i) => Err(bad(format!(
+                    "{}: entry {i} is {}, not a finite number",
+                    dir.join(name).display(),
+                    v[i]
+                ))),
+                None => Ok(v),
+            }
+        };
+        let strain_x = read("strain_x.npy", &[points])?;
+        let length = match meta["length"].as_f64() {
+            Some(l) => l,
+            None => *strain_x.last().unwrap_or(&0.0),
+        };
+        if !(length > 0.0 && length.is_finite()) {
+            return Err(bad(format!(
+                "{}: rod length {length} (expected > 0)",
+                meta_path.display()
+            )));
+        }
+        let centerline_x = match meta.get("centerline_x") {
+            None => None,
+            Some(v) => Some(
+                serde_json::from_value::<Vec<f64>>(v.clone())
+                    .ok()
+                    .filter(|x| x.len() >= 2 && x.iter().all(|x| x.is_finite()))
+                    .ok_or_else(|| {
+                        bad(format!(
+                            "{}: `centerline_x` is not a list of at least 2 finite numbers",
+                            meta_path.display()
+                        ))
+                    })?,
+            ),
+        };
+        let centerline = match &centerline_x {
+            Some(x) => Some(read("centerline.npy", &[n, x.len(), 3])?),
+            None => None,
+        };
+        Ok(Trajectory {
+            dir: dir.to_path_buf(),
+            scenario: meta["scenario"].as_str().unwrap_or("?").to_string(),
+            n_dof: count("n_dof")?,
+            complete: meta["complete"].as_bool().unwrap_or(false),
+            wall_time_s: meta["wall_time_s"].as_f64().unwrap_or(f64::NAN),
+            length,
+            t: read("t.npy", &[n])?,
+            tip: read("tip_position.npy", &[n, 3])?,
+            strain: read("strain.npy", &[n, points, 6])?,
+            strain_x,
+            t_requested: meta["t_requested"].as_f64(),
+            sample_rate: meta["sample_rate"].as_f64(),
+            input: meta.get("input").filter(|v| v.is_object()).cloned(),
+            physics: meta.get("physics").filter(|v| v.is_object()).cloned(),
+            centerline_x,
+            centerline,
+            provenance: meta.get("provenance").filter(|v| v.is_object()).cloned(),
+        })
+    }
+
+    pub fn samples(&self) -> usize {
+        self.t.len()
+    }
+}
