@@ -91,7 +91,7 @@ pub(super) fn statics_cmd(args: &StaticsArgs, out: &mut impl Write) -> Result<()
         )?;
     }
     if let Some(json) = json {
-        let path = json.commit_json(&run.json(&r.built, &provenance))?;
+        let path = json.commit_json(run.json(&r.built, &provenance))?;
         writeln!(out, "json       {}", path.display())?;
     }
     Ok(())

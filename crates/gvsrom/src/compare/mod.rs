@@ -255,6 +255,7 @@ pub fn compare(reference: &Trajectory, run: &Trajectory) -> Result<Comparison, S
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::path::PathBuf;
 
     /// Two points, three samples at t = 0, 0.1, 0.2; `bend_y` at the points per sample.
     fn trajectory(tip_x: [f64; 3], bend_y: [[f64; 2]; 3]) -> Trajectory {

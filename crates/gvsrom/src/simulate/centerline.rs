@@ -1,0 +1,49 @@
+//! The centreline of a sample at equally spaced abscissae: shared by the trajectory writer and the
+//! in-memory buffer.
+
+use crate::build::Built;
+
+/// The centreline of each sample: the forward kinematics of the model that runs (the reduced one
+/// shares the scenario's rod and points) at `q`, sampled at `x` — buffers allocated once, before
+/// the run.
+pub(super) struct Centerline {
+    /// Abscissae `x_k = L k / (c − 1)`, `k = 0 … c − 1` [m].
+    pub(super) x: Vec<f64>,
+    pub(super) q: nalgebra::DVector<f64>,
+    pub(super) ws: gvs::model::Workspace,
+    /// `c × 3` positions of the current sample.
+    pub(super) points: Vec<f64>,
+}
+
+impl Centerline {
+    pub(super) fn new(built: &Built) -> Self {
+        let (n, ws) = match &built.reduced {
+            Some(r) => (r.model.n_dof(), r.model.workspace()),
+            None => (built.model.n_dof(), built.model.workspace()),
+        };
+        let c = built.centerline_points.max(2);
+        Centerline {
+            x: crate::statics::centerline_abscissae(built.model.disc.length(), c),
+            q: nalgebra::DVector::zeros(n),
+            ws,
+            points: vec![0.0; 3 * c],
+        }
+    }
+
+    /// The centreline at `q` into [`Self::points`].
+    pub(super) fn sample(&mut self, built: &Built, q: &[f64]) {
+        self.q.as_mut_slice().copy_from_slice(q);
+        match &built.reduced {
+            Some(r) => self.fill(&r.model),
+            None => self.fill(&built.model),
+        }
+    }
+
+    pub(super) fn fill<P: gvs::strain::StrainParam>(&mut self, model: &gvs::model::Model<P>) {
+        model.forward(&self.q, &mut self.ws, false);
+        for (k, &x) in self.x.iter().enumerate() {
+            let p = model.position_at(&self.ws, x);
+            self.points[3 * k..3 * k + 3].copy_from_slice(&[p[0], p[1], p[2]]);
+        }
+    }
+}

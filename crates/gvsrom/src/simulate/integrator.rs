@@ -1,0 +1,268 @@
+//! The integrator of a run: the method and tolerances asked for (`--method`, `--rtol`, …), chosen
+//! by the rod's damping unless named, and how `meta.json` records them.
+
+use crate::build::Built;
+use crate::error::ScenarioError;
+use gvs::solve::dynamics::{IntegratorOptions, Method, OdeJacobian};
+use gvs::solve::ode::{
+    ErrorNorm, FixedStepOptions, GeneralizedAlphaOptions, MassRenewal, NdfOptions, SdirkOptions,
+};
+use serde::{Deserialize, Serialize};
+
+/// The adaptive integrator asked for (`simulate --method`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum MethodChoice {
+    Auto,
+    Ndf,
+    Galpha,
+    Sdirk,
+}
+
+/// The error test asked for (`simulate --error-norm`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum ErrorNormChoice {
+    /// Every coordinate to its own tolerance (ode15s).
+    Componentwise,
+    /// Positions and velocities in the mass-matrix norm (mass-weighted displacement).
+    Mass,
+}
+
+impl ErrorNormChoice {
+    fn norm(self) -> ErrorNorm {
+        match self {
+            ErrorNormChoice::Componentwise => ErrorNorm::Componentwise,
+            ErrorNormChoice::Mass => ErrorNorm::Mass,
+        }
+    }
+}
+
+/// What the user asked of the integrator (`simulate --method --rtol --atol --max-order
+/// --error-norm --rho-inf --fixed-step --fd-jacobian`); `None` and `Auto` leave the choice to
+/// [`choose_integrator`]. The default is the command's defaults.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct IntegratorChoice {
+    pub method: MethodChoice,
+    /// Relative tolerance; default 1e-3 (ode15s), or [`gvs::solve::dynamics::LIGHT_DAMPING_RTOL`]
+    /// when the automatic method is SDIRK4.
+    pub rtol: Option<f64>,
+    pub atol: f64,
+    /// Highest NDF order (1–5); default 5, or 2 for a lightly damped rod.
+    pub max_order: Option<usize>,
+    pub error_norm: Option<ErrorNormChoice>,
+    /// Generalized-α: spectral radius at infinite frequency.
+    pub rho_inf: f64,
+    /// A fixed step `h` [s]: the fixed-step BDF2 instead of an adaptive method.
+    pub fixed_step: Option<f64>,
+    /// Finite differences of the first-order right-hand side for the Jacobian (`--fd-jacobian`);
+    /// else the structured iteration matrix.
+    pub fd_jacobian: bool,
+}
+
+impl Default for IntegratorChoice {
+    fn default() -> Self {
+        IntegratorChoice {
+            method: MethodChoice::Auto,
+            rtol: None,
+            atol: 1e-6,
+            max_order: None,
+            error_norm: None,
+            rho_inf: 0.8,
+            fixed_step: None,
+            fd_jacobian: false,
+        }
+    }
+}
+
+/// The integrator for `built` (with its reduced model, if attached) under `choice`, and the note
+/// to print when the rod's damping chose it (`integrator …` line), else `None`.
+///
+/// - Jacobian: finite differences with `fd_jacobian`, else the structured one. A decoder's `M(q)`
+///   varies strongly, so for it the NDF renews `M` at every attempt ([`MassRenewal::EveryAttempt`];
+///   measured on IV-C2's AE-7, 10 s: 2289 steps, 322 failed, 0.27 s, against 2399 steps, 1009
+///   failed, 0.31 s when renewed only when slow and 2267 steps, 414 failed, 0.38 s with the
+///   first-order form's finite-difference Jacobian, 2r right-hand sides per Jacobian).
+/// - Method: `fixed_step` gives the fixed-step BDF2; `galpha` and `sdirk` as named; `auto` and `ndf`
+///   with a decoder are the NDF of orders ≤ 5 (SDIRK4, which renews `M` only with `D` and `K`,
+///   failed 1864 of 2164 attempts in Newton on IV-C2's AE-2, 0.84 s against 0.1 s); `auto` and `ndf`
+///   with the structured Jacobian and neither the NDF's order nor its norm given look at the rod's
+///   damping ([`gvs::solve::dynamics::damping_regime`]): for a lightly damped rod (stiffest mode
+///   underdamped) `auto` is SDIRK4 with the mass-norm error test at rtol 1e-4 and `ndf` the NDF of
+///   orders ≤ 2 with the mass norm; otherwise the NDF of orders ≤ 5, componentwise (ode15s).
+pub fn choose_integrator(
+    built: &Built,
+    choice: &IntegratorChoice,
+) -> Result<(IntegratorOptions, Option<String>), ScenarioError> {
+    check_tolerances(choice)?;
+    let decoder = built
+        .reduced
+        .as_ref()
+        .is_some_and(|r| !r.model.param.is_linear());
+    let jacobian = if choice.fd_jacobian {
+        OdeJacobian::FiniteDifference
+    } else {
+        OdeJacobian::Structured
+    };
+    let mut note = None;
+    let rtol = choice.rtol.unwrap_or(NdfOptions::default().rtol);
+    let atol = choice.atol;
+    let error_norm = |default: ErrorNorm| choice.error_norm.map_or(default, ErrorNormChoice::norm);
+    // the rod's damping chooses for `auto` and `ndf` unless the NDF's order or norm is given
+    let ndf_choice = choice.max_order.is_some() || choice.error_norm.is_some();
+    let regime = if choice.fixed_step.is_none()
+        && matches!(choice.method, MethodChoice::Auto | MethodChoice::Ndf)
+        && !ndf_choice
+        && jacobian == OdeJacobian::Structured
+        && !decoder
+    {
+        Some(match &built.reduced {
+            Some(r) => gvs::solve::dynamics::damping_regime(&r.model)?,
+            None => gvs::solve::dynamics::damping_regime(&built.model)?,
+        })
+    } else {
+        None
+    };
+    let method = match (choice.fixed_step, choice.method) {
+        (Some(h), _) => Method::Fixed(FixedStepOptions {
+            h,
+            ..FixedStepOptions::default()
+        }),
+        (None, MethodChoice::Galpha) => Method::GeneralizedAlpha(GeneralizedAlphaOptions {
+            rtol,
+            atol,
+            rho_inf: choice.rho_inf,
+            error_norm: error_norm(ErrorNorm::Componentwise),
+            ..GeneralizedAlphaOptions::default()
+        }),
+        (None, MethodChoice::Sdirk) => Method::Sdirk(SdirkOptions {
+            rtol,
+            atol,
+            error_norm: error_norm(ErrorNorm::Mass),
+            ..SdirkOptions::default()
+        }),
+        (None, MethodChoice::Auto) if regime.is_some_and(|r| r.is_light()) => {
+            let zeta = regime.map_or(0.0, |r| r.zeta_max);
+            let rtol = choice
+                .rtol
+                .unwrap_or(gvs::solve::dynamics::LIGHT_DAMPING_RTOL);
+            note = Some(format!(
+                "integrator SDIRK4 (order 4, L-stable) with the mass-norm error test at rtol {rtol:e}: lightly damped (stiffest mode ζ = {zeta:.3}; --method or --rtol to choose)"
+            ));
+            Method::Sdirk(SdirkOptions {
+                rtol,
+                atol,
+                error_norm: ErrorNorm::Mass,
+                ..SdirkOptions::default()
+            })
+        }
+        (None, MethodChoice::Ndf | MethodChoice::Auto) => {
+            let base = NdfOptions {
+                rtol,
+                atol,
+                max_order: choice.max_order.unwrap_or(5),
+                error_norm: error_norm(ErrorNorm::Componentwise),
+                mass_renewal: if decoder {
+                    MassRenewal::EveryAttempt
+                } else {
+                    MassRenewal::WhenSlow
+                },
+                ..NdfOptions::default()
+            };
+            match regime {
+                Some(regime) => {
+                    if regime.is_light() {
+                        note = Some(format!(
+                            "integrator NDF orders ≤ 2 with the mass-norm error test: lightly damped (stiffest mode ζ = {:.3}; --max-order or --error-norm to choose)",
+                            regime.zeta_max
+                        ));
+                    }
+                    Method::Ndf(gvs::solve::dynamics::ndf_for_regime(&base, &regime))
+                }
+                None => Method::Ndf(base),
+            }
+        }
+    };
+    Ok((IntegratorOptions { method, jacobian }, note))
+}
+
+/// The integrator of a run as its provenance records it (`"integrator"`): the method that ran
+/// with its tolerances and options (as [`choose_integrator`] resolved them) and what was
+/// `requested` (the command's options).
+pub fn integrator_record(
+    options: &IntegratorOptions,
+    requested: &IntegratorChoice,
+) -> serde_json::Value {
+    use serde_json::json;
+    let norm = |n: ErrorNorm| match n {
+        ErrorNorm::Componentwise => "componentwise",
+        ErrorNorm::Mass => "mass",
+    };
+    let mut v = match &options.method {
+        Method::Ndf(o) => json!({
+            "rtol": o.rtol, "atol": o.atol, "max_order": o.max_order, "bdf": o.bdf,
+            "error_norm": norm(o.error_norm),
+            "mass_renewal": match o.mass_renewal {
+                MassRenewal::WhenSlow => "when_slow",
+                MassRenewal::EveryAttempt => "every_attempt",
+            },
+            "max_steps": o.max_steps,
+        }),
+        Method::Fixed(o) => {
+            json!({"h": o.h, "newton_tol": o.newton_tol, "max_newton": o.max_newton})
+        }
+        Method::GeneralizedAlpha(o) => json!({
+            "rtol": o.rtol, "atol": o.atol, "rho_inf": o.rho_inf,
+            "error_norm": norm(o.error_norm), "max_steps": o.max_steps,
+        }),
+        Method::Sdirk(o) => json!({
+            "rtol": o.rtol, "atol": o.atol, "error_norm": norm(o.error_norm),
+            "max_steps": o.max_steps,
+        }),
+    };
+    v["method"] = json!(options.method.name());
+    v["jacobian"] = json!(match options.jacobian {
+        OdeJacobian::FiniteDifference => "finite_difference",
+        OdeJacobian::Structured => "structured",
+    });
+    v["requested"] = serde_json::to_value(requested).unwrap_or(serde_json::Value::Null);
+    v
+}
+
+/// Smallest `--atol` accepted: `1e-14 ≈ 45 ε`. The coordinates of a rod (strain coefficients
+/// in 1/m, reduced coordinates, and their rates) are of order 1e-3 … 1e2 in the presets and carry
+/// a round-off of `ε` times their scale; a run from rest starts at `q = 0`, where the absolute
+/// tolerance alone bounds the error, so below about `10 ε` the error test and Newton's ask for
+/// digits no iteration delivers (measured on the single-tendon arm at `--rtol 1e-12`: SDIRK4 took
+/// 1371 steps for the first millisecond at `--atol 1e-16`, made no progress in 10 minutes at
+/// `--rtol 1e-30 --atol 1e-30`; the NDF failed in Newton at `--atol 1e-30`). The library takes
+/// any `atol > 0` (its units are the problem's); `--rtol` is bounded as the library bounds it,
+/// [[`gvs::solve::ode::MIN_RTOL`], [`gvs::solve::ode::MAX_RTOL`]).
+pub const MIN_ATOL: f64 = 1e-14;
+
+/// `--rtol` in [[`gvs::solve::ode::MIN_RTOL`], [`gvs::solve::ode::MAX_RTOL`]) and `--atol` finite
+/// and at least [`MIN_ATOL`].
+pub(super) fn check_tolerances(choice: &IntegratorChoice) -> Result<(), ScenarioError> {
+    use gvs::solve::ode::{MAX_RTOL, MIN_RTOL};
+    if let Some(rtol) = choice.rtol {
+        if !(MIN_RTOL..MAX_RTOL).contains(&rtol) {
+            return Err(ScenarioError::value(
+                "--rtol",
+                rtol,
+                format!(
+                    "a number in [{MIN_RTOL:e}, {MAX_RTOL}); below {MIN_RTOL:e} the error estimates are round-off"
+                ),
+            ));
+        }
+    }
+    if !(choice.atol >= MIN_ATOL && choice.atol.is_finite()) {
+        return Err(ScenarioError::value(
+            "--atol",
+            choice.atol,
+            format!(
+                "a finite number >= {MIN_ATOL:e}; below it the coordinates' round-off exceeds the tolerance"
+            ),
+        ));
+    }
+    Ok(())
+}

@@ -1,0 +1,41 @@
+//! A dynamics run of a built scenario: the actuation signal (the scenario's constant tensions, a CSV
+//! file, the paper's random steps or actuator babbling), the initial state, the integrator, and the
+//! trajectory written as NumPy arrays.
+//!
+//! The samples stream to disk as they are computed (memory does not grow with the run's length),
+//! through [`crate::output`]: into a hidden staging directory beside `DIR`, moved into place at the
+//! end. A run that fails or is interrupted (SIGINT/SIGTERM) still writes the samples computed so far,
+//! with `"complete": false`, the reason and the last time reached in `meta.json`.
+//!
+//! | file | shape | content |
+//! |---|---|---|
+//! | `t.npy` | (N,) | sample times [s] |
+//! | `q.npy`, `qd.npy` | (N, n) | generalized coordinates and velocities |
+//! | `u.npy` | (N, n_a) | tendon tensions [N] |
+//! | `tip_position.npy` | (N, 3) | tip position [m] |
+//! | `tip_rotation.npy` | (N, 3, 3) | tip rotation matrices (section → world) |
+//! | `strain.npy` | (N, p, 6) | ξ at the p computational points, `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]` |
+//! | `strain_x.npy` | (p,) | abscissae of the computational points [m] |
+//! | `centerline.npy` | (N, c, 3) | centreline positions [m] at the `c` abscissae `centerline_x` of `meta.json`, equally spaced in arc length from base to tip (`output.centerline_points`, `--centerline-points`), in the world frame as `statics --json` |
+//! | `meta.json` | | manifest (`gvsrom`: format, version, files), scenario, `complete`, `reason`, `t_reached`, `t_requested`, `sample_rate`, sizes, integrator statistics, wall time, real-time factor, error, `input` ([`input_record`]), `physics` (material, geometry, base, tendon routing, loads), `centerline_x`, `provenance` ([`crate::provenance`]) |
+//!
+//! The integrator is chosen here too ([`choose_integrator`]): by the rod's damping unless named,
+//! as `gvsrom simulate` and `gvsrom reproduce` both do.
+//!
+//! Files, each using only those before it: `integrator`, `options`, `plan`, `run` (the integration
+//! loop), `centerline`, `buffer` (samples in memory), `writer` (samples to a directory).
+
+mod buffer;
+mod centerline;
+mod integrator;
+mod options;
+mod plan;
+mod run;
+mod writer;
+
+pub use buffer::*;
+pub use integrator::*;
+pub use options::*;
+pub use plan::*;
+pub use run::*;
+pub use writer::*;

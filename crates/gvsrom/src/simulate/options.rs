@@ -1,0 +1,290 @@
+//! A run's options ([`SimulateOptions`]): its actuation — where it comes from ([`InputSource`]),
+//! the signal built from it and its checks — the span, the sampling and the integrator; and how
+//! `meta.json` records the input.
+
+use crate::build::Built;
+use crate::error::ScenarioError;
+use gvs::inputs::{babble, random_steps, Interpolation, Signal};
+use gvs::solve::dynamics::IntegratorOptions;
+use std::path::{Path, PathBuf};
+
+/// Where the actuation comes from.
+#[derive(Debug, Clone)]
+pub enum InputSource {
+    /// The scenario's tendon tensions, constant.
+    Constant,
+    /// A CSV file with columns `t, u_1, …, u_na` (a header line is allowed).
+    Csv {
+        path: PathBuf,
+        interpolation: Interpolation,
+    },
+    /// New uniform random tensions in `[lo, hi]` for all actuators every `period` seconds.
+    Steps {
+        lo: f64,
+        hi: f64,
+        period: f64,
+        seed: u64,
+    },
+    /// A signal given in memory (Python's `input=` array of rows `t, u_1, …, u_na`), checked
+    /// as a CSV file's rows are.
+    Rows(Signal),
+    /// Actuator babbling: each actuator holds a uniform random value in `[lo, hi]` for a uniform random
+    /// time in `[hold_min, hold_max]` (paper IV-C2).
+    Babble {
+        lo: f64,
+        hi: f64,
+        hold_min: f64,
+        hold_max: f64,
+        seed: u64,
+    },
+}
+
+impl InputSource {
+    /// The input of the command-line options `--input FILE [--interpolate]`, `--steps LO,HI,PERIOD`
+    /// or `--babble LO,HI,HOLD_MIN,HOLD_MAX` (at most one), else the scenario's constant tensions.
+    pub fn from_options(
+        input: Option<&Path>,
+        interpolate: bool,
+        steps: Option<&[f64]>,
+        babble: Option<&[f64]>,
+        seed: u64,
+    ) -> Result<InputSource, ScenarioError> {
+        let count = |opt: &str, v: &[f64], n: usize, names: &str| {
+            if v.len() == n {
+                Ok(())
+            } else {
+                Err(ScenarioError::invalid(
+                    opt,
+                    format!("takes {n} comma-separated values {names}, got {}", v.len()),
+                ))
+            }
+        };
+        Ok(match (input, steps, babble) {
+            (Some(path), None, None) => InputSource::Csv {
+                path: path.to_path_buf(),
+                interpolation: if interpolate {
+                    Interpolation::Linear
+                } else {
+                    Interpolation::Hold
+                },
+            },
+            (None, Some(v), None) => {
+                count("--steps", v, 3, "LO,HI,PERIOD")?;
+                InputSource::Steps {
+                    lo: v[0],
+                    hi: v[1],
+                    period: v[2],
+                    seed,
+                }
+            }
+            (None, None, Some(v)) => {
+                count("--babble", v, 4, "LO,HI,HOLD_MIN,HOLD_MAX")?;
+                InputSource::Babble {
+                    lo: v[0],
+                    hi: v[1],
+                    hold_min: v[2],
+                    hold_max: v[3],
+                    seed,
+                }
+            }
+            (None, None, None) => InputSource::Constant,
+            _ => {
+                return Err(ScenarioError::invalid(
+                    "--input/--steps/--babble",
+                    "give at most one input option",
+                ))
+            }
+        })
+    }
+}
+
+/// Options of a dynamics run.
+#[derive(Debug, Clone)]
+pub struct SimulateOptions {
+    pub duration: f64,
+    /// Output samples per second.
+    pub sample_rate: f64,
+    pub input: InputSource,
+    /// Start at the static equilibrium under the scenario's tensions and loads (then switch to the
+    /// input signal at t = 0) instead of straight at rest.
+    pub start_at_equilibrium: bool,
+    pub integrator: IntegratorOptions,
+    /// A CSV file `t, λ` scaling all external loads and gravity over time (linear between rows).
+    pub load_schedule: Option<PathBuf>,
+}
+
+pub(super) fn positive(field: &str, v: f64, unit: &str) -> Result<f64, ScenarioError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(ScenarioError::value(
+            field,
+            v,
+            format!("a finite number > 0 {unit}"),
+        ))
+    }
+}
+
+/// Builds the actuation signal of a run.
+pub fn input_signal(built: &Built, opts: &SimulateOptions) -> Result<Signal, ScenarioError> {
+    let na = built.model.n_actuators();
+    let d = opts.duration;
+    Ok(match &opts.input {
+        InputSource::Constant => Signal::constant(&built.u),
+        InputSource::Csv {
+            path,
+            interpolation,
+        } => {
+            crate::scenario::check_regular_file("--input", path)?;
+            let signal = crate::csv_input::read_csv_signal(path, na, *interpolation)?;
+            covers_start("--input", path, &signal, RUN_START)?;
+            signal
+        }
+        InputSource::Rows(signal) => {
+            signal.validate("input", na)?;
+            covers_start("input", Path::new("input"), signal, RUN_START)?;
+            signal.clone()
+        }
+        InputSource::Steps {
+            lo,
+            hi,
+            period,
+            seed,
+        } => {
+            range_check("--steps", *lo, *hi)?;
+            random_steps(
+                na,
+                *lo,
+                *hi,
+                positive("--steps period", *period, "s")?,
+                d,
+                *seed,
+            )
+        }
+        InputSource::Babble {
+            lo,
+            hi,
+            hold_min,
+            hold_max,
+            seed,
+        } => {
+            range_check("--babble", *lo, *hi)?;
+            positive("--babble hold_min", *hold_min, "s")?;
+            if !(hold_max.is_finite() && hold_max >= hold_min) {
+                return Err(ScenarioError::value(
+                    "--babble hold_max",
+                    *hold_max,
+                    format!("a number >= hold_min = {hold_min} s"),
+                ));
+            }
+            babble(na, *lo, *hi, *hold_min, *hold_max, d, *seed)
+        }
+    })
+}
+
+/// Every run starts at t = 0 (its first sample).
+pub(super) const RUN_START: f64 = 0.0;
+
+/// Refuses a signal read from `path` (option `field`) whose first row comes after the run's start
+/// `t0`: before its first row the signal would silently hold that row's values.
+pub(super) fn covers_start(
+    field: &str,
+    path: &Path,
+    signal: &Signal,
+    t0: f64,
+) -> Result<(), ScenarioError> {
+    match signal.times.first() {
+        Some(&first) if first > t0 => Err(ScenarioError::invalid(
+            field,
+            format!(
+                "`{}` starts at t = {} s, after the run's start t = {} s; the input before its first row is not given (add a row at t = {})",
+                path.display(),
+                gvs::error::fmt_value(first),
+                gvs::error::fmt_value(t0),
+                gvs::error::fmt_value(t0)
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
+pub(super) fn range_check(field: &str, lo: f64, hi: f64) -> Result<(), ScenarioError> {
+    if lo.is_finite() && hi.is_finite() && lo <= hi {
+        Ok(())
+    } else {
+        Err(ScenarioError::invalid(
+            field,
+            format!("range [{lo}, {hi}] must be finite with lo <= hi"),
+        ))
+    }
+}
+
+/// The run's input as `meta.json` records it (`"input"`), for `gvsrom compare` to tell runs with
+/// other inputs apart: the signal's specification — `"constant"` with the tensions, `"csv"` with
+/// the file, its SHA-256 and the interpolation, `"steps"` or `"babble"` with their parameters and
+/// seed —, the start (`"rest"`, or `"equilibrium"` with the tensions it is solved under) and the
+/// load schedule (file and SHA-256, or null).
+pub fn input_record(
+    built: &Built,
+    opts: &SimulateOptions,
+) -> Result<serde_json::Value, ScenarioError> {
+    use serde_json::json;
+    let file = |field: &str, path: &Path| -> Result<serde_json::Value, ScenarioError> {
+        Ok(json!({
+            "file": path.display().to_string(),
+            "sha256": crate::csv_input::file_sha256(field, path)?,
+        }))
+    };
+    let mut signal = match &opts.input {
+        InputSource::Constant => json!({"signal": "constant", "tensions": built.u}),
+        InputSource::Csv {
+            path,
+            interpolation,
+        } => {
+            let mut v = file("--input", path)?;
+            v["signal"] = json!("csv");
+            v["interpolation"] = json!(match interpolation {
+                Interpolation::Hold => "hold",
+                Interpolation::Linear => "linear",
+            });
+            v
+        }
+        InputSource::Rows(signal) => json!({
+            "signal": "rows",
+            "rows": signal.times.len(),
+            "interpolation": match signal.interpolation {
+                Interpolation::Hold => "hold",
+                Interpolation::Linear => "linear",
+            },
+        }),
+        InputSource::Steps {
+            lo,
+            hi,
+            period,
+            seed,
+        } => json!({
+            "signal": "steps", "lo": lo, "hi": hi, "period": period, "seed": seed,
+        }),
+        InputSource::Babble {
+            lo,
+            hi,
+            hold_min,
+            hold_max,
+            seed,
+        } => json!({
+            "signal": "babble", "lo": lo, "hi": hi, "hold_min": hold_min, "hold_max": hold_max,
+            "seed": seed,
+        }),
+    };
+    if opts.start_at_equilibrium {
+        signal["start"] = json!("equilibrium");
+        signal["start_tensions"] = json!(built.u);
+    } else {
+        signal["start"] = json!("rest");
+    }
+    signal["load_schedule"] = match &opts.load_schedule {
+        Some(path) => file("--load-schedule", path)?,
+        None => serde_json::Value::Null,
+    };
+    Ok(signal)
+}

@@ -1,0 +1,157 @@
+//! A run's [`Plan`]: everything checked, and the sample times and signal built, before anything is
+//! computed.
+
+use super::options::*;
+use crate::build::Built;
+use crate::error::ScenarioError;
+use gvs::inputs::{Interpolation, Signal};
+use gvs::solve::dynamics::{InitialState, Method};
+
+/// Most output samples of one run.
+pub const MAX_SAMPLES: usize = 10_000_000;
+
+/// Most steps of one fixed-step run (`--duration / --fixed-step`).
+pub const MAX_FIXED_STEPS: f64 = 1e7;
+
+/// Most input switches of a random-step or babbling signal (`--duration / period`).
+pub const MAX_INPUT_SWITCHES: f64 = 1e7;
+
+/// The output times `t_k = k / rate` for `t_k ≤ duration`, followed by `duration` itself when it is
+/// not a multiple of the sample period, so the last sample is always at `duration`.
+pub fn sample_times(duration: f64, rate: f64) -> Result<Vec<f64>, ScenarioError> {
+    positive("--duration", duration, "s")?;
+    positive("--sample-rate", rate, "Hz")?;
+    let periods = (duration * rate * (1.0 + 4.0 * f64::EPSILON)).floor();
+    if !periods.is_finite() || periods >= (MAX_SAMPLES - 1) as f64 {
+        return Err(ScenarioError::invalid(
+            "--duration",
+            format!(
+                "{} s at --sample-rate {} Hz gives {:.2e} samples (accepted <= {MAX_SAMPLES}); lower --duration or --sample-rate",
+                gvs::error::fmt_value(duration),
+                gvs::error::fmt_value(rate),
+                periods + 1.0
+            ),
+        ));
+    }
+    let m = periods as usize;
+    let mut t: Vec<f64> = (0..=m).map(|k| k as f64 / rate).collect();
+    let last = t[m];
+    if last > duration {
+        t[m] = duration; // rounding put k/rate a hair past the end
+    } else if duration - last > 1e-9 * duration.max(1.0) / rate.max(1.0) {
+        t.push(duration);
+    }
+    Ok(t)
+}
+
+/// A run checked before anything is computed or written: its sample times, actuation, load schedule
+/// and initial state. Inputs whose loads or tensions lie far beyond the rod's elastic range are
+/// refused here (see [`crate::plausibility`]).
+pub struct Plan {
+    pub t_out: Vec<f64>,
+    pub signal: Signal,
+    pub schedule: Option<Signal>,
+    pub initial: InitialState,
+    /// Output samples per second.
+    pub sample_rate: f64,
+    /// What `meta.json` records of the run's input ([`input_record`]).
+    pub input: serde_json::Value,
+    /// How the input signal lies outside a reduced model's training inputs, when used with
+    /// `--extrapolate` (`Reduced::check_signal`; without it such a signal is refused).
+    pub model_extrapolated: Vec<String>,
+}
+
+/// Validates `opts` against `built` and builds the [`Plan`] of the run.
+pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError> {
+    let t_out = sample_times(opts.duration, opts.sample_rate)?;
+    if let Method::Fixed(f) = &opts.integrator.method {
+        let h = positive("--fixed-step", f.h, "s")?;
+        if opts.duration / h > MAX_FIXED_STEPS {
+            return Err(ScenarioError::invalid(
+                "--fixed-step",
+                format!(
+                    "{} s over --duration {} s is {:.2e} steps (accepted <= {}); use a larger step or the adaptive integrator",
+                    gvs::error::fmt_value(h),
+                    gvs::error::fmt_value(opts.duration),
+                    opts.duration / h,
+                    gvs::error::fmt_value(MAX_FIXED_STEPS)
+                ),
+            ));
+        }
+    }
+    let switch_period = match &opts.input {
+        InputSource::Steps { period, .. } => Some(("--steps period", *period)),
+        InputSource::Babble { hold_min, .. } => Some(("--babble hold_min", *hold_min)),
+        _ => None,
+    };
+    if let Some((field, p)) = switch_period {
+        let p = positive(field, p, "s")?;
+        if opts.duration / p > MAX_INPUT_SWITCHES {
+            return Err(ScenarioError::invalid(
+                field,
+                format!(
+                    "{} s over --duration {} s is {:.2e} input switches (accepted <= {})",
+                    gvs::error::fmt_value(p),
+                    gvs::error::fmt_value(opts.duration),
+                    opts.duration / p,
+                    gvs::error::fmt_value(MAX_INPUT_SWITCHES)
+                ),
+            ));
+        }
+    }
+    let signal = input_signal(built, opts)?;
+    // a reduced model answers only for tensions it was trained on: the signal's, at its knots
+    // (where a held or linear signal takes its extremes) and at both ends of the run
+    let model_extrapolated = match (&built.reduced, &opts.input) {
+        (Some(r), input) if !matches!(input, InputSource::Constant) => {
+            let end = t_out.last().copied().unwrap_or(0.0);
+            let mut times: Vec<f64> = signal
+                .times
+                .iter()
+                .copied()
+                .filter(|t| (0.0..=end).contains(t))
+                .chain([0.0, end])
+                .collect();
+            times.sort_by(f64::total_cmp);
+            let mut u = vec![0.0; signal.channels()];
+            r.check_signal(&times, |t| {
+                signal.eval(t, &mut u);
+                u.clone()
+            })?
+        }
+        _ => vec![],
+    };
+    let schedule = match &opts.load_schedule {
+        Some(path) => {
+            crate::scenario::check_regular_file("--load-schedule", path)?;
+            let s = crate::csv_input::read_csv_signal(path, 1, Interpolation::Linear)?;
+            covers_start("--load-schedule", path, &s, t_out[0])?;
+            Some(s)
+        }
+        None => None,
+    };
+    let u_max = crate::csv_input::max_abs_per_column(&signal);
+    let lambda_max = schedule
+        .as_ref()
+        .map(|s| crate::csv_input::max_abs_per_column(s)[0])
+        .unwrap_or(1.0);
+    crate::plausibility::check(built, &u_max, lambda_max)?;
+    let initial = if opts.start_at_equilibrium {
+        InitialState::Equilibrium {
+            u: built.u.clone(),
+            loads: built.loads.clone(),
+        }
+    } else {
+        InitialState::Rest
+    };
+    let input = input_record(built, opts)?;
+    Ok(Plan {
+        t_out,
+        signal,
+        schedule,
+        initial,
+        sample_rate: opts.sample_rate,
+        input,
+        model_extrapolated,
+    })
+}

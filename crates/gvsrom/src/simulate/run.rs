@@ -1,0 +1,159 @@
+//! Running a plan: the integrator streams samples to a [`SampleSink`] (a trajectory directory or a
+//! buffer in memory) and ends complete, failed or interrupted ([`Outcome`]).
+
+use super::plan::*;
+use crate::build::Built;
+use crate::error::ScenarioError;
+use gvs::lie::Pose;
+use gvs::solve::dynamics::{
+    simulate_streaming_interruptible, IntegratorOptions, RunSummary, Sample, SimulationError,
+};
+use std::ops::ControlFlow;
+
+/// How a run ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Ending {
+    /// Every sample up to the requested duration was computed.
+    Complete,
+    /// Stopped on request (an interrupt) after the last sample delivered.
+    Interrupted { reason: String },
+    /// The integrator failed; the samples before the failure were delivered.
+    Failed { error: String },
+}
+
+/// The result of [`run`]: the summary of the streamed simulation and the last sample's tip.
+#[derive(Debug)]
+pub struct Outcome {
+    pub summary: RunSummary,
+    pub ending: Ending,
+    /// Tip pose of the last sample.
+    pub last_tip: Option<Pose>,
+    /// The run failed because a reduced trajectory left its training region (the decoder would
+    /// extrapolate), not because the integrator did.
+    pub left_training_region: bool,
+}
+
+impl Outcome {
+    /// Simulated time per wall-clock time.
+    pub fn real_time_factor(&self) -> f64 {
+        self.summary.t_last.unwrap_or(0.0) / self.summary.wall_time_s.max(1e-12)
+    }
+}
+
+/// Where [`run_into`] delivers the samples: a [`TrajectoryWriter`] (files) or a
+/// [`TrajectoryBuffer`] (memory).
+pub trait SampleSink {
+    /// Appends one sample of the run of `built`.
+    fn push(&mut self, built: &Built, s: &Sample<'_>) -> std::io::Result<()>;
+}
+
+/// [`run`] with the samples delivered to any [`SampleSink`].
+pub fn run_into(
+    built: &Built,
+    plan: &Plan,
+    integrator: &IntegratorOptions,
+    mut writer: Option<&mut dyn SampleSink>,
+    control: &mut dyn FnMut(f64) -> ControlFlow<String>,
+) -> Result<Outcome, ScenarioError> {
+    let mut last_tip = None;
+    let mut write_error: Option<std::io::Error> = None;
+    let mut off_manifold = None;
+    // `control` is called from the sink and from the integrator's per-attempt poll, never nested
+    let control = std::cell::RefCell::new(control);
+    let interrupted = std::cell::RefCell::new(None::<String>);
+    let last_t = std::cell::Cell::new(plan.t_out.first().copied().unwrap_or(0.0));
+    let check = |t: f64| {
+        let flow = (*control.borrow_mut())(t);
+        if let ControlFlow::Break(reason) = &flow {
+            *interrupted.borrow_mut() = Some(reason.clone());
+        }
+        flow
+    };
+    let stop = || match check(last_t.get()) {
+        ControlFlow::Break(reason) => Some(reason),
+        ControlFlow::Continue(()) => None,
+    };
+    let mut sink = |s: &Sample<'_>| {
+        last_t.set(s.t);
+        last_tip = Some(*s.tip);
+        if let Some(w) = writer.as_deref_mut() {
+            if let Err(e) = w.push(built, s) {
+                let msg = format!("cannot write the trajectory: {e}");
+                write_error = Some(e);
+                return ControlFlow::Break(msg);
+            }
+        }
+        // A reduced trajectory far outside its training encodings is off the learned manifold
+        // (the decoder saturates, `Ψ_q → 0`, `M → 0`): stop there with the reason rather than
+        // integrating a spurious motion until Newton fails.
+        if let Some(v) = built.reduced.as_ref().and_then(|r| r.range_violation(s.q)) {
+            let msg = format!(
+                "the reduced trajectory left the training region at t = {:.4} s: {v}; the decoder extrapolates there (an input outside the dataset, or a poor model)",
+                s.t
+            );
+            off_manifold = Some(msg.clone());
+            return ControlFlow::Break(msg);
+        }
+        check(s.t)
+    };
+    let summary = match &built.reduced {
+        Some(r) => simulate_streaming_interruptible(
+            &r.model,
+            &plan.signal,
+            &built.loads,
+            plan.schedule.as_ref(),
+            &plan.initial,
+            &plan.t_out,
+            integrator,
+            &mut sink,
+            &stop,
+        ),
+        None => simulate_streaming_interruptible(
+            &built.model,
+            &plan.signal,
+            &built.loads,
+            plan.schedule.as_ref(),
+            &plan.initial,
+            &plan.t_out,
+            integrator,
+            &mut sink,
+            &stop,
+        ),
+    }
+    .map_err(|e| match e {
+        SimulationError::Model(m) => ScenarioError::from(m),
+        SimulationError::Initial(s) => ScenarioError::invalid(
+            "--from-equilibrium",
+            format!(
+                "the initial equilibrium failed: {s}{}",
+                crate::plausibility::largest_load(built, &built.u, 1.0)
+                    .map(|l| format!("; {l}"))
+                    .unwrap_or_default()
+            ),
+        ),
+    })?;
+    if let Some(e) = write_error {
+        return Err(ScenarioError::invalid(
+            "--out",
+            format!(
+                "cannot write the trajectory at t = {}: {e}",
+                summary.t_last.unwrap_or(0.0)
+            ),
+        ));
+    }
+    let left_training_region = summary.error.is_some() && off_manifold.is_some();
+    let ending = match (&summary.error, off_manifold, interrupted.into_inner()) {
+        (None, _, _) => Ending::Complete,
+        (Some(_), Some(error), _) => Ending::Failed { error },
+        (Some(_), None, Some(reason)) => Ending::Interrupted { reason },
+        (Some(e), None, None) => Ending::Failed {
+            error: e.to_string(),
+        },
+    };
+    Ok(Outcome {
+        summary,
+        ending,
+        last_tip,
+        left_training_region,
+    })
+}
