@@ -1,7 +1,8 @@
 //! The library's layering (`docs/architecture.md`): every module of `src/` uses only modules of
 //! its own layer listed before it or of a lower layer — never a higher one — so no two modules
 //! import each other. Read from the source text: every `crate::module` path in library code
-//! (`use` lines, paths, intra-doc links; test modules excepted) is an edge.
+//! (`use` lines, paths, intra-doc links; test modules, inline or in a file of their own, excepted)
+//! is an edge.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs;
@@ -93,6 +94,61 @@ fn library_code(text: &str) -> String {
     out
 }
 
+/// The modules `code` declares as test-only out-of-line modules: `NAME` of every
+/// `#[cfg(test)] [pub(…)] mod NAME;` (the module is then a file, e.g. `scenario/tests.rs`).
+fn test_module_decls(code: &str) -> Vec<String> {
+    let mut out = vec![];
+    let mut pending_test = false;
+    for line in code.lines() {
+        let t = line.trim();
+        if t.starts_with("#[cfg(test)]") {
+            pending_test = true;
+            continue;
+        }
+        if pending_test {
+            let decl = match t.strip_prefix("pub") {
+                Some(rest) if rest.starts_with('(') => rest.split_once(')').map_or("", |(_, r)| r),
+                Some(rest) => rest,
+                None => t,
+            };
+            if let Some(name) = decl
+                .trim()
+                .strip_prefix("mod ")
+                .and_then(|r| r.strip_suffix(';'))
+            {
+                out.push(name.trim().to_string());
+            }
+        }
+        pending_test = false;
+    }
+    out
+}
+
+/// The files of `files` that are test-only modules declared by another file of `files` (see
+/// [`test_module_decls`]): test code as a whole, like an inline `#[cfg(test)] mod tests { … }`.
+fn test_only_files(files: &[PathBuf]) -> BTreeSet<PathBuf> {
+    let mut out = BTreeSet::new();
+    for f in files {
+        // the directory of the file's submodules: its own for `mod.rs`, else `dir/stem/`
+        let dir = match f.file_stem().and_then(|s| s.to_str()) {
+            Some("mod" | "lib" | "main") => f.parent().unwrap().to_path_buf(),
+            Some(stem) => f.parent().unwrap().join(stem),
+            None => continue,
+        };
+        for name in test_module_decls(&fs::read_to_string(f).unwrap()) {
+            let file = [
+                dir.join(format!("{name}.rs")),
+                dir.join(&name).join("mod.rs"),
+            ]
+            .into_iter()
+            .find(|p| p.is_file());
+            let file = file.unwrap_or_else(|| panic!("{}: no file of `mod {name};`", f.display()));
+            out.insert(file);
+        }
+    }
+    out
+}
+
 /// The modules named by `crate::NAME` paths in `code`, including grouped `use crate::{a, b::c}`.
 fn crate_paths(code: &str, modules: &BTreeSet<String>) -> BTreeSet<String> {
     let mut found = BTreeSet::new();
@@ -134,11 +190,12 @@ fn edges() -> BTreeMap<String, BTreeSet<(String, String)>> {
         .map(|f| module_of(f.strip_prefix(&root).unwrap()))
         .filter(|m| m != "lib" && m != "main")
         .collect();
+    let tests_only = test_only_files(&files);
     let mut out: BTreeMap<String, BTreeSet<(String, String)>> = BTreeMap::new();
     for f in &files {
         let rel = f.strip_prefix(&root).unwrap();
         let from = module_of(rel);
-        if from == "lib" || from == "main" {
+        if from == "lib" || from == "main" || tests_only.contains(f) {
             continue;
         }
         let code = library_code(&fs::read_to_string(f).unwrap());
@@ -205,4 +262,10 @@ fn the_edge_finder_sees_grouped_paths_and_skips_test_modules() {
     );
     let only_test = library_code("#[cfg(test)]\nmod tests {\n    use crate::reduce;\n}\n");
     assert!(crate_paths(&only_test, &modules).is_empty());
+}
+
+#[test]
+fn out_of_line_test_modules_are_test_code() {
+    let code = "mod parse;\n#[cfg(test)]\nmod tests;\n#[cfg(test)]\npub(crate) mod test_util;\n#[cfg(test)]\nmod inline {\n}\nmod types;\n";
+    assert_eq!(test_module_decls(code), vec!["tests", "test_util"]);
 }

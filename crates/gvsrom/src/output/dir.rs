@@ -6,7 +6,7 @@ use super::lock::TargetLock;
 use super::manifest::{manifest, with_manifest};
 use super::staging::{sync_dir, unique_sibling, Prepared};
 use super::target::{inspect, Existing};
-use super::{integrity, replace, Kind, Named, OutputError, MANIFEST_FILE};
+use super::{hashes, replace, Kind, Named, OutputError, MANIFEST_FILE};
 use serde::Serialize;
 use std::fs::{self, File, OpenOptions};
 use std::io::{self, BufWriter, Write};
@@ -156,7 +156,7 @@ impl OutputDir {
                 File::open(staging.join(f))?.sync_all()?;
             }
             // the hashes of the files as they are on disk, read back
-            integrity::record_hashes(&staging, &self.files, &mut meta)?;
+            hashes::record_hashes(&staging, &self.files, &mut meta)?;
             let mut w = BufWriter::new(
                 OpenOptions::new()
                     .write(true)

@@ -35,6 +35,7 @@
 
 mod dir;
 mod file;
+mod hashes;
 pub mod integrity;
 mod lock;
 mod manifest;

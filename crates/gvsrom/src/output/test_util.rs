@@ -1,6 +1,10 @@
-//! Scratch directories and FIFOs of the unit tests (of the output module and of the readers).
+//! Scratch directories, FIFOs and committed sample outputs of the unit tests (of the output module
+//! and of the readers).
 
+use super::{OutputDir, MANIFEST_FILE};
+use serde_json::{json, Value};
 use std::fs;
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// A fresh empty directory `name` under the system's temporary directory, in a folder of this
@@ -35,4 +39,31 @@ pub(crate) fn fifo(path: &Path) {
         0,
         "mkfifo {path:?}"
     );
+}
+
+/// A committed output of format "test" with `a.bin`, `b.bin` (same length) and meta values.
+pub(super) fn committed_output(suite: &str, name: &str) -> PathBuf {
+    let target = sandbox(suite, name).join("out");
+    let mut out = OutputDir::create("--out", &target, "test", false).unwrap();
+    out.write_file("a.bin", |w| w.write_all(&[1u8; 300]))
+        .unwrap();
+    out.write_file("b.bin", |w| w.write_all(&[2u8; 300]))
+        .unwrap();
+    out.commit(json!({ "samples": 9, "x": [0.1, 1e-300, -0.0], "name": "é\"\\\n" }))
+        .unwrap();
+    target
+}
+
+/// The parsed `meta.json` of the directory output `dir`.
+pub(super) fn meta_of(dir: &Path) -> Value {
+    serde_json::from_str(&fs::read_to_string(dir.join(MANIFEST_FILE)).unwrap()).unwrap()
+}
+
+/// Writes `v` as the `meta.json` of `dir`, pretty-printed.
+pub(super) fn write_meta(dir: &Path, v: &Value) {
+    fs::write(
+        dir.join(MANIFEST_FILE),
+        serde_json::to_string_pretty(v).unwrap(),
+    )
+    .unwrap();
 }

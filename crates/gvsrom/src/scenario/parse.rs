@@ -1,0 +1,118 @@
+//! Reading a scenario: TOML text → `toml::Table` (syntax errors on one line, with line and column)
+//! → `--set` overrides → a check that no number is NaN or infinite → [`Scenario`] (type errors
+//! name the key's path); and the resolved scenario back to a table or TOML text.
+
+use super::overrides::apply_override;
+use super::path::{render_path, Seg};
+use super::types::Scenario;
+use crate::error::ScenarioError;
+use toml::{Table, Value};
+
+impl Scenario {
+    /// Parses a scenario from TOML text with `--set` overrides applied. `source_name` names the
+    /// text in syntax errors (a path or a preset name).
+    pub fn from_toml(
+        source_name: &str,
+        text: &str,
+        overrides: &[String],
+    ) -> Result<Scenario, ScenarioError> {
+        let mut table = parse_table(source_name, text)?;
+        for spec in overrides {
+            apply_override(&mut table, spec)?;
+        }
+        from_table(table)
+    }
+
+    /// The resolved scenario as a TOML table: every field, defaults filled in, `--set` overrides
+    /// applied. Parsing it back gives the same scenario.
+    pub fn to_table(&self) -> Result<Table, ScenarioError> {
+        Table::try_from(self).map_err(|e| ScenarioError::invalid("scenario", e.to_string()))
+    }
+
+    /// [`Self::to_table`] as TOML text.
+    pub fn to_toml(&self) -> Result<String, ScenarioError> {
+        toml::to_string(&self.to_table()?)
+            .map_err(|e| ScenarioError::invalid("scenario", e.to_string()))
+    }
+}
+
+/// TOML text → table; syntax errors carry line and column.
+pub fn parse_table(source_name: &str, text: &str) -> Result<Table, ScenarioError> {
+    text.parse::<Table>().map_err(|e| ScenarioError::Syntax {
+        source_name: source_name.to_string(),
+        message: one_line(&e.to_string()),
+    })
+}
+
+/// Table → [`Scenario`], after checking that no number is NaN or infinite. Errors name the key path.
+pub fn from_table(table: Table) -> Result<Scenario, ScenarioError> {
+    let value = Value::Table(table);
+    check_finite(&value, &mut Vec::new())?;
+    serde_path_to_error::deserialize::<_, Scenario>(value).map_err(|e| {
+        let mut field = e.path().to_string();
+        let message = e
+            .inner()
+            .message()
+            .replace("expected usize", "expected an integer >= 0")
+            .replace("expected f64", "expected a number");
+        // Inside tagged tables (`kind = ...`) the path stops at the table: add the unknown key.
+        if let Some(key) = message
+            .strip_prefix("unknown field `")
+            .and_then(|m| m.split('`').next())
+        {
+            if !field.ends_with(&format!(".{key}")) && field != key {
+                field = if field == "." || field.is_empty() {
+                    key.to_string()
+                } else {
+                    format!("{field}.{key}")
+                };
+            }
+        }
+        ScenarioError::Format { field, message }
+    })
+}
+
+/// Rejects NaN and ±inf anywhere in the tree (TOML allows `nan` and `inf`).
+fn check_finite(v: &Value, path: &mut Vec<Seg>) -> Result<(), ScenarioError> {
+    match v {
+        Value::Float(x) if !x.is_finite() => Err(ScenarioError::value(
+            render_path(path),
+            *x,
+            "a finite number",
+        )),
+        Value::Table(t) => {
+            for (k, v) in t {
+                path.push(Seg::Key(k.clone()));
+                check_finite(v, path)?;
+                path.pop();
+            }
+            Ok(())
+        }
+        Value::Array(a) => {
+            for (i, v) in a.iter().enumerate() {
+                path.push(Seg::Index(i));
+                check_finite(v, path)?;
+                path.pop();
+            }
+            Ok(())
+        }
+        _ => Ok(()),
+    }
+}
+
+/// Collapses a multi-line error (toml's source excerpt with carets) into one line, keeping the
+/// position and the message.
+fn one_line(s: &str) -> String {
+    let is_excerpt = |l: &str| {
+        let rest = l
+            .trim_start_matches(|c: char| c.is_ascii_digit())
+            .trim_start();
+        rest.starts_with('|') || l.chars().all(|c| c == '^' || c == ' ')
+    };
+    let lines: Vec<&str> = s
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && !is_excerpt(l))
+        .collect();
+    lines.join(": ")
+}

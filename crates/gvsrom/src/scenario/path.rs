@@ -1,0 +1,83 @@
+//! Key paths of the scenario format (`tendons.0.tension`, `divisions[0].basis.order`): parsing,
+//! rendering, and the value a path names in a table.
+
+use toml::{Table, Value};
+
+/// A segment of a key path.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Seg {
+    Key(String),
+    Index(usize),
+}
+
+/// `a.b[0].c`
+pub fn render_path(path: &[Seg]) -> String {
+    let mut s = String::new();
+    for seg in path {
+        match seg {
+            Seg::Key(k) => {
+                if !s.is_empty() {
+                    s.push('.');
+                }
+                s.push_str(k);
+            }
+            Seg::Index(i) => s.push_str(&format!("[{i}]")),
+        }
+    }
+    s
+}
+
+/// Parses `tendons.0.tension`, `tendons[0].tension` or `loads.gravity[2]` into segments. A purely
+/// numeric dotted segment is an index.
+pub fn parse_path(path: &str) -> Result<Vec<Seg>, String> {
+    let mut segs = Vec::new();
+    for part in path.split('.') {
+        if part.is_empty() {
+            return Err("empty segment in the key path".into());
+        }
+        let (key, mut rest) = match part.find('[') {
+            Some(p) => (&part[..p], &part[p..]),
+            None => (part, ""),
+        };
+        if !key.is_empty() {
+            match key.parse::<usize>() {
+                Ok(i) => segs.push(Seg::Index(i)),
+                Err(_) => segs.push(Seg::Key(key.to_string())),
+            }
+        } else if rest.is_empty() {
+            return Err("empty segment in the key path".into());
+        }
+        while !rest.is_empty() {
+            let close = rest
+                .find(']')
+                .ok_or_else(|| format!("unclosed `[` in `{part}`"))?;
+            let idx = rest[1..close].parse::<usize>().map_err(|_| {
+                format!(
+                    "`{}` is not a list index (indices are 0-based non-negative integers)",
+                    &rest[1..close]
+                )
+            })?;
+            segs.push(Seg::Index(idx));
+            rest = &rest[close + 1..];
+            if !rest.is_empty() && !rest.starts_with('[') {
+                return Err(format!("unexpected `{rest}` after an index in `{part}`"));
+            }
+        }
+    }
+    Ok(segs)
+}
+
+/// The value at `path` in `table`, if there is one.
+pub fn lookup<'a>(table: &'a Table, path: &[Seg]) -> Option<&'a Value> {
+    let (first, rest) = path.split_first()?;
+    let Seg::Key(k) = first else { return None };
+    let mut node = table.get(k)?;
+    for seg in rest {
+        node = match (seg, node) {
+            (Seg::Key(k), Value::Table(t)) => t.get(k)?,
+            (Seg::Index(i), Value::Array(a)) => a.get(*i)?,
+            _ => return None,
+        };
+    }
+    Some(node)
+}

@@ -1,0 +1,329 @@
+//! The scenario's types: one struct per table of the format (`docs/scenario-format.md`), every
+//! table rejecting unknown keys, with the documented defaults.
+
+use gvs::discretize::MagnusOrder;
+use gvs::loads::{Frame, PulseMagnitude};
+use gvs::solve::statics::StaticsOptions;
+use gvs::strain::FemDegree;
+use serde::{Deserialize, Serialize};
+
+/// A complete scenario: a rod, its discretization and strain basis, tendons, loads, solver and
+/// output options.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    /// Short name shown in summaries and written to the JSON output (default: the preset name or the
+    /// file stem).
+    #[serde(default)]
+    pub name: Option<String>,
+    #[serde(default)]
+    pub description: Option<String>,
+    pub material: MaterialSpec,
+    #[serde(default)]
+    pub base: BaseSpec,
+    /// Magnus (Zanna) order of the kinematics between computational points: `"z2"` or `"z4"`.
+    #[serde(default)]
+    pub magnus: MagnusOrder,
+    pub divisions: Vec<DivisionSpec>,
+    #[serde(default)]
+    pub tendons: Vec<TendonSpec>,
+    #[serde(default)]
+    pub loads: LoadsSpec,
+    #[serde(default)]
+    pub solver: StaticsOptions,
+    #[serde(default)]
+    pub output: OutputSpec,
+}
+
+/// Isotropic material (gvs-spec §3.2).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// E [Pa].
+    pub youngs_modulus: f64,
+    /// ν, in (−1, 0.5].
+    pub poisson_ratio: f64,
+    /// ρ [kg/m³].
+    pub density: f64,
+    /// Damping constant η [Pa·s] (SoRoSim default 1e4; statics does not use it).
+    #[serde(default = "default_damping")]
+    pub damping: f64,
+}
+
+fn default_damping() -> f64 {
+    1e4
+}
+
+/// Base pose `g(0)`: position and rotation of the first cross-section in the world frame. The
+/// rotation is either a matrix (`rotation`, rows) or an axis and an angle in degrees; default identity.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BaseSpec {
+    #[serde(default)]
+    pub position: [f64; 3],
+    #[serde(default)]
+    pub rotation: Option<[[f64; 3]; 3]>,
+    #[serde(default)]
+    pub axis: Option<[f64; 3]>,
+    #[serde(default)]
+    pub angle_deg: Option<f64>,
+}
+
+/// One division of the rod: geometry, strain basis, quadrature.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DivisionSpec {
+    /// ℓ_j [m].
+    pub length: f64,
+    /// Uniform radius [m] (shorthand for equal `radius_start` and `radius_end`).
+    #[serde(default)]
+    pub radius: Option<f64>,
+    #[serde(default)]
+    pub radius_start: Option<f64>,
+    #[serde(default)]
+    pub radius_end: Option<f64>,
+    pub basis: BasisSpec,
+    /// Default: Legendre → `gauss = max(order) + 1`, at least 5 (SoRoSim); FEM → the basis's elements
+    /// with 2 (linear) or 3 (quadratic) Gauss points each.
+    #[serde(default)]
+    pub quadrature: Option<QuadratureSpec>,
+}
+
+/// A strain component, in the engine's order `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StrainMode {
+    Torsion,
+    BendY,
+    BendZ,
+    Elongation,
+    ShearY,
+    ShearZ,
+}
+
+impl StrainMode {
+    pub const ALL: [StrainMode; 6] = [
+        StrainMode::Torsion,
+        StrainMode::BendY,
+        StrainMode::BendZ,
+        StrainMode::Elongation,
+        StrainMode::ShearY,
+        StrainMode::ShearZ,
+    ];
+
+    /// Row of the mode in the strain 6-vector.
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    pub fn name(self) -> &'static str {
+        [
+            "torsion",
+            "bend_y",
+            "bend_z",
+            "elongation",
+            "shear_y",
+            "shear_z",
+        ][self.index()]
+    }
+}
+
+/// The strain basis of one division (gvs-spec §4). `kind = "legendre"`: Legendre polynomials
+/// `P_0..P_k` per active mode, `order` for every mode in `modes` unless `orders` names the mode.
+/// `kind = "fem"`: FEM-like local (nodal) basis on `elements` equal elements per active mode, of
+/// `degree` linear (default) or quadratic. (One flat table rather than a tagged enum, so that every
+/// error can name its key.)
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BasisSpec {
+    pub kind: BasisKind,
+    pub modes: Vec<StrainMode>,
+    #[serde(default)]
+    pub order: Option<usize>,
+    #[serde(default)]
+    pub orders: ModeOrders,
+    #[serde(default)]
+    pub elements: Option<usize>,
+    #[serde(default)]
+    pub degree: Option<FemDegree>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BasisKind {
+    Legendre,
+    Fem,
+}
+
+/// Per-mode Legendre orders (override `order`).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModeOrders {
+    pub torsion: Option<usize>,
+    pub bend_y: Option<usize>,
+    pub bend_z: Option<usize>,
+    pub elongation: Option<usize>,
+    pub shear_y: Option<usize>,
+    pub shear_z: Option<usize>,
+}
+
+impl ModeOrders {
+    pub fn get(&self, mode: StrainMode) -> Option<usize> {
+        [
+            self.torsion,
+            self.bend_y,
+            self.bend_z,
+            self.elongation,
+            self.shear_y,
+            self.shear_z,
+        ][mode.index()]
+    }
+}
+
+/// Computational points of a division (gvs-spec §5.1): `gauss` Gauss points over the whole
+/// division plus its two ends, or `gauss_per_element` Gauss points in each of `elements` equal
+/// elements plus the element ends.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct QuadratureSpec {
+    pub gauss: Option<usize>,
+    pub elements: Option<usize>,
+    pub gauss_per_element: Option<usize>,
+}
+
+/// A tendon (gvs-spec §7.6–7.7). Its offset `d(X) = [0, y, z]` is interpolated linearly from
+/// `offset_start` at `x_start` to `offset_end` at `x_end`; or, with `angle_deg`, the two end
+/// offsets are `radial_fraction · r(X) · (cos θ, sin θ)` (on the surface for fraction 1).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TendonSpec {
+    #[serde(default)]
+    pub offset_start: Option<[f64; 2]>,
+    #[serde(default)]
+    pub offset_end: Option<[f64; 2]>,
+    #[serde(default)]
+    pub angle_deg: Option<f64>,
+    #[serde(default)]
+    pub radial_fraction: Option<f64>,
+    #[serde(default)]
+    pub x_start: f64,
+    /// Default: the rod's length.
+    #[serde(default)]
+    pub x_end: Option<f64>,
+    /// Capstan friction coefficient μ.
+    #[serde(default)]
+    pub friction: f64,
+    /// Curvature scale κ_ε [rad/m] below which the friction angle is smoothed (default
+    /// `gvs::actuation::DEFAULT_FRICTION_SMOOTHING`; 0 = the exact, kinked tangent rule).
+    #[serde(default)]
+    pub friction_smoothing: Option<f64>,
+    /// Tension u [N]; negative pulls (bends the rod toward the tendon).
+    #[serde(default)]
+    pub tension: f64,
+}
+
+/// Gravity, point wrenches and distributed wrenches.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadsSpec {
+    /// World gravitational acceleration [m/s²].
+    #[serde(default = "default_gravity")]
+    pub gravity: [f64; 3],
+    #[serde(default)]
+    pub point: Vec<PointLoadSpec>,
+    #[serde(default)]
+    pub distributed: Vec<DistributedLoadSpec>,
+}
+
+impl Default for LoadsSpec {
+    fn default() -> Self {
+        LoadsSpec {
+            gravity: default_gravity(),
+            point: Vec::new(),
+            distributed: Vec::new(),
+        }
+    }
+}
+
+fn default_gravity() -> [f64; 3] {
+    [0.0, 0.0, -9.81]
+}
+
+/// A concentrated wrench at abscissa `x` (which becomes a computational point).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointLoadSpec {
+    pub x: f64,
+    #[serde(default)]
+    pub force: [f64; 3],
+    #[serde(default)]
+    pub moment: [f64; 3],
+    #[serde(default)]
+    pub frame: Frame,
+}
+
+/// A distributed wrench density. `kind = "uniform"`: constant `force`/`moment` density on
+/// `[x_start, x_end]` (default the whole rod) in `frame`. `kind = "triangular_pulse"`: the paper's
+/// follower moment about the local `axis` (default local y), line density
+/// `m(X) = m̂ max(0, 1 − |X − center|/(width/2))` with `m̂ = magnitude` (`convention = "peak"`,
+/// default) or `2 magnitude / width` (`"total"`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DistributedLoadSpec {
+    pub kind: DistributedKind,
+    // uniform
+    #[serde(default)]
+    pub x_start: Option<f64>,
+    #[serde(default)]
+    pub x_end: Option<f64>,
+    #[serde(default)]
+    pub force: Option<[f64; 3]>,
+    #[serde(default)]
+    pub moment: Option<[f64; 3]>,
+    #[serde(default)]
+    pub frame: Option<Frame>,
+    // triangular pulse
+    #[serde(default)]
+    pub center: Option<f64>,
+    #[serde(default)]
+    pub width: Option<f64>,
+    #[serde(default)]
+    pub magnitude: Option<f64>,
+    #[serde(default)]
+    pub axis: Option<[f64; 3]>,
+    #[serde(default)]
+    pub convention: Option<PulseMagnitude>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DistributedKind {
+    Uniform,
+    TriangularPulse,
+}
+
+/// Default axis of a triangular pulse: local y.
+pub fn default_pulse_axis() -> [f64; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+/// What the statics command reports.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Number of equally spaced centreline samples in the JSON output (≥ 2).
+    #[serde(default = "default_centerline_points")]
+    pub centerline_points: usize,
+}
+
+impl Default for OutputSpec {
+    fn default() -> Self {
+        OutputSpec {
+            centerline_points: default_centerline_points(),
+        }
+    }
+}
+
+fn default_centerline_points() -> usize {
+    21
+}
