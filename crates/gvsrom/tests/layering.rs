@@ -151,10 +151,15 @@ fn test_only_files(files: &[PathBuf]) -> BTreeSet<PathBuf> {
 
 /// The modules named by `crate::NAME` paths in `code`, including grouped `use crate::{a, b::c}`.
 fn crate_paths(code: &str, modules: &BTreeSet<String>) -> BTreeSet<String> {
+    paths_after("crate::", code, modules)
+}
+
+/// The names of `modules` that follow `prefix` in `code` (`prefix` then `NAME` or `{a, b::c}`).
+fn paths_after(prefix: &str, code: &str, modules: &BTreeSet<String>) -> BTreeSet<String> {
     let mut found = BTreeSet::new();
     let mut rest = code;
-    while let Some(i) = rest.find("crate::") {
-        rest = &rest[i + "crate::".len()..];
+    while let Some(i) = rest.find(prefix) {
+        rest = &rest[i + prefix.len()..];
         if let Some(group) = rest.strip_prefix('{') {
             let end = group.find('}').unwrap_or(group.len());
             for item in group[..end].split(',') {
@@ -268,4 +273,113 @@ fn the_edge_finder_sees_grouped_paths_and_skips_test_modules() {
 fn out_of_line_test_modules_are_test_code() {
     let code = "mod parse;\n#[cfg(test)]\nmod tests;\n#[cfg(test)]\npub(crate) mod test_util;\n#[cfg(test)]\nmod inline {\n}\nmod types;\n";
     assert_eq!(test_module_decls(code), vec!["tests", "test_util"]);
+}
+
+/// Every directory of `src/` (a module split into files), with its files' sibling edges: file →
+/// the sibling files it names by `super::NAME` in library code.
+fn sibling_edges() -> Vec<(PathBuf, BTreeMap<String, BTreeSet<String>>)> {
+    let root = src();
+    let mut files = vec![];
+    rust_files(&root, &mut files);
+    let tests_only = test_only_files(&files);
+    let mut by_dir: BTreeMap<PathBuf, Vec<PathBuf>> = BTreeMap::new();
+    for f in &files {
+        by_dir
+            .entry(f.parent().unwrap().to_path_buf())
+            .or_default()
+            .push(f.clone());
+    }
+    let mut out = vec![];
+    for (dir, fs_) in by_dir {
+        if dir == root {
+            continue;
+        }
+        let stem = |f: &Path| f.file_stem().unwrap().to_str().unwrap().to_string();
+        let mut siblings: BTreeSet<String> = fs_.iter().map(|f| stem(f)).collect();
+        siblings.remove("mod");
+        for e in fs::read_dir(&dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                siblings.insert(stem(&p));
+            }
+        }
+        let mut edges = BTreeMap::new();
+        for f in &fs_ {
+            let name = stem(f);
+            if name == "mod" || tests_only.contains(f) {
+                continue;
+            }
+            let code = library_code(&fs::read_to_string(f).unwrap());
+            let mut to = paths_after("super::", &code, &siblings);
+            to.remove(&name);
+            edges.insert(name, to);
+        }
+        out.push((dir, edges));
+    }
+    out
+}
+
+/// A circle in `edges`, as the names along it, if there is one.
+fn circle(edges: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>> {
+    fn visit(
+        n: &str,
+        edges: &BTreeMap<String, BTreeSet<String>>,
+        path: &mut Vec<String>,
+        done: &mut BTreeSet<String>,
+    ) -> Option<Vec<String>> {
+        if let Some(i) = path.iter().position(|p| p == n) {
+            let mut c = path[i..].to_vec();
+            c.push(n.to_string());
+            return Some(c);
+        }
+        if done.contains(n) {
+            return None;
+        }
+        path.push(n.to_string());
+        for m in edges.get(n).into_iter().flatten() {
+            if let Some(c) = visit(m, edges, path, done) {
+                return Some(c);
+            }
+        }
+        path.pop();
+        done.insert(n.to_string());
+        None
+    }
+    let mut done = BTreeSet::new();
+    edges
+        .keys()
+        .find_map(|n| visit(n, edges, &mut vec![], &mut done))
+}
+
+#[test]
+fn no_two_files_of_a_module_use_each_other_in_a_circle() {
+    let mut circles = vec![];
+    for (dir, edges) in sibling_edges() {
+        if let Some(c) = circle(&edges) {
+            circles.push(format!("{}: {}", dir.display(), c.join(" → ")));
+        }
+    }
+    assert!(
+        circles.is_empty(),
+        "files of one module that use each other (through `super::NAME`):\n{}",
+        circles.join("\n")
+    );
+}
+
+#[test]
+fn the_circle_finder_finds_a_circle_and_only_a_circle() {
+    let e = |pairs: &[(&str, &[&str])]| -> BTreeMap<String, BTreeSet<String>> {
+        pairs
+            .iter()
+            .map(|(a, bs)| (a.to_string(), bs.iter().map(|b| b.to_string()).collect()))
+            .collect()
+    };
+    assert_eq!(
+        circle(&e(&[("a", &["b"]), ("b", &["c"]), ("c", &["a"])])),
+        Some(vec!["a".into(), "b".into(), "c".into(), "a".into()])
+    );
+    assert_eq!(
+        circle(&e(&[("a", &["b", "c"]), ("b", &["c"]), ("c", &[])])),
+        None
+    );
 }

@@ -1,5 +1,5 @@
 //! The content hashes a directory output records in its manifest when it is committed
-//! ([`super::OutputDir::commit`]), and the recorded hashes read back; [`super::integrity`] checks
+//! ([`super::OutputDir::commit`]), and the recorded hashes read back; `integrity.rs` checks
 //! them when the output is loaded.
 //!
 //! The manifest (the `"gvsrom"` object at the top of `DIR/meta.json`) records
