@@ -26,7 +26,7 @@ use crate::build::Built;
 use crate::error::ScenarioError;
 use crate::npy::NpyRows;
 use crate::output::{OutputDir, OutputError};
-use gvs::inputs::{babble, random_steps, Interpolation, Signal};
+use gvs::inputs::{babble, random_steps, Actuation, Interpolation, Signal};
 use gvs::lie::Pose;
 use gvs::solve::dynamics::{
     simulate_streaming_interruptible, InitialState, IntegratorOptions, Method, OdeJacobian,
@@ -38,6 +38,19 @@ use gvs::solve::ode::{
 use serde::{Deserialize, Serialize};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// An actuation given as a function of time (Python's `input=` callable): the integrator evaluates
+/// it wherever it needs `u(t)`, in any order; it checks its own values (count, finiteness) and has
+/// no breakpoints. Nothing about it is checked before the run (its extremes are unknown).
+#[derive(Clone)]
+pub struct InputFunction(pub Arc<dyn Actuation + Send + Sync>);
+
+impl std::fmt::Debug for InputFunction {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("InputFunction(..)")
+    }
+}
 
 /// Where the actuation comes from.
 #[derive(Debug, Clone)]
@@ -68,6 +81,8 @@ pub enum InputSource {
         hold_max: f64,
         seed: u64,
     },
+    /// A function of time ([`InputFunction`]).
+    Function(InputFunction),
 }
 
 impl InputSource {
@@ -414,7 +429,8 @@ fn positive(field: &str, v: f64, unit: &str) -> Result<f64, ScenarioError> {
     }
 }
 
-/// Builds the actuation signal of a run.
+/// Builds the actuation signal of a run. A function input ([`InputSource::Function`]) has none: the
+/// scenario's constant tensions stand for it in the checks before the run.
 pub fn input_signal(built: &Built, opts: &SimulateOptions) -> Result<Signal, ScenarioError> {
     let na = built.model.n_actuators();
     let d = opts.duration;
@@ -468,6 +484,7 @@ pub fn input_signal(built: &Built, opts: &SimulateOptions) -> Result<Signal, Sce
             }
             babble(na, *lo, *hi, *hold_min, *hold_max, d, *seed)
         }
+        InputSource::Function(_) => Signal::constant(&built.u),
     })
 }
 
@@ -555,6 +572,18 @@ pub struct Plan {
     /// How the input signal lies outside a reduced model's training inputs, when used with
     /// `--extrapolate` (`Reduced::check_signal`; without it such a signal is refused).
     pub model_extrapolated: Vec<String>,
+    /// A function input, which the run evaluates in place of `signal`.
+    pub function: Option<InputFunction>,
+}
+
+impl Plan {
+    /// The actuation the integrator evaluates: the function input, else the signal.
+    pub fn actuation(&self) -> &dyn Actuation {
+        match &self.function {
+            Some(f) => f.0.as_ref(),
+            None => &self.signal,
+        }
+    }
 }
 
 /// Validates `opts` against `built` and builds the [`Plan`] of the run.
@@ -599,7 +628,7 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
     // a reduced model answers only for tensions it was trained on: the signal's, at its knots
     // (where a held or linear signal takes its extremes) and at both ends of the run
     let model_extrapolated = match (&built.reduced, &opts.input) {
-        (Some(r), input) if !matches!(input, InputSource::Constant) => {
+        (Some(r), input) if !matches!(input, InputSource::Constant | InputSource::Function(_)) => {
             let end = t_out.last().copied().unwrap_or(0.0);
             let mut times: Vec<f64> = signal
                 .times
@@ -649,6 +678,10 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
         sample_rate: opts.sample_rate,
         input,
         model_extrapolated,
+        function: match &opts.input {
+            InputSource::Function(f) => Some(f.clone()),
+            _ => None,
+        },
     })
 }
 
@@ -708,6 +741,7 @@ pub fn input_record(
             "signal": "babble", "lo": lo, "hi": hi, "hold_min": hold_min, "hold_max": hold_max,
             "seed": seed,
         }),
+        InputSource::Function(_) => json!({"signal": "function"}),
     };
     if opts.start_at_equilibrium {
         signal["start"] = json!("equilibrium");
@@ -851,7 +885,7 @@ pub fn run_into(
     let summary = match &built.reduced {
         Some(r) => simulate_streaming_interruptible(
             &r.model,
-            &plan.signal,
+            plan.actuation(),
             &built.loads,
             plan.schedule.as_ref(),
             &plan.initial,
@@ -862,7 +896,7 @@ pub fn run_into(
         ),
         None => simulate_streaming_interruptible(
             &built.model,
-            &plan.signal,
+            plan.actuation(),
             &built.loads,
             plan.schedule.as_ref(),
             &plan.initial,
