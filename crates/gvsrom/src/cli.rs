@@ -1086,11 +1086,7 @@ fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
 
 fn reproduce_cmd(args: &ReproduceArgs, out: &mut impl Write) -> Result<()> {
     use gvsrom::reproduce;
-    let jobs = args.jobs.unwrap_or_else(|| {
-        std::thread::available_parallelism()
-            .map(|n| n.get())
-            .unwrap_or(1)
-    });
+    let jobs = args.jobs.unwrap_or_else(reproduce::default_jobs);
     let opts = reproduce::Options {
         cases: args.cases.clone(),
         quick: args.quick || args.test_sizes,
@@ -1116,23 +1112,14 @@ fn reproduce_cmd(args: &ReproduceArgs, out: &mut impl Write) -> Result<()> {
 fn dataset_cmd(args: &gvsrom::dataset::DatasetArgs, out: &mut impl Write) -> Result<()> {
     let signal = interrupt_flag();
     let outcome = gvsrom::dataset::run(args, &signal, out)?;
-    match outcome.interrupted {
+    match outcome.interruption_message() {
         None => Ok(()),
-        Some(reason) => Err(Interrupted {
+        Some(message) => Err(Interrupted {
             signal: match signal.load(Ordering::SeqCst) {
                 0 => signal_hook::consts::SIGINT,
                 s => s as i32,
             },
-            message: format!(
-                "{reason}; the {} finished samples were written to `{}`, marked incomplete{}",
-                outcome.meta.counts.ok + outcome.meta.counts.failed,
-                outcome.path.display(),
-                if outcome.meta.plan.is_some() {
-                    " (continue with --resume)"
-                } else {
-                    ""
-                }
-            ),
+            message,
         }
         .into()),
     }
