@@ -129,6 +129,32 @@ impl Signal {
     }
 }
 
+/// An actuation `u(t)` as the integrators use it: a [`Signal`] of knots, or any function of time (a
+/// callable of a front-end). The integrators evaluate it at the times they need, in any order (a
+/// rejected step goes back in time), and step onto its breakpoints.
+pub trait Actuation {
+    /// `u(t)` into `out` (one entry per actuator).
+    fn eval(&self, t: f64, out: &mut [f64]);
+    /// Times in `(t0, t1)` where `u` or its derivative jumps (the integrator restarts there).
+    fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64>;
+    /// Checks it for `channels` actuators before a run.
+    fn validate(&self, field: &str, channels: usize) -> Result<(), ModelError>;
+}
+
+impl Actuation for Signal {
+    fn eval(&self, t: f64, out: &mut [f64]) {
+        Signal::eval(self, t, out)
+    }
+
+    fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
+        Signal::breakpoints(self, t0, t1)
+    }
+
+    fn validate(&self, field: &str, channels: usize) -> Result<(), ModelError> {
+        Signal::validate(self, field, channels)
+    }
+}
+
 /// SplitMix64: a tiny, well-mixed, seedable generator (Steele, Lea & Flood 2014).
 #[derive(Debug, Clone)]
 pub struct SplitMix64(u64);

@@ -36,6 +36,8 @@ use std::ops::{AddAssign, Range};
 #[cfg(test)]
 #[path = "model_dense_reference.rs"]
 mod dense_reference;
+#[path = "model_forces.rs"]
+mod forces;
 
 /// `c = √3/12` of the Zanna step.
 pub const ZANNA_C: f64 = 0.144_337_567_297_406_43;

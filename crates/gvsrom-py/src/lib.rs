@@ -6,9 +6,14 @@
 //! into Python (PyO3 turns one into `PanicException`, and the library returns errors as values).
 
 mod arrays;
+mod datasets;
+mod dynamics_quantities;
 mod errors;
+mod interrupt;
 mod models;
+mod modes;
 mod quantities;
+mod reproduce;
 mod robot;
 mod scenario;
 mod simulate;
@@ -39,5 +44,9 @@ fn _gvsrom(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(models::load_model, m)?)?;
     m.add_function(wrap_pyfunction!(models::pod, m)?)?;
     m.add_function(wrap_pyfunction!(models::train, m)?)?;
+    m.add_class::<datasets::Dataset>()?;
+    m.add_function(wrap_pyfunction!(datasets::dataset, m)?)?;
+    m.add_function(wrap_pyfunction!(datasets::load_dataset, m)?)?;
+    m.add_function(wrap_pyfunction!(reproduce::reproduce, m)?)?;
     Ok(())
 }

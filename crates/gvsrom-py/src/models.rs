@@ -1,9 +1,12 @@
 //! Reduced models: `gvsrom.load_model(path)` and `gvsrom.pod(dataset, modes, out)` (the library's
 //! `gvsrom pod`).
 
+use crate::arrays::{shaped, vector};
 use crate::errors::{self, invalid};
 use gvsrom::reduced_model::ReducedModel;
+use numpy::PyArrayMethods;
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 use std::path::PathBuf;
 
 /// A reduced model directory (from ``gvsrom pod``, ``gvsrom train`` or :func:`pod`), checked
@@ -20,6 +23,17 @@ use std::path::PathBuf;
 ///     Number of reduced coordinates r.
 /// extrapolate : bool
 ///     Whether it may be used outside its training inputs (``--extrapolate``).
+/// arrays : dict of str to numpy.ndarray
+///     Its numbers as ``weights.safetensors`` stores them: POD ``modes`` (L × r) and
+///     ``singular_values``; an autoencoder's ``encoder.{k}.weight``/``.bias``,
+///     ``decoder.{k}.weight``/``.bias``, ``scaling.mean``, ``scaling.scale``; and
+///     ``anchors.inputs``, ``anchors.latent`` if it has anchors.
+/// latent_range : numpy.ndarray, shape (r, 2)
+///     Per reduced coordinate, the ``[min, max]`` of the training encodings.
+/// rest : numpy.ndarray, shape (r,)
+///     The reduced coordinates a run starts from at rest.
+/// meta : dict
+///     ``meta.json`` (layout, dataset, training, input ranges, …).
 #[pyclass(module = "gvsrom", frozen)]
 pub struct Model {
     pub dir: PathBuf,
@@ -32,6 +46,18 @@ pub struct Model {
     /// Whether it may be used outside its training inputs (`--extrapolate`).
     #[pyo3(get)]
     pub extrapolate: bool,
+    /// The numbers of `weights.safetensors` by name, as arrays.
+    #[pyo3(get)]
+    arrays: Py<PyDict>,
+    /// `[min, max]` of the training encodings per reduced coordinate, shape (r, 2).
+    #[pyo3(get)]
+    latent_range: Py<PyAny>,
+    /// Reduced coordinates of the rest state, shape (r,).
+    #[pyo3(get)]
+    rest: Py<PyAny>,
+    /// `meta.json` as a dict.
+    #[pyo3(get)]
+    meta: Py<PyAny>,
 }
 
 #[pymethods]
@@ -71,11 +97,22 @@ pub fn load_model(py: Python<'_>, path: PathBuf, extrapolate: bool) -> PyResult<
     let m = py
         .detach(|| ReducedModel::load(&path))
         .map_err(|e| invalid(e.to_string()))?;
+    let arrays = PyDict::new(py);
+    for (name, (shape, values)) in m.arrays() {
+        let a = numpy::PyArray::from_vec(py, values).reshape(shape)?;
+        arrays.set_item(name, a)?;
+    }
+    let range: Vec<f64> = m.meta.latent_range.iter().flatten().copied().collect();
+    let meta = crate::datasets::meta_json(py, &path)?;
     Ok(Model {
-        dir: path,
         kind: m.meta.kind.clone(),
         latent: m.meta.latent,
         extrapolate,
+        arrays: arrays.unbind(),
+        latent_range: shaped(py, range, [m.meta.latent_range.len(), 2])?.unbind(),
+        rest: vector(py, &m.meta.rest).unbind(),
+        meta: meta.unbind(),
+        dir: path,
     })
 }
 

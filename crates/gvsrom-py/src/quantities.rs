@@ -23,6 +23,8 @@ macro_rules! on_model {
     };
 }
 
+pub(crate) use on_model;
+
 /// Poses at the points: positions (p × 3, row-major) and rotations (p × 3 × 3, row-major).
 pub fn forward(built: &Built, q: &DVector<f64>) -> (Vec<f64>, Vec<f64>) {
     on_model!(built, m => {

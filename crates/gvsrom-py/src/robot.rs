@@ -496,11 +496,14 @@ impl Robot {
     ///     Simulated time [s].
     /// sample_rate : float
     ///     Output samples per second [Hz].
-    /// input : array_like of float, shape (k, 1 + n_actuators), optional
+    /// input : array_like of float, shape (k, 1 + n_actuators), or callable, optional
     ///     Rows ``t, u_1, …, u_na`` (times ascending from 0), held piecewise constant (or linear
-    ///     with ``interpolate``); default: the scenario's tensions, constant.
+    ///     with ``interpolate``); or a callable ``u(t) -> array of n_actuators tensions`` (or one
+    ///     number for all), called by the integrator at every time it evaluates (in any order: a
+    ///     rejected step goes back in time); an exception it raises stops the run and propagates.
+    ///     Default: the scenario's tensions, constant.
     /// interpolate : bool
-    ///     Interpolate ``input`` linearly between its rows.
+    ///     Interpolate ``input`` rows linearly.
     /// from_equilibrium : bool
     ///     Start at the static equilibrium under the scenario's tensions (else straight at rest).
     /// method : str
@@ -526,7 +529,7 @@ impl Robot {
         py: Python<'py>,
         duration: f64,
         sample_rate: f64,
-        input: Option<In2<'_>>,
+        input: Option<Bound<'_, PyAny>>,
         interpolate: bool,
         from_equilibrium: bool,
         method: &str,

@@ -1,16 +1,20 @@
 //! `Robot.simulate`: a dynamics run as `gvsrom simulate` plans and runs it, its samples kept in
-//! memory and returned as NumPy arrays; Ctrl-C interrupts it within one integrator step.
+//! memory and returned as NumPy arrays; Ctrl-C interrupts it within one integrator step. The input
+//! is the scenario's tensions, rows `t, u_1, …` or a Python callable `u(t)` ([`CallableInput`]).
 
 use crate::arrays::{self, shaped, vector};
 use crate::errors::{invalid, scenario as err};
 use crate::robot::{warn, Robot};
-use gvs::inputs::{Interpolation, Signal};
+use gvs::error::ModelError;
+use gvs::inputs::{Actuation, Interpolation, Signal};
 use gvsrom::simulate::{
-    self, Ending, InputSource, IntegratorChoice, MethodChoice, SimulateOptions, TrajectoryBuffer,
+    self, Ending, InputFunction, InputSource, IntegratorChoice, MethodChoice, SimulateOptions,
+    TrajectoryBuffer,
 };
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::ops::ControlFlow;
+use std::sync::{Arc, Mutex, PoisonError};
 use std::time::{Duration, Instant};
 
 /// How often the run looks for Ctrl-C (a signal handler needs the GIL).
@@ -20,7 +24,7 @@ const SIGNAL_POLL: Duration = Duration::from_millis(20);
 pub struct Args<'a> {
     pub duration: f64,
     pub sample_rate: f64,
-    pub input: Option<arrays::In2<'a>>,
+    pub input: Option<Bound<'a, PyAny>>,
     pub interpolate: bool,
     pub from_equilibrium: bool,
     pub method: &'a str,
@@ -42,12 +46,108 @@ fn method(name: &str) -> PyResult<MethodChoice> {
     })
 }
 
+/// A Python callable `u(t)` as the integrator's actuation: called with the GIL at every time the
+/// integrator evaluates, its value checked (one tension per tendon or one for all, finite). The
+/// first exception (the callable's own, or a `GvsromError` for a bad value) is kept and stops the
+/// run at its next step attempt; until then the actuation is zero.
+pub struct CallableInput {
+    function: Py<PyAny>,
+    n_actuators: usize,
+    error: Mutex<Option<PyErr>>,
+}
+
+impl CallableInput {
+    fn call(&self, py: Python<'_>, t: f64) -> PyResult<Vec<f64>> {
+        let value = self.function.bind(py).call1((t,))?;
+        let na = self.n_actuators;
+        let values = match value.extract::<f64>() {
+            Ok(x) => vec![x],
+            Err(_) => match value.extract::<arrays::In1<'_>>() {
+                Ok(a) => arrays::vec1(&a),
+                Err(_) => {
+                    return Err(invalid(format!(
+                        "`input({t})` returned `{}`: expected {na} tensions [N] (an array, one per tendon, or one number for all)",
+                        value.repr()?
+                    )))
+                }
+            },
+        };
+        let u = gvsrom::scenario::tensions_for(na, &values)
+            .map_err(|e| invalid(format!("`input({t})`: {e}")))?;
+        if let Some(k) = u.iter().position(|x| !x.is_finite()) {
+            return Err(invalid(format!(
+                "`input({t})` returned u[{k}] = {}: expected finite tensions [N]",
+                u[k]
+            )));
+        }
+        Ok(u)
+    }
+
+    /// Takes the error the callable raised, if any.
+    fn take_error(&self) -> Option<PyErr> {
+        self.error
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .take()
+    }
+
+    fn failed(&self) -> bool {
+        self.error
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .is_some()
+    }
+}
+
+impl Actuation for CallableInput {
+    fn eval(&self, t: f64, out: &mut [f64]) {
+        out.fill(0.0);
+        if self.failed() {
+            return;
+        }
+        match Python::attach(|py| self.call(py, t)) {
+            Ok(u) => out.copy_from_slice(&u),
+            Err(e) => *self.error.lock().unwrap_or_else(PoisonError::into_inner) = Some(e),
+        }
+    }
+
+    fn breakpoints(&self, _t0: f64, _t1: f64) -> Vec<f64> {
+        vec![]
+    }
+
+    fn validate(&self, _field: &str, _channels: usize) -> Result<(), ModelError> {
+        Ok(()) // every value is checked where it is returned
+    }
+}
+
 pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'py, PyDict>> {
     let na = robot.built.model.n_actuators();
-    let input = match &a.input {
-        None => InputSource::Constant,
-        Some(rows) => {
-            let rows = arrays::rows("input", rows, 1 + na, "t, then one tension per tendon")?;
+    let callable = match &a.input {
+        Some(f) if f.is_callable() => {
+            if a.interpolate {
+                return Err(invalid(
+                    "`interpolate` applies to an input of rows, not to a callable `input`",
+                ));
+            }
+            Some(Arc::new(CallableInput {
+                function: f.clone().unbind(),
+                n_actuators: na,
+                error: Mutex::new(None),
+            }))
+        }
+        _ => None,
+    };
+    let input = match (&a.input, &callable) {
+        (None, _) => InputSource::Constant,
+        (Some(_), Some(c)) => InputSource::Function(InputFunction(c.clone())),
+        (Some(obj), None) => {
+            let rows: arrays::In2<'_> = obj.extract().map_err(|_| {
+                invalid(format!(
+                    "`input` must be rows `t, u_1, …, u_{na}` (a 2-D array) or a callable `u(t)`; got `{}`",
+                    obj.get_type().name().map(|n| n.to_string()).unwrap_or_default()
+                ))
+            })?;
+            let rows = arrays::rows("input", &rows, 1 + na, "t, then one tension per tendon")?;
             InputSource::Rows(Signal {
                 times: rows.iter().map(|r| r[0]).collect(),
                 values: rows.iter().map(|r| r[1..].to_vec()).collect(),
@@ -94,6 +194,9 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
     let outcome = py.detach(|| {
         let mut last_poll = Instant::now();
         let mut control = |_t: f64| {
+            if callable.as_ref().is_some_and(|c| c.failed()) {
+                return ControlFlow::Break("the input callable failed".to_string());
+            }
             if last_poll.elapsed() < SIGNAL_POLL {
                 return ControlFlow::Continue(());
             }
@@ -114,6 +217,9 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
             &mut control,
         )
     });
+    if let Some(e) = callable.as_ref().and_then(|c| c.take_error()) {
+        return Err(e);
+    }
     if let Some(e) = interrupt {
         return Err(e);
     }

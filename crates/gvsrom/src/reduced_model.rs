@@ -298,6 +298,23 @@ impl ReducedModel {
         t
     }
 
+    /// The model's numbers as named row-major arrays `name → (shape, values)`, as
+    /// `weights.safetensors` stores them: POD `modes` (L × K) and `singular_values`; an
+    /// autoencoder's `encoder.{k}.weight`, `encoder.{k}.bias`, `decoder.{k}.…`, `scaling.mean` and
+    /// `scaling.scale`; and `anchors.inputs`, `anchors.latent` if it has anchors.
+    pub fn arrays(&self) -> BTreeMap<String, (Vec<usize>, Vec<f64>)> {
+        self.tensors()
+            .into_iter()
+            .map(|(name, (shape, bytes))| {
+                let values = bytes
+                    .chunks_exact(8)
+                    .map(|b| f64::from_le_bytes(b.try_into().expect("8-byte chunks")))
+                    .collect();
+                (name, (shape, values))
+            })
+            .collect()
+    }
+
     /// Writes the weights, the curves in `extra` (name → 1-D values, as `.npy`) and `meta.json`
     /// into `out` and commits it.
     pub fn save(

@@ -16,7 +16,7 @@ use super::ode::{
 };
 use super::statics::{StaticsError, StaticsOptions, StaticsSolver};
 use crate::error::ModelError;
-use crate::inputs::Signal;
+use crate::inputs::{Actuation, Signal};
 use crate::lie::{Pose, V6};
 use crate::loads::Loads;
 use crate::model::{Model, PreparedLoads, Workspace};
@@ -150,7 +150,7 @@ pub enum SimulationError {
 struct RodOde<'m, P: StrainParam> {
     model: &'m Model<P>,
     ws: Workspace,
-    actuation: &'m Signal,
+    actuation: &'m dyn Actuation,
     load_scale: Option<&'m Signal>,
     base_loads: PreparedLoads,
     loads: PreparedLoads,
@@ -405,11 +405,12 @@ pub fn simulate_streaming<P: StrainParam>(
 /// [`simulate_streaming`] that also polls `stop` before every step attempt of the integrator, so
 /// an interrupt stops the run within one step even when the next sample is far away (tight
 /// tolerances, a stiff transient); the summary then reports [`OdeError::Stopped`] with `stop`'s
-/// reason, and the samples before it were delivered.
+/// reason, and the samples before it were delivered. The actuation is a [`Signal`] or any other
+/// [`Actuation`] (a function of time).
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_streaming_interruptible<P: StrainParam>(
     model: &Model<P>,
-    actuation: &Signal,
+    actuation: &dyn Actuation,
     loads: &Loads,
     load_scale: Option<&Signal>,
     initial: &InitialState,

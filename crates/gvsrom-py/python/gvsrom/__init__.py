@@ -10,6 +10,7 @@ The same library the ``gvsrom`` command line calls, with NumPy arrays in and out
 
 from ._gvsrom import (
     ConvergenceError,
+    Dataset,
     GvsromError,
     Model,
     Robot,
@@ -17,14 +18,18 @@ from ._gvsrom import (
     Statics,
     StaticsBatch,
     __version__,
+    dataset,
+    load_dataset,
     load_model,
     pod,
     presets,
+    reproduce,
     train,
 )
 
 __all__ = [
     "ConvergenceError",
+    "Dataset",
     "GvsromError",
     "Model",
     "Robot",
@@ -32,8 +37,11 @@ __all__ = [
     "Statics",
     "StaticsBatch",
     "__version__",
+    "dataset",
+    "load_dataset",
     "load_model",
     "pod",
     "presets",
+    "reproduce",
     "train",
 ]

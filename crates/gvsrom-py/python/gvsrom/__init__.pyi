@@ -2,7 +2,7 @@
 
 import os
 from pathlib import Path
-from typing import Any, Sequence, Union, final
+from typing import Any, Callable, Mapping, Sequence, Union, final
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -11,6 +11,7 @@ __version__: str
 
 __all__ = [
     "ConvergenceError",
+    "Dataset",
     "GvsromError",
     "Model",
     "Robot",
@@ -18,14 +19,18 @@ __all__ = [
     "Statics",
     "StaticsBatch",
     "__version__",
+    "dataset",
+    "load_dataset",
     "load_model",
     "pod",
     "presets",
+    "reproduce",
     "train",
 ]
 
 _F = NDArray[np.float64]
 _Path = Union[str, os.PathLike[str]]
+_Specs = Union[str, Sequence[str], Mapping[str, tuple[float, float]]]
 
 class GvsromError(ValueError):
     """Bad input to gvsrom: the message names the field and what is accepted."""
@@ -139,7 +144,93 @@ class Model:
     def latent(self) -> int: ...
     @property
     def extrapolate(self) -> bool: ...
+    @property
+    def arrays(self) -> dict[str, _F]: ...
+    @property
+    def latent_range(self) -> _F: ...
+    @property
+    def rest(self) -> _F: ...
+    @property
+    def meta(self) -> dict[str, Any]: ...
 
+@final
+class Dataset:
+    """A dataset directory read back, its arrays as NumPy arrays."""
+
+    @property
+    def path(self) -> Path: ...
+    @property
+    def kind(self) -> str: ...
+    @property
+    def scenario(self) -> str: ...
+    @property
+    def parameters(self) -> list[str]: ...
+    @property
+    def components(self) -> list[str]: ...
+    @property
+    def n_dof(self) -> int: ...
+    @property
+    def n_points(self) -> int: ...
+    @property
+    def complete(self) -> bool: ...
+    @property
+    def seed(self) -> int: ...
+    @property
+    def inputs(self) -> _F: ...
+    @property
+    def strain(self) -> _F: ...
+    @property
+    def q(self) -> _F: ...
+    @property
+    def tip_position(self) -> _F: ...
+    @property
+    def tip_rotation(self) -> _F: ...
+    @property
+    def status(self) -> NDArray[np.uint8]: ...
+    @property
+    def iterations(self) -> NDArray[np.uint32]: ...
+    @property
+    def residual(self) -> _F: ...
+    @property
+    def strain_x(self) -> _F: ...
+    @property
+    def t(self) -> _F | None: ...
+    @property
+    def meta(self) -> dict[str, Any]: ...
+    def __len__(self) -> int: ...
+
+def load_dataset(path: _Path) -> Dataset: ...
+def dataset(
+    scenario: Union[str, os.PathLike[str], Scenario],
+    out: _Path,
+    sweep: _Specs | None = None,
+    grid: _Specs | None = None,
+    random: _Specs | None = None,
+    samples: int | None = None,
+    seed: int = 0,
+    set: Sequence[str] | None = None,
+    chunk_size: int = 128,
+    threads: int | None = None,
+    force: bool = False,
+    resume: bool = False,
+    duration: float | None = None,
+    sample_rate: float | None = None,
+    input: _Path | None = None,
+    interpolate: bool = False,
+    steps: Sequence[float] | None = None,
+    babble: Sequence[float] | None = None,
+    from_equilibrium: bool = False,
+    rtol: float | None = None,
+    atol: float = 1e-06,
+) -> Dataset: ...
+def reproduce(
+    study: Union[str, Sequence[str]],
+    out: _Path,
+    quick: bool = False,
+    jobs: int | None = None,
+    noise: float = 0.02,
+    test_sizes: bool = False,
+) -> list[dict[str, Any]]: ...
 def load_model(path: _Path, extrapolate: bool = False) -> Model: ...
 def pod(dataset: _Path, modes: int, out: _Path, force: bool = False) -> Model: ...
 def train(
@@ -197,11 +288,22 @@ class Robot:
     def mass_matrix(self, q: ArrayLike) -> _F: ...
     def statics_residual(self, q: ArrayLike, u: ArrayLike | None = None) -> _F: ...
     def statics_jacobian(self, q: ArrayLike, u: ArrayLike | None = None) -> _F: ...
+    def elastic_force(self, q: ArrayLike) -> _F: ...
+    def stiffness_matrix(self, q: ArrayLike) -> _F: ...
+    def damping_force(self, q: ArrayLike, qd: ArrayLike) -> _F: ...
+    def damping_matrix(self, q: ArrayLike) -> _F: ...
+    def coriolis_force(self, q: ArrayLike, qd: ArrayLike) -> _F: ...
+    def coriolis_matrix(self, q: ArrayLike, qd: ArrayLike) -> _F: ...
+    def external_force(self, q: ArrayLike) -> _F: ...
+    def actuation_matrix(self, q: ArrayLike) -> _F: ...
+    def accelerations(self, q: ArrayLike, qd: ArrayLike, u: ArrayLike | None = None) -> _F: ...
+    def energy(self, q: ArrayLike, qd: ArrayLike | None = None) -> dict[str, float]: ...
+    def modes(self, count: int = 10, u: ArrayLike | None = None) -> dict[str, Any]: ...
     def simulate(
         self,
         duration: float,
         sample_rate: float = 100.0,
-        input: ArrayLike | None = None,
+        input: ArrayLike | Callable[[float], ArrayLike | float] | None = None,
         interpolate: bool = False,
         from_equilibrium: bool = False,
         method: str = "auto",

@@ -275,6 +275,24 @@ pub struct Outcome {
     pub resumed_chunks: usize,
 }
 
+impl Outcome {
+    /// What to tell of an interrupted run (`None` if it finished): why it stopped and where its
+    /// finished samples were written, as `gvsrom dataset` prints it.
+    pub fn interruption_message(&self) -> Option<String> {
+        let reason = self.interrupted.as_ref()?;
+        Some(format!(
+            "{reason}; the {} finished samples were written to `{}`, marked incomplete{}",
+            self.meta.counts.ok + self.meta.counts.failed,
+            self.path.display(),
+            if self.meta.plan.is_some() {
+                " (continue with --resume)"
+            } else {
+                ""
+            }
+        ))
+    }
+}
+
 fn legacy_q_order() -> String {
     "fem-mode-major".into()
 }

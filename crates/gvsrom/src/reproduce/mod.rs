@@ -103,6 +103,13 @@ pub struct Options {
     pub noise: f64,
 }
 
+/// Worker threads unless `--jobs` says otherwise: one per core.
+pub fn default_jobs() -> usize {
+    std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1)
+}
+
 /// The noise study's level unless `--noise` says otherwise.
 pub const DEFAULT_NOISE: f64 = 0.02;
 

@@ -1,0 +1,392 @@
+//! Datasets: `gvsrom.dataset(...)` generates one as `gvsrom dataset` does (the library's
+//! [`gvsrom::dataset::run`], Ctrl-C included), `gvsrom.load_dataset(path)` reads one back
+//! ([`gvsrom::dataset::Dataset::load`]) as a `Dataset` of NumPy arrays with its metadata.
+
+use crate::arrays::shaped;
+use crate::errors::{self, invalid};
+use crate::scenario::Scenario;
+use gvsrom::dataset::{DatasetArgs, DEFAULT_CHUNK_SIZE};
+use numpy::PyArray;
+use pyo3::exceptions::PyKeyboardInterrupt;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString};
+use std::path::PathBuf;
+
+/// A dataset directory read back (``gvsrom dataset`` or :func:`dataset`), its files checked
+/// against their recorded hashes. Arrays are as the ``.npy`` files hold them, one row per sample.
+///
+/// Attributes
+/// ----------
+/// path : pathlib.Path
+/// kind : str
+///     ``"statics"`` or ``"dynamics"``.
+/// scenario : str
+/// parameters : list of str
+///     Names of the columns of ``inputs``.
+/// components : list of str
+///     The active strain components stored per point, in column order.
+/// inputs : numpy.ndarray, shape (N, len(parameters))
+/// strain : numpy.ndarray, shape (N, n_points * len(components))
+///     ``ξ − ξ*`` point-major (column ``j * len(components) + c``); NaN rows for failed samples.
+/// q : numpy.ndarray, shape (N, n_dof)
+///     HOM coordinates.
+/// tip_position : numpy.ndarray, shape (N, 3)
+///     [m]
+/// tip_rotation : numpy.ndarray, shape (N, 3, 3)
+/// status : numpy.ndarray of uint8, shape (N,)
+///     0 ok, 1 failed, 2 not computed.
+/// iterations : numpy.ndarray of uint32, shape (N,)
+/// residual : numpy.ndarray, shape (N,)
+/// strain_x : numpy.ndarray, shape (n_points,)
+///     [m]
+/// t : numpy.ndarray or None
+///     Sample times [s] of a dynamic dataset.
+/// complete : bool
+///     False for an interrupted dataset.
+/// meta : dict
+///     ``meta.json`` (manifest, scenario TOML, plan, seed, counts, failures, …).
+#[pyclass(module = "gvsrom", frozen)]
+pub struct Dataset {
+    dir: PathBuf,
+    /// ``"statics"`` or ``"dynamics"``.
+    #[pyo3(get)]
+    kind: String,
+    /// The scenario's name.
+    #[pyo3(get)]
+    scenario: String,
+    /// Names of the columns of ``inputs``.
+    #[pyo3(get)]
+    parameters: Vec<String>,
+    /// The stored strain components, in column order within a point.
+    #[pyo3(get)]
+    components: Vec<String>,
+    /// Generalized coordinates of the HOM.
+    #[pyo3(get)]
+    n_dof: usize,
+    /// Computational points.
+    #[pyo3(get)]
+    n_points: usize,
+    /// False for an interrupted dataset.
+    #[pyo3(get)]
+    complete: bool,
+    /// The sampling plan's seed.
+    #[pyo3(get)]
+    seed: u64,
+    /// Inputs, shape (N, len(parameters)).
+    #[pyo3(get)]
+    inputs: Py<PyAny>,
+    /// Strain snapshots ``ξ − ξ*``, shape (N, n_points · len(components)), point-major.
+    #[pyo3(get)]
+    strain: Py<PyAny>,
+    /// HOM coordinates, shape (N, n_dof).
+    #[pyo3(get)]
+    q: Py<PyAny>,
+    /// Tip positions [m], shape (N, 3).
+    #[pyo3(get)]
+    tip_position: Py<PyAny>,
+    /// Tip rotations, shape (N, 3, 3).
+    #[pyo3(get)]
+    tip_rotation: Py<PyAny>,
+    /// 0 ok, 1 failed, 2 not computed (uint8), shape (N,).
+    #[pyo3(get)]
+    status: Py<PyAny>,
+    /// Solver iterations (uint32), shape (N,).
+    #[pyo3(get)]
+    iterations: Py<PyAny>,
+    /// ‖R‖∞ at the solutions, shape (N,).
+    #[pyo3(get)]
+    residual: Py<PyAny>,
+    /// Abscissae of the computational points [m], shape (n_points,).
+    #[pyo3(get)]
+    strain_x: Py<PyAny>,
+    /// Sample times [s] of a dynamic dataset, else ``None``.
+    #[pyo3(get)]
+    t: Option<Py<PyAny>>,
+    /// ``meta.json`` as a dict.
+    #[pyo3(get)]
+    meta: Py<PyAny>,
+}
+
+#[pymethods]
+impl Dataset {
+    /// The dataset directory.
+    #[getter]
+    fn path(&self) -> PathBuf {
+        self.dir.clone()
+    }
+
+    fn __len__(&self, py: Python<'_>) -> PyResult<usize> {
+        self.status.bind(py).len()
+    }
+
+    fn __repr__(&self, py: Python<'_>) -> String {
+        format!(
+            "Dataset(path={:?}, kind={:?}, scenario={:?}, samples={}, parameters={:?})",
+            self.dir.display().to_string(),
+            self.kind,
+            self.scenario,
+            self.__len__(py).unwrap_or(0),
+            self.parameters
+        )
+    }
+}
+
+/// Reads a dataset directory (``gvsrom dataset`` or :func:`dataset`).
+///
+/// Parameters
+/// ----------
+/// path : str or os.PathLike
+///
+/// Returns
+/// -------
+/// Dataset
+///
+/// Raises
+/// ------
+/// GvsromError
+///     If it is not a dataset, or a file is missing, truncated or edited (naming it).
+#[pyfunction]
+pub fn load_dataset(py: Python<'_>, path: PathBuf) -> PyResult<Dataset> {
+    let d = py
+        .detach(|| gvsrom::dataset::Dataset::load(&path))
+        .map_err(|e| errors::any(e.into()))?;
+    let n = d.status.len();
+    let m = &d.meta;
+    let row = d.strain.len().checked_div(n).unwrap_or(0);
+    let meta = meta_json(py, &path)?;
+    Ok(Dataset {
+        kind: m.kind.clone(),
+        scenario: m.scenario.clone(),
+        parameters: m.parameters.clone(),
+        components: m.components.clone(),
+        n_dof: m.n_dof,
+        n_points: m.n_points,
+        complete: m.complete,
+        seed: m.seed,
+        inputs: shaped(py, d.inputs, [n, m.parameters.len()])?.unbind(),
+        strain: shaped(py, d.strain, [n, row])?.unbind(),
+        q: shaped(py, d.q, [n, m.n_dof])?.unbind(),
+        tip_position: shaped(py, d.tip_position, [n, 3])?.unbind(),
+        tip_rotation: shaped(py, d.tip_rotation, [n, 3, 3])?.unbind(),
+        status: PyArray::from_vec(py, d.status).into_any().unbind(),
+        iterations: PyArray::from_vec(py, d.iterations).into_any().unbind(),
+        residual: PyArray::from_vec(py, d.residual).into_any().unbind(),
+        strain_x: PyArray::from_vec(py, d.strain_x).into_any().unbind(),
+        t: d.t.map(|t| PyArray::from_vec(py, t).into_any().unbind()),
+        meta: meta.unbind(),
+        dir: path,
+    })
+}
+
+/// `dir/meta.json` (a dataset's or a model's, read and checked before) as a Python dict.
+pub fn meta_json<'py>(py: Python<'py>, dir: &std::path::Path) -> PyResult<Bound<'py, PyAny>> {
+    let file = dir.join("meta.json");
+    let text = gvsrom::output::read_regular_to_string(&file)
+        .map_err(|e| invalid(format!("{}: {e}", file.display())))?;
+    py.import("json")?.call_method1("loads", (text,))
+}
+
+/// The `PATH=LO:HI` specs of a `sweep`/`grid`/`random` argument: a string, a sequence of them,
+/// or a dict `{path: (lo, hi)}`.
+fn specs(name: &str, value: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<String>> {
+    let Some(v) = value else { return Ok(vec![]) };
+    if let Ok(s) = v.cast::<PyString>() {
+        return Ok(vec![s.to_str()?.to_string()]);
+    }
+    if let Ok(d) = v.cast::<PyDict>() {
+        return d
+            .iter()
+            .map(|(k, range)| {
+                let path: String = k.extract()?;
+                let (lo, hi): (f64, f64) = range.extract().map_err(|_| {
+                    invalid(format!(
+                        "`{name}[{path:?}]`: expected a (lo, hi) pair of numbers"
+                    ))
+                })?;
+                Ok(format!("{path}={lo:?}:{hi:?}"))
+            })
+            .collect();
+    }
+    v.extract::<Vec<String>>().map_err(|_| {
+        invalid(format!(
+            "`{name}`: expected \"PATH=LO:HI\", a list of them, or a dict {{path: (lo, hi)}}"
+        ))
+    })
+}
+
+/// The scenario argument of `gvsrom dataset` (a preset name or a TOML path) and the overrides
+/// to apply before `set`, for a name, a path or a `Scenario`.
+fn scenario_arg(value: &Bound<'_, PyAny>) -> PyResult<(String, Vec<String>)> {
+    if let Ok(s) = value.cast::<Scenario>() {
+        let s = s.borrow();
+        if s.src.preset {
+            return Ok((s.src.default_name.clone(), s.overrides.clone()));
+        }
+        // a file's origin is its path; text given in Python has none
+        if s.src.origin == "<string>" {
+            return Err(invalid(
+                "`scenario`: a Scenario from TOML text has no file to record in the dataset; write `scenario.to_toml()` to a file and pass its path",
+            ));
+        }
+        return Ok((s.src.origin.clone(), s.overrides.clone()));
+    }
+    let path: PathBuf = value.extract().map_err(|_| {
+        invalid(
+            "`scenario`: expected a preset name, the path of a scenario TOML file, or a Scenario",
+        )
+    })?;
+    Ok((path.to_string_lossy().into_owned(), vec![]))
+}
+
+// the signature's literal default (a constant would show as `...` in Python's signature)
+const _: () = assert!(DEFAULT_CHUNK_SIZE == 128);
+
+/// Options of a dynamic dataset given without `duration` (the command line's `requires`).
+fn dynamic_only(duration: Option<f64>, given: &[(&str, bool)]) -> PyResult<()> {
+    if duration.is_some() {
+        return Ok(());
+    }
+    match given.iter().find(|(_, g)| *g) {
+        Some((name, _)) => Err(invalid(format!(
+            "`{name}` is an option of a dynamic dataset: give `duration` too"
+        ))),
+        None => Ok(()),
+    }
+}
+
+/// Generates a dataset as ``gvsrom dataset`` does (same files, bit-identical for the same plan
+/// and seed): the HOM solved over a sampling plan (static), or one simulation sampled (dynamic,
+/// with ``duration``). Ctrl-C stops it after the chunks under way, writes the finished ones
+/// (marked incomplete; ``resume=True`` continues) and raises ``KeyboardInterrupt``.
+///
+/// Parameters
+/// ----------
+/// scenario : str, os.PathLike or Scenario
+///     A preset name, a scenario TOML file, or a :class:`Scenario` from a preset or a file (its
+///     overrides are applied before ``set``).
+/// out : str or os.PathLike
+///     The new dataset directory.
+/// sweep, grid, random : str, list of str or dict, optional
+///     ``"PATH=LO:HI"`` specs (or ``{path: (lo, hi)}``) as ``--sweep``, ``--grid``, ``--random``:
+///     an even 1-D sweep, a product grid, or uniform random values (seeded by ``seed``).
+/// samples : int, optional
+///     Number of samples (``--samples``).
+/// seed : int
+///     Seed of ``random`` (and of a dynamic dataset's ``steps``/``babble``).
+/// set : list of str, optional
+///     ``"PATH=VALUE"`` overrides (``--set``).
+/// chunk_size : int
+///     Samples per chunk (part of the plan).
+/// threads : int, optional
+///     Worker threads (default: one per core); the files do not depend on it.
+/// force : bool
+///     Replace ``out`` if it is an earlier gvsrom output.
+/// resume : bool
+///     Continue the incomplete dataset in ``out``.
+/// duration, sample_rate : float, optional
+///     A dynamic dataset: simulated time [s] and samples per second [Hz].
+/// input : str or os.PathLike, optional
+///     Dynamic: a CSV file ``t, u_1, …`` (``--input``), linear with ``interpolate``.
+/// steps : sequence of 3 floats, optional
+///     Dynamic: random steps ``(lo, hi, period)``.
+/// babble : sequence of 4 floats, optional
+///     Dynamic: actuator babbling ``(lo, hi, hold_min, hold_max)``.
+/// from_equilibrium : bool
+///     Dynamic: start at the static equilibrium.
+/// rtol, atol : float
+///     Dynamic: integrator tolerances.
+///
+/// Returns
+/// -------
+/// Dataset
+///     The new dataset, read back.
+///
+/// Raises
+/// ------
+/// GvsromError
+///     For a bad plan or option (the message of ``gvsrom dataset``).
+#[pyfunction]
+#[pyo3(signature = (scenario, out, sweep=None, grid=None, random=None, samples=None, seed=0, set=None, chunk_size=128, threads=None, force=false, resume=false, duration=None, sample_rate=None, input=None, interpolate=false, steps=None, babble=None, from_equilibrium=false, rtol=None, atol=1e-6))]
+#[allow(clippy::too_many_arguments)]
+pub fn dataset(
+    py: Python<'_>,
+    scenario: &Bound<'_, PyAny>,
+    out: PathBuf,
+    sweep: Option<&Bound<'_, PyAny>>,
+    grid: Option<&Bound<'_, PyAny>>,
+    random: Option<&Bound<'_, PyAny>>,
+    samples: Option<usize>,
+    seed: u64,
+    set: Option<Vec<String>>,
+    chunk_size: usize,
+    threads: Option<usize>,
+    force: bool,
+    resume: bool,
+    duration: Option<f64>,
+    sample_rate: Option<f64>,
+    input: Option<PathBuf>,
+    interpolate: bool,
+    steps: Option<Vec<f64>>,
+    babble: Option<Vec<f64>>,
+    from_equilibrium: bool,
+    rtol: Option<f64>,
+    atol: f64,
+) -> PyResult<Dataset> {
+    let (scenario, mut overrides) = scenario_arg(scenario)?;
+    overrides.extend(set.unwrap_or_default());
+    dynamic_only(
+        duration,
+        &[
+            ("sample_rate", sample_rate.is_some()),
+            ("input", input.is_some()),
+            ("steps", steps.is_some()),
+            ("babble", babble.is_some()),
+            ("from_equilibrium", from_equilibrium),
+        ],
+    )?;
+    if interpolate && input.is_none() {
+        return Err(invalid(
+            "`interpolate` applies to an `input` file: give one",
+        ));
+    }
+    if force && resume {
+        return Err(invalid(
+            "`force` and `resume` exclude each other: resume continues the dataset in `out`, force replaces it",
+        ));
+    }
+    let args = DatasetArgs {
+        scenario,
+        set: overrides,
+        sweep: specs("sweep", sweep)?,
+        grid: specs("grid", grid)?,
+        random: specs("random", random)?,
+        samples,
+        seed,
+        chunk_size,
+        threads,
+        out,
+        force,
+        resume,
+        duration,
+        sample_rate,
+        input,
+        interpolate,
+        steps,
+        babble,
+        from_equilibrium,
+        rtol,
+        atol,
+        stop_after_chunks: None,
+    };
+    let (outcome, caught) = crate::interrupt::run(py, |flag| {
+        gvsrom::dataset::run(&args, &flag, &mut std::io::sink())
+    });
+    let outcome = outcome.map_err(|e| errors::any(e.into()))?;
+    if let Some(message) = outcome.interruption_message() {
+        return Err(PyKeyboardInterrupt::new_err(message));
+    }
+    if let Some(e) = caught {
+        return Err(e);
+    }
+    load_dataset(py, outcome.path)
+}

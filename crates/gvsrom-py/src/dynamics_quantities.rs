@@ -1,0 +1,276 @@
+//! The terms of the equations of motion at a given state, for the model that runs (the HOM, or the
+//! reduced model attached): `M(q) q̈ + C(q, q̇) q̇ + D₁ + K₁(q) = B(q) u + F(q)` (paper eq. 8).
+//! Each is one engine call (`gvs::model::Model::elastic_force`, `coriolis_force`, …); the `Robot`
+//! methods of the same names convert their arguments and call these.
+
+use crate::arrays::{self, In1};
+use crate::errors::{invalid, scenario as err};
+use crate::quantities::on_model;
+use crate::robot::Robot;
+use gvs::dynamics::Energy;
+use gvs::loads::Loads;
+use gvsrom::Built;
+use nalgebra::{DMatrix, DVector};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// `K₁(q)`.
+pub fn elastic_force(built: &Built, q: &DVector<f64>) -> DVector<f64> {
+    on_model!(built, m => m.elastic_force(q, &mut m.workspace()))
+}
+
+/// `∂K₁/∂q`.
+pub fn elastic_stiffness(built: &Built, q: &DVector<f64>) -> DMatrix<f64> {
+    on_model!(built, m => m.elastic_stiffness(q, &mut m.workspace()))
+}
+
+/// `D₁ = D(q) q̇`.
+pub fn damping_force(built: &Built, q: &DVector<f64>, qd: &DVector<f64>) -> DVector<f64> {
+    on_model!(built, m => m.damping_force(q, qd, &mut m.workspace()))
+}
+
+/// `D(q)`.
+pub fn damping_matrix(built: &Built, q: &DVector<f64>) -> DMatrix<f64> {
+    on_model!(built, m => {
+        let mut ws = m.workspace();
+        m.forward(q, &mut ws, false);
+        m.damping_matrix(&ws)
+    })
+}
+
+/// `F(q)` of `loads`.
+pub fn external_force(
+    built: &Built,
+    q: &DVector<f64>,
+    loads: &Loads,
+) -> Result<DVector<f64>, gvsrom::ScenarioError> {
+    on_model!(built, m => {
+        let prepared = m.prepare_loads(loads)?;
+        Ok(m.external_force(q, &prepared, &mut m.workspace()))
+    })
+}
+
+/// `B(q)`.
+pub fn actuation_matrix(built: &Built, q: &DVector<f64>) -> DMatrix<f64> {
+    on_model!(built, m => m.actuation_matrix(q, &mut m.workspace()))
+}
+
+/// `C(q, q̇) q̇`.
+pub fn coriolis_force(built: &Built, q: &DVector<f64>, qd: &DVector<f64>) -> DVector<f64> {
+    on_model!(built, m => m.coriolis_force(q, qd, &mut m.workspace()))
+}
+
+/// `C(q, q̇)`.
+pub fn coriolis_matrix(built: &Built, q: &DVector<f64>, qd: &DVector<f64>) -> DMatrix<f64> {
+    on_model!(built, m => m.coriolis_matrix(q, qd, &mut m.workspace()))
+}
+
+/// `q̈ = M⁻¹ τ(q, q̇, u)` under the scenario's loads.
+pub fn accelerations(
+    built: &Built,
+    q: &DVector<f64>,
+    qd: &DVector<f64>,
+    u: &[f64],
+) -> Result<DVector<f64>, String> {
+    on_model!(built, m => {
+        let loads = m.prepare_loads(&built.loads).map_err(|e| e.to_string())?;
+        let mut qdd = DVector::zeros(m.n_dof());
+        m.accelerations(q, qd, u, &loads, &mut m.workspace(), &mut qdd)
+            .map_err(|e| e.to_string())?;
+        Ok(qdd)
+    })
+}
+
+/// Kinetic, elastic and gravitational energy at `(q, q̇)` under the scenario's gravity.
+pub fn energy(built: &Built, q: &DVector<f64>, qd: &DVector<f64>) -> Energy {
+    on_model!(built, m => m.energy(q, qd, &built.loads.gravity, &mut m.workspace()))
+}
+
+/// `q` (and `q̇`) of a robot's model from array-likes, checked (length, finite).
+pub fn state(
+    robot: &Robot,
+    q: &In1<'_>,
+    qd: Option<&In1<'_>>,
+) -> PyResult<(DVector<f64>, DVector<f64>)> {
+    let n = robot.built.n_dof();
+    let q = finite("q", arrays::dvec("q", q, n)?)?;
+    let qd = match qd {
+        Some(v) => finite("qd", arrays::dvec("qd", v, n)?)?,
+        None => DVector::zeros(n),
+    };
+    Ok((q, qd))
+}
+
+/// `v` if all its entries are finite; else a `GvsromError` naming `name` and the first bad entry.
+pub fn finite(name: &str, v: DVector<f64>) -> PyResult<DVector<f64>> {
+    match v.iter().position(|x| !x.is_finite()) {
+        None => Ok(v),
+        Some(i) => Err(invalid(format!(
+            "`{name}[{i}]` = {}: expected a finite number",
+            v[i]
+        ))),
+    }
+}
+
+/// Tensions `u` for a quantity: the scenario's, or one per tendon / one for all, finite.
+pub fn tensions(robot: &Robot, u: Option<&In1<'_>>) -> PyResult<Vec<f64>> {
+    let u = match u {
+        None => return Ok(robot.built.u.clone()),
+        Some(u) => arrays::vec1(u),
+    };
+    let u = gvsrom::scenario::tensions_for(robot.built.model.n_actuators(), &u).map_err(err)?;
+    let v = finite("u", DVector::from_vec(u))?;
+    Ok(v.as_slice().to_vec())
+}
+
+/// `energy` as a dict `{kinetic, elastic, gravitational, total}` [J].
+pub fn energy_dict<'py>(py: Python<'py>, e: &Energy) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("kinetic", e.kinetic)?;
+    d.set_item("elastic", e.elastic)?;
+    d.set_item("gravitational", e.gravitational)?;
+    d.set_item("total", e.total())?;
+    Ok(d)
+}
+
+/// A vector as a 1-D array.
+pub fn vector<'py>(py: Python<'py>, v: &DVector<f64>) -> Bound<'py, PyAny> {
+    arrays::vector(py, v.as_slice())
+}
+
+#[pymethods]
+impl Robot {
+    /// The elastic force ``K₁(q) = Σ W Ψ_qᵀ Es Ψ`` (gvs-spec §7.3): ``K q`` for the HOM's linear
+    /// basis, the generalized elastic force of a reduced model. It enters the equations of motion
+    /// as ``M q̈ + C q̇ + D₁ + K₁ = B u + F``.
+    ///
+    /// Parameters
+    /// ----------
+    /// q : array_like of float, shape (n_dof,)
+    ///
+    /// Returns
+    /// -------
+    /// numpy.ndarray
+    ///     Shape (n_dof,) [N·m per unit of q].
+    fn elastic_force<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyAny>> {
+        let (q, _) = state(self, &q, None)?;
+        let f = py.detach(|| elastic_force(&self.built, &q));
+        Ok(vector(py, &f))
+    }
+
+    /// The elastic stiffness ``K(q) = ∂K₁/∂q`` (the constant ``K`` of the HOM's linear basis; of
+    /// a reduced model, its tangent), shape (n_dof, n_dof).
+    fn stiffness_matrix<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyAny>> {
+        let (q, _) = state(self, &q, None)?;
+        let k = py.detach(|| elastic_stiffness(&self.built, &q));
+        arrays::matrix(py, &k)
+    }
+
+    /// The damping force ``D₁ = D(q) q̇`` (Kelvin–Voigt, gvs-spec §7.4), shape (n_dof,).
+    fn damping_force<'py>(
+        &self,
+        py: Python<'py>,
+        q: In1<'_>,
+        qd: In1<'_>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (q, qd) = state(self, &q, Some(&qd))?;
+        let f = py.detach(|| damping_force(&self.built, &q, &qd));
+        Ok(vector(py, &f))
+    }
+
+    /// The damping matrix ``D(q) = Σ W Ψ_qᵀ Ds Ψ_q`` (constant for the HOM), shape
+    /// (n_dof, n_dof).
+    fn damping_matrix<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyAny>> {
+        let (q, _) = state(self, &q, None)?;
+        let d = py.detach(|| damping_matrix(&self.built, &q));
+        arrays::matrix(py, &d)
+    }
+
+    /// The Coriolis and centrifugal force ``C(q, q̇) q̇ = Σ W Jᵀ (Ms J̇ q̇ + coad_η Ms η)``
+    /// (gvs-spec §7.2), shape (n_dof,).
+    fn coriolis_force<'py>(
+        &self,
+        py: Python<'py>,
+        q: In1<'_>,
+        qd: In1<'_>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (q, qd) = state(self, &q, Some(&qd))?;
+        let f = py.detach(|| coriolis_force(&self.built, &q, &qd));
+        Ok(vector(py, &f))
+    }
+
+    /// The Coriolis matrix ``C(q, q̇)`` with ``Ṁ − 2C`` skew-symmetric (gvs-spec §7.2), shape
+    /// (n_dof, n_dof); ``C(q, q̇) @ q̇`` is :meth:`coriolis_force`.
+    fn coriolis_matrix<'py>(
+        &self,
+        py: Python<'py>,
+        q: In1<'_>,
+        qd: In1<'_>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (q, qd) = state(self, &q, Some(&qd))?;
+        let c = py.detach(|| coriolis_matrix(&self.built, &q, &qd));
+        arrays::matrix(py, &c)
+    }
+
+    /// The external generalized force ``F(q) = Σ J_iᵀ w_i`` of gravity and the scenario's point
+    /// and distributed loads (gvs-spec §7.5), shape (n_dof,).
+    fn external_force<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyAny>> {
+        let (q, _) = state(self, &q, None)?;
+        let f = py
+            .detach(|| external_force(&self.built, &q, &self.built.loads))
+            .map_err(err)?;
+        Ok(vector(py, &f))
+    }
+
+    /// The actuation matrix ``B(q)``: column k is the generalized force of a unit tension in
+    /// tendon k (routing and friction included), so the tendons' force is ``B(q) @ u``. Shape
+    /// (n_dof, n_actuators).
+    fn actuation_matrix<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyAny>> {
+        let (q, _) = state(self, &q, None)?;
+        let b = py.detach(|| actuation_matrix(&self.built, &q));
+        arrays::matrix(py, &b)
+    }
+
+    /// The accelerations ``q̈ = M⁻¹ (B u + F − K₁ − D₁ − C q̇)`` the integrators use (forward
+    /// dynamics), shape (n_dof,).
+    ///
+    /// Parameters
+    /// ----------
+    /// q, qd : array_like of float, shape (n_dof,)
+    /// u : array_like of float, optional
+    ///     Tensions [N], one per tendon or one for all; default: the scenario's.
+    #[pyo3(signature = (q, qd, u=None))]
+    fn accelerations<'py>(
+        &self,
+        py: Python<'py>,
+        q: In1<'_>,
+        qd: In1<'_>,
+        u: Option<In1<'_>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (q, qd) = state(self, &q, Some(&qd))?;
+        let u = tensions(self, u.as_ref())?;
+        let a = py
+            .detach(|| accelerations(&self.built, &q, &qd, &u))
+            .map_err(invalid)?;
+        Ok(vector(py, &a))
+    }
+
+    /// Energies at ``(q, q̇)`` [J]: kinetic ``½ q̇ᵀ M q̇``, elastic ``½ Σ W Ψᵀ Es Ψ`` (whose
+    /// gradient is :meth:`elastic_force`), gravitational ``−Σ W ρA g·r``, and their total.
+    ///
+    /// Returns
+    /// -------
+    /// dict
+    ///     ``kinetic``, ``elastic``, ``gravitational``, ``total`` (floats).
+    #[pyo3(signature = (q, qd=None))]
+    fn energy<'py>(
+        &self,
+        py: Python<'py>,
+        q: In1<'_>,
+        qd: Option<In1<'_>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let (q, qd) = state(self, &q, qd.as_ref())?;
+        let e = py.detach(|| energy(&self.built, &q, &qd));
+        energy_dict(py, &e)
+    }
+}

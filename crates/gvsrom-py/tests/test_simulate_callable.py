@@ -1,0 +1,64 @@
+"""simulate with a Python callable `u(t)` as input: the trajectory of the same input given as rows,
+its exceptions propagated, its bad values refused."""
+
+import numpy as np
+import pytest
+
+import gvsrom
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return gvsrom.Scenario.preset("single-tendon").build()
+
+
+def test_a_callable_gives_the_trajectory_of_the_same_rows(robot):
+    # a linear ramp: rows interpolated linearly, and the same function of t
+    rows = np.array([[0.0, 0.0], [0.02, -4.0], [1.0, -4.0]])
+    by_rows = robot.simulate(0.03, sample_rate=500, input=rows, interpolate=True)
+    calls = []
+
+    def u(t):
+        calls.append(t)
+        return [np.interp(t, rows[:, 0], rows[:, 1])]
+
+    by_function = robot.simulate(0.03, sample_rate=500, input=u)
+    assert calls, "the callable was never called"
+    # the rows' knot at 0.02 s is a breakpoint (the integrator restarts there), the callable has
+    # none: the two runs take different steps, equal within the integrator's tolerance
+    for name in ["t", "u"]:
+        np.testing.assert_allclose(by_function[name], by_rows[name], rtol=0, atol=1e-12, err_msg=name)
+    tip = by_rows["tip_position"]
+    np.testing.assert_allclose(by_function["tip_position"], tip, rtol=0, atol=2e-3 * np.abs(tip).max())
+
+
+def test_a_held_callable_equals_held_rows_exactly(robot):
+    # a constant input: no breakpoint either way, the same steps, the same numbers
+    by_rows = robot.simulate(0.02, sample_rate=500, input=[[0.0, -2.5]])
+    by_function = robot.simulate(0.02, sample_rate=500, input=lambda t: -2.5)
+    for name in ["t", "q", "qd", "u", "tip_position"]:
+        np.testing.assert_array_equal(by_function[name], by_rows[name], err_msg=name)
+
+
+def test_an_exception_in_the_callable_propagates(robot):
+    class Stop(Exception):
+        pass
+
+    def u(t):
+        if t > 0.005:
+            raise Stop("controller gave up")
+        return [-1.0]
+
+    with pytest.raises(Stop, match="controller gave up"):
+        robot.simulate(0.02, sample_rate=500, input=u)
+
+
+def test_bad_values_of_the_callable_are_value_errors(robot):
+    with pytest.raises(gvsrom.GvsromError, match=r"`input\(0\)`: .*3 tensions given for 1 tendons"):
+        robot.simulate(0.01, input=lambda t: [1.0, 2.0, 3.0])
+    with pytest.raises(gvsrom.GvsromError, match=r"u\[0\] = NaN: expected finite tensions"):
+        robot.simulate(0.01, input=lambda t: [float("nan")])
+    with pytest.raises(gvsrom.GvsromError, match="expected 1 tensions"):
+        robot.simulate(0.01, input=lambda t: "strong")
+    with pytest.raises(gvsrom.GvsromError, match="`interpolate`"):
+        robot.simulate(0.01, input=lambda t: -1.0, interpolate=True)
