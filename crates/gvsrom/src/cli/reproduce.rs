@@ -28,11 +28,7 @@ pub struct ReproduceArgs {
 
 pub(super) fn reproduce_cmd(args: &ReproduceArgs, out: &mut impl Write) -> Result<()> {
     use gvsrom::reproduce;
-    let jobs = args.jobs.unwrap_or_else(|| {
-        std::thread::available_parallelism()
-            .map(|n| n.get())
-            .unwrap_or(1)
-    });
+    let jobs = args.jobs.unwrap_or_else(reproduce::default_jobs);
     let opts = reproduce::Options {
         cases: args.cases.clone(),
         quick: args.quick || args.test_sizes,
@@ -58,23 +54,14 @@ pub(super) fn reproduce_cmd(args: &ReproduceArgs, out: &mut impl Write) -> Resul
 pub(super) fn dataset_cmd(args: &gvsrom::dataset::DatasetArgs, out: &mut impl Write) -> Result<()> {
     let signal = interrupt_flag();
     let outcome = gvsrom::dataset::run(args, &signal, out)?;
-    match outcome.interrupted {
+    match outcome.interruption_message() {
         None => Ok(()),
-        Some(reason) => Err(Interrupted {
+        Some(message) => Err(Interrupted {
             signal: match signal.load(Ordering::SeqCst) {
                 0 => signal_hook::consts::SIGINT,
                 s => s as i32,
             },
-            message: format!(
-                "{reason}; the {} finished samples were written to `{}`, marked incomplete{}",
-                outcome.meta.counts.ok + outcome.meta.counts.failed,
-                outcome.path.display(),
-                if outcome.meta.plan.is_some() {
-                    " (continue with --resume)"
-                } else {
-                    ""
-                }
-            ),
+            message,
         }
         .into()),
     }

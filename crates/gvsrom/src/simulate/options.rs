@@ -4,9 +4,22 @@
 
 use crate::build::Built;
 use crate::error::ScenarioError;
-use gvs::inputs::{babble, random_steps, Interpolation, Signal};
+use gvs::inputs::{babble, random_steps, Actuation, Interpolation, Signal};
 use gvs::solve::dynamics::IntegratorOptions;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// An actuation given as a function of time (Python's `input=` callable): the integrator evaluates
+/// it wherever it needs `u(t)`, in any order; it checks its own values (count, finiteness) and has
+/// no breakpoints. Nothing about it is checked before the run (its extremes are unknown).
+#[derive(Clone)]
+pub struct InputFunction(pub Arc<dyn Actuation + Send + Sync>);
+
+impl std::fmt::Debug for InputFunction {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("InputFunction(..)")
+    }
+}
 
 /// Where the actuation comes from.
 #[derive(Debug, Clone)]
@@ -37,6 +50,8 @@ pub enum InputSource {
         hold_max: f64,
         seed: u64,
     },
+    /// A function of time ([`InputFunction`]).
+    Function(InputFunction),
 }
 
 impl InputSource {
@@ -125,7 +140,8 @@ pub(super) fn positive(field: &str, v: f64, unit: &str) -> Result<f64, ScenarioE
     }
 }
 
-/// Builds the actuation signal of a run.
+/// Builds the actuation signal of a run. A function input ([`InputSource::Function`]) has none: the
+/// scenario's constant tensions stand for it in the checks before the run.
 pub fn input_signal(built: &Built, opts: &SimulateOptions) -> Result<Signal, ScenarioError> {
     let na = built.model.n_actuators();
     let d = opts.duration;
@@ -179,6 +195,7 @@ pub fn input_signal(built: &Built, opts: &SimulateOptions) -> Result<Signal, Sce
             }
             babble(na, *lo, *hi, *hold_min, *hold_max, d, *seed)
         }
+        InputSource::Function(_) => Signal::constant(&built.u),
     })
 }
 
@@ -275,6 +292,7 @@ pub fn input_record(
             "signal": "babble", "lo": lo, "hi": hi, "hold_min": hold_min, "hold_max": hold_max,
             "seed": seed,
         }),
+        InputSource::Function(_) => json!({"signal": "function"}),
     };
     if opts.start_at_equilibrium {
         signal["start"] = json!("equilibrium");

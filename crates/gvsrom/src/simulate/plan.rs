@@ -4,7 +4,7 @@
 use super::options::*;
 use crate::build::Built;
 use crate::error::ScenarioError;
-use gvs::inputs::{Interpolation, Signal};
+use gvs::inputs::{Actuation, Interpolation, Signal};
 use gvs::solve::dynamics::{InitialState, Method};
 
 /// Most output samples of one run.
@@ -59,6 +59,18 @@ pub struct Plan {
     /// How the input signal lies outside a reduced model's training inputs, when used with
     /// `--extrapolate` (`Reduced::check_signal`; without it such a signal is refused).
     pub model_extrapolated: Vec<String>,
+    /// A function input, which the run evaluates in place of `signal`.
+    pub function: Option<InputFunction>,
+}
+
+impl Plan {
+    /// The actuation the integrator evaluates: the function input, else the signal.
+    pub fn actuation(&self) -> &dyn Actuation {
+        match &self.function {
+            Some(f) => f.0.as_ref(),
+            None => &self.signal,
+        }
+    }
 }
 
 /// Validates `opts` against `built` and builds the [`Plan`] of the run.
@@ -103,7 +115,7 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
     // a reduced model answers only for tensions it was trained on: the signal's, at its knots
     // (where a held or linear signal takes its extremes) and at both ends of the run
     let model_extrapolated = match (&built.reduced, &opts.input) {
-        (Some(r), input) if !matches!(input, InputSource::Constant) => {
+        (Some(r), input) if !matches!(input, InputSource::Constant | InputSource::Function(_)) => {
             let end = t_out.last().copied().unwrap_or(0.0);
             let mut times: Vec<f64> = signal
                 .times
@@ -153,5 +165,9 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
         sample_rate: opts.sample_rate,
         input,
         model_extrapolated,
+        function: match &opts.input {
+            InputSource::Function(f) => Some(f.clone()),
+            _ => None,
+        },
     })
 }

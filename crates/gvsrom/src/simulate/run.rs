@@ -99,7 +99,7 @@ pub fn run_into(
     let summary = match &built.reduced {
         Some(r) => simulate_streaming_interruptible(
             &r.model,
-            &plan.signal,
+            plan.actuation(),
             &built.loads,
             plan.schedule.as_ref(),
             &plan.initial,
