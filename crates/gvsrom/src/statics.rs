@@ -85,11 +85,12 @@ pub fn solve(built: &Built) -> Result<StaticsReport, StaticsFailure> {
 
 /// [`solve`] under the tensions `u` [N] in place of the scenario's, one per tendon: the same
 /// equilibrium as a scenario built with these tensions (`--tension`), without building it again.
-/// Check `u` first with [`Built::tensions`]. A reduced model attached starts from its initial
-/// guess at the scenario's own tensions.
+/// Check `u` first with [`Built::tensions`] (and, with a reduced model attached,
+/// [`crate::reduce::Reduced::covers_tensions`]). A reduced model starts from its initial guess at
+/// `u` ([`crate::reduce::Reduced::initial_at`]), as in a scenario built with these tensions.
 pub fn solve_under(built: &Built, u: &[f64]) -> Result<StaticsReport, StaticsFailure> {
     match &built.reduced {
-        Some(r) => solve_on(built, &r.model, u, r.initial.as_ref()),
+        Some(r) => solve_on(built, &r.model, u, r.initial_at(u).as_ref()),
         None => solve_on(built, &built.model, u, None),
     }
 }

@@ -1,7 +1,7 @@
 //! `--model MODEL`: a reduced model bound to a scenario: its parameterization in place of the
 //! scenario's basis, the layout check, and the latent range the model may be trusted in.
 
-use super::{anchors::initial_guess, invalid, projection_of};
+use super::{anchors::InitialGuess, invalid, projection_of};
 use crate::build::Built;
 use crate::dataset::Layout;
 use crate::error::ScenarioError;
@@ -32,6 +32,8 @@ pub struct Reduced {
     /// Initial guess of a statics solve: the model's anchors at this scenario's inputs
     /// ([`anchor_guess`]; models whose dataset inputs the scenario defines).
     pub initial: Option<DVector<f64>>,
+    /// The initial guesses at other tensions ([`Self::initial_at`]).
+    pub guess: Option<InitialGuess>,
     /// The training encodings' range per coordinate.
     pub latent_range: Vec<[f64; 2]>,
     /// How the scenario lies outside what the model was trained on, when used with
@@ -70,6 +72,20 @@ impl Reduced {
             ));
         }
         Ok(outside)
+    }
+
+    /// The initial guess of a statics solve under the tensions `u` in place of the scenario's: the
+    /// [`Self::initial`] of the scenario built with them.
+    pub fn initial_at(&self, u: &[f64]) -> Option<DVector<f64>> {
+        self.guess.as_ref().and_then(|g| g.at(u))
+    }
+
+    /// Whether the model, attached to a scenario with the tensions `u0`, may answer at the tensions
+    /// `u` as it was checked to ([`attach`]): it is not extrapolating, and every tension that
+    /// differs from `u0` is a training input inside its range ([`super::validity::covers`]).
+    /// If not, attaching it to the scenario with the tensions `u` gives the verdict and its reasons.
+    pub fn covers_tensions(&self, u0: &[f64], u: &[f64]) -> bool {
+        self.extrapolated.is_empty() && super::validity::covers(&self.input_range, u0, u)
     }
 
     /// Errors if `q` lies outside the training encodings' range by more than half its width in
@@ -265,12 +281,13 @@ pub fn attach(
             .map(|o| format!("extrapolating (--extrapolate): {o}")),
     );
     let reduced = reduced_model(built, &model)?;
-    let initial = initial_guess(built, Some(table), &model);
+    let guess = InitialGuess::of(built, Some(table), &model);
     built.reduced = Some(Reduced {
         model: reduced,
         kind: model.meta.kind.clone(),
         path: dir.to_path_buf(),
-        initial,
+        initial: guess.as_ref().and_then(|g| g.at(&built.u)),
+        guess,
         // a decoder saturates outside its training encodings; a POD basis is linear and is
         // bounded by its training inputs only
         latent_range: match &model.weights {

@@ -19,7 +19,7 @@ mod pod;
 mod train;
 pub mod validity;
 
-pub use anchors::{anchor_guess, solve_anchors, AnchorInput, AnchorProblem};
+pub use anchors::{anchor_guess, solve_anchors, AnchorInput, AnchorProblem, InitialGuess};
 pub use attach::{attach, attach_source, parameterization, AttachOptions, Reduced};
 pub use pod::{pod, PodSummary};
 pub use train::{train, zero_anchor_rows, Loss, TrainSummary};

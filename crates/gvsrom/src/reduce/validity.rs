@@ -158,6 +158,19 @@ pub fn check(
     Ok(outside)
 }
 
+/// Whether the tensions `u` lie where [`check`] passed the scenario's own tensions `u0`: every
+/// tension that differs from `u0` is a training input (`tendons.K.tension`) inside its range.
+pub fn covers(ranges: &[InputRange], u0: &[f64], u: &[f64]) -> bool {
+    u.len() == u0.len()
+        && u.iter().zip(u0).enumerate().all(|(k, (&v, &v0))| {
+            v.to_bits() == v0.to_bits()
+                || ranges
+                    .iter()
+                    .find(|r| super::anchors::tendon_input(&r.parameter) == Some(k))
+                    .is_some_and(|r| inside(r, v))
+        })
+}
+
 /// The tendon tensions of an input signal against the model's training ranges: `u_at(t)` gives
 /// the tensions at time `t`, sampled at `times`. One sentence per tendon whose signal leaves its
 /// range (its extreme value and when), or whose training held it fixed at another value.
