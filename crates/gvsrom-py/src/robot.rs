@@ -337,7 +337,7 @@ impl Robot {
     /// solution of its chunk (the scenario's load ramp from straight if that fails). Row ``k``
     /// equals ``statics(U[k])`` to the solver's tolerance, and the dataset's sample ``k`` of the
     /// same tensions exactly. With ``warm_start=False`` every row is solved from straight, as
-    /// ``statics(U[k])`` solves it (the same numbers; 1.4× the time on IV-A's sweep).
+    /// ``statics(U[k])`` solves it (the same numbers; 1.2–1.4× the time on IV-A's sweep).
     ///
     /// Parameters
     /// ----------
