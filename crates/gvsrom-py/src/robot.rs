@@ -7,6 +7,7 @@ use crate::models::Model;
 use crate::quantities;
 use crate::scenario::Scenario;
 use crate::statics::{Statics, StaticsBatch};
+use gvsrom::dataset::DEFAULT_CHUNK_SIZE;
 use gvsrom::reduce::{self, AttachOptions};
 use gvsrom::statics::{self, StaticsReport};
 use gvsrom::Built;
@@ -111,6 +112,27 @@ impl Robot {
         }
     }
 
+    /// The equilibrium under `u` with this robot's reduced model as attached, without building
+    /// the scenario again: `None` if `u` is not accepted as it is (a bad count or value, a tension
+    /// outside the training inputs, a model that extrapolates), where [`Self::rebuilt_with`] gives
+    /// the command line's verdict.
+    fn solve_attached(&self, py: Python<'_>, u: Option<&[f64]>) -> Option<PyResult<StaticsReport>> {
+        let r = self.built.reduced.as_ref()?;
+        let u = match u {
+            Some(u) => self.built.tensions(u).ok()?,
+            None => self.built.u.clone(),
+        };
+        if !r.covers_tensions(&self.built.u, &u) {
+            return None;
+        }
+        let report = py.detach(|| -> anyhow::Result<StaticsReport> {
+            let report = statics::solve_under(&self.built, &u)?;
+            r.check_range(&report.q)?;
+            Ok(report)
+        });
+        Some(report.map_err(errors::any))
+    }
+
     /// The equilibrium under `u` (the scenario's tensions if `None`) with `attached` (else this
     /// robot's model): `gvsrom statics [--tension u] [--model DIR]`.
     fn solve(
@@ -129,6 +151,11 @@ impl Robot {
                     .map_err(|f| errors::statics(py, f))
             }
             Some(a) => {
+                if attached.is_none() {
+                    if let Some(report) = self.solve_attached(py, u.as_deref()) {
+                        return report;
+                    }
+                }
                 let built = self.rebuilt_with(py, u.as_deref(), a)?;
                 py.detach(|| -> anyhow::Result<StaticsReport> {
                     let report = statics::solve(&built)?;
@@ -304,12 +331,20 @@ impl Robot {
     }
 
     /// Static equilibria under many tensions, solved in parallel (all cores, the GIL released).
-    /// Row ``k`` equals ``statics(U[k])``.
+    ///
+    /// As ``gvsrom dataset`` solves a plan of tensions: chunks of 128 consecutive rows in
+    /// parallel, each along a chain of nearest neighbours, every solve starting from the nearest
+    /// solution of its chunk (the scenario's load ramp from straight if that fails). Row ``k``
+    /// equals ``statics(U[k])`` to the solver's tolerance, and the dataset's sample ``k`` of the
+    /// same tensions exactly. With ``warm_start=False`` every row is solved from straight, as
+    /// ``statics(U[k])`` solves it (the same numbers; 1.2–1.4× the time on IV-A's sweep).
     ///
     /// Parameters
     /// ----------
     /// U : array_like of float, shape (m, n_actuators)
     ///     One row of tensions [N] per equilibrium.
+    /// warm_start : bool
+    ///     Start each solve from a neighbouring row's solution (default).
     ///
     /// Returns
     /// -------
@@ -321,8 +356,13 @@ impl Robot {
     /// GvsromError, ConvergenceError
     ///     For the first row that fails, named ``U[k]``.
     #[allow(non_snake_case)]
-    #[pyo3(signature = (U,))]
-    fn statics_batch(&self, py: Python<'_>, U: In2<'_>) -> PyResult<StaticsBatch> {
+    #[pyo3(signature = (U, warm_start=true))]
+    fn statics_batch(
+        &self,
+        py: Python<'_>,
+        U: In2<'_>,
+        warm_start: bool,
+    ) -> PyResult<StaticsBatch> {
         if self.attached.is_some() {
             return Err(invalid(
                 "statics_batch solves the full model; call statics(u) per row with a reduced model",
@@ -341,9 +381,13 @@ impl Robot {
             .collect::<PyResult<Vec<_>>>()?;
         let built = &self.built;
         let results: Vec<_> = py.detach(|| {
-            rows.par_iter()
-                .map(|u| statics::solve_under(built, u))
-                .collect()
+            if warm_start {
+                statics::solve_batch(built, &rows, DEFAULT_CHUNK_SIZE)
+            } else {
+                rows.par_iter()
+                    .map(|u| statics::solve_under(built, u))
+                    .collect()
+            }
         });
         let mut reports = Vec::with_capacity(results.len());
         for (k, r) in results.into_iter().enumerate() {

@@ -48,6 +48,32 @@ def test_reduced_statics_equals_the_cli_with_model(gvsrom_bin, tmp_path, request
     np.testing.assert_array_equal(same.q, eq.q)
 
 
+@pytest.mark.parametrize("which", ["pod_model", "ae_model"])
+def test_an_attached_model_solves_other_tensions_as_a_scenario_built_with_them(request, which):
+    # with_model keeps the attached model: statics(u) starts from its anchors at u without
+    # building again, and equals the model passed per call (the scenario built at u and attached)
+    model = request.getfixturevalue(which)
+    base = gvsrom.Scenario.preset("single-tendon").build()
+    robot = base.with_model(model)
+    for u in ([-3.0], [-0.7], np.array([-5.25])):
+        fast = robot.statics(u=u)
+        built = base.statics(u=u, model=model)
+        np.testing.assert_array_equal(fast.q, built.q)
+        np.testing.assert_array_equal(fast.strain, built.strain)
+        assert fast.iterations == built.iterations
+    np.testing.assert_array_equal(robot.statics().q, base.statics(model=model).q)
+
+
+def test_an_attached_model_refuses_tensions_outside_its_training_with_the_cli_message(
+        gvsrom_bin, pod_model):
+    p = run_cli(gvsrom_bin, "statics", "single-tendon", "--tension=-20", "--model", str(pod_model.path))
+    expected = p.stderr.strip().splitlines()[-1].removeprefix("error: ")
+    robot = gvsrom.Scenario.preset("single-tendon").build().with_model(pod_model)
+    with pytest.raises(gvsrom.GvsromError) as e:
+        robot.statics(u=[-20.0])
+    assert str(e.value) == expected
+
+
 def test_reduced_model_quantities_hold_as_the_full_models(ae_model):
     robot = gvsrom.Scenario.preset("single-tendon").build().with_model(ae_model)
     assert robot.n_dof == 1 and robot.model == ae_model.path

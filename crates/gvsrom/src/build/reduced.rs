@@ -33,6 +33,9 @@ pub struct Reduced {
     /// Initial guess of a statics solve: the model's anchors at this scenario's inputs
     /// ([`anchor_guess`]; models whose dataset inputs the scenario defines).
     pub initial: Option<DVector<f64>>,
+    /// The initial guesses at other tensions ([`Self::initial_at`]; the reduction layer's
+    /// anchors).
+    pub guess: Option<Box<dyn GuessAt>>,
     /// The training encodings' range per coordinate.
     pub latent_range: Vec<[f64; 2]>,
     /// How the scenario lies outside what the model was trained on, when used with
@@ -47,7 +50,27 @@ pub struct Reduced {
     pub extrapolate: bool,
 }
 
+/// Initial guesses of a reduced statics solve at any tendon tensions `u` (one per tendon): what
+/// the reduction layer's anchors give (`reduce::InitialGuess`); `None` where they give none.
+pub trait GuessAt: Send + Sync {
+    fn at(&self, u: &[f64]) -> Option<DVector<f64>>;
+}
+
 impl Reduced {
+    /// The initial guess of a statics solve under the tensions `u` in place of the scenario's: the
+    /// [`Self::initial`] of the scenario built with them.
+    pub fn initial_at(&self, u: &[f64]) -> Option<DVector<f64>> {
+        self.guess.as_ref().and_then(|g| g.at(u))
+    }
+
+    /// Whether the model, attached to a scenario with the tensions `u0`, may answer at the tensions
+    /// `u` as it was checked to when attached: it is not extrapolating, and every tension that
+    /// differs from `u0` is a training input inside its range ([`covers`]). If not, attaching it to
+    /// the scenario with the tensions `u` gives the verdict and its reasons.
+    pub fn covers_tensions(&self, u0: &[f64], u: &[f64]) -> bool {
+        self.extrapolated.is_empty() && covers(&self.input_range, u0, u)
+    }
+
     /// Checks an input signal's tensions (`u_at(t)` at `times`) against the training ranges
     /// ([`signal_outside`]): an error listing how it lies outside, or with
     /// `--extrapolate` those sentences, to be printed and recorded with the run.
@@ -179,4 +202,27 @@ pub fn signal_outside(
         }
     }
     out
+}
+
+/// Whether the tensions `u` lie where the attach check passed the scenario's own tensions `u0`:
+/// every tension that differs from `u0` is a training input (`tendons.K.tension`) inside its range.
+pub fn covers(ranges: &[InputRange], u0: &[f64], u: &[f64]) -> bool {
+    u.len() == u0.len()
+        && u.iter().zip(u0).enumerate().all(|(k, (&v, &v0))| {
+            v.to_bits() == v0.to_bits()
+                || ranges
+                    .iter()
+                    .find(|r| tendon_input(&r.parameter) == Some(k))
+                    .is_some_and(|r| inside(r, v))
+        })
+}
+
+/// Index `K` of a dataset input `tendons.K.tension`; `None` for any other input.
+pub fn tendon_input(path: &str) -> Option<usize> {
+    use crate::scenario::{parse_path, Seg};
+    let segs = parse_path(path).ok()?;
+    match segs.as_slice() {
+        [Seg::Key(t), Seg::Index(k), Seg::Key(f)] if t == "tendons" && f == "tension" => Some(*k),
+        _ => None,
+    }
 }

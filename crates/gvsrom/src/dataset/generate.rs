@@ -7,14 +7,16 @@
 //! warm-started from the nearest already solved sample of the chunk: one full-load dogleg solve from
 //! its `q`, without ramping. If that fails, the sample is solved again from the straight
 //! configuration with the scenario's own solver options (load ramping). A sample that fails both is
-//! recorded with the reason.
+//! recorded with the reason. The chain and the warm starts are [`crate::statics`]'s, which solves a
+//! batch of tensions (`statics_batch` in Python) the same way.
 
 use super::plan::Plan;
 use crate::build::Built;
 pub use crate::layout::Layout;
 use crate::scenario::{apply_override, from_table};
+use crate::statics::{self, warm_or_ramp};
 use gvs::model::Model;
-use gvs::solve::statics::{StaticsError, StaticsOptions, StaticsSolution, StaticsSolver};
+use gvs::solve::statics::{StaticsError, StaticsSolution, StaticsSolver};
 use gvs::solve::StopCheck;
 use gvs::strain::LinearBasis;
 use nalgebra::DVector;
@@ -24,9 +26,6 @@ use toml::Table;
 pub const STATUS_OK: u8 = 0;
 pub const STATUS_FAILED: u8 = 1;
 pub const STATUS_NOT_COMPUTED: u8 = 2;
-
-/// Iteration limit of a warm-started solve before falling back to the ramp from straight.
-const WARM_MAX_ITERATIONS: usize = 50;
 
 /// One solved (or failed) sample.
 #[derive(Debug, Clone)]
@@ -159,149 +158,41 @@ impl Generator<'_> {
         Ok(Setup::Rebuilt(Box::new(built)))
     }
 
-    /// Order of the chunk's samples (indices into the chunk): a greedy nearest-neighbour chain in
-    /// normalised parameters, from the sample closest to zero load. Ties go to the lower index.
-    fn chain(&self, z: &[Vec<f64>], zero: &[f64]) -> Vec<usize> {
-        let n = z.len();
-        let mut done = vec![false; n];
-        let mut order = Vec::with_capacity(n);
-        let mut cur = (0..n)
-            .min_by(|&a, &b| zero[a].total_cmp(&zero[b]).then(a.cmp(&b)))
-            .unwrap_or(0);
-        for _ in 0..n {
-            done[cur] = true;
-            order.push(cur);
-            let next = (0..n)
-                .filter(|&j| !done[j])
-                .min_by(|&a, &b| dist(&z[cur], &z[a]).total_cmp(&dist(&z[cur], &z[b])));
-            match next {
-                Some(j) => cur = j,
-                None => break,
-            }
-        }
-        order
-    }
-
     /// Solves chunk `c`; results in plan order. `stop` is polled before every load stage of every
     /// solve: `None` if it asked to stop (the chunk is then not done and none of its results kept).
+    /// The samples are solved along the chunk's warm-start chain ([`statics::along_chain`],
+    /// [`statics::warm_or_ramp`]), as [`statics::solve_batch`] solves a batch of tensions.
     pub fn chunk(&self, c: usize, stop: &StopCheck<'_>) -> Option<Vec<SampleResult>> {
         let range = self.chunk_range(c);
-        let params = &self.plan.parameters;
-        // normalised coordinates for distances, and the distance to zero for the chain's start
-        let z: Vec<Vec<f64>> = range
-            .clone()
-            .map(|k| {
-                params
-                    .iter()
-                    .zip(self.row(k))
-                    .map(|(p, v)| {
-                        let w = p.hi - p.lo;
-                        if w > 0.0 {
-                            (v - p.lo) / w
-                        } else {
-                            0.0
-                        }
-                    })
-                    .collect()
-            })
-            .collect();
-        let zero: Vec<f64> = range
-            .clone()
-            .map(|k| {
-                params
-                    .iter()
-                    .zip(self.row(k))
-                    .map(|(p, v)| {
-                        let s = p.lo.abs().max(p.hi.abs());
-                        if s > 0.0 {
-                            (v / s) * (v / s)
-                        } else {
-                            0.0
-                        }
-                    })
-                    .sum()
-            })
-            .collect();
-        let order = self.chain(&z, &zero);
-        let mut out: Vec<Option<SampleResult>> = vec![None; range.len()];
-        let mut solved: Vec<(usize, DVector<f64>)> = vec![];
+        let d = self.plan.parameters.len();
+        let ranges: Vec<[f64; 2]> = self.plan.parameters.iter().map(|p| [p.lo, p.hi]).collect();
         let base = &self.base.model;
         let mut shared = StaticsSolver::new(base, self.base.options.clone());
         let mut ws = base.workspace();
-        for &i in &order {
+        let values = &self.values[range.start * d..range.end * d];
+        statics::along_chain(values, &ranges, range.len(), |i, warm| {
             let k = range.start + i;
-            let warm = solved
-                .iter()
-                .min_by(|a, b| dist(&z[i], &z[a.0]).total_cmp(&dist(&z[i], &z[b.0])))
-                .map(|(_, q)| q);
+            let options = &self.base.options;
             let result = match self.setup(k) {
                 Err(reason) => SampleResult::missing(self.layout, STATUS_FAILED, Some(reason)),
                 Ok(Setup::Shared(u)) => {
-                    let options = &self.base.options;
-                    let r = solve(&mut shared, options, &u, &self.base.loads, warm, stop)?;
+                    let r = warm_or_ramp(&mut shared, options, &u, &self.base.loads, warm, stop)?;
                     record(base, &mut ws, self.layout, r)
                 }
                 Ok(Setup::Loads(u, loads)) => {
-                    let r = solve(&mut shared, &self.base.options, &u, &loads, warm, stop)?;
+                    let r = warm_or_ramp(&mut shared, options, &u, &loads, warm, stop)?;
                     record(base, &mut ws, self.layout, r)
                 }
                 Ok(Setup::Rebuilt(b)) => {
                     let mut solver = StaticsSolver::new(&b.model, b.options.clone());
-                    let r = solve(&mut solver, &b.options, &b.u, &b.loads, warm, stop)?;
+                    let r = warm_or_ramp(&mut solver, &b.options, &b.u, &b.loads, warm, stop)?;
                     let mut ws = b.model.workspace();
                     record(&b.model, &mut ws, self.layout, r)
                 }
             };
-            if result.status == STATUS_OK {
-                solved.push((i, DVector::from_column_slice(&result.q)));
-            }
-            out[i] = Some(result);
-        }
-        Some(
-            out.into_iter()
-                .map(|r| {
-                    r.unwrap_or_else(|| {
-                        SampleResult::missing(self.layout, STATUS_NOT_COMPUTED, None)
-                    })
-                })
-                .collect(),
-        )
-    }
-}
-
-fn dist(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()
-}
-
-/// A warm-started full-load solve from `warm` if given, else (or if it fails) the scenario's solve
-/// from straight. Returns the solution and whether the warm start was used, or the failure's
-/// reason; `None` if `stop` asked to stop (polled before every load stage).
-fn solve(
-    solver: &mut StaticsSolver<'_, LinearBasis>,
-    options: &StaticsOptions,
-    u: &[f64],
-    loads: &gvs::loads::Loads,
-    warm: Option<&DVector<f64>>,
-    stop: &StopCheck<'_>,
-) -> Option<Result<(StaticsSolution, bool), String>> {
-    if let Some(q0) = warm {
-        solver.options = StaticsOptions {
-            ramp_steps: 1,
-            min_increment: 1.0,
-            max_iterations: options.max_iterations.min(WARM_MAX_ITERATIONS),
-            ..options.clone()
-        };
-        match solver.solve_interruptible(u, loads, Some(q0), stop) {
-            Ok(s) => return Some(Ok((s, true))),
-            Err(StaticsError::Stopped { .. }) => return None,
-            Err(_) => {}
-        }
-    }
-    solver.options = options.clone();
-    match solver.solve_interruptible(u, loads, None, stop) {
-        Ok(s) => Some(Ok((s, false))),
-        Err(StaticsError::Stopped { .. }) => None,
-        Err(e) => Some(Err(e.to_string())),
+            let q = (result.status == STATUS_OK).then(|| DVector::from_column_slice(&result.q));
+            Some((result, q))
+        })
     }
 }
 
@@ -310,11 +201,11 @@ fn record(
     model: &Model<LinearBasis>,
     ws: &mut gvs::model::Workspace,
     layout: &Layout,
-    r: Result<(StaticsSolution, bool), String>,
+    r: Result<(StaticsSolution, bool), StaticsError>,
 ) -> SampleResult {
     let (sol, warm) = match r {
         Ok(s) => s,
-        Err(reason) => return SampleResult::missing(layout, STATUS_FAILED, Some(reason)),
+        Err(e) => return SampleResult::missing(layout, STATUS_FAILED, Some(e.to_string())),
     };
     model.forward(&sol.q, ws, false);
     let xi = model.point_strains(ws);

@@ -1,6 +1,7 @@
 //! Anchors: training samples kept in a model as (inputs, reduced coordinates) pairs, the initial
 //! guesses of reduced statics solves, and their replacement by the reduced model's own equilibria.
 
+use crate::build::reduced::{tendon_input, GuessAt};
 use crate::build::Built;
 use crate::reduced_model::ReducedModel;
 use gvs::model::Model;
@@ -22,20 +23,62 @@ pub(super) fn input_value(built: &Built, table: Option<&toml::Table>, path: &str
     }
 }
 
-/// The initial guess of a reduced statics solve at the scenario's inputs, from the model's anchors
-/// ([`anchor_guess`]).
-pub(super) fn initial_guess(
-    built: &Built,
-    table: Option<&toml::Table>,
-    model: &ReducedModel,
-) -> Option<DVector<f64>> {
-    let a = model.anchors.as_ref()?;
-    let names = &model.meta.anchor_parameters;
-    let x: Vec<f64> = names
-        .iter()
-        .map(|p| input_value(built, table, p))
-        .collect::<Option<_>>()?;
-    anchor_guess(&a.inputs, &a.latent, names.len(), model.meta.latent, &x)
+/// The initial guesses of a reduced statics solve at any tendon tensions: the model's anchors
+/// ([`anchor_guess`]) with the scenario's values of their inputs other than tensions.
+#[derive(Debug, Clone)]
+pub struct InitialGuess {
+    anchors: crate::reduced_model::Anchors,
+    /// Per anchor input: the tendon whose tension it is, or its value in the scenario.
+    inputs: Vec<GuessInput>,
+    /// Reduced coordinates r.
+    r: usize,
+}
+
+#[derive(Debug, Clone, Copy)]
+enum GuessInput {
+    Tension(usize),
+    Value(f64),
+}
+
+impl InitialGuess {
+    /// The guesses of `model` in the scenario of `built` (its TOML `table`, for inputs other than
+    /// tensions); `None` without anchors or if such an input has no numeric value in the scenario.
+    pub(super) fn of(
+        built: &Built,
+        table: Option<&toml::Table>,
+        model: &ReducedModel,
+    ) -> Option<InitialGuess> {
+        let inputs = model
+            .meta
+            .anchor_parameters
+            .iter()
+            .map(|p| match tendon_input(p) {
+                Some(k) => Some(GuessInput::Tension(k)),
+                None => input_value(built, table, p).map(GuessInput::Value),
+            })
+            .collect::<Option<_>>()?;
+        Some(InitialGuess {
+            anchors: model.anchors.clone()?,
+            inputs,
+            r: model.meta.latent,
+        })
+    }
+}
+
+impl GuessAt for InitialGuess {
+    /// The guess at the tensions `u` (one per tendon); `None` if an input's tendon has none.
+    fn at(&self, u: &[f64]) -> Option<DVector<f64>> {
+        let x: Vec<f64> = self
+            .inputs
+            .iter()
+            .map(|i| match *i {
+                GuessInput::Tension(k) => u.get(k).copied(),
+                GuessInput::Value(v) => Some(v),
+            })
+            .collect::<Option<_>>()?;
+        let a = &self.anchors;
+        anchor_guess(&a.inputs, &a.latent, self.inputs.len(), self.r, &x)
+    }
 }
 
 /// An initial guess at the inputs `x` (k values) from anchors: `inputs` (`n × k`) and their reduced
@@ -150,19 +193,6 @@ pub(super) fn local_linear(
     let beta = svd.solve(&z, 1e-8 * smax).ok()?;
     let z0 = beta.row(0).transpose();
     z0.iter().all(|v| v.is_finite()).then_some(z0)
-}
-
-/// Index `K` of a dataset input `tendons.K.tension`; `None` for any other input.
-pub(super) fn tendon_input(path: &str) -> Option<usize> {
-    let segs = crate::scenario::parse_path(path).ok()?;
-    match segs.as_slice() {
-        [crate::scenario::Seg::Key(t), crate::scenario::Seg::Index(k), crate::scenario::Seg::Key(f)]
-            if t == "tendons" && f == "tension" =>
-        {
-            Some(*k)
-        }
-        _ => None,
-    }
 }
 
 /// How a dataset input enters an anchor's statics problem ([`solve_anchors`]).

@@ -1,7 +1,8 @@
 //! `--model MODEL`: a reduced model bound to a scenario: its parameterization in place of the
 //! scenario's basis, the layout check, and the latent range the model may be trusted in.
 
-use super::{anchors::initial_guess, invalid, projection_of};
+use super::{anchors::InitialGuess, invalid, projection_of};
+use crate::build::reduced::GuessAt;
 use crate::build::{Built, Reduced, Resolved};
 use crate::dataset::Layout;
 use crate::error::ScenarioError;
@@ -155,12 +156,13 @@ pub fn attach(
             .map(|o| format!("extrapolating (--extrapolate): {o}")),
     );
     let reduced = reduced_model(built, &model)?;
-    let initial = initial_guess(built, Some(table), &model);
+    let guess = InitialGuess::of(built, Some(table), &model);
     built.reduced = Some(Reduced {
         model: reduced,
         kind: model.meta.kind.clone(),
         path: dir.to_path_buf(),
-        initial,
+        initial: guess.as_ref().and_then(|g| g.at(&built.u)),
+        guess: guess.map(|g| Box::new(g) as Box<dyn GuessAt>),
         // a decoder saturates outside its training encodings; a POD basis is linear and is
         // bounded by its training inputs only
         latent_range: match &model.weights {

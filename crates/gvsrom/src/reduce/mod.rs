@@ -20,7 +20,7 @@ mod train;
 pub mod validity;
 
 pub use crate::build::Reduced;
-pub use anchors::{anchor_guess, solve_anchors, AnchorInput, AnchorProblem};
+pub use anchors::{anchor_guess, solve_anchors, AnchorInput, AnchorProblem, InitialGuess};
 pub use attach::{attach, attach_resolved, attach_source, parameterization, AttachOptions};
 pub use pod::{pod, PodSummary};
 pub use train::{train, zero_anchor_rows, Loss, TrainSummary};
