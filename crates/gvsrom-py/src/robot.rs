@@ -125,11 +125,7 @@ impl Robot {
         if !r.covers_tensions(&self.built.u, &u) {
             return None;
         }
-        let report = py.detach(|| -> anyhow::Result<StaticsReport> {
-            let report = statics::solve_under(&self.built, &u)?;
-            r.check_range(&report.q)?;
-            Ok(report)
-        });
+        let report = py.detach(|| statics::solve_checked(&self.built, &u));
         Some(report.map_err(errors::any))
     }
 
@@ -157,14 +153,8 @@ impl Robot {
                     }
                 }
                 let built = self.rebuilt_with(py, u.as_deref(), a)?;
-                py.detach(|| -> anyhow::Result<StaticsReport> {
-                    let report = statics::solve(&built)?;
-                    if let Some(r) = &built.reduced {
-                        r.check_range(&report.q)?;
-                    }
-                    Ok(report)
-                })
-                .map_err(errors::any)
+                py.detach(|| statics::solve_checked(&built, &built.u))
+                    .map_err(errors::any)
             }
         }
     }

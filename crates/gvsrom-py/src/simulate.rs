@@ -8,8 +8,7 @@ use crate::robot::{warn, Robot};
 use gvs::error::ModelError;
 use gvs::inputs::{Actuation, Interpolation, Signal};
 use gvsrom::simulate::{
-    self, Ending, InputFunction, InputSource, IntegratorChoice, MethodChoice, SimulateOptions,
-    TrajectoryBuffer,
+    self, Ending, InputFunction, InputSource, IntegratorChoice, MethodChoice, TrajectoryBuffer,
 };
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -176,16 +175,18 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
         atol: a.atol,
         ..IntegratorChoice::default()
     };
-    let (integrator, _note) = simulate::choose_integrator(built, &choice).map_err(err)?;
-    let opts = SimulateOptions {
-        duration: a.duration,
-        sample_rate: a.sample_rate,
-        input,
-        start_at_equilibrium: a.from_equilibrium,
-        integrator,
-        load_schedule: None,
-    };
-    let plan = simulate::plan(built, &opts).map_err(err)?;
+    let simulate::Prepared { opts, plan, .. } = simulate::prepare(
+        built,
+        simulate::Request {
+            duration: a.duration,
+            sample_rate: a.sample_rate,
+            input,
+            start_at_equilibrium: a.from_equilibrium,
+            load_schedule: None,
+            integrator: choice,
+        },
+    )
+    .map_err(err)?;
     for o in &plan.model_extrapolated {
         warn(py, &format!("extrapolating (--extrapolate): {o}"))?;
     }

@@ -96,6 +96,16 @@ pub fn solve_under(built: &Built, u: &[f64]) -> Result<StaticsReport, StaticsFai
     }
 }
 
+/// [`solve_under`] as a run answers it: for an attached reduced model, the solution must also lie
+/// where the model was trained (`Reduced::check_range`), else the error names the likely cause.
+pub fn solve_checked(built: &Built, u: &[f64]) -> anyhow::Result<StaticsReport> {
+    let report = solve_under(built, u)?;
+    if let Some(r) = &built.reduced {
+        r.check_range(&report.q)?;
+    }
+    Ok(report)
+}
+
 /// [`solve`] `repeat` times (≥ 1); the report's `solve_time_s` is the mean over the repetitions.
 pub fn solve_repeated(built: &Built, repeat: u32) -> Result<StaticsReport, StaticsFailure> {
     let mut report = solve(built)?;

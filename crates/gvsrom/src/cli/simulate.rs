@@ -124,7 +124,7 @@ pub struct SimulateArgs {
 }
 
 pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
-    use gvsrom::simulate::{self, InputSource, SimulateOptions};
+    use gvsrom::simulate::{self, InputSource};
     use std::io::IsTerminal;
     if let Some(dir) = &args.out {
         let mut inputs = scenario_inputs(&args.scenario, args.model.as_ref());
@@ -160,31 +160,26 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
         fixed_step: args.fixed_step,
         fd_jacobian: args.fd_jacobian,
     };
-    // the note printed when the rod's damping chose the method
-    let (integrator, light) = simulate::choose_integrator(built, &choice)?;
-    let opts = SimulateOptions {
-        duration: args.duration,
-        sample_rate: args.sample_rate,
-        input,
-        start_at_equilibrium: args.from_equilibrium,
-        integrator,
-        load_schedule: args.load_schedule.clone(),
-    };
     // everything is checked, and the output staged, before the computation starts
-    let plan = simulate::plan(built, &opts)?;
-    for o in &plan.model_extrapolated {
+    let prepared = simulate::prepare(
+        built,
+        simulate::Request {
+            duration: args.duration,
+            sample_rate: args.sample_rate,
+            input,
+            start_at_equilibrium: args.from_equilibrium,
+            load_schedule: args.load_schedule.clone(),
+            integrator: choice,
+        },
+    )?;
+    for o in &prepared.plan.model_extrapolated {
         eprintln!("warning: extrapolating (--extrapolate): {o}");
     }
-    let provenance = r
-        .provenance
-        .clone()
-        .seed("input", args.seed)
-        .input(plan.input.clone())
-        .sampling(opts.duration, opts.sample_rate)
-        .integrator(simulate::integrator_record(&opts.integrator, &choice));
+    let provenance = prepared.record(r.provenance.clone().seed("input", args.seed), &choice);
+    let (opts, plan, light) = (&prepared.opts, &prepared.plan, &prepared.note);
     let mut writer = match &args.out {
         Some(dir) => {
-            simulate::check_output_size(built, &plan)?;
+            simulate::check_output_size(built, plan)?;
             let mut w = TrajectoryWriter::create(dir, args.force, built)?;
             w.set_provenance(&provenance);
             Some(w)
@@ -222,13 +217,7 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
             s => ControlFlow::Break(format!("interrupted by {}", signal_name(s))),
         }
     };
-    let outcome = simulate::run(
-        built,
-        &plan,
-        &opts.integrator,
-        writer.as_mut(),
-        &mut control,
-    )?;
+    let outcome = simulate::run(built, plan, &opts.integrator, writer.as_mut(), &mut control)?;
     if tty {
         eprintln!();
     }
@@ -255,7 +244,7 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
     let written = match writer {
         Some(w) => {
             let samples = w.samples();
-            let dir = w.finish(built, &plan, &outcome)?;
+            let dir = w.finish(built, plan, &outcome)?;
             let partial = if outcome.ending == Ending::Complete {
                 ""
             } else {

@@ -1,11 +1,13 @@
 //! A run's [`Plan`]: everything checked, and the sample times and signal built, before anything is
 //! computed.
 
+use super::integrator::{choose_integrator, integrator_record, IntegratorChoice};
 use super::options::*;
 use crate::build::Built;
 use crate::error::ScenarioError;
 use gvs::inputs::{Actuation, Interpolation, Signal};
 use gvs::solve::dynamics::{InitialState, Method};
+use std::path::PathBuf;
 
 /// Most output samples of one run.
 pub const MAX_SAMPLES: usize = 10_000_000;
@@ -170,4 +172,58 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
             _ => None,
         },
     })
+}
+
+/// A dynamics run as a front-end asks for it (the options of `gvsrom simulate`).
+#[derive(Debug, Clone)]
+pub struct Request {
+    /// Simulated time [s].
+    pub duration: f64,
+    /// Output samples per second [Hz].
+    pub sample_rate: f64,
+    pub input: InputSource,
+    /// Start at the scenario's static equilibrium instead of the straight rod at rest.
+    pub start_at_equilibrium: bool,
+    /// A CSV load schedule (`--load-schedule`).
+    pub load_schedule: Option<PathBuf>,
+    /// The integrator asked for (`--method`, tolerances …).
+    pub integrator: IntegratorChoice,
+}
+
+/// A run ready to go: its options with the integrator chosen ([`choose_integrator`]), its
+/// [`Plan`], and the note to print when the rod's damping chose the method.
+pub struct Prepared {
+    pub opts: SimulateOptions,
+    pub plan: Plan,
+    pub note: Option<String>,
+}
+
+impl Prepared {
+    /// The run's record in `meta.json`'s provenance: the input, the sampling and the integrator.
+    pub fn record(
+        &self,
+        provenance: crate::provenance::Provenance,
+        choice: &IntegratorChoice,
+    ) -> crate::provenance::Provenance {
+        provenance
+            .input(self.plan.input.clone())
+            .sampling(self.opts.duration, self.opts.sample_rate)
+            .integrator(integrator_record(&self.opts.integrator, choice))
+    }
+}
+
+/// Chooses the integrator of `request` for `built` and plans the run ([`plan`]): everything is
+/// checked before anything is computed. What `gvsrom simulate` and Python's `Robot.simulate` do.
+pub fn prepare(built: &Built, request: Request) -> Result<Prepared, ScenarioError> {
+    let (integrator, note) = choose_integrator(built, &request.integrator)?;
+    let opts = SimulateOptions {
+        duration: request.duration,
+        sample_rate: request.sample_rate,
+        input: request.input,
+        start_at_equilibrium: request.start_at_equilibrium,
+        integrator,
+        load_schedule: request.load_schedule,
+    };
+    let plan = plan(built, &opts)?;
+    Ok(Prepared { opts, plan, note })
 }
