@@ -110,7 +110,7 @@ pub fn run_into(
         ),
         None => simulate_streaming_interruptible(
             &built.model,
-            &plan.signal,
+            plan.actuation(),
             &built.loads,
             plan.schedule.as_ref(),
             &plan.initial,
