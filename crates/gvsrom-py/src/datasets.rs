@@ -5,7 +5,7 @@
 use crate::arrays::shaped;
 use crate::errors::{self, invalid};
 use crate::scenario::Scenario;
-use gvsrom::dataset::{DatasetArgs, DEFAULT_CHUNK_SIZE};
+use gvsrom::dataset::{DatasetRequest, DEFAULT_CHUNK_SIZE};
 use numpy::PyArray;
 use pyo3::exceptions::PyKeyboardInterrupt;
 use pyo3::prelude::*;
@@ -354,7 +354,7 @@ pub fn dataset(
             "`force` and `resume` exclude each other: resume continues the dataset in `out`, force replaces it",
         ));
     }
-    let args = DatasetArgs {
+    let args = DatasetRequest {
         scenario,
         set: overrides,
         sweep: specs("sweep", sweep)?,
@@ -378,9 +378,7 @@ pub fn dataset(
         atol,
         stop_after_chunks: None,
     };
-    let (outcome, caught) = crate::interrupt::run(py, |flag| {
-        gvsrom::dataset::run(&args, &flag, &mut std::io::sink())
-    });
+    let (outcome, caught) = crate::interrupt::run(py, |flag| gvsrom::dataset::run(&args, &flag));
     let outcome = outcome.map_err(|e| errors::any(e.into()))?;
     if let Some(message) = outcome.interruption_message() {
         return Err(PyKeyboardInterrupt::new_err(message));

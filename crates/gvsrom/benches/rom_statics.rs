@@ -94,7 +94,7 @@ fn model_dir() -> PathBuf {
     }
     std::fs::create_dir_all(&data).expect("bench-data directory");
     let dataset = data.join("iv-a-200");
-    let args = gvsrom::dataset::DatasetArgs {
+    let args = gvsrom::dataset::DatasetRequest {
         scenario: "single-tendon".into(),
         set: vec![],
         sweep: vec!["tendons.0.tension=-6:3".into()],
@@ -118,7 +118,7 @@ fn model_dir() -> PathBuf {
         atol: 1e-6,
         stop_after_chunks: None,
     };
-    gvsrom::dataset::run(&args, &AtomicUsize::new(0), &mut std::io::sink()).expect("dataset");
+    gvsrom::dataset::run(&args, &AtomicUsize::new(0)).expect("dataset");
     let options = rom::nn::TrainOptions {
         latent: 1,
         hidden_layers: 7,

@@ -61,7 +61,7 @@ pub enum Command {
     Modes(ModesArgs),
     /// Generate a strain snapshot dataset: solve the statics over a sampling plan (`--sweep`,
     /// `--grid`, `--random`) in parallel and write NumPy arrays (see docs/datasets.md).
-    Dataset(gvsrom::dataset::DatasetArgs),
+    Dataset(DatasetArgs),
     /// POD of a dataset's strain snapshots: K modes become a reduced model (`--model` on `statics`
     /// and `simulate`).
     Pod(PodArgs),

@@ -51,9 +51,10 @@ pub(super) fn reproduce_cmd(args: &ReproduceArgs, out: &mut impl Write) -> Resul
     }
 }
 
-pub(super) fn dataset_cmd(args: &gvsrom::dataset::DatasetArgs, out: &mut impl Write) -> Result<()> {
+pub(super) fn dataset_cmd(args: &DatasetArgs, out: &mut impl Write) -> Result<()> {
     let signal = interrupt_flag();
-    let outcome = gvsrom::dataset::run(args, &signal, out)?;
+    let outcome = gvsrom::dataset::run(&args.request(), &signal)?;
+    summary(out, &outcome.path, &outcome.meta, outcome.resumed_chunks)?;
     match outcome.interruption_message() {
         None => Ok(()),
         Some(message) => Err(Interrupted {
@@ -65,4 +66,224 @@ pub(super) fn dataset_cmd(args: &gvsrom::dataset::DatasetArgs, out: &mut impl Wr
         }
         .into()),
     }
+}
+
+/// `gvsrom dataset`: the scenario, the plan and the output.
+#[derive(Debug, Args)]
+pub struct DatasetArgs {
+    /// A preset name (see `gvsrom presets`) or the path of a scenario TOML file.
+    pub scenario: String,
+
+    /// Override a scenario value by its TOML path before sampling (as for `statics`); repeatable.
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    pub set: Vec<String>,
+
+    /// Sweep PATH over an even 1-D grid from LO to HI including both ends (`--samples` values).
+    /// Repeat it (or use `*`, e.g. `tendons.*.tension`) to sweep several values together.
+    #[arg(long, value_name = "PATH=LO:HI", allow_hyphen_values = true)]
+    pub sweep: Vec<String>,
+
+    /// Grid over the product of the ranges: round(samples^(1/d)) even values per parameter, which
+    /// must give exactly `--samples` (e.g. 15625 = 5^6 for `tendons.*.tension` on six tendons).
+    #[arg(long, value_name = "PATH=LO:HI", allow_hyphen_values = true)]
+    pub grid: Vec<String>,
+
+    /// Uniform random values in [LO, HI), seeded by `--seed`; repeatable, `*` allowed.
+    #[arg(long, value_name = "PATH=LO:HI", allow_hyphen_values = true)]
+    pub random: Vec<String>,
+
+    /// Number of samples.
+    #[arg(long, value_name = "N")]
+    pub samples: Option<usize>,
+
+    /// Seed of `--random` (same seed, same dataset).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+
+    /// Samples per chunk: the unit of parallel work, of warm-start chains and of resuming. Part of
+    /// the plan (a different chunk size gives slightly different last digits).
+    #[arg(long, value_name = "N", default_value_t = gvsrom::dataset::DEFAULT_CHUNK_SIZE)]
+    pub chunk_size: usize,
+
+    /// Worker threads (default: one per core). The files do not depend on it.
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+
+    /// Write the dataset into the new directory DIR.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+
+    /// Replace DIR if it is an earlier gvsrom output holding only its own files.
+    #[arg(long, conflicts_with = "resume")]
+    pub force: bool,
+
+    /// Continue the incomplete dataset in DIR (same scenario, plan and seed): its finished chunks are
+    /// kept, the missing ones computed, and DIR replaced by the result.
+    #[arg(long)]
+    pub resume: bool,
+
+    /// Dynamic dataset: simulate T seconds (inputs as for `simulate`) and store every output sample.
+    #[arg(long, value_name = "T", allow_hyphen_values = true)]
+    pub duration: Option<f64>,
+
+    /// Dynamic dataset: output samples per second [Hz].
+    #[arg(
+        long,
+        value_name = "HZ",
+        allow_hyphen_values = true,
+        requires = "duration"
+    )]
+    pub sample_rate: Option<f64>,
+
+    /// Dynamic dataset: actuation from a CSV file `t, u_1, …, u_na` (as for `simulate`).
+    #[arg(long, value_name = "FILE", requires = "duration", conflicts_with_all = ["steps", "babble"])]
+    pub input: Option<PathBuf>,
+
+    /// Dynamic dataset: interpolate the CSV input linearly.
+    #[arg(long, requires = "input")]
+    pub interpolate: bool,
+
+    /// Dynamic dataset: random step actuation LO,HI,PERIOD (seeded by `--seed`).
+    #[arg(
+        long,
+        value_name = "LO,HI,PERIOD",
+        value_delimiter = ',',
+        allow_hyphen_values = true,
+        requires = "duration",
+        conflicts_with = "babble"
+    )]
+    pub steps: Option<Vec<f64>>,
+
+    /// Dynamic dataset: actuator babbling LO,HI,HOLD_MIN,HOLD_MAX (paper IV-C2: `--babble=-15,0,0.5,1`).
+    #[arg(
+        long,
+        value_name = "LO,HI,HOLD_MIN,HOLD_MAX",
+        value_delimiter = ',',
+        allow_hyphen_values = true,
+        requires = "duration"
+    )]
+    pub babble: Option<Vec<f64>>,
+
+    /// Dynamic dataset: start at the static equilibrium under the scenario's loads and tensions.
+    #[arg(long, requires = "duration")]
+    pub from_equilibrium: bool,
+
+    /// Dynamic dataset: relative tolerance of the integrator (default as `simulate`: 1e-3, or
+    /// 1e-4 with SDIRK4 for a lightly damped rod).
+    #[arg(long)]
+    pub rtol: Option<f64>,
+
+    /// Dynamic dataset: absolute tolerance of the integrator.
+    #[arg(long, default_value_t = 1e-6)]
+    pub atol: f64,
+
+    /// Testing aid: stop (as if interrupted) once N chunks have been started.
+    #[arg(long, value_name = "N", hide = true)]
+    pub stop_after_chunks: Option<usize>,
+}
+
+impl DatasetArgs {
+    /// The library's request of these options.
+    fn request(&self) -> gvsrom::dataset::DatasetRequest {
+        gvsrom::dataset::DatasetRequest {
+            scenario: self.scenario.clone(),
+            set: self.set.clone(),
+            sweep: self.sweep.clone(),
+            grid: self.grid.clone(),
+            random: self.random.clone(),
+            samples: self.samples,
+            seed: self.seed,
+            chunk_size: self.chunk_size,
+            threads: self.threads,
+            out: self.out.clone(),
+            force: self.force,
+            resume: self.resume,
+            duration: self.duration,
+            sample_rate: self.sample_rate,
+            input: self.input.clone(),
+            interpolate: self.interpolate,
+            steps: self.steps.clone(),
+            babble: self.babble.clone(),
+            from_equilibrium: self.from_equilibrium,
+            rtol: self.rtol,
+            atol: self.atol,
+            stop_after_chunks: self.stop_after_chunks,
+        }
+    }
+}
+
+/// The summary `gvsrom dataset` prints of a finished (or interrupted) dataset.
+fn summary(
+    out: &mut dyn Write,
+    path: &std::path::Path,
+    m: &gvsrom::dataset::Meta,
+    resumed: usize,
+) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "scenario   {}: {} DOF, {} computational points, active strains [{}]",
+        m.scenario,
+        m.n_dof,
+        m.n_points,
+        m.components.join(", ")
+    )?;
+    match (&m.plan, &m.dynamic) {
+        (Some(p), _) => writeln!(
+            out,
+            "plan       {} {} ({} samples, {} parameters, seed {})",
+            p.kind.option(),
+            p.specs.join(" "),
+            m.samples,
+            m.parameters.len(),
+            m.seed
+        )?,
+        (None, Some(d)) => writeln!(
+            out,
+            "run        {} s at {} Hz, input {} ({} samples)",
+            d.duration, d.sample_rate, d.input, m.samples
+        )?,
+        (None, None) => {}
+    }
+    let c = &m.counts;
+    if m.dynamic.is_some() {
+        writeln!(
+            out,
+            "simulated  {} samples stored in {:.2} s",
+            c.ok, m.wall_time_s
+        )?;
+    } else {
+        writeln!(
+            out,
+            "solved     {} ok ({} warm-started), {} failed, {} not computed in {:.2} s on {} threads{}",
+            c.ok,
+            c.warm_started,
+            c.failed,
+            c.not_computed,
+            m.wall_time_s,
+            m.threads,
+            if resumed > 0 {
+                format!(" ({resumed} chunks kept from the resumed run)")
+            } else {
+                String::new()
+            }
+        )?;
+    }
+    for f in m.failures.iter().take(5) {
+        writeln!(out, "failed     sample {}: {}", f.index, f.reason)?;
+    }
+    if m.failures.len() > 5 {
+        writeln!(
+            out,
+            "failed     … {} more in meta.json",
+            m.failures.len() - 5
+        )?;
+    }
+    writeln!(
+        out,
+        "dataset    {} ({} × {} strain values{})",
+        path.display(),
+        m.samples,
+        m.n_points * m.components.len(),
+        if m.complete { "" } else { ", incomplete" }
+    )
 }

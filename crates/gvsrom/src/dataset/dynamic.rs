@@ -5,7 +5,7 @@
 
 use super::generate::{Layout, SampleResult, STATUS_OK};
 use super::{
-    progress_bar, summary, write::write_arrays, Counts, DatasetArgs, DatasetError, Meta, Outcome,
+    progress_bar, write::write_arrays, Counts, DatasetError, DatasetRequest, Meta, Outcome,
     MAX_DATASET_BYTES,
 };
 use crate::build::Built;
@@ -16,7 +16,6 @@ use gvs::solve::dynamics::{
     simulate_streaming_interruptible, IntegratorOptions, OdeJacobian, SimulationError,
 };
 use serde::{Deserialize, Serialize};
-use std::io::Write;
 use std::ops::ControlFlow;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
@@ -52,11 +51,10 @@ fn join(v: &[f64]) -> String {
 
 /// Runs the simulation of `args` and writes every output sample as a dataset row.
 pub fn run(
-    args: &DatasetArgs,
+    args: &DatasetRequest,
     built: &Built,
     scenario_toml: String,
     interrupt: &AtomicUsize,
-    out: &mut dyn Write,
     provenance: crate::provenance::Provenance,
     t0: Instant,
 ) -> Result<Outcome, DatasetError> {
@@ -241,7 +239,6 @@ pub fn run(
     };
     write_arrays(&mut dir, &mut meta, &layout, &inputs, &rows, Some(&t))?;
     let path = dir.commit(&meta)?;
-    summary(out, &path, &meta, 0).map_err(|e| DatasetError::Plan(format!("stdout: {e}")))?;
     if let Some(e) = failed {
         return Err(DatasetError::Plan(format!(
             "the integration failed at t = {}: {e} (the {n} samples before it were written to `{}`, marked incomplete)",

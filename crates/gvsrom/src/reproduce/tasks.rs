@@ -3,7 +3,7 @@
 //! statics of the HOM and reduced models at test inputs (`gvsrom statics [--model]`).
 
 use super::step::{Interrupted, Run, Step};
-use crate::dataset::{Dataset, DatasetArgs, Layout};
+use crate::dataset::{Dataset, DatasetRequest, Layout};
 use crate::reduced_model::{ModelWeights, ReducedModel};
 use crate::{build, presets, reduce, scenario, statics, Built};
 use serde::{Deserialize, Serialize};
@@ -91,7 +91,7 @@ pub fn dataset(
         &config,
         |p| Dataset::load(p).is_ok_and(|d| d.meta.complete),
         |path| {
-            let args = DatasetArgs {
+            let args = DatasetRequest {
                 scenario: scenario.preset.clone(),
                 set: scenario.set.clone(),
                 sweep: plan.sweep.clone(),
@@ -115,7 +115,7 @@ pub fn dataset(
                 atol: 1e-6,
                 stop_after_chunks: None,
             };
-            let outcome = crate::dataset::run(&args, run.interrupt(), &mut std::io::sink())?;
+            let outcome = crate::dataset::run(&args, run.interrupt())?;
             if outcome.interrupted.is_some() {
                 run.check_interrupt()?;
                 anyhow::bail!("the dataset `{}` stopped early", path.display());
