@@ -108,10 +108,18 @@ pub fn solve_checked(built: &Built, u: &[f64]) -> anyhow::Result<StaticsReport> 
 
 /// [`solve`] `repeat` times (≥ 1); the report's `solve_time_s` is the mean over the repetitions.
 pub fn solve_repeated(built: &Built, repeat: u32) -> Result<StaticsReport, StaticsFailure> {
-    let mut report = solve(built)?;
+    repeated(repeat, || solve(built))
+}
+
+/// `solve()` `repeat` times (≥ 1): the first report, its `solve_time_s` the mean.
+fn repeated(
+    repeat: u32,
+    mut solve: impl FnMut() -> Result<StaticsReport, StaticsFailure>,
+) -> Result<StaticsReport, StaticsFailure> {
+    let mut report = solve()?;
     let mut total = report.solve_time_s;
     for _ in 1..repeat {
-        total += solve(built)?.solve_time_s;
+        total += solve()?.solve_time_s;
     }
     report.solve_time_s = total / repeat.max(1) as f64;
     Ok(report)
@@ -120,13 +128,7 @@ pub fn solve_repeated(built: &Built, repeat: u32) -> Result<StaticsReport, Stati
 /// The full model's equilibrium under the scenario's tensions, whether or not a reduced model
 /// is attached: the reference of `statics --model --compare`.
 pub fn solve_full(built: &Built, repeat: u32) -> Result<StaticsReport, StaticsFailure> {
-    let mut report = solve_on(built, &built.model, &built.u, None)?;
-    let mut total = report.solve_time_s;
-    for _ in 1..repeat {
-        total += solve_on(built, &built.model, &built.u, None)?.solve_time_s;
-    }
-    report.solve_time_s = total / repeat.max(1) as f64;
-    Ok(report)
+    repeated(repeat, || solve_on(built, &built.model, &built.u, None))
 }
 
 /// A `statics` run ([`run`]): the equilibrium of the model that runs and, with `compare`, the
