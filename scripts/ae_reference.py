@@ -7,12 +7,14 @@ and not from gvsrom's code, to judge the Rust trainer against a standard stack:
 - architecture: n → n/2 → … → r → … → n (the encoder halves the width per layer, the decoder
   mirrors it), tanh on every hidden layer, linear latent and output layers, Glorot-uniform weights,
   zero biases;
-- loss: mean squared reconstruction error over the batch and the features in scaled units plus
-  λ Σ‖W‖² (biases not regularised), λ = 1e-4;
+- loss: eq. (15), `‖x̂ − x‖² + λ Σ‖W‖²` with the squared error of a whole snapshot, averaged over
+  the batch and divided by the number of features n: the mean squared error per entry in scaled
+  units plus (λ/n) Σ‖W‖² (biases not regularised), λ = 1e-4;
 - scaling: `standardized` (each feature by its own standard deviation) or `physical` (one common
   scale: the plain physical MSE);
 - Adam (optax defaults β = 0.9/0.999, ε = 1e-8), shuffled mini-batches, a fixed epoch budget and
-  the weights with the lowest validation loss kept.
+  the weights with the lowest validation loss kept; the rate constant, or decaying exponentially
+  to `--final-lr-factor` of itself over the run.
 
 It prints the RMSE over the whole dataset in physical units (Table I's metric) and the mean wall
 time of an epoch after the first (compiled) one.
@@ -111,6 +113,12 @@ def main() -> None:
     ap.add_argument("--epochs", type=int, default=200)
     ap.add_argument("--batch-size", type=int, default=64)
     ap.add_argument("--learning-rate", type=float, default=1e-3)
+    ap.add_argument(
+        "--final-lr-factor",
+        type=float,
+        default=1.0,
+        help="decay the rate exponentially to this fraction of itself over the epochs (1: constant)",
+    )
     ap.add_argument("--lambda", dest="lam", type=float, default=1e-4)
     ap.add_argument("--validation-fraction", type=float, default=0.1)
     ap.add_argument("--loss", choices=["standardized", "physical"], default="standardized")
@@ -142,9 +150,15 @@ def main() -> None:
 
     def loss(p, batch):
         rec = jnp.mean((forward(p, batch, flags) - batch) ** 2)
-        return rec + args.lam * sum(jnp.sum(w * w) for w, _ in p), rec
+        return rec + args.lam / n * sum(jnp.sum(w * w) for w, _ in p), rec
 
-    opt = optax.adam(args.learning_rate)
+    steps = args.epochs * -(-len(train) // args.batch_size)
+    rate = (
+        args.learning_rate
+        if args.final_lr_factor == 1.0
+        else optax.exponential_decay(args.learning_rate, steps, args.final_lr_factor)
+    )
+    opt = optax.adam(rate)
     state = opt.init(params)
 
     @jax.jit
@@ -183,6 +197,10 @@ def main() -> None:
         "sizes": sizes,
         "loss": args.loss,
         "epochs": args.epochs,
+        "learning_rate": args.learning_rate,
+        "final_lr_factor": args.final_lr_factor,
+        "seed": args.seed,
+        "latent": args.latent,
         "rmse_full": rmse,
         "epoch_s": epoch_s,
         "epoch_min_s": float(np.min(times[1:])) if len(times) > 1 else float(times[0]),

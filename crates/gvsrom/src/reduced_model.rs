@@ -108,6 +108,13 @@ pub struct TrainingMeta {
     /// Iterations allowed to the final L-BFGS phase (absent: from before the option, 300).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lbfgs_iterations: Option<usize>,
+    /// The snapshot weighting: `"uniform"` or `"relative"` (absent: from before the option,
+    /// uniform).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sample_weighting: Option<String>,
+    /// The floor of the relative weighting (absent for uniform).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub relative_floor: Option<f64>,
     pub epochs_run: usize,
     pub best_epoch: usize,
     pub stop: String,

@@ -203,6 +203,17 @@ pub fn train(
             lr_reductions: Some(options.lr_reductions),
             zero_anchor_rows: Some(anchor_rows),
             lbfgs_iterations: Some(options.fine_tune.lbfgs_iterations()),
+            sample_weighting: Some(
+                match options.sample_weighting {
+                    rom::nn::SampleWeighting::Uniform => "uniform",
+                    rom::nn::SampleWeighting::Relative { .. } => "relative",
+                }
+                .into(),
+            ),
+            relative_floor: match options.sample_weighting {
+                rom::nn::SampleWeighting::Relative { floor } => Some(floor),
+                rom::nn::SampleWeighting::Uniform => None,
+            },
             epochs_run: report.epochs_run,
             best_epoch: report.best_epoch,
             stop: format!("{:?}", report.stop),

@@ -111,12 +111,26 @@ impl Autoencoder {
         let mut scaled = data.to_vec();
         scaling.to_scaled(&mut scaled);
         let tanh = chain_tanh_flags(opts.hidden_layers);
+        // each snapshot's own size in the loss's norm, ‖x / s‖ (not centred: the deviation from
+        // the straight rod), for a relative sample weighting
+        let norms: Vec<f64> = data
+            .chunks_exact(n_features)
+            .map(|x| {
+                x.iter()
+                    .zip(scaling.scale())
+                    .map(|(x, s)| (x / s).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+            })
+            .collect();
+        let weights = opts.sample_weighting.weights(&norms, &train);
         let problem = Problem {
             layers: &mut layers,
             tanh: &tanh,
             data: &scaled,
             train: &train,
             val: &val,
+            weights: weights.as_deref(),
         };
         let outcome = fit(problem, opts, &mut rng, progress);
         // a diverged run or one that never beat its initial weights is no model
@@ -139,7 +153,7 @@ impl Autoencoder {
         let mut errors = |index: &[usize]| {
             let (layers, tanh, scaled, scaling, ws) = (&layers, &tanh, &scaled, &scaling, &mut ws);
             in_pool(|| {
-                let mse = dataset_mse(layers, tanh, scaled, index, ws);
+                let mse = dataset_mse(layers, tanh, scaled, index, weights.as_deref(), ws);
                 (mse, physical_rmse(layers, tanh, scaled, index, scaling, ws))
             })
         };
@@ -283,7 +297,7 @@ fn physical_rmse(
     let n = scaling.len();
     let mut sum = 0.0;
     for chunk in index.chunks(ws.capacity()) {
-        ws.load_rows(scaled, n, chunk);
+        ws.load_rows(scaled, n, chunk, None);
         forward_batch(layers, tanh, ws, chunk.len());
         let (x, y) = (&ws.acts[0][..chunk.len() * n], ws.output(chunk.len()));
         for (xr, yr) in x.chunks_exact(n).zip(y.chunks_exact(n)) {

@@ -6,10 +6,11 @@
 //! The loss is paper eq. (15) with the reconstruction term normalised as a mean squared error over
 //! the batch and the features, on scaled data (see [`crate::nn::Scaling`]):
 //!
-//! `L = (1/(B·n)) Σ_b ‖x̂_b − x_b‖² + λ Σ_k ‖W_k‖²_F`   (biases are not regularised),
+//! `L = (1/(B·n)) Σ_b ω_b ‖x̂_b − x_b‖² + λ Σ_k ‖W_k‖²_F`   (biases are not regularised),
 //!
-//! where the target `x_b` is the chain's own input (an autoencoder). Backpropagation:
-//! `Δ_L = (2/(B·n)) (X̂ − X)`, `∂L/∂W_k = Δ_{k+1}ᵀ H_k + 2λ W_k`, `∂L/∂b_k = Δ_{k+1}ᵀ 1`,
+//! where the target `x_b` is the chain's own input (an autoencoder) and `ω_b` the row's weight (1
+//! unless the rows are loaded with weights: [`crate::nn::SampleWeighting`]). Backpropagation:
+//! `Δ_L = (2/(B·n)) diag(ω) (X̂ − X)`, `∂L/∂W_k = Δ_{k+1}ᵀ H_k + 2λ W_k`, `∂L/∂b_k = Δ_{k+1}ᵀ 1`,
 //! `Δ_k = (Δ_{k+1} W_k) ⊙ σ'_{k−1}` with `σ' = 1 − H_k²` for tanh and 1 for identity.
 //!
 //! All buffers live in a [`Workspace`] sized once for the largest batch, so a training epoch allocates
@@ -73,6 +74,10 @@ pub struct Workspace {
     pub(crate) grad_w: Vec<Vec<f64>>,
     /// `∂L/∂b_k`.
     pub(crate) grad_b: Vec<Vec<f64>>,
+    /// The loss weight `ω_b` of each loaded row, read only when `weighted`.
+    row_weight: Vec<f64>,
+    /// Whether the last [`Workspace::load_rows`] loaded row weights (else every `ω_b = 1`).
+    weighted: bool,
 }
 
 impl Workspace {
@@ -86,6 +91,8 @@ impl Workspace {
             delta: [vec![0.0; capacity * widest], vec![0.0; capacity * widest]],
             grad_w: sizes.windows(2).map(|s| vec![0.0; s[0] * s[1]]).collect(),
             grad_b: sizes.windows(2).map(|s| vec![0.0; s[1]]).collect(),
+            row_weight: vec![1.0; capacity],
+            weighted: false,
         }
     }
 
@@ -94,10 +101,23 @@ impl Workspace {
         self.capacity
     }
 
-    /// Copies data rows `index` (row-major data with `n` features) into the input batch `H_0`.
-    pub(crate) fn load_rows(&mut self, data: &[f64], n: usize, index: &[usize]) {
+    /// Copies data rows `index` (row-major data with `n` features) into the input batch `H_0`, with
+    /// their loss weights `weights[i]` when given (one per data row).
+    pub(crate) fn load_rows(
+        &mut self,
+        data: &[f64],
+        n: usize,
+        index: &[usize],
+        weights: Option<&[f64]>,
+    ) {
         for (b, &i) in index.iter().enumerate() {
             self.acts[0][b * n..(b + 1) * n].copy_from_slice(&data[i * n..(i + 1) * n]);
+        }
+        self.weighted = weights.is_some();
+        if let Some(w) = weights {
+            for (o, &i) in self.row_weight.iter_mut().zip(index) {
+                *o = w[i];
+            }
         }
     }
 
@@ -134,16 +154,22 @@ pub(crate) fn forward_batch(layers: &[Layer], tanh: &[bool], ws: &mut Workspace,
     }
 }
 
-/// Reconstruction mean squared error `(1/(B·n)) Σ ‖x̂_b − x_b‖²` of the last forward pass.
+/// Reconstruction mean squared error `(1/(B·n)) Σ ω_b ‖x̂_b − x_b‖²` of the last forward pass.
 pub(crate) fn reconstruction_mse(ws: &Workspace, rows: usize) -> f64 {
     let n = ws.acts[0].len() / ws.capacity;
     let x = &ws.acts[0][..rows * n];
-    let sum: f64 = ws
-        .output(rows)
-        .iter()
-        .zip(x)
-        .map(|(y, x)| (y - x) * (y - x))
-        .sum();
+    let squares =
+        |y: &[f64], x: &[f64]| -> f64 { y.iter().zip(x).map(|(y, x)| (y - x) * (y - x)).sum() };
+    let sum: f64 = match ws.weighted {
+        false => squares(ws.output(rows), x),
+        true => ws
+            .output(rows)
+            .chunks_exact(n)
+            .zip(x.chunks_exact(n))
+            .zip(&ws.row_weight)
+            .map(|((y, x), w)| w * squares(y, x))
+            .sum(),
+    };
     sum / (rows * n) as f64
 }
 
@@ -180,14 +206,27 @@ fn backward(layers: &[Layer], tanh: &[bool], ws: &mut Workspace, rows: usize, la
         delta: [d_cur, d_prev],
         grad_w,
         grad_b,
+        row_weight,
+        weighted,
         ..
     } = ws;
-    output_delta(
+    let (d, y, x) = (
         &mut d_cur[..rows * n],
         &acts[n_layers][..rows * n],
         &acts[0][..rows * n],
-        scale,
     );
+    match weighted {
+        false => output_delta(d, y, x, scale),
+        true => {
+            let rows = d
+                .chunks_exact_mut(n)
+                .zip(y.chunks_exact(n))
+                .zip(x.chunks_exact(n));
+            for (((d, y), x), w) in rows.zip(row_weight.iter()) {
+                output_delta(d, y, x, scale * w);
+            }
+        }
+    }
     if tanh[n_layers - 1] {
         apply_tanh_derivative(&mut d_cur[..rows * n], &acts[n_layers][..rows * n]);
     }
@@ -303,19 +342,21 @@ pub(crate) fn forward_rows(
     }
 }
 
-/// Mean reconstruction error `(1/(N·n)) Σ ‖x̂ − x‖²` of an autoencoder chain over the data rows
-/// `index` (row-major data with `n` features), evaluated in workspace-sized chunks.
+/// Mean reconstruction error `(1/(N·n)) Σ ω ‖x̂ − x‖²` of an autoencoder chain over the data rows
+/// `index` (row-major data with `n` features; `ω = weights[row]`, or 1), evaluated in
+/// workspace-sized chunks.
 pub(crate) fn dataset_mse(
     layers: &[Layer],
     tanh: &[bool],
     data: &[f64],
     index: &[usize],
+    weights: Option<&[f64]>,
     ws: &mut Workspace,
 ) -> f64 {
     let n = layers[0].n_in;
     let mut sum = 0.0;
     for chunk in index.chunks(ws.capacity) {
-        ws.load_rows(data, n, chunk);
+        ws.load_rows(data, n, chunk, weights);
         forward_batch(layers, tanh, ws, chunk.len());
         sum += reconstruction_mse(ws, chunk.len()) * chunk.len() as f64;
     }
@@ -398,6 +439,76 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn row_weighted_loss_gradient_matches_central_differences() {
+        // With row weights ω_b the loss is (1/(B·n)) Σ_b ω_b ‖x̂_b − x_b‖² + λΣ‖W‖², written here
+        // row by row without the workspace's weighted paths; the weighted backward pass must be its
+        // gradient, and weights of 1 must give the unweighted pass bit for bit.
+        let sizes = [4, 3, 2, 3, 4];
+        let tanh = [true, false, true, false];
+        let mut rng = SplitMix64::new(13);
+        let mut layers = test_layers(&sizes, &mut rng);
+        let (rows, lambda) = (6, 0.01);
+        let x: Vec<f64> = (0..rows * 4).map(|_| rng.range(-1.0, 1.0)).collect();
+        let omega: Vec<f64> = (0..rows).map(|b| 0.1 + 3.0 * b as f64).collect();
+        let index: Vec<usize> = (0..rows).collect();
+        let mut ws = Workspace::new(&sizes, 8);
+        let loss = |layers: &[Layer], ws: &mut Workspace| {
+            ws.load_rows(&x, 4, &index, None);
+            forward_batch(layers, &tanh, ws, rows);
+            let out = ws.output(rows);
+            let mut sum = 0.0;
+            for b in 0..rows {
+                let e: f64 = (0..4)
+                    .map(|j| (out[b * 4 + j] - x[b * 4 + j]).powi(2))
+                    .sum();
+                sum += omega[b] * e;
+            }
+            let penalty: f64 = layers.iter().map(Layer::sum_squared_weights).sum();
+            sum / (rows * 4) as f64 + lambda * penalty
+        };
+        ws.load_rows(&x, 4, &index, Some(&omega));
+        forward_batch(&layers, &tanh, &mut ws, rows);
+        let weighted_mse = reconstruction_mse(&ws, rows);
+        backward_batch(&layers, &tanh, &mut ws, rows, lambda);
+        let (gw, gb) = (ws.grad_w.clone(), ws.grad_b.clone());
+        let penalty: f64 = layers.iter().map(Layer::sum_squared_weights).sum();
+        let direct = loss(&layers, &mut ws);
+        assert!((weighted_mse + lambda * penalty - direct).abs() <= 1e-14 * direct);
+        let h = 1e-5;
+        for k in 0..layers.len() {
+            for (is_w, grad) in [(true, &gw[k]), (false, &gb[k])] {
+                for i in 0..grad.len() {
+                    let probe = |delta: f64, layers: &mut Vec<Layer>| match is_w {
+                        true => layers[k].w[i] += delta,
+                        false => layers[k].b[i] += delta,
+                    };
+                    probe(h, &mut layers);
+                    let up = loss(&layers, &mut ws);
+                    probe(-2.0 * h, &mut layers);
+                    let down = loss(&layers, &mut ws);
+                    probe(h, &mut layers);
+                    let fd = (up - down) / (2.0 * h);
+                    let err = (fd - grad[i]).abs() / grad[i].abs().max(1e-3);
+                    assert!(err <= 1e-6, "layer {k} [{i}]: fd {fd} vs {}", grad[i]);
+                }
+            }
+        }
+        // weights of 1: the unweighted pass (gradients bit for bit; the loss sums per row first,
+        // so to rounding)
+        let ones = vec![1.0; rows];
+        let mut pass = |w: Option<&[f64]>| {
+            ws.load_rows(&x, 4, &index, w);
+            forward_batch(&layers, &tanh, &mut ws, rows);
+            let mse = reconstruction_mse(&ws, rows);
+            backward_batch(&layers, &tanh, &mut ws, rows, lambda);
+            (mse, ws.grad_w.clone(), ws.grad_b.clone())
+        };
+        let (weighted, unweighted) = (pass(Some(&ones)), pass(None));
+        assert_eq!((&weighted.1, &weighted.2), (&unweighted.1, &unweighted.2));
+        assert!((weighted.0 - unweighted.0).abs() <= 1e-15 * unweighted.0);
     }
 
     #[test]

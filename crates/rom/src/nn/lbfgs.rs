@@ -1,6 +1,7 @@
 //! Full-batch L-BFGS on the loss of eq. (15), the optional final training phase.
 //!
-//! The objective is `f(θ) = (1/(N·n)) Σ_b ‖x̂_b − x_b‖² + λ Σ‖W‖²` over all `N` training rows, its
+//! The objective is `f(θ) = (1/(N·n)) Σ_b ω_b ‖x̂_b − x_b‖² + λ Σ‖W‖²` over all `N` training rows
+//! (`ω_b` the row weights, or 1), its
 //! gradient the row-weighted sum of the batch gradients of [`crate::nn::batch`]. The direction is the
 //! two-loop recursion `d = −H g` over the last `memory` pairs `s = θ⁺ − θ`, `y = g⁺ − g` (Nocedal &
 //! Wright, Alg. 7.4, initial `H₀ = (sᵀy / yᵀy) I`); pairs with `sᵀy ≤ 1e-10 ‖s‖‖y‖` are skipped. The
@@ -35,6 +36,8 @@ pub(crate) struct Objective<'a> {
     pub tanh: &'a [bool],
     pub data: &'a [f64],
     pub rows: &'a [usize],
+    /// The loss weight of every data row, or `None` for 1.
+    pub weights: Option<&'a [f64]>,
     pub lambda: f64,
 }
 
@@ -167,7 +170,7 @@ fn value_and_gradient(
     let mut mse = 0.0;
     for chunk in obj.rows.chunks(ws.capacity()) {
         let weight = chunk.len() as f64 / total;
-        ws.load_rows(obj.data, n, chunk);
+        ws.load_rows(obj.data, n, chunk, obj.weights);
         forward_batch(layers, obj.tanh, ws, chunk.len());
         mse += weight * reconstruction_mse(ws, chunk.len());
         backward_batch(layers, obj.tanh, ws, chunk.len(), obj.lambda);

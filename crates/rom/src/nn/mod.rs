@@ -54,7 +54,9 @@ pub use autoencoder::Autoencoder;
 pub use decoder_map::DecoderMap;
 pub use mlp::Mlp;
 pub use scaling::{Scaling, Weighting};
-pub use train::{FineTune, Progress, StopReason, TrainOptions, TrainReport, EXPLODED};
+pub use train::{
+    FineTune, Progress, SampleWeighting, StopReason, TrainOptions, TrainReport, EXPLODED,
+};
 
 use thiserror::Error;
 

@@ -65,6 +65,44 @@ pub struct TrainOptions {
     pub seed: u64,
     /// How each feature's error weighs in the loss (through the data scaling).
     pub weighting: Weighting,
+    /// How each snapshot's error weighs in the loss.
+    pub sample_weighting: SampleWeighting,
+}
+
+/// How each snapshot's (row's) squared error weighs in the loss of eq. (15).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum SampleWeighting {
+    /// Every snapshot weighs 1: eq. (15) as the paper writes it.
+    #[default]
+    Uniform,
+    /// Snapshot `b` weighs `ω_b ∝ 1 / max(‖x_b‖, floor · max_c ‖x_c‖)²` (norms of the snapshots
+    /// themselves, the deviation from the straight rod, in the loss's feature norm), scaled to a
+    /// mean of 1 over the training rows: the loss becomes the *relative* squared error of each
+    /// snapshot, the measure of "strain error in % of the peak", so that small loads (which a
+    /// uniform loss lets the decoder miss by as much as large ones in absolute terms) are fitted as
+    /// closely as large ones. `floor` in (0, 1] bounds the weight of near-zero snapshots.
+    Relative { floor: f64 },
+}
+
+impl SampleWeighting {
+    /// The floor of [`SampleWeighting::Relative`] that `gvsrom train --sample-weighting relative`
+    /// uses: snapshots below a tenth of the largest norm weigh as one at a tenth.
+    pub const DEFAULT_FLOOR: f64 = 0.1;
+
+    /// The weights of data `rows` (row-major, `n` features, already in the loss's scaled units
+    /// but *not* centred: `x / s`) normalised to a mean of 1 over `train`, or `None` for
+    /// [`SampleWeighting::Uniform`].
+    pub(crate) fn weights(&self, norms: &[f64], train: &[usize]) -> Option<Vec<f64>> {
+        let SampleWeighting::Relative { floor } = *self else {
+            return None;
+        };
+        let largest = norms.iter().copied().fold(0.0f64, f64::max);
+        let least = (floor * largest).max(f64::MIN_POSITIVE);
+        let mut w: Vec<f64> = norms.iter().map(|v| 1.0 / v.max(least).powi(2)).collect();
+        let mean = train.iter().map(|&i| w[i]).sum::<f64>() / train.len().max(1) as f64;
+        w.iter_mut().for_each(|v| *v /= mean);
+        Some(w)
+    }
 }
 
 impl Default for TrainOptions {
@@ -82,6 +120,7 @@ impl Default for TrainOptions {
             fine_tune: FineTune::lbfgs(300),
             seed: 0,
             weighting: Weighting::Standardize,
+            sample_weighting: SampleWeighting::Uniform,
         }
     }
 }
@@ -114,6 +153,11 @@ impl TrainOptions {
         }
         if !(0.0..1.0).contains(&self.validation_fraction) {
             return bad("validation_fraction", self.validation_fraction, "in [0, 1)");
+        }
+        if let SampleWeighting::Relative { floor } = self.sample_weighting {
+            if !(floor > 0.0 && floor <= 1.0) {
+                return bad("sample_weighting.floor", floor, "in (0, 1]");
+            }
         }
         if self.patience == Some(0) {
             return bad("patience", 0.0, "≥ 1 epoch, or None");
@@ -362,6 +406,8 @@ pub(crate) struct Problem<'a> {
     pub data: &'a [f64],
     pub train: &'a [usize],
     pub val: &'a [usize],
+    /// The loss weight of every data row ([`SampleWeighting`]), or `None` for 1.
+    pub weights: Option<&'a [f64]>,
 }
 
 /// What [`fit`] observed; the chain ends with the best weights.
@@ -400,7 +446,7 @@ impl Tracker<'_, '_> {
     ) -> Option<StopReason> {
         let val = (!self.val.is_empty()).then(|| {
             let (layers, val) = (&*p.layers, self.val);
-            in_pool(|| dataset_mse(layers, p.tanh, p.data, val, ws))
+            in_pool(|| dataset_mse(layers, p.tanh, p.data, val, p.weights, ws))
         });
         self.out.train_loss.push(train);
         self.out.val_loss.extend(val);
@@ -444,10 +490,11 @@ pub(crate) fn fit(
     let mut ws = Workspace::new(&sizes, opts.batch_size.min(p.train.len()));
     // eq. (15) over n: the mean squared error per entry plus λ/n Σ‖W‖² (module docs)
     let lambda = opts.lambda / sizes[0].max(1) as f64;
-    let initial_train_loss = in_pool(|| dataset_mse(p.layers, p.tanh, p.data, p.train, &mut ws));
+    let initial_train_loss =
+        in_pool(|| dataset_mse(p.layers, p.tanh, p.data, p.train, p.weights, &mut ws));
     let initial_loss = match p.val.is_empty() {
         true => initial_train_loss,
-        false => in_pool(|| dataset_mse(p.layers, p.tanh, p.data, p.val, &mut ws)),
+        false => in_pool(|| dataset_mse(p.layers, p.tanh, p.data, p.val, p.weights, &mut ws)),
     };
     let mut t = Tracker {
         best: p.layers.to_vec(),
@@ -521,7 +568,8 @@ fn adam_phase(
     for _ in 0..epochs {
         shuffle(&mut order, rng);
         let (layers, order, adam) = (&mut *p.layers, &order, &mut adam);
-        let train = in_pool(|| run_epoch(layers, p.tanh, p.data, order, ws, adam, (lr, lambda)));
+        let rows = (p.data, p.weights);
+        let train = in_pool(|| run_epoch(layers, p.tanh, rows, order, ws, adam, (lr, lambda)));
         match t.record(p, ws, train, fine) {
             Some(StopReason::EarlyStopping) if reductions > 0 && t.out.best_epoch > 0 => {
                 // a plateau: back to the best weights with a smaller step
@@ -547,6 +595,7 @@ fn lbfgs_phase(
         tanh: p.tanh,
         data: p.data,
         rows: p.train,
+        weights: p.weights,
         lambda,
     };
     let mut lbfgs = in_pool(|| Lbfgs::new(p.layers, memory, &obj, ws));
@@ -566,7 +615,7 @@ fn lbfgs_phase(
 fn run_epoch(
     layers: &mut [Layer],
     tanh: &[bool],
-    data: &[f64],
+    (data, weights): (&[f64], Option<&[f64]>),
     order: &[usize],
     ws: &mut Workspace,
     adam: &mut Adam,
@@ -575,7 +624,7 @@ fn run_epoch(
     let n = layers[0].n_in;
     let mut sum = 0.0;
     for batch in order.chunks(ws.capacity()) {
-        ws.load_rows(data, n, batch);
+        ws.load_rows(data, n, batch, weights);
         forward_batch(layers, tanh, ws, batch.len());
         sum += reconstruction_mse(ws, batch.len()) * batch.len() as f64;
         backward_batch_without_penalty(layers, tanh, ws, batch.len());
