@@ -292,6 +292,44 @@ pub fn reconstruction_rmse(dataset: &Path, model: &ReducedModel) -> anyhow::Resu
     Ok((sum / count as f64).sqrt())
 }
 
+/// For every solved sample of `dataset`: its value of the input `parameter` and the model's
+/// reconstruction error in the strain-error measure of the accuracy tables, mean `|x̂ − x|` over the
+/// row in % of the row's largest `|x|` (for an autoencoder through its encoder; the best point of
+/// the decoder's manifold, which a reduced equilibrium of a linear-elastic problem reaches, is at
+/// most this far). Rows with no strain are skipped.
+pub fn relative_errors(
+    dataset: &Path,
+    model: &ReducedModel,
+    parameter: &str,
+) -> anyhow::Result<Vec<(f64, f64)>> {
+    let ds = Dataset::load(dataset)?;
+    let d = ds.meta.parameters.len();
+    let column = ds
+        .meta
+        .parameters
+        .iter()
+        .position(|p| p == parameter)
+        .ok_or_else(|| anyhow::anyhow!("`{}` varies no `{parameter}`", dataset.display()))?;
+    let mut out = vec![];
+    for k in ds.ok_rows() {
+        let x = ds.strain_row(k);
+        let peak = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if peak == 0.0 {
+            continue;
+        }
+        let rec: Vec<f64> = match &model.weights {
+            ModelWeights::Autoencoder(ae) => ae.reconstruct(x)?,
+            ModelWeights::Pod { modes, .. } => {
+                let v = nalgebra::DVector::from_column_slice(x);
+                (modes * (modes.transpose() * v)).iter().copied().collect()
+            }
+        };
+        let mae = x.iter().zip(&rec).map(|(a, b)| (a - b).abs()).sum::<f64>() / x.len() as f64;
+        out.push((ds.inputs[k * d + column], 100.0 * mae / peak));
+    }
+    Ok(out)
+}
+
 /// One model of an evaluation: a label, and a reduced model's directory (None: the HOM).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct EvalModel {
