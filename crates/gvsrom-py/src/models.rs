@@ -174,6 +174,11 @@ const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 ///     never stop early).
 /// loss : str
 ///     ``"energy"``, ``"physical"`` or ``"standardized"``.
+/// sample_weighting : str
+///     ``"uniform"`` (eq. 15) or ``"relative"``: each snapshot's squared error over its own
+///     squared norm, so that small loads are fitted as closely as large ones.
+/// relative_floor : float
+///     The relative weighting's floor, a fraction of the largest snapshot norm in (0, 1].
 /// force : bool
 ///     Replace ``out`` if it is an earlier gvsrom output.
 ///
@@ -182,7 +187,7 @@ const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 /// Model
 ///     The new model.
 #[pyfunction]
-#[pyo3(signature = (dataset, out, latent=1, hidden_layers=7, epochs=2000, batch_size=64, learning_rate=1e-3, lambda_=1e-4, validation_fraction=0.1, patience=50, lr_reductions=4, lbfgs_iterations=300, seed=0, loss="energy", force=false))]
+#[pyo3(signature = (dataset, out, latent=1, hidden_layers=7, epochs=2000, batch_size=64, learning_rate=1e-3, lambda_=1e-4, validation_fraction=0.1, patience=50, lr_reductions=4, lbfgs_iterations=300, seed=0, loss="energy", sample_weighting="uniform", relative_floor=0.1, force=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn train(
     py: Python<'_>,
@@ -200,6 +205,8 @@ pub fn train(
     lbfgs_iterations: usize,
     seed: u64,
     loss: &str,
+    sample_weighting: &str,
+    relative_floor: f64,
     force: bool,
 ) -> PyResult<Model> {
     use gvsrom::reduce::Loss;
@@ -224,6 +231,8 @@ pub fn train(
         seed,
         lr_reductions,
         fine_tune: rom::nn::FineTune::lbfgs(lbfgs_iterations),
+        sample_weighting: gvsrom::reduce::sample_weighting(sample_weighting, relative_floor)
+            .map_err(errors::scenario)?,
         ..TrainOptions::default()
     };
     let mut interrupt: Option<PyErr> = None;

@@ -97,6 +97,21 @@ def test_a_python_dataset_trains_models_whose_arrays_and_statics_hold(sweep, tmp
     np.testing.assert_allclose(k1, f - rom.statics_residual(q, u=[0.0]), rtol=0, atol=1e-12 * scale)
 
 
+def test_a_relative_sample_weighting_is_recorded_and_a_bad_one_refused_as_the_cli_does(
+        gvsrom_bin, sweep, tmp_path):
+    ae = gvsrom.train(sweep.path, tmp_path / "rel", latent=1, hidden_layers=3, epochs=5, patience=0,
+                      lbfgs_iterations=0, sample_weighting="relative", relative_floor=0.2)
+    assert ae.meta["training"]["sample_weighting"] == "relative"
+    assert ae.meta["training"]["relative_floor"] == 0.2
+    expected = cli_error(gvsrom_bin, "train", str(sweep.path), "--sample-weighting", "relative",
+                         "--relative-floor", "0", "--out", str(tmp_path / "cli"))
+    with pytest.raises(gvsrom.GvsromError) as e:
+        gvsrom.train(sweep.path, tmp_path / "py", sample_weighting="relative", relative_floor=0.0)
+    assert str(e.value) == expected
+    with pytest.raises(gvsrom.GvsromError, match="--sample-weighting.*accepted: uniform, relative"):
+        gvsrom.train(sweep.path, tmp_path / "py", sample_weighting="per-row")
+
+
 def test_bad_plans_are_refused_with_the_cli_message(gvsrom_bin, tmp_path):
     expected = cli_error(gvsrom_bin, "dataset", "single-tendon", "--sweep", "tendons.0.tension=-6",
                          "--samples", "3", "--out", str(tmp_path / "cli"))

@@ -248,6 +248,8 @@ def train(
     lbfgs_iterations: int = 300,
     seed: int = 0,
     loss: str = "energy",
+    sample_weighting: str = "uniform",
+    relative_floor: float = 0.1,
     force: bool = False,
 ) -> Model: ...
 

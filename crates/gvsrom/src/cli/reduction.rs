@@ -65,7 +65,7 @@ pub struct TrainArgs {
     /// How each snapshot's error weighs: `uniform` (eq. 15 as the paper writes it) or `relative`
     /// (each snapshot by the inverse of its own squared norm, floored at `--relative-floor` of the
     /// largest: the relative error, so that small loads are fitted as closely as large ones).
-    #[arg(long, default_value = "uniform", value_parser = ["uniform", "relative"])]
+    #[arg(long, default_value = "uniform", value_parser = reduce::SAMPLE_WEIGHTINGS)]
     pub sample_weighting: String,
     /// The floor of `--sample-weighting relative`, as a fraction of the largest snapshot norm, in
     /// (0, 1].
@@ -129,12 +129,7 @@ pub(super) fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
         seed: args.seed,
         lr_reductions: args.lr_reductions,
         fine_tune: rom::nn::FineTune::lbfgs(args.lbfgs_iterations),
-        sample_weighting: match args.sample_weighting.as_str() {
-            "relative" => rom::nn::SampleWeighting::Relative {
-                floor: args.relative_floor,
-            },
-            _ => rom::nn::SampleWeighting::Uniform,
-        },
+        sample_weighting: reduce::sample_weighting(&args.sample_weighting, args.relative_floor)?,
         ..TrainOptions::default()
     };
     let signal = interrupt_flag();

@@ -11,7 +11,7 @@ use crate::error::ScenarioError;
 use crate::output::OutputDir;
 use crate::reduced_model::{ModelMeta, ModelWeights, ReducedModel, TrainingMeta};
 use nalgebra::DVector;
-use rom::nn::{Autoencoder, TrainOptions, TrainReport};
+use rom::nn::{Autoencoder, SampleWeighting, TrainOptions, TrainReport};
 use rom::reduced::{projection_residual, PointLayout};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
@@ -205,14 +205,14 @@ pub fn train(
             lbfgs_iterations: Some(options.fine_tune.lbfgs_iterations()),
             sample_weighting: Some(
                 match options.sample_weighting {
-                    rom::nn::SampleWeighting::Uniform => "uniform",
-                    rom::nn::SampleWeighting::Relative { .. } => "relative",
+                    SampleWeighting::Uniform => "uniform",
+                    SampleWeighting::Relative { .. } => "relative",
                 }
                 .into(),
             ),
             relative_floor: match options.sample_weighting {
-                rom::nn::SampleWeighting::Relative { floor } => Some(floor),
-                rom::nn::SampleWeighting::Uniform => None,
+                SampleWeighting::Relative { floor } => Some(floor),
+                SampleWeighting::Uniform => None,
             },
             epochs_run: report.epochs_run,
             best_epoch: report.best_epoch,
@@ -269,6 +269,26 @@ pub fn train(
     })
 }
 
+/// The names of the snapshot weightings (`gvsrom train --sample-weighting`).
+pub const SAMPLE_WEIGHTINGS: [&str; 2] = ["uniform", "relative"];
+
+/// The snapshot weighting named `name` ([`SAMPLE_WEIGHTINGS`]); `floor` (a fraction of the largest
+/// snapshot norm, in (0, 1]) bounds the relative weighting's weights.
+pub fn sample_weighting(name: &str, floor: f64) -> Result<SampleWeighting, ScenarioError> {
+    match name {
+        "uniform" => Ok(SampleWeighting::Uniform),
+        "relative" if floor > 0.0 && floor <= 1.0 => Ok(SampleWeighting::Relative { floor }),
+        "relative" => Err(invalid(
+            "--relative-floor",
+            format!("{floor} (accepted: a fraction of the largest snapshot norm in (0, 1])"),
+        )),
+        _ => Err(invalid(
+            "--sample-weighting",
+            format!("`{name}` (accepted: {})", SAMPLE_WEIGHTINGS.join(", ")),
+        )),
+    }
+}
+
 /// Copies of the zero-strain snapshot added to `rows` training rows: for trajectory data (which
 /// start from the straight rod at rest, as every simulation from rest does) 1 % of the rows and at
 /// least 10, so that the straight rod is a point of the learned manifold and not just one sample
@@ -294,4 +314,31 @@ pub(super) fn train_error(e: &rom::nn::NnError) -> ScenarioError {
         _ => "train".to_string(),
     };
     invalid(&option, e.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sample_weightings_are_named_and_a_bad_name_or_floor_is_refused_by_its_option() {
+        assert_eq!(
+            sample_weighting("uniform", 0.0).unwrap(),
+            SampleWeighting::Uniform
+        );
+        assert_eq!(
+            sample_weighting("relative", 0.25).unwrap(),
+            SampleWeighting::Relative { floor: 0.25 }
+        );
+        for (name, floor, field) in [
+            ("relative", 0.0, "--relative-floor"),
+            ("relative", 1.5, "--relative-floor"),
+            ("relative", f64::NAN, "--relative-floor"),
+            ("per-row", 0.1, "--sample-weighting"),
+        ] {
+            let e = sample_weighting(name, floor).unwrap_err().to_string();
+            assert!(e.starts_with(&format!("invalid `{field}`")), "{name} {floor}: {e}");
+            assert!(e.contains("accepted"), "{e}");
+        }
+    }
 }

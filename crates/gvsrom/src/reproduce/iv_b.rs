@@ -368,7 +368,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     report.notes = vec![
         "Table I's bottom half is measured in the paper's convention (total moment in N·m); the variant `soft-beam-peak` (`convention = \"peak\"`, the magnitude read as the peak line density) gives 25× smaller strains.".into(),
         format!(
-            "Table I at 7 hidden layers, ours / the paper's: r = 1 {}, r = 2 {}, r = 3 {}. The weight penalty weighs against a whole snapshot's squared error, as eq. (15) writes it; against the per-entry mean it is 148× stronger here and held the r = 2 error at 3.9 (docs/assumptions.md). A 1-D code of this 2-D family is a hard, non-convex fit: training stops at its first plateaus.",
+            "Table I at 7 hidden layers, ours / the paper's: r = 1 {}, r = 2 {}, r = 3 {}. The weight penalty weighs against a whole snapshot's squared error, as eq. (15) writes it; against the per-entry mean it is 148× stronger here and held the r = 2 error at 3.9 (docs/assumptions.md). A 1-D code of this 2-D family is a hard, non-convex fit: an independent JAX + optax trainer of the same architecture (scripts/ae_reference.py) lands where gvsrom does, 10.3 and 11.4 at r = 1 for two seeds, 0.547 at r = 2 and 0.396 at r = 3 (docs/assumptions.md).",
             ratio_at_7(&aes, 0),
             ratio_at_7(&aes, 1),
             ratio_at_7(&aes, 2)

@@ -639,6 +639,32 @@ mod tests {
     use crate::nn::batch::{backward_batch, test_layers};
 
     #[test]
+    fn relative_sample_weights_are_inverse_squared_norms_floored_with_mean_one() {
+        // norms 1, 2, 0 (the straight rod) and 10, floor 0.2: the least norm is 2, so the weights
+        // are 1/4, 1/4, 1/4, 1/100 before the mean over the training rows {0, 1, 3} is made 1.
+        let w = SampleWeighting::Relative { floor: 0.2 }
+            .weights(&[1.0, 2.0, 0.0, 10.0], &[0, 1, 3])
+            .unwrap();
+        let mean = (0.25 + 0.25 + 0.01) / 3.0;
+        let expected = [0.25 / mean, 0.25 / mean, 0.25 / mean, 0.01 / mean];
+        for (a, b) in w.iter().zip(expected) {
+            assert!((a - b).abs() <= 1e-15 * b, "{w:?} vs {expected:?}");
+        }
+        assert!(SampleWeighting::Uniform.weights(&[1.0], &[0]).is_none());
+        let bad = TrainOptions {
+            sample_weighting: SampleWeighting::Relative { floor: 0.0 },
+            ..TrainOptions::default()
+        };
+        assert!(matches!(
+            bad.validate(),
+            Err(NnError::InvalidOption {
+                field: "sample_weighting.floor",
+                ..
+            })
+        ));
+    }
+
+    #[test]
     fn adam_step_adds_the_penalty_as_backward_batch_does() {
         // Two Adam steps with the penalty added in the update equal, bit for bit, the update on the
         // full gradient of `backward_batch`; and the textbook update to rounding.
