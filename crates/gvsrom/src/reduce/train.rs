@@ -337,7 +337,10 @@ mod tests {
             ("per-row", 0.1, "--sample-weighting"),
         ] {
             let e = sample_weighting(name, floor).unwrap_err().to_string();
-            assert!(e.starts_with(&format!("invalid `{field}`")), "{name} {floor}: {e}");
+            assert!(
+                e.starts_with(&format!("invalid `{field}`")),
+                "{name} {floor}: {e}"
+            );
             assert!(e.contains("accepted"), "{e}");
         }
     }

@@ -41,15 +41,7 @@ pub(super) fn run_more_tests(
                 ..test.clone()
             };
             let tag = format!("test seed {seed}");
-            let hom = simulate_test(
-                run,
-                &format!("iv-c2/test-hom-seed{seed}"),
-                &format!("HOM ({tag})"),
-                scenario,
-                &t,
-                None,
-                None,
-            )?;
+            let hom = hom_run(run, scenario, &t)?;
             let ae_run = simulate_test(
                 run,
                 &format!("iv-c2/test-ae-r{r}-test-seed{seed}"),
@@ -76,6 +68,24 @@ pub(super) fn run_more_tests(
             })
         })
         .collect()
+}
+
+/// The HOM's run of `test` (with its own seed, not the paper's [`super::TEST_SEED`]): a step that
+/// every model tested on that input compares with.
+pub(super) fn hom_run(
+    run: &Run,
+    scenario: &ScenarioSpec,
+    test: &Test,
+) -> anyhow::Result<Step<SimRun>> {
+    simulate_test(
+        run,
+        &format!("iv-c2/test-hom-seed{}", test.seed),
+        &format!("HOM (test seed {})", test.seed),
+        scenario,
+        test,
+        None,
+        None,
+    )
 }
 
 /// Per test input: both ROMs' mean tip error, wall time and status, and the HOM's time; the mean
