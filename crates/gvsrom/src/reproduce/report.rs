@@ -142,10 +142,13 @@ impl CaseReport {
         }
         for t in &self.tables {
             s.push_str(&format!("\n## {}\n\n", t.title));
-            s.push_str(&format!("| {} |\n", t.columns.join(" | ")));
+            // a `|` inside a cell (|ξ − ξ*|) would end it: Markdown's escape keeps it
+            let escape = |c: &str| c.replace('|', "\\|");
+            let columns: Vec<String> = t.columns.iter().map(|c| escape(c)).collect();
+            s.push_str(&format!("| {} |\n", columns.join(" | ")));
             s.push_str(&format!("|{}\n", "---|".repeat(t.columns.len())));
             for row in &t.rows {
-                let cells: Vec<String> = row.iter().map(Cell::render).collect();
+                let cells: Vec<String> = row.iter().map(|c| escape(&c.render())).collect();
                 s.push_str(&format!("| {} |\n", cells.join(" | ")));
             }
             if !t.note.is_empty() {
@@ -256,6 +259,25 @@ pub fn ratio(ours: f64, paper: f64) -> Cell {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_bar_inside_a_cell_is_escaped_and_does_not_split_the_markdown_row() {
+        let mut r = super::super::new_report(super::super::Case::IvC2, "t");
+        r.tables.push(Table {
+            id: "t".into(),
+            title: "T".into(),
+            columns: vec!["r".into(), "max |ξ − ξ*|".into()],
+            rows: vec![vec![Cell::int(7), Cell::text("|a|")]],
+            note: String::new(),
+        });
+        let md = r.markdown();
+        assert!(md.contains("| r | max \\|ξ − ξ*\\| |"), "{md}");
+        assert!(md.contains("| 7 | \\|a\\| |"), "{md}");
+        // every row has as many unescaped separators as the header
+        let cells = |l: &str| l.replace("\\|", "").matches('|').count();
+        let rows: Vec<&str> = md.lines().filter(|l| l.starts_with('|')).take(3).collect();
+        assert!(rows.iter().all(|l| cells(l) == 3), "{rows:?}");
+    }
 
     #[test]
     fn numbers_print_with_their_digits() {
