@@ -11,7 +11,7 @@
 
 mod more_tests;
 mod report;
-mod spread;
+mod variants;
 
 use super::report::{CaseReport, RenderedFigure};
 use super::sim_test::{simulate_test, SimRun, Test};
@@ -26,7 +26,7 @@ use report::{
     Inset,
 };
 use serde_json::json;
-use spread::{run_spread, spread_finding, spread_table};
+use variants::{run_variant, variant_finding, variant_table, DataVariant};
 
 /// Hidden layers of every autoencoder (the paper's deepest, as in Table I).
 const HIDDEN_LAYERS: usize = 7;
@@ -268,31 +268,34 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         &inset_dof.ae,
         &inset_dof.pod,
     )?);
-    // beyond the paper: the same budget over a longer babbling, on the same inputs; a model the
-    // inputs lie outside of (a short quick-run babbling may not reach the test's tensions) leaves
-    // the study out, with the reason in the notes
-    let spread = run_spread(
-        run,
-        &scenario,
-        &plan,
-        opts.jobs,
-        &ae_config(inset, LAMBDA, first_seed),
-        &test,
-        &hom,
-        &std::iter::once(TEST_SEED)
-            .chain(s.more_tests.iter().copied())
-            .collect::<Vec<_>>(),
-    );
-    run.check_interrupt()?;
-    let (spread, spread_skipped) = match spread {
-        Ok(spread) => (Some(spread), None),
-        Err(e) => (
-            None,
-            Some(format!(
-                "The study of the same budget over a longer babbling was left out: {e:#}"
+    // beyond the paper: the same budget over a longer babbling, and a more damped arm, on the same
+    // inputs; a variant whose model the inputs lie outside of (a short quick-run babbling may not
+    // reach the test's tensions) is left out, with the reason in the notes
+    let test_seeds: Vec<u64> = std::iter::once(TEST_SEED)
+        .chain(s.more_tests.iter().copied())
+        .collect();
+    let mut variant_runs = vec![];
+    let mut variants_skipped = vec![];
+    for variant in [DataVariant::Spread, DataVariant::Damped] {
+        let result = run_variant(
+            run,
+            variant,
+            &scenario,
+            &plan,
+            opts.jobs,
+            &ae_config(inset, LAMBDA, first_seed),
+            &test,
+            &hom,
+            &test_seeds,
+        );
+        run.check_interrupt()?;
+        match result {
+            Ok(v) => variant_runs.push(v),
+            Err(e) => variants_skipped.push(format!(
+                "The variant {variant:?} (beyond the paper) was left out: {e:#}"
             )),
-        ),
-    };
+        }
+    }
     let (ae, pod) = inset_runs.expect("the inset's r is tried");
     let trajectories = Inset {
         r: inset,
@@ -325,16 +328,18 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     report.tables.push(fig9_table(&dofs, &hom));
     report.tables.push(table_iii(inset_dof, &hom));
     report.tables.push(more_tests_table(inset, &tests));
-    if let Some(spread) = &spread {
-        report.tables.push(spread_table(inset, spread, &plan));
+    for v in &variant_runs {
+        report.tables.push(variant_table(inset, v, &plan));
     }
     report.tables.push(lambda_table(inset, &lambdas));
     report.tables.push(models_table(&dofs));
     report.findings = findings(&dofs, &hom, inset_dof);
     report.findings.extend(more_tests_findings(inset, &tests));
-    report
-        .findings
-        .extend(spread.as_ref().map(|sp| spread_finding(inset, sp)));
+    report.findings.extend(
+        variant_runs
+            .iter()
+            .map(|v| variant_finding(inset, v, &plan)),
+    );
     let context = Context {
         data_s: s.data_s,
         swing: tip_travel(&trajectories.hom, 1.0),
@@ -342,7 +347,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         lambdas: &lambdas,
     };
     report.notes = notes(&dofs, &hom, inset_dof, &context);
-    report.notes.extend(spread_skipped);
+    report.notes.extend(variants_skipped);
     report.settings = json!({
         "scenario": scenario,
         "plan": plan,
@@ -360,10 +365,10 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
             "ae": d.ae_run, "pod": d.pod_run,
         })).collect::<Vec<_>>(),
         "more_tests": tests,
-        "spread": spread.as_ref().map(|sp| json!({
-            "dataset": sp.data.value, "ae_model": sp.ae.value,
-            "pod_model": sp.pod.value, "tests": sp.tests,
-        })),
+        "variants": variant_runs.iter().map(|v| json!({
+            "variant": format!("{:?}", v.variant), "dataset": v.data.value,
+            "ae_model": v.ae.value, "pod_model": v.pod.value, "tests": v.tests,
+        })).collect::<Vec<_>>(),
         "lambda": lambdas.iter().map(|v| json!({
             "lambda": v.lambda, "seed": v.seed, "model": v.model, "run": v.run,
         })).collect::<Vec<_>>(),
