@@ -12,6 +12,7 @@ use super::report::{figure, CaseReport, Cell, Finding, RenderedFigure, Table};
 use super::step::Step;
 use super::tasks::{self, AeConfig, DatasetSpec, EvalModel, Evaluation, ScenarioSpec};
 use super::{iv_common, new_report, paper, Case, Options, Run};
+use crate::dataset::Dataset;
 use crate::plot::{palette, Figure, SeriesStyle};
 use crate::reduced_model::ReducedModel;
 use serde_json::json;
@@ -86,7 +87,8 @@ fn pod_index(modes: &[usize], k: usize) -> anyhow::Result<usize> {
         .ok_or_else(|| anyhow::anyhow!("no POD-{k} among the POD models {modes:?}"))
 }
 
-/// Bins of the load magnitude |M| [N·m] of [`error_by_magnitude`].
+/// Bins of the load magnitude |M| [N·m] of [`error_by_magnitude`]; the last is closed (the data's
+/// largest magnitude, 5 N·m).
 const MAGNITUDE_BINS: [f64; 6] = [0.0, 0.5, 1.0, 1.5, 2.5, 5.0];
 
 /// The AE-2's and POD-2's reconstruction error over the dataset by load magnitude: where the
@@ -96,35 +98,38 @@ fn error_by_magnitude(
     ae: &Step<tasks::ModelInfo>,
     pod: &Step<tasks::ModelInfo>,
 ) -> anyhow::Result<Table> {
-    let parameter = "loads.distributed.0.magnitude";
-    let errors = |m: &Step<tasks::ModelInfo>| -> anyhow::Result<Vec<(f64, f64)>> {
-        tasks::relative_errors(data, &ReducedModel::load(&m.path)?, parameter)
-    };
-    let (ae, pod) = (errors(ae)?, errors(pod)?);
+    let (ae, pod) = (
+        ReducedModel::load(&ae.path)?,
+        ReducedModel::load(&pod.path)?,
+    );
+    let errors = tasks::relative_errors(
+        &Dataset::load(data)?,
+        &[&ae, &pod],
+        "loads.distributed.0.magnitude",
+    )?;
+    let top = MAGNITUDE_BINS[MAGNITUDE_BINS.len() - 1];
     let rows = MAGNITUDE_BINS
         .windows(2)
         .map(|b| {
-            let inside = |e: &[(f64, f64)]| -> Vec<f64> {
-                e.iter()
-                    .filter(|(m, _)| {
-                        (b[0]..b[1]).contains(&m.abs()) || (b[1] == 5.0 && m.abs() == 5.0)
-                    })
-                    .map(|&(_, v)| v)
-                    .collect()
-            };
-            let (a, p) = (inside(&ae), inside(&pod));
-            let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
-            let above = a.iter().filter(|&&v| v >= 1.0).count();
+            let last = b[1] == top;
+            let inside: Vec<&Vec<f64>> = errors
+                .iter()
+                .filter(|(m, _)| (b[0]..b[1]).contains(&m.abs()) || (last && m.abs() == top))
+                .map(|(_, e)| e)
+                .collect();
+            let n = inside.len().max(1) as f64;
+            let mean = |i: usize| inside.iter().map(|e| e[i]).sum::<f64>() / n;
+            let above = inside.iter().filter(|e| e[0] >= 1.0).count();
             vec![
-                Cell::text(match b[1] == 5.0 {
+                Cell::text(match last {
                     true => format!("[{}, {}]", b[0], b[1]),
                     false => format!("[{}, {})", b[0], b[1]),
                 }),
-                Cell::int(a.len()),
-                Cell::sig(mean(&a), 3),
-                Cell::sig(a.iter().fold(0.0f64, |m, v| m.max(*v)), 3),
-                Cell::sig(100.0 * above as f64 / a.len().max(1) as f64, 3),
-                Cell::sig(mean(&p), 3),
+                Cell::int(inside.len()),
+                Cell::sig(mean(0), 3),
+                Cell::sig(inside.iter().fold(0.0f64, |m, e| m.max(e[0])), 3),
+                Cell::sig(100.0 * above as f64 / n, 3),
+                Cell::sig(mean(1), 3),
             ]
         })
         .collect();

@@ -274,13 +274,7 @@ pub fn reconstruction_rmse(dataset: &Path, model: &ReducedModel) -> anyhow::Resu
     let (mut sum, mut count) = (0.0, 0usize);
     for k in ds.ok_rows() {
         let x = ds.strain_row(k);
-        let rec: Vec<f64> = match &model.weights {
-            ModelWeights::Autoencoder(ae) => ae.reconstruct(x)?,
-            ModelWeights::Pod { modes, .. } => {
-                let v = nalgebra::DVector::from_column_slice(x);
-                (modes * (modes.transpose() * v)).iter().copied().collect()
-            }
-        };
+        let rec = reconstruct(model, x)?;
         sum += x
             .iter()
             .zip(&rec)
@@ -292,24 +286,35 @@ pub fn reconstruction_rmse(dataset: &Path, model: &ReducedModel) -> anyhow::Resu
     Ok((sum / count as f64).sqrt())
 }
 
-/// For every solved sample of `dataset`: its value of the input `parameter` and the model's
+/// A model's reconstruction of snapshot `x`: an autoencoder's decoding of its encoding, POD's
+/// projection `V Vᵀ x`.
+fn reconstruct(model: &ReducedModel, x: &[f64]) -> anyhow::Result<Vec<f64>> {
+    Ok(match &model.weights {
+        ModelWeights::Autoencoder(ae) => ae.reconstruct(x)?,
+        ModelWeights::Pod { modes, .. } => {
+            let v = nalgebra::DVector::from_column_slice(x);
+            (modes * (modes.transpose() * v)).iter().copied().collect()
+        }
+    })
+}
+
+/// For every solved sample of `ds`: its value of the input `parameter` and each of `models`'
 /// reconstruction error in the strain-error measure of the accuracy tables, mean `|x̂ − x|` over the
 /// row in % of the row's largest `|x|` (for an autoencoder through its encoder; the best point of
 /// the decoder's manifold, which a reduced equilibrium of a linear-elastic problem reaches, is at
 /// most this far). Rows with no strain are skipped.
 pub fn relative_errors(
-    dataset: &Path,
-    model: &ReducedModel,
+    ds: &Dataset,
+    models: &[&ReducedModel],
     parameter: &str,
-) -> anyhow::Result<Vec<(f64, f64)>> {
-    let ds = Dataset::load(dataset)?;
+) -> anyhow::Result<Vec<(f64, Vec<f64>)>> {
     let d = ds.meta.parameters.len();
     let column = ds
         .meta
         .parameters
         .iter()
         .position(|p| p == parameter)
-        .ok_or_else(|| anyhow::anyhow!("`{}` varies no `{parameter}`", dataset.display()))?;
+        .ok_or_else(|| anyhow::anyhow!("the dataset varies no `{parameter}`"))?;
     let mut out = vec![];
     for k in ds.ok_rows() {
         let x = ds.strain_row(k);
@@ -317,15 +322,15 @@ pub fn relative_errors(
         if peak == 0.0 {
             continue;
         }
-        let rec: Vec<f64> = match &model.weights {
-            ModelWeights::Autoencoder(ae) => ae.reconstruct(x)?,
-            ModelWeights::Pod { modes, .. } => {
-                let v = nalgebra::DVector::from_column_slice(x);
-                (modes * (modes.transpose() * v)).iter().copied().collect()
-            }
-        };
-        let mae = x.iter().zip(&rec).map(|(a, b)| (a - b).abs()).sum::<f64>() / x.len() as f64;
-        out.push((ds.inputs[k * d + column], 100.0 * mae / peak));
+        let errors = models
+            .iter()
+            .map(|m| {
+                let rec = reconstruct(m, x)?;
+                let mae = x.iter().zip(&rec).map(|(a, b)| (a - b).abs()).sum::<f64>();
+                Ok(100.0 * mae / x.len() as f64 / peak)
+            })
+            .collect::<anyhow::Result<Vec<f64>>>()?;
+        out.push((ds.inputs[k * d + column], errors));
     }
     Ok(out)
 }

@@ -111,19 +111,9 @@ impl Autoencoder {
         let mut scaled = data.to_vec();
         scaling.to_scaled(&mut scaled);
         let tanh = chain_tanh_flags(opts.hidden_layers);
-        // each snapshot's own size in the loss's norm, ‖x / s‖ (not centred: the deviation from
-        // the straight rod), for a relative sample weighting
-        let norms: Vec<f64> = data
-            .chunks_exact(n_features)
-            .map(|x| {
-                x.iter()
-                    .zip(scaling.scale())
-                    .map(|(x, s)| (x / s).powi(2))
-                    .sum::<f64>()
-                    .sqrt()
-            })
-            .collect();
-        let weights = opts.sample_weighting.weights(&norms, &train);
+        let weights = opts
+            .sample_weighting
+            .weights(data, n_features, scaling.scale(), &train);
         let problem = Problem {
             layers: &mut layers,
             tanh: &tanh,

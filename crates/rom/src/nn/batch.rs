@@ -396,6 +396,41 @@ mod tests {
         reconstruction_mse(ws, rows) + lambda * penalty
     }
 
+    /// Checks the gradients `gw`, `gb` of every weight and bias of `layers` against central
+    /// differences of `loss` (h = 1e-5: truncation O(h²) ≈ 1e-10, rounding ≈ 1e-16/h ≈ 1e-11),
+    /// relative to max(|g|, 1e-3), within 1e-6.
+    fn assert_gradient_is_central_differences(
+        layers: &mut [Layer],
+        gw: &[Vec<f64>],
+        gb: &[Vec<f64>],
+        mut loss: impl FnMut(&[Layer]) -> f64,
+    ) {
+        let h = 1e-5;
+        for k in 0..layers.len() {
+            for (is_w, grad) in [(true, &gw[k]), (false, &gb[k])] {
+                for i in 0..grad.len() {
+                    let probe = |delta: f64, layers: &mut [Layer]| match is_w {
+                        true => layers[k].w[i] += delta,
+                        false => layers[k].b[i] += delta,
+                    };
+                    probe(h, layers);
+                    let up = loss(layers);
+                    probe(-2.0 * h, layers);
+                    let down = loss(layers);
+                    probe(h, layers);
+                    let fd = (up - down) / (2.0 * h);
+                    let err = (fd - grad[i]).abs() / grad[i].abs().max(1e-3);
+                    assert!(
+                        err <= 1e-6,
+                        "layer {k} {} [{i}]: fd {fd} vs {}",
+                        if is_w { "W" } else { "b" },
+                        grad[i]
+                    );
+                }
+            }
+        }
+    }
+
     #[test]
     fn gradient_matches_central_differences_on_tiny_autoencoder() {
         // 4 → 3 → 2 (linear latent) → 3 → 4 (linear output), 5 samples, random biases.
@@ -410,42 +445,16 @@ mod tests {
         forward_batch(&layers, &tanh, &mut ws, rows);
         backward_batch(&layers, &tanh, &mut ws, rows, lambda);
         let (gw, gb) = (ws.grad_w.clone(), ws.grad_b.clone());
-        let h = 1e-5;
-        for k in 0..layers.len() {
-            for (is_w, grad) in [(true, &gw[k]), (false, &gb[k])] {
-                for i in 0..grad.len() {
-                    let probe = |delta: f64, layers: &mut Vec<Layer>| {
-                        let p = if is_w {
-                            &mut layers[k].w[i]
-                        } else {
-                            &mut layers[k].b[i]
-                        };
-                        *p += delta;
-                    };
-                    probe(h, &mut layers);
-                    let up = total_loss(&layers, &tanh, &mut ws, rows, lambda);
-                    probe(-2.0 * h, &mut layers);
-                    let down = total_loss(&layers, &tanh, &mut ws, rows, lambda);
-                    probe(h, &mut layers);
-                    let fd = (up - down) / (2.0 * h);
-                    // Central differences: truncation O(h²) ≈ 1e-10, rounding ≈ 1e-16/h ≈ 1e-11.
-                    let err = (fd - grad[i]).abs() / grad[i].abs().max(1e-3);
-                    assert!(
-                        err <= 1e-6,
-                        "layer {k} {} [{i}]: fd {fd} vs {}",
-                        if is_w { "W" } else { "b" },
-                        grad[i]
-                    );
-                }
-            }
-        }
+        assert_gradient_is_central_differences(&mut layers, &gw, &gb, |layers| {
+            total_loss(layers, &tanh, &mut ws, rows, lambda)
+        });
     }
 
     #[test]
     fn row_weighted_loss_gradient_matches_central_differences() {
         // With row weights ω_b the loss is (1/(B·n)) Σ_b ω_b ‖x̂_b − x_b‖² + λΣ‖W‖², written here
         // row by row without the workspace's weighted paths; the weighted backward pass must be its
-        // gradient, and weights of 1 must give the unweighted pass bit for bit.
+        // gradient, and weights of 1 must give the unweighted gradients bit for bit.
         let sizes = [4, 3, 2, 3, 4];
         let tanh = [true, false, true, false];
         let mut rng = SplitMix64::new(13);
@@ -477,25 +486,9 @@ mod tests {
         let penalty: f64 = layers.iter().map(Layer::sum_squared_weights).sum();
         let direct = loss(&layers, &mut ws);
         assert!((weighted_mse + lambda * penalty - direct).abs() <= 1e-14 * direct);
-        let h = 1e-5;
-        for k in 0..layers.len() {
-            for (is_w, grad) in [(true, &gw[k]), (false, &gb[k])] {
-                for i in 0..grad.len() {
-                    let probe = |delta: f64, layers: &mut Vec<Layer>| match is_w {
-                        true => layers[k].w[i] += delta,
-                        false => layers[k].b[i] += delta,
-                    };
-                    probe(h, &mut layers);
-                    let up = loss(&layers, &mut ws);
-                    probe(-2.0 * h, &mut layers);
-                    let down = loss(&layers, &mut ws);
-                    probe(h, &mut layers);
-                    let fd = (up - down) / (2.0 * h);
-                    let err = (fd - grad[i]).abs() / grad[i].abs().max(1e-3);
-                    assert!(err <= 1e-6, "layer {k} [{i}]: fd {fd} vs {}", grad[i]);
-                }
-            }
-        }
+        assert_gradient_is_central_differences(&mut layers, &gw, &gb, |layers| {
+            loss(layers, &mut ws)
+        });
         // weights of 1: the unweighted pass (gradients bit for bit; the loss sums per row first,
         // so to rounding)
         let ones = vec![1.0; rows];

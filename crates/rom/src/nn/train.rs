@@ -89,13 +89,27 @@ impl SampleWeighting {
     /// uses: snapshots below a tenth of the largest norm weigh as one at a tenth.
     pub const DEFAULT_FLOOR: f64 = 0.1;
 
-    /// The weights of data `rows` (row-major, `n` features, already in the loss's scaled units
-    /// but *not* centred: `x / s`) normalised to a mean of 1 over `train`, or `None` for
-    /// [`SampleWeighting::Uniform`].
-    pub(crate) fn weights(&self, norms: &[f64], train: &[usize]) -> Option<Vec<f64>> {
+    /// The weight of every row of `data` (row-major, `n` features, physical units) from its norm
+    /// in the loss's feature scaling, `‖x / s‖` (not centred: the deviation from the straight rod),
+    /// normalised to a mean of 1 over the rows `train`; `None` for [`SampleWeighting::Uniform`]
+    /// (nothing computed).
+    pub(crate) fn weights(
+        &self,
+        data: &[f64],
+        n: usize,
+        scale: &[f64],
+        train: &[usize],
+    ) -> Option<Vec<f64>> {
         let SampleWeighting::Relative { floor } = *self else {
             return None;
         };
+        let norms: Vec<f64> = data
+            .chunks_exact(n)
+            .map(|x| {
+                let squares = x.iter().zip(scale).map(|(x, s)| (x / s).powi(2));
+                squares.sum::<f64>().sqrt()
+            })
+            .collect();
         let largest = norms.iter().copied().fold(0.0f64, f64::max);
         let least = (floor * largest).max(f64::MIN_POSITIVE);
         let mut w: Vec<f64> = norms.iter().map(|v| 1.0 / v.max(least).powi(2)).collect();
@@ -642,15 +656,18 @@ mod tests {
     fn relative_sample_weights_are_inverse_squared_norms_floored_with_mean_one() {
         // norms 1, 2, 0 (the straight rod) and 10, floor 0.2: the least norm is 2, so the weights
         // are 1/4, 1/4, 1/4, 1/100 before the mean over the training rows {0, 1, 3} is made 1.
+        // (one feature of scale 2: the norms are |x| / 2)
         let w = SampleWeighting::Relative { floor: 0.2 }
-            .weights(&[1.0, 2.0, 0.0, 10.0], &[0, 1, 3])
+            .weights(&[2.0, -4.0, 0.0, 20.0], 1, &[2.0], &[0, 1, 3])
             .unwrap();
         let mean = (0.25 + 0.25 + 0.01) / 3.0;
         let expected = [0.25 / mean, 0.25 / mean, 0.25 / mean, 0.01 / mean];
         for (a, b) in w.iter().zip(expected) {
             assert!((a - b).abs() <= 1e-15 * b, "{w:?} vs {expected:?}");
         }
-        assert!(SampleWeighting::Uniform.weights(&[1.0], &[0]).is_none());
+        assert!(SampleWeighting::Uniform
+            .weights(&[1.0], 1, &[1.0], &[0])
+            .is_none());
         let bad = TrainOptions {
             sample_weighting: SampleWeighting::Relative { floor: 0.0 },
             ..TrainOptions::default()

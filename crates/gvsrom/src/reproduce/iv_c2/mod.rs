@@ -329,17 +329,15 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     report.tables.push(table_iii(inset_dof, &hom));
     report.tables.push(more_tests_table(inset, &tests));
     for v in &variant_runs {
-        report.tables.push(variant_table(inset, v, &plan));
+        report.tables.push(variant_table(inset, v));
     }
     report.tables.push(lambda_table(inset, &lambdas));
     report.tables.push(models_table(&dofs));
     report.findings = findings(&dofs, &hom, inset_dof);
     report.findings.extend(more_tests_findings(inset, &tests));
-    report.findings.extend(
-        variant_runs
-            .iter()
-            .map(|v| variant_finding(inset, v, &plan)),
-    );
+    report
+        .findings
+        .extend(variant_runs.iter().map(|v| variant_finding(inset, v)));
     let context = Context {
         data_s: s.data_s,
         swing: tip_travel(&trajectories.hom, 1.0),

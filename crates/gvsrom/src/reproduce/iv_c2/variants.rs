@@ -20,8 +20,6 @@ use super::more_tests::{hom_run, more_tests_table, TestRuns};
 pub(super) const SPREAD: f64 = 2.0;
 /// The damped variant's material damping, as a multiple of the preset's (the paper's 10⁴ Pa·s).
 pub(super) const DAMPING_FACTOR: f64 = 3.0;
-/// The preset's material damping [Pa·s] (`examples/six-tendon.toml`, the paper's Table II).
-const DAMPING: f64 = 1e4;
 
 /// A variant of the data (and, for [`DataVariant::Damped`], of the arm).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -33,6 +31,8 @@ pub(super) enum DataVariant {
 /// A variant's data, its two models and their runs on each test input.
 pub(super) struct VariantRuns {
     pub(super) variant: DataVariant,
+    /// What the variant changes, for the reports.
+    pub(super) description: String,
     pub(super) data: Step<DatasetInfo>,
     pub(super) ae: Step<ModelInfo>,
     pub(super) pod: Step<ModelInfo>,
@@ -48,14 +48,18 @@ impl DataVariant {
         }
     }
 
-    /// The variant's scenario.
-    fn scenario(self, scenario: &ScenarioSpec) -> ScenarioSpec {
-        match self {
+    /// The variant's scenario: for [`DataVariant::Damped`] the material damping of `scenario`
+    /// times [`DAMPING_FACTOR`].
+    fn scenario(self, scenario: &ScenarioSpec) -> anyhow::Result<ScenarioSpec> {
+        Ok(match self {
             DataVariant::Spread => scenario.clone(),
             DataVariant::Damped => {
-                scenario.with(&[format!("material.damping={:e}", DAMPING * DAMPING_FACTOR)])
+                let eta = crate::presets::load(&scenario.preset, &scenario.set)?
+                    .material
+                    .damping;
+                scenario.with(&[format!("material.damping={:e}", eta * DAMPING_FACTOR)])
             }
-        }
+        })
     }
 
     /// The variant's data plan.
@@ -70,20 +74,18 @@ impl DataVariant {
         }
     }
 
-    /// What the variant changes, for the reports.
-    fn describe(self, plan: &DatasetSpec) -> String {
+    /// What the variant changes (its plan and scenario as [`DataVariant::plan`] and
+    /// [`DataVariant::scenario`] make them), for the reports.
+    fn describe(self, plan: &DatasetSpec, scenario: &ScenarioSpec) -> String {
         match self {
-            DataVariant::Spread => {
-                let p = self.plan(plan);
-                format!(
-                    "the same number of snapshots over a {SPREAD}× longer babbling ({} s at {} Hz)",
-                    p.duration.unwrap_or(f64::NAN),
-                    p.sample_rate.unwrap_or(f64::NAN)
-                )
-            }
+            DataVariant::Spread => format!(
+                "the same number of snapshots over a {SPREAD}× longer babbling ({} s at {} Hz)",
+                plan.duration.unwrap_or(f64::NAN),
+                plan.sample_rate.unwrap_or(f64::NAN)
+            ),
             DataVariant::Damped => format!(
-                "{DAMPING_FACTOR}× the material damping ({:e} Pa·s instead of the paper's {DAMPING:e}), in the data and in every run",
-                DAMPING * DAMPING_FACTOR
+                "{DAMPING_FACTOR}× the material damping (`--set {}`), in the data and in every run",
+                scenario.set.last().map_or("", String::as_str)
             ),
         }
     }
@@ -105,14 +107,9 @@ pub(super) fn run_variant(
     seeds: &[u64],
 ) -> anyhow::Result<VariantRuns> {
     let (r, name) = (ae.latent, variant.name());
-    let sc = variant.scenario(scenario);
-    let data = tasks::dataset(
-        run,
-        &format!("iv-c2/dataset-{name}"),
-        &sc,
-        &variant.plan(plan),
-        jobs,
-    )?;
+    let (sc, data_plan) = (variant.scenario(scenario)?, variant.plan(plan));
+    let description = variant.describe(&data_plan, &sc);
+    let data = tasks::dataset(run, &format!("iv-c2/dataset-{name}"), &sc, &data_plan, jobs)?;
     let model = tasks::train(run, &format!("iv-c2/ae-r{r}-{name}"), &data, ae)?;
     let pod = tasks::pod(run, &format!("iv-c2/pod-{r}-{name}"), &data, r)?;
     let mut tests = vec![];
@@ -157,6 +154,7 @@ pub(super) fn run_variant(
     }
     Ok(VariantRuns {
         variant,
+        description,
         data,
         ae: model,
         pod,
@@ -165,9 +163,9 @@ pub(super) fn run_variant(
 }
 
 /// The table of a variant's models on every test input.
-pub(super) fn variant_table(r: usize, v: &VariantRuns, plan: &DatasetSpec) -> Table {
+pub(super) fn variant_table(r: usize, v: &VariantRuns) -> Table {
     let mut t = more_tests_table(r, &v.tests);
-    let what = v.variant.describe(plan);
+    let what = &v.description;
     t.id = format!("{}-data", v.variant.name());
     t.title = format!("AE-{r} and POD-{r} with {what} (not in the paper)");
     t.note = format!(
@@ -183,7 +181,7 @@ pub(super) fn variant_table(r: usize, v: &VariantRuns, plan: &DatasetSpec) -> Ta
 
 /// The variant's finding: for [`DataVariant::Spread`] whether every run stays inside its training
 /// region, for [`DataVariant::Damped`] whether AE-r reaches the paper's error on every input.
-pub(super) fn variant_finding(r: usize, v: &VariantRuns, plan: &DatasetSpec) -> Finding {
+pub(super) fn variant_finding(r: usize, v: &VariantRuns) -> Finding {
     let n = v.tests.len();
     let mean = |f: &dyn Fn(&TestRuns) -> f64| v.tests.iter().map(f).sum::<f64>() / n.max(1) as f64;
     let (ae, pod) = (mean(&|t| t.ae.tip_mean()), mean(&|t| t.pod.tip_mean()));
@@ -193,7 +191,7 @@ pub(super) fn variant_finding(r: usize, v: &VariantRuns, plan: &DatasetSpec) -> 
         .map(|t| Cell::sig(t.ae.tip_mean(), 3).render())
         .collect::<Vec<_>>()
         .join(", ");
-    let what = v.variant.describe(plan);
+    let what = &v.description;
     let left: Vec<String> = v
         .tests
         .iter()
