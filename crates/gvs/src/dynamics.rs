@@ -77,6 +77,10 @@ impl<P: StrainParam> Model<P> {
         qdd: Option<&DVector<f64>>,
         ws: &mut Workspace,
     ) {
+        if ws.ev.motion {
+            self.velocities_from_motion(ws);
+            return;
+        }
         let nonlinear = !self.param.is_linear();
         if nonlinear {
             self.param.eval_rate(q, qd, &mut ws.ev);
@@ -128,6 +132,45 @@ impl<P: StrainParam> Model<P> {
                     }
                     xid1 * h
                 }
+            };
+            let sqd = et.t_mul(&om_dot);
+            let sdqd = et.t_dot_mul(&om_dot, &om_dot) + et.t_mul(&zd);
+            ws.eta[i + 1] = et.g.adjoint_inv_mul(&(ws.eta[i] + sqd));
+            ws.zeta[i + 1] =
+                et.g.adjoint_inv_mul(&(ws.zeta[i] + ad_mul(&ws.eta[i], &sqd) + sdqd));
+        }
+    }
+
+    /// [`Self::velocities_with`] from a motion evaluation ([`StrainParam::eval_motion`] at the same
+    /// `q, q̇, q̈`): the site rates `ξ̇_s` and `ξ̈ᵇ_s = Ψ̇_q,s q̇ + Ψ_q,s q̈` are given, so each step is
+    /// the Magnus rate of the module doc on 6-vectors (`ξ̈ᵇ` enters `Ż q̇ + Z q̈` as the sum of the
+    /// two); a call without `q̈` must follow a motion evaluation without `q̈`.
+    fn velocities_from_motion(&self, ws: &mut Workspace) {
+        ws.eta[0] = V6::zeros();
+        ws.zeta[0] = V6::zeros();
+        for i in 0..self.disc.n_points() - 1 {
+            let Some(st) = self.disc.steps[i] else {
+                ws.eta[i + 1] = ws.eta[i];
+                ws.zeta[i + 1] = ws.zeta[i];
+                continue;
+            };
+            let [s1, s2] = st.sites;
+            let h = st.h;
+            let et = &ws.et[i];
+            let (xid1, a1) = (ws.ev.xi_dot[s1], ws.ev.xi_acc[s1]);
+            let (om_dot, zd): (V6, V6) = match self.disc.order {
+                MagnusOrder::Z4 => {
+                    let (xid2, a2) = (ws.ev.xi_dot[s2], ws.ev.xi_acc[s2]);
+                    let k = ZANNA_C * h * h;
+                    let (xi1, xi2) = (&ws.xi[s1], &ws.xi[s2]);
+                    let zd = (ad_mul(&xid1, &xid2) - ad_mul(&xid2, &xid1)) * k
+                        + (a1 + a2) * (0.5 * h)
+                        + (ad_mul(xi1, &a2) - ad_mul(xi2, &a1)) * k;
+                    let om_dot =
+                        (xid1 + xid2) * (0.5 * h) + (ad_mul(xi1, &xid2) - ad_mul(xi2, &xid1)) * k;
+                    (om_dot, zd)
+                }
+                MagnusOrder::Z2 => (xid1 * h, a1 * h),
             };
             let sqd = et.t_mul(&om_dot);
             let sdqd = et.t_dot_mul(&om_dot, &om_dot) + et.t_mul(&zd);
@@ -242,7 +285,9 @@ impl<P: StrainParam> Model<P> {
     /// integrators in second-order form, without forming `M`: the inertial wrenches
     /// `W (Ms η̇_i + coad_{η_i} Ms η_i)` with the body accelerations `η̇_i = J_i q̈ + J̇ˢ_i q̇` of
     /// [`Self::velocities_with`] join the external ones in the statics backward pass
-    /// (recursive Newton–Euler, spec §7.8). Cost: one statics residual plus `O(n)` per site.
+    /// (recursive Newton–Euler, spec §7.8). Cost: one statics residual plus `O(n)` per site. A
+    /// parameterization with a motion evaluation ([`StrainParam::eval_motion`]: a decoder) gives
+    /// the strains and their rates without `Ψ_q`, and projects the wrenches in one reverse pass.
     #[allow(clippy::too_many_arguments)]
     pub fn dynamics_residual(
         &self,
@@ -254,7 +299,13 @@ impl<P: StrainParam> Model<P> {
         ws: &mut Workspace,
         r: &mut DVector<f64>,
     ) {
-        self.forward(q, ws, false);
+        if self.param.eval_motion(q, qd, Some(qdd), &mut ws.ev) {
+            ws.ev.motion = true;
+            ws.ev.psi_q_stale = true;
+            self.forward_from_strains(ws, false);
+        } else {
+            self.forward(q, ws, false);
+        }
         self.residual_after_forward(q, qd, qdd, u, loads, ws, r);
     }
 
@@ -274,6 +325,8 @@ impl<P: StrainParam> Model<P> {
     ) {
         self.forward(q, ws, true);
         self.assemble_mass(ws);
+        // the rates by the motion evaluation where it is cheaper than `Ψ̇_q` (Ψ_q stays valid)
+        ws.ev.motion = self.param.eval_motion(q, qd, Some(qdd), &mut ws.ev);
         self.residual_after_forward(q, qd, qdd, u, loads, ws, r);
     }
 

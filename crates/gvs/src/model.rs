@@ -111,6 +111,9 @@ pub struct Workspace {
     dtau_prev: Matrix3xX<f64>,
     dtheta: DVector<f64>,
     rtmp: DVector<f64>,
+    /// Per site: the elastic and damping wrenches of a motion evaluation's residual, projected
+    /// through [`StrainParam::project`].
+    ye: Vec<V6>,
     /// Body velocity `η_i` and `J̇ˢ_i q̇` at every point (dynamics).
     pub eta: Vec<V6>,
     pub(crate) zeta: Vec<V6>,
@@ -246,6 +249,7 @@ impl<P: StrainParam> Model<P> {
             dtau_prev: Matrix3xX::zeros(n),
             dtheta: DVector::zeros(n),
             rtmp: DVector::zeros(n),
+            ye: vec![V6::zeros(); ns],
             eta: vec![V6::zeros(); np],
             zeta: vec![V6::zeros(); np],
             mass: DMatrix::zeros(0, 0),
@@ -322,6 +326,15 @@ impl<P: StrainParam> Model<P> {
     /// `Z`, `J` at every point.
     pub fn forward(&self, q: &DVector<f64>, ws: &mut Workspace, jacobians: bool) {
         self.param.eval(q, &mut ws.ev);
+        ws.ev.motion = false;
+        ws.ev.psi_q_stale = false;
+        self.forward_from_strains(ws, jacobians);
+    }
+
+    /// [`Self::forward`] after the strains `ws.ev.psi` were evaluated (by [`StrainParam::eval`], or
+    /// by [`StrainParam::eval_motion`] for a residual pass without Jacobians).
+    pub(crate) fn forward_from_strains(&self, ws: &mut Workspace, jacobians: bool) {
+        debug_assert!(!(jacobians && ws.ev.psi_q_stale), "Jacobians need Ψ_q");
         for s in 0..ws.xi.len() {
             ws.xi[s] = ws.ev.psi[s] + self.xi_star[s];
         }
@@ -473,34 +486,46 @@ impl<P: StrainParam> Model<P> {
         let ext = r.amax();
         // elastic (and damping) part, projected separately for the scale
         ws.rtmp.fill(0.0);
-        for (i, p) in self.disc.points.iter().enumerate() {
-            if p.weight > 0.0 {
-                let c = self.param.columns(i);
-                let mut e = -self.props[i].es.component_mul(&ws.ev.psi[i]) * p.weight;
-                if let Some(qd) = qd {
-                    let xid = ws.ev.psi_q_at(i, &c) * qd.rows(c.start, c.len());
-                    e -= self.props[i].ds.component_mul(&xid) * p.weight;
+        if ws.ev.motion {
+            // ξ̇ from the motion evaluation; all sites' wrenches projected in one pass
+            ws.ye.iter_mut().for_each(|e| *e = V6::zeros());
+            for (i, p) in self.disc.points.iter().enumerate() {
+                if p.weight > 0.0 {
+                    let mut e = -self.props[i].es.component_mul(&ws.ev.psi[i]) * p.weight;
+                    if qd.is_some() {
+                        e -= self.props[i].ds.component_mul(&ws.ev.xi_dot[i]) * p.weight;
+                    }
+                    ws.y[i] += e;
+                    ws.ye[i] = e;
                 }
-                ws.y[i] += e;
-                ws.rtmp
-                    .rows_mut(c.start, c.len())
-                    .gemv_tr(1.0, &ws.ev.psi_q_at(i, &c), &e, 1.0);
+            }
+            self.param.project(&ws.ye, &mut ws.ev, &mut ws.rtmp);
+        } else {
+            for (i, p) in self.disc.points.iter().enumerate() {
+                if p.weight > 0.0 {
+                    let c = self.param.columns(i);
+                    let mut e = -self.props[i].es.component_mul(&ws.ev.psi[i]) * p.weight;
+                    if let Some(qd) = qd {
+                        let xid = ws.ev.psi_q_at(i, &c) * qd.rows(c.start, c.len());
+                        e -= self.props[i].ds.component_mul(&xid) * p.weight;
+                    }
+                    ws.y[i] += e;
+                    ws.rtmp.rows_mut(c.start, c.len()).gemv_tr(
+                        1.0,
+                        &ws.ev.psi_q_at(i, &c),
+                        &e,
+                        1.0,
+                    );
+                }
             }
         }
         *r += &ws.rtmp;
         ws.residual_scale = 1f64.max(ext).max(ws.rtmp.amax());
     }
 
-    /// `r += Σ_s Ψ_q,sᵀ y_s`.
-    fn project(&self, ws: &Workspace, r: &mut DVector<f64>) {
-        for (s, y) in ws.y.iter().enumerate() {
-            if *y == V6::zeros() {
-                continue;
-            }
-            let c = self.param.columns(s);
-            r.rows_mut(c.start, c.len())
-                .gemv_tr(1.0, &ws.ev.psi_q_at(s, &c), y, 1.0);
-        }
+    /// `r += Σ_s Ψ_q,sᵀ y_s` ([`StrainParam::project`]).
+    fn project(&self, ws: &mut Workspace, r: &mut DVector<f64>) {
+        self.param.project(&ws.y, &mut ws.ev, r);
     }
 
     /// Tendon forces into `ws.y`; with `jac`, their derivatives into `ws.dyp` (per point 6×n).

@@ -20,12 +20,11 @@
 //! not represent, a part [`projection_residual`] measures. Every derivative of `Ψ_s` is `Φ_s` times
 //! the same derivative of `c`, so the engine's statics, dynamics and Jacobians apply unchanged.
 
+use crate::gemm::{mul_cols_strided, mul_tr_cols_into};
 use crate::map::CoefficientMap;
-use faer::linalg::matmul::matmul;
-use faer::{Accum, MatMut, MatRef, Par};
 use gvs::discretize::Discretization;
 use gvs::lie::V6;
-use gvs::strain::{LinearBasis, StrainEval, StrainParam};
+use gvs::strain::{project_with_psi_q, LinearBasis, StrainEval, StrainParam};
 use nalgebra::{DMatrix, DVector, Matrix6xX};
 use std::ops::Range;
 use thiserror::Error;
@@ -151,107 +150,163 @@ pub struct ReducedParam<M: CoefficientMap> {
     rest: DVector<f64>,
 }
 
-/// `Φ_s` of every site stacked per active strain component: block `i` holds row `active[i]` of every
-/// `Φ_s` (`n_sites × width`, column-major) on the coordinates `cols` where that row is non-zero at
-/// some site. For a global basis whose strain components have coefficients of their own (Legendre),
-/// a block is one component's coefficients only, a third or less of all `Φ_s`. With the blocks,
-/// `Ψ`, `Ψ_q` (and `Ψ̇_q`) at all sites are one product `Φ_i [c | C_z]_{cols}` per component, and
-/// `g = Σ_s Φ_sᵀ w_s` is `Σ_i Φ_iᵀ w_i`.
+/// `Φ_s` stacked per strain component and run of sites: block `i` holds row `a_i` of `Φ_s` for the
+/// consecutive sites `sites_i` whose non-zero entries in that row lie on the same coordinates
+/// `cols_i` (`|sites_i| × |cols_i|`, column-major). For a global basis whose strain components and
+/// divisions have coefficients of their own (Legendre per division), a block is one component of
+/// one division: no stored zero. With the blocks, `Ψ`, `Ψ_q` (and `Ψ̇_q`) at all sites are one
+/// product `Φ_i [c | C_z]_{cols_i}` per block, and `g = Σ_s Φ_sᵀ w_s` is `Σ_i Φ_iᵀ w_i`.
 struct Stacked {
-    n_sites: usize,
     blocks: Vec<Block>,
+    /// `Σ_i |sites_i|`: the rows of all blocks.
+    rows: usize,
 }
 
 struct Block {
     /// Index into the strain 6-vector.
     a: usize,
+    sites: Range<usize>,
     cols: Range<usize>,
     mat: Vec<f64>,
 }
 
 impl Stacked {
-    /// Stacks `basis` if the blocks store at most twice the entries of its per-site blocks (global
-    /// bases: Legendre, POD); `None` for local-support bases, where the per-site loop is cheaper.
-    fn of(basis: &LinearBasis, phi: &Matrix6xX<f64>) -> Option<Stacked> {
+    /// Stacks `basis` if its blocks are tall (four sites or more on average: global bases per
+    /// division, Legendre and POD); `None` for local-support bases, where the per-site loop is
+    /// cheaper.
+    fn of(basis: &LinearBasis) -> Option<Stacked> {
         let ns = basis.n_sites();
-        let mut blocks = Vec::new();
+        let mut blocks: Vec<Block> = Vec::new();
         for a in 0..6 {
-            let (mut lo, mut hi) = (usize::MAX, 0);
-            for s in 0..ns {
-                let block = basis.phi_at(s);
-                for (j, col) in basis.columns(s).enumerate() {
-                    if block[(a, j)] != 0.0 {
-                        (lo, hi) = (lo.min(col), hi.max(col + 1));
+            let mut open: Option<(usize, Range<usize>)> = None;
+            for s in 0..=ns {
+                let span = (s < ns).then(|| {
+                    let block = basis.phi_at(s);
+                    let (mut lo, mut hi) = (usize::MAX, 0);
+                    for (j, col) in basis.columns(s).enumerate() {
+                        if block[(a, j)] != 0.0 {
+                            (lo, hi) = (lo.min(col), hi.max(col + 1));
+                        }
+                    }
+                    lo..hi
+                });
+                let same = matches!((&open, &span), (Some((_, c)), Some(sp)) if c == sp);
+                if same {
+                    continue;
+                }
+                if let Some((start, cols)) = open.take() {
+                    if !cols.is_empty() {
+                        blocks.push(Block {
+                            a,
+                            sites: start..s,
+                            cols,
+                            mat: Vec::new(),
+                        });
                     }
                 }
-            }
-            if lo < hi {
-                blocks.push(Block {
-                    a,
-                    cols: lo..hi,
-                    mat: vec![0.0; ns * (hi - lo)],
-                });
+                open = span.map(|sp| (s, sp));
             }
         }
-        let stored: usize = blocks.iter().map(|b| b.mat.len()).sum();
-        if stored > 2 * blocks.len() * phi.ncols() {
+        let rows: usize = blocks.iter().map(|b| b.sites.len()).sum();
+        if blocks.is_empty() || blocks.len() * 4 > rows {
             return None;
         }
         for b in &mut blocks {
-            for s in 0..ns {
+            let (h, w) = (b.sites.len(), b.cols.len());
+            b.mat = vec![0.0; h * w];
+            for (i, s) in b.sites.clone().enumerate() {
                 let block = basis.phi_at(s);
                 for (j, col) in basis.columns(s).enumerate() {
                     if b.cols.contains(&col) {
-                        b.mat[s + (col - b.cols.start) * ns] = block[(b.a, j)];
+                        b.mat[i + (col - b.cols.start) * h] = block[(b.a, j)];
                     }
                 }
             }
         }
-        Some(Stacked {
-            n_sites: ns,
-            blocks,
-        })
+        Some(Stacked { blocks, rows })
     }
 
     /// Length of the product buffer for `k` right-hand columns.
     fn y_len(&self, k: usize) -> usize {
-        self.blocks.len() * self.n_sites * k
+        self.rows * k
     }
 
-    /// `Y_i = Φ_i X[cols_i, :]` for every block, `X` column-major `m × k`; `Y_i` at
-    /// `i·n_sites·k` in `y`, column-major `n_sites × k`.
+    /// `Y_i = Φ_i X[cols_i, :]` for every block, `X` column-major `m × k`; the `Y_i` one after the
+    /// other in `y`, each column-major `|sites_i| × k`.
     fn mul(&self, x: &[f64], m: usize, k: usize, y: &mut [f64]) {
-        let ns = self.n_sites;
-        for (b, yb) in self.blocks.iter().zip(y.chunks_exact_mut(ns * k)) {
-            let w = b.cols.len();
-            let phi = MatRef::from_column_major_slice(&b.mat, ns, w);
-            let xb = MatRef::from_column_major_slice_with_stride(&x[b.cols.start..], w, k, m);
-            let yb = MatMut::from_column_major_slice_mut(yb, ns, k);
-            matmul(yb, Accum::Replace, phi, xb, 1.0, Par::Seq);
+        let mut off = 0;
+        for b in &self.blocks {
+            let h = b.sites.len();
+            let yb = &mut y[off..off + h * k];
+            mul_cols_strided((h, b.cols.len(), k), &b.mat, &x[b.cols.start..], m, yb);
+            off += h * k;
         }
-        gvs::cpu::clear_upper_state();
     }
 
-    /// `g = Σ_i Φ_iᵀ w_i` (`g` of length m) with `w_i` the component `a_i` of `w` at every site,
-    /// gathered into `buf` (`n_sites`).
+    /// Scatters the products of [`Stacked::mul`] (`k = 1 + r`: value then `r` tangents, or
+    /// `k = r` tangents only) into the site vectors `psi` (if given) and the site matrices `out`
+    /// (`6 × r` per site, column-major), which are zeroed first.
+    fn scatter(&self, y: &[f64], r: usize, mut psi: Option<&mut [V6]>, out: &mut [f64]) {
+        out.fill(0.0);
+        if let Some(psi) = psi.as_deref_mut() {
+            psi.iter_mut().for_each(|p| *p = V6::zeros());
+        }
+        let k = r + usize::from(psi.is_some());
+        let t0 = k - r;
+        let mut off = 0;
+        for b in &self.blocks {
+            let h = b.sites.len();
+            let yb = &y[off..off + h * k];
+            for (i, s) in b.sites.clone().enumerate() {
+                if let Some(psi) = psi.as_deref_mut() {
+                    psi[s][b.a] = yb[i];
+                }
+                for l in 0..r {
+                    out[6 * (s * r + l) + b.a] = yb[(t0 + l) * h + i];
+                }
+            }
+            off += h * k;
+        }
+    }
+
+    /// Scatters the products of [`Stacked::mul`] with `k = 3` (`[c | ċ | c̈]`) into the site
+    /// vectors `out[0]` (`Ψ`), `out[1]` (`ξ̇`), `out[2]` (`ξ̈ᵇ`), which are zeroed first.
+    fn scatter_motion(&self, y: &[f64], out: [&mut [V6]; 3]) {
+        let [psi, xi_dot, xi_acc] = out;
+        for v in [&mut *psi, &mut *xi_dot, &mut *xi_acc] {
+            v.iter_mut().for_each(|p| *p = V6::zeros());
+        }
+        let mut off = 0;
+        for b in &self.blocks {
+            let h = b.sites.len();
+            let yb = &y[off..off + 3 * h];
+            for (i, s) in b.sites.clone().enumerate() {
+                psi[s][b.a] = yb[i];
+                xi_dot[s][b.a] = yb[h + i];
+                xi_acc[s][b.a] = yb[2 * h + i];
+            }
+            off += 3 * h;
+        }
+    }
+
+    /// `g = Σ_i Φ_iᵀ w_i` (`g` of length m) with `w_i` the component `a_i` of `w` at the sites
+    /// of block `i`, gathered into `buf` (`n_sites`).
     fn mul_tr(&self, w: &[V6], buf: &mut [f64], g: &mut [f64]) {
         g.fill(0.0);
-        let ns = self.n_sites;
         for b in &self.blocks {
-            for (v, ws) in buf[..ns].iter_mut().zip(w) {
+            let h = b.sites.len();
+            for (v, ws) in buf[..h].iter_mut().zip(&w[b.sites.clone()]) {
                 *v = ws[b.a];
             }
-            let phi = MatRef::from_column_major_slice(&b.mat, ns, b.cols.len());
-            let wb = MatRef::from_column_major_slice(&buf[..ns], ns, 1);
-            let gb = MatMut::from_column_major_slice_mut(&mut g[b.cols.clone()], b.cols.len(), 1);
-            matmul(gb, Accum::Add, phi.transpose(), wb, 1.0, Par::Seq);
+            let w = b.cols.len();
+            mul_tr_cols_into((h, w, 1), &b.mat, &buf[..h], &mut g[b.cols.clone()], true);
         }
-        gvs::cpu::clear_upper_state();
     }
 }
 
 /// Where the parts of [`StrainEval::scratch`] start: `c`, `C_z` (adjacent: `[c | C_z]` is one
-/// `m × (1 + r)` matrix), `Ċ_z`, `g`, `H`, the stacked products `Y`, the map's own.
+/// `m × (1 + r)` matrix), `Ċ_z`, `g`, `H`, the motion `[c | ċ | c̈]` (`m × 3`), `C_zᵀ g`, the
+/// stacked products `Y`, the map's own.
 #[derive(Debug, Clone, Copy)]
 struct Layout {
     /// `c` starts at 0.
@@ -259,6 +314,8 @@ struct Layout {
     czd: usize,
     g: usize,
     h: usize,
+    mo: usize,
+    zt: usize,
     y: usize,
     map: usize,
     end: usize,
@@ -298,7 +355,7 @@ impl<M: CoefficientMap> ReducedParam<M> {
             phi.columns_mut(offsets[s], cols[s].len())
                 .copy_from(&basis.phi_at(s));
         }
-        let stacked = Stacked::of(basis, &phi);
+        let stacked = Stacked::of(basis);
         Ok(ReducedParam {
             map,
             phi,
@@ -321,13 +378,20 @@ impl<M: CoefficientMap> ReducedParam<M> {
         let czd = cz + m * r;
         let g = czd + m * r;
         let h = g + m;
-        let y = h + r * r;
-        let map = y + self.stacked.as_ref().map_or(0, |st| st.y_len(1 + r));
+        let mo = h + r * r;
+        let zt = mo + 3 * m;
+        let y = zt + r;
+        let map = y + self
+            .stacked
+            .as_ref()
+            .map_or(0, |st| st.y_len((1 + r).max(3)));
         Layout {
             cz,
             czd,
             g,
             h,
+            mo,
+            zt,
             y,
             map,
             end: map + self.map.scratch_len(),
@@ -442,19 +506,10 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
         let out = ev.psi_q.as_mut_slice();
         match &self.stacked {
             Some(st) => {
-                // Y_i = Φ_i [c | C_z]   (n_sites × (1 + r) per component)
+                // Y_i = Φ_i [c | C_z]   (|sites_i| × (1 + r) per block)
                 let y = &mut rest[l.y - l.czd..l.map - l.czd];
                 st.mul(cc, m, 1 + r, y);
-                ev.psi.iter_mut().for_each(|psi| *psi = V6::zeros());
-                let ns = st.n_sites;
-                for (b, yb) in st.blocks.iter().zip(y.chunks_exact(ns * (1 + r))) {
-                    for (s, psi) in ev.psi.iter_mut().enumerate() {
-                        psi[b.a] = yb[s];
-                        for k in 0..r {
-                            out[6 * (s * r + k) + b.a] = yb[(k + 1) * ns + s];
-                        }
-                    }
-                }
+                st.scatter(y, r, Some(&mut ev.psi), out);
             }
             None => {
                 let (c, cz) = cc.split_at(l.cz);
@@ -478,14 +533,7 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
         match &self.stacked {
             Some(st) => {
                 st.mul(czd, m, r, y);
-                let ns = st.n_sites;
-                for (b, yb) in st.blocks.iter().zip(y.chunks_exact(ns * r)) {
-                    for s in 0..ns {
-                        for k in 0..r {
-                            out[6 * (s * r + k) + b.a] = yb[k * ns + s];
-                        }
-                    }
-                }
+                st.scatter(y, r, None, out);
             }
             None => {
                 for s in 0..self.cols.len() {
@@ -535,6 +583,88 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
 
     fn rest_coordinates(&self) -> DVector<f64> {
         self.rest.clone()
+    }
+
+    /// `[c | ċ | c̈]` by the map's motion evaluation, then `Ψ_s`, `ξ̇_s`, `ξ̈ᵇ_s` as `Φ_s` times
+    /// each: three columns through the basis instead of `1 + 2r`.
+    fn eval_motion(
+        &self,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        qdd: Option<&DVector<f64>>,
+        ev: &mut StrainEval,
+    ) -> bool {
+        let l = self.layout();
+        let m = self.m;
+        let (head, map_scratch) = ev.scratch.split_at_mut(l.map);
+        let (front, y) = head.split_at_mut(l.y);
+        let mo = &mut front[l.mo..l.mo + 3 * m];
+        {
+            let (c, rest) = mo.split_at_mut(m);
+            let (c_dot, c_acc) = rest.split_at_mut(m);
+            self.map.eval_motion(
+                q.as_slice(),
+                qd.as_slice(),
+                qdd.map(|v| v.as_slice()),
+                c,
+                c_dot,
+                c_acc,
+                map_scratch,
+            );
+        }
+        match &self.stacked {
+            Some(st) => {
+                st.mul(mo, m, 3, y);
+                st.scatter_motion(y, [&mut ev.psi, &mut ev.xi_dot, &mut ev.xi_acc]);
+            }
+            None => {
+                let (c, rest) = mo.split_at(m);
+                let (c_dot, c_acc) = rest.split_at(m);
+                for (s, cols) in self.cols.iter().enumerate() {
+                    let phi = self.phi.columns(self.offsets[s], cols.len());
+                    let cr = cols.clone();
+                    ev.psi[s] = phi * DVector::from_column_slice(&c[cr.clone()]);
+                    ev.xi_dot[s] = phi * DVector::from_column_slice(&c_dot[cr.clone()]);
+                    ev.xi_acc[s] = phi * DVector::from_column_slice(&c_acc[cr]);
+                }
+            }
+        }
+        true
+    }
+
+    /// After a motion evaluation: `g = Σ_s Φ_sᵀ y_s`, then `C_zᵀ g` by the map's reverse pass;
+    /// otherwise from `Ψ_q`.
+    fn project(&self, y: &[V6], ev: &mut StrainEval, r: &mut DVector<f64>) {
+        if !ev.motion {
+            project_with_psi_q(self, y, ev, r);
+            return;
+        }
+        let l = self.layout();
+        let (m, rr) = (self.m, self.r);
+        let (head, map_scratch) = ev.scratch.split_at_mut(l.map);
+        let (front, buf) = head.split_at_mut(l.y);
+        let (front, zt) = front.split_at_mut(l.zt);
+        let g = &mut front[l.g..l.g + m];
+        match &self.stacked {
+            Some(st) => st.mul_tr(y, buf, g),
+            None => {
+                g.fill(0.0);
+                for (s, cols) in self.cols.iter().enumerate() {
+                    if y[s] == V6::zeros() {
+                        continue;
+                    }
+                    let phi = self.phi.columns(self.offsets[s], cols.len());
+                    for (j, col) in cols.clone().enumerate() {
+                        g[col] += phi.column(j).dot(&y[s]);
+                    }
+                }
+            }
+        }
+        let zt = &mut zt[..rr];
+        self.map.vjp(g, zt, map_scratch);
+        for (ri, z) in r.iter_mut().zip(zt.iter()) {
+            *ri += z;
+        }
     }
 }
 
@@ -600,6 +730,40 @@ mod tests {
                 *o += v;
             }
         }
+        fn eval_motion(
+            &self,
+            z: &[f64],
+            zd: &[f64],
+            zdd: Option<&[f64]>,
+            c: &mut [f64],
+            c_dot: &mut [f64],
+            c_acc: &mut [f64],
+            scratch: &mut [f64],
+        ) {
+            // closed form: a = B z + b, ȧ = B ż, ä = B z̈; t = tanh a; ċ = A (σ' ȧ),
+            // c̈ = A (σ' ä + σ'' ȧ²)
+            let t = (&self.b * DVector::from_column_slice(z) + &self.bias).map(f64::tanh);
+            scratch.copy_from_slice(t.as_slice());
+            let ad = &self.b * DVector::from_column_slice(zd);
+            let add = match zdd {
+                Some(zdd) => &self.b * DVector::from_column_slice(zdd),
+                None => DVector::zeros(t.len()),
+            };
+            let d1 = t.map(|t| 1.0 - t * t);
+            let hd = d1.component_mul(&ad);
+            let hdd = DVector::from_fn(t.len(), |i, _| {
+                d1[i] * add[i] - 2.0 * t[i] * d1[i] * ad[i] * ad[i]
+            });
+            c.copy_from_slice((&self.a * &t).as_slice());
+            c_dot.copy_from_slice((&self.a * hd).as_slice());
+            c_acc.copy_from_slice((&self.a * hdd).as_slice());
+        }
+        fn vjp(&self, g: &[f64], out: &mut [f64], scratch: &mut [f64]) {
+            let t = DVector::from_column_slice(scratch);
+            let ag = self.a.transpose() * DVector::from_column_slice(g);
+            let mu = DVector::from_fn(t.len(), |i, _| (1.0 - t[i] * t[i]) * ag[i]);
+            out.copy_from_slice((self.b.transpose() * mu).as_slice());
+        }
     }
 
     fn single_tendon_like() -> (Discretization, LinearBasis) {
@@ -624,6 +788,40 @@ mod tests {
             }],
         )
         .unwrap();
+        (disc, basis)
+    }
+
+    /// Two divisions (0.15 + 0.1 m), each with Legendre coefficients of its own on every strain
+    /// component: the stacked blocks are one component of one division.
+    fn two_division_legendre() -> (Discretization, LinearBasis) {
+        let material = Material {
+            youngs_modulus: 1e6,
+            poisson_ratio: 0.5,
+            density: 1000.0,
+            damping: 0.0,
+        };
+        let rod = Rod {
+            material,
+            divisions: vec![
+                gvs::rod::DivisionGeometry {
+                    length: 0.15,
+                    radius_start: 0.02,
+                    radius_end: 0.015,
+                },
+                gvs::rod::DivisionGeometry {
+                    length: 0.1,
+                    radius_start: 0.015,
+                    radius_end: 0.01,
+                },
+            ],
+        };
+        let q = Quadrature::Gauss { n: 4 };
+        let disc = Discretization::new(&rod, &[q, q], MagnusOrder::Z4, &[]).unwrap();
+        let legendre = DivisionBasis::Legendre {
+            modes: [true; 6],
+            orders: [1, 2, 2, 1, 1, 0],
+        };
+        let basis = LinearBasis::per_division(&disc, &[legendre.clone(), legendre]).unwrap();
         (disc, basis)
     }
 
@@ -720,6 +918,79 @@ mod tests {
                 close(ha.as_slice(), hb.as_slice()),
                 "weighted Hessian, r = {r}"
             );
+        }
+    }
+
+    #[test]
+    fn the_motion_evaluation_and_its_projection_equal_those_from_psi_q_stacked_and_looped() {
+        // ξ̇_s = Ψ_q,s q̇, Ψ̇_q,s q̇ + Ψ_q,s q̈ and Σ_s Ψ_q,sᵀ w_s from eval + eval_rate (checked against
+        // central differences in `reduced_derivatives_match_central_differences`) against the
+        // motion evaluation's direct ones, on a one- and a two-division basis
+        for (label, (_disc, basis)) in [
+            ("one division", single_tendon_like()),
+            ("two divisions", two_division_legendre()),
+        ] {
+            let m = basis.n_dof();
+            for r in [1, 3] {
+                let map = || TanhMap {
+                    a: pattern(m, 6, r) * 0.5,
+                    b: pattern(6, r, 2 * r + 1),
+                    bias: DVector::from_fn(6, |i, _| 0.1 * i as f64 - 0.2),
+                };
+                let stacked = ReducedParam::new(&basis, map(), DVector::zeros(r)).unwrap();
+                // one block per component and run of sites on the same coefficients: one division,
+                // all sites (3 components); two divisions, each division's points and then its
+                // Magnus sub-points (sites are numbered points first): 6 × 2 × 2 blocks, each on
+                // that component's coefficients of that division only
+                let st = stacked
+                    .stacked
+                    .as_ref()
+                    .expect("a per-division basis is stacked");
+                let (n_blocks, widest) = match label {
+                    "one division" => (3, 5),
+                    _ => (24, 3),
+                };
+                assert_eq!(st.blocks.len(), n_blocks, "{label}");
+                assert!(st.blocks.iter().all(|b| b.cols.len() <= widest), "{label}");
+                let mut looped = ReducedParam::new(&basis, map(), DVector::zeros(r)).unwrap();
+                looped.stacked = None;
+                let q = DVector::from_fn(r, |i, _| 0.3 - 0.25 * i as f64);
+                let qd = DVector::from_fn(r, |i, _| 0.7 + 0.5 * i as f64);
+                let qdd = DVector::from_fn(r, |i, _| -1.3 + 0.9 * i as f64);
+                let w: Vec<V6> = (0..basis.n_sites())
+                    .map(|s| V6::from_fn(|a, _| ((s * 5 + a * 3) % 7) as f64 - 3.0))
+                    .collect();
+                for p in [&stacked, &looped] {
+                    let mut ev = p.new_eval();
+                    p.eval(&q, &mut ev);
+                    p.eval_rate(&q, &qd, &mut ev);
+                    let mut proj = DVector::zeros(r);
+                    p.project(&w, &mut ev, &mut proj);
+                    let mut mo = p.new_eval();
+                    for with_qdd in [true, false] {
+                        let qdd = with_qdd.then_some(&qdd);
+                        assert!(p.eval_motion(&q, &qd, qdd, &mut mo));
+                        mo.motion = true;
+                        mo.psi_q_stale = true;
+                        let close = |x: &V6, y: &V6| (x - y).amax() <= 1e-12 * y.amax().max(1.0);
+                        for s in 0..basis.n_sites() {
+                            let c = 0..r;
+                            let xid: V6 = ev.psi_q_at(s, &c) * &qd;
+                            let mut acc: V6 = ev.psi_q_dot_at(s, &c) * &qd;
+                            if let Some(qdd) = qdd {
+                                acc += ev.psi_q_at(s, &c) * qdd;
+                            }
+                            assert!(close(&mo.psi[s], &ev.psi[s]), "{label} r = {r}: Ψ at {s}");
+                            assert!(close(&mo.xi_dot[s], &xid), "{label} r = {r}: ξ̇ at {s}");
+                            assert!(close(&mo.xi_acc[s], &acc), "{label} r = {r}: ξ̈ᵇ at {s}");
+                        }
+                        let mut proj_mo = DVector::zeros(r);
+                        p.project(&w, &mut mo, &mut proj_mo);
+                        let err = (&proj_mo - &proj).amax() / proj.amax();
+                        assert!(err < 1e-12, "{label} r = {r}: Σ Ψ_qᵀ w off by {err:e}");
+                    }
+                }
+            }
         }
     }
 

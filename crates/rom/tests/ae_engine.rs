@@ -475,6 +475,17 @@ fn dynamics_residual_is_m_qdd_minus_tau_with_ae_param() {
             let err = (&eps - &expected).amax() / expected.amax();
             eprintln!("r = {r}: ε vs M q̈ − τ {err:.3e}");
             assert!(err < 1e-10, "r = {r}: ε vs M q̈ − τ {err:e}");
+            // the same residual from the forward pass that also renews M (Ψ_q evaluated too)
+            let mut mass = DMatrix::zeros(n, n);
+            m.dynamics_residual_and_mass(q, &qd, &qdd, &[-1.0], &loads, &mut ws, &mut eps);
+            mass.copy_from(&ws.mass);
+            let err = (&eps - &expected).amax() / expected.amax();
+            assert!(err < 1e-10, "r = {r}: ε with M vs M q̈ − τ {err:e}");
+            let m_err = (&mass - m.mass_matrix(q, &mut ws)).amax() / mass.amax();
+            assert!(
+                m_err < 1e-12,
+                "r = {r}: M of the residual pass off by {m_err:e}"
+            );
         }
     }
 }

@@ -11,6 +11,11 @@
 //! | `Ψ̇_q,s = (∂²Ψ_s/∂q² q̇)` (paper eq. 17) | 0 | directional second derivative |
 //! | `Σ_s Σ_a w_{s,a} ∇²Ψ_{s,a}` (statics Jacobian) | 0 | contraction with per-site weights |
 //!
+//! A parameterization whose `Ψ_q` costs `n` directional derivatives (a decoder) may also offer the
+//! *motion* evaluation of a dynamics residual pass, which needs no `Ψ_q`: `Ψ_s`, `ξ̇_s = Ψ_q,s q̇` and
+//! `Ψ̇_q,s q̇ + Ψ_q,s q̈` ([`StrainParam::eval_motion`], two directional derivatives instead of `n`),
+//! and the projection `Σ_s Ψ_q,sᵀ y_s` as one reverse pass ([`StrainParam::project`]).
+//!
 //! Every model quantity (kinematics, M, C, K, forces) is computed by the engine from these, so a reduced
 //! model keeps the Lagrangian structure by construction.
 
@@ -40,6 +45,16 @@ pub struct StrainEval {
     pub psi: Vec<V6>,
     pub psi_q: Matrix6xX<f64>,
     pub psi_q_dot: Matrix6xX<f64>,
+    /// Set by the engine after [`StrainParam::eval_motion`], cleared after [`StrainParam::eval`]:
+    /// `xi_dot` and `xi_acc` hold, and the engine takes the strain rates from them.
+    pub motion: bool,
+    /// Set by the engine after [`StrainParam::eval_motion`] without [`StrainParam::eval`] at the
+    /// same `q`: `psi_q` and `psi_q_dot` must not be read.
+    pub psi_q_stale: bool,
+    /// `ξ̇_s = Ψ_q,s q̇` per site (after [`StrainParam::eval_motion`]).
+    pub xi_dot: Vec<V6>,
+    /// `Ψ̇_q,s q̇ + Ψ_q,s q̈` per site (after [`StrainParam::eval_motion`]; `q̈ = 0` if not given).
+    pub xi_acc: Vec<V6>,
     /// The parameterization's own scratch: what [`StrainParam::eval`] computes once and
     /// [`StrainParam::eval_rate`] and [`StrainParam::add_weighted_hessian`] reuse at the same `q`
     /// (e.g. a network's activations). Sized by [`StrainParam::new_eval`]; never resized after.
@@ -69,6 +84,10 @@ impl StrainEval {
             psi: vec![V6::zeros(); cols.len()],
             psi_q: crate::model::zeros6_lazy(total),
             psi_q_dot: crate::model::zeros6_lazy(total),
+            motion: false,
+            psi_q_stale: false,
+            xi_dot: vec![V6::zeros(); cols.len()],
+            xi_acc: vec![V6::zeros(); cols.len()],
             scratch: Vec::new(),
             cols: cols.to_vec(),
             offsets,
@@ -92,6 +111,7 @@ impl StrainEval {
     #[inline]
     pub fn psi_q_at(&self, site: usize, cols: &Range<usize>) -> SiteJacobian<'_> {
         debug_assert!(cols.end <= self.cols[site].end);
+        debug_assert!(!self.psi_q_stale, "Ψ_q is stale after a motion evaluation");
         self.psi_q.columns(self.index(site, cols.start), cols.len())
     }
 
@@ -99,6 +119,7 @@ impl StrainEval {
     #[inline]
     pub fn psi_q_dot_at(&self, site: usize, cols: &Range<usize>) -> SiteJacobian<'_> {
         debug_assert!(cols.end <= self.cols[site].end);
+        debug_assert!(!self.psi_q_stale, "Ψ̇_q is stale after a motion evaluation");
         self.psi_q_dot
             .columns(self.index(site, cols.start), cols.len())
     }
@@ -160,6 +181,52 @@ pub trait StrainParam: Send + Sync {
     fn rest_coordinates(&self) -> DVector<f64> {
         DVector::zeros(self.n_dof())
     }
+
+    /// The motion evaluation of a dynamics residual pass, if this parameterization has one cheaper
+    /// than [`StrainParam::eval`] + [`StrainParam::eval_rate`]: fills `ev.psi`, `ev.xi_dot`
+    /// (`Ψ_q,s q̇`) and `ev.xi_acc` (`Ψ̇_q,s q̇ + Ψ_q,s q̈`, with `q̈ = 0` if `None`) at every site,
+    /// and returns `true`; the engine then sets `ev.motion`. It may leave `ev.psi_q` and
+    /// `ev.psi_q_dot` stale (then the engine sets `ev.psi_q_stale`), but must keep what
+    /// [`StrainParam::eval`] stored at the same `q` for [`StrainParam::add_weighted_hessian`] valid.
+    /// The default returns `false` and touches nothing (linear bases: their `Ψ_q` is a constant,
+    /// nothing to save).
+    fn eval_motion(
+        &self,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        qdd: Option<&DVector<f64>>,
+        ev: &mut StrainEval,
+    ) -> bool {
+        let _ = (q, qd, qdd, ev);
+        false
+    }
+
+    /// `r += Σ_s Ψ_q,sᵀ y_s` (`y` one 6-vector per site, zeros skipped), after [`StrainParam::eval`]
+    /// or (if it returned `true`) [`StrainParam::eval_motion`] at the same `q` with the same `ev`.
+    /// The default reads `ev.psi_q` ([`project_with_psi_q`]); a parameterization with a motion
+    /// evaluation must override it for `ev.motion`.
+    fn project(&self, y: &[V6], ev: &mut StrainEval, r: &mut DVector<f64>) {
+        project_with_psi_q(self, y, ev, r);
+    }
+}
+
+/// `r += Σ_s Ψ_q,sᵀ y_s` from the stored `ev.psi_q`, site by site on the site's
+/// [`StrainParam::columns`] (zero `y_s` skipped).
+pub fn project_with_psi_q<P: StrainParam + ?Sized>(
+    param: &P,
+    y: &[V6],
+    ev: &StrainEval,
+    r: &mut DVector<f64>,
+) {
+    debug_assert!(!ev.psi_q_stale, "Ψ_q is stale after a motion evaluation");
+    for (s, ys) in y.iter().enumerate() {
+        if *ys == V6::zeros() {
+            continue;
+        }
+        let c = param.columns(s);
+        r.rows_mut(c.start, c.len())
+            .gemv_tr(1.0, &ev.psi_q_at(s, &c), ys, 1.0);
+    }
 }
 
 /// A boxed parameterization is one too, so a program can choose the HOM basis or a reduced one at run
@@ -197,6 +264,18 @@ impl<P: StrainParam + ?Sized> StrainParam for Box<P> {
     }
     fn rest_coordinates(&self) -> DVector<f64> {
         (**self).rest_coordinates()
+    }
+    fn eval_motion(
+        &self,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        qdd: Option<&DVector<f64>>,
+        ev: &mut StrainEval,
+    ) -> bool {
+        (**self).eval_motion(q, qd, qdd, ev)
+    }
+    fn project(&self, y: &[V6], ev: &mut StrainEval, r: &mut DVector<f64>) {
+        (**self).project(y, ev, r)
     }
 }
 

@@ -14,17 +14,23 @@
 //!   second order, so residual-only evaluations pay for value and Jacobian alone.
 //! - [`CoefficientMap::eval_rate`], one directional pass along `ż` (eq. 17): with `Ṫ_0 = 0`,
 //!   `Ṫ_{k+1} = σ'(a_k) ⊙ (W_k Ṫ_k) + σ''(a_k) ⊙ (P_k ż) ⊙ P_k` (row-wise), `Ċ_z = W_L Ṫ_L`.
+//! - [`CoefficientMap::eval_motion`], second-order forward mode along `z(t)`: with `ḣ_0 = ż`,
+//!   `ḧ_0 = z̈`, `ȧ_k = W_k ḣ_k`, `ä_k = W_k ḧ_k`, then `ḣ_{k+1} = σ'(a_k) ȧ_k` and
+//!   `ḧ_{k+1} = σ'(a_k) ä_k + σ''(a_k) ȧ_k²` (elementwise); three columns per layer instead of
+//!   `1 + r`. It stores `σ(a_k)` only.
+//! - [`CoefficientMap::vjp`], reverse mode: `μ_{L−1} = W_Lᵀ g`, `μ_{k−1} = W_kᵀ (σ'(a_k) ⊙ μ_k)`,
+//!   `C_zᵀ g = μ_{−1}`: one column per layer.
 //! - [`CoefficientMap::add_weighted_hessian`], reverse over forward: for `φ = gᵀ c`, the linear
 //!   maps have no curvature, so `∇²φ = Σ_k P_kᵀ diag(μ_k ⊙ σ''(a_k)) P_k` with the adjoints
 //!   `μ_{L−1} = W_Lᵀ g`, `μ_{k−1} = W_kᵀ (σ'(a_k) ⊙ μ_k)` — `O(Σ n_k r²)`, no third-order tensor.
 //!
-//! The weights are kept column-major, so every product is one faer call (value and tangents
-//! together). No call allocates, but a thread's first, where faer allocates its thread-local
-//! packing buffer once (`tests/decoder_map_no_alloc.rs`).
+//! The weights are kept column-major (and transposed, for the reverse passes), so every product is
+//! one call of this crate's small kernels ([`crate::gemm`]: value and tangents together). No call
+//! allocates (`tests/decoder_map_no_alloc.rs`).
 
 use super::mlp::{Layer, Mlp};
 use super::{NnError, Scaling};
-use crate::gemm::{mul_cols, mul_tr_cols};
+use crate::gemm::mul_cols;
 use crate::map::CoefficientMap;
 
 /// A decoder network whose last layer is folded with `c = A (s ⊙ y + μ)`.
@@ -90,6 +96,11 @@ impl DecoderMap {
             .sum()
     }
 
+    /// Columns of a work block: `1 + r` ([`CoefficientMap::eval`]) or 3 ([`CoefficientMap::eval_motion`]).
+    fn work_cols(&self) -> usize {
+        (1 + self.r).max(3)
+    }
+
     /// Length of the stored part of `scratch`.
     fn stored_len(&self) -> usize {
         self.store(self.layers.len() - 1)
@@ -97,12 +108,14 @@ impl DecoderMap {
 }
 
 /// A layer as the evaluation uses it: `W` column-major `n_out × n_in` (element `(i, j)` at
-/// `i + j·n_out`, the transpose of [`Layer`]'s storage), `b` of `n_out`.
+/// `i + j·n_out`, the transpose of [`Layer`]'s storage), `Wᵀ` column-major (the reverse passes:
+/// a product with one column is then contiguous row updates, not dot products), `b` of `n_out`.
 #[derive(Debug, Clone, PartialEq)]
 struct ColLayer {
     n_in: usize,
     n_out: usize,
     w: Vec<f64>,
+    wt: Vec<f64>,
     b: Vec<f64>,
 }
 
@@ -118,6 +131,7 @@ impl ColLayer {
             n_in: l.n_in,
             n_out: l.n_out,
             w,
+            wt: l.w.clone(),
             b: l.b.clone(),
         }
     }
@@ -158,16 +172,17 @@ impl CoefficientMap for DecoderMap {
         self.m
     }
 
-    /// The stored `σ(a_k)`, `P_k` of the hidden layers, plus two work blocks of `widest × (1 + r)`.
+    /// The stored `σ(a_k)`, `P_k` of the hidden layers, plus two work blocks of
+    /// `widest × max(1 + r, 3)`.
     fn scratch_len(&self) -> usize {
-        self.stored_len() + 2 * self.widest * (1 + self.r)
+        self.stored_len() + 2 * self.widest * self.work_cols()
     }
 
     fn eval(&self, z: &[f64], c: &mut [f64], c_z: &mut [f64], scratch: &mut [f64]) {
         let (r, m) = (self.r, self.m);
         let cols = 1 + r;
         let (stored, work) = scratch.split_at_mut(self.stored_len());
-        let (x, y) = work.split_at_mut(self.widest * cols);
+        let (x, y) = work.split_at_mut(self.widest * self.work_cols());
         let (mut x, mut y) = (x, y);
         // input block: value z, tangents I
         x[..r * cols].iter_mut().for_each(|v| *v = 0.0);
@@ -208,7 +223,7 @@ impl CoefficientMap for DecoderMap {
     fn eval_rate(&self, _z: &[f64], zd: &[f64], c_z_dot: &mut [f64], scratch: &mut [f64]) {
         let r = self.r;
         let (stored, work) = scratch.split_at_mut(self.stored_len());
-        let (x, y) = work.split_at_mut(self.widest * (1 + r));
+        let (x, y) = work.split_at_mut(self.widest * self.work_cols());
         let (mut x, mut y) = (x, y);
         let last = self.layers.len() - 1;
         let mut off = 0;
@@ -243,12 +258,12 @@ impl CoefficientMap for DecoderMap {
     fn add_weighted_hessian(&self, _z: &[f64], g: &[f64], out: &mut [f64], scratch: &mut [f64]) {
         let r = self.r;
         let (stored, work) = scratch.split_at_mut(self.stored_len());
-        let (mu, next) = work.split_at_mut(self.widest * (1 + r));
+        let (mu, next) = work.split_at_mut(self.widest * self.work_cols());
         let (mut mu, mut next) = (mu, next);
         let last = self.layers.len() - 1;
         // μ_{L−1} = W_Lᵀ g
         let wl = &self.layers[last];
-        mul_tr_cols((wl.n_out, wl.n_in, 1), &wl.w, g, mu);
+        mul_cols((wl.n_in, wl.n_out, 1), &wl.wt, g, mu);
         for k in (0..last).rev() {
             let layer = &self.layers[k];
             let (n_in, n_out) = (layer.n_in, layer.n_out);
@@ -275,8 +290,86 @@ impl CoefficientMap for DecoderMap {
             }
             if k > 0 {
                 // μ_{k−1} = W_kᵀ (σ' ⊙ μ_k)
-                mul_tr_cols((n_out, n_in, 1), &layer.w, mu, next);
+                mul_cols((n_in, n_out, 1), &layer.wt, mu, next);
                 std::mem::swap(&mut mu, &mut next);
+            }
+        }
+    }
+
+    fn eval_motion(
+        &self,
+        z: &[f64],
+        zd: &[f64],
+        zdd: Option<&[f64]>,
+        c: &mut [f64],
+        c_dot: &mut [f64],
+        c_acc: &mut [f64],
+        scratch: &mut [f64],
+    ) {
+        let (r, m) = (self.r, self.m);
+        let (stored, work) = scratch.split_at_mut(self.stored_len());
+        let (x, y) = work.split_at_mut(self.widest * self.work_cols());
+        let (mut x, mut y) = (x, y);
+        // input block [z | ż | z̈]
+        x[..r].copy_from_slice(z);
+        x[r..2 * r].copy_from_slice(zd);
+        match zdd {
+            Some(zdd) => x[2 * r..3 * r].copy_from_slice(zdd),
+            None => x[2 * r..3 * r].fill(0.0),
+        }
+        let last = self.layers.len() - 1;
+        for (k, layer) in self.layers.iter().enumerate() {
+            let (n_in, n_out) = (layer.n_in, layer.n_out);
+            mul_cols((n_out, n_in, 3), &layer.w, x, y);
+            y[..n_out]
+                .iter_mut()
+                .zip(&layer.b)
+                .for_each(|(yi, b)| *yi += b);
+            if k < last {
+                let st = &mut stored[self.store(k)..self.store(k) + n_out];
+                let (v, rest) = y.split_at_mut(n_out);
+                let (ad, add) = rest.split_at_mut(n_out);
+                for i in 0..n_out {
+                    let sigma = super::activation::tanh(v[i]);
+                    let d1 = 1.0 - sigma * sigma;
+                    let d2 = -2.0 * sigma * d1;
+                    st[i] = sigma;
+                    v[i] = sigma;
+                    add[i] = d1 * add[i] + d2 * ad[i] * ad[i];
+                    ad[i] *= d1;
+                }
+            }
+            std::mem::swap(&mut x, &mut y);
+        }
+        c.copy_from_slice(&x[..m]);
+        c_dot.copy_from_slice(&x[m..2 * m]);
+        c_acc.copy_from_slice(&x[2 * m..3 * m]);
+    }
+
+    fn vjp(&self, g: &[f64], out: &mut [f64], scratch: &mut [f64]) {
+        let (stored, work) = scratch.split_at_mut(self.stored_len());
+        let (mu, next) = work.split_at_mut(self.widest * self.work_cols());
+        let (mut mu, mut next) = (mu, next);
+        let last = self.layers.len() - 1;
+        let wl = &self.layers[last];
+        if last == 0 {
+            mul_cols((wl.n_in, wl.n_out, 1), &wl.wt, g, out);
+            return;
+        }
+        // μ_{L−1} = W_Lᵀ g
+        mul_cols((wl.n_in, wl.n_out, 1), &wl.wt, g, mu);
+        for k in (0..last).rev() {
+            let layer = &self.layers[k];
+            let (n_in, n_out) = (layer.n_in, layer.n_out);
+            let st = &stored[self.store(k)..self.store(k) + n_out];
+            for (m, &sigma) in mu[..n_out].iter_mut().zip(st) {
+                *m *= 1.0 - sigma * sigma;
+            }
+            if k > 0 {
+                mul_cols((n_in, n_out, 1), &layer.wt, mu, next);
+                std::mem::swap(&mut mu, &mut next);
+            } else {
+                mul_cols((n_in, n_out, 1), &layer.wt, mu, out);
             }
         }
     }

@@ -1,5 +1,5 @@
-//! Value, Jacobian, eq. (17) term and weighted Hessian of the folded decoder against central
-//! differences and against `Autoencoder::decode`.
+//! Value, Jacobian, eq. (17) term, weighted Hessian, motion and reverse pass of the folded decoder
+//! against central differences and against `Autoencoder::decode`.
 
 use super::*;
 use crate::nn::Autoencoder;
@@ -89,6 +89,88 @@ fn jacobian_matches_central_differences_for_r_1_2_3() {
                 &format!("r = {r}, column {l}"),
             );
         }
+    }
+}
+
+#[test]
+fn motion_is_the_first_and_second_time_derivative_of_c_along_a_parabola() {
+    // z(t) = z + t ż + t²/2 z̈: ċ(0) and c̈(0) by central differences of c(z(t)) in t, h = 1e-4
+    // (second difference: truncation h²·|c⁗|/12 ≈ 1e-9, rounding 4·1e-16/h² ≈ 4e-8 on O(1) values)
+    let mut rng = SplitMix64::new(17);
+    for r in [1, 2, 3, 6] {
+        let map = random_map(r, &mut rng);
+        let z = random_vec(r, -1.0, 1.0, &mut rng);
+        let zd = random_vec(r, -2.0, 2.0, &mut rng);
+        let zdd = random_vec(r, -3.0, 3.0, &mut rng);
+        let m = map.n_out();
+        let at = |t: f64| {
+            let zt: Vec<f64> = (0..r)
+                .map(|i| z[i] + t * zd[i] + 0.5 * t * t * zdd[i])
+                .collect();
+            eval_at(&map, &zt).0
+        };
+        const H: f64 = 1e-4;
+        let (cp, c0, cm) = (at(H), at(0.0), at(-H));
+        let fd_dot: Vec<f64> = (0..m).map(|i| (cp[i] - cm[i]) / (2.0 * H)).collect();
+        let fd_acc: Vec<f64> = (0..m)
+            .map(|i| (cp[i] - 2.0 * c0[i] + cm[i]) / (H * H))
+            .collect();
+        let mut scratch = vec![0.0; map.scratch_len()];
+        let (mut c, mut c_dot, mut c_acc) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
+        map.eval_motion(
+            &z,
+            &zd,
+            Some(&zdd),
+            &mut c,
+            &mut c_dot,
+            &mut c_acc,
+            &mut scratch,
+        );
+        assert_relative(&c0, &c, &format!("r = {r}: value"));
+        assert_relative(&fd_dot, &c_dot, &format!("r = {r}: ċ"));
+        let scale = c_acc.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let err = fd_acc
+            .iter()
+            .zip(&c_acc)
+            .fold(0.0f64, |a, (f, e)| a.max((f - e).abs()));
+        assert!(
+            err <= 1e-5 * scale,
+            "r = {r}: c̈ off by {err:e} (scale {scale:e})"
+        );
+        // without z̈: the curvature term alone, (∂²c/∂z² ż) ż = Ċ_z ż from eval_rate
+        map.eval_motion(&z, &zd, None, &mut c, &mut c_dot, &mut c_acc, &mut scratch);
+        let (_, _, mut full) = eval_at(&map, &z);
+        let mut rate = vec![0.0; m * r];
+        map.eval_rate(&z, &zd, &mut rate, &mut full);
+        let curvature: Vec<f64> = (0..m)
+            .map(|i| (0..r).map(|l| rate[i + l * m] * zd[l]).sum())
+            .collect();
+        assert_relative(&c_acc, &curvature, &format!("r = {r}: c̈ at z̈ = 0"));
+    }
+}
+
+#[test]
+fn reverse_pass_is_the_transposed_jacobian_after_either_evaluation() {
+    let mut rng = SplitMix64::new(18);
+    for r in [1, 2, 3, 6] {
+        let map = random_map(r, &mut rng);
+        let m = map.n_out();
+        let z = random_vec(r, -1.0, 1.0, &mut rng);
+        let g = random_vec(m, -1.0, 1.0, &mut rng);
+        let (_, c_z, mut scratch) = eval_at(&map, &z);
+        // C_zᵀ g from the Jacobian (checked against central differences above)
+        let expected: Vec<f64> = (0..r)
+            .map(|l| (0..m).map(|i| c_z[i + l * m] * g[i]).sum())
+            .collect();
+        let mut out = vec![f64::NAN; r];
+        map.vjp(&g, &mut out, &mut scratch);
+        assert_relative(&out, &expected, &format!("r = {r}: after eval"));
+        let mut fresh = vec![0.0; map.scratch_len()];
+        let zd = random_vec(r, -1.0, 1.0, &mut rng);
+        let (mut c, mut c_dot, mut c_acc) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
+        map.eval_motion(&z, &zd, None, &mut c, &mut c_dot, &mut c_acc, &mut fresh);
+        map.vjp(&g, &mut out, &mut fresh);
+        assert_relative(&out, &expected, &format!("r = {r}: after eval_motion"));
     }
 }
 
