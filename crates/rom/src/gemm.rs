@@ -78,7 +78,8 @@ fn mul_tr_cols_avx2(
 }
 
 /// Register-blocked: `Y` in tiles of `8 × 4` (eight AVX2 accumulators held in registers over the
-/// whole `l` sweep), the rows left over in tiles of 4, 2 and 1, the columns left over one at a time.
+/// whole `l` sweep), the rows left over in tiles of 4, 2 and 1, the columns left over (1–3) in one
+/// narrower block.
 #[inline(always)]
 fn mul_cols_body<const FMA: bool>(
     (rows, k, n): (usize, usize, usize),
@@ -92,9 +93,15 @@ fn mul_cols_body<const FMA: bool>(
         col_block::<4, FMA>((rows, k), a, &b[jb * ldb..], ldb, &mut y[jb * rows..]);
         jb += 4;
     }
-    while jb < n {
-        col_block::<1, FMA>((rows, k), a, &b[jb * ldb..], ldb, &mut y[jb * rows..]);
-        jb += 1;
+    if jb == n {
+        return;
+    }
+    let (b, y) = (&b[jb * ldb..], &mut y[jb * rows..]);
+    match n - jb {
+        3 => col_block::<3, FMA>((rows, k), a, b, ldb, y),
+        2 => col_block::<2, FMA>((rows, k), a, b, ldb, y),
+        1 => col_block::<1, FMA>((rows, k), a, b, ldb, y),
+        _ => {}
     }
 }
 
@@ -212,6 +219,8 @@ mod tests {
             (42, 21, 9),
             (28, 42, 8),
             (84, 42, 3),
+            (19, 3, 4),
+            (7, 2, 2),
             (3, 2, 1),
         ] {
             let ldb = k + 3;

@@ -160,6 +160,9 @@ struct Stacked {
     blocks: Vec<Block>,
     /// `Σ_i |sites_i|`: the rows of all blocks.
     rows: usize,
+    /// Whether the blocks cover every site's every strain component (a basis on all six): then a
+    /// scatter writes every entry and needs no zeroing first.
+    covers_all: bool,
 }
 
 struct Block {
@@ -223,7 +226,12 @@ impl Stacked {
                 }
             }
         }
-        Some(Stacked { blocks, rows })
+        let covers_all = rows == 6 * ns;
+        Some(Stacked {
+            blocks,
+            rows,
+            covers_all,
+        })
     }
 
     /// Length of the product buffer for `k` right-hand columns.
@@ -245,11 +253,13 @@ impl Stacked {
 
     /// Scatters the products of [`Stacked::mul`] (`k = 1 + r`: value then `r` tangents, or
     /// `k = r` tangents only) into the site vectors `psi` (if given) and the site matrices `out`
-    /// (`6 × r` per site, column-major), which are zeroed first.
+    /// (`6 × r` per site, column-major), zeroed first unless the blocks cover every entry.
     fn scatter(&self, y: &[f64], r: usize, mut psi: Option<&mut [V6]>, out: &mut [f64]) {
-        out.fill(0.0);
-        if let Some(psi) = psi.as_deref_mut() {
-            psi.iter_mut().for_each(|p| *p = V6::zeros());
+        if !self.covers_all {
+            out.fill(0.0);
+            if let Some(psi) = psi.as_deref_mut() {
+                psi.iter_mut().for_each(|p| *p = V6::zeros());
+            }
         }
         let k = r + usize::from(psi.is_some());
         let t0 = k - r;
@@ -270,11 +280,14 @@ impl Stacked {
     }
 
     /// Scatters the products of [`Stacked::mul`] with `k = 3` (`[c | ċ | c̈]`) into the site
-    /// vectors `out[0]` (`Ψ`), `out[1]` (`ξ̇`), `out[2]` (`ξ̈ᵇ`), which are zeroed first.
+    /// vectors `out[0]` (`Ψ`), `out[1]` (`ξ̇`), `out[2]` (`ξ̈ᵇ`), zeroed first unless the blocks
+    /// cover every entry.
     fn scatter_motion(&self, y: &[f64], out: [&mut [V6]; 3]) {
         let [psi, xi_dot, xi_acc] = out;
-        for v in [&mut *psi, &mut *xi_dot, &mut *xi_acc] {
-            v.iter_mut().for_each(|p| *p = V6::zeros());
+        if !self.covers_all {
+            for v in [&mut *psi, &mut *xi_dot, &mut *xi_acc] {
+                v.iter_mut().for_each(|p| *p = V6::zeros());
+            }
         }
         let mut off = 0;
         for b in &self.blocks {
