@@ -191,3 +191,94 @@ pub fn simulate_test(
         },
     )
 }
+
+/// The wall time of a reduced model against the HOM's on the same test, measured in interleaved
+/// pairs: per round the HOM's integration, then the model's, without output; the median of the
+/// rounds' ratios. A shared machine's speed drifts over seconds to minutes, which best-of-N times
+/// taken one after the other turn into ratios off by 1.5× either way; a pair's two runs are
+/// seconds apart, so the drift cancels in their ratio.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct PairedTiming {
+    pub rounds: usize,
+    pub hom_s: Vec<f64>,
+    pub rom_s: Vec<f64>,
+    /// Median over the rounds of `rom_s / hom_s`.
+    pub median_ratio: f64,
+}
+
+/// [`PairedTiming`] of `model` against the HOM on `test`, `rounds` pairs (a step of its own, so
+/// a resumed run keeps it).
+pub fn time_pairs(
+    run: &Run,
+    name: &str,
+    scenario: &ScenarioSpec,
+    test: &Test,
+    model: &Step<ModelInfo>,
+    rounds: usize,
+) -> anyhow::Result<Step<PairedTiming>> {
+    let config = json!({
+        "scenario": scenario, "test": test, "model": model.key(), "rounds": rounds,
+    });
+    run.step(
+        name,
+        &config,
+        |_| true,
+        |_| {
+            let (hom, table) = scenario.build()?;
+            let (mut rom, _) = scenario.build()?;
+            let options = reduce::AttachOptions {
+                extrapolate: false,
+                tensions_from_signal: true,
+            };
+            reduce::attach(&mut rom, &table, &model.path, options)?;
+            let interrupt = run.interrupt().clone();
+            let mut control = |_: f64| match interrupt.load(Ordering::SeqCst) {
+                0 => ControlFlow::Continue(()),
+                _ => ControlFlow::Break("interrupted".to_string()),
+            };
+            let mut once = |built: &Built| -> anyhow::Result<f64> {
+                let (opts, _) = test.options(built)?;
+                let plan = simulate::plan(built, &opts)?;
+                let out = simulate::run(built, &plan, &opts.integrator, None, &mut control)?;
+                run.check_interrupt()?;
+                Ok(out.summary.wall_time_s)
+            };
+            let (mut hom_s, mut rom_s) = (vec![], vec![]);
+            for _ in 0..rounds.max(1) {
+                hom_s.push(once(&hom)?);
+                rom_s.push(once(&rom)?);
+            }
+            let ratios: Vec<f64> = rom_s.iter().zip(&hom_s).map(|(r, h)| r / h).collect();
+            Ok(PairedTiming {
+                rounds: ratios.len(),
+                median_ratio: median(ratios),
+                hom_s,
+                rom_s,
+            })
+        },
+    )
+}
+
+/// The median of `v` (the mean of the two middle values for an even count; NaN if empty).
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let k = v.len();
+    match k {
+        0 => f64::NAN,
+        _ if k % 2 == 1 => v[k / 2],
+        _ => 0.5 * (v[k / 2 - 1] + v[k / 2]),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::median;
+
+    #[test]
+    fn the_median_of_odd_and_even_counts_and_of_none() {
+        assert_eq!(median(vec![3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(vec![4.0, 1.0, 3.0, 2.0]), 2.5);
+        assert_eq!(median(vec![0.9]), 0.9);
+        assert!(median(vec![]).is_nan());
+    }
+}

@@ -20,7 +20,7 @@ use super::tasks::{self, AeConfig, DatasetSpec, ModelInfo, ScenarioSpec};
 use super::{new_report, paper, Case, Options, Run};
 use crate::compare::Trajectory;
 use crate::simulate::IntegratorChoice;
-use more_tests::{more_tests_findings, more_tests_table, run_more_tests, TestRuns};
+use more_tests::{ae_timing, more_tests_findings, more_tests_table, run_more_tests, TestRuns};
 use report::{
     fig9, fig9_table, findings, lambda_table, models_table, notes, table_iii, tip_travel, Context,
     Inset,
@@ -46,6 +46,8 @@ const DATA_SEED: u64 = 0;
 /// The test input: new tensions uniform in [lo, hi] N on every tendon every `period` s.
 const TEST_STEPS: [f64; 3] = [-15.0, 0.0, 1.0];
 const TEST_SEED: u64 = 2;
+/// Interleaved HOM/AE-ROM timing pairs per repetition of a test run (9 in the full run).
+const TIMING_ROUNDS_PER_REPEAT: usize = 3;
 
 /// Sizes of the full, the quick and the tiny run.
 struct Sizes {
@@ -253,11 +255,15 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
             run: inset_dof.ae_run.clone(),
         },
     );
+    // the inset AE-ROM's wall time against the HOM's in interleaved pairs, on every test input
+    let rounds = TIMING_ROUNDS_PER_REPEAT * s.repeat;
+    let paper_timing = ae_timing(run, &scenario, &test, inset, &inset_dof.ae, rounds)?;
     let mut tests = vec![TestRuns {
         seed: TEST_SEED,
         hom: hom.value.clone(),
         ae: inset_dof.ae_run.clone(),
         pod: inset_dof.pod_run.clone(),
+        ae_timing: Some(paper_timing),
     }];
     tests.extend(run_more_tests(
         run,
@@ -267,6 +273,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         inset,
         &inset_dof.ae,
         &inset_dof.pod,
+        rounds,
     )?);
     // beyond the paper: the same budget over a longer babbling, and a more damped arm, on the same
     // inputs; a variant whose model the inputs lie outside of (a short quick-run babbling may not
@@ -323,7 +330,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         format!("autoencoders: one per r = {dof_list}, each with {HIDDEN_LAYERS} hidden layers, tanh, λ = {LAMBDA:e} (the paper's, against a whole snapshot's squared error), loss weighted by the section stiffness (strain-energy norm), 1 % zero-strain rows (the straight rod the simulations start from), Adam ≤ {} epochs with early stopping (patience {}) and learning-rate reductions, then L-BFGS, seed {first_seed}; at r = {inset} also λ = {LAMBDA:e} and {LAMBDA_OTHER:e} with seeds {}, otherwise the same", s.epochs, AeConfig::new(1, HIDDEN_LAYERS, s.epochs).patience, s.seeds.iter().map(u64::to_string).collect::<Vec<_>>().join(", ")),
         format!("POD: r = {dof_list} modes of the uncentred snapshots"),
         format!("test: {} s of new uniform random tensions in [{tlo}, {thi}] N on every tendon every {period} s, seed {TEST_SEED}, sampled at {SAMPLE_RATE} Hz (`gvsrom simulate six-tendon --duration {} --steps={tlo},{thi},{period} --seed {TEST_SEED} [--model M] --out DIR`, then `gvsrom compare HOM-DIR DIR`); every model starts at rest (the HOM and POD from the straight rod, an AE from its rest point, the encoding of the straight rod, as the data start there), with `simulate`'s automatic integrator{}", s.test_s, s.test_s, if s.more_tests.is_empty() { String::new() } else { format!("; the r = {inset} ROMs also on {} more inputs of the same kind, seeds {}", s.more_tests.len(), s.more_tests.iter().map(u64::to_string).collect::<Vec<_>>().join(", ")) }),
-        format!("timing: the simulations run one after the other on one thread, each {} time(s) (the trajectory written once), the smallest wall time of the integration kept; error: mean over the samples of ‖p_ROM − p_HOM‖ / L (`gvsrom compare`'s tip mean)", s.repeat),
+        format!("timing: the simulations run one after the other on one thread, each {} time(s) (the trajectory written once), the smallest wall time of the integration kept; the AE-{inset}-ROM against the HOM also in {} interleaved pairs per test input (HOM, then AE-ROM, without output), the median of the pairs' time ratios kept; error: mean over the samples of ‖p_ROM − p_HOM‖ / L (`gvsrom compare`'s tip mean)", s.repeat, TIMING_ROUNDS_PER_REPEAT * s.repeat),
     ];
     report.tables.push(fig9_table(&dofs, &hom));
     report.tables.push(table_iii(inset_dof, &hom));

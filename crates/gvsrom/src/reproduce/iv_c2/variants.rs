@@ -150,6 +150,7 @@ pub(super) fn run_variant(
             hom: hom.value,
             ae: ae_run.value,
             pod: pod_run.value,
+            ae_timing: None,
         });
     }
     Ok(VariantRuns {
