@@ -97,7 +97,6 @@ impl<P: StrainParam> Model<P> {
             let c = self.param.columns(s1);
             let qdc = qd.rows(c.start, c.len());
             let h = st.h;
-            let et = &ws.et[i];
             let xid1: V6 = ws.ev.psi_q_at(s1, &c) * qdc;
             let mut zd = V6::zeros(); // Ż q̇ (+ Z q̈)
             let om_dot: V6 = match self.disc.order {
@@ -133,12 +132,19 @@ impl<P: StrainParam> Model<P> {
                     xid1 * h
                 }
             };
-            let sqd = et.t_mul(&om_dot);
-            let sdqd = et.t_dot_mul(&om_dot, &om_dot) + et.t_mul(&zd);
-            ws.eta[i + 1] = et.g.adjoint_inv_mul(&(ws.eta[i] + sqd));
-            ws.zeta[i + 1] =
-                et.g.adjoint_inv_mul(&(ws.zeta[i] + ad_mul(&ws.eta[i], &sqd) + sdqd));
+            Self::propagate_velocity(i, &om_dot, &zd, ws);
         }
+    }
+
+    /// One step of the velocity recursion (module doc): `η_{i+1}` and `ζ_{i+1}` from `η_i`, `ζ_i`,
+    /// the step's `Ω̇` and `Ż q̇ (+ Z q̈)`.
+    fn propagate_velocity(i: usize, om_dot: &V6, zd: &V6, ws: &mut Workspace) {
+        let et = &ws.et[i];
+        let sqd = et.t_mul(om_dot);
+        let sdqd = et.t_dot_mul(om_dot, om_dot) + et.t_mul(zd);
+        ws.eta[i + 1] = et.g.adjoint_inv_mul(&(ws.eta[i] + sqd));
+        ws.zeta[i + 1] =
+            et.g.adjoint_inv_mul(&(ws.zeta[i] + ad_mul(&ws.eta[i], &sqd) + sdqd));
     }
 
     /// [`Self::velocities_with`] from a motion evaluation ([`StrainParam::eval_motion`] at the same
@@ -156,7 +162,6 @@ impl<P: StrainParam> Model<P> {
             };
             let [s1, s2] = st.sites;
             let h = st.h;
-            let et = &ws.et[i];
             let (xid1, a1) = (ws.ev.xi_dot[s1], ws.ev.xi_acc[s1]);
             let (om_dot, zd): (V6, V6) = match self.disc.order {
                 MagnusOrder::Z4 => {
@@ -172,11 +177,7 @@ impl<P: StrainParam> Model<P> {
                 }
                 MagnusOrder::Z2 => (xid1 * h, a1 * h),
             };
-            let sqd = et.t_mul(&om_dot);
-            let sdqd = et.t_dot_mul(&om_dot, &om_dot) + et.t_mul(&zd);
-            ws.eta[i + 1] = et.g.adjoint_inv_mul(&(ws.eta[i] + sqd));
-            ws.zeta[i + 1] =
-                et.g.adjoint_inv_mul(&(ws.zeta[i] + ad_mul(&ws.eta[i], &sqd) + sdqd));
+            Self::propagate_velocity(i, &om_dot, &zd, ws);
         }
     }
 

@@ -411,6 +411,26 @@ impl<M: CoefficientMap> ReducedParam<M> {
         }
     }
 
+    /// `g = Σ_s Φ_sᵀ w_s` (m) for one 6-vector per site (zeros skipped): by the stacked blocks
+    /// (`buf`: their gather buffer, `n_sites` or more) or site by site.
+    fn basis_transpose_times(&self, w: &[V6], buf: &mut [f64], g: &mut [f64]) {
+        match &self.stacked {
+            Some(st) => st.mul_tr(w, buf, g),
+            None => {
+                g.fill(0.0);
+                for (s, cols) in self.cols.iter().enumerate() {
+                    if w[s] == V6::zeros() {
+                        continue;
+                    }
+                    let phi = self.phi.columns(self.offsets[s], cols.len());
+                    for (j, col) in cols.clone().enumerate() {
+                        g[col] += phi.column(j).dot(&w[s]);
+                    }
+                }
+            }
+        }
+    }
+
     /// Refines a guess `z0` of the straight rod's coordinates (e.g. the encoder of the zero strain) by
     /// Gauss–Newton on `½‖c(z)‖²` (at most 50 iterations); returns the best `z` found and `‖c(z)‖`.
     pub fn find_rest(map: &M, z0: &DVector<f64>) -> (DVector<f64>, f64) {
@@ -569,21 +589,7 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
         let (head, map_scratch) = ev.scratch.split_at_mut(l.map);
         let (g, rest) = head[l.g..].split_at_mut(l.h - l.g);
         let (h, y) = rest.split_at_mut(l.y - l.h);
-        match &self.stacked {
-            Some(st) => st.mul_tr(w, y, g),
-            None => {
-                g.fill(0.0);
-                for (s, cols) in self.cols.iter().enumerate() {
-                    if w[s] == V6::zeros() {
-                        continue;
-                    }
-                    let phi = self.phi.columns(self.offsets[s], cols.len());
-                    for (j, col) in cols.clone().enumerate() {
-                        g[col] += phi.column(j).dot(&w[s]);
-                    }
-                }
-            }
-        }
+        self.basis_transpose_times(w, y, g);
         h.fill(0.0);
         self.map
             .add_weighted_hessian(q.as_slice(), g, h, &mut map_scratch[..]);
@@ -658,21 +664,7 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
         let (front, buf) = head.split_at_mut(l.y);
         let (front, zt) = front.split_at_mut(l.zt);
         let g = &mut front[l.g..l.g + m];
-        match &self.stacked {
-            Some(st) => st.mul_tr(y, buf, g),
-            None => {
-                g.fill(0.0);
-                for (s, cols) in self.cols.iter().enumerate() {
-                    if y[s] == V6::zeros() {
-                        continue;
-                    }
-                    let phi = self.phi.columns(self.offsets[s], cols.len());
-                    for (j, col) in cols.clone().enumerate() {
-                        g[col] += phi.column(j).dot(&y[s]);
-                    }
-                }
-            }
-        }
+        self.basis_transpose_times(y, buf, g);
         let zt = &mut zt[..rr];
         self.map.vjp(g, zt, map_scratch);
         for (ri, z) in r.iter_mut().zip(zt.iter()) {
