@@ -830,6 +830,24 @@ mod tests {
         (disc, basis)
     }
 
+    /// The same `TanhMap` (r inputs) bound to `basis` twice: with its stacked blocks, and forced to
+    /// the per-site loop.
+    fn stacked_and_looped(
+        basis: &LinearBasis,
+        r: usize,
+    ) -> (ReducedParam<TanhMap>, ReducedParam<TanhMap>) {
+        let m = basis.n_dof();
+        let map = || TanhMap {
+            a: pattern(m, 6, r) * 0.5,
+            b: pattern(6, r, 2 * r + 1),
+            bias: DVector::from_fn(6, |i, _| 0.1 * i as f64 - 0.2),
+        };
+        let stacked = ReducedParam::new(basis, map(), DVector::zeros(r)).unwrap();
+        let mut looped = ReducedParam::new(basis, map(), DVector::zeros(r)).unwrap();
+        looped.stacked = None;
+        (stacked, looped)
+    }
+
     fn pattern(rows: usize, cols: usize, k: usize) -> DMatrix<f64> {
         DMatrix::from_fn(rows, cols, |i, j| {
             (((i * 7 + j * 13 + k) % 11) as f64 - 5.0) / 5.0
@@ -875,17 +893,9 @@ mod tests {
     #[test]
     fn the_stacked_products_equal_the_per_site_loop() {
         let (_disc, basis) = single_tendon_like();
-        let m = basis.n_dof();
         for r in [1, 3] {
-            let map = || TanhMap {
-                a: pattern(m, 6, r) * 0.5,
-                b: pattern(6, r, 2 * r + 1),
-                bias: DVector::from_fn(6, |i, _| 0.1 * i as f64 - 0.2),
-            };
-            let stacked = ReducedParam::new(&basis, map(), DVector::zeros(r)).unwrap();
+            let (stacked, looped) = stacked_and_looped(&basis, r);
             assert!(stacked.stacked.is_some(), "a global basis is stacked");
-            let mut looped = ReducedParam::new(&basis, map(), DVector::zeros(r)).unwrap();
-            looped.stacked = None;
             let q = DVector::from_fn(r, |i, _| 0.3 - 0.25 * i as f64);
             let qd = DVector::from_fn(r, |i, _| 0.7 + 0.5 * i as f64);
             let w: Vec<V6> = (0..basis.n_sites())
@@ -935,14 +945,8 @@ mod tests {
             ("one division", single_tendon_like()),
             ("two divisions", two_division_legendre()),
         ] {
-            let m = basis.n_dof();
             for r in [1, 3] {
-                let map = || TanhMap {
-                    a: pattern(m, 6, r) * 0.5,
-                    b: pattern(6, r, 2 * r + 1),
-                    bias: DVector::from_fn(6, |i, _| 0.1 * i as f64 - 0.2),
-                };
-                let stacked = ReducedParam::new(&basis, map(), DVector::zeros(r)).unwrap();
+                let (stacked, looped) = stacked_and_looped(&basis, r);
                 // one block per component and run of sites on the same coefficients: one division,
                 // all sites (3 components); two divisions, each division's points and then its
                 // Magnus sub-points (sites are numbered points first): 6 × 2 × 2 blocks, each on
@@ -957,8 +961,6 @@ mod tests {
                 };
                 assert_eq!(st.blocks.len(), n_blocks, "{label}");
                 assert!(st.blocks.iter().all(|b| b.cols.len() <= widest), "{label}");
-                let mut looped = ReducedParam::new(&basis, map(), DVector::zeros(r)).unwrap();
-                looped.stacked = None;
                 let q = DVector::from_fn(r, |i, _| 0.3 - 0.25 * i as f64);
                 let qd = DVector::from_fn(r, |i, _| 0.7 + 0.5 * i as f64);
                 let qdd = DVector::from_fn(r, |i, _| -1.3 + 0.9 * i as f64);
