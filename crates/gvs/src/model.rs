@@ -331,6 +331,20 @@ impl<P: StrainParam> Model<P> {
         self.forward_from_strains(ws, jacobians);
     }
 
+    /// The poses `g_i` and strains `ξ_i` at `q` without Jacobians, for positions and output: as
+    /// [`Self::forward`] with `jacobians = false`, but by [`StrainParam::eval_strains`] where the
+    /// parameterization offers it (a decoder's value without its `r` tangents); `ws.ev.psi_q` is
+    /// then stale.
+    pub fn forward_pose(&self, q: &DVector<f64>, ws: &mut Workspace) {
+        if self.param.eval_strains(q, &mut ws.ev) {
+            ws.ev.motion = false;
+            ws.ev.psi_q_stale = true;
+            self.forward_from_strains(ws, false);
+        } else {
+            self.forward(q, ws, false);
+        }
+    }
+
     /// [`Self::forward`] after the strains `ws.ev.psi` were evaluated (by [`StrainParam::eval`], or
     /// by [`StrainParam::eval_motion`] for a residual pass without Jacobians).
     pub(crate) fn forward_from_strains(&self, ws: &mut Workspace, jacobians: bool) {

@@ -268,9 +268,9 @@ fn modal_strain<P: StrainParam>(
     ws: &mut gvs::model::Workspace,
 ) -> Vec<V6> {
     let eps = 1e-6 / phi.amax().max(f64::MIN_POSITIVE);
-    model.forward(&(q0 + phi * eps), ws, false);
+    model.forward_pose(&(q0 + phi * eps), ws);
     let plus = model.point_strains(ws);
-    model.forward(&(q0 - phi * eps), ws, false);
+    model.forward_pose(&(q0 - phi * eps), ws);
     let minus = model.point_strains(ws);
     plus.iter()
         .zip(&minus)

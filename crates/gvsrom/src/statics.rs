@@ -419,7 +419,7 @@ fn report<P: StrainParam>(
     solve_time_s: f64,
     ws: &mut Workspace,
 ) -> StaticsReport {
-    model.forward(&sol.q, ws, false);
+    model.forward_pose(&sol.q, ws);
     let tip = &ws.g[model.disc.tip()];
     let length = model.disc.length();
     let centerline_x = centerline_abscissae(length, built.centerline_points);

@@ -32,6 +32,8 @@ pub trait CoefficientMap: Send + Sync {
     fn scratch_len(&self) -> usize;
     /// `c = c(z)` and `c_z = ∂c/∂z` (m × r, column-major); fills `scratch` for the calls below.
     fn eval(&self, z: &[f64], c: &mut [f64], c_z: &mut [f64], scratch: &mut [f64]);
+    /// `c = c(z)` alone (a pose, output): no derivative, nothing kept in `scratch` for later calls.
+    fn eval_value(&self, z: &[f64], c: &mut [f64], scratch: &mut [f64]);
     /// `c_z_dot = (∂²c/∂z² ż)` (m × r): the derivative of `C_z` along `ż` (paper eq. 17).
     fn eval_rate(&self, z: &[f64], zd: &[f64], c_z_dot: &mut [f64], scratch: &mut [f64]);
     /// `out += Σ_k g_k ∇²_z c_k` (r × r, column-major, symmetric).

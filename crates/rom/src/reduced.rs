@@ -279,6 +279,22 @@ impl Stacked {
         }
     }
 
+    /// Scatters the products of [`Stacked::mul`] with `k = 1` (`c`) into the site vectors `psi`,
+    /// zeroed first unless the blocks cover every entry.
+    fn scatter_values(&self, y: &[f64], psi: &mut [V6]) {
+        if !self.covers_all {
+            psi.iter_mut().for_each(|p| *p = V6::zeros());
+        }
+        let mut off = 0;
+        for b in &self.blocks {
+            let h = b.sites.len();
+            for (p, v) in psi[b.sites.clone()].iter_mut().zip(&y[off..off + h]) {
+                p[b.a] = *v;
+            }
+            off += h;
+        }
+    }
+
     /// Scatters the products of [`Stacked::mul`] with `k = 3` (`[c | ċ | c̈]`) into the site
     /// vectors `out[0]` (`Ψ`), `out[1]` (`ξ̇`), `out[2]` (`ξ̈ᵇ`), zeroed first unless the blocks
     /// cover every entry.
@@ -474,6 +490,19 @@ impl<M: CoefficientMap> ReducedParam<M> {
 /// At site `s`: returns `Φ_s c[cols]` (zero if `c` is empty) and writes `Φ_s D[cols, :]` (6 × r,
 /// column-major) into `out`, for `D` given column-major `m × r`. One pass over `Φ_s`.
 #[inline]
+/// `Φ_s c` on the site's columns (no allocation).
+fn site_value<M: CoefficientMap>(p: &ReducedParam<M>, s: usize, c: &[f64]) -> V6 {
+    let cols = &p.cols[s];
+    let phi = &p.phi.as_slice()[6 * p.offsets[s]..6 * (p.offsets[s] + cols.len())];
+    let mut acc = V6::zeros();
+    for (ph, &cj) in phi.chunks_exact(6).zip(&c[cols.clone()]) {
+        for a in 0..6 {
+            acc[a] += ph[a] * cj;
+        }
+    }
+    acc
+}
+
 fn site_products<M: CoefficientMap>(
     p: &ReducedParam<M>,
     s: usize,
@@ -639,12 +668,33 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
             None => {
                 let (c, rest) = mo.split_at(m);
                 let (c_dot, c_acc) = rest.split_at(m);
-                for (s, cols) in self.cols.iter().enumerate() {
-                    let phi = self.phi.columns(self.offsets[s], cols.len());
-                    let cr = cols.clone();
-                    ev.psi[s] = phi * DVector::from_column_slice(&c[cr.clone()]);
-                    ev.xi_dot[s] = phi * DVector::from_column_slice(&c_dot[cr.clone()]);
-                    ev.xi_acc[s] = phi * DVector::from_column_slice(&c_acc[cr]);
+                for s in 0..self.cols.len() {
+                    ev.psi[s] = site_value(self, s, c);
+                    ev.xi_dot[s] = site_value(self, s, c_dot);
+                    ev.xi_acc[s] = site_value(self, s, c_acc);
+                }
+            }
+        }
+        true
+    }
+
+    /// `c` alone by the map ([`CoefficientMap::eval_value`]), then `Ψ_s = Φ_s c`: one column
+    /// through the network and the basis instead of `1 + r`.
+    fn eval_strains(&self, q: &DVector<f64>, ev: &mut StrainEval) -> bool {
+        let l = self.layout();
+        let m = self.m;
+        let (head, map_scratch) = ev.scratch.split_at_mut(l.map);
+        let (front, y) = head.split_at_mut(l.y);
+        let c = &mut front[l.mo..l.mo + m];
+        self.map.eval_value(q.as_slice(), c, map_scratch);
+        match &self.stacked {
+            Some(st) => {
+                st.mul(c, m, 1, y);
+                st.scatter_values(y, &mut ev.psi);
+            }
+            None => {
+                for (s, psi) in ev.psi.iter_mut().enumerate() {
+                    *psi = site_value(self, s, c);
                 }
             }
         }
@@ -705,6 +755,10 @@ mod tests {
             c.copy_from_slice((&self.a * &t).as_slice());
             let d = DMatrix::from_diagonal(&t.map(|t| 1.0 - t * t));
             c_z.copy_from_slice((&self.a * d * &self.b).as_slice());
+        }
+        fn eval_value(&self, z: &[f64], c: &mut [f64], _scratch: &mut [f64]) {
+            let t = (&self.b * DVector::from_column_slice(z) + &self.bias).map(f64::tanh);
+            c.copy_from_slice((&self.a * &t).as_slice());
         }
         fn eval_rate(&self, z: &[f64], zd: &[f64], c_z_dot: &mut [f64], scratch: &mut [f64]) {
             let _ = z;
@@ -937,7 +991,8 @@ mod tests {
     }
 
     #[test]
-    fn the_motion_evaluation_and_its_projection_equal_those_from_psi_q_stacked_and_looped() {
+    fn the_motion_and_strain_evaluations_and_the_projection_equal_those_from_psi_q_stacked_and_looped(
+    ) {
         // ξ̇_s = Ψ_q,s q̇, Ψ̇_q,s q̇ + Ψ_q,s q̈ and Σ_s Ψ_q,sᵀ w_s from eval + eval_rate (checked against
         // central differences in `reduced_derivatives_match_central_differences`) against the
         // motion evaluation's direct ones, on a one- and a two-division basis
@@ -990,6 +1045,14 @@ mod tests {
                             assert!(close(&mo.psi[s], &ev.psi[s]), "{label} r = {r}: Ψ at {s}");
                             assert!(close(&mo.xi_dot[s], &xid), "{label} r = {r}: ξ̇ at {s}");
                             assert!(close(&mo.xi_acc[s], &acc), "{label} r = {r}: ξ̈ᵇ at {s}");
+                        }
+                        let mut sv = p.new_eval();
+                        assert!(p.eval_strains(&q, &mut sv));
+                        for s in 0..basis.n_sites() {
+                            assert!(
+                                close(&sv.psi[s], &ev.psi[s]),
+                                "{label} r = {r}: Ψ alone at {s}"
+                            );
                         }
                         let mut proj_mo = DVector::zeros(r);
                         p.project(&w, &mut mo, &mut proj_mo);

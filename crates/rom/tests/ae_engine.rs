@@ -371,6 +371,31 @@ fn geometric_jacobian_matches_finite_differences_with_ae_param() {
 }
 
 #[test]
+fn the_pose_alone_equals_the_full_forward_pass_with_ae_param() {
+    // `forward_pose` takes the decoder's value without its tangents; the poses and strains must be
+    // those of the full pass (which the Jacobian test above checks against differences)
+    let fx = fixture();
+    for r in [1, 2] {
+        let m = fx.rom(r, 0.0);
+        for q in latent_points(fx, r) {
+            let (mut full, mut pose) = (m.workspace(), m.workspace());
+            m.forward(&q, &mut full, true);
+            m.forward_pose(&q, &mut pose);
+            let (xf, xp) = (m.point_strains(&full), m.point_strains(&pose));
+            for i in 0..m.disc.n_points() {
+                let dg = (full.g[i].to_homogeneous() - pose.g[i].to_homogeneous()).amax();
+                let dxi = (xf[i] - xp[i]).amax();
+                assert!(dg < 1e-13, "r = {r}: g at point {i} off by {dg:e}");
+                assert!(
+                    dxi < 1e-12 * (1.0 + xf[i].amax()),
+                    "r = {r}: ξ at {i} off by {dxi:e}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
 fn statics_jacobian_matches_finite_differences_with_gravity_and_tendon_friction() {
     let fx = fixture();
     for r in [1, 2] {

@@ -201,6 +201,15 @@ pub trait StrainParam: Send + Sync {
         false
     }
 
+    /// The strains alone, for a pose (positions, output): fills `ev.psi` at `q` and returns `true`
+    /// if this parameterization can do so more cheaply than [`StrainParam::eval`] (a decoder: its
+    /// value without the `r` tangents); `ev.psi_q` is then stale (the engine sets
+    /// `ev.psi_q_stale`). The default returns `false` and touches nothing.
+    fn eval_strains(&self, q: &DVector<f64>, ev: &mut StrainEval) -> bool {
+        let _ = (q, ev);
+        false
+    }
+
     /// `r += Σ_s Ψ_q,sᵀ y_s` (`y` one 6-vector per site, zeros skipped), after [`StrainParam::eval`]
     /// or (if it returned `true`) [`StrainParam::eval_motion`] at the same `q` with the same `ev`.
     /// The default reads `ev.psi_q` ([`project_with_psi_q`]); a parameterization with a motion
@@ -273,6 +282,9 @@ impl<P: StrainParam + ?Sized> StrainParam for Box<P> {
         ev: &mut StrainEval,
     ) -> bool {
         (**self).eval_motion(q, qd, qdd, ev)
+    }
+    fn eval_strains(&self, q: &DVector<f64>, ev: &mut StrainEval) -> bool {
+        (**self).eval_strains(q, ev)
     }
     fn project(&self, y: &[V6], ev: &mut StrainEval, r: &mut DVector<f64>) {
         (**self).project(y, ev, r)

@@ -124,7 +124,7 @@ impl Reduced {
     pub fn rest_strain_offset(&self) -> f64 {
         let m = &self.model;
         let mut ws = m.workspace();
-        m.forward(&m.param.rest_coordinates(), &mut ws, false);
+        m.forward_pose(&m.param.rest_coordinates(), &mut ws);
         m.point_strains(&ws)
             .iter()
             .enumerate()

@@ -207,7 +207,7 @@ fn record(
         Ok(s) => s,
         Err(e) => return SampleResult::missing(layout, STATUS_FAILED, Some(e.to_string())),
     };
-    model.forward(&sol.q, ws, false);
+    model.forward_pose(&sol.q, ws);
     let xi = model.point_strains(ws);
     let mut strain = Vec::with_capacity(layout.row_len());
     for (j, x) in xi.iter().enumerate() {

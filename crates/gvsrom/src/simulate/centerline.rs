@@ -40,7 +40,7 @@ impl Centerline {
     }
 
     pub(super) fn fill<P: gvs::strain::StrainParam>(&mut self, model: &gvs::model::Model<P>) {
-        model.forward(&self.q, &mut self.ws, false);
+        model.forward_pose(&self.q, &mut self.ws);
         for (k, &x) in self.x.iter().enumerate() {
             let p = model.position_at(&self.ws, x);
             self.points[3 * k..3 * k + 3].copy_from_slice(&[p[0], p[1], p[2]]);

@@ -12,6 +12,7 @@
 //!   `T_{k+1} = σ'(a_k) ⊙ P_k`; the linear last layer gives `c = W h + b`, `C_z = W T`. It keeps
 //!   `σ(a_k)` and `P_k` of every hidden layer in `scratch` (`Σ_k n_k (1 + r)` values) and nothing of
 //!   second order, so residual-only evaluations pay for value and Jacobian alone.
+//! - [`CoefficientMap::eval_value`], `c` alone: one column per layer.
 //! - [`CoefficientMap::eval_rate`], one directional pass along `ż` (eq. 17): with `Ṫ_0 = 0`,
 //!   `Ṫ_{k+1} = σ'(a_k) ⊙ (W_k Ṫ_k) + σ''(a_k) ⊙ (P_k ż) ⊙ P_k` (row-wise), `Ċ_z = W_L Ṫ_L`.
 //! - [`CoefficientMap::eval_motion`], second-order forward mode along `z(t)`: with `ḣ_0 = ż`,
@@ -218,6 +219,27 @@ impl CoefficientMap for DecoderMap {
         }
         c.copy_from_slice(&x[..m]);
         c_z.copy_from_slice(&x[m..m * cols]);
+    }
+
+    /// One column per layer; the stored part of `scratch` is left as it was.
+    fn eval_value(&self, z: &[f64], c: &mut [f64], scratch: &mut [f64]) {
+        let (_, work) = scratch.split_at_mut(self.stored_len());
+        let (x, y) = work.split_at_mut(self.widest * self.work_cols());
+        let (mut x, mut y) = (x, y);
+        x[..self.r].copy_from_slice(z);
+        let last = self.layers.len() - 1;
+        for (k, layer) in self.layers.iter().enumerate() {
+            let (n_in, n_out) = (layer.n_in, layer.n_out);
+            mul_cols((n_out, n_in, 1), &layer.w, x, y);
+            for (yi, b) in y[..n_out].iter_mut().zip(&layer.b) {
+                *yi += b;
+                if k < last {
+                    *yi = super::activation::tanh(*yi);
+                }
+            }
+            std::mem::swap(&mut x, &mut y);
+        }
+        c.copy_from_slice(&x[..self.m]);
     }
 
     fn eval_rate(&self, _z: &[f64], zd: &[f64], c_z_dot: &mut [f64], scratch: &mut [f64]) {

@@ -227,7 +227,7 @@ fn weighted_hessian_matches_central_differences_and_accumulates() {
 }
 
 #[test]
-fn identity_projection_reproduces_autoencoder_decode() {
+fn identity_projection_reproduces_autoencoder_decode_with_and_without_derivatives() {
     let mut rng = SplitMix64::new(14);
     for r in [1, 2, 3, 6] {
         let encoder = random_mlp(&[7, 5, r], &mut rng);
@@ -244,10 +244,18 @@ fn identity_projection_reproduces_autoencoder_decode() {
         let map = ae.decoder_map(&identity, 7).unwrap();
         let z = random_vec(r, -1.5, 1.5, &mut rng);
         let (c, _, _) = eval_at(&map, &z);
+        // the value-only pass, after a full one (its stored part must not matter)
+        let mut value = vec![0.0; 7];
+        let mut scratch = vec![0.0; map.scratch_len()];
+        map.eval_value(&z, &mut value, &mut scratch);
         let decoded = ae.decode(&z).unwrap();
         // Folding s into W and the loop vs dgemm summation orders differ only by rounding.
-        for (c, d) in c.iter().zip(&decoded) {
+        for ((c, v), d) in c.iter().zip(&value).zip(&decoded) {
             assert!((c - d).abs() <= 1e-13 * (1.0 + d.abs()), "{c} vs {d}");
+            assert!(
+                (v - d).abs() <= 1e-13 * (1.0 + d.abs()),
+                "value pass {v} vs {d}"
+            );
         }
     }
 }
