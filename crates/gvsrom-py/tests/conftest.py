@@ -2,6 +2,7 @@
 
 import json
 import os
+import signal
 import subprocess
 from pathlib import Path
 
@@ -17,6 +18,16 @@ def gvsrom_bin() -> Path:
     if not path or not Path(path).is_file():
         pytest.skip("GVSROM_BIN is not set to the gvsrom binary")
     return Path(path)
+
+
+@pytest.fixture
+def sigint_raises():
+    """SIGINT raises KeyboardInterrupt for the test's duration, whatever the runner inherited: a
+    shell's background job (`pytest … &`) starts with SIGINT ignored, and Python then installs no
+    handler, so a test's Ctrl-C to itself would be lost and its long run never stopped."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
 
 
 def run_cli(bin_path: Path, *args: str) -> subprocess.CompletedProcess:

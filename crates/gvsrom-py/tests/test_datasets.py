@@ -143,7 +143,7 @@ def test_an_unknown_study_is_refused_naming_it_and_the_accepted(tmp_path):
 
 
 @pytest.mark.skipif(os.name != "posix", reason="SIGINT to self")
-def test_ctrl_c_stops_a_dataset_and_keeps_its_finished_chunks(tmp_path):
+def test_ctrl_c_stops_a_dataset_and_keeps_its_finished_chunks(tmp_path, sigint_raises):
     timer = threading.Timer(1.0, lambda: os.kill(os.getpid(), signal.SIGINT))
     timer.start()
     with pytest.raises(KeyboardInterrupt, match="interrupted by SIGINT; the .* finished samples were written"):

@@ -50,7 +50,7 @@ def test_an_input_of_the_wrong_width_or_start_is_a_value_error():
 
 
 @pytest.mark.skipif(os.name != "posix", reason="SIGINT to self")
-def test_ctrl_c_interrupts_a_long_simulation():
+def test_ctrl_c_interrupts_a_long_simulation(sigint_raises):
     robot = gvsrom.Scenario.preset("single-tendon").build()
     # a tension switching every 10 ms for 1000 s keeps the integrator's steps short
     t = np.arange(0.0, 1000.0, 0.01)
