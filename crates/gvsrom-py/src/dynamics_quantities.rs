@@ -5,7 +5,7 @@
 
 use crate::arrays::{self, In1};
 use crate::errors::{invalid, scenario as err};
-use crate::quantities::on_model;
+use crate::quantities::{with_model, WorkspaceCache};
 use crate::robot::Robot;
 use gvs::dynamics::Energy;
 use gvs::loads::Loads;
@@ -15,75 +15,96 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 /// `K₁(q)`.
-pub fn elastic_force(built: &Built, q: &DVector<f64>) -> DVector<f64> {
-    on_model!(built, m => m.elastic_force(q, &mut m.workspace()))
+pub fn elastic_force(built: &Built, cache: &WorkspaceCache, q: &DVector<f64>) -> DVector<f64> {
+    with_model!(built, cache, m, ws => m.elastic_force(q, ws))
 }
 
 /// `∂K₁/∂q`.
-pub fn elastic_stiffness(built: &Built, q: &DVector<f64>) -> DMatrix<f64> {
-    on_model!(built, m => m.elastic_stiffness(q, &mut m.workspace()))
+pub fn elastic_stiffness(built: &Built, cache: &WorkspaceCache, q: &DVector<f64>) -> DMatrix<f64> {
+    with_model!(built, cache, m, ws => m.elastic_stiffness(q, ws))
 }
 
 /// `D₁ = D(q) q̇`.
-pub fn damping_force(built: &Built, q: &DVector<f64>, qd: &DVector<f64>) -> DVector<f64> {
-    on_model!(built, m => m.damping_force(q, qd, &mut m.workspace()))
+pub fn damping_force(
+    built: &Built,
+    cache: &WorkspaceCache,
+    q: &DVector<f64>,
+    qd: &DVector<f64>,
+) -> DVector<f64> {
+    with_model!(built, cache, m, ws => m.damping_force(q, qd, ws))
 }
 
 /// `D(q)`.
-pub fn damping_matrix(built: &Built, q: &DVector<f64>) -> DMatrix<f64> {
-    on_model!(built, m => {
-        let mut ws = m.workspace();
-        m.forward(q, &mut ws, false);
-        m.damping_matrix(&ws)
+pub fn damping_matrix(built: &Built, cache: &WorkspaceCache, q: &DVector<f64>) -> DMatrix<f64> {
+    with_model!(built, cache, m, ws => {
+        m.forward(q, ws, false);
+        m.damping_matrix(ws)
     })
 }
 
 /// `F(q)` of `loads`.
 pub fn external_force(
     built: &Built,
+    cache: &WorkspaceCache,
     q: &DVector<f64>,
     loads: &Loads,
 ) -> Result<DVector<f64>, gvsrom::ScenarioError> {
-    on_model!(built, m => {
+    with_model!(built, cache, m, ws => {
         let prepared = m.prepare_loads(loads)?;
-        Ok(m.external_force(q, &prepared, &mut m.workspace()))
+        Ok(m.external_force(q, &prepared, ws))
     })
 }
 
 /// `B(q)`.
-pub fn actuation_matrix(built: &Built, q: &DVector<f64>) -> DMatrix<f64> {
-    on_model!(built, m => m.actuation_matrix(q, &mut m.workspace()))
+pub fn actuation_matrix(built: &Built, cache: &WorkspaceCache, q: &DVector<f64>) -> DMatrix<f64> {
+    with_model!(built, cache, m, ws => m.actuation_matrix(q, ws))
 }
 
 /// `C(q, q̇) q̇`.
-pub fn coriolis_force(built: &Built, q: &DVector<f64>, qd: &DVector<f64>) -> DVector<f64> {
-    on_model!(built, m => m.coriolis_force(q, qd, &mut m.workspace()))
+pub fn coriolis_force(
+    built: &Built,
+    cache: &WorkspaceCache,
+    q: &DVector<f64>,
+    qd: &DVector<f64>,
+) -> DVector<f64> {
+    with_model!(built, cache, m, ws => m.coriolis_force(q, qd, ws))
 }
 
 /// `C(q, q̇)`.
-pub fn coriolis_matrix(built: &Built, q: &DVector<f64>, qd: &DVector<f64>) -> DMatrix<f64> {
-    on_model!(built, m => m.coriolis_matrix(q, qd, &mut m.workspace()))
+pub fn coriolis_matrix(
+    built: &Built,
+    cache: &WorkspaceCache,
+    q: &DVector<f64>,
+    qd: &DVector<f64>,
+) -> DMatrix<f64> {
+    with_model!(built, cache, m, ws => m.coriolis_matrix(q, qd, ws))
 }
 
 /// `q̈ = M⁻¹ τ(q, q̇, u)` under the scenario's loads.
 pub fn accelerations(
     built: &Built,
+    cache: &WorkspaceCache,
     q: &DVector<f64>,
     qd: &DVector<f64>,
     u: &[f64],
 ) -> Result<DVector<f64>, String> {
-    on_model!(built, m => {
+    with_model!(built, cache, m, ws => {
         let loads = m.prepare_loads(&built.loads).map_err(|e| e.to_string())?;
         let mut qdd = DVector::zeros(m.n_dof());
-        m.accelerations(q, qd, u, &loads, &mut m.workspace(), &mut qdd)
+        m.accelerations(q, qd, u, &loads, ws, &mut qdd)
             .map_err(|e| e.to_string())?;
         Ok(qdd)
     })
 }
 
 /// Kinetic, elastic and gravitational energy at `(q, q̇)` under the scenario's gravity.
-pub fn energy(built: &Built, q: &DVector<f64>, qd: &DVector<f64>) -> Energy {
-    on_model!(built, m => m.energy(q, qd, &built.loads.gravity, &mut m.workspace()))
+pub fn energy(
+    built: &Built,
+    cache: &WorkspaceCache,
+    q: &DVector<f64>,
+    qd: &DVector<f64>,
+) -> Energy {
+    with_model!(built, cache, m, ws => m.energy(q, qd, &built.loads.gravity, ws))
 }
 
 /// `q` (and `q̇`) of a robot's model from array-likes, checked (length, finite).
@@ -154,7 +175,7 @@ impl Robot {
     ///     Shape (n_dof,) [N·m per unit of q].
     fn elastic_force<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyAny>> {
         let (q, _) = state(self, &q, None)?;
-        let f = py.detach(|| elastic_force(&self.built, &q));
+        let f = py.detach(|| elastic_force(&self.built, &self.workspaces, &q));
         Ok(vector(py, &f))
     }
 
@@ -162,7 +183,7 @@ impl Robot {
     /// a reduced model, its tangent), shape (n_dof, n_dof).
     fn stiffness_matrix<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyAny>> {
         let (q, _) = state(self, &q, None)?;
-        let k = py.detach(|| elastic_stiffness(&self.built, &q));
+        let k = py.detach(|| elastic_stiffness(&self.built, &self.workspaces, &q));
         arrays::matrix(py, &k)
     }
 
@@ -174,7 +195,7 @@ impl Robot {
         qd: In1<'_>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (q, qd) = state(self, &q, Some(&qd))?;
-        let f = py.detach(|| damping_force(&self.built, &q, &qd));
+        let f = py.detach(|| damping_force(&self.built, &self.workspaces, &q, &qd));
         Ok(vector(py, &f))
     }
 
@@ -182,7 +203,7 @@ impl Robot {
     /// (n_dof, n_dof).
     fn damping_matrix<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyAny>> {
         let (q, _) = state(self, &q, None)?;
-        let d = py.detach(|| damping_matrix(&self.built, &q));
+        let d = py.detach(|| damping_matrix(&self.built, &self.workspaces, &q));
         arrays::matrix(py, &d)
     }
 
@@ -195,7 +216,7 @@ impl Robot {
         qd: In1<'_>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (q, qd) = state(self, &q, Some(&qd))?;
-        let f = py.detach(|| coriolis_force(&self.built, &q, &qd));
+        let f = py.detach(|| coriolis_force(&self.built, &self.workspaces, &q, &qd));
         Ok(vector(py, &f))
     }
 
@@ -208,7 +229,7 @@ impl Robot {
         qd: In1<'_>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (q, qd) = state(self, &q, Some(&qd))?;
-        let c = py.detach(|| coriolis_matrix(&self.built, &q, &qd));
+        let c = py.detach(|| coriolis_matrix(&self.built, &self.workspaces, &q, &qd));
         arrays::matrix(py, &c)
     }
 
@@ -217,7 +238,7 @@ impl Robot {
     fn external_force<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyAny>> {
         let (q, _) = state(self, &q, None)?;
         let f = py
-            .detach(|| external_force(&self.built, &q, &self.built.loads))
+            .detach(|| external_force(&self.built, &self.workspaces, &q, &self.built.loads))
             .map_err(err)?;
         Ok(vector(py, &f))
     }
@@ -227,7 +248,7 @@ impl Robot {
     /// (n_dof, n_actuators).
     fn actuation_matrix<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyAny>> {
         let (q, _) = state(self, &q, None)?;
-        let b = py.detach(|| actuation_matrix(&self.built, &q));
+        let b = py.detach(|| actuation_matrix(&self.built, &self.workspaces, &q));
         arrays::matrix(py, &b)
     }
 
@@ -250,7 +271,7 @@ impl Robot {
         let (q, qd) = state(self, &q, Some(&qd))?;
         let u = tensions(self, u.as_ref())?;
         let a = py
-            .detach(|| accelerations(&self.built, &q, &qd, &u))
+            .detach(|| accelerations(&self.built, &self.workspaces, &q, &qd, &u))
             .map_err(invalid)?;
         Ok(vector(py, &a))
     }
@@ -270,7 +291,7 @@ impl Robot {
         qd: Option<In1<'_>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let (q, qd) = state(self, &q, qd.as_ref())?;
-        let e = py.detach(|| energy(&self.built, &q, &qd));
+        let e = py.detach(|| energy(&self.built, &self.workspaces, &q, &qd));
         energy_dict(py, &e)
     }
 }

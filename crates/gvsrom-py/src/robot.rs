@@ -4,7 +4,7 @@
 use crate::arrays::{self, In1, In2};
 use crate::errors::{self, invalid, scenario as err};
 use crate::models::Model;
-use crate::quantities;
+use crate::quantities::{self, WorkspaceCache};
 use crate::scenario::Scenario;
 use crate::statics::{Statics, StaticsBatch};
 use gvsrom::dataset::DEFAULT_CHUNK_SIZE;
@@ -35,6 +35,8 @@ pub struct Robot {
     pub scenario: Scenario,
     pub built: Built,
     pub attached: Option<Attached>,
+    /// The workspace of the model that runs, kept between the quantity calls.
+    pub workspaces: WorkspaceCache,
 }
 
 /// Builds `scenario` and attaches `attached` as `gvsrom … --model DIR` does, warning in Python
@@ -83,6 +85,7 @@ impl Robot {
             scenario,
             built,
             attached,
+            workspaces: WorkspaceCache::default(),
         })
     }
 
@@ -405,7 +408,7 @@ impl Robot {
     ///     world).
     fn forward<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyDict>> {
         let q = arrays::dvec("q", &q, self.built.n_dof())?;
-        let (pos, rot) = py.detach(|| quantities::forward(&self.built, &q));
+        let (pos, rot) = py.detach(|| quantities::forward(&self.built, &self.workspaces, &q));
         let p = self.built.model.disc.n_points();
         let d = PyDict::new(py);
         d.set_item("x", self.point_x(py))?;
@@ -449,7 +452,7 @@ impl Robot {
                 vec![j as usize]
             }
         };
-        let flat = py.detach(|| quantities::jacobians(&self.built, &q, &which));
+        let flat = py.detach(|| quantities::jacobians(&self.built, &self.workspaces, &q, &which));
         match point {
             None => arrays::shaped(py, flat, [p, 6, n]),
             Some(_) => arrays::shaped(py, flat, [6, n]),
@@ -471,14 +474,14 @@ impl Robot {
     ) -> PyResult<Bound<'py, PyAny>> {
         let n = self.built.n_dof();
         let (q, qd) = (arrays::dvec("q", &q, n)?, arrays::dvec("qd", &qd, n)?);
-        let flat = py.detach(|| quantities::velocities(&self.built, &q, &qd));
+        let flat = py.detach(|| quantities::velocities(&self.built, &self.workspaces, &q, &qd));
         arrays::shaped(py, flat, [self.built.model.disc.n_points(), 6])
     }
 
     /// The mass matrix ``M(q)`` (symmetric positive definite), shape (n_dof, n_dof).
     fn mass_matrix<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyAny>> {
         let q = arrays::dvec("q", &q, self.built.n_dof())?;
-        let m = py.detach(|| quantities::mass_matrix(&self.built, &q));
+        let m = py.detach(|| quantities::mass_matrix(&self.built, &self.workspaces, &q));
         arrays::matrix(py, &m)
     }
 
@@ -500,7 +503,7 @@ impl Robot {
         let q = arrays::dvec("q", &q, self.built.n_dof())?;
         let u = self.quantity_tensions(u)?;
         let r = py
-            .detach(|| quantities::statics_residual(&self.built, &q, &u))
+            .detach(|| quantities::statics_residual(&self.built, &self.workspaces, &q, &u))
             .map_err(err)?;
         Ok(arrays::vector(py, r.as_slice()))
     }
@@ -516,7 +519,7 @@ impl Robot {
         let q = arrays::dvec("q", &q, self.built.n_dof())?;
         let u = self.quantity_tensions(u)?;
         let j = py
-            .detach(|| quantities::statics_jacobian(&self.built, &q, &u))
+            .detach(|| quantities::statics_jacobian(&self.built, &self.workspaces, &q, &u))
             .map_err(err)?;
         arrays::matrix(py, &j)
     }

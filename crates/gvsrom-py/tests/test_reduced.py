@@ -99,3 +99,51 @@ def test_a_model_outside_its_training_is_refused_with_the_cli_message(gvsrom_bin
 def test_load_model_of_a_non_model_is_a_value_error(tmp_path):
     with pytest.raises(ValueError):
         gvsrom.load_model(tmp_path)
+
+
+QUANTITIES = [
+    ("forward", lambda r, q, qd: r.forward(q)),
+    ("jacobian", lambda r, q, qd: r.jacobian(q)),
+    ("point_velocities", lambda r, q, qd: r.point_velocities(q, qd)),
+    ("mass_matrix", lambda r, q, qd: r.mass_matrix(q)),
+    ("statics_residual", lambda r, q, qd: r.statics_residual(q)),
+    ("statics_jacobian", lambda r, q, qd: r.statics_jacobian(q)),
+    ("elastic_force", lambda r, q, qd: r.elastic_force(q)),
+    ("stiffness_matrix", lambda r, q, qd: r.stiffness_matrix(q)),
+    ("damping_force", lambda r, q, qd: r.damping_force(q, qd)),
+    ("damping_matrix", lambda r, q, qd: r.damping_matrix(q)),
+    ("coriolis_force", lambda r, q, qd: r.coriolis_force(q, qd)),
+    ("coriolis_matrix", lambda r, q, qd: r.coriolis_matrix(q, qd)),
+    ("external_force", lambda r, q, qd: r.external_force(q)),
+    ("actuation_matrix", lambda r, q, qd: r.actuation_matrix(q)),
+    ("accelerations", lambda r, q, qd: r.accelerations(q, qd)),
+    ("energy", lambda r, q, qd: r.energy(q, qd)),
+]
+
+
+def _flat(value):
+    """A quantity's values as one array (dicts of arrays or numbers in key order)."""
+    if isinstance(value, dict):
+        return np.concatenate([_flat(value[k]) for k in sorted(value)])
+    return np.asarray(value, dtype=float).ravel()
+
+
+@pytest.mark.parametrize("reduced", [False, True])
+def test_quantities_do_not_depend_on_the_calls_before_them(ae_model, reduced):
+    # a robot keeps its model's workspace between calls: every quantity, asked after all the
+    # others at other states, must be bit for bit what a new robot's first call gives
+    base = gvsrom.Scenario.preset("single-tendon").build()
+    make = (lambda: base.with_model(ae_model)) if reduced else (lambda: base)
+    robot = make()
+    q0 = robot.statics(u=[-3.0]).q
+    rng = np.random.default_rng(5)
+    states = [(q0 + 0.02 * rng.standard_normal(robot.n_dof), rng.standard_normal(robot.n_dof))
+              for _ in range(3)]
+    for name, f in QUANTITIES:
+        for q, qd in states:
+            f(robot, q, qd)
+    for name, f in QUANTITIES:
+        for q, qd in states:
+            first = _flat(f(make(), q, qd))
+            again = _flat(f(robot, q, qd))
+            np.testing.assert_array_equal(again, first, err_msg=f"{name} after other calls")
