@@ -333,15 +333,8 @@ fn site_products<M: CoefficientMap>(
     let cols = &p.cols[s];
     let phi = &p.phi.as_slice()[6 * p.offsets[s]..6 * (p.offsets[s] + cols.len())];
     out.fill(0.0);
-    let mut acc = [0.0f64; 6];
     for (j, col) in cols.clone().enumerate() {
         let ph = &phi[6 * j..6 * j + 6];
-        if !c.is_empty() {
-            let cj = c[col];
-            for a in 0..6 {
-                acc[a] += ph[a] * cj;
-            }
-        }
         for k in 0..r {
             let w = d[k * m + col];
             if w != 0.0 {
@@ -352,7 +345,11 @@ fn site_products<M: CoefficientMap>(
             }
         }
     }
-    V6::from_column_slice(&acc)
+    if c.is_empty() {
+        V6::zeros()
+    } else {
+        site_value(p, s, c)
+    }
 }
 
 impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
