@@ -1,6 +1,7 @@
 //! Small dense products for the narrow right-hand sides of one evaluation: a value and a few
-//! tangents through a decoder layer (`≤ 84 × 42` times `≤ 9` columns) or through the stacked strain
-//! basis (`n_sites × ≤ 10`). The mini-batches of training call faer directly ([`crate::nn::batch`]).
+//! tangents through a decoder layer (`≤ 84 × 42` times `≤ 9` columns) or through a tall block of
+//! the stacked strain basis (`n_sites × ≤ 12`). The mini-batches of training call faer directly
+//! ([`crate::nn::batch`]).
 //!
 //! At these sizes a general GEMM's dispatch, packing and thread-local bookkeeping cost more than
 //! the arithmetic: with faer here, an IV-C2 AE-7 run spent 30 % of its time in faer's matmul
@@ -8,6 +9,13 @@
 //! for the baseline target and with AVX2 + FMA enabled — and chosen once per call by a cached CPU
 //! feature test. Every kernel is allocation-free; results agree with the textbook sums to rounding
 //! (tests below).
+
+/// Whether the CPU has AVX2 and FMA, for the kernels compiled with them (the standard library
+/// caches the test).
+#[cfg(target_arch = "x86_64")]
+pub(crate) fn has_avx2_fma() -> bool {
+    std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+}
 
 /// `Y = A·B` for column-major `A` (`rows × k`), `B` (`k × n`, column stride `ldb ≥ k`) and `Y`
 /// (`rows × n`).
@@ -22,8 +30,7 @@ pub(crate) fn mul_cols_strided(
     assert!(n == 0 || b.len() >= ldb * (n - 1) + k);
     #[cfg(target_arch = "x86_64")]
     {
-        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
-        {
+        if has_avx2_fma() {
             // SAFETY: the CPU has AVX2 and FMA (checked just above), all the function requires.
             unsafe { mul_cols_avx2((rows, k, n), a, b, ldb, y) };
             return;
@@ -49,8 +56,7 @@ pub(crate) fn mul_tr_cols_into(
     assert!(a.len() >= rows * k && b.len() >= rows * n && y.len() >= k * n);
     #[cfg(target_arch = "x86_64")]
     {
-        if std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
-        {
+        if has_avx2_fma() {
             // SAFETY: the CPU has AVX2 and FMA (checked just above), all the function requires.
             unsafe { mul_tr_cols_avx2((rows, k, n), a, b, y, accumulate) };
             return;
@@ -159,7 +165,7 @@ fn tile<const MR: usize, const NR: usize, const FMA: bool>(
 
 /// `x·s + v`, fused if `FMA`.
 #[inline(always)]
-fn madd<const FMA: bool>(x: f64, s: f64, v: f64) -> f64 {
+pub(crate) fn madd<const FMA: bool>(x: f64, s: f64, v: f64) -> f64 {
     if FMA {
         x.mul_add(s, v)
     } else {

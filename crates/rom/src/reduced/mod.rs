@@ -24,12 +24,13 @@ use crate::map::CoefficientMap;
 use gvs::discretize::Discretization;
 use gvs::lie::V6;
 use gvs::strain::{project_with_psi_q, LinearBasis, StrainEval, StrainParam};
-use nalgebra::{DMatrix, DVector, Matrix6xX};
-use std::ops::Range;
+use nalgebra::{DMatrix, DVector};
 use thiserror::Error;
 
+mod basis_rows;
+mod site_rows;
 mod stacked;
-use stacked::Stacked;
+use basis_rows::BasisRows;
 
 #[derive(Debug, Error, PartialEq)]
 pub enum ReducedError {
@@ -141,12 +142,9 @@ pub fn projection_residual(point_matrix: &DMatrix<f64>, p: &DMatrix<f64>, x: &DV
 /// `c` a [`CoefficientMap`] (a decoder folded with the projection `P`).
 pub struct ReducedParam<M: CoefficientMap> {
     map: M,
-    /// HOM basis: `Φ_s` restricted to `cols[s]`, stored side by side (6 × Σ|cols|).
-    phi: Matrix6xX<f64>,
-    offsets: Vec<usize>,
-    cols: Vec<Range<usize>>,
-    /// The same `Φ_s` stacked densely for one GEMM per evaluation, when the basis is dense enough.
-    stacked: Option<Stacked>,
+    /// HOM basis `Φ_s` at every site.
+    rows: BasisRows,
+    n_sites: usize,
     m: usize,
     r: usize,
     rest: DVector<f64>,
@@ -154,7 +152,7 @@ pub struct ReducedParam<M: CoefficientMap> {
 
 /// Where the parts of [`StrainEval::scratch`] start: `c`, `C_z` (adjacent: `[c | C_z]` is one
 /// `m × (1 + r)` matrix), `Ċ_z`, `g`, `H`, the motion `[c | ċ | c̈]` (`m × 3`), `C_zᵀ g`, the
-/// stacked products `Y`, the map's own.
+/// basis products' work space ([`SiteRows::products`]), the map's own.
 #[derive(Debug, Clone, Copy)]
 struct Layout {
     /// `c` starts at 0.
@@ -164,7 +162,7 @@ struct Layout {
     h: usize,
     mo: usize,
     zt: usize,
-    y: usize,
+    work: usize,
     map: usize,
     end: usize,
 }
@@ -190,26 +188,10 @@ impl<M: CoefficientMap> ReducedParam<M> {
                 format!("expected {r} finite rest coordinates, got {}", rest.len()),
             ));
         }
-        let ns = basis.n_sites();
-        let cols: Vec<Range<usize>> = (0..ns).map(|s| basis.columns(s)).collect();
-        let mut offsets = Vec::with_capacity(ns);
-        let mut total = 0;
-        for c in &cols {
-            offsets.push(total);
-            total += c.len();
-        }
-        let mut phi = Matrix6xX::zeros(total);
-        for s in 0..ns {
-            phi.columns_mut(offsets[s], cols[s].len())
-                .copy_from(&basis.phi_at(s));
-        }
-        let stacked = Stacked::of(basis);
         Ok(ReducedParam {
             map,
-            phi,
-            stacked,
-            offsets,
-            cols,
+            rows: BasisRows::of(basis),
+            n_sites: basis.n_sites(),
             m,
             r,
             rest,
@@ -228,11 +210,8 @@ impl<M: CoefficientMap> ReducedParam<M> {
         let h = g + m;
         let mo = h + r * r;
         let zt = mo + 3 * m;
-        let y = zt + r;
-        let map = y + self
-            .stacked
-            .as_ref()
-            .map_or(0, |st| st.y_len((1 + r).max(3)));
+        let work = zt + r;
+        let map = work + self.rows.work_len(m, (1 + r).max(3), self.n_sites);
         Layout {
             cz,
             czd,
@@ -240,29 +219,9 @@ impl<M: CoefficientMap> ReducedParam<M> {
             h,
             mo,
             zt,
-            y,
+            work,
             map,
             end: map + self.map.scratch_len(),
-        }
-    }
-
-    /// `g = Σ_s Φ_sᵀ w_s` (m) for one 6-vector per site (zeros skipped): by the stacked blocks
-    /// (`buf`: their gather buffer, `n_sites` or more) or site by site.
-    fn basis_transpose_times(&self, w: &[V6], buf: &mut [f64], g: &mut [f64]) {
-        match &self.stacked {
-            Some(st) => st.mul_tr(w, buf, g),
-            None => {
-                g.fill(0.0);
-                for (s, cols) in self.cols.iter().enumerate() {
-                    if w[s] == V6::zeros() {
-                        continue;
-                    }
-                    let phi = self.phi.columns(self.offsets[s], cols.len());
-                    for (j, col) in cols.clone().enumerate() {
-                        g[col] += phi.column(j).dot(&w[s]);
-                    }
-                }
-            }
         }
     }
 
@@ -306,59 +265,13 @@ impl<M: CoefficientMap> ReducedParam<M> {
     }
 }
 
-/// At site `s`: returns `Φ_s c[cols]` (zero if `c` is empty) and writes `Φ_s D[cols, :]` (6 × r,
-/// column-major) into `out`, for `D` given column-major `m × r`. One pass over `Φ_s`.
-#[inline]
-/// `Φ_s c` on the site's columns (no allocation).
-fn site_value<M: CoefficientMap>(p: &ReducedParam<M>, s: usize, c: &[f64]) -> V6 {
-    let cols = &p.cols[s];
-    let phi = &p.phi.as_slice()[6 * p.offsets[s]..6 * (p.offsets[s] + cols.len())];
-    let mut acc = V6::zeros();
-    for (ph, &cj) in phi.chunks_exact(6).zip(&c[cols.clone()]) {
-        for a in 0..6 {
-            acc[a] += ph[a] * cj;
-        }
-    }
-    acc
-}
-
-fn site_products<M: CoefficientMap>(
-    p: &ReducedParam<M>,
-    s: usize,
-    c: &[f64],
-    d: &[f64],
-    out: &mut [f64],
-) -> V6 {
-    let (m, r) = (p.m, p.r);
-    let cols = &p.cols[s];
-    let phi = &p.phi.as_slice()[6 * p.offsets[s]..6 * (p.offsets[s] + cols.len())];
-    out.fill(0.0);
-    for (j, col) in cols.clone().enumerate() {
-        let ph = &phi[6 * j..6 * j + 6];
-        for k in 0..r {
-            let w = d[k * m + col];
-            if w != 0.0 {
-                let o = &mut out[6 * k..6 * k + 6];
-                for a in 0..6 {
-                    o[a] += ph[a] * w;
-                }
-            }
-        }
-    }
-    if c.is_empty() {
-        V6::zeros()
-    } else {
-        site_value(p, s, c)
-    }
-}
-
 impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
     fn n_dof(&self) -> usize {
         self.r
     }
 
     fn n_sites(&self) -> usize {
-        self.cols.len()
+        self.n_sites
     }
 
     fn is_linear(&self) -> bool {
@@ -377,25 +290,13 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
         let (m, r) = (self.m, self.r);
         let (head, map_scratch) = ev.scratch.split_at_mut(l.map);
         let (cc, rest) = head.split_at_mut(l.czd);
+        let work = &mut rest[l.work - l.czd..];
         {
             let (c, cz) = cc.split_at_mut(l.cz);
             self.map.eval(q.as_slice(), c, cz, map_scratch);
         }
-        let out = ev.psi_q.as_mut_slice();
-        match &self.stacked {
-            Some(st) => {
-                // Y_i = Φ_i [c | C_z]   (|sites_i| × (1 + r) per block)
-                let y = &mut rest[l.y - l.czd..l.map - l.czd];
-                st.mul(cc, m, 1 + r, y);
-                st.scatter(y, r, Some(&mut ev.psi), out);
-            }
-            None => {
-                let (c, cz) = cc.split_at(l.cz);
-                for (s, psi) in ev.psi.iter_mut().enumerate() {
-                    *psi = site_products(self, s, c, cz, &mut out[6 * s * r..6 * (s + 1) * r]);
-                }
-            }
-        }
+        let (psi, out) = (Some(&mut ev.psi[..]), ev.psi_q.as_mut_slice());
+        self.rows.products(cc, m, r, psi, out, work);
     }
 
     /// `Ψ̇_q,s = Φ_s (∂²c/∂z² ż)` (eq. 17).
@@ -403,22 +304,12 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
         let l = self.layout();
         let (m, r) = (self.m, self.r);
         let (head, map_scratch) = ev.scratch.split_at_mut(l.map);
-        let (czd, y) = head[l.czd..].split_at_mut(l.y - l.czd);
-        let czd = &mut czd[..m * r];
+        let (front, work) = head.split_at_mut(l.work);
+        let czd = &mut front[l.czd..l.czd + m * r];
         self.map
             .eval_rate(q.as_slice(), qd.as_slice(), czd, map_scratch);
         let out = ev.psi_q_dot.as_mut_slice();
-        match &self.stacked {
-            Some(st) => {
-                st.mul(czd, m, r, y);
-                st.scatter(y, r, None, out);
-            }
-            None => {
-                for s in 0..self.cols.len() {
-                    site_products(self, s, &[], czd, &mut out[6 * s * r..6 * (s + 1) * r]);
-                }
-            }
-        }
+        self.rows.products(czd, m, r, None, out, work);
     }
 
     /// `Σ_s Σ_a w_{s,a} ∇²Ψ_{s,a} = Σ_k g_k ∇²c_k` with `g = Σ_s Φ_sᵀ w_s`.
@@ -432,9 +323,10 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
         let l = self.layout();
         let r = self.r;
         let (head, map_scratch) = ev.scratch.split_at_mut(l.map);
-        let (g, rest) = head[l.g..].split_at_mut(l.h - l.g);
-        let (h, y) = rest.split_at_mut(l.y - l.h);
-        self.basis_transpose_times(w, y, g);
+        let (front, work) = head.split_at_mut(l.work);
+        let (g, rest) = front[l.g..].split_at_mut(l.h - l.g);
+        let h = &mut rest[..r * r];
+        self.rows.mul_tr(w, g, work);
         h.fill(0.0);
         self.map
             .add_weighted_hessian(q.as_slice(), g, h, &mut map_scratch[..]);
@@ -461,7 +353,7 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
         let l = self.layout();
         let m = self.m;
         let (head, map_scratch) = ev.scratch.split_at_mut(l.map);
-        let (front, y) = head.split_at_mut(l.y);
+        let (front, work) = head.split_at_mut(l.work);
         let mo = &mut front[l.mo..l.mo + 3 * m];
         {
             let (c, rest) = mo.split_at_mut(m);
@@ -476,21 +368,8 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
                 map_scratch,
             );
         }
-        match &self.stacked {
-            Some(st) => {
-                st.mul(mo, m, 3, y);
-                st.scatter_motion(y, [&mut ev.psi, &mut ev.xi_dot, &mut ev.xi_acc]);
-            }
-            None => {
-                let (c, rest) = mo.split_at(m);
-                let (c_dot, c_acc) = rest.split_at(m);
-                for s in 0..self.cols.len() {
-                    ev.psi[s] = site_value(self, s, c);
-                    ev.xi_dot[s] = site_value(self, s, c_dot);
-                    ev.xi_acc[s] = site_value(self, s, c_acc);
-                }
-            }
-        }
+        let out = [&mut ev.psi[..], &mut ev.xi_dot[..], &mut ev.xi_acc[..]];
+        self.rows.motion(mo, m, out, work);
         true
     }
 
@@ -500,20 +379,10 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
         let l = self.layout();
         let m = self.m;
         let (head, map_scratch) = ev.scratch.split_at_mut(l.map);
-        let (front, y) = head.split_at_mut(l.y);
+        let (front, work) = head.split_at_mut(l.work);
         let c = &mut front[l.mo..l.mo + m];
         self.map.eval_value(q.as_slice(), c, map_scratch);
-        match &self.stacked {
-            Some(st) => {
-                st.mul(c, m, 1, y);
-                st.scatter_values(y, &mut ev.psi);
-            }
-            None => {
-                for (s, psi) in ev.psi.iter_mut().enumerate() {
-                    *psi = site_value(self, s, c);
-                }
-            }
-        }
+        self.rows.values(c, m, &mut ev.psi, work);
         true
     }
 
@@ -527,10 +396,10 @@ impl<M: CoefficientMap> StrainParam for ReducedParam<M> {
         let l = self.layout();
         let (m, rr) = (self.m, self.r);
         let (head, map_scratch) = ev.scratch.split_at_mut(l.map);
-        let (front, buf) = head.split_at_mut(l.y);
-        let (front, zt) = front.split_at_mut(l.zt);
+        let (front, rest) = head.split_at_mut(l.zt);
+        let (zt, work) = rest.split_at_mut(l.work - l.zt);
         let g = &mut front[l.g..l.g + m];
-        self.basis_transpose_times(y, buf, g);
+        self.rows.mul_tr(y, g, work);
         let zt = &mut zt[..rr];
         self.map.vjp(g, zt, map_scratch);
         for (ri, z) in r.iter_mut().zip(zt.iter()) {

@@ -99,6 +99,11 @@ impl CoefficientMap for TanhMap {
 }
 
 fn single_tendon_like() -> (Discretization, LinearBasis) {
+    single_tendon_like_with(10)
+}
+
+/// [`single_tendon_like`] with `n` Gauss points.
+fn single_tendon_like_with(n: usize) -> (Discretization, LinearBasis) {
     let rod = Rod::tapered(
         Material {
             youngs_modulus: 6.17e5,
@@ -110,8 +115,7 @@ fn single_tendon_like() -> (Discretization, LinearBasis) {
         0.0125,
         0.005,
     );
-    let disc =
-        Discretization::new(&rod, &[Quadrature::Gauss { n: 10 }], MagnusOrder::Z4, &[]).unwrap();
+    let disc = Discretization::new(&rod, &[Quadrature::Gauss { n }], MagnusOrder::Z4, &[]).unwrap();
     let basis = LinearBasis::per_division(
         &disc,
         &[DivisionBasis::Legendre {
@@ -157,22 +161,21 @@ fn two_division_legendre() -> (Discretization, LinearBasis) {
     (disc, basis)
 }
 
-/// The same `TanhMap` (r inputs) bound to `basis` twice: with its stacked blocks, and forced to
-/// the per-site loop.
-fn stacked_and_looped(
-    basis: &LinearBasis,
-    r: usize,
-) -> (ReducedParam<TanhMap>, ReducedParam<TanhMap>) {
+/// A `TanhMap` of `r` inputs onto the coefficients of `basis`, bound to its sites.
+fn tanh_param(basis: &LinearBasis, r: usize) -> ReducedParam<TanhMap> {
     let m = basis.n_dof();
-    let map = || TanhMap {
+    let map = TanhMap {
         a: pattern(m, 6, r) * 0.5,
         b: pattern(6, r, 2 * r + 1),
         bias: DVector::from_fn(6, |i, _| 0.1 * i as f64 - 0.2),
     };
-    let stacked = ReducedParam::new(basis, map(), DVector::zeros(r)).unwrap();
-    let mut looped = ReducedParam::new(basis, map(), DVector::zeros(r)).unwrap();
-    looped.stacked = None;
-    (stacked, looped)
+    ReducedParam::new(basis, map, DVector::zeros(r)).unwrap()
+}
+
+/// `Φ_s X` with the dense `Φ_s` of the basis (`6 × |cols_s|`) and `X` (`m × k`).
+fn dense_phi_times(basis: &LinearBasis, s: usize, x: &DMatrix<f64>) -> DMatrix<f64> {
+    let cols = basis.columns(s);
+    basis.phi_at(s) * x.rows(cols.start, cols.len())
 }
 
 fn pattern(rows: usize, cols: usize, k: usize) -> DMatrix<f64> {
@@ -218,54 +221,82 @@ fn reduced_derivatives_match_central_differences() {
 }
 
 #[test]
-fn the_stacked_products_equal_the_per_site_loop() {
-    let (_disc, basis) = single_tendon_like();
-    for r in [1, 3] {
-        let (stacked, looped) = stacked_and_looped(&basis, r);
-        assert!(stacked.stacked.is_some(), "a global basis is stacked");
-        let q = DVector::from_fn(r, |i, _| 0.3 - 0.25 * i as f64);
-        let qd = DVector::from_fn(r, |i, _| 0.7 + 0.5 * i as f64);
-        let w: Vec<V6> = (0..basis.n_sites())
-            .map(|s| V6::from_fn(|a, _| ((s * 5 + a * 3) % 7) as f64 - 3.0))
-            .collect();
-        let run = |p: &ReducedParam<TanhMap>| {
+fn the_site_products_equal_the_dense_basis_times_the_map() {
+    // every product of `Φ_s` against `Φ_s` (dense, from the basis) times the map's own `c`,
+    // `C_z`, `Ċ_z` and, transposed, `Σ_s Φ_sᵀ w_s` through the weighted Hessian: on per-site rows
+    // of 5 (one division) and 3 (two divisions) coefficients, and for r that give one to five
+    // groups of four columns (the rows' products run in windows of four groups); and on the
+    // stacked blocks of one division at 10 Gauss points (a block per component, tall enough)
+    for (label, (_disc, basis), stacked) in [
+        ("one short division", single_tendon_like_with(5), false),
+        ("two divisions", two_division_legendre(), false),
+        ("one division", single_tendon_like(), true),
+    ] {
+        let m = basis.n_dof();
+        for r in [1, 3, 4, 9, 13, 17] {
+            let p = tanh_param(&basis, r);
+            assert_eq!(
+                matches!(p.rows, BasisRows::Stacked(_)),
+                stacked,
+                "{label}: stacked blocks"
+            );
+            let z = DVector::from_fn(r, |i, _| 0.3 - 0.05 * i as f64);
+            let zd = DVector::from_fn(r, |i, _| 0.7 - 0.1 * i as f64);
             let mut ev = p.new_eval();
-            p.eval(&q, &mut ev);
-            p.eval_rate(&q, &qd, &mut ev);
+            p.eval(&z, &mut ev);
+            p.eval_rate(&z, &zd, &mut ev);
+            let w: Vec<V6> = (0..basis.n_sites())
+                .map(|s| V6::from_fn(|a, _| ((s * 5 + a * 3) % 7) as f64 - 3.0))
+                .collect();
             let mut h = DMatrix::zeros(r, r);
-            p.add_weighted_hessian(&q, &w, &mut ev, &mut h);
-            (ev, h)
-        };
-        let ((a, ha), (b, hb)) = (run(&stacked), run(&looped));
-        let close = |x: &[f64], y: &[f64]| {
-            let scale = y.iter().fold(1.0f64, |m, v| m.max(v.abs()));
-            x.iter().zip(y).all(|(u, v)| (u - v).abs() <= 1e-12 * scale)
-        };
-        let psi = |e: &StrainEval| {
-            e.psi
-                .iter()
-                .flat_map(|v| v.iter().copied())
-                .collect::<Vec<_>>()
-        };
-        assert!(close(&psi(&a), &psi(&b)), "Ψ, r = {r}");
-        assert!(
-            close(a.psi_q.as_slice(), b.psi_q.as_slice()),
-            "Ψ_q, r = {r}"
-        );
-        assert!(
-            close(a.psi_q_dot.as_slice(), b.psi_q_dot.as_slice()),
-            "Ψ̇_q, r = {r}"
-        );
-        assert!(
-            close(ha.as_slice(), hb.as_slice()),
-            "weighted Hessian, r = {r}"
-        );
+            p.add_weighted_hessian(&z, &w, &mut ev, &mut h);
+            // the reference, from the map and the dense basis
+            let map = p.map();
+            let mut scratch = vec![0.0; map.scratch_len()];
+            let (mut c, mut cz, mut czd) = (vec![0.0; m], vec![0.0; m * r], vec![0.0; m * r]);
+            map.eval(z.as_slice(), &mut c, &mut cz, &mut scratch);
+            map.eval_rate(z.as_slice(), zd.as_slice(), &mut czd, &mut scratch);
+            let mut g = DVector::zeros(m);
+            for (s, ws) in w.iter().enumerate() {
+                let cols = basis.columns(s);
+                let phi_t_w = basis.phi_at(s).transpose() * ws;
+                let mut part = g.rows_mut(cols.start, cols.len());
+                part += phi_t_w;
+            }
+            let mut h_ref = vec![0.0; r * r];
+            map.add_weighted_hessian(z.as_slice(), g.as_slice(), &mut h_ref, &mut scratch);
+            let close = |x: &[f64], y: &[f64]| {
+                let scale = y.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+                x.len() == y.len() && x.iter().zip(y).all(|(u, v)| (u - v).abs() <= 1e-12 * scale)
+            };
+            let (c, cz, czd) = (
+                DMatrix::from_column_slice(m, 1, &c),
+                DMatrix::from_column_slice(m, r, &cz),
+                DMatrix::from_column_slice(m, r, &czd),
+            );
+            for s in 0..basis.n_sites() {
+                let psi = dense_phi_times(&basis, s, &c);
+                assert!(
+                    close(ev.psi[s].as_slice(), psi.as_slice()),
+                    "{label} r = {r}: Ψ at {s}"
+                );
+                let got = &ev.psi_q.as_slice()[6 * r * s..6 * r * (s + 1)];
+                let want = dense_phi_times(&basis, s, &cz);
+                assert!(close(got, want.as_slice()), "{label} r = {r}: Ψ_q at {s}");
+                let got = &ev.psi_q_dot.as_slice()[6 * r * s..6 * r * (s + 1)];
+                let want = dense_phi_times(&basis, s, &czd);
+                assert!(close(got, want.as_slice()), "{label} r = {r}: Ψ̇_q at {s}");
+            }
+            assert!(
+                close(h.as_slice(), &h_ref),
+                "{label} r = {r}: weighted Hessian"
+            );
+        }
     }
 }
 
 #[test]
-fn the_motion_and_strain_evaluations_and_the_projection_equal_those_from_psi_q_stacked_and_looped()
-{
+fn the_motion_and_strain_evaluations_and_the_projection_equal_those_from_psi_q() {
     // ξ̇_s = Ψ_q,s q̇, Ψ̇_q,s q̇ + Ψ_q,s q̈ and Σ_s Ψ_q,sᵀ w_s from eval + eval_rate (checked against
     // central differences in `reduced_derivatives_match_central_differences`) against the
     // motion evaluation's direct ones, on a one- and a two-division basis
@@ -274,28 +305,14 @@ fn the_motion_and_strain_evaluations_and_the_projection_equal_those_from_psi_q_s
         ("two divisions", two_division_legendre()),
     ] {
         for r in [1, 3] {
-            let (stacked, looped) = stacked_and_looped(&basis, r);
-            // one block per component and run of sites on the same coefficients: one division,
-            // all sites (3 components); two divisions, each division's points and then its
-            // Magnus sub-points (sites are numbered points first): 6 × 2 × 2 blocks, each on
-            // that component's coefficients of that division only
-            let st = stacked
-                .stacked
-                .as_ref()
-                .expect("a per-division basis is stacked");
-            let (n_blocks, widest) = match label {
-                "one division" => (3, 5),
-                _ => (24, 3),
-            };
-            assert_eq!(st.blocks.len(), n_blocks, "{label}");
-            assert!(st.blocks.iter().all(|b| b.cols.len() <= widest), "{label}");
+            let p = tanh_param(&basis, r);
             let q = DVector::from_fn(r, |i, _| 0.3 - 0.25 * i as f64);
             let qd = DVector::from_fn(r, |i, _| 0.7 + 0.5 * i as f64);
             let qdd = DVector::from_fn(r, |i, _| -1.3 + 0.9 * i as f64);
             let w: Vec<V6> = (0..basis.n_sites())
                 .map(|s| V6::from_fn(|a, _| ((s * 5 + a * 3) % 7) as f64 - 3.0))
                 .collect();
-            for p in [&stacked, &looped] {
+            {
                 let mut ev = p.new_eval();
                 p.eval(&q, &mut ev);
                 p.eval_rate(&q, &qd, &mut ev);
