@@ -179,6 +179,9 @@ const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 ///     squared norm, so that small loads are fitted as closely as large ones.
 /// relative_floor : float
 ///     The relative weighting's floor, a fraction of the largest snapshot norm in (0, 1].
+/// decoder : str
+///     ``"plain"`` (the paper's, x̂ = D(z)) or ``"scaled"`` (x̂ = z₁ D(z): every code with z₁ = 0
+///     decodes to the straight rod, for snapshots that shrink to rest as their load vanishes).
 /// force : bool
 ///     Replace ``out`` if it is an earlier gvsrom output.
 ///
@@ -187,7 +190,7 @@ const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 /// Model
 ///     The new model.
 #[pyfunction]
-#[pyo3(signature = (dataset, out, latent=1, hidden_layers=7, epochs=2000, batch_size=64, learning_rate=1e-3, lambda_=1e-4, validation_fraction=0.1, patience=50, lr_reductions=4, lbfgs_iterations=300, seed=0, loss="energy", sample_weighting="uniform", relative_floor=0.1, force=false))]
+#[pyo3(signature = (dataset, out, latent=1, hidden_layers=7, epochs=2000, batch_size=64, learning_rate=1e-3, lambda_=1e-4, validation_fraction=0.1, patience=50, lr_reductions=4, lbfgs_iterations=300, seed=0, loss="energy", sample_weighting="uniform", relative_floor=0.1, decoder="plain", force=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn train(
     py: Python<'_>,
@@ -207,6 +210,7 @@ pub fn train(
     loss: &str,
     sample_weighting: &str,
     relative_floor: f64,
+    decoder: &str,
     force: bool,
 ) -> PyResult<Model> {
     use gvsrom::reduce::Loss;
@@ -233,6 +237,7 @@ pub fn train(
         fine_tune: rom::nn::FineTune::lbfgs(lbfgs_iterations),
         sample_weighting: gvsrom::reduce::sample_weighting(sample_weighting, relative_floor)
             .map_err(errors::scenario)?,
+        decoder: gvsrom::reduce::decoder_form(decoder).map_err(errors::scenario)?,
         ..TrainOptions::default()
     };
     let mut interrupt: Option<PyErr> = None;

@@ -112,6 +112,15 @@ def test_a_relative_sample_weighting_is_recorded_and_a_bad_one_refused_as_the_cl
         gvsrom.train(sweep.path, tmp_path / "py", sample_weighting="per-row")
 
 
+def test_a_scaled_decoder_is_recorded_its_rest_is_z1_zero_and_a_bad_form_refused(sweep, tmp_path):
+    ae = gvsrom.train(sweep.path, tmp_path / "scaled", latent=1, hidden_layers=3, epochs=5,
+                      patience=0, lbfgs_iterations=0, decoder="scaled")
+    assert ae.meta["training"]["decoder"] == "scaled"
+    assert ae.rest[0] == 0.0
+    with pytest.raises(gvsrom.GvsromError, match="--decoder.*`cone`.*accepted: plain, scaled"):
+        gvsrom.train(sweep.path, tmp_path / "py", decoder="cone")
+
+
 def test_bad_plans_are_refused_with_the_cli_message(gvsrom_bin, tmp_path):
     expected = cli_error(gvsrom_bin, "dataset", "single-tendon", "--sweep", "tendons.0.tension=-6",
                          "--samples", "3", "--out", str(tmp_path / "cli"))

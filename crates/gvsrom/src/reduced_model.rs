@@ -20,7 +20,7 @@
 
 use crate::npy::write_array;
 use crate::output::{Integrity, OutputDir, OutputError, MANIFEST_KEY};
-use rom::nn::{Autoencoder, Mlp, Scaling};
+use rom::nn::{Autoencoder, DecoderForm, Mlp, Scaling};
 use safetensors::tensor::{Dtype, SafeTensors, TensorView};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -115,6 +115,10 @@ pub struct TrainingMeta {
     /// The floor of the relative weighting (absent for uniform).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub relative_floor: Option<f64>,
+    /// The decoder's form, `"plain"` or `"scaled"` (`rom::nn::DecoderForm`; absent: from before
+    /// the option, plain).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub decoder: Option<String>,
     pub epochs_run: usize,
     pub best_epoch: usize,
     pub stop: String,
@@ -457,8 +461,18 @@ impl ReducedModel {
                     get("scaling.scale", &[features])?,
                 )
                 .map_err(|e| bad(format!("scaling: {e}")))?;
-                let ae =
-                    Autoencoder::new(encoder, decoder, scaling).map_err(|e| bad(e.to_string()))?;
+                let form = match tr.decoder.as_deref() {
+                    None => DecoderForm::Plain,
+                    Some(name) => DecoderForm::from_name(name).ok_or_else(|| {
+                        bad(format!(
+                            "meta.json: training.decoder is \"{name}\" (expected one of {:?})",
+                            DecoderForm::NAMES
+                        ))
+                    })?,
+                };
+                let ae = Autoencoder::new(encoder, decoder, scaling)
+                    .map_err(|e| bad(e.to_string()))?
+                    .with_form(form);
                 if ae.n_features() != features || ae.latent() != meta.latent {
                     return Err(bad(format!(
                         "the network maps {} features to {} coordinates, meta.json says {features} and {}",

@@ -100,10 +100,62 @@ pub fn solve_under(built: &Built, u: &[f64]) -> Result<StaticsReport, StaticsFai
 /// where the model was trained (`Reduced::check_range`), else the error names the likely cause.
 pub fn solve_checked(built: &Built, u: &[f64]) -> anyhow::Result<StaticsReport> {
     let report = solve_under(built, u)?;
+    check_reduced(built, &report)?;
+    Ok(report)
+}
+
+/// For an attached reduced model, whether its solution `report` is to be trusted: inside the
+/// training encodings' range (`Reduced::check_range`) and not a spurious straight rod
+/// ([`check_not_spurious_rest`]); else the error names the likely cause. Nothing to check for the
+/// full model.
+pub fn check_reduced(built: &Built, report: &StaticsReport) -> anyhow::Result<()> {
     if let Some(r) = &built.reduced {
         r.check_range(&report.q)?;
+        check_not_spurious_rest(built, report)?;
     }
-    Ok(report)
+    Ok(())
+}
+
+/// Refuses a reduced solution that is the straight rod (every `|ξ − ξ*| ≤ 1e-9`) where the full
+/// model's straight rod is not an equilibrium (its residual above the solver's tolerance): a
+/// spurious root where the decoder degenerates. A [`rom::nn::DecoderForm::Scaled`] decoder maps
+/// the whole line `z₁ = 0` to the straight rod; there `C_z`'s other columns vanish and the reduced
+/// residual's first component `−c̃(0, z₂)ᵀ f` vanishes wherever `c̃` is orthogonal to the load, a
+/// saddle of the reduced potential that Newton can reach from a poor guess.
+fn check_not_spurious_rest(built: &Built, report: &StaticsReport) -> anyhow::Result<()> {
+    let m = &built.model;
+    let off = report
+        .strain
+        .iter()
+        .enumerate()
+        .map(|(j, xi)| {
+            let star = m.xi_star(j);
+            (0..6).map(|a| (xi[a] - star[a]).abs()).fold(0.0, f64::max)
+        })
+        .fold(0.0, f64::max);
+    if off > 1e-9 {
+        return Ok(());
+    }
+    let loads = m.prepare_loads(&built.loads)?;
+    let mut ws = m.workspace();
+    let mut res = DVector::zeros(m.n_dof());
+    m.statics_residual(
+        &DVector::zeros(m.n_dof()),
+        &report.u,
+        &loads,
+        &mut ws,
+        &mut res,
+    );
+    let tol = built.options.ftol * ws.residual_scale;
+    if res.amax() <= tol {
+        return Ok(());
+    }
+    anyhow::bail!(
+        "--model: the reduced solution q_r = {:?} is the straight rod, which is not an equilibrium of the full model under these inputs (its residual there is {:.3e}, the tolerance {:.1e}): a spurious root where the decoder maps several coordinates to the straight rod (a scaled decoder's z₁ = 0), reached from a poor initial guess. The model is poor here (more data, or more training)",
+        report.q,
+        res.amax(),
+        tol
+    )
 }
 
 /// [`solve`] `repeat` times (≥ 1); the report's `solve_time_s` is the mean over the repetitions.
@@ -145,14 +197,14 @@ pub struct StaticsRun {
 /// (`Reduced::check_range`), and with `compare` the full model is solved too and compared.
 pub fn run(built: &Built, repeat: u32, compare_full: bool) -> anyhow::Result<StaticsRun> {
     let report = solve_repeated(built, repeat)?;
-    let Some(r) = &built.reduced else {
+    if built.reduced.is_none() {
         return Ok(StaticsRun {
             report,
             full: None,
             comparison: None,
         });
     };
-    r.check_range(&report.q)?;
+    check_reduced(built, &report)?;
     let (full, comparison) = if compare_full {
         let full = solve_full(built, repeat)?;
         let c = compare(built, &full, &report);

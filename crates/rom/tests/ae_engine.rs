@@ -23,12 +23,12 @@ use gvs::strain::{DivisionBasis, LinearBasis, StrainParam};
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use rom::map::CoefficientMap;
 use rom::metrics::strain_error_percent;
-use rom::nn::{Autoencoder, DecoderMap, FineTune, TrainOptions};
+use rom::nn::{AeDecoderMap, Autoencoder, FineTune, TrainOptions};
 use rom::reduced::{point_matrix, projection, projection_residual, PointLayout, ReducedParam};
 use std::sync::OnceLock;
 use std::time::Instant;
 
-type AeModel = Model<ReducedParam<DecoderMap>>;
+type AeModel = Model<ReducedParam<AeDecoderMap>>;
 
 const N_SAMPLES: usize = 60;
 const U_MIN: f64 = -6.0;

@@ -250,6 +250,7 @@ def train(
     loss: str = "energy",
     sample_weighting: str = "uniform",
     relative_floor: float = 0.1,
+    decoder: str = "plain",
     force: bool = False,
 ) -> Model: ...
 

@@ -71,6 +71,11 @@ pub struct TrainArgs {
     /// (0, 1].
     #[arg(long, default_value_t = rom::nn::SampleWeighting::DEFAULT_FLOOR)]
     pub relative_floor: f64,
+    /// The decoder's form: `plain` (the paper's, x̂ = D(z)) or `scaled` (x̂ = z₁ D(z): every code with
+    /// z₁ = 0 decodes to the straight rod, for snapshot families that shrink to rest as their load
+    /// vanishes, such as a load of varying magnitude and position).
+    #[arg(long, default_value = "plain", value_parser = rom::nn::DecoderForm::NAMES)]
+    pub decoder: String,
     /// The new model directory.
     #[arg(long, value_name = "MODEL")]
     pub out: PathBuf,
@@ -130,6 +135,7 @@ pub(super) fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
         lr_reductions: args.lr_reductions,
         fine_tune: rom::nn::FineTune::lbfgs(args.lbfgs_iterations),
         sample_weighting: reduce::sample_weighting(&args.sample_weighting, args.relative_floor)?,
+        decoder: reduce::decoder_form(&args.decoder)?,
         ..TrainOptions::default()
     };
     let signal = interrupt_flag();

@@ -23,7 +23,9 @@ pub use crate::build::Reduced;
 pub use anchors::{anchor_guess, solve_anchors, AnchorInput, AnchorProblem, InitialGuess};
 pub use attach::{attach, attach_resolved, attach_source, parameterization, AttachOptions};
 pub use pod::{pod, PodSummary};
-pub use train::{sample_weighting, train, zero_anchor_rows, Loss, TrainSummary, SAMPLE_WEIGHTINGS};
+pub use train::{
+    decoder_form, sample_weighting, train, zero_anchor_rows, Loss, TrainSummary, SAMPLE_WEIGHTINGS,
+};
 
 use crate::build::reduced::outside_range;
 use crate::build::{build, Built};

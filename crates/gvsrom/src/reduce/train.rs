@@ -11,7 +11,7 @@ use crate::error::ScenarioError;
 use crate::output::OutputDir;
 use crate::reduced_model::{ModelMeta, ModelWeights, ReducedModel, TrainingMeta};
 use nalgebra::DVector;
-use rom::nn::{Autoencoder, SampleWeighting, TrainOptions, TrainReport};
+use rom::nn::{Autoencoder, DecoderForm, SampleWeighting, TrainOptions, TrainReport};
 use rom::reduced::{projection_residual, PointLayout};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
@@ -165,13 +165,17 @@ pub fn train(
             })
             .expect("at least one usable row")
     };
-    let rest = ae
+    let mut rest = ae
         .encode(if anchor_rows > 0 {
             &zero
         } else {
             straightest()
         })
         .map_err(|e| invalid("train", e.to_string()))?;
+    if ae.form() == DecoderForm::Scaled {
+        // z₁ = 0 decodes to the straight rod exactly
+        rest[0] = 0.0;
+    }
     let rest_decoded = ae
         .decode(&rest)
         .map_err(|e| invalid("train", e.to_string()))?;
@@ -214,6 +218,7 @@ pub fn train(
                 SampleWeighting::Relative { floor } => Some(floor),
                 SampleWeighting::Uniform => None,
             },
+            decoder: Some(ae.form().name().into()),
             epochs_run: report.epochs_run,
             best_epoch: report.best_epoch,
             stop: format!("{:?}", report.stop),
@@ -287,6 +292,16 @@ pub fn sample_weighting(name: &str, floor: f64) -> Result<SampleWeighting, Scena
             format!("`{name}` (accepted: {})", SAMPLE_WEIGHTINGS.join(", ")),
         )),
     }
+}
+
+/// The decoder form named `name` (`gvsrom train --decoder`: [`DecoderForm::NAMES`]).
+pub fn decoder_form(name: &str) -> Result<DecoderForm, ScenarioError> {
+    DecoderForm::from_name(name).ok_or_else(|| {
+        invalid(
+            "--decoder",
+            format!("`{name}` (accepted: {})", DecoderForm::NAMES.join(", ")),
+        )
+    })
 }
 
 /// Copies of the zero-strain snapshot added to `rows` training rows: for trajectory data (which

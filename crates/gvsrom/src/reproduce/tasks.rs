@@ -194,6 +194,9 @@ pub struct AeConfig {
     pub loss: reduce::Loss,
     /// Learning-rate reductions at plateaus (`--lr-reductions`).
     pub lr_reductions: usize,
+    /// The decoder's form (`--decoder`); absent: `plain`, the paper's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub decoder: Option<String>,
 }
 
 impl AeConfig {
@@ -212,6 +215,7 @@ impl AeConfig {
             lbfgs_iterations: d.fine_tune.lbfgs_iterations(),
             loss: reduce::Loss::default(),
             lr_reductions: d.lr_reductions,
+            decoder: None,
         }
     }
 }
@@ -242,6 +246,7 @@ pub fn train(
                 seed: c.seed,
                 lr_reductions: c.lr_reductions,
                 fine_tune: rom::nn::FineTune::lbfgs(c.lbfgs_iterations),
+                decoder: reduce::decoder_form(c.decoder.as_deref().unwrap_or("plain"))?,
                 ..rom::nn::TrainOptions::default()
             };
             let interrupt = run.interrupt().clone();
@@ -483,10 +488,7 @@ pub fn statics_eval(
                     }
                     let result = statics::solve_repeated(&built, repeat)
                         .map_err(anyhow::Error::from)
-                        .and_then(|r| match &built.reduced {
-                            Some(red) => red.check_range(&r.q).map(|_| r).map_err(Into::into),
-                            None => Ok(r),
-                        });
+                        .and_then(|r| statics::check_reduced(&built, &r).map(|_| r));
                     solved.push(match result {
                         Ok(r) => {
                             let (se, te) = match &hom_report {

@@ -13,11 +13,12 @@
 //! halves are therefore plain [`Mlp`]s. The networks work in scaled units (see [`Scaling`]):
 //! `E(x) = enc((x − μ)/s)`, `D(z) = s ⊙ dec(z) + μ`.
 
+use super::ae_map::AeDecoderMap;
 use super::batch::{dataset_mse, forward_batch, in_pool, Workspace};
 use super::decoder_map::DecoderMap;
 use super::mlp::{Layer, Mlp};
 use super::train::{fit, shuffle, Problem, Progress, StopReason, TrainOptions, TrainReport};
-use super::{NnError, Scaling};
+use super::{DecoderForm, NnError, Scaling};
 use gvs::inputs::SplitMix64;
 use std::time::Instant;
 
@@ -27,6 +28,7 @@ pub struct Autoencoder {
     encoder: Mlp,
     decoder: Mlp,
     scaling: Scaling,
+    form: DecoderForm,
 }
 
 impl Autoencoder {
@@ -84,7 +86,13 @@ impl Autoencoder {
             encoder,
             decoder,
             scaling,
+            form: DecoderForm::Plain,
         })
+    }
+
+    /// The same networks with the decoder of `form` ([`DecoderForm`]).
+    pub fn with_form(self, form: DecoderForm) -> Self {
+        Autoencoder { form, ..self }
     }
 
     /// Trains an autoencoder on row-major `data` (`rows × n_features`, one snapshot `Ψ̄` of eq. 13 per
@@ -107,7 +115,12 @@ impl Autoencoder {
             .map(|s| Layer::glorot(s[0], s[1], &mut rng))
             .collect();
         let (train, val) = split_rows(rows, opts.validation_fraction, &mut rng);
-        let scaling = Scaling::from_rows(data, n_features, &train, &opts.weighting);
+        let mut scaling = Scaling::from_rows(data, n_features, &train, &opts.weighting);
+        if opts.decoder == DecoderForm::Scaled {
+            // x̂ = z₁ s ⊙ y: no mean, so that z₁ = 0 is the rest state
+            scaling = Scaling::new(vec![0.0; n_features], scaling.scale().to_vec())?;
+        }
+        let gate = (opts.decoder == DecoderForm::Scaled).then_some(opts.hidden_layers.div_ceil(2));
         let mut scaled = data.to_vec();
         scaling.to_scaled(&mut scaled);
         let tanh = chain_tanh_flags(opts.hidden_layers);
@@ -121,6 +134,7 @@ impl Autoencoder {
             train: &train,
             val: &val,
             weights: weights.as_deref(),
+            gate,
         };
         let outcome = fit(problem, opts, &mut rng, progress);
         // a diverged run or one that never beat its initial weights is no model
@@ -140,6 +154,9 @@ impl Autoencoder {
         }
 
         let mut ws = Workspace::new(&sizes, opts.batch_size.min(rows));
+        if let Some(g) = gate {
+            ws = ws.gated(g);
+        }
         let mut errors = |index: &[usize]| {
             let (layers, tanh, scaled, scaling, ws) = (&layers, &tanh, &scaled, &scaling, &mut ws);
             in_pool(|| {
@@ -171,6 +188,7 @@ impl Autoencoder {
                 encoder,
                 decoder,
                 scaling,
+                form: opts.decoder,
             },
             report,
         ))
@@ -201,6 +219,11 @@ impl Autoencoder {
         &self.scaling
     }
 
+    /// How the decoder's output becomes a snapshot.
+    pub fn form(&self) -> DecoderForm {
+        self.form
+    }
+
     /// `z = E(x) = enc((x − μ)/s)` for row-major snapshots (`rows × n` → `rows × r`).
     pub fn encode(&self, x: &[f64]) -> Result<Vec<f64>, NnError> {
         check_rows(x, self.n_features(), "snapshots to encode")?;
@@ -209,11 +232,18 @@ impl Autoencoder {
         self.encoder.forward(&scaled)
     }
 
-    /// `Ψ̄ = D(z) = s ⊙ dec(z) + μ` for row-major latent points (`rows × r` → `rows × n`).
+    /// `Ψ̄ = D(z) = s ⊙ dec(z) + μ` (times `z₁` for [`DecoderForm::Scaled`]) for row-major latent
+    /// points (`rows × r` → `rows × n`).
     pub fn decode(&self, z: &[f64]) -> Result<Vec<f64>, NnError> {
-        check_rows(z, self.latent(), "latent points to decode")?;
+        let r = self.latent();
+        check_rows(z, r, "latent points to decode")?;
         let mut y = self.decoder.forward(z)?;
         self.scaling.to_physical(&mut y);
+        if self.form == DecoderForm::Scaled {
+            for (row, z) in y.chunks_exact_mut(self.n_features()).zip(z.chunks_exact(r)) {
+                row.iter_mut().for_each(|v| *v *= z[0]);
+            }
+        }
         Ok(y)
     }
 
@@ -222,10 +252,12 @@ impl Autoencoder {
         self.decode(&self.encode(x)?)
     }
 
-    /// The decoder as a [`crate::map::CoefficientMap`] `c(z) = A (s ⊙ dec(z) + μ)` with `A` an
-    /// `m × n` column-major matrix (see [`DecoderMap::new`]).
-    pub fn decoder_map(&self, a: &[f64], m: usize) -> Result<DecoderMap, NnError> {
-        DecoderMap::new(&self.decoder, &self.scaling, a, m)
+    /// The decoder as a [`crate::map::CoefficientMap`] `c(z) = A D(z)`: `A (s ⊙ dec(z) + μ)`, times
+    /// `z₁` for [`DecoderForm::Scaled`], with `A` an `m × n` column-major matrix (see
+    /// [`DecoderMap::new`]).
+    pub fn decoder_map(&self, a: &[f64], m: usize) -> Result<AeDecoderMap, NnError> {
+        let map = DecoderMap::new(&self.decoder, &self.scaling, a, m)?;
+        Ok(AeDecoderMap::new(map, self.form))
     }
 }
 

@@ -78,6 +78,13 @@ pub struct Workspace {
     row_weight: Vec<f64>,
     /// Whether the last [`Workspace::load_rows`] loaded row weights (else every `ω_b = 1`).
     weighted: bool,
+    /// A [`crate::nn::DecoderForm::Scaled`] chain: the index `g` of the latent layer `H_g`; the
+    /// output is `z₁ ⊙ H_L` with `z₁` the first column of `H_g` ([`Workspace::gated`]).
+    gate: Option<usize>,
+    /// `H_L` before the scaling by `z₁` (gated chains only).
+    pre_gate: Vec<f64>,
+    /// `∂L/∂z₁ = Σ_j Δ_bj (H_L)_bj` per row (gated chains only).
+    gate_grad: Vec<f64>,
 }
 
 impl Workspace {
@@ -93,7 +100,25 @@ impl Workspace {
             grad_b: sizes.windows(2).map(|s| vec![0.0; s[1]]).collect(),
             row_weight: vec![1.0; capacity],
             weighted: false,
+            gate: None,
+            pre_gate: Vec::new(),
+            gate_grad: Vec::new(),
         }
+    }
+
+    /// The same buffers for a chain whose output is scaled by the first unit of its layer
+    /// `H_latent` (`0 < latent < L`): `x̂_b = z_b1 (H_L)_b` (a [`crate::nn::DecoderForm::Scaled`]
+    /// autoencoder).
+    pub(crate) fn gated(mut self, latent: usize) -> Self {
+        let n_out = self.acts[self.acts.len() - 1].len();
+        assert!(
+            latent > 0 && latent + 1 < self.acts.len(),
+            "gate layer {latent}"
+        );
+        self.gate = Some(latent);
+        self.pre_gate = vec![0.0; n_out];
+        self.gate_grad = vec![0.0; self.capacity];
+        self
     }
 
     /// The largest batch the buffers hold.
@@ -152,6 +177,17 @@ pub(crate) fn forward_batch(layers: &[Layer], tanh: &[bool], ws: &mut Workspace,
             units(out, w_t, &layer.b);
         }
     }
+    if let Some(g) = ws.gate {
+        // x̂_b = z_b1 (H_L)_b, keeping H_L for the backward pass
+        let n = layers[layers.len() - 1].n_out;
+        let r = layers[g].n_in;
+        let (head, tail) = ws.acts.split_at_mut(layers.len());
+        let out = &mut tail[0][..rows * n];
+        ws.pre_gate[..rows * n].copy_from_slice(out);
+        for (row, z) in out.chunks_exact_mut(n).zip(head[g].chunks_exact(r)) {
+            row.iter_mut().for_each(|v| *v *= z[0]);
+        }
+    }
 }
 
 /// Reconstruction mean squared error `(1/(B·n)) Σ ω_b ‖x̂_b − x_b‖²` of the last forward pass.
@@ -208,6 +244,9 @@ fn backward(layers: &[Layer], tanh: &[bool], ws: &mut Workspace, rows: usize, la
         grad_b,
         row_weight,
         weighted,
+        gate,
+        pre_gate,
+        gate_grad,
         ..
     } = ws;
     let (d, y, x) = (
@@ -225,6 +264,20 @@ fn backward(layers: &[Layer], tanh: &[bool], ws: &mut Workspace, rows: usize, la
             for (((d, y), x), w) in rows.zip(row_weight.iter()) {
                 output_delta(d, y, x, scale * w);
             }
+        }
+    }
+    if let Some(g) = *gate {
+        // x̂ = z₁ y: ∂L/∂z₁ = Σ_j Δ_j y_j, ∂L/∂y = z₁ Δ
+        let r = layers[g].n_in;
+        let rows_of = d_cur[..rows * n].chunks_exact_mut(n);
+        let pre = pre_gate[..rows * n].chunks_exact(n);
+        for (((d, y), z), gz) in rows_of
+            .zip(pre)
+            .zip(acts[g].chunks_exact(r))
+            .zip(gate_grad.iter_mut())
+        {
+            *gz = d.iter().zip(y).map(|(d, y)| d * y).sum();
+            d.iter_mut().for_each(|d| *d *= z[0]);
         }
     }
     if tanh[n_layers - 1] {
@@ -277,6 +330,13 @@ fn backward(layers: &[Layer], tanh: &[bool], ws: &mut Workspace, rows: usize, la
             } else {
                 gradients(gw, gb, 0);
                 back(d_prev);
+            }
+            if *gate == Some(k) {
+                // the latent layer is linear: add ∂L/∂z₁ of the output's scaling
+                debug_assert!(!tanh[k - 1]);
+                for (d, gz) in d_prev.chunks_exact_mut(n_in).zip(&gate_grad[..rows]) {
+                    d[0] += gz;
+                }
             }
             std::mem::swap(d_cur, d_prev);
         } else if parallel {
@@ -447,6 +507,49 @@ mod tests {
         let (gw, gb) = (ws.grad_w.clone(), ws.grad_b.clone());
         assert_gradient_is_central_differences(&mut layers, &gw, &gb, |layers| {
             total_loss(layers, &tanh, &mut ws, rows, lambda)
+        });
+    }
+
+    #[test]
+    fn scaled_output_gradient_matches_central_differences() {
+        // x̂_b = z_b1 (H_L)_b with z = H_2 (the linear latent of 4 → 3 → 2 → 3 → 4), weighted rows:
+        // the loss is written here from a plain (ungated) forward pass, the product taken by hand.
+        let sizes = [4, 3, 2, 3, 4];
+        let tanh = [true, false, true, false];
+        let mut rng = SplitMix64::new(17);
+        let mut layers = test_layers(&sizes, &mut rng);
+        let (rows, lambda) = (5, 0.02);
+        let x: Vec<f64> = (0..rows * 4).map(|_| rng.range(-1.0, 1.0)).collect();
+        let omega: Vec<f64> = (0..rows).map(|b| 0.5 + b as f64).collect();
+        let index: Vec<usize> = (0..rows).collect();
+        let mut plain = Workspace::new(&sizes, 8);
+        let loss = |layers: &[Layer], ws: &mut Workspace| {
+            ws.load_rows(&x, 4, &index, None);
+            forward_batch(layers, &tanh, ws, rows);
+            let mut sum = 0.0;
+            for b in 0..rows {
+                let z1 = ws.acts[2][b * 2];
+                let y = &ws.acts[4][b * 4..(b + 1) * 4];
+                let e: f64 = (0..4).map(|j| (z1 * y[j] - x[b * 4 + j]).powi(2)).sum();
+                sum += omega[b] * e;
+            }
+            let penalty: f64 = layers.iter().map(Layer::sum_squared_weights).sum();
+            sum / (rows * 4) as f64 + lambda * penalty
+        };
+        let mut gated = Workspace::new(&sizes, 8).gated(2);
+        gated.load_rows(&x, 4, &index, Some(&omega));
+        forward_batch(&layers, &tanh, &mut gated, rows);
+        // the gated output is the product
+        for b in 0..rows {
+            for j in 0..4 {
+                let expected = gated.acts[2][b * 2] * gated.pre_gate[b * 4 + j];
+                assert_eq!(gated.acts[4][b * 4 + j], expected);
+            }
+        }
+        backward_batch(&layers, &tanh, &mut gated, rows, lambda);
+        let (gw, gb) = (gated.grad_w.clone(), gated.grad_b.clone());
+        assert_gradient_is_central_differences(&mut layers, &gw, &gb, |layers| {
+            loss(layers, &mut plain)
         });
     }
 

@@ -8,6 +8,8 @@
 //! - [`lbfgs`]: full-batch L-BFGS, the optional final training phase.
 //! - [`autoencoder`]: the symmetric architecture, encode/decode, training entry point.
 //! - [`decoder_map`]: the decoder folded with an output projection; value, Jacobian, eq. (17), Hessians.
+//! - [`ae_map`]: an autoencoder's decoder map of either [`DecoderForm`].
+//! - [`scaled_map`]: a map scaled by its first input, `z₁ c̃(z)` ([`DecoderForm::Scaled`]).
 
 /// `simd_fn! { fn name(args) -> R { body } }` defines `name` whose body is compiled twice, for
 /// AVX2 + FMA and for the baseline target, and runs the AVX2 build when the CPU has them (a cached
@@ -42,23 +44,63 @@ macro_rules! simd_fn {
 }
 
 pub mod activation;
+pub mod ae_map;
 pub mod autoencoder;
 pub mod batch;
 pub mod decoder_map;
 pub mod lbfgs;
 pub mod mlp;
+pub mod scaled_map;
 pub mod scaling;
 pub mod train;
 
+pub use ae_map::AeDecoderMap;
 pub use autoencoder::Autoencoder;
 pub use decoder_map::DecoderMap;
 pub use mlp::Mlp;
+pub use scaled_map::ScaledMap;
 pub use scaling::{Scaling, Weighting};
 pub use train::{
     FineTune, Progress, SampleWeighting, StopReason, TrainOptions, TrainReport, EXPLODED,
 };
 
 use thiserror::Error;
+
+/// How the decoder network's output `y = dec(z)` (scaled units) becomes a snapshot.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum DecoderForm {
+    /// `x̂ = s ⊙ y + μ`: the paper's decoder (eq. 14).
+    #[default]
+    Plain,
+    /// `x̂ = z₁ (s ⊙ y + μ)`, trained with `μ = 0`: the first latent coordinate scales the
+    /// snapshot, so every code with `z₁ = 0` decodes to the rest state (zero strain deviation).
+    /// For families that shrink to rest as their load vanishes, e.g. IV-B's `ξ = M g(X)`: a plain
+    /// smooth decoder cannot reach that apex for every `X`, and its error relative to a small
+    /// snapshot grows as `1/|M|` ([`scaled_map`]).
+    Scaled,
+}
+
+impl DecoderForm {
+    /// The names used in options and model files: `plain`, `scaled`.
+    pub const NAMES: [&'static str; 2] = ["plain", "scaled"];
+
+    /// The name of this form ([`DecoderForm::NAMES`]).
+    pub fn name(self) -> &'static str {
+        match self {
+            DecoderForm::Plain => "plain",
+            DecoderForm::Scaled => "scaled",
+        }
+    }
+
+    /// The form called `name`, or `None`.
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "plain" => Some(DecoderForm::Plain),
+            "scaled" => Some(DecoderForm::Scaled),
+            _ => None,
+        }
+    }
+}
 
 /// Errors of network construction, training and evaluation; each names the offending quantity.
 #[derive(Debug, Clone, PartialEq, Error)]

@@ -29,7 +29,7 @@ use super::batch::{
 use super::lbfgs::{Lbfgs, Objective};
 use super::mlp::Layer;
 use super::scaling::Weighting;
-use super::NnError;
+use super::{DecoderForm, NnError};
 use gvs::inputs::SplitMix64;
 use std::ops::ControlFlow;
 use std::time::Duration;
@@ -67,6 +67,8 @@ pub struct TrainOptions {
     pub weighting: Weighting,
     /// How each snapshot's error weighs in the loss.
     pub sample_weighting: SampleWeighting,
+    /// How the decoder's output becomes a snapshot.
+    pub decoder: DecoderForm,
 }
 
 /// How each snapshot's (row's) squared error weighs in the loss of eq. (15).
@@ -135,6 +137,7 @@ impl Default for TrainOptions {
             seed: 0,
             weighting: Weighting::Standardize,
             sample_weighting: SampleWeighting::Uniform,
+            decoder: DecoderForm::Plain,
         }
     }
 }
@@ -422,6 +425,8 @@ pub(crate) struct Problem<'a> {
     pub val: &'a [usize],
     /// The loss weight of every data row ([`SampleWeighting`]), or `None` for 1.
     pub weights: Option<&'a [f64]>,
+    /// The latent layer whose first unit scales the output ([`DecoderForm::Scaled`]), if any.
+    pub gate: Option<usize>,
 }
 
 /// What [`fit`] observed; the chain ends with the best weights.
@@ -502,6 +507,9 @@ pub(crate) fn fit(
         .collect();
     // Batches never exceed the training rows; the validation pass reuses the same buffers.
     let mut ws = Workspace::new(&sizes, opts.batch_size.min(p.train.len()));
+    if let Some(g) = p.gate {
+        ws = ws.gated(g);
+    }
     // eq. (15) over n: the mean squared error per entry plus λ/n Σ‖W‖² (module docs)
     let lambda = opts.lambda / sizes[0].max(1) as f64;
     let initial_train_loss =

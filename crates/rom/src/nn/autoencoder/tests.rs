@@ -1,7 +1,7 @@
 //! Architecture sizes, shapes, input errors, determinism and learning a one-parameter family.
 
 use super::*;
-use crate::nn::{FineTune, StopReason};
+use crate::nn::{DecoderForm, FineTune, StopReason};
 use std::ops::ControlFlow;
 
 /// `x_j(θ) = sin(θ X_j) + θ² X_j²`, `X_j = j/(n − 1)` (a rod abscissa), for `rows` values of θ
@@ -363,4 +363,53 @@ fn a_training_that_never_beats_its_initial_weights_is_an_error() {
         ..opts
     };
     Autoencoder::train(&data, 12, &opts, &mut quiet()).unwrap();
+}
+
+/// `x_j = a sin(θ + 2 X_j) X_j`, `X_j = j/(n − 1)`, for `a`, `θ` uniform in [−1, 1]: a cone over a
+/// curve, every snapshot shrinking to 0 with `a` (the shape of IV-B's `M g(X)`).
+fn cone_family(rows: usize, n: usize, seed: u64) -> Vec<f64> {
+    let mut rng = SplitMix64::new(seed);
+    let mut data = Vec::with_capacity(rows * n);
+    for _ in 0..rows {
+        let (a, theta) = (rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));
+        data.extend((0..n).map(|j| {
+            let x = j as f64 / (n - 1) as f64;
+            a * (theta + 2.0 * x).sin() * x
+        }));
+    }
+    data
+}
+
+#[test]
+fn a_scaled_decoder_is_trained_uncentred_and_decodes_z1_zero_to_rest() {
+    let (rows, n) = (300, 24);
+    let data = cone_family(rows, n, 3);
+    let opts = TrainOptions {
+        latent: 2,
+        hidden_layers: 3,
+        lambda: 1e-6,
+        epochs: 300,
+        batch_size: 16,
+        learning_rate: 3e-3,
+        patience: Some(100),
+        seed: 1,
+        decoder: DecoderForm::Scaled,
+        ..TrainOptions::default()
+    };
+    let (ae, report) = Autoencoder::train(&data, n, &opts, &mut quiet()).unwrap();
+    assert_eq!(ae.form(), DecoderForm::Scaled);
+    assert!(ae.scaling().mean().iter().all(|&m| m == 0.0));
+    // every z with z₁ = 0 decodes to exactly zero
+    let z: Vec<f64> = [-3.0, -0.5, 0.0, 0.7, 4.0]
+        .iter()
+        .flat_map(|&z2| [0.0, z2])
+        .collect();
+    assert!(ae.decode(&z).unwrap().iter().all(|&v| v == 0.0));
+    // it learns the cone: RMSE below 2.5 % of the data's RMS (measured 1.75 %; a plain decoder
+    // gets 0.63 % with the same options: the product is the harder fit, as on IV-B)
+    let rec = ae.reconstruct(&data).unwrap();
+    let sq = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>();
+    let rmse = (sq(&rec, &data) / data.len() as f64).sqrt();
+    let rms = (sq(&data, &vec![0.0; data.len()]) / data.len() as f64).sqrt();
+    assert!(rmse < 0.025 * rms, "rmse {rmse} vs rms {rms} ({report:?})");
 }

@@ -2,7 +2,7 @@
 //! against central differences and against `Autoencoder::decode`.
 
 use super::*;
-use crate::nn::Autoencoder;
+use crate::nn::{Autoencoder, DecoderForm};
 use gvs::inputs::SplitMix64;
 
 /// A random `sizes` network with weights of Glorot size ×1.5 (clearly nonlinear) and random biases.
@@ -35,7 +35,7 @@ fn random_map(r: usize, rng: &mut SplitMix64) -> DecoderMap {
 }
 
 /// `(c, C_z, scratch)` at `z`.
-fn eval_at(map: &DecoderMap, z: &[f64]) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+fn eval_at(map: &impl CoefficientMap, z: &[f64]) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     let (m, r) = (map.n_out(), map.n_in());
     let (mut c, mut c_z, mut scratch) =
         (vec![0.0; m], vec![0.0; m * r], vec![0.0; map.scratch_len()]);
@@ -229,7 +229,8 @@ fn weighted_hessian_matches_central_differences_and_accumulates() {
 #[test]
 fn identity_projection_reproduces_autoencoder_decode_with_and_without_derivatives() {
     let mut rng = SplitMix64::new(14);
-    for r in [1, 2, 3, 6] {
+    let forms = [DecoderForm::Plain, DecoderForm::Scaled];
+    for (r, form) in [1, 2, 3, 6].into_iter().flat_map(|r| forms.map(|f| (r, f))) {
         let encoder = random_mlp(&[7, 5, r], &mut rng);
         let decoder = random_mlp(&[r, 5, 7], &mut rng);
         let scaling = Scaling::new(
@@ -237,7 +238,9 @@ fn identity_projection_reproduces_autoencoder_decode_with_and_without_derivative
             random_vec(7, 0.2, 2.0, &mut rng),
         )
         .unwrap();
-        let ae = Autoencoder::new(encoder, decoder, scaling).unwrap();
+        let ae = Autoencoder::new(encoder, decoder, scaling)
+            .unwrap()
+            .with_form(form);
         let identity: Vec<f64> = (0..49)
             .map(|k| if k % 8 == 0 { 1.0 } else { 0.0 })
             .collect();
