@@ -470,6 +470,18 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     let figures = vec![
         fig6(ev, pod_k.as_deref())?,
         figure("fig5-latent", "Fig. 5: latent coordinates of the training samples, AE with r = 2 (left) and r = 3 (right), 3 hidden layers, coloured by the moment's magnitude", &latent.figure, 1400, 620)?,
+        figure(
+            "scaled-latent",
+            "Beyond the paper: the latent coordinates of the training samples under the scaled AE-2 (x̂ = z₁ D(z), 7 hidden layers), coloured by the moment's magnitude (left) and centre (right): z₁ follows the signed magnitude (its sign is the training's choice), z₂ the centre, and the whole line z₁ = 0 decodes to the straight rod",
+            &iv_common::latent_plane(
+                &data.path,
+                scaled,
+                "scaled AE-2: latent coordinates of the training samples",
+                &[(1, "magnitude [N·m]"), (0, "centre [m]")],
+            )?,
+            1400,
+            620,
+        )?,
     ];
     Ok((report, figures))
 }

@@ -40,6 +40,35 @@ fn encodings(
     Ok((super::latent::encodings(data, model)?, c))
 }
 
+/// The encodings of the training samples by `model` in the 2-D plane of its first two coordinates,
+/// once coloured by each of the dataset inputs `inputs` (`(index, label)`), side by side.
+pub fn latent_plane(
+    data: &Path,
+    model: &Step<ModelInfo>,
+    title: &str,
+    inputs: &[(usize, &str)],
+) -> anyhow::Result<Figure> {
+    let ds = Dataset::load(data)?;
+    let mut panels = vec![];
+    for &(k, label) in inputs {
+        let (z, c) = encodings(&ds, data, &model.path, k)?;
+        panels.push(Figure::Scatter2(Scatter2 {
+            title: format!("coloured by {label}"),
+            x_label: "q₁".into(),
+            y_label: "q₂".into(),
+            x: z.iter().map(|z| z[0]).collect(),
+            y: z.iter().map(|z| z[1]).collect(),
+            color: Some(c),
+            color_label: label.into(),
+        }));
+    }
+    Ok(Figure::Grid {
+        title: title.into(),
+        cols: inputs.len(),
+        panels,
+    })
+}
+
 /// Fig. 3 / Fig. 5: the training samples' encodings by `vis[0]` (r = 2) and `vis[1]` (r = 3),
 /// coloured by dataset input `color_input`; the intrinsic dimension by the elbow of `depth_row`'s
 /// RMSE over r = 1, 2, 3 and by the correlation dimension of the snapshots and encodings.
