@@ -117,9 +117,7 @@ pub struct ModesReport {
 /// attached) and returns it with the lowest `count` modes about it.
 pub fn compute(built: &Built, count: usize) -> Result<(StaticsReport, ModesReport), ModesError> {
     let eq = statics::solve(built)?;
-    if let Some(r) = &built.reduced {
-        r.check_range(&eq.q)?;
-    }
+    statics::check_reduced(built, &eq)?;
     let modes = match &built.reduced {
         Some(r) => modes_on(built, &r.model, &eq, count)?,
         None => modes_on(built, &built.model, &eq, count)?,

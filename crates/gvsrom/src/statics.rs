@@ -2,7 +2,7 @@
 //! sampled at equally spaced abscissae, the strain at the computational points, and solver statistics.
 
 use crate::build::Built;
-use crate::error::StaticsFailure;
+use crate::error::{ScenarioError, StaticsFailure};
 use crate::provenance::Provenance;
 use gvs::lie::V3;
 use gvs::model::Model;
@@ -108,7 +108,7 @@ pub fn solve_checked(built: &Built, u: &[f64]) -> anyhow::Result<StaticsReport> 
 /// training encodings' range (`Reduced::check_range`) and not a spurious straight rod
 /// ([`check_not_spurious_rest`]); else the error names the likely cause. Nothing to check for the
 /// full model.
-pub fn check_reduced(built: &Built, report: &StaticsReport) -> anyhow::Result<()> {
+pub fn check_reduced(built: &Built, report: &StaticsReport) -> Result<(), ScenarioError> {
     if let Some(r) = &built.reduced {
         r.check_range(&report.q)?;
         check_not_spurious_rest(built, report)?;
@@ -122,7 +122,7 @@ pub fn check_reduced(built: &Built, report: &StaticsReport) -> anyhow::Result<()
 /// the whole line `z₁ = 0` to the straight rod; there `C_z`'s other columns vanish and the reduced
 /// residual's first component `−c̃(0, z₂)ᵀ f` vanishes wherever `c̃` is orthogonal to the load, a
 /// saddle of the reduced potential that Newton can reach from a poor guess.
-fn check_not_spurious_rest(built: &Built, report: &StaticsReport) -> anyhow::Result<()> {
+fn check_not_spurious_rest(built: &Built, report: &StaticsReport) -> Result<(), ScenarioError> {
     let m = &built.model;
     let off = report
         .strain
@@ -150,12 +150,15 @@ fn check_not_spurious_rest(built: &Built, report: &StaticsReport) -> anyhow::Res
     if res.amax() <= tol {
         return Ok(());
     }
-    anyhow::bail!(
-        "--model: the reduced solution q_r = {:?} is the straight rod, which is not an equilibrium of the full model under these inputs (its residual there is {:.3e}, the tolerance {:.1e}): a spurious root where the decoder maps several coordinates to the straight rod (a scaled decoder's z₁ = 0), reached from a poor initial guess. The model is poor here (more data, or more training)",
-        report.q,
-        res.amax(),
-        tol
-    )
+    Err(ScenarioError::invalid(
+        "--model",
+        format!(
+            "the reduced solution q_r = {:?} is the straight rod, which is not an equilibrium of the full model under these inputs (its residual there is {:.3e}, the tolerance {:.1e}): a spurious root where the decoder maps several coordinates to the straight rod (a scaled decoder's z₁ = 0), reached from a poor initial guess. The model is poor here (more data, or more training)",
+            report.q,
+            res.amax(),
+            tol
+        ),
+    ))
 }
 
 /// [`solve`] `repeat` times (≥ 1); the report's `solve_time_s` is the mean over the repetitions.

@@ -488,7 +488,11 @@ pub fn statics_eval(
                     }
                     let result = statics::solve_repeated(&built, repeat)
                         .map_err(anyhow::Error::from)
-                        .and_then(|r| statics::check_reduced(&built, &r).map(|_| r));
+                        .and_then(|r| {
+                            statics::check_reduced(&built, &r)
+                                .map(|_| r)
+                                .map_err(Into::into)
+                        });
                     solved.push(match result {
                         Ok(r) => {
                             let (se, te) = match &hom_report {
