@@ -181,6 +181,20 @@ fn a_spurious_straight_rod_under_load_is_refused_not_returned() {
             "spurious",
         ],
     );
+    // and the modes about it are not computed either
+    expect_error(
+        &[
+            "modes",
+            "soft-beam",
+            "--set",
+            m,
+            "--set",
+            c,
+            "--model",
+            s(&poor),
+        ],
+        &["straight rod", "spurious"],
+    );
 }
 
 #[test]
