@@ -2,7 +2,8 @@
 //! its rest coordinates decode to the straight rod exactly, a zero load's reduced equilibrium is
 //! the straight rod to the solver's tolerance, a nonzero load is solved (or, from a model too poor
 //! to hold it, refused as a spurious straight rod, never returned as one), and an unknown form is
-//! refused (on the command line and in a model file).
+//! refused (on the command line and in a model file); dynamics from the rest, where the mass matrix
+//! is singular, are refused before any step and leave no output.
 
 mod common;
 
@@ -195,6 +196,26 @@ fn a_spurious_straight_rod_under_load_is_refused_not_returned() {
         ],
         &["straight rod", "spurious"],
     );
+}
+
+#[test]
+fn dynamics_from_a_scaled_models_rest_are_refused_before_any_step() {
+    // at z₁ = 0 every z₂ decodes to the straight rod: ∂ξ/∂z₂ = 0 and M is singular
+    let out = scratch("scaled-sim");
+    expect_error(
+        &[
+            "simulate",
+            "soft-beam",
+            "--model",
+            s(model()),
+            "--duration",
+            "0.01",
+            "--out",
+            s(&out),
+        ],
+        &["mass matrix is singular", "z₁ = 0", "--decoder plain"],
+    );
+    assert!(!out.exists(), "{} written", out.display());
 }
 
 #[test]

@@ -5,9 +5,12 @@ use super::plan::*;
 use crate::build::Built;
 use crate::error::ScenarioError;
 use gvs::lie::Pose;
+use gvs::model::Model;
+use gvs::solve::dynamics::InitialState;
 use gvs::solve::dynamics::{
     simulate_streaming_interruptible, IntegratorOptions, RunSummary, Sample, SimulationError,
 };
+use gvs::strain::StrainParam;
 use std::ops::ControlFlow;
 
 /// How a run ended.
@@ -45,6 +48,41 @@ impl Outcome {
 pub trait SampleSink {
     /// Appends one sample of the run of `built`.
     fn push(&mut self, built: &Built, s: &Sample<'_>) -> std::io::Result<()>;
+}
+
+/// Refuses to start a reduced model's dynamics where its mass matrix `M = Ψ_qᵀ … Ψ_q` is not
+/// positive definite: its coordinates degenerate there (a scaled decoder's rest `z₁ = 0` decodes
+/// every `z₂` to the straight rod, so `∂ξ/∂z₂ = 0`) and no integrator can take a step. Checked at
+/// the rest coordinates or the given state (an initial equilibrium is found by the run itself).
+fn check_start_mass<P: StrainParam>(
+    model: &Model<P>,
+    initial: &InitialState,
+) -> Result<(), ScenarioError> {
+    let q = match initial {
+        InitialState::Rest => model.param.rest_coordinates(),
+        InitialState::Given { q, .. } => q.clone(),
+        InitialState::Equilibrium { .. } => return Ok(()),
+    };
+    let mass = model.mass_matrix(&q, &mut model.workspace());
+    let scale = mass.amax();
+    if scale > 0.0
+        && nalgebra::Cholesky::new(mass.clone()).is_some_and(|c| {
+            let d = c.l_dirty().diagonal();
+            d.min() * d.min() > 1e-12 * scale
+        })
+    {
+        return Ok(());
+    }
+    let eig = nalgebra::SymmetricEigen::new(mass).eigenvalues;
+    Err(ScenarioError::invalid(
+        "--model",
+        format!(
+            "the reduced model's mass matrix is singular at its initial coordinates q_r = {:?} (eigenvalues {:.3e} … {:.3e}): its coordinates degenerate there, as a scaled decoder's do on z₁ = 0, where every z₂ decodes to the straight rod; no step can be taken from there. Simulate with a plain decoder (`gvsrom train --decoder plain`), or start from another state",
+            q.as_slice(),
+            eig.min(),
+            eig.max()
+        ),
+    ))
 }
 
 /// [`run`] with the samples delivered to any [`SampleSink`].
@@ -96,6 +134,9 @@ pub fn run_into(
         }
         check(s.t)
     };
+    if let Some(r) = &built.reduced {
+        check_start_mass(&r.model, &plan.initial)?;
+    }
     let summary = match &built.reduced {
         Some(r) => simulate_streaming_interruptible(
             &r.model,
