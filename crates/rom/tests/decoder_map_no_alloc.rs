@@ -1,9 +1,10 @@
-//! `DecoderMap`'s `CoefficientMap` calls allocate nothing (the map.rs contract), checked with a
-//! counting global allocator in this test binary.
+//! `DecoderMap`'s `CoefficientMap` calls allocate nothing (the map.rs contract), nor those of the
+//! same map scaled by `z₁` (`ScaledMap`, a scaled autoencoder's decoder), checked with a counting
+//! global allocator in this test binary.
 
 use gvs::inputs::SplitMix64;
 use rom::map::CoefficientMap;
-use rom::nn::{DecoderMap, Mlp, Scaling};
+use rom::nn::{DecoderMap, Mlp, ScaledMap, Scaling};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
@@ -27,13 +28,9 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
-#[test]
-fn no_evaluation_of_a_decoder_allocates() {
-    let (r, n, m) = (3, 40, 5);
-    let mut rng = SplitMix64::new(9);
-    let decoder = Mlp::glorot(&[r, 10, 20, n], &mut rng).unwrap();
-    let a: Vec<f64> = (0..m * n).map(|_| rng.range(-1.0, 1.0)).collect();
-    let map = DecoderMap::new(&decoder, &Scaling::identity(n), &a, m).unwrap();
+/// Every call of `map` (r = 3, m = 5) once, after a first `eval`; returns the allocations counted.
+fn allocations_of_every_call(map: &impl CoefficientMap) -> usize {
+    let (r, m) = (3, 5);
     let (z, zd, g) = (vec![0.3, -0.2, 0.5], vec![1.0, 0.5, -0.4], vec![0.1; m]);
     let (mut c, mut c_z, mut c_z_dot) = (vec![0.0; m], vec![0.0; m * r], vec![0.0; m * r]);
     let (mut hess, mut scratch) = (vec![0.0; r * r], vec![0.0; map.scratch_len()]);
@@ -53,16 +50,30 @@ fn no_evaluation_of_a_decoder_allocates() {
     );
     map.vjp(&g, &mut back, &mut scratch);
     map.eval_value(&z, &mut c, &mut scratch);
-    assert_eq!(ALLOCATIONS.with(Cell::get) - before, 0);
-    // The counter does see allocations.
-    drop(std::hint::black_box(vec![0u8; 8]));
-    assert_eq!(ALLOCATIONS.with(Cell::get) - before, 1);
+    let counted = ALLOCATIONS.with(Cell::get) - before;
     assert!(c
         .iter()
         .chain(&c_z)
         .chain(&c_z_dot)
         .chain(&hess)
         .all(|v| v.is_finite()));
+    counted
+}
+
+#[test]
+fn no_evaluation_of_a_decoder_allocates() {
+    let (r, n, m) = (3, 40, 5);
+    let mut rng = SplitMix64::new(9);
+    let decoder = Mlp::glorot(&[r, 10, 20, n], &mut rng).unwrap();
+    let a: Vec<f64> = (0..m * n).map(|_| rng.range(-1.0, 1.0)).collect();
+    let map = DecoderMap::new(&decoder, &Scaling::identity(n), &a, m).unwrap();
+    assert_eq!(allocations_of_every_call(&map), 0);
+    let scaled = ScaledMap::new(map);
+    assert_eq!(allocations_of_every_call(&scaled), 0);
+    // The counter does see allocations.
+    let before = ALLOCATIONS.with(Cell::get);
+    drop(std::hint::black_box(vec![0u8; 8]));
+    assert_eq!(ALLOCATIONS.with(Cell::get) - before, 1);
 }
 
 /// The same at the paper's IV-A size (306 point strains, 7 hidden layers halving to r = 1, folded
