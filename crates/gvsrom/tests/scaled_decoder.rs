@@ -62,36 +62,15 @@ fn model() -> &'static Path {
     M.get_or_init(|| train("scaled-ae", 300))
 }
 
-/// `statics soft-beam` at `magnitude` N·m centred at `center` m with `model`, as JSON.
-fn statics(name: &str, magnitude: f64, center: f64, model: &Path) -> serde_json::Value {
+/// `statics soft-beam` at `magnitude` N·m centred at `center` m, with `model` or the full model
+/// (`None`), as JSON.
+fn statics(name: &str, magnitude: f64, center: f64, model: Option<&Path>) -> serde_json::Value {
     let file = scratch(&format!("{name}.json"));
     let (m, c) = (
         format!("loads.distributed.0.magnitude={magnitude}"),
         format!("loads.distributed.0.center={center}"),
     );
-    run_ok(&[
-        "statics",
-        "soft-beam",
-        "--set",
-        &m,
-        "--set",
-        &c,
-        "--model",
-        s(model),
-        "--json",
-        s(&file),
-    ]);
-    json(&file)
-}
-
-/// `statics soft-beam` at the same load with the full model, as JSON.
-fn statics_full(name: &str, magnitude: f64, center: f64) -> serde_json::Value {
-    let file = scratch(&format!("{name}.json"));
-    let (m, c) = (
-        format!("loads.distributed.0.magnitude={magnitude}"),
-        format!("loads.distributed.0.center={center}"),
-    );
-    run_ok(&[
+    let mut args = vec![
         "statics",
         "soft-beam",
         "--set",
@@ -100,7 +79,11 @@ fn statics_full(name: &str, magnitude: f64, center: f64) -> serde_json::Value {
         &c,
         "--json",
         s(&file),
-    ]);
+    ];
+    if let Some(model) = model {
+        args.extend(["--model", s(model)]);
+    }
+    run_ok(&args);
     json(&file)
 }
 
@@ -128,7 +111,7 @@ fn a_scaled_model_holds_the_straight_rod_at_zero_load_and_solves_a_load() {
     // zero load: the straight rod, tip at (L, 0, 0), to the solver's tolerance (‖R‖ ≤ 1e-10 from
     // the nearest anchor leaves z₁ ~ 1e-11); a plain decoder's straight rod is off its manifold
     // (IV-B's AE-2: its closest point decodes 3 1/m of curvature away)
-    let at_zero = statics("scaled-zero", 0.0, 0.4, dir);
+    let at_zero = statics("scaled-zero", 0.0, 0.4, Some(dir));
     let tip: Vec<f64> = at_zero["tip_position"]
         .as_array()
         .unwrap()
@@ -140,8 +123,8 @@ fn a_scaled_model_holds_the_straight_rod_at_zero_load_and_solves_a_load() {
     // a load inside the training range: a bent state, the right way (a positive moment about
     // local y curls the beam towards −z), its tip moved at least half as far from the straight
     // rod's as the full model's
-    let loaded = statics("scaled-load", 2.0, 0.4, dir);
-    let hom = statics_full("scaled-hom", 2.0, 0.4);
+    let loaded = statics("scaled-load", 2.0, 0.4, Some(dir));
+    let hom = statics("scaled-hom", 2.0, 0.4, None);
     let tip = |v: &serde_json::Value| -> Vec<f64> {
         (0..3)
             .map(|i| v["tip_position"][i].as_f64().unwrap())

@@ -398,4 +398,4 @@ impl CoefficientMap for DecoderMap {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

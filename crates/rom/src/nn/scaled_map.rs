@@ -163,32 +163,13 @@ impl<M: CoefficientMap> CoefficientMap for ScaledMap<M> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::nn::{DecoderMap, Mlp, Scaling};
+    use crate::nn::DecoderMap;
     use gvs::inputs::SplitMix64;
 
-    /// A random decoder `r → 6 → 5 → 7` (weights 1.5× Glorot, random biases) folded with a random
-    /// scaling and a random 3 × 7 projection, scaled by `z₁`.
+    /// A random decoder `r → 6 → 5 → 7` folded with a random scaling and a random 3 × 7 projection
+    /// (the decoder map's own test map), scaled by `z₁`.
     fn random_map(r: usize, rng: &mut SplitMix64) -> ScaledMap<DecoderMap> {
-        let sizes = [r, 6, 5, 7];
-        let base = Mlp::glorot(&sizes, rng).unwrap();
-        let weights = (0..base.n_layers())
-            .map(|k| base.weights(k).iter().map(|w| 1.5 * w).collect())
-            .collect();
-        let biases = (0..base.n_layers())
-            .map(|k| {
-                base.biases(k)
-                    .iter()
-                    .map(|_| rng.range(-0.5, 0.5))
-                    .collect()
-            })
-            .collect();
-        let mlp = Mlp::new(&sizes, weights, biases).unwrap();
-        let v = |n: usize, lo: f64, hi: f64, rng: &mut SplitMix64| -> Vec<f64> {
-            (0..n).map(|_| rng.range(lo, hi)).collect()
-        };
-        let scaling = Scaling::new(v(7, -1.0, 1.0, rng), v(7, 0.2, 2.0, rng)).unwrap();
-        let a = v(21, -1.0, 1.0, rng);
-        ScaledMap::new(DecoderMap::new(&mlp, &scaling, &a, 3).unwrap())
+        ScaledMap::new(crate::nn::decoder_map::tests::random_map(r, rng))
     }
 
     /// `z₁ c̃(z)` evaluated directly, from the inner map's value.

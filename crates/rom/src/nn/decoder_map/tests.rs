@@ -27,7 +27,7 @@ fn random_vec(len: usize, lo: f64, hi: f64, rng: &mut SplitMix64) -> Vec<f64> {
 }
 
 /// A random decoder `r → 6 → 5 → 7` folded with a random scaling and a random 3 × 7 `A`.
-fn random_map(r: usize, rng: &mut SplitMix64) -> DecoderMap {
+pub(crate) fn random_map(r: usize, rng: &mut SplitMix64) -> DecoderMap {
     let decoder = random_mlp(&[r, 6, 5, 7], rng);
     let scaling =
         Scaling::new(random_vec(7, -1.0, 1.0, rng), random_vec(7, 0.2, 2.0, rng)).unwrap();
