@@ -398,14 +398,14 @@ fn the_pose_alone_equals_the_full_forward_pass_with_ae_param() {
 #[test]
 fn statics_jacobian_matches_finite_differences_with_gravity_and_tendon_friction() {
     let fx = fixture();
-    for r in [1, 2] {
-        let m = fx.rom(r, 1e4);
+    for c in cases(fx, 1e4) {
+        let (r, label, m) = (c.r, &c.label, &c.model);
         let n = m.n_dof();
         let pl = m.prepare_loads(&gravity()).unwrap();
         let mut ws = m.workspace();
         // off equilibrium: the shape of one tension under another
         for (k, u) in [(8, -1.5), (30, -4.2), (50, 0.8)] {
-            let q = fx.z(r, k);
+            let q = c.point(fx.z(r, k));
             let mut an = DMatrix::zeros(n, n);
             m.statics_jacobian(&q, &[u], &pl, &mut ws, &mut an);
             let mut fd = DMatrix::zeros(n, n);
@@ -421,8 +421,8 @@ fn statics_jacobian_matches_finite_differences_with_gravity_and_tendon_friction(
                 fd.set_column(j, &((&rp - &rm) / (2.0 * h)));
             }
             let err = (&an - &fd).norm() / fd.norm();
-            eprintln!("r = {r}, u = {u}: statics Jacobian vs central differences {err:.3e}");
-            assert!(err < 1e-6, "r = {r}, u = {u}: ∂R/∂q vs FD {err:e}");
+            eprintln!("r = {label}, u = {u}: statics Jacobian vs central differences {err:.3e}");
+            assert!(err < 1e-6, "r = {label}, u = {u}: ∂R/∂q vs FD {err:e}");
         }
     }
 }
@@ -430,10 +430,10 @@ fn statics_jacobian_matches_finite_differences_with_gravity_and_tendon_friction(
 #[test]
 fn mass_matrix_is_spd_and_mdot_minus_2c_is_skew_with_ae_param() {
     let fx = fixture();
-    for r in [1, 2] {
-        let m = fx.rom(r, 0.0);
+    for c in cases(fx, 0.0) {
+        let (r, label, m) = (c.r, &c.label, &c.model);
         let mut ws = m.workspace();
-        for (k, q) in latent_points(fx, r).iter().enumerate() {
+        for (k, q) in c.points.iter().enumerate() {
             let qd = latent_velocity(fx, r, k);
             let mass = m.mass_matrix(q, &mut ws);
             let asym = (&mass - mass.transpose()).amax() / mass.amax();
@@ -446,13 +446,19 @@ fn mass_matrix_is_spd_and_mdot_minus_2c_is_skew_with_ae_param() {
             let nmat = &mdot - &c * 2.0;
             let sym = (&nmat + nmat.transpose()).amax() / mdot.amax().max(c.amax());
             eprintln!(
-                "r = {r}, z = {:?}: M asymmetry {asym:.1e}, λ_min(M) = {:.3e}, ‖Ṁ − 2C + (Ṁ − 2C)ᵀ‖/‖·‖ = {sym:.3e}",
+                "r = {label}, z = {:?}: M asymmetry {asym:.1e}, λ_min(M) = {:.3e}, ‖Ṁ − 2C + (Ṁ − 2C)ᵀ‖/‖·‖ = {sym:.3e}",
                 q.as_slice(),
                 eig.min()
             );
-            assert!(asym < 1e-14, "r = {r}: M asymmetry {asym:e}");
-            assert!(eig.min() > 0.0, "r = {r}: M not positive definite: {eig}");
-            assert!(sym < 1e-7, "r = {r}: Ṁ − 2C not skew-symmetric: {sym:e}");
+            assert!(asym < 1e-14, "r = {label}: M asymmetry {asym:e}");
+            assert!(
+                eig.min() > 0.0,
+                "r = {label}: M not positive definite: {eig}"
+            );
+            assert!(
+                sym < 1e-7,
+                "r = {label}: Ṁ − 2C not skew-symmetric: {sym:e}"
+            );
         }
     }
 }
@@ -461,20 +467,20 @@ fn mass_matrix_is_spd_and_mdot_minus_2c_is_skew_with_ae_param() {
 fn coriolis_matrix_agrees_with_force_path_with_ae_param() {
     // without damping: τ(q, q̇) − τ(q, 0) = −C(q, q̇) q̇
     let fx = fixture();
-    for r in [1, 2] {
-        let m = fx.rom(r, 0.0);
+    for c in cases(fx, 0.0) {
+        let (r, label, m) = (c.r, &c.label, &c.model);
         let n = m.n_dof();
         let loads = m.prepare_loads(&gravity()).unwrap();
         let mut ws = m.workspace();
-        for (k, q) in latent_points(fx, r).iter().enumerate() {
+        for (k, q) in c.points.iter().enumerate() {
             let qd = latent_velocity(fx, r, k);
             let (mut t1, mut t0) = (DVector::zeros(n), DVector::zeros(n));
             m.dynamic_forces(q, &qd, &[-1.0], &loads, &mut ws, &mut t1);
             m.dynamic_forces(q, &DVector::zeros(n), &[-1.0], &loads, &mut ws, &mut t0);
             let cqd = m.coriolis_matrix(q, &qd, &mut ws) * &qd;
             let err = (&t0 - &t1 - &cqd).amax() / cqd.amax();
-            eprintln!("r = {r}: C q̇ force path vs matrix {err:.3e}");
-            assert!(err < 1e-10, "r = {r}: C q̇ vs force path {err:e}");
+            eprintln!("r = {label}: C q̇ force path vs matrix {err:.3e}");
+            assert!(err < 1e-10, "r = {label}: C q̇ vs force path {err:e}");
         }
     }
 }
@@ -484,12 +490,12 @@ fn dynamics_residual_is_m_qdd_minus_tau_with_ae_param() {
     // the recursive residual of the second-order integrators, ε(q, q̇, q̈), against M(q) q̈ − τ(q, q̇)
     // from the mass matrix and the force path, with damping and gravity
     let fx = fixture();
-    for r in [1, 2] {
-        let m = fx.rom(r, 1e4);
+    for c in cases(fx, 1e4) {
+        let (r, label, m) = (c.r, &c.label, &c.model);
         let n = m.n_dof();
         let loads = m.prepare_loads(&gravity()).unwrap();
         let mut ws = m.workspace();
-        for (k, q) in latent_points(fx, r).iter().enumerate() {
+        for (k, q) in c.points.iter().enumerate() {
             let qd = latent_velocity(fx, r, k);
             let qdd = latent_velocity(fx, r, k + 1) * 30.0;
             let mut tau = DVector::zeros(n);
@@ -498,18 +504,18 @@ fn dynamics_residual_is_m_qdd_minus_tau_with_ae_param() {
             let mut eps = DVector::zeros(n);
             m.dynamics_residual(q, &qd, &qdd, &[-1.0], &loads, &mut ws, &mut eps);
             let err = (&eps - &expected).amax() / expected.amax();
-            eprintln!("r = {r}: ε vs M q̈ − τ {err:.3e}");
-            assert!(err < 1e-10, "r = {r}: ε vs M q̈ − τ {err:e}");
+            eprintln!("r = {label}: ε vs M q̈ − τ {err:.3e}");
+            assert!(err < 1e-10, "r = {label}: ε vs M q̈ − τ {err:e}");
             // the same residual from the forward pass that also renews M (Ψ_q evaluated too)
             let mut mass = DMatrix::zeros(n, n);
             m.dynamics_residual_and_mass(q, &qd, &qdd, &[-1.0], &loads, &mut ws, &mut eps);
             mass.copy_from(&ws.mass);
             let err = (&eps - &expected).amax() / expected.amax();
-            assert!(err < 1e-10, "r = {r}: ε with M vs M q̈ − τ {err:e}");
+            assert!(err < 1e-10, "r = {label}: ε with M vs M q̈ − τ {err:e}");
             let m_err = (&mass - m.mass_matrix(q, &mut ws)).amax() / mass.amax();
             assert!(
                 m_err < 1e-12,
-                "r = {r}: M of the residual pass off by {m_err:e}"
+                "r = {label}: M of the residual pass off by {m_err:e}"
             );
         }
     }
@@ -769,90 +775,60 @@ fn iteration_matrix_matches_finite_differences_of_the_residual_with_ae_param() {
     }
 }
 
-/// The r = 2 ROM with the trained decoder scaled by its first coordinate, `c(z) = z₁ c̃(z)`
-/// (`DecoderForm::Scaled`), at latent points with `z₁` shifted off 0 (where its tangent degenerates).
-fn scaled_rom(fx: &Fixture, damping: f64) -> (AeModel, Vec<DVector<f64>>) {
-    let h = hom(damping);
-    let t = fx.trained(2);
-    let ae = t.ae.clone().with_form(rom::nn::DecoderForm::Scaled);
-    let map = ae.decoder_map(fx.p.as_slice(), fx.p.nrows()).unwrap();
-    assert!(matches!(map, AeDecoderMap::Scaled(_)));
-    let param = ReducedParam::new(&h.param, map, t.rest.clone()).unwrap();
-    let m = Model::new(h.rod, h.disc, param, h.tendons).unwrap();
-    let points = latent_points(fx, 2)
-        .into_iter()
-        .map(|mut z| {
-            z[0] = z[0].signum() * (z[0].abs() + 0.5);
-            z
-        })
-        .collect();
-    (m, points)
+/// A ROM of the engine-identity tests: the trained decoders for r = 1 and 2, and the r = 2 one
+/// scaled by its first coordinate, `c(z) = z₁ c̃(z)` (`DecoderForm::Scaled`: every derivative
+/// through the product rule of `ScaledMap`), with the latent points they are checked at.
+struct Case {
+    r: usize,
+    label: String,
+    model: AeModel,
+    scaled: bool,
+    points: Vec<DVector<f64>>,
 }
 
-#[test]
-fn engine_identities_hold_with_a_scaled_decoder() {
-    // M SPD and Ṁ − 2C skew; C q̇ by the force path; ε = M q̈ − τ (with and without renewing M);
-    // the statics Jacobian (with the decoder's Hessian) against central differences: every
-    // derivative the engine takes of `z₁ c̃(z)` goes through the product rule of `ScaledMap`
-    let fx = fixture();
-    let (m, points) = scaled_rom(fx, 1e4);
-    let (m0, _) = scaled_rom(fx, 0.0);
-    let n = m.n_dof();
-    let loads = m.prepare_loads(&gravity()).unwrap();
-    let mut ws = m.workspace();
-    for (k, q) in points.iter().enumerate() {
-        let qd = latent_velocity(fx, 2, k);
-        let qdd = latent_velocity(fx, 2, k + 1) * 30.0;
-        // mass matrix and the skew identity (undamped model)
-        let mass = m0.mass_matrix(q, &mut ws);
-        let eig = SymmetricEigen::new(mass.clone()).eigenvalues;
-        assert!(eig.min() > 0.0, "M not positive definite at {q}: {eig}");
-        let e = 1e-6;
-        let mdot = (m0.mass_matrix(&(q + &qd * e), &mut ws)
-            - m0.mass_matrix(&(q - &qd * e), &mut ws))
-            / (2.0 * e);
-        let c = m0.coriolis_matrix(q, &qd, &mut ws);
-        let nmat = &mdot - &c * 2.0;
-        let sym = (&nmat + nmat.transpose()).amax() / mdot.amax().max(c.amax());
-        assert!(sym < 1e-7, "Ṁ − 2C not skew-symmetric: {sym:e}");
-        // C q̇ through the force path, without damping
-        let (mut t1, mut t0) = (DVector::zeros(n), DVector::zeros(n));
-        m0.dynamic_forces(q, &qd, &[-1.0], &loads, &mut ws, &mut t1);
-        m0.dynamic_forces(q, &DVector::zeros(n), &[-1.0], &loads, &mut ws, &mut t0);
-        let cqd = &c * &qd;
-        let err = (&t0 - &t1 - &cqd).amax() / cqd.amax();
-        assert!(err < 1e-10, "C q̇ vs force path {err:e}");
-        // the dynamics residual, damped, with and without renewing M
-        let mut tau = DVector::zeros(n);
-        m.dynamic_forces(q, &qd, &[-1.0], &loads, &mut ws, &mut tau);
-        let expected = m.mass_matrix(q, &mut ws) * &qdd - &tau;
-        let mut eps = DVector::zeros(n);
-        m.dynamics_residual(q, &qd, &qdd, &[-1.0], &loads, &mut ws, &mut eps);
-        let err = (&eps - &expected).amax() / expected.amax();
-        assert!(err < 1e-10, "ε vs M q̈ − τ {err:e}");
-        m.dynamics_residual_and_mass(q, &qd, &qdd, &[-1.0], &loads, &mut ws, &mut eps);
-        let err = (&eps - &expected).amax() / expected.amax();
-        assert!(err < 1e-10, "ε with M vs M q̈ − τ {err:e}");
-        // the statics Jacobian against central differences
-        let u = [-2.0];
-        let mut an = DMatrix::zeros(n, n);
-        m.statics_jacobian(q, &u, &loads, &mut ws, &mut an);
-        let mut fd = DMatrix::zeros(n, n);
-        let (mut rp, mut rm) = (DVector::zeros(n), DVector::zeros(n));
-        for j in 0..n {
-            let h = 1e-6 * (1.0 + q[j].abs());
-            let (mut qp, mut qm) = (q.clone(), q.clone());
-            qp[j] += h;
-            qm[j] -= h;
-            m.statics_residual(&qp, &u, &loads, &mut ws, &mut rp);
-            m.statics_residual(&qm, &u, &loads, &mut ws, &mut rm);
-            fd.set_column(j, &((&rp - &rm) / (2.0 * h)));
+impl Case {
+    /// `z`, with `z₁` moved 0.5 away from 0 for the scaled decoder (its tangent degenerates on
+    /// `z₁ = 0`, where every `z₂` decodes to the rest).
+    fn point(&self, mut z: DVector<f64>) -> DVector<f64> {
+        if self.scaled {
+            z[0] = z[0].signum() * (z[0].abs() + 0.5);
         }
-        let err = (&an - &fd).norm() / fd.norm();
-        eprintln!(
-            "scaled, z = {:?}: statics Jacobian vs central differences {err:.3e}, Ṁ − 2C {sym:.1e}",
-            q.as_slice()
-        );
-        assert!(err < 1e-6, "∂R/∂q vs FD {err:e}");
+        z
     }
+}
+
+/// The three [`Case`]s with material damping `damping`.
+fn cases(fx: &Fixture, damping: f64) -> Vec<Case> {
+    let scaled = {
+        let h = hom(damping);
+        let t = fx.trained(2);
+        let ae = t.ae.clone().with_form(rom::nn::DecoderForm::Scaled);
+        let map = ae.decoder_map(fx.p.as_slice(), fx.p.nrows()).unwrap();
+        assert!(matches!(map, AeDecoderMap::Scaled(_)));
+        let param = ReducedParam::new(&h.param, map, t.rest.clone()).unwrap();
+        Model::new(h.rod, h.disc, param, h.tendons).unwrap()
+    };
+    let mut out: Vec<Case> = [1, 2]
+        .into_iter()
+        .map(|r| Case {
+            r,
+            label: r.to_string(),
+            model: fx.rom(r, damping),
+            scaled: false,
+            points: latent_points(fx, r),
+        })
+        .collect();
+    let mut case = Case {
+        r: 2,
+        label: "2 (scaled decoder)".into(),
+        model: scaled,
+        scaled: true,
+        points: vec![],
+    };
+    case.points = latent_points(fx, 2)
+        .into_iter()
+        .map(|z| case.point(z))
+        .collect();
+    out.push(case);
+    out
 }
