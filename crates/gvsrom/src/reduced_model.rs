@@ -363,16 +363,14 @@ impl ReducedModel {
             message,
         };
         // every listed file and the metadata as written, before anything is parsed
-        let integrity = crate::output::verify_dir(dir, MODEL_FORMAT).map_err(|e| {
+        let crate::output::Verified {
+            integrity,
+            meta: value,
+        } = crate::output::verify_dir_meta(dir, MODEL_FORMAT).map_err(|e| {
             bad(format!(
                 "{e}; an edited model is not the model that was trained — re-create it"
             ))
         })?;
-        let meta_path = dir.join("meta.json");
-        let text = crate::output::read_regular_to_string(&meta_path)
-            .map_err(|e| bad(format!("cannot read meta.json: {e}")))?;
-        let value: serde_json::Value =
-            serde_json::from_str(&text).map_err(|e| bad(format!("meta.json: {e}")))?;
         let format = value
             .get(MANIFEST_KEY)
             .and_then(|m| m.get("format"))

@@ -54,12 +54,15 @@ impl Trajectory {
                 dir.display()
             )));
         }
-        // its files as written (an older trajectory without hashes is read unchecked)
-        crate::output::verify_dir(dir, "trajectory").map_err(|e| {
-            bad(format!(
-                "{e}; an edited trajectory is not the run that was simulated"
-            ))
-        })?;
+        // its files as written (an older trajectory without hashes is read unchecked), and its
+        // meta.json as it was checked
+        let meta = crate::output::verify_dir_meta(dir, "trajectory")
+            .map_err(|e| {
+                bad(format!(
+                    "{e}; an edited trajectory is not the run that was simulated"
+                ))
+            })?
+            .meta;
         let count = |key: &str| {
             meta[key]
                 .as_u64()

@@ -110,7 +110,7 @@ impl Arrays<'_> {
 fn integrity_error(dir: &Path, e: IntegrityError) -> DatasetError {
     let mut message = e.problem.to_string();
     if matches!(e.problem, Problem::Changed | Problem::MetaEdited) {
-        if let Err(found) = Dataset::read(dir, Integrity::Unhashed) {
+        if let Err(found) = Dataset::read_unchecked(dir) {
             message = format!("{message}; as read now: {found}");
         }
     }
@@ -139,13 +139,13 @@ impl Dataset {
     /// Loads and validates the dataset in `dir`: its files against the hashes in its manifest, then
     /// its arrays against `meta.json`.
     pub fn load(dir: &Path) -> Result<Dataset, DatasetError> {
-        let integrity =
-            crate::output::verify_dir(dir, DATASET_FORMAT).map_err(|e| integrity_error(dir, e))?;
-        Dataset::read(dir, integrity)
+        let verified = crate::output::verify_dir_meta(dir, DATASET_FORMAT)
+            .map_err(|e| integrity_error(dir, e))?;
+        Dataset::read(dir, verified.integrity, verified.meta)
     }
 
-    /// Reads and validates the arrays of the dataset in `dir` (its integrity checked or not).
-    fn read(dir: &Path, integrity: Integrity) -> Result<Dataset, DatasetError> {
+    /// The dataset in `dir` read as it is now, its integrity unchecked: what a changed file holds.
+    fn read_unchecked(dir: &Path) -> Result<Dataset, DatasetError> {
         let meta_path = dir.join(crate::output::MANIFEST_FILE);
         let shown = meta_path.display().to_string();
         let text =
@@ -157,6 +157,17 @@ impl Dataset {
             })?;
         let value: serde_json::Value = serde_json::from_str(&text)
             .map_err(|e| file_error(&shown, format!("not valid JSON: {e}")))?;
+        Dataset::read(dir, Integrity::Unhashed, value)
+    }
+
+    /// Reads and validates the arrays of the dataset in `dir` described by its meta.json `value`
+    /// (its integrity checked or not).
+    fn read(
+        dir: &Path,
+        integrity: Integrity,
+        value: serde_json::Value,
+    ) -> Result<Dataset, DatasetError> {
+        let shown = dir.join(crate::output::MANIFEST_FILE).display().to_string();
         let format = value
             .get(crate::output::MANIFEST_KEY)
             .and_then(|m| m.get("format"))

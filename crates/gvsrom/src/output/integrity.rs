@@ -65,11 +65,25 @@ fn plain(name: &str) -> bool {
         && !name.contains(['/', '\\', '\0'])
 }
 
+/// A directory output checked by [`verify_dir_meta`]: what could be checked, and its meta.json as
+/// it was checked (a loader parses this value rather than reading the file a second time, so what
+/// it reads is what was verified).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Verified {
+    pub integrity: Integrity,
+    pub meta: Value,
+}
+
 /// Checks the directory output `dir` against its manifest before it is read: `meta.json` holds a
 /// manifest of format `expected_format`; every file it lists exists as a regular file; and, if the
 /// output records hashes, every listed file and meta.json itself match them. Never panics; an error
 /// names the file at fault and what differs.
 pub fn verify_dir(dir: &Path, expected_format: &str) -> Result<Integrity, IntegrityError> {
+    verify_dir_meta(dir, expected_format).map(|v| v.integrity)
+}
+
+/// [`verify_dir`], returning meta.json's value as it was checked with the result.
+pub fn verify_dir_meta(dir: &Path, expected_format: &str) -> Result<Verified, IntegrityError> {
     let meta_path = dir.join(MANIFEST_FILE);
     let bad_meta = |message: String| IntegrityError {
         path: meta_path.clone(),
@@ -209,9 +223,13 @@ pub fn verify_dir(dir: &Path, expected_format: &str) -> Result<Integrity, Integr
             });
         }
     }
-    Ok(match hashes {
+    let integrity = match hashes {
         Some(_) => Integrity::Checked,
         None => Integrity::Unhashed,
+    };
+    Ok(Verified {
+        integrity,
+        meta: Value::Object(meta),
     })
 }
 
@@ -242,6 +260,23 @@ mod tests {
         assert_eq!(problem(&dir), ("b.bin".into(), Problem::Changed));
         let e = verify_dir(&dir, "test").unwrap_err().to_string();
         assert!(e.contains("differs from the hash recorded"), "{e}");
+    }
+
+    #[test]
+    fn the_verified_meta_is_the_file_as_checked() {
+        let dir = written("verified");
+        let v = verify_dir_meta(&dir, "test").unwrap();
+        assert_eq!(v.integrity, Integrity::Checked);
+        assert_eq!(v.meta, meta_of(&dir));
+        assert_eq!(v.meta["samples"], 9);
+        // an edited meta.json gives no value at all
+        let mut edited = meta_of(&dir);
+        edited["samples"] = 10.into();
+        write_meta(&dir, &edited);
+        assert_eq!(
+            verify_dir_meta(&dir, "test").unwrap_err().problem,
+            Problem::MetaEdited
+        );
     }
 
     #[test]
