@@ -5,7 +5,7 @@ use super::*;
 /// `gvsrom reproduce`.
 #[derive(Debug, Args)]
 pub struct ReproduceArgs {
-    /// The paper's cases to run: `iv-a`, `iv-b`, `v`, or `all`.
+    /// The paper's cases to run (one or more, or `all`).
     #[arg(required = true, value_enum)]
     pub cases: Vec<gvsrom::reproduce::Case>,
     /// Reduced sizes (fewer samples, epochs, POD modes): every case in minutes, the paper's trends
