@@ -6,7 +6,8 @@
 //! equilibrium is solved as `gvsrom statics [--model]` solves it.
 
 use super::figures;
-use super::report::{figure, ratio, CaseReport, Cell, Finding, RenderedFigure, Table};
+use super::report::{figure, ratio, CaseReport, Cell, RenderedFigure, Table};
+use super::statics_study::StaticsComparison;
 use super::step::Step;
 use super::tasks::{self, AeConfig, DatasetSpec, EvalModel, Evaluation, ModelInfo, ScenarioSpec};
 use super::{new_report, paper, Case, Options, Run};
@@ -170,64 +171,11 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     let ev = tasks::statics_eval(run, "iv-a/eval", &m.scenario, &inputs, &models, s.repeat)?;
     let ev = &ev.value;
     let modes: Vec<usize> = (1..=m.pods.len()).collect();
-    let k = fewest_pod_below(ev, &modes, 1.0);
+    let c = StaticsComparison::of(ev, 1, &modes);
+    let (k, pod_k) = (c.pod_k, c.pod_k_label());
     report.tables.push(accuracy_table(ev, &models));
-    let (ae_err, ae_max) = ev.stats("AE-1", |s| s.strain_error_percent);
-    let (hom_t, _) = ev.stats("HOM", |s| s.time_s);
-    let (ae_t, _) = ev.stats("AE-1", |s| s.time_s);
-    let pod_k = k.map(|k| format!("POD-{k}"));
-    let (pod_t, _) = pod_k
-        .as_deref()
-        .map(|l| ev.stats(l, |s| s.time_s))
-        .unwrap_or((f64::NAN, f64::NAN));
-    report
-        .tables
-        .push(table_iii(&paper::TABLE_III_IV_A, k, pod_t, 1, ae_t, hom_t));
-    let (pod1_err, _) = ev.stats("POD-1", |s| s.strain_error_percent);
-    report.findings = vec![
-        Finding {
-            claim: "the AE-ROM is more accurate than the POD-ROM of equal DOF (r = 1)".into(),
-            holds: ae_err < pod1_err,
-            evidence: format!(
-                "mean strain error {} % (AE-1) against {} % (POD-1)",
-                Cell::sig(ae_err, 3).render(),
-                Cell::sig(pod1_err, 3).render()
-            ),
-        },
-        Finding {
-            claim: "the AE-ROM reaches < 1 % strain error with 1 DOF".into(),
-            holds: ae_max < 1.0,
-            evidence: format!(
-                "largest strain error over the 20 test tensions {} %",
-                Cell::sig(ae_max, 3).render()
-            ),
-        },
-        Finding {
-            claim: "at equal accuracy (< 1 %) the AE-ROM is faster than the POD-ROM".into(),
-            holds: ae_t < pod_t,
-            evidence: match &pod_k {
-                Some(l) => format!(
-                    "AE-1 {} ms against {l} {} ms per equilibrium",
-                    Cell::sig(ae_t * 1e3, 3).render(),
-                    Cell::sig(pod_t * 1e3, 3).render()
-                ),
-                None => format!(
-                    "no POD model up to {} modes reaches < 1 % at every test tension",
-                    m.pods.len()
-                ),
-            },
-        },
-        Finding {
-            claim: "both ROMs are faster than the HOM".into(),
-            holds: ae_t < hom_t && pod_t < hom_t,
-            evidence: format!(
-                "HOM {} ms, AE-1 {} ms, POD-k {} ms",
-                Cell::sig(hom_t * 1e3, 3).render(),
-                Cell::sig(ae_t * 1e3, 3).render(),
-                Cell::sig(pod_t * 1e3, 3).render()
-            ),
-        },
-    ];
+    report.tables.push(c.table_iii(&paper::TABLE_III_IV_A));
+    report.findings = c.findings("the 20 test tensions");
     let latent = super::iv_common::latent_and_dimension(
         &m.data.path,
         &[&m.aes[0][1], &m.aes[0][2]],
@@ -252,15 +200,6 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         figure("fig3-latent", "Fig. 3: latent coordinates of the training samples, AE with r = 2 (left) and r = 3 (right), 3 hidden layers, coloured by the tension", &latent.figure, 1400, 620)?,
     ];
     Ok((report, figures))
-}
-
-/// The fewest POD modes among `modes` (ascending) whose largest strain error over the test inputs
-/// is below `limit` %.
-pub fn fewest_pod_below(ev: &Evaluation, modes: &[usize], limit: f64) -> Option<usize> {
-    modes
-        .iter()
-        .copied()
-        .find(|k| ev.stats(&format!("POD-{k}"), |s| s.strain_error_percent).1 < limit)
 }
 
 /// Table I for one case: ours, the paper's and the ratio per r, one row per depth.
@@ -340,79 +279,6 @@ pub fn accuracy_table(ev: &Evaluation, models: &[EvalModel]) -> Table {
         .to_vec(),
         rows,
         note: "Strain error: mean |ξ_ROM − ξ_HOM| over the points and active components, in % of the HOM's largest |ξ − ξ*| (the paper's \"< 1 % strain error\"); tip error: ‖p_ROM − p_HOM‖ / L. A failed solve (no convergence, or the decoder extrapolating) makes its row's errors –.".into(),
-    }
-}
-
-/// Table III (same-accuracy rows): our POD-k and AE DOF and times beside the paper's.
-pub fn table_iii(
-    p: &paper::TableIiiRow,
-    pod_k: Option<usize>,
-    pod_t: f64,
-    ae_dof: usize,
-    ae_t: f64,
-    hom_t: f64,
-) -> Table {
-    let row = |q: &str, ours: Cell, paper: Cell, r: Cell| vec![Cell::text(q), ours, paper, r];
-    let pod_dof = pod_k.map_or(
-        Cell::num(f64::NAN, super::report::Digits::Fixed(0)),
-        Cell::int,
-    );
-    let rows = vec![
-        row(
-            "POD DOF for < 1 % strain error",
-            pod_dof,
-            Cell::int(p.pod_dof),
-            ratio(pod_k.map_or(f64::NAN, |k| k as f64), p.pod_dof as f64),
-        ),
-        row(
-            "POD-ROM time [s]",
-            Cell::sig(pod_t, 3),
-            Cell::sig(p.pod_time_s, 3),
-            ratio(pod_t, p.pod_time_s),
-        ),
-        row(
-            "AE DOF",
-            Cell::int(ae_dof),
-            Cell::int(p.ae_dof),
-            ratio(ae_dof as f64, p.ae_dof as f64),
-        ),
-        row(
-            "AE-ROM time [s]",
-            Cell::sig(ae_t, 3),
-            Cell::sig(p.ae_time_s, 3),
-            ratio(ae_t, p.ae_time_s),
-        ),
-        row(
-            "HOM time [s]",
-            Cell::sig(hom_t, 3),
-            Cell::sig(p.hom_time_s, 3),
-            ratio(hom_t, p.hom_time_s),
-        ),
-        row(
-            "AE-ROM speed-up over POD-ROM",
-            Cell::sig(pod_t / ae_t, 3),
-            Cell::sig(p.pod_time_s / p.ae_time_s, 3),
-            ratio(pod_t / ae_t, p.pod_time_s / p.ae_time_s),
-        ),
-        row(
-            "AE-ROM speed-up over the HOM",
-            Cell::sig(hom_t / ae_t, 3),
-            Cell::sig(p.hom_time_s / p.ae_time_s, 3),
-            ratio(hom_t / ae_t, p.hom_time_s / p.ae_time_s),
-        ),
-        row(
-            "POD-ROM speed-up over the HOM",
-            Cell::sig(hom_t / pod_t, 3),
-            Cell::sig(p.hom_time_s / p.pod_time_s, 3),
-            ratio(hom_t / pod_t, p.hom_time_s / p.pod_time_s),
-        ),
-    ];
-    Table {
-        id: "table-iii".into(),
-        title: "Table III row (same accuracy level, < 1 % strain error)".into(),
-        columns: ["quantity", "ours", "paper", "ratio"].map(String::from).to_vec(),
-        rows,
-        note: "Times: mean wall time of one static equilibrium over the test inputs. Ours: gvsrom, one thread, this machine; the paper's: MATLAB fsolve on an i9-13900HX.".into(),
     }
 }
 

@@ -7,8 +7,9 @@
 //! 2 N·m at X/L = 0.75 (Fig. 6).
 
 use super::figures;
-use super::iv_a::{accuracy_table, fewest_pod_below, table_i, table_iii};
+use super::iv_a::{accuracy_table, table_i};
 use super::report::{figure, CaseReport, Cell, Finding, RenderedFigure, Table};
+use super::statics_study::StaticsComparison;
 use super::step::Step;
 use super::tasks::{self, AeConfig, DatasetSpec, EvalModel, Evaluation, ScenarioSpec};
 use super::{iv_common, new_report, paper, Case, Options, Run};
@@ -316,20 +317,10 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         .collect();
     let ev = tasks::statics_eval(run, "iv-b/eval", &scenario, &inputs, &models, s.repeat)?;
     let ev = &ev.value;
-    let k = fewest_pod_below(ev, &modes, 1.0);
+    let c = StaticsComparison::of(ev, 2, &modes);
+    let (k, pod_k) = (c.pod_k, c.pod_k_label());
     report.tables.push(accuracy_table(ev, &models));
-    let (ae_err, ae_max) = ev.stats("AE-2", |s| s.strain_error_percent);
-    let (pod2_err, _) = ev.stats("POD-2", |s| s.strain_error_percent);
-    let (hom_t, _) = ev.stats("HOM", |s| s.time_s);
-    let (ae_t, _) = ev.stats("AE-2", |s| s.time_s);
-    let pod_k = k.map(|k| format!("POD-{k}"));
-    let (pod_t, _) = pod_k
-        .as_deref()
-        .map(|l| ev.stats(l, |s| s.time_s))
-        .unwrap_or((f64::NAN, f64::NAN));
-    report
-        .tables
-        .push(table_iii(&paper::TABLE_III_IV_B, k, pod_t, 2, ae_t, hom_t));
+    report.tables.push(c.table_iii(&paper::TABLE_III_IV_B));
     // beyond the paper: five random loads, the AE-2 against POD-2 and POD-k
     let random_models: Vec<EvalModel> = models
         .iter()
@@ -363,24 +354,8 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     let (pod2_rand, _) = ev_random.stats("POD-2", |s| s.strain_error_percent);
     let (_, scaled_max) = ev.stats(SCALED, |s| s.strain_error_percent);
     let (scaled_rand, scaled_rand_max) = ev_random.stats(SCALED, |s| s.strain_error_percent);
-    report.findings = vec![
-        Finding {
-            claim: "the AE-ROM is more accurate than the POD-ROM of equal DOF (r = 2)".into(),
-            holds: ae_err < pod2_err,
-            evidence: format!(
-                "mean strain error {} % (AE-2) against {} % (POD-2)",
-                Cell::sig(ae_err, 3).render(),
-                Cell::sig(pod2_err, 3).render()
-            ),
-        },
-        Finding {
-            claim: "the AE-ROM reaches < 1 % strain error with 2 DOF".into(),
-            holds: ae_max < 1.0,
-            evidence: format!(
-                "largest strain error at the two test loads {} %",
-                Cell::sig(ae_max, 3).render()
-            ),
-        },
+    report.findings = c.findings("the two test loads");
+    report.findings.extend([
         Finding {
             claim: format!("the AE-2 ROM stays below 1 % strain error, and below POD-2, at {RANDOM_LOADS} random loads (beyond the paper)"),
             holds: ae_rand_max < 1.0 && ae_rand < pod2_rand,
@@ -412,37 +387,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
                     .join(", ")
             ),
         },
-        Finding {
-            claim: "at equal accuracy (< 1 %) the AE-ROM is faster than the POD-ROM".into(),
-            holds: ae_max < 1.0 && ae_t < pod_t,
-            evidence: match &pod_k {
-                Some(l) => format!(
-                    "AE-2 {} ms against {l} {} ms per equilibrium{}",
-                    Cell::sig(ae_t * 1e3, 3).render(),
-                    Cell::sig(pod_t * 1e3, 3).render(),
-                    if ae_max < 1.0 {
-                        ""
-                    } else {
-                        "; but the AE-ROM itself is not below 1 %"
-                    }
-                ),
-                None => format!(
-                    "no POD model up to {} modes reaches < 1 %",
-                    modes.last().copied().unwrap_or(0)
-                ),
-            },
-        },
-        Finding {
-            claim: "both ROMs are faster than the HOM".into(),
-            holds: ae_t < hom_t && pod_t < hom_t,
-            evidence: format!(
-                "HOM {} ms, AE-2 {} ms, POD-k {} ms",
-                Cell::sig(hom_t * 1e3, 3).render(),
-                Cell::sig(ae_t * 1e3, 3).render(),
-                Cell::sig(pod_t * 1e3, 3).render()
-            ),
-        },
-    ];
+    ]);
     let latent = iv_common::latent_and_dimension(
         &data.path,
         &[&aes[0][1], &aes[0][2]],

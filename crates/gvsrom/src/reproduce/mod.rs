@@ -21,6 +21,7 @@ pub mod noise;
 pub mod paper;
 pub mod report;
 pub mod sim_test;
+pub mod statics_study;
 pub mod step;
 pub mod tasks;
 pub mod v;
@@ -191,6 +192,7 @@ pub fn run(
         })?;
         report.wall_time_s = t0.elapsed().as_secs_f64();
         report.steps = run.records()[before..].to_vec();
+        report.steps.sort_by(StepRecord::report_order);
         report.crate_version = env!("CARGO_PKG_VERSION").into();
         report.quick = opts.quick;
         report.provenance = Some(provenance);

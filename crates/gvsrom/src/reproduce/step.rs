@@ -47,6 +47,39 @@ pub struct StepRecord {
     pub reused: bool,
 }
 
+impl StepRecord {
+    /// The reports' order of steps: by name, with runs of digits compared as numbers (`pod-2`
+    /// before `pod-10`), so that a report lists its steps the same way whatever order its parallel
+    /// steps finished in.
+    pub fn report_order(a: &StepRecord, b: &StepRecord) -> std::cmp::Ordering {
+        natural_key(&a.name).cmp(&natural_key(&b.name))
+    }
+}
+
+/// `name` cut into runs of digits (as numbers) and runs of other characters, for
+/// [`StepRecord::report_order`].
+fn natural_key(name: &str) -> Vec<(String, u128)> {
+    let mut key: Vec<(String, u128)> = vec![];
+    let mut text = String::new();
+    let mut digits = String::new();
+    for ch in name.chars() {
+        if ch.is_ascii_digit() {
+            digits.push(ch);
+        } else {
+            if !digits.is_empty() {
+                key.push((
+                    std::mem::take(&mut text),
+                    digits.parse().unwrap_or(u128::MAX),
+                ));
+                digits.clear();
+            }
+            text.push(ch);
+        }
+    }
+    key.push((text, digits.parse().unwrap_or(0)));
+    key
+}
+
 /// A finished step: its value, where its output is, and its record.
 #[derive(Debug, Clone)]
 pub struct Step<T> {
@@ -259,6 +292,44 @@ mod tests {
         assert_eq!(a, b);
         assert_ne!(a, c);
         assert_ne!(a, d);
+    }
+
+    #[test]
+    fn reports_list_steps_by_name_with_numbers_compared_as_numbers() {
+        let names = [
+            "iv-b/pod-10",
+            "iv-b/pod-2",
+            "iv-b/dataset",
+            "iv-b/ae-r2-h7-scaled-seed1",
+            "iv-b/ae-r1-h7",
+            "iv-b/ae-r10-h3",
+            "iv-b/ae-r2-h7",
+            "iv-b/pod-1",
+        ];
+        let mut records: Vec<StepRecord> = names
+            .iter()
+            .map(|n| StepRecord {
+                name: n.to_string(),
+                key: String::new(),
+                wall_time_s: 0.0,
+                reused: true,
+            })
+            .collect();
+        records.sort_by(StepRecord::report_order);
+        let sorted: Vec<&str> = records.iter().map(|r| r.name.as_str()).collect();
+        assert_eq!(
+            sorted,
+            [
+                "iv-b/ae-r1-h7",
+                "iv-b/ae-r2-h7",
+                "iv-b/ae-r2-h7-scaled-seed1",
+                "iv-b/ae-r10-h3",
+                "iv-b/dataset",
+                "iv-b/pod-1",
+                "iv-b/pod-2",
+                "iv-b/pod-10",
+            ]
+        );
     }
 
     #[test]
