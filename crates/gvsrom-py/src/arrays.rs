@@ -2,13 +2,15 @@
 
 use crate::errors::invalid;
 use nalgebra::{DMatrix, DVector};
-use numpy::{AllowTypeChange, PyArray, PyArrayLike1, PyArrayLike2, PyArrayMethods};
+use numpy::{AllowTypeChange, PyArray, PyArrayLike1, PyArrayLike2, PyArrayLikeDyn, PyArrayMethods};
 use pyo3::prelude::*;
 
 /// A 1-D input (`float64` after conversion).
 pub type In1<'py> = PyArrayLike1<'py, f64, AllowTypeChange>;
 /// A 2-D input (`float64` after conversion).
 pub type In2<'py> = PyArrayLike2<'py, f64, AllowTypeChange>;
+/// An input of any dimension (`float64` after conversion).
+pub type InDyn<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
 
 /// The values of a 1-D input.
 pub fn vec1(a: &In1<'_>) -> Vec<f64> {

@@ -1,7 +1,7 @@
 //! Reduced models: `gvsrom.load_model(path)` and `gvsrom.pod(dataset, modes, out)` (the library's
 //! `gvsrom pod`).
 
-use crate::arrays::{shaped, vector};
+use crate::arrays::{shaped, vector, InDyn};
 use crate::errors::{self, invalid};
 use gvsrom::reduced_model::ReducedModel;
 use numpy::PyArrayMethods;
@@ -58,6 +58,53 @@ pub struct Model {
     /// `meta.json` as a dict.
     #[pyo3(get)]
     meta: Py<PyAny>,
+    /// The model itself, for `encode` / `decode` / `reconstruct`.
+    model: ReducedModel,
+}
+
+/// The rows of a 1-D (one row) or 2-D input with `cols` columns each, row-major, and whether it was
+/// 1-D; else a `GvsromError` naming `name`.
+fn rows_of(name: &str, a: &InDyn<'_>, cols: usize, what: &str) -> PyResult<(Vec<f64>, bool)> {
+    let v = a.as_array();
+    let ok = match v.ndim() {
+        1 => v.len() == cols,
+        2 => v.shape()[1] == cols,
+        _ => false,
+    };
+    if !ok {
+        let dims: Vec<String> = v.shape().iter().map(usize::to_string).collect();
+        let shape = match dims.len() {
+            1 => format!("({},)", dims[0]),
+            _ => format!("({})", dims.join(", ")),
+        };
+        return Err(invalid(format!(
+            "`{name}` has shape {shape}; expected ({cols},) or (rows, {cols}) ({what})"
+        )));
+    }
+    Ok((v.iter().copied().collect(), v.ndim() == 1))
+}
+
+impl Model {
+    /// `f` on the rows of `a` (1-D or 2-D, `cols` wide), its rows `out` wide, in `a`'s dimensions.
+    fn map_rows<'py>(
+        &self,
+        py: Python<'py>,
+        (name, a, cols, what): (&str, &InDyn<'_>, usize, &str),
+        out: usize,
+        f: impl FnOnce(&ReducedModel, &[f64]) -> Result<Vec<f64>, gvsrom::reduced_model::CodecError>
+            + Send,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let (x, one) = rows_of(name, a, cols, what)?;
+        let y = py
+            .detach(|| f(&self.model, &x))
+            .map_err(|e| invalid(e.to_string()))?;
+        if one {
+            Ok(vector(py, &y))
+        } else {
+            let rows = y.len() / out;
+            shaped(py, y, [rows, out])
+        }
+    }
 }
 
 #[pymethods]
@@ -66,6 +113,94 @@ impl Model {
     #[getter]
     fn path(&self) -> PathBuf {
         self.dir.clone()
+    }
+
+    /// Number of values of one snapshot: computational points × active strain components.
+    #[getter]
+    fn features(&self) -> usize {
+        self.model.features()
+    }
+
+    /// Reduced coordinates of strain snapshots, ``q = E(x)``: POD ``Vᵀ x``, an autoencoder's
+    /// encoder.
+    ///
+    /// Parameters
+    /// ----------
+    /// strain : array_like, shape (features,) or (rows, features)
+    ///     Snapshots as a dataset stores them (:attr:`Dataset.strain`): ``ξ − ξ*`` of the active
+    ///     components at the model's points, point-major.
+    /// extrapolate : bool, optional
+    ///     Encode a snapshot whose code lies far outside the training encodings (default: the
+    ///     model's own ``extrapolate``).
+    ///
+    /// Returns
+    /// -------
+    /// numpy.ndarray, shape (latent,) or (rows, latent)
+    ///
+    /// Raises
+    /// ------
+    /// GvsromError
+    ///     On a wrong shape or a non-finite value, or a code far outside the training encodings
+    ///     (the snapshot is unlike the training data) unless ``extrapolate``.
+    #[pyo3(signature = (strain, extrapolate=None))]
+    fn encode<'py>(
+        &self,
+        py: Python<'py>,
+        strain: InDyn<'py>,
+        extrapolate: Option<bool>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let e = extrapolate.unwrap_or(self.extrapolate);
+        let arg = ("strain", &strain, self.model.features(), "snapshots");
+        self.map_rows(py, arg, self.latent, |m, x| m.encode(x, e))
+    }
+
+    /// Strain snapshots of reduced coordinates, ``x̂ = D(q)``: POD ``V q``, an autoencoder's
+    /// decoder.
+    ///
+    /// Parameters
+    /// ----------
+    /// q : array_like, shape (latent,) or (rows, latent)
+    /// extrapolate : bool, optional
+    ///     Decode a code far outside the training encodings, where a decoder has no data (default:
+    ///     the model's own ``extrapolate``).
+    ///
+    /// Returns
+    /// -------
+    /// numpy.ndarray, shape (features,) or (rows, features)
+    ///     In the layout of :attr:`Dataset.strain`.
+    #[pyo3(signature = (q, extrapolate=None))]
+    fn decode<'py>(
+        &self,
+        py: Python<'py>,
+        q: InDyn<'py>,
+        extrapolate: Option<bool>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let e = extrapolate.unwrap_or(self.extrapolate);
+        let arg = ("q", &q, self.latent, "reduced coordinates");
+        self.map_rows(py, arg, self.model.features(), |m, q| m.decode(q, e))
+    }
+
+    /// The model's reconstruction of strain snapshots, ``D(E(x))`` (Table I's ``x̂``).
+    ///
+    /// Parameters
+    /// ----------
+    /// strain : array_like, shape (features,) or (rows, features)
+    /// extrapolate : bool, optional
+    ///
+    /// Returns
+    /// -------
+    /// numpy.ndarray, the shape of ``strain``
+    #[pyo3(signature = (strain, extrapolate=None))]
+    fn reconstruct<'py>(
+        &self,
+        py: Python<'py>,
+        strain: InDyn<'py>,
+        extrapolate: Option<bool>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let e = extrapolate.unwrap_or(self.extrapolate);
+        let n = self.model.features();
+        let arg = ("strain", &strain, n, "snapshots");
+        self.map_rows(py, arg, n, |m, x| m.reconstruct(x, e))
     }
 
     fn __repr__(&self) -> String {
@@ -113,6 +248,7 @@ pub fn load_model(py: Python<'_>, path: PathBuf, extrapolate: bool) -> PyResult<
         rest: vector(py, &m.meta.rest).unbind(),
         meta: meta.unbind(),
         dir: path,
+        model: m,
     })
 }
 

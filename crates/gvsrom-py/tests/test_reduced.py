@@ -147,3 +147,50 @@ def test_quantities_do_not_depend_on_the_calls_before_them(ae_model, reduced):
             first = _flat(f(make(), q, qd))
             again = _flat(f(robot, q, qd))
             np.testing.assert_array_equal(again, first, err_msg=f"{name} after other calls")
+
+
+def test_pod_encode_decode_is_the_projection_onto_the_stored_modes(dataset, pod_model):
+    x = gvsrom.load_dataset(dataset).strain
+    v = pod_model.arrays["modes"]
+    assert pod_model.features == x.shape[1] == v.shape[0]
+    q = pod_model.encode(x)
+    np.testing.assert_allclose(q, x @ v, rtol=0, atol=1e-12 * np.abs(x).max())
+    np.testing.assert_allclose(pod_model.decode(q), q @ v.T, rtol=0, atol=1e-12 * np.abs(x).max())
+    np.testing.assert_array_equal(pod_model.reconstruct(x), pod_model.decode(q))
+    # one snapshot in, one out: the dimensions follow the input
+    assert pod_model.encode(x[3]).shape == (2,)
+    assert pod_model.decode(q[3]).shape == (x.shape[1],)
+
+
+def test_autoencoder_reconstruction_is_its_network_from_the_stored_weights(dataset, ae_model):
+    x = gvsrom.load_dataset(dataset).strain
+    a = ae_model.arrays
+
+    def mlp(prefix, y):
+        k = 0
+        while f"{prefix}.{k}.weight" in a:
+            y = y @ a[f"{prefix}.{k}.weight"].T + a[f"{prefix}.{k}.bias"]
+            if f"{prefix}.{k + 1}.weight" in a:
+                y = np.tanh(y)
+            k += 1
+        return y
+
+    mu, s = a["scaling.mean"], a["scaling.scale"]
+    z = mlp("encoder", (x - mu) / s)
+    np.testing.assert_allclose(ae_model.encode(x), z, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(ae_model.reconstruct(x), mlp("decoder", z) * s + mu,
+                               rtol=1e-12, atol=1e-12 * np.abs(x).max())
+
+
+def test_codes_far_outside_the_training_encodings_are_refused_unless_extrapolating(pod_model):
+    lo, hi = pod_model.latent_range[0]
+    far = np.array([hi + 2 * (hi - lo), 0.5 * sum(pod_model.latent_range[1])])
+    with pytest.raises(gvsrom.GvsromError, match=r"q_r\[0\].*far outside"):
+        pod_model.decode(far)
+    assert pod_model.decode(far, extrapolate=True).shape == (pod_model.features,)
+    with pytest.raises(gvsrom.GvsromError, match=r"`strain` has shape \(5,\)"):
+        pod_model.encode(np.zeros(5))
+    bad = np.zeros((2, pod_model.features))
+    bad[1, 1] = np.nan
+    with pytest.raises(gvsrom.GvsromError, match="row 1, entry 1 is NaN"):
+        pod_model.encode(bad)

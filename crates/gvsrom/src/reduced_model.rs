@@ -27,6 +27,9 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
+mod codec;
+pub use codec::{outside_range, CodecError};
+
 /// The manifest format of a model directory.
 pub const MODEL_FORMAT: &str = "reduced-model";
 /// The weights file of a model directory.

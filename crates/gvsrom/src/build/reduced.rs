@@ -3,7 +3,7 @@
 //! and the latent range. The reduction layer attaches one (its `attach`); the runs only read it.
 
 use crate::error::ScenarioError;
-use crate::reduced_model::InputRange;
+use crate::reduced_model::{outside_range, InputRange};
 use gvs::model::Model;
 use gvs::strain::StrainParam;
 use nalgebra::DVector;
@@ -145,15 +145,6 @@ impl Reduced {
             )
         })
     }
-}
-
-/// The first coordinate of `q` outside `range` widened by half its width on each side, or not
-/// finite (see [`Reduced::range_violation`]).
-pub fn outside_range(range: &[[f64; 2]], q: &[f64]) -> Option<usize> {
-    q.iter().zip(range).position(|(v, [lo, hi])| {
-        let margin = 0.5 * (hi - lo).max(1e-12);
-        !(*v >= lo - margin && *v <= hi + margin)
-    })
 }
 
 /// The tendon tensions of an input signal against the model's training ranges: `u_at(t)` gives

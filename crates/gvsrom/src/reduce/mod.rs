@@ -27,10 +27,10 @@ pub use train::{
     decoder_form, sample_weighting, train, zero_anchor_rows, Loss, TrainSummary, SAMPLE_WEIGHTINGS,
 };
 
-use crate::build::reduced::outside_range;
 use crate::build::{build, Built};
 use crate::dataset::Dataset;
 use crate::error::ScenarioError;
+use crate::reduced_model::outside_range;
 use crate::reduced_model::{DatasetRef, ModelLayout, ReducedModel};
 use crate::scenario::Scenario;
 use attach::reduced_model;

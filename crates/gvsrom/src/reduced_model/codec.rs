@@ -1,0 +1,153 @@
+//! A reduced model as a map between strain snapshots and reduced coordinates, for inspecting what
+//! a model learned outside any simulation: `q = E(x)`, `x̂ = D(q)` and `x̂ = D(E(x))` on rows of
+//! snapshots in a dataset's layout (`ξ − ξ*` of the active components, point-major, the
+//! [`ModelLayout`](super::ModelLayout)).
+//!
+//! - POD: `E(x) = Vᵀ x`, `D(q) = V q` (orthonormal modes `V`, L × r).
+//! - Autoencoder: its encoder and decoder, with the data scaling (`D(z) = s ⊙ dec(z) + μ`, times
+//!   `z₁` for the scaled decoder form).
+//!
+//! A code far outside the training encodings (by more than half the range's width in some
+//! coordinate, as a reduced solve is refused) is refused unless `extrapolate` is set: there a
+//! decoder's tanh layers saturate and its answer is not to be trusted, and an encoding that lands
+//! there says the snapshot is unlike the training data.
+
+use super::{ModelWeights, ReducedModel};
+use thiserror::Error;
+
+/// Why an encoding or a decoding was refused. Each message names the argument, the offending
+/// value and what is accepted.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum CodecError {
+    #[error("`{name}` is empty: give at least one row ({what})")]
+    Empty {
+        name: &'static str,
+        what: &'static str,
+    },
+    #[error("`{name}` holds {len} values, not a whole number of rows of {row} ({what})")]
+    Shape {
+        name: &'static str,
+        len: usize,
+        row: usize,
+        what: &'static str,
+    },
+    #[error("`{name}` row {row}, entry {index} is {value}: the values must be finite")]
+    NotFinite {
+        name: &'static str,
+        row: usize,
+        index: usize,
+        value: f64,
+    },
+    #[error("{0}")]
+    OutsideRange(String),
+    #[error("the autoencoder refused the data: {0}")]
+    Network(String),
+}
+
+/// The first coordinate of `q` outside `range` widened by half its width on each side (or not
+/// finite); `None` if every coordinate lies inside (always, for an empty range: a model written
+/// before ranges were recorded).
+pub fn outside_range(range: &[[f64; 2]], q: &[f64]) -> Option<usize> {
+    q.iter().zip(range).position(|(v, [lo, hi])| {
+        let margin = 0.5 * (hi - lo).max(1e-12);
+        !(*v >= lo - margin && *v <= hi + margin)
+    })
+}
+
+/// Rows of `data` with `row` values each, checked to be whole and finite.
+fn check_rows(
+    name: &'static str,
+    data: &[f64],
+    row: usize,
+    what: &'static str,
+) -> Result<usize, CodecError> {
+    if data.is_empty() {
+        return Err(CodecError::Empty { name, what });
+    }
+    if row == 0 || !data.len().is_multiple_of(row) {
+        return Err(CodecError::Shape {
+            name,
+            len: data.len(),
+            row,
+            what,
+        });
+    }
+    if let Some(i) = data.iter().position(|v| !v.is_finite()) {
+        return Err(CodecError::NotFinite {
+            name,
+            row: i / row,
+            index: i % row,
+            value: data[i],
+        });
+    }
+    Ok(data.len() / row)
+}
+
+impl ReducedModel {
+    /// Values of one snapshot: points × active components ([`super::ModelLayout::features`]).
+    pub fn features(&self) -> usize {
+        self.meta.layout.features()
+    }
+
+    /// `q = E(x)` for the row-major snapshots `x` (`rows × features` → `rows × r`). Unless
+    /// `extrapolate`, refuses a snapshot whose code lies far outside the training encodings.
+    pub fn encode(&self, x: &[f64], extrapolate: bool) -> Result<Vec<f64>, CodecError> {
+        let (n, r) = (self.features(), self.meta.latent);
+        let rows = check_rows("strain", x, n, "snapshots of the model's layout")?;
+        let q = match &self.weights {
+            ModelWeights::Pod { modes, .. } => x
+                .chunks_exact(n)
+                .flat_map(|row| {
+                    (0..r).map(move |k| modes.column(k).iter().zip(row).map(|(v, x)| v * x).sum())
+                })
+                .collect(),
+            ModelWeights::Autoencoder(ae) => ae
+                .encode(x)
+                .map_err(|e| CodecError::Network(e.to_string()))?,
+        };
+        if !extrapolate {
+            self.check_codes(&q, rows, "the snapshot is unlike the training data")?;
+        }
+        Ok(q)
+    }
+
+    /// `x̂ = D(q)` for the row-major codes `q` (`rows × r` → `rows × features`). Unless
+    /// `extrapolate`, refuses a code far outside the training encodings.
+    pub fn decode(&self, q: &[f64], extrapolate: bool) -> Result<Vec<f64>, CodecError> {
+        let (n, r) = (self.features(), self.meta.latent);
+        let rows = check_rows("q", q, r, "reduced coordinates of the model")?;
+        if !extrapolate {
+            self.check_codes(q, rows, "the decoder has no data there")?;
+        }
+        match &self.weights {
+            ModelWeights::Pod { modes, .. } => Ok(q
+                .chunks_exact(r)
+                .flat_map(|z| {
+                    (0..n).map(move |i| (0..r).map(|k| modes[(i, k)] * z[k]).sum::<f64>())
+                })
+                .collect()),
+            ModelWeights::Autoencoder(ae) => {
+                ae.decode(q).map_err(|e| CodecError::Network(e.to_string()))
+            }
+        }
+    }
+
+    /// `x̂ = D(E(x))`: the model's reconstruction of each snapshot (Table I's `x̂`).
+    pub fn reconstruct(&self, x: &[f64], extrapolate: bool) -> Result<Vec<f64>, CodecError> {
+        self.decode(&self.encode(x, extrapolate)?, extrapolate)
+    }
+
+    fn check_codes(&self, q: &[f64], rows: usize, why: &str) -> Result<(), CodecError> {
+        let (r, range) = (self.meta.latent, &self.meta.latent_range);
+        for (row, z) in q.chunks_exact(r).enumerate().take(rows) {
+            if let Some(d) = outside_range(range, z) {
+                let [lo, hi] = range[d];
+                return Err(CodecError::OutsideRange(format!(
+                    "row {row}: q_r[{d}] = {} lies far outside the range of the training encodings [{lo:.6}, {hi:.6}] ({why}); accepted: within half the range's width of it, or extrapolate = true",
+                    z[d]
+                )));
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,188 @@
+//! A reduced model as a map between snapshots and codes (`ReducedModel::encode`, `decode`,
+//! `reconstruct`), checked against what must hold independently of the code under test:
+//!
+//! - POD: the reconstruction is the orthogonal projection onto the modes, so `‖x̂‖² + ‖x − x̂‖² =
+//!   ‖x‖²` and the residual is orthogonal to every mode (read from the stored `modes` array);
+//!   `E(D(q)) = q` (orthonormal modes).
+//! - Autoencoder: `D(E(x))` equals a forward pass written here from the stored weights (tanh hidden
+//!   layers, linear output, `x = s ⊙ y + μ`), and its RMS error over the dataset is the training's.
+//! - Codes far outside the training encodings and malformed input are refused, naming the value.
+
+mod common;
+
+use common::{run_ok, s, scratch, sweep_dataset};
+use gvsrom::reduced_model::{CodecError, ReducedModel};
+use std::path::PathBuf;
+use std::sync::OnceLock;
+
+fn data() -> &'static PathBuf {
+    static D: OnceLock<PathBuf> = OnceLock::new();
+    D.get_or_init(|| sweep_dataset("codec-data", "-6:3", 40))
+}
+
+fn strain(dir: &std::path::Path) -> (usize, Vec<f64>) {
+    let (shape, v) = common::npy(&dir.join("strain.npy"));
+    (shape[1], v)
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+#[test]
+fn pod_reconstruction_is_the_orthogonal_projection_onto_its_modes() {
+    let model = scratch("codec-pod");
+    run_ok(&["pod", s(data()), "--modes", "2", "--out", s(&model)]);
+    let m = ReducedModel::load(&model).unwrap();
+    let (n, x) = strain(data());
+    assert_eq!(m.features(), n);
+    let arrays = m.arrays();
+    let (shape, modes) = &arrays["modes"]; // row-major n × 2
+    assert_eq!(shape, &vec![n, 2]);
+    let mode = |k: usize| -> Vec<f64> { (0..n).map(|i| modes[i * 2 + k]).collect() };
+    let q = m.encode(&x, false).unwrap();
+    let rec = m.reconstruct(&x, false).unwrap();
+    for (row, (xr, rr)) in x.chunks_exact(n).zip(rec.chunks_exact(n)).enumerate() {
+        let resid: Vec<f64> = xr.iter().zip(rr).map(|(a, b)| a - b).collect();
+        let scale = dot(xr, xr).max(1e-300);
+        let pythagoras = dot(rr, rr) + dot(&resid, &resid) - dot(xr, xr);
+        assert!(
+            pythagoras.abs() <= 1e-10 * scale,
+            "row {row}: {pythagoras:e}"
+        );
+        for k in 0..2 {
+            let along = dot(&resid, &mode(k));
+            assert!(
+                along.abs() <= 1e-10 * scale.sqrt(),
+                "row {row} mode {k}: {along:e}"
+            );
+            assert!((q[row * 2 + k] - dot(xr, &mode(k))).abs() <= 1e-12 * scale.sqrt());
+        }
+    }
+    // E(D(q)) = q for codes inside the range
+    let back = m.encode(&m.decode(&q, false).unwrap(), false).unwrap();
+    for (a, b) in q.iter().zip(&back) {
+        assert!((a - b).abs() <= 1e-10 * (1.0 + a.abs()), "{a} vs {b}");
+    }
+}
+
+/// `D(E(x))` of a model whose stored weights are read back here and evaluated by hand.
+fn by_hand(m: &ReducedModel, x: &[f64]) -> Vec<f64> {
+    let a = m.arrays();
+    let layers = |prefix: &str| -> Vec<(Vec<usize>, Vec<f64>, Vec<f64>)> {
+        (0..)
+            .map_while(|k| {
+                let (shape, w) = a.get(&format!("{prefix}.{k}.weight"))?;
+                let (_, b) = &a[&format!("{prefix}.{k}.bias")];
+                Some((shape.clone(), w.clone(), b.clone()))
+            })
+            .collect()
+    };
+    let forward = |layers: &[(Vec<usize>, Vec<f64>, Vec<f64>)], mut v: Vec<f64>| {
+        for (l, (shape, w, b)) in layers.iter().enumerate() {
+            let (rows, cols) = (shape[0], shape[1]);
+            v = (0..rows)
+                .map(|i| {
+                    let z = dot(&w[i * cols..(i + 1) * cols], &v) + b[i];
+                    if l + 1 < layers.len() {
+                        z.tanh()
+                    } else {
+                        z
+                    }
+                })
+                .collect();
+        }
+        v
+    };
+    let (mean, scale) = (&a["scaling.mean"].1, &a["scaling.scale"].1);
+    let y: Vec<f64> = x
+        .iter()
+        .zip(mean.iter().zip(scale))
+        .map(|(x, (mu, s))| (x - mu) / s)
+        .collect();
+    let z = forward(&layers("encoder"), y);
+    forward(&layers("decoder"), z)
+        .iter()
+        .zip(mean.iter().zip(scale))
+        .map(|(y, (mu, s))| s * y + mu)
+        .collect()
+}
+
+#[test]
+fn autoencoder_reconstruction_is_its_network_evaluated_from_the_stored_weights() {
+    let model = scratch("codec-ae");
+    let out = run_ok(&[
+        "train",
+        s(data()),
+        "--latent",
+        "1",
+        "--hidden-layers",
+        "3",
+        "--epochs",
+        "60",
+        "--lbfgs-iterations",
+        "20",
+        "--validation-fraction",
+        "0",
+        "--out",
+        s(&model),
+    ]);
+    let m = ReducedModel::load(&model).unwrap();
+    let (n, x) = strain(data());
+    let rec = m.reconstruct(&x, false).unwrap();
+    let mut sq = 0.0;
+    for (row, (xr, rr)) in x.chunks_exact(n).zip(rec.chunks_exact(n)).enumerate() {
+        let hand = by_hand(&m, xr);
+        for (i, (a, b)) in rr.iter().zip(&hand).enumerate() {
+            assert!(
+                (a - b).abs() <= 1e-12 * (1.0 + b.abs()),
+                "row {row} [{i}]: {a} vs {b}"
+            );
+        }
+        sq += xr
+            .iter()
+            .zip(rr)
+            .map(|(a, b)| (a - b) * (a - b))
+            .sum::<f64>();
+    }
+    // the training summary's RMSE (physical units, every row trains here)
+    let rmse = (sq / x.len() as f64).sqrt();
+    let line = out.lines().find(|l| l.starts_with("RMSE")).unwrap();
+    let reported: f64 = line.split_whitespace().nth(1).unwrap().parse().unwrap();
+    assert!(
+        (rmse - reported).abs() <= 1e-3 * reported,
+        "{rmse} against the training's {reported} ({line})"
+    );
+}
+
+#[test]
+fn codes_far_outside_the_training_encodings_and_malformed_input_are_refused() {
+    let model = scratch("codec-range");
+    run_ok(&["pod", s(data()), "--modes", "1", "--out", s(&model)]);
+    let m = ReducedModel::load(&model).unwrap();
+    let [lo, hi] = m.meta.latent_range[0];
+    let far = hi + 2.0 * (hi - lo);
+    let e = m.decode(&[far], false).unwrap_err();
+    assert!(matches!(e, CodecError::OutsideRange(_)), "{e}");
+    let msg = e.to_string();
+    assert!(
+        msg.contains("q_r[0]") && msg.contains("extrapolate"),
+        "{msg}"
+    );
+    assert!(m.decode(&[far], true).is_ok(), "extrapolate decodes anyway");
+    assert!(m.decode(&[0.5 * (lo + hi)], false).is_ok());
+    // a snapshot 100 times the data's largest encodes far outside
+    let (n, x) = strain(data());
+    let big: Vec<f64> = x[..n].iter().map(|v| 100.0 * v).collect();
+    let e = m.encode(&big, false).unwrap_err().to_string();
+    assert!(e.contains("unlike the training data"), "{e}");
+    // a ragged buffer and a NaN are named
+    let e = m.encode(&x[..n + 1], false).unwrap_err().to_string();
+    assert!(e.contains("`strain`") && e.contains(&n.to_string()), "{e}");
+    let mut nan = x[..n].to_vec();
+    nan[3] = f64::NAN;
+    let e = m.encode(&nan, false).unwrap_err().to_string();
+    assert!(e.contains("entry 3") && e.contains("NaN"), "{e}");
+    let e = m.decode(&[], false).unwrap_err().to_string();
+    assert!(e.contains("`q`"), "{e}");
+}
