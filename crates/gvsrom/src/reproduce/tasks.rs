@@ -4,7 +4,7 @@
 
 use super::step::{Interrupted, Run, Step};
 use crate::dataset::{Dataset, DatasetRequest, Layout};
-use crate::reduced_model::{ModelWeights, ReducedModel};
+use crate::reduced_model::ReducedModel;
 use crate::{build, presets, reduce, scenario, statics, Built};
 use serde::{Deserialize, Serialize};
 use std::ops::ControlFlow;
@@ -279,7 +279,8 @@ pub fn reconstruction_rmse(dataset: &Path, model: &ReducedModel) -> anyhow::Resu
     let (mut sum, mut count) = (0.0, 0usize);
     for k in ds.ok_rows() {
         let x = ds.strain_row(k);
-        let rec = reconstruct(model, x)?;
+        // the data the model was made from: inside its encodings by construction
+        let rec = model.reconstruct(x, true)?;
         sum += x
             .iter()
             .zip(&rec)
@@ -289,18 +290,6 @@ pub fn reconstruction_rmse(dataset: &Path, model: &ReducedModel) -> anyhow::Resu
     }
     anyhow::ensure!(count > 0, "`{}` has no solved samples", dataset.display());
     Ok((sum / count as f64).sqrt())
-}
-
-/// A model's reconstruction of snapshot `x`: an autoencoder's decoding of its encoding, POD's
-/// projection `V Vᵀ x`.
-fn reconstruct(model: &ReducedModel, x: &[f64]) -> anyhow::Result<Vec<f64>> {
-    Ok(match &model.weights {
-        ModelWeights::Autoencoder(ae) => ae.reconstruct(x)?,
-        ModelWeights::Pod { modes, .. } => {
-            let v = nalgebra::DVector::from_column_slice(x);
-            (modes * (modes.transpose() * v)).iter().copied().collect()
-        }
-    })
 }
 
 /// For every solved sample of `ds`: its value of the input `parameter` and each of `models`'
@@ -330,7 +319,7 @@ pub fn relative_errors(
         let errors = models
             .iter()
             .map(|m| {
-                let rec = reconstruct(m, x)?;
+                let rec = m.reconstruct(x, true)?;
                 let mae = x.iter().zip(&rec).map(|(a, b)| (a - b).abs()).sum::<f64>();
                 Ok(100.0 * mae / x.len() as f64 / peak)
             })
