@@ -186,3 +186,66 @@ fn codes_far_outside_the_training_encodings_and_malformed_input_are_refused() {
     let e = m.decode(&[], false).unwrap_err().to_string();
     assert!(e.contains("`q`"), "{e}");
 }
+
+/// The value after `label` on the line of `gvsrom reconstruct`'s output that starts with it.
+fn printed(out: &str, label: &str) -> f64 {
+    let line = out.lines().find(|l| l.starts_with(label)).unwrap();
+    line.split_whitespace().nth(1).unwrap().parse().unwrap()
+}
+
+#[test]
+fn reconstruct_cli_gives_pods_discarded_singular_values_and_counts_extrapolated_snapshots() {
+    let model = scratch("codec-cli-pod");
+    run_ok(&["pod", s(data()), "--modes", "2", "--out", s(&model)]);
+    let out = run_ok(&["reconstruct", s(&model), s(data())]);
+    // the SVD: ‖X − X̂‖²_F = Σ_{k>K} σ_k², ‖X‖²_F = Σ σ_k² (the stored singular values)
+    let m = ReducedModel::load(&model).unwrap();
+    let sigma = &m.arrays()["singular_values"].1;
+    let (n, x) = strain(data());
+    let tail: f64 = sigma[2..].iter().map(|v| v * v).sum();
+    let all: f64 = sigma.iter().map(|v| v * v).sum();
+    let rmse = printed(&out, "RMSE");
+    let expected = (tail / x.len() as f64).sqrt();
+    assert!(
+        (rmse - expected).abs() <= 1e-4 * expected,
+        "{rmse} vs {expected}\n{out}"
+    );
+    let relative = printed(&out, "relative") / 100.0;
+    let expected = (tail / all).sqrt();
+    assert!(
+        (relative - expected).abs() <= 1e-4 * expected,
+        "{relative} vs {expected}\n{out}"
+    );
+    assert!(
+        out.contains(&format!("({} solved snapshots × {n} values)", x.len() / n)),
+        "{out}"
+    );
+    assert!(out.contains("outside    0 of"), "{out}");
+    // tensions beyond the training's [-6, 3] N encode outside its codes
+    let wide = sweep_dataset("codec-cli-wide", "-30:-20", 5);
+    let out = run_ok(&["reconstruct", s(&model), s(&wide)]);
+    assert!(
+        out.contains("outside    5 of 5") && out.contains("extrapolates"),
+        "{out}"
+    );
+    // another layout is refused, naming the dataset
+    let other = scratch("codec-cli-other");
+    run_ok(&[
+        "dataset",
+        "soft-beam",
+        "--sweep",
+        "loads.distributed.0.magnitude=1:2",
+        "--samples",
+        "2",
+        "--out",
+        s(&other),
+    ]);
+    let e = common::expect_error(
+        &["reconstruct", s(&model), s(&other)],
+        &["DATASET", "layout"],
+    );
+    assert!(
+        e.contains("soft-beam") && e.contains("single-tendon"),
+        "{e}"
+    );
+}

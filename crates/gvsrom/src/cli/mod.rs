@@ -68,6 +68,10 @@ pub enum Command {
     /// Train a tanh autoencoder on a dataset's strain snapshots; its decoder becomes a nonlinear
     /// reduced model (`--model` on `statics` and `simulate`).
     Train(TrainArgs),
+    /// How closely a reduced model reconstructs a dataset's snapshots, `D(E(x))`: Table I's RMSE,
+    /// the relative error and the worst snapshot, e.g. on data the model was not trained on.
+    /// Prints; writes nothing.
+    Reconstruct(ReconstructArgs),
     /// Compare a trajectory with a reference one (e.g. `simulate --model` against the full model)
     /// of the same scenario, input and sample times: tip and strain errors over the common samples,
     /// and the speed ratio (simulated time per wall time).
@@ -135,6 +139,7 @@ pub fn run(cli: Cli, out: &mut impl Write) -> Result<()> {
         Command::Dataset(args) => dataset_cmd(&args, out),
         Command::Pod(args) => pod_cmd(&args, out),
         Command::Train(args) => train_cmd(&args, out),
+        Command::Reconstruct(args) => reconstruct_cmd(&args, out),
         Command::Compare(args) => compare_cmd(&args, out),
         Command::Reproduce(args) => reproduce_cmd(&args, out),
         Command::Check(args) => check_cmd(&args, out),

@@ -1,4 +1,4 @@
-//! `gvsrom pod` and `gvsrom train`.
+//! `gvsrom pod`, `gvsrom train` and `gvsrom reconstruct`.
 
 use super::*;
 
@@ -15,6 +15,14 @@ pub struct PodArgs {
     /// Replace MODEL if it is an earlier gvsrom output.
     #[arg(long)]
     pub force: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct ReconstructArgs {
+    /// A reduced model directory (from `gvsrom pod` or `gvsrom train`).
+    pub model: PathBuf,
+    /// A dataset directory of the model's layout (from `gvsrom dataset`).
+    pub dataset: PathBuf,
 }
 
 #[derive(Debug, Args)]
@@ -223,5 +231,55 @@ pub(super) fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
         }
         .into());
     }
+    Ok(())
+}
+
+pub(super) fn reconstruct_cmd(args: &ReconstructArgs, out: &mut impl Write) -> Result<()> {
+    let model = gvsrom::reduced_model::ReducedModel::load(&args.model)?;
+    let ds = gvsrom::dataset::Dataset::load(&args.dataset)?;
+    let r = reduce::reconstruction(&model, &ds)?;
+    writeln!(
+        out,
+        "model      {} ({}, r = {})",
+        args.model.display(),
+        model.meta.kind,
+        model.meta.latent
+    )?;
+    writeln!(
+        out,
+        "dataset    {} ({} solved snapshots × {} values)",
+        args.dataset.display(),
+        r.rows,
+        model.features()
+    )?;
+    writeln!(
+        out,
+        "RMSE       {:.4e} (every entry of every snapshot, Table I's measure)",
+        r.rmse
+    )?;
+    writeln!(
+        out,
+        "relative   {:.4} % (‖X̂ − X‖ / ‖X‖)",
+        100.0 * r.relative
+    )?;
+    if let Some((row, e, norm)) = r.worst {
+        writeln!(
+            out,
+            "worst      row {row}: {:.4} % of its norm ‖x‖ = {norm:.4e} (the largest ‖x‖ is {:.4e})",
+            100.0 * e,
+            r.largest_norm
+        )?;
+    }
+    writeln!(
+        out,
+        "outside    {} of {} snapshots encode far outside the training encodings{}",
+        r.outside,
+        r.rows,
+        if r.outside > 0 {
+            " (the model extrapolates there)"
+        } else {
+            ""
+        }
+    )?;
     Ok(())
 }

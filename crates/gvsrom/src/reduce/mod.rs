@@ -15,6 +15,7 @@
 
 mod anchors;
 mod attach;
+mod evaluate;
 mod pod;
 mod train;
 pub mod validity;
@@ -22,6 +23,7 @@ pub mod validity;
 pub use crate::build::Reduced;
 pub use anchors::{anchor_guess, solve_anchors, AnchorInput, AnchorProblem, InitialGuess};
 pub use attach::{attach, attach_resolved, attach_source, parameterization, AttachOptions};
+pub use evaluate::{reconstruction, Reconstruction};
 pub use pod::{pod, PodSummary};
 pub use train::{
     decoder_form, sample_weighting, train, zero_anchor_rows, Loss, TrainSummary, SAMPLE_WEIGHTINGS,

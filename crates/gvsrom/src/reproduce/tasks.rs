@@ -273,23 +273,9 @@ pub fn train(
 
 /// Table I's measure: `sqrt(mean (x̂ − x)²)` over every entry of every solved snapshot of the
 /// dataset (training and validation rows alike), x̂ the model's reconstruction (AE: `D(E(x))`; POD:
-/// `V Vᵀ x`), in the snapshots' units (1/m for curvatures).
+/// `V Vᵀ x`), in the snapshots' units (1/m for curvatures): [`reduce::reconstruction`].
 pub fn reconstruction_rmse(dataset: &Path, model: &ReducedModel) -> anyhow::Result<f64> {
-    let ds = Dataset::load(dataset)?;
-    let (mut sum, mut count) = (0.0, 0usize);
-    for k in ds.ok_rows() {
-        let x = ds.strain_row(k);
-        // the data the model was made from: inside its encodings by construction
-        let rec = model.reconstruct(x, true)?;
-        sum += x
-            .iter()
-            .zip(&rec)
-            .map(|(a, b)| (a - b) * (a - b))
-            .sum::<f64>();
-        count += x.len();
-    }
-    anyhow::ensure!(count > 0, "`{}` has no solved samples", dataset.display());
-    Ok((sum / count as f64).sqrt())
+    Ok(reduce::reconstruction(model, &Dataset::load(dataset)?)?.rmse)
 }
 
 /// For every solved sample of `ds`: its value of the input `parameter` and each of `models`'
