@@ -32,8 +32,7 @@ pub use train::{
 use crate::build::{build, Built};
 use crate::dataset::Dataset;
 use crate::error::ScenarioError;
-use crate::reduced_model::outside_range;
-use crate::reduced_model::{DatasetRef, ModelLayout, ReducedModel};
+use crate::reduced_model::{outside_range, DatasetRef, ModelLayout, ReducedModel};
 use crate::scenario::Scenario;
 use attach::reduced_model;
 use nalgebra::DMatrix;

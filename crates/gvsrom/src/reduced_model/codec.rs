@@ -54,13 +54,13 @@ pub fn outside_range(range: &[[f64; 2]], q: &[f64]) -> Option<usize> {
     })
 }
 
-/// Rows of `data` with `row` values each, checked to be whole and finite.
+/// Checks that `data` is a whole, non-empty number of rows of `row` values, all finite.
 fn check_rows(
     name: &'static str,
     data: &[f64],
     row: usize,
     what: &'static str,
-) -> Result<usize, CodecError> {
+) -> Result<(), CodecError> {
     if data.is_empty() {
         return Err(CodecError::Empty { name, what });
     }
@@ -80,7 +80,7 @@ fn check_rows(
             value: data[i],
         });
     }
-    Ok(data.len() / row)
+    Ok(())
 }
 
 impl ReducedModel {
@@ -93,7 +93,7 @@ impl ReducedModel {
     /// `extrapolate`, refuses a snapshot whose code lies far outside the training encodings.
     pub fn encode(&self, x: &[f64], extrapolate: bool) -> Result<Vec<f64>, CodecError> {
         let (n, r) = (self.features(), self.meta.latent);
-        let rows = check_rows("strain", x, n, "snapshots of the model's layout")?;
+        check_rows("strain", x, n, "snapshots of the model's layout")?;
         let q = match &self.weights {
             ModelWeights::Pod { modes, .. } => x
                 .chunks_exact(n)
@@ -106,7 +106,7 @@ impl ReducedModel {
                 .map_err(|e| CodecError::Network(e.to_string()))?,
         };
         if !extrapolate {
-            self.check_codes(&q, rows, "the snapshot is unlike the training data")?;
+            self.check_codes(&q, "the snapshot is unlike the training data")?;
         }
         Ok(q)
     }
@@ -115,9 +115,9 @@ impl ReducedModel {
     /// `extrapolate`, refuses a code far outside the training encodings.
     pub fn decode(&self, q: &[f64], extrapolate: bool) -> Result<Vec<f64>, CodecError> {
         let (n, r) = (self.features(), self.meta.latent);
-        let rows = check_rows("q", q, r, "reduced coordinates of the model")?;
+        check_rows("q", q, r, "reduced coordinates of the model")?;
         if !extrapolate {
-            self.check_codes(q, rows, "the decoder has no data there")?;
+            self.check_codes(q, "the decoder has no data there")?;
         }
         match &self.weights {
             ModelWeights::Pod { modes, .. } => Ok(q
@@ -137,9 +137,10 @@ impl ReducedModel {
         self.decode(&self.encode(x, extrapolate)?, extrapolate)
     }
 
-    fn check_codes(&self, q: &[f64], rows: usize, why: &str) -> Result<(), CodecError> {
+    /// Refuses the first row of codes `q` far outside the training encodings, saying `why`.
+    fn check_codes(&self, q: &[f64], why: &str) -> Result<(), CodecError> {
         let (r, range) = (self.meta.latent, &self.meta.latent_range);
-        for (row, z) in q.chunks_exact(r).enumerate().take(rows) {
+        for (row, z) in q.chunks_exact(r).enumerate() {
             if let Some(d) = outside_range(range, z) {
                 let [lo, hi] = range[d];
                 return Err(CodecError::OutsideRange(format!(
