@@ -65,6 +65,13 @@ impl ModelLayout {
     }
 }
 
+/// Whether two lists of point abscissae [m] are the same points: equal lengths and every pair
+/// within 1e-12 of the larger of 1 m and the largest abscissa (rounding of the same quadrature).
+pub fn same_abscissae(a: &[f64], b: &[f64]) -> bool {
+    let scale = a.iter().chain(b).fold(1.0f64, |m, x| m.max(x.abs()));
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() <= 1e-12 * scale)
+}
+
 /// Where the training data came from.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DatasetRef {

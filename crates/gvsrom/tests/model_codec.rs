@@ -249,3 +249,13 @@ fn reconstruct_cli_gives_pods_discarded_singular_values_and_counts_extrapolated_
         "{e}"
     );
 }
+
+#[test]
+fn abscissae_match_to_rounding_only() {
+    use gvsrom::reduced_model::same_abscissae;
+    let a = [0.0, 0.0141, 0.3, 0.6];
+    assert!(same_abscissae(&a, &a));
+    assert!(same_abscissae(&a, &[0.0, 0.0141 + 1e-16, 0.3, 0.6 - 1e-16]));
+    assert!(!same_abscissae(&a, &[0.0, 0.0141 + 1e-9, 0.3, 0.6]));
+    assert!(!same_abscissae(&a, &a[..3]));
+}

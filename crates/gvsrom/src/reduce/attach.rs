@@ -6,7 +6,7 @@ use crate::build::reduced::GuessAt;
 use crate::build::{Built, Reduced, Resolved};
 use crate::dataset::Layout;
 use crate::error::ScenarioError;
-use crate::reduced_model::{ModelWeights, ReducedModel};
+use crate::reduced_model::{same_abscissae, ModelWeights, ReducedModel};
 use gvs::model::Model;
 use gvs::strain::{LinearBasis, StrainParam};
 use nalgebra::DVector;
@@ -32,13 +32,7 @@ pub(super) fn check_layout(
     let l = Layout::of(built);
     let ml = &model.meta.layout;
     let names = l.component_names();
-    let length = built.model.disc.length();
-    let same_points = ml.strain_x.len() == l.strain_x.len()
-        && ml
-            .strain_x
-            .iter()
-            .zip(&l.strain_x)
-            .all(|(a, b)| (a - b).abs() <= 1e-12 * length.max(1.0));
+    let same_points = same_abscissae(&ml.strain_x, &l.strain_x);
     if !same_points || ml.active != names || ml.hom_dof != built.model.n_dof() {
         return Err(invalid(
             "--model",

@@ -5,7 +5,7 @@
 use super::invalid;
 use crate::dataset::Dataset;
 use crate::error::ScenarioError;
-use crate::reduced_model::{outside_range, ReducedModel};
+use crate::reduced_model::{outside_range, same_abscissae, ReducedModel};
 
 /// The reconstruction errors of a model on a dataset's solved snapshots.
 #[derive(Debug, Clone, PartialEq)]
@@ -31,12 +31,7 @@ pub struct Reconstruction {
 /// model's layout (points and active components); otherwise an error names `DATASET`.
 pub fn reconstruction(model: &ReducedModel, ds: &Dataset) -> Result<Reconstruction, ScenarioError> {
     let layout = &model.meta.layout;
-    let same_points = layout.strain_x.len() == ds.meta.strain_x.len()
-        && layout
-            .strain_x
-            .iter()
-            .zip(&ds.meta.strain_x)
-            .all(|(a, b)| (a - b).abs() <= 1e-12 * (1.0 + a.abs()));
+    let same_points = same_abscissae(&layout.strain_x, &ds.meta.strain_x);
     if !same_points || layout.active != ds.meta.components {
         return Err(invalid(
             "DATASET",

@@ -32,7 +32,7 @@ pub use train::{
 use crate::build::{build, Built};
 use crate::dataset::Dataset;
 use crate::error::ScenarioError;
-use crate::reduced_model::{outside_range, DatasetRef, ModelLayout, ReducedModel};
+use crate::reduced_model::{outside_range, same_abscissae, DatasetRef, ModelLayout, ReducedModel};
 use crate::scenario::Scenario;
 use attach::reduced_model;
 use nalgebra::DMatrix;
@@ -51,12 +51,7 @@ pub fn dataset_scenario(ds: &Dataset) -> Result<Built, ScenarioError> {
     let built = build(&s)?;
     let l = crate::dataset::Layout::of(&built);
     let m = &ds.meta;
-    let length = built.model.disc.length().max(1.0);
-    let same_x = l.strain_x.len() == m.strain_x.len()
-        && l.strain_x
-            .iter()
-            .zip(&m.strain_x)
-            .all(|(a, b)| (a - b).abs() <= 1e-12 * length);
+    let same_x = same_abscissae(&l.strain_x, &m.strain_x);
     if !same_x || l.component_names() != m.components || l.n_dof != m.n_dof {
         return Err(invalid(
             "DATASET",
