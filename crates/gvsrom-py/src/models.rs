@@ -256,8 +256,9 @@ pub fn load_model(py: Python<'_>, path: PathBuf, extrapolate: bool) -> PyResult<
 ///
 /// Parameters
 /// ----------
-/// dataset : str or os.PathLike
-///     A dataset directory (``gvsrom dataset``).
+/// dataset : str or os.PathLike, or a sequence of them
+///     A dataset directory (``gvsrom dataset``), or several of one scenario (the same points,
+///     components, sampled inputs and physics) whose snapshots are combined in order.
 /// modes : int
 ///     POD modes kept (reduced coordinates).
 /// out : str or os.PathLike
@@ -273,11 +274,12 @@ pub fn load_model(py: Python<'_>, path: PathBuf, extrapolate: bool) -> PyResult<
 #[pyo3(signature = (dataset, modes, out, force=false))]
 pub fn pod(
     py: Python<'_>,
-    dataset: PathBuf,
+    dataset: Datasets,
     modes: usize,
     out: PathBuf,
     force: bool,
 ) -> PyResult<Model> {
+    let dataset = dataset.paths();
     let summary = py
         .detach(|| gvsrom::reduce::pod(&dataset, modes, &out, force))
         .map_err(errors::any)?;
@@ -285,6 +287,23 @@ pub fn pod(
         crate::robot::warn(py, w)?;
     }
     load_model(py, summary.path, false)
+}
+
+/// The ``dataset`` argument of ``pod`` and ``train``: one dataset directory, or a sequence of
+/// directories of one scenario whose snapshots are combined in order.
+#[derive(FromPyObject)]
+pub enum Datasets {
+    One(PathBuf),
+    Many(Vec<PathBuf>),
+}
+
+impl Datasets {
+    fn paths(self) -> Vec<PathBuf> {
+        match self {
+            Datasets::One(p) => vec![p],
+            Datasets::Many(v) => v,
+        }
+    }
 }
 
 /// How often training looks for Ctrl-C.
@@ -296,8 +315,9 @@ const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 ///
 /// Parameters
 /// ----------
-/// dataset : str or os.PathLike
-///     A dataset directory (``gvsrom dataset``).
+/// dataset : str or os.PathLike, or a sequence of them
+///     A dataset directory (``gvsrom dataset``), or several of one scenario (the same points,
+///     components, sampled inputs and physics) whose snapshots are combined in order.
 /// out : str or os.PathLike
 ///     The new model directory.
 /// latent : int
@@ -330,7 +350,7 @@ const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 #[allow(clippy::too_many_arguments)]
 pub fn train(
     py: Python<'_>,
-    dataset: PathBuf,
+    dataset: Datasets,
     out: PathBuf,
     latent: usize,
     hidden_layers: usize,
@@ -376,6 +396,7 @@ pub fn train(
         decoder: gvsrom::reduce::decoder_form(decoder).map_err(errors::scenario)?,
         ..TrainOptions::default()
     };
+    let dataset = dataset.paths();
     let mut interrupt: Option<PyErr> = None;
     let summary = py.detach(|| {
         let mut last_poll = std::time::Instant::now();

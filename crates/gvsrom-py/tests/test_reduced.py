@@ -194,3 +194,34 @@ def test_codes_far_outside_the_training_encodings_are_refused_unless_extrapolati
     bad[1, 1] = np.nan
     with pytest.raises(gvsrom.GvsromError, match="row 1, entry 1 is NaN"):
         pod_model.encode(bad)
+
+
+def test_several_datasets_make_one_model_of_their_stacked_snapshots(gvsrom_bin, dataset, tmp_path):
+    # a second dataset of the same scenario: POD of both is the POD of the stacked snapshots, whose
+    # squared singular values are the eigenvalues of X_Aᵀ X_A + X_Bᵀ X_B (numpy's eigvalsh)
+    other = tmp_path / "random"
+    p = run_cli(gvsrom_bin, "dataset", "single-tendon", "--random", "tendons.0.tension=-2:2.5",
+                "--samples", "5", "--seed", "2", "--out", str(other))
+    assert p.returncode == 0, p.stderr
+    a, b = gvsrom.load_dataset(dataset), gvsrom.load_dataset(other)
+    xa, xb = a.strain.reshape(len(a.strain), -1), b.strain.reshape(len(b.strain), -1)
+    model = gvsrom.pod([dataset, str(other)], 3, tmp_path / "pod")
+    eig = np.sort(np.linalg.eigvalsh(xa.T @ xa + xb.T @ xb))[::-1][:3]
+    sigma = model.arrays["singular_values"][:3]
+    np.testing.assert_allclose(sigma**2, eig, rtol=0, atol=1e-9 * eig[0])
+    assert model.meta["more_datasets"][0]["rows"] == 5
+    lo = min(a.inputs.min(), b.inputs.min())
+    hi = max(a.inputs.max(), b.inputs.max())
+    assert model.meta["input_range"][0]["min"] == lo and model.meta["input_range"][0]["max"] == hi
+    ae = gvsrom.train((dataset, other), tmp_path / "ae", latent=1, hidden_layers=3, epochs=5,
+                      lbfgs_iterations=0)
+    assert ae.meta["dataset"]["rows"] == 7 and ae.meta["more_datasets"][0]["rows"] == 5
+
+
+def test_datasets_of_other_physics_are_refused_naming_the_field(gvsrom_bin, dataset, tmp_path):
+    other = tmp_path / "stiffer"
+    p = run_cli(gvsrom_bin, "dataset", "single-tendon", "--set", "material.youngs_modulus=2e6",
+                "--random", "tendons.0.tension=-2:0", "--samples", "3", "--out", str(other))
+    assert p.returncode == 0, p.stderr
+    with pytest.raises(ValueError, match=r"invalid `DATASET`.*material\.youngs_modulus"):
+        gvsrom.pod([dataset, other], 2, tmp_path / "pod")

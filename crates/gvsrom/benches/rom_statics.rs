@@ -127,7 +127,7 @@ fn model_dir() -> PathBuf {
     };
     let mut progress = |_: usize, _: f64, _: Option<f64>| ControlFlow::Continue(());
     reduce::train(
-        &dataset,
+        &[&dataset],
         &options,
         reduce::Loss::default(),
         &model,

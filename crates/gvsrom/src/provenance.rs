@@ -15,6 +15,7 @@
 //! | `integrator` | a dynamics run's method and tolerances (`simulate::integrator_record`) |
 //! | `solver` | a statics run's solver options (the scenario's `[solver]`) |
 //! | `model`, `dataset`, `reference`, `run` | an input directory (`compare`'s trajectories for the last two): its path and the hashes its manifest records (`meta_sha256`, `sha256` per file) |
+//! | `more_datasets` | a model made from several datasets: those after the first, in order, each as `dataset` |
 //!
 //! Keys that do not apply are left out. One struct, [`Provenance`], builds them all.
 
@@ -52,6 +53,9 @@ pub struct Provenance {
     pub model: Option<DirOrigin>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dataset: Option<DirOrigin>,
+    /// A model made from several datasets: those after the first (`dataset`), in order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub more_datasets: Vec<DirOrigin>,
     /// `compare`'s two trajectories.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reference: Option<DirOrigin>,
@@ -130,6 +134,7 @@ impl Provenance {
             solver: None,
             model: None,
             dataset: None,
+            more_datasets: vec![],
             reference: None,
             run: None,
         }

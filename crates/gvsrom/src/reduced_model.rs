@@ -148,7 +148,12 @@ pub struct ModelMeta {
     /// Number of reduced coordinates r.
     pub latent: usize,
     pub layout: ModelLayout,
+    /// The dataset the model was made from (the first, if several).
     pub dataset: DatasetRef,
+    /// A model made from several datasets: those after the first, in order (their rows followed
+    /// the first's in training and in the anchors).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub more_datasets: Vec<DatasetRef>,
     /// Reduced coordinates where statics and dynamics start "from rest": for an autoencoder the
     /// encoding of the training snapshot closest to the straight rod (zero strain may lie off the
     /// learned manifold, e.g. under gravity).

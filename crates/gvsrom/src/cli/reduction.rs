@@ -4,8 +4,10 @@ use super::*;
 
 #[derive(Debug, Args)]
 pub struct PodArgs {
-    /// A dataset directory (from `gvsrom dataset`).
-    pub dataset: PathBuf,
+    /// One or more dataset directories (from `gvsrom dataset`); several must share one scenario
+    /// (points, components, sampled inputs and physics), and their snapshots are combined in order.
+    #[arg(value_name = "DATASET", required = true)]
+    pub datasets: Vec<PathBuf>,
     /// Number of POD modes kept (reduced coordinates).
     #[arg(long, value_name = "K")]
     pub modes: usize,
@@ -27,8 +29,11 @@ pub struct ReconstructArgs {
 
 #[derive(Debug, Args)]
 pub struct TrainArgs {
-    /// A dataset directory (from `gvsrom dataset`).
-    pub dataset: PathBuf,
+    /// One or more dataset directories (from `gvsrom dataset`); several must share one scenario
+    /// (points, components, sampled inputs and physics), and their snapshots are combined in order
+    /// (e.g. a babbling trajectory and static equilibria of the same input range).
+    #[arg(value_name = "DATASET", required = true)]
+    pub datasets: Vec<PathBuf>,
     /// Latent size r (reduced coordinates).
     #[arg(long, value_name = "R", default_value_t = 1)]
     pub latent: usize,
@@ -93,10 +98,11 @@ pub struct TrainArgs {
 }
 
 pub(super) fn pod_cmd(args: &PodArgs, out: &mut impl Write) -> Result<()> {
-    let s = reduce::pod(&args.dataset, args.modes, &args.out, args.force)?;
+    let s = reduce::pod(&args.datasets, args.modes, &args.out, args.force)?;
     for w in &s.warnings {
         eprintln!("warning: {w}");
     }
+    datasets_line(out, &s.datasets)?;
     writeln!(
         out,
         "snapshots  {} × {} (failed samples skipped), numerical rank {}",
@@ -125,6 +131,18 @@ pub(super) fn pod_cmd(args: &PodArgs, out: &mut impl Write) -> Result<()> {
     )?;
     anchors_line(out, s.anchor_equilibria, s.rows, s.anchor_time_s)?;
     writeln!(out, "model      {}", s.path.display())?;
+    Ok(())
+}
+
+/// With several datasets, each one's usable rows (one dataset needs no line).
+fn datasets_line(out: &mut impl Write, datasets: &[(PathBuf, usize)]) -> Result<()> {
+    if datasets.len() > 1 {
+        let each: Vec<String> = datasets
+            .iter()
+            .map(|(p, n)| format!("{} ({n} rows)", p.display()))
+            .collect();
+        writeln!(out, "datasets   {}", each.join(" + "))?;
+    }
     Ok(())
 }
 
@@ -164,7 +182,7 @@ pub(super) fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
         }
     };
     let s = reduce::train(
-        &args.dataset,
+        &args.datasets,
         &options,
         args.loss,
         &args.out,
@@ -176,6 +194,7 @@ pub(super) fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
         eprintln!("warning: {w}");
     }
     let r = &s.report;
+    datasets_line(out, &s.datasets)?;
     writeln!(
         out,
         "snapshots  {} × {} ({} training, {} validation)",

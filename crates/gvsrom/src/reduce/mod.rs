@@ -1,7 +1,7 @@
 //! Reduction commands and reduced models on a scenario (paper Sections III–IV):
 //!
-//! - [`pod`]: `gvsrom pod DATASET --modes K --out MODEL`;
-//! - [`train`]: `gvsrom train DATASET --latent R --hidden-layers 3|5|7 --out MODEL`;
+//! - [`pod`]: `gvsrom pod DATASET… --modes K --out MODEL`;
+//! - [`train`]: `gvsrom train DATASET… --latent R --hidden-layers 3|5|7 --out MODEL`;
 //! - [`attach`]: `--model MODEL` on `statics` and `simulate`: the scenario's engine with the model's
 //!   strain parameterization in place of its basis (no physics re-implemented).
 //!
@@ -10,13 +10,15 @@
 //! linear basis) or `Φ_s P D(q_r)` (autoencoder).
 //!
 //! Files: [`pod`](pod()) and [`train`](train()) build models from a dataset (`pod.rs`, `train.rs`);
-//! `anchors.rs` holds the training samples kept as initial guesses; `attach.rs` binds a model to a
+//! `sources.rs` gathers the snapshots of one or more datasets; `anchors.rs` holds the training
+//! samples kept as initial guesses; `attach.rs` binds a model to a
 //! scenario; this file the steps both commands share.
 
 mod anchors;
 mod attach;
 mod evaluate;
 mod pod;
+mod sources;
 mod train;
 pub mod validity;
 

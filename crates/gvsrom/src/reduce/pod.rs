@@ -1,11 +1,8 @@
-//! `gvsrom pod DATASET --modes K --out MODEL`: proper orthogonal decomposition of a dataset's
-//! strain snapshots as a linear reduced model.
+//! `gvsrom pod DATASET… --modes K --out MODEL`: proper orthogonal decomposition of the strain
+//! snapshots of one or more datasets as a linear reduced model.
 
-use super::{
-    dataset_ref, dataset_scenario, equilibrium_anchors, invalid, model_layout, projection_of,
-    sample_inputs, snapshot_rows,
-};
-use crate::dataset::Dataset;
+use super::sources::Sources;
+use super::{equilibrium_anchors, invalid, model_layout, projection_of};
 use crate::error::ScenarioError;
 use crate::output::OutputDir;
 use crate::reduced_model::{ModelMeta, ModelWeights, ReducedModel};
@@ -16,6 +13,8 @@ use std::path::{Path, PathBuf};
 pub struct PodSummary {
     pub path: PathBuf,
     pub rows: usize,
+    /// Each dataset and its usable rows, in order (the rows are `rows` in all).
+    pub datasets: Vec<(PathBuf, usize)>,
     pub features: usize,
     pub modes: usize,
     pub captured_energy: f64,
@@ -28,35 +27,37 @@ pub struct PodSummary {
     pub warnings: Vec<String>,
 }
 
-/// POD of a dataset's strain snapshots, `modes` modes, saved as a model at `out`.
-pub fn pod(
-    dataset: &Path,
+/// POD of the strain snapshots of `datasets` (one, or several of one scenario: their rows in
+/// order), `modes` modes, saved as a model at `out`.
+pub fn pod<P: AsRef<Path>>(
+    datasets: &[P],
     modes: usize,
     out: &Path,
     force: bool,
 ) -> Result<PodSummary, anyhow::Error> {
     let provenance = crate::provenance::Provenance::of_command();
-    let ds = Dataset::load(dataset)?;
-    let provenance = provenance.dataset("DATASET", dataset)?;
-    let built = dataset_scenario(&ds)?;
-    projection_of(&built)?; // the HOM basis must be recoverable from point strains
-    let (x, rows) = snapshot_rows(&ds, "DATASET", built.model.rod.length())?;
-    let features = ds.row_len();
+    let src = Sources::load(datasets)?;
+    let provenance = src.record(provenance)?;
+    let built = &src.built;
+    projection_of(built)?; // the HOM basis must be recoverable from point strains
+    let (x, rows, features) = (&src.x, src.rows(), src.features);
     let dir = OutputDir::create("--out", out, crate::reduced_model::MODEL_FORMAT, force)?;
-    let pod = Pod::compute(&x, features, modes).map_err(|e| pod_error(e, &ds, &x, features))?;
+    let pod = Pod::compute(x, features, modes).map_err(|e| pod_error(e, &src))?;
     let energy = pod.captured_energy();
     // anchors: each sample's POD coordinates Vᵀx, then the POD-ROM's own equilibria
-    let latent = pod.encode_rows(&x);
+    let latent = pod.encode_rows(x);
     let latent_range = super::latent_range(&latent, modes);
+    let refs = src.refs();
     let meta = ModelMeta {
         kind: "pod".into(),
         latent: modes,
-        layout: model_layout(&ds, &built),
-        dataset: dataset_ref(dataset, &ds, rows),
+        layout: model_layout(src.first(), built),
+        dataset: refs.0,
+        more_datasets: refs.1,
         rest: vec![0.0; modes],
         latent_range,
-        input_range: super::validity::input_ranges(&ds),
-        anchor_parameters: ds.meta.parameters.clone(),
+        input_range: src.input_ranges(),
+        anchor_parameters: src.first().meta.parameters.clone(),
         anchor_equilibria: 0,
         captured_energy: Some(energy[modes - 1]),
         training: None,
@@ -74,12 +75,14 @@ pub fn pod(
         integrity: crate::output::Integrity::Checked,
         anchors: Some(crate::reduced_model::Anchors {
             n: rows,
-            inputs: sample_inputs(&ds),
+            inputs: src.sample_inputs(),
             latent,
         }),
     };
     let t_anchors = std::time::Instant::now();
-    model.meta.anchor_equilibria = equilibrium_anchors(&built, &ds, &mut model)?;
+    if let Some(ds) = src.all_static() {
+        model.meta.anchor_equilibria = equilibrium_anchors(built, ds, &mut model)?;
+    }
     let anchor_time_s = t_anchors.elapsed().as_secs_f64();
     let path = model.save(
         dir,
@@ -89,7 +92,8 @@ pub fn pod(
         ],
     )?;
     Ok(PodSummary {
-        warnings: super::dataset_warnings(&ds, dataset),
+        warnings: src.warnings(),
+        datasets: src.listing(),
         path,
         rows,
         features,
@@ -104,7 +108,8 @@ pub fn pod(
 
 /// A POD error named by its cause: the number of modes, or the dataset (for a failed SVD, with the
 /// largest strain value and its sample: a pathological value, not an option, makes it fail).
-fn pod_error(e: PodError, ds: &Dataset, x: &[f64], features: usize) -> ScenarioError {
+fn pod_error(e: PodError, src: &Sources) -> ScenarioError {
+    let (x, features) = (&src.x, src.features);
     match e {
         PodError::Modes { .. } => invalid("--modes", e.to_string()),
         PodError::Data(_) => invalid("DATASET", e.to_string()),
@@ -115,11 +120,12 @@ fn pod_error(e: PodError, ds: &Dataset, x: &[f64], features: usize) -> ScenarioE
                 .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
                 .map(|(i, v)| (i, *v))
                 .unwrap_or((0, 0.0));
-            let sample = ds.ok_rows().get(i / features.max(1)).copied().unwrap_or(0);
+            let (dir, sample) = src.origin_of(i / features.max(1));
             invalid(
                 "DATASET",
                 format!(
-                    "{e}: its largest strain value is {v:e} (sample {sample}); a value that large is not a strain the model can hold — check that sample"
+                    "{e}: the largest strain value is {v:e} (sample {sample} of `{}`); a value that large is not a strain the model can hold — check that sample",
+                    dir.display()
                 ),
             )
         }

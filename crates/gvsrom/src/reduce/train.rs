@@ -1,12 +1,10 @@
-//! `gvsrom train DATASET --latent R --hidden-layers N --out MODEL`: a tanh autoencoder learned
-//! from a dataset's strain snapshots, whose decoder becomes a nonlinear reduced model.
+//! `gvsrom train DATASET… --latent R --hidden-layers N --out MODEL`: a tanh autoencoder learned
+//! from the strain snapshots of one or more datasets, whose decoder becomes a nonlinear reduced
+//! model.
 
-use super::{
-    dataset_ref, dataset_scenario, equilibrium_anchors, invalid, model_layout, projection_of,
-    sample_inputs, snapshot_rows,
-};
+use super::sources::Sources;
+use super::{equilibrium_anchors, invalid, model_layout, projection_of};
 use crate::build::Built;
-use crate::dataset::Dataset;
 use crate::error::ScenarioError;
 use crate::output::OutputDir;
 use crate::reduced_model::{ModelMeta, ModelWeights, ReducedModel, TrainingMeta};
@@ -20,6 +18,8 @@ use std::path::{Path, PathBuf};
 pub struct TrainSummary {
     pub path: PathBuf,
     pub rows: usize,
+    /// Each dataset and its usable rows, in order (the rows are `rows` in all).
+    pub datasets: Vec<(PathBuf, usize)>,
     pub features: usize,
     pub report: TrainReport,
     pub encoder_sizes: Vec<usize>,
@@ -95,11 +95,12 @@ impl Loss {
     }
 }
 
-/// Trains an autoencoder on a dataset's snapshots and saves it at `out`. `progress(epoch, train,
-/// validation)` is called after every epoch; `Break` stops training early (the best weights so far
-/// are kept and saved, marked by the stop reason).
-pub fn train(
-    dataset: &Path,
+/// Trains an autoencoder on the snapshots of `datasets` (one, or several of one scenario: their
+/// rows in order) and saves it at `out`. `progress(epoch, train, validation)` is called after every
+/// epoch; `Break` stops training early (the best weights so far are kept and saved, marked by the
+/// stop reason).
+pub fn train<P: AsRef<Path>>(
+    datasets: &[P],
     options: &TrainOptions,
     loss: Loss,
     out: &Path,
@@ -107,27 +108,25 @@ pub fn train(
     progress: &mut dyn FnMut(usize, f64, Option<f64>) -> ControlFlow<()>,
 ) -> Result<TrainSummary, anyhow::Error> {
     let provenance = crate::provenance::Provenance::of_command();
-    let ds = Dataset::load(dataset)?;
-    let provenance = provenance
-        .dataset("DATASET", dataset)?
-        .seed("training", options.seed);
-    let built = dataset_scenario(&ds)?;
-    let (layout, pm, p) = projection_of(&built)?;
-    let (x, rows) = snapshot_rows(&ds, "DATASET", built.model.rod.length())?;
-    let features = ds.row_len();
+    let src = Sources::load(datasets)?;
+    let provenance = src.record(provenance)?.seed("training", options.seed);
+    let built = &src.built;
+    let (layout, pm, p) = projection_of(built)?;
+    let (x, rows, features) = (&src.x, src.rows(), src.features);
     let options = &TrainOptions {
-        weighting: loss.weighting(&built, &layout),
+        weighting: loss.weighting(built, &layout),
         ..options.clone()
     };
     let dir = OutputDir::create("--out", out, crate::reduced_model::MODEL_FORMAT, force)?;
     // the zero-strain anchor of trajectory data: the straight rod, where simulations from rest
     // start, joins the training rows so that a latent point decodes to it
-    let anchor_rows = zero_anchor_rows(rows, ds.meta.dynamic.is_some());
+    let dynamic_rows = src.dynamic_rows();
+    let anchor_rows = zero_anchor_rows(dynamic_rows, dynamic_rows > 0);
     let training: std::borrow::Cow<[f64]> = match anchor_rows {
         0 => (&x[..]).into(),
         k => {
             let mut t = Vec::with_capacity((rows + k) * features);
-            t.extend_from_slice(&x);
+            t.extend_from_slice(x);
             t.resize((rows + k) * features, 0.0);
             t.into()
         }
@@ -181,17 +180,19 @@ pub fn train(
         .map_err(|e| invalid("train", e.to_string()))?;
     let rest_residual = rest_decoded.iter().map(|v| v * v).sum::<f64>().sqrt();
     let rest = DVector::from_vec(rest);
-    let mut warnings = super::dataset_warnings(&ds, dataset);
+    let mut warnings = src.warnings();
+    let refs = src.refs();
     warnings.extend(scaled_basin_warning(ae.form(), range[0]));
     let meta = ModelMeta {
         kind: "autoencoder".into(),
         latent: options.latent,
-        layout: model_layout(&ds, &built),
-        dataset: dataset_ref(dataset, &ds, rows),
+        layout: model_layout(src.first(), built),
+        dataset: refs.0,
+        more_datasets: refs.1,
         rest: rest.iter().copied().collect(),
         latent_range: range,
-        input_range: super::validity::input_ranges(&ds),
-        anchor_parameters: ds.meta.parameters.clone(),
+        input_range: src.input_ranges(),
+        anchor_parameters: src.first().meta.parameters.clone(),
         anchor_equilibria: 0,
         captured_energy: None,
         training: Some(TrainingMeta {
@@ -242,14 +243,17 @@ pub fn train(
         integrity: crate::output::Integrity::Checked,
         anchors: Some(crate::reduced_model::Anchors {
             n: rows,
-            inputs: sample_inputs(&ds),
+            inputs: src.sample_inputs(),
             latent,
         }),
     };
     let t_anchors = std::time::Instant::now();
     // (an interrupted run is saved at once, with the encodings)
-    if report.stop != rom::nn::StopReason::Interrupted {
-        model.meta.anchor_equilibria = equilibrium_anchors(&built, &ds, &mut model)?;
+    if let (Some(ds), false) = (
+        src.all_static(),
+        report.stop == rom::nn::StopReason::Interrupted,
+    ) {
+        model.meta.anchor_equilibria = equilibrium_anchors(built, ds, &mut model)?;
     }
     let anchor_time_s = t_anchors.elapsed().as_secs_f64();
     let anchor_equilibria = model.meta.anchor_equilibria;
@@ -262,6 +266,7 @@ pub fn train(
     )?;
     Ok(TrainSummary {
         warnings,
+        datasets: src.listing(),
         path,
         rows,
         features,

@@ -112,8 +112,6 @@ pub fn check(
         }
     }
     let current = crate::scenario::from_table(table.clone())?;
-    let mut a = trained.to_table()?;
-    let mut b = current.to_table()?;
     let mut skip: Vec<Vec<Seg>> = meta
         .input_range
         .iter()
@@ -126,16 +124,7 @@ pub fn check(
             Seg::Key("tension".into()),
         ]);
     }
-    for key in NOT_PHYSICS {
-        a.remove(*key);
-        b.remove(*key);
-    }
-    for path in &skip {
-        remove(&mut a, path);
-        remove(&mut b, path);
-    }
-    let mut diffs = vec![];
-    diff(&Value::Table(a), &Value::Table(b), &mut vec![], &mut diffs);
+    let diffs = physics_differences(&trained, &current, &skip)?;
     outside.extend(diffs.into_iter().map(|(path, there, here)| {
         format!(
             "{path} differs: {there} in the model's scenario `{}`, {here} here",
@@ -143,6 +132,28 @@ pub fn check(
         )
     }));
     Ok(outside)
+}
+
+/// Every leaf where the physics of scenario `b` differs from `a`'s, as `(path, in a, in b)`:
+/// the keys that are not physics ([`NOT_PHYSICS`]) and the paths `skip` (inputs) are left out.
+pub(super) fn physics_differences(
+    a: &Scenario,
+    b: &Scenario,
+    skip: &[Vec<Seg>],
+) -> Result<Vec<(String, String, String)>, ScenarioError> {
+    let mut a = a.to_table()?;
+    let mut b = b.to_table()?;
+    for key in NOT_PHYSICS {
+        a.remove(*key);
+        b.remove(*key);
+    }
+    for path in skip {
+        remove(&mut a, path);
+        remove(&mut b, path);
+    }
+    let mut diffs = vec![];
+    diff(&Value::Table(a), &Value::Table(b), &mut vec![], &mut diffs);
+    Ok(diffs)
 }
 
 /// Removes the value at `path` from `table`, if present (an array entry is replaced by a marker,

@@ -162,7 +162,7 @@ pub fn pod(
         // (a model without a recorded validity range is from an earlier build: made again)
         |p| ReducedModel::load(p).is_ok_and(|m| !m.meta.input_range.is_empty()),
         |path| {
-            let s = reduce::pod(&data.path, modes, path, true)?;
+            let s = reduce::pod(&[&data.path], modes, path, true)?;
             let model = ReducedModel::load(path)?;
             Ok(ModelInfo {
                 latent: modes,
@@ -255,7 +255,7 @@ pub fn train(
                     0 => ControlFlow::Continue(()),
                     _ => ControlFlow::Break(()),
                 };
-            let s = reduce::train(&data.path, &options, c.loss, path, true, &mut progress)?;
+            let s = reduce::train(&[&data.path], &options, c.loss, path, true, &mut progress)?;
             run.check_interrupt()?;
             let model = ReducedModel::load(path)?;
             Ok(ModelInfo {
