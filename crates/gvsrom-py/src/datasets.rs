@@ -111,7 +111,7 @@ pub struct Dataset {
 impl Dataset {
     /// The dataset directory.
     #[getter]
-    fn path(&self) -> PathBuf {
+    pub(crate) fn path(&self) -> PathBuf {
         self.dir.clone()
     }
 

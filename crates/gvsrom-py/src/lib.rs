@@ -41,6 +41,7 @@ fn _gvsrom(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<statics::Statics>()?;
     m.add_class::<statics::StaticsBatch>()?;
     m.add_class::<models::Model>()?;
+    m.add_class::<models::Reconstruction>()?;
     m.add_function(wrap_pyfunction!(models::load_model, m)?)?;
     m.add_function(wrap_pyfunction!(models::pod, m)?)?;
     m.add_function(wrap_pyfunction!(models::train, m)?)?;

@@ -225,3 +225,28 @@ def test_datasets_of_other_physics_are_refused_naming_the_field(gvsrom_bin, data
     assert p.returncode == 0, p.stderr
     with pytest.raises(ValueError, match=r"invalid `DATASET`.*material\.youngs_modulus"):
         gvsrom.pod([dataset, other], 2, tmp_path / "pod")
+
+
+def test_reconstruction_of_its_own_data_is_what_pod_discards(dataset, pod_model, tmp_path, gvsrom_bin):
+    # POD-2 on its own snapshots: the squared error is the energy of the discarded singular values
+    ds = gvsrom.load_dataset(dataset)
+    x = ds.strain.reshape(len(ds.strain), -1)
+    sigma = pod_model.arrays["singular_values"]
+    r = pod_model.reconstruction(ds)
+    assert r.rows == len(x) and r.outside == 0
+    np.testing.assert_allclose(r.rmse, np.sqrt((sigma[2:] ** 2).sum() / x.size), rtol=1e-9)
+    np.testing.assert_allclose(r.relative, np.sqrt((sigma[2:] ** 2).sum() / (sigma**2).sum()),
+                               rtol=1e-9)
+    norms = np.linalg.norm(x, axis=1)
+    assert r.largest_norm == pytest.approx(norms.max(), rel=1e-12)
+    row, ratio, norm = r.worst
+    assert norm == pytest.approx(norms[row], rel=1e-12) and 0 < ratio < 1
+    # the directory gives the same numbers; another layout is refused naming both
+    same = pod_model.reconstruction(str(dataset))
+    assert (same.rmse, same.worst) == (r.rmse, r.worst)
+    beam = tmp_path / "beam"
+    p = run_cli(gvsrom_bin, "dataset", "soft-beam", "--random", "loads.distributed.0.magnitude=-1:1",
+                "--samples", "2", "--out", str(beam))
+    assert p.returncode == 0, p.stderr
+    with pytest.raises(ValueError, match=r"invalid `DATASET`.*soft-beam.*single-tendon"):
+        pod_model.reconstruction(beam)
