@@ -9,7 +9,9 @@ target="${CARGO_TARGET_DIR:-$root/target}"
 venv="$target/py-venv"
 python="${PYTHON:-python3}"
 
-cargo build -p gvsrom --quiet
+# the CLI the tests compare with: `--workspace` resolves features as `cargo test --workspace` does,
+# so after the tests nothing is compiled again (`-p gvsrom` alone would rebuild most dependencies)
+cargo build --workspace --bins --quiet
 if [ ! -x "$venv/bin/python" ]; then
     "$python" -m venv "$venv"
 fi
