@@ -350,9 +350,10 @@ pub fn load_model(py: Python<'_>, path: PathBuf, extrapolate: bool) -> PyResult<
 ///
 /// Parameters
 /// ----------
-/// dataset : str or os.PathLike, or a sequence of them
-///     A dataset directory (``gvsrom dataset``), or several of one scenario (the same points,
-///     components, sampled inputs and physics) whose snapshots are combined in order.
+/// dataset : Dataset or str or os.PathLike, or a sequence of them
+///     A dataset (``gvsrom dataset``, ``load_dataset``) or its directory, or several of one scenario
+///     (the same points, components, sampled inputs and physics) whose snapshots are combined in
+///     order.
 /// modes : int
 ///     POD modes kept (reduced coordinates).
 /// out : str or os.PathLike
@@ -368,12 +369,12 @@ pub fn load_model(py: Python<'_>, path: PathBuf, extrapolate: bool) -> PyResult<
 #[pyo3(signature = (dataset, modes, out, force=false))]
 pub fn pod(
     py: Python<'_>,
-    dataset: Datasets,
+    dataset: &Bound<'_, PyAny>,
     modes: usize,
     out: PathBuf,
     force: bool,
 ) -> PyResult<Model> {
-    let dataset = dataset.paths();
+    let dataset = dataset_paths(dataset)?;
     let summary = py
         .detach(|| gvsrom::reduce::pod(&dataset, modes, &out, force))
         .map_err(errors::any)?;
@@ -383,21 +384,38 @@ pub fn pod(
     load_model(py, summary.path, false)
 }
 
-/// The ``dataset`` argument of ``pod`` and ``train``: one dataset directory, or a sequence of
-/// directories of one scenario whose snapshots are combined in order.
-#[derive(FromPyObject)]
-pub enum Datasets {
-    One(PathBuf),
-    Many(Vec<PathBuf>),
-}
-
-impl Datasets {
-    fn paths(self) -> Vec<PathBuf> {
-        match self {
-            Datasets::One(p) => vec![p],
-            Datasets::Many(v) => v,
+/// The ``dataset`` argument of ``pod`` and ``train``: a dataset (a ``Dataset`` or its directory)
+/// or a sequence of them, of one scenario, whose snapshots are combined in order; a ``TypeError``
+/// naming ``dataset`` otherwise.
+fn dataset_paths(arg: &Bound<'_, PyAny>) -> PyResult<Vec<PathBuf>> {
+    let one = |a: &Bound<'_, PyAny>| -> Option<PathBuf> {
+        match a.extract::<Bound<'_, crate::datasets::Dataset>>() {
+            Ok(d) => Some(d.get().path()),
+            Err(_) => a.extract::<PathBuf>().ok(),
         }
+    };
+    let refuse = |a: &Bound<'_, PyAny>| {
+        let kind = a
+            .get_type()
+            .name()
+            .map(|n| n.to_string())
+            .unwrap_or_else(|_| "?".into());
+        pyo3::exceptions::PyTypeError::new_err(format!(
+            "invalid `dataset`: got a {kind}; accepted: a Dataset, a dataset directory (str or os.PathLike), or a sequence of them"
+        ))
+    };
+    if let Some(p) = one(arg) {
+        return Ok(vec![p]);
     }
+    let Ok(items) = arg.try_iter() else {
+        return Err(refuse(arg));
+    };
+    let mut paths = vec![];
+    for item in items {
+        let item = item?;
+        paths.push(one(&item).ok_or_else(|| refuse(&item))?);
+    }
+    Ok(paths)
 }
 
 /// How often training looks for Ctrl-C.
@@ -409,9 +427,10 @@ const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 ///
 /// Parameters
 /// ----------
-/// dataset : str or os.PathLike, or a sequence of them
-///     A dataset directory (``gvsrom dataset``), or several of one scenario (the same points,
-///     components, sampled inputs and physics) whose snapshots are combined in order.
+/// dataset : Dataset or str or os.PathLike, or a sequence of them
+///     A dataset (``gvsrom dataset``, ``load_dataset``) or its directory, or several of one scenario
+///     (the same points, components, sampled inputs and physics) whose snapshots are combined in
+///     order.
 /// out : str or os.PathLike
 ///     The new model directory.
 /// latent : int
@@ -444,7 +463,7 @@ const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 #[allow(clippy::too_many_arguments)]
 pub fn train(
     py: Python<'_>,
-    dataset: Datasets,
+    dataset: &Bound<'_, PyAny>,
     out: PathBuf,
     latent: usize,
     hidden_layers: usize,
@@ -490,7 +509,7 @@ pub fn train(
         decoder: gvsrom::reduce::decoder_form(decoder).map_err(errors::scenario)?,
         ..TrainOptions::default()
     };
-    let dataset = dataset.paths();
+    let dataset = dataset_paths(dataset)?;
     let mut interrupt: Option<PyErr> = None;
     let summary = py.detach(|| {
         let mut last_poll = std::time::Instant::now();

@@ -213,9 +213,13 @@ def test_several_datasets_make_one_model_of_their_stacked_snapshots(gvsrom_bin, 
     lo = min(a.inputs.min(), b.inputs.min())
     hi = max(a.inputs.max(), b.inputs.max())
     assert model.meta["input_range"][0]["min"] == lo and model.meta["input_range"][0]["max"] == hi
-    ae = gvsrom.train((dataset, other), tmp_path / "ae", latent=1, hidden_layers=3, epochs=5,
+    ae = gvsrom.train((a, other), tmp_path / "ae", latent=1, hidden_layers=3, epochs=5,
                       lbfgs_iterations=0)
     assert ae.meta["dataset"]["rows"] == 7 and ae.meta["more_datasets"][0]["rows"] == 5
+    with pytest.raises(TypeError, match=r"invalid `dataset`: got a int"):
+        gvsrom.pod(3, 2, tmp_path / "never")
+    with pytest.raises(TypeError, match=r"invalid `dataset`: got a float"):
+        gvsrom.pod([dataset, 2.5], 2, tmp_path / "never")
 
 
 def test_datasets_of_other_physics_are_refused_naming_the_field(gvsrom_bin, dataset, tmp_path):

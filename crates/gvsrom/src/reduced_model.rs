@@ -6,7 +6,8 @@
 //!   `encoder.{k}.weight` (out × in, row-major), `encoder.{k}.bias`, `decoder.{k}.…`,
 //!   `scaling.mean`, `scaling.scale` (`x = mean + scale ⊙ y` undoes the data scaling);
 //! - `meta.json`: the kind, the point layout the model was learned on (scenario, `strain_x`, active
-//!   components, HOM size), the dataset it came from (path, hash of its `strain.npy`, rows used),
+//!   components, HOM size), the datasets it came from (`dataset` and, for a model of several,
+//!   `more_datasets`: path, hash of its `strain.npy`, rows used),
 //!   the rest coordinates of the straight rod, and the training settings and results;
 //! - training curves (`train_loss.npy`, `val_loss.npy`) or the POD spectrum (`singular_values.npy`,
 //!   `captured_energy.npy`).

@@ -147,10 +147,20 @@ fn training_on_two_datasets_uses_both_and_anchors_rest_for_trajectory_rows_only(
         (run_ok(&args), json(&out.join("meta.json")))
     };
     let (printed, meta) = train(&[a, b], "several-train-ab");
-    // 25 rows, no zero-strain rows for equilibria
+    // 25 rows, every one trained on (training + validation), no zero-strain rows for equilibria
     assert!(printed.contains("snapshots  25 × 306"), "{printed}");
+    assert_eq!(split_rows(&printed), 25, "{printed}");
     assert_eq!(meta["training"]["zero_anchor_rows"], 0);
     assert_eq!(meta["more_datasets"][0]["rows"], 10);
+    let model = ReducedModel::load(&scratch_path("several-train-ab")).unwrap();
+    let anchors = model.anchors.expect("anchors");
+    assert_eq!(anchors.n, 25);
+    let all: Vec<f64> = inputs(a).into_iter().chain(inputs(b)).collect();
+    assert_eq!(anchors.inputs, all);
+    assert!(
+        model.meta.anchor_equilibria > 0,
+        "equilibria only: the model's own equilibria"
+    );
 
     // A, then a 0.3 s trajectory (31 rows): the trajectory brings the zero-strain rows (1 % of its
     // rows, at least 10) although the first dataset holds equilibria
@@ -168,8 +178,47 @@ fn training_on_two_datasets_uses_both_and_anchors_rest_for_trajectory_rows_only(
     ]);
     let (printed, meta) = train(&[a, &dynamic], "several-train-dyn");
     assert!(printed.contains("snapshots  46 × 306"), "{printed}");
+    assert_eq!(split_rows(&printed), 46 + 10, "{printed}");
     assert_eq!(meta["training"]["zero_anchor_rows"], 10);
     assert_eq!(meta["more_datasets"][0]["rows"], 31);
+    // with a trajectory among the datasets every anchor keeps its encoding
+    assert!(
+        meta.get("anchor_equilibria").is_none_or(|v| v == 0),
+        "{meta}"
+    );
+
+    // 1100 equilibria and the trajectory, in either order: 1 % of the 31 trajectory rows (at least
+    // 10), not 1 % of all 1131 rows (11)
+    let many = sweep_dataset("several-sweep1100", "-6:0", 1100);
+    for (order, name) in [
+        ([&many, &dynamic], "several-1100-dyn"),
+        ([&dynamic, &many], "several-dyn-1100"),
+    ] {
+        let (printed, meta) = train(&[order[0].as_path(), order[1].as_path()], name);
+        assert_eq!(meta["training"]["zero_anchor_rows"], 10, "{name}");
+        assert_eq!(split_rows(&printed), 1131 + 10, "{printed}");
+    }
+}
+
+/// The scratch path `name` without clearing it (a model a test just wrote there).
+fn scratch_path(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join("gvsrom-cli-tests")
+        .join(name)
+}
+
+/// The rows `train` printed it trained on: `(N training, M validation)` → N + M.
+fn split_rows(printed: &str) -> usize {
+    let inner = printed
+        .split('(')
+        .find(|p| p.contains(" training, "))
+        .unwrap_or_else(|| panic!("no training split in: {printed}"));
+    inner
+        .split(|c: char| !c.is_ascii_digit())
+        .filter(|t| !t.is_empty())
+        .take(2)
+        .map(|t| t.parse::<usize>().unwrap())
+        .sum()
 }
 
 #[test]
@@ -209,6 +258,36 @@ fn datasets_of_other_physics_inputs_or_points_are_refused_naming_both() {
     expect_error(
         &["pod", s(a), s(&beam), "--modes", "2", "--out", s(&out)],
         &["invalid `DATASET`", s(&beam), "points"],
+    );
+    // the same dataset twice, and ranges of an input with a gap no sample covers: A holds [-6, 0] N,
+    // this one [1, 3] N; a model of both would accept 0.5 N
+    expect_error(
+        &["pod", s(a), s(a), "--modes", "2", "--out", s(&out)],
+        &[
+            "invalid `DATASET`",
+            "same snapshots",
+            "give each dataset once",
+        ],
+    );
+    let beyond = scratch("several-beyond");
+    run_ok(&[
+        "dataset",
+        "single-tendon",
+        "--random",
+        "tendons.0.tension=1:3",
+        "--samples",
+        "5",
+        "--out",
+        s(&beyond),
+    ]);
+    expect_error(
+        &["train", s(a), s(&beyond), "--out", s(&out)],
+        &[
+            "invalid `DATASET`",
+            "tendons.0.tension",
+            "without a sample",
+            s(&beyond),
+        ],
     );
     // nothing was written
     assert!(!out.exists());

@@ -9,10 +9,10 @@
 //! point strains onto its coefficients (`rom::reduced`): `Ψ_s(q_r) = Φ_s P V q_r` (POD, a constant
 //! linear basis) or `Φ_s P D(q_r)` (autoencoder).
 //!
-//! Files: [`pod`](pod()) and [`train`](train()) build models from a dataset (`pod.rs`, `train.rs`);
-//! `sources.rs` gathers the snapshots of one or more datasets; `anchors.rs` holds the training
-//! samples kept as initial guesses; `attach.rs` binds a model to a
-//! scenario; this file the steps both commands share.
+//! Files: [`pod`](pod()) and [`train`](train()) build models from one or more datasets (`pod.rs`,
+//! `train.rs`); `sources.rs` gathers and checks their snapshots; `anchors.rs` holds the training
+//! samples kept as initial guesses; `attach.rs` binds a model to a scenario; this file the steps
+//! both commands share.
 
 mod anchors;
 mod attach;

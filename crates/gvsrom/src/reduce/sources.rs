@@ -12,6 +12,7 @@
 
 use super::validity::{input_ranges, physics_differences};
 use super::{dataset_scenario, invalid, snapshot_rows};
+use crate::build::reduced::INPUT_MARGIN;
 use crate::build::Built;
 use crate::dataset::Dataset;
 use crate::error::ScenarioError;
@@ -44,15 +45,19 @@ impl Sources {
             return Err(invalid(FIELD, "no dataset given: at least one is needed").into());
         };
         let first = first.as_ref();
-        let ds = Dataset::load(first)?;
-        let built = dataset_scenario(&ds)?;
-        let length = built.model.rod.length();
         // with several datasets, a dataset's own error names it
-        let field = |p: &Path| match paths.len() {
-            1 => FIELD.to_string(),
-            _ => format!("{FIELD} {}", p.display()),
+        let several = paths.len() > 1;
+        let named = |p: &Path, e: ScenarioError| match (several, e) {
+            (true, ScenarioError::Invalid { field, message }) => ScenarioError::Invalid {
+                field,
+                message: format!("`{}`: {message}", p.display()),
+            },
+            (_, e) => e,
         };
-        let (mut x, rows) = snapshot_rows(&ds, &field(first), length)?;
+        let ds = Dataset::load(first)?;
+        let built = dataset_scenario(&ds).map_err(|e| named(first, e))?;
+        let length = built.model.rod.length();
+        let (mut x, rows) = snapshot_rows(&ds, FIELD, length).map_err(|e| named(first, e))?;
         let features = ds.row_len();
         let mut sources = Sources {
             sets: vec![(first.to_path_buf(), ds)],
@@ -64,14 +69,15 @@ impl Sources {
         for p in &paths[1..] {
             let p = p.as_ref();
             let ds = Dataset::load(p)?;
-            dataset_scenario(&ds)?;
+            dataset_scenario(&ds).map_err(|e| named(p, e))?;
             sources.check_joins(p, &ds)?;
-            let (more, rows) = snapshot_rows(&ds, &field(p), length)?;
+            let (more, rows) = snapshot_rows(&ds, FIELD, length).map_err(|e| named(p, e))?;
             x.extend_from_slice(&more);
             sources.rows_of.push(rows);
             sources.sets.push((p.to_path_buf(), ds));
         }
         sources.x = x;
+        sources.check_coverage()?;
         Ok(sources)
     }
 
@@ -90,6 +96,20 @@ impl Sources {
                 ),
             )
         };
+        if let Some((twin, _)) = self
+            .sets
+            .iter()
+            .find(|(_, d)| d.strain_sha256 == ds.strain_sha256)
+        {
+            return Err(invalid(
+                FIELD,
+                format!(
+                    "`{}` holds the same snapshots as `{}` (the same strain.npy): give each dataset once",
+                    path.display(),
+                    twin.display()
+                ),
+            ));
+        }
         if !same_abscissae(&a.strain_x, &b.strain_x) || a.components != b.components {
             return Err(refuse(format!(
                 "its snapshots have {} points × [{}], the first's {} points × [{}]{}",
@@ -97,7 +117,8 @@ impl Sources {
                 b.components.join(", "),
                 a.strain_x.len(),
                 a.components.join(", "),
-                if a.strain_x.len() == b.strain_x.len() {
+                if a.strain_x.len() == b.strain_x.len() && !same_abscissae(&a.strain_x, &b.strain_x)
+                {
                     " (at other abscissae)"
                 } else {
                     ""
@@ -138,6 +159,45 @@ impl Sources {
             .zip(&self.rows_of)
             .map(|((dir, _), &n)| (dir.clone(), n))
             .collect()
+    }
+
+    /// Refuses datasets whose ranges of an input leave a gap no dataset covers (wider than the
+    /// margin `--model` allows, [`INPUT_MARGIN`] of the united range): the model records one range
+    /// per input (their union, [`Sources::input_ranges`]) and would answer inside the gap, where it
+    /// saw no data.
+    fn check_coverage(&self) -> Result<(), ScenarioError> {
+        if self.sets.len() < 2 {
+            return Ok(());
+        }
+        let ranges: Vec<Vec<InputRange>> =
+            self.sets.iter().map(|(_, ds)| input_ranges(ds)).collect();
+        for (d, united) in self.input_ranges().iter().enumerate() {
+            let mut spans: Vec<(f64, f64, &Path)> = ranges
+                .iter()
+                .zip(&self.sets)
+                .map(|(r, (dir, _))| (r[d].min, r[d].max, dir.as_path()))
+                .collect();
+            spans.sort_by(|p, q| p.0.total_cmp(&q.0));
+            let margin = INPUT_MARGIN * (united.max - united.min);
+            let mut reach = spans[0].1;
+            for w in spans.windows(2) {
+                reach = reach.max(w[0].1);
+                if w[1].0 - reach > margin {
+                    return Err(invalid(
+                        FIELD,
+                        format!(
+                            "the datasets leave {} between {reach} and {} without a sample (`{}` starts there), yet a model of them would accept all of [{}, {}]: add a dataset that covers the gap, or make one model per range",
+                            united.parameter,
+                            w[1].0,
+                            w[1].2.display(),
+                            united.min,
+                            united.max
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Usable rows of all datasets.

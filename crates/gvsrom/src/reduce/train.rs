@@ -323,7 +323,8 @@ pub fn decoder_form(name: &str) -> Result<DecoderForm, ScenarioError> {
     })
 }
 
-/// Copies of the zero-strain snapshot added to `rows` training rows: for trajectory data (which
+/// Copies of the zero-strain snapshot added for `rows` training rows of trajectories (with several
+/// datasets, the rows of those that are trajectories; `dynamic` false: none): for trajectory data (which
 /// start from the straight rod at rest, as every simulation from rest does) 1 % of the rows and at
 /// least 10, so that the straight rod is a point of the learned manifold and not just one sample
 /// among thousands; none for equilibria, whose manifold need not contain the straight rod (under
