@@ -177,7 +177,10 @@ fn training_on_two_datasets_uses_both_and_anchors_rest_for_trajectory_rows_only(
         s(&dynamic),
     ]);
     let (printed, meta) = train(&[a, &dynamic], "several-train-dyn");
-    assert!(printed.contains("snapshots  46 × 306"), "{printed}");
+    assert!(
+        printed.contains("snapshots  46 × 306 + 10 zero-strain rows ("),
+        "{printed}"
+    );
     assert_eq!(split_rows(&printed), 46 + 10, "{printed}");
     assert_eq!(meta["training"]["zero_anchor_rows"], 10);
     assert_eq!(meta["more_datasets"][0]["rows"], 31);

@@ -195,9 +195,13 @@ pub(super) fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
     }
     let r = &s.report;
     datasets_line(out, &s.datasets)?;
+    let zero_rows = match s.zero_anchor_rows {
+        0 => String::new(),
+        k => format!(" + {k} zero-strain rows"),
+    };
     writeln!(
         out,
-        "snapshots  {} × {} ({} training, {} validation)",
+        "snapshots  {} × {}{zero_rows} ({} training, {} validation)",
         s.rows, s.features, r.n_train, r.n_val
     )?;
     writeln!(
