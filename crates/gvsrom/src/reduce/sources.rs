@@ -57,12 +57,12 @@ impl Sources {
         let ds = Dataset::load(first)?;
         let built = dataset_scenario(&ds).map_err(|e| named(first, e))?;
         let length = built.model.rod.length();
-        let (mut x, rows) = snapshot_rows(&ds, FIELD, length).map_err(|e| named(first, e))?;
+        let (x, rows) = snapshot_rows(&ds, FIELD, length).map_err(|e| named(first, e))?;
         let features = ds.row_len();
         let mut sources = Sources {
             sets: vec![(first.to_path_buf(), ds)],
             built,
-            x: vec![],
+            x,
             rows_of: vec![rows],
             features,
         };
@@ -72,11 +72,10 @@ impl Sources {
             dataset_scenario(&ds).map_err(|e| named(p, e))?;
             sources.check_joins(p, &ds)?;
             let (more, rows) = snapshot_rows(&ds, FIELD, length).map_err(|e| named(p, e))?;
-            x.extend_from_slice(&more);
+            sources.x.extend_from_slice(&more);
             sources.rows_of.push(rows);
             sources.sets.push((p.to_path_buf(), ds));
         }
-        sources.x = x;
         sources.check_coverage()?;
         Ok(sources)
     }
