@@ -120,8 +120,7 @@ pub fn train<P: AsRef<Path>>(
     let dir = OutputDir::create("--out", out, crate::reduced_model::MODEL_FORMAT, force)?;
     // the zero-strain anchor of trajectory data: the straight rod, where simulations from rest
     // start, joins the training rows so that a latent point decodes to it
-    let dynamic_rows = src.dynamic_rows();
-    let anchor_rows = zero_anchor_rows(dynamic_rows, dynamic_rows > 0);
+    let anchor_rows = zero_anchor_rows(src.dynamic_rows());
     let training: std::borrow::Cow<[f64]> = match anchor_rows {
         0 => (&x[..]).into(),
         k => {
@@ -323,17 +322,16 @@ pub fn decoder_form(name: &str) -> Result<DecoderForm, ScenarioError> {
     })
 }
 
-/// Copies of the zero-strain snapshot added for `rows` training rows of trajectories (with several
-/// datasets, the rows of those that are trajectories; `dynamic` false: none): for trajectory data (which
-/// start from the straight rod at rest, as every simulation from rest does) 1 % of the rows and at
-/// least 10, so that the straight rod is a point of the learned manifold and not just one sample
-/// among thousands; none for equilibria, whose manifold need not contain the straight rod (under
-/// gravity no equilibrium is straight, and a 1-D decoder forced through it bends away from the data).
-pub fn zero_anchor_rows(rows: usize, dynamic: bool) -> usize {
-    if dynamic {
-        (rows / 100).max(10)
-    } else {
-        0
+/// Copies of the zero-strain snapshot added for `trajectory_rows` training rows of trajectories
+/// (the rows of the datasets that are trajectories): trajectories start from the straight rod at
+/// rest, as every simulation from rest does, so 1 % of their rows and at least 10 make it a point of
+/// the learned manifold and not just one sample among thousands; none without trajectory rows, since
+/// the manifold of equilibria need not contain the straight rod (under gravity no equilibrium is
+/// straight, and a 1-D decoder forced through it bends away from the data).
+pub fn zero_anchor_rows(trajectory_rows: usize) -> usize {
+    match trajectory_rows {
+        0 => 0,
+        n => (n / 100).max(10),
     }
 }
 
