@@ -360,23 +360,36 @@ pub fn load_model(py: Python<'_>, path: PathBuf, extrapolate: bool) -> PyResult<
 ///     The new model directory.
 /// force : bool
 ///     Replace ``out`` if it is an earlier gvsrom output.
+/// norm : str
+///     ``"plain"`` (every strain value weighs 1: the paper's POD) or ``"energy"`` (each value weighted
+///     by the section stiffness, as ``train(loss="energy")``; ``gvsrom pod --norm``).
 ///
 /// Returns
 /// -------
 /// Model
 ///     The new model.
 #[pyfunction]
-#[pyo3(signature = (dataset, modes, out, force=false))]
+#[pyo3(signature = (dataset, modes, out, force=false, norm="plain"))]
 pub fn pod(
     py: Python<'_>,
     dataset: &Bound<'_, PyAny>,
     modes: usize,
     out: PathBuf,
     force: bool,
+    norm: &str,
 ) -> PyResult<Model> {
+    use gvsrom::reduce::PodNorm;
+    let norm = [PodNorm::Plain, PodNorm::Energy]
+        .into_iter()
+        .find(|n| n.name() == norm)
+        .ok_or_else(|| {
+            invalid(format!(
+                "invalid `norm`: `{norm}` (accepted: plain, energy)"
+            ))
+        })?;
     let dataset = dataset_paths(dataset)?;
     let summary = py
-        .detach(|| gvsrom::reduce::pod(&dataset, modes, &out, force))
+        .detach(|| gvsrom::reduce::pod(&dataset, modes, norm, &out, force))
         .map_err(errors::any)?;
     for w in &summary.warnings {
         crate::robot::warn(py, w)?;

@@ -162,6 +162,26 @@ def test_pod_encode_decode_is_the_projection_onto_the_stored_modes(dataset, pod_
     assert pod_model.decode(q[3]).shape == (x.shape[1],)
 
 
+def test_energy_pod_encodes_by_the_projection_in_its_norm(dataset, pod_model, tmp_path):
+    x = gvsrom.load_dataset(dataset).strain
+    model = gvsrom.pod(dataset, 2, tmp_path / "energy", norm="energy")
+    assert model.meta["pod_norm"] == "energy"
+    v, w = model.arrays["modes"], model.arrays["norm_weights"]
+    assert w.shape == (x.shape[1],) and (w > 0).all()
+    np.testing.assert_allclose(v.T @ (w[:, None] * v), np.eye(2), atol=1e-10)
+    q = model.encode(x)
+    np.testing.assert_allclose(q, (x * w) @ v, rtol=0, atol=1e-10 * np.abs(q).max())
+    # the closer fit in the energy norm than the plain POD's, the looser in the plain norm
+    def errors(m):
+        d = m.reconstruct(x) - x
+        return (w * d * d).sum(), (d * d).sum()
+    (energy_w, energy_plain), (plain_w, plain_plain) = errors(model), errors(pod_model)
+    assert energy_w < plain_w and plain_plain < energy_plain
+    with pytest.raises(gvsrom.GvsromError, match="invalid `norm`: `kinetic` .*plain, energy"):
+        gvsrom.pod(dataset, 2, tmp_path / "bad", norm="kinetic")
+    assert not (tmp_path / "bad").exists()
+
+
 def test_autoencoder_reconstruction_is_its_network_from_the_stored_weights(dataset, ae_model):
     x = gvsrom.load_dataset(dataset).strain
     a = ae_model.arrays

@@ -181,6 +181,10 @@ pub struct ModelMeta {
     /// POD: fraction of the snapshot energy the kept modes capture.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub captured_energy: Option<f64>,
+    /// The norm of a POD (`gvsrom pod --norm`; absent in models written before it: plain). An
+    /// energy POD's feature weights are stored beside its modes (`norm_weights`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pod_norm: Option<crate::reduce::PodNorm>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub training: Option<TrainingMeta>,
     /// Largest relative part of a reconstructed training snapshot the HOM basis cannot represent,
@@ -195,10 +199,13 @@ pub struct ModelMeta {
 /// The numbers of a model.
 #[derive(Debug, Clone, PartialEq)]
 pub enum ModelWeights {
-    /// POD modes (L × K, column k = mode k) and all singular values.
+    /// POD modes (L × K, column k = mode k) and all singular values; for a POD in a weighted norm,
+    /// the feature weights `w` of that norm (the modes are then W-orthonormal and a snapshot's
+    /// coordinates `Φᵀ W x`: `rom::pod`).
     Pod {
         modes: nalgebra::DMatrix<f64>,
         singular_values: Vec<f64>,
+        norm_weights: Option<Vec<f64>>,
     },
     Autoencoder(Autoencoder),
 }
@@ -288,6 +295,7 @@ impl ReducedModel {
             ModelWeights::Pod {
                 modes,
                 singular_values,
+                norm_weights,
             } => {
                 // row-major L × K
                 let rm: Vec<f64> = modes.transpose().iter().copied().collect();
@@ -299,6 +307,9 @@ impl ReducedModel {
                     "singular_values".into(),
                     (vec![singular_values.len()], f64_bytes(singular_values)),
                 );
+                if let Some(w) = norm_weights {
+                    t.insert("norm_weights".into(), (vec![w.len()], f64_bytes(w)));
+                }
             }
             ModelWeights::Autoencoder(ae) => {
                 mlp_tensors("encoder", ae.encoder(), &mut t);
@@ -446,9 +457,22 @@ impl ReducedModel {
                     .map(|t| t.shape().first().copied().unwrap_or(0))
                     .unwrap_or(0);
                 let singular_values = get("singular_values", &[n_sv])?;
+                let norm_weights = match meta.pod_norm.unwrap_or_default() {
+                    crate::reduce::PodNorm::Plain => None,
+                    crate::reduce::PodNorm::Energy => {
+                        let w = get("norm_weights", &[features])?;
+                        if let Some((j, v)) = w.iter().enumerate().find(|(_, v)| **v <= 0.0) {
+                            return Err(bad(format!(
+                                "{WEIGHTS_FILE}: tensor `norm_weights` holds {v} at index {j} (expected > 0)"
+                            )));
+                        }
+                        Some(w)
+                    }
+                };
                 ModelWeights::Pod {
                     modes: nalgebra::DMatrix::from_row_slice(features, meta.latent, &rm),
                     singular_values,
+                    norm_weights,
                 }
             }
             "autoencoder" => {

@@ -848,7 +848,8 @@ fn check_dataset(dir: &Path, pass: &str, reach: &Reach) {
         dir.file_name().unwrap().to_string_lossy()
     ));
     let _ = fs::remove_dir_all(&out);
-    if let Ok(summary) = gvsrom::reduce::pod(&[dir], 1, &out, true) {
+    if let Ok(summary) = gvsrom::reduce::pod(&[dir], 1, gvsrom::reduce::PodNorm::Plain, &out, true)
+    {
         assert!(
             summary.captured_energy.is_finite()
                 && summary.singular_values.iter().all(|v| v.is_finite()),

@@ -256,7 +256,13 @@ def reproduce(
     test_sizes: bool = False,
 ) -> list[dict[str, Any]]: ...
 def load_model(path: _Path, extrapolate: bool = False) -> Model: ...
-def pod(dataset: Dataset | _Path | Sequence[Dataset | _Path], modes: int, out: _Path, force: bool = False) -> Model: ...
+def pod(
+    dataset: Dataset | _Path | Sequence[Dataset | _Path],
+    modes: int,
+    out: _Path,
+    force: bool = False,
+    norm: str = "plain",
+) -> Model: ...
 def train(
     dataset: Dataset | _Path | Sequence[Dataset | _Path],
     out: _Path,

@@ -11,6 +11,11 @@ pub struct PodArgs {
     /// Number of POD modes kept (reduced coordinates).
     #[arg(long, value_name = "K")]
     pub modes: usize,
+    /// The norm the modes are optimal in: `plain` (every strain value weighs 1: the paper's POD) or
+    /// `energy` (each value weighted by the section stiffness, as `train --loss energy`: stiff
+    /// elongation and shear weigh what they cost in elastic force).
+    #[arg(long, value_enum, default_value_t)]
+    pub norm: reduce::PodNorm,
     /// The new model directory.
     #[arg(long, value_name = "MODEL")]
     pub out: PathBuf,
@@ -98,7 +103,7 @@ pub struct TrainArgs {
 }
 
 pub(super) fn pod_cmd(args: &PodArgs, out: &mut impl Write) -> Result<()> {
-    let s = reduce::pod(&args.datasets, args.modes, &args.out, args.force)?;
+    let s = reduce::pod(&args.datasets, args.modes, args.norm, &args.out, args.force)?;
     for w in &s.warnings {
         eprintln!("warning: {w}");
     }
@@ -126,8 +131,13 @@ pub(super) fn pod_cmd(args: &PodArgs, out: &mut impl Write) -> Result<()> {
     )?;
     writeln!(
         out,
-        "modes      {} capture {:.8} of the snapshot energy",
-        s.modes, s.captured_energy
+        "modes      {} capture {:.8} of the snapshot energy{}",
+        s.modes,
+        s.captured_energy,
+        match s.norm {
+            reduce::PodNorm::Plain => "",
+            reduce::PodNorm::Energy => " in the strain-energy norm",
+        }
     )?;
     anchors_line(out, s.anchor_equilibria, s.rows, s.anchor_time_s)?;
     writeln!(out, "model      {}", s.path.display())?;

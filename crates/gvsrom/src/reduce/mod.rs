@@ -26,7 +26,7 @@ pub use crate::build::Reduced;
 pub use anchors::{anchor_guess, solve_anchors, AnchorInput, AnchorProblem, InitialGuess};
 pub use attach::{attach, attach_resolved, attach_source, parameterization, AttachOptions};
 pub use evaluate::{reconstruction, Reconstruction};
-pub use pod::{pod, PodSummary};
+pub use pod::{pod, PodNorm, PodSummary};
 pub use train::{
     decoder_form, sample_weighting, train, zero_anchor_rows, Loss, TrainSummary, SAMPLE_WEIGHTINGS,
 };
@@ -239,4 +239,18 @@ pub(super) fn dataset_warnings(ds: &Dataset, dir: &Path) -> Vec<String> {
             dir.display()
         )],
     }
+}
+
+/// The strain-energy norm's weight of every snapshot feature of `layout` (point `j`, active
+/// component `a`, point-major): the section stiffness `Σ_s,aa` at the point (`E J`-, `E I`-, `E A`-
+/// and `G A`-type entries). `‖x‖²_W = Σ w x²` is twice the strain energy per unit length, summed
+/// over the points without their quadrature weights, under which the kinematic points would weigh
+/// nothing.
+pub(crate) fn stiffness_weights(built: &Built, layout: &PointLayout) -> Vec<f64> {
+    (0..layout.n_points)
+        .flat_map(|i| {
+            let es = built.model.section(i).es;
+            layout.active.iter().map(move |&a| es[a])
+        })
+        .collect()
 }

@@ -9,6 +9,40 @@ use crate::reduced_model::{ModelMeta, ModelWeights, ReducedModel};
 use rom::pod::{Pod, PodError};
 use std::path::{Path, PathBuf};
 
+/// The norm a POD is optimal in (`gvsrom pod --norm`).
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Default,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
+#[serde(rename_all = "kebab-case")]
+pub enum PodNorm {
+    /// The plain Euclidean norm of the point strains, every value with weight 1: the paper's POD.
+    #[default]
+    Plain,
+    /// The strain-energy norm: each point's component weighted by its section stiffness `Σ_s,aa`,
+    /// as `gvsrom train --loss energy`. Elongation and shear, small in value but stiff, weigh what
+    /// they cost in elastic force; the modes are orthonormal in that norm and a snapshot's
+    /// coordinates are its projection in it.
+    Energy,
+}
+
+impl PodNorm {
+    /// The name used on the command line and in `meta.json`.
+    pub fn name(self) -> &'static str {
+        match self {
+            PodNorm::Plain => "plain",
+            PodNorm::Energy => "energy",
+        }
+    }
+}
+
 /// What `gvsrom pod` reports.
 pub struct PodSummary {
     pub path: PathBuf,
@@ -17,6 +51,8 @@ pub struct PodSummary {
     pub datasets: Vec<(PathBuf, usize)>,
     pub features: usize,
     pub modes: usize,
+    /// The norm of the POD, in which `captured_energy` is measured.
+    pub norm: PodNorm,
     pub captured_energy: f64,
     pub singular_values: Vec<f64>,
     pub numerical_rank: usize,
@@ -28,10 +64,11 @@ pub struct PodSummary {
 }
 
 /// POD of the strain snapshots of `datasets` (one, or several of one scenario: their rows in
-/// order), `modes` modes, saved as a model at `out`.
+/// order) in the norm `norm`, `modes` modes, saved as a model at `out`.
 pub fn pod<P: AsRef<Path>>(
     datasets: &[P],
     modes: usize,
+    norm: PodNorm,
     out: &Path,
     force: bool,
 ) -> Result<PodSummary, anyhow::Error> {
@@ -39,10 +76,20 @@ pub fn pod<P: AsRef<Path>>(
     let src = Sources::load(datasets)?;
     let provenance = src.record(provenance)?;
     let built = &src.built;
-    projection_of(built)?; // the HOM basis must be recoverable from point strains
+    // the HOM basis must be recoverable from point strains
+    let (layout, _, _) = projection_of(built)?;
     let (x, rows, features) = (&src.x, src.rows(), src.features);
     let dir = OutputDir::create("--out", out, crate::reduced_model::MODEL_FORMAT, force)?;
-    let pod = Pod::compute(x, features, modes).map_err(|e| pod_error(e, &src))?;
+    let pod = match norm {
+        PodNorm::Plain => Pod::compute(x, features, modes),
+        PodNorm::Energy => Pod::compute_weighted(
+            x,
+            features,
+            modes,
+            &super::stiffness_weights(built, &layout),
+        ),
+    }
+    .map_err(|e| pod_error(e, &src))?;
     let energy = pod.captured_energy();
     // anchors: each sample's POD coordinates Vᵀx, then the POD-ROM's own equilibria
     let latent = pod.encode_rows(x);
@@ -60,6 +107,7 @@ pub fn pod<P: AsRef<Path>>(
         anchor_parameters: src.first().meta.parameters.clone(),
         anchor_equilibria: 0,
         captured_energy: Some(energy[modes - 1]),
+        pod_norm: Some(norm),
         training: None,
         projection_residual: 0.0,
         crate_version: env!("CARGO_PKG_VERSION").into(),
@@ -70,6 +118,7 @@ pub fn pod<P: AsRef<Path>>(
         weights: ModelWeights::Pod {
             modes: pod.modes.clone(),
             singular_values: pod.singular_values.clone(),
+            norm_weights: pod.weights.clone(),
         },
         // written by this run: as its files will be hashed
         integrity: crate::output::Integrity::Checked,
@@ -98,6 +147,7 @@ pub fn pod<P: AsRef<Path>>(
         rows,
         features,
         modes,
+        norm,
         captured_energy: energy[modes - 1],
         numerical_rank: pod.rank(1e-12),
         singular_values: pod.singular_values,

@@ -83,14 +83,7 @@ impl Loss {
         match self {
             Loss::Standardized => Weighting::Standardize,
             Loss::Physical => Weighting::Physical(vec![1.0; layout.len()]),
-            Loss::Energy => Weighting::Physical(
-                (0..layout.n_points)
-                    .flat_map(|i| {
-                        let es = built.model.section(i).es;
-                        layout.active.iter().map(move |&a| es[a])
-                    })
-                    .collect(),
-            ),
+            Loss::Energy => Weighting::Physical(super::stiffness_weights(built, layout)),
         }
     }
 }
@@ -194,6 +187,7 @@ pub fn train<P: AsRef<Path>>(
         anchor_parameters: src.first().meta.parameters.clone(),
         anchor_equilibria: 0,
         captured_energy: None,
+        pod_norm: None,
         training: Some(TrainingMeta {
             hidden_layers: options.hidden_layers,
             encoder_sizes: ae.encoder().layer_sizes().to_vec(),

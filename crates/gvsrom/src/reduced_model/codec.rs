@@ -92,15 +92,14 @@ impl ReducedModel {
     /// `q = E(x)` for the row-major snapshots `x` (`rows × features` → `rows × r`). Unless
     /// `extrapolate`, refuses a snapshot whose code lies far outside the training encodings.
     pub fn encode(&self, x: &[f64], extrapolate: bool) -> Result<Vec<f64>, CodecError> {
-        let (n, r) = (self.features(), self.meta.latent);
+        let n = self.features();
         check_rows("strain", x, n, "snapshots of the model's layout")?;
         let q = match &self.weights {
-            ModelWeights::Pod { modes, .. } => x
-                .chunks_exact(n)
-                .flat_map(|row| {
-                    (0..r).map(move |k| modes.column(k).iter().zip(row).map(|(v, x)| v * x).sum())
-                })
-                .collect(),
+            ModelWeights::Pod {
+                modes,
+                norm_weights,
+                ..
+            } => rom::pod::project_rows(modes, norm_weights.as_deref(), x),
             ModelWeights::Autoencoder(ae) => ae
                 .encode(x)
                 .map_err(|e| CodecError::Network(e.to_string()))?,

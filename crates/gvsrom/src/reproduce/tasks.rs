@@ -162,7 +162,7 @@ pub fn pod(
         // (a model without a recorded validity range is from an earlier build: made again)
         |p| ReducedModel::load(p).is_ok_and(|m| !m.meta.input_range.is_empty()),
         |path| {
-            let s = reduce::pod(&[&data.path], modes, path, true)?;
+            let s = reduce::pod(&[&data.path], modes, reduce::PodNorm::Plain, path, true)?;
             let model = ReducedModel::load(path)?;
             Ok(ModelInfo {
                 latent: modes,
