@@ -155,14 +155,29 @@ pub fn pod(
     data: &Step<DatasetInfo>,
     modes: usize,
 ) -> anyhow::Result<Step<ModelInfo>> {
-    let config = serde_json::json!({ "dataset": data.key(), "modes": modes });
+    pod_in(run, name, data, modes, reduce::PodNorm::Plain)
+}
+
+/// `gvsrom pod DATASET --modes K --norm N` at `<out>/steps/<name>` (the plain norm's step is
+/// [`pod`]'s, with the same key).
+pub fn pod_in(
+    run: &Run,
+    name: &str,
+    data: &Step<DatasetInfo>,
+    modes: usize,
+    norm: reduce::PodNorm,
+) -> anyhow::Result<Step<ModelInfo>> {
+    let mut config = serde_json::json!({ "dataset": data.key(), "modes": modes });
+    if norm != reduce::PodNorm::Plain {
+        config["norm"] = serde_json::json!(norm);
+    }
     run.step(
         name,
         &config,
         // (a model without a recorded validity range is from an earlier build: made again)
         |p| ReducedModel::load(p).is_ok_and(|m| !m.meta.input_range.is_empty()),
         |path| {
-            let s = reduce::pod(&[&data.path], modes, reduce::PodNorm::Plain, path, true)?;
+            let s = reduce::pod(&[&data.path], modes, norm, path, true)?;
             let model = ReducedModel::load(path)?;
             Ok(ModelInfo {
                 latent: modes,

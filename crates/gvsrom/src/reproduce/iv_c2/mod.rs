@@ -9,6 +9,7 @@
 //! simulated with it one after the other (`gvsrom simulate [--model]`), each ROM's trajectory
 //! compared with the HOM's (`gvsrom compare`: mean tip error in % of the length) and timed.
 
+mod energy_pod;
 mod more_tests;
 mod report;
 mod variants;
@@ -20,7 +21,10 @@ use super::tasks::{self, AeConfig, DatasetSpec, ModelInfo, ScenarioSpec};
 use super::{new_report, paper, Case, Options, Run};
 use crate::compare::Trajectory;
 use crate::simulate::IntegratorChoice;
-use more_tests::{ae_timing, more_tests_findings, more_tests_table, run_more_tests, TestRuns};
+use energy_pod::{energy_pod_finding, energy_pod_table, run_energy_pod};
+use more_tests::{
+    ae_timing, hom_run, more_tests_findings, more_tests_table, run_more_tests, TestRuns,
+};
 use report::{
     fig9, fig9_table, findings, lambda_table, models_table, notes, table_iii, tip_travel, Context,
     Inset,
@@ -275,6 +279,21 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         &inset_dof.pod,
         rounds,
     )?);
+    // beyond the paper: POD in the norm the autoencoders are trained in, on every test input
+    let mut homs = vec![hom.clone()];
+    for &seed in &s.more_tests {
+        homs.push(hom_run(
+            run,
+            &scenario,
+            &Test {
+                seed,
+                ..test.clone()
+            },
+        )?);
+    }
+    let test_seeds_all: Vec<u64> = tests.iter().map(|t| t.seed).collect();
+    let (energy_pod, energy_runs) =
+        run_energy_pod(run, &scenario, &test, &data, inset, &homs, &test_seeds_all)?;
     // beyond the paper: the same budget over a longer babbling, and a more damped arm, on the same
     // inputs; a variant whose model the inputs lie outside of (a short quick-run babbling may not
     // reach the test's tensions) is left out, with the reason in the notes
@@ -335,6 +354,9 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     report.tables.push(fig9_table(&dofs, &hom));
     report.tables.push(table_iii(inset_dof, &hom));
     report.tables.push(more_tests_table(inset, &tests));
+    report
+        .tables
+        .push(energy_pod_table(inset, &tests, &energy_runs));
     for v in &variant_runs {
         report.tables.push(variant_table(inset, v));
     }
@@ -342,6 +364,9 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     report.tables.push(models_table(&dofs));
     report.findings = findings(&dofs, &hom, inset_dof);
     report.findings.extend(more_tests_findings(inset, &tests));
+    report
+        .findings
+        .push(energy_pod_finding(inset, &tests, &energy_runs));
     report
         .findings
         .extend(variant_runs.iter().map(|v| variant_finding(inset, v)));
@@ -370,6 +395,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
             "ae": d.ae_run, "pod": d.pod_run,
         })).collect::<Vec<_>>(),
         "more_tests": tests,
+        "energy_pod": { "model": energy_pod.value, "tests": energy_runs },
         "variants": variant_runs.iter().map(|v| json!({
             "variant": format!("{:?}", v.variant), "dataset": v.data.value,
             "ae_model": v.ae.value, "pod_model": v.pod.value, "tests": v.tests,
