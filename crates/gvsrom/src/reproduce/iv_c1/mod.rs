@@ -130,6 +130,14 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         anyhow::bail!("expected three trained autoencoders");
     };
     let pod = tasks::pod(run, "iv-c1/pod-6", &data, R)?;
+    // beyond the paper: the POD of the autoencoders' norm
+    let pod_energy = tasks::pod_in(
+        run,
+        "iv-c1/pod-6-energy",
+        &data,
+        R,
+        crate::reduce::PodNorm::Energy,
+    )?;
 
     let tensions = test_tensions();
     let inputs: Vec<Vec<String>> = tensions
@@ -145,6 +153,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         EvalModel::hom(),
         EvalModel::of("AE-6", &ae),
         EvalModel::of("POD-6", &pod),
+        EvalModel::of("POD-6 (energy norm)", &pod_energy),
     ];
     let eval_scenario = scenario.with(&[format!("output.centerline_points={CENTERLINE_POINTS}")]);
     let ev = tasks::statics_eval(
@@ -171,7 +180,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         format!("scenario: preset `six-tendon` ({} m arm in two equal divisions, radius 2 → 1 cm, E = 1 MPa; base along +x, gravity along −z: a horizontal cantilever that sags under its own weight, as IV-A; six frictionless tendons 60° apart on the surface, alternating full and half length; {hom_dof}-DOF Legendre basis, {} computational points, 6 active strain components)", Cell::sig(ev.length, 3).render(), ev.strain_x.len()),
         format!("data: {} equilibria at uniform random tensions in [−30, 30] N on all six tendons, seed 0 (`gvsrom dataset six-tendon --random 'tendons.*.tension=-30:30' --samples {} --seed 0`); solved and failed counts in the table below", s.samples, s.samples),
         format!("autoencoder: r = {R}, {HIDDEN_LAYERS} hidden layers, tanh, λ = 1e-4 against a whole snapshot's squared error (eq. 15), loss in the strain-energy norm, Adam ≤ {} epochs with learning-rate reductions at plateaus and early stopping (patience {}), then L-BFGS (`gvsrom train` defaults)", s.epochs, ae_config.patience),
-        format!("POD: {R} modes of the uncentred snapshots"),
+        format!("POD: {R} modes of the uncentred snapshots; beyond the paper also in the strain-energy norm, the autoencoder's (`gvsrom pod --norm energy`: each strain value weighted by its section stiffness)"),
         format!("test: {TESTS} tension vectors uniform in [−30, 30) N (SplitMix64, seed {TEST_SEED}, rounded to 0.1 N; listed below); each equilibrium solved {} times, mean time, one thread; the HOM from the straight rod, the ROMs from their anchors (as `gvsrom statics [--model]`); centrelines sampled at {CENTERLINE_POINTS} points for Fig. 7", s.repeat),
         format!("Fig. 8: two more r = {R} autoencoders (same settings) trained on {} equilibria each: a grid of {}⁶ tensions over [−30, 30] N (`--grid 'tendons.*.tension=-30:30' --samples {}`) and uniform random tensions (`--random … --samples {} --seed 0`)", fig8_samples, s.per_axis, fig8_samples, fig8_samples),
     ];
@@ -291,7 +300,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
             "fig8_random": &random.value,
             "training_failures": failed_samples(&data.path),
         },
-        "models": { "ae": &ae.value, "pod": &pod.value, "fig8_ae_grid": &ae_grid.value, "fig8_ae_random": &ae_random.value },
+        "models": { "ae": &ae.value, "pod": &pod.value, "pod_energy": &pod_energy.value, "fig8_ae_grid": &ae_grid.value, "fig8_ae_random": &ae_random.value },
         "tip_error_mean_percent": { "ae": ae_tip, "pod": pod_tip },
         "time_mean_s": { "hom": hom_t, "ae": ae_t, "pod": pod_t },
         "fig8": fig8.iter().map(Sampling::values).collect::<Vec<_>>(),
