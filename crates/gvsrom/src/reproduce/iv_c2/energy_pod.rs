@@ -9,27 +9,31 @@ use super::super::step::Step;
 use super::super::tasks::{self, DatasetInfo, ModelInfo, ScenarioSpec};
 use super::super::Run;
 use super::more_tests::TestRuns;
+use super::Dof;
 use crate::reduce::PodNorm;
 
-/// The energy-norm POD of size `r` from `data`, simulated on each test input of `tests` (their
-/// seeds; `homs` the HOM's run of each, in the same order).
+/// The energy-norm POD of size `r` from `data` (`gvsrom pod DATASET --modes r --norm energy`).
+pub(super) fn energy_pod_model(
+    run: &Run,
+    data: &Step<DatasetInfo>,
+    r: usize,
+) -> anyhow::Result<Step<ModelInfo>> {
+    let name = format!("iv-c2/pod-{r}-energy");
+    tasks::pod_in(run, &name, data, r, PodNorm::Energy)
+}
+
+/// The energy-norm POD `pod` of size `r` simulated on each test input of `seeds` (`homs`: the HOM's
+/// run of each, in the same order).
 pub(super) fn run_energy_pod(
     run: &Run,
     scenario: &ScenarioSpec,
     test: &Test,
-    data: &Step<DatasetInfo>,
+    pod: &Step<ModelInfo>,
     r: usize,
     homs: &[Step<SimRun>],
     seeds: &[u64],
-) -> anyhow::Result<(Step<ModelInfo>, Vec<SimRun>)> {
-    let pod = tasks::pod_in(
-        run,
-        &format!("iv-c2/pod-{r}-energy"),
-        data,
-        r,
-        PodNorm::Energy,
-    )?;
-    let runs = seeds
+) -> anyhow::Result<Vec<SimRun>> {
+    seeds
         .iter()
         .zip(homs)
         .map(|(&seed, hom)| {
@@ -43,13 +47,12 @@ pub(super) fn run_energy_pod(
                 &format!("POD-{r}, energy norm (test seed {seed})"),
                 scenario,
                 &t,
-                Some(&pod),
+                Some(pod),
                 Some(hom),
             )?
             .value)
         })
-        .collect::<anyhow::Result<Vec<_>>>()?;
-    Ok((pod, runs))
+        .collect()
 }
 
 /// Per test input: the tip errors of the AE-ROM, the paper's POD-ROM and the energy-norm POD-ROM,
@@ -131,6 +134,39 @@ pub(super) fn energy_pod_finding(r: usize, tests: &[TestRuns], energy: &[SimRun]
         evidence: format!(
             "{better} of {} inputs, AE-{r} against energy-norm POD-{r} tip error in % L: {list}",
             pairs.len()
+        ),
+    }
+}
+
+/// Fig. 9 beyond the paper: at which DOFs the AE-ROM is more accurate than the energy-norm POD-ROM
+/// on the paper's test (complete runs both).
+pub(super) fn fig9_energy_finding(dofs: &[Dof]) -> Finding {
+    let ahead: Vec<usize> = dofs
+        .iter()
+        .filter(|d| {
+            d.ae_run.complete
+                && d.pod_energy_run.complete
+                && d.ae_run.tip_mean() < d.pod_energy_run.tip_mean()
+        })
+        .map(|d| d.r)
+        .collect();
+    let list = dofs
+        .iter()
+        .map(|d| {
+            let (a, e) = (d.ae_run.tip_mean(), d.pod_energy_run.tip_mean());
+            let (a, e) = (Cell::sig(a, 3).render(), Cell::sig(e, 3).render());
+            format!("r = {}: {a} against {e}", d.r)
+        })
+        .collect::<Vec<_>>()
+        .join("; ");
+    let at = ahead.iter().map(usize::to_string).collect::<Vec<_>>();
+    Finding {
+        claim: "the AE-ROM is more accurate than a POD-ROM of the same norm (strain energy) and DOF at every r of Fig. 9 (beyond the paper)".into(),
+        holds: !dofs.is_empty() && ahead.len() == dofs.len(),
+        evidence: format!(
+            "ahead at r = {} of {} DOFs; mean tip error in % L, AE against energy-norm POD: {list}",
+            if at.is_empty() { "none".into() } else { at.join(", ") },
+            dofs.len()
         ),
     }
 }

@@ -21,7 +21,9 @@ use super::tasks::{self, AeConfig, DatasetSpec, ModelInfo, ScenarioSpec};
 use super::{new_report, paper, Case, Options, Run};
 use crate::compare::Trajectory;
 use crate::simulate::IntegratorChoice;
-use energy_pod::{energy_pod_finding, energy_pod_table, run_energy_pod};
+use energy_pod::{
+    energy_pod_finding, energy_pod_model, energy_pod_table, fig9_energy_finding, run_energy_pod,
+};
 use more_tests::{
     ae_timing, hom_run, more_tests_findings, more_tests_table, run_more_tests, TestRuns,
 };
@@ -110,6 +112,9 @@ pub(super) struct Dof {
     pub(super) pod: Step<ModelInfo>,
     pub(super) ae_run: SimRun,
     pub(super) pod_run: SimRun,
+    /// Beyond the paper: the POD of the autoencoders' norm (`gvsrom pod --norm energy`).
+    pub(super) pod_energy: Step<ModelInfo>,
+    pub(super) pod_energy_run: SimRun,
 }
 
 /// An autoencoder of the λ comparison at the inset's r: its weight decay and seed, and its run.
@@ -182,6 +187,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     let pods = tasks::parallel(&s.dofs, |&r| {
         tasks::pod(run, &format!("iv-c2/pod-{r}"), &data, r)
     })?;
+    let energy_pods = tasks::parallel(&s.dofs, |&r| energy_pod_model(run, &data, r))?;
 
     // the test runs, one after the other so that their wall times compare
     let test = Test {
@@ -195,7 +201,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     let hom = simulate_test(run, "iv-c2/test-hom", "HOM", &scenario, &test, None, None)?;
     let mut dofs = vec![];
     let mut inset_runs = None;
-    for ((&r, ae), pod) in s.dofs.iter().zip(trained).zip(pods) {
+    for (((&r, ae), pod), pod_energy) in s.dofs.iter().zip(trained).zip(pods).zip(energy_pods) {
         let ae_run = simulate_test(
             run,
             &format!("iv-c2/test-ae-r{r}"),
@@ -214,6 +220,15 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
             Some(&pod),
             Some(&hom),
         )?;
+        let pod_energy_run = simulate_test(
+            run,
+            &format!("iv-c2/test-pod-{r}-energy"),
+            &format!("POD-{r}, energy norm"),
+            &scenario,
+            &test,
+            Some(&pod_energy),
+            Some(&hom),
+        )?;
         if r == inset {
             inset_runs = Some((
                 Trajectory::load(&ae_run.path, "AE")?,
@@ -226,6 +241,8 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
             pod,
             ae_run: ae_run.value,
             pod_run: pod_run.value,
+            pod_energy,
+            pod_energy_run: pod_energy_run.value,
         });
     }
     let mut lambdas = vec![];
@@ -292,8 +309,15 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         )?);
     }
     let test_seeds_all: Vec<u64> = tests.iter().map(|t| t.seed).collect();
-    let (energy_pod, energy_runs) =
-        run_energy_pod(run, &scenario, &test, &data, inset, &homs, &test_seeds_all)?;
+    let energy_runs = run_energy_pod(
+        run,
+        &scenario,
+        &test,
+        &inset_dof.pod_energy,
+        inset,
+        &homs,
+        &test_seeds_all,
+    )?;
     // beyond the paper: the same budget over a longer babbling, and a more damped arm, on the same
     // inputs; a variant whose model the inputs lie outside of (a short quick-run babbling may not
     // reach the test's tensions) is left out, with the reason in the notes
@@ -364,6 +388,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     report.tables.push(models_table(&dofs));
     report.findings = findings(&dofs, &hom, inset_dof);
     report.findings.extend(more_tests_findings(inset, &tests));
+    report.findings.push(fig9_energy_finding(&dofs));
     report
         .findings
         .push(energy_pod_finding(inset, &tests, &energy_runs));
@@ -393,9 +418,10 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         "dofs": dofs.iter().map(|d| json!({
             "r": d.r, "ae_model": d.ae.value, "pod_model": d.pod.value,
             "ae": d.ae_run, "pod": d.pod_run,
+            "pod_energy_model": d.pod_energy.value, "pod_energy": d.pod_energy_run,
         })).collect::<Vec<_>>(),
         "more_tests": tests,
-        "energy_pod": { "model": energy_pod.value, "tests": energy_runs },
+        "energy_pod": { "model": inset_dof.pod_energy.value, "tests": energy_runs },
         "variants": variant_runs.iter().map(|v| json!({
             "variant": format!("{:?}", v.variant), "dataset": v.data.value,
             "ae_model": v.ae.value, "pod_model": v.pod.value, "tests": v.tests,

@@ -24,6 +24,8 @@ pub(super) fn fig9_table(dofs: &[Dof], hom: &SimRun) -> Table {
             "POD-ROM tip error [% L]",
             "POD-ROM time [s]",
             "POD-ROM reached [s]",
+            "energy-norm POD-ROM tip error [% L]",
+            "energy-norm POD-ROM time [s]",
             "HOM time [s]",
         ]
         .map(String::from)
@@ -39,11 +41,13 @@ pub(super) fn fig9_table(dofs: &[Dof], hom: &SimRun) -> Table {
                     Cell::sig(d.pod_run.tip_mean(), 3),
                     Cell::sig(d.pod_run.wall_time_s, 3),
                     reached(&d.pod_run),
+                    Cell::sig(d.pod_energy_run.tip_mean(), 3),
+                    Cell::sig(d.pod_energy_run.wall_time_s, 3),
                     Cell::sig(hom.wall_time_s, 3),
                 ]
             })
             .collect(),
-        note: format!("Tip error: mean over the samples of ‖p_ROM − p_HOM‖ / L, L = 0.6 m. Time: wall time of the integration (smallest of the repetitions), one thread. Reached: the time of the last sample; a run that stopped before {} s (the decoder left its training region, or the integrator failed: reasons in results.json) is partial, and its error and time are up to where it stopped.", hom.t_reached),
+        note: format!("Tip error: mean over the samples of ‖p_ROM − p_HOM‖ / L, L = 0.6 m. Time: wall time of the integration (smallest of the repetitions), one thread. Reached: the time of the last sample; a run that stopped before {} s (the decoder left its training region, or the integrator failed: reasons in results.json) is partial, and its error and time are up to where it stopped. Energy-norm POD (not in the paper): the POD of the same data in the norm the autoencoders are trained in (`gvsrom pod --norm energy`), its runs complete unless the error is marked.", hom.t_reached),
     }
 }
 
@@ -457,7 +461,7 @@ pub(super) fn fig9(dofs: &[Dof], hom: &SimRun, inset: &Inset) -> anyhow::Result<
     let partial = |f: &dyn Fn(&SimRun) -> f64| {
         let (mut x, mut y) = (vec![], vec![]);
         for d in dofs {
-            for run in [&d.ae_run, &d.pod_run] {
+            for run in [&d.ae_run, &d.pod_run, &d.pod_energy_run] {
                 if !run.complete {
                     x.push(d.r as f64);
                     y.push(f(run));
@@ -485,6 +489,12 @@ pub(super) fn fig9(dofs: &[Dof], hom: &SimRun, inset: &Inset) -> anyhow::Result<
             palette::POD,
             SeriesStyle::LineMarkers,
         ),
+        over_r(
+            "POD-ROM, energy norm",
+            &|d| d.pod_energy_run.tip_mean(),
+            palette::POD_ALT,
+            SeriesStyle::LineMarkers,
+        ),
     ];
     let mut time_series = vec![
         over_r(
@@ -497,6 +507,12 @@ pub(super) fn fig9(dofs: &[Dof], hom: &SimRun, inset: &Inset) -> anyhow::Result<
             "POD-ROM",
             &|d| d.pod_run.wall_time_s,
             palette::POD,
+            SeriesStyle::LineMarkers,
+        ),
+        over_r(
+            "POD-ROM, energy norm",
+            &|d| d.pod_energy_run.wall_time_s,
+            palette::POD_ALT,
             SeriesStyle::LineMarkers,
         ),
         over_r(
@@ -595,7 +611,7 @@ pub(super) fn fig9(dofs: &[Dof], hom: &SimRun, inset: &Inset) -> anyhow::Result<
     ];
     figure(
         "fig9-dof",
-        &format!("Fig. 9: mean tip error (% of the length) and wall time of the {d} s test against the number of DOFs for the AE-ROM (gold) and the POD-ROM (red), the HOM's time as the green dashed line (log scales where the values span two powers of ten; black dots: runs that stopped early, measured up to where they stopped); the tip traces of the HOM, AE-{r} and POD-{r} (r = {r}, the paper's inset): the path seen along the arm (y–z, gravity along −z) and the tip's x, y, z over time", r = inset.r, d = hom.t_reached),
+        &format!("Fig. 9: mean tip error (% of the length) and wall time of the {d} s test against the number of DOFs for the AE-ROM (gold), the POD-ROM (red) and, beyond the paper, the POD-ROM of the autoencoders' strain-energy norm (blue), the HOM's time as the green dashed line (log scales where the values span two powers of ten; black dots: runs that stopped early, measured up to where they stopped); the tip traces of the HOM, AE-{r} and POD-{r} (r = {r}, the paper's inset): the path seen along the arm (y–z, gravity along −z) and the tip's x, y, z over time", r = inset.r, d = hom.t_reached),
         &Figure::Grid {
             title: "IV-C2: six-tendon manipulator dynamics, ROMs against the HOM".into(),
             cols: 3,
