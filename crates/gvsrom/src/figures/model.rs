@@ -100,7 +100,16 @@ fn pod_spectrum(
         cols: 2,
         panels: vec![
             panel("Singular values", "σ_k / σ_1", rel),
-            panel("Energy left out by the first k modes", "1 − E_k", left),
+            panel(
+                match model.meta.pod_norm.unwrap_or_default() {
+                    crate::reduce::PodNorm::Plain => "Energy left out by the first k modes",
+                    crate::reduce::PodNorm::Energy => {
+                        "Strain energy left out by the first k modes (energy norm)"
+                    }
+                },
+                "1 − E_k",
+                left,
+            ),
         ],
     };
     sink.figure("pod_spectrum", &fig, (1400, 600))
