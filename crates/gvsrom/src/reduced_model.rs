@@ -184,7 +184,7 @@ pub struct ModelMeta {
     /// The norm of a POD (`gvsrom pod --norm`; absent in models written before it: plain). An
     /// energy POD's feature weights are stored beside its modes (`norm_weights`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub pod_norm: Option<crate::reduce::PodNorm>,
+    pub pod_norm: Option<PodNorm>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub training: Option<TrainingMeta>,
     /// Largest relative part of a reconstructed training snapshot the HOM basis cannot represent,
@@ -212,6 +212,40 @@ pub enum ModelWeights {
 
 fn is_zero(n: &usize) -> bool {
     *n == 0
+}
+
+/// The norm a POD is optimal in (`gvsrom pod --norm`).
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Default,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
+#[serde(rename_all = "kebab-case")]
+pub enum PodNorm {
+    /// The plain Euclidean norm of the point strains, every value with weight 1: the paper's POD.
+    #[default]
+    Plain,
+    /// The strain-energy norm: each point's component weighted by its section stiffness `Σ_s,aa`,
+    /// as `gvsrom train --loss energy`. Elongation and shear, small in value but stiff, weigh what
+    /// they cost in elastic force; the modes are orthonormal in that norm and a snapshot's
+    /// coordinates are its projection in it.
+    Energy,
+}
+
+impl PodNorm {
+    /// The name used on the command line and in `meta.json`.
+    pub fn name(self) -> &'static str {
+        match self {
+            PodNorm::Plain => "plain",
+            PodNorm::Energy => "energy",
+        }
+    }
 }
 
 /// Training samples as (inputs, reduced coordinates) pairs: initial guesses for reduced solves. The
@@ -458,8 +492,8 @@ impl ReducedModel {
                     .unwrap_or(0);
                 let singular_values = get("singular_values", &[n_sv])?;
                 let norm_weights = match meta.pod_norm.unwrap_or_default() {
-                    crate::reduce::PodNorm::Plain => None,
-                    crate::reduce::PodNorm::Energy => {
+                    PodNorm::Plain => None,
+                    PodNorm::Energy => {
                         let w = get("norm_weights", &[features])?;
                         if let Some((j, v)) = w.iter().enumerate().find(|(_, v)| **v <= 0.0) {
                             return Err(bad(format!(

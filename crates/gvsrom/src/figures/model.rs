@@ -102,8 +102,8 @@ fn pod_spectrum(
             panel("Singular values", "σ_k / σ_1", rel),
             panel(
                 match model.meta.pod_norm.unwrap_or_default() {
-                    crate::reduce::PodNorm::Plain => "Energy left out by the first k modes",
-                    crate::reduce::PodNorm::Energy => {
+                    crate::reduced_model::PodNorm::Plain => "Energy left out by the first k modes",
+                    crate::reduced_model::PodNorm::Energy => {
                         "Strain energy left out by the first k modes (energy norm)"
                     }
                 },

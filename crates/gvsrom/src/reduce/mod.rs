@@ -23,10 +23,11 @@ mod train;
 pub mod validity;
 
 pub use crate::build::Reduced;
+pub use crate::reduced_model::PodNorm;
 pub use anchors::{anchor_guess, solve_anchors, AnchorInput, AnchorProblem, InitialGuess};
 pub use attach::{attach, attach_resolved, attach_source, parameterization, AttachOptions};
 pub use evaluate::{reconstruction, Reconstruction};
-pub use pod::{pod, PodNorm, PodSummary};
+pub use pod::{pod, PodSummary};
 pub use train::{
     decoder_form, sample_weighting, train, zero_anchor_rows, Loss, TrainSummary, SAMPLE_WEIGHTINGS,
 };

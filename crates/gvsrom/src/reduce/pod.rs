@@ -5,43 +5,9 @@ use super::sources::Sources;
 use super::{equilibrium_anchors, invalid, model_layout, projection_of};
 use crate::error::ScenarioError;
 use crate::output::OutputDir;
-use crate::reduced_model::{ModelMeta, ModelWeights, ReducedModel};
+use crate::reduced_model::{ModelMeta, ModelWeights, PodNorm, ReducedModel};
 use rom::pod::{Pod, PodError};
 use std::path::{Path, PathBuf};
-
-/// The norm a POD is optimal in (`gvsrom pod --norm`).
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Eq,
-    Default,
-    serde::Serialize,
-    serde::Deserialize,
-    clap::ValueEnum,
-)]
-#[serde(rename_all = "kebab-case")]
-pub enum PodNorm {
-    /// The plain Euclidean norm of the point strains, every value with weight 1: the paper's POD.
-    #[default]
-    Plain,
-    /// The strain-energy norm: each point's component weighted by its section stiffness `Σ_s,aa`,
-    /// as `gvsrom train --loss energy`. Elongation and shear, small in value but stiff, weigh what
-    /// they cost in elastic force; the modes are orthonormal in that norm and a snapshot's
-    /// coordinates are its projection in it.
-    Energy,
-}
-
-impl PodNorm {
-    /// The name used on the command line and in `meta.json`.
-    pub fn name(self) -> &'static str {
-        match self {
-            PodNorm::Plain => "plain",
-            PodNorm::Energy => "energy",
-        }
-    }
-}
 
 /// What `gvsrom pod` reports.
 pub struct PodSummary {
