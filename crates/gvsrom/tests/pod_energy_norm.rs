@@ -6,7 +6,10 @@
 
 mod common;
 
-use common::{gvsrom, json, npy, run_ok, s, scratch, sweep_dataset};
+use common::{
+    assert_sigma_squared_are_eigenvalues, gvsrom, json, run_ok, s, scratch, snapshots,
+    sweep_dataset,
+};
 use gvsrom::reduced_model::{ModelWeights, ReducedModel};
 use nalgebra::{DMatrix, DVector};
 use std::path::{Path, PathBuf};
@@ -33,12 +36,6 @@ fn models() -> &'static (PathBuf, PathBuf, PathBuf) {
         assert!(printed.contains("in the strain-energy norm"), "{printed}");
         (data, plain, energy)
     })
-}
-
-fn snapshots(dir: &Path) -> DMatrix<f64> {
-    let (shape, v) = npy(&dir.join("strain.npy"));
-    let features: usize = shape[1..].iter().product();
-    DMatrix::from_row_slice(shape[0], features, &v)
 }
 
 fn pod_of(dir: &Path) -> (DMatrix<f64>, Option<Vec<f64>>) {
@@ -110,21 +107,7 @@ fn energy_pod_modes_are_orthonormal_in_the_norm_and_its_singular_values_are_the_
     let x = snapshots(data);
     let root = DMatrix::from_diagonal(&w.map(f64::sqrt));
     let xw = &x * &root;
-    let mut eig: Vec<f64> = (xw.transpose() * &xw)
-        .symmetric_eigenvalues()
-        .iter()
-        .copied()
-        .collect();
-    eig.sort_by(|p, q| q.total_cmp(p));
-    let sigma = npy(&energy.join("singular_values.npy")).1;
-    for k in 0..2 {
-        assert!(
-            (sigma[k] * sigma[k] - eig[k]).abs() <= 1e-8 * eig[0],
-            "σ_{k}² = {} against the eigenvalue {}",
-            sigma[k] * sigma[k],
-            eig[k]
-        );
-    }
+    assert_sigma_squared_are_eigenvalues(energy, &(xw.transpose() * &xw), 2, 1e-8);
 }
 
 #[test]

@@ -4,9 +4,11 @@
 
 mod common;
 
-use common::{expect_error, json, npy, run_ok, s, scratch, sweep_dataset};
+use common::{
+    assert_sigma_squared_are_eigenvalues, expect_error, json, npy, run_ok, s, scratch, snapshots,
+    sweep_dataset,
+};
 use gvsrom::reduced_model::ReducedModel;
-use nalgebra::DMatrix;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
@@ -41,13 +43,6 @@ fn two() -> &'static (PathBuf, PathBuf) {
     })
 }
 
-/// The strain snapshots of a dataset as a matrix (rows: samples), read from its files.
-fn snapshots(dir: &Path) -> DMatrix<f64> {
-    let (shape, v) = npy(&dir.join("strain.npy"));
-    let features: usize = shape[1..].iter().product();
-    DMatrix::from_row_slice(shape[0], features, &v)
-}
-
 fn inputs(dir: &Path) -> Vec<f64> {
     npy(&dir.join("inputs.npy")).1
 }
@@ -64,17 +59,8 @@ fn pod_of_two_datasets_is_the_pod_of_their_stacked_snapshots() {
     // σ_k² are the eigenvalues of XᵀX = X_Aᵀ X_A + X_Bᵀ X_B (a symmetric eigensolver, not an SVD)
     let (xa, xb) = (snapshots(a), snapshots(b));
     let gram = xa.transpose() * &xa + xb.transpose() * &xb;
-    let mut eig: Vec<f64> = gram.symmetric_eigenvalues().iter().copied().collect();
-    eig.sort_by(|p, q| q.total_cmp(p));
+    assert_sigma_squared_are_eigenvalues(&ab, &gram, 3, 1e-9);
     let sigma = npy(&ab.join("singular_values.npy")).1;
-    for k in 0..3 {
-        assert!(
-            (sigma[k] * sigma[k] - eig[k]).abs() <= 1e-9 * eig[0],
-            "σ_{k}² = {} against the eigenvalue {}",
-            sigma[k] * sigma[k],
-            eig[k]
-        );
-    }
     // one dataset alone is another POD
     let a_only = scratch("several-pod-a");
     run_ok(&["pod", s(a), "--modes", "3", "--out", s(&a_only)]);

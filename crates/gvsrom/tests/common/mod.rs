@@ -181,3 +181,32 @@ pub fn interrupted(args: &[&str], after: Duration) -> Output {
     assert!(sent.success(), "SIGINT could not be sent");
     child.wait_with_output().expect("gvsrom exits")
 }
+
+/// The strain snapshots of a dataset as a matrix (rows: samples), read from its files.
+pub fn snapshots(dir: &Path) -> nalgebra::DMatrix<f64> {
+    let (shape, v) = npy(&dir.join("strain.npy"));
+    let features: usize = shape[1..].iter().product();
+    nalgebra::DMatrix::from_row_slice(shape[0], features, &v)
+}
+
+/// Asserts that the first `k` squared singular values a POD model at `model` stored
+/// (`singular_values.npy`) are the `k` largest eigenvalues of the Gram matrix `gram` (a symmetric
+/// eigensolver, not an SVD), within `rel` of the largest.
+pub fn assert_sigma_squared_are_eigenvalues(
+    model: &Path,
+    gram: &nalgebra::DMatrix<f64>,
+    k: usize,
+    rel: f64,
+) {
+    let mut eig: Vec<f64> = gram.symmetric_eigenvalues().iter().copied().collect();
+    eig.sort_by(|p, q| q.total_cmp(p));
+    let sigma = npy(&model.join("singular_values.npy")).1;
+    for i in 0..k {
+        assert!(
+            (sigma[i] * sigma[i] - eig[i]).abs() <= rel * eig[0],
+            "σ_{i}² = {} against the eigenvalue {}",
+            sigma[i] * sigma[i],
+            eig[i]
+        );
+    }
+}
