@@ -492,6 +492,11 @@ impl ReducedModel {
                     .unwrap_or(0);
                 let singular_values = get("singular_values", &[n_sv])?;
                 let norm_weights = match meta.pod_norm.unwrap_or_default() {
+                    PodNorm::Plain if st.tensor("norm_weights").is_ok() => {
+                        return Err(bad(format!(
+                            "{WEIGHTS_FILE}: tensor `norm_weights` in a POD whose meta.json records the plain norm (`pod_norm`): the files do not belong together"
+                        )));
+                    }
                     PodNorm::Plain => None,
                     PodNorm::Energy => {
                         let w = get("norm_weights", &[features])?;

@@ -7,7 +7,7 @@
 mod common;
 
 use common::{
-    assert_sigma_squared_are_eigenvalues, gvsrom, json, run_ok, s, scratch, snapshots,
+    assert_sigma_squared_are_eigenvalues, copy_dir, gvsrom, json, run_ok, s, scratch, snapshots,
     sweep_dataset,
 };
 use gvsrom::reduced_model::{ModelWeights, ReducedModel};
@@ -169,4 +169,32 @@ fn an_unknown_norm_is_refused_with_the_accepted_ones() {
         assert!(err.contains(needle), "`{needle}` in {err}");
     }
     assert!(!out.exists());
+}
+
+/// A copy of the model `from` at the scratch path `name` with `meta.json`'s `pod_norm` set to
+/// `norm`, its hashes recomputed (a consistent file set that disagrees with itself).
+fn relabelled(from: &Path, name: &str, norm: &str) -> PathBuf {
+    let dir = copy_dir(from, name);
+    let path = dir.join("meta.json");
+    let mut meta = json(&path);
+    meta["pod_norm"] = serde_json::json!(norm);
+    std::fs::write(&path, serde_json::to_string_pretty(&meta).unwrap()).unwrap();
+    common::reseal::reseal(&dir);
+    dir
+}
+
+#[test]
+fn a_pod_whose_norm_and_weights_disagree_is_refused_on_load() {
+    let (_, plain, energy) = models();
+    // energy in meta.json, but no weights to project with
+    let dir = relabelled(plain, "energy-pod-no-weights", "energy");
+    let e = ReducedModel::load(&dir).expect_err("refused").to_string();
+    assert!(e.contains("norm_weights"), "{e}");
+    // weights, but meta.json says plain: the coordinates would silently be another projection
+    let dir = relabelled(energy, "energy-pod-said-plain", "plain");
+    let e = ReducedModel::load(&dir).expect_err("refused").to_string();
+    assert!(e.contains("norm_weights") && e.contains("plain"), "{e}");
+    // the copies themselves are sound: relabelled as they were, both load
+    assert!(ReducedModel::load(&relabelled(energy, "energy-pod-same", "energy")).is_ok());
+    assert!(ReducedModel::load(&relabelled(plain, "energy-pod-plain-same", "plain")).is_ok());
 }
