@@ -10,6 +10,7 @@
 //! compared with the HOM's (`gvsrom compare`: mean tip error in % of the length) and timed.
 
 mod energy_pod;
+mod frequencies;
 mod more_tests;
 mod report;
 mod variants;
@@ -24,6 +25,7 @@ use crate::simulate::IntegratorChoice;
 use energy_pod::{
     energy_pod_finding, energy_pod_model, energy_pod_table, fig9_energy_finding, run_energy_pod,
 };
+use frequencies::{frequencies_table, natural_frequencies};
 use more_tests::{
     ae_timing, hom_run, more_tests_findings, more_tests_table, run_more_tests, TestRuns,
 };
@@ -296,6 +298,16 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         &inset_dof.pod,
         rounds,
     )?);
+    // beyond the paper: the inset ROMs' lowest natural frequencies against the HOM's
+    let frequencies = natural_frequencies(
+        run,
+        &scenario,
+        &[
+            (format!("AE-{inset}"), &inset_dof.ae),
+            (format!("POD-{inset}"), &inset_dof.pod),
+            (format!("POD-{inset}, energy norm"), &inset_dof.pod_energy),
+        ],
+    )?;
     // beyond the paper: POD in the norm the autoencoders are trained in, on every test input
     let mut homs = vec![hom.clone()];
     for &seed in &s.more_tests {
@@ -381,6 +393,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     report
         .tables
         .push(energy_pod_table(inset, &tests, &energy_runs));
+    report.tables.push(frequencies_table(&frequencies.value));
     for v in &variant_runs {
         report.tables.push(variant_table(inset, v));
     }
@@ -422,6 +435,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         })).collect::<Vec<_>>(),
         "more_tests": tests,
         "energy_pod": { "model": inset_dof.pod_energy.value, "tests": energy_runs },
+        "frequencies": frequencies.value,
         "variants": variant_runs.iter().map(|v| json!({
             "variant": format!("{:?}", v.variant), "dataset": v.data.value,
             "ae_model": v.ae.value, "pod_model": v.pod.value, "tests": v.tests,
