@@ -100,13 +100,16 @@ impl Pod {
             });
         }
         faer::set_global_parallelism(faer::Par::Seq);
-        let root = |j: usize| weights.map_or(1.0, |w| w[j].sqrt());
-        let x = faer::Mat::<f64>::from_fn(n, n_features, |i, j| rows[i * n_features + j] * root(j));
+        let root: Vec<f64> = match weights {
+            Some(w) => w.iter().map(|w| w.sqrt()).collect(),
+            None => vec![1.0; n_features],
+        };
+        let x = faer::Mat::<f64>::from_fn(n, n_features, |i, j| rows[i * n_features + j] * root[j]);
         let svd = x.thin_svd().map_err(|_| PodError::Svd)?;
         let s = svd.S().column_vector();
         let singular_values: Vec<f64> = (0..rank_max).map(|k| s[k]).collect();
         let v = svd.V();
-        let mut m = DMatrix::from_fn(n_features, modes, |i, k| v[(i, k)] / root(i));
+        let mut m = DMatrix::from_fn(n_features, modes, |i, k| v[(i, k)] / root[i]);
         for mut col in m.column_iter_mut() {
             let imax = col.iamax();
             if col[imax] < 0.0 {

@@ -8,7 +8,7 @@ use super::super::sim_test::{simulate_test, SimRun, Test};
 use super::super::step::Step;
 use super::super::tasks::{self, DatasetInfo, ModelInfo, ScenarioSpec};
 use super::super::Run;
-use super::more_tests::TestRuns;
+use super::more_tests::{hom_run, TestRuns};
 use super::Dof;
 use crate::reduce::PodNorm;
 
@@ -22,25 +22,24 @@ pub(super) fn energy_pod_model(
     tasks::pod_in(run, &name, data, r, PodNorm::Energy)
 }
 
-/// The energy-norm POD `pod` of size `r` simulated on each test input of `seeds` (`homs`: the HOM's
-/// run of each, in the same order).
+/// The energy-norm POD `pod` of size `r` simulated on the test inputs of `seeds`, each against the
+/// HOM's run of that input.
 pub(super) fn run_energy_pod(
     run: &Run,
     scenario: &ScenarioSpec,
     test: &Test,
     pod: &Step<ModelInfo>,
     r: usize,
-    homs: &[Step<SimRun>],
     seeds: &[u64],
 ) -> anyhow::Result<Vec<SimRun>> {
     seeds
         .iter()
-        .zip(homs)
-        .map(|(&seed, hom)| {
+        .map(|&seed| {
             let t = Test {
                 seed,
                 ..test.clone()
             };
+            let hom = hom_run(run, scenario, &t)?;
             Ok(simulate_test(
                 run,
                 &format!("iv-c2/test-pod-{r}-energy-test-seed{seed}"),
@@ -48,7 +47,7 @@ pub(super) fn run_energy_pod(
                 scenario,
                 &t,
                 Some(pod),
-                Some(hom),
+                Some(&hom),
             )?
             .value)
         })
