@@ -63,6 +63,19 @@ impl ScenarioError {
             message: message.into(),
         }
     }
+
+    /// An [`Invalid`](ScenarioError::Invalid) error about one of several inputs given under the
+    /// same name (e.g. `DATASET`), its message prefixed with that input's path; other errors as
+    /// they are.
+    pub fn naming(self, path: &std::path::Path) -> Self {
+        match self {
+            ScenarioError::Invalid { field, message } => ScenarioError::Invalid {
+                field,
+                message: format!("`{}`: {message}", path.display()),
+            },
+            e => e,
+        }
+    }
 }
 
 /// A statics run that failed: the engine's error and, for a non-convergence, what the scenario says

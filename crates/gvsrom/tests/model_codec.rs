@@ -248,6 +248,29 @@ fn reconstruct_cli_gives_pods_discarded_singular_values_and_counts_extrapolated_
         e.contains("soft-beam") && e.contains("single-tendon"),
         "{e}"
     );
+    // several datasets: each judged on its own, then the RMSE over all their values; a refusal
+    // names the dataset's directory
+    let out = run_ok(&["reconstruct", s(&model), s(data()), s(&wide)]);
+    let rmses: Vec<f64> = out
+        .lines()
+        .filter(|l| l.starts_with("RMSE"))
+        .map(|l| l.split_whitespace().nth(1).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(rmses.len(), 2, "{out}");
+    let (rows_a, rows_b) = ((x.len() / n) as f64, 5.0);
+    let pooled =
+        ((rmses[0].powi(2) * rows_a + rmses[1].powi(2) * rows_b) / (rows_a + rows_b)).sqrt();
+    let all = out.lines().find(|l| l.starts_with("all")).expect(&out);
+    let printed_all: f64 = all.split_whitespace().nth(2).unwrap().parse().unwrap();
+    assert!(
+        (printed_all - pooled).abs() <= 1e-3 * pooled,
+        "{printed_all} vs {pooled}\n{out}"
+    );
+    let e = common::expect_error(
+        &["reconstruct", s(&model), s(data()), s(&other)],
+        &["DATASET", "layout"],
+    );
+    assert!(e.contains(&format!("`{}`", other.display())), "{e}");
 }
 
 #[test]

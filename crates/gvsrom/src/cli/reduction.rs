@@ -28,8 +28,10 @@ pub struct PodArgs {
 pub struct ReconstructArgs {
     /// A reduced model directory (from `gvsrom pod` or `gvsrom train`).
     pub model: PathBuf,
-    /// A dataset directory of the model's layout (from `gvsrom dataset`).
-    pub dataset: PathBuf,
+    /// One or more dataset directories of the model's layout (from `gvsrom dataset`), each
+    /// judged on its own (e.g. the training data and data the model did not see).
+    #[arg(value_name = "DATASET", required = true)]
+    pub datasets: Vec<PathBuf>,
 }
 
 #[derive(Debug, Args)]
@@ -269,8 +271,6 @@ pub(super) fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
 
 pub(super) fn reconstruct_cmd(args: &ReconstructArgs, out: &mut impl Write) -> Result<()> {
     let model = gvsrom::reduced_model::ReducedModel::load(&args.model)?;
-    let ds = gvsrom::dataset::Dataset::load(&args.dataset)?;
-    let r = reduce::reconstruction(&model, &ds)?;
     writeln!(
         out,
         "model      {} ({}, r = {})",
@@ -278,12 +278,37 @@ pub(super) fn reconstruct_cmd(args: &ReconstructArgs, out: &mut impl Write) -> R
         model.meta.kind,
         model.meta.latent
     )?;
+    // (squared error, entries) over every dataset, for the combined RMSE
+    let (mut err2, mut entries) = (0.0, 0usize);
+    for path in &args.datasets {
+        let ds = gvsrom::dataset::Dataset::load(path)?;
+        let r = reduce::reconstruction(&model, &ds).map_err(|e| e.naming(path))?;
+        reconstruction_lines(out, path, &r, model.features())?;
+        let n = r.rows * model.features();
+        (err2, entries) = (err2 + r.rmse * r.rmse * n as f64, entries + n);
+    }
+    if args.datasets.len() > 1 {
+        writeln!(
+            out,
+            "all        RMSE {:.4e} over the {} datasets' {entries} values",
+            (err2 / entries as f64).sqrt(),
+            args.datasets.len()
+        )?;
+    }
+    Ok(())
+}
+
+fn reconstruction_lines(
+    out: &mut impl Write,
+    path: &std::path::Path,
+    r: &reduce::Reconstruction,
+    features: usize,
+) -> Result<()> {
     writeln!(
         out,
-        "dataset    {} ({} solved snapshots × {} values)",
-        args.dataset.display(),
+        "dataset    {} ({} solved snapshots × {features} values)",
+        path.display(),
         r.rows,
-        model.features()
     )?;
     writeln!(
         out,

@@ -47,13 +47,7 @@ impl Sources {
         let first = first.as_ref();
         // with several datasets, a dataset's own error names it
         let several = paths.len() > 1;
-        let named = |p: &Path, e: ScenarioError| match (several, e) {
-            (true, ScenarioError::Invalid { field, message }) => ScenarioError::Invalid {
-                field,
-                message: format!("`{}`: {message}", p.display()),
-            },
-            (_, e) => e,
-        };
+        let named = |p: &Path, e: ScenarioError| if several { e.naming(p) } else { e };
         let ds = Dataset::load(first)?;
         let built = dataset_scenario(&ds).map_err(|e| named(first, e))?;
         let length = built.model.rod.length();
