@@ -1,0 +1,101 @@
+#!/usr/bin/env python3
+"""Can the paper's 1-D decoder hold a code that folds K times through the IV-B family? (JAX, float64)
+
+IV-B's strain is linear in the moment: x(c, M) = M g(c) (c the pulse's centre, M its total moment).
+A 1-D code of this 2-D family can at best be a serpentine: K bands of the magnitude, each swept along
+the centre, alternately up and down. With every sample at the centre of its band the RMSE is that of
+quantizing M to K levels — printed as the bound `exact`. This script fits the paper's 7-layer decoder
+(r = 1: 1-18-37-74-n, tanh, linear output, eq. (15) with λ/n) to the snapshots *given* their
+serpentine codes z ∈ [-1, 1] (no encoder), to see whether the architecture can hold such a curve:
+
+    .venv/bin/python scripts/ae_serpentine.py DATASET --bands 10 --epochs 3000 --learning-rate 3e-3 \
+        --first-layer-scale 10
+
+DATASET is `gvsrom dataset soft-beam --random loads.distributed.0.center=0:0.8 --random
+loads.distributed.0.magnitude=-5:5 --samples 5000 --seed 1` (or `reproduce iv-b`'s). Its inputs
+must be (centre, magnitude) in that order. `--first-layer-scale` multiplies the Glorot bound of the
+decoder's first layer (larger: more folds at the start). RMSE over the whole dataset, physical units.
+"""
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+
+import jax
+
+jax.config.update("jax_enable_x64", True)
+import jax.numpy as jnp  # noqa: E402
+import optax  # noqa: E402
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("dataset", type=Path)
+    ap.add_argument("--bands", type=int, default=10)
+    ap.add_argument("--epochs", type=int, default=3000)
+    ap.add_argument("--learning-rate", type=float, default=3e-3)
+    ap.add_argument("--first-layer-scale", type=float, default=1.0)
+    ap.add_argument("--lambda", dest="lam", type=float, default=1e-4)
+    ap.add_argument("--seed", type=int, default=0)
+    a = ap.parse_args()
+
+    x = np.load(a.dataset / "strain.npy")
+    x = x.reshape(x.shape[0], -1)
+    u = np.load(a.dataset / "inputs.npy")
+    ok = np.load(a.dataset / "status.npy") == 0
+    x, u = x[ok], u[ok]
+    rows, n = x.shape
+    c = (u[:, 0] - u[:, 0].min()) / np.ptp(u[:, 0])
+    m_lo, m_hi = u[:, 1].min(), u[:, 1].max()
+    k = a.bands
+    band = np.minimum(((u[:, 1] - m_lo) / (m_hi - m_lo) * k).astype(int), k - 1)
+    t = np.where(band % 2 == 0, c, 1.0 - c)
+    z = jnp.asarray(((band + t) / k * 2.0 - 1.0)[:, None])
+    # the bound: every magnitude moved to its band's centre, x = M g(c) scaled accordingly
+    centre = m_lo + (band + 0.5) * (m_hi - m_lo) / k
+    exact = float(np.sqrt(np.mean((x - x * (centre / u[:, 1])[:, None]) ** 2)))
+
+    s = float(np.sqrt(np.mean(x.std(0) ** 2)))
+    y = jnp.asarray(x / s)
+    sizes = [1] + [max(n >> j, 2) for j in (3, 2, 1)] + [n]
+    key = jax.random.PRNGKey(a.seed)
+    params = []
+    for i, (p, q) in enumerate(zip(sizes[:-1], sizes[1:])):
+        key, sub = jax.random.split(key)
+        lim = np.sqrt(6.0 / (p + q)) * (a.first_layer_scale if i == 0 else 1.0)
+        params.append((jax.random.uniform(sub, (p, q), minval=-lim, maxval=lim), jnp.zeros(q)))
+
+    def decode(ps, h):
+        for i, (w, b) in enumerate(ps):
+            h = h @ w + b
+            if i + 1 < len(ps):
+                h = jnp.tanh(h)
+        return h
+
+    def loss(ps, idx):
+        rec = jnp.mean((decode(ps, z[idx]) - y[idx]) ** 2)
+        return rec + a.lam / n * sum(jnp.sum(w * w) for w, _ in ps)
+
+    batches = -(-rows // 64)
+    opt = optax.adam(optax.exponential_decay(a.learning_rate, a.epochs * batches, 0.03))
+    state = opt.init(params)
+
+    @jax.jit
+    def step(ps, st, idx):
+        g = jax.grad(loss)(ps, idx)
+        upd, st = opt.update(g, st, ps)
+        return optax.apply_updates(ps, upd), st
+
+    rng = np.random.default_rng(a.seed)
+    for _ in range(a.epochs):
+        perm = rng.permutation(rows)
+        for j in range(0, rows, 64):
+            params, state = step(params, state, perm[j : j + 64])
+    rmse = float(np.sqrt(np.mean((np.asarray(decode(params, z)) * s - x) ** 2)))
+    print(json.dumps({"sizes": sizes, "bands": k, "exact": exact, "rmse": rmse, **vars(a)}, default=str))
+
+
+if __name__ == "__main__":
+    main()
