@@ -1,7 +1,8 @@
 //! Built-in scenarios for the paper's robots (Section IV, gvs-spec §3.4, §10.4). Each is the TOML of
 //! `examples/<name>.toml`, embedded so that `gvsrom statics single-tendon` works from any directory.
 //! The first three are the paper's setups; `soft-beam-peak` (the pulse read as a peak line density)
-//! and `six-tendon-no-gravity` are milder variants, kept for the gvs-spec §10.4 anchors.
+//! and `six-tendon-no-gravity` are milder variants, kept for the gvs-spec §10.4 anchors;
+//! `six-tendon-hanging` is the IV-C arm in the other orientation the paper leaves open.
 
 use crate::error::ScenarioError;
 use crate::provenance::{sha256_hex, Provenance, ScenarioOrigin};
@@ -43,6 +44,11 @@ pub const PRESETS: &[Preset] = &[
         name: "six-tendon-no-gravity",
         summary: "IV-C without gravity: actuation only, strain nearly affine in the tensions, 28 DOF",
         toml: include_str!("../../../examples/six-tendon-no-gravity.toml"),
+    },
+    Preset {
+        name: "six-tendon-hanging",
+        summary: "IV-C hanging: the arm along −z, the direction of gravity (the other reading), 28 DOF",
+        toml: include_str!("../../../examples/six-tendon-hanging.toml"),
     },
 ];
 

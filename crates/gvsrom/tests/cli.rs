@@ -126,7 +126,7 @@ fn unknown_preset_or_missing_file_lists_the_presets() {
         &["statics", "two-tendon"],
         &[
             "two-tendon",
-            "single-tendon, soft-beam, six-tendon, soft-beam-peak, six-tendon-no-gravity",
+            "single-tendon, soft-beam, six-tendon, soft-beam-peak, six-tendon-no-gravity, six-tendon-hanging",
         ],
     );
     expect_error(&["statics", "no/such/file.toml"], &["no/such/file.toml"]);

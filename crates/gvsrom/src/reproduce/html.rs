@@ -13,6 +13,25 @@ fn esc(s: &str) -> String {
         .replace('"', "&quot;")
 }
 
+/// Report prose as HTML: escaped, with each pair of backticks (Markdown's inline code, as the
+/// reports write commands, options and presets) made a `<code>` span; an unpaired backtick stays.
+fn prose(s: &str) -> String {
+    let parts: Vec<&str> = s.split('`').collect();
+    let mut h = String::new();
+    for (i, part) in parts.iter().enumerate() {
+        // odd parts follow an opening backtick; paired when another backtick follows them
+        if i % 2 == 0 {
+            h.push_str(&esc(part));
+        } else if i + 1 < parts.len() {
+            h.push_str(&format!("<code>{}</code>", esc(part)));
+        } else {
+            h.push('`');
+            h.push_str(&esc(part));
+        }
+    }
+    h
+}
+
 /// The page over `reports`, reading each case's figures from `<dir>/<case>/<stem>.png` (regular
 /// files only: [`crate::output::read`]).
 pub fn index(reports: &[CaseReport], dir: &Path) -> anyhow::Result<String> {
@@ -55,7 +74,7 @@ pub fn index(reports: &[CaseReport], dir: &Path) -> anyhow::Result<String> {
         ));
         h.push_str("<h3>Setup</h3><ul>");
         for l in &r.setup {
-            h.push_str(&format!("<li>{}</li>", esc(l)));
+            h.push_str(&format!("<li>{}</li>", prose(l)));
         }
         h.push_str("</ul>\n");
         if !r.findings.is_empty() {
@@ -65,14 +84,14 @@ pub fn index(reports: &[CaseReport], dir: &Path) -> anyhow::Result<String> {
                     "<li class=\"{}\"><b>{}</b> {} — {}</li>",
                     if f.holds { "holds" } else { "fails" },
                     if f.holds { "holds:" } else { "does not hold:" },
-                    esc(&f.claim),
-                    esc(&f.evidence)
+                    prose(&f.claim),
+                    prose(&f.evidence)
                 ));
             }
             h.push_str("</ul>\n");
         }
         for t in &r.tables {
-            h.push_str(&format!("<h3>{}</h3><table><thead><tr>", esc(&t.title)));
+            h.push_str(&format!("<h3>{}</h3><table><thead><tr>", prose(&t.title)));
             for c in &t.columns {
                 h.push_str(&format!("<th>{}</th>", esc(c)));
             }
@@ -91,13 +110,13 @@ pub fn index(reports: &[CaseReport], dir: &Path) -> anyhow::Result<String> {
             }
             h.push_str("</tbody></table>\n");
             if !t.note.is_empty() {
-                h.push_str(&format!("<p class=\"note\">{}</p>\n", esc(&t.note)));
+                h.push_str(&format!("<p class=\"note\">{}</p>\n", prose(&t.note)));
             }
         }
         if !r.notes.is_empty() {
             h.push_str("<h3>Differences from the paper</h3><ul>");
             for n in &r.notes {
-                h.push_str(&format!("<li>{}</li>", esc(n)));
+                h.push_str(&format!("<li>{}</li>", prose(n)));
             }
             h.push_str("</ul>\n");
         }
@@ -141,7 +160,7 @@ th{background:#f2f5f3}td.n{text-align:right;font-variant-numeric:tabular-nums}
 .note{font-size:.9em;color:#555;max-width:70em}
 .findings li.holds b{color:#1a7f37}.findings li.fails b{color:#c62828}
 figure{margin:1em 0}figure img{max-width:100%;border:1px solid #ddd}
-figcaption{font-size:.9em;color:#444}pre{background:#f6f6f6;padding:.5em;overflow:auto;font-size:.8em}
+figcaption{font-size:.9em;color:#444}code{background:#f2f2f2;padding:0 .2em;border-radius:3px;font-size:.92em}pre{background:#f6f6f6;padding:.5em;overflow:auto;font-size:.8em}
 ";
 
 #[cfg(all(test, target_os = "linux"))]
@@ -168,5 +187,23 @@ mod tests {
             e.contains(&pipe.display().to_string()) && e.contains("a FIFO (named pipe)"),
             "{e}"
         );
+    }
+}
+
+#[cfg(test)]
+mod prose_tests {
+    use super::prose;
+
+    #[test]
+    fn backtick_pairs_become_code_and_the_rest_is_escaped() {
+        assert_eq!(
+            prose("run `gvsrom pod --norm energy` on <data> & `x`"),
+            "run <code>gvsrom pod --norm energy</code> on &lt;data&gt; &amp; <code>x</code>"
+        );
+        assert_eq!(prose("no code"), "no code");
+        assert_eq!(prose("`a<b`"), "<code>a&lt;b</code>");
+        // an unpaired backtick is kept as text
+        assert_eq!(prose("a `b` c ` d"), "a <code>b</code> c ` d");
+        assert_eq!(prose("`"), "`");
     }
 }
