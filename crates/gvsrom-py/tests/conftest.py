@@ -8,7 +8,14 @@ from pathlib import Path
 
 import pytest
 
-PRESETS = ["single-tendon", "soft-beam", "six-tendon", "soft-beam-peak", "six-tendon-no-gravity"]
+PRESETS = [
+    "single-tendon",
+    "soft-beam",
+    "six-tendon",
+    "soft-beam-peak",
+    "six-tendon-no-gravity",
+    "six-tendon-hanging",
+]
 
 
 @pytest.fixture(scope="session")

@@ -14,6 +14,7 @@ TENSIONS = {
     "single-tendon": [-5.0],
     "six-tendon": [-4.0, 0.0, -2.0, 0.0, -1.0, 0.0],
     "six-tendon-no-gravity": [-3.0, -1.0, 0.0, 0.0, -2.0, 0.0],
+    "six-tendon-hanging": [-4.0, 0.0, -2.0, 0.0, -1.0, 0.0],
 }
 
 
