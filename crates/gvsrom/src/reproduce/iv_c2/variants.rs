@@ -25,7 +25,8 @@ pub(super) const DAMPING_FACTOR: f64 = 3.0;
 /// The hanging variant's preset: `six-tendon` with the base along −z, the direction of gravity.
 pub(super) const HANGING_PRESET: &str = "six-tendon-hanging";
 
-/// A variant of the data (and, for [`DataVariant::Damped`], of the arm).
+/// A variant of the data (and, for [`DataVariant::Damped`] and [`DataVariant::Hanging`], of the
+/// arm).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) enum DataVariant {
     Spread,
@@ -242,7 +243,7 @@ pub(super) fn variant_findings(r: usize, v: &VariantRuns) -> Vec<Finding> {
     let reaches = Finding {
         claim: format!("with {what} (beyond the paper), AE-{r}'s mean tip error is at most the paper's {target} % L on every test input"),
         holds: n > 0 && v.tests.iter().all(|t| t.ae.complete && t.ae.tip_mean() <= target),
-        evidence: summary.clone(),
+        evidence: summary,
     };
     match v.variant {
         DataVariant::Spread => vec![stays],
