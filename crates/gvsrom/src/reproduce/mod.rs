@@ -36,30 +36,31 @@ use std::sync::Arc;
 use std::time::Instant;
 
 /// A study of the paper.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 pub enum Case {
     /// IV-A: single-tendon manipulator, Table I (top), Figs. 3–4, Table III row.
-    #[value(name = "iv-a")]
+    #[cfg_attr(feature = "cli", value(name = "iv-a"))]
     IvA,
     /// IV-B: soft beam under a moment pulse, Table I (bottom), Figs. 5–6, Table III row.
-    #[value(name = "iv-b")]
+    #[cfg_attr(feature = "cli", value(name = "iv-b"))]
     IvB,
     /// IV-C1: six-tendon manipulator under gravity, statics: AE r = 6 against POD-6 (Fig. 7),
     /// grid against random sampling (Fig. 8), Table III row.
-    #[value(name = "iv-c1")]
+    #[cfg_attr(feature = "cli", value(name = "iv-c1"))]
     IvC1,
     /// IV-C2: six-tendon manipulator, dynamics: babbling data, AE- and POD-ROMs with r = 1 … 8 on a
     /// new 10 s input (Fig. 9), Table III row.
-    #[value(name = "iv-c2")]
+    #[cfg_attr(feature = "cli", value(name = "iv-c2"))]
     IvC2,
     /// V: the prototype's four tensions, AE-ROM and POD-ROM with one DOF (Fig. 10b).
-    #[value(name = "v")]
+    #[cfg_attr(feature = "cli", value(name = "v"))]
     V,
     /// The IV-A and IV-B autoencoders retrained on snapshots with Gaussian noise.
-    #[value(name = "noise")]
+    #[cfg_attr(feature = "cli", value(name = "noise"))]
     Noise,
     /// Every case above.
-    #[value(name = "all")]
+    #[cfg_attr(feature = "cli", value(name = "all"))]
     All,
 }
 
