@@ -28,8 +28,8 @@ use energy_pod::{
 use frequencies::{frequencies_notes, frequencies_table, natural_frequencies};
 use more_tests::{ae_timing, more_tests_findings, more_tests_table, run_more_tests, TestRuns};
 use report::{
-    fig9, fig9_table, findings, lambda_table, models_table, notes, table_iii, tip_travel, Context,
-    Inset,
+    fig9, fig9_table, findings, hanging_figure, lambda_table, models_table, notes, table_iii,
+    tip_travel, Context, Inset,
 };
 use serde_json::json;
 use variants::{run_variant, variant_findings, variant_table, DataVariant};
@@ -443,6 +443,19 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
             "lambda": v.lambda, "seed": v.seed, "model": v.model, "run": v.run,
         })).collect::<Vec<_>>(),
     });
-    let figures = vec![fig9(&dofs, &hom, &trajectories)?];
+    let mut figures = vec![fig9(&dofs, &hom, &trajectories)?];
+    // beyond the paper: the hanging arm's tip traces on the paper's test
+    let hanging = variant_runs
+        .iter()
+        .find(|v| v.variant == DataVariant::Hanging);
+    if let Some([h, a, p]) = hanging.and_then(|v| v.first_runs.as_ref()) {
+        let inset = Inset {
+            r: inset,
+            hom: Trajectory::load(h, "HOM")?,
+            ae: Trajectory::load(a, "AE")?,
+            pod: Trajectory::load(p, "POD")?,
+        };
+        figures.push(hanging_figure(&inset, s.test_s)?);
+    }
     Ok((report, figures))
 }

@@ -527,6 +527,52 @@ pub(super) fn fig9(dofs: &[Dof], hom: &SimRun, inset: &Inset) -> anyhow::Result<
         error_series.push(stopped);
         time_series.push(partial(&|x| x.wall_time_s));
     }
+    // a log axis labels the powers of ten only: used when at least two lie within the values
+    let spans_decade = |series: &[Series]| {
+        let v = series.iter().flat_map(|s| s.y.iter().copied());
+        let (lo, hi) = v
+            .filter(|y| y.is_finite() && *y > 0.0)
+            .fold((f64::INFINITY, 0.0f64), |(lo, hi), y| {
+                (lo.min(y), hi.max(y))
+            });
+        hi.log10().floor() - lo.log10().ceil() >= 1.0
+    };
+    let (error_log, time_log) = (spans_decade(&error_series), spans_decade(&time_series));
+    let mut panels = vec![
+        Figure::Line(LineChart {
+            title: "mean tip error over the test".into(),
+            x_label: "DOF r".into(),
+            y_label: "mean tip error [% L]".into(),
+            series: error_series,
+            log_y: error_log,
+            equal_aspect: false,
+        }),
+        Figure::Line(LineChart {
+            title: format!("wall time of the {} s test", hom.t_reached),
+            x_label: "DOF r".into(),
+            y_label: "wall time [s]".into(),
+            series: time_series,
+            log_y: time_log,
+            equal_aspect: false,
+        }),
+    ];
+    panels.extend(trace_panels(inset, [1, 2]));
+    figure(
+        "fig9-dof",
+        &format!("Fig. 9: mean tip error (% of the length) and wall time of the {d} s test against the number of DOFs for the AE-ROM (gold), the POD-ROM (red) and, beyond the paper, the POD-ROM of the autoencoders' strain-energy norm (blue), the HOM's time as the green dashed line (log scales where the values span two powers of ten; black dots: runs that stopped early, measured up to where they stopped); the tip traces of the HOM, AE-{r} and POD-{r} (r = {r}, the paper's inset): the path seen along the arm (y–z, gravity along −z) and the tip's x, y, z over time", r = inset.r, d = hom.t_reached),
+        &Figure::Grid {
+            title: "IV-C2: six-tendon manipulator dynamics, ROMs against the HOM".into(),
+            cols: 3,
+            panels,
+        },
+        1800,
+        1050,
+    )
+}
+
+/// The inset's tip traces: the path seen along the arm (world axes `path[0]`–`path[1]`, across the
+/// unloaded arm), then the tip's x, y and z over time; HOM, AE-r and POD-r.
+fn trace_panels(inset: &Inset, path: [usize; 2]) -> Vec<Figure> {
     let models = [
         (
             "HOM".to_string(),
@@ -559,65 +605,40 @@ pub(super) fn fig9(dofs: &[Dof], hom: &SimRun, inset: &Inset) -> anyhow::Result<
             })
             .collect()
     };
-    let over_t = |axis: usize, name: &str| {
+    const NAME: [&str; 3] = ["x", "y", "z"];
+    let mut panels = vec![Figure::Line(LineChart {
+        title: format!("tip path seen along the arm, r = {}", inset.r),
+        x_label: format!("tip {} [m]", NAME[path[0]]),
+        y_label: format!("tip {} [m]", NAME[path[1]]),
+        series: trace(&|t, k| t.tip[3 * k + path[0]], path[1]),
+        log_y: false,
+        equal_aspect: true,
+    })];
+    panels.extend((0..3).map(|axis| {
         Figure::Line(LineChart {
-            title: format!("tip {name} over time, r = {}", inset.r),
+            title: format!("tip {} over time, r = {}", NAME[axis], inset.r),
             x_label: "t [s]".into(),
-            y_label: format!("tip {name} [m]"),
+            y_label: format!("tip {} [m]", NAME[axis]),
             series: trace(&|t, k| t.t[k], axis),
             log_y: false,
             equal_aspect: false,
         })
-    };
-    // a log axis labels the powers of ten only: used when at least two lie within the values
-    let spans_decade = |series: &[Series]| {
-        let v = series.iter().flat_map(|s| s.y.iter().copied());
-        let (lo, hi) = v
-            .filter(|y| y.is_finite() && *y > 0.0)
-            .fold((f64::INFINITY, 0.0f64), |(lo, hi), y| {
-                (lo.min(y), hi.max(y))
-            });
-        hi.log10().floor() - lo.log10().ceil() >= 1.0
-    };
-    let (error_log, time_log) = (spans_decade(&error_series), spans_decade(&time_series));
-    let panels = vec![
-        Figure::Line(LineChart {
-            title: "mean tip error over the test".into(),
-            x_label: "DOF r".into(),
-            y_label: "mean tip error [% L]".into(),
-            series: error_series,
-            log_y: error_log,
-            equal_aspect: false,
-        }),
-        Figure::Line(LineChart {
-            title: format!("wall time of the {} s test", hom.t_reached),
-            x_label: "DOF r".into(),
-            y_label: "wall time [s]".into(),
-            series: time_series,
-            log_y: time_log,
-            equal_aspect: false,
-        }),
-        Figure::Line(LineChart {
-            title: format!("tip path seen along the arm, r = {}", inset.r),
-            x_label: "tip y [m]".into(),
-            y_label: "tip z [m]".into(),
-            series: trace(&|t, k| t.tip[3 * k + 1], 2),
-            log_y: false,
-            equal_aspect: true,
-        }),
-        over_t(0, "x"),
-        over_t(1, "y"),
-        over_t(2, "z"),
-    ];
+    }));
+    panels
+}
+
+/// The hanging arm's tip traces on the paper's test input (beyond the paper): HOM, AE-r and POD-r
+/// of the variant, the path seen along the arm (x–y: the arm hangs along −z) and x, y, z over time.
+pub(super) fn hanging_figure(inset: &Inset, test_s: f64) -> anyhow::Result<RenderedFigure> {
     figure(
-        "fig9-dof",
-        &format!("Fig. 9: mean tip error (% of the length) and wall time of the {d} s test against the number of DOFs for the AE-ROM (gold), the POD-ROM (red) and, beyond the paper, the POD-ROM of the autoencoders' strain-energy norm (blue), the HOM's time as the green dashed line (log scales where the values span two powers of ten; black dots: runs that stopped early, measured up to where they stopped); the tip traces of the HOM, AE-{r} and POD-{r} (r = {r}, the paper's inset): the path seen along the arm (y–z, gravity along −z) and the tip's x, y, z over time", r = inset.r, d = hom.t_reached),
+        "hanging-trace",
+        &format!("Beyond the paper: the six-tendon arm hanging along gravity (preset six-tendon-hanging), the tip traces of the HOM, AE-{r} and POD-{r} (trained on the hanging arm's babbling) on the paper's {test_s} s test input: the path seen along the arm (x–y, the arm along −z) and the tip's x, y, z over time", r = inset.r),
         &Figure::Grid {
-            title: "IV-C2: six-tendon manipulator dynamics, ROMs against the HOM".into(),
-            cols: 3,
-            panels,
+            title: "IV-C2 on the hanging arm: ROMs against the HOM".into(),
+            cols: 2,
+            panels: trace_panels(inset, [0, 1]),
         },
-        1800,
+        1400,
         1050,
     )
 }

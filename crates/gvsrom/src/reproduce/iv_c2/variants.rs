@@ -17,6 +17,7 @@ use super::super::step::Step;
 use super::super::tasks::{self, AeConfig, DatasetInfo, DatasetSpec, ModelInfo, ScenarioSpec};
 use super::super::Run;
 use super::more_tests::{hom_run, more_tests_table, TestRuns};
+use std::path::PathBuf;
 
 /// How many times longer the spread babbling is, and how many times less often it is sampled.
 pub(super) const SPREAD: f64 = 2.0;
@@ -43,6 +44,8 @@ pub(super) struct VariantRuns {
     pub(super) ae: Step<ModelInfo>,
     pub(super) pod: Step<ModelInfo>,
     pub(super) tests: Vec<TestRuns>,
+    /// The trajectory directories of the HOM, AE and POD runs of the first test input.
+    pub(super) first_runs: Option<[PathBuf; 3]>,
 }
 
 impl DataVariant {
@@ -129,6 +132,7 @@ pub(super) fn run_variant(
     let model = tasks::train(run, &format!("iv-c2/ae-r{r}-{name}"), &data, ae)?;
     let pod = tasks::pod(run, &format!("iv-c2/pod-{r}-{name}"), &data, r)?;
     let mut tests = vec![];
+    let mut first_runs = None;
     for &seed in seeds {
         let t = Test {
             seed,
@@ -161,6 +165,9 @@ pub(super) fn run_variant(
         };
         let ae_run = rom_run(&model, "ae-r", "AE-")?;
         let pod_run = rom_run(&pod, "pod-", "POD-")?;
+        if first_runs.is_none() {
+            first_runs = Some([hom.path.clone(), ae_run.path.clone(), pod_run.path.clone()]);
+        }
         tests.push(TestRuns {
             seed,
             hom: hom.value,
@@ -176,6 +183,7 @@ pub(super) fn run_variant(
         ae: model,
         pod,
         tests,
+        first_runs,
     })
 }
 
