@@ -2,7 +2,7 @@
 """Can the paper's 1-D decoder hold a code that folds K times through the IV-B family? (JAX, float64)
 
 IV-B's strain is linear in the moment: x(c, M) = M g(c) (c the pulse's centre, M its total moment).
-A 1-D code of this 2-D family can at best be a serpentine: K bands of the magnitude, each swept along
+A natural 1-D code of this 2-D family is a serpentine: K bands of the magnitude, each swept along
 the centre, alternately up and down. With every sample at the centre of its band the RMSE is that of
 quantizing M to K levels — printed as the bound `exact`. This script fits the paper's 7-layer decoder
 (r = 1: 1-18-37-74-n, tanh, linear output, eq. (15) with λ/n) to the snapshots *given* their
