@@ -2,9 +2,10 @@
 //! (`gvsrom modes six-tendon --tension=U,U,U,U,U,U [--model M]`: the undamped linearized
 //! eigenproblem about the equilibrium under gravity with every tendon at `U`). A model that cannot
 //! answer there (the tensions outside its training inputs, or its equilibrium off its manifold, as
-//! for a dynamic autoencoder at some holds) gets a row without numbers and its reason. A reduced model that moves the
-//! frequencies of the modes a step excites drifts out of phase with the HOM within the test's
-//! seconds; POD's frequencies are Rayleigh–Ritz upper bounds, an autoencoder's need not be.
+//! for a dynamic autoencoder at some holds) gets a row without numbers and its reason. A reduced
+//! model that moves the frequencies of the modes a step excites drifts out of phase with the HOM
+//! within the test's seconds; POD's frequencies are Rayleigh–Ritz upper bounds, an autoencoder's
+//! need not be.
 
 use super::super::report::{Cell, Table};
 use super::super::step::Step;

@@ -321,8 +321,9 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         &s.more_tests,
     )?);
     // beyond the paper: the same budget over a longer babbling, a more damped arm and the arm
-    // hanging along gravity, on the same inputs; a variant whose model the inputs lie outside of (a short quick-run babbling may not
-    // reach the test's tensions) is left out, with the reason in the notes
+    // hanging along gravity, on the same inputs; a variant whose model the inputs lie outside of
+    // (a short quick-run babbling may not reach the test's tensions) is left out, with the reason
+    // in the notes
     let test_seeds: Vec<u64> = std::iter::once(TEST_SEED)
         .chain(s.more_tests.iter().copied())
         .collect();
