@@ -130,6 +130,9 @@ pub struct TrainingMeta {
     /// the option, plain).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub decoder: Option<String>,
+    /// The weight `β` of the strain-rate term (`rom::nn::rates`; absent: from before the option, 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rate_weight: Option<f64>,
     pub epochs_run: usize,
     pub best_epoch: usize,
     pub stop: String,

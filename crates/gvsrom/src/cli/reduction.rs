@@ -96,6 +96,13 @@ pub struct TrainArgs {
     /// vanishes, such as a load of varying magnitude and position).
     #[arg(long, default_value = "plain", value_parser = rom::nn::DecoderForm::NAMES)]
     pub decoder: String,
+    /// Weight β of the strain-rate term (beyond the paper): the autoencoder's tangent map must carry
+    /// each trajectory sample's strain rate, `‖J(x) ẋ − ẋ‖²` added to the loss with weight β (rates
+    /// by central differences of the trajectory's samples; equilibria are at rest). It gives the
+    /// decoder the tangent space a dynamic model moves in. 0: eq. (15) alone (the paper's); 0.1
+    /// halves the IV-C2 tip error of AE-7 on the arm hanging along gravity (docs/paper-results.md).
+    #[arg(long, default_value_t = 0.0)]
+    pub rate_weight: f64,
     /// The new model directory.
     #[arg(long, value_name = "MODEL")]
     pub out: PathBuf,
@@ -174,6 +181,7 @@ pub(super) fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
         fine_tune: rom::nn::FineTune::lbfgs(args.lbfgs_iterations),
         sample_weighting: reduce::sample_weighting(&args.sample_weighting, args.relative_floor)?,
         decoder: reduce::decoder_form(&args.decoder)?,
+        rate_weight: args.rate_weight,
         ..TrainOptions::default()
     };
     let signal = interrupt_flag();

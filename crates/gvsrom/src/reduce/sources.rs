@@ -213,6 +213,36 @@ impl Sources {
             .sum()
     }
 
+    /// The strain rate of every usable row, row-major as [`Sources::x`] (strain per second): along a
+    /// trajectory the central difference `(ξ_{k+1} − ξ_{k−1}) / (t_{k+1} − t_{k−1})` of its usable
+    /// samples (one-sided at its ends; 0 for a trajectory of one sample); 0 for static equilibria,
+    /// which are at rest.
+    pub fn strain_rates(&self) -> Vec<f64> {
+        let n = self.features;
+        let mut v = vec![0.0; self.x.len()];
+        let mut first = 0;
+        for ((_, ds), &rows) in self.sets.iter().zip(&self.rows_of) {
+            let (x, out) = (
+                &self.x[first * n..(first + rows) * n],
+                &mut v[first * n..(first + rows) * n],
+            );
+            first += rows;
+            let (Some(t), Some(_), true) = (&ds.t, &ds.meta.dynamic, rows > 1) else {
+                continue;
+            };
+            let t: Vec<f64> = ds.ok_rows().iter().map(|&k| t[k]).collect();
+            for k in 0..rows {
+                let (a, b) = (k.saturating_sub(1), (k + 1).min(rows - 1));
+                let dt = t[b] - t[a];
+                let (xa, xb) = (&x[a * n..(a + 1) * n], &x[b * n..(b + 1) * n]);
+                for ((o, xa), xb) in out[k * n..(k + 1) * n].iter_mut().zip(xa).zip(xb) {
+                    *o = (xb - xa) / dt;
+                }
+            }
+        }
+        v
+    }
+
     /// The first dataset when every dataset holds static equilibria (whose anchors may be
     /// replaced by the reduced model's own equilibria); `None` if any is a trajectory.
     pub fn all_static(&self) -> Option<&Dataset> {

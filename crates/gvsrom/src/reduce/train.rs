@@ -101,6 +101,16 @@ pub fn train<P: AsRef<Path>>(
         weighting: loss.weighting(built, &layout),
         ..options.clone()
     };
+    if options.rate_weight > 0.0 && src.dynamic_rows() == 0 {
+        return Err(invalid(
+            "--rate-weight",
+            format!(
+                "{}: every dataset holds static equilibria, whose strain rates are 0, so the rate term has nothing to fit; it needs a trajectory dataset (`gvsrom dataset … --duration`)",
+                options.rate_weight
+            ),
+        )
+        .into());
+    }
     let dir = OutputDir::create("--out", out, crate::reduced_model::MODEL_FORMAT, force)?;
     // the zero-strain anchor of trajectory data: the straight rod, where simulations from rest
     // start, joins the training rows so that a latent point decodes to it
@@ -114,9 +124,16 @@ pub fn train<P: AsRef<Path>>(
             t.into()
         }
     };
+    // the strain-rate term: the rates of the usable rows, and the straight rod's anchor at rest
+    let rates = (options.rate_weight > 0.0).then(|| {
+        let mut v = src.strain_rates();
+        v.resize(training.len(), 0.0);
+        v
+    });
     let (ae, report) =
-        Autoencoder::train(&training, features, options, progress).map_err(|e| train_error(&e))?;
-    drop(training);
+        Autoencoder::train_with_rates(&training, rates.as_deref(), features, options, progress)
+            .map_err(|e| train_error(&e))?;
+    drop((training, rates));
     // one encoding per usable sample: its range, the anchors, and what the HOM basis cannot
     // represent of the reconstructions
     let mut worst = 0.0f64;
@@ -206,6 +223,7 @@ pub fn train<P: AsRef<Path>>(
                 SampleWeighting::Uniform => None,
             },
             decoder: Some(ae.form().name().into()),
+            rate_weight: Some(options.rate_weight),
             epochs_run: report.epochs_run,
             best_epoch: report.best_epoch,
             stop: format!("{:?}", report.stop),

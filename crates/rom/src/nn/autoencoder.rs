@@ -104,8 +104,49 @@ impl Autoencoder {
         opts: &TrainOptions,
         progress: Progress,
     ) -> Result<(Self, TrainReport), NnError> {
+        Self::train_with_rates(data, None, n_features, opts, progress)
+    }
+
+    /// [`Autoencoder::train`] with the strain-rate term ([`crate::nn::rates`]) of weight
+    /// [`TrainOptions::rate_weight`]: `rates` holds the rate of every data row (row-major, physical
+    /// units per second, as `data`). The monitored (validation) loss then includes `β Q`; the
+    /// reported RMSEs remain the reconstruction's.
+    pub fn train_with_rates(
+        data: &[f64],
+        rates: Option<&[f64]>,
+        n_features: usize,
+        opts: &TrainOptions,
+        progress: Progress,
+    ) -> Result<(Self, TrainReport), NnError> {
         let start = Instant::now();
         opts.validate()?;
+        let beta = opts.rate_weight;
+        match rates {
+            None if beta > 0.0 => {
+                return Err(NnError::InvalidOption {
+                    field: "rate_weight",
+                    value: beta,
+                    expected: "0 without strain rates (the rate term needs the rate of every row)",
+                })
+            }
+            Some(v) if v.len() != data.len() => {
+                return Err(NnError::InvalidOption {
+                    field: "rates",
+                    value: v.len() as f64,
+                    expected: "one rate per data value (as many values as the data)",
+                })
+            }
+            Some(v) => {
+                if let Some(bad) = v.iter().find(|r| !r.is_finite()) {
+                    return Err(NnError::InvalidOption {
+                        field: "rates",
+                        value: *bad,
+                        expected: "finite values",
+                    });
+                }
+            }
+            None => {}
+        }
         let sizes = Self::architecture(n_features, opts.latent, opts.hidden_layers)?;
         let rows = check_data(data, n_features)?;
         opts.weighting.check(n_features)?;
@@ -127,6 +168,17 @@ impl Autoencoder {
         let weights = opts
             .sample_weighting
             .weights(data, n_features, scaling.scale(), &train);
+        // rates scale as the data's deviations: by 1/s, without the mean
+        // rates scale as the data's deviations: by 1/s, without the mean
+        let scaled_rates = rates.filter(|_| beta > 0.0).map(|v| {
+            let s = scaling.scale();
+            let v: Vec<f64> = v
+                .iter()
+                .enumerate()
+                .map(|(i, v)| v / s[i % n_features])
+                .collect();
+            v
+        });
         let problem = Problem {
             layers: &mut layers,
             tanh: &tanh,
@@ -135,6 +187,7 @@ impl Autoencoder {
             val: &val,
             weights: weights.as_deref(),
             gate,
+            rates: scaled_rates.as_deref().map(|v| (v, beta)),
         };
         let outcome = fit(problem, opts, &mut rng, progress);
         // a diverged run or one that never beat its initial weights is no model

@@ -46,17 +46,17 @@ fn half(n: usize) -> usize {
 }
 
 /// The first `rows × cols` values of `s` as a row-major matrix.
-fn row_major(s: &[f64], rows: usize, cols: usize) -> MatRef<'_, f64> {
+pub(crate) fn row_major(s: &[f64], rows: usize, cols: usize) -> MatRef<'_, f64> {
     MatRef::from_row_major_slice(&s[..rows * cols], rows, cols)
 }
 
 /// The first `rows × cols` values of `s` as a mutable row-major matrix.
-fn row_major_mut(s: &mut [f64], rows: usize, cols: usize) -> MatMut<'_, f64> {
+pub(crate) fn row_major_mut(s: &mut [f64], rows: usize, cols: usize) -> MatMut<'_, f64> {
     MatMut::from_row_major_slice_mut(&mut s[..rows * cols], rows, cols)
 }
 
 /// `C = A·B` (`Accum::Replace`) or `C += A·B` (`Accum::Add`) on this thread.
-fn product(c: MatMut<'_, f64>, accum: Accum, a: MatRef<'_, f64>, b: MatRef<'_, f64>) {
+pub(crate) fn product(c: MatMut<'_, f64>, accum: Accum, a: MatRef<'_, f64>, b: MatRef<'_, f64>) {
     matmul(c, accum, a, b, 1.0, Par::Seq);
     // faer leaves the upper vector registers dirty; the baseline SSE code after it would pay
     gvs::cpu::clear_upper_state();
@@ -143,6 +143,14 @@ impl Workspace {
             for (o, &i) in self.row_weight.iter_mut().zip(index) {
                 *o = w[i];
             }
+        }
+    }
+
+    /// The loss weight `ω_b` of loaded row `b` (1 unless the rows were loaded with weights).
+    pub(crate) fn row_weight(&self, b: usize) -> f64 {
+        match self.weighted {
+            true => self.row_weight[b],
+            false => 1.0,
         }
     }
 

@@ -11,6 +11,7 @@
 
 use super::batch::{backward_batch, forward_batch, reconstruction_mse, Workspace};
 use super::mlp::Layer;
+use super::rates::{add_rate_gradient, forward_rates, rate_mse, RateBuffers};
 
 /// Flat parameter vectors (weights then biases, layer by layer) and the L-BFGS memory.
 pub(crate) struct Lbfgs {
@@ -39,11 +40,16 @@ pub(crate) struct Objective<'a> {
     /// The loss weight of every data row, or `None` for 1.
     pub weights: Option<&'a [f64]>,
     pub lambda: f64,
+    /// The scaled strain rates of the data rows and the rate term's weight `β`, if any.
+    pub rates: Option<(&'a [f64], f64)>,
 }
+
+/// The buffers an objective evaluation uses: the workspace, and the rate term's when it has one.
+pub(crate) type Buffers<'b> = (&'b mut Workspace, &'b mut Option<RateBuffers>);
 
 impl Lbfgs {
     /// Memory for `memory` pairs, started at the current `layers`.
-    pub fn new(layers: &[Layer], memory: usize, obj: &Objective, ws: &mut Workspace) -> Self {
+    pub fn new(layers: &[Layer], memory: usize, obj: &Objective, ws: Buffers) -> Self {
         let len: usize = layers.iter().map(|l| l.w.len() + l.b.len()).sum();
         let memory = memory.max(1);
         let mut state = Lbfgs {
@@ -72,13 +78,13 @@ impl Lbfgs {
         &mut self,
         layers: &mut [Layer],
         obj: &Objective,
-        ws: &mut Workspace,
+        (ws, rb): Buffers,
     ) -> Option<f64> {
         self.direction();
-        if !self.line_search(layers, obj, ws) {
+        if !self.line_search(layers, obj, (ws, rb)) {
             self.stored = 0;
             self.direction();
-            if !self.line_search(layers, obj, ws) {
+            if !self.line_search(layers, obj, (ws, rb)) {
                 unflatten(&self.theta, layers);
                 return None;
             }
@@ -113,7 +119,7 @@ impl Lbfgs {
     }
 
     /// Backtracking Armijo search along `dir`; on success `trial`, `trial_grad` hold the new point.
-    fn line_search(&mut self, layers: &mut [Layer], obj: &Objective, ws: &mut Workspace) -> bool {
+    fn line_search(&mut self, layers: &mut [Layer], obj: &Objective, (ws, rb): Buffers) -> bool {
         let slope = dot(&self.grad, &self.dir);
         if slope.is_nan() || slope >= 0.0 {
             return false;
@@ -128,7 +134,7 @@ impl Lbfgs {
                 *t = x + step * d;
             }
             unflatten(&self.trial, layers);
-            let value = value_and_gradient(layers, obj, ws, &mut self.trial_grad);
+            let value = value_and_gradient(layers, obj, (&mut *ws, &mut *rb), &mut self.trial_grad);
             if value.1.is_finite() && value.1 <= self.value.1 + 1e-4 * step * slope {
                 self.value = value;
                 return true;
@@ -157,11 +163,11 @@ impl Lbfgs {
     }
 }
 
-/// `(reconstruction MSE, f)` over all training rows and `∇f` into `grad` (flat layout).
+/// `(reconstruction MSE [+ β Q], f)` over all training rows and `∇f` into `grad` (flat layout).
 fn value_and_gradient(
     layers: &[Layer],
     obj: &Objective,
-    ws: &mut Workspace,
+    (ws, rb): Buffers,
     grad: &mut [f64],
 ) -> (f64, f64) {
     let n = layers[0].n_in;
@@ -174,6 +180,12 @@ fn value_and_gradient(
         forward_batch(layers, obj.tanh, ws, chunk.len());
         mse += weight * reconstruction_mse(ws, chunk.len());
         backward_batch(layers, obj.tanh, ws, chunk.len(), obj.lambda);
+        if let (Some((v, beta)), Some(rb)) = (obj.rates, rb.as_mut()) {
+            rb.load(v, n, chunk);
+            forward_rates(layers, obj.tanh, ws, rb, chunk.len());
+            mse += weight * beta * rate_mse(ws, rb, chunk.len());
+            add_rate_gradient(layers, obj.tanh, ws, rb, chunk.len(), beta);
+        }
         let flat_grads = ws
             .grad_w
             .iter()

@@ -6,6 +6,7 @@
 //! - [`batch`]: batched forward/backward passes on faer's products with a reusable workspace.
 //! - [`train`]: options, Adam, early stopping, the training report.
 //! - [`lbfgs`]: full-batch L-BFGS, the optional final training phase.
+//! - `rates`: the strain-rate term of the loss (the tangent map carries a trajectory's rates).
 //! - [`autoencoder`]: the symmetric architecture, encode/decode, training entry point.
 //! - [`decoder_map`]: the decoder folded with an output projection; value, Jacobian, eq. (17), Hessians.
 //! - [`ae_map`]: an autoencoder's decoder map of either [`DecoderForm`].
@@ -50,6 +51,7 @@ pub mod batch;
 pub mod decoder_map;
 pub mod lbfgs;
 pub mod mlp;
+pub(crate) mod rates;
 pub mod scaled_map;
 pub mod scaling;
 pub mod train;

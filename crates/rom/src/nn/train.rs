@@ -28,6 +28,7 @@ use super::batch::{
 };
 use super::lbfgs::{Lbfgs, Objective};
 use super::mlp::Layer;
+use super::rates::{add_rate_gradient, dataset_rate_mse, forward_rates, rate_mse, RateBuffers};
 use super::scaling::Weighting;
 use super::{DecoderForm, NnError};
 use gvs::inputs::SplitMix64;
@@ -69,6 +70,9 @@ pub struct TrainOptions {
     pub sample_weighting: SampleWeighting,
     /// How the decoder's output becomes a snapshot.
     pub decoder: DecoderForm,
+    /// Weight `β` of the strain-rate term `‖J_f v − v‖²` ([`crate::nn::rates`]; 0: eq. (15) alone).
+    /// It needs the rate of every row ([`crate::nn::Autoencoder::train_with_rates`]).
+    pub rate_weight: f64,
 }
 
 /// How each snapshot's (row's) squared error weighs in the loss of eq. (15).
@@ -138,6 +142,7 @@ impl Default for TrainOptions {
             weighting: Weighting::Standardize,
             sample_weighting: SampleWeighting::Uniform,
             decoder: DecoderForm::Plain,
+            rate_weight: 0.0,
         }
     }
 }
@@ -175,6 +180,16 @@ impl TrainOptions {
             if !(floor > 0.0 && floor <= 1.0) {
                 return bad("sample_weighting.floor", floor, "in (0, 1]");
             }
+        }
+        if !(self.rate_weight.is_finite() && self.rate_weight >= 0.0) {
+            return bad("rate_weight", self.rate_weight, "finite and ≥ 0");
+        }
+        if self.rate_weight > 0.0 && self.decoder == DecoderForm::Scaled {
+            return bad(
+                "rate_weight",
+                self.rate_weight,
+                "0 with the scaled decoder (the rate term is written for the plain one)",
+            );
         }
         if self.patience == Some(0) {
             return bad("patience", 0.0, "≥ 1 epoch, or None");
@@ -427,6 +442,9 @@ pub(crate) struct Problem<'a> {
     pub weights: Option<&'a [f64]>,
     /// The latent layer whose first unit scales the output ([`DecoderForm::Scaled`]), if any.
     pub gate: Option<usize>,
+    /// The scaled strain rate of every data row and the weight `β` of the rate term
+    /// ([`crate::nn::rates`]), or `None` for eq. (15) alone.
+    pub rates: Option<(&'a [f64], f64)>,
 }
 
 /// What [`fit`] observed; the chain ends with the best weights.
@@ -459,14 +477,11 @@ impl Tracker<'_, '_> {
     fn record(
         &mut self,
         p: &mut Problem,
-        ws: &mut Workspace,
+        (ws, rb): (&mut Workspace, &mut Option<RateBuffers>),
         train: f64,
         fine: bool,
     ) -> Option<StopReason> {
-        let val = (!self.val.is_empty()).then(|| {
-            let (layers, val) = (&*p.layers, self.val);
-            in_pool(|| dataset_mse(layers, p.tanh, p.data, val, p.weights, ws))
-        });
+        let val = (!self.val.is_empty()).then(|| monitored_loss(p, self.val, ws, rb));
         self.out.train_loss.push(train);
         self.out.val_loss.extend(val);
         self.out.fine_tune_epochs_run += usize::from(fine);
@@ -512,11 +527,13 @@ pub(crate) fn fit(
     }
     // eq. (15) over n: the mean squared error per entry plus λ/n Σ‖W‖² (module docs)
     let lambda = opts.lambda / sizes[0].max(1) as f64;
-    let initial_train_loss =
-        in_pool(|| dataset_mse(p.layers, p.tanh, p.data, p.train, p.weights, &mut ws));
+    let mut rb = p
+        .rates
+        .map(|_| RateBuffers::new(&sizes, opts.batch_size.min(p.train.len())));
+    let initial_train_loss = monitored_loss(&p, p.train, &mut ws, &mut rb);
     let initial_loss = match p.val.is_empty() {
         true => initial_train_loss,
-        false => in_pool(|| dataset_mse(p.layers, p.tanh, p.data, p.val, p.weights, &mut ws)),
+        false => monitored_loss(&p, p.val, &mut ws, &mut rb),
     };
     let mut t = Tracker {
         best: p.layers.to_vec(),
@@ -538,7 +555,7 @@ pub(crate) fn fit(
     };
     let mut stop = adam_phase(
         &mut p,
-        &mut ws,
+        (&mut ws, &mut rb),
         &mut t,
         rng,
         (opts.epochs, opts.learning_rate, lambda, opts.lr_reductions),
@@ -555,15 +572,19 @@ pub(crate) fn fit(
                 learning_rate_factor: f,
             } => adam_phase(
                 &mut p,
-                &mut ws,
+                (&mut ws, &mut rb),
                 &mut t,
                 rng,
                 (epochs, opts.learning_rate * f, lambda, opts.lr_reductions),
                 true,
             ),
-            FineTune::Lbfgs { iterations, memory } => {
-                lbfgs_phase(&mut p, &mut ws, &mut t, (iterations, memory), lambda)
-            }
+            FineTune::Lbfgs { iterations, memory } => lbfgs_phase(
+                &mut p,
+                (&mut ws, &mut rb),
+                &mut t,
+                (iterations, memory),
+                lambda,
+            ),
             FineTune::None => stop,
         };
     }
@@ -578,7 +599,7 @@ pub(crate) fn fit(
 /// `reductions` plateaus the best weights come back and the rate drops by [`LR_REDUCTION_FACTOR`].
 fn adam_phase(
     p: &mut Problem,
-    ws: &mut Workspace,
+    (ws, rb): (&mut Workspace, &mut Option<RateBuffers>),
     t: &mut Tracker,
     rng: &mut SplitMix64,
     (epochs, lr, lambda, reductions): (usize, f64, f64, usize),
@@ -590,9 +611,10 @@ fn adam_phase(
     for _ in 0..epochs {
         shuffle(&mut order, rng);
         let (layers, order, adam) = (&mut *p.layers, &order, &mut adam);
-        let rows = (p.data, p.weights);
-        let train = in_pool(|| run_epoch(layers, p.tanh, rows, order, ws, adam, (lr, lambda)));
-        match t.record(p, ws, train, fine) {
+        let rows = (p.data, p.weights, p.rates);
+        let bufs = (&mut *ws, &mut *rb);
+        let train = in_pool(|| run_epoch(layers, p.tanh, rows, order, bufs, adam, (lr, lambda)));
+        match t.record(p, (ws, rb), train, fine) {
             Some(StopReason::EarlyStopping) if reductions > 0 && t.out.best_epoch > 0 => {
                 // a plateau: back to the best weights with a smaller step
                 copy_layers(p.layers, &t.best);
@@ -608,7 +630,7 @@ fn adam_phase(
 /// Up to `iterations` full-batch L-BFGS iterations, each recorded as an epoch.
 fn lbfgs_phase(
     p: &mut Problem,
-    ws: &mut Workspace,
+    (ws, rb): (&mut Workspace, &mut Option<RateBuffers>),
     t: &mut Tracker,
     (iterations, memory): (usize, usize),
     lambda: f64,
@@ -619,27 +641,33 @@ fn lbfgs_phase(
         rows: p.train,
         weights: p.weights,
         lambda,
+        rates: p.rates,
     };
-    let mut lbfgs = in_pool(|| Lbfgs::new(p.layers, memory, &obj, ws));
+    let mut lbfgs = in_pool(|| Lbfgs::new(p.layers, memory, &obj, (&mut *ws, &mut *rb)));
     for _ in 0..iterations {
         let (layers, lbfgs, obj) = (&mut *p.layers, &mut lbfgs, &obj);
-        let Some(train) = in_pool(|| lbfgs.step(layers, obj, ws)) else {
+        let bufs = (&mut *ws, &mut *rb);
+        let Some(train) = in_pool(|| lbfgs.step(layers, obj, bufs)) else {
             return StopReason::Converged;
         };
-        if let Some(stop) = t.record(p, ws, train, true) {
+        if let Some(stop) = t.record(p, (ws, rb), train, true) {
             return stop;
         }
     }
     StopReason::EpochLimit
 }
 
-/// One pass over the rows in `order`, one Adam step per batch; returns the mean batch loss.
+/// The scaled data rows, their loss weights (or 1) and their scaled rates with `β` (or none).
+type Rows<'a> = (&'a [f64], Option<&'a [f64]>, Option<(&'a [f64], f64)>);
+
+/// One pass over the rows in `order`, one Adam step per batch; returns the mean batch loss (with
+/// the rate term's `β Q` when the problem has rates).
 fn run_epoch(
     layers: &mut [Layer],
     tanh: &[bool],
-    (data, weights): (&[f64], Option<&[f64]>),
+    (data, weights, rates): Rows,
     order: &[usize],
-    ws: &mut Workspace,
+    (ws, rb): (&mut Workspace, &mut Option<RateBuffers>),
     adam: &mut Adam,
     (lr, lambda): (f64, f64),
 ) -> f64 {
@@ -650,9 +678,35 @@ fn run_epoch(
         forward_batch(layers, tanh, ws, batch.len());
         sum += reconstruction_mse(ws, batch.len()) * batch.len() as f64;
         backward_batch_without_penalty(layers, tanh, ws, batch.len());
+        if let (Some((v, beta)), Some(rb)) = (rates, rb.as_mut()) {
+            rb.load(v, n, batch);
+            forward_rates(layers, tanh, ws, rb, batch.len());
+            sum += beta * rate_mse(ws, rb, batch.len()) * batch.len() as f64;
+            add_rate_gradient(layers, tanh, ws, rb, batch.len(), beta);
+        }
         adam.step(layers, ws, lr, lambda);
     }
     sum / order.len().max(1) as f64
+}
+
+/// The monitored loss over the data rows `index`: the reconstruction MSE, plus `β Q` of the rate
+/// term when the problem has rates ([`crate::nn::rates`]).
+fn monitored_loss(
+    p: &Problem,
+    index: &[usize],
+    ws: &mut Workspace,
+    rb: &mut Option<RateBuffers>,
+) -> f64 {
+    let layers = &*p.layers;
+    let mse = in_pool(|| dataset_mse(layers, p.tanh, p.data, index, p.weights, ws));
+    match (p.rates, rb.as_mut()) {
+        (Some((v, beta)), Some(rb)) => {
+            let data = (p.data, v);
+            mse + beta
+                * in_pool(|| dataset_rate_mse(layers, p.tanh, data, index, p.weights, ws, rb))
+        }
+        _ => mse,
+    }
 }
 
 #[cfg(test)]
