@@ -464,6 +464,9 @@ const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 /// decoder : str
 ///     ``"plain"`` (the paper's, x̂ = D(z)) or ``"scaled"`` (x̂ = z₁ D(z): every code with z₁ = 0
 ///     decodes to the straight rod, for snapshots that shrink to rest as their load vanishes).
+/// rate_weight : float
+///     Weight β ≥ 0 of the strain-rate term (``--rate-weight``): the autoencoder's tangent map must
+///     carry each trajectory sample's strain rate; 0 is eq. (15) alone. Needs trajectory data.
 /// force : bool
 ///     Replace ``out`` if it is an earlier gvsrom output.
 ///
@@ -472,7 +475,7 @@ const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 /// Model
 ///     The new model.
 #[pyfunction]
-#[pyo3(signature = (dataset, out, latent=1, hidden_layers=7, epochs=2000, batch_size=64, learning_rate=1e-3, lambda_=1e-4, validation_fraction=0.1, patience=50, lr_reductions=4, lbfgs_iterations=300, seed=0, loss="energy", sample_weighting="uniform", relative_floor=0.1, decoder="plain", force=false))]
+#[pyo3(signature = (dataset, out, latent=1, hidden_layers=7, epochs=2000, batch_size=64, learning_rate=1e-3, lambda_=1e-4, validation_fraction=0.1, patience=50, lr_reductions=4, lbfgs_iterations=300, seed=0, loss="energy", sample_weighting="uniform", relative_floor=0.1, decoder="plain", rate_weight=0.0, force=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn train(
     py: Python<'_>,
@@ -493,6 +496,7 @@ pub fn train(
     sample_weighting: &str,
     relative_floor: f64,
     decoder: &str,
+    rate_weight: f64,
     force: bool,
 ) -> PyResult<Model> {
     use gvsrom::reduce::Loss;
@@ -520,6 +524,7 @@ pub fn train(
         sample_weighting: gvsrom::reduce::sample_weighting(sample_weighting, relative_floor)
             .map_err(errors::scenario)?,
         decoder: gvsrom::reduce::decoder_form(decoder).map_err(errors::scenario)?,
+        rate_weight,
         ..TrainOptions::default()
     };
     let dataset = dataset_paths(dataset)?;

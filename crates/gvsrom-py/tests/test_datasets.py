@@ -121,6 +121,21 @@ def test_a_scaled_decoder_is_recorded_its_rest_is_z1_zero_and_a_bad_form_refused
         gvsrom.train(sweep.path, tmp_path / "py", decoder="cone")
 
 
+def test_a_rate_weight_is_recorded_and_refused_on_equilibria_as_the_cli_does(
+        gvsrom_bin, sweep, tmp_path):
+    traj = gvsrom.dataset("single-tendon", tmp_path / "traj", duration=0.2, sample_rate=100,
+                          steps=[-3, 0, 0.05], seed=2)
+    ae = gvsrom.train(traj, tmp_path / "rated", latent=1, hidden_layers=3, epochs=5, patience=0,
+                      lbfgs_iterations=0, rate_weight=0.5)
+    assert ae.meta["training"]["rate_weight"] == 0.5
+    expected = cli_error(gvsrom_bin, "train", str(sweep.path), "--rate-weight", "0.1",
+                         "--out", str(tmp_path / "cli"))
+    with pytest.raises(gvsrom.GvsromError) as e:
+        gvsrom.train(sweep.path, tmp_path / "py", rate_weight=0.1)
+    assert str(e.value) == expected
+    assert "static equilibria" in expected and not (tmp_path / "py").exists()
+
+
 def test_bad_plans_are_refused_with_the_cli_message(gvsrom_bin, tmp_path):
     expected = cli_error(gvsrom_bin, "dataset", "single-tendon", "--sweep", "tendons.0.tension=-6",
                          "--samples", "3", "--out", str(tmp_path / "cli"))

@@ -281,6 +281,7 @@ def train(
     sample_weighting: str = "uniform",
     relative_floor: float = 0.1,
     decoder: str = "plain",
+    rate_weight: float = 0.0,
     force: bool = False,
 ) -> Model: ...
 

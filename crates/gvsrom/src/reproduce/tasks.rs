@@ -212,6 +212,10 @@ pub struct AeConfig {
     /// The decoder's form (`--decoder`); absent: `plain`, the paper's.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub decoder: Option<String>,
+    /// The weight of the strain-rate term (`--rate-weight`); absent: 0, eq. (15) alone (the
+    /// paper's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rate_weight: Option<f64>,
 }
 
 impl AeConfig {
@@ -231,6 +235,7 @@ impl AeConfig {
             loss: reduce::Loss::default(),
             lr_reductions: d.lr_reductions,
             decoder: None,
+            rate_weight: None,
         }
     }
 }
@@ -262,6 +267,7 @@ pub fn train(
                 lr_reductions: c.lr_reductions,
                 fine_tune: rom::nn::FineTune::lbfgs(c.lbfgs_iterations),
                 decoder: reduce::decoder_form(c.decoder.as_deref().unwrap_or("plain"))?,
+                rate_weight: c.rate_weight.unwrap_or(0.0),
                 ..rom::nn::TrainOptions::default()
             };
             let interrupt = run.interrupt().clone();

@@ -333,6 +333,8 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         DataVariant::Spread,
         DataVariant::Damped,
         DataVariant::Hanging,
+        DataVariant::Rates,
+        DataVariant::HangingRates,
     ] {
         let result = run_variant(
             run,

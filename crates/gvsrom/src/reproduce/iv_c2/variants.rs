@@ -8,7 +8,11 @@
 //!   runs alike): how much of the error the arm's swinging makes (the paper gives the damping
 //!   constant, not how its model damps);
 //! - [`DataVariant::Hanging`]: the arm hanging along gravity (preset [`HANGING_PRESET`]; data, HOM
-//!   and ROM runs alike) instead of the horizontal cantilever: the orientation the paper leaves open.
+//!   and ROM runs alike) instead of the horizontal cantilever: the orientation the paper leaves open;
+//! - [`DataVariant::Rates`] and [`DataVariant::HangingRates`]: the paper's data of either arm, the
+//!   AE trained with the strain-rate term of weight [`RATE_WEIGHT`] (`gvsrom train --rate-weight`,
+//!   `rom::nn::rates`): whether a decoder whose tangents carry the babbling's strain rates tracks
+//!   the swinging arm.
 
 use super::super::paper;
 use super::super::report::{Cell, Finding, Table};
@@ -25,6 +29,8 @@ pub(super) const SPREAD: f64 = 2.0;
 pub(super) const DAMPING_FACTOR: f64 = 3.0;
 /// The hanging variant's preset: `six-tendon` with the base along −z, the direction of gravity.
 pub(super) const HANGING_PRESET: &str = "six-tendon-hanging";
+/// The rate-term variants' `--rate-weight`.
+pub(super) const RATE_WEIGHT: f64 = 0.1;
 
 /// A variant of the data (and, for [`DataVariant::Damped`] and [`DataVariant::Hanging`], of the
 /// arm).
@@ -33,6 +39,8 @@ pub(super) enum DataVariant {
     Spread,
     Damped,
     Hanging,
+    Rates,
+    HangingRates,
 }
 
 /// A variant's data, its two models and their runs on each test input.
@@ -55,6 +63,29 @@ impl DataVariant {
             DataVariant::Spread => "spread",
             DataVariant::Damped => "damped",
             DataVariant::Hanging => "hanging",
+            DataVariant::Rates => "rates",
+            DataVariant::HangingRates => "hanging-rates",
+        }
+    }
+
+    /// The name of the variant whose data, HOM runs and POD it shares (the rate-term variants
+    /// change the AE alone), or `None` for the paper's data and HOM runs.
+    fn data_name(self) -> Option<&'static str> {
+        match self {
+            DataVariant::Rates => None,
+            DataVariant::HangingRates => Some(DataVariant::Hanging.name()),
+            v => Some(v.name()),
+        }
+    }
+
+    /// `ae` as the variant trains it: with the strain-rate term for the rate-term variants.
+    fn ae_config(self, ae: &AeConfig) -> AeConfig {
+        match self {
+            DataVariant::Rates | DataVariant::HangingRates => AeConfig {
+                rate_weight: Some(RATE_WEIGHT),
+                ..ae.clone()
+            },
+            _ => ae.clone(),
         }
     }
 
@@ -63,14 +94,14 @@ impl DataVariant {
     /// overrides.
     fn scenario(self, scenario: &ScenarioSpec) -> anyhow::Result<ScenarioSpec> {
         Ok(match self {
-            DataVariant::Spread => scenario.clone(),
+            DataVariant::Spread | DataVariant::Rates => scenario.clone(),
             DataVariant::Damped => {
                 let eta = crate::presets::load(&scenario.preset, &scenario.set)?
                     .material
                     .damping;
                 scenario.with(&[format!("material.damping={:e}", eta * DAMPING_FACTOR)])
             }
-            DataVariant::Hanging => ScenarioSpec {
+            DataVariant::Hanging | DataVariant::HangingRates => ScenarioSpec {
                 preset: HANGING_PRESET.into(),
                 ..scenario.clone()
             },
@@ -85,7 +116,7 @@ impl DataVariant {
                 sample_rate: plan.sample_rate.map(|f| f / SPREAD),
                 ..plan.clone()
             },
-            DataVariant::Damped | DataVariant::Hanging => plan.clone(),
+            _ => plan.clone(),
         }
     }
 
@@ -104,6 +135,13 @@ impl DataVariant {
             ),
             DataVariant::Hanging => format!(
                 "the arm hanging along gravity (preset `{}`), in the data and in every run",
+                scenario.preset
+            ),
+            DataVariant::Rates => format!(
+                "the strain-rate term in the AE's training (`--rate-weight {RATE_WEIGHT}`), on the paper's data"
+            ),
+            DataVariant::HangingRates => format!(
+                "the arm hanging along gravity (preset `{}`) and the strain-rate term in the AE's training (`--rate-weight {RATE_WEIGHT}`)",
                 scenario.preset
             ),
         }
@@ -128,9 +166,16 @@ pub(super) fn run_variant(
     let (r, name) = (ae.latent, variant.name());
     let (sc, data_plan) = (variant.scenario(scenario)?, variant.plan(plan));
     let description = variant.describe(&data_plan, &sc);
-    let data = tasks::dataset(run, &format!("iv-c2/dataset-{name}"), &sc, &data_plan, jobs)?;
+    let data_name = variant.data_name();
+    let data_step = match data_name {
+        Some(d) => format!("iv-c2/dataset-{d}"),
+        None => "iv-c2/dataset".into(),
+    };
+    let data = tasks::dataset(run, &data_step, &sc, &data_plan, jobs)?;
+    let ae = &variant.ae_config(ae);
     let model = tasks::train(run, &format!("iv-c2/ae-r{r}-{name}"), &data, ae)?;
-    let pod = tasks::pod(run, &format!("iv-c2/pod-{r}-{name}"), &data, r)?;
+    let pod_name = data_name.unwrap_or(name);
+    let pod = tasks::pod(run, &format!("iv-c2/pod-{r}-{pod_name}"), &data, r)?;
     let mut tests = vec![];
     let mut first_runs = None;
     for &seed in seeds {
@@ -140,19 +185,21 @@ pub(super) fn run_variant(
         };
         let tag = format!("{name} data, test seed {seed}");
         let hom = match variant {
-            DataVariant::Spread if seed == test.seed => paper_hom.clone(),
-            DataVariant::Spread => hom_run(run, scenario, &t)?,
-            DataVariant::Damped | DataVariant::Hanging => simulate_test(
-                run,
-                &format!("iv-c2/test-hom-{name}-seed{seed}"),
-                &format!("HOM ({tag})"),
-                &sc,
-                &t,
-                None,
-                None,
-            )?,
+            DataVariant::Spread | DataVariant::Rates if seed == test.seed => paper_hom.clone(),
+            DataVariant::Spread | DataVariant::Rates => hom_run(run, scenario, &t)?,
+            DataVariant::Damped | DataVariant::Hanging | DataVariant::HangingRates => {
+                simulate_test(
+                    run,
+                    &format!("iv-c2/test-hom-{pod_name}-seed{seed}"),
+                    &format!("HOM ({tag})"),
+                    &sc,
+                    &t,
+                    None,
+                    None,
+                )?
+            }
         };
-        let rom_run = |m: &Step<ModelInfo>, step: &str, label: &str| {
+        let rom_run = |m: &Step<ModelInfo>, step: &str, label: &str, name: &str| {
             simulate_test(
                 run,
                 &format!("iv-c2/test-{step}{r}-{name}-test-seed{seed}"),
@@ -163,8 +210,8 @@ pub(super) fn run_variant(
                 Some(&hom),
             )
         };
-        let ae_run = rom_run(&model, "ae-r", "AE-")?;
-        let pod_run = rom_run(&pod, "pod-", "POD-")?;
+        let ae_run = rom_run(&model, "ae-r", "AE-", name)?;
+        let pod_run = rom_run(&pod, "pod-", "POD-", pod_name)?;
         if first_runs.is_none() {
             first_runs = Some([hom.path.clone(), ae_run.path.clone(), pod_run.path.clone()]);
         }
@@ -200,6 +247,8 @@ pub(super) fn variant_table(r: usize, v: &VariantRuns) -> Table {
             DataVariant::Spread => "the HOM runs are the same. The runs of a row are not one after the other: compare the errors, and the times only roughly.",
             DataVariant::Damped => "the HOM runs are the damped arm's, one after the other with its ROMs.",
             DataVariant::Hanging => "the HOM runs are the hanging arm's, one after the other with its ROMs.",
+            DataVariant::Rates => "the HOM runs and the POD are those of the paper's data; only the AE's training differs.",
+            DataVariant::HangingRates => "the HOM runs and the POD are the hanging variant's; only the AE's training differs.",
         }
     );
     t
@@ -256,7 +305,7 @@ pub(super) fn variant_findings(r: usize, v: &VariantRuns) -> Vec<Finding> {
     match v.variant {
         DataVariant::Spread => vec![stays],
         DataVariant::Damped => vec![reaches],
-        DataVariant::Hanging => {
+        DataVariant::Hanging | DataVariant::Rates | DataVariant::HangingRates => {
             let ahead = v
                 .tests
                 .iter()
