@@ -70,6 +70,8 @@ struct Sizes {
     seeds: Vec<u64>,
     /// Seeds of more test inputs for the inset's ROMs (besides [`TEST_SEED`]).
     more_tests: Vec<u64>,
+    /// Seeds of the validation inputs that choose the rate-term variants' β (never tests).
+    validation: Vec<u64>,
 }
 
 fn sizes(opts: &Options) -> Sizes {
@@ -82,6 +84,7 @@ fn sizes(opts: &Options) -> Sizes {
             repeat: 1,
             seeds: vec![0],
             more_tests: vec![],
+            validation: vec![],
         }
     } else if opts.quick {
         Sizes {
@@ -92,6 +95,7 @@ fn sizes(opts: &Options) -> Sizes {
             repeat: 1,
             seeds: vec![0],
             more_tests: vec![3],
+            validation: vec![7],
         }
     } else {
         Sizes {
@@ -102,6 +106,7 @@ fn sizes(opts: &Options) -> Sizes {
             repeat: 3,
             seeds: vec![0, 1, 2],
             more_tests: vec![3, 4, 5, 6],
+            validation: vec![7, 8, 9],
         }
     }
 }
@@ -345,7 +350,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
             &ae_config(inset, LAMBDA, first_seed),
             &test,
             &hom,
-            &test_seeds,
+            (&test_seeds, &s.validation),
         );
         run.check_interrupt()?;
         match result {
@@ -441,6 +446,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         "variants": variant_runs.iter().map(|v| json!({
             "variant": format!("{:?}", v.variant), "dataset": v.data.value,
             "ae_model": v.ae.value, "pod_model": v.pod.value, "tests": v.tests,
+            "rate_selection": v.selection,
         })).collect::<Vec<_>>(),
         "lambda": lambdas.iter().map(|v| json!({
             "lambda": v.lambda, "seed": v.seed, "model": v.model, "run": v.run,

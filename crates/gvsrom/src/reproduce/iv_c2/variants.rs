@@ -10,9 +10,10 @@
 //! - [`DataVariant::Hanging`]: the arm hanging along gravity (preset [`HANGING_PRESET`]; data, HOM
 //!   and ROM runs alike) instead of the horizontal cantilever: the orientation the paper leaves open;
 //! - [`DataVariant::Rates`] and [`DataVariant::HangingRates`]: the paper's data of either arm, the
-//!   AE trained with the strain-rate term of weight [`RATE_WEIGHT`] (`gvsrom train --rate-weight`,
-//!   `rom::nn::rates`): whether a decoder whose tangents carry the babbling's strain rates tracks
-//!   the swinging arm.
+//!   AE trained with the strain-rate term (`gvsrom train --rate-weight β`, `rom::nn::rates`):
+//!   whether a decoder whose tangents carry the babbling's strain rates tracks the swinging arm.
+//!   β is chosen among [`RATE_WEIGHTS`] by the mean tip error on validation inputs of their own
+//!   seeds (`validation`), never on the test inputs.
 
 use super::super::paper;
 use super::super::report::{Cell, Finding, Table};
@@ -29,8 +30,8 @@ pub(super) const SPREAD: f64 = 2.0;
 pub(super) const DAMPING_FACTOR: f64 = 3.0;
 /// The hanging variant's preset: `six-tendon` with the base along −z, the direction of gravity.
 pub(super) const HANGING_PRESET: &str = "six-tendon-hanging";
-/// The rate-term variants' `--rate-weight`.
-pub(super) const RATE_WEIGHT: f64 = 0.1;
+/// The rate-term variants' candidate `--rate-weight`s.
+pub(super) const RATE_WEIGHTS: [f64; 3] = [0.1, 0.3, 1.0];
 
 /// A variant of the data (and, for [`DataVariant::Damped`] and [`DataVariant::Hanging`], of the
 /// arm).
@@ -54,6 +55,51 @@ pub(super) struct VariantRuns {
     pub(super) tests: Vec<TestRuns>,
     /// The trajectory directories of the HOM, AE and POD runs of the first test input.
     pub(super) first_runs: Option<[PathBuf; 3]>,
+    /// For the rate-term variants: how β was chosen.
+    pub(super) selection: Option<RateSelection>,
+}
+
+/// How the rate-term variants chose `β` among [`RATE_WEIGHTS`].
+#[derive(Debug, Clone, serde::Serialize)]
+pub(super) struct RateSelection {
+    pub(super) validation_seeds: Vec<u64>,
+    /// Per candidate: β and the AE's mean tip error on each validation input (`None`: the run
+    /// stopped early).
+    pub(super) candidates: Vec<(f64, Vec<Option<f64>>)>,
+    pub(super) chosen: f64,
+}
+
+impl RateSelection {
+    /// The mean of a candidate's validation errors, infinite if a run stopped early.
+    fn score(errors: &[Option<f64>]) -> f64 {
+        let sum: Option<f64> = errors.iter().copied().sum();
+        sum.map_or(f64::INFINITY, |s| s / errors.len().max(1) as f64)
+    }
+
+    /// One sentence for the reports: every candidate's validation errors and the β kept.
+    pub(super) fn describe(&self) -> String {
+        let seeds: Vec<String> = self.validation_seeds.iter().map(u64::to_string).collect();
+        let cands: Vec<String> = self
+            .candidates
+            .iter()
+            .map(|(beta, e)| {
+                let errs: Vec<String> = e
+                    .iter()
+                    .map(|v| v.map_or("stopped".into(), |v| Cell::sig(v, 3).render()))
+                    .collect();
+                format!("β = {beta}: {} % L", errs.join(", "))
+            })
+            .collect();
+        match seeds.is_empty() {
+            true => format!("β = {} (no validation inputs in this run)", self.chosen),
+            false => format!(
+                "β = {} kept, the lowest mean tip error of the AE on validation inputs of seeds {} (not among the tests): {}",
+                self.chosen,
+                seeds.join(", "),
+                cands.join("; ")
+            ),
+        }
+    }
 }
 
 impl DataVariant {
@@ -78,15 +124,9 @@ impl DataVariant {
         }
     }
 
-    /// `ae` as the variant trains it: with the strain-rate term for the rate-term variants.
-    fn ae_config(self, ae: &AeConfig) -> AeConfig {
-        match self {
-            DataVariant::Rates | DataVariant::HangingRates => AeConfig {
-                rate_weight: Some(RATE_WEIGHT),
-                ..ae.clone()
-            },
-            _ => ae.clone(),
-        }
+    /// Whether the variant trains its AE with the strain-rate term.
+    fn rates(self) -> bool {
+        matches!(self, DataVariant::Rates | DataVariant::HangingRates)
     }
 
     /// The variant's scenario: for [`DataVariant::Damped`] the material damping of `scenario`
@@ -137,11 +177,11 @@ impl DataVariant {
                 "the arm hanging along gravity (preset `{}`), in the data and in every run",
                 scenario.preset
             ),
-            DataVariant::Rates => format!(
-                "the strain-rate term in the AE's training (`--rate-weight {RATE_WEIGHT}`), on the paper's data"
-            ),
+            DataVariant::Rates => {
+                "the strain-rate term in the AE's training, on the paper's data".into()
+            }
             DataVariant::HangingRates => format!(
-                "the arm hanging along gravity (preset `{}`) and the strain-rate term in the AE's training (`--rate-weight {RATE_WEIGHT}`)",
+                "the arm hanging along gravity (preset `{}`) and the strain-rate term in the AE's training",
                 scenario.preset
             ),
         }
@@ -161,20 +201,53 @@ pub(super) fn run_variant(
     ae: &AeConfig,
     test: &Test,
     paper_hom: &Step<SimRun>,
-    seeds: &[u64],
+    (seeds, validation): (&[u64], &[u64]),
 ) -> anyhow::Result<VariantRuns> {
     let (r, name) = (ae.latent, variant.name());
     let (sc, data_plan) = (variant.scenario(scenario)?, variant.plan(plan));
-    let description = variant.describe(&data_plan, &sc);
+    let mut description = variant.describe(&data_plan, &sc);
     let data_name = variant.data_name();
     let data_step = match data_name {
         Some(d) => format!("iv-c2/dataset-{d}"),
         None => "iv-c2/dataset".into(),
     };
     let data = tasks::dataset(run, &data_step, &sc, &data_plan, jobs)?;
-    let ae = &variant.ae_config(ae);
-    let model = tasks::train(run, &format!("iv-c2/ae-r{r}-{name}"), &data, ae)?;
     let pod_name = data_name.unwrap_or(name);
+    // the HOM run of test input `seed`: the paper's arm's for the variants of its arm, else the
+    // variant's own
+    let hom_of = |seed: u64| -> anyhow::Result<Step<SimRun>> {
+        let t = Test {
+            seed,
+            ..test.clone()
+        };
+        match variant {
+            DataVariant::Spread | DataVariant::Rates if seed == test.seed => Ok(paper_hom.clone()),
+            DataVariant::Spread | DataVariant::Rates => hom_run(run, scenario, &t),
+            DataVariant::Damped | DataVariant::Hanging | DataVariant::HangingRates => {
+                simulate_test(
+                    run,
+                    &format!("iv-c2/test-hom-{pod_name}-seed{seed}"),
+                    &format!("HOM ({name} data, test seed {seed})"),
+                    &sc,
+                    &t,
+                    None,
+                    None,
+                )
+            }
+        }
+    };
+    let (model, selection) = match variant.rates() {
+        false => (
+            tasks::train(run, &format!("iv-c2/ae-r{r}-{name}"), &data, ae)?,
+            None,
+        ),
+        true => {
+            let (model, selection) =
+                select_rate_weight(run, (name, &sc, &data), ae, test, validation, &hom_of)?;
+            description = format!("{description} (`--rate-weight {}`)", selection.chosen);
+            (model, Some(selection))
+        }
+    };
     let pod = tasks::pod(run, &format!("iv-c2/pod-{r}-{pod_name}"), &data, r)?;
     let mut tests = vec![];
     let mut first_runs = None;
@@ -184,21 +257,7 @@ pub(super) fn run_variant(
             ..test.clone()
         };
         let tag = format!("{name} data, test seed {seed}");
-        let hom = match variant {
-            DataVariant::Spread | DataVariant::Rates if seed == test.seed => paper_hom.clone(),
-            DataVariant::Spread | DataVariant::Rates => hom_run(run, scenario, &t)?,
-            DataVariant::Damped | DataVariant::Hanging | DataVariant::HangingRates => {
-                simulate_test(
-                    run,
-                    &format!("iv-c2/test-hom-{pod_name}-seed{seed}"),
-                    &format!("HOM ({tag})"),
-                    &sc,
-                    &t,
-                    None,
-                    None,
-                )?
-            }
-        };
+        let hom = hom_of(seed)?;
         let rom_run = |m: &Step<ModelInfo>, step: &str, label: &str, name: &str| {
             simulate_test(
                 run,
@@ -231,7 +290,70 @@ pub(super) fn run_variant(
         pod,
         tests,
         first_runs,
+        selection,
     })
+}
+
+/// Trains the rate-term variant's AE with each of [`RATE_WEIGHTS`] and keeps the one with the
+/// lowest mean tip error on the `validation` inputs (a run that stops early scores infinity); with
+/// no validation inputs, the first candidate.
+fn select_rate_weight(
+    run: &Run,
+    (name, sc, data): (&str, &ScenarioSpec, &Step<DatasetInfo>),
+    ae: &AeConfig,
+    test: &Test,
+    validation: &[u64],
+    hom_of: &dyn Fn(u64) -> anyhow::Result<Step<SimRun>>,
+) -> anyhow::Result<(Step<ModelInfo>, RateSelection)> {
+    let r = ae.latent;
+    let candidates: &[f64] = match validation.is_empty() {
+        true => &RATE_WEIGHTS[..1],
+        false => &RATE_WEIGHTS,
+    };
+    let mut best: Option<(f64, Step<ModelInfo>, f64)> = None;
+    let mut table = vec![];
+    for &beta in candidates {
+        let config = AeConfig {
+            rate_weight: Some(beta),
+            ..ae.clone()
+        };
+        let model = tasks::train(
+            run,
+            &format!("iv-c2/ae-r{r}-{name}-beta{beta}"),
+            data,
+            &config,
+        )?;
+        let mut errors = vec![];
+        for &seed in validation {
+            let t = Test {
+                seed,
+                ..test.clone()
+            };
+            let hom = hom_of(seed)?;
+            let v = simulate_test(
+                run,
+                &format!("iv-c2/val-ae-r{r}-{name}-beta{beta}-seed{seed}"),
+                &format!("AE-{r} ({name} data, β = {beta}, validation seed {seed})"),
+                sc,
+                &t,
+                Some(&model),
+                Some(&hom),
+            )?;
+            errors.push(v.value.complete.then(|| v.value.tip_mean()));
+        }
+        let score = RateSelection::score(&errors);
+        if best.as_ref().is_none_or(|(s, _, _)| score < *s) {
+            best = Some((score, model, beta));
+        }
+        table.push((beta, errors));
+    }
+    let (_, model, chosen) = best.expect("at least one candidate");
+    let selection = RateSelection {
+        validation_seeds: validation.to_vec(),
+        candidates: table,
+        chosen,
+    };
+    Ok((model, selection))
 }
 
 /// The table of a variant's models on every test input.
@@ -251,6 +373,9 @@ pub(super) fn variant_table(r: usize, v: &VariantRuns) -> Table {
             DataVariant::HangingRates => "the HOM runs and the POD are the hanging variant's; only the AE's training differs.",
         }
     );
+    if let Some(sel) = &v.selection {
+        t.note = format!("{} {}.", t.note, sel.describe());
+    }
     t
 }
 
