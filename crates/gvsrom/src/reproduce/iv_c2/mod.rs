@@ -350,7 +350,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
             &ae_config(inset, LAMBDA, first_seed),
             &test,
             &hom,
-            (&test_seeds, &s.validation),
+            (&test_seeds, &s.validation, rounds),
         );
         run.check_interrupt()?;
         match result {
