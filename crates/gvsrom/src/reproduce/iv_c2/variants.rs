@@ -227,7 +227,7 @@ pub(super) fn run_variant(
                 simulate_test(
                     run,
                     &format!("iv-c2/test-hom-{pod_name}-seed{seed}"),
-                    &format!("HOM ({name} data, test seed {seed})"),
+                    &format!("HOM ({pod_name} data, test seed {seed})"),
                     &sc,
                     &t,
                     None,
@@ -256,13 +256,12 @@ pub(super) fn run_variant(
             seed,
             ..test.clone()
         };
-        let tag = format!("{name} data, test seed {seed}");
         let hom = hom_of(seed)?;
         let rom_run = |m: &Step<ModelInfo>, step: &str, label: &str, name: &str| {
             simulate_test(
                 run,
                 &format!("iv-c2/test-{step}{r}-{name}-test-seed{seed}"),
-                &format!("{label}{r} ({tag})"),
+                &format!("{label}{r} ({name} data, test seed {seed})"),
                 &sc,
                 &t,
                 Some(m),
