@@ -457,6 +457,16 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     let hanging = variant_runs
         .iter()
         .find(|v| v.variant == DataVariant::Hanging);
+    // with the AE of the strain-rate term beside them, when that variant ran
+    let rated = variant_runs
+        .iter()
+        .find(|v| v.variant == DataVariant::HangingRates)
+        .and_then(|v| {
+            Some((
+                v.first_runs.as_ref()?[1].clone(),
+                v.selection.as_ref()?.chosen,
+            ))
+        });
     if let Some([h, a, p]) = hanging.and_then(|v| v.first_runs.as_ref()) {
         let inset = Inset {
             r: inset,
@@ -464,7 +474,11 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
             ae: Trajectory::load(a, "AE")?,
             pod: Trajectory::load(p, "POD")?,
         };
-        figures.push(hanging_figure(&inset, s.test_s)?);
+        let rated = match rated {
+            Some((path, beta)) => Some((beta, Trajectory::load(&path, "AE, rate term")?)),
+            None => None,
+        };
+        figures.push(hanging_figure(&inset, rated.as_ref(), s.test_s)?);
     }
     Ok((report, figures))
 }

@@ -556,7 +556,7 @@ pub(super) fn fig9(dofs: &[Dof], hom: &SimRun, inset: &Inset) -> anyhow::Result<
             equal_aspect: false,
         }),
     ];
-    panels.extend(trace_panels(inset, [1, 2]));
+    panels.extend(trace_panels(inset, [1, 2], None));
     figure(
         "fig9-dof",
         &format!("Fig. 9: mean tip error (% of the length) and wall time of the {d} s test against the number of DOFs for the AE-ROM (gold), the POD-ROM (red) and, beyond the paper, the POD-ROM of the autoencoders' strain-energy norm (blue), the HOM's time as the green dashed line (log scales where the values span two powers of ten; black dots: runs that stopped early, measured up to where they stopped); the tip traces of the HOM, AE-{r} and POD-{r} (r = {r}, the paper's inset): the path seen along the arm (y–z, gravity along −z) and the tip's x, y, z over time", r = inset.r, d = hom.t_reached),
@@ -571,9 +571,14 @@ pub(super) fn fig9(dofs: &[Dof], hom: &SimRun, inset: &Inset) -> anyhow::Result<
 }
 
 /// The inset's tip traces: the path seen along the arm (world axes `path[0]`–`path[1]`, across the
-/// unloaded arm), then the tip's x, y and z over time; HOM, AE-r and POD-r.
-fn trace_panels(inset: &Inset, path: [usize; 2]) -> Vec<Figure> {
-    let models = [
+/// unloaded arm), then the tip's x, y and z over time; HOM, AE-r and POD-r, and `extra` (a label
+/// and a trajectory, in blue) if given.
+fn trace_panels(
+    inset: &Inset,
+    path: [usize; 2],
+    extra: Option<(String, &Trajectory)>,
+) -> Vec<Figure> {
+    let mut models = vec![
         (
             "HOM".to_string(),
             &inset.hom,
@@ -593,6 +598,9 @@ fn trace_panels(inset: &Inset, path: [usize; 2]) -> Vec<Figure> {
             SeriesStyle::Dashed,
         ),
     ];
+    if let Some((label, t)) = extra {
+        models.push((label, t, palette::AE_ALT, SeriesStyle::Dashed));
+    }
     let trace = |x_of: &dyn Fn(&Trajectory, usize) -> f64, axis: usize| -> Vec<Series> {
         models
             .iter()
@@ -628,15 +636,28 @@ fn trace_panels(inset: &Inset, path: [usize; 2]) -> Vec<Figure> {
 }
 
 /// The hanging arm's tip traces on the paper's test input (beyond the paper): HOM, AE-r and POD-r
-/// of the variant, the path seen along the arm (x–y: the arm hangs along −z) and x, y, z over time.
-pub(super) fn hanging_figure(inset: &Inset, test_s: f64) -> anyhow::Result<RenderedFigure> {
+/// of the variant, and the AE-r trained with the strain-rate term of weight `rated.0` if given; the
+/// path seen along the arm (x–y: the arm hangs along −z) and x, y, z over time.
+pub(super) fn hanging_figure(
+    inset: &Inset,
+    rated: Option<&(f64, Trajectory)>,
+    test_s: f64,
+) -> anyhow::Result<RenderedFigure> {
+    let r = inset.r;
+    let extra = rated.map(|(beta, t)| (format!("AE-{r}, rate term β = {beta}"), t));
+    let with = match rated {
+        Some((beta, _)) => format!(
+            " and, blue, the AE-{r} trained with the strain-rate term (`--rate-weight {beta}`)"
+        ),
+        None => String::new(),
+    };
     figure(
         "hanging-trace",
-        &format!("Beyond the paper: the six-tendon arm hanging along gravity (preset six-tendon-hanging), the tip traces of the HOM, AE-{r} and POD-{r} (trained on the hanging arm's babbling) on the paper's {test_s} s test input: the path seen along the arm (x–y, the arm along −z) and the tip's x, y, z over time", r = inset.r),
+        &format!("Beyond the paper: the six-tendon arm hanging along gravity (preset six-tendon-hanging), the tip traces of the HOM, AE-{r} and POD-{r} (trained on the hanging arm's babbling){with} on the paper's {test_s} s test input: the path seen along the arm (x–y, the arm along −z) and the tip's x, y, z over time"),
         &Figure::Grid {
             title: "IV-C2 on the hanging arm: ROMs against the HOM".into(),
             cols: 2,
-            panels: trace_panels(inset, [0, 1]),
+            panels: trace_panels(inset, [0, 1], extra),
         },
         1400,
         1050,
