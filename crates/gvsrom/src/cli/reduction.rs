@@ -99,8 +99,9 @@ pub struct TrainArgs {
     /// Weight β of the strain-rate term (beyond the paper): the autoencoder's tangent map must carry
     /// each trajectory sample's strain rate, `‖J(x) ẋ − ẋ‖²` added to the loss with weight β (rates
     /// by central differences of the trajectory's samples; equilibria are at rest). It gives the
-    /// decoder the tangent space a dynamic model moves in. 0: eq. (15) alone (the paper's); 0.1
-    /// halves the IV-C2 tip error of AE-7 on the arm hanging along gravity (docs/paper-results.md).
+    /// decoder the tangent space a dynamic model moves in. 0: eq. (15) alone (the paper's); with
+    /// 0.1–1 the IV-C2 AE-7 is about half as far off (`reproduce iv-c2` chooses among 0.1, 0.3 and 1
+    /// on validation inputs; docs/assumptions.md).
     #[arg(long, default_value_t = 0.0)]
     pub rate_weight: f64,
     /// The new model directory.

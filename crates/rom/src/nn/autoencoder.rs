@@ -169,15 +169,12 @@ impl Autoencoder {
             .sample_weighting
             .weights(data, n_features, scaling.scale(), &train);
         // rates scale as the data's deviations: by 1/s, without the mean
-        // rates scale as the data's deviations: by 1/s, without the mean
-        let scaled_rates = rates.filter(|_| beta > 0.0).map(|v| {
+        let scaled_rates: Option<Vec<f64>> = rates.filter(|_| beta > 0.0).map(|v| {
             let s = scaling.scale();
-            let v: Vec<f64> = v
-                .iter()
+            v.iter()
                 .enumerate()
                 .map(|(i, v)| v / s[i % n_features])
-                .collect();
-            v
+                .collect()
         });
         let problem = Problem {
             layers: &mut layers,

@@ -11,7 +11,8 @@
 //! entry's. (Applied against the per-entry mean, λ = 1e-4 is n times stronger; on the 148-value soft
 //! beam snapshots it then outweighs the reconstruction term and caps Table I's RMSE near 4 instead
 //! of 0.6.) The monitored loss is the validation
-//! reconstruction MSE (scaled units, no penalty), or the epoch's training MSE without validation rows;
+//! reconstruction MSE (scaled units, no penalty; plus `β Q` with the strain-rate term of
+//! [`crate::nn::rates`]), or the epoch's training MSE without validation rows;
 //! the weights with the lowest monitored loss are kept. After `patience` epochs without a lower
 //! monitored loss the phase goes back to the best weights and continues with the rate times
 //! [`LR_REDUCTION_FACTOR`], up to [`TrainOptions::lr_reductions`] times, then stops. An optional fine-tuning phase ([`FineTune`]:
@@ -26,7 +27,7 @@ use super::batch::{
     backward_batch_without_penalty, dataset_mse, forward_batch, in_pool, reconstruction_mse,
     Workspace, PARALLEL_MIN_MACS,
 };
-use super::lbfgs::{Lbfgs, Objective};
+use super::lbfgs::{Buffers, Lbfgs, Objective};
 use super::mlp::Layer;
 use super::rates::{add_rate_gradient, dataset_rate_mse, forward_rates, rate_mse, RateBuffers};
 use super::scaling::Weighting;
@@ -259,7 +260,8 @@ pub enum StopReason {
 }
 
 /// Loss curves and final errors of a training run. Losses are reconstruction mean squared errors
-/// `(1/(N·n)) Σ‖x̂ − x‖²` in scaled units without the weight penalty; RMSEs are in physical units,
+/// `(1/(N·n)) Σ‖x̂ − x‖²` in scaled units without the weight penalty (the curves plus `β Q` with the
+/// strain-rate term, [`TrainOptions::rate_weight`]); RMSEs are in physical units,
 /// `√((1/(N·n)) Σ‖x̂ − x‖²)` over all rows and features (as the paper's Table I).
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrainReport {
@@ -477,7 +479,7 @@ impl Tracker<'_, '_> {
     fn record(
         &mut self,
         p: &mut Problem,
-        (ws, rb): (&mut Workspace, &mut Option<RateBuffers>),
+        (ws, rb): Buffers,
         train: f64,
         fine: bool,
     ) -> Option<StopReason> {
@@ -599,7 +601,7 @@ pub(crate) fn fit(
 /// `reductions` plateaus the best weights come back and the rate drops by [`LR_REDUCTION_FACTOR`].
 fn adam_phase(
     p: &mut Problem,
-    (ws, rb): (&mut Workspace, &mut Option<RateBuffers>),
+    (ws, rb): Buffers,
     t: &mut Tracker,
     rng: &mut SplitMix64,
     (epochs, lr, lambda, reductions): (usize, f64, f64, usize),
@@ -630,7 +632,7 @@ fn adam_phase(
 /// Up to `iterations` full-batch L-BFGS iterations, each recorded as an epoch.
 fn lbfgs_phase(
     p: &mut Problem,
-    (ws, rb): (&mut Workspace, &mut Option<RateBuffers>),
+    (ws, rb): Buffers,
     t: &mut Tracker,
     (iterations, memory): (usize, usize),
     lambda: f64,
@@ -667,7 +669,7 @@ fn run_epoch(
     tanh: &[bool],
     (data, weights, rates): Rows,
     order: &[usize],
-    (ws, rb): (&mut Workspace, &mut Option<RateBuffers>),
+    (ws, rb): Buffers,
     adam: &mut Adam,
     (lr, lambda): (f64, f64),
 ) -> f64 {

@@ -33,8 +33,8 @@ pub(super) const HANGING_PRESET: &str = "six-tendon-hanging";
 /// The rate-term variants' candidate `--rate-weight`s.
 pub(super) const RATE_WEIGHTS: [f64; 3] = [0.1, 0.3, 1.0];
 
-/// A variant of the data (and, for [`DataVariant::Damped`] and [`DataVariant::Hanging`], of the
-/// arm).
+/// A variant of the data (and, for [`DataVariant::Damped`], [`DataVariant::Hanging`] and
+/// [`DataVariant::HangingRates`], of the arm; for the rate-term variants, of the AE's training).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) enum DataVariant {
     Spread,
@@ -479,4 +479,32 @@ pub(super) fn variant_findings(r: usize, v: &VariantRuns) -> Vec<Finding> {
     };
     findings.extend(fast);
     findings
+}
+
+#[cfg(test)]
+mod tests {
+    use super::RateSelection;
+
+    #[test]
+    fn a_rate_weight_is_scored_by_its_mean_validation_error_and_a_stopped_run_never_wins() {
+        assert_eq!(
+            RateSelection::score(&[Some(1.0), Some(2.0), Some(4.5)]),
+            2.5
+        );
+        assert_eq!(RateSelection::score(&[Some(0.1), None]), f64::INFINITY);
+        let s = RateSelection {
+            validation_seeds: vec![7, 8],
+            candidates: vec![
+                (0.1, vec![Some(2.0), None]),
+                (1.0, vec![Some(1.25), Some(1.5)]),
+            ],
+            chosen: 1.0,
+        };
+        let d = s.describe();
+        assert!(d.starts_with("β = 1 kept"), "{d}");
+        assert!(
+            d.contains("seeds 7, 8") && d.contains("β = 0.1: 2.00, stopped % L"),
+            "{d}"
+        );
+    }
 }
