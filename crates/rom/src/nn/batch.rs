@@ -431,6 +431,42 @@ pub(crate) fn dataset_mse(
     sum / index.len().max(1) as f64
 }
 
+/// Checks the gradients `gw`, `gb` of every weight and bias of `layers` against central
+/// differences of `loss` (h = 1e-5: truncation O(h²) ≈ 1e-10, rounding ≈ 1e-16/h ≈ 1e-11),
+/// relative to max(|g|, 1e-3), within 1e-6.
+#[cfg(test)]
+pub(crate) fn assert_gradient_is_central_differences(
+    layers: &mut [Layer],
+    gw: &[Vec<f64>],
+    gb: &[Vec<f64>],
+    mut loss: impl FnMut(&[Layer]) -> f64,
+) {
+    let h = 1e-5;
+    for k in 0..layers.len() {
+        for (is_w, grad) in [(true, &gw[k]), (false, &gb[k])] {
+            for i in 0..grad.len() {
+                let probe = |delta: f64, layers: &mut [Layer]| match is_w {
+                    true => layers[k].w[i] += delta,
+                    false => layers[k].b[i] += delta,
+                };
+                probe(h, layers);
+                let up = loss(layers);
+                probe(-2.0 * h, layers);
+                let down = loss(layers);
+                probe(h, layers);
+                let fd = (up - down) / (2.0 * h);
+                let err = (fd - grad[i]).abs() / grad[i].abs().max(1e-3);
+                assert!(
+                    err <= 1e-6,
+                    "layer {k} {} [{i}]: fd {fd} vs {}",
+                    if is_w { "W" } else { "b" },
+                    grad[i]
+                );
+            }
+        }
+    }
+}
+
 /// Glorot weights and random biases in [−0.5, 0.5) for the layers of `sizes` (tests of the passes
 /// and of the optimiser: non-zero biases exercise their gradients).
 #[cfg(test)]
@@ -462,41 +498,6 @@ mod tests {
         forward_batch(layers, tanh, ws, rows);
         let penalty: f64 = layers.iter().map(Layer::sum_squared_weights).sum();
         reconstruction_mse(ws, rows) + lambda * penalty
-    }
-
-    /// Checks the gradients `gw`, `gb` of every weight and bias of `layers` against central
-    /// differences of `loss` (h = 1e-5: truncation O(h²) ≈ 1e-10, rounding ≈ 1e-16/h ≈ 1e-11),
-    /// relative to max(|g|, 1e-3), within 1e-6.
-    fn assert_gradient_is_central_differences(
-        layers: &mut [Layer],
-        gw: &[Vec<f64>],
-        gb: &[Vec<f64>],
-        mut loss: impl FnMut(&[Layer]) -> f64,
-    ) {
-        let h = 1e-5;
-        for k in 0..layers.len() {
-            for (is_w, grad) in [(true, &gw[k]), (false, &gb[k])] {
-                for i in 0..grad.len() {
-                    let probe = |delta: f64, layers: &mut [Layer]| match is_w {
-                        true => layers[k].w[i] += delta,
-                        false => layers[k].b[i] += delta,
-                    };
-                    probe(h, layers);
-                    let up = loss(layers);
-                    probe(-2.0 * h, layers);
-                    let down = loss(layers);
-                    probe(h, layers);
-                    let fd = (up - down) / (2.0 * h);
-                    let err = (fd - grad[i]).abs() / grad[i].abs().max(1e-3);
-                    assert!(
-                        err <= 1e-6,
-                        "layer {k} {} [{i}]: fd {fd} vs {}",
-                        if is_w { "W" } else { "b" },
-                        grad[i]
-                    );
-                }
-            }
-        }
     }
 
     #[test]

@@ -207,7 +207,7 @@ pub(crate) fn dataset_rate_mse(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::nn::batch::{forward_batch, test_layers};
+    use crate::nn::batch::{assert_gradient_is_central_differences, forward_batch, test_layers};
     use gvs::inputs::SplitMix64;
 
     /// `β Q` of the chain on the rows loaded in `ws`, `rb`.
@@ -281,39 +281,8 @@ mod tests {
         }
         add_rate_gradient(&layers, &tanh, &mut ws, &mut rb, rows, beta);
         let (gw, gb) = (ws.grad_w.clone(), ws.grad_b.clone());
-        let h = 1e-5;
-        let mut checked = 0;
-        for k in 0..layers.len() {
-            for (is_w, len) in [(true, layers[k].w.len()), (false, layers[k].b.len())] {
-                for i in 0..len {
-                    let mut at = |delta: f64, layers: &mut Vec<Layer>| {
-                        let p = if is_w {
-                            &mut layers[k].w[i]
-                        } else {
-                            &mut layers[k].b[i]
-                        };
-                        *p += delta;
-                        let l = loss(layers, &tanh, &mut ws, &mut rb, rows, beta);
-                        let p = if is_w {
-                            &mut layers[k].w[i]
-                        } else {
-                            &mut layers[k].b[i]
-                        };
-                        *p -= delta;
-                        l
-                    };
-                    let fd = (at(h, &mut layers) - at(-h, &mut layers)) / (2.0 * h);
-                    let g = if is_w { gw[k][i] } else { gb[k][i] };
-                    assert!(
-                        (g - fd).abs() <= 1e-7 * (1.0 + fd.abs()),
-                        "layer {k} {} {i}: {g} vs {fd}",
-                        if is_w { "w" } else { "b" }
-                    );
-                    checked += 1;
-                }
-            }
-        }
-        // every weight and bias: 5·4 + 4·2 + 2·4 + 4·5 weights, 4 + 2 + 4 + 5 biases
-        assert_eq!(checked, 71);
+        assert_gradient_is_central_differences(&mut layers, &gw, &gb, |layers| {
+            loss(layers, &tanh, &mut ws, &mut rb, rows, beta)
+        });
     }
 }
