@@ -107,7 +107,7 @@ impl Autoencoder {
         Self::train_with_rates(data, None, n_features, opts, progress)
     }
 
-    /// [`Autoencoder::train`] with the strain-rate term ([`crate::nn::rates`]) of weight
+    /// [`Autoencoder::train`] with the strain-rate term (`nn::rates`) of weight
     /// [`TrainOptions::rate_weight`]: `rates` holds the rate of every data row (row-major, physical
     /// units per second, as `data`). The monitored (validation) loss then includes `β Q`; the
     /// reported RMSEs remain the reconstruction's.

@@ -16,8 +16,8 @@
 //! All buffers live in a [`Workspace`] sized once for the largest batch, so a training epoch allocates
 //! nothing of its own (faer reuses its thread-local packing buffers).
 //!
-//! Parallelism (rayon's current pool, through [`in_pool`]): a layer with at least
-//! [`PARALLEL_MIN_MACS`] multiply-adds per pass runs as two tasks — in the forward pass the two
+//! Parallelism (rayon's current pool, through `in_pool`): a layer with at least
+//! `PARALLEL_MIN_MACS` multiply-adds per pass runs as two tasks — in the forward pass the two
 //! halves of its output units; in the backward pass `∂L/∂W_k` beside `Δ_k` (the same work each),
 //! and for the first layer the two halves of `∂L/∂W_0`'s rows. The split depends on the sizes only,
 //! never on the number of threads, and every output element is computed by one task in a fixed

@@ -26,7 +26,7 @@
 //!   `μ_{L−1} = W_Lᵀ g`, `μ_{k−1} = W_kᵀ (σ'(a_k) ⊙ μ_k)` — `O(Σ n_k r²)`, no third-order tensor.
 //!
 //! The weights are kept column-major (and transposed, for the reverse passes), so every product is
-//! one call of this crate's small kernels ([`crate::gemm`]: value and tangents together). No call
+//! one call of this crate's small kernels (`gemm`: value and tangents together). No call
 //! allocates (`tests/decoder_map_no_alloc.rs`).
 
 use super::mlp::{Layer, Mlp};

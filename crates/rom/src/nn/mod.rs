@@ -45,6 +45,7 @@ macro_rules! simd_fn {
 }
 
 pub mod activation;
+mod adam;
 pub mod ae_map;
 pub mod autoencoder;
 pub mod batch;
