@@ -41,13 +41,13 @@ fn default_friction_smoothing() -> f64 {
 /// A tendon routed between two offsets in the section plane.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Tendon {
-    /// `(d_y, d_z)` offset at `x_start` [m].
+    /// `(d_y, d_z)` offset at `x_start` \[m\].
     pub offset_start: [f64; 2],
-    /// `(d_y, d_z)` offset at `x_end` [m].
+    /// `(d_y, d_z)` offset at `x_end` \[m\].
     pub offset_end: [f64; 2],
-    /// Start of the tendon's span (its actuated end) [m].
+    /// Start of the tendon's span (its actuated end) \[m\].
     pub x_start: f64,
-    /// Termination [m].
+    /// Termination \[m\].
     pub x_end: f64,
     /// Coulomb friction coefficient μ ≥ 0 of the capstan law.
     pub friction: f64,
@@ -80,7 +80,7 @@ impl Tendon {
         )
     }
 
-    /// Smoothing angle `ε = κ_ε |ΔX|` [rad] of the turning angle between two tendon points `ΔX`
+    /// Smoothing angle `ε = κ_ε |ΔX|` \[rad\] of the turning angle between two tendon points `ΔX`
     /// apart: `κ_ε` is a curvature, so only pairs whose tendon-path curvature `φ/|ΔX|` is within a
     /// few `κ_ε` of 0 are smoothed, however the points are spaced, and `Θ = Σ φ_ε` converges with the
     /// discretization (an absolute ε would erase the friction of a finely discretized tendon, whose

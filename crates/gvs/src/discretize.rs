@@ -55,7 +55,7 @@ pub struct Point {
     pub x: f64,
     /// Normalized division coordinate X̄ ∈ [0, 1].
     pub x_bar: f64,
-    /// Quadrature weight W (physical, [m]); 0 at boundaries and extra points.
+    /// Quadrature weight W (physical, \[m\]); 0 at boundaries and extra points.
     pub weight: f64,
     /// Division index.
     pub div: usize,

@@ -30,7 +30,7 @@ pub enum DynamicsError {
     NonFinite { what: &'static str },
 }
 
-/// Energies of a state [J].
+/// Energies of a state \[J\].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Energy {
     pub kinetic: f64,
@@ -43,7 +43,7 @@ pub struct Energy {
 pub struct Mode {
     /// The eigenvalue `ω²` [rad²/s²], negative for a direction in which the equilibrium is unstable.
     pub omega_squared: f64,
-    /// Natural frequency `√max(ω², 0) / 2π` [Hz] (0 for an unstable direction).
+    /// Natural frequency `√max(ω², 0) / 2π` \[Hz\] (0 for an unstable direction).
     pub frequency_hz: f64,
     /// Mode shape in `q`, mass-normalized.
     pub shape: DVector<f64>,
@@ -242,7 +242,7 @@ impl<P: StrainParam> Model<P> {
         crate::cpu::clear_upper_state();
     }
 
-    /// The smallest ratio `Ds/Es` over the sections and the strain components with `Es > 0` [s]
+    /// The smallest ratio `Ds/Es` over the sections and the strain components with `Es > 0` \[s\]
     /// (Kelvin–Voigt: `3η/E` for an incompressible material; 0 without damping).
     pub fn damping_time(&self) -> f64 {
         self.props

@@ -11,7 +11,7 @@ use std::f64::consts::PI;
 /// Isotropic linear-elastic material with viscous (Kelvin–Voigt) damping.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Material {
-    /// Young's modulus E [Pa].
+    /// Young's modulus E \[Pa\].
     pub youngs_modulus: f64,
     /// Poisson ratio ν, in (−1, 0.5].
     pub poisson_ratio: f64,

@@ -2,7 +2,7 @@
 //!
 //! Thin by design: every function converts its arguments, releases the GIL where the work is long,
 //! calls the same library function the command line calls, and converts the result. Errors become
-//! Python exceptions carrying the message the command line prints ([`errors`]); no panic crosses
+//! Python exceptions carrying the message the command line prints (`errors`); no panic crosses
 //! into Python (PyO3 turns one into `PanicException`, and the library returns errors as values).
 
 mod arrays;

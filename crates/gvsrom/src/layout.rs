@@ -1,6 +1,6 @@
 //! The layout of a built scenario's strain rows: the computational points and the strain
 //! components its basis can excite. Datasets, statics comparisons and reduced models share it
-//! (build layer: it depends on [`crate::build`] and the scenario's component names only).
+//! (build layer: it depends on [`crate::build`](mod@crate::build) and the scenario's component names only).
 
 use crate::build::Built;
 

@@ -1,7 +1,7 @@
 //! # gvsrom — scenarios and runs for the GVS engine
 //!
 //! The library half of the `gvsrom` command: TOML scenario files ([`scenario`]), their validation and
-//! conversion to the engine's model ([`build`]), the built-in presets for the paper's robots
+//! conversion to the engine's model ([`build`](mod@build)), the built-in presets for the paper's robots
 //! ([`presets`]), statics runs with their JSON report ([`statics`]) and the natural frequencies and
 //! mode shapes about an equilibrium ([`modes`]). The binary only parses the command line, calls these
 //! and prints.

@@ -71,9 +71,9 @@ pub fn parse_count(text: Option<&str>, n_dof: usize) -> Result<(usize, bool), Mo
 pub struct ModeReport {
     /// 1 for the lowest.
     pub mode: usize,
-    /// Natural frequency `ω/2π` [Hz]; 0 when `ω² ≤ 0`.
+    /// Natural frequency `ω/2π` \[Hz\]; 0 when `ω² ≤ 0`.
     pub frequency_hz: f64,
-    /// `1/f` [s]; `null` when the frequency is 0.
+    /// `1/f` \[s\]; `null` when the frequency is 0.
     pub period_s: Option<f64>,
     /// `φᵀ K_T φ` [1/s²]; negative: the equilibrium is unstable along this shape.
     pub omega_squared: f64,
@@ -97,7 +97,7 @@ pub struct ModeReport {
 #[derive(Debug, Clone, Serialize)]
 pub struct ModesReport {
     pub scenario: String,
-    /// Tendon tensions u [N] of the equilibrium.
+    /// Tendon tensions u \[N\] of the equilibrium.
     pub u: Vec<f64>,
     pub n_dof: usize,
     pub n_points: usize,
@@ -105,9 +105,9 @@ pub struct ModesReport {
     pub q0: Vec<f64>,
     pub equilibrium_tip_position: [f64; 3],
     pub equilibrium_residual_norm: f64,
-    /// Frequencies of all `n_dof` modes, ascending [Hz].
+    /// Frequencies of all `n_dof` modes, ascending \[Hz\].
     pub all_frequencies_hz: Vec<f64>,
-    /// Abscissae of the computational points [m].
+    /// Abscissae of the computational points \[m\].
     pub strain_x: Vec<f64>,
     /// The lowest `--count` modes.
     pub modes: Vec<ModeReport>,

@@ -11,7 +11,7 @@
 //! | `scenario_toml` | the scenario as run (after `--set`, `--tension`, `--centerline-points`): `gvsrom statics FILE` on this text alone solves the same problem |
 //! | `seeds` | every seed, by what it seeds (`{"input": 1}`, `{"plan": 0}`, `{"training": 0}`) |
 //! | `input` | a run's actuation (`simulate::input_record`) |
-//! | `sampling` | a dynamics run's `duration` [s] and `sample_rate` [Hz] |
+//! | `sampling` | a dynamics run's `duration` \[s\] and `sample_rate` \[Hz\] |
 //! | `integrator` | a dynamics run's method and tolerances (`simulate::integrator_record`) |
 //! | `solver` | a statics run's solver options (the scenario's `[solver]`) |
 //! | `model`, `dataset`, `reference`, `run` | an input directory (`compare`'s trajectories for the last two): its path and the hashes its manifest records (`meta_sha256`, `sha256` per file) |
@@ -66,9 +66,9 @@ pub struct Provenance {
 /// The time span and output rate of a dynamics run.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Sampling {
-    /// Simulated time [s] (`--duration`).
+    /// Simulated time \[s\] (`--duration`).
     pub duration: f64,
-    /// Output samples per second [Hz] (`--sample-rate`).
+    /// Output samples per second \[Hz\] (`--sample-rate`).
     pub sample_rate: f64,
 }
 
@@ -151,7 +151,7 @@ impl Provenance {
         self
     }
 
-    /// A dynamics run's `duration` [s] and `sample_rate` [Hz].
+    /// A dynamics run's `duration` \[s\] and `sample_rate` \[Hz\].
     pub fn sampling(mut self, duration: f64, sample_rate: f64) -> Self {
         self.sampling = Some(Sampling {
             duration,

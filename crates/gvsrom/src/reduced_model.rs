@@ -51,7 +51,7 @@ pub struct ModelLayout {
     pub scenario: String,
     /// Its TOML text.
     pub scenario_toml: String,
-    /// Abscissae of the computational points [m].
+    /// Abscissae of the computational points \[m\].
     pub strain_x: Vec<f64>,
     /// Names of the active strain components, in 6-vector order.
     pub active: Vec<String>,
@@ -66,7 +66,7 @@ impl ModelLayout {
     }
 }
 
-/// Whether two lists of point abscissae [m] are the same points: equal lengths and every pair
+/// Whether two lists of point abscissae \[m\] are the same points: equal lengths and every pair
 /// within 1e-12 of the larger of 1 m and the largest abscissa (rounding of the same quadrature).
 pub fn same_abscissae(a: &[f64], b: &[f64]) -> bool {
     let scale = a.iter().chain(b).fold(1.0f64, |m, x| m.max(x.abs()));

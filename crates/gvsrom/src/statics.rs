@@ -20,21 +20,21 @@ use std::time::Instant;
 #[derive(Debug, Clone, Serialize)]
 pub struct StaticsReport {
     pub scenario: String,
-    /// Tendon tensions u [N].
+    /// Tendon tensions u \[N\].
     pub u: Vec<f64>,
     pub n_dof: usize,
     pub n_points: usize,
     /// Generalized coordinates at equilibrium.
     pub q: Vec<f64>,
-    /// Tip position in the world frame [m].
+    /// Tip position in the world frame \[m\].
     pub tip_position: [f64; 3],
     /// Tip rotation matrix (rows), section frame → world.
     pub tip_rotation: [[f64; 3]; 3],
-    /// Abscissae of the centreline samples [m].
+    /// Abscissae of the centreline samples \[m\].
     pub centerline_x: Vec<f64>,
-    /// Centreline positions at `centerline_x` [m].
+    /// Centreline positions at `centerline_x` \[m\].
     pub centerline: Vec<[f64; 3]>,
-    /// Abscissae of the computational points [m].
+    /// Abscissae of the computational points \[m\].
     pub strain_x: Vec<f64>,
     /// ξ at the computational points, `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]`.
     pub strain: Vec<[f64; 6]>,
@@ -45,7 +45,7 @@ pub struct StaticsReport {
     pub jacobian_evaluations: usize,
     /// `‖R(q)‖∞` at the solution.
     pub residual_norm: f64,
-    /// Wall-clock time of the solve alone [s].
+    /// Wall-clock time of the solve alone \[s\].
     pub solve_time_s: f64,
     /// Set when the load ramp stalled and the equilibrium was reached by arc-length continuation
     /// from the straight rod.
@@ -65,7 +65,7 @@ pub struct ContinuationSummary {
 }
 
 impl StaticsReport {
-    /// Tip rotation as a unit axis and an angle [rad] (axis `[1, 0, 0]` for the identity).
+    /// Tip rotation as a unit axis and an angle \[rad\] (axis `[1, 0, 0]` for the identity).
     pub fn tip_axis_angle(&self) -> ([f64; 3], f64) {
         let r = self.tip_rotation;
         let m = nalgebra::Matrix3::from_fn(|i, j| r[i][j]);
@@ -84,7 +84,7 @@ pub fn solve(built: &Built) -> Result<StaticsReport, StaticsFailure> {
     solve_under(built, &built.u)
 }
 
-/// [`solve`] under the tensions `u` [N] in place of the scenario's, one per tendon: the same
+/// [`solve`] under the tensions `u` \[N\] in place of the scenario's, one per tendon: the same
 /// equilibrium as a scenario built with these tensions (`--tension`), without building it again.
 /// Check `u` first with [`Built::tensions`] (and, with a reduced model attached,
 /// [`crate::build::Reduced::covers_tensions`]). A reduced model starts from its initial guess at
@@ -106,7 +106,7 @@ pub fn solve_checked(built: &Built, u: &[f64]) -> anyhow::Result<StaticsReport> 
 
 /// For an attached reduced model, whether its solution `report` is to be trusted: inside the
 /// training encodings' range (`Reduced::check_range`) and not a spurious straight rod
-/// ([`check_not_spurious_rest`]); else the error names the likely cause. Nothing to check for the
+/// (`check_not_spurious_rest`); else the error names the likely cause. Nothing to check for the
 /// full model.
 pub fn check_reduced(built: &Built, report: &StaticsReport) -> Result<(), ScenarioError> {
     if let Some(r) = &built.reduced {

@@ -96,7 +96,7 @@ pub struct ContinuationOptions {
     pub max_corrector_iterations: usize,
     /// Relative residual tolerance of the points on the path.
     pub corrector_ftol: f64,
-    /// Largest angle between consecutive tangents [rad].
+    /// Largest angle between consecutive tangents \[rad\].
     pub max_turn: f64,
     /// Step below which a sign change of `det ∂R/∂x` without a fold (or the reverse) is accepted.
     pub singular_step: f64,

@@ -545,7 +545,7 @@ pub fn simulate_streaming_interruptible<P: StrainParam>(
 /// ([`ndf_for_rod`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DampingRegime {
-    /// Smallest ratio `Ds/Es` over the sections and strain components [s]: Kelvin–Voigt damping
+    /// Smallest ratio `Ds/Es` over the sections and strain components \[s\]: Kelvin–Voigt damping
     /// gives a mode of frequency `ω` the damping ratio `ζ ≥ τ ω/2`.
     pub tau: f64,
     /// Highest natural frequency of the straight rod, `√λ_max(M⁻¹K)` [rad/s] (`None` when

@@ -15,16 +15,16 @@ pub const MAX_BASIS_SIZE: usize = 5_000_000;
 /// Largest number of generalized coordinates (DOF). Statics factorizes a dense n × n Jacobian per
 /// iteration (O(n³)): 2000 DOF is about a second per iteration on one core.
 pub const MAX_DOF: usize = 2000;
-/// Accepted Young's modulus E [Pa]: from the softest hydrogels (≈ 1 kPa) with three decades of
+/// Accepted Young's modulus E \[Pa\]: from the softest hydrogels (≈ 1 kPa) with three decades of
 /// room below, to stiffer than diamond (1.2e12 Pa).
 pub const YOUNGS_MODULUS_RANGE: (f64, f64) = (1.0, 1e13);
 /// Accepted density ρ [kg/m³]: 0 (massless) to 1e5, five times the densest element (osmium 2.26e4).
 pub const DENSITY_RANGE: (f64, f64) = (0.0, 1e5);
 /// Largest gravitational acceleration |g| [m/s²] (1000 g).
 pub const MAX_GRAVITY: f64 = 1e4;
-/// Accepted division length ℓ_j [m]: 1 µm to 1 km.
+/// Accepted division length ℓ_j \[m\]: 1 µm to 1 km.
 pub const DIVISION_LENGTH_RANGE: (f64, f64) = (1e-6, 1e3);
-/// Smallest radius [m] (0.1 µm); the largest is the rod's total length L (a rod is slender).
+/// Smallest radius \[m\] (0.1 µm); the largest is the rod's total length L (a rod is slender).
 pub const MIN_RADIUS: f64 = 1e-7;
 /// Largest number of centreline samples.
 pub const MAX_CENTERLINE_POINTS: usize = 100_000;

@@ -12,7 +12,7 @@ pub(super) fn wrench(moment: [f64; 3], force: [f64; 3]) -> [f64; 6] {
     ]
 }
 
-/// The validated loads of `s` on a rod of length `l` (part of [`build`]; a dataset that varies only
+/// The validated loads of `s` on a rod of length `l` (part of `build`; a dataset that varies only
 /// loads rebuilds just these).
 pub fn loads(s: &Scenario, l: f64) -> Result<Loads, ScenarioError> {
     let spec = &s.loads;

@@ -37,7 +37,7 @@ pub struct Built {
     pub name: String,
     pub model: Model<LinearBasis>,
     pub loads: Loads,
-    /// Tendon tensions u [N], in tendon order.
+    /// Tendon tensions u \[N\], in tendon order.
     pub u: Vec<f64>,
     pub options: StaticsOptions,
     pub centerline_points: usize,
@@ -54,7 +54,7 @@ impl Built {
         }
     }
 
-    /// Tensions `u` [N] for a run in place of the scenario's, checked as a scenario built with
+    /// Tensions `u` \[N\] for a run in place of the scenario's, checked as a scenario built with
     /// them (`--tension`) would be: one value for every tendon or one per tendon
     /// ([`crate::scenario::tensions_for`]), finite, and plausible with the loads
     /// ([`crate::plausibility::check`]). Returns one value per tendon.

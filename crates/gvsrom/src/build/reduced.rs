@@ -31,7 +31,7 @@ pub struct Reduced {
     pub kind: String,
     pub path: PathBuf,
     /// Initial guess of a statics solve: the model's anchors at this scenario's inputs
-    /// ([`anchor_guess`]; models whose dataset inputs the scenario defines).
+    /// (`anchor_guess`; models whose dataset inputs the scenario defines).
     pub initial: Option<DVector<f64>>,
     /// The initial guesses at other tensions ([`Self::initial_at`]; the reduction layer's
     /// anchors).
@@ -46,7 +46,7 @@ pub struct Reduced {
     pub warnings: Vec<String>,
     /// The training inputs' ranges ([`InputRange`]).
     pub input_range: Vec<InputRange>,
-    /// [`AttachOptions::extrapolate`], for the checks that come later (an input signal's).
+    /// `AttachOptions::extrapolate`, for the checks that come later (an input signal's).
     pub extrapolate: bool,
 }
 

@@ -75,10 +75,10 @@ pub struct Side {
     pub scenario: String,
     pub n_dof: usize,
     pub samples: usize,
-    /// The last sample's time [s].
+    /// The last sample's time \[s\].
     pub t_last: Option<f64>,
     pub complete: bool,
-    /// Wall time of the run [s], if recorded.
+    /// Wall time of the run \[s\], if recorded.
     pub wall_time_s: Option<f64>,
 }
 

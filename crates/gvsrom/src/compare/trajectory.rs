@@ -13,7 +13,7 @@ pub struct Trajectory {
     pub n_dof: usize,
     pub complete: bool,
     pub wall_time_s: f64,
-    /// Rod length [m].
+    /// Rod length \[m\].
     pub length: f64,
     pub t: Vec<f64>,
     /// `samples × 3`.
@@ -29,10 +29,10 @@ pub struct Trajectory {
     pub input: Option<Value>,
     /// The physics record (`physics`), if recorded.
     pub physics: Option<Value>,
-    /// Abscissae of the centreline samples [m] (`centerline_x`; trajectories written before the
+    /// Abscissae of the centreline samples \[m\] (`centerline_x`; trajectories written before the
     /// centreline was recorded have none).
     pub centerline_x: Option<Vec<f64>>,
-    /// `samples × centerline_x.len() × 3`: the centreline positions [m] (`centerline.npy`), with
+    /// `samples × centerline_x.len() × 3`: the centreline positions \[m\] (`centerline.npy`), with
     /// `centerline_x`.
     pub centerline: Option<Vec<f64>>,
     /// How the run was made (`provenance`), if recorded.

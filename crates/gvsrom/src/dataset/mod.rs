@@ -6,12 +6,12 @@
 //! | `inputs.npy` | (N, k) | f64 | the plan's parameter values (`parameters` in meta.json names the columns) |
 //! | `strain.npy` | (N, p·a) | f64 | ξ − ξ* at the p computational points, the a active components, point-major: column `j·a + c` is point j, component `components[c]`; NaN rows for failed samples |
 //! | `q.npy` | (N, n) | f64 | HOM coordinates, in the order `q_order` of meta.json names ([`gvs::strain::COORDINATE_ORDER`]) |
-//! | `tip_position.npy` | (N, 3) | f64 | tip position [m] |
+//! | `tip_position.npy` | (N, 3) | f64 | tip position \[m\] |
 //! | `tip_rotation.npy` | (N, 3, 3) | f64 | tip rotation (section → world) |
 //! | `status.npy` | (N,) | u8 | 0 ok, 1 failed (reason in meta.json `failures`), 2 not computed (incomplete dataset) |
 //! | `iterations.npy` | (N,) | u32 | dogleg iterations of the successful solve |
 //! | `residual.npy` | (N,) | f64 | ‖R‖∞ at the solution |
-//! | `strain_x.npy` | (p,) | f64 | abscissae of the computational points [m] |
+//! | `strain_x.npy` | (p,) | f64 | abscissae of the computational points \[m\] |
 //! | `meta.json` | | | manifest, scenario TOML (after `--set`), plan, seed, parameters, point layout, active components, chunking and `chunk_done`, counts, failures, `complete`, crate version, wall time |
 //!
 //! A strain component is *active* if the scenario's basis can excite it at some site; the others are
@@ -64,7 +64,7 @@ pub const T_FILE: &str = "t.npy";
 pub const DEFAULT_CHUNK_SIZE: usize = 128;
 /// Largest `--chunk-size`.
 pub const MAX_CHUNK_SIZE: usize = 4096;
-/// Largest dataset held in memory while it is generated [bytes] (8 GiB).
+/// Largest dataset held in memory while it is generated \[bytes\] (8 GiB).
 pub const MAX_DATASET_BYTES: f64 = 8.0 * 1024.0 * 1024.0 * 1024.0;
 
 #[derive(Debug, Error)]
@@ -131,7 +131,7 @@ pub struct DatasetRequest {
     /// Dynamic dataset: simulate T seconds (inputs as for `simulate`) and store every output sample.
     pub duration: Option<f64>,
 
-    /// Dynamic dataset: output samples per second [Hz].
+    /// Dynamic dataset: output samples per second \[Hz\].
     pub sample_rate: Option<f64>,
 
     /// Dynamic dataset: actuation from a CSV file `t, u_1, …, u_na` (as for `simulate`).

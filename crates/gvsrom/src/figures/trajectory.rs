@@ -26,7 +26,7 @@ const STRAIN_POINTS: usize = 4;
 #[derive(Debug, Clone)]
 pub struct Centerlines {
     pub x: Vec<f64>,
-    /// `samples`, each `x.len()` points [m].
+    /// `samples`, each `x.len()` points \[m\].
     pub shapes: Vec<Vec<[f64; 3]>>,
 }
 

@@ -25,7 +25,7 @@
 //!    is unavailable (other systems; `ENOSYS`, `EINVAL`, `EOPNOTSUPP`, `EPERM` from old kernels, some
 //!    file systems and sandboxes) it takes two renames, the old output aside to
 //!    `.P.gvsrom-old-<pid>-<n>` and the new one in: between them `P` holds nothing, and a kill there
-//!    leaves the old output complete under the `-old-` name ([`replace`]). The target is re-checked
+//!    leaves the old output complete under the `-old-` name (`replace`). The target is re-checked
 //!    under the lock at commit time. If the commit cannot complete, the staging is kept and the error
 //!    names it.
 //! 6. A run that ends without committing (an error before the results exist) removes its staging.

@@ -6,7 +6,7 @@
 //! For a load with internal bending moment `M_b(s)` and internal force `N(s)` at the section `s`
 //! (magnitudes, cantilever clamped at X = 0, reference configuration):
 //!
-//! - implied bending angle `θ = ∫₀ᴸ M_b(s) / EI(s) ds` [rad] (the tip rotation of a linear beam);
+//! - implied bending angle `θ = ∫₀ᴸ M_b(s) / EI(s) ds` \[rad\] (the tip rotation of a linear beam);
 //! - implied strain `ε = max_s N(s) / EA(s)` for a tendon (axial), `max_s N(s) / min(EA, GA)(s)` for
 //!   a force of unknown direction (axial or shear).
 //!
@@ -49,7 +49,7 @@ use gvs::loads::Loads;
 use gvs::model::Model;
 use gvs::strain::LinearBasis;
 
-/// Largest implied bending angle `θ` accepted [rad] (about 30 turns).
+/// Largest implied bending angle `θ` accepted \[rad\] (about 30 turns).
 pub const MAX_BENDING: f64 = 200.0;
 /// Largest implied axial or shear strain accepted.
 pub const MAX_STRAIN: f64 = 1.0;

@@ -48,7 +48,7 @@ pub fn check<'a>(
     }
 }
 
-/// One phrase naming the load with the largest implied strain, e.g. "the largest load is tendons[0].tension = -40 N (implied bending ~12 rad)", or None without loads.
+/// One phrase naming the load with the largest implied strain, e.g. "the largest load is tendons\[0\].tension = -40 N (implied bending ~12 rad)", or None without loads.
 pub fn largest_load<'a>(
     subject: impl Into<Subject<'a>>,
     u: &[f64],

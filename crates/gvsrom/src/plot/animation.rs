@@ -1,7 +1,7 @@
 //! Animations: a sequence of figures (e.g. a rod's shape at successive times, on the same axes) as
 //! the frames of one looping animated GIF, which every browser and image viewer plays without a
 //! video codec. Frames are drawn like [`super::render`]'s PNG, mapped to one colour table shared by
-//! all frames ([`super::gif_palette`]), and each frame after the first stores only the rectangle
+//! all frames (`gif_palette`), and each frame after the first stores only the rectangle
 //! that changed, its unchanged pixels transparent over the previous frame (disposal "keep").
 
 use std::borrow::Cow;

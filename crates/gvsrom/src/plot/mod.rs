@@ -74,7 +74,7 @@ impl Series {
     }
 }
 
-/// A 2-D chart: axes whose labels carry quantity and unit (e.g. "X [m]"), and a legend in the upper
+/// A 2-D chart: axes whose labels carry quantity and unit (e.g. "X \[m\]"), and a legend in the upper
 /// right when any series has a non-empty label.
 ///
 /// `log_y` puts y on a log₁₀ scale (points with y ≤ 0 are skipped); `equal_aspect` gives one unit the

@@ -263,7 +263,7 @@ const ANCHOR_MAX_ITERATIONS: usize = 50;
 ///
 /// Anchor `i` has the inputs `inputs[i·k..(i+1)·k]` (`k = problem.inputs.len()`), and its solve
 /// starts from `latent[i·r..(i+1)·r]` (the training sample's encoding) at the full load, at most
-/// [`ANCHOR_MAX_ITERATIONS`] iterations. A solution is kept if `accept` takes it (e.g. inside the
+/// `ANCHOR_MAX_ITERATIONS` iterations. A solution is kept if `accept` takes it (e.g. inside the
 /// training encodings' range); otherwise the encoding stays. An encoding lies off the reduced
 /// model's equilibrium by the encoder's error (IV-A: 2e-3 in `q_r`, twice what a 1.5e-3 N
 /// change of tension moves it), so equilibria are the better starts, and between two of them

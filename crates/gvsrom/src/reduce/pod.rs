@@ -22,7 +22,7 @@ pub struct PodSummary {
     pub captured_energy: f64,
     pub singular_values: Vec<f64>,
     pub numerical_rank: usize,
-    /// As [`TrainSummary::anchor_equilibria`] and [`TrainSummary::anchor_time_s`].
+    /// As `TrainSummary::anchor_equilibria` and `TrainSummary::anchor_time_s`.
     pub anchor_equilibria: usize,
     pub anchor_time_s: f64,
     /// Warnings for the user (a dataset without content hashes).

@@ -132,7 +132,7 @@ pub fn models(run: &Run, opts: &Options) -> anyhow::Result<Models> {
     })
 }
 
-/// The 20 test tensions of IV-A [N]: midway between training levels, never on one.
+/// The 20 test tensions of IV-A \[N\]: midway between training levels, never on one.
 pub fn test_tensions() -> Vec<f64> {
     (0..20)
         .map(|i| (-585.0 + 45.0 * i as f64) / 100.0)

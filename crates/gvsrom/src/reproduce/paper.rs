@@ -20,7 +20,7 @@ pub const TABLE_I_IV_B: [[f64; 3]; 3] = [
 pub const TABLE_I_LAYERS: [usize; 3] = [3, 5, 7];
 
 /// A Table III row: POD and AE DOF (same-accuracy rows) or errors in % of the length (same-DOF
-/// rows), their times and the HOM's time [s].
+/// rows), their times and the HOM's time \[s\].
 #[derive(Debug, Clone, Copy)]
 pub struct TableIiiRow {
     pub pod_dof: usize,
@@ -67,7 +67,7 @@ pub const TABLE_III_IV_C1: TableIiiRow = TableIiiRow {
 };
 
 /// Section IV-C1 (text): mean tip errors of the 6-DOF ROMs against the HOM at the five test inputs
-/// [cm]: AE-ROM 2.32 cm (3.9 % L), POD-ROM 4.95 cm (8.3 % L).
+/// \[cm\]: AE-ROM 2.32 cm (3.9 % L), POD-ROM 4.95 cm (8.3 % L).
 pub const IV_C1_AE_TIP_ERROR_CM: f64 = 2.32;
 pub const IV_C1_POD_TIP_ERROR_CM: f64 = 4.95;
 
@@ -89,7 +89,7 @@ pub const TABLE_III_IV_C2: TableIiiRow = TableIiiRow {
 /// DOF ("reductions in average errors of up to 80%"), as a fraction.
 pub const IV_C2_MAX_ERROR_REDUCTION: f64 = 0.80;
 
-/// Section V: the prototype's tensions [N].
+/// Section V: the prototype's tensions \[N\].
 pub const V_TENSIONS: [f64; 4] = [-1.12, -2.35, -3.7, -5.05];
 
 /// Section V: tip errors against the *measured* tip positions, [mean, max] in cm and in % of the

@@ -58,10 +58,10 @@ pub struct SimRun {
     pub reason: Option<String>,
     /// The run ended early because it left the training region (else: the integrator failed).
     pub left_training_region: bool,
-    /// Time of the last sample [s].
+    /// Time of the last sample \[s\].
     pub t_reached: f64,
     pub samples: usize,
-    /// The smallest wall time of the integration over the repetitions [s].
+    /// The smallest wall time of the integration over the repetitions \[s\].
     pub wall_time_s: f64,
     pub wall_times_s: Vec<f64>,
     pub method: String,

@@ -28,7 +28,7 @@ pub struct StaticsComparison {
     /// The fewest POD modes below 1 % at every test input, if any up to `max_modes`.
     pub pod_k: Option<usize>,
     pub max_modes: usize,
-    /// Mean times per equilibrium [s]: HOM, AE-r, POD-k (NaN without a POD-k).
+    /// Mean times per equilibrium \[s\]: HOM, AE-r, POD-k (NaN without a POD-k).
     pub hom_t: f64,
     pub ae_t: f64,
     pub pod_k_t: f64,

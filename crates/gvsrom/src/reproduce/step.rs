@@ -41,7 +41,7 @@ fn signal_name(sig: usize) -> &'static str {
 pub struct StepRecord {
     pub name: String,
     pub key: String,
-    /// Wall time of the computation when it ran [s] (a reused step shows the time it took then).
+    /// Wall time of the computation when it ran \[s\] (a reused step shows the time it took then).
     pub wall_time_s: f64,
     /// Reused from an earlier run (same key, output present).
     pub reused: bool,

@@ -375,7 +375,7 @@ pub struct Solved {
     /// ξ − ξ* at the points, active components, point-major.
     pub strain: Vec<f64>,
     pub centerline: Vec<[f64; 3]>,
-    /// Mean solve time over the repetitions [s].
+    /// Mean solve time over the repetitions \[s\].
     #[serde(with = "nan_as_null")]
     pub time_s: f64,
     pub iterations: usize,

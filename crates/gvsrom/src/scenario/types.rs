@@ -39,7 +39,7 @@ pub struct Scenario {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialSpec {
-    /// E [Pa].
+    /// E \[Pa\].
     pub youngs_modulus: f64,
     /// ν, in (−1, 0.5].
     pub poisson_ratio: f64,
@@ -73,9 +73,9 @@ pub struct BaseSpec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DivisionSpec {
-    /// ℓ_j [m].
+    /// ℓ_j \[m\].
     pub length: f64,
-    /// Uniform radius [m] (shorthand for equal `radius_start` and `radius_end`).
+    /// Uniform radius \[m\] (shorthand for equal `radius_start` and `radius_end`).
     #[serde(default)]
     pub radius: Option<f64>,
     #[serde(default)]
@@ -217,7 +217,7 @@ pub struct TendonSpec {
     /// `gvs::actuation::DEFAULT_FRICTION_SMOOTHING`; 0 = the exact, kinked tangent rule).
     #[serde(default)]
     pub friction_smoothing: Option<f64>,
-    /// Tension u [N]; negative pulls (bends the rod toward the tendon).
+    /// Tension u \[N\]; negative pulls (bends the rod toward the tendon).
     #[serde(default)]
     pub tension: f64,
 }

@@ -5,7 +5,7 @@ use super::run::*;
 use crate::build::Built;
 use gvs::solve::dynamics::Sample;
 
-/// A trajectory kept in memory (the arrays of the files a [`TrajectoryWriter`] writes, row-major,
+/// A trajectory kept in memory (the arrays of the files a `TrajectoryWriter` writes, row-major,
 /// one row per sample): what the Python binding returns.
 pub struct TrajectoryBuffer {
     pub t: Vec<f64>,
@@ -41,7 +41,7 @@ impl TrajectoryBuffer {
         }
     }
 
-    /// Abscissae of the centreline samples [m].
+    /// Abscissae of the centreline samples \[m\].
     pub fn centerline_x(&self) -> &[f64] {
         &self.shape.x
     }

@@ -55,7 +55,7 @@ pub struct IntegratorChoice {
     pub error_norm: Option<ErrorNormChoice>,
     /// Generalized-α: spectral radius at infinite frequency.
     pub rho_inf: f64,
-    /// A fixed step `h` [s]: the fixed-step BDF2 instead of an adaptive method.
+    /// A fixed step `h` \[s\]: the fixed-step BDF2 instead of an adaptive method.
     pub fixed_step: Option<f64>,
     /// Finite differences of the first-order right-hand side for the Jacobian (`--fd-jacobian`);
     /// else the structured iteration matrix.

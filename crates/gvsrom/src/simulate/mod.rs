@@ -9,14 +9,14 @@
 //!
 //! | file | shape | content |
 //! |---|---|---|
-//! | `t.npy` | (N,) | sample times [s] |
+//! | `t.npy` | (N,) | sample times \[s\] |
 //! | `q.npy`, `qd.npy` | (N, n) | generalized coordinates and velocities |
-//! | `u.npy` | (N, n_a) | tendon tensions [N] |
-//! | `tip_position.npy` | (N, 3) | tip position [m] |
+//! | `u.npy` | (N, n_a) | tendon tensions \[N\] |
+//! | `tip_position.npy` | (N, 3) | tip position \[m\] |
 //! | `tip_rotation.npy` | (N, 3, 3) | tip rotation matrices (section → world) |
 //! | `strain.npy` | (N, p, 6) | ξ at the p computational points, `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]` |
-//! | `strain_x.npy` | (p,) | abscissae of the computational points [m] |
-//! | `centerline.npy` | (N, c, 3) | centreline positions [m] at the `c` abscissae `centerline_x` of `meta.json`, equally spaced in arc length from base to tip (`output.centerline_points`, `--centerline-points`), in the world frame as `statics --json` |
+//! | `strain_x.npy` | (p,) | abscissae of the computational points \[m\] |
+//! | `centerline.npy` | (N, c, 3) | centreline positions \[m\] at the `c` abscissae `centerline_x` of `meta.json`, equally spaced in arc length from base to tip (`output.centerline_points`, `--centerline-points`), in the world frame as `statics --json` |
 //! | `meta.json` | | manifest (`gvsrom`: format, version, files), scenario, `complete`, `reason`, `t_reached`, `t_requested`, `sample_rate`, sizes, integrator statistics, wall time, real-time factor, error, `input` ([`input_record`]), `physics` (material, geometry, base, tendon routing, loads), `centerline_x`, `provenance` ([`crate::provenance`]) |
 //!
 //! The integrator is chosen here too ([`choose_integrator`]): by the rod's damping unless named,

@@ -177,9 +177,9 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
 /// A dynamics run as a front-end asks for it (the options of `gvsrom simulate`).
 #[derive(Debug, Clone)]
 pub struct Request {
-    /// Simulated time [s].
+    /// Simulated time \[s\].
     pub duration: f64,
-    /// Output samples per second [Hz].
+    /// Output samples per second \[Hz\].
     pub sample_rate: f64,
     pub input: InputSource,
     /// Start at the scenario's static equilibrium instead of the straight rod at rest.

@@ -24,7 +24,7 @@ pub enum Ending {
     Failed { error: String },
 }
 
-/// The result of [`run`]: the summary of the streamed simulation and the last sample's tip.
+/// The result of `run`: the summary of the streamed simulation and the last sample's tip.
 #[derive(Debug)]
 pub struct Outcome {
     pub summary: RunSummary,
@@ -43,8 +43,8 @@ impl Outcome {
     }
 }
 
-/// Where [`run_into`] delivers the samples: a [`TrajectoryWriter`] (files) or a
-/// [`TrajectoryBuffer`] (memory).
+/// Where [`run_into`] delivers the samples: a `TrajectoryWriter` (files) or a
+/// `TrajectoryBuffer` (memory).
 pub trait SampleSink {
     /// Appends one sample of the run of `built`.
     fn push(&mut self, built: &Built, s: &Sample<'_>) -> std::io::Result<()>;
@@ -85,7 +85,7 @@ fn check_start_mass<P: StrainParam>(
     ))
 }
 
-/// [`run`] with the samples delivered to any [`SampleSink`].
+/// `run` with the samples delivered to any [`SampleSink`].
 pub fn run_into(
     built: &Built,
     plan: &Plan,

@@ -14,7 +14,7 @@ use serde::Serialize;
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
-/// Largest trajectory one run writes [bytes] (16 GiB).
+/// Largest trajectory one run writes \[bytes\] (16 GiB).
 pub const MAX_OUTPUT_BYTES: f64 = 16.0 * 1024.0 * 1024.0 * 1024.0;
 
 /// The scenario's physics as `meta.json` records it (`"physics"`), for `gvsrom compare`: the

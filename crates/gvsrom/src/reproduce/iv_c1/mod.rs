@@ -81,7 +81,7 @@ fn sizes(opts: &Options) -> Sizes {
     }
 }
 
-/// The five test tension vectors [N]: uniform in [−30, 30) N from SplitMix64 with [`TEST_SEED`],
+/// The five test tension vectors \[N\]: uniform in [−30, 30) N from SplitMix64 with `TEST_SEED`,
 /// rounded to 0.1 N so that the inputs print exactly.
 pub fn test_tensions() -> Vec<[f64; 6]> {
     let mut rng = gvs::inputs::SplitMix64::new(TEST_SEED);
