@@ -21,7 +21,7 @@
 //! at an identity layer `P = G`, `D = D'`; then `∂Q/∂W_k += Pᵀ T_k + Dᵀ H_k`, `∂Q/∂b_k += Dᵀ 1`,
 //! `G_k = P W_k`, `D'_k = D W_k`. The gradient is checked against central differences in the tests.
 
-use super::batch::{product, row_major, row_major_mut, Workspace};
+use super::batch::{product, row_major, row_major_mut, Workspace, PARALLEL_MIN_MACS};
 use super::mlp::Layer;
 use faer::Accum;
 
@@ -157,27 +157,37 @@ pub(crate) fn add_rate_gradient(
             row_major(&g_cur[..m], rows, n_out),
             row_major(&d_cur[..m], rows, n_out),
         );
-        let gw = row_major_mut(&mut ws.grad_w[k], n_out, n_in);
-        product(gw, Accum::Add, p.transpose(), row_major(&t[k], rows, n_in));
-        let gw = row_major_mut(&mut ws.grad_w[k], n_out, n_in);
-        product(
-            gw,
-            Accum::Add,
-            dk.transpose(),
-            row_major(&ws.acts[k], rows, n_in),
-        );
-        for row in d_cur[..m].chunks_exact(n_out) {
-            ws.grad_b[k]
-                .iter_mut()
-                .zip(row)
-                .for_each(|(gb, d)| *gb += d);
-        }
+        let (gw, gb, h) = (&mut ws.grad_w[k], &mut ws.grad_b[k], &ws.acts[k]);
+        let (tk, d_rows) = (&t[k], &d_cur[..m]);
+        // ∂Q/∂W_k += Pᵀ T_k + Dᵀ H_k, ∂Q/∂b_k += Dᵀ 1
+        let mut gradients = move || {
+            let gw_mat = row_major_mut(gw, n_out, n_in);
+            product(gw_mat, Accum::Add, p.transpose(), row_major(tk, rows, n_in));
+            let gw_mat = row_major_mut(gw, n_out, n_in);
+            product(gw_mat, Accum::Add, dk.transpose(), row_major(h, rows, n_in));
+            for row in d_rows.chunks_exact(n_out) {
+                gb.iter_mut().zip(row).for_each(|(gb, d)| *gb += d);
+            }
+        };
         if k > 0 {
+            // G_k = P W_k, D'_k = D W_k
             let w = row_major(&layer.w, n_out, n_in);
-            product(row_major_mut(g_prev, rows, n_in), Accum::Replace, p, w);
-            product(row_major_mut(d_prev, rows, n_in), Accum::Replace, dk, w);
+            let (g_next, d_next) = (&mut *g_prev, &mut *d_prev);
+            let mut back = move || {
+                product(row_major_mut(g_next, rows, n_in), Accum::Replace, p, w);
+                product(row_major_mut(d_next, rows, n_in), Accum::Replace, dk, w);
+            };
+            // two tasks with disjoint outputs, as `batch`'s backward pass: the same bits either way
+            if rows * layer.w.len() >= PARALLEL_MIN_MACS {
+                rayon::join(gradients, back);
+            } else {
+                gradients();
+                back();
+            }
             std::mem::swap(g_cur, g_prev);
             std::mem::swap(d_cur, d_prev);
+        } else {
+            gradients();
         }
     }
 }

@@ -213,6 +213,38 @@ fn weights_do_not_depend_on_the_number_of_threads() {
         Autoencoder::train(&data, n, &opts, &mut quiet()).unwrap().0,
         one
     );
+    // with the strain-rate term, whose backward pass also runs as two tasks (nn::rates): the
+    // rates are the differences of consecutive rows of the family
+    let rates: Vec<f64> = (0..data.len())
+        .map(|i| {
+            if i + n < data.len() {
+                data[i + n] - data[i]
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let with_rates = TrainOptions {
+        rate_weight: 0.5,
+        ..opts.clone()
+    };
+    let train_rates = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            Autoencoder::train_with_rates(&data, Some(&rates), n, &with_rates, &mut quiet())
+                .unwrap()
+        })
+    };
+    let (one_rates, report_rates) = train_rates(1);
+    assert_ne!(one_rates, one, "the rate term changes the training");
+    for threads in [2, 3] {
+        let (many, report_many) = train_rates(threads);
+        assert_eq!(many, one_rates, "{threads} threads, with rates");
+        assert_eq!(report_many.val_loss, report_rates.val_loss);
+    }
 }
 
 #[test]
