@@ -20,6 +20,8 @@
 //! at a tanh layer `P = G ⊙ s` and `D = D' ⊙ s − 2 G ⊙ U ⊙ H ⊙ s` (`s = 1 − H²`; `D'` is `∂Q/∂H`),
 //! at an identity layer `P = G`, `D = D'`; then `∂Q/∂W_k += Pᵀ T_k + Dᵀ H_k`, `∂Q/∂b_k += Dᵀ 1`,
 //! `G_k = P W_k`, `D'_k = D W_k`. The gradient is checked against central differences in the tests.
+//! A layer with at least `PARALLEL_MIN_MACS` multiply-adds computes `∂Q/∂W_k` beside `G_k`, `D'_k`
+//! as two tasks (disjoint outputs, as in `batch`'s backward pass): the bits do not depend on the pool.
 
 use super::batch::{product, row_major, row_major_mut, Workspace, PARALLEL_MIN_MACS};
 use super::mlp::Layer;
