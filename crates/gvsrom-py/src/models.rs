@@ -467,6 +467,9 @@ const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 /// rate_weight : float
 ///     Weight β ≥ 0 of the strain-rate term (``--rate-weight``): the autoencoder's tangent map must
 ///     carry each trajectory sample's strain rate; 0 is eq. (15) alone. Needs trajectory data.
+/// lr_decay : float or None
+///     ``--lr-decay``: the Adam rate decays exponentially to this factor of it, in (0, 1], over
+///     ``epochs``; None keeps it constant between plateaus.
 /// force : bool
 ///     Replace ``out`` if it is an earlier gvsrom output.
 ///
@@ -475,7 +478,7 @@ const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 /// Model
 ///     The new model.
 #[pyfunction]
-#[pyo3(signature = (dataset, out, latent=1, hidden_layers=7, epochs=2000, batch_size=64, learning_rate=1e-3, lambda_=1e-4, validation_fraction=0.1, patience=50, lr_reductions=4, lbfgs_iterations=300, seed=0, loss="energy", sample_weighting="uniform", relative_floor=0.1, decoder="plain", rate_weight=0.0, force=false))]
+#[pyo3(signature = (dataset, out, latent=1, hidden_layers=7, epochs=2000, batch_size=64, learning_rate=1e-3, lambda_=1e-4, validation_fraction=0.1, patience=50, lr_reductions=4, lbfgs_iterations=300, seed=0, loss="energy", sample_weighting="uniform", relative_floor=0.1, decoder="plain", rate_weight=0.0, lr_decay=None, force=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn train(
     py: Python<'_>,
@@ -497,6 +500,7 @@ pub fn train(
     relative_floor: f64,
     decoder: &str,
     rate_weight: f64,
+    lr_decay: Option<f64>,
     force: bool,
 ) -> PyResult<Model> {
     use gvsrom::reduce::Loss;
@@ -520,6 +524,7 @@ pub fn train(
         patience: (patience > 0).then_some(patience),
         seed,
         lr_reductions,
+        lr_decay,
         fine_tune: rom::nn::FineTune::lbfgs(lbfgs_iterations),
         sample_weighting: gvsrom::reduce::sample_weighting(sample_weighting, relative_floor)
             .map_err(errors::scenario)?,

@@ -136,6 +136,19 @@ def test_a_rate_weight_is_recorded_and_refused_on_equilibria_as_the_cli_does(
     assert "static equilibria" in expected and not (tmp_path / "py").exists()
 
 
+def test_a_learning_rate_decay_is_recorded_and_a_bad_factor_refused_as_the_cli_does(
+        gvsrom_bin, sweep, tmp_path):
+    ae = gvsrom.train(sweep, tmp_path / "decayed", latent=1, hidden_layers=3, epochs=5,
+                      lr_decay=0.05)
+    assert ae.meta["training"]["lr_decay"] == 0.05
+    expected = cli_error(gvsrom_bin, "train", str(sweep.path), "--lr-decay", "1.5",
+                         "--out", str(tmp_path / "cli"))
+    with pytest.raises(gvsrom.GvsromError) as e:
+        gvsrom.train(sweep.path, tmp_path / "py", lr_decay=1.5)
+    assert str(e.value) == expected
+    assert "--lr-decay" in expected and not (tmp_path / "py").exists()
+
+
 def test_bad_plans_are_refused_with_the_cli_message(gvsrom_bin, tmp_path):
     expected = cli_error(gvsrom_bin, "dataset", "single-tendon", "--sweep", "tendons.0.tension=-6",
                          "--samples", "3", "--out", str(tmp_path / "cli"))

@@ -113,6 +113,9 @@ pub struct TrainingMeta {
     /// Learning-rate reductions at plateaus (absent: from before they existed, none).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lr_reductions: Option<usize>,
+    /// The final factor of the exponential rate decay (`--lr-decay`; absent: none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lr_decay: Option<f64>,
     /// Copies of the zero-strain snapshot trained with the data (absent: none, from before).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub zero_anchor_rows: Option<usize>,

@@ -137,6 +137,38 @@ fn a_model_records_the_strain_hash_its_dataset_manifest_records() {
 }
 
 #[test]
+fn a_decaying_learning_rate_is_recorded_and_a_bad_factor_refused() {
+    // the same run as `ae_small` with the rate decaying to 5 % over its 30 epochs
+    let dir = scratch("red-ae-decay");
+    #[rustfmt::skip]
+    run_ok(&[
+        "train", s(dataset40()), "--latent", "1", "--hidden-layers", "3", "--epochs", "30",
+        "--seed", "3", "--lr-decay", "0.05", "--out", s(&dir),
+    ]);
+    let meta = json(&dir.join("meta.json"));
+    assert_eq!(meta["training"]["lr_decay"], 0.05);
+    assert!(json(&ae_small().join("meta.json"))["training"]
+        .get("lr_decay")
+        .is_none());
+    let weights = |d: &Path| std::fs::read(d.join("weights.safetensors")).unwrap();
+    assert!(
+        weights(&dir) != weights(ae_small()),
+        "the decay changes the training"
+    );
+    let refused = scratch("red-ae-decay-refused");
+    for bad in ["0", "1.5", "NaN", "-0.1"] {
+        let decay = format!("--lr-decay={bad}");
+        #[rustfmt::skip]
+        expect_error(
+            &["train", s(dataset40()), "--latent", "1", "--hidden-layers", "3", "--epochs", "5",
+              &decay, "--out", s(&refused)],
+            &["--lr-decay", "(0, 1]"],
+        );
+        assert!(!refused.exists(), "a refused run writes nothing");
+    }
+}
+
+#[test]
 fn a_pod_rom_with_all_modes_reproduces_the_hom_equilibrium() {
     let (model, rank) = pod_full();
     // sample k = 13 of the sweep: -6 + 9·13/39 = -3 N

@@ -282,6 +282,7 @@ def train(
     relative_floor: float = 0.1,
     decoder: str = "plain",
     rate_weight: float = 0.0,
+    lr_decay: float | None = None,
     force: bool = False,
 ) -> Model: ...
 

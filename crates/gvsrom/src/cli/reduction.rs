@@ -70,6 +70,11 @@ pub struct TrainArgs {
     /// `--patience` epochs before Adam stops.
     #[arg(long, default_value_t = 4)]
     pub lr_reductions: usize,
+    /// An exponential decay of the Adam rate to this factor of it over `--epochs` (epoch e of E at
+    /// rate × F^(e/E)), in (0, 1]; with `--patience 0 --lbfgs-iterations 0` it is the JAX reference
+    /// scripts' schedule. Unset: a constant rate between plateaus.
+    #[arg(long, value_name = "F")]
+    pub lr_decay: Option<f64>,
     /// Iterations of the full-batch L-BFGS phase that follows Adam from its best weights (0: none).
     #[arg(long, default_value_t = 300)]
     pub lbfgs_iterations: usize,
@@ -179,6 +184,7 @@ pub(super) fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
         patience: (args.patience > 0).then_some(args.patience),
         seed: args.seed,
         lr_reductions: args.lr_reductions,
+        lr_decay: args.lr_decay,
         fine_tune: rom::nn::FineTune::lbfgs(args.lbfgs_iterations),
         sample_weighting: reduce::sample_weighting(&args.sample_weighting, args.relative_floor)?,
         decoder: reduce::decoder_form(&args.decoder)?,

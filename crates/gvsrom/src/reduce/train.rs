@@ -209,6 +209,7 @@ pub fn train<P: AsRef<Path>>(
             seed: options.seed,
             loss: Some(loss.name().into()),
             lr_reductions: Some(options.lr_reductions),
+            lr_decay: options.lr_decay,
             zero_anchor_rows: Some(anchor_rows),
             lbfgs_iterations: Some(options.fine_tune.lbfgs_iterations()),
             sample_weighting: Some(

@@ -216,6 +216,9 @@ pub struct AeConfig {
     /// paper's).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rate_weight: Option<f64>,
+    /// The final factor of the exponential rate decay (`--lr-decay`); absent: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lr_decay: Option<f64>,
 }
 
 impl AeConfig {
@@ -236,6 +239,7 @@ impl AeConfig {
             lr_reductions: d.lr_reductions,
             decoder: None,
             rate_weight: None,
+            lr_decay: None,
         }
     }
 }
@@ -265,6 +269,7 @@ pub fn train(
                 patience: (c.patience > 0).then_some(c.patience),
                 seed: c.seed,
                 lr_reductions: c.lr_reductions,
+                lr_decay: c.lr_decay,
                 fine_tune: rom::nn::FineTune::lbfgs(c.lbfgs_iterations),
                 decoder: reduce::decoder_form(c.decoder.as_deref().unwrap_or("plain"))?,
                 rate_weight: c.rate_weight.unwrap_or(0.0),

@@ -15,7 +15,9 @@
 //! `nn::rates`), or the epoch's training MSE without validation rows;
 //! the weights with the lowest monitored loss are kept. After `patience` epochs without a lower
 //! monitored loss the phase goes back to the best weights and continues with the rate times
-//! [`LR_REDUCTION_FACTOR`], up to [`TrainOptions::lr_reductions`] times, then stops. An optional fine-tuning phase ([`FineTune`]:
+//! [`LR_REDUCTION_FACTOR`], up to [`TrainOptions::lr_reductions`] times, then stops; with
+//! [`TrainOptions::lr_decay`] `= f` the rate also decays exponentially, `η_e = η f^(e/E)` at epoch
+//! `e` of `E` (the schedule of the JAX reference scripts). An optional fine-tuning phase ([`FineTune`]:
 //! Adam with a smaller rate, or full-batch L-BFGS, which converges much further on smooth small
 //! problems) restarts from the best weights and only changes the result if it lowers the monitored
 //! loss. The passes and the Adam step run as pairs of tasks on rayon's current pool (the caller's, or
@@ -62,6 +64,10 @@ pub struct TrainOptions {
     /// weights go back to the best ones and the rate is multiplied by [`LR_REDUCTION_FACTOR`], up to
     /// this many times, before the phase stops (0: stop at the first plateau).
     pub lr_reductions: usize,
+    /// An exponential decay of the main Adam phase's rate: `Some(f)` runs epoch `e` (from 0) of
+    /// `E = epochs` at `η_e = η f^(e/E)` (times any plateau reductions), so the last epochs run near
+    /// `f η`; `f` in (0, 1]. `None`: a constant rate between plateaus.
+    pub lr_decay: Option<f64>,
     /// The final phase after the main Adam phase.
     pub fine_tune: FineTune,
     /// Seed of the initialisation, the train/validation split and the shuffles.
@@ -139,6 +145,7 @@ impl Default for TrainOptions {
             validation_fraction: 0.1,
             patience: Some(50),
             lr_reductions: 4,
+            lr_decay: None,
             fine_tune: FineTune::lbfgs(300),
             seed: 0,
             weighting: Weighting::Standardize,
@@ -177,6 +184,15 @@ impl TrainOptions {
         }
         if !(0.0..1.0).contains(&self.validation_fraction) {
             return bad("validation_fraction", self.validation_fraction, "in [0, 1)");
+        }
+        if let Some(f) = self.lr_decay {
+            if !(f > 0.0 && f <= 1.0) {
+                return bad(
+                    "lr_decay",
+                    f,
+                    "in (0, 1]: the rate's factor at the last epoch",
+                );
+            }
         }
         if let SampleWeighting::Relative { floor } = self.sample_weighting {
             if !(floor > 0.0 && floor <= 1.0) {
@@ -444,7 +460,7 @@ pub(crate) fn fit(
         &mut t,
         rng,
         (opts.epochs, opts.learning_rate, lambda, opts.lr_reductions),
-        false,
+        (false, opts.lr_decay),
     );
     let resumable =
         matches!(stop, StopReason::EpochLimit | StopReason::EarlyStopping) && t.out.best_epoch > 0;
@@ -461,7 +477,7 @@ pub(crate) fn fit(
                 &mut t,
                 rng,
                 (epochs, opts.learning_rate * f, lambda, opts.lr_reductions),
-                true,
+                (true, None),
             ),
             FineTune::Lbfgs { iterations, memory } => lbfgs_phase(
                 &mut p,
@@ -480,20 +496,31 @@ pub(crate) fn fit(
     t.out
 }
 
+/// The rate of epoch `e` (from 0) of `epochs` under [`TrainOptions::lr_decay`]: `η f^(e/E)`, or
+/// `η` without a decay.
+pub(crate) fn decayed_rate(lr: f64, decay: Option<f64>, e: usize, epochs: usize) -> f64 {
+    match decay {
+        Some(f) => lr * f.powf(e as f64 / epochs.max(1) as f64),
+        None => lr,
+    }
+}
+
 /// Up to `epochs` epochs of mini-batch Adam with a fresh optimiser state; at each of up to
-/// `reductions` plateaus the best weights come back and the rate drops by [`LR_REDUCTION_FACTOR`].
+/// `reductions` plateaus the best weights come back and the rate drops by [`LR_REDUCTION_FACTOR`];
+/// `decay` ([`TrainOptions::lr_decay`]) lowers it epoch by epoch.
 fn adam_phase(
     p: &mut Problem,
     (ws, rb): Buffers,
     t: &mut Tracker,
     rng: &mut SplitMix64,
     (epochs, lr, lambda, reductions): (usize, f64, f64, usize),
-    fine: bool,
+    (fine, decay): (bool, Option<f64>),
 ) -> StopReason {
     let mut adam = Adam::new(p.layers);
     let mut order = p.train.to_vec();
-    let (mut lr, mut reductions) = (lr, reductions);
-    for _ in 0..epochs {
+    let (mut base, mut reductions) = (lr, reductions);
+    for e in 0..epochs {
+        let lr = decayed_rate(base, decay, e, epochs);
         shuffle(&mut order, rng);
         let (layers, order, adam) = (&mut *p.layers, &order, &mut adam);
         let rows = (p.data, p.weights, p.rates);
@@ -503,7 +530,7 @@ fn adam_phase(
             Some(StopReason::EarlyStopping) if reductions > 0 && t.out.best_epoch > 0 => {
                 // a plateau: back to the best weights with a smaller step
                 copy_layers(p.layers, &t.best);
-                (lr, reductions, t.since_best) = (lr * LR_REDUCTION_FACTOR, reductions - 1, 0);
+                (base, reductions, t.since_best) = (base * LR_REDUCTION_FACTOR, reductions - 1, 0);
             }
             Some(stop) => return stop,
             None => {}
@@ -597,6 +624,40 @@ fn monitored_loss(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn decayed_rate_falls_geometrically_to_its_final_factor() {
+        // η f^(e/E): η at the first epoch, η √f halfway, a constant ratio f^(1/E) between epochs
+        let (lr, f, epochs) = (2e-3, 0.04, 10);
+        assert_eq!(decayed_rate(lr, Some(f), 0, epochs), lr);
+        assert!((decayed_rate(lr, Some(f), 5, epochs) - lr * 0.2).abs() <= 1e-15);
+        assert!((decayed_rate(lr, Some(f), epochs, epochs) - lr * f).abs() <= 1e-17);
+        let ratio = f.powf(0.1);
+        for e in 0..epochs {
+            let (a, b) = (
+                decayed_rate(lr, Some(f), e, epochs),
+                decayed_rate(lr, Some(f), e + 1, epochs),
+            );
+            assert!((b / a - ratio).abs() <= 1e-12, "epoch {e}: {a} → {b}");
+        }
+        assert_eq!(decayed_rate(lr, None, 7, epochs), lr);
+        for bad in [0.0, -0.5, 1.5, f64::NAN] {
+            let opts = TrainOptions {
+                lr_decay: Some(bad),
+                ..TrainOptions::default()
+            };
+            assert!(
+                matches!(
+                    opts.validate(),
+                    Err(NnError::InvalidOption {
+                        field: "lr_decay",
+                        ..
+                    })
+                ),
+                "{bad}"
+            );
+        }
+    }
 
     #[test]
     fn relative_sample_weights_are_inverse_squared_norms_floored_with_mean_one() {

@@ -177,6 +177,37 @@ fn same_seed_gives_bit_identical_weights() {
 }
 
 #[test]
+fn lr_decay_starts_at_the_full_rate_and_lowers_it_afterwards() {
+    // Epoch 0 runs at η whatever the decay, so the losses seen during it (before each of its
+    // steps) are the same with and without it; from epoch 1 the steps are smaller and the
+    // curves part. A factor of 1 is no decay at all, bit for bit.
+    let data = one_parameter_family(50, 16, 3);
+    let opts = TrainOptions {
+        latent: 1,
+        hidden_layers: 3,
+        epochs: 6,
+        batch_size: 8,
+        patience: None,
+        fine_tune: FineTune::None,
+        ..TrainOptions::default()
+    };
+    let train = |decay| {
+        let opts = TrainOptions {
+            lr_decay: decay,
+            ..opts.clone()
+        };
+        Autoencoder::train(&data, 16, &opts, &mut quiet()).unwrap()
+    };
+    let (plain, plain_report) = train(None);
+    let (unit, _) = train(Some(1.0));
+    assert_eq!(plain, unit);
+    let (decayed, report) = train(Some(0.01));
+    assert_eq!(report.train_loss[0], plain_report.train_loss[0]);
+    assert_ne!(report.train_loss[1], plain_report.train_loss[1]);
+    assert_ne!(decayed, plain);
+}
+
+#[test]
 fn weights_do_not_depend_on_the_number_of_threads() {
     // Layers large enough for the two-task passes and the split Adam step (batch.rs, train.rs),
     // with Adam, L-BFGS and a ragged last batch: one, two and three threads agree bit for bit.
