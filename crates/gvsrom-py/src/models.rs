@@ -470,6 +470,9 @@ const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 /// lr_decay : float or None
 ///     ``--lr-decay``: the Adam rate decays exponentially to this factor of it, in (0, 1], over
 ///     ``epochs``; None keeps it constant between plateaus.
+/// kinetic_weight : float
+///     ``--kinetic-weight``: weight κ ≥ 0 of the kinetic-energy norm (errors weighed by each
+///     snapshot's mass matrix M(q)); needs ``rate_weight`` > 0. 0: none.
 /// force : bool
 ///     Replace ``out`` if it is an earlier gvsrom output.
 ///
@@ -478,7 +481,7 @@ const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 /// Model
 ///     The new model.
 #[pyfunction]
-#[pyo3(signature = (dataset, out, latent=1, hidden_layers=7, epochs=2000, batch_size=64, learning_rate=1e-3, lambda_=1e-4, validation_fraction=0.1, patience=50, lr_reductions=4, lbfgs_iterations=300, seed=0, loss="energy", sample_weighting="uniform", relative_floor=0.1, decoder="plain", rate_weight=0.0, lr_decay=None, force=false))]
+#[pyo3(signature = (dataset, out, latent=1, hidden_layers=7, epochs=2000, batch_size=64, learning_rate=1e-3, lambda_=1e-4, validation_fraction=0.1, patience=50, lr_reductions=4, lbfgs_iterations=300, seed=0, loss="energy", sample_weighting="uniform", relative_floor=0.1, decoder="plain", rate_weight=0.0, lr_decay=None, kinetic_weight=0.0, force=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn train(
     py: Python<'_>,
@@ -501,6 +504,7 @@ pub fn train(
     decoder: &str,
     rate_weight: f64,
     lr_decay: Option<f64>,
+    kinetic_weight: f64,
     force: bool,
 ) -> PyResult<Model> {
     use gvsrom::reduce::Loss;
@@ -549,7 +553,15 @@ pub fn train(
                 }
             }
         };
-        gvsrom::reduce::train(&dataset, &options, loss, &out, force, &mut progress)
+        gvsrom::reduce::train(
+            &dataset,
+            &options,
+            loss,
+            kinetic_weight,
+            &out,
+            force,
+            &mut progress,
+        )
     });
     let summary = summary.map_err(errors::any)?;
     for w in &summary.warnings {

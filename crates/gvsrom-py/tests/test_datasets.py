@@ -134,6 +134,15 @@ def test_a_rate_weight_is_recorded_and_refused_on_equilibria_as_the_cli_does(
         gvsrom.train(sweep.path, tmp_path / "py", rate_weight=0.1)
     assert str(e.value) == expected
     assert "static equilibria" in expected and not (tmp_path / "py").exists()
+    kinetic = gvsrom.train(traj, tmp_path / "kinetic", latent=1, hidden_layers=3, epochs=5,
+                           patience=0, lbfgs_iterations=0, rate_weight=0.5, kinetic_weight=1.0)
+    assert kinetic.meta["training"]["kinetic_weight"] == 1.0
+    expected = cli_error(gvsrom_bin, "train", str(traj.path), "--kinetic-weight", "1",
+                         "--out", str(tmp_path / "cli-k"))
+    with pytest.raises(gvsrom.GvsromError) as e:
+        gvsrom.train(traj, tmp_path / "py-k", kinetic_weight=1.0)
+    assert str(e.value) == expected
+    assert "--rate-weight" in expected and not (tmp_path / "py-k").exists()
 
 
 def test_a_learning_rate_decay_is_recorded_and_a_bad_factor_refused_as_the_cli_does(

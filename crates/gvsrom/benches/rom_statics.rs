@@ -130,6 +130,7 @@ fn model_dir() -> PathBuf {
         &[&dataset],
         &options,
         reduce::Loss::default(),
+        0.0,
         &model,
         true,
         &mut progress,

@@ -136,6 +136,9 @@ pub struct TrainingMeta {
     /// The weight `β` of the strain-rate term (`rom::nn::rates`; absent: from before the option, 0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rate_weight: Option<f64>,
+    /// The weight `κ` of the kinetic-energy norm (`--kinetic-weight`; absent: none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kinetic_weight: Option<f64>,
     pub epochs_run: usize,
     pub best_epoch: usize,
     pub stop: String,

@@ -35,10 +35,11 @@ fn babbling() -> &'static Path {
     })
 }
 
-/// Trains r = 1, 3 hidden layers with rate weight `beta`; returns the model directory.
-fn train(name: &str, beta: &str) -> std::path::PathBuf {
+/// Trains r = 1, 3 hidden layers with rate weight `beta` (and `more` options); returns the model
+/// directory.
+fn train_with(name: &str, beta: &str, more: &[&str]) -> std::path::PathBuf {
     let model = scratch(name);
-    run_ok(&[
+    let mut args = vec![
         "train",
         s(babbling()),
         "--latent",
@@ -53,8 +54,23 @@ fn train(name: &str, beta: &str) -> std::path::PathBuf {
         beta,
         "--out",
         s(&model),
-    ]);
+    ];
+    args.extend_from_slice(more);
+    run_ok(&args);
     model
+}
+
+/// Trains r = 1, 3 hidden layers with rate weight `beta`; returns the model directory.
+fn train(name: &str, beta: &str) -> std::path::PathBuf {
+    static MODELS: OnceLock<std::sync::Mutex<Vec<(String, std::path::PathBuf)>>> = OnceLock::new();
+    let models = MODELS.get_or_init(Default::default);
+    let mut models = models.lock().unwrap();
+    if let Some((_, m)) = models.iter().find(|(n, _)| n == name) {
+        return m.clone();
+    }
+    let m = train_with(name, beta, &[]);
+    models.push((name.to_string(), m.clone()));
+    m
 }
 
 /// `‖J_f v − v‖ / ‖v‖` over the interior samples of the dataset, `v` the central difference of its
@@ -125,4 +141,45 @@ fn the_rate_weight_is_refused_where_it_has_nothing_to_fit_or_is_not_a_weight() {
     refuse("0.1", &["--rate-weight", "static equilibria", "trajectory"]);
     refuse("-1", &["--rate-weight", "-1", "≥ 0"]);
     refuse("NaN", &["--rate-weight", "finite"]);
+}
+
+#[test]
+fn a_kinetic_weight_is_recorded_changes_the_training_and_is_refused_without_a_rate_term() {
+    // the norm's value is checked against q̇ᵀ M q̇ in `reduce::kinetic`, its gradient in `rom`
+    let rated = train("rates-model-1", "1");
+    let kinetic = train_with("rates-model-k", "1", &["--kinetic-weight", "1"]);
+    let m = ReducedModel::load(&kinetic).unwrap();
+    let t = m.meta.training.as_ref().unwrap();
+    assert_eq!((t.rate_weight, t.kinetic_weight), (Some(1.0), Some(1.0)));
+    assert_eq!(
+        ReducedModel::load(&rated)
+            .unwrap()
+            .meta
+            .training
+            .unwrap()
+            .kinetic_weight,
+        None
+    );
+    let weights = |d: &Path| std::fs::read(d.join("weights.safetensors")).unwrap();
+    assert!(
+        weights(&kinetic) != weights(&rated),
+        "the norm changes the training"
+    );
+    let out = scratch("kinetic-refused");
+    let refuse = |beta: &str, kappa: &str, needles: &[&str]| {
+        let (weight, k) = (
+            format!("--rate-weight={beta}"),
+            format!("--kinetic-weight={kappa}"),
+        );
+        #[rustfmt::skip]
+        let args = [
+            "train", s(babbling()), "--latent", "1", "--hidden-layers", "3", "--epochs", "5",
+            &weight, &k, "--out", s(&out),
+        ];
+        expect_error(&args, needles);
+        assert!(!out.exists(), "a refused run writes nothing");
+    };
+    refuse("0", "1", &["--kinetic-weight", "--rate-weight"]);
+    refuse("1", "-1", &["--kinetic-weight", "-1", "≥ 0"]);
+    refuse("1", "NaN", &["--kinetic-weight", "finite"]);
 }

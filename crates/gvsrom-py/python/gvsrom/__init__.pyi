@@ -283,6 +283,7 @@ def train(
     decoder: str = "plain",
     rate_weight: float = 0.0,
     lr_decay: float | None = None,
+    kinetic_weight: float = 0.0,
     force: bool = False,
 ) -> Model: ...
 

@@ -109,6 +109,13 @@ pub struct TrainArgs {
     /// on validation inputs; docs/assumptions.md).
     #[arg(long, default_value_t = 0.0)]
     pub rate_weight: f64,
+    /// Weight κ of the kinetic-energy norm (beyond the paper): the reconstruction and rate errors
+    /// are also measured as coefficient errors weighed by the mass matrix M(q) of each snapshot's
+    /// own configuration (the norm the reduced Lagrangian model feels them in), κ relative to the
+    /// energy norm (scaled so that the rates weigh alike in both). Needs `--rate-weight` > 0.
+    /// 0: none.
+    #[arg(long, default_value_t = 0.0)]
+    pub kinetic_weight: f64,
     /// The new model directory.
     #[arg(long, value_name = "MODEL")]
     pub out: PathBuf,
@@ -212,6 +219,7 @@ pub(super) fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
         &args.datasets,
         &options,
         args.loss,
+        args.kinetic_weight,
         &args.out,
         args.force,
         &mut progress,

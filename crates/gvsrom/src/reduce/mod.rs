@@ -11,12 +11,14 @@
 //!
 //! Files: [`pod`](pod()) and [`train`](train()) build models from one or more datasets (`pod.rs`,
 //! `train.rs`); `sources.rs` gathers and checks their snapshots; `anchors.rs` holds the training
-//! samples kept as initial guesses; `attach.rs` binds a model to a scenario; this file the steps
+//! samples kept as initial guesses; `kinetic.rs` the mass matrices of `train --kinetic-weight`;
+//! `attach.rs` binds a model to a scenario; this file the steps
 //! both commands share.
 
 mod anchors;
 mod attach;
 mod evaluate;
+mod kinetic;
 mod pod;
 mod sources;
 mod train;

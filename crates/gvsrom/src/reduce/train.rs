@@ -13,6 +13,7 @@ use rom::nn::{Autoencoder, DecoderForm, SampleWeighting, TrainOptions, TrainRepo
 use rom::reduced::{projection_residual, PointLayout};
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// What `gvsrom train` reports.
 pub struct TrainSummary {
@@ -82,11 +83,13 @@ impl Loss {
 /// Trains an autoencoder on the snapshots of `datasets` (one, or several of one scenario: their
 /// rows in order) and saves it at `out`. `progress(epoch, train, validation)` is called after every
 /// epoch; `Break` stops training early (the best weights so far are kept and saved, marked by the
-/// stop reason).
+/// stop reason). With `kinetic_weight` κ > 0 (and a rate term) the errors are also measured in
+/// the kinetic-energy norm of each row's own mass matrix (`reduce::kinetic`, [`rom::nn::metric`]).
 pub fn train<P: AsRef<Path>>(
     datasets: &[P],
     options: &TrainOptions,
     loss: Loss,
+    kinetic_weight: f64,
     out: &Path,
     force: bool,
     progress: &mut dyn FnMut(usize, f64, Option<f64>) -> ControlFlow<()>,
@@ -111,6 +114,22 @@ pub fn train<P: AsRef<Path>>(
         )
         .into());
     }
+    if !(kinetic_weight.is_finite() && kinetic_weight >= 0.0) {
+        return Err(invalid(
+            "--kinetic-weight",
+            format!("{kinetic_weight}: expected finite and ≥ 0"),
+        )
+        .into());
+    }
+    if kinetic_weight > 0.0 && options.rate_weight == 0.0 {
+        return Err(invalid(
+            "--kinetic-weight",
+            format!(
+                "{kinetic_weight} without a rate term: the kinetic-energy norm is scaled on the strain rates of trajectory data, so it needs `--rate-weight` > 0"
+            ),
+        )
+        .into());
+    }
     let dir = OutputDir::create("--out", out, crate::reduced_model::MODEL_FORMAT, force)?;
     // the zero-strain anchor of trajectory data: the straight rod, where simulations from rest
     // start, joins the training rows so that a latent point decodes to it
@@ -130,9 +149,25 @@ pub fn train<P: AsRef<Path>>(
         v.resize(training.len(), 0.0);
         v
     });
-    let (ae, report) =
-        Autoencoder::train_with_rates(&training, rates.as_deref(), features, options, progress)
-            .map_err(|e| train_error(&e))?;
+    let metric = match kinetic_weight > 0.0 {
+        true => Some(Arc::new(super::kinetic::kinetic_metric(
+            built,
+            &p,
+            &training,
+            features,
+            kinetic_weight,
+        )?)),
+        false => None,
+    };
+    let (ae, report) = Autoencoder::train_with_metric(
+        &training,
+        rates.as_deref(),
+        metric,
+        features,
+        options,
+        progress,
+    )
+    .map_err(|e| train_error(&e))?;
     drop((training, rates));
     // one encoding per usable sample: its range, the anchors, and what the HOM basis cannot
     // represent of the reconstructions
@@ -225,6 +260,7 @@ pub fn train<P: AsRef<Path>>(
             },
             decoder: Some(ae.form().name().into()),
             rate_weight: Some(options.rate_weight),
+            kinetic_weight: (kinetic_weight > 0.0).then_some(kinetic_weight),
             epochs_run: report.epochs_run,
             best_epoch: report.best_epoch,
             stop: format!("{:?}", report.stop),

@@ -219,6 +219,9 @@ pub struct AeConfig {
     /// The final factor of the exponential rate decay (`--lr-decay`); absent: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub lr_decay: Option<f64>,
+    /// The weight of the kinetic-energy norm (`--kinetic-weight`); absent: 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kinetic_weight: Option<f64>,
 }
 
 impl AeConfig {
@@ -240,6 +243,7 @@ impl AeConfig {
             decoder: None,
             rate_weight: None,
             lr_decay: None,
+            kinetic_weight: None,
         }
     }
 }
@@ -281,7 +285,16 @@ pub fn train(
                     0 => ControlFlow::Continue(()),
                     _ => ControlFlow::Break(()),
                 };
-            let s = reduce::train(&[&data.path], &options, c.loss, path, true, &mut progress)?;
+            let kinetic = c.kinetic_weight.unwrap_or(0.0);
+            let s = reduce::train(
+                &[&data.path],
+                &options,
+                c.loss,
+                kinetic,
+                path,
+                true,
+                &mut progress,
+            )?;
             run.check_interrupt()?;
             let model = ReducedModel::load(path)?;
             Ok(ModelInfo {

@@ -16,10 +16,12 @@
 use super::ae_map::AeDecoderMap;
 use super::batch::{dataset_mse, forward_batch, in_pool, Workspace};
 use super::decoder_map::DecoderMap;
+use super::metric::{MetricBuffers, RowMetric};
 use super::mlp::{Layer, Mlp};
 use super::train::{fit, shuffle, Problem, Progress, StopReason, TrainOptions, TrainReport};
 use super::{DecoderForm, NnError, Scaling};
 use gvs::inputs::SplitMix64;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Encoder, decoder and the data scaling they work in.
@@ -118,6 +120,23 @@ impl Autoencoder {
         opts: &TrainOptions,
         progress: Progress,
     ) -> Result<(Self, TrainReport), NnError> {
+        Self::train_with_metric(data, rates, None, n_features, opts, progress)
+    }
+
+    /// [`Autoencoder::train_with_rates`] with the reconstruction and rate errors also measured in
+    /// the row metric `metric` ([`crate::nn::metric`]: the mass-matrix norm of each row's own
+    /// configuration), weighted by `κ = metric.weight()` relative to the plain terms: `metric`'s
+    /// scale is set so that the training rows' rates have the same mean square in both norms
+    /// (so it needs the rates, `β > 0`). The loss curves include its terms; the reported RMSEs
+    /// remain the reconstruction's.
+    pub fn train_with_metric(
+        data: &[f64],
+        rates: Option<&[f64]>,
+        metric: Option<Arc<RowMetric>>,
+        n_features: usize,
+        opts: &TrainOptions,
+        progress: Progress,
+    ) -> Result<(Self, TrainReport), NnError> {
         let start = Instant::now();
         opts.validate()?;
         let beta = opts.rate_weight;
@@ -176,6 +195,17 @@ impl Autoencoder {
                 .map(|(i, v)| v / s[i % n_features])
                 .collect()
         });
+        let capacity = opts.batch_size.min(train.len()).max(1);
+        let metric = match metric {
+            Some(m) => Some(metric_buffers(
+                m,
+                &scaled_rates,
+                scaling.scale(),
+                &train,
+                capacity,
+            )?),
+            None => None,
+        };
         let problem = Problem {
             layers: &mut layers,
             tanh: &tanh,
@@ -185,6 +215,7 @@ impl Autoencoder {
             weights: weights.as_deref(),
             gate,
             rates: scaled_rates.as_deref().map(|v| (v, beta)),
+            metric: metric.as_ref(),
         };
         let outcome = fit(problem, opts, &mut rng, progress);
         // a diverged run or one that never beat its initial weights is no model
@@ -309,6 +340,55 @@ impl Autoencoder {
         let map = DecoderMap::new(&self.decoder, &self.scaling, a, m)?;
         Ok(AeDecoderMap::new(map, self.form))
     }
+}
+
+/// The row metric's training buffers: `C = diag(s) Pᵀ` and `κ` scaled so that the training rows'
+/// scaled rates have the same mean square in the metric as in the plain norm (module docs of
+/// [`Autoencoder::train_with_metric`]).
+fn metric_buffers(
+    metric: Arc<RowMetric>,
+    scaled_rates: &Option<Vec<f64>>,
+    scale: &[f64],
+    train: &[usize],
+    capacity: usize,
+) -> Result<MetricBuffers, NnError> {
+    let n = scale.len();
+    let bad = |field, value: f64, expected| {
+        Err(NnError::InvalidOption {
+            field,
+            value,
+            expected,
+        })
+    };
+    let Some(v) = scaled_rates else {
+        return bad(
+            "metric",
+            metric.weight(),
+            "no metric without strain rates and a rate weight β > 0 (its scale is set on the rates)",
+        );
+    };
+    if metric.rows() * n != v.len() {
+        return bad(
+            "metric.mass",
+            metric.rows() as f64,
+            "one mass matrix per data row",
+        );
+    }
+    let mut rows_rates = Vec::with_capacity(train.len() * n);
+    train
+        .iter()
+        .for_each(|&i| rows_rates.extend_from_slice(&v[i * n..(i + 1) * n]));
+    let plain: f64 = rows_rates.iter().map(|v| v * v).sum();
+    let in_metric = metric.sum_of_squares(scale, train, &rows_rates);
+    if !(plain > 0.0 && in_metric > 0.0 && in_metric.is_finite()) {
+        return bad(
+            "metric",
+            in_metric,
+            "a positive size of the training rows' rates in the metric (moving data, mass matrices that are not zero)",
+        );
+    }
+    let kappa = metric.weight() * plain / in_metric;
+    Ok(MetricBuffers::new(metric, scale, kappa, capacity))
 }
 
 /// Number of rows of row-major `data` with `n` features; rejects empty, ragged and non-finite data.

@@ -9,7 +9,8 @@
 //! `L = (1/(B·n)) Σ_b ω_b ‖x̂_b − x_b‖² + λ Σ_k ‖W_k‖²_F`   (biases are not regularised),
 //!
 //! where the target `x_b` is the chain's own input (an autoencoder) and `ω_b` the row's weight (1
-//! unless the rows are loaded with weights: [`crate::nn::SampleWeighting`]). Backpropagation:
+//! unless the rows are loaded with weights: [`crate::nn::SampleWeighting`]); with a row metric
+//! ([`crate::nn::metric`], `Workspace::with_metric`) each row adds `κ ‖x̂_b − x_b‖²_b`. Backpropagation:
 //! `Δ_L = (2/(B·n)) diag(ω) (X̂ − X)`, `∂L/∂W_k = Δ_{k+1}ᵀ H_k + 2λ W_k`, `∂L/∂b_k = Δ_{k+1}ᵀ 1`,
 //! `Δ_k = (Δ_{k+1} W_k) ⊙ σ'_{k−1}` with `σ' = 1 − H_k²` for tanh and 1 for identity.
 //!
@@ -24,10 +25,11 @@
 //! order, so results are bit-identical whatever the pool (one thread runs both tasks in turn).
 
 use super::activation::add_bias_and_activate;
+pub(crate) use super::dense::{product, row_major, row_major_mut};
+use super::metric::MetricBuffers;
 use super::mlp::Layer;
-use faer::linalg::matmul::matmul;
 use faer::reborrow::ReborrowMut;
-use faer::{Accum, MatMut, MatRef, Par};
+use faer::{Accum, MatMut, MatRef};
 
 /// A layer's pass runs as two parallel tasks from this many multiply-adds (rows × weights): ~10 µs
 /// of work, against ~1 µs for a rayon join between running workers.
@@ -43,23 +45,6 @@ pub(crate) fn in_pool<R: Send>(f: impl FnOnce() -> R + Send) -> R {
 /// Where `n` units are cut into two tasks: about half, on a multiple of 4 (the SIMD width).
 fn half(n: usize) -> usize {
     n.div_ceil(2).next_multiple_of(4).min(n)
-}
-
-/// The first `rows × cols` values of `s` as a row-major matrix.
-pub(crate) fn row_major(s: &[f64], rows: usize, cols: usize) -> MatRef<'_, f64> {
-    MatRef::from_row_major_slice(&s[..rows * cols], rows, cols)
-}
-
-/// The first `rows × cols` values of `s` as a mutable row-major matrix.
-pub(crate) fn row_major_mut(s: &mut [f64], rows: usize, cols: usize) -> MatMut<'_, f64> {
-    MatMut::from_row_major_slice_mut(&mut s[..rows * cols], rows, cols)
-}
-
-/// `C = A·B` (`Accum::Replace`) or `C += A·B` (`Accum::Add`) on this thread.
-pub(crate) fn product(c: MatMut<'_, f64>, accum: Accum, a: MatRef<'_, f64>, b: MatRef<'_, f64>) {
-    matmul(c, accum, a, b, 1.0, Par::Seq);
-    // faer leaves the upper vector registers dirty; the baseline SSE code after it would pay
-    gvs::cpu::clear_upper_state();
 }
 
 /// Buffers for batches of up to `capacity` rows: activations, backpropagated errors, gradients.
@@ -85,6 +70,8 @@ pub struct Workspace {
     pre_gate: Vec<f64>,
     /// `∂L/∂z₁ = Σ_j Δ_bj (H_L)_bj` per row (gated chains only).
     gate_grad: Vec<f64>,
+    /// A metric of each row's own added to the output error ([`crate::nn::metric`]), if any.
+    pub(crate) metric: Option<MetricBuffers>,
 }
 
 impl Workspace {
@@ -103,7 +90,16 @@ impl Workspace {
             gate: None,
             pre_gate: Vec::new(),
             gate_grad: Vec::new(),
+            metric: None,
         }
+    }
+
+    /// The same buffers with the row metric `metric` ([`crate::nn::metric`]) added to the output
+    /// error of the reconstruction and of the rate term; `metric` must hold `capacity` rows.
+    pub(crate) fn with_metric(mut self, metric: MetricBuffers) -> Self {
+        debug_assert!(metric.rows.len() >= self.capacity);
+        self.metric = Some(metric);
+        self
     }
 
     /// The same buffers for a chain whose output is scaled by the first unit of its layer
@@ -138,6 +134,9 @@ impl Workspace {
         for (b, &i) in index.iter().enumerate() {
             self.acts[0][b * n..(b + 1) * n].copy_from_slice(&data[i * n..(i + 1) * n]);
         }
+        if let Some(m) = &mut self.metric {
+            m.rows[..index.len()].copy_from_slice(index);
+        }
         self.weighted = weights.is_some();
         if let Some(w) = weights {
             for (o, &i) in self.row_weight.iter_mut().zip(index) {
@@ -154,11 +153,25 @@ impl Workspace {
         }
     }
 
+    /// `κ Σ_b ω_b ‖y_b − x_b‖²_b` of the row metric over the first `rows` loaded rows, or 0 without
+    /// one ([`crate::nn::metric`]).
+    pub(crate) fn metric_energy(&mut self, y: &[f64], x: &[f64], rows: usize) -> f64 {
+        match self.metric.as_mut() {
+            Some(m) => m.energy(y, x, rows, omega(self.weighted, &self.row_weight)),
+            None => 0.0,
+        }
+    }
+
     /// The chain's output `H_L` for the first `rows` samples.
     pub(crate) fn output(&self, rows: usize) -> &[f64] {
         let last = &self.acts[self.acts.len() - 1];
         &last[..rows * (last.len() / self.capacity)]
     }
+}
+
+/// `b ↦ ω_b` of loaded rows with weights `row_weight` if `weighted`, else 1.
+fn omega(weighted: bool, row_weight: &[f64]) -> impl Fn(usize) -> f64 + '_ {
+    move |b| if weighted { row_weight[b] } else { 1.0 }
 }
 
 /// Forward pass of the first `rows` samples of `H_0`: `H_{k+1} = σ_k(H_k W_kᵀ + 1 b_kᵀ)`.
@@ -198,22 +211,29 @@ pub(crate) fn forward_batch(layers: &[Layer], tanh: &[bool], ws: &mut Workspace,
     }
 }
 
-/// Reconstruction mean squared error `(1/(B·n)) Σ ω_b ‖x̂_b − x_b‖²` of the last forward pass.
-pub(crate) fn reconstruction_mse(ws: &Workspace, rows: usize) -> f64 {
+/// Reconstruction mean squared error `(1/(B·n)) Σ ω_b ‖x̂_b − x_b‖²` of the last forward pass (plus
+/// `κ ‖x̂_b − x_b‖²_b` per row with a row metric, [`crate::nn::metric`]).
+pub(crate) fn reconstruction_mse(ws: &mut Workspace, rows: usize) -> f64 {
     let n = ws.acts[0].len() / ws.capacity;
     let x = &ws.acts[0][..rows * n];
     let squares =
         |y: &[f64], x: &[f64]| -> f64 { y.iter().zip(x).map(|(y, x)| (y - x) * (y - x)).sum() };
-    let sum: f64 = match ws.weighted {
-        false => squares(ws.output(rows), x),
-        true => ws
-            .output(rows)
-            .chunks_exact(n)
-            .zip(x.chunks_exact(n))
-            .zip(&ws.row_weight)
-            .map(|((y, x), w)| w * squares(y, x))
-            .sum(),
+    let y = &ws.acts[ws.acts.len() - 1][..rows * n];
+    let metric = match ws.metric.as_mut() {
+        Some(m) => m.energy(y, x, rows, omega(ws.weighted, &ws.row_weight)),
+        None => 0.0,
     };
+    let sum: f64 = metric
+        + match ws.weighted {
+            false => squares(ws.output(rows), x),
+            true => ws
+                .output(rows)
+                .chunks_exact(n)
+                .zip(x.chunks_exact(n))
+                .zip(&ws.row_weight)
+                .map(|((y, x), w)| w * squares(y, x))
+                .sum(),
+        };
     sum / (rows * n) as f64
 }
 
@@ -255,6 +275,7 @@ fn backward(layers: &[Layer], tanh: &[bool], ws: &mut Workspace, rows: usize, la
         gate,
         pre_gate,
         gate_grad,
+        metric,
         ..
     } = ws;
     let (d, y, x) = (
@@ -273,6 +294,10 @@ fn backward(layers: &[Layer], tanh: &[bool], ws: &mut Workspace, rows: usize, la
                 output_delta(d, y, x, scale * w);
             }
         }
+    }
+    if let Some(m) = metric {
+        // the row metric's part of ∂L/∂x̂ (nn::metric)
+        m.add_gradient(&mut d_cur[..rows * n], rows);
     }
     if let Some(g) = *gate {
         // x̂ = z₁ y: ∂L/∂z₁ = Σ_j Δ_j y_j, ∂L/∂y = z₁ Δ
@@ -563,6 +588,37 @@ mod tests {
     }
 
     #[test]
+    fn row_metric_loss_gradient_matches_central_differences() {
+        // (1/(B·n)) Σ_b ω_b (‖e_b‖² + κ ‖e_b‖²_{i_b}) + λΣ‖W‖² (nn::metric; its value is checked
+        // there against plain loops) on loaded rows that are data rows 7, 2, 5, 0, 3: the backward
+        // pass is its gradient, and the metric changes it
+        let sizes = [4, 3, 2, 3, 4];
+        let tanh = [true, false, true, false];
+        let mut rng = SplitMix64::new(17);
+        let mut layers = test_layers(&sizes, &mut rng);
+        let (rows, lambda) = (5, 0.01);
+        let x: Vec<f64> = (0..8 * 4).map(|_| rng.range(-1.0, 1.0)).collect();
+        let omega: Vec<f64> = (0..8).map(|_| rng.range(0.5, 2.0)).collect();
+        let index = [7, 2, 5, 0, 3];
+        let (metric, _) = crate::nn::metric::test_metric((4, 3, 8), 0.8, 8, &mut rng);
+        let mut ws = Workspace::new(&sizes, 8).with_metric(metric);
+        let total = |layers: &[Layer], ws: &mut Workspace| {
+            ws.load_rows(&x, 4, &index, Some(&omega));
+            total_loss(layers, &tanh, ws, rows, lambda)
+        };
+        total(&layers, &mut ws);
+        backward_batch(&layers, &tanh, &mut ws, rows, lambda);
+        let (gw, gb) = (ws.grad_w.clone(), ws.grad_b.clone());
+        let mut plain = Workspace::new(&sizes, 8);
+        total(&layers, &mut plain);
+        backward_batch(&layers, &tanh, &mut plain, rows, lambda);
+        assert!(plain.grad_w[0] != gw[0], "the metric changes the gradient");
+        assert_gradient_is_central_differences(&mut layers, &gw, &gb, |layers| {
+            total(layers, &mut ws)
+        });
+    }
+
+    #[test]
     fn row_weighted_loss_gradient_matches_central_differences() {
         // With row weights ω_b the loss is (1/(B·n)) Σ_b ω_b ‖x̂_b − x_b‖² + λΣ‖W‖², written here
         // row by row without the workspace's weighted paths; the weighted backward pass must be its
@@ -592,7 +648,7 @@ mod tests {
         };
         ws.load_rows(&x, 4, &index, Some(&omega));
         forward_batch(&layers, &tanh, &mut ws, rows);
-        let weighted_mse = reconstruction_mse(&ws, rows);
+        let weighted_mse = reconstruction_mse(&mut ws, rows);
         backward_batch(&layers, &tanh, &mut ws, rows, lambda);
         let (gw, gb) = (ws.grad_w.clone(), ws.grad_b.clone());
         let penalty: f64 = layers.iter().map(Layer::sum_squared_weights).sum();
@@ -607,7 +663,7 @@ mod tests {
         let mut pass = |w: Option<&[f64]>| {
             ws.load_rows(&x, 4, &index, w);
             forward_batch(&layers, &tanh, &mut ws, rows);
-            let mse = reconstruction_mse(&ws, rows);
+            let mse = reconstruction_mse(&mut ws, rows);
             backward_batch(&layers, &tanh, &mut ws, rows, lambda);
             (mse, ws.grad_w.clone(), ws.grad_b.clone())
         };

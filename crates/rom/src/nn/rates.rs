@@ -20,6 +20,8 @@
 //! at a tanh layer `P = G ⊙ s` and `D = D' ⊙ s − 2 G ⊙ U ⊙ H ⊙ s` (`s = 1 − H²`; `D'` is `∂Q/∂H`),
 //! at an identity layer `P = G`, `D = D'`; then `∂Q/∂W_k += Pᵀ T_k + Dᵀ H_k`, `∂Q/∂b_k += Dᵀ 1`,
 //! `G_k = P W_k`, `D'_k = D W_k`. The gradient is checked against central differences in the tests.
+//! With a row metric ([`crate::nn::metric`]) each row's error also counts in it,
+//! `‖e_b‖² + κ ‖e_b‖²_b`, and `G_L` gains its part (`metric::MetricBuffers::add_gradient`).
 //! A layer with at least `PARALLEL_MIN_MACS` multiply-adds computes `∂Q/∂W_k` beside `G_k`, `D'_k`
 //! as two tasks (disjoint outputs, as in `batch`'s backward pass): the bits do not depend on the pool.
 
@@ -98,10 +100,11 @@ pub(crate) fn forward_rates(
 }
 
 /// `(1/(B·n)) Σ_b ω_b ‖T_L − V‖²` of the last [`forward_rates`] (without `β`).
-pub(crate) fn rate_mse(ws: &Workspace, rb: &RateBuffers, rows: usize) -> f64 {
+pub(crate) fn rate_mse(ws: &mut Workspace, rb: &RateBuffers, rows: usize) -> f64 {
     let last = rb.t.len() - 1;
     let n = rb.t[last].len() / rb.capacity;
     let (y, v) = (&rb.t[last][..rows * n], &rb.t[0][..rows * n]);
+    let metric = ws.metric_energy(y, v, rows);
     let sum: f64 = y
         .chunks_exact(n)
         .zip(v.chunks_exact(n))
@@ -111,7 +114,7 @@ pub(crate) fn rate_mse(ws: &Workspace, rb: &RateBuffers, rows: usize) -> f64 {
             ws.row_weight(b) * e
         })
         .sum();
-    sum / (rows * n) as f64
+    (metric + sum) / (rows * n) as f64
 }
 
 /// Adds `β ∂(rate_mse)/∂θ` of the last [`forward_rates`] to `ws.grad_w`, `ws.grad_b` (module docs).
@@ -139,6 +142,10 @@ pub(crate) fn add_rate_gradient(
         for ((g, y), v) in gr.iter_mut().zip(y).zip(v) {
             *g = w * (y - v);
         }
+    }
+    if let Some(m) = ws.metric.as_mut() {
+        // the row metric's part of ∂Q/∂T_L (nn::metric)
+        m.add_gradient(&mut g_cur[..rows * n], rows);
     }
     d_cur[..rows * n].iter_mut().for_each(|d| *d = 0.0);
     for k in (0..n_layers).rev() {
@@ -293,6 +300,40 @@ mod tests {
         }
         add_rate_gradient(&layers, &tanh, &mut ws, &mut rb, rows, beta);
         let (gw, gb) = (ws.grad_w.clone(), ws.grad_b.clone());
+        assert_gradient_is_central_differences(&mut layers, &gw, &gb, |layers| {
+            loss(layers, &tanh, &mut ws, &mut rb, rows, beta)
+        });
+    }
+
+    #[test]
+    fn rate_gradient_with_a_row_metric_matches_central_differences() {
+        // β (1/(B·n)) Σ_b ω_b (‖e_b‖² + κ ‖e_b‖²_{i_b}), e_b = J_f(x_b) v_b − v_b, on loaded rows
+        // that are data rows 6, 1, 4, 2 (nn::metric)
+        let sizes = [5, 4, 2, 4, 5];
+        let tanh = [true, false, true, false];
+        let mut rng = SplitMix64::new(19);
+        let mut layers = test_layers(&sizes, &mut rng);
+        let (rows, beta) = (4, 0.7);
+        let x: Vec<f64> = (0..7 * 5).map(|_| rng.range(-1.0, 1.0)).collect();
+        let v: Vec<f64> = (0..7 * 5).map(|_| rng.range(-3.0, 3.0)).collect();
+        let weights: Vec<f64> = (0..7).map(|_| rng.range(0.5, 2.0)).collect();
+        let index = [6, 1, 4, 2];
+        let (metric, _) = crate::nn::metric::test_metric((5, 3, 7), 1.3, rows, &mut rng);
+        let mut ws = Workspace::new(&sizes, rows).with_metric(metric);
+        let mut rb = RateBuffers::new(&sizes, rows);
+        ws.load_rows(&x, 5, &index, Some(&weights));
+        rb.load(&v, 5, &index);
+        let with_metric = loss(&layers, &tanh, &mut ws, &mut rb, rows, beta);
+        for (gw, gb) in ws.grad_w.iter_mut().zip(ws.grad_b.iter_mut()) {
+            gw.iter_mut().chain(gb.iter_mut()).for_each(|g| *g = 0.0);
+        }
+        add_rate_gradient(&layers, &tanh, &mut ws, &mut rb, rows, beta);
+        let (gw, gb) = (ws.grad_w.clone(), ws.grad_b.clone());
+        let mut plain = Workspace::new(&sizes, rows);
+        plain.load_rows(&x, 5, &index, Some(&weights));
+        let without = loss(&layers, &tanh, &mut plain, &mut rb, rows, beta);
+        assert!(with_metric > without, "{with_metric} vs {without}");
+        rb.load(&v, 5, &index);
         assert_gradient_is_central_differences(&mut layers, &gw, &gb, |layers| {
             loss(layers, &tanh, &mut ws, &mut rb, rows, beta)
         });

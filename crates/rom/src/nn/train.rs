@@ -31,6 +31,7 @@ use super::batch::{
     Workspace,
 };
 use super::lbfgs::{Buffers, Lbfgs, Objective};
+use super::metric::MetricBuffers;
 use super::mlp::Layer;
 use super::rates::{add_rate_gradient, dataset_rate_mse, forward_rates, rate_mse, RateBuffers};
 use super::scaling::Weighting;
@@ -346,6 +347,9 @@ pub(crate) struct Problem<'a> {
     /// The scaled strain rate of every data row and the weight `β` of the rate term
     /// ([`crate::nn::rates`]), or `None` for eq. (15) alone.
     pub rates: Option<(&'a [f64], f64)>,
+    /// The row metric's buffers (for batches of the workspace's capacity) when the errors are also
+    /// measured in it ([`crate::nn::metric`]).
+    pub metric: Option<&'a MetricBuffers>,
 }
 
 /// What [`fit`] observed; the chain ends with the best weights.
@@ -425,6 +429,9 @@ pub(crate) fn fit(
     let mut ws = Workspace::new(&sizes, opts.batch_size.min(p.train.len()));
     if let Some(g) = p.gate {
         ws = ws.gated(g);
+    }
+    if let Some(m) = p.metric {
+        ws = ws.with_metric(m.clone());
     }
     // eq. (15) over n: the mean squared error per entry plus λ/n Σ‖W‖² (module docs)
     let lambda = opts.lambda / sizes[0].max(1) as f64;

@@ -279,6 +279,84 @@ fn weights_do_not_depend_on_the_number_of_threads() {
 }
 
 #[test]
+fn a_row_metric_of_weight_zero_changes_nothing_and_a_positive_one_changes_the_training() {
+    // κ = 0 adds exact zeros to the losses and gradients (bit-identical weights and curves, with
+    // Adam and L-BFGS); κ = 1 trains another network; without rates (nothing to set its scale on)
+    // or with one mass matrix too few it is refused naming it
+    let (rows, n, m) = (40, 8, 3);
+    let data = one_parameter_family(rows, n, 6);
+    let rates: Vec<f64> = (0..data.len())
+        .map(|i| {
+            if i + n < data.len() {
+                data[i + n] - data[i]
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let mut rng = SplitMix64::new(21);
+    let p_t: Vec<f64> = (0..n * m).map(|_| rng.range(-1.0, 1.0)).collect();
+    let mut mass = Vec::new();
+    for _ in 0..rows {
+        let d: Vec<f64> = (0..m).map(|_| rng.range(0.5, 2.0)).collect();
+        for i in 0..m {
+            for j in 0..m {
+                mass.push(if i == j { d[i] } else { 0.1 * d[i].min(d[j]) });
+            }
+        }
+    }
+    let metric = |kappa: f64, mass: &[f64]| {
+        std::sync::Arc::new(RowMetric::new(n, p_t.clone(), mass.to_vec(), kappa).unwrap())
+    };
+    let opts = TrainOptions {
+        latent: 1,
+        hidden_layers: 3,
+        epochs: 4,
+        batch_size: 16,
+        rate_weight: 0.5,
+        fine_tune: FineTune::lbfgs(2),
+        ..TrainOptions::default()
+    };
+    let train = |metric| {
+        Autoencoder::train_with_metric(&data, Some(&rates), metric, n, &opts, &mut quiet())
+    };
+    let (plain, plain_report) =
+        Autoencoder::train_with_rates(&data, Some(&rates), n, &opts, &mut quiet()).unwrap();
+    let (zero, zero_report) = train(Some(metric(0.0, &mass))).unwrap();
+    assert_eq!(zero, plain);
+    assert_eq!(zero_report.val_loss, plain_report.val_loss);
+    let (one, one_report) = train(Some(metric(1.0, &mass))).unwrap();
+    assert_ne!(one, plain);
+    assert!(
+        one_report.val_loss[0] > plain_report.val_loss[0],
+        "its terms join the loss"
+    );
+    let refused = |r: Result<(Autoencoder, TrainReport), NnError>| match r {
+        Err(NnError::InvalidOption { field, .. }) => field,
+        other => panic!("{:?}", other.map(|_| ())),
+    };
+    assert_eq!(
+        refused(train(Some(metric(1.0, &mass[m * m..])))),
+        "metric.mass"
+    );
+    let static_opts = TrainOptions {
+        rate_weight: 0.0,
+        ..opts.clone()
+    };
+    assert_eq!(
+        refused(Autoencoder::train_with_metric(
+            &data,
+            None,
+            Some(metric(1.0, &mass)),
+            n,
+            &static_opts,
+            &mut quiet()
+        )),
+        "metric"
+    );
+}
+
+#[test]
 fn progress_callback_break_stops_training_and_keeps_best_weights() {
     let data = one_parameter_family(30, 8, 4);
     let opts = TrainOptions {
