@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 import jax
+import jax.flatten_util
 
 jax.config.update("jax_enable_x64", True)
 import jax.numpy as jnp  # noqa: E402
@@ -39,6 +40,8 @@ def main() -> None:
     ap.add_argument("--first-layer-scale", type=float, default=1.0)
     ap.add_argument("--lambda", dest="lam", type=float, default=1e-4)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--lbfgs", type=int, default=0,
+                    help="then this many full-batch L-BFGS iterations (scipy) from Adam's weights")
     a = ap.parse_args()
 
     x = np.load(a.dataset / "strain.npy")
@@ -93,8 +96,25 @@ def main() -> None:
         perm = rng.permutation(rows)
         for j in range(0, rows, 64):
             params, state = step(params, state, perm[j : j + 64])
-    rmse = float(np.sqrt(np.mean((np.asarray(decode(params, z)) * s - x) ** 2)))
-    print(json.dumps({"sizes": sizes, "bands": k, "exact": exact, "rmse": rmse, **vars(a)}, default=str))
+    rmse_of = lambda ps: float(np.sqrt(np.mean((np.asarray(decode(ps, z)) * s - x) ** 2)))
+    out = {"sizes": sizes, "bands": k, "exact": exact, "rmse_adam": rmse_of(params)}
+    if a.lbfgs > 0:
+        from scipy.optimize import minimize
+
+        flat, unravel = jax.flatten_util.ravel_pytree(params)
+        every = jnp.arange(rows)
+        fg = jax.jit(jax.value_and_grad(lambda f: loss(unravel(f), every)))
+
+        def fun(f):
+            v, g = fg(jnp.asarray(f))
+            return float(v), np.asarray(g)
+
+        res = minimize(fun, np.asarray(flat), jac=True, method="L-BFGS-B",
+                       options={"maxiter": a.lbfgs, "maxcor": 20, "gtol": 0, "ftol": 0})
+        params = unravel(jnp.asarray(res.x))
+        out["lbfgs_iterations"] = int(res.nit)
+    out["rmse"] = rmse_of(params)
+    print(json.dumps({**out, **vars(a)}, default=str))
 
 
 if __name__ == "__main__":

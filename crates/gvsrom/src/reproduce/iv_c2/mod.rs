@@ -340,6 +340,8 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         DataVariant::Hanging,
         DataVariant::Rates,
         DataVariant::HangingRates,
+        DataVariant::Kinetic,
+        DataVariant::HangingKinetic,
     ] {
         let result = run_variant(
             run,

@@ -13,7 +13,10 @@
 //!   AE trained with the strain-rate term (`gvsrom train --rate-weight β`, `rom::nn::rates`):
 //!   whether a decoder whose tangents carry the babbling's strain rates tracks the swinging arm.
 //!   β is chosen among [`RATE_WEIGHTS`] by the mean tip error on validation inputs of their own
-//!   seeds (`validation`), never on the test inputs.
+//!   seeds (`validation`), never on the test inputs;
+//! - [`DataVariant::Kinetic`] and [`DataVariant::HangingKinetic`]: the same with the errors also in
+//!   the kinetic-energy norm of each snapshot's mass matrix (`gvsrom train --kinetic-weight`
+//!   [`KINETIC_WEIGHT`], `rom::nn::metric`), β chosen the same way.
 
 use super::super::paper;
 use super::super::report::{Cell, Finding, Table};
@@ -32,6 +35,8 @@ pub(super) const DAMPING_FACTOR: f64 = 3.0;
 pub(super) const HANGING_PRESET: &str = "six-tendon-hanging";
 /// The rate-term variants' candidate `--rate-weight`s.
 pub(super) const RATE_WEIGHTS: [f64; 3] = [0.1, 0.3, 1.0];
+/// The kinetic-energy-norm variants' `--kinetic-weight`.
+pub(super) const KINETIC_WEIGHT: f64 = 1.0;
 
 /// A variant of the data (and, for [`DataVariant::Damped`], [`DataVariant::Hanging`] and
 /// [`DataVariant::HangingRates`], of the arm; for the rate-term variants, of the AE's training).
@@ -42,6 +47,8 @@ pub(super) enum DataVariant {
     Hanging,
     Rates,
     HangingRates,
+    Kinetic,
+    HangingKinetic,
 }
 
 /// A variant's data, its two models and their runs on each test input.
@@ -111,6 +118,8 @@ impl DataVariant {
             DataVariant::Hanging => "hanging",
             DataVariant::Rates => "rates",
             DataVariant::HangingRates => "hanging-rates",
+            DataVariant::Kinetic => "kinetic",
+            DataVariant::HangingKinetic => "hanging-kinetic",
         }
     }
 
@@ -118,15 +127,28 @@ impl DataVariant {
     /// change the AE alone), or `None` for the paper's data and HOM runs.
     fn data_name(self) -> Option<&'static str> {
         match self {
-            DataVariant::Rates => None,
-            DataVariant::HangingRates => Some(DataVariant::Hanging.name()),
+            DataVariant::Rates | DataVariant::Kinetic => None,
+            DataVariant::HangingRates | DataVariant::HangingKinetic => {
+                Some(DataVariant::Hanging.name())
+            }
             v => Some(v.name()),
         }
     }
 
     /// Whether the variant trains its AE with the strain-rate term.
     fn rates(self) -> bool {
-        matches!(self, DataVariant::Rates | DataVariant::HangingRates)
+        matches!(
+            self,
+            DataVariant::Rates
+                | DataVariant::HangingRates
+                | DataVariant::Kinetic
+                | DataVariant::HangingKinetic
+        )
+    }
+
+    /// The variant's `--kinetic-weight` (`None`: not used).
+    fn kinetic_weight(self) -> Option<f64> {
+        matches!(self, DataVariant::Kinetic | DataVariant::HangingKinetic).then_some(KINETIC_WEIGHT)
     }
 
     /// The variant's scenario: for [`DataVariant::Damped`] the material damping of `scenario`
@@ -134,17 +156,19 @@ impl DataVariant {
     /// overrides.
     fn scenario(self, scenario: &ScenarioSpec) -> anyhow::Result<ScenarioSpec> {
         Ok(match self {
-            DataVariant::Spread | DataVariant::Rates => scenario.clone(),
+            DataVariant::Spread | DataVariant::Rates | DataVariant::Kinetic => scenario.clone(),
             DataVariant::Damped => {
                 let eta = crate::presets::load(&scenario.preset, &scenario.set)?
                     .material
                     .damping;
                 scenario.with(&[format!("material.damping={:e}", eta * DAMPING_FACTOR)])
             }
-            DataVariant::Hanging | DataVariant::HangingRates => ScenarioSpec {
-                preset: HANGING_PRESET.into(),
-                ..scenario.clone()
-            },
+            DataVariant::Hanging | DataVariant::HangingRates | DataVariant::HangingKinetic => {
+                ScenarioSpec {
+                    preset: HANGING_PRESET.into(),
+                    ..scenario.clone()
+                }
+            }
         })
     }
 
@@ -184,6 +208,13 @@ impl DataVariant {
                 "the arm hanging along gravity (preset `{}`) and the strain-rate term in the AE's training",
                 scenario.preset
             ),
+            DataVariant::Kinetic => format!(
+                "the strain-rate term and the kinetic-energy norm (`--kinetic-weight {KINETIC_WEIGHT}`) in the AE's training, on the paper's data"
+            ),
+            DataVariant::HangingKinetic => format!(
+                "the arm hanging along gravity (preset `{}`), the strain-rate term and the kinetic-energy norm (`--kinetic-weight {KINETIC_WEIGHT}`) in the AE's training",
+                scenario.preset
+            ),
         }
     }
 }
@@ -221,19 +252,26 @@ pub(super) fn run_variant(
             ..test.clone()
         };
         match variant {
-            DataVariant::Spread | DataVariant::Rates if seed == test.seed => Ok(paper_hom.clone()),
-            DataVariant::Spread | DataVariant::Rates => hom_run(run, scenario, &t),
-            DataVariant::Damped | DataVariant::Hanging | DataVariant::HangingRates => {
-                simulate_test(
-                    run,
-                    &format!("iv-c2/test-hom-{pod_name}-seed{seed}"),
-                    &format!("HOM ({pod_name} data, test seed {seed})"),
-                    &sc,
-                    &t,
-                    None,
-                    None,
-                )
+            DataVariant::Spread | DataVariant::Rates | DataVariant::Kinetic
+                if seed == test.seed =>
+            {
+                Ok(paper_hom.clone())
             }
+            DataVariant::Spread | DataVariant::Rates | DataVariant::Kinetic => {
+                hom_run(run, scenario, &t)
+            }
+            DataVariant::Damped
+            | DataVariant::Hanging
+            | DataVariant::HangingRates
+            | DataVariant::HangingKinetic => simulate_test(
+                run,
+                &format!("iv-c2/test-hom-{pod_name}-seed{seed}"),
+                &format!("HOM ({pod_name} data, test seed {seed})"),
+                &sc,
+                &t,
+                None,
+                None,
+            ),
         }
     };
     let (model, selection) = match variant.rates() {
@@ -242,6 +280,10 @@ pub(super) fn run_variant(
             None,
         ),
         true => {
+            let ae = &AeConfig {
+                kinetic_weight: variant.kinetic_weight(),
+                ..ae.clone()
+            };
             let (model, selection) =
                 select_rate_weight(run, (name, &sc, &data), ae, test, validation, &hom_of)?;
             description = format!("{description} (`--rate-weight {}`)", selection.chosen);
@@ -377,8 +419,8 @@ pub(super) fn variant_table(r: usize, v: &VariantRuns) -> Table {
             DataVariant::Spread => "the HOM runs are the same. The runs of a row are not one after the other: compare the errors, and the times only roughly.",
             DataVariant::Damped => "the HOM runs are the damped arm's, one after the other with its ROMs.",
             DataVariant::Hanging => "the HOM runs are the hanging arm's, one after the other with its ROMs.",
-            DataVariant::Rates => "the HOM runs and the POD are those of the paper's data; only the AE's training differs.",
-            DataVariant::HangingRates => "the HOM runs and the POD are the hanging variant's; only the AE's training differs.",
+            DataVariant::Rates | DataVariant::Kinetic => "the HOM runs and the POD are those of the paper's data; only the AE's training differs.",
+            DataVariant::HangingRates | DataVariant::HangingKinetic => "the HOM runs and the POD are the hanging variant's; only the AE's training differs.",
         }
     );
     if let Some(sel) = &v.selection {
@@ -456,7 +498,11 @@ pub(super) fn variant_findings(r: usize, v: &VariantRuns) -> Vec<Finding> {
     let mut findings = match v.variant {
         DataVariant::Spread => vec![stays],
         DataVariant::Damped => vec![reaches],
-        DataVariant::Hanging | DataVariant::Rates | DataVariant::HangingRates => {
+        DataVariant::Hanging
+        | DataVariant::Rates
+        | DataVariant::HangingRates
+        | DataVariant::Kinetic
+        | DataVariant::HangingKinetic => {
             let ahead = v
                 .tests
                 .iter()
