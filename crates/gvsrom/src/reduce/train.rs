@@ -381,6 +381,9 @@ pub(super) fn train_error(e: &rom::nn::NnError) -> ScenarioError {
     let option = match e {
         NnError::InvalidLatent { .. } => "--latent".to_string(),
         NnError::InvalidHiddenLayers { .. } => "--hidden-layers".to_string(),
+        NnError::InvalidOption { field, .. } if field.starts_with("metric") => {
+            "--kinetic-weight".to_string()
+        }
         NnError::InvalidOption { field, .. } => format!("--{}", field.replace('_', "-")),
         NnError::EmptyData | NnError::NonFiniteData { .. } => "DATASET".to_string(),
         NnError::Diverged { .. } => "--learning-rate".to_string(),

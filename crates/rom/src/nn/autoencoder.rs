@@ -367,6 +367,13 @@ fn metric_buffers(
             "no metric without strain rates and a rate weight β > 0 (its scale is set on the rates)",
         );
     };
+    if metric.features() != n {
+        return bad(
+            "metric.projection",
+            metric.features() as f64,
+            "as many values per row as the data",
+        );
+    }
     if metric.rows() * n != v.len() {
         return bad(
             "metric.mass",

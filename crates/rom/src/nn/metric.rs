@@ -82,6 +82,11 @@ impl RowMetric {
         self.mass.len() / (self.m * self.m)
     }
 
+    /// Values `n` of a row.
+    pub fn features(&self) -> usize {
+        self.n
+    }
+
     /// Coefficients `m` of the full model.
     pub fn coefficients(&self) -> usize {
         self.m

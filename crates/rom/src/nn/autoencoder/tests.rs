@@ -339,6 +339,11 @@ fn a_row_metric_of_weight_zero_changes_nothing_and_a_positive_one_changes_the_tr
         refused(train(Some(metric(1.0, &mass[m * m..])))),
         "metric.mass"
     );
+    let other_rows = RowMetric::new(n / 2, p_t[..n / 2 * m].to_vec(), mass.clone(), 1.0).unwrap();
+    assert_eq!(
+        refused(train(Some(std::sync::Arc::new(other_rows)))),
+        "metric.projection"
+    );
     let static_opts = TrainOptions {
         rate_weight: 0.0,
         ..opts.clone()
