@@ -26,7 +26,7 @@
 
 use super::activation::add_bias_and_activate;
 pub(crate) use super::dense::{product, row_major, row_major_mut};
-use super::metric::MetricBuffers;
+use super::metric::{MetricBuffers, Residual};
 use super::mlp::Layer;
 use faer::reborrow::ReborrowMut;
 use faer::{Accum, MatMut, MatRef};
@@ -136,6 +136,7 @@ impl Workspace {
         }
         if let Some(m) = &mut self.metric {
             m.rows[..index.len()].copy_from_slice(index);
+            m.forget(None);
         }
         self.weighted = weights.is_some();
         if let Some(w) = weights {
@@ -153,12 +154,29 @@ impl Workspace {
         }
     }
 
-    /// `κ Σ_b ω_b ‖y_b − x_b‖²_b` of the row metric over the first `rows` loaded rows, or 0 without
-    /// one ([`crate::nn::metric`]).
-    pub(crate) fn metric_energy(&mut self, y: &[f64], x: &[f64], rows: usize) -> f64 {
+    /// `κ Σ_b ω_b ‖y_b − x_b‖²_b` of the row metric over the first `rows` loaded rows for the rate
+    /// term's residual `y − x`, or 0 without one ([`crate::nn::metric`]).
+    pub(crate) fn rate_metric_energy(&mut self, y: &[f64], x: &[f64], rows: usize) -> f64 {
+        let weight = omega(self.weighted, &self.row_weight);
         match self.metric.as_mut() {
-            Some(m) => m.energy(y, x, rows, omega(self.weighted, &self.row_weight)),
+            Some(m) => m.energy((y, x), rows, weight, Residual::Rate),
             None => 0.0,
+        }
+    }
+
+    /// Adds the row metric's part to the rate term's output gradient `g = scale ω_b (T_L − V)`
+    /// (nothing without a metric).
+    pub(crate) fn add_rate_metric_gradient(&mut self, g: &mut [f64], rows: usize, scale: f64) {
+        let weight = omega(self.weighted, &self.row_weight);
+        if let Some(m) = self.metric.as_mut() {
+            m.add_gradient(g, rows, Residual::Rate, |b| scale * weight(b));
+        }
+    }
+
+    /// Forgets the metric's kept product of `residual` (`None`: both): its inputs changed.
+    pub(crate) fn forget_metric(&mut self, residual: Option<Residual>) {
+        if let Some(m) = self.metric.as_mut() {
+            m.forget(residual);
         }
     }
 
@@ -176,6 +194,7 @@ fn omega(weighted: bool, row_weight: &[f64]) -> impl Fn(usize) -> f64 + '_ {
 
 /// Forward pass of the first `rows` samples of `H_0`: `H_{k+1} = σ_k(H_k W_kᵀ + 1 b_kᵀ)`.
 pub(crate) fn forward_batch(layers: &[Layer], tanh: &[bool], ws: &mut Workspace, rows: usize) {
+    ws.forget_metric(None);
     for (k, layer) in layers.iter().enumerate() {
         let (head, tail) = ws.acts.split_at_mut(k + 1);
         let (n_in, n_out) = (layer.n_in, layer.n_out);
@@ -220,7 +239,12 @@ pub(crate) fn reconstruction_mse(ws: &mut Workspace, rows: usize) -> f64 {
         |y: &[f64], x: &[f64]| -> f64 { y.iter().zip(x).map(|(y, x)| (y - x) * (y - x)).sum() };
     let y = &ws.acts[ws.acts.len() - 1][..rows * n];
     let metric = match ws.metric.as_mut() {
-        Some(m) => m.energy(y, x, rows, omega(ws.weighted, &ws.row_weight)),
+        Some(m) => m.energy(
+            (y, x),
+            rows,
+            omega(ws.weighted, &ws.row_weight),
+            Residual::Reconstruction,
+        ),
         None => 0.0,
     };
     let sum: f64 = metric
@@ -297,7 +321,13 @@ fn backward(layers: &[Layer], tanh: &[bool], ws: &mut Workspace, rows: usize, la
     }
     if let Some(m) = metric {
         // the row metric's part of ∂L/∂x̂ (nn::metric)
-        m.add_gradient(&mut d_cur[..rows * n], rows);
+        let weight = omega(*weighted, row_weight);
+        m.add_gradient(
+            &mut d_cur[..rows * n],
+            rows,
+            Residual::Reconstruction,
+            |b| scale * weight(b),
+        );
     }
     if let Some(g) = *gate {
         // x̂ = z₁ y: ∂L/∂z₁ = Σ_j Δ_j y_j, ∂L/∂y = z₁ Δ
@@ -609,6 +639,14 @@ mod tests {
         total(&layers, &mut ws);
         backward_batch(&layers, &tanh, &mut ws, rows, lambda);
         let (gw, gb) = (ws.grad_w.clone(), ws.grad_b.clone());
+        // without the loss evaluated first, the metric's product is computed from Δ itself: the
+        // same gradient to rounding
+        ws.load_rows(&x, 4, &index, Some(&omega));
+        forward_batch(&layers, &tanh, &mut ws, rows);
+        backward_batch(&layers, &tanh, &mut ws, rows, lambda);
+        for (a, b) in ws.grad_w.iter().flatten().zip(gw.iter().flatten()) {
+            assert!((a - b).abs() <= 1e-13 * (1.0 + b.abs()), "{a} vs {b}");
+        }
         let mut plain = Workspace::new(&sizes, 8);
         total(&layers, &mut plain);
         backward_batch(&layers, &tanh, &mut plain, rows, lambda);

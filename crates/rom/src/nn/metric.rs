@@ -13,8 +13,9 @@
 //! it; for a state error the mass-weighted size of the configuration error. A loss term
 //! `(κ/(B·n)) Σ_b ω_b ‖e_b‖²_b` has the gradient `(2κ ω_b/(B·n)) (e_b C M_b) Cᵀ`: with the plain
 //! term's `d_b = (2ω_b/(B·n)) e_b` already formed, `d_b ← d_b + κ (d_b C M_b) Cᵀ` adds it
-//! (`MetricBuffers::add_gradient`). Checked against central differences in the tests of
-//! `batch` and `rates`.
+//! (`MetricBuffers::add_gradient`), reusing the `e_b C M_b` of the loss just evaluated on the same
+//! residual when there is one (the training loop evaluates each loss, then its gradient). Checked
+//! against central differences in the tests of `batch` and `rates`.
 
 use super::dense::{product, row_major, row_major_mut};
 use super::NnError;
@@ -148,6 +149,15 @@ fn quadratic(mass: &[f64], k: &[f64]) -> f64 {
         .sum()
 }
 
+/// The residual whose `(e C) M` the buffers hold from the last [`MetricBuffers::energy`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Residual {
+    /// `x̂ − x`, the reconstruction's.
+    Reconstruction,
+    /// `J_f v − v`, the rate term's.
+    Rate,
+}
+
 /// The metric as a training workspace uses it: `C = diag(s) Pᵀ` in the data's scaling, `κ`
 /// normalised ([`MetricBuffers::new`]), the data row of each loaded row and scratch for batches of
 /// up to `capacity` rows.
@@ -164,6 +174,8 @@ pub(crate) struct MetricBuffers {
     e: Vec<f64>,
     k: Vec<f64>,
     km: Vec<f64>,
+    /// Which residual `km` holds `(e C) M` of, until its inputs change.
+    cached: Option<Residual>,
 }
 
 impl MetricBuffers {
@@ -184,6 +196,14 @@ impl MetricBuffers {
             e: vec![0.0; capacity * n],
             k: vec![0.0; capacity * m],
             km: vec![0.0; capacity * m],
+            cached: None,
+        }
+    }
+
+    /// Forgets the kept product of `residual` (`None`: of both), whose inputs changed.
+    pub(crate) fn forget(&mut self, residual: Option<Residual>) {
+        if residual.is_none() || self.cached == residual {
+            self.cached = None;
         }
     }
 
@@ -208,13 +228,14 @@ impl MetricBuffers {
         }
     }
 
-    /// `κ Σ_b ω_b ‖y_b − x_b‖²_b` over the first `rows` loaded rows (`ω_b = weight(b)`).
+    /// `κ Σ_b ω_b ‖y_b − x_b‖²_b` over the first `rows` loaded rows (`ω_b = weight(b)`), keeping
+    /// `(e C) M` of `residual` for its gradient.
     pub(crate) fn energy(
         &mut self,
-        y: &[f64],
-        x: &[f64],
+        (y, x): (&[f64], &[f64]),
         rows: usize,
         weight: impl Fn(usize) -> f64,
+        residual: Residual,
     ) -> f64 {
         let (n, m) = (self.metric.n, self.metric.m);
         let mut e = std::mem::take(&mut self.e);
@@ -223,6 +244,7 @@ impl MetricBuffers {
         }
         self.project(&e, rows);
         self.e = e;
+        self.cached = Some(residual);
         let sum: f64 = self.k[..rows * m]
             .chunks_exact(m)
             .zip(self.km[..rows * m].chunks_exact(m))
@@ -232,12 +254,28 @@ impl MetricBuffers {
         self.kappa * sum
     }
 
-    /// `d_b ← d_b + κ (d_b C M_b) Cᵀ` for the first `rows` rows of `d` (module docs).
-    pub(crate) fn add_gradient(&mut self, d: &mut [f64], rows: usize) {
+    /// `d_b ← d_b + κ (d_b C M_b) Cᵀ` for the first `rows` rows of `d = s_b e` (module docs), `e`
+    /// the `residual` and `s_b = row_scale(b)`: from the kept `(e C) M` if the last
+    /// [`MetricBuffers::energy`] was of this residual and its inputs have not changed since, else
+    /// from `d`.
+    pub(crate) fn add_gradient(
+        &mut self,
+        d: &mut [f64],
+        rows: usize,
+        residual: Residual,
+        row_scale: impl Fn(usize) -> f64,
+    ) {
         let (n, m) = (self.metric.n, self.metric.m);
-        self.project(d, rows);
         let kappa = self.kappa;
-        self.km[..rows * m].iter_mut().for_each(|v| *v *= kappa);
+        if self.cached.take() == Some(residual) {
+            for (b, km) in self.km[..rows * m].chunks_exact_mut(m).enumerate() {
+                let s = kappa * row_scale(b);
+                km.iter_mut().for_each(|v| *v *= s);
+            }
+        } else {
+            self.project(d, rows);
+            self.km[..rows * m].iter_mut().for_each(|v| *v *= kappa);
+        }
         product(
             row_major_mut(&mut d[..rows * n], rows, n),
             Accum::Add,
@@ -309,7 +347,7 @@ mod tests {
             }
             expected += kappa * omega[b] * energy;
         }
-        let got = buffers.energy(&y, &x, 3, |b| omega[b]);
+        let got = buffers.energy((&y, &x), 3, |b| omega[b], Residual::Reconstruction);
         assert!(
             (got - expected).abs() <= 1e-13 * expected,
             "{got} vs {expected}"
@@ -317,7 +355,7 @@ mod tests {
         // the unscaled sum of squares the trainer normalises κ with
         let e: Vec<f64> = y.iter().zip(&x).map(|(y, x)| y - x).collect();
         let plain = metric.sum_of_squares(&scale, &index, &e);
-        let unweighted = buffers.energy(&y, &x, 3, |_| 1.0) / kappa;
+        let unweighted = buffers.energy((&y, &x), 3, |_| 1.0, Residual::Rate) / kappa;
         assert!((plain - unweighted).abs() <= 1e-13 * plain);
     }
 

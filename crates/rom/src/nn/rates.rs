@@ -72,10 +72,11 @@ impl RateBuffers {
 pub(crate) fn forward_rates(
     layers: &[Layer],
     tanh: &[bool],
-    ws: &Workspace,
+    ws: &mut Workspace,
     rb: &mut RateBuffers,
     rows: usize,
 ) {
+    ws.forget_metric(Some(super::metric::Residual::Rate));
     for (k, layer) in layers.iter().enumerate() {
         let (n_in, n_out) = (layer.n_in, layer.n_out);
         let (head, tail) = rb.t.split_at_mut(k + 1);
@@ -104,7 +105,7 @@ pub(crate) fn rate_mse(ws: &mut Workspace, rb: &RateBuffers, rows: usize) -> f64
     let last = rb.t.len() - 1;
     let n = rb.t[last].len() / rb.capacity;
     let (y, v) = (&rb.t[last][..rows * n], &rb.t[0][..rows * n]);
-    let metric = ws.metric_energy(y, v, rows);
+    let metric = ws.rate_metric_energy(y, v, rows);
     let sum: f64 = y
         .chunks_exact(n)
         .zip(v.chunks_exact(n))
@@ -143,10 +144,8 @@ pub(crate) fn add_rate_gradient(
             *g = w * (y - v);
         }
     }
-    if let Some(m) = ws.metric.as_mut() {
-        // the row metric's part of ∂Q/∂T_L (nn::metric)
-        m.add_gradient(&mut g_cur[..rows * n], rows);
-    }
+    // the row metric's part of ∂Q/∂T_L (nn::metric)
+    ws.add_rate_metric_gradient(&mut g_cur[..rows * n], rows, scale);
     d_cur[..rows * n].iter_mut().for_each(|d| *d = 0.0);
     for k in (0..n_layers).rev() {
         let layer = &layers[k];
@@ -259,7 +258,7 @@ mod tests {
         ws.load_rows(&x, 6, &index, None);
         forward_batch(&layers, &tanh, &mut ws, rows);
         rb.load(&v, 6, &index);
-        forward_rates(&layers, &tanh, &ws, &mut rb, rows);
+        forward_rates(&layers, &tanh, &mut ws, &mut rb, rows);
         let jv = rb.t[4][..rows * 6].to_vec();
         let h = 1e-6;
         let shifted = |sign: f64, ws: &mut Workspace| {
@@ -329,6 +328,16 @@ mod tests {
         }
         add_rate_gradient(&layers, &tanh, &mut ws, &mut rb, rows, beta);
         let (gw, gb) = (ws.grad_w.clone(), ws.grad_b.clone());
+        // without the loss evaluated first (the tangent pass forgets the kept product), the same
+        // gradient to rounding
+        forward_rates(&layers, &tanh, &mut ws, &mut rb, rows);
+        for (gw, gb) in ws.grad_w.iter_mut().zip(ws.grad_b.iter_mut()) {
+            gw.iter_mut().chain(gb.iter_mut()).for_each(|g| *g = 0.0);
+        }
+        add_rate_gradient(&layers, &tanh, &mut ws, &mut rb, rows, beta);
+        for (a, b) in ws.grad_w.iter().flatten().zip(gw.iter().flatten()) {
+            assert!((a - b).abs() <= 1e-13 * (1.0 + b.abs()), "{a} vs {b}");
+        }
         let mut plain = Workspace::new(&sizes, rows);
         plain.load_rows(&x, 5, &index, Some(&weights));
         let without = loss(&layers, &tanh, &mut plain, &mut rb, rows, beta);
