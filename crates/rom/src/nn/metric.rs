@@ -221,9 +221,11 @@ impl MetricBuffers {
             .zip(self.km[..rows * m].chunks_exact_mut(m))
             .enumerate()
         {
+            // k M = Σ_j k_j M[j, :] (rows of M, axpys that vectorize; M symmetric)
             let mass = self.metric.mass_of(self.rows[b]);
-            for (o, row) in km.iter_mut().zip(mass.chunks_exact(m)) {
-                *o = row.iter().zip(k).map(|(a, b)| a * b).sum();
+            km.iter_mut().for_each(|o| *o = 0.0);
+            for (row, &kj) in mass.chunks_exact(m).zip(k) {
+                km.iter_mut().zip(row).for_each(|(o, mij)| *o += kj * mij);
             }
         }
     }
