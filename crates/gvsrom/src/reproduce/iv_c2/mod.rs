@@ -459,14 +459,16 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     let hanging = variant_runs
         .iter()
         .find(|v| v.variant == DataVariant::Hanging);
-    // with the AE of the strain-rate term beside them, when that variant ran
-    let rated = variant_runs
+    // with the AE of the strain-rate term beside them (and the kinetic-energy norm, the best of
+    // them, when that variant ran)
+    let rated = [DataVariant::HangingKinetic, DataVariant::HangingRates]
         .iter()
-        .find(|v| v.variant == DataVariant::HangingRates)
+        .find_map(|&wanted| variant_runs.iter().find(|v| v.variant == wanted))
         .and_then(|v| {
             Some((
                 v.first_runs.as_ref()?[1].clone(),
                 v.selection.as_ref()?.chosen,
+                v.variant.kinetic_weight(),
             ))
         });
     if let Some([h, a, p]) = hanging.and_then(|v| v.first_runs.as_ref()) {
@@ -477,7 +479,9 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
             pod: Trajectory::load(p, "POD")?,
         };
         let rated = match rated {
-            Some((path, beta)) => Some((beta, Trajectory::load(&path, "AE, rate term")?)),
+            Some((path, beta, kappa)) => {
+                Some((beta, kappa, Trajectory::load(&path, "AE, rate term")?))
+            }
             None => None,
         };
         figures.push(hanging_figure(&inset, rated.as_ref(), s.test_s)?);

@@ -636,18 +636,28 @@ fn trace_panels(
 }
 
 /// The hanging arm's tip traces on the paper's test input (beyond the paper): HOM, AE-r and POD-r
-/// of the variant, and the AE-r trained with the strain-rate term of weight `rated.0` if given; the
-/// path seen along the arm (x–y: the arm hangs along −z) and x, y, z over time.
+/// of the variant, and the AE-r trained with the strain-rate term of weight `rated.0` (and the
+/// kinetic-energy norm of weight `rated.1`, if any) if given; the path seen along the arm (x–y: the
+/// arm hangs along −z) and x, y, z over time.
 pub(super) fn hanging_figure(
     inset: &Inset,
-    rated: Option<&(f64, Trajectory)>,
+    rated: Option<&(f64, Option<f64>, Trajectory)>,
     test_s: f64,
 ) -> anyhow::Result<RenderedFigure> {
     let r = inset.r;
-    let extra = rated.map(|(beta, t)| (format!("AE-{r}, rate term β = {beta}"), t));
+    let extra = rated.map(|(beta, kappa, t)| {
+        let label = match kappa {
+            Some(k) => format!("AE-{r}, rate term β = {beta}, kinetic norm κ = {k}"),
+            None => format!("AE-{r}, rate term β = {beta}"),
+        };
+        (label, t)
+    });
     let with = match rated {
-        Some((beta, _)) => format!(
-            " and, blue, the AE-{r} trained with the strain-rate term (`--rate-weight {beta}`)"
+        Some((beta, kappa, _)) => format!(
+            " and, blue, the AE-{r} trained with the strain-rate term (`--rate-weight {beta}`){}",
+            kappa.map_or(String::new(), |k| format!(
+                " and the kinetic-energy norm (`--kinetic-weight {k}`)"
+            ))
         ),
         None => String::new(),
     };

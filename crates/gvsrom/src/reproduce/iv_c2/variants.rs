@@ -147,7 +147,7 @@ impl DataVariant {
     }
 
     /// The variant's `--kinetic-weight` (`None`: not used).
-    fn kinetic_weight(self) -> Option<f64> {
+    pub(super) fn kinetic_weight(self) -> Option<f64> {
         matches!(self, DataVariant::Kinetic | DataVariant::HangingKinetic).then_some(KINETIC_WEIGHT)
     }
 
