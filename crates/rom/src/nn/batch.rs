@@ -25,7 +25,7 @@
 //! order, so results are bit-identical whatever the pool (one thread runs both tasks in turn).
 
 use super::activation::add_bias_and_activate;
-pub(crate) use super::dense::{product, row_major, row_major_mut};
+use super::dense::{product, row_major, row_major_mut};
 use super::metric::{MetricBuffers, Residual};
 use super::mlp::Layer;
 use faer::reborrow::ReborrowMut;
@@ -148,10 +148,7 @@ impl Workspace {
 
     /// The loss weight `ω_b` of loaded row `b` (1 unless the rows were loaded with weights).
     pub(crate) fn row_weight(&self, b: usize) -> f64 {
-        match self.weighted {
-            true => self.row_weight[b],
-            false => 1.0,
-        }
+        omega(self.weighted, &self.row_weight)(b)
     }
 
     /// `κ Σ_b ω_b ‖y_b − x_b‖²_b` of the row metric over the first `rows` loaded rows for the rate

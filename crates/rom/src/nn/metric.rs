@@ -98,19 +98,6 @@ impl RowMetric {
         self.weight
     }
 
-    /// The same metric with weight `κ` (the mass matrices are not copied if unshared).
-    pub fn with_weight(mut self, weight: f64) -> Result<Self, NnError> {
-        if !(weight.is_finite() && weight >= 0.0) {
-            return Err(NnError::InvalidOption {
-                field: "metric.weight",
-                value: weight,
-                expected: "finite and ≥ 0",
-            });
-        }
-        self.weight = weight;
-        Ok(self)
-    }
-
     /// `‖e‖²_b = (e Pᵀ) M_b (e Pᵀ)ᵀ` of an error `e` (`n` values, physical units) on data row `b`,
     /// without `κ`.
     pub fn squared_norm(&self, b: usize, e: &[f64]) -> f64 {

@@ -25,7 +25,8 @@
 //! A layer with at least `PARALLEL_MIN_MACS` multiply-adds computes `∂Q/∂W_k` beside `G_k`, `D'_k`
 //! as two tasks (disjoint outputs, as in `batch`'s backward pass): the bits do not depend on the pool.
 
-use super::batch::{product, row_major, row_major_mut, Workspace, PARALLEL_MIN_MACS};
+use super::batch::{Workspace, PARALLEL_MIN_MACS};
+use super::dense::{product, row_major, row_major_mut};
 use super::mlp::Layer;
 use faer::Accum;
 
