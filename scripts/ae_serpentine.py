@@ -13,12 +13,19 @@ serpentine codes z ∈ [-1, 1] (no encoder), to see whether the architecture can
 
 DATASET is `gvsrom dataset soft-beam --random loads.distributed.0.center=0:0.8 --random
 loads.distributed.0.magnitude=-5:5 --samples 5000 --seed 1` (or `reproduce iv-b`'s). Its inputs
-must be (centre, magnitude) in that order. `--first-layer-scale` multiplies the Glorot bound of the
+must be (centre, magnitude) in that order.
+
+`--whole` trains the whole autoencoder instead (the encoder 148-74-37-18-1 too): the loss is eq. (15)
+of `D(E(x))`, plus `--code-weight` × the mean squared distance of `E(x)` from the serpentine code,
+plus the decoder's error on the given codes; its `--lbfgs` phase minimises the same loss, and
+`--release N` more L-BFGS iterations minimise eq. (15) alone. `rmse_ae` is the autoencoder's
+RMSE, `rmse` the decoder's on the given codes. `--first-layer-scale` multiplies the Glorot bound of the
 decoder's first layer (larger: more folds at the start). RMSE over the whole dataset, physical units.
 """
 
 import argparse
 import json
+import time
 from pathlib import Path
 
 import numpy as np
@@ -42,7 +49,12 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--lbfgs", type=int, default=0,
                     help="then this many full-batch L-BFGS iterations (scipy) from Adam's weights")
+    ap.add_argument("--whole", action="store_true", help="train an encoder too (see above)")
+    ap.add_argument("--code-weight", type=float, default=1.0)
+    ap.add_argument("--release", type=int, default=0,
+                    help="--whole: then this many L-BFGS iterations of eq. (15) alone")
     a = ap.parse_args()
+    t0 = time.time()
 
     x = np.load(a.dataset / "strain.npy")
     x = x.reshape(x.shape[0], -1)
@@ -64,11 +76,19 @@ def main() -> None:
     y = jnp.asarray(x / s)
     sizes = [1] + [max(n >> j, 2) for j in (3, 2, 1)] + [n]
     key = jax.random.PRNGKey(a.seed)
-    params = []
-    for i, (p, q) in enumerate(zip(sizes[:-1], sizes[1:])):
-        key, sub = jax.random.split(key)
-        lim = np.sqrt(6.0 / (p + q)) * (a.first_layer_scale if i == 0 else 1.0)
-        params.append((jax.random.uniform(sub, (p, q), minval=-lim, maxval=lim), jnp.zeros(q)))
+
+    def glorot(sizes, first_scale):
+        nonlocal key
+        ps = []
+        for i, (p, q) in enumerate(zip(sizes[:-1], sizes[1:])):
+            key, sub = jax.random.split(key)
+            lim = np.sqrt(6.0 / (p + q)) * (first_scale if i == 0 else 1.0)
+            ps.append((jax.random.uniform(sub, (p, q), minval=-lim, maxval=lim), jnp.zeros(q)))
+        return ps
+
+    params = glorot(sizes, a.first_layer_scale)
+    if a.whole:
+        params = {"dec": params, "enc": glorot(sizes[::-1], 1.0)}
 
     def decode(ps, h):
         for i, (w, b) in enumerate(ps):
@@ -77,9 +97,18 @@ def main() -> None:
                 h = jnp.tanh(h)
         return h
 
-    def loss(ps, idx):
-        rec = jnp.mean((decode(ps, z[idx]) - y[idx]) ** 2)
-        return rec + a.lam / n * sum(jnp.sum(w * w) for w, _ in ps)
+    def penalty(layers):
+        return a.lam / n * sum(jnp.sum(w * w) for w, _ in layers)
+
+    def loss(ps, idx, mu=a.code_weight):
+        if not a.whole:
+            return jnp.mean((decode(ps, z[idx]) - y[idx]) ** 2) + penalty(ps)
+        e = decode(ps["enc"], y[idx])
+        out = jnp.mean((decode(ps["dec"], e) - y[idx]) ** 2) + penalty(ps["enc"] + ps["dec"])
+        if mu > 0:
+            out = out + mu * jnp.mean((e - z[idx]) ** 2)
+            out = out + jnp.mean((decode(ps["dec"], z[idx]) - y[idx]) ** 2)
+        return out
 
     batches = -(-rows // 64)
     opt = optax.adam(optax.exponential_decay(a.learning_rate, a.epochs * batches, 0.03))
@@ -96,25 +125,44 @@ def main() -> None:
         perm = rng.permutation(rows)
         for j in range(0, rows, 64):
             params, state = step(params, state, perm[j : j + 64])
-    rmse_of = lambda ps: float(np.sqrt(np.mean((np.asarray(decode(ps, z)) * s - x) ** 2)))
+    t_adam = time.time() - t0
+    def rmse_of(ps):
+        dec = ps["dec"] if a.whole else ps
+        return float(np.sqrt(np.mean((np.asarray(decode(dec, z)) * s - x) ** 2)))
+
+    def rmse_ae(ps):
+        xr = np.asarray(decode(ps["dec"], decode(ps["enc"], y))) * s
+        return float(np.sqrt(np.mean((xr - x) ** 2)))
+
     out = {"sizes": sizes, "bands": k, "exact": exact, "rmse_adam": rmse_of(params)}
-    if a.lbfgs > 0:
+    if a.whole:
+        out["rmse_ae_adam"] = rmse_ae(params)
+
+    def lbfgs(params, iterations, mu):
         from scipy.optimize import minimize
 
         flat, unravel = jax.flatten_util.ravel_pytree(params)
         every = jnp.arange(rows)
-        fg = jax.jit(jax.value_and_grad(lambda f: loss(unravel(f), every)))
+        fg = jax.jit(jax.value_and_grad(lambda f: loss(unravel(f), every, mu)))
 
         def fun(f):
             v, g = fg(jnp.asarray(f))
             return float(v), np.asarray(g)
 
         res = minimize(fun, np.asarray(flat), jac=True, method="L-BFGS-B",
-                       options={"maxiter": a.lbfgs, "maxcor": 20, "gtol": 0, "ftol": 0})
-        params = unravel(jnp.asarray(res.x))
-        out["lbfgs_iterations"] = int(res.nit)
+                       options={"maxiter": iterations, "maxcor": 20, "gtol": 0, "ftol": 0})
+        return unravel(jnp.asarray(res.x)), int(res.nit)
+
+    if a.lbfgs > 0:
+        params, out["lbfgs_iterations"] = lbfgs(params, a.lbfgs, a.code_weight)
     out["rmse"] = rmse_of(params)
-    print(json.dumps({**out, **vars(a)}, default=str))
+    if a.whole:
+        out["rmse_ae"] = rmse_ae(params)
+        if a.release > 0:
+            params, out["release_iterations"] = lbfgs(params, a.release, 0.0)
+            out["rmse_ae_released"] = rmse_ae(params)
+    out["seconds_adam"], out["seconds"] = t_adam, time.time() - t0
+    print(json.dumps({**vars(a), **out}, default=str))
 
 
 if __name__ == "__main__":
