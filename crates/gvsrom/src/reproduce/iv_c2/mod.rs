@@ -465,11 +465,8 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         .iter()
         .find_map(|&wanted| variant_runs.iter().find(|v| v.variant == wanted))
         .and_then(|v| {
-            Some((
-                v.first_runs.as_ref()?[1].clone(),
-                v.selection.as_ref()?.chosen,
-                v.variant.kinetic_weight(),
-            ))
+            let chosen = v.selection.as_ref()?.chosen;
+            Some((v.first_runs.as_ref()?[1].clone(), chosen.beta, chosen.kappa))
         });
     if let Some([h, a, p]) = hanging.and_then(|v| v.first_runs.as_ref()) {
         let inset = Inset {

