@@ -440,7 +440,12 @@ fn select_rate_weight(
             ..ae.clone()
         };
         let suffix = w.step_suffix();
-        let model = tasks::train(run, &format!("iv-c2/ae-r{r}-{name}-{suffix}"), data, &config)?;
+        let model = tasks::train(
+            run,
+            &format!("iv-c2/ae-r{r}-{name}-{suffix}"),
+            data,
+            &config,
+        )?;
         let mut errors = vec![];
         for &seed in validation {
             let t = Test {
@@ -451,7 +456,10 @@ fn select_rate_weight(
             let v = simulate_test(
                 run,
                 &format!("iv-c2/val-ae-r{r}-{name}-{suffix}-seed{seed}"),
-                &format!("AE-{r} ({name} data, {}, validation seed {seed})", w.label()),
+                &format!(
+                    "AE-{r} ({name} data, {}, validation seed {seed})",
+                    w.label()
+                ),
                 sc,
                 &t,
                 Some(&model),
