@@ -10,6 +10,7 @@
 //! compared with the HOM's (`gvsrom compare`: mean tip error in % of the length) and timed.
 
 mod energy_pod;
+mod figures;
 mod frequencies;
 mod more_tests;
 mod report;
@@ -25,11 +26,11 @@ use crate::simulate::IntegratorChoice;
 use energy_pod::{
     energy_pod_finding, energy_pod_model, energy_pod_table, fig9_energy_finding, run_energy_pod,
 };
+use figures::{fig9, trace_figure, Arm, Inset};
 use frequencies::{frequencies_notes, frequencies_table, natural_frequencies};
 use more_tests::{ae_timing, more_tests_findings, more_tests_table, run_more_tests, TestRuns};
 use report::{
-    fig9, fig9_table, findings, hanging_figure, lambda_table, models_table, notes, table_iii,
-    tip_travel, Context, Inset,
+    fig9_table, findings, lambda_table, models_table, notes, table_iii, tip_travel, Context,
 };
 use serde_json::json;
 use variants::{run_variant, variant_findings, variant_table, DataVariant};
@@ -455,19 +456,36 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         })).collect::<Vec<_>>(),
     });
     let mut figures = vec![fig9(&dofs, &hom, &trajectories)?];
-    // beyond the paper: the hanging arm's tip traces on the paper's test
+    // beyond the paper: each arm's tip traces on the paper's test, with the AE of the strain-rate
+    // term beside them (and the kinetic-energy norm, the best of them, when that variant ran)
+    let rated =
+        |wanted: [DataVariant; 2]| -> anyhow::Result<Option<(f64, Option<f64>, Trajectory)>> {
+            let found = wanted
+                .iter()
+                .find_map(|&w| variant_runs.iter().find(|v| v.variant == w))
+                .and_then(|v| {
+                    let chosen = v.selection.as_ref()?.chosen;
+                    Some((v.first_runs.as_ref()?[1].clone(), chosen.beta, chosen.kappa))
+                });
+            Ok(match found {
+                Some((path, beta, kappa)) => {
+                    Some((beta, kappa, Trajectory::load(&path, "AE, rate term")?))
+                }
+                None => None,
+            })
+        };
+    // the paper's arm: only with such an AE (else Fig. 9 shows the same traces)
+    if let Some(rated) = rated([DataVariant::Kinetic, DataVariant::Rates])? {
+        figures.push(trace_figure(
+            Arm::Horizontal,
+            &trajectories,
+            Some(&rated),
+            s.test_s,
+        )?);
+    }
     let hanging = variant_runs
         .iter()
         .find(|v| v.variant == DataVariant::Hanging);
-    // with the AE of the strain-rate term beside them (and the kinetic-energy norm, the best of
-    // them, when that variant ran)
-    let rated = [DataVariant::HangingKinetic, DataVariant::HangingRates]
-        .iter()
-        .find_map(|&wanted| variant_runs.iter().find(|v| v.variant == wanted))
-        .and_then(|v| {
-            let chosen = v.selection.as_ref()?.chosen;
-            Some((v.first_runs.as_ref()?[1].clone(), chosen.beta, chosen.kappa))
-        });
     if let Some([h, a, p]) = hanging.and_then(|v| v.first_runs.as_ref()) {
         let inset = Inset {
             r: inset,
@@ -475,13 +493,13 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
             ae: Trajectory::load(a, "AE")?,
             pod: Trajectory::load(p, "POD")?,
         };
-        let rated = match rated {
-            Some((path, beta, kappa)) => {
-                Some((beta, kappa, Trajectory::load(&path, "AE, rate term")?))
-            }
-            None => None,
-        };
-        figures.push(hanging_figure(&inset, rated.as_ref(), s.test_s)?);
+        let rated = rated([DataVariant::HangingKinetic, DataVariant::HangingRates])?;
+        figures.push(trace_figure(
+            Arm::Hanging,
+            &inset,
+            rated.as_ref(),
+            s.test_s,
+        )?);
     }
     Ok((report, figures))
 }
