@@ -3,6 +3,7 @@
 
 use super::super::report::{figure, RenderedFigure};
 use super::super::sim_test::SimRun;
+use super::kinetic_dofs::KineticDof;
 use super::Dof;
 use crate::compare::Trajectory;
 use crate::plot::{palette, Figure, LineChart, Series, SeriesStyle};
@@ -17,7 +18,12 @@ pub(super) struct Inset {
 
 /// Fig. 9: mean tip error and wall time against the DOF for both ROMs (and the HOM's time), and the
 /// inset's tip traces: the tip's path seen along the arm (y–z) and its coordinates over time.
-pub(super) fn fig9(dofs: &[Dof], hom: &SimRun, inset: &Inset) -> anyhow::Result<RenderedFigure> {
+pub(super) fn fig9(
+    dofs: &[Dof],
+    hom: &SimRun,
+    inset: &Inset,
+    kinetic: Option<&[KineticDof]>,
+) -> anyhow::Result<RenderedFigure> {
     let r: Vec<f64> = dofs.iter().map(|d| d.r as f64).collect();
     let over_r = |label: &str, f: &dyn Fn(&Dof) -> f64, color, style| Series {
         label: label.into(),
@@ -35,6 +41,12 @@ pub(super) fn fig9(dofs: &[Dof], hom: &SimRun, inset: &Inset) -> anyhow::Result<
                     x.push(d.r as f64);
                     y.push(f(run));
                 }
+            }
+        }
+        for k in kinetic.unwrap_or_default() {
+            if !k.run.complete {
+                x.push(k.r as f64);
+                y.push(f(&k.run));
             }
         }
         Series {
@@ -91,6 +103,18 @@ pub(super) fn fig9(dofs: &[Dof], hom: &SimRun, inset: &Inset) -> anyhow::Result<
             SeriesStyle::Dashed,
         ),
     ];
+    // beyond the paper: the AE-ROMs of the kinetic-energy norm, purple
+    if let Some(k) = kinetic {
+        let of = |f: &dyn Fn(&SimRun) -> f64| Series {
+            label: "AE-ROM, rate term + kinetic norm".into(),
+            x: k.iter().map(|d| d.r as f64).collect(),
+            y: k.iter().map(|d| f(&d.run)).collect(),
+            style: SeriesStyle::LineMarkers,
+            color: Some(palette::EXTRA[2]),
+        };
+        error_series.push(of(&SimRun::tip_mean));
+        time_series.push(of(&|x| x.wall_time_s));
+    }
     let stopped = partial(&SimRun::tip_mean);
     if !stopped.x.is_empty() {
         error_series.push(stopped);
@@ -128,7 +152,10 @@ pub(super) fn fig9(dofs: &[Dof], hom: &SimRun, inset: &Inset) -> anyhow::Result<
     panels.extend(trace_panels(inset, [1, 2], None));
     figure(
         "fig9-dof",
-        &format!("Fig. 9: mean tip error (% of the length) and wall time of the {d} s test against the number of DOFs for the AE-ROM (gold), the POD-ROM (red) and, beyond the paper, the POD-ROM of the autoencoders' strain-energy norm (blue), the HOM's time as the green dashed line (log scales where the values span two powers of ten; black dots: runs that stopped early, measured up to where they stopped); the tip traces of the HOM, AE-{r} and POD-{r} (r = {r}, the paper's inset): the path seen along the arm (y–z, gravity along −z) and the tip's x, y, z over time", r = inset.r, d = hom.t_reached),
+        &format!("Fig. 9: mean tip error (% of the length) and wall time of the {d} s test against the number of DOFs for the AE-ROM (gold), the POD-ROM (red) and, beyond the paper, the POD-ROM of the autoencoders' strain-energy norm (blue){kinetic}, the HOM's time as the green dashed line (log scales where the values span two powers of ten; black dots: runs that stopped early, measured up to where they stopped); the tip traces of the HOM, AE-{r} and POD-{r} (r = {r}, the paper's inset): the path seen along the arm (y–z, gravity along −z) and the tip's x, y, z over time", r = inset.r, d = hom.t_reached, kinetic = match kinetic {
+            Some(_) => " and the AE-ROMs trained with the strain-rate term, the kinetic-energy norm and a decaying rate (purple; table \"Fig. 9 with the AE-ROMs trained with…\")",
+            None => "",
+        }),
         &Figure::Grid {
             title: "IV-C2: six-tendon manipulator dynamics, ROMs against the HOM".into(),
             cols: 3,

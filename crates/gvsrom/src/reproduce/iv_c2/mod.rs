@@ -12,6 +12,7 @@
 mod energy_pod;
 mod figures;
 mod frequencies;
+mod kinetic_dofs;
 mod more_tests;
 mod report;
 mod variants;
@@ -28,6 +29,7 @@ use energy_pod::{
 };
 use figures::{fig9, trace_figure, Arm, Inset};
 use frequencies::{frequencies_notes, frequencies_table, natural_frequencies};
+use kinetic_dofs::{kinetic_dofs_finding, kinetic_dofs_table, run_kinetic_dofs};
 use more_tests::{ae_timing, more_tests_findings, more_tests_table, run_more_tests, TestRuns};
 use report::{
     fig9_table, findings, lambda_table, models_table, notes, table_iii, tip_travel, Context,
@@ -363,6 +365,21 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
             )),
         }
     }
+    // beyond the paper: Fig. 9 with every r's AE trained as the kinetic variant's chosen one
+    let kinetic_weights = variant_runs
+        .iter()
+        .find(|v| v.variant == DataVariant::Kinetic)
+        .and_then(|v| v.selection.as_ref())
+        .map(|sel| sel.chosen);
+    let kinetic_dofs = match kinetic_weights {
+        Some(w) => {
+            let ae = |r: usize| ae_config(r, LAMBDA, first_seed);
+            let runs = run_kinetic_dofs(run, (&data, &scenario), &ae, w, (&test, &hom), &s.dofs)?;
+            Some((w, runs))
+        }
+        None => None,
+    };
+    run.check_interrupt()?;
     let (ae, pod) = inset_runs.expect("the inset's r is tried");
     let trajectories = Inset {
         r: inset,
@@ -404,6 +421,9 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     for v in &variant_runs {
         report.tables.push(variant_table(inset, v));
     }
+    if let Some((w, k)) = &kinetic_dofs {
+        report.tables.push(kinetic_dofs_table(&dofs, k, w));
+    }
     report.tables.push(lambda_table(inset, &lambdas));
     report.tables.push(models_table(&dofs));
     report.findings = findings(&dofs, &hom, inset_dof);
@@ -415,6 +435,9 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     report
         .findings
         .extend(variant_runs.iter().flat_map(|v| variant_findings(inset, v)));
+    if let Some((_, k)) = &kinetic_dofs {
+        report.findings.push(kinetic_dofs_finding(&dofs, k));
+    }
     let context = Context {
         data_s: s.data_s,
         swing: tip_travel(&trajectories.hom, 1.0),
@@ -438,6 +461,10 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         "dataset": data.value,
         "hom": hom,
         "hom_tip_travel_within_1s_m": context.swing,
+        "kinetic_dofs": kinetic_dofs.as_ref().map(|(w, k)| json!({
+            "weights": w,
+            "runs": k.iter().map(|d| json!({ "r": d.r, "run": d.run })).collect::<Vec<_>>(),
+        })),
         "dofs": dofs.iter().map(|d| json!({
             "r": d.r, "ae_model": d.ae.value, "pod_model": d.pod.value,
             "ae": d.ae_run, "pod": d.pod_run,
@@ -455,7 +482,8 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
             "lambda": v.lambda, "seed": v.seed, "model": v.model, "run": v.run,
         })).collect::<Vec<_>>(),
     });
-    let mut figures = vec![fig9(&dofs, &hom, &trajectories)?];
+    let kinetic_runs = kinetic_dofs.as_ref().map(|(_, k)| k.as_slice());
+    let mut figures = vec![fig9(&dofs, &hom, &trajectories, kinetic_runs)?];
     // beyond the paper: each arm's tip traces on the paper's test, with the AE of the strain-rate
     // term beside them (and the kinetic-energy norm, the best of them, when that variant ran)
     let rated =

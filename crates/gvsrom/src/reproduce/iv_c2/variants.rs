@@ -93,7 +93,7 @@ impl LossWeights {
     }
 
     /// The step names' suffix: `beta0.3` or `kappa3-beta0.3`.
-    fn step_suffix(&self) -> String {
+    pub(super) fn step_suffix(&self) -> String {
         match self.kappa {
             Some(k) => format!("kappa{k}-beta{}", self.beta),
             None => format!("beta{}", self.beta),
@@ -101,7 +101,7 @@ impl LossWeights {
     }
 
     /// The `gvsrom train` options.
-    fn options(&self) -> String {
+    pub(super) fn options(&self) -> String {
         match self.kappa {
             Some(k) => format!("--rate-weight {} --kinetic-weight {k}", self.beta),
             None => format!("--rate-weight {}", self.beta),
@@ -155,7 +155,7 @@ impl RateSelection {
 
 impl DataVariant {
     /// The step names' suffix.
-    fn name(self) -> &'static str {
+    pub(super) fn name(self) -> &'static str {
         match self {
             DataVariant::Spread => "spread",
             DataVariant::Damped => "damped",
@@ -191,7 +191,7 @@ impl DataVariant {
     }
 
     /// Whether the variant also measures the errors in the kinetic-energy norm (`--kinetic-weight`).
-    fn kinetic(self) -> bool {
+    pub(super) fn kinetic(self) -> bool {
         matches!(self, DataVariant::Kinetic | DataVariant::HangingKinetic)
     }
 
@@ -325,12 +325,7 @@ pub(super) fn run_variant(
         ),
         true => {
             let ae = &match variant.kinetic() {
-                true => AeConfig {
-                    lr_decay: Some(KINETIC_LR_DECAY),
-                    patience: 0,
-                    lbfgs_iterations: 0,
-                    ..ae.clone()
-                },
+                true => kinetic_schedule(ae),
                 false => ae.clone(),
             };
             let kappas: &[f64] = match variant.kinetic() {
@@ -359,15 +354,8 @@ pub(super) fn run_variant(
         };
         let hom = hom_of(seed)?;
         let rom_run = |m: &Step<ModelInfo>, step: &str, label: &str, name: &str| {
-            simulate_test(
-                run,
-                &format!("iv-c2/test-{step}{r}-{name}-test-seed{seed}"),
-                &format!("{label}{r} ({name} data, test seed {seed})"),
-                &sc,
-                &t,
-                Some(m),
-                Some(&hom),
-            )
+            let (step, label) = test_step(step, label, r, name, seed);
+            simulate_test(run, &step, &label, &sc, &t, Some(m), Some(&hom))
         };
         let ae_run = rom_run(&model, "ae-r", "AE-", name)?;
         let pod_run = rom_run(&pod, "pod-", "POD-", pod_name)?;
@@ -401,6 +389,37 @@ pub(super) fn run_variant(
         first_runs,
         selection,
     })
+}
+
+/// `ae` with the kinetic variants' schedule: the rate decaying to [`KINETIC_LR_DECAY`] of itself,
+/// no plateaus, no L-BFGS phase.
+pub(super) fn kinetic_schedule(ae: &AeConfig) -> AeConfig {
+    AeConfig {
+        lr_decay: Some(KINETIC_LR_DECAY),
+        patience: 0,
+        lbfgs_iterations: 0,
+        ..ae.clone()
+    }
+}
+
+/// The step name of the rate-term variant `name`'s AE with `r` coordinates and weights `w`.
+pub(super) fn ae_step_name(r: usize, name: &str, w: &LossWeights) -> String {
+    format!("iv-c2/ae-r{r}-{name}-{}", w.step_suffix())
+}
+
+/// The step name and label of a variant's ROM run (`kind` "ae-r" or "pod-", `label` "AE-" or
+/// "POD-") of size `r` and data `name` on test input `seed`.
+pub(super) fn test_step(
+    kind: &str,
+    label: &str,
+    r: usize,
+    name: &str,
+    seed: u64,
+) -> (String, String) {
+    (
+        format!("iv-c2/test-{kind}{r}-{name}-test-seed{seed}"),
+        format!("{label}{r} ({name} data, test seed {seed})"),
+    )
 }
 
 /// The candidate weights: every β of [`RATE_WEIGHTS`] with every κ of `kappas` (none: β alone);
@@ -440,12 +459,7 @@ fn select_rate_weight(
             ..ae.clone()
         };
         let suffix = w.step_suffix();
-        let model = tasks::train(
-            run,
-            &format!("iv-c2/ae-r{r}-{name}-{suffix}"),
-            data,
-            &config,
-        )?;
+        let model = tasks::train(run, &ae_step_name(r, name, &w), data, &config)?;
         let mut errors = vec![];
         for &seed in validation {
             let t = Test {
