@@ -31,14 +31,7 @@ pub(super) fn run_kinetic_dofs(
     let name = DataVariant::Kinetic.name();
     let configs: Vec<(usize, AeConfig)> = dofs
         .iter()
-        .map(|&r| {
-            let c = AeConfig {
-                rate_weight: Some(w.beta),
-                kinetic_weight: w.kappa,
-                ..kinetic_schedule(&ae(r))
-            };
-            (r, c)
-        })
+        .map(|&r| (r, w.config(&kinetic_schedule(&ae(r)))))
         .collect();
     let models = tasks::parallel(&configs, |(r, c)| {
         tasks::train(run, &ae_step_name(*r, name, &w), data, c)

@@ -100,6 +100,16 @@ impl LossWeights {
         }
     }
 
+    /// `ae` trained with these weights (the reproduce steps' one definition of a weighted AE, so
+    /// that the same weights on the same data make the same step).
+    pub(super) fn config(&self, ae: &AeConfig) -> AeConfig {
+        AeConfig {
+            rate_weight: Some(self.beta),
+            kinetic_weight: self.kappa,
+            ..ae.clone()
+        }
+    }
+
     /// The `gvsrom train` options.
     pub(super) fn options(&self) -> String {
         match self.kappa {
@@ -324,13 +334,9 @@ pub(super) fn run_variant(
             None,
         ),
         true => {
-            let ae = &match variant.kinetic() {
-                true => kinetic_schedule(ae),
-                false => ae.clone(),
-            };
-            let kappas: &[f64] = match variant.kinetic() {
-                true => &KINETIC_WEIGHTS,
-                false => &[],
+            let (ae, kappas): (&AeConfig, &[f64]) = match variant.kinetic() {
+                true => (&kinetic_schedule(ae), &KINETIC_WEIGHTS),
+                false => (ae, &[]),
             };
             let (model, selection) = select_rate_weight(
                 run,
@@ -453,13 +459,8 @@ fn select_rate_weight(
     let mut best: Option<(f64, Step<ModelInfo>, LossWeights)> = None;
     let mut table = vec![];
     for w in candidates(kappas, !validation.is_empty()) {
-        let config = AeConfig {
-            rate_weight: Some(w.beta),
-            kinetic_weight: w.kappa,
-            ..ae.clone()
-        };
         let suffix = w.step_suffix();
-        let model = tasks::train(run, &ae_step_name(r, name, &w), data, &config)?;
+        let model = tasks::train(run, &ae_step_name(r, name, &w), data, &w.config(ae))?;
         let mut errors = vec![];
         for &seed in validation {
             let t = Test {
