@@ -3,7 +3,9 @@
 # under gravity (gravity-release.toml) in gvsrom, PyElastica and soromox, each at several
 # resolutions, every run's tip compared with gvsrom's converged run.
 #
-#   scripts/peers/run.sh OUT        # OUT: a new directory; about 2 minutes plus the venvs' install
+#   scripts/peers/run.sh OUT        # OUT: a new directory; 5.5 minutes with the venvs' install
+#
+# Writes OUT/table.md (docs/speed.md's table) and OUT/peers.png (tip traces; error against time).
 #
 # Installs PyElastica 1.0.0 and soromox 0.5.0 into venvs under OUT (pip reaches PyPI) and uses
 # target/release/gvsrom (built if absent; GVSROM=path to use another). Writes nothing outside OUT.
@@ -18,17 +20,20 @@ mkdir -p "$OUT"
 for peer in pyelastica soromox; do
   python3 -m venv "$OUT/venv-$peer"
 done
-"$OUT/venv-pyelastica/bin/pip" install -q "pyelastica==1.0.0"
+"$OUT/venv-pyelastica/bin/pip" install -q "pyelastica==1.0.0" matplotlib
 "$OUT/venv-soromox/bin/pip" install -q "soromox==0.5.0"
 S="$HERE/gravity-release.toml"
 RUNS=()
 
-# gvsrom: Legendre order k in all six strains (6 (k + 1) DOF), the default adaptive integrator
+# gvsrom: Legendre order k in all six strains (6 (k + 1) DOF), the default adaptive integrator;
+# three runs of each, timed by their median
 "$B" simulate "$S" --set divisions.0.basis.order=10 --duration 1 --rtol 1e-8 --atol 1e-10 \
   --out "$OUT/gvsrom-ref" > "$OUT/gvsrom-ref.log"
 for k in 2 3 4 6 8; do
-  "$B" simulate "$S" --set divisions.0.basis.order=$k --duration 1 --out "$OUT/gvsrom-k$k" > "$OUT/gvsrom-k$k.log"
-  RUNS+=("gvsrom, order $k=$OUT/gvsrom-k$k")
+  for i in 1 2 3; do
+    "$B" simulate "$S" --set divisions.0.basis.order=$k --duration 1 --out "$OUT/gvsrom-k$k-$i" > "$OUT/gvsrom-k$k-$i.log"
+  done
+  RUNS+=("gvsrom, order $k=$OUT/gvsrom-k$k-1|$OUT/gvsrom-k$k-2|$OUT/gvsrom-k$k-3")
 done
 
 # PyElastica: n elements, the step at its stability limit's half (dt = 2.5e-3 / n; 1e-4 at n = 50
@@ -55,6 +60,7 @@ for n in 4 8; do
   RUNS+=("soromox PCS, $n segments=$OUT/soromox-pcs-n$n")
 done
 $SX --model pcs --segments 4 --solver sie --dt 1e-4 --out "$OUT/soromox-pcs-n4-sie" > "$OUT/soromox-pcs-n4-sie.log"
-RUNS+=("soromox PCS, 4 segments, semi-implicit Euler=$OUT/soromox-pcs-n4-sie")
+RUNS+=("soromox PCS semi-implicit Euler, 4 segments=$OUT/soromox-pcs-n4-sie")
 
-"$OUT/venv-pyelastica/bin/python" "$HERE/compare.py" "$OUT/gvsrom-ref" "${RUNS[@]}" | tee "$OUT/table.md"
+"$OUT/venv-pyelastica/bin/python" "$HERE/compare.py" --figure "$OUT/peers.png" "$OUT/gvsrom-ref" "${RUNS[@]}" \
+  | tee "$OUT/table.md"
