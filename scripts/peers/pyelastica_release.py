@@ -17,7 +17,7 @@ Writes DIR/t.npy (101,), DIR/tip_position.npy (101, 3) at 100 Hz and DIR/timing.
 numba compilation measured apart (a 20-step run of a fresh system first), then the median wall
 time of `--repeat` full runs.
 
-    python scripts/peers/pyelastica_release.py --elements 50 --dt 5e-5 --out pe50
+    python scripts/peers/pyelastica_release.py --elements 50 --dt 8e-5 --out pe50
 """
 import argparse
 import importlib.metadata
@@ -81,7 +81,7 @@ def run(elements, dt, steps, every):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--elements", type=int, default=50)
-    ap.add_argument("--dt", type=float, default=5e-5)
+    ap.add_argument("--dt", type=float, default=8e-5)
     ap.add_argument("--repeat", type=int, default=1)
     ap.add_argument("--out", required=True)
     a = ap.parse_args()
