@@ -10,6 +10,11 @@
 //! - The release: 1 s of the undamped rod falling from straight under gravity, the tip falling
 //!   0.40 m; the two codes integrate with different methods (SDIRK4 here, Tsit5 there), so
 //!   they agree to their tolerances only if mass matrix, Coriolis, elastic and gravity forces agree.
+//! - A tendon: `scripts/peers/tendon-statics.toml`, the same rod without gravity and a full-length
+//!   frictionless tendon pulled with 2 N, at a constant offset and on an oblique path. soromox
+//!   derives the tendon's generalized force from the path length, `−T ∂ℓ/∂q`
+//!   (`scripts/peers/soromox_tendon.py`); gvsrom from the internal wrench of gvs-spec §7.6. The
+//!   equilibria agree to rounding (observed 1.5e-13 m).
 
 mod common;
 
@@ -20,6 +25,10 @@ const SCENARIO: &str = concat!(
     "/../../scripts/peers/gravity-release.toml"
 );
 const FIXTURE: &str = include_str!("peers/soromox-gravity-release-order2.csv");
+const TENDON: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../../scripts/peers/tendon-statics.toml"
+);
 
 /// The fixture's static tip and its 101 rows `[t, x, y, z]`.
 fn soromox() -> ([f64; 3], Vec<[f64; 4]>) {
@@ -105,4 +114,83 @@ fn the_undamped_release_under_gravity_agrees_with_soromox_over_a_second() {
     // 2.6e-7 m: the tolerances of the two integrators)
     assert!(deepest < -0.3, "fixture's deepest tip {deepest}");
     assert!(worst <= 1e-6, "tip {worst:.3e} m from soromox's at worst");
+}
+
+/// The tip of `tendon-statics.toml` at Legendre order `order`, with `extra` overrides.
+fn tendon_tip(name: &str, order: usize, extra: &[&str]) -> Vec<f64> {
+    let out = scratch(name);
+    let order = format!("divisions.0.basis.order={order}");
+    let mut args = vec!["statics", TENDON, "--set", &order];
+    for e in extra {
+        args.extend(["--set", e]);
+    }
+    args.extend(["--json", s(&out)]);
+    run_ok(&args);
+    json(&out)["tip_position"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect()
+}
+
+#[test]
+fn a_pulled_tendon_bends_the_rod_as_in_soromox_to_rounding() {
+    // soromox 0.5.0, `python scripts/peers/soromox_tendon.py --case const|linear --order 2|4`
+    // (GVS, one segment, five Gauss points; residual ≤ 2.1e-17)
+    let cases: [(&str, usize, &[&str], [f64; 3]); 4] = [
+        (
+            "peer-tendon-const-2",
+            2,
+            &[],
+            [0.49881808123760935, 0.0, 0.02542658408248584],
+        ),
+        (
+            "peer-tendon-const-4",
+            4,
+            &[],
+            [0.49881808123760935, 0.0, 0.02542658408248584],
+        ),
+        (
+            "peer-tendon-oblique-2",
+            2,
+            &[
+                "tendons.0.offset_start=[0.0,0.01]",
+                "tendons.0.offset_end=[0.0,0.003]",
+            ],
+            [0.49894102847321214, 0.0, 0.024382836800395553],
+        ),
+        (
+            "peer-tendon-oblique-4",
+            4,
+            &[
+                "tendons.0.offset_start=[0.0,0.01]",
+                "tendons.0.offset_end=[0.0,0.003]",
+            ],
+            [0.49894102847314536, 0.0, 0.024382836800596414],
+        ),
+    ];
+    for (name, order, extra, expected) in cases {
+        let tip = tendon_tip(name, order, extra);
+        for k in 0..3 {
+            assert!(
+                (tip[k] - expected[k]).abs() <= 1e-10,
+                "{name}: tip component {k}: gvsrom {} against soromox {}",
+                tip[k],
+                expected[k]
+            );
+        }
+    }
+    // the closed form of the constant offset: a constant moment T d and axial force −T, so the
+    // curvature T d / EI (0.2037 1/m) per reference length and the stretch 1 − T / EA: an arc of
+    // angle κ L and radius (1 − T / EA) / κ
+    let (t, d, r, e): (f64, f64, f64, f64) = (2.0, 0.008, 0.01, 1e7);
+    let ei = e * std::f64::consts::PI * r.powi(4) / 4.0;
+    let ea = e * std::f64::consts::PI * r * r;
+    let (kappa, stretch) = (t * d / ei, 1.0 - t / ea);
+    let x = stretch * (kappa * 0.5).sin() / kappa;
+    let z = stretch * (1.0 - (kappa * 0.5).cos()) / kappa;
+    let tip = tendon_tip("peer-tendon-closed-form", 2, &[]);
+    assert!((tip[0] - x).abs() <= 1e-9, "tip x {} against {x}", tip[0]);
+    assert!((tip[2] - z).abs() <= 1e-9, "tip z {} against {z}", tip[2]);
 }
