@@ -51,6 +51,7 @@ import equinox as eqx  # noqa: E402
 import jax.numpy as jnp  # noqa: E402
 import numpy as np  # noqa: E402
 import soromox as sx  # noqa: E402
+from soromox_statics import equilibrium  # noqa: E402
 
 L, R, E, NU, RHO, GRAV, T, FS = 0.5, 0.01, 1e7, 0.5, 1000.0, 9.81, 1.0, 100
 
@@ -99,15 +100,8 @@ def tip(robot, q):
 def static_tip(robot, nload=10, iters=30):
     """Static equilibrium under gravity via Newton + load continuation."""
     res = lambda r, q, lam: r.elastic_force(q) + lam * r.gravitational_force(q)
-    step = eqx.filter_jit(lambda r, q, lam: q - jnp.linalg.solve(
-        jax.jacfwd(res, argnums=1)(r, q, lam), res(r, q, lam)))
-    q = jnp.zeros(robot.num_coordinates)
-    for lam in np.linspace(1.0 / nload, 1.0, nload):
-        for _ in range(iters):
-            q, q_old = step(robot, q, lam), q
-            if float(jnp.abs(q - q_old).max()) < 1e-13:
-                break
-    return np.asarray(tip(robot, q)), float(jnp.abs(res(robot, q, 1.0)).max())
+    q, residual = equilibrium(robot, res, nload, iters, 1e-13)
+    return np.asarray(tip(robot, q)), residual
 
 
 def main():

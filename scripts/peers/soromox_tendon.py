@@ -27,11 +27,11 @@ import argparse
 import jax
 
 jax.config.update("jax_enable_x64", True)
-import equinox as eqx  # noqa: E402
 import jax.numpy as jnp  # noqa: E402
 import numpy as np  # noqa: E402
 import soromox as sx  # noqa: E402
 from soromox.actuation import ThreadlikeActuator, ThreadlikeRouting  # noqa: E402
+from soromox_statics import equilibrium  # noqa: E402
 
 L, R, E, RHO, TENSION = 0.5, 0.01, 1e7, 1000.0, 2.0
 
@@ -57,16 +57,9 @@ def build(order, gauss, case):
 
 def static_tip(robot, nload=4, iters=40):
     res = lambda r, q, lam: r.elastic_force(q) - r.actuation_force(q, jnp.array([lam * TENSION]))
-    step = eqx.filter_jit(lambda r, q, lam: q - jnp.linalg.solve(
-        jax.jacfwd(res, argnums=1)(r, q, lam), res(r, q, lam)))
-    q = jnp.zeros(robot.num_coordinates)
-    for lam in np.linspace(1.0 / nload, 1.0, nload):
-        for _ in range(iters):
-            q, q_old = step(robot, q, lam), q
-            if float(jnp.abs(q - q_old).max()) < 1e-14:
-                break
+    q, residual = equilibrium(robot, res, nload, iters, 1e-14)
     tip = np.asarray(robot.forward_kinematics(q, jnp.array(L))[:3, 3])
-    return tip, float(jnp.abs(res(robot, q, 1.0)).max()), q
+    return tip, residual, q
 
 
 def main():
