@@ -51,31 +51,10 @@ fn soromox() -> ([f64; 3], Vec<[f64; 4]>) {
 #[test]
 fn the_sagged_cantilever_agrees_with_soromox_to_a_tenth_of_a_micrometre() {
     let (expected, _) = soromox();
-    let out = scratch("peer-soromox-statics.json");
-    run_ok(&[
-        "statics",
-        SCENARIO,
-        "--set",
-        "divisions.0.basis.order=2",
-        "--json",
-        s(&out),
-    ]);
-    let tip: Vec<f64> = json(&out)["tip_position"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap())
-        .collect();
+    let tip = statics_tip(SCENARIO, "peer-soromox-statics.json", 2, &[]);
     // the tip sags far: a linear model would be 0.06 m off here
     assert!(expected[2] < -0.2, "fixture's sag {}", expected[2]);
-    for k in 0..3 {
-        assert!(
-            (tip[k] - expected[k]).abs() <= 1e-7,
-            "tip component {k}: gvsrom {} against soromox {}",
-            tip[k],
-            expected[k]
-        );
-    }
+    assert_tip_near("sagged cantilever", &tip, &expected, 1e-7);
 }
 
 #[test]
@@ -116,11 +95,23 @@ fn the_undamped_release_under_gravity_agrees_with_soromox_over_a_second() {
     assert!(worst <= 1e-6, "tip {worst:.3e} m from soromox's at worst");
 }
 
-/// The tip of `tendon-statics.toml` at Legendre order `order`, with `extra` overrides.
-fn tendon_tip(name: &str, order: usize, extra: &[&str]) -> Vec<f64> {
+/// Every component of gvsrom's `tip` within `tol` [m] of soromox's `expected`.
+fn assert_tip_near(case: &str, tip: &[f64], expected: &[f64; 3], tol: f64) {
+    for k in 0..3 {
+        assert!(
+            (tip[k] - expected[k]).abs() <= tol,
+            "{case}: tip component {k}: gvsrom {} against soromox {}",
+            tip[k],
+            expected[k]
+        );
+    }
+}
+
+/// The equilibrium's tip of `scenario` at Legendre order `order`, with `extra` overrides.
+fn statics_tip(scenario: &str, name: &str, order: usize, extra: &[&str]) -> Vec<f64> {
     let out = scratch(name);
     let order = format!("divisions.0.basis.order={order}");
-    let mut args = vec!["statics", TENDON, "--set", &order];
+    let mut args = vec!["statics", scenario, "--set", &order];
     for e in extra {
         args.extend(["--set", e]);
     }
@@ -171,15 +162,8 @@ fn a_pulled_tendon_bends_the_rod_as_in_soromox_to_rounding() {
         ),
     ];
     for (name, order, extra, expected) in cases {
-        let tip = tendon_tip(name, order, extra);
-        for k in 0..3 {
-            assert!(
-                (tip[k] - expected[k]).abs() <= 1e-10,
-                "{name}: tip component {k}: gvsrom {} against soromox {}",
-                tip[k],
-                expected[k]
-            );
-        }
+        let tip = statics_tip(TENDON, name, order, extra);
+        assert_tip_near(name, &tip, &expected, 1e-10);
     }
     // the closed form of the constant offset: a constant moment T d and axial force −T, so the
     // curvature T d / EI (0.2037 1/m) per reference length and the stretch 1 − T / EA: an arc of
@@ -190,7 +174,7 @@ fn a_pulled_tendon_bends_the_rod_as_in_soromox_to_rounding() {
     let (kappa, stretch) = (t * d / ei, 1.0 - t / ea);
     let x = stretch * (kappa * 0.5).sin() / kappa;
     let z = stretch * (1.0 - (kappa * 0.5).cos()) / kappa;
-    let tip = tendon_tip("peer-tendon-closed-form", 2, &[]);
+    let tip = statics_tip(TENDON, "peer-tendon-closed-form", 2, &[]);
     assert!((tip[0] - x).abs() <= 1e-9, "tip x {} against {x}", tip[0]);
     assert!((tip[2] - z).abs() <= 1e-9, "tip z {} against {z}", tip[2]);
 }
