@@ -3,7 +3,7 @@
 # under gravity (gravity-release.toml) in gvsrom, PyElastica and soromox, each at several
 # resolutions, every run's tip compared with gvsrom's converged run.
 #
-#   scripts/peers/run.sh OUT        # OUT: a new directory; 5.5 minutes with the venvs' install
+#   scripts/peers/run.sh OUT        # OUT: a new directory; 4–6 minutes with the venvs' install
 #
 # Writes OUT/table.md (docs/speed.md's table) and OUT/peers.png (tip traces; error against time).
 #
@@ -37,7 +37,7 @@ for k in 2 3 4 6 8; do
 done
 
 # PyElastica: n elements, dt = 4e-3 / n: at 50 elements the largest step dividing the output period
-# that stays stable (1e-4 diverges), scaled with the element length (half of it changes no digit of
+# that stays stable (1e-4 diverges), scaled with the element length (a step 0.625× as long changes no digit of
 # the error)
 for n in 50 100 200 400; do
   dt=$(python3 -c "print(4e-3 / $n)")
@@ -49,7 +49,7 @@ RUNS+=("PyElastica, extrapolated=$OUT/pyelastica-n200+$OUT/pyelastica-n400")
 
 # soromox: its GVS (one segment, Legendre order k: the same model class as gvsrom's) and PCS
 # (N segments of constant strain), all six strains, diffrax's Tsit5 at rtol 1e-4 as gvsrom's (the
-# stiff modes, not the tolerance, set its step: rtol 1e-6 takes twice the steps for the same tip),
+# stiff modes, not the tolerance, set its step: rtol 1e-6 takes 1.3–1.9× the steps for the same tip),
 # its explicit solvers being what it offers in practice (Kvaerno5 took 122 s for PCS N = 4), and
 # its own semi-implicit Euler at a fixed step
 SX="$OUT/venv-soromox/bin/python $HERE/soromox_release.py --repeat 1 --rtol 1e-4 --atol 1e-6"
