@@ -78,12 +78,11 @@ def main():
         fig_path, args = args[1], args[2:]
     if len(args) < 2:
         raise SystemExit(__doc__)
-    sys.argv = [sys.argv[0]] + args
     runs = []
-    t_ref, ref, _, _ = load(sys.argv[1])
+    t_ref, ref, _, _ = load(args[0])
     print("| run | settings | tip error mean / max [% L] | wall time [s] |")
     print("|---|---|---|---|")
-    for arg in sys.argv[2:]:
+    for arg in args[1:]:
         label, _, d = arg.partition("=")
         if "+" in d:
             coarse, fine = d.split("+")
