@@ -382,3 +382,67 @@ fn lightly_damped_rod_gets_an_l_stable_method_and_says_so() {
     assert!(out.status.success());
     assert!(!String::from_utf8_lossy(&out.stdout).contains("integrator "));
 }
+
+#[test]
+fn repeated_runs_record_every_wall_time_and_keep_the_smallest() {
+    let args = |dir: &Path, repeat: &str| {
+        vec![
+            "simulate".to_string(),
+            "single-tendon".into(),
+            "--duration".into(),
+            "0.2".into(),
+            "--steps=-3,0,0.1".into(),
+            "--repeat".into(),
+            repeat.into(),
+            "--out".into(),
+            dir.to_str().unwrap().into(),
+        ]
+    };
+    let once = scratch("repeat-once");
+    let thrice = scratch("repeat-thrice");
+    let run = |a: Vec<String>| common::run_ok(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    run(args(&once, "1"));
+    let stdout = run(args(&thrice, "3"));
+    assert!(
+        stdout.contains("the smallest of 3 runs (median"),
+        "{stdout}"
+    );
+    let meta = common::json(&thrice.join("meta.json"));
+    let times: Vec<f64> = meta["wall_times_s"]
+        .as_array()
+        .expect("wall_times_s with --repeat 3")
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert_eq!(times.len(), 3);
+    assert!(times.iter().all(|t| *t > 0.0));
+    let smallest = times.iter().copied().fold(f64::INFINITY, f64::min);
+    assert_eq!(meta["wall_time_s"].as_f64().unwrap(), smallest);
+    assert!(meta["complete"].as_bool().unwrap());
+    // the timing runs change nothing that is written
+    assert!(common::json(&once.join("meta.json"))
+        .get("wall_times_s")
+        .is_none());
+    for f in ["q.npy", "qd.npy", "u.npy", "tip_position.npy"] {
+        assert_eq!(
+            npy_values(&once.join(f)),
+            npy_values(&thrice.join(f)),
+            "{f}"
+        );
+    }
+    // a usage error (clap's exit code 2) naming the option, the value and the accepted range
+    let zero = gvsrom(&[
+        "simulate",
+        "single-tendon",
+        "--duration",
+        "0.1",
+        "--repeat",
+        "0",
+    ]);
+    let stderr = String::from_utf8_lossy(&zero.stderr);
+    assert_eq!(zero.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("'0' for '--repeat <N>'") && stderr.contains("1..=10000"),
+        "{stderr}"
+    );
+}

@@ -117,6 +117,12 @@ pub struct SimulateArgs {
     #[arg(long, requires = "out")]
     pub force: bool,
 
+    /// Time the integration N times (≥ 1): after the written run, N − 1 more without output, one
+    /// after the other; the wall time reported and recorded (`meta.json`'s `wall_time_s`) is the
+    /// smallest, with every run's in `wall_times_s` — for speed comparisons on a shared machine.
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=10_000))]
+    pub repeat: u32,
+
     /// Simulate with the reduced model in directory MODEL (from `gvsrom pod` or `gvsrom train`) in
     /// place of the scenario's basis.
     #[arg(long, value_name = "MODEL")]
@@ -217,15 +223,32 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
             s => ControlFlow::Break(format!("interrupted by {}", signal_name(s))),
         }
     };
-    let outcome = simulate::run(built, plan, &opts.integrator, writer.as_mut(), &mut control)?;
+    let mut outcome = simulate::run(built, plan, &opts.integrator, writer.as_mut(), &mut control)?;
     if tty {
         eprintln!();
     }
+    let timing_stopped = outcome.time_again(
+        built,
+        plan,
+        &opts.integrator,
+        args.repeat as usize - 1,
+        &mut |_| match signal.load(Ordering::SeqCst) {
+            0 => ControlFlow::Continue(()),
+            s => ControlFlow::Break(format!("interrupted by {}", signal_name(s))),
+        },
+    )?;
     let sm = &outcome.summary;
     let t_last = sm.t_last.unwrap_or(0.0);
+    let timed = match outcome.wall_times_s.len() {
+        1 => String::new(),
+        n => format!(
+            ", the smallest of {n} runs (median {:.3} s)",
+            outcome.median_wall_time_s()
+        ),
+    };
     writeln!(
         out,
-        "simulated  {t_last:.3} s in {:.3} s wall time (real-time factor {:.1}), {} steps ({} failed, {} of them in Newton), {} RHS and {} Jacobian evaluations",
+        "simulated  {t_last:.3} s in {:.3} s wall time{timed} (real-time factor {:.1}), {} steps ({} failed, {} of them in Newton), {} RHS and {} Jacobian evaluations",
         sm.wall_time_s,
         outcome.real_time_factor(),
         sm.stats.steps,
@@ -270,7 +293,22 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
         ),
     };
     match &outcome.ending {
-        Ending::Complete => Ok(()),
+        Ending::Complete => match timing_stopped {
+            None => Ok(()),
+            Some(reason) => Err(Interrupted {
+                signal: signal.load(Ordering::SeqCst) as i32,
+                message: format!(
+                    "{reason} while timing the run again (--repeat {}): the trajectory is complete{}; {} of the runs were timed",
+                    args.repeat,
+                    match &written {
+                        Some((dir, _)) => format!(" and written to `{}`", dir.display()),
+                        None => String::new(),
+                    },
+                    outcome.wall_times_s.len()
+                ),
+            }
+            .into()),
+        },
         Ending::Failed { error } => anyhow::bail!("{error} ({kept})"),
         Ending::Interrupted { reason } => Err(Interrupted {
             signal: signal.load(Ordering::SeqCst) as i32,

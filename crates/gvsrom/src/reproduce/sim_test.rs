@@ -142,7 +142,7 @@ pub fn simulate_test(
             let written =
                 simulate::run_to_dir(&built, &opts, path, true, Some(provenance), &mut control)?;
             run.check_interrupt()?;
-            let outcome = &written.outcome;
+            let mut outcome = written.outcome;
             let reason = match &outcome.ending {
                 Ending::Complete => None,
                 Ending::Failed { error } => Some(error.clone()),
@@ -151,13 +151,15 @@ pub fn simulate_test(
             if let (None, Some(r)) = (model, &reason) {
                 anyhow::bail!("the HOM's simulation of the test failed: {r}");
             }
-            let mut wall_times_s = vec![outcome.summary.wall_time_s];
-            for _ in 1..test.repeat {
-                let plan = simulate::plan(&built, &opts)?;
-                let again = simulate::run(&built, &plan, &opts.integrator, None, &mut control)?;
-                run.check_interrupt()?;
-                wall_times_s.push(again.summary.wall_time_s);
-            }
+            let plan = simulate::plan(&built, &opts)?;
+            outcome.time_again(
+                &built,
+                &plan,
+                &opts.integrator,
+                test.repeat - 1,
+                &mut control,
+            )?;
+            run.check_interrupt()?;
             let error = match hom {
                 Some(h) => Some(compare(
                     &Trajectory::load(&h.path, "REFERENCE")?,
@@ -174,8 +176,8 @@ pub fn simulate_test(
                 left_training_region: outcome.left_training_region,
                 t_reached: sm.t_last.unwrap_or(0.0),
                 samples: written.samples,
-                wall_time_s: wall_times_s.iter().copied().fold(f64::INFINITY, f64::min),
-                wall_times_s,
+                wall_time_s: outcome.summary.wall_time_s,
+                wall_times_s: outcome.wall_times_s.clone(),
                 method: opts.integrator.method.name().into(),
                 integrator_note: note,
                 steps: sm.stats.steps,

@@ -34,12 +34,56 @@ pub struct Outcome {
     /// The run failed because a reduced trajectory left its training region (the decoder would
     /// extrapolate), not because the integrator did.
     pub left_training_region: bool,
+    /// The wall time of every timed run \[s\]: this one's, then those of [`Outcome::time_again`].
+    pub wall_times_s: Vec<f64>,
 }
 
 impl Outcome {
     /// Simulated time per wall-clock time.
     pub fn real_time_factor(&self) -> f64 {
         self.summary.t_last.unwrap_or(0.0) / self.summary.wall_time_s.max(1e-12)
+    }
+
+    /// Runs `plan` `extra` more times without a sink, for timing on a shared machine
+    /// (`gvsrom simulate --repeat`): each wall time joins [`Outcome::wall_times_s`] and
+    /// `summary.wall_time_s` becomes the smallest of them (other load only adds time). The samples
+    /// and the ending stay this run's: the same plan gives the same trajectory, complete or failed
+    /// alike. `Some(reason)` if a repetition was interrupted (through `control`): the timing ends
+    /// there, with the runs before it.
+    pub fn time_again(
+        &mut self,
+        built: &Built,
+        plan: &Plan,
+        integrator: &IntegratorOptions,
+        extra: usize,
+        control: &mut dyn FnMut(f64) -> ControlFlow<String>,
+    ) -> Result<Option<String>, ScenarioError> {
+        let mut stopped = None;
+        for _ in 0..extra {
+            let again = run_into(built, plan, integrator, None, &mut *control)?;
+            if let Ending::Interrupted { reason } = again.ending {
+                stopped = Some(reason);
+                break;
+            }
+            self.wall_times_s.push(again.summary.wall_time_s);
+        }
+        self.summary.wall_time_s = self
+            .wall_times_s
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min);
+        Ok(stopped)
+    }
+
+    /// The median of [`Outcome::wall_times_s`] \[s\].
+    pub fn median_wall_time_s(&self) -> f64 {
+        let mut t = self.wall_times_s.clone();
+        t.sort_by(f64::total_cmp);
+        match t.len() {
+            0 => self.summary.wall_time_s,
+            n if n % 2 == 1 => t[n / 2],
+            n => 0.5 * (t[n / 2 - 1] + t[n / 2]),
+        }
     }
 }
 
@@ -192,6 +236,7 @@ pub fn run_into(
         },
     };
     Ok(Outcome {
+        wall_times_s: vec![summary.wall_time_s],
         summary,
         ending,
         last_tip,

@@ -290,6 +290,10 @@ impl TrajectoryWriter {
             n_actuators: built.model.n_actuators(),
             length: built.model.rod.length(),
             wall_time_s: sm.wall_time_s,
+            wall_times_s: match outcome.wall_times_s.len() {
+                0 | 1 => vec![],
+                _ => outcome.wall_times_s.clone(),
+            },
             real_time_factor: outcome.real_time_factor(),
             steps: sm.stats.steps,
             failed_steps: sm.stats.failed_steps,
@@ -333,7 +337,11 @@ pub(super) struct Meta<'a> {
     n_actuators: usize,
     /// Rod length [m].
     length: f64,
+    /// Wall time of the integration \[s\]: with `--repeat`, the smallest of `wall_times_s`.
     wall_time_s: f64,
+    /// Every timed run's wall time \[s\] (`--repeat` > 1), the written one first.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    wall_times_s: Vec<f64>,
     real_time_factor: f64,
     /// Work counts of the integrator (up to the end of the run, or to where it stopped).
     steps: usize,
