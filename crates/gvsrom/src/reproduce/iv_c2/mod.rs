@@ -345,6 +345,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         DataVariant::HangingRates,
         DataVariant::Kinetic,
         DataVariant::HangingKinetic,
+        DataVariant::SpreadKinetic,
     ] {
         let result = run_variant(
             run,

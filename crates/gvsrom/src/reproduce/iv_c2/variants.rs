@@ -18,7 +18,10 @@
 //!   the kinetic-energy norm of each snapshot's mass matrix (`gvsrom train --kinetic-weight κ`,
 //!   `rom::nn::metric`) and the JAX reference's schedule (a rate decaying to
 //!   [`KINETIC_LR_DECAY`] of itself, no plateaus, no L-BFGS phase), β and κ chosen together among
-//!   [`RATE_WEIGHTS`] × [`KINETIC_WEIGHTS`] the same way.
+//!   [`RATE_WEIGHTS`] × [`KINETIC_WEIGHTS`] the same way;
+//! - [`DataVariant::SpreadKinetic`]: the kinetic variant's training on the spread variant's data
+//!   (the paper's budget of snapshots over a [`SPREAD`]× longer babbling), β and κ chosen the same
+//!   way.
 
 use super::super::paper;
 use super::super::report::{Cell, Finding, Table};
@@ -57,6 +60,7 @@ pub(super) enum DataVariant {
     HangingRates,
     Kinetic,
     HangingKinetic,
+    SpreadKinetic,
 }
 
 /// A variant's data, its two models and their runs on each test input.
@@ -174,6 +178,7 @@ impl DataVariant {
             DataVariant::HangingRates => "hanging-rates",
             DataVariant::Kinetic => "kinetic",
             DataVariant::HangingKinetic => "hanging-kinetic",
+            DataVariant::SpreadKinetic => "spread-kinetic",
         }
     }
 
@@ -185,6 +190,7 @@ impl DataVariant {
             DataVariant::HangingRates | DataVariant::HangingKinetic => {
                 Some(DataVariant::Hanging.name())
             }
+            DataVariant::SpreadKinetic => Some(DataVariant::Spread.name()),
             v => Some(v.name()),
         }
     }
@@ -197,12 +203,16 @@ impl DataVariant {
                 | DataVariant::HangingRates
                 | DataVariant::Kinetic
                 | DataVariant::HangingKinetic
+                | DataVariant::SpreadKinetic
         )
     }
 
     /// Whether the variant also measures the errors in the kinetic-energy norm (`--kinetic-weight`).
     pub(super) fn kinetic(self) -> bool {
-        matches!(self, DataVariant::Kinetic | DataVariant::HangingKinetic)
+        matches!(
+            self,
+            DataVariant::Kinetic | DataVariant::HangingKinetic | DataVariant::SpreadKinetic
+        )
     }
 
     /// The variant's scenario: for [`DataVariant::Damped`] the material damping of `scenario`
@@ -210,7 +220,10 @@ impl DataVariant {
     /// overrides.
     fn scenario(self, scenario: &ScenarioSpec) -> anyhow::Result<ScenarioSpec> {
         Ok(match self {
-            DataVariant::Spread | DataVariant::Rates | DataVariant::Kinetic => scenario.clone(),
+            DataVariant::Spread
+            | DataVariant::Rates
+            | DataVariant::Kinetic
+            | DataVariant::SpreadKinetic => scenario.clone(),
             DataVariant::Damped => {
                 let eta = crate::presets::load(&scenario.preset, &scenario.set)?
                     .material
@@ -229,7 +242,7 @@ impl DataVariant {
     /// The variant's data plan.
     fn plan(self, plan: &DatasetSpec) -> DatasetSpec {
         match self {
-            DataVariant::Spread => DatasetSpec {
+            DataVariant::Spread | DataVariant::SpreadKinetic => DatasetSpec {
                 duration: plan.duration.map(|d| d * SPREAD),
                 sample_rate: plan.sample_rate.map(|f| f / SPREAD),
                 ..plan.clone()
@@ -269,6 +282,11 @@ impl DataVariant {
                 "the arm hanging along gravity (preset `{}`), the strain-rate term and the kinetic-energy norm in the AE's training with a decaying rate (`--lr-decay {KINETIC_LR_DECAY} --patience 0 --lbfgs-iterations 0`)",
                 scenario.preset
             ),
+            DataVariant::SpreadKinetic => format!(
+                "the strain-rate term and the kinetic-energy norm in the AE's training with a decaying rate (`--lr-decay {KINETIC_LR_DECAY} --patience 0 --lbfgs-iterations 0`), on the same number of snapshots over a {SPREAD}× longer babbling ({} s at {} Hz)",
+                plan.duration.unwrap_or(f64::NAN),
+                plan.sample_rate.unwrap_or(f64::NAN)
+            ),
         }
     }
 }
@@ -306,14 +324,18 @@ pub(super) fn run_variant(
             ..test.clone()
         };
         match variant {
-            DataVariant::Spread | DataVariant::Rates | DataVariant::Kinetic
+            DataVariant::Spread
+            | DataVariant::Rates
+            | DataVariant::Kinetic
+            | DataVariant::SpreadKinetic
                 if seed == test.seed =>
             {
                 Ok(paper_hom.clone())
             }
-            DataVariant::Spread | DataVariant::Rates | DataVariant::Kinetic => {
-                hom_run(run, scenario, &t)
-            }
+            DataVariant::Spread
+            | DataVariant::Rates
+            | DataVariant::Kinetic
+            | DataVariant::SpreadKinetic => hom_run(run, scenario, &t),
             DataVariant::Damped
             | DataVariant::Hanging
             | DataVariant::HangingRates
@@ -512,6 +534,7 @@ pub(super) fn variant_table(r: usize, v: &VariantRuns) -> Table {
             DataVariant::Hanging => "the HOM runs are the hanging arm's, one after the other with its ROMs.",
             DataVariant::Rates | DataVariant::Kinetic => "the HOM runs and the POD are those of the paper's data; only the AE's training differs.",
             DataVariant::HangingRates | DataVariant::HangingKinetic => "the HOM runs and the POD are the hanging variant's; only the AE's training differs.",
+            DataVariant::SpreadKinetic => "the HOM runs are the paper's and the POD the spread variant's; only the AE's training differs from that variant's.",
         }
     );
     if let Some(sel) = &v.selection {
@@ -522,7 +545,8 @@ pub(super) fn variant_table(r: usize, v: &VariantRuns) -> Table {
 
 /// The variant's findings: for [`DataVariant::Spread`] whether every run stays inside its training
 /// region, for [`DataVariant::Damped`] whether AE-r reaches the paper's error on every input, for
-/// [`DataVariant::Hanging`] both, and whether AE-r is ahead of POD-r on every input.
+/// the others both, and whether AE-r is ahead of POD-r on every input (with the rate term, also
+/// whether the AE-ROM is no slower than the HOM).
 pub(super) fn variant_findings(r: usize, v: &VariantRuns) -> Vec<Finding> {
     let n = v.tests.len();
     let mean = |f: &dyn Fn(&TestRuns) -> f64| v.tests.iter().map(f).sum::<f64>() / n.max(1) as f64;
@@ -593,7 +617,8 @@ pub(super) fn variant_findings(r: usize, v: &VariantRuns) -> Vec<Finding> {
         | DataVariant::Rates
         | DataVariant::HangingRates
         | DataVariant::Kinetic
-        | DataVariant::HangingKinetic => {
+        | DataVariant::HangingKinetic
+        | DataVariant::SpreadKinetic => {
             let ahead = v
                 .tests
                 .iter()
@@ -620,7 +645,33 @@ pub(super) fn variant_findings(r: usize, v: &VariantRuns) -> Vec<Finding> {
 
 #[cfg(test)]
 mod tests {
-    use super::{candidates, LossWeights, RateSelection};
+    use super::{candidates, DataVariant, DatasetSpec, LossWeights, RateSelection, SPREAD};
+
+    #[test]
+    fn the_spread_kinetic_variant_trains_like_the_kinetic_one_on_the_spread_data() {
+        let paper = DatasetSpec {
+            duration: Some(180.0),
+            sample_rate: Some(100.0),
+            babble: Some(vec![-15.0, 0.0, 0.5, 1.0]),
+            ..DatasetSpec::default()
+        };
+        let v = DataVariant::SpreadKinetic;
+        let plan = v.plan(&paper);
+        // the same budget of snapshots: twice as long, half as often
+        assert_eq!(plan.duration, Some(180.0 * SPREAD));
+        assert_eq!(plan.sample_rate, Some(100.0 / SPREAD));
+        assert_eq!(plan.babble, paper.babble);
+        let spread = DataVariant::Spread.plan(&paper);
+        assert_eq!(
+            (plan.duration, plan.sample_rate),
+            (spread.duration, spread.sample_rate)
+        );
+        // its data, HOM runs and POD are the spread variant's; its AE trains as the kinetic one's
+        assert_eq!(v.data_name(), Some(DataVariant::Spread.name()));
+        assert!(v.rates() && v.kinetic());
+        assert_ne!(v.name(), DataVariant::Spread.name());
+        assert_ne!(v.name(), DataVariant::Kinetic.name());
+    }
 
     #[test]
     fn a_rate_weight_is_scored_by_its_mean_validation_error_and_a_stopped_run_never_wins() {
