@@ -4,6 +4,7 @@
 use super::super::report::{figure, RenderedFigure};
 use super::super::sim_test::SimRun;
 use super::kinetic_dofs::KineticDof;
+use super::variants::LossWeights;
 use super::Dof;
 use crate::compare::Trajectory;
 use crate::plot::{palette, Figure, LineChart, Series, SeriesStyle};
@@ -260,18 +261,20 @@ impl Arm {
 }
 
 /// An arm's tip traces on the paper's test input (beyond the paper): HOM, AE-r and POD-r, and the
-/// AE-r trained with the strain-rate term of weight `rated.0` (and the kinetic-energy norm of
-/// weight `rated.1`, if any) if given; the path seen along the arm and x, y, z over time.
+/// AE-r trained with the strain-rate term and the loss weights `rated.0` (the kinetic-energy norm
+/// too, if `kappa`) on the data `rated.1` says (empty: the paper's), if given; the path seen along
+/// the arm and x, y, z over time.
 pub(super) fn trace_figure(
     arm: Arm,
     inset: &Inset,
-    rated: Option<&(f64, Option<f64>, Trajectory)>,
+    rated: Option<&(LossWeights, String, Trajectory)>,
     test_s: f64,
 ) -> anyhow::Result<RenderedFigure> {
     let r = inset.r;
     let (id, subject, title, path) = arm.describe();
     let subject = subject.replace("{r}", &r.to_string());
-    let extra = rated.map(|(beta, kappa, t)| {
+    let extra = rated.map(|(w, _, t)| {
+        let (beta, kappa) = (w.beta, w.kappa);
         let label = match kappa {
             Some(k) => format!("AE-{r}, rate term β = {beta}, kinetic norm κ = {k}"),
             None => format!("AE-{r}, rate term β = {beta}"),
@@ -279,9 +282,10 @@ pub(super) fn trace_figure(
         (label, t)
     });
     let with = match rated {
-        Some((beta, kappa, _)) => format!(
-            " and, blue, the AE-{r} trained with the strain-rate term (`--rate-weight {beta}`){}",
-            kappa.map_or(String::new(), |k| format!(
+        Some((w, data, _)) => format!(
+            " and, blue, the AE-{r} trained with the strain-rate term (`--rate-weight {}`){}{data}",
+            w.beta,
+            w.kappa.map_or(String::new(), |k| format!(
                 " and the kinetic-energy norm (`--kinetic-weight {k}`)"
             ))
         ),

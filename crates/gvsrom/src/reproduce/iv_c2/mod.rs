@@ -35,7 +35,7 @@ use report::{
     fig9_table, findings, lambda_table, models_table, notes, table_iii, tip_travel, Context,
 };
 use serde_json::json;
-use variants::{run_variant, variant_findings, variant_table, DataVariant};
+use variants::{run_variant, variant_findings, variant_table, DataVariant, LossWeights};
 
 /// Hidden layers of every autoencoder (the paper's deepest, as in Table I).
 const HIDDEN_LAYERS: usize = 7;
@@ -488,23 +488,31 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
     // beyond the paper: each arm's tip traces on the paper's test, with the AE of the strain-rate
     // term beside them (and the kinetic-energy norm, the best of them, when that variant ran)
     let rated =
-        |wanted: [DataVariant; 2]| -> anyhow::Result<Option<(f64, Option<f64>, Trajectory)>> {
+        |wanted: &[DataVariant]| -> anyhow::Result<Option<(LossWeights, String, Trajectory)>> {
             let found = wanted
                 .iter()
                 .find_map(|&w| variant_runs.iter().find(|v| v.variant == w))
                 .and_then(|v| {
                     let chosen = v.selection.as_ref()?.chosen;
-                    Some((v.first_runs.as_ref()?[1].clone(), chosen.beta, chosen.kappa))
+                    Some((
+                        v.first_runs.as_ref()?[1].clone(),
+                        chosen,
+                        v.variant.data_note(),
+                    ))
                 });
             Ok(match found {
-                Some((path, beta, kappa)) => {
-                    Some((beta, kappa, Trajectory::load(&path, "AE, rate term")?))
-                }
+                Some((path, w, note)) => Some((w, note, Trajectory::load(&path, "AE, rate term")?)),
                 None => None,
             })
         };
-    // the paper's arm: only with such an AE (else Fig. 9 shows the same traces)
-    if let Some(rated) = rated([DataVariant::Kinetic, DataVariant::Rates])? {
+    // the paper's arm: only with such an AE (else Fig. 9 shows the same traces); the spread
+    // babbling's when it ran (the paper's budget, the lowest errors)
+    let horizontal = [
+        DataVariant::SpreadKinetic,
+        DataVariant::Kinetic,
+        DataVariant::Rates,
+    ];
+    if let Some(rated) = rated(&horizontal)? {
         figures.push(trace_figure(
             Arm::Horizontal,
             &trajectories,
@@ -522,7 +530,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
             ae: Trajectory::load(a, "AE")?,
             pod: Trajectory::load(p, "POD")?,
         };
-        let rated = rated([DataVariant::HangingKinetic, DataVariant::HangingRates])?;
+        let rated = rated(&[DataVariant::HangingKinetic, DataVariant::HangingRates])?;
         figures.push(trace_figure(
             Arm::Hanging,
             &inset,

@@ -195,6 +195,16 @@ impl DataVariant {
         }
     }
 
+    /// How the variant's data differ from the paper's, for a figure's caption (empty if not).
+    pub(super) fn data_note(self) -> String {
+        match self {
+            DataVariant::Spread | DataVariant::SpreadKinetic => {
+                format!(", on the paper's number of snapshots over a {SPREAD}× longer babbling")
+            }
+            _ => String::new(),
+        }
+    }
+
     /// Whether the variant trains its AE with the strain-rate term.
     fn rates(self) -> bool {
         matches!(
