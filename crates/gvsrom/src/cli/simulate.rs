@@ -209,6 +209,11 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
     let tty = std::io::stderr().is_terminal();
     let mut last_pct = usize::MAX;
     let duration = args.duration;
+    // Ctrl-C or SIGTERM stops the run (and any timing repetition) within one step
+    let on_signal = || match signal.load(Ordering::SeqCst) {
+        0 => ControlFlow::Continue(()),
+        s => ControlFlow::Break(format!("interrupted by {}", signal_name(s))),
+    };
     let mut control = |t: f64| {
         if tty {
             let pct = ((t / duration) * 100.0).clamp(0.0, 100.0) as usize;
@@ -218,10 +223,7 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
                 eprint!("\r[{bar}] {pct:3}%  t = {t:.2} s");
             }
         }
-        match signal.load(Ordering::SeqCst) {
-            0 => ControlFlow::Continue(()),
-            s => ControlFlow::Break(format!("interrupted by {}", signal_name(s))),
-        }
+        on_signal()
     };
     let mut outcome = simulate::run(built, plan, &opts.integrator, writer.as_mut(), &mut control)?;
     if tty {
@@ -232,10 +234,7 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
         plan,
         &opts.integrator,
         args.repeat as usize - 1,
-        &mut |_| match signal.load(Ordering::SeqCst) {
-            0 => ControlFlow::Continue(()),
-            s => ControlFlow::Break(format!("interrupted by {}", signal_name(s))),
-        },
+        &mut |_| on_signal(),
     )?;
     let sm = &outcome.summary;
     let t_last = sm.t_last.unwrap_or(0.0);

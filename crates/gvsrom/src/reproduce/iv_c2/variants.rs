@@ -671,11 +671,6 @@ mod tests {
         assert_eq!(plan.duration, Some(180.0 * SPREAD));
         assert_eq!(plan.sample_rate, Some(100.0 / SPREAD));
         assert_eq!(plan.babble, paper.babble);
-        let spread = DataVariant::Spread.plan(&paper);
-        assert_eq!(
-            (plan.duration, plan.sample_rate),
-            (spread.duration, spread.sample_rate)
-        );
         // its data, HOM runs and POD are the spread variant's; its AE trains as the kinetic one's
         assert_eq!(v.data_name(), Some(DataVariant::Spread.name()));
         assert!(v.rates() && v.kinetic());
