@@ -10,8 +10,10 @@ and not from gvsrom's code, to judge the Rust trainer against a standard stack:
 - loss: eq. (15), `‖x̂ − x‖² + λ Σ‖W‖²` with the squared error of a whole snapshot, averaged over
   the batch and divided by the number of features n: the mean squared error per entry in scaled
   units plus (λ/n) Σ‖W‖² (biases not regularised), λ = 1e-4;
-- scaling: `standardized` (each feature by its own standard deviation) or `physical` (one common
-  scale: the plain physical MSE);
+- scaling: `standardized` (each feature by its own standard deviation), `physical` (one common
+  scale: the plain physical MSE) or `raw` (none: the network sees and returns strains in 1/m, as a
+  network trained without input normalisation would); `--input-gain G` multiplies the encoder's
+  input by G (the decoder's target stays scaled), to test whether sharper first-layer units help;
 - Adam (optax defaults β = 0.9/0.999, ε = 1e-8), shuffled mini-batches, a fixed epoch budget and
   the weights with the lowest validation loss kept; the rate constant, or decaying exponentially
   to `--final-lr-factor` of itself over the run.
@@ -42,6 +44,7 @@ import jax
 
 jax.config.update("jax_enable_x64", True)
 import jax.numpy as jnp  # noqa: E402
+from jax.flatten_util import ravel_pytree  # noqa: E402
 import optax  # noqa: E402
 
 
@@ -121,7 +124,13 @@ def main() -> None:
     )
     ap.add_argument("--lambda", dest="lam", type=float, default=1e-4)
     ap.add_argument("--validation-fraction", type=float, default=0.1)
-    ap.add_argument("--loss", choices=["standardized", "physical"], default="standardized")
+    ap.add_argument(
+        "--loss", choices=["standardized", "physical", "raw"], default="standardized"
+    )
+    ap.add_argument(
+        "--input-gain", type=float, default=1.0, help="multiply the encoder's input by this"
+    )
+    ap.add_argument("--save", type=Path, help="write the kept weights (flattened, .npy)")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--json", action="store_true", help="print one JSON line instead of text")
     args = ap.parse_args()
@@ -138,6 +147,8 @@ def main() -> None:
     sd = x[train].std(0)
     if args.loss == "standardized":
         s = np.where(sd <= 1e-12 * (1 + np.abs(mu)), 1.0, sd)
+    elif args.loss == "raw":
+        mu, s = np.zeros(n), np.ones(n)
     else:
         c = np.sqrt(np.mean(sd**2))
         s = np.full(n, c if c > 0 else 1.0)
@@ -147,9 +158,10 @@ def main() -> None:
     half = (args.hidden_layers + 1) // 2
     flags = [k + 1 < half for k in range(half)] * 2
     params = init(sizes, jax.random.PRNGKey(args.seed))
+    gain = args.input_gain
 
     def loss(p, batch):
-        rec = jnp.mean((forward(p, batch, flags) - batch) ** 2)
+        rec = jnp.mean((forward(p, gain * batch, flags) - batch) ** 2)
         return rec + args.lam / n * sum(jnp.sum(w * w) for w, _ in p), rec
 
     steps = args.epochs * -(-len(train) // args.batch_size)
@@ -169,7 +181,7 @@ def main() -> None:
 
     @jax.jit
     def mse(p, data):
-        return jnp.mean((forward(p, data, flags) - data) ** 2)
+        return jnp.mean((forward(p, gain * data, flags) - data) ** 2)
 
     best, best_val, times = params, np.inf, []
     y_train, y_val = y[train], y[val]
@@ -187,7 +199,7 @@ def main() -> None:
         times.append(time.perf_counter() - t0)
         if v < best_val:
             best, best_val = params, v
-    rec = np.asarray(forward(best, y, flags)) * s + mu
+    rec = np.asarray(forward(best, gain * y, flags)) * s + mu
     rmse = float(np.sqrt(np.mean((rec - x) ** 2)))
     epoch_s = float(np.mean(times[1:])) if len(times) > 1 else float(times[0])
     out = {
@@ -200,12 +212,15 @@ def main() -> None:
         "learning_rate": args.learning_rate,
         "final_lr_factor": args.final_lr_factor,
         "seed": args.seed,
+        "input_gain": gain,
         "latent": args.latent,
         "rmse_full": rmse,
         "epoch_s": epoch_s,
         "epoch_min_s": float(np.min(times[1:])) if len(times) > 1 else float(times[0]),
         "backend": jax.default_backend(),
     }
+    if args.save:
+        np.save(args.save, np.asarray(ravel_pytree(best)[0]))
     if args.json:
         print(json.dumps(out))
     else:

@@ -378,7 +378,7 @@ pub(super) fn run_variant(
                 validation,
                 &hom_of,
             )?;
-            description = format!("{description} (`{}`)", selection.chosen.options());
+            description = format!("{description}, kept: `{}`", selection.chosen.options());
             (model, Some(selection))
         }
     };
