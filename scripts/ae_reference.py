@@ -14,6 +14,8 @@ and not from gvsrom's code, to judge the Rust trainer against a standard stack:
   scale: the plain physical MSE) or `raw` (none: the network sees and returns strains in 1/m, as a
   network trained without input normalisation would); `--input-gain G` multiplies the encoder's
   input by G (the decoder's target stays scaled), to test whether sharper first-layer units help;
+  `--odd` drops the biases and the centring: the autoencoder is then an odd function, as IV-B's
+  family is (`x(c, −M) = −x(c, M)`), so each half of the family is learnt once for both;
 - Adam (optax defaults β = 0.9/0.999, ε = 1e-8), shuffled mini-batches, a fixed epoch budget and
   the weights with the lowest validation loss kept; the rate constant, or decaying exponentially
   to `--final-lr-factor` of itself over the run.
@@ -96,10 +98,10 @@ def init(sizes: list[int], key) -> list[tuple]:
     return params
 
 
-def forward(params, x, tanh_flags):
+def forward(params, x, tanh_flags, odd=False):
     h = x
     for (w, b), t in zip(params, tanh_flags):
-        h = h @ w + b
+        h = h @ w if odd else h @ w + b
         if t:
             h = jnp.tanh(h)
     return h
@@ -130,6 +132,7 @@ def main() -> None:
     ap.add_argument(
         "--input-gain", type=float, default=1.0, help="multiply the encoder's input by this"
     )
+    ap.add_argument("--odd", action="store_true", help="no biases, no centring: an odd network")
     ap.add_argument("--save", type=Path, help="write the kept weights (flattened, .npy)")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--json", action="store_true", help="print one JSON line instead of text")
@@ -152,6 +155,8 @@ def main() -> None:
     else:
         c = np.sqrt(np.mean(sd**2))
         s = np.full(n, c if c > 0 else 1.0)
+    if args.odd:
+        mu = np.zeros(n)
     y = jnp.asarray((x - mu) / s)
 
     sizes = architecture(n, args.latent, args.hidden_layers)
@@ -161,7 +166,7 @@ def main() -> None:
     gain = args.input_gain
 
     def loss(p, batch):
-        rec = jnp.mean((forward(p, gain * batch, flags) - batch) ** 2)
+        rec = jnp.mean((forward(p, gain * batch, flags, args.odd) - batch) ** 2)
         return rec + args.lam / n * sum(jnp.sum(w * w) for w, _ in p), rec
 
     steps = args.epochs * -(-len(train) // args.batch_size)
@@ -181,7 +186,7 @@ def main() -> None:
 
     @jax.jit
     def mse(p, data):
-        return jnp.mean((forward(p, gain * data, flags) - data) ** 2)
+        return jnp.mean((forward(p, gain * data, flags, args.odd) - data) ** 2)
 
     best, best_val, times = params, np.inf, []
     y_train, y_val = y[train], y[val]
@@ -199,7 +204,7 @@ def main() -> None:
         times.append(time.perf_counter() - t0)
         if v < best_val:
             best, best_val = params, v
-    rec = np.asarray(forward(best, gain * y, flags)) * s + mu
+    rec = np.asarray(forward(best, gain * y, flags, args.odd)) * s + mu
     rmse = float(np.sqrt(np.mean((rec - x) ** 2)))
     epoch_s = float(np.mean(times[1:])) if len(times) > 1 else float(times[0])
     out = {
@@ -213,6 +218,7 @@ def main() -> None:
         "final_lr_factor": args.final_lr_factor,
         "seed": args.seed,
         "input_gain": gain,
+        "odd": args.odd,
         "latent": args.latent,
         "rmse_full": rmse,
         "epoch_s": epoch_s,
