@@ -52,24 +52,11 @@ from pathlib import Path
 import numpy as np
 
 import jax
-import jax.flatten_util
 
 jax.config.update("jax_enable_x64", True)
 import jax.numpy as jnp  # noqa: E402
-import optax  # noqa: E402
-from scipy.optimize import minimize  # noqa: E402
 
-
-def forward(layers, h):
-    for i, (w, b) in enumerate(layers):
-        h = h @ w + b
-        if i + 1 < len(layers):
-            h = jnp.tanh(h)
-    return h
-
-
-def squares(layers):
-    return sum(jnp.sum(w * w) for w, _ in layers)
+from ae_fan_code import fit, forward, glorot, squares  # noqa: E402
 
 
 def constructed_encoder(x, s, tears, a, eps, beta, big, delta, sizes, shrink=0.96):
@@ -237,50 +224,15 @@ def main() -> None:
         out["ls_rmse_train"] = float(np.sqrt(np.mean((f_tr @ sol - y_np[train]) ** 2)) * scale)
         out["features_used"] = int((np.abs(feats).max(0) > 0).sum())
     else:
-        k_dec = jax.random.PRNGKey(a.seed)
-        dec = []
-        for i, (p, q) in enumerate(zip(sizes[::-1][:-1], sizes[::-1][1:])):
-            k_dec, sub = jax.random.split(k_dec)
-            lim = np.sqrt(6.0 / (p + q)) * (a.first_layer_scale if i == 0 else 1.0)
-            dec.append((jax.random.uniform(sub, (p, q), minval=-lim, maxval=lim), jnp.zeros(q)))
+        dec = glorot(sizes[::-1], jax.random.PRNGKey(a.seed), a.first_layer_scale)
     lam = a.lam / n
-    tr = jnp.asarray(train)
     zj = jnp.asarray(z)
 
     def rmse(pred, rows_) -> float:
         return float(np.sqrt(np.mean((np.asarray(pred)[rows_] - y_np[rows_]) ** 2)) * scale)
 
-    def fit(params, loss, epochs, iterations, rate):
-        if epochs:
-            nb = len(train)
-            opt = optax.adam(optax.exponential_decay(rate, epochs * -(-nb // 64), 0.03))
-            state = opt.init(params)
-
-            @jax.jit
-            def step(p, st, idx):
-                upd, st = opt.update(jax.grad(loss)(p, idx), st, p)
-                return optax.apply_updates(p, upd), st
-
-            for _ in range(epochs):
-                perm = rng.permutation(nb)
-                for j in range(0, nb, 64):
-                    params, state = step(params, state, tr[perm[j:j + 64]])
-        if iterations:
-            flat, unravel = jax.flatten_util.ravel_pytree(params)
-            fg = jax.jit(jax.value_and_grad(lambda f: loss(unravel(f), tr)))
-
-            def fun(f):
-                v, g = fg(jnp.asarray(f))
-                return float(v), np.asarray(g)
-
-            res = minimize(fun, np.asarray(flat), jac=True, method="L-BFGS-B",
-                           options={"maxiter": iterations, "maxfun": 2 * iterations,
-                                    "gtol": 0, "ftol": 0})
-            params = unravel(jnp.asarray(res.x))
-        return params
-
     dec = fit(dec, lambda p, i: jnp.mean((forward(p, zj[i]) - y[i]) ** 2) + lam * squares(p),
-              a.dec_epochs, a.dec_lbfgs, 3e-3)
+              train, a.dec_epochs, a.dec_lbfgs, 3e-3, rng)
     pred = forward(dec, zj)
     out["rmse_train"] = rmse(pred, train)
     out["rmse_validation"] = rmse(pred, val)
@@ -301,7 +253,7 @@ def main() -> None:
             rec = forward(p[1], forward(p[0], y[i]))
             return jnp.mean((rec - y[i]) ** 2) + lam * (squares(p[0]) + squares(p[1]))
 
-        enc, dec = fit((enc, dec), whole, 0, a.whole_lbfgs, 0.0)
+        enc, dec = fit((enc, dec), whole, train, 0, a.whole_lbfgs, 0.0, rng)
         pred = forward(dec, forward(enc, y))
         out["whole_rmse_validation"] = rmse(pred, val)
         out["whole_encoder_weights_sq"] = float(squares(enc))

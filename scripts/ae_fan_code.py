@@ -88,6 +88,38 @@ def squares(layers):
     return sum(jnp.sum(w * w) for w, _ in layers)
 
 
+def fit(params, loss, index, epochs, iterations, rate, rng):
+    """Adam on batches of 64 of the rows `index` (the rate decaying to 3 %), then full-batch L-BFGS
+    (scipy, no tolerance stop) on them; `loss(params, rows)`."""
+    if epochs:
+        opt = optax.adam(optax.exponential_decay(rate, epochs * -(-len(index) // 64), 0.03))
+        state = opt.init(params)
+
+        @jax.jit
+        def step(p, st, idx):
+            upd, st = opt.update(jax.grad(loss)(p, idx), st, p)
+            return optax.apply_updates(p, upd), st
+
+        for _ in range(epochs):
+            perm = rng.permutation(len(index))
+            for j in range(0, len(index), 64):
+                params, state = step(params, state, jnp.asarray(index[perm[j : j + 64]]))
+    if iterations:
+        flat, unravel = jax.flatten_util.ravel_pytree(params)
+        every = jnp.asarray(index)
+        fg = jax.jit(jax.value_and_grad(lambda f: loss(unravel(f), every)))
+
+        def fun(f):
+            v, g = fg(jnp.asarray(f))
+            return float(v), np.asarray(g)
+
+        res = minimize(fun, np.asarray(flat), jac=True, method="L-BFGS-B",
+                       options={"maxiter": iterations, "maxfun": 2 * iterations,
+                                "gtol": 0, "ftol": 0})
+        params = unravel(jnp.asarray(res.x))
+    return params
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("dataset", type=Path)
@@ -122,36 +154,6 @@ def main() -> None:
     def rmse(pred) -> float:
         return float(np.sqrt(np.mean((np.asarray(pred) - y_np) ** 2)) * scale)
 
-    def fit(params, loss, epochs, iterations, rate):
-        """Adam on batches of 64 (rate decaying to 3 %), then full-batch L-BFGS (scipy)."""
-        if epochs:
-            opt = optax.adam(optax.exponential_decay(rate, epochs * -(-rows // 64), 0.03))
-            state = opt.init(params)
-
-            @jax.jit
-            def step(p, st, idx):
-                upd, st = opt.update(jax.grad(loss)(p, idx), st, p)
-                return optax.apply_updates(p, upd), st
-
-            for _ in range(epochs):
-                perm = rng.permutation(rows)
-                for j in range(0, rows, 64):
-                    params, state = step(params, state, jnp.asarray(perm[j : j + 64]))
-        if iterations:
-            flat, unravel = jax.flatten_util.ravel_pytree(params)
-            every = jnp.arange(rows)
-            fg = jax.jit(jax.value_and_grad(lambda f: loss(unravel(f), every)))
-
-            def fun(f):
-                v, g = fg(jnp.asarray(f))
-                return float(v), np.asarray(g)
-
-            res = minimize(fun, np.asarray(flat), jac=True, method="L-BFGS-B",
-                           options={"maxiter": iterations, "maxfun": 2 * iterations,
-                                    "gtol": 0, "ftol": 0})
-            params = unravel(jnp.asarray(res.x))
-        return params
-
     grid = jnp.linspace(-1.2, 1.2, 4001)[:, None]
 
     def project(dec):
@@ -162,26 +164,27 @@ def main() -> None:
         return np.asarray(grid)[best], float(np.sqrt(np.maximum(d.min(1), 0).mean() / n) * scale)
 
     out = {"bands": a.bands, "rows": rows}
+    all_rows = np.arange(rows)
     z = jnp.asarray(fan_codes(y_np, a.bands))
     dec = fit(dec, lambda p, i: jnp.mean((forward(p, z[i]) - y[i]) ** 2) + lam * squares(p),
-              a.dec_epochs, a.dec_lbfgs, 3e-3)
+              all_rows, a.dec_epochs, a.dec_lbfgs, 3e-3, rng)
     out["decoder"] = rmse(forward(dec, z))
     nearest, out["projection"] = project(dec)
     out["seconds_decoder"] = time.time() - t0
 
     z = jnp.asarray(nearest)
     enc = fit(enc, lambda p, i: jnp.mean((forward(p, y[i]) - z[i]) ** 2) + lam * squares(p),
-              a.enc_epochs, a.enc_lbfgs, 3e-3)
+              all_rows, a.enc_epochs, a.enc_lbfgs, 3e-3, rng)
     out["ae_encoder_regressed"] = rmse(forward(dec, forward(enc, y)))
     enc = fit(enc, lambda p, i: jnp.mean((forward(dec, forward(p, y[i])) - y[i]) ** 2)
-              + lam * squares(p), a.enc_ae_epochs, a.enc_ae_lbfgs, 3e-4)
+              + lam * squares(p), all_rows, a.enc_ae_epochs, a.enc_ae_lbfgs, 3e-4, rng)
     out["ae_decoder_frozen"] = rmse(forward(dec, forward(enc, y)))
 
     def whole(p, i):
         rec = forward(p[1], forward(p[0], y[i]))
         return jnp.mean((rec - y[i]) ** 2) + lam * (squares(p[0]) + squares(p[1]))
 
-    enc, dec = fit((enc, dec), whole, 0, a.whole_lbfgs, 0.0)
+    enc, dec = fit((enc, dec), whole, all_rows, 0, a.whole_lbfgs, 0.0, rng)
     out["ae_whole"] = rmse(forward(dec, forward(enc, y)))
     out["projection_whole"] = project(dec)[1]
     out["seconds"] = time.time() - t0
