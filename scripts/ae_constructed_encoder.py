@@ -57,6 +57,7 @@ jax.config.update("jax_enable_x64", True)
 import jax.numpy as jnp  # noqa: E402
 
 from ae_fan_code import fit, forward, glorot, squares  # noqa: E402
+from ae_reference import load  # noqa: E402
 
 
 def constructed_encoder(x, s, tears, a, eps, beta, big, delta, sizes, shrink=0.96):
@@ -170,8 +171,7 @@ def main() -> None:
     a = ap.parse_args()
     t0 = time.time()
 
-    x = np.load(a.dataset / "strain.npy")
-    x = x.reshape(x.shape[0], -1)[np.load(a.dataset / "status.npy") == 0]
+    x = load(a.dataset)
     rows, n = x.shape
     scenario = tomllib.loads(json.loads((a.dataset / "meta.json").read_text())["scenario_toml"])
     length = sum(d["length"] for d in scenario["divisions"])
@@ -240,8 +240,7 @@ def main() -> None:
     out["seconds_decoder"] = time.time() - t0
     out["decoder_weights_sq"] = float(squares(dec))
     if a.test:
-        xt = np.load(a.test / "strain.npy")
-        xt = xt.reshape(xt.shape[0], -1)[np.load(a.test / "status.npy") == 0]
+        xt = load(a.test)
         yt = (xt - mean) / scale
         rec = np.asarray(forward(dec, forward(enc, jnp.asarray(yt))))
         out["rmse_test"] = float(np.sqrt(np.mean((rec - yt) ** 2)) * scale)

@@ -48,6 +48,8 @@ import jax.numpy as jnp  # noqa: E402
 import optax  # noqa: E402
 from scipy.optimize import minimize  # noqa: E402
 
+from ae_reference import load  # noqa: E402
+
 
 def fan_codes(y: np.ndarray, bands: int) -> np.ndarray:
     """The fan code of every row of the centred, scaled snapshots `y` (module docs)."""
@@ -137,8 +139,7 @@ def main() -> None:
     a = ap.parse_args()
     t0 = time.time()
 
-    x = np.load(a.dataset / "strain.npy")
-    x = x.reshape(x.shape[0], -1)[np.load(a.dataset / "status.npy") == 0]
+    x = load(a.dataset)
     rows, n = x.shape
     mean = x.mean(0)
     scale = float(np.sqrt(np.mean(x.std(0) ** 2)))
