@@ -27,8 +27,8 @@ Encoder (nothing fitted):
 Decoder: layer 1 passes u (linear range); layer 2 holds the K − 1 steps tanh(S (u − b)) between
 passes; layer 3 the gates tanh(β (u − j − ½) + B (I_j − 1)) of every pass (I_j from the steps)
 and the steps again, so that the output layer spans every per-pass affine function of the moment;
-the output layer is the least-squares solution of eq. (15) (with λ/n on its weights, not its
-bias) on the training rows. `--decoder fitted` fits a Glorot-initialised decoder to the same
+the output layer is the least-squares fit on the training rows (with `--output-penalty`, the
+minimiser of eq. (15) including its penalty on those weights). `--decoder fitted` fits a Glorot-initialised decoder to the same
 codes instead (`--dec-epochs` Adam epochs at 3e-3 decaying to 3 %, `--dec-lbfgs` L-BFGS
 iterations); `--whole-lbfgs N` then minimises eq. (15) over both halves from there (relaxation).
 
@@ -63,7 +63,7 @@ from ae_reference import load  # noqa: E402
 def constructed_encoder(x, s, tears, a, eps, beta, big, delta, sizes, shrink=0.96):
     """Encoder weights acting on physical strains x (rows × n) at arc lengths s (module docs)."""
     n = x.shape[1]
-    x0max = np.abs(x[:, 0]).max()
+    x0max = np.abs(x[:, 0]).max()  # x: the training rows
     alpha = 0.1 / x0max  # α x(0) ≤ 0.1: tanh is linear to 0.3 %
     # tear k at the grid point nearest to s_k (the curvature there is zero until the pulse's far
     # end passes it)
@@ -166,6 +166,8 @@ def main() -> None:
     ap.add_argument("--dec-lbfgs", type=int, default=0)
     ap.add_argument("--whole-lbfgs", type=int, default=0)
     ap.add_argument("--lambda", dest="lam", type=float, default=1e-4)
+    ap.add_argument("--output-penalty", action="store_true",
+                    help="the decoder's output layer minimises eq. (15) with its penalty")
     ap.add_argument("--test", type=Path, help="a second dataset of the same scenario, unseen")
     ap.add_argument("--seed", type=int, default=0)
     a = ap.parse_args()
@@ -194,7 +196,7 @@ def main() -> None:
     y_np = (x - mean) / scale
     y = jnp.asarray(y_np)
     sizes = [n, n // 2, n // 4, n // 8, 1]
-    enc_phys = constructed_encoder(x, s, tears, a.sharpness, a.threshold, a.beta, a.gate,
+    enc_phys = constructed_encoder(x[train], s, tears, a.sharpness, a.threshold, a.beta, a.gate,
                                    a.delta, sizes)
     # to scaled inputs: x = scale y + mean
     (w1, b1) = enc_phys[0]
@@ -215,8 +217,10 @@ def main() -> None:
         feats = np.asarray(forward(dec + [(jnp.eye(sizes[1]), jnp.zeros(sizes[1]))],
                                    jnp.asarray(z)))
         f_tr = np.c_[feats[train], np.ones(len(train))]
-        # least squares with eq. (15)'s penalty on the output weights (not on the bias)
-        reg = a.lam / n * len(train) * np.eye(f_tr.shape[1])
+        # plain least squares (the minimum-norm solution: unused units get no weight), or with
+        # eq. (15)'s penalty on the output weights, not the bias (eq. (15) is the mean over rows
+        # and values plus λ/n Σ‖W‖²; times rows · n: the squared residual plus λ · rows Σ‖W‖²)
+        reg = (a.lam * len(train) if a.output_penalty else 0.0) * np.eye(f_tr.shape[1])
         reg[-1, -1] = 0.0
         sol = np.linalg.lstsq(np.r_[f_tr, np.sqrt(reg)],
                               np.r_[y_np[train], np.zeros((len(reg), n))], rcond=None)[0]
