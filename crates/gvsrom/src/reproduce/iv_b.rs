@@ -12,10 +12,10 @@ use super::report::{figure, CaseReport, Cell, Finding, RenderedFigure, Table};
 use super::statics_study::StaticsComparison;
 use super::step::Step;
 use super::tasks::{self, AeConfig, DatasetSpec, EvalModel, Evaluation, ScenarioSpec};
-use super::{iv_common, new_report, paper, Case, Options, Run};
+use super::{iv_b_built, iv_common, new_report, paper, Case, Options, Run};
 use crate::dataset::Dataset;
 use crate::plot::{palette, Figure, SeriesStyle};
-use crate::reduced_model::ReducedModel;
+use crate::reduced_model::{ModelWeights, ReducedModel};
 use serde_json::json;
 use std::path::Path;
 
@@ -298,6 +298,27 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         &paper::TABLE_I_IV_B,
         "RMS of x̂ − x over every entry of every snapshot, x = bend-y curvature deviation at the 148 points [1/m]. Columns: ours, the paper's, ours / paper.",
     ));
+    let unseen = tasks::dataset(
+        run,
+        "iv-b/dataset-unseen",
+        &scenario,
+        &DatasetSpec {
+            seed: 2,
+            ..plan.clone()
+        },
+        opts.jobs,
+    )?;
+    let trained = ReducedModel::load(&aes[2][0].path)?;
+    let ModelWeights::Autoencoder(trained_ae) = &trained.weights else {
+        anyhow::bail!("{}: not an autoencoder", aes[2][0].path.display());
+    };
+    report.tables.push(iv_b_built::table(
+        &data.path,
+        &unseen.path,
+        trained_ae,
+        aes[2][0].value.rmse_full,
+        paper::TABLE_I_IV_B[2][0],
+    )?);
     let mut models = vec![
         EvalModel::hom(),
         EvalModel::of("AE-2", &aes[2][1]),

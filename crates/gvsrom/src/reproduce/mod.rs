@@ -13,6 +13,7 @@ pub mod html;
 pub mod intrinsic;
 pub mod iv_a;
 pub mod iv_b;
+pub mod iv_b_built;
 pub mod iv_c1;
 pub mod iv_c2;
 pub mod iv_common;
