@@ -29,7 +29,7 @@ use nalgebra::DMatrix;
 use rom::nn::{Autoencoder, Mlp, Scaling};
 use std::path::Path;
 
-/// Threshold ε of the tears [1/m]: above the oscillating tail the FEM basis leaves beyond the
+/// Threshold ε of the tears \[1/m\]: above the oscillating tail the FEM basis leaves beyond the
 /// load (about 0.5 1/m at 4 N·m).
 const THRESHOLD: f64 = 1.5;
 /// Slope β of the gates and saturation B of their indicator term.
@@ -42,7 +42,7 @@ const STEEPNESS: f64 = 500.0;
 /// The moment's share of a pass (the rest keeps codes off the pass ends).
 const SHRINK: f64 = 0.96;
 
-/// IV-B snapshots: `rows × n` curvatures [1/m] at the arc lengths `s`, on a rod of `length` under a
+/// IV-B snapshots: `rows × n` curvatures \[1/m\] at the arc lengths `s`, on a rod of `length` under a
 /// pulse of base `width`.
 pub struct Snapshots<'a> {
     pub x: &'a [f64],
@@ -175,7 +175,7 @@ fn decoder_hidden(passes: usize, d1: usize, d2: usize, d3: usize) -> Vec<Dense> 
     vec![l1, l2, l3]
 }
 
-/// The built autoencoder with `passes` passes and tear slope `slope` [per 1/m], its scaling and
+/// The built autoencoder with `passes` passes and tear slope `slope` \[per 1/m\], its scaling and
 /// output layer from the rows `train` of `d`. Errors: fewer than 2 passes, more than the layers
 /// hold (`n/4`), or no training row.
 pub fn build(
@@ -287,7 +287,7 @@ pub fn rmse(
     Ok((sum / count as f64).sqrt())
 }
 
-/// Passes of the built networks in `reproduce iv-b`'s table, and their tears' slope [per 1/m].
+/// Passes of the built networks in `reproduce iv-b`'s table, and their tears' slope \[per 1/m\].
 const PASSES: [usize; 3] = [16, 24, 36];
 const SLOPE: f64 = 4000.0;
 /// Fewer training rows per pass leave the output layer's least squares underdetermined or nearly.

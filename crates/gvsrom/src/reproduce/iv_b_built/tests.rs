@@ -6,7 +6,7 @@ use super::*;
 const L: f64 = 0.8;
 const W: f64 = 0.08;
 const N: usize = 148;
-/// 1 / EI of the soft beam [1/(N·m²)].
+/// 1 / EI of the soft beam \[1/(N·m²)\].
 const KAPPA: f64 = 25.15;
 
 /// The share of a triangular pulse of base `W` centred at `c` that lies beyond `s`.
