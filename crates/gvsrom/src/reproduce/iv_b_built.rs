@@ -338,16 +338,21 @@ fn weights(ae: &Autoencoder) -> (f64, f64) {
     (largest, nets.iter().map(|m| m.sum_squared_weights()).sum())
 }
 
-/// `reproduce iv-b`'s table: networks of the paper's r = 1, 7-hidden-layer architecture built on
-/// the dataset at `data` (every tenth row held out), beside the `trained` one and the `paper`'s
-/// error, each also on the unseen dataset at `unseen`.
-pub fn table(
+/// A built network's errors: over a dataset, its held-out rows (every tenth) and an unseen draw;
+/// its largest |W| and Σ‖W‖². `None` where the dataset has fewer than [`MIN_ROWS_PER_PASS`]
+/// training rows per pass.
+struct BuiltErrors {
+    passes: usize,
+    measured: Option<[f64; 5]>,
+}
+
+/// The networks of [`PASSES`] built on the dataset at `data` (every tenth row held out) and
+/// measured there and on the dataset at `unseen`; also returns the training rows' count and the
+/// unseen rows with their width.
+fn built_errors(
     data: &Path,
     unseen: &Path,
-    trained: &Autoencoder,
-    trained_rmse: f64,
-    paper: f64,
-) -> anyhow::Result<Table> {
+) -> anyhow::Result<(Vec<BuiltErrors>, usize, Vec<f64>, usize)> {
     let (x, n, s, length, width) = solved(data)?;
     let (xu, nu, ..) = solved(unseen)?;
     anyhow::ensure!(
@@ -366,31 +371,55 @@ pub fn table(
     let train: Vec<usize> = (0..rows).filter(|i| i % 10 != 0).collect();
     let mut out = Vec::new();
     for passes in PASSES {
-        if train.len() < MIN_ROWS_PER_PASS * passes {
-            out.push(vec![
-                Cell::text(format!("built, {passes} passes")),
-                Cell::text(format!(
-                    "not built: {} training rows, fewer than {MIN_ROWS_PER_PASS} per pass",
-                    train.len()
-                )),
-                Cell::text("—"),
-                Cell::text("—"),
-                Cell::text("—"),
-                Cell::text("—"),
-            ]);
-            continue;
-        }
-        let ae = build(&d, &train, passes, SLOPE)?;
-        let (largest, squares) = weights(&ae);
-        out.push(vec![
-            Cell::text(format!("built, {passes} passes")),
-            Cell::sig(rmse(&ae, &x, n, 0..rows)?, 3),
-            Cell::sig(rmse(&ae, &x, n, (0..rows).step_by(10))?, 3),
-            Cell::sig(rmse(&ae, &xu, n, 0..xu.len() / n)?, 3),
-            Cell::sig(largest, 2),
-            Cell::sig(squares, 2),
-        ]);
+        let measured = if train.len() < MIN_ROWS_PER_PASS * passes {
+            None
+        } else {
+            let ae = build(&d, &train, passes, SLOPE)?;
+            let (largest, squares) = weights(&ae);
+            Some([
+                rmse(&ae, &x, n, 0..rows)?,
+                rmse(&ae, &x, n, (0..rows).step_by(10))?,
+                rmse(&ae, &xu, n, 0..xu.len() / n)?,
+                largest,
+                squares,
+            ])
+        };
+        out.push(BuiltErrors { passes, measured });
     }
+    Ok((out, train.len(), xu, n))
+}
+
+/// `reproduce iv-b`'s table: networks of the paper's r = 1, 7-hidden-layer architecture built on
+/// the dataset at `data` (every tenth row held out), beside the `trained` one and the `paper`'s
+/// error, each also on the unseen dataset at `unseen`.
+pub fn table(
+    data: &Path,
+    unseen: &Path,
+    trained: &Autoencoder,
+    trained_rmse: f64,
+    paper: f64,
+) -> anyhow::Result<Table> {
+    let (built, train, xu, n) = built_errors(data, unseen)?;
+    let mut out: Vec<Vec<Cell>> = built
+        .iter()
+        .map(|b| {
+            let mut row = vec![Cell::text(format!("built, {} passes", b.passes))];
+            match b.measured {
+                Some(v) => row.extend(
+                    v.iter()
+                        .zip([3, 3, 3, 2, 2])
+                        .map(|(&v, digits)| Cell::sig(v, digits)),
+                ),
+                None => {
+                    row.push(Cell::text(format!(
+                        "not built: {train} training rows, fewer than {MIN_ROWS_PER_PASS} per pass"
+                    )));
+                    row.extend((0..4).map(|_| Cell::text("—")));
+                }
+            }
+            row
+        })
+        .collect();
     let (largest, squares) = weights(trained);
     out.push(vec![
         Cell::text("trained (Table I above)"),

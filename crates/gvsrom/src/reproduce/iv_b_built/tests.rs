@@ -148,32 +148,18 @@ fn built_network_refuses_more_passes_than_its_layers_hold() {
 fn built_network_is_below_table_i_r1_on_the_iv_b_data() {
     let paths = std::env::var("GVSROM_IVB_DATASETS").expect("GVSROM_IVB_DATASETS=A:B");
     let (a, b) = paths.split_once(':').expect("A:B");
-    let (x, n, s, length, width) = solved(Path::new(a)).unwrap();
-    let (xu, ..) = solved(Path::new(b)).unwrap();
-    let d = Snapshots {
-        x: &x,
-        n,
-        s: &s,
-        length,
-        width,
-    };
-    let rows = x.len() / n;
-    let train: Vec<usize> = (0..rows).filter(|i| i % 10 != 0).collect();
-    for passes in PASSES {
-        let ae = build(&d, &train, passes, SLOPE).unwrap();
-        let (all, held) = (
-            rmse(&ae, &x, n, 0..rows).unwrap(),
-            rmse(&ae, &x, n, (0..rows).step_by(10)).unwrap(),
-        );
-        let unseen = rmse(&ae, &xu, n, 0..xu.len() / n).unwrap();
+    let (built, ..) = built_errors(Path::new(a), Path::new(b)).unwrap();
+    for e in built {
+        let [all, held, unseen, largest, squares] = e.measured.expect("5000 rows");
         println!(
-            "{passes} passes: {all:.3} all, {held:.3} held out, {unseen:.3} unseen, weights {:?}",
-            weights(&ae)
+            "{} passes: {all:.3} all, {held:.3} held out, {unseen:.3} unseen, largest |W| {largest:.2e}, Σ‖W‖² {squares:.2e}",
+            e.passes
         );
-        if passes >= 24 {
+        if e.passes >= 24 {
             assert!(
                 unseen < 4.81,
-                "{passes} passes: {unseen} on the unseen draw"
+                "{} passes: {unseen} on the unseen draw",
+                e.passes
             );
         }
     }
