@@ -26,7 +26,7 @@
 use super::report::{Cell, Table};
 use crate::dataset::Dataset;
 use nalgebra::DMatrix;
-use rom::nn::{Autoencoder, Mlp, Scaling};
+use rom::nn::{Autoencoder, Mlp, Scaling, Weighting};
 use std::path::Path;
 
 /// Threshold ε of the tears \[1/m\]: above the oscillating tail the FEM basis leaves beyond the
@@ -193,19 +193,9 @@ pub fn build(
         sizes[2]
     );
     let row = |i: usize| &d.x[i * n..(i + 1) * n];
-    let count = train.len() as f64;
-    let mut mean = vec![0.0; n];
-    for &i in train {
-        mean.iter_mut()
-            .zip(row(i))
-            .for_each(|(m, x)| *m += x / count);
-    }
-    let var = train
-        .iter()
-        .flat_map(|&i| row(i).iter().zip(&mean).map(|(x, m)| (x - m).powi(2)))
-        .sum::<f64>()
-        / (count * n as f64);
-    let scale = var.sqrt().max(f64::MIN_POSITIVE);
+    // one common scale, as `gvsrom train`'s physical loss: μ per value, s = √(mean variance)
+    let scaling = Scaling::from_rows(d.x, n, train, &Weighting::Physical(vec![1.0; n]));
+    let (mean, scale) = (scaling.mean().to_vec(), scaling.scale()[0]);
     let x0max = train.iter().fold(0.0f64, |a, &i| a.max(row(i)[0].abs()));
     anyhow::ensure!(
         x0max > 0.0,
@@ -229,23 +219,20 @@ pub fn build(
     let mut hidden = decoder_hidden(passes, d1, d2, d3);
     hidden.push(identity);
     let features = mlp(hidden)?;
-    let scaling = Scaling::new(mean.clone(), vec![scale; n])?;
     let mut f = DMatrix::zeros(train.len(), d3 + 1);
     let mut y = DMatrix::zeros(train.len(), n);
     for (r, &i) in train.iter().enumerate() {
-        let z = encoder.forward(
-            &row(i)
-                .iter()
-                .zip(&mean)
-                .map(|(x, m)| (x - m) / scale)
-                .collect::<Vec<_>>(),
-        )?;
-        let h = features.forward(&z)?;
+        let scaled: Vec<f64> = row(i)
+            .iter()
+            .zip(&mean)
+            .map(|(x, m)| (x - m) / scale)
+            .collect();
+        let h = features.forward(&encoder.forward(&scaled)?)?;
         for (c, v) in h.iter().chain(std::iter::once(&1.0)).enumerate() {
             f[(r, c)] = *v;
         }
-        for (c, (x, m)) in row(i).iter().zip(&mean).enumerate() {
-            y[(r, c)] = (x - m) / scale;
+        for (c, v) in scaled.iter().enumerate() {
+            y[(r, c)] = *v;
         }
     }
     let sol = f

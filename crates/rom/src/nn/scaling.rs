@@ -63,12 +63,7 @@ impl Scaling {
 
     /// The scaling of `weighting` (module docs) from the rows `index` of row-major `data` with `n`
     /// features. The data must be finite and the weights checked ([`Weighting::check`]).
-    pub(crate) fn from_rows(
-        data: &[f64],
-        n: usize,
-        index: &[usize],
-        weighting: &Weighting,
-    ) -> Self {
+    pub fn from_rows(data: &[f64], n: usize, index: &[usize], weighting: &Weighting) -> Self {
         let (mean, var) = mean_and_variance(data, n, index);
         let scale = match weighting {
             Weighting::Standardize => var
@@ -168,7 +163,7 @@ pub enum Weighting {
 
 impl Weighting {
     /// Checks the weights against the number of features `n`.
-    pub(crate) fn check(&self, n: usize) -> Result<(), NnError> {
+    pub fn check(&self, n: usize) -> Result<(), NnError> {
         let Weighting::Physical(w) = self else {
             return Ok(());
         };
