@@ -53,6 +53,7 @@ pub struct Snapshots<'a> {
 }
 
 /// A dense layer under construction, row-major `n_out × n_in`.
+#[derive(Clone)]
 struct Dense {
     n_in: usize,
     n_out: usize,
@@ -216,9 +217,8 @@ pub fn build(
     let (d1, d2, d3) = (sizes[5], sizes[6], sizes[7]);
     let mut identity = Dense::new(d3, d3);
     (0..d3).for_each(|i| identity.add(i, i, 1.0));
-    let mut hidden = decoder_hidden(passes, d1, d2, d3);
-    hidden.push(identity);
-    let features = mlp(hidden)?;
+    let hidden = decoder_hidden(passes, d1, d2, d3);
+    let features = mlp(hidden.iter().cloned().chain([identity]).collect())?;
     let mut f = DMatrix::zeros(train.len(), d3 + 1);
     let mut y = DMatrix::zeros(train.len(), n);
     for (r, &i) in train.iter().enumerate() {
@@ -239,7 +239,6 @@ pub fn build(
         .svd(true, true)
         .solve(&y, 1e-12)
         .map_err(|e| anyhow::anyhow!("built IV-B autoencoder: least squares: {e}"))?;
-    let mut hidden = decoder_hidden(passes, d1, d2, d3);
     let mut out = Dense::new(d3, n);
     for o in 0..n {
         for i in 0..d3 {
@@ -247,8 +246,8 @@ pub fn build(
         }
         out.b[o] = sol[(d3, o)];
     }
-    hidden.push(out);
-    Ok(Autoencoder::new(encoder, mlp(hidden)?, scaling)?)
+    let decoder = mlp(hidden.into_iter().chain([out]).collect())?;
+    Ok(Autoencoder::new(encoder, decoder, scaling)?)
 }
 
 /// Table I's RMSE of `ae` over the rows `rows` of `x` (`n` values each): every value of every
