@@ -224,8 +224,17 @@ fn is_zero(n: &usize) -> bool {
 }
 
 /// The norm a POD is optimal in (`gvsrom pod --norm`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Default,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum PodNorm {
     /// The plain Euclidean norm of the point strains, every value with weight 1: the paper's POD.

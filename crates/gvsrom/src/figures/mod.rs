@@ -47,8 +47,7 @@ pub(crate) fn input_error(path: &Path, message: impl Into<String>) -> FiguresErr
 }
 
 /// An image format of the figures.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum FigureFormat {
     Svg,

@@ -42,8 +42,17 @@ pub struct TrainSummary {
 }
 
 /// How a snapshot feature's error weighs in the autoencoder's training loss (`gvsrom train --loss`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Default,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum Loss {
     /// Each feature standardized by its own spread: every point and component weighs the same

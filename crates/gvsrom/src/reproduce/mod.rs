@@ -37,31 +37,30 @@ use std::sync::Arc;
 use std::time::Instant;
 
 /// A study of the paper.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Case {
     /// IV-A: single-tendon manipulator, Table I (top), Figs. 3–4, Table III row.
-    #[cfg_attr(feature = "cli", value(name = "iv-a"))]
+    #[value(name = "iv-a")]
     IvA,
     /// IV-B: soft beam under a moment pulse, Table I (bottom), Figs. 5–6, Table III row.
-    #[cfg_attr(feature = "cli", value(name = "iv-b"))]
+    #[value(name = "iv-b")]
     IvB,
     /// IV-C1: six-tendon manipulator under gravity, statics: AE r = 6 against POD-6 (Fig. 7),
     /// grid against random sampling (Fig. 8), Table III row.
-    #[cfg_attr(feature = "cli", value(name = "iv-c1"))]
+    #[value(name = "iv-c1")]
     IvC1,
     /// IV-C2: six-tendon manipulator, dynamics: babbling data, AE- and POD-ROMs with r = 1 … 8 on a
     /// new 10 s input (Fig. 9), Table III row.
-    #[cfg_attr(feature = "cli", value(name = "iv-c2"))]
+    #[value(name = "iv-c2")]
     IvC2,
     /// V: the prototype's four tensions, AE-ROM and POD-ROM with one DOF (Fig. 10b).
-    #[cfg_attr(feature = "cli", value(name = "v"))]
+    #[value(name = "v")]
     V,
     /// The IV-A and IV-B autoencoders retrained on snapshots with Gaussian noise.
-    #[cfg_attr(feature = "cli", value(name = "noise"))]
+    #[value(name = "noise")]
     Noise,
     /// Every case above.
-    #[cfg_attr(feature = "cli", value(name = "all"))]
+    #[value(name = "all")]
     All,
 }
 

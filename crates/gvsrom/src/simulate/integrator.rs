@@ -10,8 +10,7 @@ use gvs::solve::ode::{
 use serde::{Deserialize, Serialize};
 
 /// The adaptive integrator asked for (`simulate --method`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum MethodChoice {
     Auto,
@@ -21,8 +20,7 @@ pub enum MethodChoice {
 }
 
 /// The error test asked for (`simulate --error-norm`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum ErrorNormChoice {
     /// Every coordinate to its own tolerance (ode15s).
