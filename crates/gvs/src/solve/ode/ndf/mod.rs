@@ -5,23 +5,18 @@
 use super::corrector::{Corrector, FirstOrder, SecondOrder};
 use super::mass_norm::MassNorm;
 use super::{
-    check_common, check_tolerances, deliver, invalid, mechanical_state, ulp, wnorm, Clamp,
-    ErrorNorm, MechanicalSystem, NdfOptions, OdeError, OdeFailure, OdeStats, OdeSystem, Output,
+    check_common, check_tolerances, deliver, invalid, mechanical_state, ulp, Clamp, ErrorNorm,
+    MechanicalSystem, NdfOptions, OdeError, OdeFailure, OdeStats, OdeSystem, Output,
 };
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 
-/// `γ_k = Σ_{j=1..k} 1/j`, `k = 1..5`.
-const GAMMA: [f64; 5] = [1.0, 3.0 / 2.0, 11.0 / 6.0, 25.0 / 12.0, 137.0 / 60.0];
-/// The NDF coefficients `κ_k` (Shampine & Reichelt 1997, table 2.1).
-const KAPPA: [f64; 5] = [-37.0 / 200.0, -1.0 / 9.0, -0.0823, -0.0415, 0.0];
-/// `U_ij = (−1)^i binom(j, i)` (1-based), the difference-rescaling factor; `U = U⁻¹`.
-const DIF_U: [[f64; 5]; 5] = [
-    [-1.0, -2.0, -3.0, -4.0, -5.0],
-    [0.0, 1.0, 3.0, 6.0, 10.0],
-    [0.0, 0.0, -1.0, -4.0, -10.0],
-    [0.0, 0.0, 0.0, 1.0, 5.0],
-    [0.0, 0.0, 0.0, 0.0, -1.0],
-];
+mod formulas;
+mod work;
+
+use formulas::GAMMA;
+pub(super) use formulas::{coefficients, interpolate, rescale};
+use work::Work;
+
 /// Maximum simplified Newton iterations per attempt.
 const MAX_IT: usize = 4;
 
@@ -115,175 +110,6 @@ fn check_options(
         inv_ga,
         erconst,
     })
-}
-
-/// `(1/((1−κ_k)γ_k), C_k = κ_k γ_k + 1/(k+1))` for `k = 1..5` (`κ = 0` for the BDFs).
-pub(super) fn coefficients(bdf: bool) -> ([f64; 5], [f64; 5]) {
-    let mut inv_ga = [0.0; 5];
-    let mut erconst = [0.0; 5];
-    for k in 0..5 {
-        let kappa = if bdf { 0.0 } else { KAPPA[k] };
-        inv_ga[k] = 1.0 / (GAMMA[k] * (1.0 - kappa));
-        erconst[k] = kappa * GAMMA[k] + 1.0 / (k as f64 + 2.0);
-    }
-    (inv_ga, erconst)
-}
-
-/// All buffers of one integration.
-struct Work {
-    n: usize,
-    y: DVector<f64>,
-    yp: DVector<f64>,
-    ynew: DVector<f64>,
-    pred: DVector<f64>,
-    psi: DVector<f64>,
-    difkp1: DVector<f64>,
-    del: DVector<f64>,
-    f: DVector<f64>,
-    tmp: DVector<f64>,
-    invwt: DVector<f64>,
-    thresh: DVector<f64>,
-    out: DVector<f64>,
-    /// Backward differences `∇^j y_n`, `j = 1..maxk+2`, in columns `0..maxk+2`.
-    dif: DMatrix<f64>,
-    /// [`ErrorNorm::Mass`]: the norm of `M̂`, the scales of the `q` and `q̇` halves, and a buffer.
-    mass_norm: bool,
-    mnorm: MassNorm,
-    scale_q: f64,
-    scale_v: f64,
-    /// `(mhat_of, ‖y_q‖, ‖y_v‖)` of the current `y` (the same for every attempt at a step).
-    ynorm: Option<(usize, f64, f64)>,
-    /// `‖y⁽⁰⁾‖` of the current attempt in the error norm (for the Newton floor).
-    pred_norm: f64,
-    nbuf: DVector<f64>,
-}
-
-impl Work {
-    fn new(n: usize) -> Self {
-        let v = || DVector::zeros(n);
-        Work {
-            n,
-            y: v(),
-            yp: v(),
-            ynew: v(),
-            pred: v(),
-            psi: v(),
-            difkp1: v(),
-            del: v(),
-            f: v(),
-            tmp: v(),
-            invwt: v(),
-            thresh: v(),
-            out: v(),
-            dif: DMatrix::zeros(n, 7),
-            mass_norm: false,
-            mnorm: MassNorm::new(0),
-            scale_q: 1.0,
-            scale_v: 1.0,
-            ynorm: None,
-            pred_norm: 0.0,
-            nbuf: v(),
-        }
-    }
-
-    /// The error norm of `x` (relative, as `‖x‖ / scale`): componentwise
-    /// `max_i |x_i| / max(|y_i|, |y⁽⁰⁾_i|, atol_i/rtol)`, or with [`ErrorNorm::Mass`]
-    /// `max(‖x_q‖_M̂ / s_q, ‖x_v‖_M̂ / s_v)`, `s = max(‖y‖_M̂, ‖y⁽⁰⁾‖_M̂, max_i atol_i/rtol)` per half.
-    fn norm(&self, x: &DVector<f64>) -> f64 {
-        if !self.mass_norm {
-            return wnorm(x, &self.invwt);
-        }
-        let m = self.n / 2;
-        let q = self.mnorm.half(&x.as_slice()[..m]) / self.scale_q;
-        let v = self.mnorm.half(&x.as_slice()[m..]) / self.scale_v;
-        if q.is_nan() || v.is_nan() {
-            f64::NAN
-        } else {
-            q.max(v)
-        }
-    }
-
-    /// [`Work::norm`] of column `col` of the difference table, plus `difkp1` if asked.
-    fn norm_col(&mut self, col: usize, plus_difkp1: bool) -> f64 {
-        self.nbuf.copy_from(&self.dif.column(col));
-        if plus_difkp1 {
-            self.nbuf += &self.difkp1;
-        }
-        self.norm(&self.nbuf)
-    }
-
-    /// The scales of the mass norm at the predictor (after `mnorm` is set).
-    fn set_mass_scales(&mut self) {
-        let m = self.n / 2;
-        let thr = |lo: usize| self.thresh.rows(lo, m).amax();
-        let (yq, yv) = match self.ynorm {
-            Some((of, q, v)) if of == self.mnorm.of() => (q, v),
-            _ => {
-                let y = self.y.as_slice();
-                let (q, v) = (self.mnorm.half(&y[..m]), self.mnorm.half(&y[m..]));
-                self.ynorm = Some((self.mnorm.of(), q, v));
-                (q, v)
-            }
-        };
-        let p = self.pred.as_slice();
-        let (pq, pv) = (self.mnorm.half(&p[..m]), self.mnorm.half(&p[m..]));
-        self.scale_q = yq.max(pq).max(thr(0));
-        self.scale_v = yv.max(pv).max(thr(m));
-        self.pred_norm = (pq / self.scale_q).max(pv / self.scale_v);
-    }
-}
-
-/// Re-expresses the differences `∇^1..∇^k` for the step ratio `r = h_new/h_old`:
-/// `dif[:, 0..k] ← dif[:, 0..k]·(R U)`, `R_ij = Π_{m=1..i} (m − 1 − j r)/m`.
-pub(super) fn rescale(dif: &mut DMatrix<f64>, k: usize, r: f64) {
-    let mut rm = [[0.0; 5]; 5];
-    for j in 0..k {
-        let mut p = 1.0;
-        for (i, row) in rm.iter_mut().enumerate().take(k) {
-            let m = (i + 1) as f64;
-            p *= (m - 1.0 - (j + 1) as f64 * r) / m;
-            row[j] = p;
-        }
-    }
-    let mut ru = [[0.0; 5]; 5];
-    for i in 0..k {
-        for j in 0..k {
-            ru[i][j] = (0..=j).map(|m| rm[i][m] * DIF_U[m][j]).sum();
-        }
-    }
-    let n = dif.nrows();
-    let d = dif.as_mut_slice();
-    for row in 0..n {
-        let mut old = [0.0; 5];
-        for (m, o) in old.iter_mut().enumerate().take(k) {
-            *o = d[row + m * n];
-        }
-        for j in 0..k {
-            d[row + j * n] = (0..k).map(|m| old[m] * ru[m][j]).sum();
-        }
-    }
-}
-
-/// `y(tq)` from the interpolating polynomial of the step `(t_new − h, t_new]` of order `k`.
-pub(super) fn interpolate(
-    tq: f64,
-    t_new: f64,
-    h: f64,
-    ynew: &DVector<f64>,
-    dif: &DMatrix<f64>,
-    k: usize,
-    out: &mut DVector<f64>,
-) {
-    out.copy_from(ynew);
-    if tq == t_new {
-        return;
-    }
-    let s = (tq - t_new) / h;
-    let mut c = 1.0;
-    for j in 0..k {
-        c *= (s + j as f64) / (j + 1) as f64;
-        out.axpy(c, &dif.column(j), 1.0);
-    }
 }
 
 /// Integrates `y' = f(t, y)` from `(t0, y0)` to the last of `t_out` with the variable-step,
