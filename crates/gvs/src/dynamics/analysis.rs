@@ -1,0 +1,177 @@
+//! Analysis of the equations of motion (not used by the integrators): linearized vibration modes
+//! about an equilibrium (spec §10.5), the Coriolis *matrix* `C(q, q̇)` whose `Ṁ − 2C` is
+//! skew-symmetric (§7.2), and the kinetic, elastic and gravitational energies of a state (§9.4).
+
+use super::{cholesky_factor_in_place, DynamicsError};
+use crate::discretize::MagnusOrder;
+use crate::lie::{ad, V3, V6};
+use crate::model::{Model, PreparedLoads, Workspace, ZANNA_C};
+use crate::strain::StrainParam;
+use nalgebra::{DMatrix, DVector, Matrix6xX};
+
+/// Energies of a state \[J\].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Energy {
+    pub kinetic: f64,
+    pub elastic: f64,
+    pub gravitational: f64,
+}
+
+/// A linearized vibration mode.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mode {
+    /// The eigenvalue `ω²` [rad²/s²], negative for a direction in which the equilibrium is unstable.
+    pub omega_squared: f64,
+    /// Natural frequency `√max(ω², 0) / 2π` \[Hz\] (0 for an unstable direction).
+    pub frequency_hz: f64,
+    /// Mode shape in `q`, mass-normalized.
+    pub shape: DVector<f64>,
+}
+
+impl Energy {
+    pub fn total(&self) -> f64 {
+        self.kinetic + self.elastic + self.gravitational
+    }
+}
+
+impl<P: StrainParam> Model<P> {
+    /// Linearized undamped vibration modes about `q0` (spec §10.5): `(K_T − ω² M) φ = 0` with the
+    /// tangent stiffness `K_T = −∂R/∂q` (elastic plus load stiffness; symmetrized, since follower
+    /// loads and tendons make it slightly non-symmetric). Returned in ascending `ω²` (directions in
+    /// which the equilibrium is unstable, `ω² < 0`, first), shapes mass-normalized (`φᵀ M φ = 1`).
+    pub fn linearized_modes(
+        &self,
+        q0: &DVector<f64>,
+        u: &[f64],
+        loads: &PreparedLoads,
+        ws: &mut Workspace,
+    ) -> Result<Vec<Mode>, DynamicsError> {
+        let n = self.n_dof();
+        let mut kt = DMatrix::zeros(n, n);
+        self.statics_jacobian(q0, u, loads, ws, &mut kt);
+        let kt = (&kt + kt.transpose()) * -0.5;
+        self.assemble_mass(ws);
+        let mut l = ws.mass.clone();
+        cholesky_factor_in_place(&mut l)?;
+        let l = l.lower_triangle();
+        let linv = l.try_inverse().ok_or(DynamicsError::NonFinite {
+            what: "mass factor",
+        })?;
+        let a = &linv * kt * linv.transpose();
+        let eig = nalgebra::SymmetricEigen::new((&a + a.transpose()) * 0.5);
+        let mut modes: Vec<Mode> = eig
+            .eigenvalues
+            .iter()
+            .zip(eig.eigenvectors.column_iter())
+            .map(|(w2, v)| Mode {
+                omega_squared: *w2,
+                frequency_hz: w2.max(0.0).sqrt() / (2.0 * std::f64::consts::PI),
+                shape: linv.transpose() * v,
+            })
+            .collect();
+        // unstable directions (ω² < 0) first, then by frequency
+        modes.sort_by(|a, b| a.omega_squared.total_cmp(&b.omega_squared));
+        Ok(modes)
+    }
+
+    /// Coriolis matrix `C(q, q̇) = Σ W Jᵀ (Ms J̇ˢ + coad_η Ms J)` (spec §7.2); for tests and analysis.
+    pub fn coriolis_matrix(
+        &self,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        ws: &mut Workspace,
+    ) -> DMatrix<f64> {
+        let n = self.n_dof();
+        self.forward(q, ws, true);
+        self.velocities(q, qd, ws); // also fills Ψ̇_q for nonlinear parameterizations
+        let np = self.disc.n_points();
+        let mut jds = Matrix6xX::<f64>::zeros(n); // J̇ˢ_i
+        let mut c = DMatrix::zeros(n, n);
+        for i in 0..np {
+            if i > 0 {
+                if let Some(st) = self.disc.steps[i - 1] {
+                    let s = i - 1;
+                    let [s1, s2] = st.sites;
+                    let cols = self.param.columns(s1);
+                    let h = st.h;
+                    let et = &ws.et[s];
+                    let z = ws.z.columns(s * n + cols.start, cols.len()).into_owned();
+                    let qdc = qd.rows(cols.start, cols.len());
+                    // Ż (6×cols)
+                    let mut zdot = DMatrix::zeros(6, cols.len());
+                    let p1 = ws.ev.psi_q_at(s1, &cols).into_owned();
+                    let p2 = ws.ev.psi_q_at(s2, &cols).into_owned();
+                    match self.disc.order {
+                        MagnusOrder::Z4 => {
+                            let k = ZANNA_C * h * h;
+                            let xd1: V6 = &p1 * qdc;
+                            let xd2: V6 = &p2 * qdc;
+                            zdot += (ad(&xd1) * &p2 - ad(&xd2) * &p1) * k;
+                            if !self.param.is_linear() {
+                                let d1 = ws.ev.psi_q_dot_at(s1, &cols).into_owned();
+                                let d2 = ws.ev.psi_q_dot_at(s2, &cols).into_owned();
+                                zdot += (&d1 + &d2) * (0.5 * h)
+                                    + (ad(&ws.xi[s1]) * &d2 - ad(&ws.xi[s2]) * &d1) * k;
+                            }
+                        }
+                        MagnusOrder::Z2 => {
+                            if !self.param.is_linear() {
+                                zdot += ws.ev.psi_q_dot_at(s1, &cols).into_owned() * h;
+                            }
+                        }
+                    }
+                    let om_dot: V6 = &z * qdc;
+                    let sdot = et.t_dot(&om_dot) * &z + et.t * zdot;
+                    let smat = et.t * &z;
+                    let mut next = jds.clone();
+                    {
+                        let mut blk = next.columns_mut(cols.start, cols.len());
+                        blk += ad(&ws.eta[s]) * &smat + sdot;
+                    }
+                    jds = et.g.adjoint_inv() * next;
+                }
+            }
+            let w = self.disc.points[i].weight;
+            if w == 0.0 {
+                continue;
+            }
+            let ms = self.props[i].ms;
+            let j = ws.jac.columns(i * n, n).into_owned();
+            let msj = DMatrix::from_fn(6, n, |a, b| ms[a] * j[(a, b)]);
+            let msjd = DMatrix::from_fn(6, n, |a, b| ms[a] * jds[(a, b)]);
+            let inner = msjd + crate::lie::coad(&ws.eta[i]) * msj;
+            c += j.transpose() * inner * w;
+        }
+        c
+    }
+
+    /// Kinetic, elastic and gravitational energies at `(q, q̇)` (spec §9.4):
+    /// `T = ½ q̇ᵀ M q̇`, `U_e = ½ Σ W Ψᵀ Es Ψ`, `U_g = −Σ W ρA g·r`.
+    pub fn energy(
+        &self,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        gravity: &[f64; 3],
+        ws: &mut Workspace,
+    ) -> Energy {
+        self.forward(q, ws, true);
+        self.assemble_mass(ws);
+        let kinetic = 0.5 * qd.dot(&(&ws.mass * qd));
+        let g = V3::from_row_slice(gravity);
+        let mut elastic = 0.0;
+        let mut gravitational = 0.0;
+        for (i, p) in self.disc.points.iter().enumerate() {
+            if p.weight == 0.0 {
+                continue;
+            }
+            let psi = ws.ev.psi[i];
+            elastic += 0.5 * p.weight * psi.dot(&self.props[i].es.component_mul(&psi));
+            gravitational -= p.weight * self.props[i].ms[3] * g.dot(&ws.g[i].pos);
+        }
+        Energy {
+            kinetic,
+            elastic,
+            gravitational,
+        }
+    }
+}
