@@ -4,7 +4,7 @@
 use super::super::report::{figure, RenderedFigure};
 use super::super::sim_test::SimRun;
 use super::kinetic_dofs::KineticDof;
-use super::variants::LossWeights;
+use super::rate_weights::LossWeights;
 use super::Dof;
 use crate::compare::Trajectory;
 use crate::plot::{palette, Figure, LineChart, Series, SeriesStyle};

@@ -8,7 +8,8 @@ use super::super::sim_test::{simulate_test, SimRun, Test};
 use super::super::step::Step;
 use super::super::tasks::{self, AeConfig, DatasetInfo, ScenarioSpec};
 use super::super::Run;
-use super::variants::{ae_step_name, kinetic_schedule, test_step, DataVariant, LossWeights};
+use super::rate_weights::{ae_step_name, LossWeights};
+use super::variants::{kinetic_schedule, test_step, DataVariant};
 use super::Dof;
 
 /// The kinetic-norm AE-r's run on the paper's test input.

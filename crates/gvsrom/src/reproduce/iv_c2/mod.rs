@@ -14,6 +14,7 @@ mod figures;
 mod frequencies;
 mod kinetic_dofs;
 mod more_tests;
+mod rate_weights;
 mod report;
 mod variants;
 
@@ -31,11 +32,12 @@ use figures::{fig9, trace_figure, Arm, Inset};
 use frequencies::{frequencies_notes, frequencies_table, natural_frequencies};
 use kinetic_dofs::{kinetic_dofs_finding, kinetic_dofs_table, run_kinetic_dofs};
 use more_tests::{ae_timing, more_tests_findings, more_tests_table, run_more_tests, TestRuns};
+use rate_weights::LossWeights;
 use report::{
     fig9_table, findings, lambda_table, models_table, notes, table_iii, tip_travel, Context,
 };
 use serde_json::json;
-use variants::{run_variant, variant_findings, variant_table, DataVariant, LossWeights};
+use variants::{run_variant, variant_findings, variant_table, DataVariant};
 
 /// Hidden layers of every autoencoder (the paper's deepest, as in Table I).
 const HIDDEN_LAYERS: usize = 7;
