@@ -543,10 +543,18 @@ impl Robot {
     ///     Interpolate ``input`` rows linearly.
     /// from_equilibrium : bool
     ///     Start at the static equilibrium under the scenario's tensions (else straight at rest).
+    /// q0, qd0 : array_like of float, shape (n,), optional
+    ///     Start at this state instead (``qd0`` zeros if not given): the coordinates of the model
+    ///     that runs (the reduced model's with one attached, inside its training encodings), e.g.
+    ///     ``tr["q"][-1], tr["qd"][-1]`` of an earlier run, to continue it under another input —
+    ///     a controller's loop, one control period per call with the tensions held.
     /// method : str
     ///     ``"auto"``, ``"ndf"``, ``"sdirk"`` or ``"galpha"`` (``--method``).
     /// rtol, atol : float
     ///     Tolerances of the adaptive integrator (default rtol: chosen by ``method``).
+    /// fixed_step : float, optional
+    ///     A fixed step [s]: the fixed-step BDF2 (``--fixed-step``) instead of an adaptive method;
+    ///     its cost is set by the number of steps, its accuracy by the step (not checked).
     ///
     /// Returns
     /// -------
@@ -559,7 +567,7 @@ impl Robot {
     /// ------
     /// GvsromError
     ///     For bad options or input, or an integrator failure (with the samples computed).
-    #[pyo3(signature = (duration, sample_rate=100.0, input=None, interpolate=false, from_equilibrium=false, method="auto", rtol=None, atol=1e-6))]
+    #[pyo3(signature = (duration, sample_rate=100.0, input=None, interpolate=false, from_equilibrium=false, q0=None, qd0=None, method="auto", rtol=None, atol=1e-6, fixed_step=None))]
     #[allow(clippy::too_many_arguments)]
     fn simulate<'py>(
         &self,
@@ -569,9 +577,12 @@ impl Robot {
         input: Option<Bound<'_, PyAny>>,
         interpolate: bool,
         from_equilibrium: bool,
+        q0: Option<arrays::In1<'_>>,
+        qd0: Option<arrays::In1<'_>>,
         method: &str,
         rtol: Option<f64>,
         atol: f64,
+        fixed_step: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let args = crate::simulate::Args {
             duration,
@@ -579,9 +590,12 @@ impl Robot {
             input,
             interpolate,
             from_equilibrium,
+            q0: q0.as_ref().map(arrays::vec1),
+            qd0: qd0.as_ref().map(arrays::vec1),
             method,
             rtol,
             atol,
+            fixed_step,
         };
         crate::simulate::run(self, py, args)
     }

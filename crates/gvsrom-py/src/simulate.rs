@@ -26,9 +26,14 @@ pub struct Args<'a> {
     pub input: Option<Bound<'a, PyAny>>,
     pub interpolate: bool,
     pub from_equilibrium: bool,
+    /// A given start `(q, q̇)` (`q̇ = 0` if only `q` is given).
+    pub q0: Option<Vec<f64>>,
+    pub qd0: Option<Vec<f64>>,
     pub method: &'a str,
     pub rtol: Option<f64>,
     pub atol: f64,
+    /// A fixed step \[s\]: the fixed-step BDF2 instead of an adaptive method (`--fixed-step`).
+    pub fixed_step: Option<f64>,
 }
 
 fn method(name: &str) -> PyResult<MethodChoice> {
@@ -119,8 +124,32 @@ impl Actuation for CallableInput {
     }
 }
 
+/// Where the run starts: `from_equilibrium`, a given state `q0` (`qd0`: zero if not given), or
+/// straight at rest.
+fn start(a: &Args<'_>) -> PyResult<simulate::Start> {
+    Ok(match (&a.q0, &a.qd0, a.from_equilibrium) {
+        (Some(_), _, true) => {
+            return Err(invalid(
+                "`from_equilibrium=True` and `q0` both say where the run starts: give one",
+            ))
+        }
+        (None, Some(_), _) => {
+            return Err(invalid(
+                "`qd0` given without `q0`: the start state needs both (`qd0` defaults to zeros)",
+            ))
+        }
+        (Some(q), qd, false) => simulate::Start::State {
+            q: q.clone(),
+            qd: qd.clone().unwrap_or_else(|| vec![0.0; q.len()]),
+        },
+        (None, None, true) => simulate::Start::Equilibrium,
+        (None, None, false) => simulate::Start::Rest,
+    })
+}
+
 pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'py, PyDict>> {
     let na = robot.built.model.n_actuators();
+    let start = start(&a)?;
     let callable = match &a.input {
         Some(f) if f.is_callable() => {
             if a.interpolate {
@@ -173,6 +202,7 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
         method: method(a.method)?,
         rtol: a.rtol,
         atol: a.atol,
+        fixed_step: a.fixed_step,
         ..IntegratorChoice::default()
     };
     let simulate::Prepared { opts, plan, .. } = simulate::prepare(
@@ -181,7 +211,7 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
             duration: a.duration,
             sample_rate: a.sample_rate,
             input,
-            start_at_equilibrium: a.from_equilibrium,
+            start,
             load_schedule: None,
             integrator: choice,
         },

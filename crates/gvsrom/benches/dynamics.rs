@@ -12,7 +12,7 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use gvs::solve::dynamics::{IntegratorOptions, Method, OdeJacobian};
 use gvs::solve::ode::NdfOptions;
-use gvsrom::simulate::{plan, run, InputSource, SimulateOptions};
+use gvsrom::simulate::{plan, run, InputSource, SimulateOptions, Start};
 use std::hint::black_box;
 use std::ops::ControlFlow;
 
@@ -26,7 +26,7 @@ fn options(jacobian: OdeJacobian) -> SimulateOptions {
             period: 1.0,
             seed: 1,
         },
-        start_at_equilibrium: false,
+        start: Start::Rest,
         integrator: IntegratorOptions {
             method: Method::Ndf(NdfOptions {
                 rtol: 1e-3,
@@ -87,7 +87,7 @@ fn release(c: &mut Criterion) {
             duration: 6.0,
             sample_rate: 50.0,
             input: InputSource::Constant,
-            start_at_equilibrium: true,
+            start: Start::Equilibrium,
             integrator: IntegratorOptions {
                 method,
                 jacobian: OdeJacobian::Structured,

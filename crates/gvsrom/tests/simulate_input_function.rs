@@ -39,7 +39,7 @@ fn run(built: &gvsrom::Built, input: InputSource) -> TrajectoryBuffer {
             duration: 0.2,
             sample_rate: 50.0,
             input,
-            start_at_equilibrium: false,
+            start: simulate::Start::Rest,
             load_schedule: None,
             integrator: IntegratorChoice::default(),
         },

@@ -342,7 +342,10 @@ class Robot:
         input: ArrayLike | Callable[[float], ArrayLike | float] | None = None,
         interpolate: bool = False,
         from_equilibrium: bool = False,
+        q0: ArrayLike | None = None,
+        qd0: ArrayLike | None = None,
         method: str = "auto",
         rtol: float | None = None,
         atol: float = 1e-06,
+        fixed_step: float | None = None,
     ) -> dict[str, Any]: ...

@@ -173,7 +173,11 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
             duration: args.duration,
             sample_rate: args.sample_rate,
             input,
-            start_at_equilibrium: args.from_equilibrium,
+            start: if args.from_equilibrium {
+                simulate::Start::Equilibrium
+            } else {
+                simulate::Start::Rest
+            },
             load_schedule: args.load_schedule.clone(),
             integrator: choice,
         },

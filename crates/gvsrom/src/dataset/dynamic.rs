@@ -11,7 +11,7 @@ use super::{
 use crate::build::Built;
 use crate::error::ScenarioError;
 use crate::output::OutputDir;
-use crate::simulate::{self, InputSource, SimulateOptions};
+use crate::simulate::{self, InputSource, SimulateOptions, Start};
 use gvs::solve::dynamics::{
     simulate_streaming_interruptible, IntegratorOptions, OdeJacobian, SimulationError,
 };
@@ -91,7 +91,11 @@ pub fn run(
         duration,
         sample_rate: args.sample_rate.unwrap_or(100.0),
         input,
-        start_at_equilibrium: args.from_equilibrium,
+        start: if args.from_equilibrium {
+            Start::Equilibrium
+        } else {
+            Start::Rest
+        },
         integrator: IntegratorOptions {
             method: method.clone(),
             jacobian: OdeJacobian::Structured,

@@ -38,7 +38,7 @@ impl Test {
                     period,
                     seed: self.seed,
                 },
-                start_at_equilibrium: false,
+                start: simulate::Start::Rest,
                 integrator,
                 load_schedule: None,
             },

@@ -113,6 +113,23 @@ impl InputSource {
     }
 }
 
+/// Where a dynamics run starts.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub enum Start {
+    /// Straight at rest: the rest coordinates of the model that runs, `q̇ = 0`.
+    #[default]
+    Rest,
+    /// At rest in the static equilibrium under the scenario's tensions and loads, then released
+    /// to the input signal at t = 0 (`--from-equilibrium`).
+    Equilibrium,
+    /// A given state `(q, q̇)` of the model that runs — the reduced model's coordinates when one is
+    /// attached — e.g. the last sample of an earlier run, to continue it under another input
+    /// (Python's `Robot.simulate(q0=…, qd0=…)`: a controller stepping the rod one period at a
+    /// time). Checked when the run is planned: `n` finite values each, and for a reduced model inside
+    /// its training encodings.
+    State { q: Vec<f64>, qd: Vec<f64> },
+}
+
 /// Options of a dynamics run.
 #[derive(Debug, Clone)]
 pub struct SimulateOptions {
@@ -120,9 +137,8 @@ pub struct SimulateOptions {
     /// Output samples per second.
     pub sample_rate: f64,
     pub input: InputSource,
-    /// Start at the static equilibrium under the scenario's tensions and loads (then switch to the
-    /// input signal at t = 0) instead of straight at rest.
-    pub start_at_equilibrium: bool,
+    /// Where the run starts ([`Start`]).
+    pub start: Start,
     pub integrator: IntegratorOptions,
     /// A CSV file `t, λ` scaling all external loads and gravity over time (linear between rows).
     pub load_schedule: Option<PathBuf>,
@@ -294,11 +310,17 @@ pub fn input_record(
         }),
         InputSource::Function(_) => json!({"signal": "function"}),
     };
-    if opts.start_at_equilibrium {
-        signal["start"] = json!("equilibrium");
-        signal["start_tensions"] = json!(built.u);
-    } else {
-        signal["start"] = json!("rest");
+    match &opts.start {
+        Start::Rest => signal["start"] = json!("rest"),
+        Start::Equilibrium => {
+            signal["start"] = json!("equilibrium");
+            signal["start_tensions"] = json!(built.u);
+        }
+        Start::State { q, qd } => {
+            signal["start"] = json!("state");
+            signal["start_q"] = json!(q);
+            signal["start_qd"] = json!(qd);
+        }
     }
     signal["load_schedule"] = match &opts.load_schedule {
         Some(path) => file("--load-schedule", path)?,

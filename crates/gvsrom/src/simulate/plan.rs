@@ -7,6 +7,7 @@ use crate::build::Built;
 use crate::error::ScenarioError;
 use gvs::inputs::{Actuation, Interpolation, Signal};
 use gvs::solve::dynamics::{InitialState, Method};
+use nalgebra::DVector;
 use std::path::PathBuf;
 
 /// Most output samples of one run.
@@ -150,13 +151,13 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
         .map(|s| crate::csv_input::max_abs_per_column(s)[0])
         .unwrap_or(1.0);
     crate::plausibility::check(built, &u_max, lambda_max)?;
-    let initial = if opts.start_at_equilibrium {
-        InitialState::Equilibrium {
+    let initial = match &opts.start {
+        Start::Rest => InitialState::Rest,
+        Start::Equilibrium => InitialState::Equilibrium {
             u: built.u.clone(),
             loads: built.loads.clone(),
-        }
-    } else {
-        InitialState::Rest
+        },
+        Start::State { q, qd } => initial_state(built, q, qd)?,
     };
     let input = input_record(built, opts)?;
     Ok(Plan {
@@ -174,6 +175,43 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
     })
 }
 
+/// The given start `(q, q̇)` of a run ([`Start::State`]) as the integrator's initial state: `n`
+/// finite values each, `n` the degrees of freedom of the model that runs; for a reduced model, `q`
+/// inside its training encodings ([`crate::build::Reduced::range_violation`]), where its decoder
+/// answers.
+fn initial_state(built: &Built, q: &[f64], qd: &[f64]) -> Result<InitialState, ScenarioError> {
+    let n = built.n_dof();
+    for (field, v) in [("q0", q), ("qd0", qd)] {
+        if v.len() != n {
+            return Err(ScenarioError::invalid(
+                field,
+                format!(
+                    "{} values given: expected {n}, one per degree of freedom of the model that runs{}",
+                    v.len(),
+                    if built.reduced.is_some() { " (the reduced model's coordinates)" } else { "" }
+                ),
+            ));
+        }
+        if let Some(k) = v.iter().position(|x| !x.is_finite()) {
+            return Err(ScenarioError::value(
+                format!("{field}[{k}]"),
+                v[k],
+                "a finite number",
+            ));
+        }
+    }
+    if let Some(v) = built.reduced.as_ref().and_then(|r| r.range_violation(q)) {
+        return Err(ScenarioError::invalid(
+            "q0",
+            format!("{v}: the decoder extrapolates there; start inside the training region"),
+        ));
+    }
+    Ok(InitialState::Given {
+        q: DVector::from_column_slice(q),
+        qd: DVector::from_column_slice(qd),
+    })
+}
+
 /// A dynamics run as a front-end asks for it (the options of `gvsrom simulate`).
 #[derive(Debug, Clone)]
 pub struct Request {
@@ -182,8 +220,8 @@ pub struct Request {
     /// Output samples per second \[Hz\].
     pub sample_rate: f64,
     pub input: InputSource,
-    /// Start at the scenario's static equilibrium instead of the straight rod at rest.
-    pub start_at_equilibrium: bool,
+    /// Where the run starts ([`Start`]).
+    pub start: Start,
     /// A CSV load schedule (`--load-schedule`).
     pub load_schedule: Option<PathBuf>,
     /// The integrator asked for (`--method`, tolerances …).
@@ -220,7 +258,7 @@ pub fn prepare(built: &Built, request: Request) -> Result<Prepared, ScenarioErro
         duration: request.duration,
         sample_rate: request.sample_rate,
         input: request.input,
-        start_at_equilibrium: request.start_at_equilibrium,
+        start: request.start,
         integrator,
         load_schedule: request.load_schedule,
     };
