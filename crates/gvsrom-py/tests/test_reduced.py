@@ -216,6 +216,23 @@ def test_codes_far_outside_the_training_encodings_are_refused_unless_extrapolati
         pod_model.encode(bad)
 
 
+def test_a_reduced_run_starts_inside_the_training_encodings_but_not_far_outside_them(ae_model):
+    # q0 is in the reduced model's coordinates: a code inside the autoencoder's training encodings
+    # is a valid start (the run's first sample is that code), one far outside them is refused — its
+    # decoder would extrapolate (a POD basis is linear: only its inputs are bounded)
+    robot = gvsrom.Scenario.preset("single-tendon").set("tendons.0.tension", -3.0).build()
+    reduced = robot.with_model(ae_model)
+    lo, hi = ae_model.latent_range[0]
+    inside = np.array([0.5 * (lo + hi)])
+    tr = reduced.simulate(0.02, sample_rate=100, q0=inside)
+    np.testing.assert_array_equal(tr["q"][0], inside)
+    assert tr["q"].shape == (3, 1)
+    with pytest.raises(gvsrom.GvsromError, match=r"q0.*q_r\[0\].*far outside"):
+        reduced.simulate(0.02, q0=np.array([hi + 2 * (hi - lo)]))
+    with pytest.raises(gvsrom.GvsromError, match=r"q0.*2 values given: expected 1.*reduced"):
+        reduced.simulate(0.02, q0=np.zeros(2))
+
+
 def test_several_datasets_make_one_model_of_their_stacked_snapshots(gvsrom_bin, dataset, tmp_path):
     # a second dataset of the same scenario: POD of both is the POD of the stacked snapshots, whose
     # squared singular values are the eigenvalues of X_Aᵀ X_A + X_Bᵀ X_B (numpy's eigvalsh)

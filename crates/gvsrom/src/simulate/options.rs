@@ -125,8 +125,8 @@ pub enum Start {
     /// A given state `(q, q̇)` of the model that runs — the reduced model's coordinates when one is
     /// attached — e.g. the last sample of an earlier run, to continue it under another input
     /// (Python's `Robot.simulate(q0=…, qd0=…)`: a controller stepping the rod one period at a
-    /// time). Checked when the run is planned: `n` finite values each, and for a reduced model inside
-    /// its training encodings.
+    /// time). Checked when the run is planned: `n` finite values each, and for an autoencoder model
+    /// inside its training encodings.
     State { q: Vec<f64>, qd: Vec<f64> },
 }
 

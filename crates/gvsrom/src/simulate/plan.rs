@@ -176,9 +176,9 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
 }
 
 /// The given start `(q, q̇)` of a run ([`Start::State`]) as the integrator's initial state: `n`
-/// finite values each, `n` the degrees of freedom of the model that runs; for a reduced model, `q`
-/// inside its training encodings ([`crate::build::Reduced::range_violation`]), where its decoder
-/// answers.
+/// finite values each, `n` the degrees of freedom of the model that runs; for an autoencoder model,
+/// `q` inside its training encodings ([`crate::build::Reduced::range_violation`]), where its decoder
+/// answers (a POD basis is linear: its range is not bounded).
 fn initial_state(built: &Built, q: &[f64], qd: &[f64]) -> Result<InitialState, ScenarioError> {
     let n = built.n_dof();
     for (field, v) in [("q0", q), ("qd0", qd)] {
