@@ -46,3 +46,19 @@ def test_a_bad_start_is_a_value_error_naming_the_argument(robot):
         robot.simulate(0.01, q0=np.zeros(n), from_equilibrium=True)
     with pytest.raises(gvsrom.GvsromError, match="qd0.*without `q0`"):
         robot.simulate(0.01, qd0=np.zeros(n))
+
+
+def test_a_fixed_step_run_converges_to_the_adaptive_one(robot):
+    # `fixed_step` (the CLI's --fixed-step, BDF2): its error against a tight adaptive run of the
+    # same held tension shrinks with the step
+    rows = np.array([[0.0, -3.0]])
+    ref = robot.simulate(0.2, sample_rate=50, input=rows, rtol=1e-9, atol=1e-11)
+    err = {}
+    for h in (4e-3, 1e-3):
+        run = robot.simulate(0.2, sample_rate=50, input=rows, fixed_step=h)
+        np.testing.assert_array_equal(run["t"], ref["t"])
+        err[h] = np.abs(run["tip_position"] - ref["tip_position"]).max() / robot.length
+    assert err[1e-3] < 1e-4, err
+    assert err[1e-3] < 0.5 * err[4e-3], err
+    with pytest.raises(gvsrom.GvsromError, match="fixed-step"):
+        robot.simulate(0.1, fixed_step=-1.0)
