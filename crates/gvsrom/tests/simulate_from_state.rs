@@ -5,7 +5,8 @@
 
 use gvs::inputs::Signal;
 use gvsrom::simulate::{self, InputSource, IntegratorChoice, Request, Start, TrajectoryBuffer};
-use std::ops::ControlFlow;
+
+mod common;
 
 /// Tight tolerances, so that the comparison measures the start, not the integrators' error.
 fn tight() -> IntegratorChoice {
@@ -28,18 +29,7 @@ fn request(duration: f64, start: Start) -> Request {
 }
 
 fn run(built: &gvsrom::Built, request: Request) -> TrajectoryBuffer {
-    let prepared = simulate::prepare(built, request).expect("the run is planned");
-    let mut buffer = TrajectoryBuffer::new(built);
-    let outcome = simulate::run_into(
-        built,
-        &prepared.plan,
-        &prepared.opts.integrator,
-        Some(&mut buffer),
-        &mut |_| ControlFlow::Continue(()),
-    )
-    .expect("the run starts");
-    assert_eq!(outcome.ending, simulate::Ending::Complete);
-    buffer
+    common::run_to_buffer(built, request)
 }
 
 /// Sample `k`'s row of a (samples × width) buffer.

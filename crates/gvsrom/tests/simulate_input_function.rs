@@ -7,9 +7,10 @@ use gvs::inputs::{Actuation, Interpolation, Signal};
 use gvsrom::simulate::{
     self, InputFunction, InputSource, IntegratorChoice, Request, TrajectoryBuffer,
 };
-use std::ops::ControlFlow;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
+
+mod common;
 
 /// `u(t) = -4 N` for `t ≥ 0.05 s`, else 0, counting its calls.
 struct Step {
@@ -33,7 +34,7 @@ impl Actuation for Step {
 }
 
 fn run(built: &gvsrom::Built, input: InputSource) -> TrajectoryBuffer {
-    let prepared = simulate::prepare(
+    common::run_to_buffer(
         built,
         Request {
             duration: 0.2,
@@ -44,18 +45,6 @@ fn run(built: &gvsrom::Built, input: InputSource) -> TrajectoryBuffer {
             integrator: IntegratorChoice::default(),
         },
     )
-    .expect("the run is planned");
-    let mut buffer = TrajectoryBuffer::new(built);
-    let outcome = simulate::run_into(
-        built,
-        &prepared.plan,
-        &prepared.opts.integrator,
-        Some(&mut buffer),
-        &mut |_| ControlFlow::Continue(()),
-    )
-    .expect("the run starts");
-    assert_eq!(outcome.ending, simulate::Ending::Complete);
-    buffer
 }
 
 #[test]

@@ -1,5 +1,6 @@
 //! Helpers shared by the command-line tests: run the binary (and expect success), scratch paths,
-//! small single-tendon sweep datasets, and the check of a one-line user error.
+//! small single-tendon sweep datasets, and the check of a one-line user error; and a dynamics run
+//! through the library into memory ([`run_to_buffer`]).
 #![allow(dead_code)]
 
 pub mod reseal;
@@ -209,4 +210,25 @@ pub fn assert_sigma_squared_are_eigenvalues(
             eig[i]
         );
     }
+}
+
+/// A dynamics run of `built` through the library (`simulate::prepare`, `run_into`), its samples in
+/// memory; the run must complete.
+pub fn run_to_buffer(
+    built: &gvsrom::Built,
+    request: gvsrom::simulate::Request,
+) -> gvsrom::simulate::TrajectoryBuffer {
+    use gvsrom::simulate;
+    let prepared = simulate::prepare(built, request).expect("the run is planned");
+    let mut buffer = simulate::TrajectoryBuffer::new(built);
+    let outcome = simulate::run_into(
+        built,
+        &prepared.plan,
+        &prepared.opts.integrator,
+        Some(&mut buffer),
+        &mut |_| std::ops::ControlFlow::Continue(()),
+    )
+    .expect("the run starts");
+    assert_eq!(outcome.ending, simulate::Ending::Complete);
+    buffer
 }
