@@ -17,6 +17,7 @@ use pyo3::types::PyDict;
 use rayon::prelude::*;
 use std::ffi::CString;
 use std::path::PathBuf;
+use std::sync::OnceLock;
 
 /// A reduced model to attach: its directory and whether it may extrapolate (`--extrapolate`).
 #[derive(Clone)]
@@ -37,6 +38,10 @@ pub struct Robot {
     pub attached: Option<Attached>,
     /// The workspace of the model that runs, kept between the quantity calls.
     pub workspaces: WorkspaceCache,
+    /// With a model attached, the scenario built for runs driven by an input signal (whose
+    /// tensions the model checks instead of the scenario's): built on the first such run and kept,
+    /// so that a control loop of short runs does not read and check the model at every call.
+    signal_built: OnceLock<Built>,
 }
 
 /// Builds `scenario` and attaches `attached` as `gvsrom … --model DIR` does, warning in Python
@@ -86,7 +91,22 @@ impl Robot {
             built,
             attached,
             workspaces: WorkspaceCache::default(),
+            signal_built: OnceLock::new(),
         })
+    }
+
+    /// The scenario to run under an input signal: with a model attached, built (once) with the
+    /// model checking the signal's tensions rather than the scenario's ([`build_with`]); else the
+    /// robot's own.
+    pub fn built_for_signal(&self, py: Python<'_>) -> PyResult<&Built> {
+        let Some(att) = &self.attached else {
+            return Ok(&self.built);
+        };
+        if let Some(b) = self.signal_built.get() {
+            return Ok(b);
+        }
+        let b = build_with(py, &self.scenario, Some(att), true)?;
+        Ok(self.signal_built.get_or_init(|| b))
     }
 
     /// The scenario with tensions `u` (`--tension`), built with the model attached: for the runs

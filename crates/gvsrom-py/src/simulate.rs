@@ -188,16 +188,10 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
         }
     };
     // a reduced model checks a signal's tensions, not the scenario's (`simulate --model`)
-    let rebuilt = match &robot.attached {
-        Some(att) if a.input.is_some() => Some(crate::robot::build_with(
-            py,
-            &robot.scenario,
-            Some(att),
-            true,
-        )?),
-        _ => None,
+    let built = match a.input {
+        Some(_) => robot.built_for_signal(py)?,
+        None => &robot.built,
     };
-    let built = rebuilt.as_ref().unwrap_or(&robot.built);
     let choice = IntegratorChoice {
         method: method(a.method)?,
         rtol: a.rtol,

@@ -233,6 +233,20 @@ def test_a_reduced_run_starts_inside_the_training_encodings_but_not_far_outside_
         reduced.simulate(0.02, q0=np.zeros(2))
 
 
+def test_a_reduced_run_checks_each_input_signal_against_the_training_tensions(pod_model):
+    # the model was trained on tensions in [-6, 0] N: a signal inside runs (twice: the scenario
+    # built for signals is kept between runs), one that leaves the range is refused, and the next
+    # inside one still runs — each run checks its own signal
+    robot = gvsrom.Scenario.preset("single-tendon").build().with_model(pod_model)
+    inside = np.array([[0.0, -2.0], [0.01, -5.0]])
+    first = robot.simulate(0.02, sample_rate=100, input=inside)
+    again = robot.simulate(0.02, sample_rate=100, input=inside)
+    np.testing.assert_array_equal(first["q"], again["q"])
+    with pytest.raises(gvsrom.GvsromError, match="not trained for this input"):
+        robot.simulate(0.02, sample_rate=100, input=np.array([[0.0, -2.0], [0.01, -20.0]]))
+    np.testing.assert_array_equal(robot.simulate(0.02, sample_rate=100, input=inside)["q"], first["q"])
+
+
 def test_several_datasets_make_one_model_of_their_stacked_snapshots(gvsrom_bin, dataset, tmp_path):
     # a second dataset of the same scenario: POD of both is the POD of the stacked snapshots, whose
     # squared singular values are the eigenvalues of X_Aᵀ X_A + X_Bᵀ X_B (numpy's eigvalsh)
