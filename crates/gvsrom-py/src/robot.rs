@@ -566,9 +566,8 @@ impl Robot {
     /// q0, qd0 : array_like of float, shape (n,), optional
     ///     Start at this state instead (``qd0`` zeros if not given): the coordinates of the model
     ///     that runs (the reduced model's with one attached; an autoencoder's inside its training
-    ///     encodings), e.g.
-    ///     ``tr["q"][-1], tr["qd"][-1]`` of an earlier run, to continue it under another input —
-    ///     a controller's loop, one control period per call with the tensions held.
+    ///     encodings), e.g. ``tr["q"][-1], tr["qd"][-1]`` of an earlier run, to continue it under
+    ///     another input — a controller's loop, one control period per call with the tensions held.
     /// method : str
     ///     ``"auto"``, ``"ndf"``, ``"sdirk"`` or ``"galpha"`` (``--method``).
     /// rtol, atol : float

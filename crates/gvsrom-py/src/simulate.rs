@@ -135,15 +135,14 @@ fn start(a: &Args<'_>) -> PyResult<simulate::Start> {
         }
         (None, Some(_), _) => {
             return Err(invalid(
-                "`qd0` given without `q0`: the start state needs both (`qd0` defaults to zeros)",
+                "`qd0` given without `q0`: a start state needs its coordinates `q0` (`qd0` defaults to zeros)",
             ))
         }
         (Some(q), qd, false) => simulate::Start::State {
             q: q.clone(),
             qd: qd.clone().unwrap_or_else(|| vec![0.0; q.len()]),
         },
-        (None, None, true) => simulate::Start::Equilibrium,
-        (None, None, false) => simulate::Start::Rest,
+        (None, None, from_equilibrium) => simulate::Start::rest_or_equilibrium(from_equilibrium),
     })
 }
 

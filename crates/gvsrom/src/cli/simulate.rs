@@ -173,11 +173,7 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
             duration: args.duration,
             sample_rate: args.sample_rate,
             input,
-            start: if args.from_equilibrium {
-                simulate::Start::Equilibrium
-            } else {
-                simulate::Start::Rest
-            },
+            start: simulate::Start::rest_or_equilibrium(args.from_equilibrium),
             load_schedule: args.load_schedule.clone(),
             integrator: choice,
         },

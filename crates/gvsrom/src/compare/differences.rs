@@ -85,7 +85,14 @@ pub fn differences(reference: &Trajectory, run: &Trajectory) -> Differences {
     let (mut a, mut b) = (reference.input.clone(), run.input.clone());
     if let (Some(Value::Object(x)), Some(Value::Object(y))) = (&mut a, &mut b) {
         if x.get("signal") != y.get("signal") {
-            let shared = ["signal", "start", "start_tensions", "load_schedule"];
+            let shared = [
+                "signal",
+                "start",
+                "start_tensions",
+                "start_q",
+                "start_qd",
+                "load_schedule",
+            ];
             x.retain(|k, _| shared.contains(&k.as_str()));
             y.retain(|k, _| shared.contains(&k.as_str()));
         }

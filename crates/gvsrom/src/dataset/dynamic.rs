@@ -91,11 +91,7 @@ pub fn run(
         duration,
         sample_rate: args.sample_rate.unwrap_or(100.0),
         input,
-        start: if args.from_equilibrium {
-            Start::Equilibrium
-        } else {
-            Start::Rest
-        },
+        start: Start::rest_or_equilibrium(args.from_equilibrium),
         integrator: IntegratorOptions {
             method: method.clone(),
             jacobian: OdeJacobian::Structured,

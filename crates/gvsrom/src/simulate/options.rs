@@ -130,6 +130,18 @@ pub enum Start {
     State { q: Vec<f64>, qd: Vec<f64> },
 }
 
+impl Start {
+    /// [`Start::Equilibrium`] if `from_equilibrium` (the `--from-equilibrium` flag), else
+    /// [`Start::Rest`].
+    pub fn rest_or_equilibrium(from_equilibrium: bool) -> Start {
+        if from_equilibrium {
+            Start::Equilibrium
+        } else {
+            Start::Rest
+        }
+    }
+}
+
 /// Options of a dynamics run.
 #[derive(Debug, Clone)]
 pub struct SimulateOptions {
