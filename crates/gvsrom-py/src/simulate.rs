@@ -36,6 +36,85 @@ pub struct Args<'a> {
     pub fixed_step: Option<f64>,
 }
 
+#[pymethods]
+impl Robot {
+    /// Simulates the dynamics as ``gvsrom simulate`` does (stiff adaptive integrator), keeping the
+    /// samples in memory. Ctrl-C interrupts it (``KeyboardInterrupt``).
+    ///
+    /// Parameters
+    /// ----------
+    /// duration : float
+    ///     Simulated time [s].
+    /// sample_rate : float
+    ///     Output samples per second [Hz].
+    /// input : array_like of float, shape (k, 1 + n_actuators), or callable, optional
+    ///     Rows ``t, u_1, …, u_na`` (times ascending from 0), held piecewise constant (or linear
+    ///     with ``interpolate``); or a callable ``u(t) -> array of n_actuators tensions`` (or one
+    ///     number for all), called by the integrator at every time it evaluates (in any order: a
+    ///     rejected step goes back in time); an exception it raises stops the run and propagates.
+    ///     Default: the scenario's tensions, constant.
+    /// interpolate : bool
+    ///     Interpolate ``input`` rows linearly.
+    /// from_equilibrium : bool
+    ///     Start at the static equilibrium under the scenario's tensions (else straight at rest).
+    /// q0, qd0 : array_like of float, shape (n,), optional
+    ///     Start at this state instead (``qd0`` zeros if not given): the coordinates of the model
+    ///     that runs (the reduced model's with one attached; an autoencoder's inside its training
+    ///     encodings), e.g. ``tr["q"][-1], tr["qd"][-1]`` of an earlier run, to continue it under
+    ///     another input — a controller's loop, one control period per call with the tensions held.
+    /// method : str
+    ///     ``"auto"``, ``"ndf"``, ``"sdirk"`` or ``"galpha"`` (``--method``).
+    /// rtol, atol : float
+    ///     Tolerances of the adaptive integrator (default rtol: chosen by ``method``).
+    /// fixed_step : float, optional
+    ///     A fixed step [s]: the fixed-step BDF2 (``--fixed-step``) instead of an adaptive method;
+    ///     its cost is set by the number of steps, its accuracy by the step (not checked).
+    ///
+    /// Returns
+    /// -------
+    /// dict
+    ///     ``t`` (k,), ``q``/``qd`` (k, n), ``u`` (k, n_a), ``tip_position`` (k, 3),
+    ///     ``tip_rotation`` (k, 3, 3), ``strain`` (k, p, 6), ``strain_x`` (p,), ``centerline``
+    ///     (k, c, 3), ``centerline_x`` (c,), and ``steps``, ``failed_steps``, ``wall_time_s``.
+    ///
+    /// Raises
+    /// ------
+    /// GvsromError
+    ///     For bad options or input, or an integrator failure (with the samples computed).
+    #[pyo3(signature = (duration, sample_rate=100.0, input=None, interpolate=false, from_equilibrium=false, q0=None, qd0=None, method="auto", rtol=None, atol=1e-6, fixed_step=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn simulate<'py>(
+        &self,
+        py: Python<'py>,
+        duration: f64,
+        sample_rate: f64,
+        input: Option<Bound<'_, PyAny>>,
+        interpolate: bool,
+        from_equilibrium: bool,
+        q0: Option<arrays::In1<'_>>,
+        qd0: Option<arrays::In1<'_>>,
+        method: &str,
+        rtol: Option<f64>,
+        atol: f64,
+        fixed_step: Option<f64>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let args = Args {
+            duration,
+            sample_rate,
+            input,
+            interpolate,
+            from_equilibrium,
+            q0: q0.as_ref().map(arrays::vec1),
+            qd0: qd0.as_ref().map(arrays::vec1),
+            method,
+            rtol,
+            atol,
+            fixed_step,
+        };
+        run(self, py, args)
+    }
+}
+
 fn method(name: &str) -> PyResult<MethodChoice> {
     Ok(match name {
         "auto" => MethodChoice::Auto,
