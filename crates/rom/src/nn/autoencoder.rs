@@ -137,6 +137,83 @@ impl Autoencoder {
         opts: &TrainOptions,
         progress: Progress,
     ) -> Result<(Self, TrainReport), NnError> {
+        Self::fit_from(None, data, rates, metric, n_features, opts, progress)
+    }
+
+    /// Trains on, from this autoencoder's weights instead of a Glorot initialisation: more epochs
+    /// of the same fit, a fine-tuning on new snapshots of the same layout, or another loss (another
+    /// `λ`, say) from a network found elsewhere. The model's scaling is kept (so the loss is
+    /// measured in the units the network was built in) and `opts.weighting` is not used; the
+    /// architecture and decoder form of `opts` must be this model's. `opts.seed` still draws the
+    /// validation split and the shuffles, as in [`Autoencoder::train_with_metric`].
+    pub fn train_on(
+        &self,
+        data: &[f64],
+        rates: Option<&[f64]>,
+        metric: Option<Arc<RowMetric>>,
+        opts: &TrainOptions,
+        progress: Progress,
+    ) -> Result<(Self, TrainReport), NnError> {
+        let own_hidden = self.encoder.n_layers() + self.decoder.n_layers() - 1;
+        let own_sizes: Vec<usize> = self
+            .encoder
+            .layer_sizes()
+            .iter()
+            .chain(&self.decoder.layer_sizes()[1..])
+            .copied()
+            .collect();
+        let sizes = Self::architecture(self.n_features(), self.latent(), own_hidden)?;
+        if own_sizes != sizes {
+            return Err(NnError::Mismatch {
+                what: "the model's units vs the paper's architecture of its latent size and depth",
+                got: own_sizes.iter().sum(),
+                expected: sizes.iter().sum(),
+            });
+        }
+        let checks = [
+            ("options' latent vs the model's", opts.latent, self.latent()),
+            (
+                "options' hidden_layers vs the model's",
+                opts.hidden_layers,
+                own_hidden,
+            ),
+            (
+                "options' decoder form (0 plain, 1 scaled) vs the model's",
+                opts.decoder as usize,
+                self.form as usize,
+            ),
+        ];
+        for (what, got, expected) in checks {
+            if got != expected {
+                return Err(NnError::Mismatch {
+                    what,
+                    got,
+                    expected,
+                });
+            }
+        }
+        Self::fit_from(
+            Some(self),
+            data,
+            rates,
+            metric,
+            self.n_features(),
+            opts,
+            progress,
+        )
+    }
+
+    /// The fit of [`Autoencoder::train_with_metric`] (`start` None: Glorot weights and the
+    /// training rows' scaling) and [`Autoencoder::train_on`] (`start`'s weights and scaling).
+    fn fit_from(
+        start_from: Option<&Autoencoder>,
+        data: &[f64],
+        rates: Option<&[f64]>,
+        metric: Option<Arc<RowMetric>>,
+        n_features: usize,
+        opts: &TrainOptions,
+        progress: Progress,
+    ) -> Result<(Self, TrainReport), NnError> {
         let start = Instant::now();
         opts.validate()?;
         let beta = opts.rate_weight;
@@ -174,9 +251,21 @@ impl Autoencoder {
             .windows(2)
             .map(|s| Layer::glorot(s[0], s[1], &mut rng))
             .collect();
+        if let Some(init) = start_from {
+            layers = init
+                .encoder
+                .layers()
+                .iter()
+                .chain(init.decoder.layers())
+                .cloned()
+                .collect();
+        }
         let (train, val) = split_rows(rows, opts.validation_fraction, &mut rng);
-        let mut scaling = Scaling::from_rows(data, n_features, &train, &opts.weighting);
-        if opts.decoder == DecoderForm::Scaled {
+        let mut scaling = match start_from {
+            Some(init) => init.scaling.clone(),
+            None => Scaling::from_rows(data, n_features, &train, &opts.weighting),
+        };
+        if opts.decoder == DecoderForm::Scaled && start_from.is_none() {
             // x̂ = z₁ s ⊙ y: no mean, so that z₁ = 0 is the rest state
             scaling = Scaling::new(vec![0.0; n_features], scaling.scale().to_vec())?;
         }

@@ -559,3 +559,82 @@ fn a_scaled_decoder_is_trained_uncentred_and_decodes_z1_zero_to_rest() {
     let rms = (sq(&data, &vec![0.0; data.len()]) / data.len() as f64).sqrt();
     assert!(rmse < 0.025 * rms, "rmse {rmse} vs rms {rms} ({report:?})");
 }
+
+/// `Autoencoder::train_on` starts from the model's weights and scaling: 40 more epochs of a
+/// 40-epoch model fit better than the 40-epoch model, and a run that ignored the weights would
+/// repeat the fresh run bit for bit (same seed, same data); a fine-tuning on a subset keeps the
+/// model's scaling; an architecture or decoder that is not the model's is refused, naming it.
+#[test]
+fn training_on_from_a_model_continues_its_fit_in_its_own_scaling() {
+    let (rows, n) = (200, 30);
+    let data = one_parameter_family(rows, n, 5);
+    let opts = TrainOptions {
+        latent: 1,
+        hidden_layers: 3,
+        epochs: 40,
+        batch_size: 16,
+        learning_rate: 3e-3,
+        patience: None,
+        fine_tune: FineTune::None,
+        seed: 1,
+        ..TrainOptions::default()
+    };
+    let (first, r1) = Autoencoder::train(&data, n, &opts, &mut quiet()).unwrap();
+    let (again, r2) = first
+        .train_on(&data, None, None, &opts, &mut quiet())
+        .unwrap();
+    assert!(
+        r2.final_train_loss < 0.8 * r1.final_train_loss,
+        "40 + 40 epochs: loss {} against {} after 40",
+        r2.final_train_loss,
+        r1.final_train_loss
+    );
+    assert_eq!(again.scaling(), first.scaling());
+
+    // fine-tuning on the first 50 rows: their spread is not the data's, the scaling stays
+    let (tuned, _) = first
+        .train_on(&data[..50 * n], None, None, &opts, &mut quiet())
+        .unwrap();
+    assert_eq!(tuned.scaling(), first.scaling());
+    let fresh = Scaling::from_rows(
+        &data[..50 * n],
+        n,
+        &(0..50).collect::<Vec<_>>(),
+        &opts.weighting,
+    );
+    assert_ne!(&fresh, first.scaling());
+
+    for (bad, field) in [
+        (
+            TrainOptions {
+                latent: 2,
+                ..opts.clone()
+            },
+            "latent",
+        ),
+        (
+            TrainOptions {
+                hidden_layers: 5,
+                ..opts.clone()
+            },
+            "hidden_layers",
+        ),
+        (
+            TrainOptions {
+                decoder: DecoderForm::Scaled,
+                ..opts.clone()
+            },
+            "decoder form",
+        ),
+    ] {
+        let err = first
+            .train_on(&data, None, None, &bad, &mut quiet())
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(field), "{field}: {err}");
+    }
+    let err = first
+        .train_on(&data[..n * 10 - 1], None, None, &opts, &mut quiet())
+        .unwrap_err();
+    assert!(matches!(err, NnError::DataShape { .. }), "{err}");
+}
