@@ -16,6 +16,11 @@ and not from gvsrom's code, to judge the Rust trainer against a standard stack:
   input by G (the decoder's target stays scaled), to test whether sharper first-layer units help;
   `--odd` drops the biases and the centring: the autoencoder is then an odd function, as IV-B's
   family is (`x(c, −M) = −x(c, M)`), so each half of the family is learnt once for both;
+- `--log-gain`: the same network and loss, optimised in another parametrisation: each unit's
+  weights are `W = e^g v` (a gain per unit, `g` from 0) and Adam moves `g`, `v` and `b`; the
+  penalty is still on `W`. Adam moves a weight by about one learning rate per step, so a unit
+  grows sharp only linearly in time; through `g` it grows geometrically (a test of whether the
+  step bound is what keeps a trained r = 1 encoder from tearing IV-B's family sharply);
 - Adam (optax defaults β = 0.9/0.999, ε = 1e-8), shuffled mini-batches, a fixed epoch budget and
   the weights with the lowest validation loss kept; the rate constant, or decaying exponentially
   to `--final-lr-factor` of itself over the run.
@@ -98,9 +103,14 @@ def init(sizes: list[int], key) -> list[tuple]:
     return params
 
 
+def effective(params):
+    """The network's `(W, b)` per layer: with `--log-gain` the layers are `(v, g, b)`, `W = e^g v`."""
+    return [(p[0] * jnp.exp(p[1]), p[2]) if len(p) == 3 else p for p in params]
+
+
 def forward(params, x, tanh_flags, odd=False):
     h = x
-    for (w, b), t in zip(params, tanh_flags):
+    for (w, b), t in zip(effective(params), tanh_flags):
         h = h @ w if odd else h @ w + b
         if t:
             h = jnp.tanh(h)
@@ -133,6 +143,9 @@ def main() -> None:
         "--input-gain", type=float, default=1.0, help="multiply the encoder's input by this"
     )
     ap.add_argument("--odd", action="store_true", help="no biases, no centring: an odd network")
+    ap.add_argument(
+        "--log-gain", action="store_true", help="optimise W = e^g v: a log-gain g per unit"
+    )
     ap.add_argument("--save", type=Path, help="write the kept weights (flattened, .npy)")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--json", action="store_true", help="print one JSON line instead of text")
@@ -163,11 +176,13 @@ def main() -> None:
     half = (args.hidden_layers + 1) // 2
     flags = [k + 1 < half for k in range(half)] * 2
     params = init(sizes, jax.random.PRNGKey(args.seed))
+    if args.log_gain:
+        params = [(w, jnp.zeros(w.shape[1]), b) for w, b in params]
     gain = args.input_gain
 
     def loss(p, batch):
         rec = jnp.mean((forward(p, gain * batch, flags, args.odd) - batch) ** 2)
-        return rec + args.lam / n * sum(jnp.sum(w * w) for w, _ in p), rec
+        return rec + args.lam / n * sum(jnp.sum(w * w) for w, _ in effective(p)), rec
 
     steps = args.epochs * -(-len(train) // args.batch_size)
     rate = (
@@ -219,6 +234,9 @@ def main() -> None:
         "seed": args.seed,
         "input_gain": gain,
         "odd": args.odd,
+        "log_gain": args.log_gain,
+        "largest_weight": float(max(jnp.max(jnp.abs(w)) for w, _ in effective(best))),
+        "sum_squared_weights": float(sum(jnp.sum(w * w) for w, _ in effective(best))),
         "latent": args.latent,
         "rmse_full": rmse,
         "epoch_s": epoch_s,
@@ -226,7 +244,7 @@ def main() -> None:
         "backend": jax.default_backend(),
     }
     if args.save:
-        np.save(args.save, np.asarray(ravel_pytree(best)[0]))
+        np.save(args.save, np.asarray(ravel_pytree(effective(best))[0]))
     if args.json:
         print(json.dumps(out))
     else:

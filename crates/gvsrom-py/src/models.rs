@@ -397,6 +397,24 @@ pub fn pod(
     load_model(py, summary.path, false)
 }
 
+/// The ``init`` argument of ``train``: a ``Model`` or its directory; a ``TypeError`` naming
+/// ``init`` otherwise.
+fn model_path(arg: &Bound<'_, PyAny>) -> PyResult<PathBuf> {
+    if let Ok(m) = arg.extract::<PyRef<'_, Model>>() {
+        return Ok(m.dir.clone());
+    }
+    arg.extract::<PathBuf>().map_err(|_| {
+        let kind = arg
+            .get_type()
+            .name()
+            .map(|n| n.to_string())
+            .unwrap_or_else(|_| "?".into());
+        pyo3::exceptions::PyTypeError::new_err(format!(
+            "invalid `init`: got a {kind}; accepted: a Model or a model directory (str or os.PathLike)"
+        ))
+    })
+}
+
 /// The ``dataset`` argument of ``pod`` and ``train``: a dataset (a ``Dataset`` or its directory)
 /// or a sequence of them, of one scenario, whose snapshots are combined in order; a ``TypeError``
 /// naming ``dataset`` otherwise.
@@ -446,23 +464,23 @@ const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 ///     order.
 /// out : str or os.PathLike
 ///     The new model directory.
-/// latent : int
-///     Latent size r (reduced coordinates).
-/// hidden_layers : int
-///     Hidden layers of the whole autoencoder (odd: 3, 5, 7…).
+/// latent : int, optional
+///     Latent size r (reduced coordinates); default 1, or the ``init`` model's.
+/// hidden_layers : int, optional
+///     Hidden layers of the whole autoencoder (odd: 3, 5, 7…); default 7, or the ``init`` model's.
 /// epochs, batch_size, learning_rate, lambda_, validation_fraction, patience, lr_reductions,
 /// lbfgs_iterations, seed
 ///     As the ``gvsrom train`` options of the same names (``lambda_`` is ``--lambda``; patience 0:
 ///     never stop early).
-/// loss : str
-///     ``"energy"``, ``"physical"`` or ``"standardized"``.
+/// loss : str, optional
+///     ``"energy"`` (default), ``"physical"`` or ``"standardized"``; with ``init``, the model's.
 /// sample_weighting : str
 ///     ``"uniform"`` (eq. 15) or ``"relative"``: each snapshot's squared error over its own
 ///     squared norm, so that small loads are fitted as closely as large ones.
 /// relative_floor : float
 ///     The relative weighting's floor, a fraction of the largest snapshot norm in (0, 1].
-/// decoder : str
-///     ``"plain"`` (the paper's, x̂ = D(z)) or ``"scaled"`` (x̂ = z₁ D(z): every code with z₁ = 0
+/// decoder : str, optional
+///     Default ``"plain"``, or the ``init`` model's: ``"plain"`` (the paper's, x̂ = D(z)) or ``"scaled"`` (x̂ = z₁ D(z): every code with z₁ = 0
 ///     decodes to the straight rod, for snapshots that shrink to rest as their load vanishes).
 /// rate_weight : float
 ///     Weight β ≥ 0 of the strain-rate term (``--rate-weight``): the autoencoder's tangent map must
@@ -473,6 +491,10 @@ const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 /// kinetic_weight : float
 ///     ``--kinetic-weight``: weight κ ≥ 0 of the kinetic-energy norm (errors weighed by each
 ///     snapshot's mass matrix M(q)); needs ``rate_weight`` > 0. 0: none.
+/// init : Model or str or os.PathLike, optional
+///     ``--init``: start from this autoencoder model's weights and scaling (more epochs, or a
+///     fine-tuning on new snapshots of its scenario); its latent size, hidden layers, decoder and
+///     loss are kept (give none of them, or the model's).
 /// force : bool
 ///     Replace ``out`` if it is an earlier gvsrom output.
 ///
@@ -481,14 +503,14 @@ const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 /// Model
 ///     The new model.
 #[pyfunction]
-#[pyo3(signature = (dataset, out, latent=1, hidden_layers=7, epochs=2000, batch_size=64, learning_rate=1e-3, lambda_=1e-4, validation_fraction=0.1, patience=50, lr_reductions=4, lbfgs_iterations=300, seed=0, loss="energy", sample_weighting="uniform", relative_floor=0.1, decoder="plain", rate_weight=0.0, lr_decay=None, kinetic_weight=0.0, force=false))]
+#[pyo3(signature = (dataset, out, latent=None, hidden_layers=None, epochs=2000, batch_size=64, learning_rate=1e-3, lambda_=1e-4, validation_fraction=0.1, patience=50, lr_reductions=4, lbfgs_iterations=300, seed=0, loss=None, sample_weighting="uniform", relative_floor=0.1, decoder=None, rate_weight=0.0, lr_decay=None, kinetic_weight=0.0, init=None, force=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn train(
     py: Python<'_>,
     dataset: &Bound<'_, PyAny>,
     out: PathBuf,
-    latent: usize,
-    hidden_layers: usize,
+    latent: Option<usize>,
+    hidden_layers: Option<usize>,
     epochs: usize,
     batch_size: usize,
     learning_rate: f64,
@@ -498,28 +520,39 @@ pub fn train(
     lr_reductions: usize,
     lbfgs_iterations: usize,
     seed: u64,
-    loss: &str,
+    loss: Option<&str>,
     sample_weighting: &str,
     relative_floor: f64,
-    decoder: &str,
+    decoder: Option<&str>,
     rate_weight: f64,
     lr_decay: Option<f64>,
     kinetic_weight: f64,
+    init: Option<&Bound<'_, PyAny>>,
     force: bool,
 ) -> PyResult<Model> {
     use gvsrom::reduce::Loss;
     use rom::nn::TrainOptions;
-    let loss = [Loss::Energy, Loss::Physical, Loss::Standardized]
-        .into_iter()
-        .find(|l| l.name() == loss)
-        .ok_or_else(|| {
+    let init = match init {
+        Some(m) => Some(gvsrom::reduce::start_model(&model_path(m)?).map_err(errors::any)?),
+        None => None,
+    };
+    let loss = match loss {
+        Some(name) => Loss::from_name(name).ok_or_else(|| {
             invalid(format!(
-                "invalid `loss`: `{loss}` (accepted: energy, physical, standardized)"
+                "invalid `loss`: `{name}` (accepted: energy, physical, standardized)"
             ))
-        })?;
+        })?,
+        None => init.as_ref().map(|s| s.loss).unwrap_or_default(),
+    };
+    let decoder = match decoder {
+        Some(name) => gvsrom::reduce::decoder_form(name).map_err(errors::scenario)?,
+        None => init.as_ref().map(|s| s.decoder).unwrap_or_default(),
+    };
     let options = TrainOptions {
-        latent,
-        hidden_layers,
+        latent: latent.or(init.as_ref().map(|s| s.latent)).unwrap_or(1),
+        hidden_layers: hidden_layers
+            .or(init.as_ref().map(|s| s.hidden_layers))
+            .unwrap_or(7),
         lambda: lambda_,
         epochs,
         batch_size,
@@ -532,7 +565,7 @@ pub fn train(
         fine_tune: rom::nn::FineTune::lbfgs(lbfgs_iterations),
         sample_weighting: gvsrom::reduce::sample_weighting(sample_weighting, relative_floor)
             .map_err(errors::scenario)?,
-        decoder: gvsrom::reduce::decoder_form(decoder).map_err(errors::scenario)?,
+        decoder,
         rate_weight,
         ..TrainOptions::default()
     };
@@ -555,6 +588,7 @@ pub fn train(
         };
         gvsrom::reduce::train(
             &dataset,
+            init.as_ref(),
             &options,
             loss,
             kinetic_weight,

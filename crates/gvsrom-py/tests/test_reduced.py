@@ -305,3 +305,18 @@ def test_reconstruction_of_its_own_data_is_what_pod_discards(dataset, pod_model,
     assert p.returncode == 0, p.stderr
     with pytest.raises(ValueError, match=r"invalid `DATASET`.*soft-beam.*single-tendon"):
         pod_model.reconstruction(beam)
+
+
+def test_a_training_from_a_model_continues_it_and_keeps_its_architecture(dataset, ae_model, tmp_path):
+    # no latent or hidden_layers given: the start model's (r = 1, 3 hidden layers)
+    more = gvsrom.train(dataset, tmp_path / "more", epochs=40, patience=0, lbfgs_iterations=20,
+                        seed=3, init=ae_model)
+    a, b = ae_model.meta["training"], more.meta["training"]
+    assert more.latent == 1 and b["hidden_layers"] == 3 and b["loss"] == a["loss"]
+    # from random weights the same seed would repeat the start model's training exactly
+    assert b["final_train_loss"] < 0.9 * a["final_train_loss"], (a, b)
+    assert more.meta["provenance"]["model"]["path"] == str(ae_model.path)
+    with pytest.raises(gvsrom.GvsromError, match=r"--latent.*2, but the start model.*has 1"):
+        gvsrom.train(dataset, tmp_path / "never", latent=2, epochs=5, init=str(ae_model.path))
+    with pytest.raises(TypeError, match=r"invalid `init`: got a int"):
+        gvsrom.train(dataset, tmp_path / "never", epochs=5, init=3)

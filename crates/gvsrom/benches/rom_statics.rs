@@ -128,6 +128,7 @@ fn model_dir() -> PathBuf {
     let mut progress = |_: usize, _: f64, _: Option<f64>| ControlFlow::Continue(());
     reduce::train(
         &[&dataset],
+        None,
         &options,
         reduce::Loss::default(),
         0.0,

@@ -177,6 +177,12 @@ impl Provenance {
         Ok(self)
     }
 
+    /// The model a training started from (`train --init`), by its manifest's hashes.
+    pub fn start_model(mut self, dir: &Path) -> Result<Self, ScenarioError> {
+        self.model = Some(DirOrigin::of("--init", dir)?);
+        Ok(self)
+    }
+
     /// `compare`'s reference and run trajectories, by their manifests' hashes.
     pub fn compared(mut self, reference: &Path, run: &Path) -> Result<Self, ScenarioError> {
         self.reference = Some(DirOrigin::of("REFERENCE", reference)?);

@@ -266,8 +266,8 @@ def pod(
 def train(
     dataset: Dataset | _Path | Sequence[Dataset | _Path],
     out: _Path,
-    latent: int = 1,
-    hidden_layers: int = 7,
+    latent: int | None = None,
+    hidden_layers: int | None = None,
     epochs: int = 2000,
     batch_size: int = 64,
     learning_rate: float = 0.001,
@@ -277,13 +277,14 @@ def train(
     lr_reductions: int = 4,
     lbfgs_iterations: int = 300,
     seed: int = 0,
-    loss: str = "energy",
+    loss: str | None = None,
     sample_weighting: str = "uniform",
     relative_floor: float = 0.1,
-    decoder: str = "plain",
+    decoder: str | None = None,
     rate_weight: float = 0.0,
     lr_decay: float | None = None,
     kinetic_weight: float = 0.0,
+    init: Model | _Path | None = None,
     force: bool = False,
 ) -> Model: ...
 

@@ -41,13 +41,19 @@ pub struct TrainArgs {
     /// (e.g. a babbling trajectory and static equilibria of the same input range).
     #[arg(value_name = "DATASET", required = true)]
     pub datasets: Vec<PathBuf>,
-    /// Latent size r (reduced coordinates).
-    #[arg(long, value_name = "R", default_value_t = 1)]
-    pub latent: usize,
+    /// Start from this autoencoder model's weights and scaling instead of random weights: more
+    /// epochs for a model that was still improving or was interrupted, or a fine-tuning on new
+    /// snapshots of its scenario. Its latent size, hidden layers, decoder and loss are kept (give
+    /// none of them, or the model's); the new model records its start in `provenance.model`.
+    #[arg(long, value_name = "MODEL")]
+    pub init: Option<PathBuf>,
+    /// Latent size r (reduced coordinates) [default: 1; with `--init`, the model's].
+    #[arg(long, value_name = "R")]
+    pub latent: Option<usize>,
     /// Hidden layers of the whole autoencoder (odd: 3, 5, 7…); layer sizes halve from the snapshot
-    /// size towards the latent size (paper Section III).
-    #[arg(long, value_name = "N", default_value_t = 7)]
-    pub hidden_layers: usize,
+    /// size towards the latent size (paper Section III) [default: 7; with `--init`, the model's].
+    #[arg(long, value_name = "N")]
+    pub hidden_layers: Option<usize>,
     /// Maximum Adam epochs.
     #[arg(long, default_value_t = 2000)]
     pub epochs: usize,
@@ -84,9 +90,9 @@ pub struct TrainArgs {
     /// How each strain value's error weighs in the loss: `standardized` (each point and component
     /// by its own spread), `physical` (plain squared error, the RMSE of Table I) or `energy`
     /// (weighted by the section stiffness: the strain-energy norm, which the reduced model's
-    /// elastic force feels).
-    #[arg(long, value_enum, default_value_t = reduce::Loss::Energy)]
-    pub loss: reduce::Loss,
+    /// elastic force feels) [default: energy; with `--init`, the model's].
+    #[arg(long, value_enum)]
+    pub loss: Option<reduce::Loss>,
     /// How each snapshot's error weighs: `uniform` (eq. 15 as the paper writes it) or `relative`
     /// (each snapshot by the inverse of its own squared norm, floored at `--relative-floor` of the
     /// largest: the relative error, so that small loads are fitted as closely as large ones).
@@ -98,9 +104,10 @@ pub struct TrainArgs {
     pub relative_floor: f64,
     /// The decoder's form: `plain` (the paper's, x̂ = D(z)) or `scaled` (x̂ = z₁ D(z): every code with
     /// z₁ = 0 decodes to the straight rod, for snapshot families that shrink to rest as their load
-    /// vanishes, such as a load of varying magnitude and position).
-    #[arg(long, default_value = "plain", value_parser = rom::nn::DecoderForm::NAMES)]
-    pub decoder: String,
+    /// vanishes, such as a load of varying magnitude and position) [default: plain; with `--init`,
+    /// the model's].
+    #[arg(long, value_parser = rom::nn::DecoderForm::NAMES)]
+    pub decoder: Option<String>,
     /// Weight β of the strain-rate term (beyond the paper): the autoencoder's tangent map must carry
     /// each trajectory sample's strain rate, `‖J(x) ẋ − ẋ‖²` added to the loss with weight β (rates
     /// by central differences of the trajectory's samples; equilibria are at rest). It gives the
@@ -180,9 +187,16 @@ fn datasets_line(out: &mut impl Write, datasets: &[(PathBuf, usize)]) -> Result<
 
 pub(super) fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
     use rom::nn::TrainOptions;
+    let init = args.init.as_deref().map(reduce::start_model).transpose()?;
+    let decoder = match &args.decoder {
+        Some(name) => reduce::decoder_form(name)?,
+        None => init.as_ref().map_or(Default::default(), |s| s.decoder),
+    };
     let options = TrainOptions {
-        latent: args.latent,
-        hidden_layers: args.hidden_layers,
+        latent: args.latent.or(init.as_ref().map(|s| s.latent)).unwrap_or(1),
+        hidden_layers: (args.hidden_layers)
+            .or(init.as_ref().map(|s| s.hidden_layers))
+            .unwrap_or(7),
         lambda: args.lambda,
         epochs: args.epochs,
         batch_size: args.batch_size,
@@ -194,10 +208,13 @@ pub(super) fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
         lr_decay: args.lr_decay,
         fine_tune: rom::nn::FineTune::lbfgs(args.lbfgs_iterations),
         sample_weighting: reduce::sample_weighting(&args.sample_weighting, args.relative_floor)?,
-        decoder: reduce::decoder_form(&args.decoder)?,
+        decoder,
         rate_weight: args.rate_weight,
         ..TrainOptions::default()
     };
+    let loss = (args.loss)
+        .or(init.as_ref().map(|s| s.loss))
+        .unwrap_or_default();
     let signal = interrupt_flag();
     let bar = gvsrom::dataset::progress_bar_of(args.epochs as u64, "epochs");
     let mut progress = |epoch: usize, train: f64, val: Option<f64>| {
@@ -217,8 +234,9 @@ pub(super) fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
     };
     let s = reduce::train(
         &args.datasets,
+        init.as_ref(),
         &options,
-        args.loss,
+        loss,
         args.kinetic_weight,
         &args.out,
         args.force,

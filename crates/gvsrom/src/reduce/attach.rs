@@ -23,8 +23,10 @@ pub struct AttachOptions {
     pub tensions_from_signal: bool,
 }
 
-/// Checks that `model` was learned on the layout of `built` (points, active components, HOM size).
+/// Checks that `model` (given as option `field`) was learned on the layout of `built` (points,
+/// active components, HOM size).
 pub(super) fn check_layout(
+    field: &str,
     built: &Built,
     model: &ReducedModel,
     path: &Path,
@@ -35,7 +37,7 @@ pub(super) fn check_layout(
     let same_points = same_abscissae(&ml.strain_x, &l.strain_x);
     if !same_points || ml.active != names || ml.hom_dof != built.model.n_dof() {
         return Err(invalid(
-            "--model",
+            field,
             format!(
                 "`{}` was learned on {} points × [{}] with a {}-DOF basis (scenario `{}`); this scenario has {} points × [{}] with {} DOF{}",
                 path.display(),
@@ -114,7 +116,7 @@ pub fn attach(
         tensions_from_signal,
     } = options;
     let model = ReducedModel::load(dir)?;
-    check_layout(built, &model, dir)?;
+    check_layout("--model", built, &model, dir)?;
     let outside = super::validity::check(built, table, &model, tensions_from_signal)?;
     if !outside.is_empty() && !extrapolate {
         return Err(invalid(

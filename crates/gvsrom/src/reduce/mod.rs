@@ -10,7 +10,7 @@
 //! linear basis) or `Φ_s P D(q_r)` (autoencoder).
 //!
 //! Files: [`pod`](pod()) and [`train`](train()) build models from one or more datasets (`pod.rs`,
-//! `train.rs`); `sources.rs` gathers and checks their snapshots; `anchors.rs` holds the training
+//! `train.rs`, and `start.rs`: a training from a model's weights); `sources.rs` gathers and checks their snapshots; `anchors.rs` holds the training
 //! samples kept as initial guesses; `kinetic.rs` the mass matrices of `train --kinetic-weight`;
 //! `attach.rs` binds a model to a scenario; this file the steps
 //! both commands share.
@@ -21,6 +21,7 @@ mod evaluate;
 mod kinetic;
 mod pod;
 mod sources;
+mod start;
 mod train;
 pub mod validity;
 
@@ -30,6 +31,7 @@ pub use anchors::{anchor_guess, solve_anchors, AnchorInput, AnchorProblem, Initi
 pub use attach::{attach, attach_resolved, attach_source, parameterization, AttachOptions};
 pub use evaluate::{reconstruction, Reconstruction};
 pub use pod::{pod, PodSummary};
+pub use start::{start_model, StartModel};
 pub use train::{
     decoder_form, sample_weighting, train, zero_anchor_rows, Loss, TrainSummary, SAMPLE_WEIGHTINGS,
 };

@@ -3,6 +3,7 @@
 //! model.
 
 use super::sources::Sources;
+use super::start::StartModel;
 use super::{equilibrium_anchors, invalid, model_layout, projection_of};
 use crate::build::Built;
 use crate::error::ScenarioError;
@@ -69,6 +70,13 @@ pub enum Loss {
 }
 
 impl Loss {
+    /// The loss of a [`Loss::name`].
+    pub fn from_name(name: &str) -> Option<Loss> {
+        [Loss::Standardized, Loss::Physical, Loss::Energy]
+            .into_iter()
+            .find(|l| l.name() == name)
+    }
+
     /// The name used on the command line and in `meta.json`.
     pub fn name(self) -> &'static str {
         match self {
@@ -94,8 +102,12 @@ impl Loss {
 /// epoch; `Break` stops training early (the best weights so far are kept and saved, marked by the
 /// stop reason). With `kinetic_weight` κ > 0 (and a rate term) the errors are also measured in
 /// the kinetic-energy norm of each row's own mass matrix (`reduce::kinetic`, [`rom::nn::metric`]).
+/// With `init` the training starts from that model's weights and scaling (`--init`, [`StartModel`]):
+/// its architecture, decoder form and loss must be `options`' and `loss`.
+#[allow(clippy::too_many_arguments)]
 pub fn train<P: AsRef<Path>>(
     datasets: &[P],
+    init: Option<&StartModel>,
     options: &TrainOptions,
     loss: Loss,
     kinetic_weight: f64,
@@ -103,10 +115,16 @@ pub fn train<P: AsRef<Path>>(
     force: bool,
     progress: &mut dyn FnMut(usize, f64, Option<f64>) -> ControlFlow<()>,
 ) -> Result<TrainSummary, anyhow::Error> {
-    let provenance = crate::provenance::Provenance::of_command();
+    let mut provenance = crate::provenance::Provenance::of_command();
+    if let Some(start) = init {
+        provenance = provenance.start_model(&start.dir)?;
+    }
     let src = Sources::load(datasets)?;
     let provenance = src.record(provenance)?.seed("training", options.seed);
     let built = &src.built;
+    if let Some(start) = init {
+        start.check(built, options, loss)?;
+    }
     let (layout, pm, p) = projection_of(built)?;
     let (x, rows, features) = (&src.x, src.rows(), src.features);
     let options = &TrainOptions {
@@ -168,14 +186,21 @@ pub fn train<P: AsRef<Path>>(
         )?)),
         false => None,
     };
-    let (ae, report) = Autoencoder::train_with_metric(
-        &training,
-        rates.as_deref(),
-        metric,
-        features,
-        options,
-        progress,
-    )
+    let (ae, report) = match init {
+        Some(start) => {
+            start
+                .autoencoder()
+                .train_on(&training, rates.as_deref(), metric, options, progress)
+        }
+        None => Autoencoder::train_with_metric(
+            &training,
+            rates.as_deref(),
+            metric,
+            features,
+            options,
+            progress,
+        ),
+    }
     .map_err(|e| train_error(&e))?;
     drop((training, rates));
     // one encoding per usable sample: its range, the anchors, and what the HOM basis cannot

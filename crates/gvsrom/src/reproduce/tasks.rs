@@ -288,6 +288,7 @@ pub fn train(
             let kinetic = c.kinetic_weight.unwrap_or(0.0);
             let s = reduce::train(
                 &[&data.path],
+                None,
                 &options,
                 c.loss,
                 kinetic,

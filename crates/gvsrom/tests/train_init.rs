@@ -1,0 +1,135 @@
+//! `gvsrom train --init MODEL`: a training that starts from a model's weights continues its fit,
+//! keeps its architecture, decoder and loss, records where it started, and refuses a start that
+//! does not fit (a POD model, another architecture or loss, a dataset of another layout).
+
+mod common;
+
+use common::{expect_error, json, run_ok, s, scratch, sweep_dataset};
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+/// 20 single-tendon equilibria at tensions in [-6, 3] N.
+fn dataset() -> &'static Path {
+    static D: OnceLock<PathBuf> = OnceLock::new();
+    D.get_or_init(|| sweep_dataset("init-ds20", "-6:3", 20))
+}
+
+/// `args` of a short `train` (3 hidden layers, 30 Adam epochs, no L-BFGS, seed 1) into `out`.
+fn train(out: &Path, extra: &[&str]) -> String {
+    let mut args = vec![
+        "train",
+        s(dataset()),
+        "--epochs",
+        "30",
+        "--lbfgs-iterations",
+        "0",
+        "--patience",
+        "0",
+        "--seed",
+        "1",
+        "--out",
+        s(out),
+    ];
+    args.extend_from_slice(extra);
+    run_ok(&args)
+}
+
+/// A 1-coordinate autoencoder of [`dataset`] after 30 epochs, physical loss.
+fn first() -> &'static Path {
+    static M: OnceLock<PathBuf> = OnceLock::new();
+    M.get_or_init(|| {
+        let dir = scratch("init-first");
+        train(&dir, &["--hidden-layers", "3", "--loss", "physical"]);
+        dir
+    })
+}
+
+fn training(model: &Path) -> serde_json::Value {
+    json(&model.join("meta.json"))["training"].clone()
+}
+
+#[test]
+fn a_training_from_a_model_continues_its_fit_and_records_its_start() {
+    let next = scratch("init-next");
+    // no --latent, --hidden-layers or --loss: the model's
+    train(&next, &["--init", s(first())]);
+    let (a, b) = (training(first()), training(&next));
+    assert_eq!(b["hidden_layers"], 3);
+    assert_eq!(b["loss"], "physical");
+    assert_eq!(b["encoder_sizes"], a["encoder_sizes"]);
+    let (la, lb) = (
+        a["final_train_loss"].as_f64().unwrap(),
+        b["final_train_loss"].as_f64().unwrap(),
+    );
+    // the same seed from random weights would repeat the first model's 30 epochs exactly
+    assert!(lb < 0.8 * la, "30 + 30 epochs: loss {lb}, after 30: {la}");
+    let start = &json(&next.join("meta.json"))["provenance"]["model"];
+    assert_eq!(start["path"], s(first()));
+    let manifest = &json(&first().join("meta.json"))["gvsrom"];
+    assert_eq!(start["meta_sha256"], manifest["meta_sha256"]);
+}
+
+#[test]
+fn a_start_that_does_not_fit_is_refused_by_name() {
+    let out = scratch("init-refused");
+    let base = |extra: &[&str]| -> Vec<String> {
+        let mut v: Vec<String> = ["train", s(dataset()), "--epochs", "5", "--out", s(&out)]
+            .map(String::from)
+            .to_vec();
+        v.extend(extra.iter().map(|e| e.to_string()));
+        v
+    };
+    let refused = |extra: &[&str], needles: &[&str]| {
+        let args = base(extra);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        expect_error(&args, needles);
+        assert!(!out.exists(), "a refused training wrote a model");
+    };
+    let m = s(first());
+    refused(
+        &["--init", m, "--latent", "2"],
+        &["--latent", "2, but the start model", "has 1"],
+    );
+    refused(
+        &["--init", m, "--hidden-layers", "5"],
+        &["--hidden-layers", "5", "has 3"],
+    );
+    refused(
+        &["--init", m, "--loss", "energy"],
+        &["--loss", "energy", "has physical"],
+    );
+    refused(
+        &["--init", m, "--decoder", "scaled"],
+        &["--decoder", "scaled", "has plain"],
+    );
+
+    let pod = scratch("init-pod");
+    run_ok(&["pod", s(dataset()), "--modes", "2", "--out", s(&pod)]);
+    refused(&["--init", s(&pod)], &["--init", "is a POD model"]);
+    refused(&["--init", s(&scratch("init-missing"))], &["init-missing"]);
+
+    // a dataset of another scenario: the model's points and basis are not its
+    let beam = scratch("init-beam");
+    run_ok(&[
+        "dataset",
+        "soft-beam",
+        "--sweep",
+        "loads.distributed.0.magnitude=1:2",
+        "--samples",
+        "3",
+        "--out",
+        s(&beam),
+    ]);
+    let args = [
+        "train",
+        s(&beam),
+        "--init",
+        m,
+        "--epochs",
+        "5",
+        "--out",
+        s(&out),
+    ];
+    expect_error(&args, &["--init", "was learned on", "single-tendon"]);
+    assert!(!out.exists());
+}
