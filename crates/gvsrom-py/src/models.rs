@@ -404,15 +404,19 @@ fn model_path(arg: &Bound<'_, PyAny>) -> PyResult<PathBuf> {
         return Ok(m.dir.clone());
     }
     arg.extract::<PathBuf>().map_err(|_| {
-        let kind = arg
-            .get_type()
-            .name()
-            .map(|n| n.to_string())
-            .unwrap_or_else(|_| "?".into());
         pyo3::exceptions::PyTypeError::new_err(format!(
-            "invalid `init`: got a {kind}; accepted: a Model or a model directory (str or os.PathLike)"
+            "invalid `init`: got a {}; accepted: a Model or a model directory (str or os.PathLike)",
+            type_name(arg)
         ))
     })
+}
+
+/// The name of `a`'s Python type, for a ``TypeError`` (``?`` if it has none).
+fn type_name(a: &Bound<'_, PyAny>) -> String {
+    a.get_type()
+        .name()
+        .map(|n| n.to_string())
+        .unwrap_or_else(|_| "?".into())
 }
 
 /// The ``dataset`` argument of ``pod`` and ``train``: a dataset (a ``Dataset`` or its directory)
@@ -426,13 +430,9 @@ fn dataset_paths(arg: &Bound<'_, PyAny>) -> PyResult<Vec<PathBuf>> {
         }
     };
     let refuse = |a: &Bound<'_, PyAny>| {
-        let kind = a
-            .get_type()
-            .name()
-            .map(|n| n.to_string())
-            .unwrap_or_else(|_| "?".into());
         pyo3::exceptions::PyTypeError::new_err(format!(
-            "invalid `dataset`: got a {kind}; accepted: a Dataset, a dataset directory (str or os.PathLike), or a sequence of them"
+            "invalid `dataset`: got a {}; accepted: a Dataset, a dataset directory (str or os.PathLike), or a sequence of them",
+            type_name(a)
         ))
     };
     if let Some(p) = one(arg) {

@@ -75,15 +75,7 @@ impl Autoencoder {
             ("decoder output vs encoder input", decoder.n_out(), n),
             ("scaling features vs encoder input", scaling.len(), n),
         ];
-        for (what, got, expected) in checks {
-            if got != expected {
-                return Err(NnError::Mismatch {
-                    what,
-                    got,
-                    expected,
-                });
-            }
-        }
+        all_match(&checks)?;
         Ok(Autoencoder {
             encoder,
             decoder,
@@ -183,15 +175,7 @@ impl Autoencoder {
                 self.form as usize,
             ),
         ];
-        for (what, got, expected) in checks {
-            if got != expected {
-                return Err(NnError::Mismatch {
-                    what,
-                    got,
-                    expected,
-                });
-            }
-        }
+        all_match(&checks)?;
         Self::fit_from(
             Some(self),
             data,
@@ -558,6 +542,18 @@ fn physical_rmse(
         }
     }
     (sum / (index.len() * n).max(1) as f64).sqrt()
+}
+
+/// The first `(what, got, expected)` of `checks` whose counts differ, as [`NnError::Mismatch`].
+fn all_match(checks: &[(&'static str, usize, usize)]) -> Result<(), NnError> {
+    match checks.iter().find(|(_, got, expected)| got != expected) {
+        Some(&(what, got, expected)) => Err(NnError::Mismatch {
+            what,
+            got,
+            expected,
+        }),
+        None => Ok(()),
+    }
 }
 
 #[cfg(test)]
