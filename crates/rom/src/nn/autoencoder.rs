@@ -187,8 +187,8 @@ impl Autoencoder {
         )
     }
 
-    /// The fit of [`Autoencoder::train_with_metric`] (`start` None: Glorot weights and the
-    /// training rows' scaling) and [`Autoencoder::train_on`] (`start`'s weights and scaling).
+    /// The fit of [`Autoencoder::train_with_metric`] (`start_from` None: Glorot weights and the
+    /// training rows' scaling) and [`Autoencoder::train_on`] (`start_from`'s weights and scaling).
     fn fit_from(
         start_from: Option<&Autoencoder>,
         data: &[f64],
