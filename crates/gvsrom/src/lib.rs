@@ -19,6 +19,7 @@ pub mod output;
 pub mod plausibility;
 pub mod plot;
 pub mod presets;
+pub mod progress;
 pub mod provenance;
 pub mod reduce;
 pub mod reduced_model;

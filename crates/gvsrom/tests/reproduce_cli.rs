@@ -178,7 +178,7 @@ fn records(out: &Path) -> usize {
 }
 
 fn start(out: &Path) -> std::process::Child {
-    Command::new(env!("CARGO_BIN_EXE_gvsrom"))
+    common::command()
         .args([
             "reproduce",
             "iv-a",

@@ -133,3 +133,47 @@ fn a_start_that_does_not_fit_is_refused_by_name() {
     expect_error(&args, &["--init", "was learned on", "single-tendon"]);
     assert!(!out.exists());
 }
+
+/// Outside a terminal (a log, a batch job) a long training says how far it is in plain lines,
+/// at most one per `GVSROM_PROGRESS_SECONDS` (default 30 s: none in a run this short).
+#[test]
+fn a_training_in_the_background_logs_its_progress_in_plain_lines() {
+    let run = |period: Option<&str>| {
+        let out = scratch(&format!("init-progress-{}", period.unwrap_or("default")));
+        let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_gvsrom"));
+        cmd.args([
+            "train",
+            s(dataset()),
+            "--hidden-layers",
+            "3",
+            "--epochs",
+            "150",
+            "--patience",
+            "0",
+            "--out",
+            s(&out),
+        ]);
+        cmd.env_remove("GVSROM_PROGRESS_SECONDS");
+        if let Some(p) = period {
+            cmd.env("GVSROM_PROGRESS_SECONDS", p);
+        }
+        let o = cmd.output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8(o.stderr).unwrap()
+    };
+    let lines = run(Some("0"));
+    let progress: Vec<&str> = lines
+        .lines()
+        .filter(|l| l.starts_with("progress"))
+        .collect();
+    assert!(!progress.is_empty(), "no progress line: {lines:?}");
+    for l in &progress {
+        assert!(l.contains(" epochs ") && l.contains("elapsed"), "{l}");
+        assert!(!l.contains('\r') && !l.contains('\x1b'), "{l:?}");
+    }
+    assert!(
+        progress.iter().any(|l| l.contains("validation")),
+        "{progress:?}"
+    );
+    assert_eq!(run(None), "", "a short run logs nothing by default");
+}

@@ -500,22 +500,13 @@ pub(crate) fn signal_name(sig: usize) -> &'static str {
     }
 }
 
-/// A progress bar of `len` samples on stderr (hidden when stderr is not a terminal).
+/// A progress bar of `len` samples on stderr ([`crate::progress::bar`]).
 pub(crate) fn progress_bar(len: u64) -> indicatif::ProgressBar {
     progress_bar_of(len, "samples")
 }
 
-/// A progress bar counting `unit` with an ETA (hidden when stderr is not a terminal).
+/// A progress bar counting `unit` with an ETA: live on a terminal, else plain lines at most every
+/// 30 s ([`crate::progress`]).
 pub fn progress_bar_of(len: u64, unit: &str) -> indicatif::ProgressBar {
-    use std::io::IsTerminal;
-    if !std::io::stderr().is_terminal() {
-        return indicatif::ProgressBar::hidden();
-    }
-    let bar = indicatif::ProgressBar::new(len);
-    if let Ok(style) = indicatif::ProgressStyle::with_template(
-        &format!("[{{bar:30}}] {{pos}}/{{len}} {unit}  {{elapsed_precise}} elapsed, ETA {{eta_precise}}  {{msg}}"),
-    ) {
-        bar.set_style(style.progress_chars("#>."));
-    }
-    bar
+    crate::progress::bar(len, unit)
 }

@@ -9,8 +9,16 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
+/// The binary, with no periodic progress lines on its stderr (`GVSROM_PROGRESS_SECONDS`: a slow
+/// machine must not change what a test reads there).
+pub fn command() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_gvsrom"));
+    c.env("GVSROM_PROGRESS_SECONDS", "1e9");
+    c
+}
+
 pub fn gvsrom(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_gvsrom"))
+    command()
         .args(args)
         .output()
         .expect("the gvsrom binary runs")
@@ -87,7 +95,7 @@ pub fn expect_error(args: &[&str], needles: &[&str]) -> String {
 
 /// Starts `gvsrom args` (stdin empty, stdout and stderr captured).
 pub fn spawn(args: &[&str]) -> Child {
-    Command::new(env!("CARGO_BIN_EXE_gvsrom"))
+    command()
         .args(args)
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
