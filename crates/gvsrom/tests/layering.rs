@@ -12,7 +12,14 @@ use std::path::{Path, PathBuf};
 const ORDER: &[(&str, &[&str])] = &[
     (
         "files",
-        &["error", "output", "npy", "provenance", "reduced_model"],
+        &[
+            "error",
+            "output",
+            "progress",
+            "npy",
+            "provenance",
+            "reduced_model",
+        ],
     ),
     (
         "scenario",

@@ -140,7 +140,7 @@ fn a_start_that_does_not_fit_is_refused_by_name() {
 fn a_training_in_the_background_logs_its_progress_in_plain_lines() {
     let run = |period: Option<&str>| {
         let out = scratch(&format!("init-progress-{}", period.unwrap_or("default")));
-        let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_gvsrom"));
+        let mut cmd = common::command();
         cmd.args([
             "train",
             s(dataset()),

@@ -216,7 +216,7 @@ pub(super) fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
         .or(init.as_ref().map(|s| s.loss))
         .unwrap_or_default();
     let signal = interrupt_flag();
-    let bar = gvsrom::dataset::progress_bar_of(args.epochs as u64, "epochs");
+    let bar = gvsrom::progress::bar(args.epochs as u64, "epochs");
     let mut progress = |epoch: usize, train: f64, val: Option<f64>| {
         // the fine-tuning phase runs past --epochs
         if epoch as u64 > bar.length().unwrap_or(0) {

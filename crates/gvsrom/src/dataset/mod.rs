@@ -502,11 +502,5 @@ pub(crate) fn signal_name(sig: usize) -> &'static str {
 
 /// A progress bar of `len` samples on stderr ([`crate::progress::bar`]).
 pub(crate) fn progress_bar(len: u64) -> indicatif::ProgressBar {
-    progress_bar_of(len, "samples")
-}
-
-/// A progress bar counting `unit` with an ETA: live on a terminal, else plain lines at most every
-/// 30 s ([`crate::progress`]).
-pub fn progress_bar_of(len: u64, unit: &str) -> indicatif::ProgressBar {
-    crate::progress::bar(len, unit)
+    crate::progress::bar(len, "samples")
 }

@@ -19,6 +19,7 @@ mod anchors;
 mod attach;
 mod evaluate;
 mod kinetic;
+mod loss;
 mod pod;
 mod sources;
 mod start;
@@ -30,10 +31,11 @@ pub use crate::reduced_model::PodNorm;
 pub use anchors::{anchor_guess, solve_anchors, AnchorInput, AnchorProblem, InitialGuess};
 pub use attach::{attach, attach_resolved, attach_source, parameterization, AttachOptions};
 pub use evaluate::{reconstruction, Reconstruction};
+pub use loss::Loss;
 pub use pod::{pod, PodSummary};
 pub use start::{start_model, StartModel};
 pub use train::{
-    decoder_form, sample_weighting, train, zero_anchor_rows, Loss, TrainSummary, SAMPLE_WEIGHTINGS,
+    decoder_form, sample_weighting, train, zero_anchor_rows, TrainSummary, SAMPLE_WEIGHTINGS,
 };
 
 use crate::build::{build, Built};

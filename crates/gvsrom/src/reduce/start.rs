@@ -8,7 +8,7 @@
 //! asks for others is refused, naming the option; the new model records its start in
 //! `provenance.model` (path and hashes).
 
-use super::train::Loss;
+use super::loss::Loss;
 use super::{attach::check_layout, invalid};
 use crate::build::Built;
 use crate::error::ScenarioError;

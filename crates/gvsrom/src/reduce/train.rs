@@ -2,16 +2,16 @@
 //! from the strain snapshots of one or more datasets, whose decoder becomes a nonlinear reduced
 //! model.
 
+use super::loss::Loss;
 use super::sources::Sources;
 use super::start::StartModel;
 use super::{equilibrium_anchors, invalid, model_layout, projection_of};
-use crate::build::Built;
 use crate::error::ScenarioError;
 use crate::output::OutputDir;
 use crate::reduced_model::{ModelMeta, ModelWeights, ReducedModel, TrainingMeta};
 use nalgebra::DVector;
 use rom::nn::{Autoencoder, DecoderForm, SampleWeighting, TrainOptions, TrainReport};
-use rom::reduced::{projection_residual, PointLayout};
+use rom::reduced::projection_residual;
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -40,61 +40,6 @@ pub struct TrainSummary {
     pub anchor_time_s: f64,
     /// Warnings for the user (a dataset without content hashes).
     pub warnings: Vec<String>,
-}
-
-/// How a snapshot feature's error weighs in the autoencoder's training loss (`gvsrom train --loss`).
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Eq,
-    Default,
-    serde::Serialize,
-    serde::Deserialize,
-    clap::ValueEnum,
-)]
-#[serde(rename_all = "kebab-case")]
-pub enum Loss {
-    /// Each feature standardized by its own spread: every point and component weighs the same
-    /// relative to its own variation, whatever its physical magnitude.
-    Standardized,
-    /// The physical mean squared error, every feature with weight 1 (the RMSE of Table I).
-    Physical,
-    /// The strain-energy norm: feature (point j, component a) weighted by the section stiffness
-    /// `Σ_s,aa` at point j (not by the quadrature weight, under which the kinematic points would
-    /// weigh nothing). Errors in stiff shear and elongation weigh what they cost in elastic force.
-    /// The default: the reduced model feels strain errors through exactly this norm.
-    #[default]
-    Energy,
-}
-
-impl Loss {
-    /// The loss of a [`Loss::name`].
-    pub fn from_name(name: &str) -> Option<Loss> {
-        [Loss::Standardized, Loss::Physical, Loss::Energy]
-            .into_iter()
-            .find(|l| l.name() == name)
-    }
-
-    /// The name used on the command line and in `meta.json`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Loss::Standardized => "standardized",
-            Loss::Physical => "physical",
-            Loss::Energy => "energy",
-        }
-    }
-
-    /// The per-feature weighting of the point layout `layout` of `built`.
-    fn weighting(self, built: &Built, layout: &PointLayout) -> rom::nn::Weighting {
-        use rom::nn::Weighting;
-        match self {
-            Loss::Standardized => Weighting::Standardize,
-            Loss::Physical => Weighting::Physical(vec![1.0; layout.len()]),
-            Loss::Energy => Weighting::Physical(super::stiffness_weights(built, layout)),
-        }
-    }
 }
 
 /// Trains an autoencoder on the snapshots of `datasets` (one, or several of one scenario: their

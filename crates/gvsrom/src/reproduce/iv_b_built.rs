@@ -85,7 +85,7 @@ fn mlp(layers: Vec<Dense>) -> anyhow::Result<Mlp> {
 
 /// `(−1)^k` for the tear `k` counted from 1.
 fn sign(k: usize) -> f64 {
-    if k % 2 == 0 {
+    if k.is_multiple_of(2) {
         1.0
     } else {
         -1.0

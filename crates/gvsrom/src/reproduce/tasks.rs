@@ -579,7 +579,7 @@ pub fn parallel<I: Sync, T: Send>(
     f: impl Fn(&I) -> anyhow::Result<T> + Sync + Send,
 ) -> anyhow::Result<Vec<T>> {
     use rayon::prelude::*;
-    let bar = crate::dataset::progress_bar_of(items.len() as u64, "models");
+    let bar = crate::progress::bar(items.len() as u64, "models");
     let results: Vec<anyhow::Result<T>> = items
         .par_iter()
         .map(|i| {
