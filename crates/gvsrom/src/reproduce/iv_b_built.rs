@@ -279,9 +279,22 @@ const SLOPE: f64 = 4000.0;
 /// Fewer training rows per pass leave the output layer's least squares underdetermined or nearly.
 const MIN_ROWS_PER_PASS: usize = 40;
 
-/// The solved rows of a static dataset (`rows × n`), its arc lengths, and the rod's length and the
-/// pulse's base from its scenario.
-fn solved(path: &Path) -> anyhow::Result<(Vec<f64>, usize, Vec<f64>, f64, f64)> {
+/// The solved rows of a static dataset and what its scenario says of them.
+struct Solved {
+    /// The rows, `rows × n`, row-major.
+    x: Vec<f64>,
+    /// Strain values per row.
+    n: usize,
+    /// Their arc lengths \[m\].
+    s: Vec<f64>,
+    /// The rod's length \[m\].
+    length: f64,
+    /// The pulse's base \[m\].
+    width: f64,
+}
+
+/// The solved rows of the static dataset at `path` ([`Solved`]).
+fn solved(path: &Path) -> anyhow::Result<Solved> {
     let d = Dataset::load(path)?;
     let n = d.strain_x.len();
     let x: Vec<f64> = d
@@ -311,7 +324,13 @@ fn solved(path: &Path) -> anyhow::Result<(Vec<f64>, usize, Vec<f64>, f64, f64)> 
             .and_then(|d| d.get("width")),
         "loads.distributed.0.width",
     )?;
-    Ok((x, n, d.strain_x, length, width))
+    Ok(Solved {
+        x,
+        n,
+        s: d.strain_x,
+        length,
+        width,
+    })
 }
 
 /// The largest |W| and Σ‖W‖² over both networks of `ae` (biases excluded).
@@ -339,8 +358,14 @@ fn built_errors(
     data: &Path,
     unseen: &Path,
 ) -> anyhow::Result<(Vec<BuiltErrors>, usize, Vec<f64>, usize)> {
-    let (x, n, s, length, width) = solved(data)?;
-    let (xu, nu, ..) = solved(unseen)?;
+    let Solved {
+        x,
+        n,
+        s,
+        length,
+        width,
+    } = solved(data)?;
+    let Solved { x: xu, n: nu, .. } = solved(unseen)?;
     anyhow::ensure!(
         nu == n,
         "{}: {nu} strain values, the dataset {n}",
