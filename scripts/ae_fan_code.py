@@ -69,6 +69,22 @@ def fan_codes(y: np.ndarray, bands: int) -> np.ndarray:
     return ((band + along) / bands * 2 - 1)[:, None]
 
 
+def physical_scaling(x: np.ndarray) -> tuple[np.ndarray, float]:
+    """The snapshots centred and divided by one common scale (the physical loss's), and the scale:
+    the root mean of the values' variances."""
+    scale = float(np.sqrt(np.mean(x.std(0) ** 2)))
+    return (x - x.mean(0)) / scale, scale
+
+
+def nearest(dec, y: np.ndarray, grid: np.ndarray) -> tuple[np.ndarray, float]:
+    """The nearest of the decoder's points `D(grid)` to each row of `y`: its code, and the mean
+    squared distance per value over all rows (scaled units)."""
+    g = np.asarray(forward(dec, jnp.asarray(grid)))
+    d = (y**2).sum(1)[:, None] - 2 * y @ g.T + (g**2).sum(1)[None]
+    best = d.argmin(1)
+    return grid[best], float(np.maximum(d[np.arange(len(y)), best], 0).mean() / y.shape[1])
+
+
 def glorot(sizes, key, first_scale=1.0):
     layers = []
     for i, (p, q) in enumerate(zip(sizes[:-1], sizes[1:])):
@@ -139,11 +155,8 @@ def main() -> None:
     a = ap.parse_args()
     t0 = time.time()
 
-    x = load(a.dataset)
-    rows, n = x.shape
-    mean = x.mean(0)
-    scale = float(np.sqrt(np.mean(x.std(0) ** 2)))
-    y_np = (x - mean) / scale
+    y_np, scale = physical_scaling(load(a.dataset))
+    rows, n = y_np.shape
     y = jnp.asarray(y_np)
     lam = a.lam / n
     rng = np.random.default_rng(a.seed)
@@ -159,10 +172,8 @@ def main() -> None:
 
     def project(dec):
         """The nearest point of the decoder's curve to each snapshot: codes and RMSE."""
-        g = np.asarray(forward(dec, grid))
-        d = (y_np**2).sum(1)[:, None] - 2 * y_np @ g.T + (g**2).sum(1)[None]
-        best = d.argmin(1)
-        return np.asarray(grid)[best], float(np.sqrt(np.maximum(d.min(1), 0).mean() / n) * scale)
+        codes, ms = nearest(dec, y_np, np.asarray(grid))
+        return codes, float(np.sqrt(ms) * scale)
 
     out = {"bands": a.bands, "rows": rows}
     all_rows = np.arange(rows)
@@ -170,10 +181,10 @@ def main() -> None:
     dec = fit(dec, lambda p, i: jnp.mean((forward(p, z[i]) - y[i]) ** 2) + lam * squares(p),
               all_rows, a.dec_epochs, a.dec_lbfgs, 3e-3, rng)
     out["decoder"] = rmse(forward(dec, z))
-    nearest, out["projection"] = project(dec)
+    nearest_codes, out["projection"] = project(dec)
     out["seconds_decoder"] = time.time() - t0
 
-    z = jnp.asarray(nearest)
+    z = jnp.asarray(nearest_codes)
     enc = fit(enc, lambda p, i: jnp.mean((forward(p, y[i]) - z[i]) ** 2) + lam * squares(p),
               all_rows, a.enc_epochs, a.enc_lbfgs, 3e-3, rng)
     out["ae_encoder_regressed"] = rmse(forward(dec, forward(enc, y)))
