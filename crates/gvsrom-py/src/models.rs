@@ -468,10 +468,13 @@ const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 ///     Latent size r (reduced coordinates); default 1, or the ``init`` model's.
 /// hidden_layers : int, optional
 ///     Hidden layers of the whole autoencoder (odd: 3, 5, 7…); default 7, or the ``init`` model's.
-/// epochs, batch_size, learning_rate, lambda_, validation_fraction, patience, lr_reductions,
-/// lbfgs_iterations, seed
+/// epochs, batch_size, learning_rate, lambda_, patience, lr_reductions, lbfgs_iterations
 ///     As the ``gvsrom train`` options of the same names (``lambda_`` is ``--lambda``; patience 0:
 ///     never stop early).
+/// validation_fraction, seed : optional
+///     The fraction held out for validation (default 0.1) and the seed of the initialisation,
+///     split and shuffles (default 0); with ``init``, the model's, so that a continuation holds
+///     out the same rows (others are allowed, with a warning).
 /// loss : str, optional
 ///     ``"energy"`` (default), ``"physical"`` or ``"standardized"``; with ``init``, the model's.
 /// sample_weighting : str
@@ -503,7 +506,7 @@ const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 /// Model
 ///     The new model.
 #[pyfunction]
-#[pyo3(signature = (dataset, out, latent=None, hidden_layers=None, epochs=2000, batch_size=64, learning_rate=1e-3, lambda_=1e-4, validation_fraction=0.1, patience=50, lr_reductions=4, lbfgs_iterations=300, seed=0, loss=None, sample_weighting="uniform", relative_floor=0.1, decoder=None, rate_weight=0.0, lr_decay=None, kinetic_weight=0.0, init=None, force=false))]
+#[pyo3(signature = (dataset, out, latent=None, hidden_layers=None, epochs=2000, batch_size=64, learning_rate=1e-3, lambda_=1e-4, validation_fraction=None, patience=50, lr_reductions=4, lbfgs_iterations=300, seed=None, loss=None, sample_weighting="uniform", relative_floor=0.1, decoder=None, rate_weight=0.0, lr_decay=None, kinetic_weight=0.0, init=None, force=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn train(
     py: Python<'_>,
@@ -515,11 +518,11 @@ pub fn train(
     batch_size: usize,
     learning_rate: f64,
     lambda_: f64,
-    validation_fraction: f64,
+    validation_fraction: Option<f64>,
     patience: usize,
     lr_reductions: usize,
     lbfgs_iterations: usize,
-    seed: u64,
+    seed: Option<u64>,
     loss: Option<&str>,
     sample_weighting: &str,
     relative_floor: f64,
@@ -537,38 +540,40 @@ pub fn train(
         None => None,
     };
     let loss = match loss {
-        Some(name) => Loss::from_name(name).ok_or_else(|| {
+        Some(name) => Some(Loss::from_name(name).ok_or_else(|| {
             invalid(format!(
                 "invalid `loss`: `{name}` (accepted: energy, physical, standardized)"
             ))
-        })?,
-        None => init.as_ref().map(|s| s.loss).unwrap_or_default(),
+        })?),
+        None => None,
     };
     let decoder = match decoder {
-        Some(name) => gvsrom::reduce::decoder_form(name).map_err(errors::scenario)?,
-        None => init.as_ref().map(|s| s.decoder).unwrap_or_default(),
+        Some(name) => Some(gvsrom::reduce::decoder_form(name).map_err(errors::scenario)?),
+        None => None,
     };
-    let options = TrainOptions {
-        latent: latent.or(init.as_ref().map(|s| s.latent)).unwrap_or(1),
-        hidden_layers: hidden_layers
-            .or(init.as_ref().map(|s| s.hidden_layers))
-            .unwrap_or(7),
+    let asked = gvsrom::reduce::TrainChoices {
+        latent,
+        hidden_layers,
+        decoder,
+        loss,
+        seed,
+        validation_fraction,
+    };
+    let given = TrainOptions {
         lambda: lambda_,
         epochs,
         batch_size,
         learning_rate,
-        validation_fraction,
         patience: (patience > 0).then_some(patience),
-        seed,
         lr_reductions,
         lr_decay,
         fine_tune: rom::nn::FineTune::lbfgs(lbfgs_iterations),
         sample_weighting: gvsrom::reduce::sample_weighting(sample_weighting, relative_floor)
             .map_err(errors::scenario)?,
-        decoder,
         rate_weight,
         ..TrainOptions::default()
     };
+    let (options, loss) = gvsrom::reduce::train_settings(init.as_ref(), &asked, given);
     let dataset = dataset_paths(dataset)?;
     let mut interrupt: Option<PyErr> = None;
     let summary = py.detach(|| {

@@ -308,11 +308,12 @@ def test_reconstruction_of_its_own_data_is_what_pod_discards(dataset, pod_model,
 
 
 def test_a_training_from_a_model_continues_it_and_keeps_its_architecture(dataset, ae_model, tmp_path):
-    # no latent or hidden_layers given: the start model's (r = 1, 3 hidden layers)
+    # no latent, hidden_layers or seed given: the start model's (r = 1, 3 hidden layers, seed 3)
     more = gvsrom.train(dataset, tmp_path / "more", epochs=40, patience=0, lbfgs_iterations=20,
-                        seed=3, init=ae_model)
+                        init=ae_model)
     a, b = ae_model.meta["training"], more.meta["training"]
     assert more.latent == 1 and b["hidden_layers"] == 3 and b["loss"] == a["loss"]
+    assert (b["seed"], b["validation_fraction"]) == (3, a["validation_fraction"])
     # from random weights the same seed would repeat the start model's training exactly
     assert b["final_train_loss"] < 0.9 * a["final_train_loss"], (a, b)
     assert more.meta["provenance"]["model"]["path"] == str(ae_model.path)

@@ -4,8 +4,8 @@
 //! alive, without filling its log with redraws.
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle, TermLike};
-use std::io::{self, IsTerminal};
-use std::sync::Mutex;
+use std::io::{self, IsTerminal, Write};
+use std::sync::{Mutex, Once};
 use std::time::{Duration, Instant};
 
 /// The environment variable that sets the period of the plain progress lines, in seconds.
@@ -14,14 +14,33 @@ pub const PERIOD_VAR: &str = "GVSROM_PROGRESS_SECONDS";
 pub const DEFAULT_PERIOD: Duration = Duration::from_secs(30);
 
 /// The period of the plain progress lines: [`PERIOD_VAR`] if it holds a finite number of
-/// seconds ≥ 0 (`0`: a line at every update the bar draws, about one a second), else
-/// [`DEFAULT_PERIOD`].
+/// seconds ≥ 0 (`0`: a line at every update the bar draws, at most one a second after the first
+/// few), else [`DEFAULT_PERIOD`] — with a warning on stderr, once per process, when the variable
+/// is set to anything else.
 pub fn log_period() -> Duration {
-    std::env::var(PERIOD_VAR)
-        .ok()
-        .and_then(|v| v.trim().parse::<f64>().ok())
-        .and_then(|s| Duration::try_from_secs_f64(s).ok())
-        .unwrap_or(DEFAULT_PERIOD)
+    let Ok(value) = std::env::var(PERIOD_VAR) else {
+        return DEFAULT_PERIOD;
+    };
+    match period_of(&value) {
+        Some(period) => period,
+        None => {
+            static WARNED: Once = Once::new();
+            WARNED.call_once(|| {
+                let _ = writeln!(
+                    io::stderr().lock(),
+                    "warning: {PERIOD_VAR}={value:?} is not a number of seconds ≥ 0 (e.g. 5 or 0.5); progress lines come every {} s",
+                    DEFAULT_PERIOD.as_secs()
+                );
+            });
+            DEFAULT_PERIOD
+        }
+    }
+}
+
+/// `value` as a period: a finite number of seconds ≥ 0, else `None`.
+fn period_of(value: &str) -> Option<Duration> {
+    let seconds = value.trim().parse::<f64>().ok()?;
+    Duration::try_from_secs_f64(seconds).ok()
 }
 
 /// A progress bar counting `len` `unit`s with the time elapsed and an estimate of what is left:
@@ -63,17 +82,27 @@ struct LogLines {
 
 impl LogLines {
     fn offer(&self, line: &str) -> io::Result<()> {
-        let line = line.trim_end();
-        if line.is_empty() {
-            return Ok(());
-        }
-        let now = Instant::now();
-        let mut last = self.last.lock().unwrap_or_else(|e| e.into_inner());
-        if now.duration_since(last.unwrap_or(self.start)) >= self.period {
-            *last = Some(now);
-            eprintln!("{line}");
+        if self.due(line, Instant::now()) {
+            // best effort: a closed or full stderr (a reader that went away) must not stop the
+            // work the line reports on, so a failed write is dropped, never a panic
+            let _ = writeln!(io::stderr().lock(), "{}", line.trim_end());
         }
         Ok(())
+    }
+
+    /// Whether `line`, offered at `now`, is written: not blank, and a period after the last line
+    /// written (or after the start, for the first); if so, `now` becomes the last.
+    fn due(&self, line: &str, now: Instant) -> bool {
+        if line.trim_end().is_empty() {
+            return false;
+        }
+        let mut last = self.last.lock().unwrap_or_else(|e| e.into_inner());
+        let since = now.saturating_duration_since(last.unwrap_or(self.start));
+        if since >= self.period {
+            *last = Some(now);
+            return true;
+        }
+        false
     }
 }
 
@@ -113,24 +142,40 @@ mod tests {
 
     #[test]
     fn plain_lines_come_at_most_once_a_period() {
+        let start = Instant::now();
         let lines = LogLines {
-            period: Duration::from_millis(50),
-            start: Instant::now(),
+            period: Duration::from_secs(30),
+            start,
             last: Mutex::new(None),
         };
-        let written = |l: &LogLines| *l.last.lock().unwrap();
-        lines.offer("progress   1/10").unwrap();
-        assert_eq!(written(&lines), None, "a line before the first period");
-        std::thread::sleep(Duration::from_millis(60));
-        lines.offer("progress   2/10").unwrap();
-        let first = written(&lines).expect("a line after a period");
-        lines.offer("progress   3/10").unwrap();
-        assert_eq!(
-            written(&lines),
-            Some(first),
+        let at = |s: u64| start + Duration::from_secs(s);
+        assert!(
+            !lines.due("progress   1/10", at(29)),
+            "a line before the first period"
+        );
+        assert!(
+            lines.due("progress   2/10", at(30)),
+            "a line a period after the start"
+        );
+        assert!(
+            !lines.due("progress   3/10", at(59)),
             "a second line within the period"
         );
-        lines.offer("   ").unwrap();
-        assert_eq!(written(&lines), Some(first));
+        assert!(!lines.due("   ", at(90)), "a blank line");
+        assert!(
+            lines.due("progress   4/10", at(60)),
+            "a line a period after the last"
+        );
+        assert!(!lines.due("progress   5/10", at(61)));
+    }
+
+    #[test]
+    fn a_period_is_a_finite_number_of_seconds_at_least_zero() {
+        assert_eq!(period_of("5"), Some(Duration::from_secs(5)));
+        assert_eq!(period_of(" 0.5 "), Some(Duration::from_millis(500)));
+        assert_eq!(period_of("0"), Some(Duration::ZERO));
+        for bad in ["-5", "abc", "", "inf", "NaN", "1e400"] {
+            assert_eq!(period_of(bad), None, "{bad:?}");
+        }
     }
 }

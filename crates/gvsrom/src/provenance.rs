@@ -5,6 +5,7 @@
 //! |---|---|
 //! | `gvsrom_version` | the crate version that wrote it |
 //! | `command` | the command line (argv, lossily UTF-8) |
+//! | `cwd` | the working directory it ran in, against which the relative paths of `command` and of the input directories below resolve |
 //! | `started` | wall-clock start, UTC, RFC 3339 (`2025-06-01T12:34:56Z`) |
 //! | `scenario` | where the scenario came from: `{"source": "preset", "name": …}` or `{"source": "file", "path": …}`, with the SHA-256 of its text (`sha256`) |
 //! | `overrides` | every `--set PATH=VALUE`, in order |
@@ -32,6 +33,9 @@ use std::time::{SystemTime, UNIX_EPOCH};
 pub struct Provenance {
     pub gvsrom_version: String,
     pub command: Vec<String>,
+    /// The working directory of the run (absent in outputs written before it was recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cwd: Option<String>,
     pub started: String,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scenario: Option<ScenarioOrigin>,
@@ -123,6 +127,9 @@ impl Provenance {
             command: std::env::args_os()
                 .map(|a| a.to_string_lossy().into_owned())
                 .collect(),
+            cwd: std::env::current_dir()
+                .ok()
+                .map(|d| d.to_string_lossy().into_owned()),
             started: rfc3339_utc(SystemTime::now()),
             scenario: None,
             overrides: vec![],

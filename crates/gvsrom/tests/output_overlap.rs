@@ -226,3 +226,42 @@ fn a_preset_name_is_not_an_input_path() {
     );
     assert!(dir.join("single-tendon").is_file());
 }
+
+#[test]
+fn pod_and_train_out_naming_their_inputs_are_refused_and_the_inputs_kept() {
+    let ds = sweep_dataset("overlap-train-ds", "-6:3", 10);
+    let ae = scratch("overlap-train-ae");
+    let small = [
+        "--hidden-layers",
+        "3",
+        "--epochs",
+        "5",
+        "--lbfgs-iterations",
+        "0",
+    ];
+    let mut args = vec!["train", s(&ds), "--out", s(&ae)];
+    args.extend_from_slice(&small);
+    run_ok(&args);
+    let (before_ds, before_ae) = (snapshot(&ds), snapshot(&ae));
+    expect_error(
+        &["pod", s(&ds), "--modes", "1", "--out", s(&ds), "--force"],
+        &["--out", "is the input DATASET"],
+    );
+    let mut args = vec!["train", s(&ds), "--out", s(&ds), "--force"];
+    args.extend_from_slice(&small);
+    expect_error(&args, &["--out", "is the input DATASET"]);
+    // a continuation written over its own start model
+    let mut args = vec![
+        "train",
+        s(&ds),
+        "--init",
+        s(&ae),
+        "--out",
+        s(&ae),
+        "--force",
+    ];
+    args.extend_from_slice(&["--epochs", "5", "--lbfgs-iterations", "0"]);
+    expect_error(&args, &["--out", "is the input --init"]);
+    assert_eq!(snapshot(&ds), before_ds);
+    assert_eq!(snapshot(&ae), before_ae);
+}

@@ -1,10 +1,11 @@
 //! `gvsrom train --init MODEL`: a training that starts from a model's weights continues its fit,
-//! keeps its architecture, decoder and loss, records where it started, and refuses a start that
-//! does not fit (a POD model, another architecture or loss, a dataset of another layout).
+//! keeps its architecture, decoder, loss, seed and split, records where it started, and refuses a
+//! start that does not fit (a POD model, another architecture or loss, a dataset of another layout
+//! or physics, an output in its place) or that it cannot improve on.
 
 mod common;
 
-use common::{expect_error, json, run_ok, s, scratch, sweep_dataset};
+use common::{expect_error, json, run_ok, run_ok_with_stderr, s, scratch, sweep_dataset};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
@@ -134,6 +135,143 @@ fn a_start_that_does_not_fit_is_refused_by_name() {
     assert!(!out.exists());
 }
 
+#[test]
+fn a_start_trained_on_other_physics_is_refused_naming_the_field() {
+    // the same points, basis and inputs, a stiffer material
+    let stiff = scratch("init-stiff-ds");
+    run_ok(&[
+        "dataset",
+        "single-tendon",
+        "--sweep",
+        "tendons.0.tension=-6:3",
+        "--samples",
+        "5",
+        "--set",
+        "material.youngs_modulus=8e6",
+        "--out",
+        s(&stiff),
+    ]);
+    let out = scratch("init-stiff");
+    expect_error(
+        &[
+            "train",
+            s(&stiff),
+            "--init",
+            s(first()),
+            "--epochs",
+            "5",
+            "--out",
+            s(&out),
+        ],
+        &[
+            "--init",
+            "other physics",
+            "material.youngs_modulus",
+            "8000000",
+        ],
+    );
+    assert!(!out.exists(), "a refused training wrote a model");
+}
+
+#[test]
+fn a_continuation_keeps_the_start_models_seed_and_split_unless_told_otherwise() {
+    let args = |out: &Path, extra: &[&str]| -> Vec<String> {
+        let mut v: Vec<String> = [
+            "train",
+            s(dataset()),
+            "--init",
+            s(first()),
+            "--epochs",
+            "3",
+            "--lbfgs-iterations",
+            "0",
+            "--out",
+            s(out),
+        ]
+        .map(String::from)
+        .to_vec();
+        v.extend(extra.iter().map(|e| e.to_string()));
+        v
+    };
+    let run = |out: &Path, extra: &[&str]| {
+        let a = args(out, extra);
+        run_ok_with_stderr(&a.iter().map(String::as_str).collect::<Vec<_>>()).1
+    };
+    let kept = scratch("init-kept-split");
+    let stderr = run(&kept, &[]);
+    assert_eq!(
+        training(&kept)["seed"],
+        1,
+        "the start's seed (1), not the default 0"
+    );
+    assert_eq!(training(&kept)["validation_fraction"], 0.1);
+    assert!(!stderr.contains("optimistic"), "{stderr}");
+    let other = scratch("init-other-split");
+    let stderr = run(&other, &["--seed", "5"]);
+    assert_eq!(training(&other)["seed"], 5);
+    assert!(
+        stderr.contains("--seed 1") && stderr.contains("optimistic"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn a_start_the_training_cannot_improve_on_is_reported_naming_it() {
+    // a rate so small that no step changes a weight: the start's loss is never beaten
+    let out = scratch("init-no-gain");
+    expect_error(
+        &[
+            "train",
+            s(dataset()),
+            "--init",
+            s(first()),
+            "--epochs",
+            "3",
+            "--lbfgs-iterations",
+            "0",
+            "--learning-rate",
+            "1e-300",
+            "--out",
+            s(&out),
+        ],
+        &["--init", "was not improved on", "not beaten in 3 epochs"],
+    );
+    assert!(!out.exists(), "nothing is written");
+}
+
+/// Progress lines are best effort: a stderr whose reader went away must not stop the training.
+#[test]
+fn a_training_whose_stderr_is_closed_still_finishes() {
+    let out = scratch("init-closed-stderr");
+    let mut cmd = common::command();
+    cmd.args([
+        "train",
+        s(dataset()),
+        "--hidden-layers",
+        "3",
+        "--epochs",
+        "100",
+        "--patience",
+        "0",
+        "--out",
+        s(&out),
+    ])
+    .env("GVSROM_PROGRESS_SECONDS", "0")
+    .stdin(std::process::Stdio::null())
+    .stdout(std::process::Stdio::piped())
+    .stderr(std::process::Stdio::piped());
+    let mut child = cmd.spawn().unwrap();
+    drop(child.stderr.take()); // the reader is gone before the first line
+    let o = child.wait_with_output().unwrap();
+    assert!(
+        o.status.success(),
+        "{:?}: {}",
+        o.status,
+        String::from_utf8_lossy(&o.stdout)
+    );
+    assert!(out.join("meta.json").exists());
+}
+
 /// Outside a terminal (a log, a batch job) a long training says how far it is in plain lines,
 /// at most one per `GVSROM_PROGRESS_SECONDS` (default 30 s: none in a run this short).
 #[test]
@@ -159,6 +297,11 @@ fn a_training_in_the_background_logs_its_progress_in_plain_lines() {
         }
         let o = cmd.output().unwrap();
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let stdout = String::from_utf8(o.stdout).unwrap();
+        assert!(
+            !stdout.lines().any(|l| l.starts_with("progress")),
+            "progress on stdout: {stdout}"
+        );
         String::from_utf8(o.stderr).unwrap()
     };
     let lines = run(Some("0"));

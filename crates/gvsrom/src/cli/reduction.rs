@@ -66,9 +66,10 @@ pub struct TrainArgs {
     /// L2 weight regularization λ of eq. (15) (paper: 1e-4).
     #[arg(long, default_value_t = 1e-4)]
     pub lambda: f64,
-    /// Fraction of the snapshots held out for validation and early stopping.
-    #[arg(long, default_value_t = 0.1)]
-    pub validation_fraction: f64,
+    /// Fraction of the snapshots held out for validation and early stopping [default: 0.1; with
+    /// `--init`, the model's].
+    #[arg(long, value_name = "F")]
+    pub validation_fraction: Option<f64>,
     /// Epochs without a better validation loss before stopping (0: never stop early).
     #[arg(long, default_value_t = 50)]
     pub patience: usize,
@@ -84,9 +85,10 @@ pub struct TrainArgs {
     /// Iterations of the full-batch L-BFGS phase that follows Adam from its best weights (0: none).
     #[arg(long, default_value_t = 300)]
     pub lbfgs_iterations: usize,
-    /// Seed of the initialization, the split and the shuffles (same seed, same model).
-    #[arg(long, default_value_t = 0)]
-    pub seed: u64,
+    /// Seed of the initialization, the split and the shuffles (same seed, same model) [default: 0;
+    /// with `--init`, the model's, so that a continuation holds out the same rows].
+    #[arg(long, value_name = "SEED")]
+    pub seed: Option<u64>,
     /// How each strain value's error weighs in the loss: `standardized` (each point and component
     /// by its own spread), `physical` (plain squared error, the RMSE of Table I) or `energy`
     /// (weighted by the section stiffness: the strain-energy norm, which the reduced model's
@@ -188,33 +190,32 @@ fn datasets_line(out: &mut impl Write, datasets: &[(PathBuf, usize)]) -> Result<
 pub(super) fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
     use rom::nn::TrainOptions;
     let init = args.init.as_deref().map(reduce::start_model).transpose()?;
-    let decoder = match &args.decoder {
-        Some(name) => reduce::decoder_form(name)?,
-        None => init.as_ref().map_or(Default::default(), |s| s.decoder),
+    let asked = reduce::TrainChoices {
+        latent: args.latent,
+        hidden_layers: args.hidden_layers,
+        decoder: args
+            .decoder
+            .as_deref()
+            .map(reduce::decoder_form)
+            .transpose()?,
+        loss: args.loss,
+        seed: args.seed,
+        validation_fraction: args.validation_fraction,
     };
-    let options = TrainOptions {
-        latent: args.latent.or(init.as_ref().map(|s| s.latent)).unwrap_or(1),
-        hidden_layers: (args.hidden_layers)
-            .or(init.as_ref().map(|s| s.hidden_layers))
-            .unwrap_or(7),
+    let given = TrainOptions {
         lambda: args.lambda,
         epochs: args.epochs,
         batch_size: args.batch_size,
         learning_rate: args.learning_rate,
-        validation_fraction: args.validation_fraction,
         patience: (args.patience > 0).then_some(args.patience),
-        seed: args.seed,
         lr_reductions: args.lr_reductions,
         lr_decay: args.lr_decay,
         fine_tune: rom::nn::FineTune::lbfgs(args.lbfgs_iterations),
         sample_weighting: reduce::sample_weighting(&args.sample_weighting, args.relative_floor)?,
-        decoder,
         rate_weight: args.rate_weight,
         ..TrainOptions::default()
     };
-    let loss = (args.loss)
-        .or(init.as_ref().map(|s| s.loss))
-        .unwrap_or_default();
+    let (options, loss) = reduce::train_settings(init.as_ref(), &asked, given);
     let signal = interrupt_flag();
     let bar = gvsrom::progress::bar(args.epochs as u64, "epochs");
     let mut progress = |epoch: usize, train: f64, val: Option<f64>| {
@@ -222,11 +223,12 @@ pub(super) fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
         if epoch as u64 > bar.length().unwrap_or(0) {
             bar.set_length(epoch as u64);
         }
-        bar.set_position(epoch as u64);
+        // the message first: each call may draw, and a line must carry this epoch's loss
         bar.set_message(match val {
             Some(v) => format!("loss {train:.3e} / validation {v:.3e}"),
             None => format!("loss {train:.3e}"),
         });
+        bar.set_position(epoch as u64);
         match signal.load(Ordering::SeqCst) {
             0 => ControlFlow::Continue(()),
             _ => ControlFlow::Break(()),

@@ -33,7 +33,7 @@ pub use attach::{attach, attach_resolved, attach_source, parameterization, Attac
 pub use evaluate::{reconstruction, Reconstruction};
 pub use loss::Loss;
 pub use pod::{pod, PodSummary};
-pub use start::{start_model, StartModel};
+pub use start::{start_model, train_settings, StartModel, TrainChoices};
 pub use train::{
     decoder_form, sample_weighting, train, zero_anchor_rows, TrainSummary, SAMPLE_WEIGHTINGS,
 };
@@ -50,6 +50,18 @@ use std::path::Path;
 
 pub(super) fn invalid(field: &str, message: impl Into<String>) -> ScenarioError {
     ScenarioError::invalid(field, message)
+}
+
+/// Refuses an `--out` that is, or contains, one of the command's inputs — a `DATASET` or the
+/// `--init` model — which `--force` would otherwise replace ([`crate::output::refuse_overlap`]).
+fn refuse_input_overlap<P: AsRef<Path>>(
+    out: &Path,
+    datasets: &[P],
+    init: Option<&Path>,
+) -> Result<(), crate::output::OutputError> {
+    let mut inputs: Vec<(&str, &Path)> = datasets.iter().map(|d| ("DATASET", d.as_ref())).collect();
+    inputs.extend(init.map(|m| ("--init", m)));
+    crate::output::refuse_overlap("--out", out, &inputs)
 }
 
 /// The HOM a dataset was generated on (its scenario TOML, as stored), checked against the dataset's

@@ -38,6 +38,7 @@ pub fn pod<P: AsRef<Path>>(
     out: &Path,
     force: bool,
 ) -> Result<PodSummary, anyhow::Error> {
+    super::refuse_input_overlap(out, datasets, None)?;
     let provenance = crate::provenance::Provenance::of_command();
     let src = Sources::load(datasets)?;
     let provenance = src.record(provenance)?;

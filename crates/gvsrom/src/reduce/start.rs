@@ -4,15 +4,18 @@
 //! same scenario, or another loss (another `λ`) from a network found elsewhere.
 //!
 //! The start model fixes what its weights mean: the architecture (latent size, hidden layers), the
-//! decoder form and the loss weighting (through the scaling it was trained in). A training that
-//! asks for others is refused, naming the option; the new model records its start in
-//! `provenance.model` (path and hashes).
+//! decoder form, the loss weighting (through the scaling it was trained in) and the physics of its
+//! scenario. A training that asks for others is refused, naming the option; the new model records
+//! its start in `provenance.model` (path and hashes). The seed and validation fraction default to
+//! the start's, so that a continuation on the same data holds out the same rows ([`train_settings`]).
 
 use super::loss::Loss;
+use super::sources::Sources;
+use super::validity::physics_differences;
 use super::{attach::check_layout, invalid};
-use crate::build::Built;
 use crate::error::ScenarioError;
 use crate::reduced_model::{ModelWeights, ReducedModel};
+use crate::scenario::{parse_path, Scenario, Seg};
 use rom::nn::{Autoencoder, DecoderForm, TrainOptions};
 use std::path::{Path, PathBuf};
 
@@ -28,6 +31,54 @@ pub struct StartModel {
     pub hidden_layers: usize,
     pub decoder: DecoderForm,
     pub loss: Loss,
+    /// The seed of its training (initialisation, split, shuffles).
+    pub seed: u64,
+    /// The fraction of its rows it held out for validation.
+    pub validation_fraction: f64,
+}
+
+/// The settings of a training that a start model fixes or suggests, as a front-end was given
+/// them: `None` where the user gave none ([`train_settings`]).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct TrainChoices {
+    pub latent: Option<usize>,
+    pub hidden_layers: Option<usize>,
+    pub decoder: Option<DecoderForm>,
+    pub loss: Option<Loss>,
+    pub seed: Option<u64>,
+    pub validation_fraction: Option<f64>,
+}
+
+/// The training's options and loss: `options` with each setting of `asked` the user left open
+/// taken from the start model `init`, or without one from [`TrainOptions::default`] (latent 1,
+/// 7 hidden layers, the plain decoder, seed 0, a tenth held out) and [`Loss::default`]. Every
+/// front-end resolves `--init` this way; [`train`](super::train()) then refuses what the start
+/// cannot be trained with.
+pub fn train_settings(
+    init: Option<&StartModel>,
+    asked: &TrainChoices,
+    options: TrainOptions,
+) -> (TrainOptions, Loss) {
+    let fresh = TrainOptions::default();
+    let options = TrainOptions {
+        latent: asked
+            .latent
+            .or(init.map(|s| s.latent))
+            .unwrap_or(fresh.latent),
+        hidden_layers: (asked.hidden_layers)
+            .or(init.map(|s| s.hidden_layers))
+            .unwrap_or(fresh.hidden_layers),
+        decoder: (asked.decoder)
+            .or(init.map(|s| s.decoder))
+            .unwrap_or(fresh.decoder),
+        seed: asked.seed.or(init.map(|s| s.seed)).unwrap_or(fresh.seed),
+        validation_fraction: (asked.validation_fraction)
+            .or(init.map(|s| s.validation_fraction))
+            .unwrap_or(fresh.validation_fraction),
+        ..options
+    };
+    let loss = asked.loss.or(init.map(|s| s.loss)).unwrap_or_default();
+    (options, loss)
 }
 
 /// Reads `dir` (`--init`) as the start of a training: an intact autoencoder model with its
@@ -63,6 +114,8 @@ pub fn start_model(dir: &Path) -> Result<StartModel, anyhow::Error> {
         hidden_layers: training.hidden_layers,
         decoder: ae.form(),
         loss,
+        seed: training.seed,
+        validation_fraction: training.validation_fraction,
         model,
     })
 }
@@ -76,15 +129,19 @@ impl StartModel {
         }
     }
 
-    /// Checks the start against the datasets' scenario `built` (points, components, basis) and
-    /// the training's `options` and `loss`: each must be the model's.
+    /// Checks the start against the datasets `src` (points, components, basis, and the physics of
+    /// their scenario apart from the sampled inputs) and the training's `options` and `loss`: each
+    /// must be the model's. A seed or validation fraction other than the start's is allowed, with
+    /// a warning: on the data the start was trained on, the new validation rows would hold some
+    /// of its training rows.
     pub(super) fn check(
         &self,
-        built: &Built,
+        src: &Sources,
         options: &TrainOptions,
         loss: Loss,
-    ) -> Result<(), ScenarioError> {
-        check_layout("--init", built, &self.model, &self.dir)?;
+    ) -> Result<Vec<String>, ScenarioError> {
+        check_layout("--init", &src.built, &self.model, &self.dir)?;
+        self.check_physics(src)?;
         let differs = |option: &str, asked: String, own: String| {
             invalid(
                 option,
@@ -121,6 +178,52 @@ impl StartModel {
                 "--loss",
                 loss.name().into(),
                 self.loss.name().into(),
+            ));
+        }
+        let mut warnings = vec![];
+        if options.seed != self.seed || options.validation_fraction != self.validation_fraction {
+            warnings.push(format!(
+                "--init: the start model `{}` was trained with --seed {} and --validation-fraction {}, this training uses {} and {}: on the data the start was trained on, some of the new validation rows were its training rows, so the validation loss (and the early stopping it drives) is optimistic; leave both out to keep the start's split",
+                self.dir.display(),
+                self.seed,
+                self.validation_fraction,
+                options.seed,
+                options.validation_fraction
+            ));
+        }
+        Ok(warnings)
+    }
+
+    /// Refuses datasets whose scenario's physics differs from the start model's (inputs that
+    /// either samples aside): its weights, and under the energy loss its scaling's stiffness
+    /// weights, belong to its own scenario.
+    fn check_physics(&self, src: &Sources) -> Result<(), ScenarioError> {
+        let layout = &self.model.meta.layout;
+        let own =
+            Scenario::from_toml(&layout.scenario, &layout.scenario_toml, &[]).map_err(|e| {
+                invalid(
+                    "--init",
+                    format!("the start model's recorded scenario cannot be read: {e}"),
+                )
+            })?;
+        let meta = &src.sets[0].1.meta;
+        let data = Scenario::from_toml(&meta.scenario, &meta.scenario_toml, &[])?;
+        let skip: Vec<Vec<Seg>> = (meta.parameters.iter())
+            .chain(self.model.meta.input_range.iter().map(|r| &r.parameter))
+            .filter_map(|p| parse_path(p).ok())
+            .collect();
+        let diffs = physics_differences(&own, &data, &skip)?;
+        if let Some((path, there, here)) = diffs.first() {
+            return Err(invalid(
+                "--init",
+                format!(
+                    "the start model `{}` was trained on other physics: its scenario's {path} is {there}, the dataset's {here}{}; a training from a model continues it on its own scenario (train a new model for this one)",
+                    self.dir.display(),
+                    match diffs.len() {
+                        1 => String::new(),
+                        n => format!(" (and {} more differences)", n - 1),
+                    }
+                ),
             ));
         }
         Ok(())

@@ -60,6 +60,7 @@ pub fn train<P: AsRef<Path>>(
     force: bool,
     progress: &mut dyn FnMut(usize, f64, Option<f64>) -> ControlFlow<()>,
 ) -> Result<TrainSummary, anyhow::Error> {
+    super::refuse_input_overlap(out, datasets, init.map(|s| s.dir.as_path()))?;
     let mut provenance = crate::provenance::Provenance::of_command();
     if let Some(start) = init {
         provenance = provenance.start_model(&start.dir)?;
@@ -67,9 +68,10 @@ pub fn train<P: AsRef<Path>>(
     let src = Sources::load(datasets)?;
     let provenance = src.record(provenance)?.seed("training", options.seed);
     let built = &src.built;
-    if let Some(start) = init {
-        start.check(built, options, loss)?;
-    }
+    let start_warnings = match init {
+        Some(start) => start.check(&src, options, loss)?,
+        None => vec![],
+    };
     let (layout, pm, p) = projection_of(built)?;
     let (x, rows, features) = (&src.x, src.rows(), src.features);
     let options = &TrainOptions {
@@ -146,7 +148,23 @@ pub fn train<P: AsRef<Path>>(
             progress,
         ),
     }
-    .map_err(|e| train_error(&e))?;
+    .map_err(|e| match (init, &e) {
+        // a start already at its best for these options: say so, naming it
+        (Some(start), rom::nn::NnError::NoProgress { epochs, initial }) => invalid(
+            "--init",
+            format!(
+                "the start model `{}` was not improved on: its loss {initial:.3e} was not beaten in {epochs} epochs with these options, so nothing was written; keep the start model, or try another --learning-rate or --lambda{}",
+                start.dir.display(),
+                match options.seed != start.seed
+                    || options.validation_fraction != start.validation_fraction
+                {
+                    true => " (with another --seed or --validation-fraction than the start's, its validation rows may be rows it was trained on, a loss hard to beat: leave both out to keep its split)",
+                    false => "",
+                }
+            ),
+        ),
+        _ => train_error(&e),
+    })?;
     drop((training, rates));
     // one encoding per usable sample: its range, the anchors, and what the HOM basis cannot
     // represent of the reconstructions
@@ -195,6 +213,7 @@ pub fn train<P: AsRef<Path>>(
     let rest_residual = rest_decoded.iter().map(|v| v * v).sum::<f64>().sqrt();
     let rest = DVector::from_vec(rest);
     let mut warnings = src.warnings();
+    warnings.extend(start_warnings);
     let refs = src.refs();
     warnings.extend(scaled_basin_warning(ae.form(), range[0]));
     let meta = ModelMeta {

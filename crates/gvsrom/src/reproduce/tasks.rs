@@ -572,8 +572,9 @@ pub fn statics_eval(
     )
 }
 
-/// Runs `f` over `items` on the run's thread pool (in parallel), keeping the order, with a progress
-/// bar on a terminal; the first interrupt or error wins.
+/// Runs `f` over `items` on the run's thread pool (in parallel), keeping the order, with its
+/// progress on stderr ([`crate::progress::bar`]: a bar on a terminal, plain lines elsewhere); the
+/// first interrupt or error wins.
 pub fn parallel<I: Sync, T: Send>(
     items: &[I],
     f: impl Fn(&I) -> anyhow::Result<T> + Sync + Send,
