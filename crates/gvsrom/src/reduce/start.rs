@@ -52,7 +52,7 @@ pub struct TrainChoices {
 /// The training's options and loss: `options` with each setting of `asked` the user left open
 /// taken from the start model `init`, or without one from [`TrainOptions::default`] (latent 1,
 /// 7 hidden layers, the plain decoder, seed 0, a tenth held out) and [`Loss::default`]. Every
-/// front-end resolves `--init` this way; [`train`](super::train()) then refuses what the start
+/// front-end resolves `--init` this way; `reduce::train` then refuses what the start
 /// cannot be trained with.
 pub fn train_settings(
     init: Option<&StartModel>,
