@@ -49,6 +49,30 @@ fn training(model: &Path) -> serde_json::Value {
     json(&model.join("meta.json"))["training"].clone()
 }
 
+/// The arguments of a 3-epoch continuation of [`first`] on [`dataset`] into `out`, no L-BFGS.
+fn continuation(out: &Path, extra: &[&str]) -> Vec<String> {
+    let mut v: Vec<String> = [
+        "train",
+        s(dataset()),
+        "--init",
+        s(first()),
+        "--epochs",
+        "3",
+        "--lbfgs-iterations",
+        "0",
+        "--out",
+        s(out),
+    ]
+    .map(String::from)
+    .to_vec();
+    v.extend(extra.iter().map(|e| e.to_string()));
+    v
+}
+
+fn strs(v: &[String]) -> Vec<&str> {
+    v.iter().map(String::as_str).collect()
+}
+
 #[test]
 fn a_training_from_a_model_continues_its_fit_and_records_its_start() {
     let next = scratch("init-next");
@@ -175,28 +199,7 @@ fn a_start_trained_on_other_physics_is_refused_naming_the_field() {
 
 #[test]
 fn a_continuation_keeps_the_start_models_seed_and_split_unless_told_otherwise() {
-    let args = |out: &Path, extra: &[&str]| -> Vec<String> {
-        let mut v: Vec<String> = [
-            "train",
-            s(dataset()),
-            "--init",
-            s(first()),
-            "--epochs",
-            "3",
-            "--lbfgs-iterations",
-            "0",
-            "--out",
-            s(out),
-        ]
-        .map(String::from)
-        .to_vec();
-        v.extend(extra.iter().map(|e| e.to_string()));
-        v
-    };
-    let run = |out: &Path, extra: &[&str]| {
-        let a = args(out, extra);
-        run_ok_with_stderr(&a.iter().map(String::as_str).collect::<Vec<_>>()).1
-    };
+    let run = |out: &Path, extra: &[&str]| run_ok_with_stderr(&strs(&continuation(out, extra))).1;
     let kept = scratch("init-kept-split");
     let stderr = run(&kept, &[]);
     assert_eq!(
@@ -220,20 +223,7 @@ fn a_start_the_training_cannot_improve_on_is_reported_naming_it() {
     // a rate so small that no step changes a weight: the start's loss is never beaten
     let out = scratch("init-no-gain");
     expect_error(
-        &[
-            "train",
-            s(dataset()),
-            "--init",
-            s(first()),
-            "--epochs",
-            "3",
-            "--lbfgs-iterations",
-            "0",
-            "--learning-rate",
-            "1e-300",
-            "--out",
-            s(&out),
-        ],
+        &strs(&continuation(&out, &["--learning-rate", "1e-300"])),
         &["--init", "was not improved on", "not beaten in 3 epochs"],
     );
     assert!(!out.exists(), "nothing is written");

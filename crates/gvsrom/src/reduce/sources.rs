@@ -8,9 +8,9 @@
 //! Datasets are combined only when the model they make means the same thing for every row: the
 //! same points and active components, the same sampled inputs (names and order), and the same
 //! physics (the scenario's TOML, everything but the inputs and the keys that are not physics,
-//! compared as `--model` compares a scenario with a model's: `validity::physics_differences`).
+//! compared as `--model` compares a scenario with a model's: `validity::first_physics_difference`).
 
-use super::validity::{input_ranges, physics_differences};
+use super::validity::{first_physics_difference, input_ranges};
 use super::{dataset_scenario, invalid, snapshot_rows};
 use crate::build::reduced::INPUT_MARGIN;
 use crate::build::Built;
@@ -18,7 +18,7 @@ use crate::dataset::Dataset;
 use crate::error::ScenarioError;
 use crate::provenance::{DirOrigin, Provenance};
 use crate::reduced_model::{same_abscissae, DatasetRef, InputRange};
-use crate::scenario::{parse_path, Scenario, Seg};
+use crate::scenario::Scenario;
 use std::path::{Path, PathBuf};
 
 /// The usable snapshots of one or more datasets of one scenario.
@@ -127,20 +127,13 @@ impl Sources {
         }
         let scenario =
             |m: &crate::dataset::Meta| Scenario::from_toml(&m.scenario, &m.scenario_toml, &[]);
-        let skip: Vec<Vec<Seg>> = a
-            .parameters
-            .iter()
-            .filter_map(|p| parse_path(p).ok())
-            .collect();
-        let diffs = physics_differences(&scenario(a)?, &scenario(b)?, &skip)?;
-        if let Some((where_, first_value, value)) = diffs.first() {
-            return Err(refuse(format!(
-                "its scenario's {where_} is {value}, the first's {first_value}{}",
-                match diffs.len() {
-                    1 => String::new(),
-                    n => format!(" (and {} more differences)", n - 1),
-                }
-            )));
+        let inputs = a.parameters.iter().map(String::as_str);
+        let difference =
+            first_physics_difference(&scenario(a)?, &scenario(b)?, inputs, |at, first, value| {
+                format!("its scenario's {at} is {value}, the first's {first}")
+            })?;
+        if let Some(what) = difference {
+            return Err(refuse(what));
         }
         Ok(())
     }

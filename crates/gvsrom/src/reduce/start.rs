@@ -11,11 +11,11 @@
 
 use super::loss::Loss;
 use super::sources::Sources;
-use super::validity::physics_differences;
+use super::validity::first_physics_difference;
 use super::{attach::check_layout, invalid};
 use crate::error::ScenarioError;
 use crate::reduced_model::{ModelWeights, ReducedModel};
-use crate::scenario::{parse_path, Scenario, Seg};
+use crate::scenario::Scenario;
 use rom::nn::{Autoencoder, DecoderForm, TrainOptions};
 use std::path::{Path, PathBuf};
 
@@ -208,21 +208,18 @@ impl StartModel {
             })?;
         let meta = &src.sets[0].1.meta;
         let data = Scenario::from_toml(&meta.scenario, &meta.scenario_toml, &[])?;
-        let skip: Vec<Vec<Seg>> = (meta.parameters.iter())
+        let inputs = (meta.parameters.iter())
             .chain(self.model.meta.input_range.iter().map(|r| &r.parameter))
-            .filter_map(|p| parse_path(p).ok())
-            .collect();
-        let diffs = physics_differences(&own, &data, &skip)?;
-        if let Some((path, there, here)) = diffs.first() {
+            .map(String::as_str);
+        let difference = first_physics_difference(&own, &data, inputs, |at, there, here| {
+            format!("its scenario's {at} is {there}, the dataset's {here}")
+        })?;
+        if let Some(what) = difference {
             return Err(invalid(
                 "--init",
                 format!(
-                    "the start model `{}` was trained on other physics: its scenario's {path} is {there}, the dataset's {here}{}; a training from a model continues it on its own scenario (train a new model for this one)",
-                    self.dir.display(),
-                    match diffs.len() {
-                        1 => String::new(),
-                        n => format!(" (and {} more differences)", n - 1),
-                    }
+                    "the start model `{}` was trained on other physics: {what}; a training from a model continues it on its own scenario (train a new model for this one)",
+                    self.dir.display()
                 ),
             ));
         }

@@ -136,7 +136,7 @@ pub fn check(
 
 /// Every leaf where the physics of scenario `b` differs from `a`'s, as `(path, in a, in b)`:
 /// the keys that are not physics ([`NOT_PHYSICS`]) and the paths `skip` (inputs) are left out.
-pub(super) fn physics_differences(
+fn physics_differences(
     a: &Scenario,
     b: &Scenario,
     skip: &[Vec<Seg>],
@@ -154,6 +154,29 @@ pub(super) fn physics_differences(
     let mut diffs = vec![];
     diff(&Value::Table(a), &Value::Table(b), &mut vec![], &mut diffs);
     Ok(diffs)
+}
+
+/// The first leaf where the physics of `b` differs from `a`'s, the scenario paths `inputs` (sampled
+/// by either side) aside ([`physics_differences`]), as `"P is B, … A"` worded by `say(path, in a,
+/// in b)` with `" (and N more differences)"` when there are more; `None` when they agree.
+pub(super) fn first_physics_difference<'p>(
+    a: &Scenario,
+    b: &Scenario,
+    inputs: impl IntoIterator<Item = &'p str>,
+    say: impl Fn(&str, &str, &str) -> String,
+) -> Result<Option<String>, ScenarioError> {
+    let skip: Vec<Vec<Seg>> = inputs
+        .into_iter()
+        .filter_map(|p| parse_path(p).ok())
+        .collect();
+    let diffs = physics_differences(a, b, &skip)?;
+    Ok(diffs.first().map(|(path, in_a, in_b)| {
+        let more = match diffs.len() {
+            1 => String::new(),
+            n => format!(" (and {} more differences)", n - 1),
+        };
+        format!("{}{more}", say(path, in_a, in_b))
+    }))
 }
 
 /// Removes the value at `path` from `table`, if present (an array entry is replaced by a marker,
