@@ -9,7 +9,9 @@ use std::process::ExitCode;
 fn main() -> ExitCode {
     // A bug must still end in one line, not a backtrace (exit code 101 tells it from a user error).
     std::panic::set_hook(Box::new(|info| {
-        eprintln!("error: internal error (please report): {info}");
+        gvsrom::progress::stderr_line(format_args!(
+            "error: internal error (please report): {info}"
+        ));
     }));
     let cli = cli::Cli::parse();
     let stdout = std::io::stdout();
@@ -26,10 +28,10 @@ fn main() -> ExitCode {
             }
             let msg = format!("{e:#}").replace('\n', " ");
             if let Some(i) = e.downcast_ref::<cli::Interrupted>() {
-                eprintln!("interrupted: {msg}");
+                gvsrom::progress::stderr_line(format_args!("interrupted: {msg}"));
                 return ExitCode::from((128 + i.signal).clamp(0, 255) as u8);
             }
-            eprintln!("error: {msg}");
+            gvsrom::progress::stderr_line(format_args!("error: {msg}"));
             ExitCode::FAILURE
         }
     }

@@ -4,6 +4,7 @@
 //! alive, without filling its log with redraws.
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle, TermLike};
+use std::fmt;
 use std::io::{self, IsTerminal, Write};
 use std::sync::{Mutex, Once};
 use std::time::{Duration, Instant};
@@ -12,6 +13,14 @@ use std::time::{Duration, Instant};
 pub const PERIOD_VAR: &str = "GVSROM_PROGRESS_SECONDS";
 /// The period of the plain progress lines when [`PERIOD_VAR`] is not set.
 pub const DEFAULT_PERIOD: Duration = Duration::from_secs(30);
+
+/// One line on stderr (a warning, a progress line, the final error), best effort: a closed or full
+/// stderr — a reader that went away, `2>&-` — must not stop or abort the work the line reports on,
+/// so a failed write is dropped where `eprintln!` would panic. Called as
+/// `stderr_line(format_args!("warning: {w}"))`.
+pub fn stderr_line(line: fmt::Arguments<'_>) {
+    let _ = writeln!(io::stderr().lock(), "{line}");
+}
 
 /// The period of the plain progress lines: [`PERIOD_VAR`] if it holds a finite number of
 /// seconds ≥ 0 (`0`: a line at every update the bar draws, at most one a second after the first
@@ -26,11 +35,10 @@ pub fn log_period() -> Duration {
         None => {
             static WARNED: Once = Once::new();
             WARNED.call_once(|| {
-                let _ = writeln!(
-                    io::stderr().lock(),
+                stderr_line(format_args!(
                     "warning: {PERIOD_VAR}={value:?} is not a number of seconds ≥ 0 (e.g. 5 or 0.5); progress lines come every {} s",
                     DEFAULT_PERIOD.as_secs()
-                );
+                ));
             });
             DEFAULT_PERIOD
         }
@@ -83,9 +91,7 @@ struct LogLines {
 impl LogLines {
     fn offer(&self, line: &str) -> io::Result<()> {
         if self.due(line, Instant::now()) {
-            // best effort: a closed or full stderr (a reader that went away) must not stop the
-            // work the line reports on, so a failed write is dropped, never a panic
-            let _ = writeln!(io::stderr().lock(), "{}", line.trim_end());
+            stderr_line(format_args!("{}", line.trim_end()));
         }
         Ok(())
     }

@@ -178,7 +178,7 @@ fn attach_model(
     };
     reduce::attach_resolved(r, dir, options)?;
     for w in r.built.reduced.iter().flat_map(|m| &m.warnings) {
-        eprintln!("warning: {w}");
+        gvsrom::progress::stderr_line(format_args!("warning: {w}"));
     }
     Ok(())
 }

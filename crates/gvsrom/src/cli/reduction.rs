@@ -136,7 +136,7 @@ pub struct TrainArgs {
 pub(super) fn pod_cmd(args: &PodArgs, out: &mut impl Write) -> Result<()> {
     let s = reduce::pod(&args.datasets, args.modes, args.norm, &args.out, args.force)?;
     for w in &s.warnings {
-        eprintln!("warning: {w}");
+        gvsrom::progress::stderr_line(format_args!("warning: {w}"));
     }
     datasets_line(out, &s.datasets)?;
     writeln!(
@@ -246,7 +246,7 @@ pub(super) fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
     )?;
     bar.finish_and_clear();
     for w in &s.warnings {
-        eprintln!("warning: {w}");
+        gvsrom::progress::stderr_line(format_args!("warning: {w}"));
     }
     let r = &s.report;
     datasets_line(out, &s.datasets)?;

@@ -179,7 +179,7 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
         },
     )?;
     for o in &prepared.plan.model_extrapolated {
-        eprintln!("warning: extrapolating (--extrapolate): {o}");
+        gvsrom::progress::stderr_line(format_args!("warning: extrapolating (--extrapolate): {o}"));
     }
     let provenance = prepared.record(r.provenance.clone().seed("input", args.seed), &choice);
     let (opts, plan, light) = (&prepared.opts, &prepared.plan, &prepared.note);
@@ -220,14 +220,15 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
             if pct != last_pct {
                 last_pct = pct;
                 let bar = "#".repeat(pct / 4) + &".".repeat(25 - pct / 4);
-                eprint!("\r[{bar}] {pct:3}%  t = {t:.2} s");
+                // best effort, as every stderr line ([`gvsrom::progress::stderr_line`])
+                let _ = write!(std::io::stderr().lock(), "\r[{bar}] {pct:3}%  t = {t:.2} s");
             }
         }
         on_signal()
     };
     let mut outcome = simulate::run(built, plan, &opts.integrator, writer.as_mut(), &mut control)?;
     if tty {
-        eprintln!();
+        gvsrom::progress::stderr_line(format_args!(""));
     }
     let timing_stopped = outcome.time_again(
         built,

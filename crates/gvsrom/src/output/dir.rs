@@ -185,7 +185,9 @@ impl OutputDir {
                 .map_err(|(op, e)| keep(named.io(op)(e), &staging))?;
                 // The new output is in place; the old one goes only by its own manifest.
                 if let Err(e) = remove_previous_dir(&old, &files) {
-                    eprintln!(
+                    // best effort: a closed stderr must not turn a finished output into a panic
+                    let _ = writeln!(
+                        std::io::stderr().lock(),
                         "warning: the replaced output was kept in `{}`: {e}",
                         old.display()
                     );

@@ -24,6 +24,18 @@ pub fn gvsrom(args: &[&str]) -> Output {
         .expect("the gvsrom binary runs")
 }
 
+/// Runs `cmd` with its stderr a pipe whose reader is gone before the first line (a log reader
+/// that exited, `2>&1 | head`): every write there fails with a broken pipe. Returns the output
+/// (stdout read whole; stderr empty).
+pub fn with_stderr_gone(cmd: &mut Command) -> Output {
+    cmd.stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    let mut child = cmd.spawn().expect("the gvsrom binary runs");
+    drop(child.stderr.take());
+    child.wait_with_output().unwrap()
+}
+
 /// A test path as the `&str` of a command-line argument (scratch paths are UTF-8).
 pub fn s(p: &Path) -> &str {
     p.to_str().unwrap()
