@@ -1,7 +1,7 @@
 //! Figure builders the statics cases share: strain profiles along the rod and side views of the
 //! configurations, from an [`Evaluation`].
 
-use super::tasks::{Evaluation, Solved};
+use super::evaluation::{Evaluation, Solved};
 use crate::plot::{Figure, LineChart, Rgb, Series, SeriesStyle};
 
 /// How a model is drawn: its label in the evaluation, its colour and its line style.

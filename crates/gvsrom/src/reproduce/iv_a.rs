@@ -5,11 +5,12 @@
 //! 1 … 10 modes. Test: 20 tensions between the training ones (−5.85 + 0.45 i N), where every model's
 //! equilibrium is solved as `gvsrom statics [--model]` solves it.
 
+use super::evaluation::{statics_eval, EvalModel, Evaluation};
 use super::figures;
 use super::report::{figure, ratio, CaseReport, Cell, RenderedFigure, Table};
 use super::statics_study::StaticsComparison;
 use super::step::Step;
-use super::tasks::{self, AeConfig, DatasetSpec, EvalModel, Evaluation, ModelInfo, ScenarioSpec};
+use super::tasks::{self, AeConfig, DatasetSpec, ModelInfo, ScenarioSpec};
 use super::{new_report, paper, Case, Options, Run};
 use crate::plot::{palette, Figure, SeriesStyle};
 use serde_json::json;
@@ -185,7 +186,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         .iter()
         .map(|u| vec![format!("tendons.0.tension={u}")])
         .collect();
-    let ev = tasks::statics_eval(run, "iv-a/eval", &m.scenario, &inputs, &models, s.repeat)?;
+    let ev = statics_eval(run, "iv-a/eval", &m.scenario, &inputs, &models, s.repeat)?;
     let ev = &ev.value;
     let modes: Vec<usize> = (1..=m.pods.len()).collect();
     let c = StaticsComparison::of(ev, 1, &modes);

@@ -6,12 +6,13 @@
 //! r = 1, 2, 3 × 3, 5, 7 hidden layers and POD with 1 … 30 modes. Test: 4 N·m at X/L = 0.25 and
 //! 2 N·m at X/L = 0.75 (Fig. 6).
 
+use super::evaluation::{statics_eval, EvalModel, Evaluation};
 use super::figures;
 use super::iv_a::{accuracy_table, table_i};
 use super::report::{figure, CaseReport, Cell, Finding, RenderedFigure, Table};
 use super::statics_study::StaticsComparison;
 use super::step::Step;
-use super::tasks::{self, AeConfig, DatasetSpec, EvalModel, Evaluation, ScenarioSpec};
+use super::tasks::{self, AeConfig, DatasetSpec, ScenarioSpec};
 use super::{iv_b_built, iv_common, new_report, paper, Case, Options, Run};
 use crate::dataset::Dataset;
 use crate::plot::{palette, Figure, SeriesStyle};
@@ -336,7 +337,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
             ]
         })
         .collect();
-    let ev = tasks::statics_eval(run, "iv-b/eval", &scenario, &inputs, &models, s.repeat)?;
+    let ev = statics_eval(run, "iv-b/eval", &scenario, &inputs, &models, s.repeat)?;
     let ev = &ev.value;
     let c = StaticsComparison::of(ev, 2, &modes);
     let (k, pod_k) = (c.pod_k, c.pod_k_label());
@@ -351,7 +352,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         })
         .cloned()
         .collect();
-    let ev_random = tasks::statics_eval(
+    let ev_random = statics_eval(
         run,
         "iv-b/eval-random",
         &scenario,

@@ -8,6 +8,7 @@
 //! reuses every step whose key is unchanged, so an interrupted run resumes and one changed option
 //! recomputes only what depends on it.
 
+pub mod evaluation;
 pub mod figures;
 pub mod html;
 pub mod intrinsic;

@@ -8,9 +8,10 @@
 //! it with the same settings; the reconstruction error is measured against the clean snapshots and
 //! the ROM's strain error at the study's test inputs against the HOM.
 
+use super::evaluation::{statics_eval, EvalModel, Evaluation};
 use super::report::{figure, CaseReport, Cell, Finding, RenderedFigure, Table};
 use super::step::Step;
-use super::tasks::{self, DatasetInfo, EvalModel, ModelInfo, ScenarioSpec};
+use super::tasks::{self, DatasetInfo, ModelInfo, ScenarioSpec};
 use super::{iv_a, iv_b, iv_common, new_report, Case, Options, Run};
 use crate::plot::Figure;
 use serde_json::json;
@@ -51,7 +52,7 @@ struct Study {
     noisy: Step<ModelInfo>,
     /// RMSE of the noisy model against the clean snapshots.
     noisy_vs_clean: f64,
-    ev: tasks::Evaluation,
+    ev: Evaluation,
     latent_clean: iv_common::Latent,
     latent_noisy: iv_common::Latent,
 }
@@ -84,7 +85,7 @@ fn study(
         EvalModel::of(&rom_label, &clean),
         EvalModel::of(&format!("{rom_label} noisy"), &noisy_models[0]),
     ];
-    let ev = tasks::statics_eval(
+    let ev = statics_eval(
         run,
         &format!("noise/{prefix}-eval"),
         scenario,

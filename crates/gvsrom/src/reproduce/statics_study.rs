@@ -2,9 +2,9 @@
 //! modes below 1 % strain error (POD-k, Table III's same-accuracy row) and the HOM, at the case's
 //! test inputs, and the four conclusions of the paper drawn from them.
 
+use super::evaluation::Evaluation;
 use super::paper;
 use super::report::{ratio, Cell, Digits, Finding, Table};
-use super::tasks::Evaluation;
 
 /// The fewest POD modes among `modes` (ascending) whose largest strain error over the test inputs
 /// is below `limit` %.

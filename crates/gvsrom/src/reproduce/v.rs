@@ -3,9 +3,9 @@
 //! the HOM, which the paper's ROMs approximate, and prints the paper's measured errors beside.
 //! Data and models are IV-A's (same robot: gravity, friction 0.88; same steps, reused).
 
+use super::evaluation::{statics_eval, EvalModel};
 use super::figures;
 use super::report::{figure, CaseReport, Cell, Finding, RenderedFigure, Table};
-use super::tasks::{self, EvalModel};
 use super::{iv_a, new_report, paper, Case, Options, Run};
 use crate::plot::{palette, Figure, Series, SeriesStyle};
 use serde_json::json;
@@ -32,7 +32,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         .iter()
         .map(|u| vec![format!("tendons.0.tension={u}")])
         .collect();
-    let ev = tasks::statics_eval(run, "v/eval", &m.scenario, &inputs, &models, 1)?;
+    let ev = statics_eval(run, "v/eval", &m.scenario, &inputs, &models, 1)?;
     let ev = &ev.value;
     let length = ev.length;
     let mut rows = vec![];

@@ -3,11 +3,10 @@
 //! size and test inputs as the case itself, on the hanging arm: whether the paper's comparison
 //! depends on that reading.
 
+use super::super::evaluation::{statics_eval, EvalModel, Evaluation};
 use super::super::report::{Cell, Finding, Table};
 use super::super::step::Step;
-use super::super::tasks::{
-    self, AeConfig, DatasetInfo, DatasetSpec, EvalModel, Evaluation, ModelInfo, ScenarioSpec,
-};
+use super::super::tasks::{self, AeConfig, DatasetInfo, DatasetSpec, ModelInfo, ScenarioSpec};
 use super::super::{paper, Run};
 use super::accuracy_table;
 
@@ -46,7 +45,7 @@ pub(super) fn run_hanging(
         EvalModel::of(&format!("POD-{r}"), &pod),
     ];
     let eval_scenario = scenario.with(&[format!("output.centerline_points={centerline_points}")]);
-    let ev = tasks::statics_eval(
+    let ev = statics_eval(
         run,
         "iv-c1/hanging-eval",
         &eval_scenario,

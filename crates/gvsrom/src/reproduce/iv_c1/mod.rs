@@ -14,11 +14,12 @@
 mod hanging;
 mod report;
 
+use super::evaluation::{statics_eval, EvalModel};
 use super::iv_a::accuracy_table;
 use super::latent::{encodings, occupied_fraction, principal_components};
 use super::report::{CaseReport, Cell, Finding, RenderedFigure};
 use super::step::Step;
-use super::tasks::{self, AeConfig, DatasetInfo, DatasetSpec, EvalModel, ModelInfo, ScenarioSpec};
+use super::tasks::{self, AeConfig, DatasetInfo, DatasetSpec, ModelInfo, ScenarioSpec};
 use super::{new_report, paper, Case, Options, Run};
 use crate::dataset::Dataset;
 use report::{
@@ -158,7 +159,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         EvalModel::of("POD-6 (energy norm)", &pod_energy),
     ];
     let eval_scenario = scenario.with(&[format!("output.centerline_points={CENTERLINE_POINTS}")]);
-    let ev = tasks::statics_eval(
+    let ev = statics_eval(
         run,
         "iv-c1/eval",
         &eval_scenario,

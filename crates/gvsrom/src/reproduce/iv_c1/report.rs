@@ -1,10 +1,11 @@
 //! IV-C1's tables and figures: the datasets and models tables, Fig. 7's configurations with its
 //! inputs table, the Table III same-DOF row beside the paper's, and Fig. 8's table and figure.
 
+use super::super::evaluation::{EvalPoint, Evaluation};
 use super::super::paper;
 use super::super::report::{figure, ratio, Cell, Digits, RenderedFigure, Table};
 use super::super::step::Step;
-use super::super::tasks::{self, DatasetInfo, Evaluation, ModelInfo};
+use super::super::tasks::{DatasetInfo, ModelInfo};
 use super::{Sampling, Times, R, TESTS};
 use crate::plot::{palette, Figure, LineChart, Scatter3, Series, SeriesStyle};
 
@@ -110,7 +111,7 @@ pub(super) fn inputs_table(ev: &Evaluation, tensions: &[[f64; 6]]) -> Table {
 
 /// Model `label`'s tip error at point `p`: ‖p_ROM − p_HOM‖ [cm] and in % of the length (NaN if a
 /// solve failed).
-fn tip_error(p: &tasks::EvalPoint, label: &str) -> (f64, f64) {
+fn tip_error(p: &EvalPoint, label: &str) -> (f64, f64) {
     let find = |l: &str| p.models.iter().find(|m| m.label == l && m.error.is_none());
     match (find("HOM"), find(label)) {
         (Some(h), Some(m)) => {
