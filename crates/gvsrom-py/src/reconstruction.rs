@@ -1,0 +1,105 @@
+//! `Model.reconstruction(dataset)` and its result, the `Reconstruction` class: a model's
+//! reconstruction errors on a dataset (the library's [`gvsrom::reduce::reconstruction`], as
+//! `gvsrom reconstruct`).
+
+use crate::errors;
+use crate::models::Model;
+use pyo3::prelude::*;
+use std::path::PathBuf;
+
+#[pymethods]
+impl Model {
+    /// How closely the model reconstructs the solved snapshots of a dataset of its layout,
+    /// ``x̂ = D(E(x))`` (``gvsrom reconstruct MODEL DATASET``): Table I's RMSE on any data, e.g. data
+    /// the model was not trained on.
+    ///
+    /// Parameters
+    /// ----------
+    /// dataset : Dataset or str or os.PathLike
+    ///     A dataset (``load_dataset``) or its directory, of the model's points and components.
+    ///
+    /// Returns
+    /// -------
+    /// Reconstruction
+    ///
+    /// Raises
+    /// ------
+    /// ValueError
+    ///     If the dataset has another layout (naming both) or no solved snapshot.
+    fn reconstruction(&self, py: Python<'_>, dataset: DatasetArg<'_>) -> PyResult<Reconstruction> {
+        let dir = match dataset {
+            DatasetArg::Loaded(d) => d.get().path(),
+            DatasetArg::Dir(p) => p,
+        };
+        let r = py
+            .detach(|| {
+                let ds = gvsrom::dataset::Dataset::load(&dir)?;
+                gvsrom::reduce::reconstruction(&self.model, &ds).map_err(anyhow::Error::from)
+            })
+            .map_err(errors::any)?;
+        Ok(Reconstruction {
+            rows: r.rows,
+            rmse: r.rmse,
+            relative: r.relative,
+            worst: r.worst,
+            largest_norm: r.largest_norm,
+            outside: r.outside,
+        })
+    }
+}
+
+/// The ``dataset`` argument of [`Model::reconstruction`]: a loaded dataset or a directory.
+#[derive(FromPyObject)]
+pub enum DatasetArg<'py> {
+    Loaded(Bound<'py, crate::datasets::Dataset>),
+    Dir(PathBuf),
+}
+
+/// A model's reconstruction errors on a dataset (``Model.reconstruction``).
+///
+/// Attributes
+/// ----------
+/// rows : int
+///     Solved snapshots evaluated.
+/// rmse : float
+///     ``sqrt(mean (x̂ − x)²)`` over every entry of every snapshot (Table I), in strain units.
+/// relative : float
+///     ``‖X̂ − X‖_F / ‖X‖_F`` over the dataset.
+/// worst : tuple[int, float, float] or None
+///     The dataset row with the largest ``‖x̂ − x‖ / ‖x‖``, that ratio and ``‖x‖`` (None if every
+///     snapshot is zero).
+/// largest_norm : float
+///     The largest ``‖x‖``, for scale.
+/// outside : int
+///     Snapshots whose code lies far outside the training encodings.
+#[pyclass(module = "gvsrom", frozen)]
+pub struct Reconstruction {
+    /// Solved snapshots evaluated.
+    #[pyo3(get)]
+    rows: usize,
+    /// ``sqrt(mean (x̂ − x)²)`` over every entry of every snapshot (Table I).
+    #[pyo3(get)]
+    rmse: f64,
+    /// ``‖X̂ − X‖_F / ‖X‖_F`` over the dataset.
+    #[pyo3(get)]
+    relative: f64,
+    /// ``(row, ‖x̂ − x‖ / ‖x‖, ‖x‖)`` of the worst snapshot, or None.
+    #[pyo3(get)]
+    worst: Option<(usize, f64, f64)>,
+    /// The largest ``‖x‖`` of the snapshots.
+    #[pyo3(get)]
+    largest_norm: f64,
+    /// Snapshots whose code lies far outside the training encodings.
+    #[pyo3(get)]
+    outside: usize,
+}
+
+#[pymethods]
+impl Reconstruction {
+    fn __repr__(&self) -> String {
+        format!(
+            "Reconstruction(rows={}, rmse={:.4e}, relative={:.4e}, outside={})",
+            self.rows, self.rmse, self.relative, self.outside
+        )
+    }
+}
