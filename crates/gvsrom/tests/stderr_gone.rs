@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{s, scratch, with_stderr_gone};
+use common::{rust_files, s, scratch, with_stderr_gone};
 use std::fs;
 use std::path::Path;
 
@@ -50,15 +50,4 @@ fn no_source_writes_to_stderr_with_a_macro_that_panics_on_a_failed_write() {
         "use gvsrom::progress::stderr_line (best effort) instead:\n{}",
         offenders.join("\n")
     );
-}
-
-fn rust_files(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
-    for e in fs::read_dir(dir).unwrap() {
-        let p = e.unwrap().path();
-        if p.is_dir() {
-            rust_files(&p, out);
-        } else if p.extension().is_some_and(|x| x == "rs") {
-            out.push(p);
-        }
-    }
 }

@@ -252,3 +252,15 @@ pub fn run_to_buffer(
     assert_eq!(outcome.ending, simulate::Ending::Complete);
     buffer
 }
+
+/// Every `.rs` file under `dir`, recursively (source-reading tests).
+pub fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            rust_files(&p, out);
+        } else if p.extension().is_some_and(|x| x == "rs") {
+            out.push(p);
+        }
+    }
+}
