@@ -1,0 +1,177 @@
+//! Forward kinematics (gvs-spec §5.3, §6): the strains `ξ_s = Ψ_s + ξ*_s` at the sites, the Magnus
+//! steps `g_{i+1} = g_i exp(Ω̂)`, the geometric Jacobian `J_{i+1} = Ad⁻¹_{exp Ω}(J_i + T(Ω) Z)`, and
+//! what is read off the poses (tip, point strains, the centreline between the points).
+
+use super::{Model, Workspace, STEP_MATRIX_COLUMNS};
+use crate::discretize::MagnusOrder;
+use crate::lie::{ad_mul, exp_tangent, Pose, V3, V6};
+use crate::strain::StrainParam;
+use nalgebra::DVector;
+
+/// `c = √3/12` of the Zanna step.
+pub const ZANNA_C: f64 = 0.144_337_567_297_406_43;
+
+impl<P: StrainParam> Model<P> {
+    /// Forward pass: strains at all sites, poses at all points, Magnus steps, and (if `jacobians`)
+    /// `Z`, `J` at every point.
+    pub fn forward(&self, q: &DVector<f64>, ws: &mut Workspace, jacobians: bool) {
+        self.param.eval(q, &mut ws.ev);
+        ws.ev.motion = false;
+        ws.ev.psi_q_stale = false;
+        self.forward_from_strains(ws, jacobians);
+    }
+
+    /// The poses `g_i` and strains `ξ_i` at `q` without Jacobians, for positions and output: as
+    /// [`Self::forward`] with `jacobians = false`, but by [`StrainParam::eval_strains`] where the
+    /// parameterization offers it (a decoder's value without its `r` tangents); `ws.ev.psi_q` is
+    /// then stale.
+    pub fn forward_pose(&self, q: &DVector<f64>, ws: &mut Workspace) {
+        if self.param.eval_strains(q, &mut ws.ev) {
+            ws.ev.motion = false;
+            ws.ev.psi_q_stale = true;
+            self.forward_from_strains(ws, false);
+        } else {
+            self.forward(q, ws, false);
+        }
+    }
+
+    /// [`Self::forward`] after the strains `ws.ev.psi` were evaluated (by [`StrainParam::eval`], or
+    /// by [`StrainParam::eval_motion`] for a residual pass without Jacobians).
+    pub(crate) fn forward_from_strains(&self, ws: &mut Workspace, jacobians: bool) {
+        debug_assert!(!(jacobians && ws.ev.psi_q_stale), "Jacobians need Ψ_q");
+        for s in 0..ws.xi.len() {
+            ws.xi[s] = ws.ev.psi[s] + self.xi_star[s];
+        }
+        ws.g[0] = self.base;
+        for i in 0..self.disc.n_points() - 1 {
+            let Some(st) = self.disc.steps[i] else {
+                ws.g[i + 1] = ws.g[i];
+                continue;
+            };
+            let h = st.h;
+            let [s1, s2] = st.sites;
+            let omega = match self.disc.order {
+                MagnusOrder::Z4 => {
+                    (ws.xi[s1] + ws.xi[s2]) * (0.5 * h)
+                        + crate::lie::ad_mul(&ws.xi[s1], &ws.xi[s2]) * (ZANNA_C * h * h)
+                }
+                MagnusOrder::Z2 => ws.xi[s1] * h,
+            };
+            if jacobians {
+                ws.et[i] = exp_tangent(&omega);
+            } else {
+                ws.et[i].set_lean(&omega);
+            }
+            ws.g[i + 1] = ws.g[i].compose(&ws.et[i].g);
+        }
+        if jacobians {
+            self.forward_jacobians(ws);
+        }
+    }
+
+    /// The Jacobian part of the forward pass, from the strains and Magnus steps already in `ws`:
+    /// `Z_i = ∂Ω_i/∂q` and `J_{i+1} = Ad⁻¹_{exp Ω_i} (J_i + T(Ω_i) Z_i)` (spec §5).
+    ///
+    /// `Z_i` lives on the step's columns `c` only, and `J_{i+1}` is zero beyond `hi = max c.end` of
+    /// the steps so far: the recursion costs `36·hi` per step, one pass over the columns.
+    pub(super) fn forward_jacobians(&self, ws: &mut Workspace) {
+        let n = self.n_dof();
+        ws.set_jac_bound(0, 0);
+        let mut hi = 0;
+        for i in 0..self.disc.n_points() - 1 {
+            let Some(st) = self.disc.steps[i] else {
+                let (a, mut b) = ws
+                    .jac
+                    .columns_range_pair_mut(i * n..i * n + hi, (i + 1) * n..(i + 1) * n + hi);
+                b.copy_from(&a);
+                ws.set_jac_bound(i + 1, hi);
+                continue;
+            };
+            let h = st.h;
+            let [s1, s2] = st.sites;
+            let c = self.param.columns(s1);
+            hi = hi.max(c.end);
+            let wide = c.len() > STEP_MATRIX_COLUMNS;
+            if wide {
+                // after a residual-only forward pass: T and the powers, for the many products
+                // with T on this step's columns here and in the backward pass
+                ws.et[i].complete();
+            }
+            let mut z = ws.z.columns_mut(i * n + c.start, c.len());
+            match self.disc.order {
+                MagnusOrder::Z4 => {
+                    let p1 = ws.ev.psi_q_at(s1, &c);
+                    let p2 = ws.ev.psi_q_at(s2, &c);
+                    let k = ZANNA_C * h * h;
+                    // Z = h/2 (Ψ_q1 + Ψ_q2) + k (ad_ξ1 Ψ_q2 − ad_ξ2 Ψ_q1), column by column
+                    // (6-vector products: no GEMM call and its packing buffers per step)
+                    for j in 0..c.len() {
+                        let (a, b): (V6, V6) =
+                            (p1.column(j).into_owned(), p2.column(j).into_owned());
+                        let zj = (a + b) * (0.5 * h)
+                            + (ad_mul(&ws.xi[s1], &b) - ad_mul(&ws.xi[s2], &a)) * k;
+                        z.column_mut(j).copy_from(&zj);
+                    }
+                }
+                MagnusOrder::Z2 => {
+                    z.copy_from(&ws.ev.psi_q_at(s1, &c));
+                    z *= h;
+                }
+            }
+            let et = &ws.et[i];
+            // J_{i+1} = Ad⁻¹ (J_i + T Z) column by column (Z only on the step's columns)
+            let zi = ws.z.columns(i * n, n);
+            let (a, mut b) = ws
+                .jac
+                .columns_range_pair_mut(i * n..i * n + hi, (i + 1) * n..(i + 1) * n + hi);
+            let adinv = (hi > STEP_MATRIX_COLUMNS).then(|| et.g.adjoint_inv());
+            for j in 0..hi {
+                let mut x: V6 = a.fixed_columns::<1>(j).into_owned();
+                if c.contains(&j) {
+                    let zj: V6 = zi.fixed_columns::<1>(j).into_owned();
+                    x += if wide { et.t * zj } else { et.t_mul(&zj) };
+                }
+                let y = match &adinv {
+                    Some(m) => m * x,
+                    None => et.g.adjoint_inv_mul(&x),
+                };
+                b.fixed_columns_mut::<1>(j).copy_from(&y);
+            }
+            ws.set_jac_bound(i + 1, hi);
+        }
+    }
+
+    /// Tip pose `g(L)` after a forward pass.
+    pub fn tip_pose(&self, ws: &Workspace) -> Pose {
+        ws.g[self.disc.tip()]
+    }
+
+    /// Strain `ξ_i` at every computational point after a forward pass.
+    pub fn point_strains(&self, ws: &Workspace) -> Vec<V6> {
+        ws.xi[..self.disc.n_points()].to_vec()
+    }
+
+    /// Position of the centreline at `x` by cubic Hermite interpolation between the neighbouring
+    /// computational points (tangent `r' = R ν`), after a forward pass.
+    pub fn position_at(&self, ws: &Workspace, x: f64) -> V3 {
+        let pts = &self.disc.points;
+        let i = match pts.iter().position(|p| p.x > x) {
+            Some(0) => 0,
+            Some(i) => i - 1,
+            None => return ws.g[pts.len() - 1].pos,
+        };
+        let (a, b) = (pts[i], pts[i + 1]);
+        let hx = b.x - a.x;
+        if hx <= 0.0 {
+            return ws.g[i].pos;
+        }
+        let t = ((x - a.x) / hx).clamp(0.0, 1.0);
+        let ta = ws.g[i].rot * V3::new(ws.xi[i][3], ws.xi[i][4], ws.xi[i][5]);
+        let tb = ws.g[i + 1].rot * V3::new(ws.xi[i + 1][3], ws.xi[i + 1][4], ws.xi[i + 1][5]);
+        let (t2, t3) = (t * t, t * t * t);
+        ws.g[i].pos * (2.0 * t3 - 3.0 * t2 + 1.0)
+            + ta * ((t3 - 2.0 * t2 + t) * hx)
+            + ws.g[i + 1].pos * (-2.0 * t3 + 3.0 * t2)
+            + tb * ((t3 - t2) * hx)
+    }
+}
