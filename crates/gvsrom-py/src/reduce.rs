@@ -2,8 +2,9 @@
 //! [`gvsrom::reduce::pod`] and [`gvsrom::reduce::train`], `gvsrom pod` and `gvsrom train`), with
 //! their `dataset` and `init` arguments.
 
-use crate::errors::{self, invalid};
+use crate::errors;
 use crate::models::{load_model, Model};
+use gvsrom::reduce::TrainRequest;
 use pyo3::prelude::*;
 use std::path::PathBuf;
 
@@ -39,15 +40,7 @@ pub fn pod(
     force: bool,
     norm: &str,
 ) -> PyResult<Model> {
-    use gvsrom::reduce::PodNorm;
-    let norm = [PodNorm::Plain, PodNorm::Energy]
-        .into_iter()
-        .find(|n| n.name() == norm)
-        .ok_or_else(|| {
-            invalid(format!(
-                "invalid `norm`: `{norm}` (accepted: plain, energy)"
-            ))
-        })?;
+    let norm = gvsrom::reduce::named("norm", norm).map_err(errors::scenario)?;
     let dataset = dataset_paths(dataset)?;
     let summary = py
         .detach(|| gvsrom::reduce::pod(&dataset, modes, norm, &out, force))
@@ -110,9 +103,6 @@ fn dataset_paths(arg: &Bound<'_, PyAny>) -> PyResult<Vec<PathBuf>> {
     Ok(paths)
 }
 
-/// How often training looks for Ctrl-C.
-const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(100);
-
 /// Trains a tanh autoencoder on a dataset's strain snapshots; its decoder becomes a nonlinear
 /// reduced model (``gvsrom train DATASET … --out MODEL``, with the same defaults). Ctrl-C stops
 /// training, saves the best weights so far and raises ``KeyboardInterrupt``.
@@ -166,6 +156,8 @@ const SIGNAL_POLL: std::time::Duration = std::time::Duration::from_millis(100);
 /// -------
 /// Model
 ///     The new model.
+// the defaults are literals, so that Python's signature shows them; tests/test_reduced.py checks
+// them against `gvsrom train --help` (the library's `TrainRequest::DEFAULT`)
 #[pyfunction]
 #[pyo3(signature = (dataset, out, latent=None, hidden_layers=None, epochs=2000, batch_size=64, learning_rate=1e-3, lambda_=1e-4, validation_fraction=None, patience=50, lr_reductions=4, lbfgs_iterations=300, seed=None, loss=None, sample_weighting="uniform", relative_floor=0.1, decoder=None, rate_weight=0.0, lr_decay=None, kinetic_weight=0.0, init=None, force=false))]
 #[allow(clippy::too_many_arguments)]
@@ -194,65 +186,48 @@ pub fn train(
     init: Option<&Bound<'_, PyAny>>,
     force: bool,
 ) -> PyResult<Model> {
-    use gvsrom::reduce::Loss;
-    use rom::nn::TrainOptions;
+    use gvsrom::reduce::{self, TrainChoices};
     let init = match init {
-        Some(m) => Some(gvsrom::reduce::start_model(&model_path(m)?).map_err(errors::any)?),
+        Some(m) => Some(reduce::start_model(&model_path(m)?).map_err(errors::any)?),
         None => None,
     };
-    let loss = match loss {
-        Some(name) => Some(Loss::from_name(name).ok_or_else(|| {
-            invalid(format!(
-                "invalid `loss`: `{name}` (accepted: energy, physical, standardized)"
-            ))
-        })?),
-        None => None,
-    };
-    let decoder = match decoder {
-        Some(name) => Some(gvsrom::reduce::decoder_form(name).map_err(errors::scenario)?),
-        None => None,
-    };
-    let asked = gvsrom::reduce::TrainChoices {
-        latent,
-        hidden_layers,
-        decoder,
-        loss,
-        seed,
-        validation_fraction,
-    };
-    let given = TrainOptions {
+    let request = TrainRequest {
+        choices: TrainChoices {
+            latent,
+            hidden_layers,
+            decoder: decoder
+                .map(reduce::decoder_form)
+                .transpose()
+                .map_err(errors::scenario)?,
+            loss: loss
+                .map(|name| reduce::named("loss", name))
+                .transpose()
+                .map_err(errors::scenario)?,
+            seed,
+            validation_fraction,
+        },
         lambda: lambda_,
         epochs,
         batch_size,
         learning_rate,
-        patience: (patience > 0).then_some(patience),
+        patience,
         lr_reductions,
         lr_decay,
-        fine_tune: rom::nn::FineTune::lbfgs(lbfgs_iterations),
-        sample_weighting: gvsrom::reduce::sample_weighting(sample_weighting, relative_floor)
+        lbfgs_iterations,
+        sample_weighting: reduce::sample_weighting(sample_weighting, relative_floor)
             .map_err(errors::scenario)?,
         rate_weight,
-        ..TrainOptions::default()
     };
-    let (options, loss) = gvsrom::reduce::train_settings(init.as_ref(), &asked, given);
+    let (options, loss) = request.resolve(init.as_ref());
     let dataset = dataset_paths(dataset)?;
-    let mut interrupt: Option<PyErr> = None;
+    let mut signals = crate::interrupt::SignalPoll::new();
     let summary = py.detach(|| {
-        let mut last_poll = std::time::Instant::now();
-        let mut progress = |_epoch: usize, _train: f64, _val: Option<f64>| {
-            if last_poll.elapsed() < SIGNAL_POLL {
-                return std::ops::ControlFlow::Continue(());
-            }
-            last_poll = std::time::Instant::now();
-            match Python::attach(|py| py.check_signals()) {
-                Ok(()) => std::ops::ControlFlow::Continue(()),
-                Err(e) => {
-                    interrupt = Some(e);
-                    std::ops::ControlFlow::Break(())
-                }
-            }
-        };
-        gvsrom::reduce::train(
+        let mut progress =
+            |_epoch: usize, _train: f64, _val: Option<f64>| match signals.interrupted() {
+                false => std::ops::ControlFlow::Continue(()),
+                true => std::ops::ControlFlow::Break(()),
+            };
+        reduce::train(
             &dataset,
             init.as_ref(),
             &options,
@@ -267,7 +242,7 @@ pub fn train(
     for w in &summary.warnings {
         crate::robot::warn(py, w)?;
     }
-    if let Some(e) = interrupt {
+    if let Some(e) = signals.caught() {
         return Err(e);
     }
     load_model(py, summary.path, false)

@@ -14,10 +14,6 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::ops::ControlFlow;
 use std::sync::{Arc, Mutex, PoisonError};
-use std::time::{Duration, Instant};
-
-/// How often the run looks for Ctrl-C (a signal handler needs the GIL).
-const SIGNAL_POLL: Duration = Duration::from_millis(20);
 
 /// The arguments of [`run`] (the options of `gvsrom simulate`).
 pub struct Args<'a> {
@@ -293,23 +289,15 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
         warn(py, &format!("extrapolating (--extrapolate): {o}"))?;
     }
     let mut buffer = TrajectoryBuffer::new(built);
-    let mut interrupt: Option<PyErr> = None;
+    let mut signals = crate::interrupt::SignalPoll::new();
     let outcome = py.detach(|| {
-        let mut last_poll = Instant::now();
         let mut control = |_t: f64| {
             if callable.as_ref().is_some_and(|c| c.failed()) {
                 return ControlFlow::Break("the input callable failed".to_string());
             }
-            if last_poll.elapsed() < SIGNAL_POLL {
-                return ControlFlow::Continue(());
-            }
-            last_poll = Instant::now();
-            match Python::attach(|py| py.check_signals()) {
-                Ok(()) => ControlFlow::Continue(()),
-                Err(e) => {
-                    interrupt = Some(e);
-                    ControlFlow::Break("interrupted".to_string())
-                }
+            match signals.interrupted() {
+                false => ControlFlow::Continue(()),
+                true => ControlFlow::Break("interrupted".to_string()),
             }
         };
         simulate::run_into(
@@ -323,7 +311,7 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
     if let Some(e) = callable.as_ref().and_then(|c| c.take_error()) {
         return Err(e);
     }
-    if let Some(e) = interrupt {
+    if let Some(e) = signals.caught() {
         return Err(e);
     }
     let outcome = outcome.map_err(err)?;

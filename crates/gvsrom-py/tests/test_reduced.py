@@ -321,3 +321,38 @@ def test_a_training_from_a_model_continues_it_and_keeps_its_architecture(dataset
         gvsrom.train(dataset, tmp_path / "never", latent=2, epochs=5, init=str(ae_model.path))
     with pytest.raises(TypeError, match=r"invalid `init`: got a int"):
         gvsrom.train(dataset, tmp_path / "never", epochs=5, init=3)
+
+
+def _cli_defaults(gvsrom_bin, command):
+    """`gvsrom COMMAND --help`'s options with a plain `[default: V]`: option name → V."""
+    p = run_cli(gvsrom_bin, command, "--help")
+    assert p.returncode == 0, p.stderr
+    defaults, option = {}, None
+    for line in p.stdout.splitlines():
+        s = line.strip()
+        if s.startswith("--"):
+            option = s.split()[0].lstrip("-")
+        elif option and s.startswith("[default: ") and s.endswith("]"):
+            defaults[option] = s[len("[default: "):-1]
+    return defaults
+
+
+@pytest.mark.parametrize("command", ["train", "pod"])
+def test_the_python_defaults_are_the_command_lines(gvsrom_bin, command):
+    import inspect
+
+    cli = _cli_defaults(gvsrom_bin, command)
+    params = inspect.signature(getattr(gvsrom, command)).parameters
+    compared = []
+    for name, p in params.items():
+        option = name.rstrip("_").replace("_", "-")
+        if option not in cli or p.default is inspect.Parameter.empty:
+            continue
+        value = cli[option]
+        if isinstance(p.default, bool) or isinstance(p.default, str):
+            assert str(p.default) == value, (name, p.default, value)
+        else:
+            assert p.default == type(p.default)(float(value)), (name, p.default, value)
+        compared.append(name)
+    # every plain default of the command line has its Python counterpart (not a vacuous test)
+    assert len(compared) == len(cli), (sorted(compared), sorted(cli))

@@ -55,27 +55,27 @@ pub struct TrainArgs {
     #[arg(long, value_name = "N")]
     pub hidden_layers: Option<usize>,
     /// Maximum Adam epochs.
-    #[arg(long, default_value_t = 2000)]
+    #[arg(long, default_value_t = reduce::TrainRequest::DEFAULT.epochs)]
     pub epochs: usize,
     /// Mini-batch size.
-    #[arg(long, default_value_t = 64)]
+    #[arg(long, default_value_t = reduce::TrainRequest::DEFAULT.batch_size)]
     pub batch_size: usize,
     /// Adam learning rate.
-    #[arg(long, default_value_t = 1e-3)]
+    #[arg(long, default_value_t = reduce::TrainRequest::DEFAULT.learning_rate)]
     pub learning_rate: f64,
     /// L2 weight regularization λ of eq. (15) (paper: 1e-4).
-    #[arg(long, default_value_t = 1e-4)]
+    #[arg(long, default_value_t = reduce::TrainRequest::DEFAULT.lambda)]
     pub lambda: f64,
     /// Fraction of the snapshots held out for validation and early stopping [default: 0.1; with
     /// `--init`, the model's].
     #[arg(long, value_name = "F")]
     pub validation_fraction: Option<f64>,
     /// Epochs without a better validation loss before stopping (0: never stop early).
-    #[arg(long, default_value_t = 50)]
+    #[arg(long, default_value_t = reduce::TrainRequest::DEFAULT.patience)]
     pub patience: usize,
     /// Learning-rate reductions (× 0.3 each, from the best weights so far) at validation plateaus of
     /// `--patience` epochs before Adam stops.
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = reduce::TrainRequest::DEFAULT.lr_reductions)]
     pub lr_reductions: usize,
     /// An exponential decay of the Adam rate to this factor of it over `--epochs` (epoch e of E at
     /// rate × F^(e/E)), in (0, 1]; with `--patience 0 --lbfgs-iterations 0` it is the JAX reference
@@ -83,7 +83,7 @@ pub struct TrainArgs {
     #[arg(long, value_name = "F")]
     pub lr_decay: Option<f64>,
     /// Iterations of the full-batch L-BFGS phase that follows Adam from its best weights (0: none).
-    #[arg(long, default_value_t = 300)]
+    #[arg(long, default_value_t = reduce::TrainRequest::DEFAULT.lbfgs_iterations)]
     pub lbfgs_iterations: usize,
     /// Seed of the initialization, the split and the shuffles (same seed, same model) [default: 0;
     /// with `--init`, the model's, so that a continuation holds out the same rows].
@@ -116,7 +116,7 @@ pub struct TrainArgs {
     /// decoder the tangent space a dynamic model moves in. 0: eq. (15) alone (the paper's); with
     /// 0.1–1 the IV-C2 AE-7 is about half as far off (`reproduce iv-c2` chooses among 0.1, 0.3 and 1
     /// on validation inputs; docs/assumptions.md).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = reduce::TrainRequest::DEFAULT.rate_weight)]
     pub rate_weight: f64,
     /// Weight κ of the kinetic-energy norm (beyond the paper): the reconstruction and rate errors
     /// are also measured as coefficient errors weighed by the mass matrix M(q) of each snapshot's
@@ -188,34 +188,32 @@ fn datasets_line(out: &mut impl Write, datasets: &[(PathBuf, usize)]) -> Result<
 }
 
 pub(super) fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
-    use rom::nn::TrainOptions;
     let init = args.init.as_deref().map(reduce::start_model).transpose()?;
-    let asked = reduce::TrainChoices {
-        latent: args.latent,
-        hidden_layers: args.hidden_layers,
-        decoder: args
-            .decoder
-            .as_deref()
-            .map(reduce::decoder_form)
-            .transpose()?,
-        loss: args.loss,
-        seed: args.seed,
-        validation_fraction: args.validation_fraction,
-    };
-    let given = TrainOptions {
+    let request = reduce::TrainRequest {
+        choices: reduce::TrainChoices {
+            latent: args.latent,
+            hidden_layers: args.hidden_layers,
+            decoder: args
+                .decoder
+                .as_deref()
+                .map(reduce::decoder_form)
+                .transpose()?,
+            loss: args.loss,
+            seed: args.seed,
+            validation_fraction: args.validation_fraction,
+        },
         lambda: args.lambda,
         epochs: args.epochs,
         batch_size: args.batch_size,
         learning_rate: args.learning_rate,
-        patience: (args.patience > 0).then_some(args.patience),
+        patience: args.patience,
         lr_reductions: args.lr_reductions,
         lr_decay: args.lr_decay,
-        fine_tune: rom::nn::FineTune::lbfgs(args.lbfgs_iterations),
+        lbfgs_iterations: args.lbfgs_iterations,
         sample_weighting: reduce::sample_weighting(&args.sample_weighting, args.relative_floor)?,
         rate_weight: args.rate_weight,
-        ..TrainOptions::default()
     };
-    let (options, loss) = reduce::train_settings(init.as_ref(), &asked, given);
+    let (options, loss) = request.resolve(init.as_ref());
     let signal = interrupt_flag();
     let bar = gvsrom::progress::bar(args.epochs as u64, "epochs");
     let mut progress = |epoch: usize, train: f64, val: Option<f64>| {

@@ -10,7 +10,8 @@
 //! linear basis) or `Φ_s P D(q_r)` (autoencoder).
 //!
 //! Files: [`pod`](pod()) and [`train`](train()) build models from one or more datasets (`pod.rs`,
-//! `train.rs`, and `start.rs`: a training from a model's weights); `sources.rs` gathers and checks their snapshots; `anchors.rs` holds the training
+//! `train.rs`, `start.rs`: a training from a model's weights, and `request.rs`: a training's options as
+//! every front-end is given them); `sources.rs` gathers and checks their snapshots; `anchors.rs` holds the training
 //! samples kept as initial guesses; `kinetic.rs` the mass matrices of `train --kinetic-weight`;
 //! `attach.rs` binds a model to a scenario; this file the steps
 //! both commands share.
@@ -21,6 +22,7 @@ mod evaluate;
 mod kinetic;
 mod loss;
 mod pod;
+mod request;
 mod sources;
 mod start;
 mod train;
@@ -33,6 +35,7 @@ pub use attach::{attach, attach_resolved, attach_source, parameterization, Attac
 pub use evaluate::{reconstruction, Reconstruction};
 pub use loss::Loss;
 pub use pod::{pod, PodSummary};
+pub use request::{named, TrainRequest};
 pub use start::{start_model, train_settings, StartModel, TrainChoices};
 pub use train::{
     decoder_form, sample_weighting, train, zero_anchor_rows, TrainSummary, SAMPLE_WEIGHTINGS,

@@ -39,7 +39,7 @@ pub struct StartModel {
 
 /// The settings of a training that a start model fixes or suggests, as a front-end was given
 /// them: `None` where the user gave none ([`train_settings`]).
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct TrainChoices {
     pub latent: Option<usize>,
     pub hidden_layers: Option<usize>,
