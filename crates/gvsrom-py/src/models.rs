@@ -97,7 +97,7 @@ impl Model {
         let (x, one) = rows_of(name, a, cols, what)?;
         let y = py
             .detach(|| f(&self.model, &x))
-            .map_err(|e| invalid(e.to_string()))?;
+            .map_err(|e| invalid(crate::errors::chain(&e)))?;
         if one {
             Ok(vector(py, &y))
         } else {
@@ -231,7 +231,7 @@ impl Model {
 pub fn load_model(py: Python<'_>, path: PathBuf, extrapolate: bool) -> PyResult<Model> {
     let m = py
         .detach(|| ReducedModel::load(&path))
-        .map_err(|e| invalid(e.to_string()))?;
+        .map_err(|e| invalid(crate::errors::chain(&e)))?;
     let arrays = PyDict::new(py);
     for (name, (shape, values)) in m.arrays() {
         let a = numpy::PyArray::from_vec(py, values).reshape(shape)?;

@@ -20,8 +20,7 @@
 //!
 //! Keys that do not apply are left out. One struct, [`Provenance`], builds them all.
 
-use crate::error::ScenarioError;
-use crate::output::{MANIFEST_FILE, MANIFEST_KEY};
+use crate::output::MANIFEST_KEY;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::collections::BTreeMap;
@@ -178,46 +177,47 @@ impl Provenance {
         self
     }
 
-    /// The reduced model in `dir` (`--model`), by its manifest's hashes.
-    pub fn model(mut self, dir: &Path) -> Result<Self, ScenarioError> {
-        self.model = Some(DirOrigin::of("--model", dir)?);
-        Ok(self)
+    /// The reduced model a run used (`--model`), by its manifest's hashes as it was loaded.
+    pub fn model(mut self, model: &DirOrigin) -> Self {
+        self.model = Some(model.clone());
+        self
     }
 
-    /// The model a training started from (`train --init`), by its manifest's hashes.
-    pub fn start_model(mut self, dir: &Path) -> Result<Self, ScenarioError> {
-        self.model = Some(DirOrigin::of("--init", dir)?);
-        Ok(self)
+    /// The model a training started from (`train --init`), by its manifest's hashes as it was
+    /// loaded.
+    pub fn start_model(self, model: &DirOrigin) -> Self {
+        self.model(model)
     }
 
-    /// `compare`'s reference and run trajectories, by their manifests' hashes.
-    pub fn compared(mut self, reference: &Path, run: &Path) -> Result<Self, ScenarioError> {
-        self.reference = Some(DirOrigin::of("REFERENCE", reference)?);
-        self.run = Some(DirOrigin::of("RUN", run)?);
-        Ok(self)
+    /// `compare`'s reference and run trajectories, by their manifests' hashes as they were read.
+    pub fn compared(mut self, reference: &DirOrigin, run: &DirOrigin) -> Self {
+        self.reference = Some(reference.clone());
+        self.run = Some(run.clone());
+        self
     }
 
-    /// The dataset in `dir`, by its manifest's hashes.
-    pub fn dataset(mut self, field: &str, dir: &Path) -> Result<Self, ScenarioError> {
-        self.dataset = Some(DirOrigin::of(field, dir)?);
-        Ok(self)
+    /// The dataset a model was made from, by its manifest's hashes as it was read.
+    pub fn dataset(mut self, dataset: &DirOrigin) -> Self {
+        self.dataset = Some(dataset.clone());
+        self
     }
 }
 
 impl DirOrigin {
-    /// The path and manifest hashes of the gvsrom output directory `dir` (given as option `field`).
-    pub fn of(field: &str, dir: &Path) -> Result<DirOrigin, ScenarioError> {
-        let meta_path = dir.join(MANIFEST_FILE);
-        let bad = |why: String| {
-            ScenarioError::invalid(
-                field,
-                format!("cannot record `{}` in the provenance: {why}", dir.display()),
-            )
-        };
-        let text = crate::output::read::read_regular(&meta_path)
-            .map_err(|e| bad(format!("cannot read {}: {e}", meta_path.display())))?;
-        let meta: Value = serde_json::from_slice(&text)
-            .map_err(|e| bad(format!("{} is not valid JSON: {e}", meta_path.display())))?;
+    /// The directory `dir` with no hashes (an output whose manifest records none).
+    pub fn unhashed(dir: &Path) -> DirOrigin {
+        DirOrigin {
+            path: dir.display().to_string(),
+            meta_sha256: None,
+            sha256: BTreeMap::new(),
+        }
+    }
+
+    /// The gvsrom output directory `dir` by the hashes of the manifest in `meta` — its meta.json
+    /// as the loader checked and parsed it ([`crate::output::Verified::meta`]), so that what a
+    /// provenance records is what was read, not the directory as it is later. An output written
+    /// before hashes were recorded has none.
+    pub fn of_manifest(dir: &Path, meta: &Value) -> DirOrigin {
         let manifest = &meta[MANIFEST_KEY];
         let sha256 = manifest["sha256"]
             .as_object()
@@ -227,11 +227,11 @@ impl DirOrigin {
                     .collect()
             })
             .unwrap_or_default();
-        Ok(DirOrigin {
+        DirOrigin {
             path: dir.display().to_string(),
             meta_sha256: manifest["meta_sha256"].as_str().map(str::to_string),
             sha256,
-        })
+        }
     }
 }
 

@@ -276,6 +276,9 @@ pub struct ReducedModel {
     /// Whether its files were checked against their recorded hashes when loaded (a new model:
     /// [`Integrity::Checked`]; `Unhashed` if written before hashes were recorded).
     pub integrity: Integrity,
+    /// The directory it was loaded from, by its manifest's hashes as loaded (what a run's
+    /// provenance records of it); `None` for a model not read from a directory.
+    pub origin: Option<crate::provenance::DirOrigin>,
 }
 
 /// FNV-1a 64-bit hash, as 16 hex digits.

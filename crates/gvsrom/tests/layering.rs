@@ -4,6 +4,9 @@
 //! (`use` lines, paths, intra-doc links; test modules, inline or in a file of their own, excepted)
 //! is an edge.
 
+mod common;
+
+use common::rust_files;
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -41,18 +44,6 @@ fn src() -> PathBuf {
 }
 
 /// Every `.rs` file under `dir`, recursively.
-fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    for e in fs::read_dir(dir).unwrap() {
-        let p = e.unwrap().path();
-        if p.is_dir() {
-            rust_files(&p, out);
-        } else if p.extension().is_some_and(|x| x == "rs") {
-            out.push(p);
-        }
-    }
-}
-
-/// The top-level module a file of `src/` belongs to (`build/loads.rs` → `build`).
 fn module_of(rel: &Path) -> String {
     let first = rel
         .components()

@@ -332,6 +332,17 @@ fn an_autoencoder_model_is_repeatable_and_loads_back_identically() {
     assert!(a.meta.provenance.is_some() && b.meta.provenance.is_some());
     a.meta.provenance = None;
     b.meta.provenance = None;
+    // each records the directory it was loaded from, by its manifest's hashes (of meta.json, which
+    // holds the provenance, and of the weights, which are the same)
+    let (o1, o2) = (a.origin.take().unwrap(), b.origin.take().unwrap());
+    assert_eq!(o1.sha256, o2.sha256);
+    let recorded = &json(&m1.join("meta.json"))["gvsrom"];
+    assert_eq!(
+        serde_json::to_value(&o1.sha256).unwrap(),
+        recorded["sha256"]
+    );
+    assert_eq!(o1.meta_sha256.as_deref(), recorded["meta_sha256"].as_str());
+    assert_ne!(o1.meta_sha256, o2.meta_sha256);
     assert_eq!(a, b);
     // loading is exact: the tensors are the file's bytes
     let again = ReducedModel::load(m1).unwrap();

@@ -30,6 +30,8 @@ pub struct Reduced {
     /// `"pod"` or `"autoencoder"`.
     pub kind: String,
     pub path: PathBuf,
+    /// The model's directory by its manifest's hashes as it was loaded (what a run records).
+    pub origin: crate::provenance::DirOrigin,
     /// Initial guess of a statics solve: the model's anchors at this scenario's inputs
     /// (`anchor_guess`; models whose dataset inputs the scenario defines).
     pub initial: Option<DVector<f64>>,

@@ -162,7 +162,7 @@ impl Compared {
             differ: self.differences.differ.clone(),
             unknown: self.differences.unknown.clone(),
             provenance: crate::provenance::Provenance::of_command()
-                .compared(&self.reference.dir, &self.run.dir)?,
+                .compared(&self.reference.origin, &self.run.origin),
         })
     }
 }
@@ -267,6 +267,7 @@ mod tests {
         }
         Trajectory {
             dir: PathBuf::from("x"),
+            origin: crate::provenance::DirOrigin::unhashed(Path::new("x")),
             scenario: "s".into(),
             n_dof: 2,
             complete: true,

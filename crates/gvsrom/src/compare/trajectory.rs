@@ -1,7 +1,6 @@
 //! A trajectory directory written by `gvsrom simulate --out`, read for a comparison.
 
 use crate::error::ScenarioError;
-use crate::npy::read_checked;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -9,6 +8,8 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, Clone)]
 pub struct Trajectory {
     pub dir: PathBuf,
+    /// `dir` by its manifest's hashes as read (what `compare` records of it).
+    pub origin: crate::provenance::DirOrigin,
     pub scenario: String,
     pub n_dof: usize,
     pub complete: bool,
@@ -56,13 +57,13 @@ impl Trajectory {
         }
         // its files as written (an older trajectory without hashes is read unchecked), and its
         // meta.json as it was checked
-        let meta = crate::output::verify_dir_meta(dir, "trajectory")
-            .map_err(|e| {
+        let crate::output::Verified { meta, files, .. } =
+            crate::output::verify_dir_meta(dir, "trajectory").map_err(|e| {
                 bad(format!(
                     "{e}; an edited trajectory is not the run that was simulated"
                 ))
-            })?
-            .meta;
+            })?;
+        let origin = crate::provenance::DirOrigin::of_manifest(dir, &meta);
         let count = |key: &str| {
             meta[key]
                 .as_u64()
@@ -72,7 +73,11 @@ impl Trajectory {
         let (n, points) = (count("samples")?, count("n_points")?);
         let f8 = "<f8";
         let read = |name: &str, shape: &[usize]| {
-            let v = read_checked::<f64>(dir, name, f8, shape).map_err(|e| bad(e.to_string()))?;
+            // the bytes parsed are the bytes whose hash is checked
+            let bytes = files.read(name).map_err(|e| bad(e.to_string()))?;
+            let shown = dir.join(name).display().to_string();
+            let v = crate::npy::parse_checked::<f64>(&bytes, &shown, f8, shape)
+                .map_err(|e| bad(e.to_string()))?;
             match v.iter().position(|x| !x.is_finite()) {
                 Some(i) => Err(bad(format!(
                     "{}: entry {i} is {}, not a finite number",
@@ -113,6 +118,7 @@ impl Trajectory {
         };
         Ok(Trajectory {
             dir: dir.to_path_buf(),
+            origin,
             scenario: meta["scenario"].as_str().unwrap_or("?").to_string(),
             n_dof: count("n_dof")?,
             complete: meta["complete"].as_bool().unwrap_or(false),

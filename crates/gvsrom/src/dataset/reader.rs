@@ -41,6 +41,8 @@ pub struct Dataset {
     /// The SHA-256 (hex) of the `strain.npy` bytes `strain` was read from: for a checked dataset,
     /// the hash its manifest records. What a model or a noisy copy records of its source.
     pub strain_sha256: String,
+    /// Its directory by its manifest's hashes as read (what a model records of its dataset).
+    pub origin: crate::provenance::DirOrigin,
 }
 
 fn file_error(file: &str, message: impl Into<String>) -> DatasetError {
@@ -185,6 +187,7 @@ impl Dataset {
                 Integrity::Unhashed => None,
             },
         };
+        let origin = crate::provenance::DirOrigin::of_manifest(dir, &value);
         let meta: Meta = serde_json::from_value(value)
             .map_err(|e| file_error(&shown, format!("does not describe a dataset: {e}")))?;
         let kind_ok = match meta.kind.as_str() {
@@ -232,6 +235,7 @@ impl Dataset {
             meta,
             integrity,
             strain_sha256,
+            origin,
         };
         ds.check_consistency(dir)?;
         Ok(ds)

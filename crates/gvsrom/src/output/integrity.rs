@@ -16,6 +16,7 @@ use super::hashes::{file_sha256, meta_sha256, recorded};
 use super::read::{file_kind, read_regular};
 use super::{MANIFEST_FILE, MANIFEST_KEY};
 use serde_json::Value;
+use std::collections::BTreeMap;
 use std::fs;
 use std::io;
 use std::path::{Path, PathBuf};
@@ -51,6 +52,10 @@ pub enum Problem {
     /// A listed file's content differs from its recorded hash.
     #[error("differs from the hash recorded when it was written (edited, truncated or replaced)")]
     Changed,
+    /// A listed file's content differs from its recorded hash when the loader read it, after it
+    /// was checked (or it has no recorded hash).
+    #[error("differs from the hash recorded when it was written: it changed while the output was being read (is another process writing it?)")]
+    ChangedWhileRead,
     /// meta.json's content (apart from the manifest) differs from its recorded hash.
     #[error("meta.json was edited after it was written: its values (apart from the `{MANIFEST_KEY}` manifest) no longer match the `{META_SHA256_KEY}` recorded in it")]
     MetaEdited,
@@ -72,6 +77,39 @@ fn plain(name: &str) -> bool {
 pub struct Verified {
     pub integrity: Integrity,
     pub meta: Value,
+    /// The listed files, for the loader to read through [`ListedFiles::read`].
+    pub files: ListedFiles,
+}
+
+/// The files of a verified output as a loader reads them: each once, its bytes checked against
+/// the hash recorded for it, so that what is parsed is what was verified — a file replaced between
+/// [`verify_dir_meta`] and the read is refused, not used.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ListedFiles {
+    dir: PathBuf,
+    /// The recorded hashes of a hashed output (`None`: written before hashes were recorded).
+    hashes: Option<BTreeMap<String, String>>,
+}
+
+impl ListedFiles {
+    /// The bytes of the file `name` of the output, read once; for a hashed output they must have
+    /// the hash recorded for `name` (an error naming the file otherwise).
+    pub fn read(&self, name: &str) -> Result<Vec<u8>, IntegrityError> {
+        let path = self.dir.join(name);
+        let bytes = read_regular(&path).map_err(|e| IntegrityError {
+            path: path.clone(),
+            problem: Problem::File(format!("cannot read it: {e}")),
+        })?;
+        if let Some(hashes) = &self.hashes {
+            if hashes.get(name) != Some(&sha256_hex(&bytes)) {
+                return Err(IntegrityError {
+                    path,
+                    problem: Problem::ChangedWhileRead,
+                });
+            }
+        }
+        Ok(bytes)
+    }
 }
 
 /// Checks the directory output `dir` against its manifest before it is read: `meta.json` holds a
@@ -227,9 +265,15 @@ pub fn verify_dir_meta(dir: &Path, expected_format: &str) -> Result<Verified, In
         Some(_) => Integrity::Checked,
         None => Integrity::Unhashed,
     };
+    let meta = Value::Object(meta);
+    let files = ListedFiles {
+        dir: dir.to_path_buf(),
+        hashes: (integrity == Integrity::Checked).then(|| recorded_hashes(&meta)),
+    };
     Ok(Verified {
         integrity,
-        meta: Value::Object(meta),
+        meta,
+        files,
     })
 }
 
@@ -276,6 +320,27 @@ mod tests {
         assert_eq!(
             verify_dir_meta(&dir, "test").unwrap_err().problem,
             Problem::MetaEdited
+        );
+    }
+
+    #[test]
+    fn a_file_replaced_after_the_check_is_refused_when_read_not_parsed() {
+        let dir = written("replaced");
+        let v = verify_dir_meta(&dir, "test").unwrap();
+        let before = fs::read(dir.join("b.bin")).unwrap();
+        assert_eq!(v.files.read("b.bin").unwrap(), before);
+        // another process rewrites the file between the check and the loader's read
+        let mut after = before.clone();
+        after[0] ^= 1;
+        fs::write(dir.join("b.bin"), &after).unwrap();
+        let e = v.files.read("b.bin").unwrap_err();
+        assert_eq!(e.problem, Problem::ChangedWhileRead);
+        assert!(e.to_string().contains("b.bin"), "{e}");
+        // a name the manifest does not hash is not read as verified either
+        fs::write(dir.join("extra.bin"), b"x").unwrap();
+        assert_eq!(
+            v.files.read("extra.bin").unwrap_err().problem,
+            Problem::ChangedWhileRead
         );
     }
 

@@ -48,7 +48,9 @@ mod target;
 pub(crate) mod test_util;
 pub use dir::OutputDir;
 pub use file::OutputFile;
-pub use integrity::{verify_dir, verify_dir_meta, Integrity, IntegrityError, Verified};
+pub use integrity::{
+    verify_dir, verify_dir_meta, Integrity, IntegrityError, ListedFiles, Verified,
+};
 pub use read::{read_regular, read_regular_to_string};
 pub use run_dir::{RunDir, RUN_FORMAT};
 pub use target::refuse_overlap;

@@ -157,6 +157,8 @@ pub fn attach(
         model: reduced,
         kind: model.meta.kind.clone(),
         path: dir.to_path_buf(),
+        origin: (model.origin.clone())
+            .unwrap_or_else(|| crate::provenance::DirOrigin::unhashed(dir)),
         initial: guess.as_ref().and_then(|g| g.at(&built.u)),
         guess: guess.map(|g| Box::new(g) as Box<dyn GuessAt>),
         // a decoder saturates outside its training encodings; a POD basis is linear and is
@@ -197,6 +199,8 @@ pub fn attach_resolved(
     options: AttachOptions,
 ) -> Result<(), anyhow::Error> {
     attach_source(&mut r.built, &r.source, &r.overrides, dir, options)?;
-    r.provenance = r.provenance.clone().model(dir)?;
+    if let Some(reduced) = &r.built.reduced {
+        r.provenance = r.provenance.clone().model(&reduced.origin);
+    }
     Ok(())
 }

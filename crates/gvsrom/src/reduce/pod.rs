@@ -41,7 +41,7 @@ pub fn pod<P: AsRef<Path>>(
     super::refuse_input_overlap(out, datasets, None)?;
     let provenance = crate::provenance::Provenance::of_command();
     let src = Sources::load(datasets)?;
-    let provenance = src.record(provenance)?;
+    let provenance = src.record(provenance);
     let built = &src.built;
     // the HOM basis must be recoverable from point strains
     let (layout, _, _) = projection_of(built)?;
@@ -89,6 +89,7 @@ pub fn pod<P: AsRef<Path>>(
         },
         // written by this run: as its files will be hashed
         integrity: crate::output::Integrity::Checked,
+        origin: None,
         anchors: Some(crate::reduced_model::Anchors {
             n: rows,
             inputs: src.sample_inputs(),

@@ -16,7 +16,7 @@ use crate::build::reduced::INPUT_MARGIN;
 use crate::build::Built;
 use crate::dataset::Dataset;
 use crate::error::ScenarioError;
-use crate::provenance::{DirOrigin, Provenance};
+use crate::provenance::Provenance;
 use crate::reduced_model::{same_abscissae, DatasetRef, InputRange};
 use crate::scenario::Scenario;
 use std::path::{Path, PathBuf};
@@ -245,12 +245,12 @@ impl Sources {
 
     /// `provenance` with every dataset recorded: the first as `dataset`, the others as
     /// `more_datasets`, in order.
-    pub fn record(&self, provenance: Provenance) -> Result<Provenance, ScenarioError> {
-        let mut p = provenance.dataset(FIELD, &self.sets[0].0)?;
-        for (path, _) in &self.sets[1..] {
-            p.more_datasets.push(DirOrigin::of(FIELD, path)?);
+    pub fn record(&self, provenance: Provenance) -> Provenance {
+        let mut p = provenance.dataset(&self.sets[0].1.origin);
+        for (_, ds) in &self.sets[1..] {
+            p.more_datasets.push(ds.origin.clone());
         }
-        Ok(p)
+        p
     }
 
     /// What the model records of its datasets: the first, and the others in order.

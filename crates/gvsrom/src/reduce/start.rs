@@ -121,6 +121,14 @@ pub fn start_model(dir: &Path) -> Result<StartModel, anyhow::Error> {
 }
 
 impl StartModel {
+    /// The start model's directory by its manifest's hashes as it was loaded.
+    pub fn origin(&self) -> crate::provenance::DirOrigin {
+        self.model
+            .origin
+            .clone()
+            .unwrap_or_else(|| crate::provenance::DirOrigin::unhashed(&self.dir))
+    }
+
     /// The start's networks and scaling.
     pub fn autoencoder(&self) -> &Autoencoder {
         match &self.model.weights {

@@ -63,10 +63,10 @@ pub fn train<P: AsRef<Path>>(
     super::refuse_input_overlap(out, datasets, init.map(|s| s.dir.as_path()))?;
     let mut provenance = crate::provenance::Provenance::of_command();
     if let Some(start) = init {
-        provenance = provenance.start_model(&start.dir)?;
+        provenance = provenance.start_model(&start.origin());
     }
     let src = Sources::load(datasets)?;
-    let provenance = src.record(provenance)?.seed("training", options.seed);
+    let provenance = src.record(provenance).seed("training", options.seed);
     let built = &src.built;
     let start_warnings = match init {
         Some(start) => start.check(&src, options, loss)?,
@@ -278,6 +278,7 @@ pub fn train<P: AsRef<Path>>(
         weights: ModelWeights::Autoencoder(ae),
         // written by this run: as its files will be hashed
         integrity: crate::output::Integrity::Checked,
+        origin: None,
         anchors: Some(crate::reduced_model::Anchors {
             n: rows,
             inputs: src.sample_inputs(),

@@ -161,6 +161,7 @@ impl ReducedModel {
         let crate::output::Verified {
             integrity,
             meta: value,
+            files,
         } = crate::output::verify_dir_meta(dir, MODEL_FORMAT).map_err(|e| {
             bad(format!(
                 "{e}; an edited model is not the model that was trained — re-create it"
@@ -176,6 +177,7 @@ impl ReducedModel {
                 format.map_or("missing".to_string(), |f| format!("\"{f}\""))
             )));
         }
+        let origin = crate::provenance::DirOrigin::of_manifest(dir, &value);
         let meta: ModelMeta =
             serde_json::from_value(value).map_err(|e| bad(format!("meta.json: {e}")))?;
         if meta.latent == 0 || meta.rest.len() != meta.latent {
@@ -185,8 +187,10 @@ impl ReducedModel {
                 meta.rest.len()
             )));
         }
-        let bytes = crate::output::read_regular(&dir.join(WEIGHTS_FILE))
-            .map_err(|e| bad(format!("cannot read {WEIGHTS_FILE}: {e}")))?;
+        // the bytes parsed are the bytes whose hash is checked
+        let bytes = files
+            .read(WEIGHTS_FILE)
+            .map_err(|e| bad(format!("{e}; re-create the model")))?;
         if let Some(message) = offsets_beyond_data(&bytes) {
             return Err(bad(format!("{WEIGHTS_FILE} is damaged: {message}")));
         }
@@ -324,6 +328,7 @@ impl ReducedModel {
             weights,
             anchors,
             integrity,
+            origin: Some(origin),
         })
     }
 }

@@ -136,8 +136,8 @@ pub fn simulate_test(
             let mut provenance = scenario.provenance()?.seed("input", test.seed).integrator(
                 simulate::integrator_record(&opts.integrator, &test.integrator),
             );
-            if let Some(m) = model {
-                provenance = provenance.model(&m.path)?;
+            if let Some(reduced) = &built.reduced {
+                provenance = provenance.model(&reduced.origin);
             }
             let written =
                 simulate::run_to_dir(&built, &opts, path, true, Some(provenance), &mut control)?;
