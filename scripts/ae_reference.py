@@ -16,6 +16,9 @@ and not from gvsrom's code, to judge the Rust trainer against a standard stack:
   input by G (the decoder's target stays scaled), to test whether sharper first-layer units help;
   `--odd` drops the biases and the centring: the autoencoder is then an odd function, as IV-B's
   family is (`x(c, −M) = −x(c, M)`), so each half of the family is learnt once for both;
+- `--init-gain G`: every layer's Glorot bound × G; above about 1 a deep tanh network is in its
+  chaotic phase, where its function of the input folds many times (a test of whether the initial
+  network's few folds are what keeps a trained r = 1 code of IV-B to a few passes);
 - `--log-gain`: the same network and loss, optimised in another parametrisation: each unit's
   weights are `W = e^g v` (a gain per unit, `g` from 0) and Adam moves `g`, `v` and `b`; the
   penalty is still on `W`. Adam moves a weight by about one learning rate per step, so a unit
@@ -94,11 +97,12 @@ def architecture(n: int, r: int, hidden: int) -> list[int]:
     return enc + [r] + enc[::-1]
 
 
-def init(sizes: list[int], key) -> list[tuple]:
+def init(sizes: list[int], key, gain: float = 1.0) -> list[tuple]:
+    """Glorot-uniform weights (× `gain`), zero biases."""
     params = []
     for a, b in zip(sizes[:-1], sizes[1:]):
         key, sub = jax.random.split(key)
-        lim = np.sqrt(6.0 / (a + b))
+        lim = gain * np.sqrt(6.0 / (a + b))
         params.append((jax.random.uniform(sub, (a, b), minval=-lim, maxval=lim), jnp.zeros(b)))
     return params
 
@@ -144,6 +148,12 @@ def main() -> None:
     )
     ap.add_argument("--odd", action="store_true", help="no biases, no centring: an odd network")
     ap.add_argument(
+        "--init-gain",
+        type=float,
+        default=1.0,
+        help="every layer's Glorot bound × this (> 1: the chaotic phase of deep tanh networks)",
+    )
+    ap.add_argument(
         "--log-gain", action="store_true", help="optimise W = e^g v: a log-gain g per unit"
     )
     ap.add_argument("--save", type=Path, help="write the kept weights (flattened, .npy)")
@@ -175,7 +185,7 @@ def main() -> None:
     sizes = architecture(n, args.latent, args.hidden_layers)
     half = (args.hidden_layers + 1) // 2
     flags = [k + 1 < half for k in range(half)] * 2
-    params = init(sizes, jax.random.PRNGKey(args.seed))
+    params = init(sizes, jax.random.PRNGKey(args.seed), args.init_gain)
     if args.log_gain:
         params = [(w, jnp.zeros(w.shape[1]), b) for w, b in params]
     gain = args.input_gain
@@ -234,6 +244,7 @@ def main() -> None:
         "seed": args.seed,
         "input_gain": gain,
         "odd": args.odd,
+        "init_gain": args.init_gain,
         "log_gain": args.log_gain,
         "largest_weight": float(max(jnp.max(jnp.abs(w)) for w, _ in effective(best))),
         "sum_squared_weights": float(sum(jnp.sum(w * w) for w, _ in effective(best))),
