@@ -153,7 +153,7 @@ pub fn load_dataset(py: Python<'_>, path: PathBuf) -> PyResult<Dataset> {
     let n = d.status.len();
     let m = &d.meta;
     let row = d.strain.len().checked_div(n).unwrap_or(0);
-    let meta = meta_json(py, &path)?;
+    let meta = meta_dict(py, &d.meta_json)?;
     Ok(Dataset {
         kind: m.kind.clone(),
         scenario: m.scenario.clone(),
@@ -178,12 +178,10 @@ pub fn load_dataset(py: Python<'_>, path: PathBuf) -> PyResult<Dataset> {
     })
 }
 
-/// `dir/meta.json` (a dataset's or a model's, read and checked before) as a Python dict.
-pub fn meta_json<'py>(py: Python<'py>, dir: &std::path::Path) -> PyResult<Bound<'py, PyAny>> {
-    let file = dir.join("meta.json");
-    let text = gvsrom::output::read_regular_to_string(&file)
-        .map_err(|e| invalid(format!("{}: {e}", file.display())))?;
-    py.import("json")?.call_method1("loads", (text,))
+/// A meta.json value as the loader verified it (a dataset's or a model's) as a Python dict.
+pub fn meta_dict<'py>(py: Python<'py>, meta: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
+    py.import("json")?
+        .call_method1("loads", (meta.to_string(),))
 }
 
 /// The `PATH=LO:HI` specs of a `sweep`/`grid`/`random` argument: a string, a sequence of them,

@@ -238,7 +238,10 @@ pub fn load_model(py: Python<'_>, path: PathBuf, extrapolate: bool) -> PyResult<
         arrays.set_item(name, a)?;
     }
     let range: Vec<f64> = m.meta.latent_range.iter().flatten().copied().collect();
-    let meta = crate::datasets::meta_json(py, &path)?;
+    let meta = match &m.dir {
+        Some(dir) => crate::datasets::meta_dict(py, &dir.meta_json)?,
+        None => py.None().into_bound(py),
+    };
     Ok(Model {
         kind: m.meta.kind.clone(),
         latent: m.meta.latent,

@@ -238,12 +238,19 @@ pub fn train(
             &mut progress,
         )
     });
+    // a Ctrl-C first: the run it stopped may then end in an error (no epoch beat the start yet),
+    // and the signal, already taken from Python's queue, would otherwise be lost
+    if let Some(e) = signals.caught() {
+        if let Ok(summary) = &summary {
+            for w in &summary.warnings {
+                let _ = crate::robot::warn(py, w);
+            }
+        }
+        return Err(e);
+    }
     let summary = summary.map_err(errors::any)?;
     for w in &summary.warnings {
         crate::robot::warn(py, w)?;
-    }
-    if let Some(e) = signals.caught() {
-        return Err(e);
     }
     load_model(py, summary.path, false)
 }

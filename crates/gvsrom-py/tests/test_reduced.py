@@ -1,6 +1,11 @@
 """A tiny dataset (CLI) → POD and autoencoder (Python) → reduced statics, equal to the CLI's
 `statics --model`; the reduced model's quantities checked as the full model's are."""
 
+import json
+import os
+import signal
+import threading
+
 import numpy as np
 import pytest
 
@@ -321,6 +326,28 @@ def test_a_training_from_a_model_continues_it_and_keeps_its_architecture(dataset
         gvsrom.train(dataset, tmp_path / "never", latent=2, epochs=5, init=str(ae_model.path))
     with pytest.raises(TypeError, match=r"invalid `init`: got a int"):
         gvsrom.train(dataset, tmp_path / "never", epochs=5, init=3)
+
+
+@pytest.mark.skipif(os.name != "posix", reason="SIGINT to self")
+def test_ctrl_c_reaches_python_when_the_stopped_training_then_fails(dataset, ae_model, tmp_path,
+                                                                     sigint_raises):
+    # at this rate the weights never move, so no epoch beats the start model's validation loss and
+    # the run Ctrl-C stops ends in "not improved on": the KeyboardInterrupt, taken from Python's
+    # queue during the run, must still be raised
+    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        gvsrom.train(dataset, tmp_path / "stopped", init=ae_model, epochs=10**7, learning_rate=1e-300,
+                     patience=0, lbfgs_iterations=0, validation_fraction=0.3)
+    assert not (tmp_path / "stopped").exists()
+
+
+def test_meta_is_the_verified_meta_json(dataset, ae_model):
+    # the dict is the file's content as the loader checked it (not a second, unchecked read)
+    for loaded, d in ((gvsrom.load_model(ae_model.path), ae_model.path),
+                      (gvsrom.load_dataset(dataset), dataset)):
+        with open(os.path.join(d, "meta.json")) as f:
+            assert loaded.meta == json.load(f)
 
 
 def _cli_defaults(gvsrom_bin, command):

@@ -119,17 +119,23 @@ pub fn parse_checked<T: npyz::Deserialize>(
 /// such as a model's `train_loss.npy`), checked like [`read_checked`].
 pub fn read_vector(dir: &Path, name: &str) -> Result<Vec<f64>, NpyError> {
     let (bytes, shown) = read_file(dir, name)?;
-    let len = header_number_bits(&bytes)
+    parse_vector(&bytes, &shown)
+}
+
+/// The 1-D little-endian f64 array held by `bytes` (of the file shown as `shown` in errors), of
+/// whatever length its header gives, checked like [`parse_checked`].
+pub fn parse_vector(bytes: &[u8], shown: &str) -> Result<Vec<f64>, NpyError> {
+    let len = header_number_bits(bytes)
         .filter(|&b| b <= 64)
-        .and_then(|_| npyz::NpyFile::new(&bytes[..]).ok())
+        .and_then(|_| npyz::NpyFile::new(bytes).ok())
         .map(|npy| npy.shape().to_vec());
     match len.as_deref() {
-        Some(&[n]) => parse_checked(&bytes, &shown, "<f8", &[n as usize]),
+        Some(&[n]) => parse_checked(bytes, shown, "<f8", &[n as usize]),
         Some(shape) => Err(npy_error(
-            &shown,
+            shown,
             format!("shape {shape:?}, expected a 1-D array"),
         )),
-        None => Err(npy_error(&shown, "not a valid .npy file")),
+        None => Err(npy_error(shown, "not a valid .npy file")),
     }
 }
 

@@ -276,9 +276,30 @@ pub struct ReducedModel {
     /// Whether its files were checked against their recorded hashes when loaded (a new model:
     /// [`Integrity::Checked`]; `Unhashed` if written before hashes were recorded).
     pub integrity: Integrity,
+    /// The directory it was loaded from, as loaded; `None` for a model not read from a directory.
+    pub dir: Option<ModelDir>,
+}
+
+/// What a model read from a directory keeps of it, so that nothing of it is read a second time
+/// unchecked.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelDir {
+    pub path: std::path::PathBuf,
+    /// meta.json as it was verified: the value [`ReducedModel::meta`] was parsed from (a front-end
+    /// shows it whole).
+    pub meta_json: serde_json::Value,
+    /// Its listed files (the training curves, the POD spectrum), each read through a check of the
+    /// hash recorded for it.
+    pub files: crate::output::ListedFiles,
+}
+
+impl ReducedModel {
     /// The directory it was loaded from, by its manifest's hashes as loaded (what a run's
     /// provenance records of it); `None` for a model not read from a directory.
-    pub origin: Option<crate::provenance::DirOrigin>,
+    pub fn origin(&self) -> Option<crate::provenance::DirOrigin> {
+        (self.dir.as_ref())
+            .map(|d| crate::provenance::DirOrigin::of_manifest(&d.path, &d.meta_json))
+    }
 }
 
 /// FNV-1a 64-bit hash, as 16 hex digits.

@@ -43,7 +43,7 @@ fn src() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("src")
 }
 
-/// Every `.rs` file under `dir`, recursively.
+/// The top-level module a source file belongs to, from its path relative to `src/`.
 fn module_of(rel: &Path) -> String {
     let first = rel
         .components()

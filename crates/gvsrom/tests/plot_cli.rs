@@ -375,3 +375,53 @@ fn write_samples() {
         }
     }
 }
+
+/// Rewrites the `.npy` file `f` (f64 data) with every value scaled by `k`: the same header, other
+/// numbers (another process writing the file).
+fn scale_npy(f: &Path, k: f64) {
+    let mut bytes = std::fs::read(f).unwrap();
+    let n = bytes.len();
+    let shape = npyz::NpyFile::new(&bytes[..]).unwrap().shape().to_vec();
+    let v = shape.iter().product::<u64>() as usize;
+    for c in bytes[n - 8 * v..].chunks_exact_mut(8) {
+        let x = f64::from_le_bytes(c.try_into().unwrap());
+        c.copy_from_slice(&(k * x).to_le_bytes());
+    }
+    std::fs::write(f, bytes).unwrap();
+}
+
+#[test]
+fn figures_draw_the_files_as_they_were_checked_not_a_second_read() {
+    // a trajectory's centrelines are the ones its loader read and checked: a centerline.npy
+    // rewritten afterwards (another process writing the directory) is not what is drawn
+    let d = copy_dir(trajectory(), "plot-reread-traj");
+    let tr = gvsrom::compare::Trajectory::load(&d, "INPUT").unwrap();
+    let loaded = tr.centerline.clone().unwrap();
+    scale_npy(&d.join("centerline.npy"), 10.0);
+    let c = gvsrom::figures::trajectory::centerlines(&tr)
+        .unwrap()
+        .unwrap();
+    let drawn: Vec<f64> = c.shapes.iter().flatten().flatten().copied().collect();
+    assert_eq!(drawn, loaded);
+    // a model's curves are read through the hashes it was loaded with: a train_loss.npy rewritten
+    // after the load is refused, naming the file, not drawn
+    let m = copy_dir(autoencoder(), "plot-reread-ae");
+    let model = gvsrom::reduced_model::ReducedModel::load(&m).unwrap();
+    let curve = gvsrom::figures::model::curve(&model, "train_loss.npy")
+        .unwrap()
+        .unwrap();
+    assert!(!curve.is_empty());
+    scale_npy(&m.join("train_loss.npy"), 2.0);
+    let e = gvsrom::figures::model::curve(&model, "train_loss.npy")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("train_loss.npy") && e.contains("changed while"),
+        "{e}"
+    );
+    // a curve the manifest does not list is not read at all
+    assert_eq!(
+        gvsrom::figures::model::curve(&model, "no_such.npy").unwrap(),
+        None
+    );
+}

@@ -43,6 +43,9 @@ pub struct Dataset {
     pub strain_sha256: String,
     /// Its directory by its manifest's hashes as read (what a model records of its dataset).
     pub origin: crate::provenance::DirOrigin,
+    /// meta.json as it was verified: the value `meta` was parsed from (a front-end shows it whole
+    /// rather than reading the file a second time).
+    pub meta_json: serde_json::Value,
 }
 
 fn file_error(file: &str, message: impl Into<String>) -> DatasetError {
@@ -188,7 +191,7 @@ impl Dataset {
             },
         };
         let origin = crate::provenance::DirOrigin::of_manifest(dir, &value);
-        let meta: Meta = serde_json::from_value(value)
+        let meta: Meta = serde_json::from_value(value.clone())
             .map_err(|e| file_error(&shown, format!("does not describe a dataset: {e}")))?;
         let kind_ok = match meta.kind.as_str() {
             "statics" => meta.plan.is_some(),
@@ -236,6 +239,7 @@ impl Dataset {
             integrity,
             strain_sha256,
             origin,
+            meta_json: value,
         };
         ds.check_consistency(dir)?;
         Ok(ds)

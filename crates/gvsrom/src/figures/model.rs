@@ -24,19 +24,25 @@ pub(crate) fn figures(dir: &Path, sink: &mut Sink) -> Result<(), FiguresError> {
         ModelWeights::Pod {
             singular_values, ..
         } => pod_spectrum(dir, &model, singular_values, &caption, sink)?,
-        ModelWeights::Autoencoder(_) => training_curves(dir, &model, &caption, sink)?,
+        ModelWeights::Autoencoder(_) => training_curves(&model, &caption, sink)?,
     }
     latent(&model, &caption, sink)
 }
 
-/// A 1-D curve `name` of the model directory, if the model has it.
-fn curve(dir: &Path, name: &str) -> Result<Option<Vec<f64>>, FiguresError> {
-    if !dir.join(name).exists() {
+/// A 1-D curve `name` of the model's directory, if the model has it: read through the hash check of
+/// the files the model was loaded with, not a second time unchecked.
+pub fn curve(model: &ReducedModel, name: &str) -> Result<Option<Vec<f64>>, FiguresError> {
+    let Some(dir) = &model.dir else {
+        return Ok(None);
+    };
+    if !dir.files.lists(name) {
         return Ok(None);
     }
-    crate::npy::read_vector(dir, name)
+    let path = dir.path.join(name);
+    let bytes = (dir.files.read(name)).map_err(|e| input_error(&path, e.problem.to_string()))?;
+    crate::npy::parse_vector(&bytes, &path.display().to_string())
         .map(Some)
-        .map_err(|e| input_error(&dir.join(name), e.message))
+        .map_err(|e| input_error(&path, e.message))
 }
 
 /// `pod_spectrum`: σ_k/σ_1 and `1 − E_k`, the snapshot energy the first k modes leave out (from
@@ -48,7 +54,7 @@ fn pod_spectrum(
     caption: &str,
     sink: &mut Sink,
 ) -> Result<(), FiguresError> {
-    let sigma = match curve(dir, "singular_values.npy")? {
+    let sigma = match curve(model, "singular_values.npy")? {
         Some(s) if !s.is_empty() => s,
         _ => sigma.to_vec(),
     };
@@ -58,7 +64,7 @@ fn pod_spectrum(
             "the POD model holds no positive singular value to plot",
         ));
     }
-    let energy = match curve(dir, "captured_energy.npy")? {
+    let energy = match curve(model, "captured_energy.npy")? {
         Some(e) if e.len() == sigma.len() => e,
         _ => {
             let total: f64 = sigma.iter().map(|s| s * s).sum();
@@ -117,13 +123,12 @@ fn pod_spectrum(
 
 /// `training_curves`: training and validation loss per epoch (log scale), the best epoch marked.
 fn training_curves(
-    dir: &Path,
     model: &ReducedModel,
     caption: &str,
     sink: &mut Sink,
 ) -> Result<(), FiguresError> {
-    let train = curve(dir, "train_loss.npy")?.unwrap_or_default();
-    let val = curve(dir, "val_loss.npy")?.unwrap_or_default();
+    let train = curve(model, "train_loss.npy")?.unwrap_or_default();
+    let val = curve(model, "val_loss.npy")?.unwrap_or_default();
     if train.is_empty() && val.is_empty() {
         sink.note("training_curves: the model records no training curve");
         return Ok(());

@@ -30,42 +30,28 @@ pub struct Centerlines {
     pub shapes: Vec<Vec<[f64; 3]>>,
 }
 
-/// Reads `dir/centerline.npy` if there is one: `None` for an older trajectory without it; an error
-/// naming the file when it is there but `meta.json` gives no `centerline_x` or the array is not
-/// `[samples, len(centerline_x), 3]` finite f64.
-pub fn load_centerlines(dir: &Path, samples: usize) -> Result<Option<Centerlines>, FiguresError> {
-    let file = dir.join(CENTERLINE_FILE);
-    if !file.exists() {
+/// The centrelines `Trajectory::load` read (and checked against their recorded hash): `None` for
+/// an older trajectory without `centerline.npy`; an error naming the file when it is there but
+/// `meta.json` gives no `centerline_x` to read it by.
+pub fn centerlines(tr: &Trajectory) -> Result<Option<Centerlines>, FiguresError> {
+    let (Some(x), Some(v)) = (&tr.centerline_x, &tr.centerline) else {
+        let file = tr.dir.join(CENTERLINE_FILE);
+        if file.exists() {
+            return Err(input_error(
+                &tr.dir.join(crate::output::MANIFEST_FILE),
+                format!("{CENTERLINE_FILE} is there but `centerline_x` (at least 2 abscissae [m]) is missing"),
+            ));
+        }
         return Ok(None);
-    }
-    let meta_path = dir.join(crate::output::MANIFEST_FILE);
-    let meta: serde_json::Value = crate::output::read::read_regular_to_string(&meta_path)
-        .ok()
-        .and_then(|t| serde_json::from_str(&t).ok())
-        .unwrap_or_default();
-    let x: Option<Vec<f64>> = meta["centerline_x"]
-        .as_array()
-        .and_then(|a| a.iter().map(|v| v.as_f64()).collect());
-    let x = x.filter(|x| x.len() >= 2).ok_or_else(|| {
-        input_error(
-            &meta_path,
-            format!("{CENTERLINE_FILE} is there but `centerline_x` (at least 2 abscissae [m]) is missing"),
-        )
-    })?;
-    let n = x.len();
-    let v = crate::npy::read_checked::<f64>(dir, CENTERLINE_FILE, "<f8", &[samples, n, 3])
-        .map_err(|e| input_error(&file, e.message))?;
-    if let Some(i) = v.iter().position(|x| !x.is_finite()) {
-        return Err(input_error(
-            &file,
-            format!("entry {i} is {}, not a finite number", v[i]),
-        ));
-    }
+    };
     let shapes = v
-        .chunks_exact(3 * n)
+        .chunks_exact(3 * x.len())
         .map(|s| s.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect())
         .collect();
-    Ok(Some(Centerlines { x, shapes }))
+    Ok(Some(Centerlines {
+        x: x.clone(),
+        shapes,
+    }))
 }
 
 /// The tip position of sample `k`.
@@ -87,7 +73,7 @@ pub(crate) fn figures(dir: &Path, sink: &mut Sink) -> Result<(), FiguresError> {
         tr.t[n - 1],
         if tr.complete { "" } else { " (incomplete run)" }
     );
-    let centerlines = load_centerlines(dir, n)?;
+    let centerlines = centerlines(&tr)?;
     tip_figures(&tr, &caption, sink)?;
     strain_time(&tr, &caption, sink)?;
     match &centerlines {

@@ -53,9 +53,13 @@ pub enum Problem {
     #[error("differs from the hash recorded when it was written (edited, truncated or replaced)")]
     Changed,
     /// A listed file's content differs from its recorded hash when the loader read it, after it
-    /// was checked (or it has no recorded hash).
+    /// was checked.
     #[error("differs from the hash recorded when it was written: it changed while the output was being read (is another process writing it?)")]
     ChangedWhileRead,
+    /// A loader asked for a file the manifest of a hashed output does not list (records no hash
+    /// for): not a file the output was written with, so not read as one.
+    #[error("meta.json does not list it among the output's files (records no hash for it): the manifest was edited, or the file is not this output's")]
+    NotListed,
     /// meta.json's content (apart from the manifest) differs from its recorded hash.
     #[error("meta.json was edited after it was written: its values (apart from the `{MANIFEST_KEY}` manifest) no longer match the `{META_SHA256_KEY}` recorded in it")]
     MetaEdited,
@@ -101,14 +105,23 @@ impl ListedFiles {
             problem: Problem::File(format!("cannot read it: {e}")),
         })?;
         if let Some(hashes) = &self.hashes {
-            if hashes.get(name) != Some(&sha256_hex(&bytes)) {
-                return Err(IntegrityError {
-                    path,
-                    problem: Problem::ChangedWhileRead,
-                });
-            }
+            let problem = match hashes.get(name) {
+                None => Problem::NotListed,
+                Some(h) if *h != sha256_hex(&bytes) => Problem::ChangedWhileRead,
+                Some(_) => return Ok(bytes),
+            };
+            return Err(IntegrityError { path, problem });
         }
         Ok(bytes)
+    }
+
+    /// Whether the output has a file `name`: listed in its manifest (for an output written before
+    /// hashes were recorded, present in its directory).
+    pub fn lists(&self, name: &str) -> bool {
+        match &self.hashes {
+            Some(hashes) => hashes.contains_key(name),
+            None => plain(name) && self.dir.join(name).is_file(),
+        }
     }
 }
 
@@ -336,11 +349,12 @@ mod tests {
         let e = v.files.read("b.bin").unwrap_err();
         assert_eq!(e.problem, Problem::ChangedWhileRead);
         assert!(e.to_string().contains("b.bin"), "{e}");
-        // a name the manifest does not hash is not read as verified either
+        // a name the manifest does not hash is not read as verified either, and the error says why
         fs::write(dir.join("extra.bin"), b"x").unwrap();
+        assert!(!v.files.lists("extra.bin") && v.files.lists("a.bin"));
         assert_eq!(
             v.files.read("extra.bin").unwrap_err().problem,
-            Problem::ChangedWhileRead
+            Problem::NotListed
         );
     }
 

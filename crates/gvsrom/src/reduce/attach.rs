@@ -157,8 +157,7 @@ pub fn attach(
         model: reduced,
         kind: model.meta.kind.clone(),
         path: dir.to_path_buf(),
-        origin: (model.origin.clone())
-            .unwrap_or_else(|| crate::provenance::DirOrigin::unhashed(dir)),
+        origin: (model.origin()).unwrap_or_else(|| crate::provenance::DirOrigin::unhashed(dir)),
         initial: guess.as_ref().and_then(|g| g.at(&built.u)),
         guess: guess.map(|g| Box::new(g) as Box<dyn GuessAt>),
         // a decoder saturates outside its training encodings; a POD basis is linear and is

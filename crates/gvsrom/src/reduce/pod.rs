@@ -89,7 +89,7 @@ pub fn pod<P: AsRef<Path>>(
         },
         // written by this run: as its files will be hashed
         integrity: crate::output::Integrity::Checked,
-        origin: None,
+        dir: None,
         anchors: Some(crate::reduced_model::Anchors {
             n: rows,
             inputs: src.sample_inputs(),

@@ -124,8 +124,7 @@ impl StartModel {
     /// The start model's directory by its manifest's hashes as it was loaded.
     pub fn origin(&self) -> crate::provenance::DirOrigin {
         self.model
-            .origin
-            .clone()
+            .origin()
             .unwrap_or_else(|| crate::provenance::DirOrigin::unhashed(&self.dir))
     }
 

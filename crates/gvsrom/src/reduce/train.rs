@@ -278,7 +278,7 @@ pub fn train<P: AsRef<Path>>(
         weights: ModelWeights::Autoencoder(ae),
         // written by this run: as its files will be hashed
         integrity: crate::output::Integrity::Checked,
-        origin: None,
+        dir: None,
         anchors: Some(crate::reduced_model::Anchors {
             n: rows,
             inputs: src.sample_inputs(),

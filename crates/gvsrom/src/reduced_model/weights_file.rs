@@ -177,9 +177,8 @@ impl ReducedModel {
                 format.map_or("missing".to_string(), |f| format!("\"{f}\""))
             )));
         }
-        let origin = crate::provenance::DirOrigin::of_manifest(dir, &value);
         let meta: ModelMeta =
-            serde_json::from_value(value).map_err(|e| bad(format!("meta.json: {e}")))?;
+            serde_json::from_value(value.clone()).map_err(|e| bad(format!("meta.json: {e}")))?;
         if meta.latent == 0 || meta.rest.len() != meta.latent {
             return Err(bad(format!(
                 "meta.json: latent {} with {} rest coordinates",
@@ -328,7 +327,11 @@ impl ReducedModel {
             weights,
             anchors,
             integrity,
-            origin: Some(origin),
+            dir: Some(super::ModelDir {
+                path: dir.to_path_buf(),
+                meta_json: value,
+                files,
+            }),
         })
     }
 }
