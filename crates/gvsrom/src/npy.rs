@@ -115,15 +115,9 @@ pub fn parse_checked<T: npyz::Deserialize>(
         .map_err(|e| npy_error(shown, format!("cannot read the data: {e}")))
 }
 
-/// Reads `dir/name` as a 1-D little-endian f64 array of whatever length its header gives (a curve
-/// such as a model's `train_loss.npy`), checked like [`read_checked`].
-pub fn read_vector(dir: &Path, name: &str) -> Result<Vec<f64>, NpyError> {
-    let (bytes, shown) = read_file(dir, name)?;
-    parse_vector(&bytes, &shown)
-}
-
 /// The 1-D little-endian f64 array held by `bytes` (of the file shown as `shown` in errors), of
-/// whatever length its header gives, checked like [`parse_checked`].
+/// whatever length its header gives (a curve such as a model's `train_loss.npy`), checked like
+/// [`parse_checked`].
 pub fn parse_vector(bytes: &[u8], shown: &str) -> Result<Vec<f64>, NpyError> {
     let len = header_number_bits(bytes)
         .filter(|&b| b <= 64)
