@@ -17,7 +17,8 @@ pub fn vec1(a: &In1<'_>) -> Vec<f64> {
     a.as_array().iter().copied().collect()
 }
 
-/// A 1-D input of length `n` as a vector; else a `GvsromError` naming `name`.
+/// A 1-D input of length `n` and finite entries (coordinates, velocities) as a vector; else a
+/// `GvsromError` naming `name` and the first bad entry.
 pub fn dvec(name: &str, a: &In1<'_>, n: usize) -> PyResult<DVector<f64>> {
     let v = a.as_array();
     if v.len() != n {
@@ -26,7 +27,18 @@ pub fn dvec(name: &str, a: &In1<'_>, n: usize) -> PyResult<DVector<f64>> {
             v.len()
         )));
     }
-    Ok(DVector::from_iterator(n, v.iter().copied()))
+    finite(name, DVector::from_iterator(n, v.iter().copied()))
+}
+
+/// `v` if all its entries are finite; else a `GvsromError` naming `name` and the first bad entry.
+pub fn finite(name: &str, v: DVector<f64>) -> PyResult<DVector<f64>> {
+    match v.iter().position(|x| !x.is_finite()) {
+        None => Ok(v),
+        Some(i) => Err(invalid(format!(
+            "`{name}[{i}]` = {}: expected a finite number",
+            v[i]
+        ))),
+    }
 }
 
 /// The rows of a 2-D input, each of length `cols`; else a `GvsromError` naming `name`.

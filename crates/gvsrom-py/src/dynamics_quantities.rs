@@ -114,34 +114,12 @@ pub fn state(
     qd: Option<&In1<'_>>,
 ) -> PyResult<(DVector<f64>, DVector<f64>)> {
     let n = robot.built.n_dof();
-    let q = finite("q", arrays::dvec("q", q, n)?)?;
+    let q = arrays::dvec("q", q, n)?;
     let qd = match qd {
-        Some(v) => finite("qd", arrays::dvec("qd", v, n)?)?,
+        Some(v) => arrays::dvec("qd", v, n)?,
         None => DVector::zeros(n),
     };
     Ok((q, qd))
-}
-
-/// `v` if all its entries are finite; else a `GvsromError` naming `name` and the first bad entry.
-pub fn finite(name: &str, v: DVector<f64>) -> PyResult<DVector<f64>> {
-    match v.iter().position(|x| !x.is_finite()) {
-        None => Ok(v),
-        Some(i) => Err(invalid(format!(
-            "`{name}[{i}]` = {}: expected a finite number",
-            v[i]
-        ))),
-    }
-}
-
-/// Tensions `u` for a quantity: the scenario's, or one per tendon / one for all, finite.
-pub fn tensions(robot: &Robot, u: Option<&In1<'_>>) -> PyResult<Vec<f64>> {
-    let u = match u {
-        None => return Ok(robot.built.u.clone()),
-        Some(u) => arrays::vec1(u),
-    };
-    let u = gvsrom::scenario::tensions_for(robot.built.model.n_actuators(), &u).map_err(err)?;
-    let v = finite("u", DVector::from_vec(u))?;
-    Ok(v.as_slice().to_vec())
 }
 
 /// `energy` as a dict `{kinetic, elastic, gravitational, total}` [J].
@@ -269,7 +247,7 @@ impl Robot {
         u: Option<In1<'_>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (q, qd) = state(self, &q, Some(&qd))?;
-        let u = tensions(self, u.as_ref())?;
+        let u = self.quantity_tensions(u)?;
         let a = py
             .detach(|| accelerations(&self.built, &self.workspaces, &q, &qd, &u))
             .map_err(invalid)?;

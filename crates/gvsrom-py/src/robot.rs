@@ -124,15 +124,15 @@ impl Robot {
         build_with(py, &scenario, Some(attached), false)
     }
 
-    /// Tensions of a model quantity: the scenario's, or `u` (one per tendon or one for all).
-    fn quantity_tensions(&self, u: Option<In1<'_>>) -> PyResult<Vec<f64>> {
-        match u {
-            None => Ok(self.built.u.clone()),
-            Some(u) => {
-                gvsrom::scenario::tensions_for(self.built.model.n_actuators(), &arrays::vec1(&u))
-                    .map_err(err)
-            }
-        }
+    /// Tensions of a model quantity: the scenario's, or `u` (one per tendon or one for all),
+    /// finite.
+    pub(crate) fn quantity_tensions(&self, u: Option<In1<'_>>) -> PyResult<Vec<f64>> {
+        let Some(u) = u else {
+            return Ok(self.built.u.clone());
+        };
+        let u = gvsrom::scenario::tensions_for(self.built.model.n_actuators(), &arrays::vec1(&u))
+            .map_err(err)?;
+        Ok(arrays::finite("u", u.into()).map(|v| v.as_slice().to_vec())?)
     }
 
     /// The equilibrium under `u` with this robot's reduced model as attached, without building

@@ -239,6 +239,11 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
         }
         _ => None,
     };
+    if a.interpolate && a.input.is_none() {
+        return Err(invalid(
+            "`interpolate` applies to an `input` of rows: give one (without it the tensions are constant)",
+        ));
+    }
     let input = match (&a.input, &callable) {
         (None, _) => InputSource::Constant,
         (Some(_), Some(c)) => InputSource::Function(InputFunction(c.clone())),

@@ -126,3 +126,15 @@ def test_bad_states_name_the_argument(robot):
         robot.elastic_force(q)
     with pytest.raises(gvsrom.GvsromError, match="tension"):
         robot.accelerations(np.zeros(n), np.zeros(n), u=[1.0, 2.0, 3.0])
+    # every quantity refuses a non-finite state or tension, none returns NaN (the kinematic and
+    # statics ones once did)
+    at_q = [robot.forward, robot.jacobian, robot.mass_matrix, robot.statics_residual,
+            robot.statics_jacobian, robot.elastic_force, robot.external_force]
+    for f in at_q:
+        with pytest.raises(gvsrom.GvsromError, match=r"`q\[4\]` = NaN: expected a finite number"):
+            f(q)
+    with pytest.raises(gvsrom.GvsromError, match=r"`qd\[4\]` = inf: expected a finite number"):
+        robot.point_velocities(np.zeros(n), np.where(np.arange(n) == 4, np.inf, 0.0))
+    for f in (robot.statics_residual, robot.statics_jacobian):
+        with pytest.raises(gvsrom.GvsromError, match=r"`u\[0\]` = NaN: expected a finite number"):
+            f(np.zeros(n), u=[np.nan])

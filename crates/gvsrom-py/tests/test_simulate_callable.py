@@ -62,3 +62,7 @@ def test_bad_values_of_the_callable_are_value_errors(robot):
         robot.simulate(0.01, input=lambda t: "strong")
     with pytest.raises(gvsrom.GvsromError, match="`interpolate`"):
         robot.simulate(0.01, input=lambda t: -1.0, interpolate=True)
+    # without an input there is nothing to interpolate: refused, as `gvsrom simulate --interpolate`
+    # without --input is, rather than ignored
+    with pytest.raises(gvsrom.GvsromError, match="`interpolate` applies to an `input` of rows"):
+        robot.simulate(0.01, interpolate=True)

@@ -679,3 +679,29 @@ fn an_interrupt_stops_a_dynamic_dataset_between_integrator_steps_not_at_the_next
     let ds = Dataset::load(&dir).unwrap();
     assert_eq!(ds.t.as_deref(), Some(&[0.0][..]));
 }
+
+#[test]
+fn bad_tolerances_of_a_dynamic_dataset_are_refused_before_an_earlier_dataset_is_replaced() {
+    // a NaN or out-of-range tolerance is a planning error naming the option: the dataset already
+    // at --out stays as it was (once it was replaced by an unreadable, empty one)
+    let dir = sweep_dataset("ds-bad-tolerances", "-5:0", 3);
+    let before = std::fs::read(dir.join("meta.json")).unwrap();
+    for (opt, value) in [("--rtol", "NaN"), ("--atol", "NaN"), ("--rtol", "2")] {
+        expect_error(
+            &[
+                "dataset",
+                "single-tendon",
+                "--duration",
+                "0.02",
+                opt,
+                value,
+                "--force",
+                "--out",
+                dir.to_str().unwrap(),
+            ],
+            &[opt, value],
+        );
+        assert_eq!(std::fs::read(dir.join("meta.json")).unwrap(), before);
+        assert_eq!(Dataset::load(&dir).unwrap().status.len(), 3);
+    }
+}

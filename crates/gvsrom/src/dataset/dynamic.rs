@@ -84,6 +84,13 @@ pub fn run(
         _ => "constant".into(),
     };
     let duration = args.duration.unwrap_or(0.0);
+    // bad tolerances are refused here, with every other planning error, before the output is
+    // created (or an earlier one replaced): not by the integrator after it
+    simulate::check_tolerances(&simulate::IntegratorChoice {
+        rtol: args.rtol,
+        atol: args.atol,
+        ..Default::default()
+    })?;
     // as `simulate`'s automatic choice: the NDF, or SDIRK4 for a lightly damped rod
     let (method, _) = gvs::solve::dynamics::method_for_rod(&built.model, args.rtol, args.atol)
         .map_err(|e| DatasetError::Plan(e.to_string()))?;

@@ -241,8 +241,8 @@ pub fn integrator_record(
 pub const MIN_ATOL: f64 = 1e-14;
 
 /// `--rtol` in [[`gvs::solve::ode::MIN_RTOL`], [`gvs::solve::ode::MAX_RTOL`]) and `--atol` finite
-/// and at least [`MIN_ATOL`].
-pub(super) fn check_tolerances(choice: &IntegratorChoice) -> Result<(), ScenarioError> {
+/// and at least [`MIN_ATOL`]: checked when a run is planned, before anything is written.
+pub fn check_tolerances(choice: &IntegratorChoice) -> Result<(), ScenarioError> {
     use gvs::solve::ode::{MAX_RTOL, MIN_RTOL};
     if let Some(rtol) = choice.rtol {
         if !(MIN_RTOL..MAX_RTOL).contains(&rtol) {
