@@ -132,7 +132,7 @@ impl Robot {
         };
         let u = gvsrom::scenario::tensions_for(self.built.model.n_actuators(), &arrays::vec1(&u))
             .map_err(err)?;
-        Ok(arrays::finite("u", u.into()).map(|v| v.as_slice().to_vec())?)
+        arrays::finite("u", u.into()).map(|v| v.as_slice().to_vec())
     }
 
     /// The equilibrium under `u` with this robot's reduced model as attached, without building
