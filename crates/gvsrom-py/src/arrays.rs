@@ -17,6 +17,24 @@ pub fn vec1(a: &In1<'_>) -> Vec<f64> {
     a.as_array().iter().copied().collect()
 }
 
+/// Tendon tensions as a Python caller gives them: an array-like (one per tendon, or one for all)
+/// or one number for all (a float, an int, a NumPy scalar or 0-d array).
+#[derive(FromPyObject)]
+pub enum Tensions<'py> {
+    Array(In1<'py>),
+    Scalar(f64),
+}
+
+impl Tensions<'_> {
+    /// The values given, one or one per tendon (counted by the caller).
+    pub fn values(&self) -> Vec<f64> {
+        match self {
+            Tensions::Array(a) => vec1(a),
+            Tensions::Scalar(x) => vec![*x],
+        }
+    }
+}
+
 /// A 1-D input of length `n` and finite entries (coordinates, velocities) as a vector; else a
 /// `GvsromError` naming `name` and the first bad entry.
 pub fn dvec(name: &str, a: &In1<'_>, n: usize) -> PyResult<DVector<f64>> {

@@ -244,7 +244,7 @@ impl Robot {
         py: Python<'py>,
         q: In1<'_>,
         qd: In1<'_>,
-        u: Option<In1<'_>>,
+        u: Option<arrays::Tensions<'_>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (q, qd) = state(self, &q, Some(&qd))?;
         let u = self.quantity_tensions(u)?;

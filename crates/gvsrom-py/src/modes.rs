@@ -1,7 +1,7 @@
 //! `Robot.modes`: natural frequencies and mode shapes about the static equilibrium, as
 //! `gvsrom modes` computes them ([`gvsrom::modes::compute`]), as NumPy arrays.
 
-use crate::arrays::{self, shaped, vector, In1};
+use crate::arrays::{self, shaped, vector};
 use crate::errors::{self, scenario as err};
 use crate::robot::{build_with, Robot};
 use gvsrom::modes::{self, ModesError, ModesReport};
@@ -43,16 +43,13 @@ impl Robot {
         &self,
         py: Python<'py>,
         count: i64,
-        u: Option<In1<'_>>,
+        u: Option<arrays::Tensions<'_>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let rebuilt = match &u {
             None => None,
             Some(u) => {
                 let mut scenario = self.scenario.clone();
-                scenario
-                    .scenario
-                    .set_tensions(&arrays::vec1(u))
-                    .map_err(err)?;
+                scenario.scenario.set_tensions(&u.values()).map_err(err)?;
                 Some(build_with(py, &scenario, self.attached.as_ref(), false)?)
             }
         };

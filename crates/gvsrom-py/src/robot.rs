@@ -1,7 +1,7 @@
 //! `gvsrom.Robot`: a built scenario (the engine's model, loads, tensions and solver options), with
 //! a reduced model attached or not; its statics, dynamics and model quantities.
 
-use crate::arrays::{self, In1, In2};
+use crate::arrays::{self, In1, In2, Tensions};
 use crate::errors::{self, invalid, scenario as err};
 use crate::models::Model;
 use crate::quantities::{self, WorkspaceCache};
@@ -126,11 +126,11 @@ impl Robot {
 
     /// Tensions of a model quantity: the scenario's, or `u` (one per tendon or one for all),
     /// finite.
-    pub(crate) fn quantity_tensions(&self, u: Option<In1<'_>>) -> PyResult<Vec<f64>> {
+    pub(crate) fn quantity_tensions(&self, u: Option<Tensions<'_>>) -> PyResult<Vec<f64>> {
         let Some(u) = u else {
             return Ok(self.built.u.clone());
         };
-        let u = gvsrom::scenario::tensions_for(self.built.model.n_actuators(), &arrays::vec1(&u))
+        let u = gvsrom::scenario::tensions_for(self.built.model.n_actuators(), &u.values())
             .map_err(err)?;
         arrays::finite("u", u.into()).map(|v| v.as_slice().to_vec())
     }
@@ -331,10 +331,10 @@ impl Robot {
     fn statics(
         &self,
         py: Python<'_>,
-        u: Option<In1<'_>>,
+        u: Option<Tensions<'_>>,
         model: Option<PyRef<'_, Model>>,
     ) -> PyResult<Statics> {
-        let u = u.map(|a| arrays::vec1(&a));
+        let u = u.map(|a| a.values());
         let attached = model.map(|m| Attached {
             dir: m.dir.clone(),
             extrapolate: m.extrapolate,
@@ -518,7 +518,7 @@ impl Robot {
         &self,
         py: Python<'py>,
         q: In1<'_>,
-        u: Option<In1<'_>>,
+        u: Option<Tensions<'_>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let q = arrays::dvec("q", &q, self.built.n_dof())?;
         let u = self.quantity_tensions(u)?;
@@ -534,7 +534,7 @@ impl Robot {
         &self,
         py: Python<'py>,
         q: In1<'_>,
-        u: Option<In1<'_>>,
+        u: Option<Tensions<'_>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let q = arrays::dvec("q", &q, self.built.n_dof())?;
         let u = self.quantity_tensions(u)?;

@@ -139,17 +139,14 @@ impl CallableInput {
     fn call(&self, py: Python<'_>, t: f64) -> PyResult<Vec<f64>> {
         let value = self.function.bind(py).call1((t,))?;
         let na = self.n_actuators;
-        let values = match value.extract::<f64>() {
-            Ok(x) => vec![x],
-            Err(_) => match value.extract::<arrays::In1<'_>>() {
-                Ok(a) => arrays::vec1(&a),
-                Err(_) => {
-                    return Err(invalid(format!(
-                        "`input({t})` returned `{}`: expected {na} tensions [N] (an array, one per tendon, or one number for all)",
-                        value.repr()?
-                    )))
-                }
-            },
+        let values = match value.extract::<arrays::Tensions<'_>>() {
+            Ok(u) => u.values(),
+            Err(_) => {
+                return Err(invalid(format!(
+                    "`input({t})` returned `{}`: expected {na} tensions [N] (an array, one per tendon, or one number for all)",
+                    value.repr()?
+                )))
+            }
         };
         let u = gvsrom::scenario::tensions_for(na, &values)
             .map_err(|e| invalid(format!("`input({t})`: {e}")))?;

@@ -62,6 +62,13 @@ def test_one_tension_is_given_to_every_tendon():
     a = robot.statics(u=[-1.5])
     b = robot.statics(u=[-1.5] * 6)
     np.testing.assert_array_equal(a.q, b.q)
+    # one number for all, as the docstrings say: a float, an int, a NumPy scalar or 0-d array
+    for one in (-1.5, np.float64(-1.5), np.array(-1.5)):
+        np.testing.assert_array_equal(robot.statics(one).q, b.q)
+    np.testing.assert_array_equal(robot.statics(-2).q, robot.statics([-2.0] * 6).q)
+    np.testing.assert_array_equal(robot.statics_residual(b.q, u=-1.5), robot.statics_residual(b.q, u=[-1.5] * 6))
+    np.testing.assert_array_equal(robot.modes(2, u=-1.5)["frequency_hz"],
+                                  robot.modes(2, u=[-1.5] * 6)["frequency_hz"])
 
 
 def test_wrong_tension_count_is_a_value_error(gvsrom_bin):
