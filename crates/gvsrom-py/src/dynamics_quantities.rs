@@ -107,14 +107,15 @@ pub fn energy(
     with_model!(built, cache, m, ws => m.energy(q, qd, &built.loads.gravity, ws))
 }
 
-/// `q` (and `q̇`) of a robot's model from array-likes, checked (length, finite).
+/// `q` (and `q̇`) of a robot's model from array-likes, checked (length, finite; `q` inside a reduced
+/// model's training encodings, [`Robot::coordinates`]).
 pub fn state(
     robot: &Robot,
     q: &In1<'_>,
     qd: Option<&In1<'_>>,
 ) -> PyResult<(DVector<f64>, DVector<f64>)> {
     let n = robot.built.n_dof();
-    let q = arrays::dvec("q", q, n)?;
+    let q = robot.coordinates(q)?;
     let qd = match qd {
         Some(v) => arrays::dvec("qd", v, n)?,
         None => DVector::zeros(n),

@@ -124,6 +124,20 @@ impl Robot {
         build_with(py, &scenario, Some(attached), false)
     }
 
+    /// The coordinates `q` of a model quantity: `n_dof` finite values and, for a reduced model
+    /// attached without `extrapolate`, inside its training encodings, where its decoder answers (as
+    /// `simulate(q0=…)` and `Model.decode` refuse a code far outside them).
+    pub(crate) fn coordinates(&self, q: &In1<'_>) -> PyResult<nalgebra::DVector<f64>> {
+        let q = arrays::dvec("q", q, self.built.n_dof())?;
+        let reduced = self.built.reduced.as_ref().filter(|r| !r.extrapolate);
+        if let Some(v) = reduced.and_then(|r| r.range_violation(q.as_slice())) {
+            return Err(invalid(format!(
+                "`q`: {v}: the decoder extrapolates there and its quantities are not to be trusted; accepted: a state inside the training region, or the model attached with extrapolate=True"
+            )));
+        }
+        Ok(q)
+    }
+
     /// Tensions of a model quantity: the scenario's, or `u` (one per tendon or one for all),
     /// finite.
     pub(crate) fn quantity_tensions(&self, u: Option<Tensions<'_>>) -> PyResult<Vec<f64>> {
@@ -427,7 +441,7 @@ impl Robot {
     ///     ``x`` (p,) abscissae [m], ``position`` (p, 3) [m], ``rotation`` (p, 3, 3) (section →
     ///     world).
     fn forward<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyDict>> {
-        let q = arrays::dvec("q", &q, self.built.n_dof())?;
+        let q = self.coordinates(&q)?;
         let (pos, rot) = py.detach(|| quantities::forward(&self.built, &self.workspaces, &q));
         let p = self.built.model.disc.n_points();
         let d = PyDict::new(py);
@@ -458,7 +472,7 @@ impl Robot {
         point: Option<isize>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let n = self.built.n_dof();
-        let q = arrays::dvec("q", &q, n)?;
+        let q = self.coordinates(&q)?;
         let p = self.built.model.disc.n_points();
         let which: Vec<usize> = match point {
             None => (0..p).collect(),
@@ -493,14 +507,14 @@ impl Robot {
         qd: In1<'_>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let n = self.built.n_dof();
-        let (q, qd) = (arrays::dvec("q", &q, n)?, arrays::dvec("qd", &qd, n)?);
+        let (q, qd) = (self.coordinates(&q)?, arrays::dvec("qd", &qd, n)?);
         let flat = py.detach(|| quantities::velocities(&self.built, &self.workspaces, &q, &qd));
         arrays::shaped(py, flat, [self.built.model.disc.n_points(), 6])
     }
 
     /// The mass matrix ``M(q)`` (symmetric positive definite), shape (n_dof, n_dof).
     fn mass_matrix<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyAny>> {
-        let q = arrays::dvec("q", &q, self.built.n_dof())?;
+        let q = self.coordinates(&q)?;
         let m = py.detach(|| quantities::mass_matrix(&self.built, &self.workspaces, &q));
         arrays::matrix(py, &m)
     }
@@ -520,7 +534,7 @@ impl Robot {
         q: In1<'_>,
         u: Option<Tensions<'_>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let q = arrays::dvec("q", &q, self.built.n_dof())?;
+        let q = self.coordinates(&q)?;
         let u = self.quantity_tensions(u)?;
         let r = py
             .detach(|| quantities::statics_residual(&self.built, &self.workspaces, &q, &u))
@@ -536,7 +550,7 @@ impl Robot {
         q: In1<'_>,
         u: Option<Tensions<'_>>,
     ) -> PyResult<Bound<'py, PyAny>> {
-        let q = arrays::dvec("q", &q, self.built.n_dof())?;
+        let q = self.coordinates(&q)?;
         let u = self.quantity_tensions(u)?;
         let j = py
             .detach(|| quantities::statics_jacobian(&self.built, &self.workspaces, &q, &u))

@@ -236,6 +236,15 @@ def test_a_reduced_run_starts_inside_the_training_encodings_but_not_far_outside_
         reduced.simulate(0.02, q0=np.array([hi + 2 * (hi - lo)]))
     with pytest.raises(gvsrom.GvsromError, match=r"q0.*2 values given: expected 1.*reduced"):
         reduced.simulate(0.02, q0=np.zeros(2))
+    # the model quantities at such a code say so too, rather than return the saturated decoder's
+    # numbers (they once did), and answer when attached with extrapolate=True
+    far = np.array([hi + 2 * (hi - lo)])
+    for quantity in (reduced.mass_matrix, reduced.elastic_force, reduced.forward, reduced.statics_residual):
+        with pytest.raises(gvsrom.GvsromError, match=r"`q`: q_r\[0\].*far outside.*extrapolate=True"):
+            quantity(far)
+    np.testing.assert_array_equal(reduced.mass_matrix(inside), reduced.mass_matrix(inside))
+    bold = robot.with_model(ae_model, extrapolate=True)
+    assert np.isfinite(bold.mass_matrix(far)).all()
 
 
 def test_a_reduced_run_checks_each_input_signal_against_the_training_tensions(pod_model):
