@@ -213,6 +213,10 @@ def test_codes_far_outside_the_training_encodings_are_refused_unless_extrapolati
     with pytest.raises(gvsrom.GvsromError, match=r"q_r\[0\].*far outside"):
         pod_model.decode(far)
     assert pod_model.decode(far, extrapolate=True).shape == (pod_model.features,)
+    # a huge code is named in exponent form, not in 300 digits
+    with pytest.raises(gvsrom.GvsromError, match=r"q_r\[0\] = 1e300 lies far outside") as e:
+        pod_model.decode(np.array([1e300, 0.0]))
+    assert len(str(e.value)) < 400
     with pytest.raises(gvsrom.GvsromError, match=r"`strain` has shape \(5,\)"):
         pod_model.encode(np.zeros(5))
     bad = np.zeros((2, pod_model.features))

@@ -141,8 +141,13 @@ impl Reduced {
     pub fn range_violation(&self, q: &[f64]) -> Option<String> {
         outside_range(&self.latent_range, q).map(|d| {
             let (v, [lo, hi]) = (q[d], self.latent_range[d]);
+            // six decimals as the range, in exponent form far from it (not 300 digits for 1e300)
+            let v = match v.abs() < 1e15 {
+                true => format!("{v:.6}"),
+                false => gvs::error::fmt_value(v),
+            };
             format!(
-                "q_r[{d}] = {v:.6} lies far outside the range of the training data [{lo:.6}, {hi:.6}] of `{}`",
+                "q_r[{d}] = {v} lies far outside the range of the training data [{lo:.6}, {hi:.6}] of `{}`",
                 self.path.display()
             )
         })

@@ -144,7 +144,7 @@ impl ReducedModel {
                 let [lo, hi] = range[d];
                 return Err(CodecError::OutsideRange(format!(
                     "row {row}: q_r[{d}] = {} lies far outside the range of the training encodings [{lo:.6}, {hi:.6}] ({why}); accepted: within half the range's width of it, or extrapolate = true",
-                    z[d]
+                    gvs::error::fmt_value(z[d])
                 )));
             }
         }
