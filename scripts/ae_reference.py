@@ -107,6 +107,30 @@ def init(sizes: list[int], key, gain: float = 1.0) -> list[tuple]:
     return params
 
 
+def init_nguyen_widrow(sizes: list[int], flags: list[bool], key) -> list[tuple]:
+    """MATLAB's default layer initialisation (`initnw`) for a network with inputs in [-1, 1].
+
+    A tanh layer of S units on R inputs gets rows of norm `0.7 S^(1/R)` in random directions and
+    biases spread evenly over `[-0.7 S^(1/R), 0.7 S^(1/R)]`, so the units' active regions tile the
+    input range; a linear layer gets weights and biases uniform in [-1, 1] (`rands`). On the
+    decoder's one-input first layer (R = 1, S = 18) the units are steps of slope 12.6 at 18 evenly
+    spaced codes: a start that can fold the code many times.
+    """
+    params = []
+    for (a, b), t in zip(zip(sizes[:-1], sizes[1:]), flags):
+        key, k1, k2 = jax.random.split(key, 3)
+        if t:
+            mag = 0.7 * b ** (1.0 / a)
+            w = jax.random.normal(k1, (a, b))
+            w = mag * w / jnp.linalg.norm(w, axis=0, keepdims=True)
+            bias = mag * jnp.linspace(-1.0, 1.0, b) * jnp.sign(w[0])
+        else:
+            w = jax.random.uniform(k1, (a, b), minval=-1.0, maxval=1.0)
+            bias = jax.random.uniform(k2, (b,), minval=-1.0, maxval=1.0)
+        params.append((w, bias))
+    return params
+
+
 def effective(params):
     """The network's `(W, b)` per layer: with `--log-gain` the layers are `(v, g, b)`, `W = e^g v`."""
     return [(p[0] * jnp.exp(p[1]), p[2]) if len(p) == 3 else p for p in params]
@@ -154,6 +178,12 @@ def main() -> None:
         help="every layer's Glorot bound × this (> 1: the chaotic phase of deep tanh networks)",
     )
     ap.add_argument(
+        "--init",
+        choices=["glorot", "nguyen-widrow"],
+        default="glorot",
+        help="Glorot-uniform weights and zero biases, or MATLAB's Nguyen-Widrow (initnw)",
+    )
+    ap.add_argument(
         "--log-gain", action="store_true", help="optimise W = e^g v: a log-gain g per unit"
     )
     ap.add_argument("--save", type=Path, help="write the kept weights (flattened, .npy)")
@@ -185,7 +215,10 @@ def main() -> None:
     sizes = architecture(n, args.latent, args.hidden_layers)
     half = (args.hidden_layers + 1) // 2
     flags = [k + 1 < half for k in range(half)] * 2
-    params = init(sizes, jax.random.PRNGKey(args.seed), args.init_gain)
+    if args.init == "nguyen-widrow":
+        params = init_nguyen_widrow(sizes, flags, jax.random.PRNGKey(args.seed))
+    else:
+        params = init(sizes, jax.random.PRNGKey(args.seed), args.init_gain)
     if args.log_gain:
         params = [(w, jnp.zeros(w.shape[1]), b) for w, b in params]
     gain = args.input_gain
@@ -244,6 +277,7 @@ def main() -> None:
         "seed": args.seed,
         "input_gain": gain,
         "odd": args.odd,
+        "init": args.init,
         "init_gain": args.init_gain,
         "log_gain": args.log_gain,
         "largest_weight": float(max(jnp.max(jnp.abs(w)) for w, _ in effective(best))),

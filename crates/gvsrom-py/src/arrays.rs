@@ -59,6 +59,25 @@ pub fn finite(name: &str, v: DVector<f64>) -> PyResult<DVector<f64>> {
     }
 }
 
+/// A whole-number argument that must not be negative (a count, a size, a seed): pyo3's own
+/// conversion to an unsigned type raises a bare `OverflowError` that names neither the argument
+/// nor what is accepted.
+pub fn unsigned(name: &str, value: i128) -> PyResult<u64> {
+    u64::try_from(value).map_err(|_| match value < 0 {
+        true => invalid(format!("`{name}` = {value}: expected a whole number ≥ 0")),
+        false => invalid(format!(
+            "`{name}` = {value}: expected a whole number ≤ {}",
+            u64::MAX
+        )),
+    })
+}
+
+/// [`unsigned`] as a size or count.
+pub fn size(name: &str, value: i128) -> PyResult<usize> {
+    let v = unsigned(name, value)?;
+    usize::try_from(v).map_err(|_| invalid(format!("`{name}` = {value}: too large")))
+}
+
 /// The rows of a 2-D input, each of length `cols`; else a `GvsromError` naming `name`.
 pub fn rows(name: &str, a: &In2<'_>, cols: usize, what: &str) -> PyResult<Vec<Vec<f64>>> {
     let v = a.as_array();

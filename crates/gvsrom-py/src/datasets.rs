@@ -313,11 +313,11 @@ pub fn dataset(
     sweep: Option<&Bound<'_, PyAny>>,
     grid: Option<&Bound<'_, PyAny>>,
     random: Option<&Bound<'_, PyAny>>,
-    samples: Option<usize>,
-    seed: u64,
+    samples: Option<i128>,
+    seed: i128,
     set: Option<Vec<String>>,
-    chunk_size: usize,
-    threads: Option<usize>,
+    chunk_size: i128,
+    threads: Option<i128>,
     force: bool,
     resume: bool,
     duration: Option<f64>,
@@ -330,6 +330,11 @@ pub fn dataset(
     rtol: Option<f64>,
     atol: f64,
 ) -> PyResult<Dataset> {
+    use crate::arrays::{size, unsigned};
+    let samples = samples.map(|v| size("samples", v)).transpose()?;
+    let seed = unsigned("seed", seed)?;
+    let chunk_size = size("chunk_size", chunk_size)?;
+    let threads = threads.map(|v| size("threads", v)).transpose()?;
     let (scenario, mut overrides) = scenario_arg(scenario)?;
     overrides.extend(set.unwrap_or_default());
     dynamic_only(

@@ -1,4 +1,6 @@
-//! Library errors as Python exceptions, with the message the command line prints after `error: `.
+//! Library errors as Python exceptions, with the message the command line prints after `error: `,
+//! spelled for Python: the command line's flags become the keyword arguments of the same meaning
+//! ([`python_spelling`]).
 //!
 //! - `GvsromError(ValueError)`: bad input of any kind (a scenario field, an override, a tension,
 //!   an array's shape, a model directory);
@@ -29,17 +31,25 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add("GvsromError", py.get_type::<GvsromError>())?;
     m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
+    m.add_function(wrap_pyfunction!(_python_spelling, m)?)?;
     Ok(())
+}
+
+/// [`python_spelling`] of `message`: not part of the API (no stub); the tests call it on messages
+/// that are costly to provoke.
+#[pyfunction]
+fn _python_spelling(message: &str) -> String {
+    python_spelling(message)
 }
 
 /// A message as a `GvsromError`.
 pub fn invalid(message: impl Into<String>) -> PyErr {
-    GvsromError::new_err(message.into())
+    GvsromError::new_err(python_spelling(&message.into()))
 }
 
 /// A scenario error (`{e}`, as `error: {e}` of the command line).
 pub fn scenario(e: ScenarioError) -> PyErr {
-    GvsromError::new_err(e.to_string())
+    invalid(e.to_string())
 }
 
 /// Any library error, its causes joined by `: ` as the command line prints them.
@@ -49,7 +59,7 @@ pub fn any(e: anyhow::Error) -> PyErr {
             return Python::attach(|py| statics_with_message(py, f, &format!("{e:#}")));
         }
     }
-    GvsromError::new_err(format!("{e:#}"))
+    invalid(format!("{e:#}"))
 }
 
 /// An error with its causes joined by `: `, as the command line prints it (anyhow's `{:#}`).
@@ -78,7 +88,7 @@ pub fn statics_with_message(py: Python<'_>, f: &StaticsFailure, message: &str) -
             residual_norm,
             ..
         } => {
-            let err = ConvergenceError::new_err(message.to_string());
+            let err = ConvergenceError::new_err(python_spelling(message));
             let value = err.value(py);
             // setting attributes on a fresh exception instance cannot fail short of memory
             let _ = value.setattr("iterations", iterations);
@@ -86,6 +96,121 @@ pub fn statics_with_message(py: Python<'_>, f: &StaticsFailure, message: &str) -
             let _ = value.setattr("load_factor", load_factor);
             err
         }
-        _ => GvsromError::new_err(message.to_string()),
+        _ => invalid(message),
     }
+}
+
+/// Flags of the command line whose Python keyword argument has another spelling than the flag's
+/// with `-` → `_`.
+const RENAMED: [(&str, &str); 2] = [("lambda", "lambda_"), ("tension", "u")];
+
+/// Flags of the command line that are switches, spelled `name=True` in Python.
+const SWITCHES: [&str; 6] = [
+    "force",
+    "resume",
+    "extrapolate",
+    "from-equilibrium",
+    "interpolate",
+    "quick",
+];
+
+/// Flags of the command line that are keyword arguments of the same name in Python.
+const SAME: [&str; 41] = [
+    "out",
+    "model",
+    "set",
+    "duration",
+    "init",
+    "seed",
+    "samples",
+    "random",
+    "sweep",
+    "grid",
+    "kinetic-weight",
+    "rate-weight",
+    "input",
+    "norm",
+    "babble",
+    "sample-rate",
+    "method",
+    "steps",
+    "rtol",
+    "atol",
+    "fixed-step",
+    "patience",
+    "modes",
+    "lr-decay",
+    "lr-reductions",
+    "loss",
+    "lbfgs-iterations",
+    "sample-weighting",
+    "relative-floor",
+    "decoder",
+    "count",
+    "latent",
+    "hidden-layers",
+    "chunk-size",
+    "learning-rate",
+    "epochs",
+    "validation-fraction",
+    "batch-size",
+    "threads",
+    "noise",
+    "jobs",
+];
+
+/// The Python keyword argument for the command line's flag `--{flag}`, if it has one.
+fn keyword(flag: &str) -> Option<String> {
+    if let Some((_, python)) = RENAMED.iter().find(|(cli, _)| *cli == flag) {
+        return Some((*python).to_string());
+    }
+    if SWITCHES.contains(&flag) {
+        return Some(format!("{}=True", flag.replace('-', "_")));
+    }
+    SAME.contains(&flag).then(|| flag.replace('-', "_"))
+}
+
+/// `message` as a Python user reads it: each `--flag` of the command line that is a keyword
+/// argument in Python is named as that argument (`--sample-rate` → `sample_rate`, `--lambda` →
+/// `lambda_`, `--tension` → `u`, `--force` → `force=True`); other flags stay. A command quoted in
+/// backticks (`` `gvsrom …` ``) is kept as written: it is meant for a shell.
+pub fn python_spelling(message: &str) -> String {
+    message
+        .split('`')
+        .enumerate()
+        .map(
+            |(i, part)| match i % 2 == 1 && part.starts_with("gvsrom ") {
+                true => part.to_string(),
+                false => flags_as_keywords(part),
+            },
+        )
+        .collect::<Vec<_>>()
+        .join("`")
+}
+
+/// Every `--flag` of `text` that is a Python keyword argument, renamed ([`keyword`]).
+fn flags_as_keywords(text: &str) -> String {
+    let is_flag_char = |c: char| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-';
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(at) = rest.find("--") {
+        let before = rest[..at].chars().next_back();
+        let after = &rest[at + 2..];
+        let len = after
+            .find(|c: char| !is_flag_char(c))
+            .unwrap_or(after.len());
+        let flag = &after[..len];
+        out.push_str(&rest[..at]);
+        let starts_word = before.is_none_or(|c| !(c.is_alphanumeric() || c == '-'));
+        match keyword(flag).filter(|_| starts_word && !flag.is_empty()) {
+            Some(python) => out.push_str(&python),
+            None => {
+                out.push_str("--");
+                out.push_str(flag);
+            }
+        }
+        rest = &after[len..];
+    }
+    out.push_str(rest);
+    out
 }

@@ -35,11 +35,12 @@ use std::path::PathBuf;
 pub fn pod(
     py: Python<'_>,
     dataset: &Bound<'_, PyAny>,
-    modes: usize,
+    modes: i128,
     out: PathBuf,
     force: bool,
     norm: &str,
 ) -> PyResult<Model> {
+    let modes = crate::arrays::size("modes", modes)?;
     let norm = gvsrom::reduce::named("norm", norm).map_err(errors::scenario)?;
     let dataset = dataset_paths(dataset)?;
     let summary = py
@@ -165,17 +166,17 @@ pub fn train(
     py: Python<'_>,
     dataset: &Bound<'_, PyAny>,
     out: PathBuf,
-    latent: Option<usize>,
-    hidden_layers: Option<usize>,
-    epochs: usize,
-    batch_size: usize,
+    latent: Option<i128>,
+    hidden_layers: Option<i128>,
+    epochs: i128,
+    batch_size: i128,
     learning_rate: f64,
     lambda_: f64,
     validation_fraction: Option<f64>,
-    patience: usize,
-    lr_reductions: usize,
-    lbfgs_iterations: usize,
-    seed: Option<u64>,
+    patience: i128,
+    lr_reductions: i128,
+    lbfgs_iterations: i128,
+    seed: Option<i128>,
     loss: Option<&str>,
     sample_weighting: &str,
     relative_floor: f64,
@@ -186,7 +187,18 @@ pub fn train(
     init: Option<&Bound<'_, PyAny>>,
     force: bool,
 ) -> PyResult<Model> {
+    use crate::arrays::{size, unsigned};
     use gvsrom::reduce::{self, TrainChoices};
+    let latent = latent.map(|v| size("latent", v)).transpose()?;
+    let hidden_layers = hidden_layers
+        .map(|v| size("hidden_layers", v))
+        .transpose()?;
+    let seed = seed.map(|v| unsigned("seed", v)).transpose()?;
+    let epochs = size("epochs", epochs)?;
+    let batch_size = size("batch_size", batch_size)?;
+    let patience = size("patience", patience)?;
+    let lr_reductions = size("lr_reductions", lr_reductions)?;
+    let lbfgs_iterations = size("lbfgs_iterations", lbfgs_iterations)?;
     let init = match init {
         Some(m) => Some(reduce::start_model(&model_path(m)?).map_err(errors::any)?),
         None => None,

@@ -88,10 +88,11 @@ pub fn reproduce<'py>(
     study: &Bound<'py, PyAny>,
     out: PathBuf,
     quick: bool,
-    jobs: Option<usize>,
+    jobs: Option<i128>,
     noise: f64,
     test_sizes: bool,
 ) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    let jobs = jobs.map(|v| crate::arrays::size("jobs", v)).transpose()?;
     let opts = Options {
         cases: cases(study)?,
         quick: quick || test_sizes,

@@ -43,12 +43,16 @@ def run_cli(bin_path: Path, *args: str) -> subprocess.CompletedProcess:
 
 
 def cli_error(bin_path: Path, *args: str) -> str:
-    """The message of a failing `gvsrom ARGS`: its stderr without the `error: ` prefix."""
+    """The message of a failing `gvsrom ARGS` as Python raises it: its stderr without the
+    `error: ` prefix, the flags renamed to the keyword arguments as the binding renames them in
+    every message (`--count` → `count`; test_argument_errors checks the renaming itself)."""
+    from gvsrom._gvsrom import _python_spelling
+
     p = run_cli(bin_path, *args)
     assert p.returncode == 1, p.stdout + p.stderr
     line = p.stderr.strip().splitlines()[-1]
     assert line.startswith("error: "), line
-    return line[len("error: "):]
+    return _python_spelling(line[len("error: "):])
 
 
 def cli_statics(bin_path: Path, tmp_path: Path, *args: str) -> dict:

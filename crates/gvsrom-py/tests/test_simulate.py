@@ -45,7 +45,7 @@ def test_an_input_of_the_wrong_width_or_start_is_a_value_error():
         robot.simulate(0.01, input=np.zeros((2, 3)))
     with pytest.raises(gvsrom.GvsromError, match="starts at t = 0.5"):
         robot.simulate(0.01, input=[[0.5, -1.0]])
-    with pytest.raises(gvsrom.GvsromError, match="--duration"):
+    with pytest.raises(gvsrom.GvsromError, match="`duration`"):
         robot.simulate(-1.0)
 
 

@@ -60,5 +60,5 @@ def test_a_fixed_step_run_converges_to_the_adaptive_one(robot):
         err[h] = np.abs(run["tip_position"] - ref["tip_position"]).max() / robot.length
     assert err[1e-3] < 1e-4, err
     assert err[1e-3] < 0.5 * err[4e-3], err
-    with pytest.raises(gvsrom.GvsromError, match="fixed-step"):
+    with pytest.raises(gvsrom.GvsromError, match="`fixed_step`"):
         robot.simulate(0.1, fixed_step=-1.0)

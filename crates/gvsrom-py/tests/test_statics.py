@@ -76,8 +76,8 @@ def test_wrong_tension_count_is_a_value_error(gvsrom_bin):
     expected = cli_error(gvsrom_bin, "statics", "six-tendon", "--tension=-1,-2")
     with pytest.raises(ValueError) as e:
         robot.statics(u=[-1.0, -2.0])
-    # the command line names its option first
-    assert expected == "--tension: " + str(e.value)
+    # the command line names its option first (`--tension`, the argument `u`)
+    assert expected == "u: " + str(e.value)
 
 
 def test_non_convergence_raises_with_iterations_and_residual(gvsrom_bin):

@@ -298,6 +298,28 @@ fn edited_weights_with_their_shapes_intact_are_refused() {
 }
 
 #[test]
+fn a_directory_that_holds_no_model_is_not_called_an_edited_model() {
+    // nothing there, and a dataset given as a model: neither was edited
+    let missing = scratch("val-no-model");
+    for (dir, needle) in [
+        (missing.as_path(), "meta.json: missing"),
+        (dataset12(), "not a gvsrom reduced-model output"),
+    ] {
+        let e = expect_error(
+            &[
+                "statics",
+                "single-tendon",
+                "--tension=-3",
+                "--model",
+                s(dir),
+            ],
+            &[needle],
+        );
+        assert!(!e.contains("edited"), "{e}");
+    }
+}
+
+#[test]
 fn dataset_metadata_inconsistent_with_its_arrays_is_refused_not_a_panic() {
     let out = scratch("val-ds-inconsistent-model");
     // the component names reordered (hashes re-recorded, as by a writer with a bug)

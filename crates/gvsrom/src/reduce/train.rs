@@ -323,15 +323,19 @@ pub fn train<P: AsRef<Path>>(
 pub const SAMPLE_WEIGHTINGS: [&str; 2] = ["uniform", "relative"];
 
 /// The snapshot weighting named `name` ([`SAMPLE_WEIGHTINGS`]); `floor` (a fraction of the largest
-/// snapshot norm, in (0, 1]) bounds the relative weighting's weights.
+/// snapshot norm, in (0, 1]) bounds the relative weighting's weights. A floor outside (0, 1] is
+/// refused with either weighting: a value given by mistake is not passed over because the uniform
+/// weighting does not read it.
 pub fn sample_weighting(name: &str, floor: f64) -> Result<SampleWeighting, ScenarioError> {
-    match name {
-        "uniform" => Ok(SampleWeighting::Uniform),
-        "relative" if floor > 0.0 && floor <= 1.0 => Ok(SampleWeighting::Relative { floor }),
-        "relative" => Err(invalid(
+    if !(floor > 0.0 && floor <= 1.0) {
+        return Err(invalid(
             "--relative-floor",
             format!("{floor} (accepted: a fraction of the largest snapshot norm in (0, 1])"),
-        )),
+        ));
+    }
+    match name {
+        "uniform" => Ok(SampleWeighting::Uniform),
+        "relative" => Ok(SampleWeighting::Relative { floor }),
         _ => Err(invalid(
             "--sample-weighting",
             format!("`{name}` (accepted: {})", SAMPLE_WEIGHTINGS.join(", ")),
@@ -408,9 +412,10 @@ mod tests {
     }
 
     #[test]
-    fn sample_weightings_are_named_and_a_bad_name_or_floor_is_refused_by_its_option() {
+    fn sample_weightings_are_named_and_a_bad_name_or_floor_is_refused_by_its_option_whatever_the_weighting(
+    ) {
         assert_eq!(
-            sample_weighting("uniform", 0.0).unwrap(),
+            sample_weighting("uniform", 0.1).unwrap(),
             SampleWeighting::Uniform
         );
         assert_eq!(
@@ -421,6 +426,8 @@ mod tests {
             ("relative", 0.0, "--relative-floor"),
             ("relative", 1.5, "--relative-floor"),
             ("relative", f64::NAN, "--relative-floor"),
+            ("uniform", -1.0, "--relative-floor"),
+            ("uniform", f64::NAN, "--relative-floor"),
             ("per-row", 0.1, "--sample-weighting"),
         ] {
             let e = sample_weighting(name, floor).unwrap_err().to_string();

@@ -162,10 +162,12 @@ impl ReducedModel {
             integrity,
             meta: value,
             files,
-        } = crate::output::verify_dir_meta(dir, MODEL_FORMAT).map_err(|e| {
-            bad(format!(
+        } = crate::output::verify_dir_meta(dir, MODEL_FORMAT).map_err(|e| match e.problem {
+            // no model there (no meta.json, or not a model's): nothing was edited
+            crate::output::Problem::Manifest(_) => bad(e.to_string()),
+            _ => bad(format!(
                 "{e}; an edited model is not the model that was trained — re-create it"
-            ))
+            )),
         })?;
         let format = value
             .get(MANIFEST_KEY)

@@ -1,0 +1,102 @@
+"""A bad argument is named as the Python caller spelled it: the library's messages name the
+command line's flags (`--sample-rate`, `--lambda`, `--force`), which the binding renames to the
+keyword arguments (`sample_rate`, `lambda_`, `force=True`); a negative count is a `GvsromError`
+naming the argument, not pyo3's bare `OverflowError`."""
+
+import re
+
+import pytest
+
+import gvsrom
+from conftest import run_cli
+
+
+@pytest.fixture(scope="module")
+def dataset(gvsrom_bin, tmp_path_factory):
+    out = tmp_path_factory.mktemp("ds") / "sweep"
+    p = run_cli(gvsrom_bin, "dataset", "single-tendon", "--sweep", "tendons.0.tension=-6:0",
+                "--samples", "4", "--out", str(out))
+    assert p.returncode == 0, p.stderr
+    return out
+
+
+def message(call) -> str:
+    with pytest.raises(gvsrom.GvsromError) as e:
+        call()
+    text = str(e.value)
+    assert not re.search(r"(^|[\s`(])--[a-z]", text), f"a command-line flag in: {text}"
+    return text
+
+
+def test_simulation_options_are_named_as_keyword_arguments():
+    robot = gvsrom.Scenario.preset("single-tendon").build()
+    assert "`duration`: -1" in message(lambda: robot.simulate(-1.0))
+    assert "`sample_rate`: 0" in message(lambda: robot.simulate(0.1, sample_rate=0.0))
+    assert "`fixed_step`: 0" in message(lambda: robot.simulate(0.1, fixed_step=0.0))
+    assert "`rtol`" in message(lambda: robot.simulate(0.1, rtol=-1.0))
+    assert "count `0`" in message(lambda: robot.modes(count=0))
+
+
+def test_dataset_options_are_named_as_keyword_arguments(tmp_path, dataset):
+    beam = gvsrom.Scenario.preset("single-tendon")
+    plan = dict(sweep=["tendons.0.tension=-6:0"], samples=3)
+    assert message(lambda: gvsrom.dataset(beam, tmp_path / "a", **{**plan, "samples": 0})
+                   ).startswith("samples 0")
+    assert message(lambda: gvsrom.dataset(beam, tmp_path / "b", **plan, chunk_size=0)
+                   ).startswith("chunk_size 0")
+    assert message(lambda: gvsrom.dataset(beam, tmp_path / "c", **plan, threads=0)
+                   ).startswith("threads 0")
+    assert "`sample_rate`" in message(
+        lambda: gvsrom.dataset(beam, tmp_path / "d", duration=0.1, sample_rate=0.0))
+    # the way out of an existing output is the keyword, as Python spells it
+    assert "pass force=True to replace it" in message(lambda: gvsrom.dataset(beam, dataset, **plan))
+
+
+def test_training_options_are_named_as_keyword_arguments(tmp_path, dataset):
+    def train(**kw):
+        return lambda: gvsrom.train(dataset, tmp_path / "m", latent=1, epochs=2, **kw)
+
+    assert "invalid `lambda_`" in message(train(lambda_=-1.0))
+    assert "invalid `learning_rate`" in message(train(learning_rate=0.0))
+    assert "invalid `lr_decay`" in message(train(lr_decay=2.0))
+    assert "invalid `rate_weight`" in message(train(rate_weight=-1.0))
+    assert "invalid `kinetic_weight`" in message(train(kinetic_weight=-1.0))
+    assert "invalid `sample_weighting`" in message(train(sample_weighting="per-row"))
+    # a floor outside (0, 1] is refused even with the uniform weighting, which does not read it
+    assert "invalid `relative_floor`: -1" in message(train(relative_floor=-1.0))
+    assert not (tmp_path / "m").exists()
+
+
+@pytest.mark.parametrize("name", ["patience", "lbfgs_iterations", "lr_reductions", "batch_size",
+                                  "epochs", "seed", "latent", "hidden_layers"])
+def test_a_negative_count_of_train_is_a_value_error_naming_it(tmp_path, dataset, name):
+    kw = {"latent": 1, "epochs": 2, name: -1}
+    text = message(lambda: gvsrom.train(dataset, tmp_path / "m", **kw))
+    assert text == f"`{name}` = -1: expected a whole number ≥ 0"
+
+
+def test_a_negative_count_elsewhere_is_a_value_error_naming_it(tmp_path, dataset):
+    beam = gvsrom.Scenario.preset("single-tendon")
+    plan = dict(sweep=["tendons.0.tension=-6:0"], samples=3)
+    assert message(lambda: gvsrom.pod(dataset, -2, tmp_path / "p")).startswith("`modes` = -2")
+    for name in ["samples", "seed", "chunk_size", "threads"]:
+        text = message(lambda: gvsrom.dataset(beam, tmp_path / "d", **{**plan, name: -1}))
+        assert text.startswith(f"`{name}` = -1"), text
+    assert message(lambda: gvsrom.reproduce("iv-a", tmp_path / "r", jobs=-1)
+                   ).startswith("`jobs` = -1")
+    assert "≤ 18446744073709551615" in message(
+        lambda: gvsrom.dataset(beam, tmp_path / "e", **plan, seed=2**64))
+
+
+def test_a_command_quoted_for_the_shell_keeps_its_flags():
+    # the translation every message goes through, on messages costly to provoke
+    from gvsrom._gvsrom import _python_spelling as spell
+
+    scaled = ("no step can be taken from there. Simulate with a plain decoder "
+              "(`gvsrom train --decoder plain`), or start from another state")
+    assert spell(scaled) == scaled
+    assert spell("--tension `-3`: give --extrapolate or --from-equilibrium") == (
+        "u `-3`: give extrapolate=True or from_equilibrium=True")
+    # a flag with no Python argument, a word with a dash inside and a bare `--` stay as they are
+    assert spell("--json x, well-known--set, a -- b, --") == "--json x, well-known--set, a -- b, --"
+    assert spell("`--lambda`; `--lr-reductions`") == "`lambda_`; `lr_reductions`"
