@@ -19,6 +19,10 @@ and not from gvsrom's code, to judge the Rust trainer against a standard stack:
 - `--init-gain G`: every layer's Glorot bound × G; above about 1 a deep tanh network is in its
   chaotic phase, where its function of the input folds many times (a test of whether the initial
   network's few folds are what keeps a trained r = 1 code of IV-B to a few passes);
+- `--init nguyen-widrow`: MATLAB's default layer initialisation (`initnw`) instead of Glorot's:
+  tanh units whose active regions tile the input range evenly, the decoder's one-input first
+  layer then 18 steps of slope 12.6 at evenly spaced codes (a test of whether the paper's r = 1
+  cell owes its many folds to the initialisation of a MATLAB network);
 - `--log-gain`: the same network and loss, optimised in another parametrisation: each unit's
   weights are `W = e^g v` (a gain per unit, `g` from 0) and Adam moves `g`, `v` and `b`; the
   penalty is still on `W`. Adam moves a weight by about one learning rate per step, so a unit
