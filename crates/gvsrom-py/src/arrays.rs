@@ -102,6 +102,16 @@ where
     Ok(PyArray::from_vec(py, flat).reshape(shape)?.into_any())
 }
 
+/// `a` made read-only, as state held by a result object (`Statics`, `Dataset`, `Model`): every
+/// access returns the same array, so a write into it would change what the object reports from
+/// then on. `a.copy()` gives a writable copy.
+pub fn held(a: Bound<'_, PyAny>) -> PyResult<Py<PyAny>> {
+    let kwargs = pyo3::types::PyDict::new(a.py());
+    kwargs.set_item("write", false)?;
+    a.call_method("setflags", (), Some(&kwargs))?;
+    Ok(a.unbind())
+}
+
 /// A 1-D array.
 pub fn vector<'py>(py: Python<'py>, v: &[f64]) -> Bound<'py, PyAny> {
     PyArray::from_slice(py, v).into_any()

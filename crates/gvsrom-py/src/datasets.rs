@@ -2,7 +2,7 @@
 //! [`gvsrom::dataset::run`], Ctrl-C included), `gvsrom.load_dataset(path)` reads one back
 //! ([`gvsrom::dataset::Dataset::load`]) as a `Dataset` of NumPy arrays with its metadata.
 
-use crate::arrays::shaped;
+use crate::arrays::{held, shaped};
 use crate::errors::{self, invalid};
 use crate::scenario::Scenario;
 use gvsrom::dataset::{DatasetRequest, DEFAULT_CHUNK_SIZE};
@@ -102,9 +102,8 @@ pub struct Dataset {
     /// Sample times [s] of a dynamic dataset, else ``None``.
     #[pyo3(get)]
     t: Option<Py<PyAny>>,
-    /// ``meta.json`` as a dict.
-    #[pyo3(get)]
-    meta: Py<PyAny>,
+    /// ``meta.json`` as the loader verified it.
+    meta_json: serde_json::Value,
 }
 
 #[pymethods]
@@ -113,6 +112,12 @@ impl Dataset {
     #[getter]
     pub(crate) fn path(&self) -> PathBuf {
         self.dir.clone()
+    }
+
+    /// ``meta.json`` as a dict (a new one at each access: editing it changes nothing).
+    #[getter]
+    fn meta<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        meta_dict(py, &self.meta_json)
     }
 
     fn __len__(&self, py: Python<'_>) -> PyResult<usize> {
@@ -153,7 +158,6 @@ pub fn load_dataset(py: Python<'_>, path: PathBuf) -> PyResult<Dataset> {
     let n = d.status.len();
     let m = &d.meta;
     let row = d.strain.len().checked_div(n).unwrap_or(0);
-    let meta = meta_dict(py, &d.meta_json)?;
     Ok(Dataset {
         kind: m.kind.clone(),
         scenario: m.scenario.clone(),
@@ -163,17 +167,19 @@ pub fn load_dataset(py: Python<'_>, path: PathBuf) -> PyResult<Dataset> {
         n_points: m.n_points,
         complete: m.complete,
         seed: m.seed,
-        inputs: shaped(py, d.inputs, [n, m.parameters.len()])?.unbind(),
-        strain: shaped(py, d.strain, [n, row])?.unbind(),
-        q: shaped(py, d.q, [n, m.n_dof])?.unbind(),
-        tip_position: shaped(py, d.tip_position, [n, 3])?.unbind(),
-        tip_rotation: shaped(py, d.tip_rotation, [n, 3, 3])?.unbind(),
-        status: PyArray::from_vec(py, d.status).into_any().unbind(),
-        iterations: PyArray::from_vec(py, d.iterations).into_any().unbind(),
-        residual: PyArray::from_vec(py, d.residual).into_any().unbind(),
-        strain_x: PyArray::from_vec(py, d.strain_x).into_any().unbind(),
-        t: d.t.map(|t| PyArray::from_vec(py, t).into_any().unbind()),
-        meta: meta.unbind(),
+        inputs: held(shaped(py, d.inputs, [n, m.parameters.len()])?)?,
+        strain: held(shaped(py, d.strain, [n, row])?)?,
+        q: held(shaped(py, d.q, [n, m.n_dof])?)?,
+        tip_position: held(shaped(py, d.tip_position, [n, 3])?)?,
+        tip_rotation: held(shaped(py, d.tip_rotation, [n, 3, 3])?)?,
+        status: held(PyArray::from_vec(py, d.status).into_any())?,
+        iterations: held(PyArray::from_vec(py, d.iterations).into_any())?,
+        residual: held(PyArray::from_vec(py, d.residual).into_any())?,
+        strain_x: held(PyArray::from_vec(py, d.strain_x).into_any())?,
+        t: d.t
+            .map(|t| held(PyArray::from_vec(py, t).into_any()))
+            .transpose()?,
+        meta_json: d.meta_json,
         dir: path,
     })
 }

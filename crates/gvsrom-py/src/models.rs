@@ -46,18 +46,14 @@ pub struct Model {
     /// Whether it may be used outside its training inputs (`--extrapolate`).
     #[pyo3(get)]
     pub extrapolate: bool,
-    /// The numbers of `weights.safetensors` by name, as arrays.
-    #[pyo3(get)]
-    arrays: Py<PyDict>,
+    /// The numbers of `weights.safetensors` by name, as (read-only) arrays.
+    arrays: Vec<(String, Py<PyAny>)>,
     /// `[min, max]` of the training encodings per reduced coordinate, shape (r, 2).
     #[pyo3(get)]
     latent_range: Py<PyAny>,
     /// Reduced coordinates of the rest state, shape (r,).
     #[pyo3(get)]
     rest: Py<PyAny>,
-    /// `meta.json` as a dict.
-    #[pyo3(get)]
-    meta: Py<PyAny>,
     /// The model itself, for `encode` / `decode` / `reconstruct` (and `reconstruction`).
     pub(crate) model: ReducedModel,
 }
@@ -113,6 +109,26 @@ impl Model {
     #[getter]
     fn path(&self) -> PathBuf {
         self.dir.clone()
+    }
+
+    /// The numbers of ``weights.safetensors`` by name, as read-only arrays (a new dict at each
+    /// access: editing it changes nothing).
+    #[getter]
+    fn arrays<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (name, a) in &self.arrays {
+            d.set_item(name, a.bind(py))?;
+        }
+        Ok(d)
+    }
+
+    /// ``meta.json`` as a dict (a new one at each access: editing it changes nothing).
+    #[getter]
+    fn meta<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        match &self.model.dir {
+            Some(dir) => crate::datasets::meta_dict(py, &dir.meta_json),
+            None => Ok(py.None().into_bound(py)),
+        }
     }
 
     /// Number of values of one snapshot: computational points × active strain components.
@@ -232,24 +248,22 @@ pub fn load_model(py: Python<'_>, path: PathBuf, extrapolate: bool) -> PyResult<
     let m = py
         .detach(|| ReducedModel::load(&path))
         .map_err(|e| invalid(crate::errors::chain(&e)))?;
-    let arrays = PyDict::new(py);
-    for (name, (shape, values)) in m.arrays() {
-        let a = numpy::PyArray::from_vec(py, values).reshape(shape)?;
-        arrays.set_item(name, a)?;
-    }
+    let arrays = m
+        .arrays()
+        .into_iter()
+        .map(|(name, (shape, values))| {
+            let a = numpy::PyArray::from_vec(py, values).reshape(shape)?;
+            Ok((name, crate::arrays::held(a.into_any())?))
+        })
+        .collect::<PyResult<Vec<_>>>()?;
     let range: Vec<f64> = m.meta.latent_range.iter().flatten().copied().collect();
-    let meta = match &m.dir {
-        Some(dir) => crate::datasets::meta_dict(py, &dir.meta_json)?,
-        None => py.None().into_bound(py),
-    };
     Ok(Model {
         kind: m.meta.kind.clone(),
         latent: m.meta.latent,
         extrapolate,
-        arrays: arrays.unbind(),
-        latent_range: shaped(py, range, [m.meta.latent_range.len(), 2])?.unbind(),
-        rest: vector(py, &m.meta.rest).unbind(),
-        meta: meta.unbind(),
+        arrays,
+        latent_range: crate::arrays::held(shaped(py, range, [m.meta.latent_range.len(), 2])?)?,
+        rest: crate::arrays::held(vector(py, &m.meta.rest))?,
         dir: path,
         model: m,
     })

@@ -1,7 +1,7 @@
 //! `gvsrom.Statics` and `gvsrom.StaticsBatch`: a statics report (`gvsrom statics --json`) as NumPy
 //! arrays, one solution or many stacked.
 
-use crate::arrays::{flat, shaped, vector};
+use crate::arrays::{flat, held, shaped, vector};
 use gvsrom::statics::StaticsReport;
 use gvsrom::Built;
 use numpy::PyArray;
@@ -80,14 +80,14 @@ impl Statics {
             scenario: r.scenario.clone(),
             n_dof: r.n_dof,
             n_points: r.n_points,
-            u: vector(py, &r.u).unbind(),
-            q: vector(py, &r.q).unbind(),
-            tip_position: vector(py, &r.tip_position).unbind(),
-            tip_rotation: shaped(py, flat(&r.tip_rotation), [3, 3])?.unbind(),
-            centerline_x: vector(py, &r.centerline_x).unbind(),
-            centerline: shaped(py, flat(&r.centerline), [r.centerline.len(), 3])?.unbind(),
-            strain_x: vector(py, &r.strain_x).unbind(),
-            strain: shaped(py, flat(&r.strain), [r.strain.len(), 6])?.unbind(),
+            u: held(vector(py, &r.u))?,
+            q: held(vector(py, &r.q))?,
+            tip_position: held(vector(py, &r.tip_position))?,
+            tip_rotation: held(shaped(py, flat(&r.tip_rotation), [3, 3])?)?,
+            centerline_x: held(vector(py, &r.centerline_x))?,
+            centerline: held(shaped(py, flat(&r.centerline), [r.centerline.len(), 3])?)?,
+            strain_x: held(vector(py, &r.strain_x))?,
+            strain: held(shaped(py, flat(&r.strain), [r.strain.len(), 6])?)?,
             iterations: r.iterations,
             load_stages: r.load_stages,
             residual_evaluations: r.residual_evaluations,
@@ -100,7 +100,7 @@ impl Statics {
 
 #[pymethods]
 impl Statics {
-    /// The fields as a ``dict`` (arrays not copied).
+    /// The fields as a ``dict`` (the same read-only arrays, not copies).
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
         d.set_item("scenario", &self.scenario)?;
@@ -197,19 +197,23 @@ impl StaticsBatch {
         );
         let iterations: Vec<i64> = rs.iter().map(|r| r.iterations as i64).collect();
         Ok(StaticsBatch {
-            u: shaped(py, cat(&|r| r.u.clone()), [m, na])?.unbind(),
-            q: shaped(py, cat(&|r| r.q.clone()), [m, n])?.unbind(),
-            tip_position: shaped(py, cat(&|r| r.tip_position.to_vec()), [m, 3])?.unbind(),
-            tip_rotation: shaped(py, cat(&|r| flat(&r.tip_rotation)), [m, 3, 3])?.unbind(),
-            centerline_x: vector(py, &c).unbind(),
-            centerline: shaped(py, cat(&|r| flat(&r.centerline)), [m, c.len(), 3])?.unbind(),
-            strain_x: vector(py, &x).unbind(),
-            strain: shaped(py, cat(&|r| flat(&r.strain)), [m, x.len(), 6])?.unbind(),
-            iterations: PyArray::from_vec(py, iterations).into_any().unbind(),
-            residual_norm: vector(py, &rs.iter().map(|r| r.residual_norm).collect::<Vec<_>>())
-                .unbind(),
-            solve_time_s: vector(py, &rs.iter().map(|r| r.solve_time_s).collect::<Vec<_>>())
-                .unbind(),
+            u: held(shaped(py, cat(&|r| r.u.clone()), [m, na])?)?,
+            q: held(shaped(py, cat(&|r| r.q.clone()), [m, n])?)?,
+            tip_position: held(shaped(py, cat(&|r| r.tip_position.to_vec()), [m, 3])?)?,
+            tip_rotation: held(shaped(py, cat(&|r| flat(&r.tip_rotation)), [m, 3, 3])?)?,
+            centerline_x: held(vector(py, &c))?,
+            centerline: held(shaped(py, cat(&|r| flat(&r.centerline)), [m, c.len(), 3])?)?,
+            strain_x: held(vector(py, &x))?,
+            strain: held(shaped(py, cat(&|r| flat(&r.strain)), [m, x.len(), 6])?)?,
+            iterations: held(PyArray::from_vec(py, iterations).into_any())?,
+            residual_norm: held(vector(
+                py,
+                &rs.iter().map(|r| r.residual_norm).collect::<Vec<_>>(),
+            ))?,
+            solve_time_s: held(vector(
+                py,
+                &rs.iter().map(|r| r.solve_time_s).collect::<Vec<_>>(),
+            ))?,
         })
     }
 }
