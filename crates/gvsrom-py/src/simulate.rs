@@ -48,6 +48,8 @@ impl Robot {
     ///     with ``interpolate``); or a callable ``u(t) -> array of n_actuators tensions`` (or one
     ///     number for all), called by the integrator at every time it evaluates (in any order: a
     ///     rejected step goes back in time); an exception it raises stops the run and propagates.
+    ///     Its values are checked as rows are: finite, and within the rod's elastic range (a
+    ///     tension far beyond it stops the run after the step it was returned in, naming it).
     ///     Default: the scenario's tensions, constant.
     /// interpolate : bool
     ///     Interpolate ``input`` rows linearly.
@@ -128,11 +130,24 @@ fn method(name: &str) -> PyResult<MethodChoice> {
 /// A Python callable `u(t)` as the integrator's actuation: called with the GIL at every time the
 /// integrator evaluates, its value checked (one tension per tendon or one for all, finite). The
 /// first exception (the callable's own, or a `GvsromError` for a bad value) is kept and stops the
-/// run at its next step attempt; until then the actuation is zero.
+/// run at its next step attempt; until then the actuation is zero. The largest |u| of each tendon
+/// so far is kept with the time it was returned: the run's control checks it against the rod's
+/// elastic range after each step ([`CallableInput::check_range`]), as `gvsrom simulate` checks a
+/// signal's tensions before it starts.
 pub struct CallableInput {
     function: Py<PyAny>,
     n_actuators: usize,
     error: Mutex<Option<PyErr>>,
+    largest: Mutex<Largest>,
+}
+
+/// The largest |u| per tendon returned so far, the time of each, and whether it grew since the
+/// last check.
+#[derive(Default)]
+struct Largest {
+    abs: Vec<f64>,
+    at: Vec<f64>,
+    grown: bool,
 }
 
 impl CallableInput {
@@ -159,6 +174,49 @@ impl CallableInput {
         Ok(u)
     }
 
+    /// Records `u`, returned at `t`, in the largest |u| per tendon.
+    fn record(&self, t: f64, u: &[f64]) {
+        let mut l = self.largest.lock().unwrap_or_else(PoisonError::into_inner);
+        if l.abs.len() != u.len() {
+            l.abs = vec![0.0; u.len()];
+            l.at = vec![t; u.len()];
+        }
+        for (k, v) in u.iter().enumerate() {
+            if v.abs() > l.abs[k] {
+                l.abs[k] = v.abs();
+                l.at[k] = t;
+                l.grown = true;
+            }
+        }
+    }
+
+    /// If the largest |u| grew since the last call: checks it against the rod's elastic range
+    /// (`gvsrom::plausibility::check`, as for a signal given as rows); a value far beyond it
+    /// becomes the run's error, naming the time it was returned, and `false` is returned.
+    fn check_range(&self, built: &gvsrom::Built) -> bool {
+        let (abs, at) = {
+            let mut l = self.largest.lock().unwrap_or_else(PoisonError::into_inner);
+            if !l.grown {
+                return true;
+            }
+            l.grown = false;
+            (l.abs.clone(), l.at.clone())
+        };
+        match gvsrom::plausibility::check(built, &abs, 1.0) {
+            Ok(()) => true,
+            Err(e) => {
+                let k = (0..abs.len())
+                    .max_by(|&i, &j| abs[i].total_cmp(&abs[j]))
+                    .unwrap_or(0);
+                // the error names the tendon and its largest |u|; the time says when it came
+                let message = format!("`input({})`: {e}", at[k]);
+                let mut slot = self.error.lock().unwrap_or_else(PoisonError::into_inner);
+                slot.get_or_insert_with(|| invalid(message));
+                false
+            }
+        }
+    }
+
     /// Takes the error the callable raised, if any.
     fn take_error(&self) -> Option<PyErr> {
         self.error
@@ -182,7 +240,10 @@ impl Actuation for CallableInput {
             return;
         }
         match Python::attach(|py| self.call(py, t)) {
-            Ok(u) => out.copy_from_slice(&u),
+            Ok(u) => {
+                self.record(t, &u);
+                out.copy_from_slice(&u)
+            }
             Err(e) => *self.error.lock().unwrap_or_else(PoisonError::into_inner) = Some(e),
         }
     }
@@ -232,6 +293,7 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
                 function: f.clone().unbind(),
                 n_actuators: na,
                 error: Mutex::new(None),
+                largest: Mutex::new(Largest::default()),
             }))
         }
         _ => None,
@@ -294,7 +356,10 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
     let mut signals = crate::interrupt::SignalPoll::new();
     let outcome = py.detach(|| {
         let mut control = |_t: f64| {
-            if callable.as_ref().is_some_and(|c| c.failed()) {
+            if callable
+                .as_ref()
+                .is_some_and(|c| !c.check_range(built) || c.failed())
+            {
                 return ControlFlow::Break("the input callable failed".to_string());
             }
             match signals.interrupted() {

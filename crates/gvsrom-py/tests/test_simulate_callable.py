@@ -1,6 +1,8 @@
 """simulate with a Python callable `u(t)` as input: the trajectory of the same input given as rows,
 its exceptions propagated, its bad values refused."""
 
+import time
+
 import numpy as np
 import pytest
 
@@ -66,3 +68,26 @@ def test_bad_values_of_the_callable_are_value_errors(robot):
     # without --input is, rather than ignored
     with pytest.raises(gvsrom.GvsromError, match="`interpolate` applies to an `input` of rows"):
         robot.simulate(0.01, interpolate=True)
+
+
+def test_a_tension_far_beyond_the_elastic_range_stops_the_run_at_once(robot, gvsrom_bin, tmp_path):
+    # the same bound as the command line's check of a signal's tensions before a run
+    from conftest import cli_error
+
+    expected = cli_error(gvsrom_bin, "simulate", "single-tendon", "--duration", "0.1",
+                         "--steps=-1e6,-1e6,0.05", "--out", str(tmp_path / "run"))
+    assert "far beyond the rod's elastic range" in expected
+    for late in [False, True]:
+        # from the start, or only after 0.05 s of a moderate pull (once integrated past it)
+        def u(t):
+            return [-1e6] if (t >= 0.05 or not late) else [-2.0]
+
+        t0 = time.monotonic()
+        with pytest.raises(gvsrom.GvsromError) as e:
+            robot.simulate(0.1, input=u)
+        assert time.monotonic() - t0 < 5.0  # ran on for minutes before
+        at = str(e.value).split("`: ")[0]
+        assert str(e.value) == f"{at}`: {expected}", str(e.value)
+        assert float(at.removeprefix("`input(")[:-1]) >= (0.05 if late else 0.0)
+    # up to the bound the run goes on as before
+    assert robot.simulate(0.05, input=lambda t: [-5.0])["t"][-1] == pytest.approx(0.05)
