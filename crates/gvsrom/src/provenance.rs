@@ -17,6 +17,7 @@
 //! | `solver` | a statics run's solver options (the scenario's `[solver]`) |
 //! | `model`, `dataset`, `reference`, `run` | an input directory (`compare`'s trajectories for the last two): its path and the hashes its manifest records (`meta_sha256`, `sha256` per file) |
 //! | `more_datasets` | a model made from several datasets: those after the first, in order, each as `dataset` |
+//! | `plotted` | the output `plot` drew: a directory as `model`, a `statics --json` file by its path and the SHA-256 of its bytes as read (under its file name in `sha256`) |
 //!
 //! Keys that do not apply are left out. One struct, [`Provenance`], builds them all.
 
@@ -64,6 +65,9 @@ pub struct Provenance {
     pub reference: Option<DirOrigin>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub run: Option<DirOrigin>,
+    /// The output `plot` drew.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plotted: Option<DirOrigin>,
 }
 
 /// The time span and output rate of a dynamics run.
@@ -143,6 +147,7 @@ impl Provenance {
             more_datasets: vec![],
             reference: None,
             run: None,
+            plotted: None,
         }
     }
 
@@ -196,6 +201,12 @@ impl Provenance {
         self
     }
 
+    /// The output `plot` drew, as it was read.
+    pub fn plotted(mut self, origin: DirOrigin) -> Self {
+        self.plotted = Some(origin);
+        self
+    }
+
     /// The dataset a model was made from, by its manifest's hashes as it was read.
     pub fn dataset(mut self, dataset: &DirOrigin) -> Self {
         self.dataset = Some(dataset.clone());
@@ -210,6 +221,20 @@ impl DirOrigin {
             path: dir.display().to_string(),
             meta_sha256: None,
             sha256: BTreeMap::new(),
+        }
+    }
+
+    /// The single-file output `path` (a `statics --json` result) by the SHA-256 of `bytes`, its
+    /// content as read.
+    pub fn of_file(path: &Path, bytes: &[u8]) -> DirOrigin {
+        let name = path.file_name().map_or_else(
+            || path.display().to_string(),
+            |n| n.to_string_lossy().into(),
+        );
+        DirOrigin {
+            path: path.display().to_string(),
+            meta_sha256: None,
+            sha256: BTreeMap::from([(name, sha256_hex(bytes))]),
         }
     }
 

@@ -577,3 +577,14 @@ fn an_input_beyond_the_load_ramp_is_solved_by_continuation_and_reported() {
     assert_eq!(folds.len(), 2, "{v}");
     assert!(v["residual_norm"].as_f64().unwrap() < 1e-8);
 }
+
+#[test]
+fn check_refuses_extrapolate_that_has_no_model_to_apply_to() {
+    // `check` validates the scenario alone: a flag about `--model` is refused, not ignored
+    expect_error(
+        &["check", "single-tendon", "--extrapolate"],
+        &["--extrapolate", "no `--model`", "statics"],
+    );
+    let out = gvsrom(&["check", "single-tendon"]);
+    assert!(out.status.success());
+}

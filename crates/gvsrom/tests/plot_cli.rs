@@ -425,3 +425,36 @@ fn figures_draw_the_files_as_they_were_checked_not_a_second_read() {
         None
     );
 }
+
+#[test]
+fn figures_record_how_they_were_made_and_what_they_drew_by_its_hashes() {
+    use sha2::{Digest, Sha256};
+    // a directory: the hashes its manifest recorded when `plot` read it
+    let (out, _) = plot(dataset(), "fig-prov-dataset", &[]);
+    let p = &json(&out.join("meta.json"))["provenance"];
+    let command: Vec<&str> = p["command"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| a.as_str().unwrap())
+        .collect();
+    assert_eq!(command[1..3], ["plot", s(dataset())], "{p}");
+    assert!(p["started"].as_str().unwrap().ends_with('Z'), "{p}");
+    let manifest = &json(&dataset().join("meta.json"))["gvsrom"];
+    assert_eq!(p["plotted"]["meta_sha256"], manifest["meta_sha256"], "{p}");
+    assert_eq!(p["plotted"]["sha256"], manifest["sha256"], "{p}");
+    assert!(!p["plotted"]["sha256"].as_object().unwrap().is_empty());
+    // a statics JSON file: the SHA-256 of its bytes
+    let (out, _) = plot(statics_json(), "fig-prov-statics", &[]);
+    let p = &json(&out.join("meta.json"))["provenance"];
+    let bytes = std::fs::read(statics_json()).unwrap();
+    let hex: String = Sha256::digest(&bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    assert_eq!(
+        p["plotted"]["sha256"]["plot-statics.json"],
+        hex.as_str(),
+        "{p}"
+    );
+}

@@ -197,6 +197,11 @@ fn presets_cmd(out: &mut impl Write) -> Result<()> {
 }
 
 fn check_cmd(args: &ScenarioArgs, out: &mut impl Write) -> Result<()> {
+    if args.extrapolate {
+        anyhow::bail!(
+            "--extrapolate: `check` takes no `--model` for it to apply to (it validates the scenario alone; `statics`, `simulate` and `modes` take `--model DIR --extrapolate`)"
+        );
+    }
     let r = load(args)?;
     print_model(&r.scenario, args, &r.built, out)?;
     writeln!(out, "ok         the scenario is valid")?;

@@ -16,6 +16,7 @@ const MAX_PAIRS: usize = 6;
 /// All figures of the dataset in `dir`.
 pub(crate) fn figures(dir: &Path, sink: &mut Sink) -> Result<(), FiguresError> {
     let ds = Dataset::load(dir).map_err(|e| input_error(dir, e.to_string()))?;
+    sink.origin = Some(ds.origin.clone());
     if ds.samples() == 0 {
         return Err(input_error(dir, "the dataset has no samples"));
     }

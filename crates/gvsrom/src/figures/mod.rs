@@ -148,6 +148,8 @@ pub(crate) struct Sink {
     formats: Vec<FigureFormat>,
     written: Vec<Written>,
     pub notes: Vec<String>,
+    /// The output drawn, as its loader read it (for the provenance).
+    pub origin: Option<crate::provenance::DirOrigin>,
 }
 
 impl Sink {
@@ -206,6 +208,8 @@ struct FiguresMeta<'a> {
     figures: &'a [Written],
     notes: &'a [String],
     crate_version: &'static str,
+    /// How the figures were made: the command line, and the output drawn by its hashes as read.
+    provenance: crate::provenance::Provenance,
 }
 
 /// Draws the figures of the gvsrom output `input` into the new directory `out` (`--force` replaces
@@ -217,6 +221,7 @@ pub fn plot_outputs(
     force: bool,
 ) -> Result<PlotSummary, FiguresError> {
     let t0 = Instant::now();
+    let started = crate::provenance::rfc3339_utc(std::time::SystemTime::now());
     crate::output::refuse_overlap("--out", out, &[("INPUT", input)])?;
     let kind = detect(input)?;
     let mut formats: Vec<FigureFormat> = if formats.is_empty() {
@@ -231,6 +236,7 @@ pub fn plot_outputs(
         formats,
         written: vec![],
         notes: vec![],
+        origin: None,
     };
     match kind {
         InputKind::Statics => statics::figures(input, &mut sink)?,
@@ -246,7 +252,13 @@ pub fn plot_outputs(
         formats,
         written,
         notes,
+        origin,
     } = sink;
+    let mut provenance = crate::provenance::Provenance::of_command();
+    provenance.started = started;
+    if let Some(origin) = origin {
+        provenance = provenance.plotted(origin);
+    }
     let meta = FiguresMeta {
         input: input.display().to_string(),
         kind,
@@ -254,6 +266,7 @@ pub fn plot_outputs(
         figures: &written,
         notes: &notes,
         crate_version: env!("CARGO_PKG_VERSION"),
+        provenance,
     };
     let out = dir.commit(&meta)?;
     Ok(PlotSummary {

@@ -12,6 +12,7 @@ use std::path::Path;
 /// All figures of the model in `dir`.
 pub(crate) fn figures(dir: &Path, sink: &mut Sink) -> Result<(), FiguresError> {
     let model = ReducedModel::load(dir).map_err(|e| input_error(dir, e.to_string()))?;
+    sink.origin = model.origin();
     let name = dir.file_name().map_or_else(
         || dir.display().to_string(),
         |n| n.to_string_lossy().into_owned(),

@@ -22,6 +22,9 @@ pub struct StaticsDoc {
     pub strain: Vec<[f64; 6]>,
     #[serde(default)]
     pub model: Option<String>,
+    /// The file by the SHA-256 of the bytes read (what `plot` records of it).
+    #[serde(skip)]
+    pub origin: Option<crate::provenance::DirOrigin>,
 }
 
 impl StaticsDoc {
@@ -29,7 +32,7 @@ impl StaticsDoc {
     pub fn load(path: &Path) -> Result<StaticsDoc, FiguresError> {
         let text = crate::output::read::read_regular_to_string(path)
             .map_err(|e| input_error(path, format!("cannot read it: {e}")))?;
-        let doc: StaticsDoc = serde_json::from_str(&text).map_err(|e| {
+        let mut doc: StaticsDoc = serde_json::from_str(&text).map_err(|e| {
             input_error(
                 path,
                 format!("not a `statics --json` result the figures can read: {e}"),
@@ -57,6 +60,7 @@ impl StaticsDoc {
                 ),
             ));
         }
+        doc.origin = Some(crate::provenance::DirOrigin::of_file(path, text.as_bytes()));
         Ok(doc)
     }
 
@@ -91,6 +95,7 @@ fn rod_series(doc: &StaticsDoc) -> Vec<Series3> {
 /// `rod_3d`, `rod_side` and `strain` of the statics result at `path`.
 pub(crate) fn figures(path: &Path, sink: &mut Sink) -> Result<(), FiguresError> {
     let doc = StaticsDoc::load(path)?;
+    sink.origin = doc.origin.clone();
     let caption = doc.caption();
     let rod = rod_series(&doc);
     let rod_3d = Figure::Line3(Line3 {

@@ -62,6 +62,7 @@ fn tip(tr: &Trajectory, k: usize) -> [f64; 3] {
 /// All figures of the trajectory in `dir`.
 pub(crate) fn figures(dir: &Path, sink: &mut Sink) -> Result<(), FiguresError> {
     let tr = Trajectory::load(dir, "INPUT").map_err(|e| input_error(dir, e.to_string()))?;
+    sink.origin = Some(tr.origin.clone());
     let n = tr.samples();
     if n == 0 {
         return Err(input_error(dir, "the trajectory has no samples"));
