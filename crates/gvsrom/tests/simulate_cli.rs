@@ -446,3 +446,55 @@ fn repeated_runs_record_every_wall_time_and_keep_the_smallest() {
         "{stderr}"
     );
 }
+
+#[test]
+fn a_state_no_elastic_rod_holds_ends_the_run_naming_it_and_the_load() {
+    // 100 N on one off-centre tendon of the gravity-free arm passes the load estimate (~29 rad),
+    // but the motion it drives diverges: once the tip was reported kilometres away, "complete"
+    let out_dir = scratch("non-physical-run");
+    let msg = expect_error(
+        &[
+            "simulate",
+            "six-tendon-no-gravity",
+            "--tension=-100,0,0,0,0,0",
+            "--duration",
+            "0.5",
+            "--out",
+            out_dir.to_str().unwrap(),
+        ],
+        &[
+            "the state left the rod's elastic range at t = ",
+            "accepted |·| <= 10",
+            "tendons[0].tension = -100 N",
+            "marked partial",
+        ],
+    );
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("meta.json")).unwrap()).unwrap();
+    assert_eq!(meta["complete"], false, "{msg}");
+    // every sample written is inside the bounds: the tip within the rod's reach
+    let tip = npy_values(&out_dir.join("tip_position.npy"));
+    let reach = tip
+        .chunks(3)
+        .map(|p| (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt())
+        .fold(0.0, f64::max);
+    assert!(reach <= 0.6 * 1.5, "{reach}");
+    // the same in a dynamic dataset: an error, and the snapshots before it marked incomplete
+    let ds = scratch("non-physical-dataset");
+    expect_error(
+        &[
+            "dataset",
+            "six-tendon-no-gravity",
+            "--set",
+            "tendons.0.tension=-100",
+            "--duration",
+            "0.3",
+            "--out",
+            ds.to_str().unwrap(),
+        ],
+        &[
+            "the state left the rod's elastic range",
+            "marked incomplete",
+        ],
+    );
+}

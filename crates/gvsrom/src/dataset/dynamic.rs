@@ -124,6 +124,9 @@ pub fn run(
     let mut inputs: Vec<f64> = Vec::with_capacity(n_max * na);
     let mut t: Vec<f64> = Vec::with_capacity(n_max);
     let mut stopped = None;
+    let mut non_physical = None;
+    let x = layout.strain_x.clone();
+    let length = model.disc.length();
     // polled before every step attempt too, not only at samples: with tight tolerances the next
     // sample may be far away
     let stop = || match interrupt.load(Ordering::SeqCst) {
@@ -139,6 +142,20 @@ pub fn run(
         &plan.t_out,
         &opts.integrator,
         &mut |s| {
+            // a state no elastic rod holds ends the run before it becomes a snapshot
+            if let Some(v) =
+                crate::plausibility::state_violation(s.strain, &x, |j| model.xi_star(j), length)
+            {
+                let msg = format!(
+                    "the state left the rod's elastic range at t = {:.4} s: {v}{}",
+                    s.t,
+                    crate::plausibility::largest_load(built, s.u, 1.0)
+                        .map(|l| format!("; {l}"))
+                        .unwrap_or_default()
+                );
+                non_physical = Some(msg.clone());
+                return ControlFlow::Break(msg);
+            }
             let mut strain = Vec::with_capacity(layout.row_len());
             for (j, xi) in s.strain.iter().enumerate() {
                 let dev = xi - model.xi_star(j);
@@ -181,8 +198,9 @@ pub fn run(
         stopped = stop(); // stopped between samples
     }
     let n = rows.len();
-    let failed = match (&summary_run.error, &stopped) {
-        (Some(e), None) => Some(e.to_string()),
+    let failed = match (&summary_run.error, &stopped, non_physical) {
+        (Some(_), None, Some(v)) => Some(v),
+        (Some(e), None, None) => Some(e.to_string()),
         _ => None,
     };
     let reason = stopped.clone().or_else(|| {

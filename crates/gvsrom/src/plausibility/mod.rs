@@ -36,13 +36,16 @@
 //! comparison rejects `inf` and NaN.
 //!
 //! `estimates` computes `(θ, ε)` of every load; `verdict` rejects the worst beyond the bounds
-//! ([`check`]) or names the largest ([`largest_load`]).
+//! ([`check`]) or names the largest ([`largest_load`]); `state` refuses a computed state beyond ten
+//! times the bounds ([`state_violation`]), which ends a dynamics run.
 
 mod estimates;
+mod state;
 #[cfg(test)]
 mod tests;
 mod verdict;
 
+pub use state::{state_violation, STATE_MAX_BENDING, STATE_MAX_STRAIN};
 pub use verdict::{check, largest_load};
 
 use gvs::loads::Loads;

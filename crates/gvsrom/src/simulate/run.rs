@@ -140,6 +140,10 @@ pub fn run_into(
     let mut last_tip = None;
     let mut write_error: Option<std::io::Error> = None;
     let mut off_manifold = None;
+    let mut non_physical = None;
+    let model = &built.model;
+    let x: Vec<f64> = model.disc.points.iter().map(|p| p.x).collect();
+    let length = model.disc.length();
     // `control` is called from the sink and from the integrator's per-attempt poll, never nested
     let control = std::cell::RefCell::new(control);
     let interrupted = std::cell::RefCell::new(None::<String>);
@@ -156,6 +160,21 @@ pub fn run_into(
         ControlFlow::Continue(()) => None,
     };
     let mut sink = |s: &Sample<'_>| {
+        // a state no elastic rod holds (a diverged integration, a load the estimate underrated)
+        // ends the run before it is written: its samples would be taken for a motion
+        if let Some(v) =
+            crate::plausibility::state_violation(s.strain, &x, |j| model.xi_star(j), length)
+        {
+            let msg = format!(
+                "the state left the rod's elastic range at t = {:.4} s: {v}{}",
+                s.t,
+                crate::plausibility::largest_load(built, s.u, 1.0)
+                    .map(|l| format!("; {l}"))
+                    .unwrap_or_default()
+            );
+            non_physical = Some(msg.clone());
+            return ControlFlow::Break(msg);
+        }
         last_t.set(s.t);
         last_tip = Some(*s.tip);
         if let Some(w) = writer.as_deref_mut() {
@@ -227,6 +246,7 @@ pub fn run_into(
         ));
     }
     let left_training_region = summary.error.is_some() && off_manifold.is_some();
+    let off_manifold = off_manifold.or(non_physical);
     let ending = match (&summary.error, off_manifold, interrupted.into_inner()) {
         (None, _, _) => Ending::Complete,
         (Some(_), Some(error), _) => Ending::Failed { error },

@@ -1,0 +1,93 @@
+//! The verdict on a computed state: a strain no elastic rod holds ends a run, where the load
+//! estimate ([`super::check`]) could not foresee it (a dynamic overshoot, a load the linear
+//! estimate underrates, an integrator that diverged).
+//!
+//! With `d = ξ − ξ*` at a computational point, a state is refused when
+//!
+//! - the stretch `ν = ξ₄ ≤ 0` (`d₄ ≤ −1`): the section has passed through itself;
+//! - `|d₄|`, `|d₅|` or `|d₆|` > [`STATE_MAX_STRAIN`] (10: a tenfold stretch, a shear angle past 84°);
+//! - `‖(d₁, d₂, d₃)‖ L >` [`STATE_MAX_BENDING`] (2000 rad: a curvature that would coil the whole
+//!   rod 300 times).
+//!
+//! The bounds are ten times the load estimate's ([`super::MAX_STRAIN`], [`super::MAX_BENDING`]),
+//! so that a state the load check lets through by its estimate is never stopped, while a diverged
+//! one (strains of 1e5 and a tip kilometres away) is stopped at its first sample.
+
+use gvs::lie::V6;
+
+/// Largest axial or shear strain `|ξ − ξ*|` of a state (a tenfold stretch).
+pub const STATE_MAX_STRAIN: f64 = 10.0 * super::MAX_STRAIN;
+/// Largest `‖κ − κ*‖ L` of a state \[rad\].
+pub const STATE_MAX_BENDING: f64 = 10.0 * super::MAX_BENDING;
+
+/// The first point `j` (at abscissa `x[j]`) whose strain `strain[j]` no elastic rod holds, as a
+/// phrase ("at X = 0.12 m the stretch ν = −3.4e5 ≤ 0: a section has passed through itself"); `None`
+/// for a state inside the bounds. `xi_star(j)` is the reference strain, `length` the rod's.
+pub fn state_violation(
+    strain: &[V6],
+    x: &[f64],
+    xi_star: impl Fn(usize) -> V6,
+    length: f64,
+) -> Option<String> {
+    for (j, xi) in strain.iter().enumerate() {
+        let d = xi - xi_star(j);
+        let at = format!("at X = {:.4} m", x.get(j).copied().unwrap_or(f64::NAN));
+        let nu = xi[3];
+        if !(nu > 0.0) {
+            return Some(format!(
+                "{at} the stretch ν = {} ≤ 0: a section has passed through itself",
+                gvs::error::fmt_value(nu)
+            ));
+        }
+        for (k, name) in [(3, "axial strain"), (4, "shear y"), (5, "shear z")] {
+            if !(d[k].abs() <= STATE_MAX_STRAIN) {
+                return Some(format!(
+                    "{at} the {name} is {} (accepted |·| <= {STATE_MAX_STRAIN})",
+                    gvs::error::fmt_value(d[k])
+                ));
+            }
+        }
+        let bend = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() * length;
+        if !(bend <= STATE_MAX_BENDING) {
+            return Some(format!(
+                "{at} the curvature times the rod's length is {} rad (accepted <= {STATE_MAX_BENDING} rad)",
+                gvs::error::fmt_value(bend)
+            ));
+        }
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rest() -> V6 {
+        V6::new(0.0, 0.0, 0.0, 1.0, 0.0, 0.0)
+    }
+
+    #[test]
+    fn a_state_within_the_elastic_range_passes_and_each_bound_is_named_when_crossed() {
+        let x = [0.0, 0.5];
+        let ok = [rest(), V6::new(1.0, 20.0, 0.0, 1.9, 0.3, -0.2)];
+        assert_eq!(state_violation(&ok, &x, |_| rest(), 1.0), None);
+        let cases = [
+            (V6::new(0.0, 0.0, 0.0, -0.1, 0.0, 0.0), "stretch ν = -0.1"),
+            (V6::new(0.0, 0.0, 0.0, 12.0, 0.0, 0.0), "axial strain is 11"),
+            (V6::new(0.0, 0.0, 0.0, 1.0, -10.5, 0.0), "shear y is -10.5"),
+            (V6::new(0.0, 0.0, 0.0, 1.0, 0.0, f64::NAN), "shear z is NaN"),
+            (
+                V6::new(0.0, 1500.0, 1600.0, 1.0, 0.0, 0.0),
+                "length is 2193.17",
+            ),
+        ];
+        for (bad, needle) in cases {
+            let m = state_violation(&[rest(), bad], &x, |_| rest(), 1.0).unwrap();
+            assert!(m.starts_with("at X = 0.5000 m"), "{m}");
+            assert!(m.contains(needle), "{m}");
+        }
+        // the reference strain is subtracted: a precurved rod at rest is inside
+        let star = V6::new(0.0, 3000.0, 0.0, 1.0, 0.0, 0.0);
+        assert_eq!(state_violation(&[star], &[0.0], |_| star, 1.0), None);
+    }
+}
