@@ -204,3 +204,44 @@ fn an_input_signal_starting_after_the_run_start_is_refused_with_its_first_time()
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+#[test]
+fn a_signal_sent_twice_at_once_is_one_request_and_the_partial_trajectory_is_written() {
+    // `timeout` and batch schedulers signal the process and then its group: two SIGINTs within
+    // microseconds. The second used to end the process at once, writing nothing.
+    let dir = scratch("sigint-twice");
+    let child = spawn(&[
+        "simulate",
+        "single-tendon",
+        "--duration",
+        "10",
+        "--sample-rate",
+        "1",
+        "--method",
+        "sdirk",
+        "--rtol",
+        "1e-12",
+        "--atol",
+        "1e-14",
+        "--out",
+        path(&dir),
+    ]);
+    std::thread::sleep(Duration::from_secs(1));
+    for _ in 0..2 {
+        // SAFETY: kill(2) on the pid of our own child, which has not been waited for yet
+        assert_eq!(
+            unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGINT) },
+            0
+        );
+        // apart enough for the first to be handled (two pending SIGINTs would merge into one)
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let out = wait_within(child, Duration::from_secs(4))
+        .expect("gvsrom simulate did not stop within 4 s of SIGINT");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{stderr}");
+    assert!(stderr.contains("interrupted by SIGINT"), "{stderr}");
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("meta.json")).unwrap()).unwrap();
+    assert_eq!(meta["complete"], false, "{meta}");
+}
