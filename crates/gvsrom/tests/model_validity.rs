@@ -538,3 +538,32 @@ fn a_model_without_a_recorded_range_is_refused_and_one_without_hashes_warns() {
         "{stderr}"
     );
 }
+
+#[test]
+fn more_reduced_coordinates_than_the_full_models_dof_are_refused() {
+    // single-tendon has 33 DOF: a 34th coordinate would make the reduced mass matrix singular
+    let out = scratch("val-pod34");
+    expect_error(
+        &["pod", s(dataset12()), "--modes", "34", "--out", s(&out)],
+        &["invalid `--modes`", "34", "33 DOF"],
+    );
+    assert!(!out.exists());
+    expect_error(
+        &["train", s(dataset12()), "--latent", "34", "--out", s(&out)],
+        &["invalid `--latent`", "34", "33 DOF"],
+    );
+    expect_error(
+        &[
+            "train",
+            s(dataset12()),
+            "--latent",
+            "1",
+            "--hidden-layers",
+            "1000001",
+            "--out",
+            s(&out),
+        ],
+        &["--hidden-layers", "1000001", "from 1 to 63"],
+    );
+    assert!(!out.exists());
+}

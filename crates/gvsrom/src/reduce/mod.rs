@@ -55,6 +55,23 @@ pub(super) fn invalid(field: &str, message: impl Into<String>) -> ScenarioError 
     ScenarioError::invalid(field, message)
 }
 
+/// Refuses more reduced coordinates (`--modes`, `--latent`) than the full model has: the reduced
+/// model runs in the full model's basis (`Ψ = Φ P D(q_r)`), so coordinates beyond its DOF are
+/// redundant, its mass matrix singular, and its statics and dynamics fail.
+fn at_most_the_full_models_dof(field: &str, r: usize, built: &Built) -> Result<(), ScenarioError> {
+    let n = built.n_dof();
+    if r > n {
+        return Err(invalid(
+            field,
+            format!(
+                "{r}: more than the {n} DOF of the full model `{}` (a reduced model has at most as many coordinates as the model it reduces; beyond them its mass matrix is singular)",
+                built.name
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Refuses an `--out` that is, or contains, one of the command's inputs — a `DATASET` or the
 /// `--init` model — which `--force` would otherwise replace ([`crate::output::refuse_overlap`]).
 fn refuse_input_overlap<P: AsRef<Path>>(

@@ -43,6 +43,7 @@ pub fn pod<P: AsRef<Path>>(
     let src = Sources::load(datasets)?;
     let provenance = src.record(provenance);
     let built = &src.built;
+    super::at_most_the_full_models_dof("--modes", modes, built)?;
     // the HOM basis must be recoverable from point strains
     let (layout, _, _) = projection_of(built)?;
     let (x, rows, features) = (&src.x, src.rows(), src.features);

@@ -72,6 +72,7 @@ pub fn train<P: AsRef<Path>>(
         Some(start) => start.check(&src, options, loss)?,
         None => vec![],
     };
+    super::at_most_the_full_models_dof("--latent", options.latent, built)?;
     let (layout, pm, p) = projection_of(built)?;
     let (x, rows, features) = (&src.x, src.rows(), src.features);
     let options = &TrainOptions {

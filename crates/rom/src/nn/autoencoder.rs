@@ -33,9 +33,15 @@ pub struct Autoencoder {
     form: DecoderForm,
 }
 
+/// The deepest network accepted: far beyond what trains (tanh networks much deeper than the
+/// paper's 7 hidden layers lose their gradients), and a bound on the model's size before anything
+/// is allocated.
+pub const MAX_HIDDEN_LAYERS: usize = 63;
+
 impl Autoencoder {
     /// Layer sizes `[n, …, r, …, n]` (`hidden_layers + 2` values) of the symmetric architecture in the
-    /// module docs. Errors: `latent ∉ 1..n_features`, `hidden_layers` even or zero.
+    /// module docs. Errors: `latent ∉ 1..n_features`, `hidden_layers` even, zero or above
+    /// [`MAX_HIDDEN_LAYERS`].
     pub fn architecture(
         n_features: usize,
         latent: usize,
@@ -44,7 +50,7 @@ impl Autoencoder {
         if latent == 0 || latent >= n_features {
             return Err(NnError::InvalidLatent { latent, n_features });
         }
-        if hidden_layers.is_multiple_of(2) {
+        if hidden_layers.is_multiple_of(2) || hidden_layers > MAX_HIDDEN_LAYERS {
             return Err(NnError::InvalidHiddenLayers {
                 value: hidden_layers,
             });

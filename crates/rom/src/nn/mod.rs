@@ -155,7 +155,7 @@ pub enum NnError {
         "latent size {latent} must be in 1..{n_features} (fewer than the {n_features} features)"
     )]
     InvalidLatent { latent: usize, n_features: usize },
-    #[error("hidden_layers = {value}: expected an odd number ≥ 1 (1, 3, 5, 7, …)")]
+    #[error("hidden_layers = {value}: expected an odd number from 1 to {max} (1, 3, 5, 7, …; the paper's deepest has 7)", max = autoencoder::MAX_HIDDEN_LAYERS)]
     InvalidHiddenLayers { value: usize },
     #[error("invalid option {field} = {value}: expected {expected}")]
     InvalidOption {

@@ -45,6 +45,11 @@ fn architecture_halves_towards_latent_for_306_features() {
         Autoencoder::architecture(306, 1, 0),
         Err(NnError::InvalidHiddenLayers { value: 0 })
     );
+    assert_eq!(Autoencoder::architecture(306, 1, 63).unwrap().len(), 65);
+    assert_eq!(
+        Autoencoder::architecture(306, 1, 1_000_001),
+        Err(NnError::InvalidHiddenLayers { value: 1_000_001 })
+    );
     assert_eq!(
         Autoencoder::architecture(6, 6, 3),
         Err(NnError::InvalidLatent {
