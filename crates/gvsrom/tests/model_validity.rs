@@ -567,3 +567,59 @@ fn more_reduced_coordinates_than_the_full_models_dof_are_refused() {
     );
     assert!(!out.exists());
 }
+
+#[test]
+fn a_signal_moving_a_tension_training_held_fixed_is_refused_unless_extrapolating() {
+    // trained on the stiffness, the tension held at the preset's −3 N
+    let ds = scratch("val-ds-stiffness");
+    run_ok(&[
+        "dataset",
+        "single-tendon",
+        "--sweep",
+        "material.youngs_modulus=1e5:1e6",
+        "--samples",
+        "3",
+        "--out",
+        s(&ds),
+    ]);
+    let m = scratch("val-pod-stiffness");
+    run_ok(&["pod", s(&ds), "--modes", "2", "--out", s(&m)]);
+    let run = scratch("val-run-held");
+    let args = [
+        "simulate",
+        "single-tendon",
+        "--model",
+        s(&m),
+        "--steps=-4,-2,0.01",
+        "--duration",
+        "0.03",
+        "--out",
+        s(&run),
+    ];
+    expect_error(
+        &args,
+        &[
+            "tendons.0.tension reaches",
+            "but training held it at -3",
+            "--extrapolate",
+        ],
+    );
+    // the held value itself runs, and --extrapolate runs the signal and records it
+    run_ok(&[
+        "simulate",
+        "single-tendon",
+        "--model",
+        s(&m),
+        "--duration",
+        "0.02",
+        "--out",
+        s(&run),
+    ]);
+    let (_, stderr) = run_ok_with_stderr(&[&args[..], &["--extrapolate", "--force"]].concat());
+    assert!(stderr.contains("but training held it at -3"), "{stderr}");
+    let meta = json(&run.join("meta.json"));
+    assert!(
+        meta.to_string().contains("but training held it at -3"),
+        "{meta}"
+    );
+}

@@ -48,6 +48,8 @@ pub struct Reduced {
     pub warnings: Vec<String>,
     /// The training inputs' ranges ([`InputRange`]).
     pub input_range: Vec<InputRange>,
+    /// Per tendon, the tension training held it at (`None`: a training input, in `input_range`).
+    pub held_tensions: Vec<Option<f64>>,
     /// `AttachOptions::extrapolate`, for the checks that come later (an input signal's).
     pub extrapolate: bool,
 }
@@ -81,7 +83,7 @@ impl Reduced {
         times: &[f64],
         u_at: impl FnMut(f64) -> Vec<f64>,
     ) -> Result<Vec<String>, ScenarioError> {
-        let outside = signal_outside(&self.input_range, times, u_at);
+        let outside = signal_outside(&self.input_range, &self.held_tensions, times, u_at);
         if outside.is_empty() {
             return Ok(vec![]);
         }
@@ -156,28 +158,31 @@ impl Reduced {
 
 /// The tendon tensions of an input signal against the model's training ranges: `u_at(t)` gives
 /// the tensions at time `t`, sampled at `times`. One sentence per tendon whose signal leaves its
-/// range (its extreme value and when), or whose training held it fixed at another value.
+/// range (its extreme value and when), or whose training held it fixed (`held[k]`, a tendon
+/// without a range) at another value.
 pub fn signal_outside(
     ranges: &[InputRange],
+    held: &[Option<f64>],
     times: &[f64],
     mut u_at: impl FnMut(f64) -> Vec<f64>,
 ) -> Vec<String> {
+    let range_of = |k: usize| {
+        ranges
+            .iter()
+            .find(|r| r.parameter == format!("tendons.{k}.tension"))
+    };
     let mut worst: Vec<Option<(f64, f64)>> = vec![];
     for &t in times {
         let u = u_at(t);
         worst.resize(worst.len().max(u.len()), None);
         for (k, &v) in u.iter().enumerate() {
-            let Some(r) = ranges
-                .iter()
-                .find(|r| r.parameter == format!("tendons.{k}.tension"))
-            else {
-                continue;
-            };
-            // distance outside the range (0 inside); keep the farthest
-            let d = if inside(r, v) {
-                0.0
-            } else {
-                (r.min - v).max(v - r.max).max(f64::MIN_POSITIVE)
+            // distance outside the range, or from the held value (0 inside); keep the farthest
+            let d = match (range_of(k), held.get(k).copied().flatten()) {
+                (Some(r), _) if inside(r, v) => 0.0,
+                (Some(r), _) => (r.min - v).max(v - r.max).max(f64::MIN_POSITIVE),
+                (None, Some(h)) if (v - h).abs() <= 1e-12 * (1.0 + h.abs()) => 0.0,
+                (None, Some(h)) => (v - h).abs().max(f64::MIN_POSITIVE),
+                (None, None) => continue,
             };
             let d = if v.is_finite() { d } else { f64::INFINITY };
             if d > 0.0 && worst[k].is_none_or(|(dw, _)| d > dw) {
@@ -188,14 +193,16 @@ pub fn signal_outside(
     let mut out = vec![];
     for (k, w) in worst.iter().enumerate() {
         if let Some((_, t)) = w {
-            let r = ranges
-                .iter()
-                .find(|r| r.parameter == format!("tendons.{k}.tension"))
-                .expect("a range was found for it");
             let v = u_at(*t)[k];
+            let how = match range_of(k) {
+                Some(r) => format!("outside the training inputs [{}, {}]", r.min, r.max),
+                None => format!(
+                    "but training held it at {}",
+                    held.get(k).copied().flatten().unwrap_or(f64::NAN)
+                ),
+            };
             out.push(format!(
-                "the input signal's tendons.{k}.tension reaches {v} at t = {t} s, outside the training inputs [{}, {}]",
-                r.min, r.max
+                "the input signal's tendons.{k}.tension reaches {v} at t = {t} s, {how}"
             ));
         }
     }

@@ -169,6 +169,7 @@ pub fn attach(
         extrapolated: outside,
         warnings,
         input_range: model.meta.input_range.clone(),
+        held_tensions: super::validity::held_tensions(&model)?,
         extrapolate,
     });
     Ok(())

@@ -57,6 +57,26 @@ pub fn input_ranges(ds: &Dataset) -> Vec<InputRange> {
 ///
 /// With `tensions_from_signal` (a simulation driven by an input signal) the scenario's own
 /// tensions are not checked: the signal's are, by `Reduced::check_signal`.
+/// Per tendon of the model's training scenario, the tension training held it at, or `None` for
+/// a tendon whose tension was a training input (it has a range instead).
+pub fn held_tensions(model: &ReducedModel) -> Result<Vec<Option<f64>>, ScenarioError> {
+    let meta = &model.meta;
+    let trained = Scenario::from_toml(&meta.layout.scenario, &meta.layout.scenario_toml, &[])
+        .map_err(|e| {
+            ScenarioError::invalid(
+                "--model",
+                format!("the model's recorded scenario cannot be read: {e}"),
+            )
+        })?;
+    let is_input = |p: &str| meta.input_range.iter().any(|r| r.parameter == p);
+    Ok(trained
+        .tendons
+        .iter()
+        .enumerate()
+        .map(|(k, t)| (!is_input(&format!("tendons.{k}.tension"))).then_some(t.tension))
+        .collect())
+}
+
 pub fn check(
     built: &Built,
     table: &Table,
