@@ -623,3 +623,38 @@ fn a_signal_moving_a_tension_training_held_fixed_is_refused_unless_extrapolating
         "{meta}"
     );
 }
+
+#[test]
+fn a_load_schedule_is_checked_against_the_loads_a_model_was_trained_under() {
+    // pod2 was trained under gravity at λ = 1; a schedule up to λ = 100 is 981 m/s²
+    let f = scratch("val-schedule.csv");
+    std::fs::write(&f, "t,lambda\n0,1\n0.02,100\n").unwrap();
+    let run = scratch("val-run-schedule");
+    let args = [
+        "simulate",
+        "single-tendon",
+        "--tension=-3",
+        "--model",
+        s(pod2()),
+        "--load-schedule",
+        s(&f),
+        "--duration",
+        "0.03",
+        "--out",
+        s(&run),
+    ];
+    expect_error(
+        &args,
+        &[
+            "λ = 100 at t = 0.02 s",
+            "training held them at λ = 1",
+            "--extrapolate",
+        ],
+    );
+    let (_, stderr) = run_ok_with_stderr(&[&args[..], &["--extrapolate"]].concat());
+    assert!(stderr.contains("λ = 100"), "{stderr}");
+    assert!(json(&run.join("meta.json")).to_string().contains("λ = 100"));
+    // a schedule holding λ = 1 is the training's loads
+    std::fs::write(&f, "t,lambda\n0,1\n0.02,1\n").unwrap();
+    run_ok(&[&args[..], &["--force"]].concat());
+}

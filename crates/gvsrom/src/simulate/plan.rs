@@ -117,7 +117,7 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
     let signal = input_signal(built, opts)?;
     // a reduced model answers only for tensions it was trained on: the signal's, at its knots
     // (where a held or linear signal takes its extremes) and at both ends of the run
-    let model_extrapolated = match (&built.reduced, &opts.input) {
+    let mut model_extrapolated = match (&built.reduced, &opts.input) {
         (Some(r), input) if !matches!(input, InputSource::Constant | InputSource::Function(_)) => {
             let end = t_out.last().copied().unwrap_or(0.0);
             let mut times: Vec<f64> = signal
@@ -145,6 +145,34 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
         }
         None => None,
     };
+    // a reduced model answers only for the loads it was trained under: λ = 1 throughout
+    if let (Some(r), Some(s)) = (&built.reduced, &schedule) {
+        let scales_something = built.loads != built.loads.scaled(0.0);
+        let end = t_out.last().copied().unwrap_or(0.0);
+        let off = s
+            .times
+            .iter()
+            .zip(&s.values)
+            .filter(|(t, _)| **t <= end)
+            .map(|(t, v)| (*t, v[0]))
+            .filter(|(_, v)| !((v - 1.0).abs() <= 1e-12))
+            .max_by(|a, b| (a.1 - 1.0).abs().total_cmp(&(b.1 - 1.0).abs()));
+        if let (true, Some((t, v))) = (scales_something, off) {
+            let sentence = format!(
+                "the load schedule scales the loads and gravity by λ = {v} at t = {t} s, but training held them at λ = 1"
+            );
+            if !r.extrapolate {
+                return Err(ScenarioError::invalid(
+                    "--model",
+                    format!(
+                        "`{}` was not trained for this input: {sentence}; pass --extrapolate to use it anyway (its answer is then an extrapolation, and is marked so)",
+                        r.path.display()
+                    ),
+                ));
+            }
+            model_extrapolated.push(sentence);
+        }
+    }
     let u_max = crate::csv_input::max_abs_per_column(&signal);
     let lambda_max = schedule
         .as_ref()
