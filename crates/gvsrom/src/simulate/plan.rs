@@ -155,7 +155,7 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
             .zip(&s.values)
             .filter(|(t, _)| **t <= end)
             .map(|(t, v)| (*t, v[0]))
-            .filter(|(_, v)| !((v - 1.0).abs() <= 1e-12))
+            .filter(|(_, v)| v.is_nan() || (v - 1.0).abs() > 1e-12)
             .max_by(|a, b| (a.1 - 1.0).abs().total_cmp(&(b.1 - 1.0).abs()));
         if let (true, Some((t, v))) = (scales_something, off) {
             let sentence = format!(
