@@ -152,7 +152,7 @@ fn statics_and_modes_json_naming_an_input_are_refused() {
             ],
             &["--json", "is the input --model"],
         );
-        // a file inside the model: its meta.json carries a gvsrom manifest, but of a directory
+        // a file inside the model (its meta.json): refused as lying inside the input
         expect_error(
             &[
                 cmd,
@@ -163,7 +163,7 @@ fn statics_and_modes_json_naming_an_input_are_refused() {
                 s(&m.join("meta.json")),
                 "--force",
             ],
-            &["--json", "meta.json of a gvsrom"],
+            &["--json", "lies inside the input --model"],
         );
         assert_eq!(snapshot(m), model_before);
     }
@@ -264,4 +264,36 @@ fn pod_and_train_out_naming_their_inputs_are_refused_and_the_inputs_kept() {
     expect_error(&args, &["--out", "is the input --init"]);
     assert_eq!(snapshot(&ds), before_ds);
     assert_eq!(snapshot(&ae), before_ae);
+}
+
+#[test]
+fn an_output_inside_an_input_directory_is_refused_and_the_input_stays_usable() {
+    // a figures directory or a model written into the model (or dataset) it was made from would be
+    // an entry that directory's manifest does not list: the input would then be refused as damaged
+    let m = model();
+    let before = snapshot(m);
+    let inside = m.join("figs");
+    expect_error(
+        &["plot", s(m), "--out", s(&inside)],
+        &[
+            "--out",
+            "lies inside the input INPUT",
+            "choose a path beside it",
+        ],
+    );
+    expect_error(
+        &[
+            "statics",
+            "single-tendon",
+            "--tension=-3",
+            "--model",
+            s(m),
+            "--json",
+            s(&m.join("eq.json")),
+        ],
+        &["--json", "lies inside the input --model"],
+    );
+    assert_eq!(snapshot(m), before);
+    // still a usable model
+    run_ok(&["statics", "single-tendon", "--tension=-3", "--model", s(m)]);
 }

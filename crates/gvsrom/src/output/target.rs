@@ -40,8 +40,8 @@ pub(super) fn split_target(n: &Named) -> Result<(PathBuf, String), OutputError> 
     Ok((parent, name))
 }
 
-/// Refuses an output path (`out_option` = `out`) that equals or contains one of the command's
-/// `inputs` (`(option, path)` pairs; compared by canonical path, so `./d`, `d/` and a link to `d` are
+/// Refuses an output path (`out_option` = `out`) that equals, contains or lies inside one of the
+/// command's `inputs` (`(option, path)` pairs; compared by canonical path, so `./d`, `d/` and a link to `d` are
 /// the same): with `--force` such an output would replace the command's own input. Call it before
 /// the output is created. Inputs that do not exist are skipped (reading them fails on its own).
 pub fn refuse_overlap(
@@ -73,6 +73,14 @@ pub fn refuse_overlap(
             let how = if input_c == target { "is" } else { "contains" };
             return Err(named.refused(format!(
                 "{how} the input {option} `{}`; an output never replaces the command's own input: choose another path",
+                input.display()
+            )));
+        }
+        // inside an input directory, the output would be an entry that directory's manifest does
+        // not list: the input would then be refused as holding files gvsrom did not write
+        if input_c.is_dir() && target.starts_with(&input_c) {
+            return Err(named.refused(format!(
+                "lies inside the input {option} `{}`; an output inside another output would make that one hold a file its manifest does not list: choose a path beside it",
                 input.display()
             )));
         }
