@@ -65,12 +65,10 @@ fn tolerances_outside_their_range_are_refused_naming_option_value_and_range() {
     );
 }
 
-#[test]
-fn sigterm_stops_a_slow_simulation_within_a_step_and_writes_the_partial_trajectory() {
-    // SDIRK4 at the tightest tolerances from rest: thousands of steps per simulated millisecond,
-    // so the sample at t = 1 s lies minutes away; only a check at every step sees the signal
-    let dir = scratch("sigterm-slow");
-    let child = spawn(&[
+/// SDIRK4 at the tightest tolerances from rest, writing `dir`: thousands of steps per simulated
+/// millisecond, so its sample at t = 1 s lies minutes away.
+fn slow_simulation(dir: &Path) -> std::process::Child {
+    spawn(&[
         "simulate",
         "single-tendon",
         "--duration",
@@ -84,8 +82,16 @@ fn sigterm_stops_a_slow_simulation_within_a_step_and_writes_the_partial_trajecto
         "--atol",
         "1e-14",
         "--out",
-        path(&dir),
-    ]);
+        path(dir),
+    ])
+}
+
+#[test]
+fn sigterm_stops_a_slow_simulation_within_a_step_and_writes_the_partial_trajectory() {
+    // SDIRK4 at the tightest tolerances from rest: thousands of steps per simulated millisecond,
+    // so the sample at t = 1 s lies minutes away; only a check at every step sees the signal
+    let dir = scratch("sigterm-slow");
+    let child = slow_simulation(&dir);
     std::thread::sleep(Duration::from_secs(1));
     let sent = Instant::now();
     // SAFETY: kill(2) on the pid of our own child, which has not been waited for yet
@@ -210,22 +216,7 @@ fn a_signal_sent_twice_at_once_is_one_request_and_the_partial_trajectory_is_writ
     // `timeout` and batch schedulers signal the process and then its group: two SIGINTs within
     // microseconds. The second used to end the process at once, writing nothing.
     let dir = scratch("sigint-twice");
-    let child = spawn(&[
-        "simulate",
-        "single-tendon",
-        "--duration",
-        "10",
-        "--sample-rate",
-        "1",
-        "--method",
-        "sdirk",
-        "--rtol",
-        "1e-12",
-        "--atol",
-        "1e-14",
-        "--out",
-        path(&dir),
-    ]);
+    let child = slow_simulation(&dir);
     std::thread::sleep(Duration::from_secs(1));
     for _ in 0..2 {
         // SAFETY: kill(2) on the pid of our own child, which has not been waited for yet

@@ -126,7 +126,6 @@ pub fn run(
     let mut stopped = None;
     let mut non_physical = None;
     let x = layout.strain_x.clone();
-    let length = model.disc.length();
     // polled before every step attempt too, not only at samples: with tight tolerances the next
     // sample may be far away
     let stop = || match interrupt.load(Ordering::SeqCst) {
@@ -143,16 +142,7 @@ pub fn run(
         &opts.integrator,
         &mut |s| {
             // a state no elastic rod holds ends the run before it becomes a snapshot
-            if let Some(v) =
-                crate::plausibility::state_violation(s.strain, &x, |j| model.xi_star(j), length)
-            {
-                let msg = format!(
-                    "the state left the rod's elastic range at t = {:.4} s: {v}{}",
-                    s.t,
-                    crate::plausibility::largest_load(built, s.u, 1.0)
-                        .map(|l| format!("; {l}"))
-                        .unwrap_or_default()
-                );
+            if let Some(msg) = simulate::non_physical_state(built, &x, s) {
                 non_physical = Some(msg.clone());
                 return ControlFlow::Break(msg);
             }

@@ -57,17 +57,22 @@ pub fn input_ranges(ds: &Dataset) -> Vec<InputRange> {
 ///
 /// With `tensions_from_signal` (a simulation driven by an input signal) the scenario's own
 /// tensions are not checked: the signal's are, by `Reduced::check_signal`.
+/// The scenario the model was trained on, as its meta.json records it.
+fn trained_scenario(model: &ReducedModel) -> Result<Scenario, ScenarioError> {
+    let layout = &model.meta.layout;
+    Scenario::from_toml(&layout.scenario, &layout.scenario_toml, &[]).map_err(|e| {
+        ScenarioError::invalid(
+            "--model",
+            format!("the model's recorded scenario cannot be read: {e}"),
+        )
+    })
+}
+
 /// Per tendon of the model's training scenario, the tension training held it at, or `None` for
 /// a tendon whose tension was a training input (it has a range instead).
 pub fn held_tensions(model: &ReducedModel) -> Result<Vec<Option<f64>>, ScenarioError> {
     let meta = &model.meta;
-    let trained = Scenario::from_toml(&meta.layout.scenario, &meta.layout.scenario_toml, &[])
-        .map_err(|e| {
-            ScenarioError::invalid(
-                "--model",
-                format!("the model's recorded scenario cannot be read: {e}"),
-            )
-        })?;
+    let trained = trained_scenario(model)?;
     let is_input = |p: &str| meta.input_range.iter().any(|r| r.parameter == p);
     Ok(trained
         .tendons
@@ -108,13 +113,7 @@ pub fn check(
             )),
         }
     }
-    let trained = Scenario::from_toml(&meta.layout.scenario, &meta.layout.scenario_toml, &[])
-        .map_err(|e| {
-            ScenarioError::invalid(
-                "--model",
-                format!("the model's recorded scenario cannot be read: {e}"),
-            )
-        })?;
+    let trained = trained_scenario(model)?;
     // tensions training held fixed (not inputs) must be the trained ones
     let is_input = |p: &str| meta.input_range.iter().any(|r| r.parameter == p);
     for (k, t) in trained.tendons.iter().enumerate() {

@@ -130,6 +130,26 @@ fn check_start_mass<P: StrainParam>(
 }
 
 /// `run` with the samples delivered to any [`SampleSink`].
+/// The reason a sample `s` of a run on `built` (points at the abscissae `x`) is no state of an
+/// elastic rod ([`crate::plausibility::state_violation`]), with the run's largest load; `None` for
+/// a physical one. It ends a simulation and a dynamic dataset alike.
+pub fn non_physical_state(built: &Built, x: &[f64], s: &Sample<'_>) -> Option<String> {
+    let model = &built.model;
+    let v = crate::plausibility::state_violation(
+        s.strain,
+        x,
+        |j| model.xi_star(j),
+        model.disc.length(),
+    )?;
+    Some(format!(
+        "the state left the rod's elastic range at t = {:.4} s: {v}{}",
+        s.t,
+        crate::plausibility::largest_load(built, s.u, 1.0)
+            .map(|l| format!("; {l}"))
+            .unwrap_or_default()
+    ))
+}
+
 pub fn run_into(
     built: &Built,
     plan: &Plan,
@@ -141,9 +161,7 @@ pub fn run_into(
     let mut write_error: Option<std::io::Error> = None;
     let mut off_manifold = None;
     let mut non_physical = None;
-    let model = &built.model;
-    let x: Vec<f64> = model.disc.points.iter().map(|p| p.x).collect();
-    let length = model.disc.length();
+    let x: Vec<f64> = built.model.disc.points.iter().map(|p| p.x).collect();
     // `control` is called from the sink and from the integrator's per-attempt poll, never nested
     let control = std::cell::RefCell::new(control);
     let interrupted = std::cell::RefCell::new(None::<String>);
@@ -162,16 +180,7 @@ pub fn run_into(
     let mut sink = |s: &Sample<'_>| {
         // a state no elastic rod holds (a diverged integration, a load the estimate underrated)
         // ends the run before it is written: its samples would be taken for a motion
-        if let Some(v) =
-            crate::plausibility::state_violation(s.strain, &x, |j| model.xi_star(j), length)
-        {
-            let msg = format!(
-                "the state left the rod's elastic range at t = {:.4} s: {v}{}",
-                s.t,
-                crate::plausibility::largest_load(built, s.u, 1.0)
-                    .map(|l| format!("; {l}"))
-                    .unwrap_or_default()
-            );
+        if let Some(msg) = non_physical_state(built, &x, s) {
             non_physical = Some(msg.clone());
             return ControlFlow::Break(msg);
         }
