@@ -351,6 +351,8 @@ pub fn dataset(
             ("steps", steps.is_some()),
             ("babble", babble.is_some()),
             ("from_equilibrium", from_equilibrium),
+            ("rtol", rtol.is_some()),
+            ("atol", atol != 1e-6),
         ],
     )?;
     if interpolate && input.is_none() {

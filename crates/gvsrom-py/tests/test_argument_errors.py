@@ -100,3 +100,13 @@ def test_a_command_quoted_for_the_shell_keeps_its_flags():
     # a flag with no Python argument, a word with a dash inside and a bare `--` stay as they are
     assert spell("--json x, well-known--set, a -- b, --") == "--json x, well-known--set, a -- b, --"
     assert spell("`--lambda`; `--lr-reductions`") == "`lambda_`; `lr_reductions`"
+
+
+def test_integrator_tolerances_of_a_static_dataset_are_refused(tmp_path):
+    beam = gvsrom.Scenario.preset("single-tendon")
+    plan = dict(sweep=["tendons.0.tension=-6:0"], samples=3)
+    for kw in [{"rtol": 1e-20}, {"atol": 1e-9}]:
+        name = next(iter(kw))
+        assert message(lambda: gvsrom.dataset(beam, tmp_path / "d", **plan, **kw)) == (
+            f"`{name}` is an option of a dynamic dataset: give `duration` too")
+    assert not (tmp_path / "d").exists()

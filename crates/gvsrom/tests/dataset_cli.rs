@@ -705,3 +705,27 @@ fn bad_tolerances_of_a_dynamic_dataset_are_refused_before_an_earlier_dataset_is_
         assert_eq!(Dataset::load(&dir).unwrap().status.len(), 3);
     }
 }
+
+#[test]
+fn integrator_tolerances_of_a_static_dataset_are_refused_not_ignored() {
+    // a plan of equilibria runs no integrator: --rtol/--atol there are a mistake, not a setting
+    let dir = scratch("ds-static-rtol");
+    for opt in [["--rtol", "1e-20"], ["--atol", "1e-9"]] {
+        let out = gvsrom(&[
+            "dataset",
+            "single-tendon",
+            "--sweep",
+            "tendons.0.tension=-6:0",
+            "--samples",
+            "3",
+            opt[0],
+            opt[1],
+            "--out",
+            dir.to_str().unwrap(),
+        ]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{opt:?} accepted");
+        assert!(stderr.contains("--duration"), "{stderr}");
+        assert!(!dir.exists());
+    }
+}

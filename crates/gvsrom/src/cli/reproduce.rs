@@ -170,11 +170,11 @@ pub struct DatasetArgs {
 
     /// Dynamic dataset: relative tolerance of the integrator (default as `simulate`: 1e-3, or
     /// 1e-4 with SDIRK4 for a lightly damped rod).
-    #[arg(long)]
+    #[arg(long, requires = "duration")]
     pub rtol: Option<f64>,
 
     /// Dynamic dataset: absolute tolerance of the integrator.
-    #[arg(long, default_value_t = 1e-6)]
+    #[arg(long, default_value_t = 1e-6, requires = "duration")]
     pub atol: f64,
 
     /// Testing aid: stop (as if interrupted) once N chunks have been started.
