@@ -729,3 +729,27 @@ fn integrator_tolerances_of_a_static_dataset_are_refused_not_ignored() {
         assert!(!dir.exists());
     }
 }
+
+#[test]
+fn a_plan_none_of_whose_samples_solves_is_an_error() {
+    // every order changes the model's coordinates: no row fits the dataset's columns
+    let dir = scratch("ds-none-solved");
+    expect_error(
+        &[
+            "dataset",
+            "single-tendon",
+            "--sweep",
+            "divisions.0.basis.order=2:5",
+            "--samples",
+            "3",
+            "--out",
+            dir.to_str().unwrap(),
+        ],
+        &[
+            "none of the 3 samples solved",
+            "sample 0:",
+            "for inspection",
+        ],
+    );
+    assert_eq!(json(&dir.join("meta.json"))["counts"]["ok"], 0);
+}

@@ -484,6 +484,18 @@ pub fn run(args: &DatasetRequest, interrupt: &AtomicUsize) -> Result<Outcome, Da
     meta.wall_time_s = t0.elapsed().as_secs_f64();
     write::write(&mut dir, &mut meta, &gen, results)?;
     let path = dir.commit(&meta)?;
+    // a plan none of whose samples solves is an error, not a dataset: every row failed
+    if meta.complete && meta.samples > 0 && meta.counts.ok == 0 {
+        return Err(DatasetError::Plan(format!(
+            "none of the {} samples solved; sample {}: {} (the failures were written to `{}` for inspection)",
+            meta.samples,
+            meta.failures.first().map_or(0, |f| f.index),
+            meta.failures
+                .first()
+                .map_or("no reason recorded", |f| f.reason.as_str()),
+            path.display()
+        )));
+    }
     Ok(Outcome {
         path,
         meta,
