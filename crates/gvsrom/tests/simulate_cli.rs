@@ -498,3 +498,34 @@ fn a_state_no_elastic_rod_holds_ends_the_run_naming_it_and_the_load() {
         ],
     );
 }
+
+#[test]
+fn a_massless_rod_is_refused_for_motion_naming_the_density() {
+    // density 0 is accepted for statics; a motion (simulate, a dynamic dataset, modes) needs mass
+    let out_dir = scratch("massless-run");
+    for args in [
+        &["simulate", "single-tendon", "--duration", "0.1", "--out"][..],
+        &["dataset", "single-tendon", "--duration", "0.1", "--out"][..],
+    ] {
+        let args = [
+            args,
+            &[out_dir.to_str().unwrap(), "--set", "material.density=0"],
+        ]
+        .concat();
+        expect_error(&args, &["invalid `material.density`", "a positive density"]);
+        assert!(!out_dir.exists());
+    }
+    expect_error(
+        &["modes", "single-tendon", "--set", "material.density=0"],
+        &["invalid `material.density`"],
+    );
+    let out = gvsrom(&[
+        "statics",
+        "single-tendon",
+        "--set",
+        "material.density=0",
+        "--set",
+        "loads.gravity=[0,0,0]",
+    ]);
+    assert!(out.status.success());
+}

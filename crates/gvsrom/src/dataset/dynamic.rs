@@ -58,6 +58,7 @@ pub fn run(
     provenance: crate::provenance::Provenance,
     t0: Instant,
 ) -> Result<Outcome, DatasetError> {
+    simulate::require_mass(built)?;
     let static_opts = [
         (!args.sweep.is_empty(), "--sweep"),
         (!args.grid.is_empty(), "--grid"),
