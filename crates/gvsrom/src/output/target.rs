@@ -204,7 +204,7 @@ mod tests {
     }
 
     #[test]
-    fn an_output_that_is_or_contains_an_input_is_refused_by_any_spelling() {
+    fn an_output_that_is_contains_or_lies_inside_an_input_is_refused_by_any_spelling() {
         let d = sandbox("overlap");
         let data = d.join("data");
         fs::create_dir_all(data.join("inner")).unwrap();
@@ -229,9 +229,14 @@ mod tests {
             std::os::unix::fs::symlink(&data, &link).unwrap();
             assert!(refuse_overlap("--out", &link, &[("DATASET", &data)]).is_err());
         }
-        // distinct paths, an input inside nothing, and a missing input pass
+        // an output inside an input directory would be an entry its manifest does not list
+        let err = refuse_overlap("--out", &data.join("inner/new"), &[("DATASET", &data)])
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("lies inside the input DATASET"), "{err}");
+        // distinct paths, a sibling with the input's name as a prefix, and a missing input pass
         refuse_overlap("--out", &other, &[("DATASET", &data)]).unwrap();
-        refuse_overlap("--out", &data.join("inner/new"), &[("DATASET", &data)]).unwrap();
+        refuse_overlap("--out", &d.join("data-figs"), &[("DATASET", &data)]).unwrap();
         refuse_overlap("--out", &other, &[("DATASET", &d.join("missing"))]).unwrap();
     }
 }
