@@ -297,8 +297,8 @@ fn dynamic_only(duration: Option<f64>, given: &[(&str, bool)]) -> PyResult<()> {
 ///     Dynamic: actuator babbling ``(lo, hi, hold_min, hold_max)``.
 /// from_equilibrium : bool
 ///     Dynamic: start at the static equilibrium.
-/// rtol, atol : float
-///     Dynamic: integrator tolerances.
+/// rtol, atol : float, optional
+///     Dynamic: integrator tolerances (default as ``Robot.simulate``; atol 1e-6).
 ///
 /// Returns
 /// -------
@@ -310,7 +310,7 @@ fn dynamic_only(duration: Option<f64>, given: &[(&str, bool)]) -> PyResult<()> {
 /// GvsromError
 ///     For a bad plan or option (the message of ``gvsrom dataset``).
 #[pyfunction]
-#[pyo3(signature = (scenario, out, sweep=None, grid=None, random=None, samples=None, seed=0, set=None, chunk_size=128, threads=None, force=false, resume=false, duration=None, sample_rate=None, input=None, interpolate=false, steps=None, babble=None, from_equilibrium=false, rtol=None, atol=1e-6))]
+#[pyo3(signature = (scenario, out, sweep=None, grid=None, random=None, samples=None, seed=0, set=None, chunk_size=128, threads=None, force=false, resume=false, duration=None, sample_rate=None, input=None, interpolate=false, steps=None, babble=None, from_equilibrium=false, rtol=None, atol=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn dataset(
     py: Python<'_>,
@@ -334,7 +334,7 @@ pub fn dataset(
     babble: Option<Vec<f64>>,
     from_equilibrium: bool,
     rtol: Option<f64>,
-    atol: f64,
+    atol: Option<f64>,
 ) -> PyResult<Dataset> {
     use crate::arrays::{size, unsigned};
     let samples = samples.map(|v| size("samples", v)).transpose()?;
@@ -352,7 +352,7 @@ pub fn dataset(
             ("babble", babble.is_some()),
             ("from_equilibrium", from_equilibrium),
             ("rtol", rtol.is_some()),
-            ("atol", atol != 1e-6),
+            ("atol", atol.is_some()),
         ],
     )?;
     if interpolate && input.is_none() {
@@ -386,7 +386,7 @@ pub fn dataset(
         babble,
         from_equilibrium,
         rtol,
-        atol,
+        atol: atol.unwrap_or(gvsrom::simulate::IntegratorChoice::default().atol),
         stop_after_chunks: None,
     };
     let (outcome, caught) = crate::interrupt::run(py, |flag| gvsrom::dataset::run(&args, &flag));

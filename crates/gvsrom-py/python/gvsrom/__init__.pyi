@@ -245,7 +245,7 @@ def dataset(
     babble: Sequence[float] | None = None,
     from_equilibrium: bool = False,
     rtol: float | None = None,
-    atol: float = 1e-06,
+    atol: float | None = None,
 ) -> Dataset: ...
 def reproduce(
     study: Union[str, Sequence[str]],

@@ -23,6 +23,11 @@ pub fn inside(r: &InputRange, v: f64) -> bool {
     v.is_finite() && v >= r.min - slack && v <= r.max + slack
 }
 
+/// Whether the tension `v` is the value `held` that training held a tendon at (to a relative 1e-12).
+pub fn at_held(v: f64, held: f64) -> bool {
+    (v - held).abs() <= 1e-12 * (1.0 + held.abs())
+}
+
 /// A reduced model bound to a scenario.
 pub struct Reduced {
     /// The scenario's rod, points, tendons and loads with the reduced parameterization.
@@ -180,7 +185,7 @@ pub fn signal_outside(
             let d = match (range_of(k), held.get(k).copied().flatten()) {
                 (Some(r), _) if inside(r, v) => 0.0,
                 (Some(r), _) => (r.min - v).max(v - r.max).max(f64::MIN_POSITIVE),
-                (None, Some(h)) if (v - h).abs() <= 1e-12 * (1.0 + h.abs()) => 0.0,
+                (None, Some(h)) if at_held(v, h) => 0.0,
                 (None, Some(h)) => (v - h).abs().max(f64::MIN_POSITIVE),
                 (None, None) => continue,
             };

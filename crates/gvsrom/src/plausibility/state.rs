@@ -29,21 +29,24 @@ pub fn state_violation(
     xi_star: impl Fn(usize) -> V6,
     length: f64,
 ) -> Option<String> {
+    // called at every sample of a run: nothing is formatted until a bound is crossed
+    let at = |j: usize| format!("at X = {:.4} m", x.get(j).copied().unwrap_or(f64::NAN));
     for (j, xi) in strain.iter().enumerate() {
         let d = xi - xi_star(j);
-        let at = format!("at X = {:.4} m", x.get(j).copied().unwrap_or(f64::NAN));
         let nu = xi[3];
         // NaN fails every bound: each test is "not within", written with `is_nan` spelled out
         if nu.is_nan() || nu <= 0.0 {
             return Some(format!(
-                "{at} the stretch ν = {} ≤ 0: a section has passed through itself",
+                "{} the stretch ν = {} ≤ 0: a section has passed through itself",
+                at(j),
                 gvs::error::fmt_value(nu)
             ));
         }
         for (k, name) in [(3, "axial strain"), (4, "shear y"), (5, "shear z")] {
             if d[k].is_nan() || d[k].abs() > STATE_MAX_STRAIN {
                 return Some(format!(
-                    "{at} the {name} is {} (accepted |·| <= {STATE_MAX_STRAIN})",
+                    "{} the {name} is {} (accepted |·| <= {STATE_MAX_STRAIN})",
+                    at(j),
                     gvs::error::fmt_value(d[k])
                 ));
             }
@@ -51,7 +54,8 @@ pub fn state_violation(
         let bend = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() * length;
         if bend.is_nan() || bend > STATE_MAX_BENDING {
             return Some(format!(
-                "{at} the curvature times the rod's length is {} rad (accepted <= {STATE_MAX_BENDING} rad)",
+                "{} the curvature times the rod's length is {} rad (accepted <= {STATE_MAX_BENDING} rad)",
+                at(j),
                 gvs::error::fmt_value(bend)
             ));
         }

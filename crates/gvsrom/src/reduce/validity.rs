@@ -15,7 +15,7 @@
 //! scenario unless `--extrapolate` is given, which is then printed and recorded.
 
 use super::anchors::input_value;
-use crate::build::reduced::inside;
+use crate::build::reduced::{at_held, inside};
 use crate::build::Built;
 use crate::dataset::Dataset;
 use crate::error::ScenarioError;
@@ -50,13 +50,6 @@ pub fn input_ranges(ds: &Dataset) -> Vec<InputRange> {
         .collect()
 }
 
-/// Every way the scenario of `built` (its TOML `table`, after `--set`) lies outside what `model`
-/// was trained on, one sentence each: an input outside its training range, a tendon tension that
-/// training held fixed at another value, a physics field that differs. Empty: the model may answer.
-/// An error only if the model's own scenario cannot be read.
-///
-/// With `tensions_from_signal` (a simulation driven by an input signal) the scenario's own
-/// tensions are not checked: the signal's are, by `Reduced::check_signal`.
 /// The scenario the model was trained on, as its meta.json records it.
 fn trained_scenario(model: &ReducedModel) -> Result<Scenario, ScenarioError> {
     let layout = &model.meta.layout;
@@ -71,17 +64,27 @@ fn trained_scenario(model: &ReducedModel) -> Result<Scenario, ScenarioError> {
 /// Per tendon of the model's training scenario, the tension training held it at, or `None` for
 /// a tendon whose tension was a training input (it has a range instead).
 pub fn held_tensions(model: &ReducedModel) -> Result<Vec<Option<f64>>, ScenarioError> {
-    let meta = &model.meta;
-    let trained = trained_scenario(model)?;
-    let is_input = |p: &str| meta.input_range.iter().any(|r| r.parameter == p);
-    Ok(trained
+    Ok(held_in(&trained_scenario(model)?, &model.meta.input_range))
+}
+
+/// [`held_tensions`] of the training scenario `trained` with the training inputs `inputs`.
+fn held_in(trained: &Scenario, inputs: &[InputRange]) -> Vec<Option<f64>> {
+    let is_input = |p: &str| inputs.iter().any(|r| r.parameter == p);
+    trained
         .tendons
         .iter()
         .enumerate()
         .map(|(k, t)| (!is_input(&format!("tendons.{k}.tension"))).then_some(t.tension))
-        .collect())
+        .collect()
 }
 
+/// Every way the scenario of `built` (its TOML `table`, after `--set`) lies outside what `model`
+/// was trained on, one sentence each: an input outside its training range, a tendon tension that
+/// training held fixed at another value, a physics field that differs. Empty: the model may answer.
+/// An error only if the model's own scenario cannot be read.
+///
+/// With `tensions_from_signal` (a simulation driven by an input signal) the scenario's own
+/// tensions are not checked: the signal's are, by `Reduced::check_signal`.
 pub fn check(
     built: &Built,
     table: &Table,
@@ -115,17 +118,14 @@ pub fn check(
     }
     let trained = trained_scenario(model)?;
     // tensions training held fixed (not inputs) must be the trained ones
-    let is_input = |p: &str| meta.input_range.iter().any(|r| r.parameter == p);
-    for (k, t) in trained.tendons.iter().enumerate() {
-        let path = format!("tendons.{k}.tension");
-        if is_input(&path) || tensions_from_signal {
+    for (k, held) in held_in(&trained, &meta.input_range).into_iter().enumerate() {
+        let (Some(h), false) = (held, tensions_from_signal) else {
             continue;
-        }
+        };
         match built.u.get(k) {
-            Some(&u) if (u - t.tension).abs() <= 1e-12 * (1.0 + t.tension.abs()) => {}
+            Some(&u) if at_held(u, h) => {}
             Some(&u) => outside.push(format!(
-                "{path} = {u}, but training held it at {}",
-                t.tension
+                "tendons.{k}.tension = {u}, but training held it at {h}"
             )),
             None => {} // the tendon count is physics, reported below
         }

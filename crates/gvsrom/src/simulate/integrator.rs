@@ -75,6 +75,24 @@ impl Default for IntegratorChoice {
     }
 }
 
+/// Refuses a rod without mass for a motion (`material.density = 0`, which statics accept): its mass
+/// matrix is zero, and the motion it would define has no meaning. Checked before anything reads
+/// the mass matrix: [`choose_integrator`] (every simulation), dynamic datasets and `modes`.
+pub fn require_mass(built: &Built) -> Result<(), ScenarioError> {
+    let model = &built.model;
+    let massless = (0..model.disc.n_points()).any(|j| {
+        let ms = model.section(j).ms;
+        ms.iter().any(|m| m.is_nan() || *m <= 0.0)
+    });
+    match massless {
+        true => Err(ScenarioError::invalid(
+            "material.density",
+            "0: a motion needs a rod with mass (a positive density); statics take density 0",
+        )),
+        false => Ok(()),
+    }
+}
+
 /// The integrator for `built` (with its reduced model, if attached) under `choice`, and the note
 /// to print when the rod's damping chose it (`integrator …` line), else `None`.
 ///
@@ -94,6 +112,7 @@ pub fn choose_integrator(
     built: &Built,
     choice: &IntegratorChoice,
 ) -> Result<(IntegratorOptions, Option<String>), ScenarioError> {
+    require_mass(built)?;
     check_tolerances(choice)?;
     let decoder = built
         .reduced

@@ -77,25 +77,7 @@ impl Plan {
 }
 
 /// Validates `opts` against `built` and builds the [`Plan`] of the run.
-/// Refuses a rod without mass for a motion (`material.density = 0`, which statics accept): its mass
-/// matrix is zero, and the motion it would define has no meaning.
-pub fn require_mass(built: &Built) -> Result<(), ScenarioError> {
-    let model = &built.model;
-    let massless = (0..model.disc.n_points()).any(|j| {
-        let ms = model.section(j).ms;
-        ms.iter().any(|m| m.is_nan() || *m <= 0.0)
-    });
-    match massless {
-        true => Err(ScenarioError::invalid(
-            "material.density",
-            "0: a motion needs a rod with mass (a positive density); statics take density 0",
-        )),
-        false => Ok(()),
-    }
-}
-
 pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError> {
-    require_mass(built)?;
     let t_out = sample_times(opts.duration, opts.sample_rate)?;
     if let Method::Fixed(f) = &opts.integrator.method {
         let h = positive("--fixed-step", f.h, "s")?;
@@ -299,7 +281,6 @@ impl Prepared {
 /// Chooses the integrator of `request` for `built` and plans the run ([`plan`]): everything is
 /// checked before anything is computed. What `gvsrom simulate` and Python's `Robot.simulate` do.
 pub fn prepare(built: &Built, request: Request) -> Result<Prepared, ScenarioError> {
-    require_mass(built)?;
     let (integrator, note) = choose_integrator(built, &request.integrator)?;
     let opts = SimulateOptions {
         duration: request.duration,

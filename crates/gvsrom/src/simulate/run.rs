@@ -129,7 +129,6 @@ fn check_start_mass<P: StrainParam>(
     ))
 }
 
-/// `run` with the samples delivered to any [`SampleSink`].
 /// The reason a sample `s` of a run on `built` (points at the abscissae `x`) is no state of an
 /// elastic rod ([`crate::plausibility::state_violation`]), with the run's largest load; `None` for
 /// a physical one. It ends a simulation and a dynamic dataset alike.
@@ -150,6 +149,7 @@ pub fn non_physical_state(built: &Built, x: &[f64], s: &Sample<'_>) -> Option<St
     ))
 }
 
+/// `run` with the samples delivered to any [`SampleSink`].
 pub fn run_into(
     built: &Built,
     plan: &Plan,
