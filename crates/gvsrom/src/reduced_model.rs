@@ -80,6 +80,11 @@ pub struct DatasetRef {
     pub strain_hash: String,
     /// Rows used (failed samples skipped).
     pub rows: usize,
+    /// Whether its rows are one trajectory in time (a dynamic dataset) rather than independent
+    /// samples; absent in models from before it was recorded, which the input coverage check
+    /// (`reduce::coverage`) reads as a trajectory, the more lenient reading.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub trajectory: Option<bool>,
 }
 
 /// The range of one training input over the usable samples (see `reduce::validity`).

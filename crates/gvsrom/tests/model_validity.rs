@@ -622,6 +622,23 @@ fn a_signal_moving_a_tension_training_held_fixed_is_refused_unless_extrapolating
         meta.to_string().contains("but training held it at -3"),
         "{meta}"
     );
+    // a comparison with the full model says the run was an extrapolation
+    let hom = scratch("val-run-held-hom");
+    run_ok(&[
+        "simulate",
+        "single-tendon",
+        "--steps=-4,-2,0.01",
+        "--duration",
+        "0.03",
+        "--out",
+        s(&hom),
+    ]);
+    let out = run_ok(&["compare", s(&hom), s(&run)]);
+    assert!(
+        out.contains("note       RUN used its model outside what it was trained on (--extrapolate): the input signal's tendons.0.tension reaches"),
+        "{out}"
+    );
+    assert!(!out.contains("REFERENCE used"), "{out}");
 }
 
 #[test]
@@ -657,4 +674,91 @@ fn a_load_schedule_is_checked_against_the_loads_a_model_was_trained_under() {
     // a schedule holding λ = 1 is the training's loads
     std::fs::write(&f, "t,lambda\n0,1\n0.02,1\n").unwrap();
     run_ok(&[&args[..], &["--force"]].concat());
+}
+
+fn args(v: &[String]) -> Vec<&str> {
+    v.iter().map(String::as_str).collect()
+}
+
+#[test]
+fn a_combination_of_inputs_training_never_came_near_is_refused_though_each_is_in_range() {
+    // six tensions moved together from -10 to 0 N: one line of the six-dimensional box
+    let ds = scratch("val-ds-together");
+    run_ok(&[
+        "dataset",
+        "six-tendon-no-gravity",
+        "--sweep",
+        "tendons.*.tension=-10:0",
+        "--samples",
+        "11",
+        "--out",
+        s(&ds),
+    ]);
+    let m = scratch("val-pod-together");
+    run_ok(&["pod", s(&ds), "--modes", "2", "--out", s(&m)]);
+    let statics = |tension: &str| {
+        vec![
+            "statics".to_string(),
+            "six-tendon-no-gravity".into(),
+            format!("--tension={tension}"),
+            "--model".into(),
+            s(&m).into(),
+        ]
+    };
+    // on the line, between two samples: answered
+    run_ok(&args(&statics("-4.5,-4.5,-4.5,-4.5,-4.5,-4.5")));
+    // one tendon alone at -10 N: each tension lies in [-10, 0], the combination far off the line:
+    // in units of the range, sqrt(0.8² + 5 × 0.2²) ≈ 0.917 from its nearest sample (all at -2 N),
+    // where the samples lie sqrt(6) × 0.1 ≈ 0.245 apart, and 3 × 0.245 is accepted
+    let corner = statics("-10,0,0,0,0,0");
+    expect_error(
+        &args(&corner),
+        &[
+            "--model",
+            "tendons.0.tension = -10",
+            "lie 0.917 from the nearest training input",
+            "within 0.245 of one another and at most 0.735 is accepted",
+            "never came near this combination",
+            "--extrapolate",
+        ],
+    );
+    // on purpose: answered and recorded
+    let json = scratch("val-together.json");
+    let mut on_purpose = corner.clone();
+    on_purpose.extend(["--extrapolate".into(), "--json".into(), s(&json).into()]);
+    run_ok(&args(&on_purpose));
+    let doc = self::json(&json);
+    assert!(
+        doc["model_extrapolated"][0]
+            .as_str()
+            .is_some_and(|e| e.contains("never came near this combination")),
+        "{doc}"
+    );
+    // an input signal pulling one tendon alone is refused at its farthest time
+    let signal = scratch("val-together.csv");
+    std::fs::write(
+        &signal,
+        "t,u0,u1,u2,u3,u4,u5\n0,-2,-2,-2,-2,-2,-2\n0.01,-10,0,0,0,0,0\n",
+    )
+    .unwrap();
+    let run = scratch("val-run-together");
+    expect_error(
+        &[
+            "simulate",
+            "six-tendon-no-gravity",
+            "--model",
+            s(&m),
+            "--input",
+            s(&signal),
+            "--duration",
+            "0.02",
+            "--out",
+            s(&run),
+        ],
+        &[
+            "at t = 0.01 s the inputs together",
+            "tendons.0.tension = -10",
+            "never came near this combination",
+        ],
+    );
 }

@@ -57,6 +57,19 @@ pub struct Reduced {
     pub held_tensions: Vec<Option<f64>>,
     /// `AttachOptions::extrapolate`, for the checks that come later (an input signal's).
     pub extrapolate: bool,
+    /// The training inputs as a whole (the reduction layer's coverage): whether a combination of
+    /// inputs lies near those training saw, beyond each input inside its range. `None` for a
+    /// model without anchors or whose inputs do not vary.
+    pub joint: Option<Box<dyn JointInputs>>,
+}
+
+/// Whether the tendon tensions `u`, with the scenario's other training inputs, lie near the
+/// training inputs as a whole (the reduction layer's `reduce::coverage`).
+pub trait JointInputs: Send + Sync {
+    /// `None` near the training inputs (or when `u` has the wrong length, or is not finite: the
+    /// range check reports those); else the distance to the nearest one, in units of each input's
+    /// training range, and a sentence saying how far.
+    fn outside(&self, u: &[f64]) -> Option<(f64, String)>;
 }
 
 /// Initial guesses of a reduced statics solve at any tendon tensions `u` (one per tendon): what
@@ -74,21 +87,34 @@ impl Reduced {
 
     /// Whether the model, attached to a scenario with the tensions `u0`, may answer at the tensions
     /// `u` as it was checked to when attached: it is not extrapolating, and every tension that
-    /// differs from `u0` is a training input inside its range ([`covers`]). If not, attaching it to
-    /// the scenario with the tensions `u` gives the verdict and its reasons.
+    /// differs from `u0` is a training input inside its range ([`covers`]), and the inputs together
+    /// lie near the training inputs ([`JointInputs`]). If not, attaching it to the scenario with the
+    /// tensions `u` gives the verdict and its reasons.
     pub fn covers_tensions(&self, u0: &[f64], u: &[f64]) -> bool {
-        self.extrapolated.is_empty() && covers(&self.input_range, u0, u)
+        self.extrapolated.is_empty()
+            && covers(&self.input_range, u0, u)
+            && self.joint.as_ref().is_none_or(|j| j.outside(u).is_none())
     }
 
     /// Checks an input signal's tensions (`u_at(t)` at `times`) against the training ranges
-    /// ([`signal_outside`]): an error listing how it lies outside, or with
-    /// `--extrapolate` those sentences, to be printed and recorded with the run.
+    /// ([`signal_outside`]) and, if each tension lies in its range, against the training inputs as
+    /// a whole ([`JointInputs`], the farthest time named): an error listing how it lies outside, or
+    /// with `--extrapolate` those sentences, to be printed and recorded with the run.
     pub fn check_signal(
         &self,
         times: &[f64],
-        u_at: impl FnMut(f64) -> Vec<f64>,
+        mut u_at: impl FnMut(f64) -> Vec<f64>,
     ) -> Result<Vec<String>, ScenarioError> {
-        let outside = signal_outside(&self.input_range, &self.held_tensions, times, u_at);
+        let mut outside = signal_outside(&self.input_range, &self.held_tensions, times, &mut u_at);
+        if let (true, Some(joint)) = (outside.is_empty(), &self.joint) {
+            let farthest = (times.iter())
+                .filter_map(|&t| joint.outside(&u_at(t)).map(|(d, why)| (d, t, why)))
+                // the first time of the largest distance
+                .reduce(|a, b| if b.0 > a.0 { b } else { a });
+            if let Some((_, t, why)) = farthest {
+                outside.push(format!("at t = {t} s {why}"));
+            }
+        }
         if outside.is_empty() {
             return Ok(vec![]);
         }

@@ -70,6 +70,15 @@ pub(super) fn compare_cmd(args: &CompareArgs, out: &mut impl Write) -> Result<()
         }
     };
     writeln!(out, "run        {}: {speed}", describe(run))?;
+    for (label, tr) in [("REFERENCE", reference), ("RUN", run)] {
+        if !tr.extrapolated.is_empty() {
+            writeln!(
+                out,
+                "note       {label} used its model outside what it was trained on (--extrapolate): {}",
+                tr.extrapolated.join("; ")
+            )?;
+        }
+    }
     for d in &diffs.differ {
         writeln!(out, "differ     {d} (compared anyway: --allow-different)")?;
     }

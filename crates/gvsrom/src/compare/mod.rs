@@ -80,6 +80,10 @@ pub struct Side {
     pub complete: bool,
     /// Wall time of the run \[s\], if recorded.
     pub wall_time_s: Option<f64>,
+    /// How its reduced model was used outside what it was trained on (`--extrapolate`); empty
+    /// otherwise.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub extrapolated: Vec<String>,
 }
 
 impl Side {
@@ -93,6 +97,7 @@ impl Side {
             complete: tr.complete,
             wall_time_s: (tr.wall_time_s.is_finite() && tr.wall_time_s > 0.0)
                 .then_some(tr.wall_time_s),
+            extrapolated: tr.extrapolated.clone(),
         }
     }
 }
@@ -288,6 +293,7 @@ mod tests {
             centerline_x: None,
             centerline: None,
             provenance: None,
+            extrapolated: vec![],
         }
     }
 

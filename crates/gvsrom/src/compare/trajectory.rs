@@ -38,6 +38,9 @@ pub struct Trajectory {
     pub centerline: Option<Vec<f64>>,
     /// How the run was made (`provenance`), if recorded.
     pub provenance: Option<Value>,
+    /// How its reduced model was used outside what it was trained on (`model_extrapolated`,
+    /// `simulate --model … --extrapolate`); empty for a model used inside it, or no model.
+    pub extrapolated: Vec<String>,
 }
 
 impl Trajectory {
@@ -135,6 +138,9 @@ impl Trajectory {
             centerline_x,
             centerline,
             provenance: meta.get("provenance").filter(|v| v.is_object()).cloned(),
+            extrapolated: (meta["model_extrapolated"].as_array().into_iter().flatten())
+                .filter_map(|v| v.as_str().map(str::to_string))
+                .collect(),
         })
     }
 

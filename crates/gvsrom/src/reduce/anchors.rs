@@ -34,10 +34,44 @@ pub struct InitialGuess {
     r: usize,
 }
 
+/// Where the value of one anchor input comes from in a run: a tendon's tension (which may vary,
+/// `--tension` or a signal) or the scenario's fixed value.
 #[derive(Debug, Clone, Copy)]
-enum GuessInput {
+pub(super) enum GuessInput {
     Tension(usize),
     Value(f64),
+}
+
+impl GuessInput {
+    /// Per anchor parameter of `model`, where its value comes from in the scenario of `built`
+    /// (its TOML `table`, for inputs other than tensions); `None` if such an input has no
+    /// numeric value there.
+    pub(super) fn of_model(
+        built: &Built,
+        table: Option<&toml::Table>,
+        model: &ReducedModel,
+    ) -> Option<Vec<GuessInput>> {
+        model
+            .meta
+            .anchor_parameters
+            .iter()
+            .map(|p| match tendon_input(p) {
+                Some(k) => Some(GuessInput::Tension(k)),
+                None => input_value(built, table, p).map(GuessInput::Value),
+            })
+            .collect()
+    }
+
+    /// The values of `inputs` at the tensions `u` (one per tendon); `None` if a tendon has none.
+    pub(super) fn values(inputs: &[GuessInput], u: &[f64]) -> Option<Vec<f64>> {
+        inputs
+            .iter()
+            .map(|i| match *i {
+                GuessInput::Tension(k) => u.get(k).copied(),
+                GuessInput::Value(v) => Some(v),
+            })
+            .collect()
+    }
 }
 
 impl InitialGuess {
@@ -48,15 +82,7 @@ impl InitialGuess {
         table: Option<&toml::Table>,
         model: &ReducedModel,
     ) -> Option<InitialGuess> {
-        let inputs = model
-            .meta
-            .anchor_parameters
-            .iter()
-            .map(|p| match tendon_input(p) {
-                Some(k) => Some(GuessInput::Tension(k)),
-                None => input_value(built, table, p).map(GuessInput::Value),
-            })
-            .collect::<Option<_>>()?;
+        let inputs = GuessInput::of_model(built, table, model)?;
         Some(InitialGuess {
             anchors: model.anchors.clone()?,
             inputs,
@@ -68,14 +94,7 @@ impl InitialGuess {
 impl GuessAt for InitialGuess {
     /// The guess at the tensions `u` (one per tendon); `None` if an input's tendon has none.
     fn at(&self, u: &[f64]) -> Option<DVector<f64>> {
-        let x: Vec<f64> = self
-            .inputs
-            .iter()
-            .map(|i| match *i {
-                GuessInput::Tension(k) => u.get(k).copied(),
-                GuessInput::Value(v) => Some(v),
-            })
-            .collect::<Option<_>>()?;
+        let x = GuessInput::values(&self.inputs, u)?;
         let a = &self.anchors;
         anchor_guess(&a.inputs, &a.latent, self.inputs.len(), self.r, &x)
     }

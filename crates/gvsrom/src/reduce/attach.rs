@@ -2,7 +2,7 @@
 //! scenario's basis, the layout check, and the latent range the model may be trusted in.
 
 use super::{anchors::InitialGuess, invalid, projection_of};
-use crate::build::reduced::GuessAt;
+use crate::build::reduced::{GuessAt, JointInputs};
 use crate::build::{Built, Reduced, Resolved};
 use crate::dataset::Layout;
 use crate::error::ScenarioError;
@@ -117,7 +117,14 @@ pub fn attach(
     } = options;
     let model = ReducedModel::load(dir)?;
     check_layout("--model", built, &model, dir)?;
-    let outside = super::validity::check(built, table, &model, tensions_from_signal)?;
+    let joint = super::coverage::Coverage::of(built, Some(table), &model);
+    let outside = super::validity::check(
+        built,
+        table,
+        &model,
+        tensions_from_signal,
+        joint.as_ref().map(|j| j as &dyn JointInputs),
+    )?;
     if !outside.is_empty() && !extrapolate {
         return Err(invalid(
             "--model",
@@ -171,6 +178,7 @@ pub fn attach(
         input_range: model.meta.input_range.clone(),
         held_tensions: super::validity::held_tensions(&model)?,
         extrapolate,
+        joint: joint.map(|j| Box::new(j) as Box<dyn JointInputs>),
     });
     Ok(())
 }

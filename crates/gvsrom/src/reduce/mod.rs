@@ -12,12 +12,13 @@
 //! Files: [`pod`](pod()) and [`train`](train()) build models from one or more datasets (`pod.rs`,
 //! `train.rs`, `start.rs`: a training from a model's weights, and `request.rs`: a training's options as
 //! every front-end is given them); `sources.rs` gathers and checks their snapshots; `anchors.rs` holds the training
-//! samples kept as initial guesses; `kinetic.rs` the mass matrices of `train --kinetic-weight`;
+//! samples kept as initial guesses; `coverage.rs` judges a combination of inputs against them; `kinetic.rs` the mass matrices of `train --kinetic-weight`;
 //! `attach.rs` binds a model to a scenario; this file the steps
 //! both commands share.
 
 mod anchors;
 mod attach;
+pub mod coverage;
 mod evaluate;
 mod kinetic;
 mod loss;
@@ -195,6 +196,7 @@ pub(super) fn dataset_ref(dir: &Path, ds: &Dataset, rows: usize) -> DatasetRef {
         path: dir.display().to_string(),
         strain_hash: ds.strain_sha256.clone(),
         rows,
+        trajectory: Some(ds.meta.dynamic.is_some()),
     }
 }
 

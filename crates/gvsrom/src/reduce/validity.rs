@@ -15,7 +15,7 @@
 //! scenario unless `--extrapolate` is given, which is then printed and recorded.
 
 use super::anchors::input_value;
-use crate::build::reduced::{at_held, inside};
+use crate::build::reduced::{at_held, inside, JointInputs};
 use crate::build::Built;
 use crate::dataset::Dataset;
 use crate::error::ScenarioError;
@@ -51,7 +51,7 @@ pub fn input_ranges(ds: &Dataset) -> Vec<InputRange> {
 }
 
 /// The scenario the model was trained on, as its meta.json records it.
-fn trained_scenario(model: &ReducedModel) -> Result<Scenario, ScenarioError> {
+pub(super) fn trained_scenario(model: &ReducedModel) -> Result<Scenario, ScenarioError> {
     let layout = &model.meta.layout;
     Scenario::from_toml(&layout.scenario, &layout.scenario_toml, &[]).map_err(|e| {
         ScenarioError::invalid(
@@ -79,9 +79,10 @@ fn held_in(trained: &Scenario, inputs: &[InputRange]) -> Vec<Option<f64>> {
 }
 
 /// Every way the scenario of `built` (its TOML `table`, after `--set`) lies outside what `model`
-/// was trained on, one sentence each: an input outside its training range, a tendon tension that
-/// training held fixed at another value, a physics field that differs. Empty: the model may answer.
-/// An error only if the model's own scenario cannot be read.
+/// was trained on, one sentence each: an input outside its training range, inputs each in range
+/// whose combination lies far from the training inputs (`joint`, [`super::coverage`]), a tendon
+/// tension that training held fixed at another value, a physics field that differs. Empty: the
+/// model may answer. An error only if the model's own scenario cannot be read.
 ///
 /// With `tensions_from_signal` (a simulation driven by an input signal) the scenario's own
 /// tensions are not checked: the signal's are, by `Reduced::check_signal`.
@@ -90,6 +91,7 @@ pub fn check(
     table: &Table,
     model: &ReducedModel,
     tensions_from_signal: bool,
+    joint: Option<&dyn JointInputs>,
 ) -> Result<Vec<String>, ScenarioError> {
     let meta = &model.meta;
     let mut outside = vec![];
@@ -115,6 +117,10 @@ pub fn check(
                 r.parameter
             )),
         }
+    }
+    // each input in its range: their combination against the training inputs as a whole
+    if let (true, false, Some(joint)) = (outside.is_empty(), tensions_from_signal, joint) {
+        outside.extend(joint.outside(&built.u).map(|(_, why)| why));
     }
     let trained = trained_scenario(model)?;
     // tensions training held fixed (not inputs) must be the trained ones

@@ -1,0 +1,387 @@
+//! The training inputs as a whole: whether a combination of inputs lies near those a model was
+//! trained on, not only each input inside its own range.
+//!
+//! A per-input range is a box. A model trained with all six tensions moved together
+//! (`--sweep 'tendons.*.tension=-10:0'`) saw one line of that box, yet every corner passes a box
+//! check: at `--tension=-10,0,0,0,0,0` its POD answered 44.8 % of the length off the full model
+//! without a sign. So a model also checks the distance from the inputs `x` to the nearest training
+//! input, each input measured in units of its training range's width:
+//!
+//! `d(x) = min_i ‖(x − x_i) ⊘ w‖`, accepted when `d(x) ≤ max(C s, m)`,
+//!
+//! where `s` is how far apart the training inputs themselves lie (the largest distance from a
+//! training input to its nearest neighbour, over [`PROBES`] evenly spaced ones), `C` =
+//! [`COVERAGE_FACTOR`] and `m` the per-input margin ([`INPUT_MARGIN`]). A new draw from the
+//! training distribution lies about `s` from the data, a corner of a filled box about `2 s` (a
+//! ball there holds `2⁻ᵏ` of its volume in the box, so its radius is `2×` for `k` inputs); a point
+//! off a 1-D sweep lies many `s` away.
+//!
+//! Along a trajectory (a dynamic dataset) consecutive inputs are nearly equal: a ramp sampled at
+//! 100 Hz would make `s` the sample spacing and refuse every other draw of the same babbling. So a
+//! training input's neighbours within [`WINDOW_FRACTION`] of its trajectory's rows on either side
+//! are left out of its own distance: `s` measures how well the data cover the inputs, not how
+//! finely a signal was sampled. Independent samples (static datasets, whose sweeps and grids are
+//! ordered too) are compared with every other sample.
+
+use super::anchors::GuessInput;
+use crate::build::reduced::JointInputs;
+use crate::build::reduced::INPUT_MARGIN;
+use crate::build::Built;
+use crate::reduced_model::ReducedModel;
+
+/// `C`: a combination of inputs is accepted within this many training spacings `s` of the nearest
+/// training input.
+pub const COVERAGE_FACTOR: f64 = 3.0;
+/// How many training inputs `s` is measured at.
+pub const PROBES: usize = 256;
+/// The neighbours left out of a training input's own distance: this fraction of its dataset's rows
+/// on either side (at least one).
+pub const WINDOW_FRACTION: f64 = 1.0 / 40.0;
+
+/// The training inputs, scaled per input by its range, with their spacing `s`.
+#[derive(Debug, Clone)]
+pub struct InputCloud {
+    /// Names of the inputs, in column order.
+    names: Vec<String>,
+    /// The columns that vary in training (a held input is checked by its range alone).
+    dims: Vec<usize>,
+    /// Per column in `dims`, the training minimum and width.
+    lo: Vec<f64>,
+    width: Vec<f64>,
+    /// Distinct scaled training inputs, `n × dims.len()` row-major.
+    points: Vec<f64>,
+    /// `s`: the largest distance of a probed training input to its nearest neighbour.
+    spacing: f64,
+}
+
+impl InputCloud {
+    /// The cloud of the training inputs `rows` (`n × names.len()`, row-major, in the datasets'
+    /// order), which came from datasets of `segments` rows each, `true` for a trajectory (one
+    /// trajectory if they do not add up to `n`). `None` with fewer than two rows, no input that
+    /// varies, or a value not finite.
+    pub fn new(names: Vec<String>, rows: &[f64], segments: &[(usize, bool)]) -> Option<InputCloud> {
+        let k = names.len();
+        let n = rows.len().checked_div(k)?;
+        if n < 2 || rows.len() != n * k || rows.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        let (mut dims, mut lo, mut width) = (vec![], vec![], vec![]);
+        for c in 0..k {
+            let (min, max) = (0..n)
+                .map(|i| rows[i * k + c])
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                    (a.min(v), b.max(v))
+                });
+            if max > min {
+                dims.push(c);
+                lo.push(min);
+                width.push(max - min);
+            }
+        }
+        if dims.is_empty() {
+            return None;
+        }
+        let d = dims.len();
+        let mut scaled = Vec::with_capacity(n * d);
+        for i in 0..n {
+            for (j, &c) in dims.iter().enumerate() {
+                scaled.push((rows[i * k + c] - lo[j]) / width[j]);
+            }
+        }
+        let segments = match segments.iter().map(|s| s.0).sum::<usize>() == n {
+            true => segments.to_vec(),
+            false => vec![(n, true)],
+        };
+        let spacing = spacing(&scaled, d, &segments, true)
+            .or_else(|| spacing(&scaled, d, &segments, false))
+            .unwrap_or(0.0);
+        // distinct rows only: a held signal repeats its inputs at every sample
+        let mut order: Vec<usize> = (0..n).collect();
+        let row = |i: usize| &scaled[i * d..(i + 1) * d];
+        order.sort_by(|&a, &b| {
+            row(a)
+                .iter()
+                .zip(row(b))
+                .map(|(x, y)| x.total_cmp(y))
+                .find(|o| o.is_ne())
+                .unwrap_or(std::cmp::Ordering::Equal)
+        });
+        order.dedup_by(|a, b| row(*a) == row(*b));
+        let points = order.iter().flat_map(|&i| row(i).to_vec()).collect();
+        Some(InputCloud {
+            names,
+            dims,
+            lo,
+            width,
+            points,
+            spacing,
+        })
+    }
+
+    /// `s`, in units of each input's range.
+    pub fn spacing(&self) -> f64 {
+        self.spacing
+    }
+
+    /// The largest accepted distance to the nearest training input, `max(C s, m)`.
+    pub fn radius(&self) -> f64 {
+        (COVERAGE_FACTOR * self.spacing).max(INPUT_MARGIN)
+    }
+
+    /// `d(x)`: the distance from the inputs `x` (one per name) to the nearest training input, in
+    /// units of each input's range; `stop_below` ends the search at the first training input
+    /// closer than it (the distance returned is then that one's).
+    pub fn distance(&self, x: &[f64], stop_below: f64) -> f64 {
+        let d = self.dims.len();
+        let stop = stop_below * stop_below;
+        let mut best = f64::INFINITY;
+        for p in self.points.chunks_exact(d) {
+            let mut s = 0.0;
+            for (j, &c) in self.dims.iter().enumerate() {
+                let e = (x[c] - self.lo[j]) / self.width[j] - p[j];
+                s += e * e;
+            }
+            if s < best {
+                best = s;
+                if best < stop {
+                    break;
+                }
+            }
+        }
+        best.sqrt()
+    }
+
+    /// `None` if the inputs `x` lie within [`Self::radius`] of a training input (or are not
+    /// finite: the range check reports those); else `(d(x), a sentence saying how far)`.
+    pub fn outside(&self, x: &[f64]) -> Option<(f64, String)> {
+        if x.len() != self.names.len() || x.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        let radius = self.radius();
+        if self.distance(x, radius) <= radius {
+            return None;
+        }
+        let d = self.distance(x, 0.0);
+        let values: Vec<String> = (self.names.iter().zip(x))
+            .map(|(name, v)| format!("{name} = {v}"))
+            .collect();
+        Some((
+            d,
+            format!(
+                "the inputs together ({}) lie {d:.3} from the nearest training input, where training inputs lie within {:.3} of one another and at most {radius:.3} is accepted (distances in units of each input's training range): each input is inside its range, but training never came near this combination",
+                values.join(", "),
+                self.spacing
+            ),
+        ))
+    }
+}
+
+/// `s` of the scaled rows `x` (`n × d`): over [`PROBES`] evenly spaced rows, the largest distance
+/// to the nearest other row — with `windowed`, leaving out the rows of the same trajectory within
+/// [`WINDOW_FRACTION`] of it. `None` if no probe has a row to compare with.
+fn spacing(x: &[f64], d: usize, segments: &[(usize, bool)], windowed: bool) -> Option<f64> {
+    let n = x.len() / d;
+    let probes = n.min(PROBES);
+    let segment_of = |i: usize| {
+        let mut start = 0;
+        for &(len, trajectory) in segments {
+            if i < start + len {
+                return (start, len, trajectory);
+            }
+            start += len;
+        }
+        (0, n, true)
+    };
+    let mut largest: Option<f64> = None;
+    for m in 0..probes {
+        let i = m * n / probes;
+        let (start, len, trajectory) = segment_of(i);
+        let w = match windowed && trajectory {
+            true => ((len as f64 * WINDOW_FRACTION) as usize).max(1),
+            false => 0,
+        };
+        let (near_lo, near_hi) = (i.saturating_sub(w).max(start), (i + w).min(start + len - 1));
+        let xi = &x[i * d..(i + 1) * d];
+        let nearest = (0..n)
+            .filter(|&j| j != i && !(near_lo..=near_hi).contains(&j))
+            .map(|j| {
+                (x[j * d..(j + 1) * d].iter().zip(xi))
+                    .map(|(a, b)| (a - b) * (a - b))
+                    .sum::<f64>()
+            })
+            .min_by(f64::total_cmp);
+        if let Some(s) = nearest {
+            largest = Some(largest.unwrap_or(0.0).max(s.sqrt()));
+        }
+    }
+    largest
+}
+
+/// A model's training inputs bound to a scenario: the [`InputCloud`] of its anchors, with each
+/// input's value in a run (a tension from the run, anything else from the scenario).
+#[derive(Debug, Clone)]
+pub struct Coverage {
+    cloud: InputCloud,
+    inputs: Vec<GuessInput>,
+}
+
+impl InputCloud {
+    /// The cloud of `model`'s training inputs, its anchors' inputs named by
+    /// [`ModelMeta::anchor_parameters`](crate::reduced_model::ModelMeta::anchor_parameters);
+    /// `None` for a model without anchors or whose inputs do not vary.
+    pub fn of_model(model: &ReducedModel) -> Option<InputCloud> {
+        let anchors = model.anchors.as_ref()?;
+        let meta = &model.meta;
+        // a model from before `trajectory` was recorded: each dataset read as a trajectory
+        let segments: Vec<(usize, bool)> = std::iter::once(&meta.dataset)
+            .chain(&meta.more_datasets)
+            .map(|d| (d.rows, d.trajectory.unwrap_or(true)))
+            .collect();
+        InputCloud::new(meta.anchor_parameters.clone(), &anchors.inputs, &segments)
+    }
+
+    /// The names of the inputs, in column order.
+    pub fn names(&self) -> &[String] {
+        &self.names
+    }
+}
+
+impl Coverage {
+    /// The coverage of `model`'s training inputs in the scenario of `built` (its TOML `table`, for
+    /// inputs other than tensions); `None` for a model without anchors (the range check alone
+    /// applies), with inputs that do not vary, or whose inputs the scenario does not define.
+    pub fn of(
+        built: &Built,
+        table: Option<&toml::Table>,
+        model: &ReducedModel,
+    ) -> Option<Coverage> {
+        let inputs = GuessInput::of_model(built, table, model)?;
+        let cloud = InputCloud::of_model(model)?;
+        Some(Coverage { cloud, inputs })
+    }
+
+    pub fn cloud(&self) -> &InputCloud {
+        &self.cloud
+    }
+}
+
+impl JointInputs for Coverage {
+    fn outside(&self, u: &[f64]) -> Option<(f64, String)> {
+        let x = GuessInput::values(&self.inputs, u)?;
+        self.cloud.outside(&x)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn names(k: usize) -> Vec<String> {
+        (0..k).map(|i| format!("tendons.{i}.tension")).collect()
+    }
+
+    /// A deterministic stand-in for uniform draws in `[0, 1)` (a Weyl sequence per column).
+    fn draws(n: usize, k: usize) -> Vec<f64> {
+        let alpha = [0.754877, 0.569840, 0.438459, 0.347987, 0.281918, 0.232549];
+        (0..n)
+            .flat_map(|i| (0..k).map(move |c| ((i as f64 + 0.5) * alpha[c] * 7.31).fract()))
+            .collect()
+    }
+
+    #[test]
+    fn a_sweep_of_all_inputs_together_covers_its_line_and_not_the_corners_of_its_box() {
+        // 101 samples of six tensions moved together from -10 to 0 N
+        let n = 101;
+        let rows: Vec<f64> = (0..n)
+            .flat_map(|i| std::iter::repeat_n(-10.0 + 10.0 * i as f64 / 100.0, 6))
+            .collect();
+        let cloud = InputCloud::new(names(6), &rows, &[(n, false)]).unwrap();
+        // on the line between two samples, and just beyond its end (inside the margin)
+        assert!(cloud.outside(&[-4.95; 6]).is_none());
+        assert!(cloud.outside(&[-10.1; 6]).is_none());
+        // a corner of the box: each tension alone in its range; the line's nearest point is
+        // -10/6 N on every tendon, at sqrt(30/36) ≈ 0.913 in units of the range
+        let (d, why) = cloud.outside(&[-10.0, 0.0, 0.0, 0.0, 0.0, 0.0]).unwrap();
+        assert!((d - (30.0f64 / 36.0).sqrt()).abs() < 0.01, "{d}");
+        assert!(why.contains("tendons.0.tension = -10"), "{why}");
+        assert!(why.contains("never came near this combination"), "{why}");
+        // half-way to that corner is still far off the line
+        assert!(cloud.outside(&[-5.0, 0.0, 0.0, 0.0, 0.0, 0.0]).is_some());
+    }
+
+    #[test]
+    fn new_draws_from_a_filled_box_are_inside_its_corners_included() {
+        // 20 000 independent draws of six inputs, as a random static dataset; then 2000 more
+        let (n, k) = (20_000, 6);
+        let rows = draws(n + 2000, k);
+        let cloud = InputCloud::new(names(k), &rows[..n * k], &[(n, false)]).unwrap();
+        assert!(
+            cloud.spacing() > 0.05 && cloud.spacing() < 0.5,
+            "{}",
+            cloud.spacing()
+        );
+        for x in rows[n * k..].chunks_exact(k) {
+            assert!(cloud.outside(x).is_none(), "{x:?}");
+        }
+        // every corner of the box, and 2 % beyond it (the range check's margin)
+        for corner in 0..(1 << k) {
+            let x: Vec<f64> = (0..k)
+                .map(|c| if corner >> c & 1 == 1 { 1.02 } else { -0.02 })
+                .collect();
+            assert!(cloud.outside(&x).is_none(), "corner {x:?}");
+        }
+    }
+
+    #[test]
+    fn a_finely_sampled_trajectory_is_judged_by_how_it_covers_its_inputs_not_by_its_sample_rate() {
+        // a held signal of 400 random six-tension holds with 0.2 s ramps between them, sampled at
+        // 100 Hz (0.5 s holds): consecutive samples nearly equal
+        let (holds, k) = (400, 6);
+        let levels = draws(holds + 1, k);
+        let mut rows = vec![];
+        for h in 0..holds {
+            let (a, b) = (
+                &levels[h * k..(h + 1) * k],
+                &levels[(h + 1) * k..(h + 2) * k],
+            );
+            for step in 0..50 {
+                let w = (step as f64 / 20.0).min(1.0);
+                rows.extend(a.iter().zip(b).map(|(a, b)| a + (b - a) * w));
+            }
+        }
+        let n = rows.len() / k;
+        let cloud = InputCloud::new(names(k), &rows, &[(n, true)]).unwrap();
+        // another draw of the same babbling (a test signal) is accepted
+        let other = draws(3000, k);
+        let far = other[2000 * k..]
+            .chunks_exact(k)
+            .filter(|x| cloud.outside(x).is_some())
+            .count();
+        assert_eq!(far, 0, "spacing {}", cloud.spacing());
+        // without the window, the spacing is the ramp's sample spacing and most draws would be
+        // refused
+        let fine = spacing(&cloud.points_for_test(&rows), k, &[(n, true)], false).unwrap();
+        assert!(fine < cloud.spacing() / 3.0, "{fine} {}", cloud.spacing());
+    }
+
+    #[test]
+    fn inputs_that_do_not_vary_or_too_few_rows_give_no_cloud() {
+        assert!(InputCloud::new(names(2), &[1.0, 2.0], &[(1, false)]).is_none());
+        assert!(InputCloud::new(names(1), &[3.0; 10], &[(10, false)]).is_none());
+        assert!(InputCloud::new(names(1), &[0.0, f64::NAN, 1.0], &[(3, false)]).is_none());
+        // a held input is left to the range check: the other is judged alone
+        let rows: Vec<f64> = (0..11).flat_map(|i| [i as f64, 5.0]).collect();
+        let cloud = InputCloud::new(names(2), &rows, &[(11, false)]).unwrap();
+        assert!(cloud.outside(&[4.5, 5.0]).is_none());
+    }
+
+    impl InputCloud {
+        /// `rows` scaled as the cloud scales its inputs (all columns vary in these tests).
+        fn points_for_test(&self, rows: &[f64]) -> Vec<f64> {
+            let k = self.names.len();
+            rows.chunks_exact(k)
+                .flat_map(|r| (0..k).map(move |c| (r[c] - self.lo[c]) / self.width[c]))
+                .collect()
+        }
+    }
+}
