@@ -44,6 +44,9 @@ impl Model {
             worst: r.worst,
             largest_norm: r.largest_norm,
             outside: r.outside,
+            unseen_inputs: r.unseen_inputs,
+            inputs_note: r.inputs_note,
+            other_physics: r.other_physics,
         })
     }
 }
@@ -72,6 +75,15 @@ pub enum DatasetArg<'py> {
 ///     The largest ``‖x‖``, for scale.
 /// outside : int
 ///     Snapshots whose code lies far outside the training encodings.
+/// unseen_inputs : int or None
+///     Snapshots whose inputs lie outside what the model was trained on: an input outside its
+///     training range, or a combination far from the training inputs (as ``model=`` refuses
+///     them). None when the dataset does not sample the model's inputs (``inputs_note`` says why).
+/// inputs_note : str or None
+///     Why ``unseen_inputs`` is None.
+/// other_physics : str or None
+///     The first way the dataset's physics differs from the model's training scenario (then every
+///     snapshot is an extrapolation), or None.
 #[pyclass(module = "gvsrom", frozen)]
 pub struct Reconstruction {
     /// Solved snapshots evaluated.
@@ -92,14 +104,28 @@ pub struct Reconstruction {
     /// Snapshots whose code lies far outside the training encodings.
     #[pyo3(get)]
     outside: usize,
+    /// Snapshots whose inputs lie outside what the model was trained on, or None.
+    #[pyo3(get)]
+    unseen_inputs: Option<usize>,
+    /// Why ``unseen_inputs`` is None.
+    #[pyo3(get)]
+    inputs_note: Option<String>,
+    /// The first way the dataset's physics differs from the model's, or None.
+    #[pyo3(get)]
+    other_physics: Option<String>,
 }
 
 #[pymethods]
 impl Reconstruction {
     fn __repr__(&self) -> String {
         format!(
-            "Reconstruction(rows={}, rmse={:.4e}, relative={:.4e}, outside={})",
-            self.rows, self.rmse, self.relative, self.outside
+            "Reconstruction(rows={}, rmse={:.4e}, relative={:.4e}, outside={}, unseen_inputs={})",
+            self.rows,
+            self.rmse,
+            self.relative,
+            self.outside,
+            self.unseen_inputs
+                .map_or("None".to_string(), |n| n.to_string())
         )
     }
 }

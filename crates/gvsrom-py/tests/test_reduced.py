@@ -307,6 +307,7 @@ def test_reconstruction_of_its_own_data_is_what_pod_discards(dataset, pod_model,
     sigma = pod_model.arrays["singular_values"]
     r = pod_model.reconstruction(ds)
     assert r.rows == len(x) and r.outside == 0
+    assert (r.unseen_inputs, r.inputs_note, r.other_physics) == (0, None, None)
     np.testing.assert_allclose(r.rmse, np.sqrt((sigma[2:] ** 2).sum() / x.size), rtol=1e-9)
     np.testing.assert_allclose(r.relative, np.sqrt((sigma[2:] ** 2).sum() / (sigma**2).sum()),
                                rtol=1e-9)
@@ -323,6 +324,14 @@ def test_reconstruction_of_its_own_data_is_what_pod_discards(dataset, pod_model,
     assert p.returncode == 0, p.stderr
     with pytest.raises(ValueError, match=r"invalid `DATASET`.*soft-beam.*single-tendon"):
         pod_model.reconstruction(beam)
+    # tensions beyond the training's [-6, 0] N on a stiffer rod: the inputs and the physics named
+    beyond = tmp_path / "beyond"
+    p = run_cli(gvsrom_bin, "dataset", "single-tendon", "--sweep", "tendons.0.tension=-9:-3",
+                "--samples", "3", "--set", "material.youngs_modulus=2e6", "--out", str(beyond))
+    assert p.returncode == 0, p.stderr
+    r = pod_model.reconstruction(beyond)
+    assert r.unseen_inputs == 1 and r.inputs_note is None, r
+    assert r.other_physics.startswith("material.youngs_modulus is 2000000.0 in the dataset's"), r
 
 
 def test_a_training_from_a_model_continues_it_and_keeps_its_architecture(dataset, ae_model, tmp_path):

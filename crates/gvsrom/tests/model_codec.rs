@@ -221,11 +221,55 @@ fn reconstruct_cli_gives_pods_discarded_singular_values_and_counts_extrapolated_
         "{out}"
     );
     assert!(out.contains("outside    0 of"), "{out}");
-    // tensions beyond the training's [-6, 3] N encode outside its codes
+    assert!(out.contains("inputs     0 of"), "{out}");
+    assert!(!out.contains("physics"), "{out}");
+    // tensions beyond the training's [-6, 3] N encode outside its codes, and their inputs are
+    // counted as unseen
     let wide = sweep_dataset("codec-cli-wide", "-30:-20", 5);
     let out = run_ok(&["reconstruct", s(&model), s(&wide)]);
     assert!(
         out.contains("outside    5 of 5") && out.contains("extrapolates"),
+        "{out}"
+    );
+    assert!(
+        out.contains("inputs     5 of 5 snapshots have inputs the model was not trained on"),
+        "{out}"
+    );
+    // the training's tensions on a stiffer rod: every input seen, the physics not
+    let stiff = scratch("codec-cli-stiff");
+    run_ok(&[
+        "dataset",
+        "single-tendon",
+        "--sweep",
+        "tendons.0.tension=-6:3",
+        "--samples",
+        "3",
+        "--set",
+        "material.youngs_modulus=2e7",
+        "--out",
+        s(&stiff),
+    ]);
+    let out = run_ok(&["reconstruct", s(&model), s(&stiff)]);
+    assert!(out.contains("inputs     0 of 3"), "{out}");
+    assert!(
+        out.contains("physics    differs from the model's training: material.youngs_modulus is 20000000.0 in the dataset's scenario `single-tendon`, 617000.0 in the model's"),
+        "{out}"
+    );
+    // a dataset of another input: not compared, and said so
+    let other_input = scratch("codec-cli-other-input");
+    run_ok(&[
+        "dataset",
+        "single-tendon",
+        "--sweep",
+        "material.youngs_modulus=1e6:2e6",
+        "--samples",
+        "2",
+        "--out",
+        s(&other_input),
+    ]);
+    let out = run_ok(&["reconstruct", s(&model), s(&other_input)]);
+    assert!(
+        out.contains("inputs     not compared with the training inputs: the dataset samples [material.youngs_modulus], the model was trained on [tendons.0.tension]"),
         "{out}"
     );
     // another layout is refused, naming the dataset

@@ -380,5 +380,21 @@ fn reconstruction_lines(
             ""
         }
     )?;
+    match (r.unseen_inputs, &r.inputs_note) {
+        (Some(n), _) => writeln!(
+            out,
+            "inputs     {n} of {} snapshots have inputs the model was not trained on (outside a training range, or a combination far from the training inputs){}",
+            r.rows,
+            if n > 0 { ": its errors there are an extrapolation's" } else { "" }
+        )?,
+        (None, Some(why)) => writeln!(out, "inputs     not compared with the training inputs: {why}")?,
+        (None, None) => {}
+    }
+    if let Some(what) = &r.other_physics {
+        writeln!(
+            out,
+            "physics    differs from the model's training: {what}; every snapshot is an extrapolation"
+        )?;
+    }
     Ok(())
 }

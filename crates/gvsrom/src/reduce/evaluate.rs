@@ -1,11 +1,16 @@
 //! `gvsrom reconstruct MODEL DATASET`: how closely a reduced model reconstructs the snapshots of a
 //! dataset, `x̂ = D(E(x))` ([`ReducedModel::reconstruct`]) — Table I's measure on any dataset of the
-//! model's layout, so that a model can be judged on data it was not trained on.
+//! model's layout, so that a model can be judged on data it was not trained on — and says where
+//! that data lies outside what the model was trained on (inputs, physics), where its errors are
+//! an extrapolation's.
 
+use super::coverage::InputCloud;
 use super::invalid;
+use crate::build::reduced::inside;
 use crate::dataset::Dataset;
 use crate::error::ScenarioError;
 use crate::reduced_model::{outside_range, same_abscissae, ReducedModel};
+use crate::scenario::Scenario;
 
 /// The reconstruction errors of a model on a dataset's solved snapshots.
 #[derive(Debug, Clone, PartialEq)]
@@ -25,6 +30,16 @@ pub struct Reconstruction {
     /// Snapshots whose code lies far outside the training encodings (the model extrapolates
     /// there; their errors are included above).
     pub outside: usize,
+    /// Snapshots whose inputs lie outside what the model was trained on — an input outside its
+    /// training range, or a combination far from the training inputs (`reduce::coverage`) — as
+    /// `--model` would refuse them; `None` when the dataset's inputs are not the model's (then
+    /// [`Self::inputs_note`] says which).
+    pub unseen_inputs: Option<usize>,
+    /// Why [`Self::unseen_inputs`] could not be counted.
+    pub inputs_note: Option<String>,
+    /// The first way the dataset's physics differs from the model's training scenario (its inputs
+    /// aside), and how many more; `None` when they agree. Every snapshot is then an extrapolation.
+    pub other_physics: Option<String>,
 }
 
 /// The reconstruction of every solved snapshot of `ds` by `model`. The dataset must have the
@@ -46,6 +61,8 @@ pub fn reconstruction(model: &ReducedModel, ds: &Dataset) -> Result<Reconstructi
             ),
         ));
     }
+    let unseen = unseen_inputs(model, ds);
+    let other_physics = other_physics(model, ds)?;
     let (mut err2, mut norm2, mut entries) = (0.0, 0.0, 0usize);
     let (mut worst, mut outside, mut largest) = (None::<(usize, f64, f64)>, 0, 0.0f64);
     let rows = ds.ok_rows();
@@ -82,5 +99,74 @@ pub fn reconstruction(model: &ReducedModel, ds: &Dataset) -> Result<Reconstructi
         worst,
         largest_norm: largest,
         outside,
+        unseen_inputs: unseen.as_ref().ok().copied(),
+        inputs_note: unseen.err(),
+        other_physics,
+    })
+}
+
+/// How many solved snapshots of `ds` have inputs outside what `model` was trained on (an input
+/// outside its range, or a combination far from the training inputs); an explanation instead when
+/// the dataset does not sample the model's inputs.
+fn unseen_inputs(model: &ReducedModel, ds: &Dataset) -> Result<usize, String> {
+    let ranges = &model.meta.input_range;
+    if ranges.is_empty() {
+        return Err(
+            "the model records no training inputs (it was written before gvsrom recorded them)"
+                .into(),
+        );
+    }
+    let column = |name: &str| ds.meta.parameters.iter().position(|p| p == name);
+    let columns: Vec<usize> = ranges
+        .iter()
+        .map(|r| column(&r.parameter))
+        .collect::<Option<_>>()
+        .ok_or_else(|| {
+            let want: Vec<&str> = ranges.iter().map(|r| r.parameter.as_str()).collect();
+            format!(
+                "the dataset samples [{}], the model was trained on [{}]",
+                ds.meta.parameters.join(", "),
+                want.join(", ")
+            )
+        })?;
+    let cloud = InputCloud::of_model(model);
+    let cloud_columns: Option<Vec<usize>> = cloud
+        .as_ref()
+        .and_then(|c| c.names().iter().map(|n| column(n)).collect());
+    let k = ds.meta.parameters.len();
+    let mut x = vec![];
+    let count = ds
+        .ok_rows()
+        .iter()
+        .filter(|&&i| {
+            let row = &ds.inputs[i * k..(i + 1) * k];
+            let in_ranges = ranges.iter().zip(&columns).all(|(r, &c)| inside(r, row[c]));
+            let near = match (&cloud, &cloud_columns) {
+                (Some(cloud), Some(cols)) => {
+                    x.clear();
+                    x.extend(cols.iter().map(|&c| row[c]));
+                    cloud.outside(&x).is_none()
+                }
+                _ => true,
+            };
+            !(in_ranges && near)
+        })
+        .count();
+    Ok(count)
+}
+
+/// The first way the physics of `ds`'s scenario differs from `model`'s training scenario, the
+/// inputs of either aside ([`super::validity::physics_differences`]).
+fn other_physics(model: &ReducedModel, ds: &Dataset) -> Result<Option<String>, ScenarioError> {
+    let trained = super::validity::trained_scenario(model)?;
+    let here = Scenario::from_toml(&ds.meta.scenario, &ds.meta.scenario_toml, &[])
+        .map_err(|e| invalid("DATASET", format!("its scenario cannot be read: {e}")))?;
+    let inputs = (model.meta.input_range.iter().map(|r| r.parameter.as_str()))
+        .chain(ds.meta.parameters.iter().map(String::as_str));
+    super::validity::first_physics_difference(&trained, &here, inputs, |at, there, value| {
+        format!(
+            "{at} is {value} in the dataset's scenario `{}`, {there} in the model's `{}`",
+            ds.meta.scenario, model.meta.layout.scenario
+        )
     })
 }
