@@ -529,3 +529,67 @@ fn a_massless_rod_is_refused_for_motion_naming_the_density() {
     ]);
     assert!(out.status.success());
 }
+
+#[test]
+fn integrator_options_out_of_range_or_ignored_by_the_method_are_refused_before_any_output() {
+    let out = scratch("integrator-options");
+    let cases: [(&[&str], &[&str]); 9] = [
+        (&["--max-order", "0"], &["--max-order", "from 1 to 5"]),
+        (&["--max-order", "6"], &["--max-order", "from 1 to 5"]),
+        (
+            &["--method", "galpha", "--rho-inf", "2"],
+            &["--rho-inf", "in [0, 1]"],
+        ),
+        (
+            &["--method", "sdirk", "--max-order", "2"],
+            &["--max-order", "does not apply", "NDF"],
+        ),
+        (&["--rho-inf", "0.5"], &["--rho-inf", "generalized-α"]),
+        (
+            &["--fixed-step", "0.01", "--method", "ndf"],
+            &["--method", "fixed-step"],
+        ),
+        (
+            &["--fixed-step", "0.01", "--rtol", "1e-4"],
+            &["--rtol", "not controlled"],
+        ),
+        (
+            &["--fixed-step", "0.01", "--max-order", "2"],
+            &["--max-order", "fixed-step"],
+        ),
+        (
+            &["--fixed-step", "1"],
+            &["--fixed-step", "longer than --duration 0.1 s"],
+        ),
+    ];
+    for (extra, needles) in cases {
+        let base = [
+            "simulate",
+            "single-tendon",
+            "--duration",
+            "0.1",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        expect_error(&[&base[..], extra].concat(), needles);
+        assert!(!out.exists(), "{extra:?} created {}", out.display());
+    }
+    // where they apply they run
+    for extra in [
+        &["--method", "galpha", "--rho-inf", "0.5"][..],
+        &["--method", "ndf", "--max-order", "2"],
+        &["--fixed-step", "0.1"],
+    ] {
+        let args = [
+            &["simulate", "single-tendon", "--duration", "0.1"][..],
+            extra,
+        ]
+        .concat();
+        let o = gvsrom(&args);
+        assert!(
+            o.status.success(),
+            "{extra:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    }
+}

@@ -94,8 +94,9 @@ pub struct SimulateArgs {
     pub error_norm: Option<ErrorNormChoice>,
 
     /// Generalized-α: spectral radius at infinite frequency in [0, 1] (1: no numerical dissipation).
-    #[arg(long, default_value_t = 0.8)]
-    pub rho_inf: f64,
+    /// Default 0.8; only with `--method galpha`.
+    #[arg(long, allow_hyphen_values = true)]
+    pub rho_inf: Option<f64>,
 
     /// Time-varying external loads: a CSV file with columns `t, λ` that scales every external load and
     /// gravity, linearly interpolated between rows (e.g. a load applied then removed).

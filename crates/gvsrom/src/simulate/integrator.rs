@@ -51,8 +51,9 @@ pub struct IntegratorChoice {
     /// Highest NDF order (1–5); default 5, or 2 for a lightly damped rod.
     pub max_order: Option<usize>,
     pub error_norm: Option<ErrorNormChoice>,
-    /// Generalized-α: spectral radius at infinite frequency.
-    pub rho_inf: f64,
+    /// Generalized-α: spectral radius at infinite frequency, in \[0, 1\]; default
+    /// [`DEFAULT_RHO_INF`].
+    pub rho_inf: Option<f64>,
     /// A fixed step `h` \[s\]: the fixed-step BDF2 instead of an adaptive method.
     pub fixed_step: Option<f64>,
     /// Finite differences of the first-order right-hand side for the Jacobian (`--fd-jacobian`);
@@ -68,7 +69,7 @@ impl Default for IntegratorChoice {
             atol: 1e-6,
             max_order: None,
             error_norm: None,
-            rho_inf: 0.8,
+            rho_inf: None,
             fixed_step: None,
             fd_jacobian: false,
         }
@@ -113,7 +114,7 @@ pub fn choose_integrator(
     choice: &IntegratorChoice,
 ) -> Result<(IntegratorOptions, Option<String>), ScenarioError> {
     require_mass(built)?;
-    check_tolerances(choice)?;
+    check_choice(choice)?;
     let decoder = built
         .reduced
         .as_ref()
@@ -150,7 +151,7 @@ pub fn choose_integrator(
         (None, MethodChoice::Galpha) => Method::GeneralizedAlpha(GeneralizedAlphaOptions {
             rtol,
             atol,
-            rho_inf: choice.rho_inf,
+            rho_inf: choice.rho_inf.unwrap_or(DEFAULT_RHO_INF),
             error_norm: error_norm(ErrorNorm::Componentwise),
             ..GeneralizedAlphaOptions::default()
         }),
@@ -284,4 +285,84 @@ pub fn check_tolerances(choice: &IntegratorChoice) -> Result<(), ScenarioError> 
         ));
     }
     Ok(())
+}
+
+/// Generalized-α's spectral radius at infinite frequency when `--rho-inf` is not given.
+pub const DEFAULT_RHO_INF: f64 = 0.8;
+
+/// Checks every option of `choice` ([`check_tolerances`], then the rest) before anything runs:
+/// `--max-order` in 1–5, `--rho-inf` in \[0, 1\], `--fixed-step` finite and positive, and no
+/// option the chosen method would ignore (`--max-order` only with the NDF, `--rho-inf` only with
+/// generalized-α, no `--method`, `--rtol` or `--error-norm` with the fixed step, which is a
+/// method of its own without error control).
+pub fn check_choice(choice: &IntegratorChoice) -> Result<(), ScenarioError> {
+    check_tolerances(choice)?;
+    if let Some(m) = choice.max_order {
+        if !(1..=5).contains(&m) {
+            return Err(ScenarioError::value(
+                "--max-order",
+                m as f64,
+                "a whole number from 1 to 5 (the NDF's orders; ≤ 2 are A-stable)",
+            ));
+        }
+    }
+    if let Some(rho) = choice.rho_inf {
+        if !(0.0..=1.0).contains(&rho) {
+            return Err(ScenarioError::value(
+                "--rho-inf",
+                rho,
+                "a number in [0, 1] (1: no numerical dissipation)",
+            ));
+        }
+    }
+    let ignored = |option: &str, method: &str| {
+        Err(ScenarioError::invalid(
+            option,
+            format!("does not apply to {method}, which would ignore it"),
+        ))
+    };
+    if let Some(h) = choice.fixed_step {
+        if !(h.is_finite() && h > 0.0) {
+            return Err(ScenarioError::value(
+                "--fixed-step",
+                h,
+                "a finite step > 0 s",
+            ));
+        }
+        let fixed = "the fixed-step method (--fixed-step)";
+        if choice.method != MethodChoice::Auto {
+            return ignored("--method", fixed);
+        }
+        if choice.rtol.is_some() {
+            return ignored(
+                "--rtol",
+                "the fixed-step method (--fixed-step), whose error is not controlled",
+            );
+        }
+        if choice.error_norm.is_some() {
+            return ignored("--error-norm", fixed);
+        }
+        if choice.max_order.is_some() {
+            return ignored("--max-order", fixed);
+        }
+        if choice.rho_inf.is_some() {
+            return ignored("--rho-inf", fixed);
+        }
+        return Ok(());
+    }
+    match choice.method {
+        MethodChoice::Galpha | MethodChoice::Sdirk if choice.max_order.is_some() => ignored(
+            "--max-order",
+            "this method (it is the NDF's; --method ndf or auto)",
+        ),
+        MethodChoice::Auto | MethodChoice::Ndf | MethodChoice::Sdirk
+            if choice.rho_inf.is_some() =>
+        {
+            ignored(
+                "--rho-inf",
+                "this method (it is generalized-α's; --method galpha)",
+            )
+        }
+        _ => Ok(()),
+    }
 }

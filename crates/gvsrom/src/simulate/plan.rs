@@ -81,6 +81,16 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
     let t_out = sample_times(opts.duration, opts.sample_rate)?;
     if let Method::Fixed(f) = &opts.integrator.method {
         let h = positive("--fixed-step", f.h, "s")?;
+        if h > opts.duration {
+            return Err(ScenarioError::invalid(
+                "--fixed-step",
+                format!(
+                    "{} s is longer than --duration {} s: the run would be one step past its end; use a step ≤ the duration",
+                    gvs::error::fmt_value(h),
+                    gvs::error::fmt_value(opts.duration)
+                ),
+            ));
+        }
         if opts.duration / h > MAX_FIXED_STEPS {
             return Err(ScenarioError::invalid(
                 "--fixed-step",
