@@ -96,9 +96,20 @@ impl Source {
     }
 }
 
-/// Resolves `arg` as a preset name first, then as a file path.
+/// Resolves `arg` as a preset name first, then as a file path. A name that is both a preset and a
+/// regular file here is refused as ambiguous (`./NAME` names the file): the preset would
+/// silently win over the file the user may have meant.
 pub fn source(arg: &str) -> Result<Source, ScenarioError> {
     if let Some(p) = find(arg) {
+        if Path::new(arg).is_file() {
+            return Err(ScenarioError::invalid(
+                "SCENARIO",
+                format!(
+                    "`{arg}` names both the preset `{}` and a file in this directory: write `./{arg}` for the file; the preset is taken only where no such file exists",
+                    p.name
+                ),
+            ));
+        }
         return Ok(Source {
             origin: format!("preset `{}`", p.name),
             default_name: p.name.to_string(),

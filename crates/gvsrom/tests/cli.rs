@@ -588,3 +588,55 @@ fn check_refuses_extrapolate_that_has_no_model_to_apply_to() {
     let out = gvsrom(&["check", "single-tendon"]);
     assert!(out.status.success());
 }
+
+#[test]
+fn a_name_that_is_both_a_preset_and_a_file_here_is_refused_as_ambiguous() {
+    let dir = scratch("preset-and-file");
+    std::fs::create_dir_all(&dir).unwrap();
+    let shown = gvsrom(&["show", "single-tendon"]);
+    std::fs::write(dir.join("single-tendon"), &shown.stdout).unwrap();
+    let run = |arg: &str| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_gvsrom"))
+            .args(["check", arg])
+            .current_dir(&dir)
+            .output()
+            .unwrap()
+    };
+    let out = run("single-tendon");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("`single-tendon` names both the preset `single-tendon` and a file in this directory: write `./single-tendon` for the file"),
+        "{stderr}"
+    );
+    // the file by its path, and a directory of the same name (an output) does not count
+    assert!(run("./single-tendon").status.success());
+    std::fs::create_dir_all(dir.join("six-tendon")).unwrap();
+    assert!(run("six-tendon").status.success());
+}
+
+#[test]
+fn a_friction_or_damping_no_material_has_is_refused_naming_the_field() {
+    expect_error(
+        &["check", "single-tendon", "--set", "tendons.0.friction=1e9"],
+        &["tendons[0].friction", "a number in [0, 10]"],
+    );
+    // single-tendon: E = 617 kPa, so 1e20 Pa·s relaxes in 1.6e14 s
+    expect_error(
+        &["check", "single-tendon", "--set", "material.damping=1e20"],
+        &[
+            "material.damping",
+            "at most 6.17e8 Pa*s for this Young's modulus",
+            "relaxation time η / E of 1.62e14 s against 1000 s accepted",
+        ],
+    );
+    // the bounds themselves are accepted
+    for set in ["tendons.0.friction=10", "material.damping=6.17e8"] {
+        let out = gvsrom(&["check", "single-tendon", "--set", set]);
+        assert!(
+            out.status.success(),
+            "{set}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+}

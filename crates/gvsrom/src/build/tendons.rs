@@ -44,7 +44,12 @@ pub(super) fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, Scen
         ));
     }
     let x_end = x_end.min(l);
-    let friction = non_negative(&f("friction"), t.friction, "")?;
+    let friction = in_range(
+        &f("friction"),
+        t.friction,
+        FRICTION_RANGE,
+        "(a capstan coefficient)",
+    )?;
     let friction_smoothing = non_negative(
         &f("friction_smoothing"),
         t.friction_smoothing.unwrap_or(DEFAULT_FRICTION_SMOOTHING),
