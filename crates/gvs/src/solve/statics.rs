@@ -194,6 +194,9 @@ pub enum StaticsError {
         residual_norm: f64,
         tolerance: f64,
         reason: String,
+        /// Whether pseudo-arc-length continuation from the straight rod was tried (and failed):
+        /// the failure is then not one a finer ramp would avoid.
+        continued: bool,
     },
     /// The caller's [`StopCheck`] asked to stop (an interrupt) before the load stage at
     /// `load_factor` or a continuation step.
@@ -398,6 +401,7 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                         "stopped after {} load stages and {} iterations (limits per solve: {max_stages} stages, {max_total_iterations} iterations) with the load increment at {inc:.3e}",
                         total.load_stages, total.iterations
                     ),
+                    continued: total.continuation.is_some(),
                 });
             }
             let target = (lambda + inc).min(1.0);
@@ -491,6 +495,7 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                         residual_norm,
                         tolerance,
                         reason,
+                        continued: may_continue,
                     });
                 }
             }

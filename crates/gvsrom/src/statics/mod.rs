@@ -396,12 +396,24 @@ pub fn compare(built: &Built, hom: &StaticsReport, rom: &StaticsReport) -> Compa
 /// The engine's error with, for a non-convergence, the largest load and a remedy.
 fn failure(built: &Built, u: &[f64], error: StaticsError) -> StaticsFailure {
     let mut hint = String::new();
-    if let StaticsError::NotConverged { .. } = error {
+    if let StaticsError::NotConverged {
+        continued,
+        load_factor,
+        ..
+    } = error
+    {
         if let Some(load) = crate::plausibility::largest_load(built, u, 1.0) {
             hint.push_str(&format!("; {load}"));
         }
         let steps = built.options.ramp_steps;
-        if steps < MAX_RAMP_STEPS {
+        if continued && load_factor >= 1.0 {
+            hint.push_str("; continuation reached the full load, but the last solve there did not meet the tolerance: lower the load, or loosen solver.ftol");
+        } else if continued {
+            // continuation from the straight rod already failed: a finer ramp would not help
+            hint.push_str(&format!(
+                "; the equilibria from the straight rod were followed by continuation and do not reach the full load (it stopped at λ = {load_factor:.4}, likely a limit point): a finer ramp will not help; lower the load"
+            ));
+        } else if steps < MAX_RAMP_STEPS {
             let more = (steps * 10).clamp(10, MAX_RAMP_STEPS);
             hint.push_str(&format!("; try solver.ramp_steps = {more}"));
         } else {
@@ -420,4 +432,43 @@ pub fn centerline_abscissae(length: f64, c: usize) -> Vec<f64> {
 
 fn arr3(v: &V3) -> [f64; 3] {
     [v[0], v[1], v[2]]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn not_converged(load_factor: f64, continued: bool) -> StaticsError {
+        StaticsError::NotConverged {
+            load_factor,
+            iterations: 9,
+            residual_norm: 1.0,
+            tolerance: 1e-10,
+            reason: "test".into(),
+            continued,
+        }
+    }
+
+    #[test]
+    fn the_remedy_of_a_failed_solve_follows_what_was_tried() {
+        let built = crate::build(&crate::presets::load("single-tendon", &[]).unwrap()).unwrap();
+        let hint = |e| failure(&built, &[-3.0], e).hint;
+        // the ramp alone was tried: a finer one
+        let h = hint(not_converged(0.5, false));
+        assert!(h.contains("try solver.ramp_steps = 10"), "{h}");
+        // continuation from the straight rod stopped short of the full load: no finer ramp
+        let h = hint(not_converged(0.8125, true));
+        assert!(
+            h.contains("stopped at λ = 0.8125, likely a limit point")
+                && h.contains("a finer ramp will not help; lower the load")
+                && !h.contains("ramp_steps ="),
+            "{h}"
+        );
+        // it reached the full load but the last solve did not meet the tolerance
+        let h = hint(not_converged(1.0, true));
+        assert!(
+            h.contains("loosen solver.ftol") && !h.contains("ramp_steps ="),
+            "{h}"
+        );
+    }
 }
