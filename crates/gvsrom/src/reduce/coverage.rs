@@ -132,13 +132,18 @@ impl InputCloud {
     /// units of each input's range; `stop_below` ends the search at the first training input
     /// closer than it (the distance returned is then that one's).
     pub fn distance(&self, x: &[f64], stop_below: f64) -> f64 {
+        self.distance_by(|c| x[c], stop_below)
+    }
+
+    /// [`Self::distance`] of the inputs whose column `c` holds `value(c)` (allocates nothing).
+    fn distance_by(&self, value: impl Fn(usize) -> f64, stop_below: f64) -> f64 {
         let d = self.dims.len();
         let stop = stop_below * stop_below;
         let mut best = f64::INFINITY;
         for p in self.points.chunks_exact(d) {
             let mut s = 0.0;
             for (j, &c) in self.dims.iter().enumerate() {
-                let e = (x[c] - self.lo[j]) / self.width[j] - p[j];
+                let e = (value(c) - self.lo[j]) / self.width[j] - p[j];
                 s += e * e;
             }
             if s < best {
@@ -154,16 +159,25 @@ impl InputCloud {
     /// `None` if the inputs `x` lie within [`Self::radius`] of a training input (or are not
     /// finite: the range check reports those); else `(d(x), a sentence saying how far)`.
     pub fn outside(&self, x: &[f64]) -> Option<(f64, String)> {
-        if x.len() != self.names.len() || x.iter().any(|v| !v.is_finite()) {
+        if x.len() != self.names.len() {
+            return None;
+        }
+        self.outside_by(|c| x[c])
+    }
+
+    /// [`Self::outside`] of the inputs whose column `c` holds `value(c)`; allocates only to say
+    /// how far, when they lie outside.
+    fn outside_by(&self, value: impl Fn(usize) -> f64) -> Option<(f64, String)> {
+        if (0..self.names.len()).any(|c| !value(c).is_finite()) {
             return None;
         }
         let radius = self.radius();
-        if self.distance(x, radius) <= radius {
+        if self.distance_by(&value, radius) <= radius {
             return None;
         }
-        let d = self.distance(x, 0.0);
-        let values: Vec<String> = (self.names.iter().zip(x))
-            .map(|(name, v)| format!("{name} = {v}"))
+        let d = self.distance_by(&value, 0.0);
+        let values: Vec<String> = (self.names.iter().enumerate())
+            .map(|(c, name)| format!("{name} = {}", value(c)))
             .collect();
         Some((
             d,
@@ -266,9 +280,13 @@ impl Coverage {
 }
 
 impl JointInputs for Coverage {
+    /// Allocates nothing for inputs near the training inputs (a batch checks every one).
     fn outside(&self, u: &[f64]) -> Option<(f64, String)> {
-        let x = GuessInput::values(&self.inputs, u)?;
-        self.cloud.outside(&x)
+        let value = |c: usize| match self.inputs[c] {
+            GuessInput::Tension(k) => u.get(k).copied().unwrap_or(f64::NAN),
+            GuessInput::Value(v) => v,
+        };
+        self.cloud.outside_by(value)
     }
 }
 
