@@ -321,7 +321,13 @@ fn a_resumed_run_equals_an_uninterrupted_one() {
     );
     assert!(String::from_utf8_lossy(&out.stdout).contains("2 chunks kept"));
     assert_same_arrays(&whole, &part);
-    assert!(Dataset::load(&part).unwrap().meta.complete);
+    let (resumed, uninterrupted) = (
+        Dataset::load(&part).unwrap(),
+        Dataset::load(&whole).unwrap(),
+    );
+    assert!(resumed.meta.complete);
+    // the counts too: the kept chunks' warm starts are carried over
+    assert_eq!(resumed.meta.counts, uninterrupted.meta.counts);
     // nothing left beside it
     let parent = part.parent().unwrap();
     for e in std::fs::read_dir(parent).unwrap() {

@@ -417,8 +417,12 @@ pub fn run(args: &DatasetRequest, interrupt: &AtomicUsize) -> Result<Outcome, Da
     let mut dir = OutputDir::create("--out", &args.out, "dataset", args.force || args.resume)?;
     let mut results: Vec<Option<Vec<SampleResult>>> = vec![None; n_chunks];
     let mut resumed_chunks = 0;
+    // the kept samples' warm starts: rows do not record them, the previous counts do (its chunks
+    // not done hold none)
+    let mut kept_warm_starts = 0;
     if args.resume {
         let prev = resume::resumable(&args.out, &meta)?;
+        kept_warm_starts = prev.meta.counts.warm_started;
         for c in 0..n_chunks {
             if prev.meta.chunk_done[c] {
                 results[c] = Some(
@@ -483,6 +487,7 @@ pub fn run(args: &DatasetRequest, interrupt: &AtomicUsize) -> Result<Outcome, Da
     meta.reason = interrupted.clone();
     meta.wall_time_s = t0.elapsed().as_secs_f64();
     write::write(&mut dir, &mut meta, &gen, results)?;
+    meta.counts.warm_started += kept_warm_starts;
     let path = dir.commit(&meta)?;
     // a plan none of whose samples solves is an error, not a dataset: every row failed
     if meta.complete && meta.samples > 0 && meta.counts.ok == 0 {
