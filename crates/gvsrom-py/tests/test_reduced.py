@@ -80,6 +80,29 @@ def test_an_attached_model_refuses_tensions_outside_its_training_with_the_cli_me
     assert str(e.value) == expected
 
 
+def test_a_combination_of_tensions_training_never_came_near_is_refused_with_the_cli_message(
+        gvsrom_bin, tmp_path):
+    # six tensions moved together: every tension of [-10, 0, 0, 0, 0, 0] lies in its range, the
+    # combination far off the line the model saw
+    data = tmp_path / "together"
+    p = run_cli(gvsrom_bin, "dataset", "six-tendon-no-gravity", "--sweep", "tendons.*.tension=-10:0",
+                "--samples", "11", "--out", str(data))
+    assert p.returncode == 0, p.stderr
+    model = gvsrom.pod(data, 2, tmp_path / "pod")
+    expected = cli_error(gvsrom_bin, "statics", "six-tendon-no-gravity", "--tension=-10,0,0,0,0,0",
+                         "--model", str(model.path))
+    assert "never came near this combination" in expected
+    # the preset's own tensions are that corner: the robot is built on the line
+    scenario = gvsrom.Scenario.preset("six-tendon-no-gravity").set("tendons.0.tension", -2.0)
+    for k in range(1, 6):
+        scenario = scenario.set(f"tendons.{k}.tension", -2.0)
+    robot = scenario.build().with_model(model)
+    robot.statics(u=[-4.5] * 6)
+    with pytest.raises(gvsrom.GvsromError) as e:
+        robot.statics(u=[-10.0, 0, 0, 0, 0, 0])
+    assert str(e.value) == expected
+
+
 def test_reduced_model_quantities_hold_as_the_full_models(ae_model):
     robot = gvsrom.Scenario.preset("single-tendon").build().with_model(ae_model)
     assert robot.n_dof == 1 and robot.model == ae_model.path

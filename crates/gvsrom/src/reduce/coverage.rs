@@ -280,7 +280,8 @@ impl Coverage {
 }
 
 impl JointInputs for Coverage {
-    /// Allocates nothing for inputs near the training inputs (a batch checks every one).
+    /// Allocates nothing for inputs near the training inputs (Python's `statics(u)` checks every
+    /// call's).
     fn outside(&self, u: &[f64]) -> Option<(f64, String)> {
         let value = |c: usize| match self.inputs[c] {
             GuessInput::Tension(k) => u.get(k).copied().unwrap_or(f64::NAN),
