@@ -559,7 +559,10 @@ fn integrator_options_out_of_range_or_ignored_by_the_method_are_refused_before_a
         ),
         (
             &["--fixed-step", "1"],
-            &["--fixed-step", "longer than --duration 0.1 s"],
+            &[
+                "--fixed-step",
+                "longer than the run itself (--duration 0.1 s)",
+            ],
         ),
     ];
     for (extra, needles) in cases {

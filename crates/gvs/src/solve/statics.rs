@@ -181,6 +181,19 @@ pub struct StaticsSolution {
     pub continuation: Option<ContinuationStats>,
 }
 
+/// What pseudo-arc-length continuation did in a solve that did not converge
+/// ([`StaticsError::NotConverged`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ContinuationOutcome {
+    /// Not tried: the ramp alone failed (or a warm start, or `min_increment = 1`, forbade it).
+    NotTried,
+    /// It stopped before the full load (the reason says where and why).
+    Stopped,
+    /// It reached the full load, but the last solve there did not converge, or the work budget
+    /// ran out after it.
+    Reached,
+}
+
 #[derive(Debug, Error)]
 pub enum StaticsError {
     #[error(transparent)]
@@ -194,9 +207,9 @@ pub enum StaticsError {
         residual_norm: f64,
         tolerance: f64,
         reason: String,
-        /// Whether pseudo-arc-length continuation from the straight rod was tried (and failed):
-        /// the failure is then not one a finer ramp would avoid.
-        continued: bool,
+        /// What pseudo-arc-length continuation from the straight rod did before the failure: a
+        /// failure after it is not one a finer ramp would avoid.
+        continuation: ContinuationOutcome,
     },
     /// The caller's [`StopCheck`] asked to stop (an interrupt) before the load stage at
     /// `load_factor` or a continuation step.
@@ -401,7 +414,10 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                         "stopped after {} load stages and {} iterations (limits per solve: {max_stages} stages, {max_total_iterations} iterations) with the load increment at {inc:.3e}",
                         total.load_stages, total.iterations
                     ),
-                    continued: total.continuation.is_some(),
+                    continuation: match total.continuation {
+                        Some(_) => ContinuationOutcome::Reached,
+                        None => ContinuationOutcome::NotTried,
+                    },
                 });
             }
             let target = (lambda + inc).min(1.0);
@@ -462,7 +478,12 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                     // only from the straight rod (a warm start's caller has its own fallback) and
                     // with ramping allowed (min_increment = 1 asks for one stage)
                     let may_continue = q0.is_none() && self.options.min_increment < 1.0;
+                    let mut outcome = match total.continuation {
+                        Some(_) => ContinuationOutcome::Reached,
+                        None => ContinuationOutcome::NotTried,
+                    };
                     if may_continue && total.continuation.is_none() {
+                        outcome = ContinuationOutcome::Stopped;
                         let ws = &mut self.ws;
                         match continuation::follow_statics(self.model, ws, u, loads, &opts, stop) {
                             Ok((path, residuals, jacobians)) => {
@@ -495,7 +516,7 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                         residual_norm,
                         tolerance,
                         reason,
-                        continued: may_continue,
+                        continuation: outcome,
                     });
                 }
             }

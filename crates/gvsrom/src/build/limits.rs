@@ -24,10 +24,6 @@ pub const DENSITY_RANGE: (f64, f64) = (0.0, 1e5);
 /// grippiest pairs (rubber on dry rubber, μ ≈ 1–2; the paper's 0.88). A tension decays as
 /// `exp(−μ θ)` along the wrap angle θ: at μ = 1e9 it vanishes at the first bend.
 pub const FRICTION_RANGE: (f64, f64) = (0.0, 10.0);
-/// Largest relaxation time `η / E` of the material's viscous damping \[s\]: 1000 s. The paper's
-/// silicone has 1e4 Pa·s / 617 kPa ≈ 0.016 s, soft materials 1e-3–1 s; a rod whose damping takes
-/// longer than minutes to relax behaves as a rigid one in any motion gvsrom simulates.
-pub const MAX_RELAXATION_TIME: f64 = 1e3;
 /// Largest gravitational acceleration |g| [m/s²] (1000 g).
 pub const MAX_GRAVITY: f64 = 1e4;
 /// Accepted division length ℓ_j \[m\]: 1 µm to 1 km.

@@ -23,19 +23,6 @@ pub(super) fn material(s: &Scenario) -> Result<Material, ScenarioError> {
     }
     in_range("material.density", m.density, DENSITY_RANGE, "kg/m^3")?;
     non_negative("material.damping", m.damping, "Pa*s")?;
-    let most = MAX_RELAXATION_TIME * m.youngs_modulus;
-    if m.damping > most {
-        return Err(ScenarioError::value(
-            "material.damping",
-            m.damping,
-            format!(
-                "at most {} Pa*s for this Young's modulus: a relaxation time η / E of {:.2e} s against {} s accepted (the paper's material: 0.016 s)",
-                num(most),
-                m.damping / m.youngs_modulus,
-                num(MAX_RELAXATION_TIME)
-            ),
-        ));
-    }
     Ok(Material {
         youngs_modulus: m.youngs_modulus,
         poisson_ratio: m.poisson_ratio,

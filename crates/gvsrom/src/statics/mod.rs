@@ -8,7 +8,8 @@ use gvs::lie::V3;
 use gvs::model::Model;
 use gvs::model::Workspace;
 use gvs::solve::statics::{
-    StaticsError, StaticsOptions, StaticsSolution, StaticsSolver, MAX_RAMP_STEPS,
+    ContinuationOutcome, StaticsError, StaticsOptions, StaticsSolution, StaticsSolver,
+    MAX_RAMP_STEPS,
 };
 use gvs::strain::StrainParam;
 use nalgebra::DVector;
@@ -396,28 +397,26 @@ pub fn compare(built: &Built, hom: &StaticsReport, rom: &StaticsReport) -> Compa
 /// The engine's error with, for a non-convergence, the largest load and a remedy.
 fn failure(built: &Built, u: &[f64], error: StaticsError) -> StaticsFailure {
     let mut hint = String::new();
-    if let StaticsError::NotConverged {
-        continued,
-        load_factor,
-        ..
-    } = error
-    {
+    if let StaticsError::NotConverged { continuation, .. } = error {
         if let Some(load) = crate::plausibility::largest_load(built, u, 1.0) {
             hint.push_str(&format!("; {load}"));
         }
         let steps = built.options.ramp_steps;
-        if continued && load_factor >= 1.0 {
-            hint.push_str("; continuation reached the full load, but the last solve there did not meet the tolerance: lower the load, or loosen solver.ftol");
-        } else if continued {
-            // continuation from the straight rod already failed: a finer ramp would not help
-            hint.push_str(&format!(
-                "; the equilibria from the straight rod were followed by continuation and do not reach the full load (it stopped at λ = {load_factor:.4}, likely a limit point): a finer ramp will not help; lower the load"
-            ));
-        } else if steps < MAX_RAMP_STEPS {
-            let more = (steps * 10).clamp(10, MAX_RAMP_STEPS);
-            hint.push_str(&format!("; try solver.ramp_steps = {more}"));
-        } else {
-            hint.push_str("; lower the load: the ramp is already at its limit");
+        match continuation {
+            // continuation from the straight rod already failed (the reason says where and why)
+            ContinuationOutcome::Stopped => hint.push_str(
+                "; the equilibria from the straight rod were followed by continuation and do not reach the full load: a finer ramp will not help; lower the load",
+            ),
+            ContinuationOutcome::Reached => hint.push_str(
+                "; continuation reached the full load, but the solve there did not converge: lower the load, or loosen solver.ftol",
+            ),
+            ContinuationOutcome::NotTried if steps < MAX_RAMP_STEPS => {
+                let more = (steps * 10).clamp(10, MAX_RAMP_STEPS);
+                hint.push_str(&format!("; try solver.ramp_steps = {more}"));
+            }
+            ContinuationOutcome::NotTried => {
+                hint.push_str("; lower the load: the ramp is already at its limit")
+            }
         }
     }
     StaticsFailure { error, hint }
@@ -438,15 +437,19 @@ fn arr3(v: &V3) -> [f64; 3] {
 mod tests {
     use super::*;
 
-    fn not_converged(load_factor: f64, continued: bool) -> StaticsError {
+    fn not_converged(continuation: ContinuationOutcome) -> StaticsError {
         StaticsError::NotConverged {
-            load_factor,
+            load_factor: 0.5,
             iterations: 9,
             residual_norm: 1.0,
             tolerance: 1e-10,
             reason: "test".into(),
-            continued,
+            continuation,
         }
+    }
+
+    fn built6() -> Built {
+        crate::build(&crate::presets::load("six-tendon", &[]).unwrap()).unwrap()
     }
 
     #[test]
@@ -454,21 +457,30 @@ mod tests {
         let built = crate::build(&crate::presets::load("single-tendon", &[]).unwrap()).unwrap();
         let hint = |e| failure(&built, &[-3.0], e).hint;
         // the ramp alone was tried: a finer one
-        let h = hint(not_converged(0.5, false));
+        let h = hint(not_converged(ContinuationOutcome::NotTried));
         assert!(h.contains("try solver.ramp_steps = 10"), "{h}");
         // continuation from the straight rod stopped short of the full load: no finer ramp
-        let h = hint(not_converged(0.8125, true));
+        let h = hint(not_converged(ContinuationOutcome::Stopped));
         assert!(
-            h.contains("stopped at λ = 0.8125, likely a limit point")
-                && h.contains("a finer ramp will not help; lower the load")
+            h.contains("do not reach the full load: a finer ramp will not help; lower the load")
                 && !h.contains("ramp_steps ="),
             "{h}"
         );
-        // it reached the full load but the last solve did not meet the tolerance
-        let h = hint(not_converged(1.0, true));
+        // it reached the full load but the last solve did not converge
+        let h = hint(not_converged(ContinuationOutcome::Reached));
         assert!(
             h.contains("loosen solver.ftol") && !h.contains("ramp_steps ="),
             "{h}"
+        );
+        // a load continuation cannot follow to the end, through the CLI
+        let e = crate::statics::solve_checked(&built6(), &[-200.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("then from the straight rod, continuation stopped at")
+                && e.contains("a finer ramp will not help")
+                && !e.contains("ramp_steps ="),
+            "{e}"
         );
     }
 }
