@@ -762,3 +762,62 @@ fn a_combination_of_inputs_training_never_came_near_is_refused_though_each_is_in
         ],
     );
 }
+
+#[test]
+fn a_linear_input_signal_is_checked_between_its_knots() {
+    // trained along an L: tendon 0 from -10 N to 0, then tendon 1 from 0 to -10 N
+    let l = scratch("val-l.csv");
+    std::fs::write(
+        &l,
+        "t,u0,u1,u2,u3,u4,u5\n0,-10,0,0,0,0,0\n1,0,0,0,0,0,0\n2,0,-10,0,0,0,0\n",
+    )
+    .unwrap();
+    let ds = scratch("val-ds-l");
+    run_ok(&[
+        "dataset",
+        "six-tendon-no-gravity",
+        "--duration",
+        "2",
+        "--sample-rate",
+        "100",
+        "--input",
+        s(&l),
+        "--interpolate",
+        "--out",
+        s(&ds),
+    ]);
+    let m = scratch("val-pod-l");
+    run_ok(&["pod", s(&ds), "--modes", "2", "--out", s(&m)]);
+    // the chord from one end of the L to the other: both knots were trained on, its middle not
+    let chord = scratch("val-chord.csv");
+    std::fs::write(
+        &chord,
+        "t,u0,u1,u2,u3,u4,u5\n0,-10,0,0,0,0,0\n0.1,0,-10,0,0,0,0\n",
+    )
+    .unwrap();
+    let args = |interpolate: bool| {
+        let mut a = vec![
+            "simulate",
+            "six-tendon-no-gravity",
+            "--model",
+            s(&m),
+            "--input",
+            s(&chord),
+            "--duration",
+            "0.1",
+        ];
+        if interpolate {
+            a.push("--interpolate");
+        }
+        a
+    };
+    expect_error(
+        &args(true),
+        &[
+            "at t = 0.05 s the inputs together (tendons.0.tension = -5, tendons.1.tension = -5",
+            "never came near this combination",
+        ],
+    );
+    // held, the signal only takes the two trained combinations
+    run_ok(&args(false));
+}

@@ -383,7 +383,7 @@ fn reconstruction_lines(
     match (r.unseen_inputs, &r.inputs_note) {
         (Some(n), _) => writeln!(
             out,
-            "inputs     {n} of {} snapshots have inputs the model was not trained on (outside a training range, or a combination far from the training inputs){}",
+            "inputs     {n} of {} snapshots have inputs the model was not trained on (outside a training range, far from the training inputs together, or off a value training held){}",
             r.rows,
             if n > 0 { ": its errors there are an extrapolation's" } else { "" }
         )?,

@@ -7,14 +7,20 @@
 //! without a sign. So a model also checks the distance from the inputs `x` to the nearest training
 //! input, each input measured in units of its training range's width:
 //!
-//! `d(x) = min_i ‖(x − x_i) ⊘ w‖`, accepted when `d(x) ≤ max(C s, m)`,
+//! `d(x) = min_i ‖(x − x_i) ⊘ w‖`, accepted when `d(x) ≤ max(C s, m √k)`,
 //!
 //! where `s` is how far apart the training inputs themselves lie (the largest distance from a
 //! training input to its nearest neighbour, over [`PROBES`] evenly spaced ones), `C` =
-//! [`COVERAGE_FACTOR`] and `m` the per-input margin ([`INPUT_MARGIN`]). A new draw from the
-//! training distribution lies about `s` from the data, a corner of a filled box about `2 s` (a
-//! ball there holds `2⁻ᵏ` of its volume in the box, so its radius is `2×` for `k` inputs); a point
-//! off a 1-D sweep lies many `s` away.
+//! [`COVERAGE_FACTOR`], `m` the per-input margin ([`INPUT_MARGIN`]) and `k` the number of inputs
+//! that vary (`m √k`: a point `m` beyond the range in every input). On 20 000 random draws of six
+//! inputs a new draw lies at most 1.2 `s` from the data, a corner of the box (2 % beyond it) at most
+//! 2 `s`; a point off a fine 1-D sweep lies many `s` away.
+//!
+//! A coarse sweep has a large `s`: six samples of six tensions moved together lie 0.49 apart, and
+//! the box's corner is only 1.9 `s` from one. So where *all* training inputs lie in a subspace of
+//! lower dimension than the inputs that vary (the scatter's eigenvalues vanish, to rounding, in
+//! some directions: a sweep moving inputs together, a grid over fewer inputs), the distance off
+//! that subspace must also be at most `m √k`, however coarse the sampling along it.
 //!
 //! Along a trajectory (a dynamic dataset) consecutive inputs are nearly equal: a ramp sampled at
 //! 100 Hz would make `s` the sample spacing and refuse every other draw of the same babbling. So a
@@ -32,6 +38,9 @@ use crate::reduced_model::ReducedModel;
 /// `C`: a combination of inputs is accepted within this many training spacings `s` of the nearest
 /// training input.
 pub const COVERAGE_FACTOR: f64 = 3.0;
+/// An eigenvalue of the training inputs' scatter at most this fraction of the largest is a
+/// direction they do not vary in (exact to rounding: sweeps move inputs together exactly).
+pub const SPAN_TOLERANCE: f64 = 1e-10;
 /// How many training inputs `s` is measured at.
 pub const PROBES: usize = 256;
 /// The neighbours left out of a training input's own distance: this fraction of its dataset's rows
@@ -50,6 +59,12 @@ pub struct InputCloud {
     width: Vec<f64>,
     /// Distinct scaled training inputs, `n × dims.len()` row-major.
     points: Vec<f64>,
+    /// The mean scaled training input.
+    centre: Vec<f64>,
+    /// Unit directions (rows of `dims.len()`) in which no training input differs from the mean,
+    /// to rounding: the training inputs lie in a subspace of lower dimension (a sweep moving
+    /// several inputs together). Empty when they span every direction.
+    flat: Vec<f64>,
     /// `s`: the largest distance of a probed training input to its nearest neighbour.
     spacing: f64,
 }
@@ -95,25 +110,52 @@ impl InputCloud {
         let spacing = spacing(&scaled, d, &segments, true)
             .or_else(|| spacing(&scaled, d, &segments, false))
             .unwrap_or(0.0);
+        // the subspace the training inputs lie in: the scatter's directions without extent
+        let mut centre = vec![0.0; d];
+        for p in scaled.chunks_exact(d) {
+            for (m, v) in centre.iter_mut().zip(p) {
+                *m += v / n as f64;
+            }
+        }
+        let mut scatter = nalgebra::DMatrix::<f64>::zeros(d, d);
+        for p in scaled.chunks_exact(d) {
+            for r in 0..d {
+                for c in 0..d {
+                    scatter[(r, c)] += (p[r] - centre[r]) * (p[c] - centre[c]);
+                }
+            }
+        }
+        let eig = scatter.symmetric_eigen();
         // distinct rows only: a held signal repeats its inputs at every sample
         let mut order: Vec<usize> = (0..n).collect();
         let row = |i: usize| &scaled[i * d..(i + 1) * d];
         order.sort_by(|&a, &b| {
-            row(a)
-                .iter()
-                .zip(row(b))
+            (row(a).iter().zip(row(b)))
                 .map(|(x, y)| x.total_cmp(y))
                 .find(|o| o.is_ne())
                 .unwrap_or(std::cmp::Ordering::Equal)
         });
         order.dedup_by(|a, b| row(*a) == row(*b));
         let points = order.iter().flat_map(|&i| row(i).to_vec()).collect();
+        let largest = eig.eigenvalues.iter().fold(0.0f64, |m, v| m.max(*v));
+        let flat = (0..d)
+            .filter(|&i| eig.eigenvalues[i] <= SPAN_TOLERANCE * largest)
+            .flat_map(|i| {
+                eig.eigenvectors
+                    .column(i)
+                    .iter()
+                    .copied()
+                    .collect::<Vec<_>>()
+            })
+            .collect();
         Some(InputCloud {
             names,
             dims,
             lo,
             width,
             points,
+            centre,
+            flat,
             spacing,
         })
     }
@@ -123,9 +165,15 @@ impl InputCloud {
         self.spacing
     }
 
-    /// The largest accepted distance to the nearest training input, `max(C s, m)`.
+    /// `m √k`: the per-input margin over the `k` inputs that vary, the distance of a point
+    /// [`INPUT_MARGIN`] beyond the range in every input.
+    pub fn margin(&self) -> f64 {
+        INPUT_MARGIN * (self.dims.len() as f64).sqrt()
+    }
+
+    /// The largest accepted distance to the nearest training input, `max(C s, m √k)`.
     pub fn radius(&self) -> f64 {
-        (COVERAGE_FACTOR * self.spacing).max(INPUT_MARGIN)
+        (COVERAGE_FACTOR * self.spacing).max(self.margin())
     }
 
     /// `d(x)`: the distance from the inputs `x` (one per name) to the nearest training input, in
@@ -171,22 +219,64 @@ impl InputCloud {
         if (0..self.names.len()).any(|c| !value(c).is_finite()) {
             return None;
         }
+        let values = || {
+            (self.names.iter().enumerate())
+                .map(|(c, name)| format!("{name} = {}", value(c)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
         let radius = self.radius();
-        if self.distance_by(&value, radius) <= radius {
-            return None;
+        if self.distance_by(&value, radius) > radius {
+            let d = self.distance_by(&value, 0.0);
+            return Some((
+                d,
+                format!(
+                    "the inputs together ({}) lie {d:.3} from the nearest training input, where {} and at most {radius:.3} is accepted (distances in units of each input's training range): each input is inside its range, but training never came near this combination",
+                    values(),
+                    match self.spacing > 0.0 {
+                        true => format!("training inputs lie within {:.3} of one another", self.spacing),
+                        false => "training repeats a few combinations".to_string(),
+                    }
+                ),
+            ));
         }
-        let d = self.distance_by(&value, 0.0);
-        let values: Vec<String> = (self.names.iter().enumerate())
-            .map(|(c, name)| format!("{name} = {}", value(c)))
-            .collect();
+        let (off, rank) = self.off_span(&value)?;
         Some((
-            d,
+            off,
             format!(
-                "the inputs together ({}) lie {d:.3} from the nearest training input, where training inputs lie within {:.3} of one another and at most {radius:.3} is accepted (distances in units of each input's training range): each input is inside its range, but training never came near this combination",
-                values.join(", "),
-                self.spacing
+                "the inputs together ({}) lie {off:.3} off the {} that all training inputs lie on, where at most {:.3} is accepted (distances in units of each input's training range): each input is inside its range, but training never varied them this way",
+                values(),
+                match rank {
+                    0 => "point".to_string(),
+                    1 => "line".to_string(),
+                    2 => "plane".to_string(),
+                    r => format!("{r}-dimensional subspace"),
+                },
+                self.margin()
             ),
         ))
+    }
+
+    /// The distance of the inputs off the subspace all training inputs lie in, when they lie in
+    /// one of lower dimension than the inputs that vary (a sweep moving inputs together, a grid of
+    /// fewer inputs) and the distance exceeds the margin: `(distance, its dimension)`.
+    fn off_span(&self, value: impl Fn(usize) -> f64) -> Option<(f64, usize)> {
+        if self.flat.is_empty() {
+            return None;
+        }
+        let d = self.dims.len();
+        let off = (self.flat.chunks_exact(d))
+            .map(|v| {
+                (self.dims.iter().enumerate())
+                    .map(|(j, &c)| {
+                        v[j] * ((value(c) - self.lo[j]) / self.width[j] - self.centre[j])
+                    })
+                    .sum::<f64>()
+                    .powi(2)
+            })
+            .sum::<f64>()
+            .sqrt();
+        (off > self.margin()).then_some((off, d - self.flat.len() / d))
     }
 }
 
@@ -307,25 +397,72 @@ mod tests {
             .collect()
     }
 
+    /// `n` samples of six tensions moved together from -10 to 0 N.
+    fn line(n: usize) -> InputCloud {
+        let rows: Vec<f64> = (0..n)
+            .flat_map(|i| std::iter::repeat_n(-10.0 + 10.0 * i as f64 / (n - 1) as f64, 6))
+            .collect();
+        InputCloud::new(names(6), &rows, &[(n, false)]).unwrap()
+    }
+
     #[test]
     fn a_sweep_of_all_inputs_together_covers_its_line_and_not_the_corners_of_its_box() {
-        // 101 samples of six tensions moved together from -10 to 0 N
-        let n = 101;
-        let rows: Vec<f64> = (0..n)
-            .flat_map(|i| std::iter::repeat_n(-10.0 + 10.0 * i as f64 / 100.0, 6))
-            .collect();
-        let cloud = InputCloud::new(names(6), &rows, &[(n, false)]).unwrap();
-        // on the line between two samples, and just beyond its end (inside the margin)
-        assert!(cloud.outside(&[-4.95; 6]).is_none());
-        assert!(cloud.outside(&[-10.1; 6]).is_none());
-        // a corner of the box: each tension alone in its range; the line's nearest point is
-        // -10/6 N on every tendon, at sqrt(30/36) ≈ 0.913 in units of the range
-        let (d, why) = cloud.outside(&[-10.0, 0.0, 0.0, 0.0, 0.0, 0.0]).unwrap();
+        for n in [3, 6, 11, 101, 1001] {
+            let cloud = line(n);
+            // on the line between two samples, and beyond its ends within the per-input margin
+            // (1.5 % of the range on every input)
+            for x in [-4.95, -10.15, 0.15] {
+                assert!(cloud.outside(&[x; 6]).is_none(), "n = {n}: {x}");
+            }
+            // a corner of the box: each tension alone in its range, however coarse the sweep
+            let (_, why) = cloud
+                .outside(&[-10.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+                .unwrap_or_else(|| panic!("n = {n}: the corner was accepted"));
+            assert!(why.contains("tendons.0.tension = -10"), "{why}");
+            assert!(why.contains("never"), "{why}");
+            // half-way to that corner, and a tenth of the range off the line
+            for x in [
+                [-5.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+                [-6.0, -4.0, -5.0, -5.0, -5.0, -5.0],
+            ] {
+                assert!(cloud.outside(&x).is_some(), "n = {n}: {x:?}");
+            }
+        }
+        // 101 samples: the corner is sqrt(30/36) ≈ 0.913 of the range off the line, farther than
+        // 3 spacings (sqrt(6) × 0.01 each) from every sample
+        let (d, why) = line(101)
+            .outside(&[-10.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+            .unwrap();
         assert!((d - (30.0f64 / 36.0).sqrt()).abs() < 0.01, "{d}");
-        assert!(why.contains("tendons.0.tension = -10"), "{why}");
         assert!(why.contains("never came near this combination"), "{why}");
-        // half-way to that corner is still far off the line
-        assert!(cloud.outside(&[-5.0, 0.0, 0.0, 0.0, 0.0, 0.0]).is_some());
+        // 6 samples lie 0.49 apart: the corner is within 3 spacings of one, but 0.913 off the
+        // line they all lie on, where only the margin sqrt(6) × 0.02 ≈ 0.049 is accepted
+        let (d, why) = line(6).outside(&[-10.0, 0.0, 0.0, 0.0, 0.0, 0.0]).unwrap();
+        assert!((d - (30.0f64 / 36.0).sqrt()).abs() < 1e-9, "{d}");
+        assert!(
+            why.contains("lie 0.913 off the line that all training inputs lie on, where at most 0.049 is accepted"),
+            "{why}"
+        );
+    }
+
+    #[test]
+    fn a_straight_line_between_two_arms_of_an_l_is_off_the_data() {
+        // a trajectory along an L: (-10, 0) to (0, 0) to (0, -10), sampled finely
+        let mut rows = vec![];
+        for i in 0..=200 {
+            rows.extend([-10.0 + 10.0 * i as f64 / 200.0, 0.0]);
+        }
+        for i in 1..=200 {
+            rows.extend([0.0, -10.0 * i as f64 / 200.0]);
+        }
+        let n = rows.len() / 2;
+        let cloud = InputCloud::new(names(2), &rows, &[(n, true)]).unwrap();
+        for x in [[-10.0, 0.0], [0.0, -7.5], [-5.0, 0.1]] {
+            assert!(cloud.outside(&x).is_none(), "{x:?}");
+        }
+        // the corner of the box and the midpoint of the chord are off the L
+        assert!(cloud.outside(&[-10.0, -10.0]).is_some());
+        assert!(cloud.outside(&[-5.0, -5.0]).is_some());
     }
 
     #[test]
@@ -340,7 +477,7 @@ mod tests {
             cloud.spacing()
         );
         for x in rows[n * k..].chunks_exact(k) {
-            assert!(cloud.outside(x).is_none(), "{x:?}");
+            assert!(cloud.outside(x).is_none(), "{x:?} {:?}", cloud.outside(x));
         }
         // every corner of the box, and 2 % beyond it (the range check's margin)
         for corner in 0..(1 << k) {

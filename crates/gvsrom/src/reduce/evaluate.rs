@@ -6,7 +6,7 @@
 
 use super::coverage::InputCloud;
 use super::invalid;
-use crate::build::reduced::inside;
+use crate::build::reduced::{at_held, inside};
 use crate::dataset::Dataset;
 use crate::error::ScenarioError;
 use crate::reduced_model::{outside_range, same_abscissae, ReducedModel};
@@ -31,9 +31,10 @@ pub struct Reconstruction {
     /// there; their errors are included above).
     pub outside: usize,
     /// Snapshots whose inputs lie outside what the model was trained on — an input outside its
-    /// training range, or a combination far from the training inputs (`reduce::coverage`) — as
-    /// `--model` would refuse them; `None` when the dataset's inputs are not the model's (then
-    /// [`Self::inputs_note`] says which).
+    /// training range, a combination far from the training inputs (`reduce::coverage`), or an
+    /// input the dataset varies that training held at another value — as `--model` would refuse
+    /// them; `None` when a training input has no value in the dataset (then
+    /// [`Self::inputs_note`] says so).
     pub unseen_inputs: Option<usize>,
     /// Why [`Self::unseen_inputs`] could not be counted.
     pub inputs_note: Option<String>,
@@ -105,9 +106,21 @@ pub fn reconstruction(model: &ReducedModel, ds: &Dataset) -> Result<Reconstructi
     })
 }
 
-/// How many solved snapshots of `ds` have inputs outside what `model` was trained on (an input
-/// outside its range, or a combination far from the training inputs); an explanation instead when
-/// the dataset does not sample the model's inputs.
+/// The numeric value at the scenario path `path` of the TOML `table`, if any.
+fn value_at(table: &toml::Table, path: &str) -> Option<f64> {
+    let segs = crate::scenario::parse_path(path).ok()?;
+    match crate::scenario::lookup(table, &segs)? {
+        toml::Value::Float(v) => Some(*v),
+        toml::Value::Integer(v) => Some(*v as f64),
+        _ => None,
+    }
+}
+
+/// How many solved snapshots of `ds` have inputs outside what `model` was trained on: one of the
+/// model's inputs outside its range, their combination far from the training inputs, or an input
+/// the dataset varies that training held at another value (a tension or a material constant). A
+/// model input the dataset does not vary takes the dataset scenario's value. An explanation
+/// instead when a model input has no value in the dataset.
 fn unseen_inputs(model: &ReducedModel, ds: &Dataset) -> Result<usize, String> {
     let ranges = &model.meta.input_range;
     if ranges.is_empty() {
@@ -116,23 +129,36 @@ fn unseen_inputs(model: &ReducedModel, ds: &Dataset) -> Result<usize, String> {
                 .into(),
         );
     }
+    let trained = super::validity::trained_scenario(model)
+        .and_then(|s| s.to_table())
+        .map_err(|e| e.to_string())?;
+    let here = Scenario::from_toml(&ds.meta.scenario, &ds.meta.scenario_toml, &[])
+        .and_then(|s| s.to_table())
+        .map_err(|e| e.to_string())?;
     let column = |name: &str| ds.meta.parameters.iter().position(|p| p == name);
-    let columns: Vec<usize> = ranges
+    // where each model input's value comes from: a dataset column, or the dataset's scenario
+    let source = |name: &str| {
+        match column(name) {
+        Some(c) => Ok(Err(c)),
+        None => value_at(&here, name).map(Ok).ok_or_else(|| {
+            format!("the dataset neither samples {name} (a training input) nor gives it a numeric value")
+        }),
+    }
+    };
+    let sources: Vec<Result<f64, usize>> = ranges
         .iter()
-        .map(|r| column(&r.parameter))
-        .collect::<Option<_>>()
-        .ok_or_else(|| {
-            let want: Vec<&str> = ranges.iter().map(|r| r.parameter.as_str()).collect();
-            format!(
-                "the dataset samples [{}], the model was trained on [{}]",
-                ds.meta.parameters.join(", "),
-                want.join(", ")
-            )
-        })?;
+        .map(|r| source(&r.parameter))
+        .collect::<Result<_, _>>()?;
     let cloud = InputCloud::of_model(model);
-    let cloud_columns: Option<Vec<usize>> = cloud
+    let cloud_sources: Option<Vec<Result<f64, usize>>> = cloud
         .as_ref()
-        .and_then(|c| c.names().iter().map(|n| column(n)).collect());
+        .and_then(|c| c.names().iter().map(|n| source(n).ok()).collect());
+    // the dataset's own inputs that training held fixed: their trained values
+    let is_input = |p: &str| ranges.iter().any(|r| r.parameter == p);
+    let held: Vec<(usize, Option<f64>)> = (ds.meta.parameters.iter().enumerate())
+        .filter(|(_, p)| !is_input(p))
+        .map(|(c, p)| (c, value_at(&trained, p)))
+        .collect();
     let k = ds.meta.parameters.len();
     let mut x = vec![];
     let count = ds
@@ -140,16 +166,26 @@ fn unseen_inputs(model: &ReducedModel, ds: &Dataset) -> Result<usize, String> {
         .iter()
         .filter(|&&i| {
             let row = &ds.inputs[i * k..(i + 1) * k];
-            let in_ranges = ranges.iter().zip(&columns).all(|(r, &c)| inside(r, row[c]));
-            let near = match (&cloud, &cloud_columns) {
-                (Some(cloud), Some(cols)) => {
+            let value = |s: &Result<f64, usize>| match *s {
+                Ok(v) => v,
+                Err(c) => row[c],
+            };
+            let in_ranges = ranges
+                .iter()
+                .zip(&sources)
+                .all(|(r, s)| inside(r, value(s)));
+            let near = match (&cloud, &cloud_sources) {
+                (Some(cloud), Some(sources)) => {
                     x.clear();
-                    x.extend(cols.iter().map(|&c| row[c]));
+                    x.extend(sources.iter().map(value));
                     cloud.outside(&x).is_none()
                 }
                 _ => true,
             };
-            !(in_ranges && near)
+            let as_held = held
+                .iter()
+                .all(|&(c, v)| v.is_some_and(|v| at_held(row[c], v)));
+            !(in_ranges && near && as_held)
         })
         .count();
     Ok(count)

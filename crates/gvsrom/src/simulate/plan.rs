@@ -76,6 +76,12 @@ impl Plan {
     }
 }
 
+/// A linear input signal is checked against a model's training inputs at this many points per
+/// segment between knots (the knots included).
+const SEGMENT_CHECKS: usize = 16;
+/// At most this many points of an input signal are checked in all.
+const MAX_SIGNAL_CHECKS: usize = 100_000;
+
 /// Validates `opts` against `built` and builds the [`Plan`] of the run.
 pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError> {
     let t_out = sample_times(opts.duration, opts.sample_rate)?;
@@ -138,6 +144,16 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
                 .chain([0.0, end])
                 .collect();
             times.sort_by(f64::total_cmp);
+            // a linear signal between two knots passes combinations neither knot is: the joint
+            // check is not convex, so each segment is checked at interior points too
+            if signal.interpolation == gvs::inputs::Interpolation::Linear && times.len() > 1 {
+                let per = (MAX_SIGNAL_CHECKS / times.len()).clamp(1, SEGMENT_CHECKS);
+                let knots = times.clone();
+                for w in knots.windows(2) {
+                    times.extend((1..per).map(|i| w[0] + (w[1] - w[0]) * i as f64 / per as f64));
+                }
+                times.sort_by(f64::total_cmp);
+            }
             let mut u = vec![0.0; signal.channels()];
             r.check_signal(&times, |t| {
                 signal.eval(t, &mut u);
