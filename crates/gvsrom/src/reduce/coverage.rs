@@ -176,14 +176,9 @@ impl InputCloud {
         (COVERAGE_FACTOR * self.spacing).max(self.margin())
     }
 
-    /// `d(x)`: the distance from the inputs `x` (one per name) to the nearest training input, in
-    /// units of each input's range; `stop_below` ends the search at the first training input
-    /// closer than it (the distance returned is then that one's).
-    pub fn distance(&self, x: &[f64], stop_below: f64) -> f64 {
-        self.distance_by(|c| x[c], stop_below)
-    }
-
-    /// [`Self::distance`] of the inputs whose column `c` holds `value(c)` (allocates nothing).
+    /// `d(x)`: the distance to the nearest training input of the inputs whose column `c` holds
+    /// `value(c)`, in units of each input's range; `stop_below` ends the search at the first
+    /// training input closer than it (the distance returned is then that one's). Allocates nothing.
     fn distance_by(&self, value: impl Fn(usize) -> f64, stop_below: f64) -> f64 {
         let d = self.dims.len();
         let stop = stop_below * stop_below;
@@ -362,10 +357,6 @@ impl Coverage {
         let inputs = GuessInput::of_model(built, table, model)?;
         let cloud = InputCloud::of_model(model)?;
         Some(Coverage { cloud, inputs })
-    }
-
-    pub fn cloud(&self) -> &InputCloud {
-        &self.cloud
     }
 }
 
