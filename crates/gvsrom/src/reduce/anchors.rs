@@ -15,12 +15,7 @@ pub(super) fn input_value(built: &Built, table: Option<&toml::Table>, path: &str
     if let Some(k) = tendon_input(path) {
         return built.u.get(k).copied();
     }
-    let segs = crate::scenario::parse_path(path).ok()?;
-    match crate::scenario::lookup(table?, &segs)? {
-        toml::Value::Float(v) => Some(*v),
-        toml::Value::Integer(v) => Some(*v as f64),
-        _ => None,
-    }
+    crate::scenario::number_at(table?, path)
 }
 
 /// The initial guesses of a reduced statics solve at any tendon tensions: the model's anchors

@@ -10,7 +10,7 @@ use crate::build::reduced::{at_held, inside};
 use crate::dataset::Dataset;
 use crate::error::ScenarioError;
 use crate::reduced_model::{outside_range, same_abscissae, ReducedModel};
-use crate::scenario::Scenario;
+use crate::scenario::{number_at, Scenario};
 
 /// The reconstruction errors of a model on a dataset's solved snapshots.
 #[derive(Debug, Clone, PartialEq)]
@@ -106,16 +106,6 @@ pub fn reconstruction(model: &ReducedModel, ds: &Dataset) -> Result<Reconstructi
     })
 }
 
-/// The numeric value at the scenario path `path` of the TOML `table`, if any.
-fn value_at(table: &toml::Table, path: &str) -> Option<f64> {
-    let segs = crate::scenario::parse_path(path).ok()?;
-    match crate::scenario::lookup(table, &segs)? {
-        toml::Value::Float(v) => Some(*v),
-        toml::Value::Integer(v) => Some(*v as f64),
-        _ => None,
-    }
-}
-
 /// How many solved snapshots of `ds` have inputs outside what `model` was trained on: one of the
 /// model's inputs outside its range, their combination far from the training inputs, or an input
 /// the dataset varies that training held at another value (a tension or a material constant). A
@@ -140,7 +130,7 @@ fn unseen_inputs(model: &ReducedModel, ds: &Dataset) -> Result<usize, String> {
     let source = |name: &str| {
         match column(name) {
         Some(c) => Ok(Err(c)),
-        None => value_at(&here, name).map(Ok).ok_or_else(|| {
+        None => number_at(&here, name).map(Ok).ok_or_else(|| {
             format!("the dataset neither samples {name} (a training input) nor gives it a numeric value")
         }),
     }
@@ -157,7 +147,7 @@ fn unseen_inputs(model: &ReducedModel, ds: &Dataset) -> Result<usize, String> {
     let is_input = |p: &str| ranges.iter().any(|r| r.parameter == p);
     let held: Vec<(usize, Option<f64>)> = (ds.meta.parameters.iter().enumerate())
         .filter(|(_, p)| !is_input(p))
-        .map(|(c, p)| (c, value_at(&trained, p)))
+        .map(|(c, p)| (c, number_at(&trained, p)))
         .collect();
     let k = ds.meta.parameters.len();
     let mut x = vec![];

@@ -67,6 +67,16 @@ pub fn parse_path(path: &str) -> Result<Vec<Seg>, String> {
     Ok(segs)
 }
 
+/// The number at the dotted `path` (`tendons.0.tension`) in `table`, if there is one (an integer
+/// read as a float).
+pub fn number_at(table: &Table, path: &str) -> Option<f64> {
+    match lookup(table, &parse_path(path).ok()?)? {
+        Value::Float(v) => Some(*v),
+        Value::Integer(v) => Some(*v as f64),
+        _ => None,
+    }
+}
+
 /// The value at `path` in `table`, if there is one.
 pub fn lookup<'a>(table: &'a Table, path: &[Seg]) -> Option<&'a Value> {
     let (first, rest) = path.split_first()?;
