@@ -386,7 +386,7 @@ pub fn dataset(
         babble,
         from_equilibrium,
         rtol,
-        atol: atol.unwrap_or(gvsrom::simulate::IntegratorChoice::default().atol),
+        atol: atol.unwrap_or(gvsrom::simulate::DEFAULT_ATOL),
         stop_after_chunks: None,
     };
     let (outcome, caught) = crate::interrupt::run(py, |flag| gvsrom::dataset::run(&args, &flag));

@@ -27,7 +27,7 @@ pub struct Args<'a> {
     pub qd0: Option<Vec<f64>>,
     pub method: &'a str,
     pub rtol: Option<f64>,
-    pub atol: f64,
+    pub atol: Option<f64>,
     /// A fixed step \[s\]: the fixed-step BDF2 instead of an adaptive method (`--fixed-step`).
     pub fixed_step: Option<f64>,
 }
@@ -79,7 +79,7 @@ impl Robot {
     /// ------
     /// GvsromError
     ///     For bad options or input, or an integrator failure (with the samples computed).
-    #[pyo3(signature = (duration, sample_rate=100.0, input=None, interpolate=false, from_equilibrium=false, q0=None, qd0=None, method="auto", rtol=None, atol=1e-6, fixed_step=None))]
+    #[pyo3(signature = (duration, sample_rate=100.0, input=None, interpolate=false, from_equilibrium=false, q0=None, qd0=None, method="auto", rtol=None, atol=None, fixed_step=None))]
     #[allow(clippy::too_many_arguments)]
     fn simulate<'py>(
         &self,
@@ -93,7 +93,7 @@ impl Robot {
         qd0: Option<arrays::In1<'_>>,
         method: &str,
         rtol: Option<f64>,
-        atol: f64,
+        atol: Option<f64>,
         fixed_step: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let args = Args {

@@ -62,3 +62,7 @@ def test_a_fixed_step_run_converges_to_the_adaptive_one(robot):
     assert err[1e-3] < 0.5 * err[4e-3], err
     with pytest.raises(gvsrom.GvsromError, match="`fixed_step`"):
         robot.simulate(0.1, fixed_step=-1.0)
+    # a tolerance the fixed step would ignore is refused, as on the CLI
+    for kw in ({"rtol": 1e-4}, {"atol": 1e-6}):
+        with pytest.raises(gvsrom.GvsromError, match="not controlled"):
+            robot.simulate(0.1, fixed_step=1e-3, **kw)

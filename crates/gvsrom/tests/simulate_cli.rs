@@ -533,7 +533,7 @@ fn a_massless_rod_is_refused_for_motion_naming_the_density() {
 #[test]
 fn integrator_options_out_of_range_or_ignored_by_the_method_are_refused_before_any_output() {
     let out = scratch("integrator-options");
-    let cases: [(&[&str], &[&str]); 9] = [
+    let cases: [(&[&str], &[&str]); 10] = [
         (&["--max-order", "0"], &["--max-order", "from 1 to 5"]),
         (&["--max-order", "6"], &["--max-order", "from 1 to 5"]),
         (
@@ -552,6 +552,10 @@ fn integrator_options_out_of_range_or_ignored_by_the_method_are_refused_before_a
         (
             &["--fixed-step", "0.01", "--rtol", "1e-4"],
             &["--rtol", "not controlled"],
+        ),
+        (
+            &["--fixed-step", "0.01", "--atol", "1e-6"],
+            &["--atol", "not controlled"],
         ),
         (
             &["--fixed-step", "0.01", "--max-order", "2"],

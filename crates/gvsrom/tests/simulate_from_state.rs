@@ -12,7 +12,7 @@ mod common;
 fn tight() -> IntegratorChoice {
     IntegratorChoice {
         rtol: Some(1e-9),
-        atol: 1e-11,
+        atol: Some(1e-11),
         ..IntegratorChoice::default()
     }
 }

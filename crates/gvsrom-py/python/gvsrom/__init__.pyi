@@ -353,6 +353,6 @@ class Robot:
         qd0: ArrayLike | None = None,
         method: str = "auto",
         rtol: float | None = None,
-        atol: float = 1e-06,
+        atol: float | None = None,
         fixed_step: float | None = None,
     ) -> dict[str, Any]: ...

@@ -64,9 +64,9 @@ pub struct SimulateArgs {
     #[arg(long, allow_hyphen_values = true)]
     pub rtol: Option<f64>,
 
-    /// Absolute tolerance of the adaptive integrator, at least 1e-14 (ode15s default 1e-6).
-    #[arg(long, default_value_t = 1e-6, allow_hyphen_values = true)]
-    pub atol: f64,
+    /// Absolute tolerance of the adaptive integrator, at least 1e-14. Default 1e-6 (ode15s).
+    #[arg(long, allow_hyphen_values = true)]
+    pub atol: Option<f64>,
 
     /// Use the fixed-step implicit method with step H [s] instead of the adaptive NDF (real time).
     #[arg(long, value_name = "H")]

@@ -89,7 +89,7 @@ pub fn run(
     // created (or an earlier one replaced): not by the integrator after it
     simulate::check_tolerances(&simulate::IntegratorChoice {
         rtol: args.rtol,
-        atol: args.atol,
+        atol: Some(args.atol),
         ..Default::default()
     })?;
     // as `simulate`'s automatic choice: the NDF, or SDIRK4 for a lightly damped rod
@@ -247,7 +247,7 @@ pub fn run(
                     &opts.integrator,
                     &simulate::IntegratorChoice {
                         rtol: args.rtol,
-                        atol: args.atol,
+                        atol: Some(args.atol),
                         ..simulate::IntegratorChoice::default()
                     },
                 )),

@@ -47,7 +47,8 @@ pub struct IntegratorChoice {
     /// Relative tolerance; default 1e-3 (ode15s), or [`gvs::solve::dynamics::LIGHT_DAMPING_RTOL`]
     /// when the automatic method is SDIRK4.
     pub rtol: Option<f64>,
-    pub atol: f64,
+    /// Absolute tolerance; default [`DEFAULT_ATOL`].
+    pub atol: Option<f64>,
     /// Highest NDF order (1–5); default 5, or 2 for a lightly damped rod.
     pub max_order: Option<usize>,
     pub error_norm: Option<ErrorNormChoice>,
@@ -66,7 +67,7 @@ impl Default for IntegratorChoice {
         IntegratorChoice {
             method: MethodChoice::Auto,
             rtol: None,
-            atol: 1e-6,
+            atol: None,
             max_order: None,
             error_norm: None,
             rho_inf: None,
@@ -140,7 +141,7 @@ pub fn choose_integrator(
     };
     let mut note = None;
     let rtol = choice.rtol.unwrap_or(NdfOptions::default().rtol);
-    let atol = choice.atol;
+    let atol = choice.atol.unwrap_or(DEFAULT_ATOL);
     let error_norm = |default: ErrorNorm| choice.error_norm.map_or(default, ErrorNormChoice::norm);
     // the rod's damping chooses for `auto` and `ndf` unless the NDF's order or norm is given
     let ndf_choice = choice.max_order.is_some() || choice.error_norm.is_some();
@@ -274,6 +275,9 @@ pub fn integrator_record(
 /// [[`gvs::solve::ode::MIN_RTOL`], [`gvs::solve::ode::MAX_RTOL`]).
 pub const MIN_ATOL: f64 = 1e-14;
 
+/// `--atol` when it is not given: 1e-6, ode15s's.
+pub const DEFAULT_ATOL: f64 = 1e-6;
+
 /// `--rtol` in [[`gvs::solve::ode::MIN_RTOL`], [`gvs::solve::ode::MAX_RTOL`]) and `--atol` finite
 /// and at least [`MIN_ATOL`]: checked when a run is planned, before anything is written.
 pub fn check_tolerances(choice: &IntegratorChoice) -> Result<(), ScenarioError> {
@@ -289,10 +293,11 @@ pub fn check_tolerances(choice: &IntegratorChoice) -> Result<(), ScenarioError> 
             ));
         }
     }
-    if !(choice.atol >= MIN_ATOL && choice.atol.is_finite()) {
+    let atol = choice.atol.unwrap_or(DEFAULT_ATOL);
+    if !(atol >= MIN_ATOL && atol.is_finite()) {
         return Err(ScenarioError::value(
             "--atol",
-            choice.atol,
+            atol,
             format!(
                 "a finite number >= {MIN_ATOL:e}; below it the coordinates' round-off exceeds the tolerance"
             ),
@@ -313,8 +318,8 @@ pub const DEFAULT_RHO_INF: f64 = 0.8;
 /// Checks every option of `choice` ([`check_tolerances`], then the rest) before anything runs:
 /// `--max-order` in 1–5, `--rho-inf` in \[0, 1\], `--fixed-step` finite and positive, and no
 /// option the chosen method would ignore (`--max-order` only with the NDF, `--rho-inf` only with
-/// generalized-α, no `--method`, `--rtol` or `--error-norm` with the fixed step, which is a
-/// method of its own without error control).
+/// generalized-α, no `--method`, `--rtol`, `--atol` or `--error-norm` with the fixed step, which
+/// is a method of its own without error control).
 pub fn check_choice(choice: &IntegratorChoice) -> Result<(), ScenarioError> {
     check_tolerances(choice)?;
     if let Some(m) = choice.max_order {
@@ -353,11 +358,17 @@ pub fn check_choice(choice: &IntegratorChoice) -> Result<(), ScenarioError> {
         if choice.method != MethodChoice::Auto {
             return ignored("--method", fixed);
         }
+        let tolerance = |option: &str| {
+            Err(ScenarioError::invalid(
+                option,
+                "does not apply to the fixed-step method (--fixed-step): its error is not controlled, so it would ignore a tolerance",
+            ))
+        };
         if choice.rtol.is_some() {
-            return ignored(
-                "--rtol",
-                "the fixed-step method (--fixed-step), whose error is not controlled",
-            );
+            return tolerance("--rtol");
+        }
+        if choice.atol.is_some() {
+            return tolerance("--atol");
         }
         if choice.error_norm.is_some() {
             return ignored("--error-norm", fixed);
