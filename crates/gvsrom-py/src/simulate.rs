@@ -62,8 +62,9 @@ impl Robot {
     ///     another input — a controller's loop, one control period per call with the tensions held.
     /// method : str
     ///     ``"auto"``, ``"ndf"``, ``"sdirk"`` or ``"galpha"`` (``--method``).
-    /// rtol, atol : float
-    ///     Tolerances of the adaptive integrator (default rtol: chosen by ``method``).
+    /// rtol, atol : float, optional
+    ///     Tolerances of the adaptive integrator (default rtol: chosen by ``method``; atol 1e-6);
+    ///     refused with ``fixed_step``, which controls no error.
     /// fixed_step : float, optional
     ///     A fixed step [s]: the fixed-step BDF2 (``--fixed-step``) instead of an adaptive method;
     ///     its cost is set by the number of steps, its accuracy by the step (not checked).
