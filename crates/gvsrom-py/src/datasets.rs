@@ -106,6 +106,27 @@ pub struct Dataset {
     meta_json: serde_json::Value,
 }
 
+impl Dataset {
+    /// Its directory, for a computation that reads it again (`pod`, `train`, `reconstruction`):
+    /// refused if the directory no longer holds what `load_dataset` read (its manifest's hashes
+    /// differ, or it is gone), so that a result is never computed from other data than the
+    /// object's.
+    pub(crate) fn unchanged_dir(&self) -> PyResult<PathBuf> {
+        use gvsrom::provenance::DirOrigin;
+        let now = std::fs::read(self.dir.join(gvsrom::output::MANIFEST_FILE))
+            .ok()
+            .and_then(|b| serde_json::from_slice::<serde_json::Value>(&b).ok());
+        let loaded = DirOrigin::of_manifest(&self.dir, &self.meta_json);
+        match now.is_some_and(|m| DirOrigin::of_manifest(&self.dir, &m) == loaded) {
+            true => Ok(self.dir.clone()),
+            false => Err(errors::invalid(format!(
+                "dataset `{}`: the directory no longer holds what `load_dataset` read (it was written again, or removed): load it again to use what it holds now",
+                self.dir.display()
+            ))),
+        }
+    }
+}
+
 #[pymethods]
 impl Dataset {
     /// The dataset directory.
@@ -180,7 +201,9 @@ pub fn load_dataset(py: Python<'_>, path: PathBuf) -> PyResult<Dataset> {
             .map(|t| held(PyArray::from_vec(py, t).into_any()))
             .transpose()?,
         meta_json: d.meta_json,
-        dir: path,
+        // absolute: `pod`, `train` and `reconstruction` read the directory again, maybe after a
+        // change of the working directory
+        dir: std::path::absolute(&path).unwrap_or(path),
     })
 }
 

@@ -123,6 +123,19 @@ pub fn state(
     Ok((q, qd))
 }
 
+/// `values`, the quantity `what` at `(q, q̇)`, if all are finite; else a `GvsromError` naming
+/// `qd`: `q` was checked as a state of the rod, so an overflow comes from velocities whose
+/// products (`η ⊗ η` in `C`, `q̇ᵀ M q̇`) exceed floating point.
+pub fn finite_at(what: &str, values: &[f64], qd: &DVector<f64>) -> PyResult<()> {
+    match values.iter().all(|v| v.is_finite()) {
+        true => Ok(()),
+        false => Err(invalid(format!(
+            "{what} is not finite at this state: `qd` (largest |qd| = {:e}) overflows it; accepted: velocities whose quantities are finite",
+            qd.amax()
+        ))),
+    }
+}
+
 /// `energy` as a dict `{kinetic, elastic, gravitational, total}` [J].
 pub fn energy_dict<'py>(py: Python<'py>, e: &Energy) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
@@ -175,6 +188,7 @@ impl Robot {
     ) -> PyResult<Bound<'py, PyAny>> {
         let (q, qd) = state(self, &q, Some(&qd))?;
         let f = py.detach(|| damping_force(&self.built, &self.workspaces, &q, &qd));
+        finite_at("the damping force", f.as_slice(), &qd)?;
         Ok(vector(py, &f))
     }
 
@@ -196,6 +210,7 @@ impl Robot {
     ) -> PyResult<Bound<'py, PyAny>> {
         let (q, qd) = state(self, &q, Some(&qd))?;
         let f = py.detach(|| coriolis_force(&self.built, &self.workspaces, &q, &qd));
+        finite_at("the Coriolis force", f.as_slice(), &qd)?;
         Ok(vector(py, &f))
     }
 
@@ -209,6 +224,7 @@ impl Robot {
     ) -> PyResult<Bound<'py, PyAny>> {
         let (q, qd) = state(self, &q, Some(&qd))?;
         let c = py.detach(|| coriolis_matrix(&self.built, &self.workspaces, &q, &qd));
+        finite_at("the Coriolis matrix", c.as_slice(), &qd)?;
         arrays::matrix(py, &c)
     }
 
@@ -248,10 +264,18 @@ impl Robot {
         u: Option<arrays::Tensions<'_>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (q, qd) = state(self, &q, Some(&qd))?;
-        let u = self.quantity_tensions(u)?;
+        let u = self.quantity_tensions(py, u)?;
         let a = py
             .detach(|| accelerations(&self.built, &self.workspaces, &q, &qd, &u))
-            .map_err(invalid)?;
+            // `q` was checked as a state of the rod: what fails comes from `qd`, or `u`
+            .map_err(|e| {
+                invalid(format!(
+                    "{e}, at `qd` up to |qd| = {:e} and `u` up to |u| = {:e}",
+                    qd.amax(),
+                    u.iter().fold(0.0_f64, |m, v| m.max(v.abs()))
+                ))
+            })?;
+        finite_at("the acceleration", a.as_slice(), &qd)?;
         Ok(vector(py, &a))
     }
 
@@ -271,6 +295,7 @@ impl Robot {
     ) -> PyResult<Bound<'py, PyDict>> {
         let (q, qd) = state(self, &q, qd.as_ref())?;
         let e = py.detach(|| energy(&self.built, &self.workspaces, &q, &qd));
+        finite_at("the kinetic energy", &[e.kinetic], &qd)?;
         energy_dict(py, &e)
     }
 }

@@ -58,6 +58,17 @@ pub struct Model {
     pub(crate) model: ReducedModel,
 }
 
+impl Model {
+    /// This model to attach to a robot, with `extrapolate` (default: the model's own setting).
+    pub fn attached(&self, extrapolate: Option<bool>) -> crate::robot::Attached {
+        crate::robot::Attached {
+            dir: self.dir.clone(),
+            extrapolate: extrapolate.unwrap_or(self.extrapolate),
+            loaded: self.model.origin(),
+        }
+    }
+}
+
 /// The rows of a 1-D (one row) or 2-D input with `cols` columns each, row-major, and whether it was
 /// 1-D; else a `GvsromError` naming `name`.
 fn rows_of(name: &str, a: &InDyn<'_>, cols: usize, what: &str) -> PyResult<(Vec<f64>, bool)> {
@@ -264,7 +275,9 @@ pub fn load_model(py: Python<'_>, path: PathBuf, extrapolate: bool) -> PyResult<
         arrays,
         latent_range: crate::arrays::held(shaped(py, range, [m.meta.latent_range.len(), 2])?)?,
         rest: crate::arrays::held(vector(py, &m.meta.rest))?,
-        dir: path,
+        // absolute: a robot reads the directory again when it attaches the model, maybe after a
+        // change of the working directory
+        dir: std::path::absolute(&path).unwrap_or(path),
         model: m,
     })
 }

@@ -32,7 +32,8 @@ impl Robot {
     ///     ``dominant_strain`` (list of k names), ``tip_displacement`` and ``tip_rotation``
     ///     (k, 3) world axes, ``all_frequencies_hz`` (n_dof,), ``q0`` (n_dof,), ``u``,
     ///     ``strain_x`` (n_points,), ``equilibrium_tip_position`` (3,),
-    ///     ``equilibrium_residual_norm``.
+    ///     ``equilibrium_residual_norm``, ``model_extrapolated`` (list of str: how the reduced
+    ///     model was used outside its training, ``extrapolate=True``; empty otherwise).
     ///
     /// Raises
     /// ------
@@ -63,7 +64,10 @@ impl Robot {
                 _ => errors::invalid(message),
             }
         })?;
-        report_dict(py, &report)
+        let d = report_dict(py, &report)?;
+        let extrapolated = (built.reduced.as_ref()).map_or(vec![], |r| r.extrapolated.clone());
+        d.set_item("model_extrapolated", extrapolated)?;
+        Ok(d)
     }
 }
 

@@ -69,6 +69,22 @@ pub fn forward(built: &Built, cache: &WorkspaceCache, q: &DVector<f64>) -> (Vec<
     })
 }
 
+/// Why `q` is no state of an elastic rod (a strain past the bounds that end a simulation,
+/// [`gvsrom::plausibility::state_violation`], or not finite), as a phrase; `None` for a physical
+/// state. The model's quantities there mean nothing, and overflow to NaN far beyond.
+pub fn state_violation(built: &Built, cache: &WorkspaceCache, q: &DVector<f64>) -> Option<String> {
+    with_model!(built, cache, m, ws => {
+        m.forward_pose(q, ws);
+        let x: Vec<f64> = m.disc.points.iter().map(|p| p.x).collect();
+        gvsrom::plausibility::state_violation(
+            &m.point_strains(ws),
+            &x,
+            |j| m.xi_star(j),
+            m.disc.length(),
+        )
+    })
+}
+
 fn poses(ws: &Workspace) -> (Vec<f64>, Vec<f64>) {
     let pos =
         ws.g.iter()

@@ -28,7 +28,7 @@ impl Model {
     ///     If the dataset has another layout (naming both) or no solved snapshot.
     fn reconstruction(&self, py: Python<'_>, dataset: DatasetArg<'_>) -> PyResult<Reconstruction> {
         let dir = match dataset {
-            DatasetArg::Loaded(d) => d.get().path(),
+            DatasetArg::Loaded(d) => d.get().unchanged_dir()?,
             DatasetArg::Dir(p) => p,
         };
         let r = py

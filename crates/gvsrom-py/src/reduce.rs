@@ -78,10 +78,10 @@ fn type_name(a: &Bound<'_, PyAny>) -> String {
 /// or a sequence of them, of one scenario, whose snapshots are combined in order; a ``TypeError``
 /// naming ``dataset`` otherwise.
 fn dataset_paths(arg: &Bound<'_, PyAny>) -> PyResult<Vec<PathBuf>> {
-    let one = |a: &Bound<'_, PyAny>| -> Option<PathBuf> {
+    let one = |a: &Bound<'_, PyAny>| -> Option<PyResult<PathBuf>> {
         match a.extract::<Bound<'_, crate::datasets::Dataset>>() {
-            Ok(d) => Some(d.get().path()),
-            Err(_) => a.extract::<PathBuf>().ok(),
+            Ok(d) => Some(d.get().unchanged_dir()),
+            Err(_) => a.extract::<PathBuf>().ok().map(Ok),
         }
     };
     let refuse = |a: &Bound<'_, PyAny>| {
@@ -91,7 +91,7 @@ fn dataset_paths(arg: &Bound<'_, PyAny>) -> PyResult<Vec<PathBuf>> {
         ))
     };
     if let Some(p) = one(arg) {
-        return Ok(vec![p]);
+        return Ok(vec![p?]);
     }
     let Ok(items) = arg.try_iter() else {
         return Err(refuse(arg));
@@ -99,7 +99,7 @@ fn dataset_paths(arg: &Bound<'_, PyAny>) -> PyResult<Vec<PathBuf>> {
     let mut paths = vec![];
     for item in items {
         let item = item?;
-        paths.push(one(&item).ok_or_else(|| refuse(&item))?);
+        paths.push(one(&item).ok_or_else(|| refuse(&item))??);
     }
     Ok(paths)
 }

@@ -19,11 +19,14 @@ use std::ffi::CString;
 use std::path::PathBuf;
 use std::sync::OnceLock;
 
-/// A reduced model to attach: its directory and whether it may extrapolate (`--extrapolate`).
+/// A reduced model to attach: its directory, whether it may extrapolate (`--extrapolate`), and
+/// its content as `load_model` read it (the manifest's hashes), which the directory must still
+/// hold when a robot reads it again.
 #[derive(Clone)]
 pub struct Attached {
     pub dir: PathBuf,
     pub extrapolate: bool,
+    pub loaded: Option<gvsrom::provenance::DirOrigin>,
 }
 
 /// A built scenario: the engine's model of the rod with its loads, tendon tensions and solver
@@ -67,6 +70,14 @@ pub fn build_with(
                     &a.dir,
                     options,
                 )?;
+                if let (Some(loaded), Some(r)) = (&a.loaded, &built.reduced) {
+                    if !same_content(loaded, &r.origin) {
+                        anyhow::bail!(
+                            "model `{}`: the directory changed since `load_model` read it (it was written again): load it again to use what it holds now",
+                            a.dir.display()
+                        );
+                    }
+                }
             }
             Ok(built)
         })
@@ -77,8 +88,16 @@ pub fn build_with(
     Ok(built)
 }
 
-/// A `UserWarning` in Python.
+/// Whether two readings of a directory found the same content (the manifest's hashes; a directory
+/// without recorded hashes cannot tell, and passes).
+fn same_content(a: &gvsrom::provenance::DirOrigin, b: &gvsrom::provenance::DirOrigin) -> bool {
+    a.meta_sha256 == b.meta_sha256 && a.sha256 == b.sha256
+}
+
+/// A `UserWarning` in Python, the command line's flags spelled as keyword arguments
+/// ([`errors::python_spelling`]).
 pub fn warn(py: Python<'_>, message: &str) -> PyResult<()> {
+    let message = errors::python_spelling(message);
     let text = CString::new(message.replace('\0', " ")).unwrap_or_default();
     PyErr::warn(py, &py.get_type::<PyUserWarning>(), &text, 1)
 }
@@ -124,9 +143,10 @@ impl Robot {
         build_with(py, &scenario, Some(attached), false)
     }
 
-    /// The coordinates `q` of a model quantity: `n_dof` finite values and, for a reduced model
-    /// attached without `extrapolate`, inside its training encodings, where its decoder answers (as
-    /// `simulate(q0=…)` and `Model.decode` refuse a code far outside them).
+    /// The coordinates `q` of a model quantity: `n_dof` finite values, for a reduced model attached
+    /// without `extrapolate` inside its training encodings, where its decoder answers (as
+    /// `simulate(q0=…)` and `Model.decode` refuse a code far outside them), and a state of an
+    /// elastic rod ([`quantities::state_violation`], as a simulation's samples are checked).
     pub(crate) fn coordinates(&self, q: &In1<'_>) -> PyResult<nalgebra::DVector<f64>> {
         let q = arrays::dvec("q", q, self.built.n_dof())?;
         let reduced = self.built.reduced.as_ref().filter(|r| !r.extrapolate);
@@ -135,18 +155,36 @@ impl Robot {
                 "`q`: {v}: the decoder extrapolates there and its quantities are not to be trusted; accepted: a state inside the training region, or the model attached with extrapolate=True"
             )));
         }
+        if let Some(v) = quantities::state_violation(&self.built, &self.workspaces, &q) {
+            return Err(invalid(format!(
+                "`q` is no state of an elastic rod: {v}; accepted: a state within the bounds that end a simulation, where the model's quantities mean something"
+            )));
+        }
         Ok(q)
     }
 
     /// Tensions of a model quantity: the scenario's, or `u` (one per tendon or one for all),
-    /// finite.
-    pub(crate) fn quantity_tensions(&self, u: Option<Tensions<'_>>) -> PyResult<Vec<f64>> {
+    /// finite, and with a reduced model attached where it answers (as `statics(u)` refuses
+    /// tensions its training never came near: the model's verdict, unless attached with
+    /// `extrapolate`).
+    pub(crate) fn quantity_tensions(
+        &self,
+        py: Python<'_>,
+        u: Option<Tensions<'_>>,
+    ) -> PyResult<Vec<f64>> {
         let Some(u) = u else {
             return Ok(self.built.u.clone());
         };
         let u = gvsrom::scenario::tensions_for(self.built.model.n_actuators(), &u.values())
             .map_err(err)?;
-        arrays::finite("u", u.into()).map(|v| v.as_slice().to_vec())
+        let u = arrays::finite("u", u.into())?.as_slice().to_vec();
+        if let (Some(r), Some(a)) = (&self.built.reduced, &self.attached) {
+            if !r.extrapolate && !r.covers_tensions(&self.built.u, &u) {
+                // attaching the model to the scenario at `u` gives its verdict and reasons
+                self.rebuilt_with(py, Some(&u), a)?;
+            }
+        }
+        Ok(u)
     }
 
     /// The equilibrium under `u` with this robot's reduced model as attached, without building
@@ -167,31 +205,38 @@ impl Robot {
     }
 
     /// The equilibrium under `u` (the scenario's tensions if `None`) with `attached` (else this
-    /// robot's model): `gvsrom statics [--tension u] [--model DIR]`.
+    /// robot's model): `gvsrom statics [--tension u] [--model DIR]`; with how the model was used
+    /// outside its training (`--extrapolate`'s sentences, the `--json`'s `model_extrapolated`).
     fn solve(
         &self,
         py: Python<'_>,
         u: Option<Vec<f64>>,
         attached: Option<&Attached>,
-    ) -> PyResult<StaticsReport> {
+    ) -> PyResult<(StaticsReport, Vec<String>)> {
         match attached.or(self.attached.as_ref()) {
             None => {
                 let u = match u {
                     Some(u) => self.built.tensions(&u).map_err(err)?,
                     None => self.built.u.clone(),
                 };
-                py.detach(|| statics::solve_under(&self.built, &u))
-                    .map_err(|f| errors::statics(py, f))
+                let report = py
+                    .detach(|| statics::solve_under(&self.built, &u))
+                    .map_err(|f| errors::statics(py, f))?;
+                Ok((report, vec![]))
             }
             Some(a) => {
                 if attached.is_none() {
+                    // answered only where the model is not extrapolating
                     if let Some(report) = self.solve_attached(py, u.as_deref()) {
-                        return report;
+                        return Ok((report?, vec![]));
                     }
                 }
                 let built = self.rebuilt_with(py, u.as_deref(), a)?;
-                py.detach(|| statics::solve_checked(&built, &built.u))
-                    .map_err(errors::any)
+                let report = py
+                    .detach(|| statics::solve_checked(&built, &built.u))
+                    .map_err(errors::any)?;
+                let extrapolated = built.reduced.map(|r| r.extrapolated).unwrap_or_default();
+                Ok((report, extrapolated))
             }
         }
     }
@@ -297,27 +342,24 @@ impl Robot {
     /// ----------
     /// model : Model
     ///     From :func:`load_model`.
-    /// extrapolate : bool
+    /// extrapolate : bool, optional
     ///     Use the model where the scenario lies outside what it was trained on (``--extrapolate``);
-    ///     the reasons are then warned about.
+    ///     the reasons are then warned about. Default: the model's own setting
+    ///     (``load_model(…, extrapolate=…)``).
     ///
     /// Raises
     /// ------
     /// GvsromError
     ///     If the model was not learned on this scenario's points, or the scenario lies outside
     ///     its training (without ``extrapolate``).
-    #[pyo3(signature = (model, extrapolate=false))]
+    #[pyo3(signature = (model, extrapolate=None))]
     fn with_model(
         &self,
         py: Python<'_>,
         model: PyRef<'_, Model>,
-        extrapolate: bool,
+        extrapolate: Option<bool>,
     ) -> PyResult<Robot> {
-        let attached = Attached {
-            dir: model.dir.clone(),
-            extrapolate,
-        };
-        Robot::new(py, self.scenario.clone(), Some(attached))
+        Robot::new(py, self.scenario.clone(), Some(model.attached(extrapolate)))
     }
 
     /// Static equilibrium under tendon tensions ``u``, as ``gvsrom statics`` solves it (same
@@ -349,12 +391,9 @@ impl Robot {
         model: Option<PyRef<'_, Model>>,
     ) -> PyResult<Statics> {
         let u = u.map(|a| a.values());
-        let attached = model.map(|m| Attached {
-            dir: m.dir.clone(),
-            extrapolate: m.extrapolate,
-        });
-        let report = self.solve(py, u, attached.as_ref())?;
-        Statics::new(py, &report)
+        let attached = model.map(|m| m.attached(None));
+        let (report, extrapolated) = self.solve(py, u, attached.as_ref())?;
+        Statics::new(py, &report, extrapolated)
     }
 
     /// Static equilibria under many tensions, solved in parallel (all cores, the GIL released).
@@ -509,6 +548,7 @@ impl Robot {
         let n = self.built.n_dof();
         let (q, qd) = (self.coordinates(&q)?, arrays::dvec("qd", &qd, n)?);
         let flat = py.detach(|| quantities::velocities(&self.built, &self.workspaces, &q, &qd));
+        crate::dynamics_quantities::finite_at("the point velocities", &flat, &qd)?;
         arrays::shaped(py, flat, [self.built.model.disc.n_points(), 6])
     }
 
@@ -535,7 +575,7 @@ impl Robot {
         u: Option<Tensions<'_>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let q = self.coordinates(&q)?;
-        let u = self.quantity_tensions(u)?;
+        let u = self.quantity_tensions(py, u)?;
         let r = py
             .detach(|| quantities::statics_residual(&self.built, &self.workspaces, &q, &u))
             .map_err(err)?;
@@ -551,7 +591,7 @@ impl Robot {
         u: Option<Tensions<'_>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let q = self.coordinates(&q)?;
-        let u = self.quantity_tensions(u)?;
+        let u = self.quantity_tensions(py, u)?;
         let j = py
             .detach(|| quantities::statics_jacobian(&self.built, &self.workspaces, &q, &u))
             .map_err(err)?;

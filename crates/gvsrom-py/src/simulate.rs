@@ -74,7 +74,10 @@ impl Robot {
     /// dict
     ///     ``t`` (k,), ``q``/``qd`` (k, n), ``u`` (k, n_a), ``tip_position`` (k, 3),
     ///     ``tip_rotation`` (k, 3, 3), ``strain`` (k, p, 6), ``strain_x`` (p,), ``centerline``
-    ///     (k, c, 3), ``centerline_x`` (c,), and ``steps``, ``failed_steps``, ``wall_time_s``.
+    ///     (k, c, 3), ``centerline_x`` (c,), ``steps``, ``failed_steps``, ``wall_time_s``, and
+    ///     ``model_extrapolated`` (list of str): how the reduced model was used outside what it
+    ///     was trained on (``extrapolate=True``; the scenario, a signal's tensions, the values a
+    ///     callable ``input`` returned), empty otherwise.
     ///
     /// Raises
     /// ------
@@ -134,13 +137,24 @@ fn method(name: &str) -> PyResult<MethodChoice> {
 /// run at its next step attempt; until then the actuation is zero. The largest |u| of each tendon
 /// so far is kept with the time it was returned: the run's control checks it against the rod's
 /// elastic range after each step ([`CallableInput::check_range`]), as `gvsrom simulate` checks a
-/// signal's tensions before it starts.
+/// signal's tensions before it starts. With a reduced model attached, every value returned is
+/// checked too against what the model was trained on, as a signal of rows is
+/// ([`gvsrom::build::reduced::Reduced::check_signal`]): outside, the run stops with the model's
+/// verdict, or, with `extrapolate`, goes on and its result says so.
 pub struct CallableInput {
     function: Py<PyAny>,
     n_actuators: usize,
     error: Mutex<Option<PyErr>>,
     largest: Mutex<Largest>,
+    /// With a reduced model: the values returned since the last check, with their times.
+    returned: Option<Mutex<Vec<Returned>>>,
+    /// How the values lay outside the model's training, with `extrapolate` (the first sentence
+    /// of each kind is kept).
+    extrapolated: Mutex<Vec<String>>,
 }
+
+/// A value `u` a callable input returned, and the time `t` it was asked for.
+type Returned = (f64, Vec<f64>);
 
 /// The largest |u| per tendon returned so far, the time of each, and whether it grew since the
 /// last check.
@@ -175,8 +189,15 @@ impl CallableInput {
         Ok(u)
     }
 
-    /// Records `u`, returned at `t`, in the largest |u| per tendon.
+    /// Records `u`, returned at `t`, in the largest |u| per tendon (and for the model's check).
     fn record(&self, t: f64, u: &[f64]) {
+        if let Some(r) = &self.returned {
+            let mut r = r.lock().unwrap_or_else(PoisonError::into_inner);
+            // a value held over many evaluations (a step input) is checked once
+            if r.last().is_none_or(|(_, last)| last.as_slice() != u) {
+                r.push((t, u.to_vec()));
+            }
+        }
         let mut l = self.largest.lock().unwrap_or_else(PoisonError::into_inner);
         if l.abs.len() != u.len() {
             l.abs = vec![0.0; u.len()];
@@ -195,6 +216,62 @@ impl CallableInput {
     /// (`gvsrom::plausibility::check`, as for a signal given as rows); a value far beyond it
     /// becomes the run's error, naming the time it was returned, and `false` is returned.
     fn check_range(&self, built: &gvsrom::Built) -> bool {
+        self.check_model(built) && self.check_elastic_range(built)
+    }
+
+    /// The values returned since the last call against the reduced model's training
+    /// ([`gvsrom::build::reduced::Reduced::check_signal`] at their times): outside, the model's
+    /// verdict becomes the run's error and `false` is returned; with `extrapolate` the reasons are
+    /// kept for the result.
+    fn check_model(&self, built: &gvsrom::Built) -> bool {
+        let (Some(returned), Some(r)) = (&self.returned, &built.reduced) else {
+            return true;
+        };
+        let values = {
+            let mut r = returned.lock().unwrap_or_else(PoisonError::into_inner);
+            // the last value stays, so that the next ones are compared with it
+            let keep = r.last().cloned();
+            let values = std::mem::take(&mut *r);
+            r.extend(keep);
+            values
+        };
+        if values.is_empty() {
+            return true;
+        }
+        let times: Vec<f64> = values.iter().map(|(t, _)| *t).collect();
+        let verdict = r.check_signal(&times, |t| {
+            let at = values.iter().find(|(tv, _)| tv.to_bits() == t.to_bits());
+            at.map_or_else(Vec::new, |(_, u)| u.clone())
+        });
+        match verdict {
+            Ok(sentences) => {
+                let mut kept = self
+                    .extrapolated
+                    .lock()
+                    .unwrap_or_else(PoisonError::into_inner);
+                for s in sentences {
+                    // one sentence per way of lying outside (a tendon's range, the combination)
+                    let kind = match s.starts_with("at t = ") {
+                        true => "at t = ".to_string(),
+                        false => s.split(" reaches ").next().unwrap_or(&s).to_string(),
+                    };
+                    if !kept.iter().any(|k| k.starts_with(&kind)) {
+                        kept.push(s);
+                    }
+                }
+                true
+            }
+            Err(e) => {
+                // as for a signal of rows: the message names the tension, its value and time
+                let mut slot = self.error.lock().unwrap_or_else(PoisonError::into_inner);
+                slot.get_or_insert_with(|| invalid(e.to_string()));
+                false
+            }
+        }
+    }
+
+    /// The largest |u| against the rod's elastic range, if it grew since the last call.
+    fn check_elastic_range(&self, built: &gvsrom::Built) -> bool {
         let (abs, at) = {
             let mut l = self.largest.lock().unwrap_or_else(PoisonError::into_inner);
             if !l.grown {
@@ -295,6 +372,8 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
                 n_actuators: na,
                 error: Mutex::new(None),
                 largest: Mutex::new(Largest::default()),
+                returned: robot.attached.as_ref().map(|_| Mutex::new(vec![])),
+                extrapolated: Mutex::new(vec![]),
             }))
         }
         _ => None,
@@ -353,6 +432,12 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
     for o in &plan.model_extrapolated {
         warn(py, &format!("extrapolating (--extrapolate): {o}"))?;
     }
+    // as `simulate --out`'s `model_extrapolated`: the scenario's, then the input's
+    let mut extrapolated: Vec<String> = (built.reduced.iter())
+        .flat_map(|r| r.extrapolated.iter())
+        .chain(&plan.model_extrapolated)
+        .cloned()
+        .collect();
     let mut buffer = TrajectoryBuffer::new(built);
     let mut signals = crate::interrupt::SignalPoll::new();
     let outcome = py.detach(|| {
@@ -379,6 +464,18 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
     if let Some(e) = callable.as_ref().and_then(|c| c.take_error()) {
         return Err(e);
     }
+    if let Some(c) = &callable {
+        let kept = std::mem::take(
+            &mut *c
+                .extrapolated
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner),
+        );
+        for o in kept {
+            warn(py, &format!("extrapolating (--extrapolate): {o}"))?;
+            extrapolated.push(o);
+        }
+    }
     if let Some(e) = signals.caught() {
         return Err(e);
     }
@@ -393,7 +490,9 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
         }
         Ending::Interrupted { reason } => return Err(invalid(reason.clone())),
     }
-    trajectory(py, built, &buffer, &outcome)
+    let d = trajectory(py, built, &buffer, &outcome)?;
+    d.set_item("model_extrapolated", extrapolated)?;
+    Ok(d)
 }
 
 fn trajectory<'py>(

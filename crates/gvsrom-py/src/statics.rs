@@ -36,6 +36,9 @@ use pyo3::types::PyDict;
 ///     ``‖R(q)‖∞`` at the solution.
 /// solve_time_s : float
 ///     Wall-clock time of the solve [s].
+/// model_extrapolated : list of str
+///     How the reduced model was used outside what it was trained on (``extrapolate=True``; the
+///     ``--json``'s ``model_extrapolated``); empty inside, and without a model.
 #[pyclass(module = "gvsrom", frozen, get_all)]
 pub struct Statics {
     /// The scenario's name.
@@ -72,10 +75,16 @@ pub struct Statics {
     residual_norm: f64,
     /// Wall-clock time of the solve [s].
     solve_time_s: f64,
+    /// How the reduced model was used outside what it was trained on (`--extrapolate`).
+    model_extrapolated: Vec<String>,
 }
 
 impl Statics {
-    pub fn new(py: Python<'_>, r: &StaticsReport) -> PyResult<Statics> {
+    pub fn new(
+        py: Python<'_>,
+        r: &StaticsReport,
+        model_extrapolated: Vec<String>,
+    ) -> PyResult<Statics> {
         Ok(Statics {
             scenario: r.scenario.clone(),
             n_dof: r.n_dof,
@@ -94,6 +103,7 @@ impl Statics {
             jacobian_evaluations: r.jacobian_evaluations,
             residual_norm: r.residual_norm,
             solve_time_s: r.solve_time_s,
+            model_extrapolated,
         })
     }
 }
@@ -124,6 +134,7 @@ impl Statics {
         d.set_item("jacobian_evaluations", self.jacobian_evaluations)?;
         d.set_item("residual_norm", self.residual_norm)?;
         d.set_item("solve_time_s", self.solve_time_s)?;
+        d.set_item("model_extrapolated", &self.model_extrapolated)?;
         Ok(d)
     }
 

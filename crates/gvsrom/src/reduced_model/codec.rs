@@ -143,7 +143,7 @@ impl ReducedModel {
             if let Some(d) = outside_range(range, z) {
                 let [lo, hi] = range[d];
                 return Err(CodecError::OutsideRange(format!(
-                    "row {row}: q_r[{d}] = {} lies far outside the range of the training encodings [{lo:.6}, {hi:.6}] ({why}); accepted: within half the range's width of it, or extrapolate = true",
+                    "row {row}: q_r[{d}] = {} lies far outside the range of the training encodings [{lo:.6}, {hi:.6}] ({why}); accepted: within half the range's width of it, or --extrapolate",
                     gvs::error::fmt_value(z[d])
                 )));
             }

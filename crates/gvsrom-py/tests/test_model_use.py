@@ -1,0 +1,142 @@
+"""A reduced model used outside what it was trained on says so everywhere a Python caller reaches
+it (a callable input, the model quantities, the results); a loaded model or dataset is the one
+used, never a directory written again since; a state no rod holds is refused, not answered with
+NaN."""
+
+import os
+import warnings
+
+import numpy as np
+import pytest
+
+import gvsrom
+
+
+@pytest.fixture(scope="module")
+def dataset(tmp_path_factory):
+    return gvsrom.dataset("single-tendon", tmp_path_factory.mktemp("ds") / "sweep",
+                          sweep="tendons.0.tension=-6:0", samples=7)
+
+
+@pytest.fixture(scope="module")
+def pod(dataset, tmp_path_factory):
+    return gvsrom.pod(dataset, 2, tmp_path_factory.mktemp("pod") / "model")
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return gvsrom.Scenario.preset("single-tendon").build()
+
+
+def outside_message(excinfo):
+    return str(excinfo.value)
+
+
+def test_a_callable_input_outside_the_training_is_refused_as_rows_are(robot, pod):
+    rom = robot.with_model(pod)
+    with pytest.raises(gvsrom.GvsromError) as rows:
+        rom.simulate(0.05, input=[[0.0, -30.0]])
+    with pytest.raises(gvsrom.GvsromError) as function:
+        rom.simulate(0.05, input=lambda t: -30.0)
+    # the same verdict: the tension, its value, the time and the training range
+    for e in (rows, function):
+        assert "tendons.0.tension reaches -30 at t = 0 s, outside the training inputs [-6, 0]" \
+            in str(e.value), str(e.value)
+    # inside, it runs and nothing is marked
+    run = rom.simulate(0.05, input=lambda t: -3.0)
+    assert run["model_extrapolated"] == []
+
+
+def test_a_callable_input_that_leaves_the_training_later_is_refused_there(robot, pod):
+    rom = robot.with_model(pod)
+    with pytest.raises(gvsrom.GvsromError, match=r"reaches -20 at t = 0\.0[2-3]"):
+        rom.simulate(0.05, input=lambda t: -3.0 if t < 0.02 else -20.0)
+
+
+def test_an_extrapolating_model_marks_every_result(robot, pod):
+    loose = gvsrom.load_model(pod.path, extrapolate=True)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        run = robot.with_model(loose).simulate(0.05, input=lambda t: -30.0)
+        eq = robot.statics(u=-30.0, model=loose)
+        modes = robot.with_model(loose).modes(2, u=-30.0)
+    assert run["model_extrapolated"] and "-30" in run["model_extrapolated"][0]
+    assert eq.model_extrapolated == ["tendons.0.tension = -30 lies outside the training inputs [-6, 0]"]
+    assert eq.to_dict()["model_extrapolated"] == eq.model_extrapolated
+    assert modes["model_extrapolated"] == eq.model_extrapolated
+    # warned in Python's spelling, not the command line's
+    messages = [str(w.message) for w in caught]
+    assert messages and all("--extrapolate" not in m for m in messages), messages
+    assert any("extrapolate=True" in m for m in messages), messages
+    # a full-model solve is never marked
+    assert robot.statics(u=-30.0).model_extrapolated == []
+
+
+def test_with_model_takes_the_models_own_extrapolate_unless_told(robot, pod):
+    loose = gvsrom.load_model(pod.path, extrapolate=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert robot.with_model(loose).statics(u=-30.0).model_extrapolated
+    with pytest.raises(gvsrom.GvsromError, match="extrapolate=True"):
+        robot.with_model(loose, extrapolate=False).statics(u=-30.0)
+
+
+def test_model_quantities_refuse_tensions_outside_the_training(robot, pod):
+    rom = robot.with_model(pod)
+    rest = pod.rest
+    for f in (lambda u: rom.accelerations(rest, np.zeros(2), u=u),
+              lambda u: rom.statics_residual(rest, u=u),
+              lambda u: rom.statics_jacobian(rest, u=u)):
+        with pytest.raises(gvsrom.GvsromError, match=r"-30 lies outside the training inputs \[-6, 0\]"):
+            f(-30.0)
+        assert np.all(np.isfinite(f(-3.0)))
+
+
+def test_a_model_directory_written_again_is_refused_not_read_silently(tmp_path, dataset, robot):
+    path = tmp_path / "model"
+    loaded = gvsrom.pod(dataset, 2, path)
+    gvsrom.pod(dataset, 1, path, force=True)
+    with pytest.raises(gvsrom.GvsromError, match="changed since `load_model` read it"):
+        robot.with_model(loaded)
+    with pytest.raises(gvsrom.GvsromError, match="changed since `load_model` read it"):
+        robot.statics(model=loaded)
+    assert robot.with_model(gvsrom.load_model(path)).n_dof == 1
+
+
+def test_a_dataset_directory_written_again_is_refused_not_read_silently(tmp_path):
+    path = tmp_path / "ds"
+    loaded = gvsrom.dataset("single-tendon", path, sweep="tendons.0.tension=-6:0", samples=5)
+    gvsrom.dataset("single-tendon", path, sweep="tendons.0.tension=-6:0", samples=4, force=True)
+    for f in (lambda: gvsrom.pod(loaded, 1, tmp_path / "pod"),
+              lambda: gvsrom.pod([loaded], 1, tmp_path / "pod")):
+        with pytest.raises(gvsrom.GvsromError, match="no longer holds what `load_dataset` read"):
+            f()
+    assert not (tmp_path / "pod").exists()
+    assert len(gvsrom.load_dataset(path)) == 4
+
+
+def test_a_model_loaded_by_a_relative_path_survives_a_change_of_directory(tmp_path, dataset, robot,
+                                                                          monkeypatch):
+    gvsrom.pod(dataset, 2, tmp_path / "model")
+    monkeypatch.chdir(tmp_path)
+    loaded = gvsrom.load_model("model")
+    assert loaded.path == tmp_path / "model"
+    monkeypatch.chdir(os.path.dirname(tmp_path))
+    assert robot.with_model(loaded).n_dof == 2
+
+
+def test_a_state_no_rod_holds_is_refused_not_answered_with_nan(robot):
+    n = robot.n_dof
+    q = np.zeros(n)
+    q[0] = 1e24
+    for f in (robot.mass_matrix, robot.elastic_force, robot.forward, robot.external_force):
+        with pytest.raises(gvsrom.GvsromError, match="`q` is no state of an elastic rod"):
+            f(q)
+    fast = np.full(n, 1e200)
+    # quadratic in q̇: overflows (linear ones, as the point velocities or C(q, q̇), stay finite)
+    for f in (robot.coriolis_force, robot.accelerations, lambda q, qd: robot.energy(q, qd)):
+        with pytest.raises(gvsrom.GvsromError, match="`qd`"):
+            f(np.zeros(n), fast)
+    # a large but physical state is answered
+    q[0] = 0.5
+    assert np.all(np.isfinite(robot.mass_matrix(q)))
