@@ -151,6 +151,24 @@ impl<P: StrainParam> Model<P> {
         ws.xi[..self.disc.n_points()].to_vec()
     }
 
+    /// The strains `ξ_i = Ψ_i(q) + ξ*_i` at every computational point at `q`, without the
+    /// kinematics: `Φ_i q` for a linear basis, a decoder's value without its tangents
+    /// ([`StrainParam::eval_strains`]). The poses in `ws` are left as they were (stale); every
+    /// other method evaluates again at its own `q`. Allocates nothing.
+    pub fn strains_at<'w>(&self, q: &DVector<f64>, ws: &'w mut Workspace) -> &'w [V6] {
+        if self.param.eval_strains(q, &mut ws.ev) {
+            ws.ev.psi_q_stale = true;
+        } else {
+            self.param.eval(q, &mut ws.ev);
+            ws.ev.psi_q_stale = false;
+        }
+        ws.ev.motion = false;
+        for s in 0..ws.xi.len() {
+            ws.xi[s] = ws.ev.psi[s] + self.xi_star[s];
+        }
+        &ws.xi[..self.disc.n_points()]
+    }
+
     /// Position of the centreline at `x` by cubic Hermite interpolation between the neighbouring
     /// computational points (tangent `r' = R ν`), after a forward pass.
     pub fn position_at(&self, ws: &Workspace, x: f64) -> V3 {

@@ -619,3 +619,36 @@ fn planar_loading_keeps_out_of_plane_coordinates_exactly_zero() {
     }
     assert!(sol.q.rows(4, 4).amax() > 0.1);
 }
+
+#[test]
+fn strains_at_equals_the_forward_pass_strains_and_leaves_the_poses() {
+    // `Model::strains_at` evaluates Ψ(q) + ξ* alone; the forward pass computes the same strains on
+    // its way to the poses
+    let m = model(
+        Rod::tapered(mat(1e6, 1000.0), 0.5, 0.01, 0.008),
+        6,
+        legendre([Some(1), Some(2), Some(2), Some(1), Some(1), Some(1)]),
+        vec![],
+        &[],
+    );
+    let q = DVector::from_fn(m.n_dof(), |i, _| 0.3 * (i as f64 + 1.0).sin());
+    let mut ws = m.workspace();
+    m.forward_pose(&q, &mut ws);
+    let expected = m.point_strains(&ws);
+    let tip = ws.g.last().unwrap().pos;
+    let mut other = m.workspace();
+    m.forward_pose(&DVector::zeros(m.n_dof()), &mut other);
+    let got = m.strains_at(&q, &mut other).to_vec();
+    assert_eq!(got.len(), m.disc.n_points());
+    for (g, e) in got.iter().zip(&expected) {
+        assert!(
+            (g - e).amax() <= 1e-14 * (1.0 + e.amax()),
+            "{g} against {e}"
+        );
+    }
+    // non-trivial: the strains differ from the rest strain
+    assert!((got[1] - m.xi_star(1)).amax() > 0.1);
+    // the poses stay those of the last forward pass (the straight rod), not q's
+    assert!((other.g.last().unwrap().pos - V3::new(0.5, 0.0, 0.0)).norm() < 1e-12);
+    assert!((tip - V3::new(0.5, 0.0, 0.0)).norm() > 1e-3);
+}

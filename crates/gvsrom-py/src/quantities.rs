@@ -72,16 +72,12 @@ pub fn forward(built: &Built, cache: &WorkspaceCache, q: &DVector<f64>) -> (Vec<
 /// Why `q` is no state of an elastic rod (a strain past the bounds that end a simulation,
 /// [`gvsrom::plausibility::state_violation`], or not finite), as a phrase; `None` for a physical
 /// state. The model's quantities there mean nothing, and overflow to NaN far beyond.
+/// Only the strains are evaluated, without the kinematics ([`Model::strains_at`]).
 pub fn state_violation(built: &Built, cache: &WorkspaceCache, q: &DVector<f64>) -> Option<String> {
     with_model!(built, cache, m, ws => {
-        m.forward_pose(q, ws);
-        let x: Vec<f64> = m.disc.points.iter().map(|p| p.x).collect();
-        gvsrom::plausibility::state_violation(
-            &m.point_strains(ws),
-            &x,
-            |j| m.xi_star(j),
-            m.disc.length(),
-        )
+        let x: Vec<f64> = m.disc.points.iter().map(|pt| pt.x).collect();
+        let length = m.disc.length();
+        gvsrom::plausibility::state_violation(m.strains_at(q, ws), &x, |j| m.xi_star(j), length)
     })
 }
 
