@@ -406,9 +406,10 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
         }
     };
     // a reduced model checks a signal's tensions, not the scenario's (`simulate --model`)
+    // (from an equilibrium, the scenario's tensions are the start's: checked as attached)
     let built = match a.input {
-        Some(_) => robot.built_for_signal(py)?,
-        None => &robot.built,
+        Some(_) if !a.from_equilibrium => robot.built_for_signal(py)?,
+        _ => &robot.built,
     };
     let choice = IntegratorChoice {
         method: method(a.method)?,

@@ -528,6 +528,72 @@ fn a_reduced_start_off_the_straight_rod_is_reported() {
     assert!(!run(pod33(), &[]).contains(note));
 }
 
+#[test]
+fn a_start_at_equilibrium_is_the_equilibrium_statics_finds_with_the_same_model() {
+    // `simulate --from-equilibrium --model` starts where `statics --model` solves (from the
+    // model's anchors, checked against its training), not at a root the engine's ramp from the
+    // decoder's rest may reach
+    for (model, u) in [(ae_small(), "-5"), (ae_small(), "-1"), (pod33(), "-5")] {
+        let json_out = scratch("red-feq-statics").join("eq.json");
+        std::fs::create_dir_all(json_out.parent().unwrap()).unwrap();
+        let tension = format!("--tension={u}");
+        run_ok(&[
+            "statics",
+            "single-tendon",
+            &tension,
+            "--model",
+            s(model),
+            "--json",
+            s(&json_out),
+        ]);
+        let eq = tip(&json(&json_out)["tip_position"]);
+        let out = scratch("red-feq-sim");
+        run_ok(&[
+            "simulate",
+            "single-tendon",
+            "--duration",
+            "0.01",
+            "--from-equilibrium",
+            &tension,
+            "--model",
+            s(model),
+            "--out",
+            s(&out),
+        ]);
+        let (_, tips) = npy(&out.join("tip_position.npy"));
+        assert!(
+            dist(&tips[..3], &eq) < 1e-9 * L,
+            "{model:?} at {u} N: {:?} against {eq:?}",
+            &tips[..3]
+        );
+    }
+    // the start's tensions are the model's input too: outside its training they are refused,
+    // with an input signal as without
+    for extra in [&[][..], &["--steps=-1,0,0.005"]] {
+        let args = [
+            &[
+                "simulate",
+                "single-tendon",
+                "--duration",
+                "0.01",
+                "--from-equilibrium",
+                "--tension=-8",
+                "--model",
+                s(pod33()),
+            ][..],
+            extra,
+        ]
+        .concat();
+        expect_error(
+            &args,
+            &[
+                "--model",
+                "tendons.0.tension = -8 lies outside the training inputs",
+            ],
+        );
+    }
+}
+
 /// A copy of `model` whose `weights.safetensors` lacks the tensor `drop`.
 fn without_tensor(model: &Path, name: &str, drop: &str) -> PathBuf {
     use safetensors::tensor::{SafeTensors, TensorView};

@@ -146,7 +146,9 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
     let mut r = load(&args.scenario)?;
     if let Some(dir) = &args.model {
         // an input signal's tensions are checked against the model once the signal is built
-        let signal_driven = args.input.is_some() || args.steps.is_some() || args.babble.is_some();
+        // (with --from-equilibrium the scenario's tensions are the start's, and checked too)
+        let signal_driven = (args.input.is_some() || args.steps.is_some() || args.babble.is_some())
+            && !args.from_equilibrium;
         attach_model(&mut r, &args.scenario, dir, signal_driven)?;
     }
     let (scenario, built) = (&r.scenario, &r.built);

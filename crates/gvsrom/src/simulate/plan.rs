@@ -207,10 +207,21 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
     crate::plausibility::check(built, &u_max, lambda_max)?;
     let initial = match &opts.start {
         Start::Rest => InitialState::Rest,
-        Start::Equilibrium => InitialState::Equilibrium {
-            u: built.u.clone(),
-            loads: built.loads.clone(),
-        },
+        // the equilibrium `gvsrom statics` finds under the scenario's tensions and loads (with a
+        // reduced model: from its anchors, and checked against its training encodings), not the
+        // engine's ramp from rest, which a decoder can lead to a spurious root
+        Start::Equilibrium => {
+            let report = crate::statics::solve_checked(built, &built.u).map_err(|e| {
+                ScenarioError::invalid(
+                    "--from-equilibrium",
+                    format!("the start, the static equilibrium under the scenario's tensions and loads, failed: {e:#}"),
+                )
+            })?;
+            InitialState::Given {
+                q: DVector::from_vec(report.q),
+                qd: DVector::zeros(built.n_dof()),
+            }
+        }
         Start::State { q, qd } => initial_state(built, q, qd)?,
     };
     let input = input_record(built, opts)?;
