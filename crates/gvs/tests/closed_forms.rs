@@ -652,3 +652,27 @@ fn strains_at_equals_the_forward_pass_strains_and_leaves_the_poses() {
     assert!((other.g.last().unwrap().pos - V3::new(0.5, 0.0, 0.0)).norm() < 1e-12);
     assert!((tip - V3::new(0.5, 0.0, 0.0)).norm() > 1e-3);
 }
+
+#[test]
+fn stiffness_is_singular_with_fewer_gauss_points_than_legendre_functions() {
+    // K = Σ W Φᵀ Es Φ has rank at most the number of points: a Legendre basis of order p (p + 1
+    // functions per strain) needs p + 1 Gauss points (the rule gvsrom's scenario check applies)
+    let p = 6;
+    let smallest = |n: usize| {
+        let m = model(
+            Rod::tapered(mat(1e6, 0.0), 0.5, 0.01, 0.01),
+            n,
+            legendre([None, Some(p), None, None, None, None]),
+            vec![],
+            &[],
+        );
+        let k = m
+            .stiffness()
+            .expect("a linear basis has a constant stiffness")
+            .clone();
+        let eig = k.symmetric_eigenvalues();
+        eig.min() / eig.max()
+    };
+    assert!(smallest(p).abs() < 1e-12, "{}", smallest(p));
+    assert!(smallest(p + 1) > 1e-6, "{}", smallest(p + 1));
+}

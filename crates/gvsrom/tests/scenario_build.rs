@@ -176,6 +176,83 @@ fn rotating_the_base_rotates_the_equilibrium() {
 }
 
 #[test]
+fn a_quadrature_with_fewer_points_than_basis_functions_is_refused() {
+    // fewer points than functions per strain make the stiffness singular (gvs's
+    // `stiffness_is_singular_with_fewer_gauss_points_than_legendre_functions`): refused, naming
+    // the field and the count accepted; one more point is accepted
+    let build = |overrides: &[&str]| {
+        let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+        gvsrom::build(&Scenario::from_toml("t", UNIFORM_ROD, &o).unwrap())
+    };
+    let fem = |degree: &str| {
+        format!("divisions.0.basis={{ kind = \"fem\", modes = [\"bend_y\"], elements = 4, degree = \"{degree}\" }}")
+    };
+    let cases: [(Vec<String>, &str, &str); 4] = [
+        (
+            vec![
+                "divisions.0.basis.order=10".into(),
+                "divisions.0.quadrature={gauss=10}".into(),
+            ],
+            "divisions[0].quadrature.gauss",
+            "at least 11",
+        ),
+        (
+            vec![
+                "divisions.0.basis.order=10".into(),
+                "divisions.0.quadrature={gauss_per_element=2, elements=5}".into(),
+            ],
+            "divisions[0].quadrature.gauss_per_element",
+            "at least 11",
+        ),
+        (
+            vec![
+                fem("linear"),
+                "divisions.0.quadrature={gauss_per_element=1}".into(),
+            ],
+            "divisions[0].quadrature.gauss_per_element",
+            "at least 2",
+        ),
+        (
+            vec![
+                fem("quadratic"),
+                "divisions.0.quadrature={gauss_per_element=2}".into(),
+            ],
+            "divisions[0].quadrature.gauss_per_element",
+            "at least 3",
+        ),
+    ];
+    for (overrides, field, accepted) in cases {
+        let o: Vec<&str> = overrides.iter().map(String::as_str).collect();
+        let e = build(&o).err().expect("refused").to_string();
+        assert!(
+            e.contains(field) && e.contains(accepted) && e.contains("singular"),
+            "{e}"
+        );
+    }
+    for ok in [
+        vec![
+            "divisions.0.basis.order=10".to_string(),
+            "divisions.0.quadrature={gauss=11}".into(),
+        ],
+        vec![
+            "divisions.0.basis.order=10".into(),
+            "divisions.0.quadrature={gauss_per_element=3, elements=4}".into(),
+        ],
+        vec![
+            fem("linear"),
+            "divisions.0.quadrature={gauss_per_element=2}".into(),
+        ],
+        vec![
+            fem("quadratic"),
+            "divisions.0.quadrature={gauss_per_element=3}".into(),
+        ],
+    ] {
+        let o: Vec<&str> = ok.iter().map(String::as_str).collect();
+        assert!(build(&o).is_ok(), "{ok:?}");
+    }
+}
+
+#[test]
 fn quadrature_defaults_follow_sorosim() {
     // Legendre order 2 → max(2 + 1, 5) = 5 Gauss points + 2 ends; FEM linear → 2 per element
     let s = Scenario::from_toml("t", UNIFORM_ROD, &[]).unwrap();

@@ -122,6 +122,90 @@ pub(super) fn quadrature(
     d: &DivisionSpec,
     basis: &DivisionBasis,
 ) -> Result<Quadrature, ScenarioError> {
+    let q = d.quadrature.clone().unwrap_or_default();
+    let quadrature = chosen_quadrature(j, &q, basis)?;
+    resolves(j, &q, basis, &quadrature)?;
+    Ok(quadrature)
+}
+
+/// Refuses a quadrature with fewer points than the basis has functions per strain: the stiffness
+/// `Σ W Φᵀ Es Φ` then has rank at most the number of points and is singular, so the equilibrium
+/// is not unique (zero-energy modes) and the solver returns one of many, silently wrong
+/// (`single-tendon` with 8 Gauss points for its order-10 basis: tip 0.13 m off). Legendre of
+/// highest order `p` needs `p + 1` points in all, FEM of degree `d` `d + 1` per element (its
+/// `d · elements + 1` functions against `g · elements` points).
+fn resolves(
+    j: usize,
+    q: &crate::scenario::QuadratureSpec,
+    basis: &DivisionBasis,
+    quadrature: &Quadrature,
+) -> Result<(), ScenarioError> {
+    let points = match *quadrature {
+        Quadrature::Gauss { n } => n,
+        Quadrature::Elements {
+            elements,
+            gauss_per_element,
+        } => elements * gauss_per_element,
+    };
+    let (field, given, needed, why) = match (basis, quadrature) {
+        (DivisionBasis::Legendre { modes, orders }, _) => {
+            let p = (0..6)
+                .filter(|&i| modes[i])
+                .map(|i| orders[i])
+                .max()
+                .unwrap_or(0);
+            let field = match q.gauss {
+                Some(_) => "gauss",
+                None => "gauss_per_element",
+            };
+            (
+                field,
+                points,
+                p + 1,
+                format!(
+                    "the basis's highest order {p} has {} Legendre functions per strain",
+                    p + 1
+                ),
+            )
+        }
+        (
+            DivisionBasis::Fem { degree, .. },
+            Quadrature::Elements {
+                gauss_per_element, ..
+            },
+        ) => {
+            let d = match degree {
+                FemDegree::Linear => 1,
+                FemDegree::Quadratic => 2,
+            };
+            (
+                "gauss_per_element",
+                *gauss_per_element,
+                d + 1,
+                format!("a FEM basis of degree {d} has {d} · elements + 1 functions per strain, which fewer than {} points per element cannot tell apart", d + 1),
+            )
+        }
+        // whole-division Gauss points on a FEM basis: each element needs its own points, which
+        // the engine checks when it lays them out
+        (DivisionBasis::Fem { .. }, Quadrature::Gauss { .. }) => return Ok(()),
+    };
+    if given >= needed {
+        return Ok(());
+    }
+    Err(ScenarioError::invalid(
+        format!("divisions[{j}].quadrature.{field}"),
+        format!(
+            "{given} points resolve too few functions: {why}, so the stiffness would be singular (zero-energy modes) and the equilibrium not unique; accepted: at least {needed}"
+        ),
+    ))
+}
+
+/// The quadrature `q` asks for (its defaults filled in), each count in range.
+fn chosen_quadrature(
+    j: usize,
+    q: &crate::scenario::QuadratureSpec,
+    basis: &DivisionBasis,
+) -> Result<Quadrature, ScenarioError> {
     let f = |n: &str| format!("divisions[{j}].quadrature.{n}");
     let check = |field: String, v: usize, max: usize| {
         if (1..=max).contains(&v) {
@@ -134,7 +218,6 @@ pub(super) fn quadrature(
             ))
         }
     };
-    let q = d.quadrature.clone().unwrap_or_default();
     match (q.gauss, q.elements, q.gauss_per_element) {
         (None, None, None) => Ok(match basis {
             DivisionBasis::Fem {
