@@ -211,6 +211,68 @@ fn replacing_needs_force_and_a_previous_output_holding_only_its_own_files() {
 }
 
 #[test]
+fn an_output_edited_after_gvsrom_wrote_it_is_not_replaced_even_with_force() {
+    let dir = sandbox("safety-edited");
+    let run = |args: &[&str]| run_in(&dir, args);
+    let sim = [
+        "simulate",
+        "single-tendon",
+        "--duration",
+        "0.02",
+        "--out",
+        "run",
+        "--force",
+    ];
+    assert!(run(&sim).status.success());
+    // an edited array: refused, naming the file, and kept as the user left it
+    fs::write(dir.join("run/q.npy"), "my edited analysis").unwrap();
+    let err = String::from_utf8_lossy(&run(&sim).stderr).into_owned();
+    assert!(
+        err.contains("was changed after gvsrom wrote it") && err.contains("q.npy"),
+        "{err}"
+    );
+    assert_eq!(
+        fs::read_to_string(dir.join("run/q.npy")).unwrap(),
+        "my edited analysis"
+    );
+    // an edited meta.json value: refused too
+    fs::remove_dir_all(dir.join("run")).unwrap();
+    assert!(run(&sim).status.success());
+    let mut m = meta(&dir.join("run"));
+    m["my_notes"] = "mine".into();
+    fs::write(
+        dir.join("run/meta.json"),
+        serde_json::to_string(&m).unwrap(),
+    )
+    .unwrap();
+    let err = String::from_utf8_lossy(&run(&sim).stderr).into_owned();
+    assert!(err.contains("was changed after gvsrom wrote it"), "{err}");
+    assert_eq!(meta(&dir.join("run"))["my_notes"], "mine");
+    // a JSON file output records the hash of its values: a key added by hand makes it the user's
+    let statics = ["statics", "single-tendon", "--json", "eq.json", "--force"];
+    assert!(run(&statics).status.success());
+    let mut eq: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(dir.join("eq.json")).unwrap()).unwrap();
+    // re-indented with the same values it is still gvsrom's, and replaced
+    fs::write(
+        dir.join("eq.json"),
+        serde_json::to_string_pretty(&eq).unwrap(),
+    )
+    .unwrap();
+    assert!(run(&statics).status.success());
+    eq["my_notes"] = "mine".into();
+    fs::write(dir.join("eq.json"), serde_json::to_string(&eq).unwrap()).unwrap();
+    let err = String::from_utf8_lossy(&run(&statics).stderr).into_owned();
+    assert!(
+        err.contains("--json `eq.json`: was changed after gvsrom wrote it"),
+        "{err}"
+    );
+    assert!(fs::read_to_string(dir.join("eq.json"))
+        .unwrap()
+        .contains("my_notes"));
+}
+
+#[test]
 fn a_second_writer_of_the_same_out_is_refused_while_the_first_runs() {
     let dir = sandbox("safety-concurrent");
     let mut first = spawn_in(

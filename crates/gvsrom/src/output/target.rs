@@ -108,6 +108,34 @@ pub(super) fn refuse_special(n: &Named, parent: &Path, name: &str) -> Result<(),
     Ok(())
 }
 
+/// How the gvsrom output at `target` of `format` differs from what gvsrom wrote, by the hashes its
+/// manifest records: a listed file's content, or the values of its meta.json (a JSON file output:
+/// its own values); `None` when it is as written, or records no hashes (an output of an earlier
+/// version), or only lacks files (nothing of the user's is lost by replacing it).
+fn edited_since_written(target: &Path, kind: Kind, format: &str) -> Option<String> {
+    use super::hashes::{meta_sha256, META_SHA256_KEY};
+    use super::integrity::{verify_dir, Problem};
+    match kind {
+        Kind::Dir => match verify_dir(target, format) {
+            Err(e) if matches!(e.problem, Problem::Changed | Problem::MetaEdited) => {
+                Some(e.to_string())
+            }
+            _ => None,
+        },
+        Kind::File => {
+            let text = super::read::read_regular_to_string(target).ok()?;
+            let serde_json::Value::Object(obj) = serde_json::from_str(&text).ok()? else {
+                return None;
+            };
+            let recorded = obj.get(MANIFEST_KEY)?.get(META_SHA256_KEY)?.as_str()?;
+            (meta_sha256(&obj) != recorded).then(|| {
+                "its values no longer match the `meta_sha256` recorded in its manifest: it was edited"
+                    .to_string()
+            })
+        }
+    }
+}
+
 /// Checks what is at the target now; see the module documentation for the rules.
 pub(super) fn inspect(
     n: &Named,
@@ -163,6 +191,11 @@ pub(super) fn inspect(
     if !force {
         return Err(n.refused(format!(
             "exists (a gvsrom {format} output); pass --force to replace it, or choose another path"
+        )));
+    }
+    if let Some(why) = edited_since_written(target, kind, &format) {
+        return Err(n.refused(format!(
+            "was changed after gvsrom wrote it ({why}); gvsrom never replaces what it did not write, even with --force: move it away or choose another path"
         )));
     }
     // Only the regular files actually present *and* listed are ever removed later: a manifest
