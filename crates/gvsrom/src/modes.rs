@@ -382,6 +382,10 @@ pub struct ModesJson<'a> {
     pub report: &'a ModesReport,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub model: Option<String>,
+    /// How the scenario lies outside what the model was trained on (`--extrapolate`), as
+    /// `statics --json` records it.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub model_extrapolated: Vec<String>,
     /// How the result was made ([`crate::provenance`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub provenance: Option<&'a crate::provenance::Provenance>,

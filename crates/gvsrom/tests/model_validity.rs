@@ -159,6 +159,28 @@ fn a_model_refuses_inputs_outside_its_training_range_unless_extrapolating() {
         &["modes", "single-tendon", "--tension=-9", "--model", s(m)],
         &["tendons.0.tension = -9"],
     );
+    // modes --json records an extrapolation as statics --json does
+    let json = scratch("val-extrapolated-modes.json");
+    run_ok(&[
+        "modes",
+        "single-tendon",
+        "--tension=-9",
+        "--model",
+        s(m),
+        "--extrapolate",
+        "--count",
+        "1",
+        "--json",
+        s(&json),
+    ]);
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert!(
+        doc["model_extrapolated"][0]
+            .as_str()
+            .is_some_and(|e| e.contains("tendons.0.tension = -9")),
+        "{doc}"
+    );
 }
 
 #[test]

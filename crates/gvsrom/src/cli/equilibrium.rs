@@ -178,6 +178,8 @@ pub(super) fn modes_cmd(args: &ModesArgs, out: &mut impl Write) -> Result<()> {
         let doc = modes::ModesJson {
             report: &report,
             model: args.model.as_ref().map(|p| p.display().to_string()),
+            model_extrapolated: (built.reduced.as_ref())
+                .map_or(vec![], |r| r.extrapolated.clone()),
             provenance: Some(&provenance),
         };
         let path = json.commit_json(&doc)?;
