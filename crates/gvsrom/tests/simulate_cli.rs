@@ -533,7 +533,7 @@ fn a_massless_rod_is_refused_for_motion_naming_the_density() {
 #[test]
 fn integrator_options_out_of_range_or_ignored_by_the_method_are_refused_before_any_output() {
     let out = scratch("integrator-options");
-    let cases: [(&[&str], &[&str]); 10] = [
+    let cases: [(&[&str], &[&str]); 12] = [
         (&["--max-order", "0"], &["--max-order", "from 1 to 5"]),
         (&["--max-order", "6"], &["--max-order", "from 1 to 5"]),
         (
@@ -545,6 +545,14 @@ fn integrator_options_out_of_range_or_ignored_by_the_method_are_refused_before_a
             &["--max-order", "does not apply", "NDF"],
         ),
         (&["--rho-inf", "0.5"], &["--rho-inf", "generalized-α"]),
+        (
+            &["--method", "sdirk", "--fd-jacobian"],
+            &["--fd-jacobian", "does not apply", "second-order form"],
+        ),
+        (
+            &["--method", "galpha", "--fd-jacobian"],
+            &["--fd-jacobian", "does not apply"],
+        ),
         (
             &["--fixed-step", "0.01", "--method", "ndf"],
             &["--method", "fixed-step"],

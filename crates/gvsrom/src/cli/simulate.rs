@@ -87,9 +87,9 @@ pub struct SimulateArgs {
 
     /// Error test of the adaptive methods: `componentwise` (ode15s) or `mass` (positions and
     /// velocities in the norm of the mass matrix: modes that move little mass do not limit the
-    /// step). Default: componentwise, or with the NDF mass for a lightly damped rod (see
-    /// `--max-order`). With `--method galpha`, `mass` is what makes it usable on a lightly damped
-    /// rod.
+    /// step). Default: mass for SDIRK4 (`--method sdirk`, or `auto` on a lightly damped rod) and
+    /// for the NDF on a lightly damped rod (see `--max-order`); componentwise otherwise. With
+    /// `--method galpha`, `mass` is what makes it usable on a lightly damped rod.
     #[arg(long, value_enum)]
     pub error_norm: Option<ErrorNormChoice>,
 

@@ -318,7 +318,7 @@ pub const DEFAULT_RHO_INF: f64 = 0.8;
 /// Checks every option of `choice` ([`check_tolerances`], then the rest) before anything runs:
 /// `--max-order` in 1–5, `--rho-inf` in \[0, 1\], `--fixed-step` finite and positive, and no
 /// option the chosen method would ignore (`--max-order` only with the NDF, `--rho-inf` only with
-/// generalized-α, no `--method`, `--rtol`, `--atol` or `--error-norm` with the fixed step, which
+/// generalized-α, `--fd-jacobian` not with SDIRK4 or generalized-α, no `--method`, `--rtol`, `--atol` or `--error-norm` with the fixed step, which
 /// is a method of its own without error control).
 pub fn check_choice(choice: &IntegratorChoice) -> Result<(), ScenarioError> {
     check_tolerances(choice)?;
@@ -394,6 +394,11 @@ pub fn check_choice(choice: &IntegratorChoice) -> Result<(), ScenarioError> {
                 "this method (it is generalized-α's; --method galpha)",
             )
         }
+        // both iterate on their own second-order matrix `M + γh D + βh² K`
+        MethodChoice::Galpha | MethodChoice::Sdirk if choice.fd_jacobian => ignored(
+            "--fd-jacobian",
+            "this method, which builds its own iteration matrix in second-order form (the finite-difference Jacobian is the NDF's and the fixed step's; --method ndf or auto)",
+        ),
         _ => Ok(()),
     }
 }
