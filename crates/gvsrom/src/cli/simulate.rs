@@ -104,7 +104,7 @@ pub struct SimulateArgs {
     pub load_schedule: Option<PathBuf>,
 
     /// Use finite differences of the right-hand side for the integrator's Jacobian instead of the
-    /// structured analytic one.
+    /// structured analytic one (the NDF and the fixed step; SDIRK4 and generalized-α refuse it).
     #[arg(long)]
     pub fd_jacobian: bool,
 
