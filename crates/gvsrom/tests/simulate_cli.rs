@@ -608,3 +608,81 @@ fn integrator_options_out_of_range_or_ignored_by_the_method_are_refused_before_a
         );
     }
 }
+
+#[test]
+fn options_that_would_be_ignored_are_refused_naming_them() {
+    // a seed without a random input, random tensions for a rod without tendons, --extrapolate
+    // without a model, a chunk size for a dynamic dataset (one chunk): each was accepted and
+    // ignored
+    let out = scratch("ignored-options");
+    let cases: [(&[&str], &[&str]); 5] = [
+        (
+            &[
+                "simulate",
+                "single-tendon",
+                "--duration",
+                "0.01",
+                "--seed",
+                "5",
+            ],
+            &["--steps", "--babble"],
+        ),
+        (
+            &[
+                "simulate",
+                "soft-beam",
+                "--duration",
+                "0.01",
+                "--steps=-1,0,0.005",
+            ],
+            &["--steps", "no tendons"],
+        ),
+        (
+            &["statics", "single-tendon", "--extrapolate"],
+            &["--extrapolate", "--model"],
+        ),
+        (
+            &[
+                "simulate",
+                "single-tendon",
+                "--duration",
+                "0.01",
+                "--extrapolate",
+            ],
+            &["--extrapolate", "--model"],
+        ),
+        (
+            &[
+                "dataset",
+                "single-tendon",
+                "--duration",
+                "0.01",
+                "--chunk-size",
+                "5",
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            &["--chunk-size", "--duration"],
+        ),
+    ];
+    for (args, needles) in cases {
+        let o = gvsrom(args);
+        assert!(!o.status.success(), "{args:?} ran");
+        let err = String::from_utf8_lossy(&o.stderr);
+        for n in needles {
+            assert!(err.contains(n), "{args:?}: {err}");
+        }
+    }
+    assert!(!out.exists());
+    // where they apply they run
+    let o = gvsrom(&[
+        "simulate",
+        "single-tendon",
+        "--duration",
+        "0.01",
+        "--seed",
+        "5",
+        "--steps=-1,0,0.005",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}

@@ -57,6 +57,7 @@ pub struct ModesArgs {
 }
 
 pub(super) fn statics_cmd(args: &StaticsArgs, out: &mut impl Write) -> Result<()> {
+    super::extrapolate_needs_model(&args.scenario, args.model.as_deref())?;
     if let Some(path) = &args.json {
         let inputs = scenario_inputs(&args.scenario, args.model.as_ref());
         gvsrom::output::refuse_overlap("--json", path, &inputs)?;
@@ -98,6 +99,7 @@ pub(super) fn statics_cmd(args: &StaticsArgs, out: &mut impl Write) -> Result<()
 }
 
 pub(super) fn modes_cmd(args: &ModesArgs, out: &mut impl Write) -> Result<()> {
+    super::extrapolate_needs_model(&args.scenario, args.model.as_deref())?;
     use gvsrom::modes;
     if let Some(path) = &args.json {
         let inputs = scenario_inputs(&args.scenario, args.model.as_ref());
@@ -178,8 +180,7 @@ pub(super) fn modes_cmd(args: &ModesArgs, out: &mut impl Write) -> Result<()> {
         let doc = modes::ModesJson {
             report: &report,
             model: args.model.as_ref().map(|p| p.display().to_string()),
-            model_extrapolated: (built.reduced.as_ref())
-                .map_or(vec![], |r| r.extrapolated.clone()),
+            model_extrapolated: (built.reduced.as_ref()).map_or(vec![], |r| r.extrapolated.clone()),
             provenance: Some(&provenance),
         };
         let path = json.commit_json(&doc)?;

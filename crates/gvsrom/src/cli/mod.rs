@@ -81,6 +81,7 @@ pub enum Command {
     /// are kept and reused by the next run.
     Reproduce(ReproduceArgs),
     /// Validate a preset or scenario file and print the model's size, without solving.
+    #[command(mut_arg("extrapolate", |a| a.hide(true)))]
     Check(ScenarioArgs),
     /// Figures (SVG and PNG) of a gvsrom output: a `statics --json` file, or a `simulate --out`,
     /// `dataset`, `pod` or `train` directory (rod shapes, tip paths, strain, an animation of the
@@ -163,6 +164,16 @@ fn load(args: &ScenarioArgs) -> Result<Resolved> {
         tensions: args.tension.as_deref(),
         centerline_points: args.centerline_points,
     })
+}
+
+/// Refuses `--extrapolate` without a `--model` for it to apply to (it would be ignored).
+fn extrapolate_needs_model(args: &ScenarioArgs, model: Option<&std::path::Path>) -> Result<()> {
+    if args.extrapolate && model.is_none() {
+        anyhow::bail!(
+            "--extrapolate applies to a reduced model: give `--model DIR` with it (without a model the full model answers, which needs no permission)"
+        );
+    }
+    Ok(())
 }
 
 /// `--model DIR` on the resolved scenario ([`reduce::attach_resolved`]); its warnings go to stderr.

@@ -102,7 +102,7 @@ pub struct DatasetArgs {
 
     /// Samples per chunk: the unit of parallel work, of warm-start chains and of resuming. Part of
     /// the plan (a different chunk size gives slightly different last digits).
-    #[arg(long, value_name = "N", default_value_t = gvsrom::dataset::DEFAULT_CHUNK_SIZE)]
+    #[arg(long, value_name = "N", default_value_t = gvsrom::dataset::DEFAULT_CHUNK_SIZE, conflicts_with = "duration")]
     pub chunk_size: usize,
 
     /// Worker threads (default: one per core). The files do not depend on it.

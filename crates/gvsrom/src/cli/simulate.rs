@@ -3,6 +3,7 @@
 use super::*;
 
 #[derive(Debug, Args)]
+#[command(group(clap::ArgGroup::new("random_input").args(["steps", "babble"]).multiple(false)))]
 pub struct SimulateArgs {
     #[command(flatten)]
     pub scenario: ScenarioArgs,
@@ -50,8 +51,8 @@ pub struct SimulateArgs {
     )]
     pub babble: Option<Vec<f64>>,
 
-    /// Seed of the random inputs (same seed, same signal).
-    #[arg(long, default_value_t = 1)]
+    /// Seed of the random inputs `--steps` and `--babble` (same seed, same signal).
+    #[arg(long, default_value_t = 1, requires = "random_input")]
     pub seed: u64,
 
     /// Start at the static equilibrium under the scenario's tensions and loads, then switch to the
@@ -131,6 +132,7 @@ pub struct SimulateArgs {
 }
 
 pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<()> {
+    super::extrapolate_needs_model(&args.scenario, args.model.as_deref())?;
     use gvsrom::simulate::{self, InputSource};
     use std::io::IsTerminal;
     if let Some(dir) = &args.out {

@@ -173,6 +173,18 @@ pub(super) fn positive(field: &str, v: f64, unit: &str) -> Result<f64, ScenarioE
 pub fn input_signal(built: &Built, opts: &SimulateOptions) -> Result<Signal, ScenarioError> {
     let na = built.model.n_actuators();
     let d = opts.duration;
+    // a random signal for a rod without tendons would drive nothing: refused, not ignored
+    let random = match &opts.input {
+        InputSource::Steps { .. } => Some("--steps"),
+        InputSource::Babble { .. } => Some("--babble"),
+        _ => None,
+    };
+    if let (0, Some(option)) = (na, random) {
+        return Err(ScenarioError::invalid(
+            option,
+            "the scenario has no tendons for random tensions to drive (add [[tendons]], or drive the rod by its loads and --load-schedule)",
+        ));
+    }
     Ok(match &opts.input {
         InputSource::Constant => Signal::constant(&built.u),
         InputSource::Csv {
