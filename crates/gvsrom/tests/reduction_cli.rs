@@ -723,7 +723,7 @@ fn a_damaged_model_or_dataset_is_an_error_not_a_wrong_model() {
     assert!(!out.exists(), "no model is left behind");
     // modes out of range
     for (k, needles) in [
-        ("0", &["--modes 0", "between 1 and", "40"][..]),
+        ("0", &["--modes", "0: an integer in [1, 33]"][..]),
         ("1000", &["--modes", "1000", "more than the 33 DOF"][..]),
     ] {
         let out = scratch(&format!("red-bad-modes-{k}"));
@@ -733,6 +733,44 @@ fn a_damaged_model_or_dataset_is_an_error_not_a_wrong_model() {
         );
         assert!(!out.exists(), "no model is left behind");
     }
+}
+
+#[test]
+fn pod_bounds_its_modes_by_the_dof_and_the_snapshots_and_warns_past_the_numerical_rank() {
+    // five snapshots bound the modes below the 33 DOF; the accepted range is the one checked
+    let few = sweep("red-few", -6.0, 3.0, 5);
+    let out = scratch("red-few-pod");
+    expect_error(
+        &["pod", s(&few), "--modes", "6", "--out", s(&out)],
+        &["--modes", "6: an integer in [1, 5]", "5 snapshots"],
+    );
+    expect_error(
+        &["train", s(dataset40()), "--latent", "0", "--out", s(&out)],
+        &["--latent", "0: an integer in [1, 33]"],
+    );
+    assert!(!out.exists());
+    // modes past the numerical rank are kept, with a warning naming them
+    let (stdout, stderr) =
+        common::run_ok_with_stderr(&["pod", s(dataset40()), "--modes", "33", "--out", s(&out)]);
+    let rank = printed_rank(&stdout);
+    assert!(rank < 33, "{stdout}");
+    assert!(
+        stderr.contains(&format!(
+            "warning: --modes 33 exceeds the data's numerical rank {rank}: modes {}–33",
+            rank + 1
+        )),
+        "{stderr}"
+    );
+    let (_, stderr) = common::run_ok_with_stderr(&[
+        "pod",
+        s(dataset40()),
+        "--modes",
+        &rank.to_string(),
+        "--out",
+        s(&out),
+        "--force",
+    ]);
+    assert!(!stderr.contains("numerical rank"), "{stderr}");
 }
 
 /// `train DATASET --latent 1 --hidden-layers H --epochs E --out DIR` (seed 0); returns the model.

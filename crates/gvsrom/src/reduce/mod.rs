@@ -56,11 +56,20 @@ pub(super) fn invalid(field: &str, message: impl Into<String>) -> ScenarioError 
     ScenarioError::invalid(field, message)
 }
 
-/// Refuses more reduced coordinates (`--modes`, `--latent`) than the full model has: the reduced
+/// Refuses no reduced coordinates, or more (`--modes`, `--latent`) than the full model has: the reduced
 /// model runs in the full model's basis (`Ψ = Φ P D(q_r)`), so coordinates beyond its DOF are
 /// redundant, its mass matrix singular, and its statics and dynamics fail.
 fn at_most_the_full_models_dof(field: &str, r: usize, built: &Built) -> Result<(), ScenarioError> {
     let n = built.n_dof();
+    if r == 0 {
+        return Err(invalid(
+            field,
+            format!(
+                "0: an integer in [1, {n}] (at most the {n} DOF of the full model `{}`)",
+                built.name
+            ),
+        ));
+    }
     if r > n {
         return Err(invalid(
             field,

@@ -29,6 +29,10 @@ pub struct PodSummary {
     pub warnings: Vec<String>,
 }
 
+/// The relative singular value `σ_k / σ₁` below which a mode counts as round-off (the printed
+/// numerical rank).
+pub const ROUND_OFF_RANK: f64 = 1e-12;
+
 /// POD of the strain snapshots of `datasets` (one, or several of one scenario: their rows in
 /// order) in the norm `norm`, `modes` modes, saved as a model at `out`.
 pub fn pod<P: AsRef<Path>>(
@@ -44,6 +48,18 @@ pub fn pod<P: AsRef<Path>>(
     let provenance = src.record(provenance);
     let built = &src.built;
     super::at_most_the_full_models_dof("--modes", modes, built)?;
+    let most = built.n_dof().min(src.rows());
+    if modes > most {
+        return Err(super::invalid(
+            "--modes",
+            format!(
+                "{modes}: an integer in [1, {most}] (at most the full model's {} DOF and the {} snapshots)",
+                built.n_dof(),
+                src.rows()
+            ),
+        )
+        .into());
+    }
     // the HOM basis must be recoverable from point strains
     let (layout, _, _) = projection_of(built)?;
     let (x, rows, features) = (&src.x, src.rows(), src.features);
@@ -109,8 +125,18 @@ pub fn pod<P: AsRef<Path>>(
             ("captured_energy", &energy),
         ],
     )?;
+    let mut warnings = src.warnings();
+    let rank = pod.rank(ROUND_OFF_RANK);
+    if modes > rank {
+        warnings.push(format!(
+            "--modes {modes} exceeds the data's numerical rank {rank}: modes {}–{modes} have σ/σ₁ below {ROUND_OFF_RANK:e} (σ{modes} = {:.3e}, σ₁ = {:.3e}), directions set by the solver's tolerance and round-off rather than by the snapshots; the ROM still projects the full model onto them, but they are not the data's",
+            rank + 1,
+            pod.singular_values.get(modes - 1).copied().unwrap_or(0.0),
+            pod.singular_values.first().copied().unwrap_or(0.0),
+        ));
+    }
     Ok(PodSummary {
-        warnings: src.warnings(),
+        warnings,
         datasets: src.listing(),
         path,
         rows,
@@ -118,7 +144,7 @@ pub fn pod<P: AsRef<Path>>(
         modes,
         norm,
         captured_energy: energy[modes - 1],
-        numerical_rank: pod.rank(1e-12),
+        numerical_rank: rank,
         singular_values: pod.singular_values,
         anchor_equilibria: model.meta.anchor_equilibria,
         anchor_time_s,
