@@ -33,12 +33,12 @@ pub fn check<'a>(
             load: e.name,
             message: format!(
                 "implies a bending of ~{} rad over the rod (accepted <= {MAX_BENDING} rad){}: far beyond the rod's elastic range",
-                approx(e.bending),
+                approx_beyond(e.bending, MAX_BENDING),
                 if e.strain > 0.0 || e.strain.is_nan() {
                     format!(
                         " and {} of ~{} (accepted <= {MAX_STRAIN})",
                         e.strain_kind,
-                        approx(e.strain)
+                        approx_beyond(e.strain, MAX_STRAIN)
                     )
                 } else {
                     String::new()
@@ -71,6 +71,25 @@ pub fn largest_load<'a>(
 }
 
 /// About two significant digits: `12`, `0.62`, `3e295`.
+/// [`approx`] of a value `v` refused for exceeding `limit`, with as many more digits as it takes
+/// to show it above the limit (`1.0` against a limit of 1 reads as `1.004`), up to 12.
+fn approx_beyond(v: f64, limit: f64) -> String {
+    let shown = approx(v);
+    if !(v.is_finite() && v > limit) || shown.parse::<f64>().is_ok_and(|x| x > limit) {
+        return shown;
+    }
+    (3..=12)
+        .map(|digits| format!("{:.*}", digits - 1, v))
+        .map(|f| {
+            f.parse::<f64>().map_or_else(
+                |_| format!("{v}"),
+                |x| format!("{}", gvs::error::fmt_value(x)),
+            )
+        })
+        .find(|f| f.parse::<f64>().is_ok_and(|x| x > limit))
+        .unwrap_or_else(|| format!("{v}"))
+}
+
 fn approx(v: f64) -> String {
     if !v.is_finite() {
         return format!("{v}");
@@ -90,6 +109,15 @@ fn approx(v: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_refused_value_is_shown_above_its_limit() {
+        assert_eq!(approx_beyond(1.0042, 1.0), "1.004");
+        assert_eq!(approx_beyond(1.00000007, 1.0), "1.0000001");
+        assert_eq!(approx_beyond(12.34, 10.0), "12");
+        // at or below the limit (not refused for it) it is the plain approximation
+        assert_eq!(approx_beyond(0.6234, 1.0), "0.62");
+    }
 
     #[test]
     fn approx_keeps_two_significant_digits() {

@@ -29,10 +29,14 @@ pub fn sample_times(duration: f64, rate: f64) -> Result<Vec<f64>, ScenarioError>
         return Err(ScenarioError::invalid(
             "--duration",
             format!(
-                "{} s at --sample-rate {} Hz gives {:.2e} samples (accepted <= {MAX_SAMPLES}); lower --duration or --sample-rate",
+                "{} s at --sample-rate {} Hz gives {} samples (accepted <= {MAX_SAMPLES}); lower --duration or --sample-rate",
                 gvs::error::fmt_value(duration),
                 gvs::error::fmt_value(rate),
-                periods + 1.0
+                // the count itself: a rounded 1.00e7 would read as the limit
+                match periods < 1e15 {
+                    true => format!("{}", periods + 1.0),
+                    false => format!("{:.3e}", periods + 1.0),
+                }
             ),
         ));
     }
