@@ -202,6 +202,48 @@ mod tests {
     }
 
     #[test]
+    fn every_inertia_and_damping_entry_matches_its_closed_form() {
+        // gvs-spec §3.4 for a solid circle of radius r: A = πr², I = πr⁴/4, J = 2I;
+        // Ms = ρ diag(J, I, I, A, A, A), Ds = η diag(J, 3I, 3I, 3A, A, A) (§3.4), entry by entry
+        let m = Material {
+            youngs_modulus: 2e6,
+            poisson_ratio: 0.3,
+            density: 1200.0,
+            damping: 3e3,
+        };
+        let r = 0.015;
+        let s = SectionProps::circular(&m, r);
+        let a = PI * r * r;
+        let i = PI * r.powi(4) / 4.0;
+        let j = 2.0 * i;
+        let ms = [j, i, i, a, a, a].map(|x| 1200.0 * x);
+        let ds = [j, 3.0 * i, 3.0 * i, 3.0 * a, a, a].map(|x| 3e3 * x);
+        for k in 0..6 {
+            assert!(
+                rel(s.ms[k], ms[k]) < 1e-14,
+                "ms[{k}] = {} against {}",
+                s.ms[k],
+                ms[k]
+            );
+            assert!(
+                rel(s.ds[k], ds[k]) < 1e-14,
+                "ds[{k}] = {} against {}",
+                s.ds[k],
+                ds[k]
+            );
+        }
+        // for ν = 1/2 (G = E/3) the damping is the stiffness times 3η/E, entry by entry
+        let half = Material {
+            poisson_ratio: 0.5,
+            ..m
+        };
+        let s = SectionProps::circular(&half, r);
+        for k in 0..6 {
+            assert!(rel(s.ds[k], 3.0 * 3e3 / 2e6 * s.es[k]) < 1e-14, "ds[{k}]");
+        }
+    }
+
+    #[test]
     fn invalid_material_names_field_and_range() {
         let m = Material {
             youngs_modulus: 1e6,

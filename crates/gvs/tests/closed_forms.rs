@@ -676,3 +676,54 @@ fn stiffness_is_singular_with_fewer_gauss_points_than_legendre_functions() {
     assert!(smallest(p).abs() < 1e-12, "{}", smallest(p));
     assert!(smallest(p + 1) > 1e-6, "{}", smallest(p + 1));
 }
+
+#[test]
+fn follower_axial_load_stretches_a_rotated_rod_by_f_l2_over_2ea() {
+    // A uniform follower (local) density f along the section's own x axis on a rod whose base is
+    // rotated: it stays straight along its base axis and stretches with ν(X) = 1 + f (L − X)/EA, so
+    // the tip moves by f L²/(2EA) along that axis. Read in the world frame the same density would
+    // bend it; with the sign flipped it would shorten it.
+    let (l, r, e) = (0.4, 0.01, 1e6);
+    let rot = nalgebra::Rotation3::from_euler_angles(0.3, -1.1, 0.7);
+    let m = model(
+        Rod::tapered(mat(e, 0.0), l, r, r),
+        8,
+        legendre([Some(1), Some(2), Some(2), Some(2), Some(1), Some(1)]),
+        vec![],
+        &[],
+    )
+    .with_base(Pose::new(rot.into_inner(), V3::zeros()));
+    let f = 20.0;
+    let loads = |frame: Frame| Loads {
+        gravity: [0.0; 3],
+        point: vec![],
+        distributed: vec![DistributedWrench::Uniform {
+            x_start: 0.0,
+            x_end: l,
+            density: [0.0, 0.0, 0.0, f, 0.0, 0.0],
+            frame,
+        }],
+    };
+    let (_, ws) = solve(&m, &[], &loads(Frame::Local));
+    let ea = e * PI * r * r;
+    for (xi, p) in m.point_strains(&ws).iter().zip(&m.disc.points) {
+        let nu = 1.0 + f * (l - p.x) / ea;
+        assert!(
+            (xi[3] - nu).abs() < 1e-10,
+            "ν({}) = {} against {nu}",
+            p.x,
+            xi[3]
+        );
+        assert!(
+            xi[1].abs() + xi[2].abs() + xi[4].abs() + xi[5].abs() < 1e-10,
+            "{xi}"
+        );
+    }
+    let axis = rot * V3::x();
+    let tip = ws.g.last().unwrap().pos;
+    let expected = axis * (l + f * l * l / (2.0 * ea));
+    assert!((tip - expected).norm() < 1e-10, "{tip} against {expected}");
+    // the same numbers in the world frame are another load: they bend the rotated rod
+    let (_, ws) = solve(&m, &[], &loads(Frame::Global));
+    assert!((ws.g.last().unwrap().pos - expected).norm() > 1e-3);
+}

@@ -174,3 +174,70 @@ fn point_values_are_interpolated_to_sub_points() {
         assert!((lb.phi_at(s)[(1, 0)] - (1.0 + 2.0 * site.x)).abs() < 1e-13);
     }
 }
+
+#[test]
+fn fem_bases_reproduce_polynomials_of_their_degree_from_nodal_values() {
+    // Lagrange elements of degree d interpolate: nodal values q_k = p(X̄_k) of any polynomial p of
+    // degree ≤ d give Σ_k φ_k(X̄) q_k = p(X̄) everywhere (the nodes at X̄_k = k / (d·E), ends and,
+    // for quadratic elements, mid-points). A permutation of the shape functions fails this.
+    let e = 5;
+    let d = disc(
+        &[0.8],
+        Quadrature::Elements {
+            elements: e,
+            gauss_per_element: 3,
+        },
+    );
+    for (deg, order) in [(FemDegree::Linear, 1usize), (FemDegree::Quadratic, 2)] {
+        let p = |x: f64| match order {
+            1 => 0.3 - 1.2 * x,
+            _ => 0.3 - 1.2 * x + 0.7 * x * x,
+        };
+        let b = DivisionBasis::Fem {
+            modes: [false, false, false, true, false, false],
+            elements: e,
+            degree: deg,
+        };
+        let lb = LinearBasis::per_division(&d, &[b]).unwrap();
+        let nodes = order * e + 1;
+        let q: Vec<f64> = (0..nodes)
+            .map(|k| p(k as f64 / (order * e) as f64))
+            .collect();
+        assert_eq!(lb.n_dof(), nodes);
+        for (i, pt) in d.points.iter().enumerate() {
+            // Φ_s restricted to its columns (the element's nodes)
+            let (phi, cols) = (lb.phi_at(i), lb.columns(i));
+            let v: f64 = (0..phi.ncols())
+                .map(|c| phi[(3, c)] * q[cols.start + c])
+                .sum();
+            assert!(
+                (v - p(pt.x_bar)).abs() < 1e-13,
+                "degree {order} at X̄ = {}: {v} against {}",
+                pt.x_bar,
+                p(pt.x_bar)
+            );
+        }
+    }
+    // several active modes: node-major columns, each strain row only in its own slot
+    let b = DivisionBasis::Fem {
+        modes: [false, true, false, true, false, false],
+        elements: e,
+        degree: FemDegree::Quadratic,
+    };
+    let lb = LinearBasis::per_division(&d, &[b]).unwrap();
+    for i in 0..d.n_points() {
+        let (phi, cols) = (lb.phi_at(i), lb.columns(i));
+        for c in 0..phi.ncols() {
+            let col = cols.start + c;
+            let (slot_bend, slot_axial) = (col % 2 == 0, col % 2 == 1);
+            assert!(slot_bend || phi[(1, c)] == 0.0, "bend_y in column {col}");
+            assert!(
+                slot_axial || phi[(3, c)] == 0.0,
+                "elongation in column {col}"
+            );
+            for row in [0, 2, 4, 5] {
+                assert_eq!(phi[(row, c)], 0.0);
+            }
+        }
+    }
+}
