@@ -468,6 +468,34 @@ fn bad_plans_are_one_line_errors_naming_the_option() {
         ],
         &["--resume", "no dataset to resume"],
     );
+    // values that change the coordinates or the points, and a whole-number field that random
+    // draws give fractions of: refused before anything is computed, not failed sample by sample
+    expect_error(
+        &[
+            "dataset",
+            "single-tendon",
+            "--sweep",
+            "divisions.0.length=0.25:0.3",
+            "--samples",
+            "3",
+            "--out",
+            o,
+        ],
+        &["--sweep", "divisions.0.length = 0.3", "one layout"],
+    );
+    expect_error(
+        &[
+            "dataset",
+            "single-tendon",
+            "--random",
+            "divisions.0.basis.order=10:12",
+            "--samples",
+            "3",
+            "--out",
+            o,
+        ],
+        &["--random", "divisions.0.basis.order"],
+    );
     assert!(!out.exists());
 }
 

@@ -282,9 +282,11 @@ fn load_scenario(
     Ok((table, built, text, provenance))
 }
 
-/// Checks the extremes of the plan before computing: the tensions against the rod's elastic range
-/// (shared model), or the scenario rebuilt with every parameter at LO and at HI (which also names an
-/// unknown path or a value the format rejects).
+/// Checks the plan before computing: the tensions against the rod's elastic range (shared model),
+/// or the scenario rebuilt with every parameter at LO, at HI and at the plan's first samples (which
+/// names an unknown path, a value the format rejects — a fractional value of a whole-number field
+/// that only random draws give — or a value that changes the model's coordinates or points, which
+/// the snapshots of one dataset must share).
 fn check_plan(plan: &Plan, table: &toml::Table, built: &Built) -> Result<(), DatasetError> {
     if plan.parameters.iter().all(|p| p.tendon.is_some()) {
         let mut u_max: Vec<f64> = built.u.iter().map(|v| v.abs()).collect();
@@ -301,10 +303,29 @@ fn check_plan(plan: &Plan, table: &toml::Table, built: &Built) -> Result<(), Dat
             ))
         });
     }
-    for end in [false, true] {
+    let d = plan.parameters.len();
+    let values = plan.values();
+    let mut cases: Vec<(String, Vec<f64>)> = vec![
+        (
+            "every parameter at LO".into(),
+            plan.parameters.iter().map(|p| p.lo).collect(),
+        ),
+        (
+            "every parameter at HI".into(),
+            plan.parameters.iter().map(|p| p.hi).collect(),
+        ),
+    ];
+    for k in 0..plan.samples.min(3) {
+        cases.push((format!("sample {k}"), values[k * d..(k + 1) * d].to_vec()));
+    }
+    // coordinates, and points at the same abscissae (`strain_x`)
+    let layout = |b: &Built| {
+        let x: Vec<u64> = b.model.disc.points.iter().map(|p| p.x.to_bits()).collect();
+        (b.n_dof(), x)
+    };
+    for (which, v) in cases {
         let mut t = table.clone();
-        for p in &plan.parameters {
-            let v = if end { p.hi } else { p.lo };
+        for (p, v) in plan.parameters.iter().zip(&v) {
             crate::scenario::apply_override(&mut t, &format!("{}={v}", p.path)).map_err(|e| {
                 let why = match e {
                     ScenarioError::Override { message, .. } => message,
@@ -313,14 +334,30 @@ fn check_plan(plan: &Plan, table: &toml::Table, built: &Built) -> Result<(), Dat
                 plan_err(format!("{} {}: {why}", plan.kind.option(), p.spec))
             })?;
         }
-        let build = crate::scenario::from_table(t).and_then(|s| crate::build(&s));
-        if let Err(e) = build {
-            let which = if end { "HI" } else { "LO" };
-            return Err(plan_err(format!(
-                "{} {}: with every parameter at {which}: {e}",
+        let shown = || {
+            let at: Vec<String> = (plan.parameters.iter().zip(&v))
+                .map(|(p, v)| format!("{} = {v}", p.path))
+                .collect();
+            format!(
+                "{} {}: with {which} ({})",
                 plan.kind.option(),
-                plan.specs.join(" ")
-            )));
+                plan.specs.join(" "),
+                at.join(", ")
+            )
+        };
+        match crate::scenario::from_table(t).and_then(|s| crate::build(&s)) {
+            Err(e) => return Err(plan_err(format!("{}: {e}", shown()))),
+            Ok(b) if layout(&b) != layout(built) => {
+                return Err(plan_err(format!(
+                    "{}: the model has {} DOF and {} points (at their abscissae) there, {} and {} in the scenario: the snapshots of one dataset share one layout, coordinates and points (vary a value that keeps the basis and the points, or make one dataset per layout)",
+                    shown(),
+                    b.n_dof(),
+                    b.model.disc.n_points(),
+                    built.n_dof(),
+                    built.model.disc.n_points()
+                )))
+            }
+            Ok(_) => {}
         }
     }
     Ok(())
