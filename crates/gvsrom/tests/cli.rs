@@ -661,3 +661,22 @@ fn a_friction_or_damping_no_material_has_is_refused_naming_the_field() {
         );
     }
 }
+
+#[test]
+fn absurd_positions_are_refused_and_extreme_numbers_print_in_exponent_form() {
+    // a base 1e308 m away: the rod vanished in the rounding of positions (the tip equalled the base)
+    expect_error(
+        &[
+            "statics",
+            "single-tendon",
+            "--set",
+            "base.position=[1e308,0,0]",
+        ],
+        &["base.position[0]", "1e308", "[-1000, 1000] m"],
+    );
+    // a tension of 1e-320 N printed with 300 digits before; now as the shortest exponent form
+    let out = gvsrom(&["statics", "single-tendon", "--tension=-1e-320"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("u = [-1e-320] N"), "{stdout}");
+    assert!(stdout.lines().all(|l| l.len() < 200), "{stdout}");
+}

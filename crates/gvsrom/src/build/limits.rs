@@ -26,6 +26,10 @@ pub const DENSITY_RANGE: (f64, f64) = (0.0, 1e5);
 pub const FRICTION_RANGE: (f64, f64) = (0.0, 10.0);
 /// Largest gravitational acceleration |g| [m/s²] (1000 g).
 pub const MAX_GRAVITY: f64 = 1e4;
+/// Largest distance of the base from the origin along each axis \[m\]: a kilometre. Far beyond it
+/// the rod's own size vanishes in the rounding of its positions (at 1e308 m the tip equals the
+/// base).
+pub const MAX_BASE_POSITION: f64 = 1e3;
 /// Accepted division length ℓ_j \[m\]: 1 µm to 1 km.
 pub const DIVISION_LENGTH_RANGE: (f64, f64) = (1e-6, 1e3);
 /// Smallest radius \[m\] (0.1 µm); the largest is the rod's total length L (a rod is slender).

@@ -101,7 +101,15 @@ pub(super) fn radius_range(j: usize, d: &DivisionSpec, l: f64) -> Result<(), Sce
 pub(super) fn base_pose(s: &Scenario) -> Result<Pose, ScenarioError> {
     let b = &s.base;
     for (i, v) in b.position.iter().enumerate() {
-        finite(&format!("base.position[{i}]"), *v)?;
+        let field = format!("base.position[{i}]");
+        finite(&field, *v)?;
+        if v.abs() > MAX_BASE_POSITION {
+            return Err(ScenarioError::value(
+                field,
+                *v,
+                format!("a number in [-{MAX_BASE_POSITION}, {MAX_BASE_POSITION}] m (the rod's size would vanish in the rounding of positions farther out)"),
+            ));
+        }
     }
     let rot = match (b.rotation, b.axis, b.angle_deg) {
         (None, None, None) => M3::identity(),

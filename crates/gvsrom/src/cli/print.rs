@@ -3,13 +3,19 @@
 use super::*;
 
 pub(super) fn fmt_vec(v: &[f64], prec: usize) -> String {
-    let items: Vec<String> = v.iter().map(|x| format!("{x:.prec$}")).collect();
+    // fixed-point, or the exponent form for a magnitude whose digits would run to hundreds
+    let one = |x: &f64| match x.abs() < 1e15 {
+        true => format!("{x:.prec$}"),
+        false => format!("{x:.prec$e}"),
+    };
+    let items: Vec<String> = v.iter().map(one).collect();
     format!("[{}]", items.join(", "))
 }
 
-/// `[a, b, c]` with each number in its shortest exact form.
+/// `[a, b, c]` with each number in its shortest exact form (the exponent form far from 1,
+/// [`gvs::error::fmt_value`]).
 pub(super) fn fmt_g(v: &[f64]) -> String {
-    let items: Vec<String> = v.iter().map(|x| format!("{x}")).collect();
+    let items: Vec<String> = v.iter().map(|x| gvs::error::fmt_value(*x)).collect();
     format!("[{}]", items.join(", "))
 }
 
