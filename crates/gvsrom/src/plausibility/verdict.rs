@@ -81,10 +81,8 @@ fn approx_beyond(v: f64, limit: f64) -> String {
     (3..=12)
         .map(|digits| format!("{:.*}", digits - 1, v))
         .map(|f| {
-            f.parse::<f64>().map_or_else(
-                |_| format!("{v}"),
-                |x| format!("{}", gvs::error::fmt_value(x)),
-            )
+            f.parse::<f64>()
+                .map_or_else(|_| format!("{v}"), gvs::error::fmt_value)
         })
         .find(|f| f.parse::<f64>().is_ok_and(|x| x > limit))
         .unwrap_or_else(|| format!("{v}"))
