@@ -96,6 +96,18 @@ fn an_incomplete_dataset_is_refused_by_pod_and_train() {
     }
 }
 
+/// The JSON output at `path` records the extrapolation `what` first in `model_extrapolated`.
+fn assert_records_extrapolation(path: &std::path::Path, what: &str) {
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    assert!(
+        doc["model_extrapolated"][0]
+            .as_str()
+            .is_some_and(|e| e.contains(what)),
+        "{doc}"
+    );
+}
+
 #[test]
 fn a_model_refuses_inputs_outside_its_training_range_unless_extrapolating() {
     let m = pod2();
@@ -129,14 +141,7 @@ fn a_model_refuses_inputs_outside_its_training_range_unless_extrapolating() {
         "--json",
         s(&json),
     ]);
-    let doc: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    assert!(
-        doc["model_extrapolated"][0]
-            .as_str()
-            .is_some_and(|e| e.contains("tendons.0.tension = -9")),
-        "{doc}"
-    );
+    assert_records_extrapolation(&json, "tendons.0.tension = -9");
     assert!(stdout.contains("tip"), "{stdout}");
     assert!(
         stderr.contains("warning: extrapolating (--extrapolate): tendons.0.tension = -9"),
@@ -173,14 +178,7 @@ fn a_model_refuses_inputs_outside_its_training_range_unless_extrapolating() {
         "--json",
         s(&json),
     ]);
-    let doc: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    assert!(
-        doc["model_extrapolated"][0]
-            .as_str()
-            .is_some_and(|e| e.contains("tendons.0.tension = -9")),
-        "{doc}"
-    );
+    assert_records_extrapolation(&json, "tendons.0.tension = -9");
 }
 
 #[test]
