@@ -147,14 +147,19 @@ pub struct CallableInput {
     error: Mutex<Option<PyErr>>,
     largest: Mutex<Largest>,
     /// With a reduced model: the values returned since the last check, with their times.
-    returned: Option<Mutex<Vec<Returned>>>,
+    returned: Option<Mutex<Returned>>,
     /// How the values lay outside the model's training, with `extrapolate` (the first sentence
     /// of each kind is kept).
     extrapolated: Mutex<Vec<String>>,
 }
 
-/// A value `u` a callable input returned, and the time `t` it was asked for.
-type Returned = (f64, Vec<f64>);
+/// The values `u` a callable input returned since the last check, each with the time `t` it was
+/// asked for (a value repeated over many evaluations, a held input, once), and the last one.
+#[derive(Default)]
+struct Returned {
+    unchecked: Vec<(f64, Vec<f64>)>,
+    last: Vec<f64>,
+}
 
 /// The largest |u| per tendon returned so far, the time of each, and whether it grew since the
 /// last check.
@@ -194,8 +199,9 @@ impl CallableInput {
         if let Some(r) = &self.returned {
             let mut r = r.lock().unwrap_or_else(PoisonError::into_inner);
             // a value held over many evaluations (a step input) is checked once
-            if r.last().is_none_or(|(_, last)| last.as_slice() != u) {
-                r.push((t, u.to_vec()));
+            if r.last != u {
+                r.last = u.to_vec();
+                r.unchecked.push((t, u.to_vec()));
             }
         }
         let mut l = self.largest.lock().unwrap_or_else(PoisonError::into_inner);
@@ -227,14 +233,12 @@ impl CallableInput {
         let (Some(returned), Some(r)) = (&self.returned, &built.reduced) else {
             return true;
         };
-        let values = {
-            let mut r = returned.lock().unwrap_or_else(PoisonError::into_inner);
-            // the last value stays, so that the next ones are compared with it
-            let keep = r.last().cloned();
-            let values = std::mem::take(&mut *r);
-            r.extend(keep);
-            values
-        };
+        let values = std::mem::take(
+            &mut returned
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner)
+                .unchecked,
+        );
         if values.is_empty() {
             return true;
         }
@@ -372,7 +376,7 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
                 n_actuators: na,
                 error: Mutex::new(None),
                 largest: Mutex::new(Largest::default()),
-                returned: robot.attached.as_ref().map(|_| Mutex::new(vec![])),
+                returned: robot.attached.as_ref().map(|_| Mutex::default()),
                 extrapolated: Mutex::new(vec![]),
             }))
         }

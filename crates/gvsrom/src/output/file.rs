@@ -63,10 +63,7 @@ impl OutputFile {
             with_manifest(value, manifest(&self.format, None)).map_err(named.io("write it"))?;
         // the hash of its values, so that an edit is told from what gvsrom wrote (rule 2)
         if let serde_json::Value::Object(obj) = &mut value {
-            let hash = super::hashes::meta_sha256(obj);
-            if let Some(serde_json::Value::Object(m)) = obj.get_mut(super::MANIFEST_KEY) {
-                m.insert(super::hashes::META_SHA256_KEY.into(), hash.into());
-            }
+            super::hashes::record_meta_hash(obj);
         }
         (|| -> io::Result<()> {
             let mut w = BufWriter::new(OpenOptions::new().write(true).open(&self.staging)?);

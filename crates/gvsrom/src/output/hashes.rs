@@ -97,17 +97,28 @@ pub(super) fn record_hashes(dir: &Path, files: &[String], meta: &mut Value) -> i
             "output metadata must be a JSON object",
         ));
     };
-    let meta_hash = meta_sha256(obj);
-    match obj.get_mut(MANIFEST_KEY) {
-        Some(Value::Object(m)) => {
-            m.insert(SHA256_KEY.into(), Value::Object(hashes));
-            m.insert(META_SHA256_KEY.into(), Value::from(meta_hash));
+    match obj.get(MANIFEST_KEY) {
+        Some(Value::Object(_)) => {
+            // the files' hashes first, as written before (the meta hash leaves the manifest out)
+            if let Some(Value::Object(m)) = obj.get_mut(MANIFEST_KEY) {
+                m.insert(SHA256_KEY.into(), Value::Object(hashes));
+            }
+            record_meta_hash(obj);
             Ok(())
         }
         _ => Err(io::Error::new(
             io::ErrorKind::InvalidInput,
             "output metadata has no manifest to record the hashes in",
         )),
+    }
+}
+
+/// Records [`meta_sha256`] of `obj` in its manifest object (nothing without one): a directory's
+/// meta.json, or a JSON file output's own values.
+pub(super) fn record_meta_hash(obj: &mut Map<String, Value>) {
+    let hash = meta_sha256(obj);
+    if let Some(Value::Object(m)) = obj.get_mut(MANIFEST_KEY) {
+        m.insert(META_SHA256_KEY.into(), Value::from(hash));
     }
 }
 
