@@ -2,15 +2,120 @@
 
 use crate::errors::invalid;
 use nalgebra::{DMatrix, DVector};
-use numpy::{AllowTypeChange, PyArray, PyArrayLike1, PyArrayLike2, PyArrayLikeDyn, PyArrayMethods};
+use numpy::ndarray::{Dimension, Ix1, Ix2, IxDyn};
+use numpy::{
+    AllowTypeChange, PyArray, PyArrayDescrMethods, PyArrayLike, PyArrayMethods, PyUntypedArray,
+    PyUntypedArrayMethods,
+};
+use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
+use std::ops::Deref;
+
+/// An array-like of real numbers of `D` dimensions, `float64` after conversion: a `float64`
+/// array as it is, other real dtypes and (nested) lists converted.
+///
+/// numpy's own conversion casts complex values to real with only NumPy's warning, and refuses a
+/// wrong number of dimensions with "dimensionality mismatch: from=2, to=1". This one refuses both
+/// with a `TypeError` that says what is accepted and what was given; pyo3 adds the argument's name
+/// as the exception's note ("while processing 'q'").
+pub struct Real<'py, D: Dimension>(PyArrayLike<'py, f64, D, AllowTypeChange>);
 
 /// A 1-D input (`float64` after conversion).
-pub type In1<'py> = PyArrayLike1<'py, f64, AllowTypeChange>;
+pub type In1<'py> = Real<'py, Ix1>;
 /// A 2-D input (`float64` after conversion).
-pub type In2<'py> = PyArrayLike2<'py, f64, AllowTypeChange>;
+pub type In2<'py> = Real<'py, Ix2>;
 /// An input of any dimension (`float64` after conversion).
-pub type InDyn<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
+pub type InDyn<'py> = Real<'py, IxDyn>;
+
+impl<'py, D: Dimension> Deref for Real<'py, D> {
+    type Target = PyArrayLike<'py, f64, D, AllowTypeChange>;
+    fn deref(&self) -> &Self::Target {
+        &self.0
+    }
+}
+
+/// Kinds of NumPy dtype converted to `float64` without loss of meaning: booleans, integers,
+/// floats.
+const REAL_KINDS: &[u8] = b"biuf";
+
+impl<'a, 'py, D: Dimension + 'py> FromPyObject<'a, 'py> for Real<'py, D> {
+    type Error = PyErr;
+
+    fn extract(ob: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        let what = match D::NDIM {
+            Some(1) => "a 1-D array-like of real numbers",
+            Some(2) => "a 2-D array-like of real numbers (rows)",
+            _ => "an array-like of real numbers",
+        };
+        Real::extract_as(ob, what)
+    }
+}
+
+impl<'py, D: Dimension + 'py> Real<'py, D> {
+    /// `ob` as an array of `D` dimensions; else a `TypeError` "expected {what}; got …".
+    fn extract_as(ob: Borrowed<'_, 'py, PyAny>, what: &str) -> PyResult<Self> {
+        // The common case, a float64 array of the right dimension, goes straight through.
+        if ob.cast::<PyArray<f64, D>>().is_ok() {
+            return Ok(Real(ob.extract()?));
+        }
+        let py = ob.py();
+        let array = numpy_module(py)?
+            .call_method1("asarray", (ob,))
+            .map_err(|e| {
+                PyTypeError::new_err(format!("expected {what}; got {} ({e})", describe(&ob)))
+            })?;
+        let array = array
+            .cast::<PyUntypedArray>()
+            .map_err(|_| PyTypeError::new_err(format!("expected {what}; got {}", describe(&ob))))?;
+        let kind = array.dtype().kind();
+        if !REAL_KINDS.contains(&kind) {
+            return Err(PyTypeError::new_err(format!(
+                "expected {what}; got values of dtype {}",
+                array.dtype()
+            )));
+        }
+        if let Some(n) = D::NDIM {
+            if array.ndim() != n {
+                return Err(PyTypeError::new_err(format!(
+                    "expected {what}; got {}",
+                    shape_words(array.shape())
+                )));
+            }
+        }
+        Ok(Real(array.as_any().extract()?))
+    }
+}
+
+/// `numpy`, imported once per interpreter.
+fn numpy_module(py: Python<'_>) -> PyResult<&Bound<'_, PyModule>> {
+    static NUMPY: pyo3::sync::PyOnceLock<Py<PyModule>> = pyo3::sync::PyOnceLock::new();
+    NUMPY
+        .get_or_try_init(py, || py.import("numpy").map(Bound::unbind))
+        .map(|m| m.bind(py))
+}
+
+/// "a scalar", "an array of shape (3, 1)".
+fn shape_words(shape: &[usize]) -> String {
+    match shape {
+        [] => "a single number (a 0-D array)".into(),
+        s => format!(
+            "an array of shape ({}{})",
+            s.iter()
+                .map(usize::to_string)
+                .collect::<Vec<_>>()
+                .join(", "),
+            if s.len() == 1 { "," } else { "" }
+        ),
+    }
+}
+
+/// The Python type of `ob`, for a message.
+fn describe(ob: &Borrowed<'_, '_, PyAny>) -> String {
+    ob.get_type()
+        .name()
+        .map(|n| format!("a `{n}`"))
+        .unwrap_or_else(|_| "an object".into())
+}
 
 /// The values of a 1-D input.
 pub fn vec1(a: &In1<'_>) -> Vec<f64> {
@@ -19,10 +124,30 @@ pub fn vec1(a: &In1<'_>) -> Vec<f64> {
 
 /// Tendon tensions as a Python caller gives them: an array-like (one per tendon, or one for all)
 /// or one number for all (a float, an int, a NumPy scalar or 0-d array).
-#[derive(FromPyObject)]
 pub enum Tensions<'py> {
     Array(In1<'py>),
     Scalar(f64),
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for Tensions<'py> {
+    type Error = PyErr;
+
+    /// An array of at least one dimension is an array (NumPy would turn a 1-element one into a
+    /// number with a deprecation warning); anything else that is a real number is one; the rest
+    /// is read as an array-like, whose error says what is accepted.
+    fn extract(ob: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        let is_array = ob.cast::<PyUntypedArray>().is_ok_and(|a| a.ndim() > 0);
+        if !is_array {
+            if let Ok(x) = ob.extract::<f64>() {
+                return Ok(Tensions::Scalar(x));
+            }
+        }
+        Real::extract_as(
+            ob,
+            "tensions [N]: one real number for every tendon, or a 1-D array-like of one per tendon",
+        )
+        .map(Tensions::Array)
+    }
 }
 
 impl Tensions<'_> {
@@ -59,9 +184,30 @@ pub fn finite(name: &str, v: DVector<f64>) -> PyResult<DVector<f64>> {
     }
 }
 
-/// A whole-number argument that must not be negative (a count, a size, a seed): pyo3's own
-/// conversion to an unsigned type raises a bare `OverflowError` that names neither the argument
-/// nor what is accepted.
+/// A whole-number argument (`#[pyo3(from_py_with = arrays::whole)]`): pyo3's own conversion
+/// raises a bare `OverflowError` "int too big to convert" for an int past `i128`, which says
+/// nothing of what is accepted. No count, size, index or seed of gvsrom reaches `u64::MAX`, so
+/// this says so; pyo3 names the argument in the exception's note.
+pub fn whole(ob: &Bound<'_, PyAny>) -> PyResult<i128> {
+    match ob.extract::<i128>() {
+        Err(_) if ob.is_instance_of::<pyo3::types::PyInt>() => Err(invalid(format!(
+            "{}: too large, expected a whole number ≤ {}",
+            ob.repr()?,
+            u64::MAX
+        ))),
+        other => other,
+    }
+}
+
+/// [`whole`] for an optional argument (`None` as it is).
+pub fn whole_or_none(ob: &Bound<'_, PyAny>) -> PyResult<Option<i128>> {
+    match ob.is_none() {
+        true => Ok(None),
+        false => whole(ob).map(Some),
+    }
+}
+
+/// A whole-number argument that must not be negative (a count, a size, a seed).
 pub fn unsigned(name: &str, value: i128) -> PyResult<u64> {
     u64::try_from(value).map_err(|_| match value < 0 {
         true => invalid(format!("`{name}` = {value}: expected a whole number ≥ 0")),

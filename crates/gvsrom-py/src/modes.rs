@@ -43,7 +43,7 @@ impl Robot {
     fn modes<'py>(
         &self,
         py: Python<'py>,
-        count: i64,
+        #[pyo3(from_py_with = arrays::whole)] count: i128,
         u: Option<arrays::Tensions<'_>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let rebuilt = match &u {

@@ -88,7 +88,7 @@ pub fn reproduce<'py>(
     study: &Bound<'py, PyAny>,
     out: PathBuf,
     quick: bool,
-    jobs: Option<i128>,
+    #[pyo3(from_py_with = crate::arrays::whole_or_none)] jobs: Option<i128>,
     noise: f64,
     test_sizes: bool,
 ) -> PyResult<Vec<Bound<'py, PyDict>>> {

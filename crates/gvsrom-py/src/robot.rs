@@ -3,6 +3,7 @@
 
 use crate::arrays::{self, In1, In2, Tensions};
 use crate::errors::{self, invalid, scenario as err};
+use crate::interrupt;
 use crate::models::Model;
 use crate::quantities::{self, WorkspaceCache};
 use crate::scenario::Scenario;
@@ -17,6 +18,7 @@ use pyo3::types::PyDict;
 use rayon::prelude::*;
 use std::ffi::CString;
 use std::path::PathBuf;
+use std::sync::atomic::Ordering;
 use std::sync::OnceLock;
 
 /// A reduced model to attach: its directory, whether it may extrapolate (`--extrapolate`), and
@@ -446,15 +448,23 @@ impl Robot {
             })
             .collect::<PyResult<Vec<_>>>()?;
         let built = &self.built;
-        let results: Vec<_> = py.detach(|| {
+        let (results, caught) = interrupt::run(py, |flag| {
+            let stop =
+                || (flag.load(Ordering::SeqCst) != 0).then(|| "interrupted (Ctrl-C)".to_string());
             if warm_start {
-                statics::solve_batch(built, &rows, DEFAULT_CHUNK_SIZE)
+                statics::solve_batch(built, &rows, DEFAULT_CHUNK_SIZE, &stop)
             } else {
                 rows.par_iter()
-                    .map(|u| statics::solve_under(built, u))
-                    .collect()
+                    .map(|u| stop().is_none().then(|| statics::solve_under(built, u)))
+                    .collect::<Option<Vec<_>>>()
             }
         });
+        if let Some(e) = caught {
+            return Err(e);
+        }
+        let Some(results) = results else {
+            return Err(invalid("statics_batch was stopped before it finished"));
+        };
         let mut reports = Vec::with_capacity(results.len());
         for (k, r) in results.into_iter().enumerate() {
             match r {
@@ -508,7 +518,7 @@ impl Robot {
         &self,
         py: Python<'py>,
         q: In1<'_>,
-        point: Option<isize>,
+        #[pyo3(from_py_with = arrays::whole_or_none)] point: Option<i128>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let n = self.built.n_dof();
         let q = self.coordinates(&q)?;
@@ -516,8 +526,8 @@ impl Robot {
         let which: Vec<usize> = match point {
             None => (0..p).collect(),
             Some(i) => {
-                let j = if i < 0 { i + p as isize } else { i };
-                if !(0..p as isize).contains(&j) {
+                let j = if i < 0 { i + p as i128 } else { i };
+                if !(0..p as i128).contains(&j) {
                     return Err(invalid(format!(
                         "`point` = {i} is out of range: the rod has {p} points"
                     )));

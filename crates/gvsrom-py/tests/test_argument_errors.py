@@ -5,6 +5,7 @@ naming the argument, not pyo3's bare `OverflowError`."""
 
 import re
 
+import numpy as np
 import pytest
 
 import gvsrom
@@ -86,6 +87,61 @@ def test_a_negative_count_elsewhere_is_a_value_error_naming_it(tmp_path, dataset
                    ).startswith("`jobs` = -1")
     assert "≤ 18446744073709551615" in message(
         lambda: gvsrom.dataset(beam, tmp_path / "e", **plan, seed=2**64))
+
+
+def test_an_int_past_any_rust_integer_says_what_is_accepted(tmp_path, dataset):
+    # pyo3's own conversion raises a bare OverflowError "int too big to convert"
+    robot = gvsrom.Scenario.preset("single-tendon").build()
+    q = np.zeros(robot.n_dof)
+    for call, name in [(lambda: robot.jacobian(q, point=2**200), "point"),
+                       (lambda: robot.modes(count=-(2**130)), "count"),
+                       (lambda: gvsrom.train(dataset, tmp_path / "m", latent=1, epochs=2**130), "epochs"),
+                       (lambda: gvsrom.pod(dataset, 2**300, tmp_path / "p"), "modes")]:
+        with pytest.raises(gvsrom.GvsromError) as e:
+            call()
+        assert re.fullmatch(r"-?\d{39,}: too large, expected a whole number ≤ 18446744073709551615",
+                            str(e.value)), str(e.value)
+        assert f"while processing '{name}'" in e.value.__notes__
+    # the largest index that fits is range-checked as before
+    with pytest.raises(gvsrom.GvsromError, match=r"`point` = 9223372036854775808 is out of range"):
+        robot.jacobian(q, point=2**63)
+    assert not (tmp_path / "m").exists() and not (tmp_path / "p").exists()
+
+
+@pytest.mark.parametrize("given, got", [
+    (lambda n: np.zeros((n, 1)), r"an array of shape \(\d+, 1\)"),
+    (lambda n: np.zeros(n) + 0j, r"values of dtype complex128"),
+    (lambda n: [1.0, None] + [0.0] * (n - 2), r"values of dtype object"),
+    (lambda n: "abc", r"values of dtype <U3"),
+    (lambda n: 0.5, r"a single number \(a 0-D array\)"),
+    (lambda n: [[0.0], [0.0, 1.0]], r"a `list` \(ValueError: .*inhomogeneous"),
+])
+def test_an_array_of_the_wrong_shape_or_kind_is_a_type_error_naming_the_argument(given, got):
+    # numpy's own conversion says "dimensionality mismatch: from=2, to=1", or casts complex values
+    # to real with only a ComplexWarning
+    robot = gvsrom.Scenario.preset("single-tendon").build()
+    with pytest.raises(TypeError, match="expected a 1-D array-like of real numbers; got " + got) as e:
+        robot.mass_matrix(given(robot.n_dof))
+    assert "while processing 'q'" in e.value.__notes__
+
+
+def test_tensions_and_rows_of_the_wrong_kind_say_what_is_accepted():
+    robot = gvsrom.Scenario.preset("single-tendon").build()
+    with pytest.raises(TypeError, match=r"expected tensions \[N\]: one real number for every tendon, "
+                                        r"or a 1-D array-like of one per tendon; got values of dtype complex128"):
+        robot.statics(u=-1 + 2j)
+    with pytest.raises(TypeError, match=r"expected a 2-D array-like of real numbers \(rows\); "
+                                        r"got an array of shape \(3,\)") as e:
+        robot.statics_batch(np.zeros(3))
+    assert "while processing 'U'" in e.value.__notes__
+    # every real kind NumPy users pass is still taken, a 1-element array of tensions included
+    tip = robot.statics(-1.0).tip_position
+    for u in [-1, np.float32(-1.0), np.array(-1.0), np.array([-1.0]), [-1], (-1.0,)]:
+        np.testing.assert_array_equal(robot.statics(u).tip_position, tip)
+    m = robot.mass_matrix(np.zeros(robot.n_dof))
+    for q in [np.zeros(robot.n_dof, dtype=int), np.zeros(robot.n_dof, dtype=np.float32),
+              [0] * robot.n_dof, np.zeros(2 * robot.n_dof)[::2]]:
+        np.testing.assert_array_equal(robot.mass_matrix(q), m)
 
 
 def test_a_command_quoted_for_the_shell_keeps_its_flags():

@@ -1,6 +1,11 @@
 """statics_batch: many equilibria in parallel, as `gvsrom dataset` solves them (warm starts along
 a chain) or each as the single call."""
 
+import os
+import signal
+import threading
+import time
+
 import numpy as np
 import pytest
 
@@ -73,3 +78,17 @@ def test_batch_names_the_row_that_fails():
     robot = gvsrom.Scenario.preset("single-tendon").build()
     with pytest.raises(ValueError, match=r"U\[1\]: "):
         robot.statics_batch([[-1.0], [float("nan")]])
+
+
+@pytest.mark.skipif(os.name != "posix", reason="SIGINT to self")
+@pytest.mark.parametrize("warm_start", [True, False])
+def test_ctrl_c_stops_a_batch(sigint_raises, warm_start):
+    # 20 000 equilibria take minutes in a debug build: Ctrl-C after 0.5 s must end the call soon
+    robot = gvsrom.Scenario.preset("single-tendon").build()
+    U = np.linspace(-8.0, 0.0, 20000).reshape(-1, 1)
+    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    t0 = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        robot.statics_batch(U, warm_start=warm_start)
+    assert time.monotonic() - t0 < 10.0

@@ -6,7 +6,7 @@ use super::{failure, report, StaticsReport};
 use crate::build::Built;
 use crate::error::StaticsFailure;
 use gvs::solve::statics::{StaticsError, StaticsOptions, StaticsSolution, StaticsSolver};
-use gvs::solve::{never_stop, StopCheck};
+use gvs::solve::StopCheck;
 use gvs::strain::StrainParam;
 use nalgebra::DVector;
 use std::time::Instant;
@@ -21,12 +21,14 @@ pub const WARM_MAX_ITERATIONS: usize = 50;
 /// along its warm-start chain ([`along_chain`], [`warm_or_ramp`]) with one solver. With the same
 /// rows and chunk size the solutions are the dataset's, and they do not depend on the thread count;
 /// each equals [`solve_under`](super::solve_under)'s to the solver's tolerance. A report's `solve_time_s` is its own
-/// solve's; a row that fails has the failure of its solve from straight.
+/// solve's; a row that fails has the failure of its solve from straight. `None` if `stop` asked
+/// for it (it is checked between Newton iterations).
 pub fn solve_batch(
     built: &Built,
     rows: &[Vec<f64>],
     chunk_size: usize,
-) -> Vec<Result<StaticsReport, StaticsFailure>> {
+    stop: &(dyn Fn() -> Option<String> + Sync),
+) -> Option<Vec<Result<StaticsReport, StaticsFailure>>> {
     use rayon::prelude::*;
     let na = built.model.n_actuators();
     let ranges: Vec<[f64; 2]> = (0..na)
@@ -37,24 +39,17 @@ pub fn solve_batch(
                 })
         })
         .collect();
-    let chunks: Vec<Vec<_>> = rows
+    let chunks: Vec<Option<Vec<_>>> = rows
         .par_chunks(chunk_size.max(1))
         .map(|chunk| {
             let model = &built.model;
             let mut solver = StaticsSolver::new(model, built.options.clone());
             let mut ws = model.workspace();
             let values = chunk.concat();
-            let solved = along_chain(&values, &ranges, chunk.len(), |i, warm| {
+            along_chain(&values, &ranges, chunk.len(), |i, warm| {
                 let u = &chunk[i];
                 let t0 = Instant::now();
-                let r = warm_or_ramp(
-                    &mut solver,
-                    &built.options,
-                    u,
-                    &built.loads,
-                    warm,
-                    &never_stop,
-                )?;
+                let r = warm_or_ramp(&mut solver, &built.options, u, &built.loads, warm, stop)?;
                 let time = t0.elapsed().as_secs_f64();
                 Some(match r {
                     Ok((sol, _)) => {
@@ -63,11 +58,13 @@ pub fn solve_batch(
                     }
                     Err(error) => (Err(failure(built, u, error)), None),
                 })
-            });
-            solved.expect("a batch is never stopped")
+            })
         })
         .collect();
-    chunks.into_iter().flatten().collect()
+    chunks
+        .into_iter()
+        .collect::<Option<Vec<_>>>()
+        .map(|c| c.into_iter().flatten().collect())
 }
 
 /// Solves the `m` problems of a chunk of a batch along a warm-start chain ([`solve_batch`], the
