@@ -160,7 +160,11 @@ impl Scenario {
     /// Raises
     /// ------
     /// GvsromError
-    ///     If the path or value is not accepted; the scenario is then left unchanged.
+    ///     If the path is unknown or the value of the wrong type; the scenario is then left
+    ///     unchanged. Ranges and the agreement between fields (a basis order and its quadrature,
+    ///     a division's length and its tendons) are checked by :meth:`build`, as the command line
+    ///     checks all its ``--set`` values together: a change that takes several values can be
+    ///     made one ``set`` at a time.
     fn set<'py>(
         mut slf: PyRefMut<'py, Self>,
         path: &str,
@@ -204,13 +208,66 @@ impl Scenario {
     /// ------
     /// GvsromError
     ///     Naming the field, its value and the accepted range.
-    fn build(&self, py: Python<'_>) -> PyResult<crate::robot::Robot> {
-        crate::robot::Robot::new(py, self.clone(), None)
+    fn build(slf: PyRef<'_, Self>, py: Python<'_>) -> PyResult<crate::robot::Robot> {
+        // a copy, and the borrow released before the build: a `set` from another thread while
+        // this one builds changes the scenario, not the robot being built (and is not refused
+        // with pyo3's "Already borrowed")
+        let scenario = slf.clone();
+        drop(slf);
+        crate::robot::Robot::new(py, scenario, None)
     }
 
     /// A copy that later changes do not affect.
     fn copy(&self) -> Scenario {
         self.clone()
+    }
+
+    fn __copy__(&self) -> Scenario {
+        self.clone()
+    }
+
+    fn __deepcopy__(&self, _memo: &Bound<'_, PyAny>) -> Scenario {
+        self.clone()
+    }
+
+    /// Pickling: the source text (a file's as it was read, not the file again), its origin and
+    /// the overrides, loaded again as `set` loads them.
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(
+        Bound<'py, PyAny>,
+        (String, String, String, bool, Vec<String>),
+    )> {
+        let me = slf.borrow();
+        let restore = slf.get_type().getattr("_restore")?;
+        Ok((
+            restore,
+            (
+                me.src.origin.clone(),
+                me.src.default_name.clone(),
+                me.src.text.clone(),
+                me.src.preset,
+                me.overrides.clone(),
+            ),
+        ))
+    }
+
+    /// The scenario `__reduce__` describes (for `pickle`; not part of the API).
+    #[staticmethod]
+    fn _restore(
+        origin: String,
+        default_name: String,
+        text: String,
+        preset: bool,
+        overrides: Vec<String>,
+    ) -> PyResult<Scenario> {
+        let src = Source {
+            origin,
+            default_name,
+            text,
+            preset,
+        };
+        Scenario::load(src, overrides)
     }
 
     fn __repr__(&self) -> String {

@@ -80,3 +80,49 @@ def test_build_errors_carry_the_message_of_the_command_line(gvsrom_bin):
     with pytest.raises(ValueError) as e:
         s.build()
     assert str(e.value) == expected
+
+
+def test_copies_and_pickles_are_the_same_scenario_and_independent(tmp_path):
+    import copy
+    import pickle
+
+    path = tmp_path / "beam.toml"
+    path.write_text(gvsrom.Scenario.preset("soft-beam").to_toml())
+    for original in [gvsrom.Scenario.preset("single-tendon").set("tendons.0.tension", -2.5),
+                     gvsrom.Scenario.from_toml(path).set("material.density", 1100.0)]:
+        for other in [copy.copy(original), copy.deepcopy(original), original.copy(),
+                      pickle.loads(pickle.dumps(original))]:
+            assert other.to_toml() == original.to_toml()
+            assert (other.name, other.overrides) == (original.name, original.overrides)
+            other.set("material.damping", 123.0)
+            assert "123" not in original.to_toml().split("damping")[1].split("\n")[0]
+    # a pickle holds the file's text as it was read, not the path
+    from_file = gvsrom.Scenario.from_toml(path)
+    blob = pickle.dumps(from_file)
+    path.unlink()
+    assert pickle.loads(blob).to_toml() == from_file.to_toml()
+
+
+def test_set_while_another_thread_builds_is_not_refused():
+    # build() held the scenario borrowed while it built without the GIL: a set() from another
+    # thread then raised pyo3's "RuntimeError: Already borrowed"
+    import threading
+
+    s = gvsrom.Scenario.preset("six-tendon")
+    errors = []
+
+    def builds():
+        try:
+            for _ in range(30):
+                s.build()
+        except Exception as e:  # noqa: BLE001 - any error fails the test below
+            errors.append(e)
+
+    t = threading.Thread(target=builds)
+    t.start()
+    k = 0
+    while t.is_alive():
+        s.set("tendons.0.tension", -1.0 - (k % 5))
+        k += 1
+    t.join()
+    assert errors == [] and k > 0
