@@ -164,7 +164,7 @@ impl Robot {
     /// Returns
     /// -------
     /// numpy.ndarray
-    ///     Shape (n_dof,) [N·m per unit of q].
+    ///     Shape (n_dof,) [J per unit of q; see :class:`Robot` for the units].
     fn elastic_force<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyAny>> {
         let (q, _) = state(self, &q, None)?;
         let f = py.detach(|| elastic_force(&self.built, &self.workspaces, &q));
@@ -172,14 +172,16 @@ impl Robot {
     }
 
     /// The elastic stiffness ``K(q) = ∂K₁/∂q`` (the constant ``K`` of the HOM's linear basis; of
-    /// a reduced model, its tangent), shape (n_dof, n_dof).
+    /// a reduced model, its tangent), shape (n_dof, n_dof): ``½ δqᵀ K δq`` is an elastic energy
+    /// [J].
     fn stiffness_matrix<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyAny>> {
         let (q, _) = state(self, &q, None)?;
         let k = py.detach(|| elastic_stiffness(&self.built, &self.workspaces, &q));
         arrays::matrix(py, &k)
     }
 
-    /// The damping force ``D₁ = D(q) q̇`` (Kelvin–Voigt, gvs-spec §7.4), shape (n_dof,).
+    /// The damping force ``D₁ = D(q) q̇`` (Kelvin–Voigt, gvs-spec §7.4), shape (n_dof,)
+    /// [J per unit of q].
     fn damping_force<'py>(
         &self,
         py: Python<'py>,
@@ -193,7 +195,7 @@ impl Robot {
     }
 
     /// The damping matrix ``D(q) = Σ W Ψ_qᵀ Ds Ψ_q`` (constant for the HOM), shape
-    /// (n_dof, n_dof).
+    /// (n_dof, n_dof): ``q̇ᵀ D q̇`` is the power the damping dissipates [W].
     fn damping_matrix<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyAny>> {
         let (q, _) = state(self, &q, None)?;
         let d = py.detach(|| damping_matrix(&self.built, &self.workspaces, &q));
@@ -201,7 +203,7 @@ impl Robot {
     }
 
     /// The Coriolis and centrifugal force ``C(q, q̇) q̇ = Σ W Jᵀ (Ms J̇ q̇ + coad_η Ms η)``
-    /// (gvs-spec §7.2), shape (n_dof,).
+    /// (gvs-spec §7.2), shape (n_dof,) [J per unit of q].
     fn coriolis_force<'py>(
         &self,
         py: Python<'py>,
@@ -215,7 +217,7 @@ impl Robot {
     }
 
     /// The Coriolis matrix ``C(q, q̇)`` with ``Ṁ − 2C`` skew-symmetric (gvs-spec §7.2), shape
-    /// (n_dof, n_dof); ``C(q, q̇) @ q̇`` is :meth:`coriolis_force`.
+    /// (n_dof, n_dof); ``C(q, q̇) @ q̇`` is :meth:`coriolis_force` [J per unit of q].
     fn coriolis_matrix<'py>(
         &self,
         py: Python<'py>,
@@ -229,7 +231,7 @@ impl Robot {
     }
 
     /// The external generalized force ``F(q) = Σ J_iᵀ w_i`` of gravity and the scenario's point
-    /// and distributed loads (gvs-spec §7.5), shape (n_dof,).
+    /// and distributed loads (gvs-spec §7.5), shape (n_dof,) [J per unit of q].
     fn external_force<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyAny>> {
         let (q, _) = state(self, &q, None)?;
         let f = py
@@ -240,7 +242,7 @@ impl Robot {
 
     /// The actuation matrix ``B(q)``: column k is the generalized force of a unit tension in
     /// tendon k (routing and friction included), so the tendons' force is ``B(q) @ u``. Shape
-    /// (n_dof, n_actuators).
+    /// (n_dof, n_actuators), in m per unit of q (a work per unit of tension).
     fn actuation_matrix<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyAny>> {
         let (q, _) = state(self, &q, None)?;
         let b = py.detach(|| actuation_matrix(&self.built, &self.workspaces, &q));
@@ -248,7 +250,7 @@ impl Robot {
     }
 
     /// The accelerations ``q̈ = M⁻¹ (B u + F − K₁ − D₁ − C q̇)`` the integrators use (forward
-    /// dynamics), shape (n_dof,).
+    /// dynamics), shape (n_dof,), in units of q per s².
     ///
     /// Parameters
     /// ----------

@@ -36,6 +36,15 @@ pub struct Attached {
 /// strain basis in statics, dynamics and every model quantity.
 ///
 /// Made by :meth:`Scenario.build`.
+///
+/// Units: SI throughout. The coordinates ``q`` are the strain basis's coefficients, in strain units
+/// (1/m for a torsion or bending coefficient, 1 for elongation or shear, with dimensionless basis
+/// functions; a reduced model's latent coordinates are in the units of its code). A generalized
+/// force is work-conjugate to ``q``: ``F · δq`` is a work [J], so each entry is in J per unit of
+/// its coordinate (N·m² for a bending coefficient, N·m for an elongation one). Then
+/// ``½ q̇ᵀ M q̇`` is a kinetic energy [J], ``½ δqᵀ K δq`` an elastic energy [J], ``q̇ᵀ D q̇`` a
+/// dissipated power [W], and ``B`` is in m per unit of q, so that ``B u`` [J per unit of q] is a
+/// generalized force for tensions ``u`` [N].
 #[pyclass(module = "gvsrom", frozen)]
 pub struct Robot {
     pub scenario: Scenario,
@@ -317,7 +326,8 @@ impl Robot {
     }
 
     /// Diagonal of the cross-section inertia ``Ms`` per unit length at each point
-    /// ``[ρJ, ρI_y, ρI_z, ρA, ρA, ρA]``, shape ``(n_points, 6)``.
+    /// ``[ρJ, ρI_y, ρI_z, ρA, ρA, ρA]``, shape ``(n_points, 6)``: kg·m for the first three, kg/m
+    /// for the last three.
     #[getter]
     fn section_inertia<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let m = &self.built.model;
@@ -328,7 +338,8 @@ impl Robot {
     }
 
     /// Diagonal of the cross-section stiffness ``Es`` at each point
-    /// ``[GJ, EI_y, EI_z, EA, GA, GA]``, shape ``(n_points, 6)``.
+    /// ``[GJ, EI_y, EI_z, EA, GA, GA]``, shape ``(n_points, 6)``: N·m² for the first three, N
+    /// for the last three.
     #[getter]
     fn section_stiffness<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let m = &self.built.model;
@@ -501,7 +512,8 @@ impl Robot {
     }
 
     /// Geometric (body) Jacobian ``J_i`` of point ``i``: the section's twist is
-    /// ``η_i = J_i q̇`` (angular velocity first, then linear, both in the section frame).
+    /// ``η_i = J_i q̇`` (angular velocity first, then linear, both in the section frame): rows
+    /// 0–2 in rad/s and rows 3–5 in m/s per unit of ``q̇``.
     ///
     /// Parameters
     /// ----------
@@ -548,7 +560,7 @@ impl Robot {
     /// Returns
     /// -------
     /// numpy.ndarray
-    ///     Shape (n_points, 6).
+    ///     Shape (n_points, 6): rad/s, then m/s.
     fn point_velocities<'py>(
         &self,
         py: Python<'py>,
@@ -562,7 +574,8 @@ impl Robot {
         arrays::shaped(py, flat, [self.built.model.disc.n_points(), 6])
     }
 
-    /// The mass matrix ``M(q)`` (symmetric positive definite), shape (n_dof, n_dof).
+    /// The mass matrix ``M(q)`` (symmetric positive definite), shape (n_dof, n_dof):
+    /// ``½ q̇ᵀ M q̇`` is the kinetic energy [J] (units: see :class:`Robot`).
     fn mass_matrix<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyAny>> {
         let q = self.coordinates(&q)?;
         let m = py.detach(|| quantities::mass_matrix(&self.built, &self.workspaces, &q));
@@ -570,7 +583,7 @@ impl Robot {
     }
 
     /// The static residual ``R(q) = −K₁(q) + F(q) + B(q)u`` (paper eq. 9) under the scenario's
-    /// loads: zero at an equilibrium.
+    /// loads: zero at an equilibrium. A generalized force [J per unit of q].
     ///
     /// Parameters
     /// ----------
@@ -592,7 +605,8 @@ impl Robot {
         Ok(arrays::vector(py, r.as_slice()))
     }
 
-    /// The analytic Jacobian ``∂R/∂q`` of :meth:`statics_residual`, shape (n_dof, n_dof).
+    /// The analytic Jacobian ``∂R/∂q`` of :meth:`statics_residual`, shape (n_dof, n_dof)
+    /// [J per unit of q²: ``δqᵀ (∂R/∂q) δq`` is in J].
     #[pyo3(signature = (q, u=None))]
     fn statics_jacobian<'py>(
         &self,
