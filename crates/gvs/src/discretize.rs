@@ -29,9 +29,11 @@ use serde::{Deserialize, Serialize};
 #[serde(rename_all = "lowercase")]
 pub enum MagnusOrder {
     /// Midpoint rule, `Ω = h ξ(X + h/2)`: 2nd order.
+    #[serde(alias = "Z2")]
     Z2,
     /// Zanna / two-point Gauss Magnus, `Ω = h/2 (ξ₁+ξ₂) + (√3/12) h² ad_{ξ₁} ξ₂`: 4th order.
     #[default]
+    #[serde(alias = "Z4")]
     Z4,
 }
 

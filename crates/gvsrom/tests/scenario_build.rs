@@ -269,3 +269,19 @@ fn quadrature_defaults_follow_sorosim() {
     assert_eq!(b.model.disc.n_points(), 4 * 3 + 1);
     assert_eq!(b.model.n_dof(), 5);
 }
+
+#[test]
+fn a_tendon_given_both_ways_names_the_polar_key_it_was_given() {
+    // `single-tendon` gives offset_start/offset_end; the conflict names the key the user added
+    for (key, set) in [
+        ("radial_fraction", "tendons.0.radial_fraction=0.5"),
+        ("angle_deg", "tendons.0.angle_deg=30"),
+    ] {
+        let s = presets::load("single-tendon", &[set.to_string()]).expect("preset loads");
+        let e = gvsrom::build(&s).err().expect("refused").to_string();
+        assert!(
+            e.contains(&format!("tendons[0].{key}")) && e.contains("not both"),
+            "{set}: {e}"
+        );
+    }
+}

@@ -59,10 +59,15 @@ pub(super) fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, Scen
     let polar = t.angle_deg.is_some() || t.radial_fraction.is_some();
     let (offset_start, offset_end) = match (explicit, polar) {
         (true, true) => {
+            let polar_key = if t.angle_deg.is_some() {
+                "angle_deg"
+            } else {
+                "radial_fraction"
+            };
             return Err(ScenarioError::invalid(
-                f("angle_deg"),
+                f(polar_key),
                 "give either `offset_start` and `offset_end`, or `angle_deg` (with optional `radial_fraction`), not both",
-            ))
+            ));
         }
         (false, false) => {
             return Err(ScenarioError::invalid(
@@ -72,7 +77,11 @@ pub(super) fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, Scen
         }
         (true, false) => {
             let (Some(a), Some(b)) = (t.offset_start, t.offset_end) else {
-                let missing = if t.offset_start.is_none() { "offset_start" } else { "offset_end" };
+                let missing = if t.offset_start.is_none() {
+                    "offset_start"
+                } else {
+                    "offset_end"
+                };
                 return Err(ScenarioError::invalid(
                     f(missing),
                     "missing: a tendon needs both `offset_start` and `offset_end` ([y, z] in m)",

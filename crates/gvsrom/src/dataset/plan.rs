@@ -157,8 +157,8 @@ fn expand(kind: PlanKind, spec: &str, path: &str, table: &Table) -> Result<Vec<V
 
 impl Plan {
     /// Checks the plan arguments against the scenario table (after `--set`): exactly one kind,
-    /// `samples` in [1, [`MAX_SAMPLES`]], ranges `LO <= HI`, `*` over an existing non-empty list.
-    /// (A one-sample sweep is its LO end.)
+    /// `samples` in [1, [`MAX_SAMPLES`]], ranges `LO <= HI`, `*` over an existing non-empty list,
+    /// and at least two values per axis of a sweep or grid over `LO < HI` (one would be LO alone).
     pub fn new(
         sweep: &[String],
         grid: &[String],
@@ -234,6 +234,19 @@ impl Plan {
             PlanKind::Grid => Some(grid_per_axis(samples, parameters.len())?),
             _ => None,
         };
+        let evenly = match kind {
+            PlanKind::Sweep => Some((samples, 2)),
+            PlanKind::Grid => per_axis.map(|m| (m, 1usize << parameters.len().min(20))),
+            PlanKind::Random => None,
+        };
+        if let (Some((1, needed)), Some(p)) = (evenly, parameters.iter().find(|p| p.lo < p.hi)) {
+            return Err(format!(
+                "{} `{}`: --samples {samples} gives one value per parameter, its LO end {}: give at least {needed} samples to reach HI, or LO:LO for one value",
+                kind.option(),
+                p.spec,
+                p.lo
+            ));
+        }
         Ok(Plan {
             kind,
             specs: specs.to_vec(),
@@ -360,6 +373,30 @@ mod tests {
         let v = p.values();
         assert_eq!(&v[..6], [0.0, 0.0, 0.0, 1.0, 0.0, 2.0]);
         assert_eq!(&v[16..], [2.0, 2.0]);
+    }
+
+    #[test]
+    fn one_value_per_axis_over_a_range_is_refused_not_taken_as_its_lo_end() {
+        let t = table("[[tendons]]\ntension = 1\n[[tendons]]\ntension = 2\n");
+        let sweep = |spec: &str, n| Plan::new(&[spec.into()], &[], &[], Some(n), 0, &t);
+        let e = sweep("tendons.0.tension=-6:0", 1).unwrap_err();
+        assert!(
+            e.contains("--samples 1 gives one value per parameter, its LO end -6")
+                && e.contains("at least 2 samples"),
+            "{e}"
+        );
+        assert_eq!(
+            sweep("tendons.0.tension=-6:-6", 1).unwrap().values(),
+            [-6.0]
+        );
+        assert_eq!(
+            sweep("tendons.0.tension=-6:0", 2).unwrap().values(),
+            [-6.0, 0.0]
+        );
+        let e = Plan::new(&[], &["tendons.*.tension=0:1".into()], &[], Some(1), 0, &t).unwrap_err();
+        assert!(e.contains("at least 4 samples"), "{e}");
+        // a random plan of one sample draws one value in the range
+        assert!(Plan::new(&[], &[], &["tendons.0.tension=0:1".into()], Some(1), 0, &t).is_ok());
     }
 
     #[test]

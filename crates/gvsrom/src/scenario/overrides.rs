@@ -14,14 +14,19 @@ fn looks_like_index(key: &str) -> bool {
 }
 
 /// Parses the right-hand side of `--set` as a TOML value (number, bool, array, inline table,
-/// quoted string); anything that is not valid TOML is taken as a bare string (`--set magnus=z2`).
+/// quoted string). A number TOML does not write (`.5`, `5.`, `1e999`, which overflows to
+/// infinity and is then refused as not finite) is read as Rust reads a float; anything else that
+/// is not valid TOML is taken as a bare string (`--set magnus=z2`).
 fn parse_value(raw: &str) -> Value {
     let raw = raw.trim();
     match format!("v = {raw}").parse::<Table>() {
         Ok(mut t) => t
             .remove("v")
             .unwrap_or_else(|| Value::String(raw.to_string())),
-        Err(_) => Value::String(raw.to_string()),
+        Err(_) => match raw.parse::<f64>() {
+            Ok(x) if raw.bytes().any(|b| b.is_ascii_digit()) => Value::Float(x),
+            _ => Value::String(raw.to_string()),
+        },
     }
 }
 

@@ -191,3 +191,31 @@ fn syntax_error_is_one_line_with_position() {
     );
     assert!(!e.contains('\n'), "{e}");
 }
+
+#[test]
+fn override_numbers_toml_does_not_write_are_read_as_numbers() {
+    // `1e999` overflows: it is refused as not finite, not as "invalid type: string"
+    let e = Scenario::from_toml("t", MINIMAL, &["tendons.0.tension=1e999".into()])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("tendons[0].tension") && e.contains("inf") && !e.contains("string"),
+        "{e}"
+    );
+    let s = Scenario::from_toml(
+        "t",
+        MINIMAL,
+        &[
+            "tendons.0.tension=-.5".into(),
+            "material.density=900.".into(),
+        ],
+    )
+    .unwrap();
+    assert_eq!(s.tendons[0].tension, -0.5);
+    assert_eq!(s.material.density, 900.0);
+    // bare words stay strings, the Magnus order in either case as the summary prints it
+    for (spelled, order) in [("Z2", MagnusOrder::Z2), ("z4", MagnusOrder::Z4)] {
+        let s = Scenario::from_toml("t", MINIMAL, &[format!("magnus={spelled}")]).unwrap();
+        assert_eq!(s.magnus, order);
+    }
+}
