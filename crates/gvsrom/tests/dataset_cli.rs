@@ -765,6 +765,33 @@ fn integrator_tolerances_of_a_static_dataset_are_refused_not_ignored() {
 }
 
 #[test]
+fn a_seed_no_part_of_the_plan_draws_from_is_refused_not_ignored() {
+    // a sweep or grid draws nothing: `--seed` there is a mistake, not a setting
+    let dir = scratch("ds-unused-seed");
+    for plan in ["--sweep", "--grid"] {
+        let out = gvsrom(&[
+            "dataset",
+            "single-tendon",
+            plan,
+            "tendons.0.tension=-6:0",
+            "--samples",
+            "3",
+            "--seed",
+            "4",
+            "--out",
+            dir.to_str().unwrap(),
+        ]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{plan} with --seed accepted");
+        assert!(
+            stderr.contains("--seed") && stderr.contains("--random"),
+            "{stderr}"
+        );
+        assert!(!dir.exists());
+    }
+}
+
+#[test]
 fn a_plan_none_of_whose_samples_solves_is_an_error() {
     // one Newton iteration per load stage: no sample converges (a plan whose values change the
     // coordinates is refused before computing: `bad_plans_are_one_line_errors_naming_the_option`)

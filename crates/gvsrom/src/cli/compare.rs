@@ -63,8 +63,7 @@ pub(super) fn compare_cmd(args: &CompareArgs, out: &mut impl Write) -> Result<()
     writeln!(out, "reference  {}", describe(reference))?;
     // simulated time per wall time, so that a partial run compares fairly
     let speed = match compared.speed_ratio {
-        Some(ratio) if ratio >= 1.0 => format!("{ratio:.1}× faster"),
-        Some(ratio) => format!("{:.1}× slower", 1.0 / ratio),
+        Some(ratio) => speed_words(ratio),
         None => {
             "speed n/a (a wall time is zero or not recorded, or a run has no time span)".to_string()
         }

@@ -78,12 +78,12 @@ pub(super) fn statics_cmd(args: &StaticsArgs, out: &mut impl Write) -> Result<()
     if let (Some(full), Some(c)) = (&run.full, &run.comparison) {
         writeln!(
             out,
-            "full model {} DOF solved in {:.2} ms; reduced {} DOF in {:.2} ms: {:.1}× faster",
+            "full model {} DOF solved in {:.2} ms; reduced {} DOF in {:.2} ms: {}",
             full.n_dof,
             full.solve_time_s * 1e3,
             run.report.n_dof,
             run.report.solve_time_s * 1e3,
-            c.speedup
+            speed_words(c.speedup)
         )?;
         writeln!(
             out,

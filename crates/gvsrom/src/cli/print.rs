@@ -19,6 +19,17 @@ pub(super) fn fmt_g(v: &[f64]) -> String {
     format!("[{}]", items.join(", "))
 }
 
+/// "3.2× faster" or, below 1, "1.4× slower" (not "0.7× faster").
+pub(super) fn speed_words(speedup: f64) -> String {
+    if !(speedup.is_finite() && speedup > 0.0) {
+        "speed n/a".into()
+    } else if speedup >= 1.0 {
+        format!("{speedup:.1}× faster")
+    } else {
+        format!("{:.1}× slower", 1.0 / speedup)
+    }
+}
+
 pub(super) fn plural(n: usize, word: &str) -> String {
     if n == 1 {
         format!("{n} {word}")
@@ -140,4 +151,21 @@ pub(super) fn anchors_line(
         out,
         "anchors    {equilibria} of {rows} training inputs hold the reduced model's own equilibrium (solved in {seconds:.2} s): statics --model starts there"
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_speed_ratio_below_one_reads_as_slower() {
+        assert_eq!(speed_words(3.24), "3.2× faster");
+        assert_eq!(speed_words(1.0), "1.0× faster");
+        assert_eq!(speed_words(0.7), "1.4× slower");
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            assert_eq!(speed_words(bad), "speed n/a");
+        }
+        assert_eq!(plural(1, "thread"), "1 thread");
+        assert_eq!(plural(2, "thread"), "2 threads");
+    }
 }

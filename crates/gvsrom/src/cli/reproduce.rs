@@ -70,6 +70,7 @@ pub(super) fn dataset_cmd(args: &DatasetArgs, out: &mut impl Write) -> Result<()
 
 /// `gvsrom dataset`: the scenario, the plan and the output.
 #[derive(Debug, Args)]
+#[command(group(clap::ArgGroup::new("seeded").args(["random", "steps", "babble"]).multiple(true)))]
 pub struct DatasetArgs {
     /// A preset name (see `gvsrom presets`) or the path of a scenario TOML file.
     pub scenario: String,
@@ -96,8 +97,8 @@ pub struct DatasetArgs {
     #[arg(long, value_name = "N")]
     pub samples: Option<usize>,
 
-    /// Seed of `--random` (same seed, same dataset).
-    #[arg(long, default_value_t = 0)]
+    /// Seed of `--random`, `--steps` and `--babble` (same seed, same dataset).
+    #[arg(long, default_value_t = 0, requires = "seeded")]
     pub seed: u64,
 
     /// Samples per chunk: the unit of parallel work, of warm-start chains and of resuming. Part of
@@ -230,17 +231,20 @@ fn summary(
     match (&m.plan, &m.dynamic) {
         (Some(p), _) => writeln!(
             out,
-            "plan       {} {} ({} samples, {} parameters, seed {})",
+            "plan       {} {} ({}, {}, seed {})",
             p.kind.option(),
             p.specs.join(" "),
-            m.samples,
-            m.parameters.len(),
+            print::plural(m.samples, "sample"),
+            print::plural(m.parameters.len(), "parameter"),
             m.seed
         )?,
         (None, Some(d)) => writeln!(
             out,
-            "run        {} s at {} Hz, input {} ({} samples)",
-            d.duration, d.sample_rate, d.input, m.samples
+            "run        {} s at {} Hz, input {} ({})",
+            d.duration,
+            d.sample_rate,
+            d.input,
+            print::plural(m.samples, "sample")
         )?,
         (None, None) => {}
     }
@@ -248,19 +252,20 @@ fn summary(
     if m.dynamic.is_some() {
         writeln!(
             out,
-            "simulated  {} samples stored in {:.2} s",
-            c.ok, m.wall_time_s
+            "simulated  {} stored in {:.2} s",
+            print::plural(c.ok, "sample"),
+            m.wall_time_s
         )?;
     } else {
         writeln!(
             out,
-            "solved     {} ok ({} warm-started), {} failed, {} not computed in {:.2} s on {} threads{}",
+            "solved     {} ok ({} warm-started), {} failed, {} not computed in {:.2} s on {}{}",
             c.ok,
             c.warm_started,
             c.failed,
             c.not_computed,
             m.wall_time_s,
-            m.threads,
+            print::plural(m.threads, "thread"),
             if resumed > 0 {
                 format!(" ({resumed} chunks kept from the resumed run)")
             } else {
