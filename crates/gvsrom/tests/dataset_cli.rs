@@ -282,6 +282,27 @@ fn a_resumed_run_equals_an_uninterrupted_one() {
         ],
         &["--resume", "--seed", "7 there, 9 now"],
     );
+    // so is a different scenario, naming the value
+    expect_error(
+        &[
+            "dataset",
+            "six-tendon",
+            "--random",
+            "tendons.*.tension=-30:30",
+            "--samples",
+            "40",
+            "--chunk-size",
+            "8",
+            "--seed",
+            "7",
+            "--set",
+            "tendons.2.friction=0.25",
+            "--out",
+            part.to_str().unwrap(),
+            "--resume",
+        ],
+        &["--resume", "`tendons[2].friction` differs", "0.25 now"],
+    );
     let same_args = [
         "dataset",
         "six-tendon",

@@ -3,6 +3,7 @@
 use super::generate::SampleResult;
 use super::{Dataset, DatasetError, Meta};
 use std::path::Path;
+use toml::{Table, Value};
 
 /// The incomplete dataset at `path`, checked to be a continuation of `meta`'s run.
 pub(super) fn resumable(path: &Path, meta: &Meta) -> Result<Dataset, DatasetError> {
@@ -29,11 +30,18 @@ pub(super) fn resumable(path: &Path, meta: &Meta) -> Result<Dataset, DatasetErro
         ))
     };
     if p.scenario_toml != meta.scenario_toml {
-        return Err(differs(
-            "scenario (after --set)",
-            format!("`{}`", p.scenario),
-            format!("`{}`", meta.scenario),
-        ));
+        let what = match toml_difference(&p.scenario_toml, &meta.scenario_toml) {
+            Some((path, old, new)) => format!(
+                "scenario (after --set): `{path}` differs from the incomplete dataset's ({old} there, {new} now)"
+            ),
+            None => format!(
+                "scenario (after --set) differs from the incomplete dataset's (`{}` there, `{}` now)",
+                p.scenario, meta.scenario
+            ),
+        };
+        return Err(resume(format!(
+            "the {what}; rerun with the same arguments, or use --force instead of --resume to start again"
+        )));
     }
     let (Some(a), Some(b)) = (&p.plan, &meta.plan) else {
         return Err(resume(
@@ -88,6 +96,39 @@ pub(super) fn resumable(path: &Path, meta: &Meta) -> Result<Dataset, DatasetErro
     Ok(prev)
 }
 
+/// The first value that differs between two resolved scenario TOMLs: its key path
+/// (`divisions[0].radius_end`) and both values (`missing` where absent); `None` if either text does
+/// not parse or they are equal as tables.
+fn toml_difference(old: &str, new: &str) -> Option<(String, String, String)> {
+    let old = Value::Table(old.parse::<Table>().ok()?);
+    let new = Value::Table(new.parse::<Table>().ok()?);
+    difference_at(&old, &new, String::new())
+}
+
+fn difference_at(a: &Value, b: &Value, path: String) -> Option<(String, String, String)> {
+    let shown = |v: Option<&Value>| v.map_or_else(|| "missing".to_string(), |v| v.to_string());
+    let child = |key: &str| match path.is_empty() {
+        true => key.to_string(),
+        false => format!("{path}.{key}"),
+    };
+    match (a, b) {
+        (Value::Table(x), Value::Table(y)) => {
+            let keys: std::collections::BTreeSet<&String> = x.keys().chain(y.keys()).collect();
+            keys.into_iter().find_map(|k| match (x.get(k), y.get(k)) {
+                (Some(u), Some(v)) => difference_at(u, v, child(k)),
+                (u, v) => Some((child(k), shown(u), shown(v))),
+            })
+        }
+        (Value::Array(x), Value::Array(y)) if x.len() == y.len() => x
+            .iter()
+            .zip(y)
+            .enumerate()
+            .find_map(|(i, (u, v))| difference_at(u, v, format!("{path}[{i}]"))),
+        _ if a == b => None,
+        _ => Some((path, shown(Some(a)), shown(Some(b)))),
+    }
+}
+
 /// Sample `k` as stored in a previous dataset.
 pub(super) fn from_previous(prev: &Dataset, k: usize) -> SampleResult {
     let r = prev.row_len();
@@ -108,5 +149,26 @@ pub(super) fn from_previous(prev: &Dataset, k: usize) -> SampleResult {
         residual: prev.residual[k],
         warm_started: false,
         reason,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::toml_difference;
+
+    #[test]
+    fn the_first_differing_scenario_value_is_named_with_both_values() {
+        let a = "name = \"a\"\n[material]\ndensity = 1121.0\n[[divisions]]\nlength = 0.25\nradius = [1, 2]\n";
+        let b = a.replace("radius = [1, 2]", "radius = [1, 3]");
+        assert_eq!(
+            toml_difference(a, &b),
+            Some(("divisions[0].radius[1]".into(), "2".into(), "3".into()))
+        );
+        let c = a.replace("density = 1121.0", "density = 1000.0\ndamping = 3.0");
+        assert_eq!(
+            toml_difference(a, &c),
+            Some(("material.damping".into(), "missing".into(), "3.0".into()))
+        );
+        assert_eq!(toml_difference(a, a), None);
     }
 }
