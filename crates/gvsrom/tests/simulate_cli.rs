@@ -199,6 +199,11 @@ fn simulation_writes_numpy_arrays_with_consistent_shapes() {
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(stdout.contains("real-time factor"), "{stdout}");
+    // the summary shows the signal that drives the run, not the scenario's unused tensions
+    assert!(
+        stdout.contains("tendons    6, u(t) babbling in [-15, 0] N, holds of 0.1–0.2 s (seed 4)\n"),
+        "{stdout}"
+    );
     assert_eq!(npy_shape(&out_dir.join("t.npy")), vec![51]);
     assert_eq!(npy_shape(&out_dir.join("q.npy")), vec![51, 28]);
     assert_eq!(npy_shape(&out_dir.join("qd.npy")), vec![51, 28]);

@@ -72,7 +72,7 @@ pub(super) fn statics_cmd(args: &StaticsArgs, out: &mut impl Write) -> Result<()
         Some(path) => Some(OutputFile::create("--json", path, "statics", args.force)?),
         None => None,
     };
-    print_model(&r.scenario, &args.scenario, &r.built, out)?;
+    print_model(&r.scenario, &args.scenario, &r.built, None, out)?;
     let run = statics::run(&r.built, args.repeat, args.compare)?;
     print_solution(&run.report, out)?;
     if let (Some(full), Some(c)) = (&run.full, &run.comparison) {
@@ -118,7 +118,7 @@ pub(super) fn modes_cmd(args: &ModesArgs, out: &mut impl Write) -> Result<()> {
         Some(path) => Some(OutputFile::create("--json", path, "modes", args.force)?),
         None => None,
     };
-    print_model(scenario, &args.scenario, built, out)?;
+    print_model(scenario, &args.scenario, built, None, out)?;
     if clipped {
         writeln!(
             out,

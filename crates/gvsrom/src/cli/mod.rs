@@ -214,7 +214,7 @@ fn check_cmd(args: &ScenarioArgs, out: &mut impl Write) -> Result<()> {
         );
     }
     let r = load(args)?;
-    print_model(&r.scenario, args, &r.built, out)?;
+    print_model(&r.scenario, args, &r.built, None, out)?;
     writeln!(out, "ok         the scenario is valid")?;
     Ok(())
 }

@@ -40,11 +40,13 @@ pub(super) fn plural(n: usize, word: &str) -> String {
 
 /// The summary of the model that runs. The scenario line is derived from the scenario as built;
 /// the file's own `description` follows only when no `--set` or `--tension` changed the scenario
-/// (its text may no longer hold then).
+/// (its text may no longer hold then). `signal`: how a run's tensions vary in time, shown in place
+/// of the scenario's constant ones.
 pub(super) fn print_model(
     scenario: &Scenario,
     args: &ScenarioArgs,
     built: &Built,
+    signal: Option<&str>,
     out: &mut impl Write,
 ) -> Result<()> {
     let m = &built.model;
@@ -78,6 +80,8 @@ pub(super) fn print_model(
     }
     if built.u.is_empty() {
         writeln!(out, "tendons    none")?;
+    } else if let Some(signal) = signal {
+        writeln!(out, "tendons    {}, {signal}", built.u.len())?;
     } else {
         writeln!(
             out,

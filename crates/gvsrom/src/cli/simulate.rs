@@ -161,6 +161,13 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
         args.babble.as_deref(),
         args.seed,
     )?;
+    let signal = input.describe().map(|d| match args.from_equilibrium {
+        true => format!(
+            "{d}, from the equilibrium under the scenario's u = {} N",
+            fmt_g(&built.u)
+        ),
+        false => d,
+    });
     let choice = simulate::IntegratorChoice {
         method: args.method,
         rtol: args.rtol,
@@ -197,7 +204,7 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
         }
         None => None,
     };
-    print_model(scenario, &args.scenario, built, out)?;
+    print_model(scenario, &args.scenario, built, signal.as_deref(), out)?;
     if let Some(note) = light {
         writeln!(out, "{note}")?;
     }

@@ -55,6 +55,52 @@ pub enum InputSource {
 }
 
 impl InputSource {
+    /// How the tensions vary in time, for a run's summary; `None` for the scenario's constant
+    /// tensions.
+    pub fn describe(&self) -> Option<String> {
+        let g = gvs::error::fmt_value;
+        Some(match self {
+            InputSource::Constant => return None,
+            InputSource::Csv {
+                path,
+                interpolation,
+            } => format!(
+                "u(t) from `{}`, {}",
+                path.display(),
+                match interpolation {
+                    Interpolation::Hold => "each row held until the next",
+                    Interpolation::Linear => "interpolated linearly",
+                }
+            ),
+            InputSource::Steps {
+                lo,
+                hi,
+                period,
+                seed,
+            } => format!(
+                "u(t) random steps in [{}, {}] N every {} s (seed {seed})",
+                g(*lo),
+                g(*hi),
+                g(*period)
+            ),
+            InputSource::Babble {
+                lo,
+                hi,
+                hold_min,
+                hold_max,
+                seed,
+            } => format!(
+                "u(t) babbling in [{}, {}] N, holds of {}–{} s (seed {seed})",
+                g(*lo),
+                g(*hi),
+                g(*hold_min),
+                g(*hold_max)
+            ),
+            InputSource::Rows(s) => format!("u(t) from {} rows", s.times.len()),
+            InputSource::Function(_) => "u(t) from a function".into(),
+        })
+    }
+
     /// The input of the command-line options `--input FILE [--interpolate]`, `--steps LO,HI,PERIOD`
     /// or `--babble LO,HI,HOLD_MIN,HOLD_MAX` (at most one), else the scenario's constant tensions.
     pub fn from_options(
