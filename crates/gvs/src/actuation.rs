@@ -1,7 +1,9 @@
 //! Tendon actuation (paper eqs. 11–12, gvs-spec §7.6–7.7).
 //!
 //! A tendon runs at the local offset `d(X) = [0, d_y, d_z]` interpolated linearly between its start
-//! and end offsets over `[X_s, X_e]` ("oblique" routing; `d' = const`). At a point with strain
+//! and end offsets over `[X_s, X_e]` ("oblique" routing; `d' = const`), turned about the rod's axis
+//! by `φ(X) = 2π n s`, `s = (X − X_s)/(X_e − X_s)`, for a helical routing of `n` turns
+//! ([`Tendon::turns`]; `d' = R_x(φ)(d_lin' + φ' e_x × d_lin)`, spec §7.6 "Helical"). At a point with strain
 //! `ξ = [k; ν]` its unit tangent in the section frame is `t = t_u/‖t_u‖`, `t_u = ν + k × d + d'`, and
 //! it loads the rod with the internal wrench `Φ_a α u`, `Φ_a = [d × t; t]`.
 //!
@@ -34,6 +36,10 @@ use serde::{Deserialize, Serialize};
 /// 0.3 rad/m the §10.3.7 rod, bent by only 0.5 rad/m, would be off by 5e-3).
 pub const DEFAULT_FRICTION_SMOOTHING: f64 = 0.05;
 
+/// Most helical turns of a tendon ([`Tendon::turns`]) either way: far beyond a tendon a soft
+/// arm's cross-section could route, and within what a strain basis of practical order resolves.
+pub const MAX_TURNS: f64 = 100.0;
+
 fn default_friction_smoothing() -> f64 {
     DEFAULT_FRICTION_SMOOTHING
 }
@@ -57,27 +63,48 @@ pub struct Tendon {
     /// [`DEFAULT_FRICTION_SMOOTHING`].
     #[serde(default = "default_friction_smoothing")]
     pub friction_smoothing: f64,
+    /// Turns `n` of a helical routing: the offset turns about the rod's axis (`+x`, right-handed)
+    /// by `φ = 2π n s` over the span; 0 (the default) is the oblique routing. A helix of radius
+    /// `ρ` has `offset_start = offset_end` of norm `ρ`.
+    #[serde(default)]
+    pub turns: f64,
 }
 
 impl Tendon {
-    /// `d(X)` in the section frame.
+    /// `d(X) = R_x(φ(X)) d_lin(X)` in the section frame: the linear interpolation of the end
+    /// offsets, turned by `φ = 2π n s` (`s` the fraction of the span, `n` = [`Tendon::turns`]).
     #[inline]
     pub fn offset(&self, x: f64) -> V3 {
-        let s = (x - self.x_start) / (self.x_end - self.x_start);
-        let y = self.offset_start[0] + s * (self.offset_end[0] - self.offset_start[0]);
-        let z = self.offset_start[1] + s * (self.offset_end[1] - self.offset_start[1]);
-        V3::new(0.0, y, z)
+        let (d, _) = self.offset_and_rate(x);
+        d
     }
 
-    /// `d' = ∂d/∂X` (constant).
+    /// `d' = ∂d/∂X = R_x(φ) (d_lin' + φ' e_x × d_lin)`, `φ' = 2π n / (X_e − X_s)` (constant for
+    /// the oblique routing, `n = 0`).
     #[inline]
-    pub fn offset_rate(&self) -> V3 {
+    pub fn offset_rate(&self, x: f64) -> V3 {
+        let (_, dp) = self.offset_and_rate(x);
+        dp
+    }
+
+    /// `(d(X), d'(X))`.
+    #[inline]
+    pub fn offset_and_rate(&self, x: f64) -> (V3, V3) {
         let l = self.x_end - self.x_start;
-        V3::new(
-            0.0,
-            (self.offset_end[0] - self.offset_start[0]) / l,
-            (self.offset_end[1] - self.offset_start[1]) / l,
-        )
+        let s = (x - self.x_start) / l;
+        let [y0, z0] = self.offset_start;
+        let [y1, z1] = self.offset_end;
+        let (y, z) = (y0 + s * (y1 - y0), z0 + s * (z1 - z0));
+        let (yp, zp) = ((y1 - y0) / l, (z1 - z0) / l);
+        if self.turns == 0.0 {
+            return (V3::new(0.0, y, z), V3::new(0.0, yp, zp));
+        }
+        let phi_rate = std::f64::consts::TAU * self.turns / l;
+        // e_x × [0, y, z] = [0, −z, y]
+        let (ry, rz) = (yp - phi_rate * z, zp + phi_rate * y);
+        let (sn, cs) = (phi_rate * (x - self.x_start)).sin_cos();
+        let turn = |a: f64, b: f64| V3::new(0.0, cs * a - sn * b, sn * a + cs * b);
+        (turn(y, z), turn(ry, rz))
     }
 
     /// Smoothing angle `ε = κ_ε |ΔX|` \[rad\] of the turning angle between two tendon points `ΔX`
@@ -132,6 +159,13 @@ impl Tendon {
             Some((0.0, true)),
             None,
             "a finite curvature scale >= 0 in rad/m",
+        )?;
+        check_range(
+            &f("turns"),
+            self.turns,
+            Some((-MAX_TURNS, true)),
+            Some((MAX_TURNS, true)),
+            &format!("a number of helical turns in [-{MAX_TURNS}, {MAX_TURNS}]"),
         )?;
         // radius check at both ends of the span and at every division boundary inside it
         let mut xs = vec![self.x_start, self.x_end];

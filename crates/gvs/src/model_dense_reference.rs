@@ -294,6 +294,7 @@ mod tests {
                 x_end: 0.25,
                 friction: 0.88,
                 friction_smoothing: crate::actuation::DEFAULT_FRICTION_SMOOTHING,
+                turns: 0.0,
             },
             Tendon {
                 offset_start: [0.006, -0.002],
@@ -302,6 +303,7 @@ mod tests {
                 x_end: 0.2,
                 friction: 0.3,
                 friction_smoothing: crate::actuation::DEFAULT_FRICTION_SMOOTHING,
+                turns: 0.0,
             },
         ]
     }

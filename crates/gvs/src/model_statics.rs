@@ -105,7 +105,7 @@ impl<P: StrainParam> Model<P> {
                 continue;
             }
             let mu = td.friction;
-            let dp = td.offset_rate();
+
             let mut theta = 0.0;
             let mut tau_prev = V3::zeros();
             if jac {
@@ -113,7 +113,7 @@ impl<P: StrainParam> Model<P> {
             }
             for (m, &i) in self.tendon_points[k].iter().enumerate() {
                 let p = self.disc.points[i];
-                let d = td.offset(p.x);
+                let (d, dp) = td.offset_and_rate(p.x);
                 let tl = tendon_local(&ws.xi[i], &d, &dp);
                 if mu > 0.0 {
                     let rot = ws.g[i].rot;

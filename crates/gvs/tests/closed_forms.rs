@@ -239,6 +239,7 @@ fn constant_offset_tendon_gives_uniform_curvature_and_contraction() {
         x_end: l,
         friction: 0.0,
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+        turns: 0.0,
     };
     let m = model(
         Rod::tapered(mat(e, 0.0), l, r, r),
@@ -268,6 +269,7 @@ fn constant_offset_tendon_with_friction_follows_capstan_curvature() {
         x_end: l,
         friction: mu,
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+        turns: 0.0,
     };
     let m = model(
         Rod::tapered(mat(e, 0.0), l, r, r),
@@ -545,6 +547,7 @@ fn rotating_base_and_gravity_together_leaves_equilibrium_unchanged() {
         x_end: 0.25,
         friction: 0.88,
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+        turns: 0.0,
     };
     let m = model(
         rod.clone(),
@@ -606,6 +609,7 @@ fn planar_loading_keeps_out_of_plane_coordinates_exactly_zero() {
         x_end: 0.25,
         friction: 0.88,
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+        turns: 0.0,
     };
     let m = model(rod, 30, legendre([Some(3); 6]), vec![tendon], &[]);
     let loads = Loads {
@@ -726,4 +730,58 @@ fn follower_axial_load_stretches_a_rotated_rod_by_f_l2_over_2ea() {
     // the same numbers in the world frame are another load: they bend the rotated rod
     let (_, ws) = solve(&m, &[], &loads(Frame::Global));
     assert!((ws.g.last().unwrap().pos - expected).norm() > 1e-3);
+}
+
+#[test]
+fn helical_tendon_twists_and_bends_a_straight_rod_as_its_cut_wrench_says() {
+    // A frictionless tendon on a helix of radius ρ and n turns over a uniform rod,
+    // d(X) = ρ[0, cos φ, sin φ], φ = 2π n X/L, pulls with u. Cutting the rod and tendon at X, the
+    // rod's stress resultant balances the tendon's force u t at d (gvs-spec §7.6): to first order
+    // in u, about the straight rod, t = (e_x + φ' e_x × d)/n_t with n_t = √(1 + (φ'ρ)²), so
+    //   κ_x = u φ' ρ²/(n_t GJ),  (κ_y, κ_z) = u ρ (sin φ, −cos φ)/(n_t EI),
+    //   ν_x − 1 = u/(n_t EA),    (ν_y, ν_z) = u φ' ρ (−sin φ, cos φ)/(n_t GA):
+    // a uniform twist, a bending moment that turns with the tendon, and shears.
+    let (r, l, e, rho, n) = (0.01, 0.5, 1e6, 0.006, 1.0);
+    let u = -1e-4;
+    let tendon = Tendon {
+        offset_start: [rho, 0.0],
+        offset_end: [rho, 0.0],
+        x_start: 0.0,
+        x_end: l,
+        friction: 0.0,
+        friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+        turns: n,
+    };
+    let m = model(
+        Rod::tapered(mat(e, 0.0), l, r, r),
+        24,
+        legendre([Some(2), Some(12), Some(12), Some(2), Some(12), Some(12)]),
+        vec![tendon],
+        &[],
+    );
+    let (_, ws) = solve(&m, &[u], &no_loads());
+    let es = SectionProps::circular(&mat(e, 0.0), r).es;
+    let phi_rate = 2.0 * PI * n / l;
+    let nt = (1.0 + (phi_rate * rho).powi(2)).sqrt();
+    let strains = m.point_strains(&ws);
+    let peak = u.abs() * rho / (nt * es[1]);
+    for (p, xi) in m.disc.points.iter().zip(&strains) {
+        let (s, c) = (phi_rate * p.x).sin_cos();
+        let expected = V6::new(
+            u * phi_rate * rho * rho / (nt * es[0]),
+            u * rho * s / (nt * es[1]),
+            -u * rho * c / (nt * es[2]),
+            1.0 + u / (nt * es[3]),
+            -u * phi_rate * rho * s / (nt * es[4]),
+            u * phi_rate * rho * c / (nt * es[5]),
+        );
+        // second-order terms are O(u²): relative 1e-6 of the peak curvature
+        assert!(
+            (xi - expected).amax() < 1e-6 * peak,
+            "X = {}: ξ = {xi}, expected {expected}",
+            p.x
+        );
+    }
+    // the twist is a real share of the response, not round-off
+    assert!(strains[strains.len() / 2][0].abs() > 0.1 * peak);
 }

@@ -44,6 +44,7 @@ fn arm(damping: f64, friction: f64) -> Model<LinearBasis> {
         x_end: 0.25,
         friction,
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+        turns: 0.0,
     };
     Model::new(rod, disc, b, vec![t]).unwrap()
 }

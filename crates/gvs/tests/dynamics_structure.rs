@@ -41,6 +41,7 @@ fn linear_model(order: MagnusOrder, damping: f64) -> Model<LinearBasis> {
         x_end: 0.25,
         friction: 0.5,
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+        turns: 0.0,
     };
     Model::new(rod, disc, b, vec![t]).unwrap()
 }

@@ -45,6 +45,7 @@ fn tendon_model() -> Model<LinearBasis> {
         x_end: 0.25,
         friction,
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+        turns: 0.0,
     };
     Model::new(
         rod,

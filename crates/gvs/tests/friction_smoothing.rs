@@ -40,6 +40,7 @@ fn arm(friction_smoothing: f64) -> Model<LinearBasis> {
         x_end: 0.25,
         friction: 0.88,
         friction_smoothing,
+        turns: 0.0,
     };
     Model::new(rod, disc, basis, vec![tendon]).unwrap()
 }

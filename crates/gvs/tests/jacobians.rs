@@ -122,6 +122,7 @@ fn single_division_model(order: MagnusOrder, friction: f64) -> Model<LinearBasis
             x_end: 0.25,
             friction,
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+            turns: 0.0,
         },
         Tendon {
             offset_start: [0.006, -0.002],
@@ -130,6 +131,7 @@ fn single_division_model(order: MagnusOrder, friction: f64) -> Model<LinearBasis
             x_end: 0.25,
             friction: 0.3,
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+            turns: 0.0,
         },
     ];
     Model::new(rod, disc, basis, tendons).unwrap()
@@ -231,6 +233,7 @@ fn statics_jacobian_matches_finite_differences_two_divisions_half_tendon() {
             x_end: 0.6,
             friction: 0.4,
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+            turns: 0.0,
         },
         Tendon {
             offset_start: [0.01, 0.0173],
@@ -239,6 +242,7 @@ fn statics_jacobian_matches_finite_differences_two_divisions_half_tendon() {
             x_end: 0.3,
             friction: 0.2,
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+            turns: 0.0,
         },
     ];
     let m = Model::new(rod, disc, basis, tendons).unwrap();
@@ -269,6 +273,7 @@ fn statics_jacobian_matches_finite_differences_for_nonlinear_sigmoid_basis() {
         x_end: 0.8,
         friction: 0.5,
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+        turns: 0.0,
     }];
     let m = Model::new(rod, disc, p, tendons).unwrap();
     let q = DVector::from_vec(vec![1.1, 8.0, 0.45]);

@@ -62,6 +62,7 @@ fn arm(basis: DivisionBasis) -> Model<LinearBasis> {
         x_end: 0.25,
         friction: 0.88,
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+        turns: 0.0,
     };
     Model::new(rod, disc, b, vec![t]).unwrap()
 }

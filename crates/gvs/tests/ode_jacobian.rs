@@ -53,6 +53,7 @@ fn model() -> Model<LinearBasis> {
             x_end: 0.25,
             friction: 0.5,
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+            turns: 0.0,
         },
         Tendon {
             offset_start: [0.006, -0.002],
@@ -61,6 +62,7 @@ fn model() -> Model<LinearBasis> {
             x_end: 0.25,
             friction: 0.0,
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+            turns: 0.0,
         },
     ];
     Model::new(rod, disc, b, tendons).unwrap()

@@ -40,6 +40,7 @@ fn skew_tendon() -> Tendon {
         x_end: 0.25,
         friction: 0.0,
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+        turns: 0.0,
     }
 }
 
@@ -47,6 +48,10 @@ fn skew_tendon() -> Tendon {
 /// [1, 2, 2, 1, 1, 1], 14 coordinates), 12 Gauss points, Z4, the skew tendon; `extra` adds
 /// weight-0 points (they refine the kinematics only).
 fn model_3d(extra: &[f64]) -> Model<LinearBasis> {
+    model_3d_with(extra, skew_tendon())
+}
+
+fn model_3d_with(extra: &[f64], tendon: Tendon) -> Model<LinearBasis> {
     let rod = Rod::tapered(material(), 0.25, 0.0125, 0.005);
     let disc =
         Discretization::new(&rod, &[Quadrature::Gauss { n: 12 }], MagnusOrder::Z4, extra).unwrap();
@@ -58,7 +63,7 @@ fn model_3d(extra: &[f64]) -> Model<LinearBasis> {
         }],
     )
     .unwrap();
-    Model::new(rod, disc, b, vec![skew_tendon()]).unwrap()
+    Model::new(rod, disc, b, vec![tendon]).unwrap()
 }
 
 /// A 3-D state: every coordinate random in [−0.6, 0.6] (angles in rad, strains dimensionless),
@@ -156,11 +161,31 @@ fn elastic_force_is_gradient_of_elastic_energy_for_nonlinear_sigmoid() {
 /// The routed offset `d(X) = d₀ + (X − X_s)/(X_e − X_s) (d₁ − d₀)` ("oblique" routing, spec §7.6).
 fn offset_at(t: &Tendon, x: f64) -> V3 {
     let s = (x - t.x_start) / (t.x_end - t.x_start);
+    let y = t.offset_start[0] + s * (t.offset_end[0] - t.offset_start[0]);
+    let z = t.offset_start[1] + s * (t.offset_end[1] - t.offset_start[1]);
+    // a helical routing turns the interpolated offset about +x by 2π·turns·s
+    let phi = 2.0 * std::f64::consts::PI * t.turns * s;
     V3::new(
         0.0,
-        t.offset_start[0] + s * (t.offset_end[0] - t.offset_start[0]),
-        t.offset_start[1] + s * (t.offset_end[1] - t.offset_start[1]),
+        phi.cos() * y - phi.sin() * z,
+        phi.sin() * y + phi.cos() * z,
     )
+}
+
+/// `d'(X)` by a central difference of [`offset_at`] (independent of the engine's analytic rate).
+fn offset_rate_at(t: &Tendon, x: f64) -> V3 {
+    let h = 1e-6 * (t.x_end - t.x_start);
+    (offset_at(t, x + h) - offset_at(t, x - h)) / (2.0 * h)
+}
+
+/// A tapered helix: 1.5 turns about the axis from the top of the section, radius 9 → 4 mm.
+fn helical_tendon() -> Tendon {
+    Tendon {
+        offset_start: [0.0, 0.009],
+        offset_end: [0.0, 0.004],
+        turns: 1.5,
+        ..skew_tendon()
+    }
 }
 
 /// The discrete tendon length `ℓ_h(q) = Σ_i W_i ‖t_u(X_i)‖`, `t_u = ν + k × d + d'` (the speed
@@ -173,12 +198,6 @@ fn tendon_length<P: StrainParam>(
     ws: &mut gvs::model::Workspace,
 ) -> f64 {
     let t = m.tendons[k];
-    let span = t.x_end - t.x_start;
-    let dp = V3::new(
-        0.0,
-        (t.offset_end[0] - t.offset_start[0]) / span,
-        (t.offset_end[1] - t.offset_start[1]) / span,
-    );
     let pts = m.tendon_points(k).to_vec();
     let xi = m.strains_at(q, ws);
     pts.iter()
@@ -186,26 +205,37 @@ fn tendon_length<P: StrainParam>(
             let p = m.disc.points[i];
             let kv = V3::new(xi[i][0], xi[i][1], xi[i][2]);
             let nu = V3::new(xi[i][3], xi[i][4], xi[i][5]);
-            p.weight * (nu + kv.cross(&offset_at(&t, p.x)) + dp).norm()
+            p.weight * (nu + kv.cross(&offset_at(&t, p.x)) + offset_rate_at(&t, p.x)).norm()
         })
         .sum()
 }
 
 /// `B_k(q) = ∇_q ℓ_k(q)` for a frictionless tendon (gvs-spec §7.6: `Bu = Σ W Φᵀ Φ_a u` with
 /// `Φ_a = [d × t; t] = ∂‖t_u‖/∂ξ`), on the off-plane routing and a 3-D state. The length is first
-/// checked to be the routed tendon length: the chord length of `p_i = r_i + R_i d(X_i)` on 401
+/// checked to be the routed tendon length: the chord length of `p_i = r_i + R_i d(X_i)` on 1601
 /// extra weight-0 points (which refine the kinematics but leave the Gauss points, weights and
 /// strains unchanged).
 #[test]
 fn tendon_column_is_gradient_of_routed_tendon_length_off_plane() {
-    let m = model_3d(&[]);
+    tendon_column_is_gradient_of_routed_length(skew_tendon());
+}
+
+/// The same for a helical routing (1.5 turns about the axis, tapered radius), whose offset rate
+/// `d'(X)` turns with it: the test's `d'` is a central difference of its own `d(X)`.
+#[test]
+fn tendon_column_is_gradient_of_routed_tendon_length_helical() {
+    tendon_column_is_gradient_of_routed_length(helical_tendon());
+}
+
+fn tendon_column_is_gradient_of_routed_length(tendon: Tendon) {
+    let m = model_3d_with(&[], tendon);
     let q = state_3d(&m);
     let mut ws = m.workspace();
     let l_h = tendon_length(&m, 0, &q, &mut ws);
 
     // the same rod with a dense polyline: the tendon's geometric length
-    let xs: Vec<f64> = (1..=401).map(|k| 0.25 * k as f64 / 402.0).collect();
-    let fine = model_3d(&xs);
+    let xs: Vec<f64> = (1..=1601).map(|k| 0.25 * k as f64 / 1602.0).collect();
+    let fine = model_3d_with(&xs, tendon);
     let mut wf = fine.workspace();
     assert!(
         (tendon_length(&fine, 0, &q, &mut wf) - l_h).abs() < 1e-15,
@@ -223,7 +253,8 @@ fn tendon_column_is_gradient_of_routed_tendon_length_off_plane() {
         .collect();
     let chord: f64 = path.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
     let geo_err = (chord - l_h).abs() / l_h;
-    // chord error ~ (ΔX κ)²/24 ≈ 1e-7 and Gauss error of ∫‖t_u‖ with 12 points
+    // chord error ~ (ΔX κ)²/24 (κ ≈ 8.5 1/m on the helix: 7e-8) and Gauss error of ∫‖t_u‖ with
+    // 12 points
     assert!(
         geo_err < 1e-6,
         "ℓ_h = {l_h} vs chord length {chord}: {geo_err:e}"

@@ -232,12 +232,7 @@ impl Scenario {
 
     /// Pickling: the source text (a file's as it was read, not the file again), its origin and
     /// the overrides, loaded again as `set` loads them.
-    fn __reduce__<'py>(
-        slf: &Bound<'py, Self>,
-    ) -> PyResult<(
-        Bound<'py, PyAny>,
-        (String, String, String, bool, Vec<String>),
-    )> {
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, Parts)> {
         let me = slf.borrow();
         let restore = slf.get_type().getattr("_restore")?;
         Ok((
@@ -279,6 +274,10 @@ impl Scenario {
         )
     }
 }
+
+/// What pickling keeps of a scenario: its source's origin, default name, text and whether it is a
+/// preset, and the overrides ([`Scenario::_restore`]'s arguments).
+type Parts = (String, String, String, bool, Vec<String>);
 
 fn file_source(path: &str) -> PyResult<Source> {
     presets::source(path).map_err(err)

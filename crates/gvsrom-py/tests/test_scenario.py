@@ -126,3 +126,15 @@ def test_set_while_another_thread_builds_is_not_refused():
         k += 1
     t.join()
     assert errors == [] and k > 0
+
+
+def test_a_tendon_the_basis_cannot_hold_is_warned_about_at_build():
+    # a helical tendon on the planar single-tendon basis would twist the rod, which the basis lacks
+    s = gvsrom.Scenario.preset("single-tendon").set("tendons.0.turns", 0.5)
+    with pytest.warns(UserWarning, match=r"tendons\[0\] also loads torsion, bend_z, shear_y, which the "
+                                         r"basis of division 0 lacks"):
+        s.build()
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        gvsrom.Scenario.preset("single-tendon").build()

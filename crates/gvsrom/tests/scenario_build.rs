@@ -285,3 +285,53 @@ fn a_tendon_given_both_ways_names_the_polar_key_it_was_given() {
         );
     }
 }
+
+#[test]
+fn a_helical_tendon_twists_the_rod_and_too_many_turns_are_refused() {
+    // the uniform rod with a surface tendon of one turn: pulling it twists the rod, which the
+    // oblique routing (turns = 0) does not
+    let tendon = r#"
+    [[tendons]]
+    angle_deg = 90
+    radial_fraction = 0.6
+    tension = -0.002
+    "#;
+    let text = format!("{UNIFORM_ROD}{tendon}").replace(
+        r#"modes = ["bend_y", "elongation", "shear_z"], order = 2"#,
+        r#"modes = ["torsion", "bend_y", "bend_z", "elongation", "shear_y", "shear_z"], order = 6"#,
+    );
+    let twist = |turns: &str| {
+        let r = run_text(&text, &[&format!("tendons.0.turns={turns}")]);
+        r.strain.iter().map(|xi| xi[0].abs()).fold(0.0, f64::max)
+    };
+    assert!(twist("1") > 1e-4, "twist {}", twist("1"));
+    assert!(twist("0") < 1e-12, "twist {}", twist("0"));
+    let s = Scenario::from_toml("t", &text, &["tendons.0.turns=1e3".into()]).unwrap();
+    let e = gvsrom::build(&s).err().expect("refused").to_string();
+    assert!(
+        e.contains("tendons[0].turns") && e.contains("[-100, 100]"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_tendon_loading_components_the_basis_lacks_is_named() {
+    let warnings = |set: &[&str]| {
+        let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
+        let s = presets::load("single-tendon", &set).expect("preset loads");
+        gvsrom::build::uncovered_tendon_components(&gvsrom::build(&s).unwrap().model)
+    };
+    // the preset's tendon lies in the x-z plane of its planar basis
+    assert!(warnings(&[]).is_empty());
+    // moved sideways it bends the rod out of that plane too
+    let w = warnings(&["tendons.0.offset_start=[0.004, 0.008]"]);
+    assert_eq!(w.len(), 1);
+    assert!(
+        w[0].starts_with("tendons[0] also loads torsion, bend_z, shear_y,"),
+        "{w:?}"
+    );
+    // helical: the same; with every mode in the basis nothing is dropped
+    assert_eq!(warnings(&["tendons.0.turns=0.5"]), w);
+    let all = r#"divisions.0.basis.modes=["torsion", "bend_y", "bend_z", "elongation", "shear_y", "shear_z"]"#;
+    assert!(warnings(&["tendons.0.turns=0.5", "divisions.0.basis.order=4", all]).is_empty());
+}

@@ -72,6 +72,7 @@ fn hom(damping: f64) -> Model<LinearBasis> {
         x_end: 0.25,
         friction: FRICTION,
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+        turns: 0.0,
     };
     Model::new(rod, disc, basis, vec![tendon]).unwrap()
 }

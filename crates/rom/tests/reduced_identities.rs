@@ -120,6 +120,7 @@ fn tendons() -> Vec<Tendon> {
             x_end: 0.25,
             friction: 0.3,
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+            turns: 0.0,
         },
         // first division only, frictionless
         Tendon {
@@ -129,6 +130,7 @@ fn tendons() -> Vec<Tendon> {
             x_end: 0.15,
             friction: 0.0,
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+            turns: 0.0,
         },
     ]
 }

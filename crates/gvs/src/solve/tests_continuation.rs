@@ -162,6 +162,7 @@ fn six_tendon() -> Model<crate::strain::LinearBasis> {
                 x_end,
                 friction: 0.0,
                 friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+                turns: 0.0,
             }
         })
         .collect();

@@ -48,7 +48,16 @@ pub fn describe(s: &Scenario, built: &Built) -> String {
             } else {
                 format!("friction {lo} to {hi}")
             };
-            format!("{n} tendon{} ({friction})", if n == 1 { "" } else { "s" })
+            let helical = tendons.iter().filter(|t| t.turns != 0.0).count();
+            let helical = match (helical, n) {
+                (0, _) => String::new(),
+                (h, n) if h == n => ", helical".into(),
+                (h, _) => format!(", {h} helical"),
+            };
+            format!(
+                "{n} tendon{} ({friction}{helical})",
+                if n == 1 { "" } else { "s" }
+            )
         }
     });
     let count = |n: usize, what: &str| match n {

@@ -18,6 +18,7 @@ pub use limits::*;
 pub use loads::loads;
 pub use reduced::Reduced;
 pub use resolve::{resolve, Request, Resolved};
+pub use tendons::uncovered_tendon_components;
 
 use basis::{basis, quadrature};
 use rod::{base_pose, geometry, material, radius_range};

@@ -2,9 +2,13 @@
 
 use super::limits::*;
 use crate::error::ScenarioError;
+use crate::scenario::StrainMode;
 use crate::scenario::TendonSpec;
-use gvs::actuation::{Tendon, DEFAULT_FRICTION_SMOOTHING};
+use gvs::actuation::{tendon_local, Tendon, DEFAULT_FRICTION_SMOOTHING};
+use gvs::lie::V6;
+use gvs::model::Model;
 use gvs::rod::Rod;
+use gvs::strain::LinearBasis;
 
 /// Radius at `x` on the side given: `after = true` takes the division starting at `x` at a junction.
 pub(super) fn radius_at(rod: &Rod, x: f64, after: bool) -> f64 {
@@ -123,6 +127,12 @@ pub(super) fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, Scen
         x_end,
         friction,
         friction_smoothing,
+        turns: in_range(
+            &f("turns"),
+            t.turns,
+            (-gvs::actuation::MAX_TURNS, gvs::actuation::MAX_TURNS),
+            "(helical turns about the rod's axis over the span; 0 = oblique)",
+        )?,
     };
     // |d(X)| is convex along the span and r(X) linear per division: checking the span's ends and
     // the division junctions inside it covers the whole path.
@@ -160,4 +170,58 @@ pub(super) fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, Scen
         }
     }
     Ok(tendon)
+}
+
+/// What a tendon would do that the strain basis cannot: for each tendon, the strain components its
+/// wrench `Φ_a = [d × t; t]` loads on the straight rod (gvs-spec §7.6) at a weighted point of a
+/// division whose basis lacks them. The Galerkin projection `Σ W Φᵀ Φ_a u` drops that part of the
+/// load silently: a helical or off-plane tendon on a planar basis neither twists nor bends the rod
+/// out of plane. One sentence per such tendon, for the front-ends to warn with.
+pub fn uncovered_tendon_components(model: &Model<LinearBasis>) -> Vec<String> {
+    let disc = &model.disc;
+    let n_div = disc.div_start.len();
+    // the components each division's basis has: a row of Φ_s non-zero at one of its sites
+    let mut has = vec![[false; 6]; n_div];
+    for (s, site) in disc.sites.iter().enumerate() {
+        let phi = model.param.phi_at(s);
+        for (a, flag) in has[site.div].iter_mut().enumerate() {
+            *flag |= phi.row(a).iter().any(|v| *v != 0.0);
+        }
+    }
+    let straight = V6::new(0.0, 0.0, 0.0, 1.0, 0.0, 0.0);
+    let mut out = vec![];
+    for (k, td) in model.tendons.iter().enumerate() {
+        let mut missing = [false; 6];
+        let mut divisions = std::collections::BTreeSet::new();
+        for &i in model.tendon_points(k) {
+            let p = disc.points[i];
+            if p.weight <= 0.0 {
+                continue;
+            }
+            let (d, dp) = td.offset_and_rate(p.x);
+            let phi_a = tendon_local(&straight, &d, &dp).phi_a;
+            let scale = phi_a.amax();
+            for a in 0..6 {
+                if !has[p.div][a] && phi_a[a].abs() > 1e-9 * scale {
+                    missing[a] = true;
+                    divisions.insert(p.div);
+                }
+            }
+        }
+        if missing.iter().any(|m| *m) {
+            let names: Vec<&str> = StrainMode::ALL
+                .iter()
+                .filter(|m| missing[m.index()])
+                .map(|m| m.name())
+                .collect();
+            let divs: Vec<String> = divisions.iter().map(|j| j.to_string()).collect();
+            out.push(format!(
+                "tendons[{k}] also loads {}, which the basis of division {} lacks: that part of its load is dropped (add the mode{} to the basis to keep it)",
+                names.join(", "),
+                divs.join(", "),
+                if names.len() == 1 { "" } else { "s" }
+            ));
+        }
+    }
+    out
 }

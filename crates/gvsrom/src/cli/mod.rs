@@ -156,14 +156,19 @@ pub fn run(cli: Cli, out: &mut impl Write) -> Result<()> {
     }
 }
 
-/// The scenario of `args` resolved by the library ([`gvsrom::build::resolve`]).
+/// The scenario of `args` resolved by the library ([`gvsrom::build::resolve`]); a tendon whose
+/// load the basis cannot hold is warned about on stderr.
 fn load(args: &ScenarioArgs) -> Result<Resolved> {
-    resolve(&Request {
+    let r = resolve(&Request {
         source: &args.scenario,
         overrides: &args.set,
         tensions: args.tension.as_deref(),
         centerline_points: args.centerline_points,
-    })
+    })?;
+    for w in gvsrom::build::uncovered_tendon_components(&r.built.model) {
+        gvsrom::progress::stderr_line(format_args!("warning: {w}"));
+    }
+    Ok(r)
 }
 
 /// Refuses `--extrapolate` without a `--model` for it to apply to (it would be ignored).

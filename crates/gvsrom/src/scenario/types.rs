@@ -217,6 +217,12 @@ pub struct TendonSpec {
     /// `gvs::actuation::DEFAULT_FRICTION_SMOOTHING`; 0 = the exact, kinked tangent rule).
     #[serde(default)]
     pub friction_smoothing: Option<f64>,
+    /// Helical routing: turns of the offset about the rod's axis (+x, right-handed) over the
+    /// span; 0 (default) = the oblique routing between the two offsets. Not written when 0, so
+    /// that the resolved TOML (and every hash of it) of a scenario without helical tendons is
+    /// what it was before the key existed.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub turns: f64,
     /// Tension u \[N\]; negative pulls (bends the rod toward the tendon).
     #[serde(default)]
     pub tension: f64,
@@ -326,4 +332,8 @@ impl Default for OutputSpec {
 
 fn default_centerline_points() -> usize {
     21
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
