@@ -215,9 +215,12 @@ pub(super) fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
     };
     let (options, loss) = request.resolve(init.as_ref());
     let signal = interrupt_flag();
-    let bar = gvsrom::progress::bar(args.epochs as u64, "epochs");
+    // the L-BFGS fine-tuning runs past --epochs: the bar counts both phases to their limits, so
+    // that its ETA is the time to those limits (an upper bound when a phase stops early) rather
+    // than zero all through the fine-tuning
+    let limit = args.epochs + options.fine_tune.lbfgs_iterations();
+    let bar = gvsrom::progress::bar(limit as u64, "epochs + L-BFGS iterations");
     let mut progress = |epoch: usize, train: f64, val: Option<f64>| {
-        // the fine-tuning phase runs past --epochs
         if epoch as u64 > bar.length().unwrap_or(0) {
             bar.set_length(epoch as u64);
         }
@@ -268,13 +271,13 @@ pub(super) fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
     )?;
     writeln!(
         out,
-        "trained    {} Adam epochs + {} fine-tuning iterations in {:.1} s (best at {} of {}; last phase ended by {:?})",
+        "trained    {} Adam epochs + {} fine-tuning iterations in {:.1} s (best at {} of {}; the last phase ended {})",
         r.epochs_run - r.fine_tune_epochs_run,
         r.fine_tune_epochs_run,
         r.wall_time.as_secs_f64(),
         r.best_epoch,
         r.epochs_run,
-        r.stop
+        r.stop.describe(r.n_val > 0)
     )?;
     writeln!(
         out,

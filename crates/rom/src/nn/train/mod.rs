@@ -56,6 +56,27 @@ pub enum StopReason {
     Converged,
 }
 
+impl StopReason {
+    /// Why the last phase ended, in words (`validated`: the run had validation rows, whose loss
+    /// early stopping then watches; else it watches the training loss).
+    pub fn describe(self, validated: bool) -> &'static str {
+        match (self, validated) {
+            (StopReason::EpochLimit, _) => "at its epoch or iteration limit",
+            (StopReason::EarlyStopping, true) => {
+                "by early stopping (the validation loss stopped improving)"
+            }
+            (StopReason::EarlyStopping, false) => {
+                "by early stopping (no validation rows: the training loss stopped improving)"
+            }
+            (StopReason::Interrupted, _) => "by an interruption (Ctrl-C)",
+            (StopReason::Diverged, _) => {
+                "by divergence (a loss not finite; the best weights before it are kept)"
+            }
+            (StopReason::Converged, _) => "at convergence (L-BFGS found no descent step)",
+        }
+    }
+}
+
 /// Loss curves and final errors of a training run. Losses are reconstruction mean squared errors
 /// `(1/(N·n)) Σ‖x̂ − x‖²` in scaled units without the weight penalty (the curves plus `β Q` with the
 /// strain-rate term, [`TrainOptions::rate_weight`]); RMSEs are in physical units,
