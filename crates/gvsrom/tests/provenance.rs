@@ -389,7 +389,7 @@ fn datasets_models_and_model_runs_record_where_they_came_from() {
         "single-tendon",
         "--set",
         "tendons.0.friction=0.6",
-        "--sweep",
+        "--random",
         "tendons.0.tension=-5:0",
         "--samples",
         "6",
