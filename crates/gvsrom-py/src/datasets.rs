@@ -420,5 +420,8 @@ pub fn dataset(
     if let Some(e) = caught {
         return Err(e);
     }
+    for w in &outcome.warnings {
+        crate::robot::warn(py, w)?;
+    }
     load_dataset(py, outcome.path)
 }

@@ -203,7 +203,9 @@ impl Robot {
     }
 
     /// The Coriolis and centrifugal force ``C(q, q̇) q̇ = Σ W Jᵀ (Ms J̇ q̇ + coad_η Ms η)``
-    /// (gvs-spec §7.2), shape (n_dof,) [J per unit of q].
+    /// (gvs-spec §7.2), shape (n_dof,) [J per unit of q]. With a reduced model attached, whose
+    /// strain is ``Φ c(q)``, ``J = J_HOM C_q`` and ``J̇ q̇`` holds the map's curvature: the force is
+    /// ``C_qᵀ (C_HOM q̇_HOM + M_HOM Ċ_q q̇)`` at ``q̇_HOM = C_q q̇`` (``crates/rom/tests/reduced_identities.rs``).
     fn coriolis_force<'py>(
         &self,
         py: Python<'py>,

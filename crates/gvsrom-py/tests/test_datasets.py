@@ -210,3 +210,9 @@ def test_reproduce_runs_the_steps_the_cli_then_reuses(gvsrom_bin, tmp_path):
     assert p.returncode == 0, p.stderr
     steps = done[0]["steps"]
     assert f"({steps} steps, {steps} reused)" in p.stdout
+
+
+def test_a_dataset_of_a_tendon_the_basis_cannot_hold_warns(tmp_path):
+    s = gvsrom.Scenario.preset("single-tendon").set("tendons.0.turns", 0.5)
+    with pytest.warns(UserWarning, match=r"tendons\[0\] also loads torsion, bend_z, shear_y"):
+        gvsrom.dataset(s, tmp_path / "h", sweep="tendons.0.tension=-2:0", samples=2)

@@ -838,3 +838,26 @@ fn a_plan_none_of_whose_samples_solves_is_an_error() {
     );
     assert_eq!(json(&dir.join("meta.json"))["counts"]["ok"], 0);
 }
+
+#[test]
+fn a_dataset_of_a_tendon_the_basis_cannot_hold_warns() {
+    let dir = scratch("ds-helical-planar");
+    let out = gvsrom(&[
+        "dataset",
+        "single-tendon",
+        "--set",
+        "tendons.0.turns=0.5",
+        "--sweep",
+        "tendons.0.tension=-2:0",
+        "--samples",
+        "2",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("warning: tendons[0] also loads torsion, bend_z, shear_y"),
+        "{stderr}"
+    );
+}

@@ -54,6 +54,9 @@ pub(super) fn reproduce_cmd(args: &ReproduceArgs, out: &mut impl Write) -> Resul
 pub(super) fn dataset_cmd(args: &DatasetArgs, out: &mut impl Write) -> Result<()> {
     let signal = interrupt_flag();
     let outcome = gvsrom::dataset::run(&args.request(), &signal)?;
+    for w in &outcome.warnings {
+        gvsrom::progress::stderr_line(format_args!("warning: {w}"));
+    }
     summary(out, &outcome.path, &outcome.meta, outcome.resumed_chunks)?;
     match outcome.interruption_message() {
         None => Ok(()),

@@ -267,5 +267,6 @@ pub fn run(
         meta,
         interrupted: stopped,
         resumed_chunks: 0,
+        warnings: vec![],
     })
 }

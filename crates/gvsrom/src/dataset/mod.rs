@@ -234,6 +234,9 @@ pub struct Outcome {
     pub interrupted: Option<String>,
     /// Chunks taken over from the resumed dataset.
     pub resumed_chunks: usize,
+    /// What the scenario's model cannot do that the user may expect
+    /// ([`crate::build::uncovered_tendon_components`]), for the front-end to warn with.
+    pub warnings: Vec<String>,
 }
 
 impl Outcome {
@@ -378,9 +381,11 @@ pub fn run(args: &DatasetRequest, interrupt: &AtomicUsize) -> Result<Outcome, Da
     }
     crate::output::refuse_overlap("--out", &args.out, &inputs)?;
     let (table, built, scenario_toml, provenance) = load_scenario(args)?;
+    let warnings = crate::build::uncovered_tendon_components(&built.model);
     if args.duration.is_some() {
         let provenance = provenance.seed("input", args.seed);
-        return dynamic::run(args, &built, scenario_toml, interrupt, provenance, t0);
+        return dynamic::run(args, &built, scenario_toml, interrupt, provenance, t0)
+            .map(|o| Outcome { warnings, ..o });
     }
     let plan = Plan::new(
         &args.sweep,
@@ -544,6 +549,7 @@ pub fn run(args: &DatasetRequest, interrupt: &AtomicUsize) -> Result<Outcome, Da
         meta,
         interrupted,
         resumed_chunks,
+        warnings,
     })
 }
 
