@@ -139,6 +139,30 @@ impl<P: StrainParam> Model<P> {
         self
     }
 
+    /// The model with the reference strain `ξ*(X) = xi_star(X, division)` at every strain site
+    /// (points and Magnus sub-points; gvs-spec §3.3) instead of the straight, unstretched rod
+    /// `[0, 0, 0, 1, 0, 0]`: a pre-curved (`k*`), pre-twisted or pre-stretched rod, stress-free at
+    /// `q = 0`. The elastic force `Σ W Ψ_qᵀ Es (ξ − ξ*)` and every Jacobian are unchanged in `q`;
+    /// the kinematics integrate `ξ = Ψ(q) + ξ*`.
+    pub fn with_reference_strain(mut self, xi_star: impl Fn(f64, usize) -> V6) -> Self {
+        for (s, site) in self.disc.sites.iter().enumerate() {
+            self.xi_star[s] = xi_star(site.x, site.div);
+        }
+        self
+    }
+
+    /// The same model's reference strain at every site, carried to a model of another
+    /// parameterization built on the same discretization ([`Model::with_reference_strain`]).
+    pub fn with_reference_strain_of<Q: StrainParam>(mut self, other: &Model<Q>) -> Self {
+        assert_eq!(
+            self.xi_star.len(),
+            other.xi_star.len(),
+            "reference strain of a model on another discretization"
+        );
+        self.xi_star.copy_from_slice(&other.xi_star);
+        self
+    }
+
     pub fn n_dof(&self) -> usize {
         self.param.n_dof()
     }

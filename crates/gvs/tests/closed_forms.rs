@@ -785,3 +785,50 @@ fn helical_tendon_twists_and_bends_a_straight_rod_as_its_cut_wrench_says() {
     // the twist is a real share of the response, not round-off
     assert!(strains[strains.len() / 2][0].abs() > 0.1 * peak);
 }
+
+#[test]
+fn precurved_rod_is_stress_free_on_its_helix_and_an_end_moment_adds_m_over_ei() {
+    // reference strain ξ* = [τ*, κ*, 0, 1, 0, 0] (gvs-spec §3.3): unloaded, the rod rests on the
+    // helix exp(L ξ*̂) at q = 0 with no elastic force (constant strain, integrated exactly)
+    let (r, l, e, mom) = (0.01, 0.5, 1e6, 0.004);
+    let rod_with = |xi_star: V6| {
+        model(
+            Rod::tapered(mat(e, 0.0), l, r, r),
+            8,
+            legendre([Some(1), Some(2), Some(2), Some(1), Some(1), Some(1)]),
+            vec![],
+            &[],
+        )
+        .with_reference_strain(move |_, _| xi_star)
+    };
+    let helix = V6::new(0.8, 3.0, 0.0, 1.0, 0.0, 0.0);
+    let m = rod_with(helix);
+    let mut ws = m.workspace();
+    let q0 = DVector::zeros(m.n_dof());
+    assert_eq!(m.elastic_force(&q0, &mut ws).amax(), 0.0);
+    let (sol, ws) = solve(&m, &[], &no_loads());
+    assert!(sol.q.amax() < 1e-14, "q = {}", sol.q);
+    let (tip, exact) = (ws.g.last().unwrap(), exp_se3(&(helix * l)));
+    assert!((tip.pos - exact.pos).amax() < 1e-13 && (tip.rot - exact.rot).amax() < 1e-13);
+
+    // without twist the arc stays planar and a follower end moment M about y adds M/EI to its
+    // curvature everywhere: the tip is exp(L [0, κ* + M/EI, 0, 1, 0, 0]̂)
+    let m = rod_with(V6::new(0.0, 3.0, 0.0, 1.0, 0.0, 0.0));
+    let (_, ws) = solve(
+        &m,
+        &[],
+        &tip_load([0.0, mom, 0.0, 0.0, 0.0, 0.0], Frame::Local, l),
+    );
+    let ei = e * PI * r.powi(4) / 4.0;
+    let bent = V6::new(0.0, 3.0 + mom / ei, 0.0, 1.0, 0.0, 0.0);
+    let (tip, exact) = (ws.g.last().unwrap(), exp_se3(&(bent * l)));
+    assert!(
+        (tip.pos - exact.pos).norm() < 1e-10 && (tip.rot - exact.rot).amax() < 1e-10,
+        "tip {} vs {}",
+        tip.pos,
+        exact.pos
+    );
+    for xi in m.point_strains(&ws) {
+        assert!((xi - bent).amax() < 1e-10, "ξ = {xi}");
+    }
+}

@@ -335,3 +335,45 @@ fn a_tendon_loading_components_the_basis_lacks_is_named() {
     let all = r#"divisions.0.basis.modes=["torsion", "bend_y", "bend_z", "elongation", "shear_y", "shear_z"]"#;
     assert!(warnings(&["tendons.0.turns=0.5", "divisions.0.basis.order=4", all]).is_empty());
 }
+
+#[test]
+fn a_precurved_division_rests_on_its_arc_and_is_bounded() {
+    // reference_strain bends the unloaded rod into the arc of curvature κ*: tip (sin κL/κ, 0,
+    // −(1 − cos κL)/κ) for a curvature about y (gvs-spec §10.3.1's circle, here with no load)
+    let kappa: f64 = 4.0;
+    let r = run_text(
+        UNIFORM_ROD,
+        &[&format!(
+            "divisions.0.reference_strain=[0, {kappa}, 0, 1, 0, 0]"
+        )],
+    );
+    let l = 0.5;
+    let exact = [
+        (kappa * l).sin() / kappa,
+        0.0,
+        -(1.0 - (kappa * l).cos()) / kappa,
+    ];
+    for (a, b) in r.tip_position.iter().zip(exact) {
+        assert!(
+            (a - b).abs() < 1e-12,
+            "tip {:?} vs {exact:?}",
+            r.tip_position
+        );
+    }
+    assert!(r.q.iter().all(|v| v.abs() < 1e-14));
+    // out-of-range values name their entry
+    for (set, field) in [
+        ("[0, 0, 0, 0, 0, 0]", "reference_strain[3]"),
+        ("[0, 1000, 0, 1, 0, 0]", "reference_strain[1]"),
+        ("[0, 0, 0, 1, 2, 0]", "reference_strain[4]"),
+    ] {
+        let s = Scenario::from_toml(
+            "t",
+            UNIFORM_ROD,
+            &[format!("divisions.0.reference_strain={set}")],
+        )
+        .unwrap();
+        let e = gvsrom::build(&s).err().expect("refused").to_string();
+        assert!(e.contains(&format!("divisions[0].{field}")), "{set}: {e}");
+    }
+}

@@ -13,10 +13,12 @@ pub fn describe(s: &Scenario, built: &Built) -> String {
     let g = &m.rod.divisions;
     let tapered = g.iter().any(|d| d.radius_start != d.radius_end)
         || g.windows(2).any(|w| w[0].radius_end != w[1].radius_start);
+    let precurved = s.divisions.iter().any(|d| d.reference_strain.is_some());
     let mut parts = vec![format!(
-        "{} m {} rod{}",
+        "{} m {}{} rod{}",
         m.rod.length(),
         if tapered { "tapered" } else { "uniform" },
+        if precurved { ", pre-strained" } else { "" },
         match g.len() {
             1 => String::new(),
             n => format!(" in {n} divisions"),

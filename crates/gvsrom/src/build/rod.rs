@@ -166,3 +166,36 @@ pub(super) fn base_pose(s: &Scenario) -> Result<Pose, ScenarioError> {
     };
     Ok(Pose::new(rot, V3::from_row_slice(&b.position)))
 }
+
+/// The straight, unstretched reference strain `[0, 0, 0, 1, 0, 0]`.
+pub(super) const STRAIGHT: gvs::lie::V6 = gvs::lie::V6::new(0.0, 0.0, 0.0, 1.0, 0.0, 0.0);
+
+/// Division `j`'s reference strain ξ* (default [`STRAIGHT`]): finite; a stretch `ν₁` in
+/// (0, 10]; shears within ±1; curvatures that turn the division by at most
+/// [`crate::plausibility::MAX_BENDING`] rad over its length.
+pub(super) fn reference_strain(j: usize, d: &DivisionSpec) -> Result<gvs::lie::V6, ScenarioError> {
+    let Some(x) = d.reference_strain else {
+        return Ok(STRAIGHT);
+    };
+    let f = |i: usize| format!("divisions[{j}].reference_strain[{i}]");
+    let turn = crate::plausibility::MAX_BENDING / d.length;
+    for i in 0..3 {
+        in_range(
+            &f(i),
+            x[i],
+            (-turn, turn),
+            "1/m (a curvature; at most 200 rad over the division)",
+        )?;
+    }
+    if !(x[3].is_finite() && x[3] > 0.0 && x[3] <= 10.0) {
+        return Err(ScenarioError::value(
+            f(3),
+            x[3],
+            "a stretch in (0, 10] (1 = unstretched)",
+        ));
+    }
+    for i in 4..6 {
+        in_range(&f(i), x[i], (-1.0, 1.0), "(a shear strain)")?;
+    }
+    Ok(gvs::lie::V6::from_column_slice(&x))
+}

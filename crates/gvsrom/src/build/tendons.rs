@@ -5,7 +5,6 @@ use crate::error::ScenarioError;
 use crate::scenario::StrainMode;
 use crate::scenario::TendonSpec;
 use gvs::actuation::{tendon_local, Tendon, DEFAULT_FRICTION_SMOOTHING};
-use gvs::lie::V6;
 use gvs::model::Model;
 use gvs::rod::Rod;
 use gvs::strain::LinearBasis;
@@ -173,7 +172,7 @@ pub(super) fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, Scen
 }
 
 /// What a tendon would do that the strain basis cannot: for each tendon, the strain components its
-/// wrench `Φ_a = [d × t; t]` loads on the straight rod (gvs-spec §7.6) at a weighted point of a
+/// wrench `Φ_a = [d × t; t]` loads on the rod at rest (its reference strain; gvs-spec §7.6) at a weighted point of a
 /// division whose basis lacks them. The Galerkin projection `Σ W Φᵀ Φ_a u` drops that part of the
 /// load silently: a helical or off-plane tendon on a planar basis neither twists nor bends the rod
 /// out of plane. One sentence per such tendon, for the front-ends to warn with.
@@ -188,7 +187,6 @@ pub fn uncovered_tendon_components(model: &Model<LinearBasis>) -> Vec<String> {
             *flag |= phi.row(a).iter().any(|v| *v != 0.0);
         }
     }
-    let straight = V6::new(0.0, 0.0, 0.0, 1.0, 0.0, 0.0);
     let mut out = vec![];
     for (k, td) in model.tendons.iter().enumerate() {
         let mut missing = [false; 6];
@@ -199,7 +197,7 @@ pub fn uncovered_tendon_components(model: &Model<LinearBasis>) -> Vec<String> {
                 continue;
             }
             let (d, dp) = td.offset_and_rate(p.x);
-            let phi_a = tendon_local(&straight, &d, &dp).phi_a;
+            let phi_a = tendon_local(&model.xi_star(i), &d, &dp).phi_a;
             let scale = phi_a.amax();
             for a in 0..6 {
                 if !has[p.div][a] && phi_a[a].abs() > 1e-9 * scale {

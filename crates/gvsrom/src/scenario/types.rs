@@ -87,6 +87,11 @@ pub struct DivisionSpec {
     /// with 2 (linear) or 3 (quadratic) Gauss points each.
     #[serde(default)]
     pub quadrature: Option<QuadratureSpec>,
+    /// Reference strain ξ* `[torsion, bend_y, bend_z, elongation, shear_y, shear_z]` of the
+    /// division, constant along it: the stress-free shape (gvs-spec §3.3). Default: the straight,
+    /// unstretched rod `[0, 0, 0, 1, 0, 0]`; not written when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference_strain: Option<[f64; 6]>,
 }
 
 /// A strain component, in the engine's order `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]`.

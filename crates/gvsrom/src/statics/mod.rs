@@ -366,11 +366,15 @@ pub struct Comparison {
 /// Strain deviations `ξ − ξ*` of a report at its points, the active components of `built` only.
 pub fn active_deviations(built: &Built, report: &StaticsReport) -> Vec<f64> {
     let active = crate::layout::Layout::of(built).active;
-    let star = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0];
+    let m = &built.model;
     report
         .strain
         .iter()
-        .flat_map(|xi| active.iter().map(move |&a| xi[a] - star[a]))
+        .enumerate()
+        .flat_map(|(j, xi)| {
+            let star = m.xi_star(j);
+            active.iter().map(move |&a| xi[a] - star[a])
+        })
         .collect()
 }
 
