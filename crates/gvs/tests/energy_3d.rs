@@ -4,39 +4,21 @@
 //! and bent in both planes with an out-of-plane bending rate and a torsion rate, so the gyroscopic
 //! and torsion–bending couplings that planar motion never excites do work on each other.
 
-use gvs::discretize::{Discretization, MagnusOrder, Quadrature};
 use gvs::inputs::Signal;
 use gvs::loads::Loads;
 use gvs::model::Model;
-use gvs::rod::{Material, Rod};
 use gvs::solve::dynamics::{simulate, InitialState, IntegratorOptions, Method, OdeJacobian};
 use gvs::solve::ode::NdfOptions;
-use gvs::strain::{DivisionBasis, LinearBasis};
+use gvs::strain::LinearBasis;
 use nalgebra::DVector;
+mod common;
 
 const GRAVITY: [f64; 3] = [3.0, -4.0, -8.0];
 
 /// IV-A tapered rod without damping, all six modes (Legendre [1, 2, 2, 1, 1, 1]: torsion, two
 /// bending planes, stretch and two shears; 14 coordinates), 10 Gauss points, Z4.
 fn rod_3d() -> Model<LinearBasis> {
-    let mat = Material {
-        youngs_modulus: 0.617e6,
-        poisson_ratio: 0.5,
-        density: 1121.0,
-        damping: 0.0,
-    };
-    let rod = Rod::tapered(mat, 0.25, 0.0125, 0.005);
-    let disc =
-        Discretization::new(&rod, &[Quadrature::Gauss { n: 10 }], MagnusOrder::Z4, &[]).unwrap();
-    let b = LinearBasis::per_division(
-        &disc,
-        &[DivisionBasis::Legendre {
-            modes: [true; 6],
-            orders: [1, 2, 2, 1, 1, 1],
-        }],
-    )
-    .unwrap();
-    Model::new(rod, disc, b, vec![]).unwrap()
+    common::iva_rod_3d(0.0, 10, &[], vec![])
 }
 
 /// From a twisted, doubly bent state with a torsion rate and an out-of-plane (bend-z) rate, over

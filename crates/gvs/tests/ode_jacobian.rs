@@ -12,12 +12,10 @@
 //! equilibrium (`q̇ = 0`, `q̈ = 0`; `C q̇` is quadratic in `q̇`), where it is exact.
 
 use gvs::actuation::{Tendon, DEFAULT_FRICTION_SMOOTHING};
-use gvs::discretize::{Discretization, MagnusOrder, Quadrature};
 use gvs::loads::{Frame, Loads, PointWrench};
 use gvs::model::{Model, PreparedLoads};
-use gvs::rod::{Material, Rod};
 use gvs::solve::statics::{solve_statics, StaticsOptions};
-use gvs::strain::{DivisionBasis, LinearBasis};
+use gvs::strain::LinearBasis;
 use nalgebra::{DMatrix, DVector};
 mod common;
 
@@ -28,23 +26,6 @@ const U: [f64; 2] = [-1.5, -0.8];
 /// IV-A tapered rod with damping (η = 1e4 Pa·s), all six modes (Legendre [1, 2, 2, 1, 1, 1], 14
 /// coordinates), a planar tendon with friction and an off-plane one.
 fn model() -> Model<LinearBasis> {
-    let mat = Material {
-        youngs_modulus: 0.617e6,
-        poisson_ratio: 0.5,
-        density: 1121.0,
-        damping: 1e4,
-    };
-    let rod = Rod::tapered(mat, 0.25, 0.0125, 0.005);
-    let disc =
-        Discretization::new(&rod, &[Quadrature::Gauss { n: 10 }], MagnusOrder::Z4, &[]).unwrap();
-    let b = LinearBasis::per_division(
-        &disc,
-        &[DivisionBasis::Legendre {
-            modes: [true; 6],
-            orders: [1, 2, 2, 1, 1, 1],
-        }],
-    )
-    .unwrap();
     let tendons = vec![
         Tendon {
             offset_start: [0.0, 0.01],
@@ -65,7 +46,7 @@ fn model() -> Model<LinearBasis> {
             turns: 0.0,
         },
     ];
-    Model::new(rod, disc, b, tendons).unwrap()
+    common::iva_rod_3d(1e4, 10, &[], tendons)
 }
 
 /// Gravity oblique to the rod and a world-fixed tip force.

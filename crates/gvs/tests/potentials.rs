@@ -12,7 +12,7 @@ use gvs::lie::V3;
 use gvs::loads::Loads;
 use gvs::model::Model;
 use gvs::rod::{Material, Rod};
-use gvs::strain::{DivisionBasis, LinearBasis, SigmoidBend, StrainParam};
+use gvs::strain::{LinearBasis, SigmoidBend, StrainParam};
 use nalgebra::DVector;
 mod common;
 
@@ -52,18 +52,7 @@ fn model_3d(extra: &[f64]) -> Model<LinearBasis> {
 }
 
 fn model_3d_with(extra: &[f64], tendon: Tendon) -> Model<LinearBasis> {
-    let rod = Rod::tapered(material(), 0.25, 0.0125, 0.005);
-    let disc =
-        Discretization::new(&rod, &[Quadrature::Gauss { n: 12 }], MagnusOrder::Z4, extra).unwrap();
-    let b = LinearBasis::per_division(
-        &disc,
-        &[DivisionBasis::Legendre {
-            modes: [true; 6],
-            orders: [1, 2, 2, 1, 1, 1],
-        }],
-    )
-    .unwrap();
-    Model::new(rod, disc, b, vec![tendon]).unwrap()
+    common::iva_rod_3d(0.0, 12, extra, vec![tendon])
 }
 
 /// A 3-D state: every coordinate random in [−0.6, 0.6] (angles in rad, strains dimensionless),

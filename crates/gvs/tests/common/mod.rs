@@ -43,3 +43,38 @@ pub fn pseudo_random(n: usize, seed: u64, a: f64) -> DVector<f64> {
         ((s >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) * a
     })
 }
+
+/// The IV-A tapered rod in 3-D: L = 0.25 m, r 12.5 → 5 mm, E = 0.617 MPa, ν = ½, ρ = 1121 kg/m³,
+/// Kelvin–Voigt `damping` [Pa·s]; all six modes (Legendre orders [1, 2, 2, 1, 1, 1]: torsion, two
+/// bending planes, stretch and two shears; 14 coordinates), `gauss` points, Z4, the weight-0
+/// points `extra`, and `tendons`.
+pub fn iva_rod_3d(
+    damping: f64,
+    gauss: usize,
+    extra: &[f64],
+    tendons: Vec<gvs::actuation::Tendon>,
+) -> Model<LinearBasis> {
+    let mat = Material {
+        youngs_modulus: 0.617e6,
+        poisson_ratio: 0.5,
+        density: 1121.0,
+        damping,
+    };
+    let rod = Rod::tapered(mat, 0.25, 0.0125, 0.005);
+    let disc = Discretization::new(
+        &rod,
+        &[Quadrature::Gauss { n: gauss }],
+        MagnusOrder::Z4,
+        extra,
+    )
+    .unwrap();
+    let b = LinearBasis::per_division(
+        &disc,
+        &[DivisionBasis::Legendre {
+            modes: [true; 6],
+            orders: [1, 2, 2, 1, 1, 1],
+        }],
+    )
+    .unwrap();
+    Model::new(rod, disc, b, tendons).unwrap()
+}
