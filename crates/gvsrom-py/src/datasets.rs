@@ -298,8 +298,9 @@ fn dynamic_only(duration: Option<f64>, given: &[(&str, bool)]) -> PyResult<()> {
 ///     an even 1-D sweep, a product grid, or uniform random values (seeded by ``seed``).
 /// samples : int, optional
 ///     Number of samples (``--samples``).
-/// seed : int
-///     Seed of ``random`` (and of a dynamic dataset's ``steps``/``babble``).
+/// seed : int, optional
+///     Seed of ``random`` (and of a dynamic dataset's ``steps``/``babble``); default 0. Refused
+///     with a plan that draws nothing (``sweep``, ``grid``, ``input``).
 /// set : list of str, optional
 ///     ``"PATH=VALUE"`` overrides (``--set``).
 /// chunk_size : int
@@ -333,7 +334,7 @@ fn dynamic_only(duration: Option<f64>, given: &[(&str, bool)]) -> PyResult<()> {
 /// GvsromError
 ///     For a bad plan or option (the message of ``gvsrom dataset``).
 #[pyfunction]
-#[pyo3(signature = (scenario, out, sweep=None, grid=None, random=None, samples=None, seed=0, set=None, chunk_size=128, threads=None, force=false, resume=false, duration=None, sample_rate=None, input=None, interpolate=false, steps=None, babble=None, from_equilibrium=false, rtol=None, atol=None))]
+#[pyo3(signature = (scenario, out, sweep=None, grid=None, random=None, samples=None, seed=None, set=None, chunk_size=128, threads=None, force=false, resume=false, duration=None, sample_rate=None, input=None, interpolate=false, steps=None, babble=None, from_equilibrium=false, rtol=None, atol=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn dataset(
     py: Python<'_>,
@@ -343,7 +344,7 @@ pub fn dataset(
     grid: Option<&Bound<'_, PyAny>>,
     random: Option<&Bound<'_, PyAny>>,
     #[pyo3(from_py_with = crate::arrays::whole_or_none)] samples: Option<i128>,
-    #[pyo3(from_py_with = crate::arrays::whole)] seed: i128,
+    #[pyo3(from_py_with = crate::arrays::whole_or_none)] seed: Option<i128>,
     set: Option<Vec<String>>,
     #[pyo3(from_py_with = crate::arrays::whole)] chunk_size: i128,
     #[pyo3(from_py_with = crate::arrays::whole_or_none)] threads: Option<i128>,
@@ -361,7 +362,7 @@ pub fn dataset(
 ) -> PyResult<Dataset> {
     use crate::arrays::{size, unsigned};
     let samples = samples.map(|v| size("samples", v)).transpose()?;
-    let seed = unsigned("seed", seed)?;
+    let seed = seed.map(|v| unsigned("seed", v)).transpose()?;
     let chunk_size = size("chunk_size", chunk_size)?;
     let threads = threads.map(|v| size("threads", v)).transpose()?;
     let (scenario, mut overrides) = scenario_arg(scenario)?;

@@ -37,7 +37,7 @@ def test_a_python_dataset_is_bit_identical_to_the_cli_dataset(gvsrom_bin, tmp_pa
     ds = gvsrom.dataset(
         "single-tendon", tmp_path / "py",
         sweep=opts.get("--sweep"), random=opts.get("--random"), samples=int(opts["--samples"]),
-        seed=int(opts.get("--seed", 0)), set=[opts["--set"]] if "--set" in opts else None,
+        seed=int(opts["--seed"]) if "--seed" in opts else None, set=[opts["--set"]] if "--set" in opts else None,
     )
     for name in FILES:
         assert (ds.path / f"{name}.npy").read_bytes() == (cli / f"{name}.npy").read_bytes(), name
@@ -216,3 +216,13 @@ def test_a_dataset_of_a_tendon_the_basis_cannot_hold_warns(tmp_path):
     s = gvsrom.Scenario.preset("single-tendon").set("tendons.0.turns", 0.5)
     with pytest.warns(UserWarning, match=r"tendons\[0\] also loads torsion, bend_z, shear_y"):
         gvsrom.dataset(s, tmp_path / "h", sweep="tendons.0.tension=-2:0", samples=2)
+
+
+def test_a_seed_with_a_plan_that_draws_nothing_is_refused(tmp_path):
+    with pytest.raises(gvsrom.GvsromError, match=r"seed 3: this plan draws nothing \(a sweep, grid or input\); seed applies to random"):
+        gvsrom.dataset("single-tendon", tmp_path / "s", sweep="tendons.0.tension=-2:0", samples=2, seed=3)
+    assert not (tmp_path / "s").exists()
+    # a random plan takes it, and the default is 0
+    a = gvsrom.dataset("single-tendon", tmp_path / "a", random="tendons.0.tension=-2:0", samples=2)
+    b = gvsrom.dataset("single-tendon", tmp_path / "b", random="tendons.0.tension=-2:0", samples=2, seed=0)
+    np.testing.assert_array_equal(a.inputs, b.inputs)

@@ -101,7 +101,7 @@ fn model_dir() -> PathBuf {
         grid: vec![],
         random: vec![],
         samples: Some(200),
-        seed: 0,
+        seed: None,
         chunk_size: gvsrom::dataset::DEFAULT_CHUNK_SIZE,
         threads: None,
         out: dataset.clone(),

@@ -244,7 +244,7 @@ def dataset(
     grid: _Specs | None = None,
     random: _Specs | None = None,
     samples: int | None = None,
-    seed: int = 0,
+    seed: int | None = None,
     set: Sequence[str] | None = None,
     chunk_size: int = 128,
     threads: int | None = None,

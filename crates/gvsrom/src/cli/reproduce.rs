@@ -100,9 +100,9 @@ pub struct DatasetArgs {
     #[arg(long, value_name = "N")]
     pub samples: Option<usize>,
 
-    /// Seed of `--random`, `--steps` and `--babble` (same seed, same dataset).
-    #[arg(long, default_value_t = 0, requires = "seeded")]
-    pub seed: u64,
+    /// Seed of `--random`, `--steps` and `--babble` (same seed, same dataset) [default: 0].
+    #[arg(long, requires = "seeded")]
+    pub seed: Option<u64>,
 
     /// Samples per chunk: the unit of parallel work, of warm-start chains and of resuming. Part of
     /// the plan (a different chunk size gives slightly different last digits).

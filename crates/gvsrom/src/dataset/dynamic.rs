@@ -76,7 +76,7 @@ pub fn run(
         args.interpolate,
         args.steps.as_deref(),
         args.babble.as_deref(),
-        args.seed,
+        args.seed.unwrap_or(0),
     )?;
     let input_text = match (&args.input, &args.steps, &args.babble) {
         (Some(p), _, _) => format!("csv {}", p.display()),
@@ -220,7 +220,7 @@ pub fn run(
             rhs_evaluations: summary_run.stats.rhs_evals,
             jacobian_evaluations: summary_run.stats.jacobian_evals,
         }),
-        seed: args.seed,
+        seed: args.seed.unwrap_or(0),
         parameters: (0..na).map(|k| format!("tendons.{k}.tension")).collect(),
         samples: n,
         n_dof: layout.n_dof,

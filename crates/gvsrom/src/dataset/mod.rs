@@ -108,8 +108,9 @@ pub struct DatasetRequest {
     /// Number of samples.
     pub samples: Option<usize>,
 
-    /// Seed of `--random` (same seed, same dataset).
-    pub seed: u64,
+    /// Seed of `--random`, `--steps` and `--babble` (same seed, same dataset); `None`: 0. Given
+    /// with a plan that draws nothing (`--sweep`, `--grid`, `--input`) it is refused.
+    pub seed: Option<u64>,
 
     /// Samples per chunk: the unit of parallel work, of warm-start chains and of resuming. Part of
     /// the plan (a different chunk size gives slightly different last digits).
@@ -380,10 +381,17 @@ pub fn run(args: &DatasetRequest, interrupt: &AtomicUsize) -> Result<Outcome, Da
         inputs.push(("--input", p.as_path()));
     }
     crate::output::refuse_overlap("--out", &args.out, &inputs)?;
+    let draws = !args.random.is_empty() || args.steps.is_some() || args.babble.is_some();
+    if let (Some(s), false) = (args.seed, draws) {
+        return Err(plan_err(format!(
+            "--seed {s}: this plan draws nothing (a --sweep, --grid or --input); --seed applies to --random, --steps and --babble"
+        )));
+    }
+    let seed = args.seed.unwrap_or(0);
     let (table, built, scenario_toml, provenance) = load_scenario(args)?;
     let warnings = crate::build::uncovered_tendon_components(&built.model);
     if args.duration.is_some() {
-        let provenance = provenance.seed("input", args.seed);
+        let provenance = provenance.seed("input", seed);
         return dynamic::run(args, &built, scenario_toml, interrupt, provenance, t0)
             .map(|o| Outcome { warnings, ..o });
     }
@@ -392,7 +400,7 @@ pub fn run(args: &DatasetRequest, interrupt: &AtomicUsize) -> Result<Outcome, Da
         &args.grid,
         &args.random,
         args.samples,
-        args.seed,
+        seed,
         &table,
     )
     .map_err(plan_err)?;
@@ -454,7 +462,7 @@ pub fn run(args: &DatasetRequest, interrupt: &AtomicUsize) -> Result<Outcome, Da
         plan: Some(plan.clone()),
         dynamic: None,
         noise: None,
-        provenance: Some(provenance.seed("plan", args.seed)),
+        provenance: Some(provenance.seed("plan", seed)),
     };
     // the output is checked, locked and staged before the computation
     let mut dir = OutputDir::create("--out", &args.out, "dataset", args.force || args.resume)?;

@@ -100,7 +100,8 @@ pub fn dataset(
                 grid: plan.grid.clone(),
                 random: plan.random.clone(),
                 samples: plan.samples,
-                seed: plan.seed,
+                // a sweep or grid draws nothing, and a seed with it is refused
+                seed: (!plan.random.is_empty() || plan.babble.is_some()).then_some(plan.seed),
                 chunk_size: crate::dataset::DEFAULT_CHUNK_SIZE,
                 threads: Some(jobs),
                 out: path.to_path_buf(),
