@@ -94,7 +94,7 @@ fn numpy_module(py: Python<'_>) -> PyResult<&Bound<'_, PyModule>> {
         .map(|m| m.bind(py))
 }
 
-/// "a scalar", "an array of shape (3, 1)".
+/// "a single number (a 0-D array)", "an array of shape (3, 1)".
 fn shape_words(shape: &[usize]) -> String {
     match shape {
         [] => "a single number (a 0-D array)".into(),

@@ -13,7 +13,8 @@ pub fn describe(s: &Scenario, built: &Built) -> String {
     let g = &m.rod.divisions;
     let tapered = g.iter().any(|d| d.radius_start != d.radius_end)
         || g.windows(2).any(|w| w[0].radius_end != w[1].radius_start);
-    let precurved = s.divisions.iter().any(|d| d.reference_strain.is_some());
+    // from the model, so that a reference strain given as the straight rod is not called one
+    let precurved = (0..m.disc.n_sites()).any(|site| m.xi_star(site) != super::rod::STRAIGHT);
     let mut parts = vec![format!(
         "{} m {}{} rod{}",
         m.rod.length(),

@@ -21,7 +21,7 @@ pub use resolve::{resolve, Request, Resolved};
 pub use tendons::uncovered_tendon_components;
 
 use basis::{basis, quadrature};
-use rod::{base_pose, geometry, material, radius_range, reference_strain, STRAIGHT};
+use rod::{base_pose, geometry, material, radius_range, reference_strain};
 use tendons::tendon;
 
 use crate::error::ScenarioError;
@@ -159,11 +159,9 @@ pub fn build(s: &Scenario) -> Result<Built, ScenarioError> {
         .enumerate()
         .map(|(j, d)| reference_strain(j, d))
         .collect::<Result<Vec<_>, _>>()?;
-    let model = Model::new(rod, disc, basis, tendons)?.with_base(base);
-    let model = match reference.iter().all(|x| *x == STRAIGHT) {
-        true => model,
-        false => model.with_reference_strain(|_, div| reference[div]),
-    };
+    let model = Model::new(rod, disc, basis, tendons)?
+        .with_base(base)
+        .with_reference_strain(|_, div| reference[div]);
     let built = Built {
         name: s.name.clone().unwrap_or_else(|| "scenario".to_string()),
         model,
