@@ -352,6 +352,20 @@ impl Robot {
         arrays::shaped(py, arrays::flat(&rows), [rows.len(), 6])
     }
 
+    /// The reference strain ξ* at each point, shape ``(n_points, 6)`` in the order ``[torsion,
+    /// bend-y, bend-z, elongation, shear-y, shear-z]`` (1/m, then dimensionless): the unloaded
+    /// rod's strain, ``[0, 0, 0, 1, 0, 0]`` unless the scenario pre-strains a division
+    /// (``divisions.N.reference_strain``). ``q = 0`` is this rod; strain deviations and a
+    /// dataset's ``strain`` are ``ξ − ξ*``.
+    #[getter]
+    fn strain_reference<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let m = &self.built.model;
+        let rows: Vec<[f64; 6]> = (0..m.disc.n_points())
+            .map(|i| std::array::from_fn(|a| m.xi_star(i)[a]))
+            .collect();
+        arrays::shaped(py, arrays::flat(&rows), [rows.len(), 6])
+    }
+
     /// This scenario with a reduced model in place of its strain basis (``--model DIR``).
     ///
     /// Parameters

@@ -1,5 +1,6 @@
 """Scenario: presets, TOML text and files, `set` with the paths and errors of `--set`."""
 
+import numpy as np
 import pytest
 
 import gvsrom
@@ -138,3 +139,19 @@ def test_a_tendon_the_basis_cannot_hold_is_warned_about_at_build():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         gvsrom.Scenario.preset("single-tendon").build()
+
+
+def test_a_precurved_rod_records_its_reference_strain_and_rests_on_it():
+    straight = gvsrom.Scenario.preset("single-tendon").build()
+    assert np.array_equal(straight.strain_reference,
+                          np.tile([0.0, 0.0, 0.0, 1.0, 0.0, 0.0], (straight.n_points, 1)))
+    robot = (gvsrom.Scenario.preset("single-tendon")
+             .set("divisions.0.reference_strain", [0, 3, 0, 1, 0, 0])
+             .set("loads.gravity", [0, 0, 0]).set("tendons.0.tension", 0).build())
+    star = robot.strain_reference
+    assert star.shape == (robot.n_points, 6)
+    assert np.array_equal(star, np.tile([0.0, 3.0, 0.0, 1.0, 0.0, 0.0], (robot.n_points, 1)))
+    # unloaded, the rod rests at q = 0 on its arc: its strain is ξ* (a deviation of zero)
+    eq = robot.statics()
+    assert np.abs(eq.q).max() < 1e-12
+    assert np.abs(eq.strain - star).max() < 1e-12

@@ -227,6 +227,57 @@ fn trajectory_without_centerlines_draws_the_tip_and_says_why_not_the_rod() {
 }
 
 #[test]
+fn a_precurved_rod_at_rest_is_drawn_against_its_reference_strain() {
+    // the single-tendon arm pre-curved by 3 1/m in bend-y, no gravity, no tension: it rests on its
+    // arc, and its strain deviations ξ − ξ* are zero (measured from the straight rod they would be
+    // 3 1/m everywhere); the outputs record ξ*
+    let set = [
+        "--set",
+        "divisions.0.reference_strain=[0, 3, 0, 1, 0, 0]",
+        "--set",
+        "loads.gravity=[0, 0, 0]",
+        "--tension=0",
+    ];
+    let traj = scratch("plot-precurved-traj");
+    let args = [
+        &["simulate", "single-tendon", "--duration", "0.05"][..],
+        &set,
+        &["--out", s(&traj)],
+    ]
+    .concat();
+    run_ok(&args);
+    let (shape, xi_star) = common::npy(&traj.join("strain_reference.npy"));
+    assert_eq!(shape[1], 6);
+    for row in xi_star.chunks(6) {
+        assert_eq!(row, [0.0, 3.0, 0.0, 1.0, 0.0, 0.0]);
+    }
+    let (_, stdout) = plot(&traj, "plot-out-precurved-traj", &[]);
+    assert!(
+        stdout.contains("strain_time: the rod stays at its reference strain"),
+        "{stdout}"
+    );
+    let statics = scratch("plot-precurved.json");
+    let args = [
+        &["statics", "single-tendon"][..],
+        &set,
+        &["--json", s(&statics)],
+    ]
+    .concat();
+    run_ok(&args);
+    let doc = json(&statics);
+    let rows = doc["strain_reference"]
+        .as_array()
+        .expect("strain_reference");
+    assert_eq!(rows.len(), doc["strain"].as_array().unwrap().len());
+    assert!(rows
+        .iter()
+        .all(|r| *r == serde_json::json!([0.0, 3.0, 0.0, 1.0, 0.0, 0.0])));
+    // compare finds no difference of reference strains between a run and itself
+    let stdout = run_ok(&["compare", s(&traj), s(&traj)]);
+    assert!(!stdout.contains("reference strains"), "{stdout}");
+}
+
+#[test]
 fn dataset_gives_input_coverage_strain_envelope_and_tip_workspace() {
     let (dir, stdout) = plot(dataset(), "plot-out-ds", &[]);
     let expected = both(&["input_coverage", "strain_envelope", "tip_workspace"]);

@@ -361,6 +361,12 @@ fn a_precurved_division_rests_on_its_arc_and_is_bounded() {
         );
     }
     assert!(r.q.iter().all(|v| v.abs() < 1e-14));
+    // the report records ξ* at every point, and the strain equals it
+    assert_eq!(r.strain_reference.len(), r.strain.len());
+    for (xi, star) in r.strain.iter().zip(&r.strain_reference) {
+        assert_eq!(*star, [0.0, kappa, 0.0, 1.0, 0.0, 0.0]);
+        assert!(xi.iter().zip(star).all(|(a, b)| (a - b).abs() < 1e-12));
+    }
     // out-of-range values name their entry
     for (set, field) in [
         ("[0, 0, 0, 0, 0, 0]", "reference_strain[3]"),

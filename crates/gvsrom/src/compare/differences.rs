@@ -51,6 +51,23 @@ pub fn differences(reference: &Trajectory, run: &Trajectory) -> Differences {
             reference.scenario, run.scenario
         ));
     }
+    // the unloaded rods (a trajectory that does not record ξ* was of a straight one)
+    if reference.strain_reference.len() == run.strain_reference.len() {
+        let worst = (reference.strain_reference.iter())
+            .zip(&run.strain_reference)
+            .enumerate()
+            .map(|(i, (a, b))| (i, (a - b).abs()))
+            .max_by(|a, b| a.1.total_cmp(&b.1));
+        if let Some((i, e)) = worst.filter(|w| w.1 > 1e-12) {
+            let (j, c) = (i / 6, i % 6);
+            d.differ.push(format!(
+                "the rods have different reference strains ξ*: component {c} at point {j} (X = {} m) is {} in REFERENCE, {} in RUN (largest of the differences, {e:.3e})",
+                reference.strain_x.get(j).copied().unwrap_or(f64::NAN),
+                reference.strain_reference[i],
+                run.strain_reference[i]
+            ));
+        }
+    }
     let mut aspect = |what: &str,
                       differ: &str,
                       a: &Option<Value>,

@@ -29,13 +29,10 @@ mod differences;
 mod trajectory;
 
 pub use differences::{differences, Differences};
-pub use trajectory::Trajectory;
+pub use trajectory::{Trajectory, STRAIGHT_STRAIN};
 
 use crate::error::ScenarioError;
 use std::path::Path;
-
-/// The straight, unstretched rod's strain.
-const XI_STAR: [f64; 6] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0];
 
 /// Simulated time per wall time of `run` over that of `reference` (> 1: `run` is faster), or
 /// `None` when it cannot be told: a wall time that is zero, negative or not recorded, or a
@@ -208,8 +205,10 @@ pub fn compare(reference: &Trajectory, run: &Trajectory) -> Result<Comparison, S
         ));
     }
     let points = reference.strain_x.len();
+    // both measured from the reference's ξ*, so that `a − b` is the difference of the strains
+    // themselves even where the two runs' reference strains differ (`differences` names that)
     let deviation = |tr: &Trajectory, k: usize, j: usize, c: usize| {
-        tr.strain[(k * points + j) * 6 + c] - XI_STAR[c]
+        tr.strain[(k * points + j) * 6 + c] - reference.strain_reference[j * 6 + c]
     };
     let active: Vec<usize> = (0..6)
         .filter(|&c| {
@@ -282,6 +281,7 @@ mod tests {
             tip: tip_x.iter().flat_map(|&x| [x, 0.0, 0.0]).collect(),
             strain,
             strain_x: vec![0.0, 0.5],
+            strain_reference: STRAIGHT_STRAIN.repeat(2),
             t_requested: Some(0.2),
             sample_rate: Some(10.0),
             input: Some(
@@ -315,6 +315,47 @@ mod tests {
         // a run compared with itself
         let same = compare(&reference, &reference).unwrap();
         assert_eq!((same.tip_max, same.strain_max), (0.0, Some(0.0)));
+    }
+
+    /// `tr` as a rod pre-curved by `kappa` 1/m in bend-y: its reference strain and every strain
+    /// shifted by it, so that its deviations `ξ − ξ*` are `tr`'s.
+    fn precurved(mut tr: Trajectory, kappa: f64) -> Trajectory {
+        for i in (1..tr.strain.len()).step_by(6) {
+            tr.strain[i] += kappa;
+        }
+        for i in (1..tr.strain_reference.len()).step_by(6) {
+            tr.strain_reference[i] += kappa;
+        }
+        tr
+    }
+
+    #[test]
+    fn a_precurved_rods_errors_are_measured_from_its_reference_strain() {
+        // the by-hand case above on a rod pre-curved by 20 1/m: the same errors, not errors
+        // relative to the 20 1/m of the pre-curvature (0.5 / 24 = 2.1 % at t = 0.1)
+        let reference = precurved(
+            trajectory([0.5, 0.4, 0.3], [[0.0, 0.0], [2.0, 4.0], [1.0, 1.0]]),
+            20.0,
+        );
+        let run = precurved(
+            trajectory([0.5, 0.41, 0.3], [[0.0, 0.0], [2.0, 3.0], [1.0, 1.5]]),
+            20.0,
+        );
+        let c = compare(&reference, &run).unwrap();
+        assert_eq!(c.active, vec![1]);
+        assert!((c.strain_mean.unwrap() - 18.75).abs() < 1e-12, "{c:?}");
+        assert!((c.strain_max.unwrap() - 25.0).abs() < 1e-12, "{c:?}");
+        assert!(differences(&reference, &run).none());
+        // a run of a rod pre-curved otherwise is named, with both values
+        let other = precurved(trajectory([0.5; 3], [[0.0; 2]; 3]), 10.0);
+        let reference = precurved(trajectory([0.5; 3], [[0.0; 2]; 3]), 20.0);
+        let d = differences(&reference, &other);
+        assert!(
+            d.differ.len() == 1
+                && d.differ[0].contains("reference strains ξ*")
+                && d.differ[0].contains("20 in REFERENCE, 10 in RUN"),
+            "{d:?}"
+        );
     }
 
     #[test]

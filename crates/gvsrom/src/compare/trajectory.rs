@@ -4,6 +4,11 @@ use crate::error::ScenarioError;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
+/// The reference strain `ξ* = [0, 0, 0, 1, 0, 0]` of the straight, unstretched rod: what a result
+/// written before gvsrom recorded `strain_reference` was measured from (pre-strained rods came
+/// later).
+pub const STRAIGHT_STRAIN: [f64; 6] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0];
+
 /// A trajectory directory written by `gvsrom simulate --out`.
 #[derive(Debug, Clone)]
 pub struct Trajectory {
@@ -22,6 +27,10 @@ pub struct Trajectory {
     /// `samples × points × 6`: `ξ` at the computational points.
     pub strain: Vec<f64>,
     pub strain_x: Vec<f64>,
+    /// `points × 6`: the reference strain `ξ*` at the computational points
+    /// (`strain_reference.npy`; [`STRAIGHT_STRAIN`] at every point for a trajectory that does not
+    /// record it).
+    pub strain_reference: Vec<f64>,
     /// The requested end time (`t_requested`), if recorded.
     pub t_requested: Option<f64>,
     /// Output samples per second (`sample_rate`), if recorded.
@@ -91,6 +100,11 @@ impl Trajectory {
             }
         };
         let strain_x = read("strain_x.npy", &[points])?;
+        let strain_reference = if files.lists("strain_reference.npy") {
+            read("strain_reference.npy", &[points, 6])?
+        } else {
+            STRAIGHT_STRAIN.repeat(points)
+        };
         let length = match meta["length"].as_f64() {
             Some(l) => l,
             None => *strain_x.last().unwrap_or(&0.0),
@@ -131,6 +145,7 @@ impl Trajectory {
             tip: read("tip_position.npy", &[n, 3])?,
             strain: read("strain.npy", &[n, points, 6])?,
             strain_x,
+            strain_reference,
             t_requested: meta["t_requested"].as_f64(),
             sample_rate: meta["sample_rate"].as_f64(),
             input: meta.get("input").filter(|v| v.is_object()).cloned(),
@@ -146,5 +161,11 @@ impl Trajectory {
 
     pub fn samples(&self) -> usize {
         self.t.len()
+    }
+
+    /// The strain deviation `ξ − ξ*` of component `c` at point `j` in sample `k`.
+    pub fn deviation(&self, k: usize, j: usize, c: usize) -> f64 {
+        let p = self.strain_x.len();
+        self.strain[(k * p + j) * 6 + c] - self.strain_reference[j * 6 + c]
     }
 }

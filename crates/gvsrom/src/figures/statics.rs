@@ -2,7 +2,7 @@
 //! x–z and x–y (`rod_side`), and the strain along the rod (`strain`: curvatures in 1/m, stretch and
 //! shears dimensionless).
 
-use super::views::{self, AXES, XI_STAR};
+use super::views::{self, AXES};
 use super::{input_error, FiguresError, Sink};
 use crate::plot::{palette, Figure, Line3, Series3, SeriesStyle};
 use serde::Deserialize;
@@ -20,6 +20,10 @@ pub struct StaticsDoc {
     pub strain_x: Vec<f64>,
     /// ξ at the points, `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]`.
     pub strain: Vec<[f64; 6]>,
+    /// ξ* at the points (a result written before it was recorded: the straight rod,
+    /// [`crate::compare::STRAIGHT_STRAIN`]).
+    #[serde(default)]
+    pub strain_reference: Option<Vec<[f64; 6]>>,
     #[serde(default)]
     pub model: Option<String>,
     /// The file by the SHA-256 of the bytes read (what `plot` records of it).
@@ -50,6 +54,11 @@ impl StaticsDoc {
         }
         if doc.strain.len() != doc.strain_x.len() {
             return Err(mismatch("strain", doc.strain_x.len(), doc.strain.len()));
+        }
+        if let Some(r) = &doc.strain_reference {
+            if r.len() != doc.strain_x.len() {
+                return Err(mismatch("strain_reference", doc.strain_x.len(), r.len()));
+            }
         }
         if doc.centerline.len() < 2 {
             return Err(input_error(
@@ -111,7 +120,11 @@ pub(crate) fn figures(path: &Path, sink: &mut Sink) -> Result<(), FiguresError> 
         sink.note("strain: the result holds no computational points");
         return Ok(());
     }
-    let panels = views::strain_panels(&doc.strain_x, |c, j| doc.strain[j][c] - XI_STAR[c]);
+    let reference = |j: usize| match &doc.strain_reference {
+        Some(r) => r[j],
+        None => crate::compare::STRAIGHT_STRAIN,
+    };
+    let panels = views::strain_panels(&doc.strain_x, |c, j| doc.strain[j][c] - reference(j)[c]);
     let strain = Figure::Grid {
         title: format!("Strain along the rod — {caption}"),
         cols: 1,

@@ -4,7 +4,7 @@
 //! (`centerline.npy`, shape `[samples, N, 3]`, with `centerline_x` in `meta.json`), the rod at a
 //! few instants (`rod_3d`, `rod_side`) and an animation of it (`rod_animation.gif`).
 
-use super::views::{self, AXES, XI_STAR};
+use super::views::{self, AXES};
 use super::{input_error, FiguresError, Sink};
 use crate::compare::Trajectory;
 use crate::plot::{palette, Figure, Line3, LineChart, Series, Series3, SeriesStyle};
@@ -141,7 +141,7 @@ fn strain_time(tr: &Trajectory, caption: &str, sink: &mut Sink) -> Result<(), Fi
         sink.note("strain_time: the trajectory has no computational points");
         return Ok(());
     }
-    let dev = |k: usize, j: usize, c: usize| tr.strain[(k * p + j) * 6 + c] - XI_STAR[c];
+    let dev = |k: usize, j: usize, c: usize| tr.deviation(k, j, c);
     let active: Vec<usize> = (0..6)
         .filter(|&c| {
             views::nonzero(
@@ -152,7 +152,7 @@ fn strain_time(tr: &Trajectory, caption: &str, sink: &mut Sink) -> Result<(), Fi
         })
         .collect();
     if active.is_empty() {
-        sink.note("strain_time: the rod stays straight (every strain deviation is zero)");
+        sink.note("strain_time: the rod stays at its reference strain (every strain deviation ξ − ξ* is zero)");
         return Ok(());
     }
     let points = views::spread(p, STRAIN_POINTS);

@@ -42,9 +42,6 @@ pub(crate) fn component_index(name: &str) -> Option<usize> {
     NAMES.iter().position(|n| *n == name)
 }
 
-/// `ξ* = [0, 0, 0, 1, 0, 0]`, the straight unstretched rod.
-pub(crate) const XI_STAR: [f64; 6] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0];
-
 /// Whether any of `values` differs from zero by more than round-off of their scale.
 pub(crate) fn nonzero(values: impl IntoIterator<Item = f64>) -> bool {
     values.into_iter().any(|v| v.is_finite() && v.abs() > 1e-12)

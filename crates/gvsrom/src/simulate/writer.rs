@@ -264,6 +264,15 @@ impl TrajectoryWriter {
                     .iter()
                     .map(|p| p.x)
                     .collect::<Vec<_>>(),
+            )?;
+            let m = &built.model;
+            crate::npy::write_array(
+                &mut dir,
+                "strain_reference.npy",
+                &[m.disc.n_points(), 6],
+                &(0..m.disc.n_points())
+                    .flat_map(|j| m.xi_star(j).iter().copied().collect::<Vec<_>>())
+                    .collect::<Vec<_>>(),
             )
         })()
         .map_err(|e| dir.io_error("write the trajectory arrays", e))?;

@@ -41,6 +41,9 @@ pub struct StaticsReport {
     pub strain_x: Vec<f64>,
     /// ξ at the computational points, `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]`.
     pub strain: Vec<[f64; 6]>,
+    /// The reference strain ξ* at the computational points (the unloaded rod's: `[0, 0, 0, 1, 0, 0]`
+    /// for a straight one), what strain deviations and errors are measured from.
+    pub strain_reference: Vec<[f64; 6]>,
     /// Dogleg iterations over all load stages.
     pub iterations: usize,
     pub load_stages: usize,
@@ -316,6 +319,12 @@ fn report<P: StrainParam>(
         centerline,
         strain_x: model.disc.points.iter().map(|p| p.x).collect(),
         strain,
+        strain_reference: (0..model.disc.n_points())
+            .map(|j| {
+                let s = model.xi_star(j);
+                [s[0], s[1], s[2], s[3], s[4], s[5]]
+            })
+            .collect(),
         iterations: sol.iterations,
         load_stages: sol.load_stages,
         residual_evaluations: sol.residual_evaluations,
