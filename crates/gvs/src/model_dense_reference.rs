@@ -295,6 +295,7 @@ mod tests {
                 friction: 0.88,
                 friction_smoothing: crate::actuation::DEFAULT_FRICTION_SMOOTHING,
                 turns: 0.0,
+                path: Vec::new(),
             },
             Tendon {
                 offset_start: [0.006, -0.002],
@@ -304,6 +305,7 @@ mod tests {
                 friction: 0.3,
                 friction_smoothing: crate::actuation::DEFAULT_FRICTION_SMOOTHING,
                 turns: 0.0,
+                path: Vec::new(),
             },
         ]
     }

@@ -240,6 +240,7 @@ fn constant_offset_tendon_gives_uniform_curvature_and_contraction() {
         friction: 0.0,
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns: 0.0,
+        path: Vec::new(),
     };
     let m = model(
         Rod::tapered(mat(e, 0.0), l, r, r),
@@ -270,6 +271,7 @@ fn constant_offset_tendon_with_friction_follows_capstan_curvature() {
         friction: mu,
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns: 0.0,
+        path: Vec::new(),
     };
     let m = model(
         Rod::tapered(mat(e, 0.0), l, r, r),
@@ -548,12 +550,13 @@ fn rotating_base_and_gravity_together_leaves_equilibrium_unchanged() {
         friction: 0.88,
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns: 0.0,
+        path: Vec::new(),
     };
     let m = model(
         rod.clone(),
         20,
         legendre([Some(2), Some(4), Some(4), Some(2), Some(2), Some(2)]),
-        vec![tendon],
+        vec![tendon.clone()],
         &[0.25],
     );
     let rot = nalgebra::Rotation3::from_euler_angles(0.4, -0.9, 1.3);
@@ -610,6 +613,7 @@ fn planar_loading_keeps_out_of_plane_coordinates_exactly_zero() {
         friction: 0.88,
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns: 0.0,
+        path: Vec::new(),
     };
     let m = model(rod, 30, legendre([Some(3); 6]), vec![tendon], &[]);
     let loads = Loads {
@@ -751,6 +755,7 @@ fn helical_tendon_twists_and_bends_a_straight_rod_as_its_cut_wrench_says() {
         friction: 0.0,
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns: n,
+        path: Vec::new(),
     };
     let m = model(
         Rod::tapered(mat(e, 0.0), l, r, r),

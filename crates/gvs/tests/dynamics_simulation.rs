@@ -45,6 +45,7 @@ fn arm(damping: f64, friction: f64) -> Model<LinearBasis> {
         friction,
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns: 0.0,
+        path: Vec::new(),
     };
     Model::new(rod, disc, b, vec![t]).unwrap()
 }

@@ -42,6 +42,7 @@ fn linear_model(order: MagnusOrder, damping: f64) -> Model<LinearBasis> {
         friction: 0.5,
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns: 0.0,
+        path: Vec::new(),
     };
     Model::new(rod, disc, b, vec![t]).unwrap()
 }

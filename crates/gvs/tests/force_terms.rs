@@ -46,6 +46,7 @@ fn tendon_model() -> Model<LinearBasis> {
         friction,
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns: 0.0,
+        path: Vec::new(),
     };
     Model::new(
         rod,

@@ -41,6 +41,7 @@ fn arm(friction_smoothing: f64) -> Model<LinearBasis> {
         friction: 0.88,
         friction_smoothing,
         turns: 0.0,
+        path: Vec::new(),
     };
     Model::new(rod, disc, basis, vec![tendon]).unwrap()
 }

@@ -132,6 +132,7 @@ fn single_division_model(order: MagnusOrder, friction: f64) -> Model<LinearBasis
             friction,
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
             turns: 0.0,
+            path: Vec::new(),
         },
         Tendon {
             offset_start: [0.006, -0.002],
@@ -141,6 +142,7 @@ fn single_division_model(order: MagnusOrder, friction: f64) -> Model<LinearBasis
             friction: 0.3,
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
             turns: 0.0,
+            path: Vec::new(),
         },
     ];
     Model::new(rod, disc, basis, tendons).unwrap()
@@ -243,6 +245,7 @@ fn statics_jacobian_matches_finite_differences_two_divisions_half_tendon() {
             friction: 0.4,
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
             turns: 0.0,
+            path: Vec::new(),
         },
         Tendon {
             offset_start: [0.01, 0.0173],
@@ -252,6 +255,7 @@ fn statics_jacobian_matches_finite_differences_two_divisions_half_tendon() {
             friction: 0.2,
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
             turns: 0.0,
+            path: Vec::new(),
         },
     ];
     let m = Model::new(rod, disc, basis, tendons).unwrap();
@@ -283,6 +287,7 @@ fn statics_jacobian_matches_finite_differences_for_nonlinear_sigmoid_basis() {
         friction: 0.5,
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns: 0.0,
+        path: Vec::new(),
     }];
     let m = Model::new(rod, disc, p, tendons).unwrap();
     let q = DVector::from_vec(vec![1.1, 8.0, 0.45]);

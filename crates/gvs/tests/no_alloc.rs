@@ -63,6 +63,7 @@ fn arm(basis: DivisionBasis) -> Model<LinearBasis> {
         friction: 0.88,
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns: 0.0,
+        path: Vec::new(),
     };
     Model::new(rod, disc, b, vec![t]).unwrap()
 }

@@ -35,6 +35,7 @@ fn model() -> Model<LinearBasis> {
             friction: 0.5,
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
             turns: 0.0,
+            path: Vec::new(),
         },
         Tendon {
             offset_start: [0.006, -0.002],
@@ -44,6 +45,7 @@ fn model() -> Model<LinearBasis> {
             friction: 0.0,
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
             turns: 0.0,
+            path: Vec::new(),
         },
     ];
     common::iva_rod_3d(1e4, 10, &[], tendons)

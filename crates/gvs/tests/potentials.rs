@@ -41,6 +41,7 @@ fn skew_tendon() -> Tendon {
         friction: 0.0,
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns: 0.0,
+        path: Vec::new(),
     }
 }
 
@@ -147,8 +148,40 @@ fn elastic_force_is_gradient_of_elastic_energy_for_nonlinear_sigmoid() {
     assert!(err < 1e-8, "K₁ vs ∇U_e: relative {err:e}\nK₁ = {k1}");
 }
 
-/// The routed offset `d(X) = d₀ + (X − X_s)/(X_e − X_s) (d₁ − d₀)` ("oblique" routing, spec §7.6).
+/// The custom path of [`path_tendon`]: `d_y = 6 mm − 0.05 X + 0.1 X²`, `d_z = −2 mm + 0.05 X −
+/// 0.12 X²` (X in m), a quadratic the engine's cubic through its knots reproduces exactly.
+fn quadratic_offset(x: f64) -> V3 {
+    V3::new(
+        0.0,
+        0.006 - 0.05 * x + 0.1 * x * x,
+        -0.002 + 0.05 * x - 0.12 * x * x,
+    )
+}
+
+/// A custom path (spec §7.6 "Custom") through five uneven knots of [`quadratic_offset`]: a
+/// curved, non-planar routing from (6, −2) mm at the base to (−0.25, 3) mm at the tip.
+fn path_tendon() -> Tendon {
+    let path: Vec<[f64; 3]> = [0.0, 0.04, 0.1, 0.18, 0.25]
+        .iter()
+        .map(|&x| {
+            let d = quadratic_offset(x);
+            [x, d[1], d[2]]
+        })
+        .collect();
+    Tendon {
+        offset_start: [path[0][1], path[0][2]],
+        offset_end: [path[4][1], path[4][2]],
+        path,
+        ..skew_tendon()
+    }
+}
+
+/// The routed offset `d(X) = d₀ + (X − X_s)/(X_e − X_s) (d₁ − d₀)` ("oblique" routing, spec §7.6),
+/// turned for a helical routing; [`quadratic_offset`] for a custom path.
 fn offset_at(t: &Tendon, x: f64) -> V3 {
+    if !t.path.is_empty() {
+        return quadratic_offset(x);
+    }
     let s = (x - t.x_start) / (t.x_end - t.x_start);
     let y = t.offset_start[0] + s * (t.offset_end[0] - t.offset_start[0]);
     let z = t.offset_start[1] + s * (t.offset_end[1] - t.offset_start[1]);
@@ -186,7 +219,7 @@ fn tendon_length<P: StrainParam>(
     q: &DVector<f64>,
     ws: &mut gvs::model::Workspace,
 ) -> f64 {
-    let t = m.tendons[k];
+    let t = &m.tendons[k];
     let pts = m.tendon_points(k).to_vec();
     let xi = m.strains_at(q, ws);
     pts.iter()
@@ -194,7 +227,7 @@ fn tendon_length<P: StrainParam>(
             let p = m.disc.points[i];
             let kv = V3::new(xi[i][0], xi[i][1], xi[i][2]);
             let nu = V3::new(xi[i][3], xi[i][4], xi[i][5]);
-            p.weight * (nu + kv.cross(&offset_at(&t, p.x)) + offset_rate_at(&t, p.x)).norm()
+            p.weight * (nu + kv.cross(&offset_at(t, p.x)) + offset_rate_at(t, p.x)).norm()
         })
         .sum()
 }
@@ -216,8 +249,14 @@ fn tendon_column_is_gradient_of_routed_tendon_length_helical() {
     tendon_column_is_gradient_of_routed_length(helical_tendon());
 }
 
+/// The same for a custom path through five knots (a curved, non-planar routing).
+#[test]
+fn tendon_column_is_gradient_of_routed_tendon_length_custom_path() {
+    tendon_column_is_gradient_of_routed_length(path_tendon());
+}
+
 fn tendon_column_is_gradient_of_routed_length(tendon: Tendon) {
-    let m = model_3d_with(&[], tendon);
+    let m = model_3d_with(&[], tendon.clone());
     let q = state_3d(&m);
     let mut ws = m.workspace();
     let l_h = tendon_length(&m, 0, &q, &mut ws);
@@ -231,13 +270,13 @@ fn tendon_column_is_gradient_of_routed_length(tendon: Tendon) {
         "extra points change ℓ_h"
     );
     fine.forward(&q, &mut wf, false);
-    let t = fine.tendons[0];
+    let t = &fine.tendons[0];
     let path: Vec<V3> = fine
         .tendon_points(0)
         .iter()
         .map(|&i| {
             let x = fine.disc.points[i].x;
-            wf.g[i].pos + wf.g[i].rot * offset_at(&t, x)
+            wf.g[i].pos + wf.g[i].rot * offset_at(t, x)
         })
         .collect();
     let chord: f64 = path.windows(2).map(|w| (w[1] - w[0]).norm()).sum();

@@ -383,3 +383,77 @@ fn a_precurved_division_rests_on_its_arc_and_is_bounded() {
         assert!(e.contains(&format!("divisions[0].{field}")), "{set}: {e}");
     }
 }
+
+#[test]
+fn a_tendon_on_a_custom_path_is_routed_through_its_knots() {
+    let with = |routing: &str| format!("{UNIFORM_ROD}\n[[tendons]]\n{routing}\ntension = -0.5\n");
+    let tip = |routing: &str| run_text(&with(routing), &[]).tip_position;
+    let oblique = tip("offset_start = [0.0, 0.004]\noffset_end = [0.0, 0.001]");
+    // two knots, or uneven knots on the same line, are the oblique tendon
+    for path in [
+        "path = [[0.0, 0.0, 0.004], [0.5, 0.0, 0.001]]",
+        "path = [[0.0, 0.0, 0.004], [0.1, 0.0, 0.0034], [0.4, 0.0, 0.0016], [0.5, 0.0, 0.001]]",
+    ] {
+        let t = tip(path);
+        for (a, b) in t.iter().zip(&oblique) {
+            assert!((a - b).abs() < 1e-14, "{path}: {t:?} vs {oblique:?}");
+        }
+    }
+    // a knot moved off that line bows the path, and the rod bends otherwise
+    let bowed = tip("path = [[0.0, 0.0, 0.004], [0.25, 0.0, 0.0045], [0.5, 0.0, 0.001]]");
+    assert!(
+        (bowed[2] - oblique[2]).abs() > 1e-4,
+        "{bowed:?} vs {oblique:?}"
+    );
+    let s = Scenario::from_toml(
+        "t",
+        &with("path = [[0.0, 0.0, 0.004], [0.25, 0.0, 0.0045], [0.5, 0.0, 0.001]]"),
+        &[],
+    )
+    .unwrap();
+    let summary = gvsrom::build::describe(&s, &gvsrom::build(&s).unwrap());
+    assert!(
+        summary.contains("1 tendon (friction 0, on a custom path)"),
+        "{summary}"
+    );
+    // refused, naming the key: the end offsets given too, a span that is not the path's, knots
+    // out of order, a path that leaves the rod at a knot or between knots
+    let refused = |routing: &str, needles: &[&str]| {
+        let s = Scenario::from_toml("t", &with(routing), &[]).unwrap();
+        let e = gvsrom::build(&s).err().expect("refused").to_string();
+        assert!(needles.iter().all(|n| e.contains(n)), "{routing}: {e}");
+    };
+    let path = "path = [[0.0, 0.0, 0.004], [0.5, 0.0, 0.001]]";
+    refused(
+        &format!("{path}\noffset_end = [0.0, 0.001]"),
+        &["tendons[0].offset_end", "not both"],
+    );
+    refused(
+        &format!("{path}\nturns = 1"),
+        &["tendons[0].turns", "not both"],
+    );
+    refused(
+        &format!("{path}\nx_end = 0.4"),
+        &["tendons[0].x_end", "last abscissa 0.5 m"],
+    );
+    refused(
+        "path = [[0.0, 0.0, 0.004]]",
+        &["tendons[0].path", "1 knots"],
+    );
+    refused(
+        "path = [[0.0, 0.0, 0.004], [0.3, 0.0, 0.0], [0.2, 0.0, 0.0], [0.5, 0.0, 0.0]]",
+        &["tendons[0].path[2]", "strictly increase"],
+    );
+    refused(
+        "path = [[0.0, 0.0, 0.004], [0.2, 0.0, 0.012], [0.5, 0.0, 0.0]]",
+        &["tendons[0].path[1]", "radius 0.01 m", "at this knot"],
+    );
+    refused(
+        "path = [[0.0, 0.0, 0.0], [0.05, 0.0, 0.009], [0.1, 0.0, 0.0], [0.15, 0.0, -0.009], [0.5, 0.0, 0.0]]",
+        &["tendons[0].path", "between path[", "bulges"],
+    );
+    refused(
+        "path = [[0.0, 0.0, 0.004], [0.6, 0.0, 0.001]]",
+        &["tendons[0].path[1][0]", "0.5 m"],
+    );
+}

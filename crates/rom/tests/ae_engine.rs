@@ -73,6 +73,7 @@ fn hom(damping: f64) -> Model<LinearBasis> {
         friction: FRICTION,
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns: 0.0,
+        path: Vec::new(),
     };
     Model::new(rod, disc, basis, vec![tendon]).unwrap()
 }

@@ -121,6 +121,7 @@ fn tendons() -> Vec<Tendon> {
             friction: 0.3,
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
             turns: 0.0,
+            path: Vec::new(),
         },
         // first division only, frictionless
         Tendon {
@@ -131,6 +132,7 @@ fn tendons() -> Vec<Tendon> {
             friction: 0.0,
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
             turns: 0.0,
+            path: Vec::new(),
         },
     ]
 }

@@ -163,6 +163,7 @@ fn six_tendon() -> Model<crate::strain::LinearBasis> {
                 friction: 0.0,
                 friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
                 turns: 0.0,
+                path: Vec::new(),
             }
         })
         .collect();

@@ -51,14 +51,22 @@ pub fn describe(s: &Scenario, built: &Built) -> String {
             } else {
                 format!("friction {lo} to {hi}")
             };
-            let helical = tendons.iter().filter(|t| t.turns != 0.0).count();
-            let helical = match (helical, n) {
+            let routed = |kind: &str, count: usize| match (count, n) {
                 (0, _) => String::new(),
-                (h, n) if h == n => ", helical".into(),
-                (h, _) => format!(", {h} helical"),
+                (h, n) if h == n => format!(", {kind}"),
+                (h, _) => format!(", {h} {kind}"),
             };
+            let helical = routed("helical", tendons.iter().filter(|t| t.turns != 0.0).count());
+            let custom = routed(
+                if n == 1 {
+                    "on a custom path"
+                } else {
+                    "on custom paths"
+                },
+                tendons.iter().filter(|t| !t.path.is_empty()).count(),
+            );
             format!(
-                "{n} tendon{} ({friction}{helical})",
+                "{n} tendon{} ({friction}{helical}{custom})",
                 if n == 1 { "" } else { "s" }
             )
         }

@@ -28,6 +28,9 @@ pub(super) fn radius_at(rod: &Rod, x: f64, after: bool) -> f64 {
 }
 
 pub(super) fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, ScenarioError> {
+    if let Some(path) = &t.path {
+        return path_tendon(k, t, path, rod);
+    }
     let f = |n: &str| format!("tendons[{k}].{n}");
     let l = rod.length();
     let x_start = finite(&f("x_start"), t.x_start)?;
@@ -47,17 +50,7 @@ pub(super) fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, Scen
         ));
     }
     let x_end = x_end.min(l);
-    let friction = in_range(
-        &f("friction"),
-        t.friction,
-        FRICTION_RANGE,
-        "(a capstan coefficient)",
-    )?;
-    let friction_smoothing = non_negative(
-        &f("friction_smoothing"),
-        t.friction_smoothing.unwrap_or(DEFAULT_FRICTION_SMOOTHING),
-        "rad/m (a curvature scale; 0 = no smoothing)",
-    )?;
+    let (friction, friction_smoothing) = friction(k, t)?;
     let explicit = t.offset_start.is_some() || t.offset_end.is_some();
     let polar = t.angle_deg.is_some() || t.radial_fraction.is_some();
     let (offset_start, offset_end) = match (explicit, polar) {
@@ -132,6 +125,7 @@ pub(super) fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, Scen
             (-gvs::actuation::MAX_TURNS, gvs::actuation::MAX_TURNS),
             "(helical turns about the rod's axis over the span; 0 = oblique)",
         )?,
+        path: Vec::new(),
     };
     // |d(X)| is convex along the span and r(X) linear per division: checking the span's ends and
     // the division junctions inside it covers the whole path.
@@ -168,6 +162,104 @@ pub(super) fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, Scen
             ));
         }
     }
+    Ok(tendon)
+}
+
+/// The friction coefficient and smoothing of tendon `k`, checked.
+fn friction(k: usize, t: &TendonSpec) -> Result<(f64, f64), ScenarioError> {
+    let f = |n: &str| format!("tendons[{k}].{n}");
+    let friction = in_range(
+        &f("friction"),
+        t.friction,
+        FRICTION_RANGE,
+        "(a capstan coefficient)",
+    )?;
+    let smoothing = non_negative(
+        &f("friction_smoothing"),
+        t.friction_smoothing.unwrap_or(DEFAULT_FRICTION_SMOOTHING),
+        "rad/m (a curvature scale; 0 = no smoothing)",
+    )?;
+    Ok((friction, smoothing))
+}
+
+/// A tendon routed through the knots `path` (`tendons.N.path`, gvs-spec §7.6 "Custom"): the span
+/// and end offsets are the path's, so the keys that would give them otherwise are refused (an
+/// `x_start` or `x_end` equal to the path's end is accepted); the engine checks the knots and that
+/// the curve stays inside the rod ([`Tendon::validate_path`]).
+fn path_tendon(
+    k: usize,
+    t: &TendonSpec,
+    path: &[[f64; 3]],
+    rod: &Rod,
+) -> Result<Tendon, ScenarioError> {
+    let f = |n: &str| format!("tendons[{k}].{n}");
+    let given = [
+        ("offset_start", t.offset_start.is_some()),
+        ("offset_end", t.offset_end.is_some()),
+        ("angle_deg", t.angle_deg.is_some()),
+        ("radial_fraction", t.radial_fraction.is_some()),
+        ("turns", t.turns != 0.0),
+    ];
+    if let Some((key, _)) = given.iter().find(|g| g.1) {
+        return Err(ScenarioError::invalid(
+            f(key),
+            "give either `path` (knots [X, d_y, d_z] in m) or the end offsets (`offset_start` and `offset_end`, or `angle_deg`, optionally with `turns`), not both",
+        ));
+    }
+    let (first, last) = match (path.first(), path.last()) {
+        (Some(a), Some(b)) if path.len() >= gvs::tendon_path::MIN_KNOTS => (*a, *b),
+        _ => {
+            return Err(ScenarioError::invalid(
+                f("path"),
+                format!(
+                    "{} knots (accepted: at least {} knots [X, d_y, d_z] in m)",
+                    path.len(),
+                    gvs::tendon_path::MIN_KNOTS
+                ),
+            ))
+        }
+    };
+    if t.x_start != 0.0 && t.x_start != first[0] {
+        return Err(ScenarioError::value(
+            f("x_start"),
+            t.x_start,
+            format!("the path's first abscissa {} m, or no `x_start` (a path's span runs from its first to its last knot)", first[0]),
+        ));
+    }
+    if let Some(x_end) = t.x_end.filter(|x| *x != last[0]) {
+        return Err(ScenarioError::value(
+            f("x_end"),
+            x_end,
+            format!("the path's last abscissa {} m, or no `x_end` (a path's span runs from its first to its last knot)", last[0]),
+        ));
+    }
+    let l = rod.length();
+    if !(first[0] >= 0.0 && first[0] < l) {
+        return Err(ScenarioError::value(
+            f("path[0][0]"),
+            first[0],
+            format!("an abscissa in [0, {l}) m (the tendon's start)"),
+        ));
+    }
+    if last[0].is_nan() || last[0] > l * (1.0 + 1e-12) {
+        return Err(ScenarioError::value(
+            f(&format!("path[{}][0]", path.len() - 1)),
+            last[0],
+            format!("an abscissa <= the rod's length {l} m (the tendon's end)"),
+        ));
+    }
+    let (friction, friction_smoothing) = friction(k, t)?;
+    let tendon = Tendon {
+        offset_start: [first[1], first[2]],
+        offset_end: [last[1], last[2]],
+        x_start: first[0],
+        x_end: last[0],
+        friction,
+        friction_smoothing,
+        turns: 0.0,
+        path: path.to_vec(),
+    };
+    tendon.validate_path(rod, k)?;
     Ok(tendon)
 }
 
