@@ -23,6 +23,5 @@ pub mod model;
 pub mod rod;
 pub mod solve;
 pub mod strain;
-pub mod tendon_path;
 
 pub use error::ModelError;

@@ -292,6 +292,50 @@ fn constant_offset_tendon_with_friction_follows_capstan_curvature() {
 }
 
 #[test]
+fn capstan_curvature_holds_across_a_division_junction() {
+    // the capstan case above on the same rod cut into two divisions at X = 0.2 m, the tendon over
+    // both: the friction angle Θ runs on through the junction's coincident pair of points (their
+    // ε = 0 angle is the tangent's kink, here none), so k₂(X) keeps the one closed form
+    let (r, l, e, d, t, mu, cut) = (0.01, 0.5, 1e6, 0.008, 0.5, 0.5, 0.2);
+    let part = |length: f64| gvs::rod::DivisionGeometry {
+        length,
+        radius_start: r,
+        radius_end: r,
+    };
+    let rod = Rod {
+        material: mat(e, 0.0),
+        divisions: vec![part(cut), part(l - cut)],
+    };
+    let tendon = Tendon {
+        offset_start: [0.0, d],
+        offset_end: [0.0, d],
+        x_start: 0.0,
+        x_end: l,
+        friction: mu,
+        friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+        turns: 0.0,
+        path: Vec::new(),
+    };
+    let (g1, g2) = (Quadrature::Gauss { n: 30 }, Quadrature::Gauss { n: 40 });
+    let disc = Discretization::new(&rod, &[g1, g2], MagnusOrder::Z4, &[]).unwrap();
+    let b = legendre([None, Some(8), None, Some(8), None, Some(2)]);
+    let basis = LinearBasis::per_division(&disc, &[b.clone(), b]).unwrap();
+    let m = Model::new(rod, disc, basis, vec![tendon]).unwrap();
+    let (_, ws) = solve(&m, &[-t], &no_loads());
+    let ei = SectionProps::circular(&mat(e, 0.0), r).es[1];
+    let (mut worst, mut beyond): (f64, usize) = (0.0, 0);
+    for (xi, p) in m.point_strains(&ws).iter().zip(&m.disc.points) {
+        let exact = (-t * d / ei) / (1.0 + mu * t * d * p.x / ei);
+        worst = worst.max(((xi[1] - exact) / exact).abs());
+        beyond += usize::from(p.x > cut);
+    }
+    assert!(beyond > 30, "points past the junction: {beyond}");
+    // a friction angle restarted at the junction would put the second division's curvature
+    // (1 + cX)/(1 + c(X − 0.2)) − 1 off, c = μ|u|d/EI = 0.25 1/m: 5 % just past it
+    assert!(worst < 2e-5, "worst relative curvature error {worst:e}");
+}
+
+#[test]
 fn triangular_pulse_moment_matches_continuum_sigmoid_and_converges() {
     // k₂(X) = (1/EI) ∫_X^L m(s) ds (gvs-spec §10.3.8): the sigmoid of the IV-B beam
     let (l, r, e, me, x0) = (0.8, 0.015, 1e6, 4.0, 0.2);

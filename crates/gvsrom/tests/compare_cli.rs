@@ -198,3 +198,35 @@ fn a_trajectory_that_does_not_record_its_input_is_undecided_not_equal() {
     );
     assert!(stdout.contains("tip error  mean 0.000 %"), "{stdout}");
 }
+
+#[test]
+fn a_trajectory_without_or_with_a_damaged_reference_strain_is_read_as_written() {
+    let reference = simulate("cmp-xistar-ref", &[]);
+    // written before ξ* was recorded: the straight rod, the same run
+    let old = copy_with_meta(&reference, "cmp-xistar-old", |meta| {
+        meta["gvsrom"]["files"]
+            .as_array_mut()
+            .unwrap()
+            .retain(|f| f != "strain_reference.npy");
+    });
+    std::fs::remove_file(old.join("strain_reference.npy")).unwrap();
+    let out = gvsrom(&["compare", path(&reference), path(&old)]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // a non-finite entry (resealed, as a writer's bug would leave it) is refused naming the file
+    let bad = copy_with_meta(&reference, "cmp-xistar-nan", |_| {});
+    let f = bad.join("strain_reference.npy");
+    let mut bytes = std::fs::read(&f).unwrap();
+    let n = bytes.len();
+    bytes[n - 8..].copy_from_slice(&f64::NAN.to_le_bytes());
+    std::fs::write(&f, &bytes).unwrap();
+    common::reseal::reseal(&bad);
+    expect_error(
+        &["compare", path(&reference), path(&bad)],
+        &["strain_reference.npy", "not a finite number"],
+    );
+}

@@ -212,6 +212,10 @@ fn simulation_writes_numpy_arrays_with_consistent_shapes() {
     assert_eq!(npy_shape(&out_dir.join("tip_rotation.npy")), vec![51, 3, 3]);
     assert_eq!(npy_shape(&out_dir.join("strain.npy")), vec![51, 14, 6]);
     assert_eq!(npy_shape(&out_dir.join("strain_x.npy")), vec![14]);
+    assert_eq!(
+        npy_shape(&out_dir.join("strain_reference.npy")),
+        vec![14, 6]
+    );
     // babbled tensions stay in range and the same seed gives the same signal
     let u = npy_values(&out_dir.join("u.npy"));
     assert!(u.iter().all(|v| (-15.0..0.0).contains(v)));

@@ -4,7 +4,7 @@
 //! and end offsets over `[X_s, X_e]` ("oblique" routing; `d' = const`), turned about the rod's axis
 //! by `φ(X) = 2π n s`, `s = (X − X_s)/(X_e − X_s)`, for a helical routing of `n` turns
 //! ([`Tendon::turns`]; `d' = R_x(φ)(d_lin' + φ' e_x × d_lin)`, spec §7.6 "Helical"), or through
-//! knots of a custom path ([`Tendon::path`], [`crate::tendon_path`], spec §7.6 "Custom"). At a point with strain
+//! knots of a custom path ([`Tendon::path`], [`crate::actuation::path`], spec §7.6 "Custom"). At a point with strain
 //! `ξ = [k; ν]` its unit tangent in the section frame is `t = t_u/‖t_u‖`, `t_u = ν + k × d + d'`, and
 //! it loads the rod with the internal wrench `Φ_a α u`, `Φ_a = [d × t; t]`.
 //!
@@ -25,6 +25,7 @@ use crate::rod::Rod;
 use serde::{Deserialize, Serialize};
 
 mod local;
+pub mod path;
 pub use local::*;
 
 /// Default curvature scale `κ_ε` [rad/m] of the friction angle's smoothing
@@ -72,7 +73,7 @@ pub struct Tendon {
     /// `ρ` has `offset_start = offset_end` of norm `ρ`.
     #[serde(default)]
     pub turns: f64,
-    /// Knots `[X, d_y, d_z]` \[m\] of a custom routing ([`crate::tendon_path`]: a `C¹` cubic
+    /// Knots `[X, d_y, d_z]` \[m\] of a custom routing ([`crate::actuation::path`]: a `C¹` cubic
     /// through them); empty (the default) for the oblique or helical routing. A path has
     /// `x_start`, `x_end`, `offset_start` and `offset_end` at its first and last knots, and no
     /// `turns`.
@@ -101,7 +102,7 @@ impl Tendon {
     #[inline]
     pub fn offset_and_rate(&self, x: f64) -> (V3, V3) {
         if !self.path.is_empty() {
-            return crate::tendon_path::offset_and_rate(&self.path, x);
+            return path::offset_and_rate(&self.path, x);
         }
         let l = self.x_end - self.x_start;
         let s = (x - self.x_start) / l;
@@ -221,18 +222,18 @@ impl Tendon {
     /// cubic between two knots may bulge beyond both).
     const PATH_SAMPLES: usize = 32;
 
-    /// A custom path: its knots ([`crate::tendon_path::check`]); its ends are the tendon's
+    /// A custom path: its knots ([`path::check`]); its ends are the tendon's
     /// `x_start`, `x_end`, `offset_start` and `offset_end`; no `turns`; and the curve stays inside
     /// the cross-section at every knot, at [`Tendon::PATH_SAMPLES`] points of each interval and at
     /// the division junctions inside the span.
     pub fn validate_path(&self, rod: &Rod, index: usize) -> Result<(), ModelError> {
         let f = |name: &str| format!("tendons[{index}].{name}");
-        let path = &self.path;
-        crate::tendon_path::check(path).map_err(|(i, m)| match i {
+        let knots = &self.path;
+        path::check(knots).map_err(|(i, m)| match i {
             Some(i) => ModelError::invalid(f(&format!("path[{i}]")), m),
             None => ModelError::invalid(f("path"), m),
         })?;
-        let (first, last) = (path[0], path[path.len() - 1]);
+        let (first, last) = (knots[0], knots[knots.len() - 1]);
         for (name, v, want) in [
             ("x_start", self.x_start, first[0]),
             ("x_end", self.x_end, last[0]),
@@ -257,10 +258,10 @@ impl Tendon {
             ));
         }
         // the knots first, so that a knot outside the rod is named as such
-        let mut xs: Vec<(f64, usize)> = (0..path.len())
-            .map(|i| (path[i][0], i.min(path.len() - 2)))
+        let mut xs: Vec<(f64, usize)> = (0..knots.len())
+            .map(|i| (knots[i][0], i.min(knots.len() - 2)))
             .collect();
-        for (i, w) in path.windows(2).enumerate() {
+        for (i, w) in knots.windows(2).enumerate() {
             for k in 1..Self::PATH_SAMPLES {
                 xs.push((
                     w[0][0] + (w[1][0] - w[0][0]) * k as f64 / Self::PATH_SAMPLES as f64,
@@ -272,8 +273,8 @@ impl Tendon {
         for d in &rod.divisions {
             x0 += d.length;
             if x0 > first[0] && x0 < last[0] {
-                let i = path.partition_point(|k| k[0] <= x0).saturating_sub(1);
-                xs.push((x0, i.min(path.len() - 2)));
+                let i = knots.partition_point(|k| k[0] <= x0).saturating_sub(1);
+                xs.push((x0, i.min(knots.len() - 2)));
             }
         }
         for (x, i) in xs {
@@ -281,16 +282,16 @@ impl Tendon {
             let d = self.offset(x);
             let dn = (d[1] * d[1] + d[2] * d[2]).sqrt();
             if dn > r * (1.0 + 1e-9) {
-                let knot = path.iter().position(|k| k[0] == x);
+                let knot = knots.iter().position(|k| k[0] == x);
                 let (field, place) = match knot {
                     Some(k) => (format!("path[{k}]"), "at this knot".to_string()),
                     None => (
                         "path".to_string(),
                         format!(
                             "between path[{i}] (X = {} m) and path[{}] (X = {} m), where the cubic through the knots bulges (add knots there)",
-                            path[i][0],
+                            knots[i][0],
                             i + 1,
-                            path[i + 1][0]
+                            knots[i + 1][0]
                         ),
                     ),
                 };

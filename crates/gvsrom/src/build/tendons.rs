@@ -207,14 +207,14 @@ fn path_tendon(
         ));
     }
     let (first, last) = match (path.first(), path.last()) {
-        (Some(a), Some(b)) if path.len() >= gvs::tendon_path::MIN_KNOTS => (*a, *b),
+        (Some(a), Some(b)) if path.len() >= gvs::actuation::path::MIN_KNOTS => (*a, *b),
         _ => {
             return Err(ScenarioError::invalid(
                 f("path"),
                 format!(
                     "{} knots (accepted: at least {} knots [X, d_y, d_z] in m)",
                     path.len(),
-                    gvs::tendon_path::MIN_KNOTS
+                    gvs::actuation::path::MIN_KNOTS
                 ),
             ))
         }

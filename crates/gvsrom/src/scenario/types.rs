@@ -229,7 +229,7 @@ pub struct TendonSpec {
     #[serde(default, skip_serializing_if = "is_zero")]
     pub turns: f64,
     /// Custom routing: knots `[X, d_y, d_z]` \[m\] the offset passes through (a `C¹` cubic,
-    /// `gvs::tendon_path`), in place of the two end offsets; the span is the first to the last
+    /// `gvs::actuation::path`), in place of the two end offsets; the span is the first to the last
     /// knot. Not written when absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub path: Option<Vec<[f64; 3]>>,
