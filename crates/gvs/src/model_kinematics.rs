@@ -192,4 +192,39 @@ impl<P: StrainParam> Model<P> {
             + ws.g[i + 1].pos * (-2.0 * t3 + 3.0 * t2)
             + tb * ((t3 - t2) * hx)
     }
+
+    /// Position of tendon `k`'s thread at `x`, `p = r + R d(X)`, by cubic Hermite interpolation
+    /// between its neighbouring computational points with the tangent `p' = R t_u`,
+    /// `t_u = ν + k × d + d'` (gvs-spec §7.6), after a forward pass; `x` is clamped to the
+    /// tendon's points. Exact at the points, `O(h⁴)` between them.
+    pub fn tendon_position_at(&self, ws: &Workspace, k: usize, x: f64) -> V3 {
+        let t = &self.tendons[k];
+        let pts = &self.tendon_points[k];
+        let node = |m: usize| {
+            let i = pts[m];
+            let xm = self.disc.points[i].x;
+            let (d, dp) = t.offset_and_rate(xm);
+            let (g, xi) = (&ws.g[i], &ws.xi[i]);
+            let kv = V3::new(xi[0], xi[1], xi[2]);
+            let nu = V3::new(xi[3], xi[4], xi[5]);
+            (xm, g.pos + g.rot * d, g.rot * (nu + kv.cross(&d) + dp))
+        };
+        let m = pts
+            .partition_point(|&i| self.disc.points[i].x <= x)
+            .saturating_sub(1);
+        if m + 1 >= pts.len() {
+            return node(pts.len() - 1).1;
+        }
+        let ((xa, pa, ta), (xb, pb, tb)) = (node(m), node(m + 1));
+        let hx = xb - xa;
+        if hx <= 0.0 {
+            return pa;
+        }
+        let s = ((x - xa) / hx).clamp(0.0, 1.0);
+        let (s2, s3) = (s * s, s * s * s);
+        pa * (2.0 * s3 - 3.0 * s2 + 1.0)
+            + ta * ((s3 - 2.0 * s2 + s) * hx)
+            + pb * (-2.0 * s3 + 3.0 * s2)
+            + tb * ((s3 - s2) * hx)
+    }
 }

@@ -108,6 +108,60 @@ fn pure_end_moment_bends_rod_into_exact_circle() {
 }
 
 #[test]
+fn a_tendon_on_the_exact_circle_lies_at_its_offset_from_the_arc() {
+    // the end-moment circle above with a slack tendon at the constant offset d = (0, d_y, d_z):
+    // the section at X is turned by θ = κX about y, so the thread is at
+    // p(X) = (sin θ/κ + d_z sin θ, d_y, −(1 − cos θ)/κ + d_z cos θ); interpolated between the
+    // points (cubic Hermite with the tangent R t_u) it is exact at them and O(h⁴) between
+    let (r, l, e, mom, dy, dz) = (0.01, 0.5, 1e6, 0.01, 0.006, 0.004);
+    let tendon = Tendon {
+        offset_start: [dy, dz],
+        offset_end: [dy, dz],
+        x_start: 0.0,
+        x_end: l,
+        friction: 0.0,
+        friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+        turns: 0.0,
+        path: Vec::new(),
+    };
+    let m = model(
+        Rod::tapered(mat(e, 0.0), l, r, r),
+        8,
+        legendre([Some(1), Some(2), Some(2), Some(1), Some(1), Some(1)]),
+        vec![tendon],
+        &[],
+    );
+    let loads = tip_load([0.0, mom, 0.0, 0.0, 0.0, 0.0], Frame::Local, l);
+    let (_, ws) = solve(&m, &[0.0], &loads);
+    let kappa = mom / (e * PI * r.powi(4) / 4.0);
+    let exact = |x: f64| {
+        let th = kappa * x;
+        V3::new(
+            th.sin() / kappa + dz * th.sin(),
+            dy,
+            -(1.0 - th.cos()) / kappa + dz * th.cos(),
+        )
+    };
+    for &i in m.tendon_points(0) {
+        let x = m.disc.points[i].x;
+        let p = m.tendon_position_at(&ws, 0, x);
+        assert!(
+            (p - exact(x)).norm() < 1e-10,
+            "X = {x}: {p} vs {}",
+            exact(x)
+        );
+    }
+    let worst = (0..=500)
+        .map(|k| {
+            let x = l * k as f64 / 500.0;
+            (m.tendon_position_at(&ws, 0, x) - exact(x)).norm()
+        })
+        .fold(0.0, f64::max);
+    // 10 points, gaps up to h ≈ 0.08 m on a circle of radius 0.79 m: h⁴κ³/384 ≈ 2e-7 m
+    assert!(worst < 1e-6, "worst {worst:e} m");
+}
+
+#[test]
 fn small_tip_force_deflection_matches_bending_plus_shear_formula() {
     // δ = PL³/3EI + PL/GA (shear factor 1), gvs-spec §10.3.2
     let (r, l, e, p) = (0.01, 0.5, 1e6, 1e-4);

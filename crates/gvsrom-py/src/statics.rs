@@ -30,6 +30,11 @@ use pyo3::types::PyDict;
 ///     Abscissae of the computational points [m].
 /// strain : numpy.ndarray, shape (p, 6)
 ///     ξ at the points, ``[torsion, bend-y, bend-z, elongation, shear-y, shear-z]``.
+/// strain_reference : numpy.ndarray, shape (p, 6)
+///     The reference strain ξ* at the points (the unloaded rod's; ``[0, 0, 0, 1, 0, 0]`` straight).
+/// tendon_paths : tuple of numpy.ndarray, each shape (m_k, 3)
+///     Each tendon's thread ``r + R d(X)`` in the world frame [m], from its start to its end (at
+///     its ends and at the ``centerline_x`` between them).
 /// iterations, load_stages, residual_evaluations, jacobian_evaluations : int
 ///     Solver statistics.
 /// residual_norm : float
@@ -63,6 +68,10 @@ pub struct Statics {
     strain_x: Py<PyAny>,
     /// ξ at the points, `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]`.
     strain: Py<PyAny>,
+    /// The reference strain ξ* at the points.
+    strain_reference: Py<PyAny>,
+    /// Each tendon's thread in the world frame [m], a `(m_k, 3)` array per tendon.
+    tendon_paths: Py<PyAny>,
     /// Dogleg iterations over all load stages.
     iterations: usize,
     /// Load stages of the ramp.
@@ -97,6 +106,20 @@ impl Statics {
             centerline: held(shaped(py, flat(&r.centerline), [r.centerline.len(), 3])?)?,
             strain_x: held(vector(py, &r.strain_x))?,
             strain: held(shaped(py, flat(&r.strain), [r.strain.len(), 6])?)?,
+            strain_reference: held(shaped(
+                py,
+                flat(&r.strain_reference),
+                [r.strain_reference.len(), 6],
+            )?)?,
+            tendon_paths: pyo3::types::PyTuple::new(
+                py,
+                r.tendon_paths
+                    .iter()
+                    .map(|p| held(shaped(py, flat(p), [p.len(), 3])?))
+                    .collect::<PyResult<Vec<_>>>()?,
+            )?
+            .into_any()
+            .unbind(),
             iterations: r.iterations,
             load_stages: r.load_stages,
             residual_evaluations: r.residual_evaluations,
@@ -125,6 +148,8 @@ impl Statics {
             ("centerline", &self.centerline),
             ("strain_x", &self.strain_x),
             ("strain", &self.strain),
+            ("strain_reference", &self.strain_reference),
+            ("tendon_paths", &self.tendon_paths),
         ] {
             d.set_item(k, v.bind(py))?;
         }

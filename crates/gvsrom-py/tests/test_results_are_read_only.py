@@ -26,8 +26,12 @@ def assert_held(obj, names):
 
 def test_statics_and_batches_hold_read_only_arrays():
     robot = gvsrom.Scenario.preset("single-tendon").build()
-    assert_held(robot.statics(u=[-3.0]), ["u", "q", "tip_position", "tip_rotation", "centerline_x",
-                                          "centerline", "strain_x", "strain"])
+    eq = robot.statics(u=[-3.0])
+    assert_held(eq, ["u", "q", "tip_position", "tip_rotation", "centerline_x", "centerline",
+                     "strain_x", "strain", "strain_reference"])
+    for path in eq.tendon_paths:
+        with pytest.raises(ValueError, match="read-only"):
+            path[0, 0] = 1.0
     assert_held(robot.statics_batch([[-1.0], [-2.0]]),
                 ["u", "q", "tip_position", "tip_rotation", "centerline_x", "centerline",
                  "strain_x", "strain", "iterations", "residual_norm", "solve_time_s"])

@@ -27,6 +27,10 @@ def assert_same(py: gvsrom.Statics, cli: dict) -> None:
     np.testing.assert_allclose(py.centerline, cli["centerline"], rtol=0, atol=TOL)
     np.testing.assert_allclose(py.strain_x, cli["strain_x"], rtol=0, atol=TOL)
     np.testing.assert_allclose(py.strain, cli["strain"], rtol=0, atol=TOL)
+    np.testing.assert_allclose(py.strain_reference, cli["strain_reference"], rtol=0, atol=0)
+    assert len(py.tendon_paths) == len(cli.get("tendon_paths", []))
+    for a, b in zip(py.tendon_paths, cli.get("tendon_paths", [])):
+        np.testing.assert_allclose(a, b, rtol=0, atol=TOL)
     assert py.iterations == cli["iterations"]
     assert py.load_stages == cli["load_stages"]
     assert py.residual_norm == pytest.approx(cli["residual_norm"], rel=0, abs=TOL)
@@ -93,3 +97,18 @@ def test_non_convergence_raises_with_iterations_and_residual(gvsrom_bin):
     assert e.value.iterations >= 1 and e.value.residual_norm > 0
     assert f"after {e.value.iterations} iterations" in str(e.value)
     assert isinstance(e.value, ValueError)
+
+
+def test_tendon_paths_start_at_the_offsets_and_follow_the_rod():
+    # single-tendon: the tendon runs from (0, 0, 0.01) at the base to 3 mm above the tip's axis;
+    # at the tip it is the tip pose applied to its end offset (0, 0, 0.003)
+    robot = gvsrom.Scenario.preset("single-tendon").build()
+    eq = robot.statics(u=[-3.0])
+    (path,) = eq.tendon_paths
+    assert path.shape == (len(eq.centerline_x), 3)
+    np.testing.assert_allclose(path[0], [0.0, 0.0, 0.01], atol=1e-15)
+    np.testing.assert_allclose(path[-1], eq.tip_position + eq.tip_rotation @ [0.0, 0.0, 0.003],
+                               atol=1e-12)
+    # and it stays within the section's radius (12.5 → 5 mm) of the centreline
+    gap = np.linalg.norm(path - eq.centerline, axis=1)
+    assert np.all(gap <= 0.0125 + 1e-9) and np.all(gap > 0.0029)

@@ -188,6 +188,11 @@ fn statics_result_gives_rod_views_and_strain_profiles() {
         svg.contains("[1/m]") && svg.contains("[–]"),
         "strain.svg lacks units"
     );
+    // the tendon is drawn beside the centreline
+    for view in ["rod_side.svg", "rod_3d.svg"] {
+        let svg = std::fs::read_to_string(dir.join(view)).unwrap();
+        assert!(svg.contains("tendon 0"), "{view} lacks the tendon");
+    }
 }
 
 #[test]

@@ -24,6 +24,10 @@ pub struct StaticsDoc {
     /// [`crate::compare::STRAIGHT_STRAIN`]).
     #[serde(default)]
     pub strain_reference: Option<Vec<[f64; 6]>>,
+    /// World positions of each tendon at its points (results written before they were recorded,
+    /// and rods without tendons, have none).
+    #[serde(default)]
+    pub tendon_paths: Vec<Vec<[f64; 3]>>,
     #[serde(default)]
     pub model: Option<String>,
     /// The file by the SHA-256 of the bytes read (what `plot` records of it).
@@ -90,15 +94,28 @@ impl StaticsDoc {
     }
 }
 
-/// The rod's centreline and tip as 3-D series.
+/// The rod's centreline, tendons and tip as 3-D series.
 fn rod_series(doc: &StaticsDoc) -> Vec<Series3> {
-    vec![
+    let mut series = vec![
         Series3::new("centreline", doc.centerline.clone(), SeriesStyle::Line)
             .with_color(palette::HOM),
+    ];
+    for (k, path) in doc.tendon_paths.iter().enumerate() {
+        if path.len() >= 2 {
+            series.push(
+                Series3::new(format!("tendon {k}"), path.clone(), SeriesStyle::Line)
+                    .with_color(palette::EXTRA[k % 6]),
+            );
+        }
+    }
+    series.push(
         Series3::new("base", vec![doc.centerline[0]], SeriesStyle::Markers)
             .with_color(palette::EXTRA[6]),
+    );
+    series.push(
         Series3::new("tip", vec![doc.tip_position], SeriesStyle::Markers).with_color(palette::POD),
-    ]
+    );
+    series
 }
 
 /// `rod_3d`, `rod_side` and `strain` of the statics result at `path`.

@@ -44,6 +44,11 @@ pub struct StaticsReport {
     /// The reference strain ξ* at the computational points (the unloaded rod's: `[0, 0, 0, 1, 0, 0]`
     /// for a straight one), what strain deviations and errors are measured from.
     pub strain_reference: Vec<[f64; 6]>,
+    /// World positions \[m\] of each tendon's thread `r + R d(X)` from its start to its end, at
+    /// its ends and at the `centerline_x` between them (cubic Hermite interpolation between its
+    /// computational points, as the centreline); empty without tendons.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub tendon_paths: Vec<Vec<[f64; 3]>>,
     /// Dogleg iterations over all load stages.
     pub iterations: usize,
     pub load_stages: usize,
@@ -302,6 +307,7 @@ fn report<P: StrainParam>(
         .iter()
         .map(|&x| arr3(&model.position_at(ws, x)))
         .collect();
+    let tendon_paths = tendon_paths(model, ws, &centerline_x);
     let strain = model
         .point_strains(ws)
         .iter()
@@ -325,6 +331,7 @@ fn report<P: StrainParam>(
                 [s[0], s[1], s[2], s[3], s[4], s[5]]
             })
             .collect(),
+        tendon_paths,
         iterations: sol.iterations,
         load_stages: sol.load_stages,
         residual_evaluations: sol.residual_evaluations,
@@ -338,6 +345,29 @@ fn report<P: StrainParam>(
             lambda_max: c.lambda_max,
         }),
     }
+}
+
+/// The world positions `r + R d(X)` of every tendon ([`Model::tendon_position_at`]) at its ends
+/// and at the centreline abscissae `xs` between them, after a forward pass in `ws`.
+fn tendon_paths<P: StrainParam>(
+    model: &Model<P>,
+    ws: &Workspace,
+    xs: &[f64],
+) -> Vec<Vec<[f64; 3]>> {
+    (0..model.tendons.len())
+        .map(|k| {
+            let pts = model.tendon_points(k);
+            let (Some(&a), Some(&b)) = (pts.first(), pts.last()) else {
+                return vec![];
+            };
+            let (xa, xb) = (model.disc.points[a].x, model.disc.points[b].x);
+            std::iter::once(xa)
+                .chain(xs.iter().copied().filter(|&x| x > xa && x < xb))
+                .chain(std::iter::once(xb))
+                .map(|x| arr3(&model.tendon_position_at(ws, k, x)))
+                .collect()
+        })
+        .collect()
 }
 
 /// The `--json` document: the report, the reduced model used and the comparison with the full model.
