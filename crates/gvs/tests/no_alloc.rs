@@ -65,7 +65,16 @@ fn arm(basis: DivisionBasis) -> Model<LinearBasis> {
         turns: 0.0,
         path: Vec::new(),
     };
-    Model::new(rod, disc, b, vec![t]).unwrap()
+    // a second tendon on a custom path: its offset is interpolated at every evaluation
+    let knots = vec![[0.0, 0.0, -0.01], [0.1, 0.004, -0.004], [0.25, 0.0, -0.003]];
+    let on_path = Tendon {
+        offset_start: [0.0, -0.01],
+        offset_end: [0.0, -0.003],
+        friction: 0.3,
+        path: knots,
+        ..t.clone()
+    };
+    Model::new(rod, disc, b, vec![t, on_path]).unwrap()
 }
 
 fn allocations() -> usize {
@@ -94,7 +103,7 @@ fn residuals_mass_matrix_and_statics_jacobian_do_not_allocate() {
                 ..Loads::default()
             })
             .unwrap();
-        let u = [-2.0];
+        let u = [-2.0, -1.0];
         let q = DVector::from_fn(n, |i, _| 0.2 * ((i as f64) * 0.7).sin());
         let qd = DVector::from_fn(n, |i, _| 1.5 * ((i as f64) * 1.3).cos());
         let qdd = DVector::from_fn(n, |i, _| 4.0 * ((i as f64) * 0.4 + 1.0).sin());
