@@ -220,7 +220,7 @@ impl Tendon {
 impl Tendon {
     /// Samples per knot interval at which a custom path is checked to stay inside the rod (the
     /// cubic between two knots may bulge beyond both).
-    const PATH_SAMPLES: usize = 32;
+    pub const PATH_SAMPLES: usize = 32;
 
     /// A custom path: its knots ([`path::check`]); its ends are the tendon's
     /// `x_start`, `x_end`, `offset_start` and `offset_end`; no `turns`; and the curve stays inside
