@@ -75,6 +75,20 @@ fn tip_load(w: [f64; 6], frame: Frame, x: f64) -> Loads {
     }
 }
 
+/// A tendon at the constant offset `d` (`[d_y, d_z]`) over the whole rod `[0, l]`, friction `mu`.
+fn straight_tendon(d: [f64; 2], l: f64, mu: f64) -> Tendon {
+    Tendon {
+        offset_start: d,
+        offset_end: d,
+        x_start: 0.0,
+        x_end: l,
+        friction: mu,
+        friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+        turns: 0.0,
+        path: Vec::new(),
+    }
+}
+
 const PLANAR: [Option<usize>; 6] = [None, Some(4), None, Some(2), None, Some(2)];
 
 #[test]
@@ -114,16 +128,7 @@ fn a_tendon_on_the_exact_circle_lies_at_its_offset_from_the_arc() {
     // p(X) = (sin θ/κ + d_z sin θ, d_y, −(1 − cos θ)/κ + d_z cos θ); interpolated between the
     // points (cubic Hermite with the tangent R t_u) it is exact at them and O(h⁴) between
     let (r, l, e, mom, dy, dz) = (0.01, 0.5, 1e6, 0.01, 0.006, 0.004);
-    let tendon = Tendon {
-        offset_start: [dy, dz],
-        offset_end: [dy, dz],
-        x_start: 0.0,
-        x_end: l,
-        friction: 0.0,
-        friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
-        turns: 0.0,
-        path: Vec::new(),
-    };
+    let tendon = straight_tendon([dy, dz], l, 0.0);
     let m = model(
         Rod::tapered(mat(e, 0.0), l, r, r),
         8,
@@ -286,16 +291,7 @@ fn hanging_rod_stretches_by_rho_g_l2_over_2e() {
 fn constant_offset_tendon_gives_uniform_curvature_and_contraction() {
     // k₂ = u d/EI, ν₁ = 1 + u/EA, all else 0 (gvs-spec §10.3.6)
     let (r, l, e, d, t) = (0.01, 0.5, 1e6, 0.008, 0.5);
-    let tendon = Tendon {
-        offset_start: [0.0, d],
-        offset_end: [0.0, d],
-        x_start: 0.0,
-        x_end: l,
-        friction: 0.0,
-        friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
-        turns: 0.0,
-        path: Vec::new(),
-    };
+    let tendon = straight_tendon([0.0, d], l, 0.0);
     let m = model(
         Rod::tapered(mat(e, 0.0), l, r, r),
         8,
@@ -317,16 +313,7 @@ fn constant_offset_tendon_gives_uniform_curvature_and_contraction() {
 fn constant_offset_tendon_with_friction_follows_capstan_curvature() {
     // k₂(X) = (u d/EI)/(1 + μ|u| d X/EI): Θ' = |k₂|, α = e^{−μΘ} (gvs-spec §10.3.7)
     let (r, l, e, d, t, mu) = (0.01, 0.5, 1e6, 0.008, 0.5, 0.5);
-    let tendon = Tendon {
-        offset_start: [0.0, d],
-        offset_end: [0.0, d],
-        x_start: 0.0,
-        x_end: l,
-        friction: mu,
-        friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
-        turns: 0.0,
-        path: Vec::new(),
-    };
+    let tendon = straight_tendon([0.0, d], l, mu);
     let m = model(
         Rod::tapered(mat(e, 0.0), l, r, r),
         60,
@@ -360,16 +347,7 @@ fn capstan_curvature_holds_across_a_division_junction() {
         material: mat(e, 0.0),
         divisions: vec![part(cut), part(l - cut)],
     };
-    let tendon = Tendon {
-        offset_start: [0.0, d],
-        offset_end: [0.0, d],
-        x_start: 0.0,
-        x_end: l,
-        friction: mu,
-        friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
-        turns: 0.0,
-        path: Vec::new(),
-    };
+    let tendon = straight_tendon([0.0, d], l, mu);
     let (g1, g2) = (Quadrature::Gauss { n: 30 }, Quadrature::Gauss { n: 40 });
     let disc = Discretization::new(&rod, &[g1, g2], MagnusOrder::Z4, &[]).unwrap();
     let b = legendre([None, Some(8), None, Some(8), None, Some(2)]);
