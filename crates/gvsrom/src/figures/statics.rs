@@ -81,7 +81,12 @@ impl StaticsDoc {
     fn caption(&self) -> String {
         let mut s = self.scenario.clone();
         if !self.u.is_empty() {
-            let u: Vec<String> = self.u.iter().map(|v| format!("{v:.3}")).collect();
+            // to the millinewton, without trailing zeros: "-20", "-2.5"
+            let u: Vec<String> = self
+                .u
+                .iter()
+                .map(|v| format!("{}", (v * 1e3).round() / 1e3 + 0.0))
+                .collect();
             s.push_str(&format!(", u = [{}] N", u.join(", ")));
         }
         if let Some(m) = &self.model {
