@@ -216,6 +216,26 @@ fn simulation_writes_numpy_arrays_with_consistent_shapes() {
         npy_shape(&out_dir.join("strain_reference.npy")),
         vec![14, 6]
     );
+    // each tendon's thread at the 21 centreline abscissae clamped to its span: at rest (the first
+    // sample) tendon 0 runs on the surface at angle 0 from (0, 0.02, 0) to (0.6, 0.01, 0) and
+    // tendon 1, half length at 60°, ends at X = 0.3 m on the radius 0.015 m
+    assert_eq!(
+        npy_shape(&out_dir.join("tendon_paths.npy")),
+        vec![51, 6, 21, 3]
+    );
+    let paths = npy_values(&out_dir.join("tendon_paths.npy"));
+    let at = |tendon: usize, k: usize| &paths[3 * (tendon * 21 + k)..3 * (tendon * 21 + k) + 3];
+    let (s60, c60) = 60f64.to_radians().sin_cos();
+    for (got, want) in [
+        (at(0, 0), [0.0, 0.02, 0.0]),
+        (at(0, 20), [0.6, 0.01, 0.0]),
+        (at(1, 20), [0.3, 0.015 * c60, 0.015 * s60]),
+    ] {
+        assert!(
+            got.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-12),
+            "{got:?} vs {want:?}"
+        );
+    }
     // babbled tensions stay in range and the same seed gives the same signal
     let u = npy_values(&out_dir.join("u.npy"));
     assert!(u.iter().all(|v| (-15.0..0.0).contains(v)));

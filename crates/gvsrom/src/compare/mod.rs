@@ -292,6 +292,7 @@ mod tests {
             ),
             centerline_x: None,
             centerline: None,
+            tendon_paths: None,
             provenance: None,
             extrapolated: vec![],
         }

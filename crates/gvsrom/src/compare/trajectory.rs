@@ -45,6 +45,10 @@ pub struct Trajectory {
     /// `samples × centerline_x.len() × 3`: the centreline positions \[m\] (`centerline.npy`), with
     /// `centerline_x`.
     pub centerline: Option<Vec<f64>>,
+    /// `samples × tendons × centerline_x.len() × 3`: each tendon's thread \[m\]
+    /// (`tendon_paths.npy`; with tendons, in trajectories written since it was recorded), and the
+    /// number of tendons.
+    pub tendon_paths: Option<(usize, Vec<f64>)>,
     /// How the run was made (`provenance`), if recorded.
     pub provenance: Option<Value>,
     /// How its reduced model was used outside what it was trained on (`model_extrapolated`,
@@ -133,6 +137,14 @@ impl Trajectory {
             Some(x) => Some(read("centerline.npy", &[n, x.len(), 3])?),
             None => None,
         };
+        let file = crate::simulate::TENDON_PATHS_FILE;
+        let tendon_paths = match (&centerline_x, files.lists(file)) {
+            (Some(x), true) => {
+                let na = count("n_actuators")?;
+                Some((na, read(file, &[n, na, x.len(), 3])?))
+            }
+            _ => None,
+        };
         Ok(Trajectory {
             dir: dir.to_path_buf(),
             origin,
@@ -152,6 +164,7 @@ impl Trajectory {
             physics: meta.get("physics").filter(|v| v.is_object()).cloned(),
             centerline_x,
             centerline,
+            tendon_paths,
             provenance: meta.get("provenance").filter(|v| v.is_object()).cloned(),
             extrapolated: (meta["model_extrapolated"].as_array().into_iter().flatten())
                 .filter_map(|v| v.as_str().map(str::to_string))

@@ -28,6 +28,9 @@ pub struct Centerlines {
     pub x: Vec<f64>,
     /// `samples`, each `x.len()` points \[m\].
     pub shapes: Vec<Vec<[f64; 3]>>,
+    /// `samples`, each the tendons' threads at `x` clamped to their spans \[m\] (none in a
+    /// trajectory written before they were recorded, or without tendons).
+    pub tendons: Vec<Vec<Vec<[f64; 3]>>>,
 }
 
 /// The centrelines `Trajectory::load` read (and checked against their recorded hash): `None` for
@@ -48,9 +51,22 @@ pub fn centerlines(tr: &Trajectory) -> Result<Option<Centerlines>, FiguresError>
         .chunks_exact(3 * x.len())
         .map(|s| s.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect())
         .collect();
+    let tendons = match &tr.tendon_paths {
+        Some((na, v)) if *na > 0 => v
+            .chunks_exact(na * 3 * x.len())
+            .map(|sample| {
+                sample
+                    .chunks_exact(3 * x.len())
+                    .map(|t| t.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect())
+                    .collect()
+            })
+            .collect(),
+        _ => vec![],
+    };
     Ok(Some(Centerlines {
         x: x.clone(),
         shapes,
+        tendons,
     }))
 }
 
@@ -252,8 +268,8 @@ fn rod_figures(
     sink.animation("rod_animation", &frames, (960, 440), delay_ms)
 }
 
-/// One frame: the rod at sample `k` in 3-D and seen from the side (with the tip's path so far), on
-/// the axes of the whole run.
+/// One frame: the rod at sample `k` (with its tendons, blue, when the trajectory records them) in
+/// 3-D and seen from the side (with the tip's path so far), on the axes of the whole run.
 fn animation_frame(tr: &Trajectory, c: &Centerlines, k: usize, bounds: &[[f64; 3]]) -> Figure {
     let rod = Series3::new("", c.shapes[k].clone(), SeriesStyle::Line).with_color(palette::HOM);
     let trace = Series3::new(
@@ -264,7 +280,11 @@ fn animation_frame(tr: &Trajectory, c: &Centerlines, k: usize, bounds: &[[f64; 3
     .with_color(palette::EXTRA[6]);
     let tip_now = Series3::new("", vec![tip(tr, k)], SeriesStyle::Markers).with_color(palette::POD);
     let box3 = Series3::new("", bounds.to_vec(), SeriesStyle::Bounds);
-    let series = vec![trace, rod, tip_now];
+    let mut series = vec![trace];
+    for path in c.tendons.get(k).into_iter().flatten() {
+        series.push(Series3::new("", path.clone(), SeriesStyle::Line).with_color(palette::POD_ALT));
+    }
+    series.extend([rod, tip_now]);
     let mut in_3d = series.clone();
     in_3d.push(box3);
     Figure::Grid {

@@ -13,6 +13,9 @@ pub(super) struct Centerline {
     pub(super) ws: gvs::model::Workspace,
     /// `c × 3` positions of the current sample.
     pub(super) points: Vec<f64>,
+    /// `tendons × c × 3`: each tendon's thread `r + R d(X)` at the abscissae `x` clamped to its
+    /// span ([`gvs::model::Model::tendon_position_at`]), of the current sample.
+    pub(super) tendons: Vec<f64>,
 }
 
 impl Centerline {
@@ -27,6 +30,7 @@ impl Centerline {
             q: nalgebra::DVector::zeros(n),
             ws,
             points: vec![0.0; 3 * c],
+            tendons: vec![0.0; 3 * c * built.model.n_actuators()],
         }
     }
 
@@ -44,6 +48,19 @@ impl Centerline {
         for (k, &x) in self.x.iter().enumerate() {
             let p = model.position_at(&self.ws, x);
             self.points[3 * k..3 * k + 3].copy_from_slice(&[p[0], p[1], p[2]]);
+        }
+        let c = self.x.len();
+        for t in 0..model.tendons.len() {
+            let pts = model.tendon_points(t);
+            let (Some(&a), Some(&b)) = (pts.first(), pts.last()) else {
+                continue;
+            };
+            let (xa, xb) = (model.disc.points[a].x, model.disc.points[b].x);
+            for (k, &x) in self.x.iter().enumerate() {
+                let p = model.tendon_position_at(&self.ws, t, x.clamp(xa, xb));
+                let o = 3 * (t * c + k);
+                self.tendons[o..o + 3].copy_from_slice(&[p[0], p[1], p[2]]);
+            }
         }
     }
 }

@@ -14,6 +14,10 @@ use serde::Serialize;
 use std::ops::ControlFlow;
 use std::path::{Path, PathBuf};
 
+/// The file of per-sample tendon paths in a trajectory: `[samples, tendons, c, 3]`, each tendon's
+/// thread at the centreline abscissae clamped to its span (written only with tendons).
+pub const TENDON_PATHS_FILE: &str = "tendon_paths.npy";
+
 /// Largest trajectory one run writes \[bytes\] (16 GiB).
 pub const MAX_OUTPUT_BYTES: f64 = 16.0 * 1024.0 * 1024.0 * 1024.0;
 
@@ -109,11 +113,12 @@ pub fn run_to_dir(
 }
 
 /// Bytes written per sample: `t`, `q`, `q̇`, `u`, tip position and rotation, strains, centreline
-/// (f64 each).
+/// and tendon paths (f64 each).
 pub(super) fn bytes_per_sample(built: &Built) -> f64 {
     let m = &built.model;
     let c = built.centerline_points.max(2);
-    8.0 * (1 + 2 * built.n_dof() + m.n_actuators() + 3 + 9 + 6 * m.disc.n_points() + 3 * c) as f64
+    let (na, np) = (m.n_actuators(), m.disc.n_points());
+    8.0 * (1 + 2 * built.n_dof() + na + 3 + 9 + 6 * np + 3 * c * (1 + na)) as f64
 }
 
 /// Refuses a trajectory larger than [`MAX_OUTPUT_BYTES`] before anything is computed.
@@ -146,6 +151,8 @@ pub struct TrajectoryWriter {
     tip_rotation: NpyRows,
     strain: NpyRows,
     centerline: NpyRows,
+    /// `tendon_paths.npy`, with tendons only.
+    tendon_paths: Option<NpyRows>,
     shape: Centerline,
     provenance: Option<serde_json::Value>,
 }
@@ -173,6 +180,13 @@ impl TrajectoryWriter {
         };
         let (t, q, qd, u, tip_position, tip_rotation, strain, centerline) =
             open(&mut dir).map_err(|e| dir.io_error("create the trajectory files", e))?;
+        let tendon_paths = match na {
+            0 => None,
+            _ => Some(
+                NpyRows::new(&mut dir, TENDON_PATHS_FILE, &[na, nc, 3])
+                    .map_err(|e| dir.io_error("create the trajectory files", e))?,
+            ),
+        };
         Ok(TrajectoryWriter {
             dir,
             t,
@@ -183,6 +197,7 @@ impl TrajectoryWriter {
             tip_rotation,
             strain,
             centerline,
+            tendon_paths,
             shape,
             provenance: None,
         })
@@ -207,6 +222,9 @@ impl TrajectoryWriter {
         }
         self.shape.sample(built, s.q);
         self.centerline.push(self.shape.points.iter().copied())?;
+        if let Some(tp) = &mut self.tendon_paths {
+            tp.push(self.shape.tendons.iter().copied())?;
+        }
         self.t.push([s.t])?;
         self.q.push(s.q.iter().copied())?;
         self.qd.push(s.qd.iter().copied())?;
@@ -244,13 +262,14 @@ impl TrajectoryWriter {
             tip_rotation,
             strain,
             centerline,
+            tendon_paths,
             shape,
             provenance,
         } = self;
         let samples = t.rows();
         let arrays = [t, q, qd, u, tip_position, tip_rotation, strain, centerline];
         (|| -> std::io::Result<()> {
-            for a in arrays {
+            for a in arrays.into_iter().chain(tendon_paths) {
                 a.finish(&mut dir)?;
             }
             crate::npy::write_array(
