@@ -74,7 +74,8 @@ impl Robot {
     /// dict
     ///     ``t`` (k,), ``q``/``qd`` (k, n), ``u`` (k, n_a), ``tip_position`` (k, 3),
     ///     ``tip_rotation`` (k, 3, 3), ``strain`` (k, p, 6), ``strain_x`` (p,), ``centerline``
-    ///     (k, c, 3), ``centerline_x`` (c,), ``steps``, ``failed_steps``, ``wall_time_s``, and
+    ///     (k, c, 3), ``centerline_x`` (c,), ``tendon_paths`` (k, n_a, c, 3: each tendon's thread
+    ///     at ``centerline_x`` clamped to its span), ``steps``, ``failed_steps``, ``wall_time_s``, and
     ///     ``model_extrapolated`` (list of str): how the reduced model was used outside what it
     ///     was trained on (``extrapolate=True``; the scenario, a signal's tensions, the values a
     ///     callable ``input`` returned), empty otherwise.
@@ -526,6 +527,10 @@ fn trajectory<'py>(
     d.set_item("strain_x", vector(py, &x))?;
     d.set_item("centerline", shaped(py, b.centerline.clone(), [k, c, 3])?)?;
     d.set_item("centerline_x", vector(py, b.centerline_x()))?;
+    d.set_item(
+        "tendon_paths",
+        shaped(py, b.tendon_paths.clone(), [k, na, c, 3])?,
+    )?;
     let s = &outcome.summary;
     d.set_item("steps", s.stats.steps)?;
     d.set_item("failed_steps", s.stats.failed_steps)?;

@@ -11,7 +11,7 @@ import pytest
 import gvsrom
 from conftest import run_cli
 
-ARRAYS = ["t", "q", "qd", "u", "tip_position", "tip_rotation", "strain", "centerline"]
+ARRAYS = ["t", "q", "qd", "u", "tip_position", "tip_rotation", "strain", "centerline", "tendon_paths"]
 
 
 def test_simulate_equals_the_cli_trajectory(gvsrom_bin, tmp_path):

@@ -22,6 +22,9 @@ pub struct TrajectoryBuffer {
     pub strain: Vec<f64>,
     /// `samples × c × 3`, at [`Self::centerline_x`].
     pub centerline: Vec<f64>,
+    /// `samples × tendons × c × 3`: each tendon's thread at [`Self::centerline_x`] clamped to its
+    /// span (`tendon_paths.npy` of a written trajectory).
+    pub tendon_paths: Vec<f64>,
     shape: Centerline,
 }
 
@@ -37,6 +40,7 @@ impl TrajectoryBuffer {
             tip_rotation: vec![],
             strain: vec![],
             centerline: vec![],
+            tendon_paths: vec![],
             shape: Centerline::new(built),
         }
     }
@@ -57,6 +61,7 @@ impl SampleSink for TrajectoryBuffer {
         }
         self.shape.sample(built, s.q);
         self.centerline.extend_from_slice(&self.shape.points);
+        self.tendon_paths.extend_from_slice(&self.shape.tendons);
         self.t.push(s.t);
         self.q.extend_from_slice(s.q);
         self.qd.extend_from_slice(s.qd);
