@@ -209,6 +209,16 @@ impl<P: StrainParam> Model<P> {
     pub fn tendon_points(&self, k: usize) -> &[usize] {
         &self.tendon_points[k]
     }
+
+    /// Abscissae `[X_first, X_last]` \[m\] of tendon `k`'s first and last computational points
+    /// (where [`Model::tendon_position_at`] interpolates); `None` for a tendon with no point.
+    pub fn tendon_extent(&self, k: usize) -> Option<(f64, f64)> {
+        let pts = &self.tendon_points[k];
+        Some((
+            self.disc.points[*pts.first()?].x,
+            self.disc.points[*pts.last()?].x,
+        ))
+    }
 }
 
 /// The computational points on a tendon's span. At a termination (or start) on a division junction

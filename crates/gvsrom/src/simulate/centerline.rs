@@ -51,11 +51,9 @@ impl Centerline {
         }
         let c = self.x.len();
         for t in 0..model.tendons.len() {
-            let pts = model.tendon_points(t);
-            let (Some(&a), Some(&b)) = (pts.first(), pts.last()) else {
+            let Some((xa, xb)) = model.tendon_extent(t) else {
                 continue;
             };
-            let (xa, xb) = (model.disc.points[a].x, model.disc.points[b].x);
             for (k, &x) in self.x.iter().enumerate() {
                 let p = model.tendon_position_at(&self.ws, t, x.clamp(xa, xb));
                 let o = 3 * (t * c + k);

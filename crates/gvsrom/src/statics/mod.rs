@@ -356,11 +356,9 @@ fn tendon_paths<P: StrainParam>(
 ) -> Vec<Vec<[f64; 3]>> {
     (0..model.tendons.len())
         .map(|k| {
-            let pts = model.tendon_points(k);
-            let (Some(&a), Some(&b)) = (pts.first(), pts.last()) else {
+            let Some((xa, xb)) = model.tendon_extent(k) else {
                 return vec![];
             };
-            let (xa, xb) = (model.disc.points[a].x, model.disc.points[b].x);
             std::iter::once(xa)
                 .chain(xs.iter().copied().filter(|&x| x > xa && x < xb))
                 .chain(std::iter::once(xb))
