@@ -11,7 +11,7 @@ use gvs::discretize::{Discretization, MagnusOrder, Quadrature};
 use gvs::inputs::Signal;
 use gvs::loads::Loads;
 use gvs::model::Model;
-use gvs::rod::{Material, Rod, SectionProps};
+use gvs::rod::SectionProps;
 use gvs::solve::dynamics::{simulate, InitialState, IntegratorOptions, Method, OdeJacobian};
 use gvs::solve::ode::{FixedStepOptions, NdfOptions};
 use gvs::solve::statics::{solve_statics, StaticsOptions};
@@ -20,13 +20,7 @@ use nalgebra::DVector;
 use std::f64::consts::PI;
 
 fn arm(damping: f64, friction: f64) -> Model<LinearBasis> {
-    let mat = Material {
-        youngs_modulus: 0.617e6,
-        poisson_ratio: 0.5,
-        density: 1121.0,
-        damping,
-    };
-    let rod = Rod::tapered(mat, 0.25, 0.0125, 0.005);
+    let rod = common::iva_rod(damping);
     let disc =
         Discretization::new(&rod, &[Quadrature::Gauss { n: 12 }], MagnusOrder::Z4, &[]).unwrap();
     let b = LinearBasis::per_division(

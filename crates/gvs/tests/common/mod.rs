@@ -44,6 +44,18 @@ pub fn pseudo_random(n: usize, seed: u64, a: f64) -> DVector<f64> {
     })
 }
 
+/// The IV-A arm's rod: L = 0.25 m tapered 12.5 → 5 mm, E = 0.617 MPa, ν = 0.5, ρ = 1121 kg/m³,
+/// material damping `damping` [Pa·s].
+pub fn iva_rod(damping: f64) -> Rod {
+    let mat = Material {
+        youngs_modulus: 0.617e6,
+        poisson_ratio: 0.5,
+        density: 1121.0,
+        damping,
+    };
+    Rod::tapered(mat, 0.25, 0.0125, 0.005)
+}
+
 /// The IV-A tapered rod in 3-D: L = 0.25 m, r 12.5 → 5 mm, E = 0.617 MPa, ν = ½, ρ = 1121 kg/m³,
 /// Kelvin–Voigt `damping` [Pa·s]; all six modes (Legendre orders [1, 2, 2, 1, 1, 1]: torsion, two
 /// bending planes, stretch and two shears; 14 coordinates), `gauss` points, Z4, the weight-0
@@ -54,13 +66,7 @@ pub fn iva_rod_3d(
     extra: &[f64],
     tendons: Vec<gvs::actuation::Tendon>,
 ) -> Model<LinearBasis> {
-    let mat = Material {
-        youngs_modulus: 0.617e6,
-        poisson_ratio: 0.5,
-        density: 1121.0,
-        damping,
-    };
-    let rod = Rod::tapered(mat, 0.25, 0.0125, 0.005);
+    let rod = iva_rod(damping);
     let disc = Discretization::new(
         &rod,
         &[Quadrature::Gauss { n: gauss }],
