@@ -15,7 +15,7 @@ use super::*;
 
 impl<P: StrainParam> Model<P> {
     /// Loads that are all zero (no gravity, no wrenches).
-    fn no_loads(&self) -> PreparedLoads {
+    pub(crate) fn no_loads(&self) -> PreparedLoads {
         let np = self.disc.n_points();
         PreparedLoads {
             gravity: V3::zeros(),

@@ -10,13 +10,19 @@
 //!
 //! so what it neglects is `−M⁻¹ (∂(Cq̇)/∂q + (∂M/∂q) q̈)` and `−M⁻¹ ∂(Cq̇)/∂q̇`: zero at rest in an
 //! equilibrium (`q̇ = 0`, `q̈ = 0`; `C q̇` is quadratic in `q̇`), where it is exact.
+//!
+//! The full linearization `Model::linearize` (`A = ∂f/∂x`, `B = ∂f/∂u`) keeps those terms: it is
+//! checked here in motion against the same differences, in the tensions, on a nonlinear strain
+//! parameterization, at rest against the approximation, and on a Kelvin–Voigt rod against the
+//! poles its undamped modes imply.
 
 use gvs::actuation::{Tendon, DEFAULT_FRICTION_SMOOTHING};
 use gvs::loads::{Frame, Loads, PointWrench};
 use gvs::model::{Model, PreparedLoads};
 use gvs::solve::statics::{solve_statics, StaticsOptions};
-use gvs::strain::LinearBasis;
-use nalgebra::{DMatrix, DVector};
+use gvs::discretize::{Discretization, MagnusOrder, Quadrature};
+use gvs::strain::{LinearBasis, SigmoidBend, StrainParam};
+use nalgebra::{Complex, DMatrix, DVector};
 mod common;
 
 use common::pseudo_random;
@@ -79,10 +85,21 @@ fn rhs(
     q: &DVector<f64>,
     qd: &DVector<f64>,
 ) -> DVector<f64> {
+    rhs_at(m, pl, q, qd, &U)
+}
+
+/// `f(q, q̇, u) = [q̇; M⁻¹ τ]` for any parameterization and tensions.
+fn rhs_at<P: StrainParam>(
+    m: &Model<P>,
+    pl: &PreparedLoads,
+    q: &DVector<f64>,
+    qd: &DVector<f64>,
+    u: &[f64],
+) -> DVector<f64> {
     let n = m.n_dof();
     let mut ws = m.workspace();
     let mut qdd = DVector::zeros(n);
-    m.accelerations(q, qd, &U, pl, &mut ws, &mut qdd).unwrap();
+    m.accelerations(q, qd, u, pl, &mut ws, &mut qdd).unwrap();
     let mut f = DVector::zeros(2 * n);
     f.rows_mut(0, n).copy_from(qd);
     f.rows_mut(n, n).copy_from(&qdd);
@@ -95,6 +112,16 @@ fn fd_jacobian(
     pl: &PreparedLoads,
     q: &DVector<f64>,
     qd: &DVector<f64>,
+) -> DMatrix<f64> {
+    fd_jacobian_at(m, pl, q, qd, &U)
+}
+
+fn fd_jacobian_at<P: StrainParam>(
+    m: &Model<P>,
+    pl: &PreparedLoads,
+    q: &DVector<f64>,
+    qd: &DVector<f64>,
+    u: &[f64],
 ) -> DMatrix<f64> {
     let n = m.n_dof();
     let mut jf = DMatrix::zeros(2 * n, 2 * n);
@@ -111,7 +138,7 @@ fn fd_jacobian(
             qdp[j - n] += h;
             qdm[j - n] -= h;
         }
-        let col = (rhs(m, pl, &qp, &qdp) - rhs(m, pl, &qm, &qdm)) / (2.0 * h);
+        let col = (rhs_at(m, pl, &qp, &qdp, u) - rhs_at(m, pl, &qm, &qdm, u)) / (2.0 * h);
         jf.set_column(j, &col);
     }
     jf
@@ -195,4 +222,140 @@ fn ode_jacobian_approx_neglects_only_the_inertial_terms_in_motion() {
         err < 1e-6,
         "J_FD vs J_approx + neglected: {err:e} (J_FD − J_approx alone: {share:e})"
     );
+}
+
+/// In the same moving state as above, where the approximation misses a visible share, the full
+/// linearization `A` equals central differences of `f` (`‖A − J_FD‖_F ≤ 1e-6 ‖J_FD‖_F`, 1000×
+/// below that share), and `ẋ` is `f` itself.
+#[test]
+fn linearization_matches_differences_of_the_right_hand_side_in_motion() {
+    let m = model();
+    let n = m.n_dof();
+    let q = pseudo_random(n, 51, 0.5);
+    let qd = pseudo_random(n, 52, 3.0);
+    let pl = m.prepare_loads(&loads()).unwrap();
+    let mut ws = m.workspace();
+    let lin = m.linearize(&q, &qd, &U, &pl, &mut ws).unwrap();
+    let fd = fd_jacobian(&m, &pl, &q, &qd);
+    let share = (&fd - approx(&m, &q, &pl)).norm() / fd.norm();
+    let err = (&lin.a - &fd).norm() / fd.norm();
+    assert!(share > 1e-3, "approximation's miss {share:e}: the state is too quiet to tell");
+    assert!(err < 1e-6, "A vs FD: {err:e} (the approximation misses {share:e})");
+    let f = rhs(&m, &pl, &q, &qd);
+    assert!((&lin.xdot - &f).amax() <= 1e-12 * f.amax(), "ẋ is not f(x, u)");
+    // the top blocks are exactly [0 I]
+    for i in 0..n {
+        for j in 0..2 * n {
+            assert_eq!(lin.a[(i, j)], if j == n + i { 1.0 } else { 0.0 });
+        }
+    }
+}
+
+/// `B = ∂f/∂u` against central differences in each tension (friction on tendon 1, so the
+/// capstan's decay of the tension is in it), in motion: ≤ 1e-7 relative per column; the top
+/// half is zero.
+#[test]
+fn linearization_input_matrix_matches_differences_in_the_tensions() {
+    let m = model();
+    let n = m.n_dof();
+    let q = pseudo_random(n, 53, 0.5);
+    let qd = pseudo_random(n, 54, 2.0);
+    let pl = m.prepare_loads(&loads()).unwrap();
+    let mut ws = m.workspace();
+    let lin = m.linearize(&q, &qd, &U, &pl, &mut ws).unwrap();
+    assert_eq!(lin.b.shape(), (2 * n, 2));
+    for k in 0..2 {
+        let (mut up, mut um) = (U, U);
+        let h = 1e-4;
+        up[k] += h;
+        um[k] -= h;
+        let col = (rhs_at(&m, &pl, &q, &qd, &up) - rhs_at(&m, &pl, &q, &qd, &um)) / (2.0 * h);
+        let err = (lin.b.column(k) - &col).norm() / col.norm();
+        assert!(col.norm() > 0.0 && err < 1e-7, "B column {k}: {err:e}");
+        assert!(lin.b.column(k).rows(0, n).iter().all(|v| *v == 0.0));
+    }
+}
+
+/// At the equilibrium at rest the inertial terms vanish and `A` is the analytic approximation
+/// to rounding (no differences are taken), with `ẋ ≈ 0`.
+#[test]
+fn linearization_at_an_equilibrium_at_rest_is_analytic() {
+    let m = model();
+    let n = m.n_dof();
+    let tight = StaticsOptions {
+        ftol: 1e-13,
+        ..StaticsOptions::default()
+    };
+    let qe = solve_statics(&m, &U, &loads(), None, &tight).unwrap().q;
+    let pl = m.prepare_loads(&loads()).unwrap();
+    let mut ws = m.workspace();
+    let lin = m.linearize(&qe, &DVector::zeros(n), &U, &pl, &mut ws).unwrap();
+    assert!(lin.xdot.amax() < 1e-6, "not at rest: {:e}", lin.xdot.amax());
+    let a = approx(&m, &qe, &pl);
+    let err = (&lin.a - &a).norm() / a.norm();
+    assert!(err < 1e-9, "A vs the analytic approximation at rest: {err:e}");
+}
+
+/// On a nonlinear strain parameterization (a sigmoid bend, the decoder-like path of the reduced
+/// models) in motion under gravity: `A` against central differences of `f`, ≤ 1e-6.
+#[test]
+fn linearization_of_a_nonlinear_parameterization_matches_differences() {
+    let rod = common::iva_rod(1e4);
+    let disc =
+        Discretization::new(&rod, &[Quadrature::Gauss { n: 12 }], MagnusOrder::Z4, &[]).unwrap();
+    let p = SigmoidBend::new(&disc);
+    let m = Model::new(rod, disc, p, vec![]).unwrap();
+    let n = m.n_dof();
+    // amplitude 1.2, steepness 7, centre 0.4: M's condition number ~1e6 (a flat sigmoid, amplitude
+    // near 0, makes M nearly singular, 1e13, and differences of f meaningless)
+    let q = DVector::from_vec(vec![1.2, 7.0, 0.4]);
+    let qd = DVector::from_vec(vec![0.8, -4.0, 0.3]);
+    let pl = m.prepare_loads(&loads()).unwrap();
+    let mut ws = m.workspace();
+    let lin = m.linearize(&q, &qd, &[], &pl, &mut ws).unwrap();
+    let fd = fd_jacobian_at(&m, &pl, &q, &qd, &[]);
+    let err = (&lin.a - &fd).norm() / fd.norm();
+    assert!(err < 1e-6, "A vs FD on the sigmoid bend: {err:e}");
+    assert_eq!(lin.b.ncols(), 0);
+}
+
+/// A straight Kelvin–Voigt rod (ν = ½: `Ds = t_d Es` in every component, `t_d = 3η/E`) without
+/// loads: `D = t_d K`, so each undamped mode `(ω, φ)` of `Model::linearized_modes` (a symmetric
+/// eigenproblem, another path) gives the poles `λ² + t_d ω² λ + ω² = 0` with eigenvectors
+/// `[φ; λφ]`: `‖A v − λ v‖ ≤ 1e-8 ‖λ v‖` for the six lowest modes, under- and overdamped.
+#[test]
+fn linearization_of_a_kelvin_voigt_rod_has_the_poles_of_its_modes() {
+    let eta = 1e3;
+    let m = common::iva_rod_3d(eta, 10, &[], vec![]);
+    let n = m.n_dof();
+    let t_d = 3.0 * eta / 0.617e6;
+    assert!((m.damping_time() - t_d).abs() < 1e-12 * t_d);
+    let pl = m.prepare_loads(&Loads::default()).unwrap();
+    let mut ws = m.workspace();
+    let zero = DVector::zeros(n);
+    let lin = m.linearize(&zero, &zero, &[], &pl, &mut ws).unwrap();
+    let modes = m.linearized_modes(&zero, &[], &pl, &mut ws).unwrap();
+    let a = lin.a.map(|v| Complex::new(v, 0.0));
+    let mut kinds = (0, 0);
+    for mode in &modes {
+        let w2 = mode.omega_squared;
+        let disc = Complex::new((t_d * w2).powi(2) - 4.0 * w2, 0.0).sqrt();
+        if disc.re > 0.0 {
+            kinds.1 += 1;
+        } else {
+            kinds.0 += 1;
+        }
+        for sign in [1.0, -1.0] {
+            let lambda = (Complex::new(-t_d * w2, 0.0) + disc * sign) / 2.0;
+            let mut v = DVector::from_element(2 * n, Complex::new(0.0, 0.0));
+            for i in 0..n {
+                v[i] = Complex::new(mode.shape[i], 0.0);
+                v[n + i] = lambda * mode.shape[i];
+            }
+            let lv = v.map(|c| c * lambda);
+            let res = (&a * &v - &lv).norm() / lv.norm();
+            assert!(res < 1e-8, "mode at ω² = {w2:e}, λ = {lambda}: residual {res:e}");
+        }
+    }
+    assert!(kinds.0 > 0 && kinds.1 > 0, "under/overdamped modes {kinds:?}: both kinds wanted");
 }
