@@ -13,6 +13,7 @@ pub mod dataset;
 pub mod error;
 pub mod figures;
 pub mod layout;
+pub mod linearize;
 pub mod modes;
 pub mod npy;
 pub mod output;

@@ -4,6 +4,7 @@
 
 mod compare;
 mod equilibrium;
+mod linearize;
 mod plot;
 mod print;
 mod reduction;
@@ -15,6 +16,7 @@ pub use signals::Interrupted;
 
 use compare::*;
 use equilibrium::*;
+use linearize::*;
 use plot::*;
 use print::*;
 use reduction::*;
@@ -59,6 +61,10 @@ pub enum Command {
     /// Natural frequencies and mode shapes about the static equilibrium under the scenario's loads
     /// and tensions (undamped, linearized; see docs/modes.md).
     Modes(ModesArgs),
+    /// The equations of motion linearized about the static equilibrium, for control design:
+    /// `δẋ = A δx + B δu`, `δy = C δx` (state `[q; q̇]`, tendon tensions, tip position), its poles
+    /// and the static gain from tensions to tip (see docs/linearize.md).
+    Linearize(LinearizeArgs),
     /// Generate a strain snapshot dataset: solve the statics over a sampling plan (`--sweep`,
     /// `--grid`, `--random`) in parallel and write NumPy arrays (see docs/datasets.md).
     Dataset(DatasetArgs),
@@ -137,6 +143,7 @@ pub fn run(cli: Cli, out: &mut impl Write) -> Result<()> {
         Command::Statics(args) => statics_cmd(&args, out),
         Command::Simulate(args) => simulate_cmd(&args, out),
         Command::Modes(args) => modes_cmd(&args, out),
+        Command::Linearize(args) => linearize_cmd(&args, out),
         Command::Dataset(args) => dataset_cmd(&args, out),
         Command::Pod(args) => pod_cmd(&args, out),
         Command::Train(args) => train_cmd(&args, out),

@@ -1,0 +1,138 @@
+//! `gvsrom linearize`.
+
+use super::*;
+
+#[derive(Debug, Args)]
+pub struct LinearizeArgs {
+    #[command(flatten)]
+    pub scenario: ScenarioArgs,
+
+    /// Number of poles printed, slowest first (an integer ≥ 1, default 10); the `--json` file holds
+    /// them all.
+    #[arg(long, value_name = "K", allow_hyphen_values = true)]
+    pub count: Option<String>,
+
+    /// Also write the operating point, `A`, `B`, `C`, the poles and the static gain as JSON to FILE
+    /// (a new file; see `--force`).
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+
+    /// Replace FILE if it is an earlier gvsrom output (never anything else).
+    #[arg(long, requires = "json")]
+    pub force: bool,
+
+    /// Use the reduced model in directory MODEL (from `gvsrom pod` or `gvsrom train`) in place of
+    /// the scenario's basis, for the equilibrium and the linearization (2r states).
+    #[arg(long, value_name = "MODEL")]
+    pub model: Option<PathBuf>,
+}
+
+pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Result<()> {
+    super::extrapolate_needs_model(&args.scenario, args.model.as_deref())?;
+    use gvsrom::linearize;
+    if let Some(path) = &args.json {
+        let inputs = scenario_inputs(&args.scenario, args.model.as_ref());
+        gvsrom::output::refuse_overlap("--json", path, &inputs)?;
+    }
+    let mut r = load(&args.scenario)?;
+    if let Some(dir) = &args.model {
+        attach_model(&mut r, &args.scenario, dir, false)?;
+    }
+    let provenance = r.provenance.clone().solver(&r.built.options);
+    let (scenario, built) = (&r.scenario, &r.built);
+    let n_states = 2 * built.n_dof();
+    let count = linearize::parse_count(args.count.as_deref(), n_states)?;
+    // the output is checked, locked and staged before the solve, so a bad path fails at once
+    let json = match &args.json {
+        Some(path) => Some(OutputFile::create("--json", path, "linearize", args.force)?),
+        None => None,
+    };
+    print_model(scenario, &args.scenario, built, None, out)?;
+    let (eq, lin) = linearize::about_equilibrium(built)?;
+    writeln!(
+        out,
+        "solved     equilibrium in {} and {}, ‖R‖∞ = {:.3e} (as `gvsrom statics`)",
+        plural(eq.iterations, "iteration"),
+        plural(eq.load_stages, "load stage"),
+        eq.residual_norm,
+    )?;
+    writeln!(out, "tip        position {} m", fmt_vec(&eq.tip_position, 6))?;
+    writeln!(
+        out,
+        "system     δẋ = A δx + B δu, δy = C δx: x = [q; q̇] ({n_states} states), u the {} [N], y the tip position (world) [m]",
+        plural(lin.n_actuators, "tendon tension")
+    )?;
+    let shown = count.min(lin.poles.len());
+    writeln!(
+        out,
+        "poles      slowest {shown} of {} (eigenvalues of A; conjugate pairs once)",
+        lin.poles.len()
+    )?;
+    writeln!(
+        out,
+        "{:>4}  {:>14}  {:>14}  {:>14}  {:>13}",
+        "pole", "Re λ [1/s]", "Im λ [rad/s]", "|λ|/2π [Hz]", "damping ratio"
+    )?;
+    let mut unstable = 0;
+    for (k, p) in lin.poles.iter().enumerate() {
+        if p.re > 0.0 {
+            unstable += 1;
+        }
+        if k < shown {
+            writeln!(
+                out,
+                "{:>4}  {:>14.4}  {:>14.4}  {:>14.6}  {:>13.5}",
+                k + 1,
+                p.re,
+                p.im,
+                p.natural_frequency_hz,
+                p.damping_ratio
+            )?;
+        }
+    }
+    if lin.relaxation_poles > 1 {
+        let rate = 1.0 / lin.damping_time_s;
+        writeln!(
+            out,
+            "note       {} of the {} poles lie within 5 % of −1/t_d = −{:.4} 1/s, t_d = {:.4} s the material's relaxation time (Kelvin–Voigt): the slow pole of every overdamped mode tends there (all real when the stiffness is proportional to the damping; loads and tendons, which stiffen the rod unlike its damping, can pair some with small imaginary parts)",
+            lin.relaxation_poles,
+            2 * lin.n_dof,
+            rate,
+            lin.damping_time_s
+        )?;
+    }
+    if unstable > 0 {
+        writeln!(
+            out,
+            "note       {} with Re λ > 0: the equilibrium is unstable",
+            plural(unstable, "pole")
+        )?;
+    }
+    match &lin.static_gain {
+        Some(g) => {
+            writeln!(
+                out,
+                "gain       settled tip displacement per newton of tension, −C A⁻¹ B (world x, y, z) [mm/N]"
+            )?;
+            for k in 0..lin.n_actuators {
+                let col: Vec<f64> = g.iter().map(|row| row[k] * 1e3).collect();
+                writeln!(out, "  tendon {:<3} {}", k + 1, fmt_vec(&col, 4))?;
+            }
+        }
+        None if lin.n_actuators > 0 => {
+            writeln!(out, "gain       none: A is singular at this equilibrium")?;
+        }
+        None => {}
+    }
+    if let Some(json) = json {
+        let doc = linearize::LinearizationJson {
+            report: &lin,
+            model: args.model.as_ref().map(|p| p.display().to_string()),
+            model_extrapolated: (built.reduced.as_ref()).map_or(vec![], |r| r.extrapolated.clone()),
+            provenance: Some(&provenance),
+        };
+        let path = json.commit_json(&doc)?;
+        writeln!(out, "json       {}", path.display())?;
+    }
+    Ok(())
+}

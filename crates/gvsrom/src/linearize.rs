@@ -1,0 +1,267 @@
+//! A scenario's equations of motion linearized for control: `δẋ = A δx + B δu`, `δy = C δx` with the
+//! state `x = [q; q̇]`, the tendon tensions `u` and the tip position `y` in world axes, about the
+//! static equilibrium under the scenario's tensions (as `gvsrom statics` solves it) or about any
+//! state. With a reduced model attached, its `2r`-state linearization: the same engine on the
+//! decoder's coordinates.
+//!
+//! * `A`, `B`: the engine's [`Model::linearize`] (gvs-spec §9.3): exact static part, the inertial
+//!   terms that vanish at rest included in motion.
+//! * `C = [R_tip J_tip,v  0]` (3 × 2n): the tip's world velocity per unit `q̇` (rows 4–6 of the tip
+//!   Jacobian, body frame, rotated to the world).
+//! * Poles: the eigenvalues of `A`, each with its natural frequency `|λ|/2π` and damping ratio
+//!   `ζ = −Re λ / |λ|`; conjugate pairs listed once (`Im λ ≥ 0`), slowest (`|λ|` smallest) first.
+//! * Static gain (about an equilibrium): `G = −C A⁻¹ B` (3 × n_actuators), the tip displacement per
+//!   newton of each tendon once the motion has settled; it equals the derivative of the
+//!   equilibrium's tip position in the tensions.
+
+use crate::build::Built;
+use crate::error::{ScenarioError, StaticsFailure};
+use crate::statics::{self, StaticsReport};
+use gvs::dynamics::{DynamicsError, StateSpace};
+use gvs::model::Model;
+use gvs::strain::StrainParam;
+use gvs::ModelError;
+use nalgebra::{DMatrix, DVector};
+use serde::Serialize;
+use thiserror::Error;
+
+/// Poles printed when `--count` is not given.
+pub const DEFAULT_COUNT: usize = 10;
+
+#[derive(Debug, Error)]
+pub enum LinearizeError {
+    #[error("--count `{value}`: expected an integer ≥ 1 (the number of slowest poles to print; the linearization has {n_poles} states, so at most {n_poles} poles)")]
+    Count { value: String, n_poles: usize },
+    #[error("the equilibrium: {0}")]
+    Statics(#[from] StaticsFailure),
+    #[error(transparent)]
+    Scenario(#[from] ScenarioError),
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    #[error("the linearization: {0}")]
+    Dynamics(#[from] DynamicsError),
+}
+
+/// How many poles to print for `--count text` (`None`: [`DEFAULT_COUNT`]): an integer ≥ 1, else an
+/// error naming the value; a count beyond the poles prints them all.
+pub fn parse_count(text: Option<&str>, n_states: usize) -> Result<usize, LinearizeError> {
+    match text {
+        None => Ok(DEFAULT_COUNT),
+        Some(t) => match t.trim().parse::<usize>() {
+            Ok(k) if k >= 1 => Ok(k),
+            _ => Err(LinearizeError::Count {
+                value: t.to_string(),
+                n_poles: n_states,
+            }),
+        },
+    }
+}
+
+/// One pole of the linearization (an eigenvalue `λ` of `A`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Pole {
+    /// `Re λ` \[1/s\].
+    pub re: f64,
+    /// `Im λ ≥ 0` \[rad/s\] (the conjugate is not listed).
+    pub im: f64,
+    /// `|λ| / 2π` \[Hz\].
+    pub natural_frequency_hz: f64,
+    /// `−Re λ / |λ|`: 0 undamped, 1 critical, > 1 for a real pole's pair, negative if unstable.
+    pub damping_ratio: f64,
+}
+
+/// The linearization (also the `--json` output, with the model path and provenance added).
+#[derive(Debug, Clone, Serialize)]
+pub struct Linearization {
+    pub scenario: String,
+    /// Tendon tensions u₀ \[N\] of the operating point.
+    pub u: Vec<f64>,
+    pub n_dof: usize,
+    pub n_actuators: usize,
+    /// `"equilibrium"` (solved as `gvsrom statics`) or `"state"` (given).
+    pub about: &'static str,
+    /// The operating point's `q` and `q̇`.
+    pub q: Vec<f64>,
+    pub qd: Vec<f64>,
+    /// `ẋ = f(x₀, u₀)` there (≈ 0 about an equilibrium).
+    pub xdot: Vec<f64>,
+    /// Tip position at `q` (world) \[m\].
+    pub tip_position: [f64; 3],
+    /// `A` (2n × 2n), rows.
+    pub a: Vec<Vec<f64>>,
+    /// `B` (2n × n_actuators), rows.
+    pub b: Vec<Vec<f64>>,
+    /// `C` (3 × 2n), rows: the tip position's output matrix.
+    pub c: Vec<Vec<f64>>,
+    /// Every pole (`n` with `Im λ ≥ 0` for an underdamped model; real poles each listed), by `|λ|`.
+    pub poles: Vec<Pole>,
+    /// The material's relaxation time `t_d = min Ds/Es` \[s\] (Kelvin–Voigt: `3η/E`; 0 undamped).
+    pub damping_time_s: f64,
+    /// Poles within 5 % of `−1/t_d`: each overdamped mode of a Kelvin–Voigt rod has its slow pole
+    /// there (`λ² + t_d ω² λ + ω² = 0` → `λ → −1/t_d` as `ω → ∞`), so they cluster: all real when
+    /// the stiffness is proportional to the damping, some paired with small imaginary parts when
+    /// loads and tendons stiffen the rod unlike its damping.
+    pub relaxation_poles: usize,
+    /// Static gain `−C A⁻¹ B` (3 × n_actuators) \[m/N\] about an equilibrium; `None` about a state,
+    /// or if `A` is singular.
+    pub static_gain: Option<Vec<Vec<f64>>>,
+    /// About an equilibrium, its solver's residual `‖R‖∞`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub equilibrium_residual_norm: Option<f64>,
+}
+
+impl Linearization {
+    /// `A` as a matrix.
+    pub fn a_matrix(&self) -> DMatrix<f64> {
+        from_rows(&self.a)
+    }
+
+    /// `B` as a matrix.
+    pub fn b_matrix(&self) -> DMatrix<f64> {
+        from_rows(&self.b)
+    }
+
+    /// `C` as a matrix.
+    pub fn c_matrix(&self) -> DMatrix<f64> {
+        from_rows(&self.c)
+    }
+}
+
+/// The `--json` document: the linearization, the reduced model used and how it was made.
+#[derive(Debug, Serialize)]
+pub struct LinearizationJson<'a> {
+    #[serde(flatten)]
+    pub report: &'a Linearization,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub model: Option<String>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub model_extrapolated: Vec<String>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub provenance: Option<&'a crate::provenance::Provenance>,
+}
+
+/// Solves the equilibrium of `built` (as `gvsrom statics` does, with the reduced model if one is
+/// attached) and linearizes about it, at rest.
+pub fn about_equilibrium(
+    built: &Built,
+) -> Result<(StaticsReport, Linearization), LinearizeError> {
+    crate::simulate::require_mass(built)?;
+    let eq = statics::solve(built)?;
+    statics::check_reduced(built, &eq)?;
+    let q = DVector::from_column_slice(&eq.q);
+    let qd = DVector::zeros(q.len());
+    let mut lin = about_state(built, &q, &qd, &built.u)?;
+    lin.about = "equilibrium";
+    lin.equilibrium_residual_norm = Some(eq.residual_norm);
+    lin.static_gain = static_gain(&lin);
+    Ok((eq, lin))
+}
+
+/// Linearizes `built` (its reduced model if one is attached) at the state `(q, q̇)` under the
+/// tensions `u`, which the caller has checked (lengths, finite, a reduced model's range).
+pub fn about_state(
+    built: &Built,
+    q: &DVector<f64>,
+    qd: &DVector<f64>,
+    u: &[f64],
+) -> Result<Linearization, LinearizeError> {
+    crate::simulate::require_mass(built)?;
+    match &built.reduced {
+        Some(r) => on_model(built, &r.model, q, qd, u),
+        None => on_model(built, &built.model, q, qd, u),
+    }
+}
+
+fn on_model<P: StrainParam>(
+    built: &Built,
+    model: &Model<P>,
+    q: &DVector<f64>,
+    qd: &DVector<f64>,
+    u: &[f64],
+) -> Result<Linearization, LinearizeError> {
+    let n = model.n_dof();
+    let loads = model.prepare_loads(&built.loads)?;
+    let mut ws = model.workspace();
+    let StateSpace { a, b, xdot } = model.linearize(q, qd, u, &loads, &mut ws)?;
+    let t_d = model.damping_time();
+    let poles = poles(&a);
+
+    model.forward(q, &mut ws, true);
+    let tip = model.disc.tip();
+    let rot = ws.g[tip].rot;
+    let pos = ws.g[tip].pos;
+    let jv = rot * ws.jac.columns(tip * n, n).fixed_rows::<3>(3);
+    let mut c = DMatrix::zeros(3, 2 * n);
+    c.view_mut((0, 0), (3, n)).copy_from(&jv);
+
+    Ok(Linearization {
+        scenario: built.name.clone(),
+        u: u.to_vec(),
+        n_dof: n,
+        n_actuators: model.n_actuators(),
+        about: "state",
+        q: q.iter().copied().collect(),
+        qd: qd.iter().copied().collect(),
+        xdot: xdot.iter().copied().collect(),
+        tip_position: [pos[0], pos[1], pos[2]],
+        relaxation_poles: relaxation_poles(&poles, t_d),
+        poles,
+        damping_time_s: t_d,
+        a: rows(&a),
+        b: rows(&b),
+        c: rows(&c),
+        static_gain: None,
+        equilibrium_residual_norm: None,
+    })
+}
+
+/// The eigenvalues of `A`, conjugate pairs once (`Im λ ≥ 0`), by `|λ|` ascending.
+pub fn poles(a: &DMatrix<f64>) -> Vec<Pole> {
+    let eig = a.clone().complex_eigenvalues();
+    let mut poles: Vec<Pole> = eig
+        .iter()
+        // one of each conjugate pair (the real Schur form gives real poles a zero `Im`)
+        .filter(|l| l.im >= 0.0)
+        .map(|l| {
+            let modulus = l.norm();
+            Pole {
+                re: l.re,
+                im: l.im.max(0.0),
+                natural_frequency_hz: modulus / (2.0 * std::f64::consts::PI),
+                damping_ratio: if modulus > 0.0 { -l.re / modulus } else { 0.0 },
+            }
+        })
+        .collect();
+    poles.sort_by(|x, y| x.natural_frequency_hz.total_cmp(&y.natural_frequency_hz));
+    poles
+}
+
+/// How many poles (conjugates counted) lie within 5 % of `−1/t_d` (none without damping).
+fn relaxation_poles(poles: &[Pole], t_d: f64) -> usize {
+    if t_d <= 0.0 {
+        return 0;
+    }
+    let s = -1.0 / t_d;
+    poles
+        .iter()
+        .filter(|p| (p.re - s).hypot(p.im) <= 0.05 * s.abs())
+        .map(|p| if p.im > 0.0 { 2 } else { 1 })
+        .sum()
+}
+
+/// `−C A⁻¹ B`, or `None` if `A` is singular or the result not finite.
+fn static_gain(lin: &Linearization) -> Option<Vec<Vec<f64>>> {
+    let lu = lin.a_matrix().lu();
+    let x = lu.solve(&lin.b_matrix())?;
+    let g = -(lin.c_matrix() * x);
+    g.iter().all(|v| v.is_finite()).then(|| rows(&g))
+}
+
+fn rows(m: &DMatrix<f64>) -> Vec<Vec<f64>> {
+    m.row_iter().map(|r| r.iter().copied().collect()).collect()
+}
+
+fn from_rows(r: &[Vec<f64>]) -> DMatrix<f64> {
+    let ncols = r.first().map_or(0, Vec::len);
+    DMatrix::from_fn(r.len(), ncols, |i, j| r[i][j])
+}
