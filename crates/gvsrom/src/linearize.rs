@@ -25,6 +25,10 @@ use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 use thiserror::Error;
 
+/// A pole is unstable when `Re λ > UNSTABLE_RATIO |λ|` (a damping ratio below `−UNSTABLE_RATIO`):
+/// well above the eigensolver's rounding on the imaginary axis of an undamped model.
+pub const UNSTABLE_RATIO: f64 = 1e-8;
+
 /// Poles printed when `--count` is not given.
 pub const DEFAULT_COUNT: usize = 10;
 
@@ -102,6 +106,10 @@ pub struct Linearization {
     /// the stiffness is proportional to the damping, some paired with small imaginary parts when
     /// loads and tendons stiffen the rod unlike its damping.
     pub relaxation_poles: usize,
+    /// Poles with `Re λ > UNSTABLE_RATIO |λ|` (conjugates counted): directions in which the
+    /// operating point is unstable. An undamped model's poles lie on the imaginary axis, up to
+    /// rounding (`|Re λ| ~ 1e-12 |λ|`), and count as stable.
+    pub unstable_poles: usize,
     /// Static gain `−C A⁻¹ B` (3 × n_actuators) \[m/N\] about an equilibrium; `None` about a state,
     /// or if `A` is singular.
     pub static_gain: Option<Vec<Vec<f64>>>,
@@ -205,6 +213,11 @@ fn on_model<P: StrainParam>(
         xdot: xdot.iter().copied().collect(),
         tip_position: [pos[0], pos[1], pos[2]],
         relaxation_poles: relaxation_poles(&poles, t_d),
+        unstable_poles: poles
+            .iter()
+            .filter(|p| p.damping_ratio < -UNSTABLE_RATIO)
+            .map(|p| if p.im > 0.0 { 2 } else { 1 })
+            .sum(),
         poles,
         damping_time_s: t_d,
         a: rows(&a),
@@ -215,9 +228,12 @@ fn on_model<P: StrainParam>(
     })
 }
 
-/// The eigenvalues of `A`, conjugate pairs once (`Im λ ≥ 0`), by `|λ|` ascending.
+/// The eigenvalues of `A`, conjugate pairs once (`Im λ ≥ 0`), by `|λ|` ascending. `A` is balanced
+/// first ([`balance`]): a rod's `[0 I; −M⁻¹K −M⁻¹D]` has a norm of order `ω_max²`, and the QR
+/// algorithm's absolute error `ε‖A‖` would swamp the slow poles; balanced, the norm is of order
+/// `ω_max`.
 pub fn poles(a: &DMatrix<f64>) -> Vec<Pole> {
-    let eig = a.clone().complex_eigenvalues();
+    let eig = balance(a).complex_eigenvalues();
     let mut poles: Vec<Pole> = eig
         .iter()
         // one of each conjugate pair (the real Schur form gives real poles a zero `Im`)
@@ -234,6 +250,50 @@ pub fn poles(a: &DMatrix<f64>) -> Vec<Pole> {
         .collect();
     poles.sort_by(|x, y| x.natural_frequency_hz.total_cmp(&y.natural_frequency_hz));
     poles
+}
+
+/// `T⁻¹ A T` with `T` diagonal, powers of 2 (exact in floating point), chosen so that each row
+/// and column have about the same norm (Parlett & Reinsch 1969, LAPACK's `gebal` without the
+/// permutations): the same eigenvalues, a smaller norm.
+pub fn balance(a: &DMatrix<f64>) -> DMatrix<f64> {
+    let mut a = a.clone();
+    let n = a.nrows();
+    let radix = 2.0_f64;
+    let mut converged = false;
+    while !converged {
+        converged = true;
+        for i in 0..n {
+            let (mut c, mut r) = (0.0, 0.0);
+            for j in 0..n {
+                if j != i {
+                    c += a[(j, i)].abs();
+                    r += a[(i, j)].abs();
+                }
+            }
+            if c == 0.0 || r == 0.0 {
+                continue;
+            }
+            let (s, mut f) = (c + r, 1.0);
+            let (mut c2, mut r2) = (c, r);
+            while c2 < r2 / radix {
+                c2 *= radix;
+                r2 /= radix;
+                f *= radix;
+            }
+            while c2 >= r2 * radix {
+                c2 /= radix;
+                r2 *= radix;
+                f /= radix;
+            }
+            if c2 + r2 < 0.95 * s {
+                converged = false;
+                // column i × f, row i ÷ f
+                a.column_mut(i).scale_mut(f);
+                a.row_mut(i).scale_mut(1.0 / f);
+            }
+        }
+    }
+    a
 }
 
 /// How many poles (conjugates counted) lie within 5 % of `−1/t_d` (none without damping).

@@ -73,22 +73,16 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
         "{:>4}  {:>14}  {:>14}  {:>14}  {:>13}",
         "pole", "Re λ [1/s]", "Im λ [rad/s]", "|λ|/2π [Hz]", "damping ratio"
     )?;
-    let mut unstable = 0;
-    for (k, p) in lin.poles.iter().enumerate() {
-        if p.re > 0.0 {
-            unstable += 1;
-        }
-        if k < shown {
-            writeln!(
-                out,
-                "{:>4}  {:>14.4}  {:>14.4}  {:>14.6}  {:>13.5}",
-                k + 1,
-                p.re,
-                p.im,
-                p.natural_frequency_hz,
-                p.damping_ratio
-            )?;
-        }
+    for (k, p) in lin.poles.iter().enumerate().take(shown) {
+        writeln!(
+            out,
+            "{:>4}  {:>14.4}  {:>14.4}  {:>14.6}  {:>13.5}",
+            k + 1,
+            p.re,
+            p.im,
+            p.natural_frequency_hz,
+            p.damping_ratio
+        )?;
     }
     if lin.relaxation_poles > 1 {
         let rate = 1.0 / lin.damping_time_s;
@@ -101,11 +95,11 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
             lin.damping_time_s
         )?;
     }
-    if unstable > 0 {
+    if lin.unstable_poles > 0 {
         writeln!(
             out,
             "note       {} with Re λ > 0: the equilibrium is unstable",
-            plural(unstable, "pole")
+            plural(lin.unstable_poles, "pole")
         )?;
     }
     match &lin.static_gain {

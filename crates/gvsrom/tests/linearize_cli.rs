@@ -1,0 +1,291 @@
+//! `gvsrom linearize` end to end: the poles of a uniform cantilever against its undamped modes and
+//! the Kelvin–Voigt damping ratio `ζ = t_d ω / 2` of each; the static gain `−C A⁻¹ B` against the
+//! closed form of a straight tendon's uniform moment and against differences of `gvsrom statics`
+//! under gravity and friction (another path: the nonlinear solver); a reduced model's 2r states; the
+//! JSON and one-line errors.
+
+mod common;
+
+use common::{expect_error, gvsrom, s, scratch, sweep_dataset};
+use std::f64::consts::PI;
+use std::path::PathBuf;
+
+/// The uniform clamped–free rod of `modes_cli.rs` (L = 0.5 m, r = 5 mm, E = 1 MPa, ν = ½,
+/// ρ = 1000 kg/m³, no gravity; six components in Legendre order 6: 42 DOF) with material damping
+/// `DAMPING` and a frictionless tendon at a constant offset `d = 3 mm` along +z, slack at 0 N.
+const ROD: &str = r#"
+name = "uniform-cantilever"
+magnus = "z4"
+[material]
+youngs_modulus = 1e6
+poisson_ratio = 0.5
+density = 1000.0
+damping = DAMPING
+[[divisions]]
+length = 0.5
+radius = 0.005
+basis = { kind = "legendre", modes = ["torsion", "bend_y", "bend_z", "elongation", "shear_y", "shear_z"], order = 6 }
+quadrature = { gauss = 12 }
+[[tendons]]
+offset_start = [0.0, 0.003]
+offset_end = [0.0, 0.003]
+x_start = 0.0
+x_end = 0.5
+tension = 0.0
+[loads]
+gravity = [0.0, 0.0, 0.0]
+"#;
+const L: f64 = 0.5;
+const R: f64 = 0.005;
+const E: f64 = 1e6;
+const D: f64 = 0.003;
+
+fn rod_file(name: &str, damping: f64) -> PathBuf {
+    let path = scratch(&format!("{name}.toml"));
+    std::fs::write(&path, ROD.replace("DAMPING", &format!("{damping:e}"))).unwrap();
+    path
+}
+
+/// Runs `gvsrom CMD ARGS --json FILE`, expects success; returns stdout and the JSON.
+fn run_json(cmd: &str, name: &str, args: &[&str]) -> (String, serde_json::Value) {
+    let file = scratch(&format!("{name}.json"));
+    let mut all = vec![cmd];
+    all.extend_from_slice(args);
+    all.extend(["--json", s(&file)]);
+    let out = gvsrom(&all);
+    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(
+        out.status.success(),
+        "gvsrom {all:?} failed: {}{stdout}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json = serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
+    (stdout, json)
+}
+
+fn f64s(v: &serde_json::Value) -> Vec<f64> {
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect()
+}
+
+fn matrix(v: &serde_json::Value) -> Vec<Vec<f64>> {
+    v.as_array().unwrap().iter().map(f64s).collect()
+}
+
+/// `(Re λ, Im λ)` of the listed poles.
+fn poles(json: &serde_json::Value) -> Vec<(f64, f64)> {
+    json["poles"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| (p["re"].as_f64().unwrap(), p["im"].as_f64().unwrap()))
+        .collect()
+}
+
+fn rel(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs()
+}
+
+#[test]
+fn undamped_cantilever_poles_are_its_modes_frequencies() {
+    // without damping A = [0 I; −M⁻¹K 0]: poles ±iω for every mode of `gvsrom modes`
+    let path = rod_file("lin-undamped", 0.0);
+    let (_, modes) = run_json("modes", "lin-undamped-modes", &[s(&path)]);
+    let (stdout, lin) = run_json("linearize", "lin-undamped", &[s(&path)]);
+    let freqs = f64s(&modes["all_frequencies_hz"]);
+    let p = poles(&lin);
+    assert_eq!(p.len(), freqs.len(), "one conjugate pair per mode");
+    let scale = p.iter().fold(0.0_f64, |m, (re, im)| m.max(re.hypot(*im)));
+    for (k, ((re, im), f)) in p.iter().zip(&freqs).enumerate().take(12) {
+        assert!(re.abs() < 1e-9 * scale, "pole {k}: Re λ = {re:e}");
+        assert!(rel(im / (2.0 * PI), *f) < 1e-7, "pole {k}: {im} rad/s vs mode {f} Hz");
+    }
+    assert!(stdout.contains("(84 states)") && stdout.contains("1 tendon tension"), "{stdout}");
+    assert!(!stdout.contains("note"), "no relaxation cluster without damping: {stdout}");
+}
+
+#[test]
+fn kelvin_voigt_cantilever_poles_have_the_damping_ratio_t_d_omega_over_2() {
+    // ν = ½: Ds = t_d Es in every component, t_d = 3η/E, so D = t_d K and each mode ω has the
+    // poles of λ² + t_d ω² λ + ω² = 0: |λ| = ω and ζ = t_d ω / 2 while underdamped
+    let eta = 2e3;
+    let t_d = 3.0 * eta / E;
+    let undamped = rod_file("lin-kv-undamped", 0.0);
+    let (_, modes) = run_json("modes", "lin-kv-modes", &[s(&undamped)]);
+    let path = rod_file("lin-kv", eta);
+    let (stdout, lin) = run_json("linearize", "lin-kv", &[s(&path)]);
+    assert!(rel(lin["damping_time_s"].as_f64().unwrap(), t_d) < 1e-12);
+    let freqs = f64s(&modes["all_frequencies_hz"]);
+    let listed = lin["poles"].as_array().unwrap();
+    let mut checked = 0;
+    for (k, f) in freqs.iter().enumerate() {
+        let omega = 2.0 * PI * f;
+        let zeta = t_d * omega / 2.0;
+        if zeta >= 0.5 {
+            break;
+        }
+        let pole = &listed[k];
+        let (hz, z) = (
+            pole["natural_frequency_hz"].as_f64().unwrap(),
+            pole["damping_ratio"].as_f64().unwrap(),
+        );
+        assert!(rel(hz, *f) < 1e-7, "pole {k}: |λ|/2π = {hz} vs {f} Hz");
+        assert!(rel(z, zeta) < 1e-6, "pole {k}: ζ = {z} vs t_d ω/2 = {zeta}");
+        checked += 1;
+    }
+    assert!(checked >= 6, "only {checked} underdamped modes: {stdout}");
+    // the overdamped modes' slow poles gather near −1/t_d, and the note says so
+    assert!(lin["relaxation_poles"].as_u64().unwrap() > 10, "{stdout}");
+    assert!(stdout.contains("−1/t_d = −166.6667 1/s"), "{stdout}");
+}
+
+#[test]
+fn static_gain_of_a_straight_tendon_is_the_uniform_moments_closed_form() {
+    // About the straight rod a tension u gives the uniform moment u d about y and the axial force
+    // u: the tip moves by δz = −d L²/(2EI) u (a pull, u < 0, lifts it towards the tendon) and
+    // δx = L/(EA) u; the basis holds uniform strains exactly, so only rounding separates them.
+    let path = rod_file("lin-gain", 1e3);
+    let (stdout, lin) = run_json("linearize", "lin-gain", &[s(&path)]);
+    let g = matrix(&lin["static_gain"]);
+    let (area, inertia) = (PI * R * R, PI * R.powi(4) / 4.0);
+    let gz = -D * L * L / (2.0 * E * inertia);
+    let gx = L / (E * area);
+    assert!(rel(g[2][0], gz) < 1e-9, "δz/δu = {} vs {gz}", g[2][0]);
+    assert!(rel(g[0][0], gx) < 1e-9, "δx/δu = {} vs {gx}", g[0][0]);
+    assert!(g[1][0].abs() < 1e-12 * gz.abs(), "δy/δu = {}", g[1][0]);
+    assert!(stdout.contains("  tendon 1"), "{stdout}");
+}
+
+/// `δy/δu` by central differences of `gvsrom statics --json` tip positions at `u ± h`.
+fn statics_gain(scenario: &[&str], u: f64, h: f64, name: &str) -> [f64; 3] {
+    let tip = |t: f64, tag: &str| {
+        let mut args = scenario.to_vec();
+        let tension = format!("--tension={t}");
+        args.push(&tension);
+        let (_, json) = run_json("statics", &format!("{name}-{tag}"), &args);
+        f64s(&json["tip_position"])
+    };
+    let (p, m) = (tip(u + h, "plus"), tip(u - h, "minus"));
+    [0, 1, 2].map(|i| (p[i] - m[i]) / (2.0 * h))
+}
+
+#[test]
+fn static_gain_under_gravity_and_friction_is_the_equilibriums_derivative() {
+    // IV-A: gravity, a tapered arm bent to 5 % of its length, friction 0.88; the equilibrium's tip
+    // by the nonlinear solver at −3 ± 0.01 N against −C A⁻¹ B (difference error O(h²) ≈ 1e-6)
+    let (_, lin) = run_json("linearize", "lin-iva", &["single-tendon"]);
+    assert_eq!(lin["about"], "equilibrium");
+    assert!(lin["equilibrium_residual_norm"].as_f64().unwrap() < 1e-8);
+    let g = matrix(&lin["static_gain"]);
+    let fd = statics_gain(&["single-tendon"], -3.0, 0.01, "lin-iva-statics");
+    let norm = fd.iter().map(|v| v * v).sum::<f64>().sqrt();
+    for i in 0..3 {
+        assert!(
+            (g[i][0] - fd[i]).abs() < 1e-5 * norm,
+            "axis {i}: gain {} vs statics {}",
+            g[i][0],
+            fd[i]
+        );
+    }
+    // at the solved equilibrium q̇ = 0, and the residual's q̈ moves the tip by a tiny acceleration
+    let xdot = f64s(&lin["xdot"]);
+    let c = matrix(&lin["c"]);
+    let n = xdot.len() / 2;
+    assert!(xdot[..n].iter().all(|v| *v == 0.0));
+    let tip_acc = (0..3)
+        .map(|i| (0..n).map(|j| c[i][j] * xdot[n + j]).sum::<f64>().powi(2))
+        .sum::<f64>()
+        .sqrt();
+    assert!(tip_acc < 1e-6, "tip acceleration {tip_acc:e} m/s² at the equilibrium");
+}
+
+#[test]
+fn a_pod_models_linearization_has_2r_states_and_its_own_static_gain() {
+    let ds = sweep_dataset("lin-pod-ds", "-6:0", 12);
+    let pod = scratch("lin-pod3");
+    let out = gvsrom(&["pod", s(&ds), "--modes", "3", "--out", s(&pod)]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let (stdout, lin) = run_json("linearize", "lin-rom", &["single-tendon", "--model", s(&pod)]);
+    assert_eq!(lin["n_dof"].as_u64(), Some(3));
+    assert_eq!(matrix(&lin["a"]).len(), 6);
+    assert_eq!(matrix(&lin["b"])[0].len(), 1);
+    assert_eq!(matrix(&lin["c"]).len(), 3);
+    assert_eq!(lin["model"].as_str(), Some(s(&pod)));
+    assert!(stdout.contains("(6 states)"), "{stdout}");
+    let g = matrix(&lin["static_gain"]);
+    let fd = statics_gain(
+        &["single-tendon", "--model", s(&pod)],
+        -3.0,
+        0.01,
+        "lin-rom-statics",
+    );
+    let norm = fd.iter().map(|v| v * v).sum::<f64>().sqrt();
+    for i in 0..3 {
+        assert!((g[i][0] - fd[i]).abs() < 1e-5 * norm, "axis {i}: {} vs {}", g[i][0], fd[i]);
+    }
+}
+
+#[test]
+fn json_records_the_run_and_bad_input_is_a_one_line_error() {
+    let (_, lin) = run_json("linearize", "lin-six", &["six-tendon"]);
+    assert_eq!(lin["gvsrom"]["format"], "linearize");
+    assert!(lin["provenance"].is_object(), "{lin}");
+    let n = lin["n_dof"].as_u64().unwrap() as usize;
+    assert_eq!(n, 28);
+    let (a, b, c) = (matrix(&lin["a"]), matrix(&lin["b"]), matrix(&lin["c"]));
+    assert_eq!((a.len(), a[0].len()), (2 * n, 2 * n));
+    assert_eq!((b.len(), b[0].len()), (2 * n, 6));
+    assert_eq!((c.len(), c[0].len()), (3, 2 * n));
+    assert_eq!(matrix(&lin["static_gain"])[0].len(), 6);
+    for bad in ["0", "-1", "2.5", "many"] {
+        expect_error(
+            &["linearize", "six-tendon", "--count", bad],
+            &[&format!("--count `{bad}`"), "integer ≥ 1", "56 states"],
+        );
+    }
+    expect_error(
+        &["linearize", "six-tendon", "--set", "material.density=0"],
+        &["material.density", "a motion needs a rod with mass"],
+    );
+    // the file the first run wrote (not cleared: `scratch` would remove it)
+    let file = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("gvsrom-cli-tests/lin-six.json");
+    assert!(file.is_file());
+    expect_error(
+        &["linearize", "six-tendon", "--json", s(&file)],
+        &["--json", "--force"],
+    );
+}
+
+#[test]
+fn upright_rod_beyond_self_weight_buckling_has_one_unstable_pole_per_buckling_mode() {
+    // The rod of `modes_cli.rs` standing in gravity along −x, 2.9× the critical length of
+    // self-weight buckling: each mode with ω² < 0 gives the real poles ±√(−ω²) undamped, so as
+    // many unstable poles as `gvsrom modes` reports unstable modes; with damping they stay unstable
+    // (a damper slows a divergence, it cannot stop one).
+    for (name, damping) in [("lin-upright", 0.0), ("lin-upright-damped", 1e3)] {
+        let path = scratch(&format!("{name}.toml"));
+        let text = ROD
+            .replace("DAMPING", &format!("{damping:e}"))
+            .replace("gravity = [0.0, 0.0, 0.0]", "gravity = [-9.81, 0.0, 0.0]");
+        std::fs::write(&path, text).unwrap();
+        let (_, modes) = run_json("modes", &format!("{name}-modes"), &[s(&path), "--count", "42"]);
+        let negative = modes["modes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|m| m["omega_squared"].as_f64().unwrap() < 0.0)
+            .count();
+        assert!(negative >= 2, "{modes}");
+        let (stdout, lin) = run_json("linearize", name, &[s(&path)]);
+        assert_eq!(lin["unstable_poles"].as_u64(), Some(negative as u64), "{stdout}");
+        assert!(
+            stdout.contains(&format!("note       {negative} poles with Re λ > 0")),
+            "{stdout}"
+        );
+        // about an unstable equilibrium the static gain still exists (A is regular)
+        assert!(lin["static_gain"].is_array());
+    }
+}
