@@ -305,7 +305,6 @@ fn linearization_of_a_nonlinear_parameterization_matches_differences() {
         Discretization::new(&rod, &[Quadrature::Gauss { n: 12 }], MagnusOrder::Z4, &[]).unwrap();
     let p = SigmoidBend::new(&disc);
     let m = Model::new(rod, disc, p, vec![]).unwrap();
-    let n = m.n_dof();
     // amplitude 1.2, steepness 7, centre 0.4: M's condition number ~1e6 (a flat sigmoid, amplitude
     // near 0, makes M nearly singular, 1e13, and differences of f meaningless)
     let q = DVector::from_vec(vec![1.2, 7.0, 0.4]);
