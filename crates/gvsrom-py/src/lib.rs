@@ -10,6 +10,7 @@ mod datasets;
 mod dynamics_quantities;
 mod errors;
 mod interrupt;
+mod linearize;
 mod models;
 mod modes;
 mod quantities;

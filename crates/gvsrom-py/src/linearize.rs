@@ -1,0 +1,130 @@
+//! `Robot.linearize`: the equations of motion linearized for control, as `gvsrom linearize`
+//! computes them ([`gvsrom::linearize`]), as NumPy arrays.
+
+use crate::arrays::{self, matrix, vector};
+use crate::dynamics_quantities::state;
+use crate::errors::{self, invalid, scenario as err};
+use crate::robot::{build_with, Robot};
+use gvsrom::linearize::{self, LinearizeError, Linearization};
+use numpy::{Complex64, PyArray};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+#[pymethods]
+impl Robot {
+    /// The equations of motion linearized for control design, as ``gvsrom linearize`` computes
+    /// them (the same numbers as its ``--json``): ``δẋ = A δx + B δu`` and ``δy = C δx`` with the
+    /// state ``x = [q; q̇]``, the tendon tensions ``u`` [N] and the tip position ``y`` (world axes,
+    /// m). ``A`` keeps every term of the dynamics (gvs-spec §9.3), the inertial ones that vanish at
+    /// rest included. With a reduced model attached, its ``2r``-state linearization.
+    ///
+    /// Parameters
+    /// ----------
+    /// u : array_like of float, optional
+    ///     Tensions [N] of the operating point, one per tendon or one for all; default: the
+    ///     scenario's.
+    /// q : array_like of float, optional
+    ///     Linearize about this state instead of the static equilibrium under ``u`` (no solve);
+    ///     shape (n_dof,).
+    /// qd : array_like of float, optional
+    ///     The state's velocities (with ``q`` only); default zero.
+    ///
+    /// Returns
+    /// -------
+    /// dict
+    ///     ``A`` (2n, 2n), ``B`` (2n, n_actuators), ``C`` (3, 2n), ``x0`` (2n,) the operating
+    ///     point, ``u`` (n_actuators,), ``xdot`` (2n,) ``f(x0, u)`` (≈ 0 about an equilibrium),
+    ///     ``tip_position`` (3,), ``poles`` (complex, the eigenvalues of A with ``Im ≥ 0``,
+    ///     conjugates once, slowest first), ``natural_frequency_hz`` and ``damping_ratio`` per pole,
+    ///     ``unstable_poles`` (count, conjugates counted), ``static_gain`` (3, n_actuators) [m/N]
+    ///     ``−C A⁻¹ B`` about an equilibrium (``None`` about a given state), ``about``
+    ///     (``"equilibrium"`` or ``"state"``), ``damping_time_s``, ``relaxation_poles``,
+    ///     ``equilibrium_residual_norm`` (about an equilibrium), ``model_extrapolated``.
+    ///
+    /// Raises
+    /// ------
+    /// GvsromError
+    ///     For bad tensions or states, ``qd`` without ``q``, a massless rod, or an equilibrium
+    ///     that fails (``ConvergenceError``).
+    #[pyo3(signature = (u=None, q=None, qd=None))]
+    fn linearize<'py>(
+        &self,
+        py: Python<'py>,
+        u: Option<arrays::Tensions<'_>>,
+        q: Option<arrays::In1<'_>>,
+        qd: Option<arrays::In1<'_>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let to_py = |e: LinearizeError| {
+            let message = errors::chain(&e);
+            match &e {
+                LinearizeError::Statics(f) => errors::statics_with_message(py, f, &message),
+                _ => invalid(message),
+            }
+        };
+        let lin = match (&q, &qd) {
+            (None, Some(_)) => {
+                return Err(invalid(
+                    "`qd` without `q`: give the state's `q` too, or neither to linearize about the equilibrium at rest",
+                ))
+            }
+            (None, None) => {
+                let rebuilt = match &u {
+                    None => None,
+                    Some(u) => {
+                        let mut scenario = self.scenario.clone();
+                        scenario.scenario.set_tensions(&u.values()).map_err(err)?;
+                        Some(build_with(py, &scenario, self.attached.as_ref(), false)?)
+                    }
+                };
+                let built = rebuilt.as_ref().unwrap_or(&self.built);
+                py.detach(|| linearize::about_equilibrium(built))
+                    .map_err(to_py)?
+                    .1
+            }
+            (Some(q), qd) => {
+                let (q, qd) = state(self, q, qd.as_ref())?;
+                let u = self.quantity_tensions(py, u)?;
+                py.detach(|| linearize::about_state(&self.built, &q, &qd, &u))
+                    .map_err(to_py)?
+            }
+        };
+        let d = report_dict(py, &lin)?;
+        let extrapolated =
+            (self.built.reduced.as_ref()).map_or(vec![], |r| r.extrapolated.clone());
+        d.set_item("model_extrapolated", extrapolated)?;
+        Ok(d)
+    }
+}
+
+fn report_dict<'py>(py: Python<'py>, r: &Linearization) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("A", matrix(py, &r.a_matrix())?)?;
+    d.set_item("B", matrix(py, &r.b_matrix())?)?;
+    d.set_item("C", matrix(py, &r.c_matrix())?)?;
+    let x0: Vec<f64> = r.q.iter().chain(&r.qd).copied().collect();
+    d.set_item("x0", vector(py, &x0))?;
+    d.set_item("u", vector(py, &r.u))?;
+    d.set_item("xdot", vector(py, &r.xdot))?;
+    d.set_item("tip_position", vector(py, &r.tip_position))?;
+    let poles: Vec<Complex64> = r.poles.iter().map(|p| Complex64::new(p.re, p.im)).collect();
+    d.set_item("poles", PyArray::from_vec(py, poles))?;
+    let col = |f: &dyn Fn(&linearize::Pole) -> f64| -> Vec<f64> { r.poles.iter().map(f).collect() };
+    d.set_item(
+        "natural_frequency_hz",
+        vector(py, &col(&|p| p.natural_frequency_hz)),
+    )?;
+    d.set_item("damping_ratio", vector(py, &col(&|p| p.damping_ratio)))?;
+    d.set_item("unstable_poles", r.unstable_poles)?;
+    match &r.static_gain {
+        Some(g) => {
+            let m = nalgebra::DMatrix::from_fn(3, r.n_actuators, |i, j| g[i][j]);
+            d.set_item("static_gain", matrix(py, &m)?)?
+        }
+        None => d.set_item("static_gain", py.None())?,
+    }
+    d.set_item("about", r.about)?;
+    d.set_item("damping_time_s", r.damping_time_s)?;
+    d.set_item("relaxation_poles", r.relaxation_poles)?;
+    d.set_item("equilibrium_residual_norm", r.equilibrium_residual_norm)?;
+    Ok(d)
+}

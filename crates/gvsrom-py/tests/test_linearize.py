@@ -1,0 +1,123 @@
+"""linearize: the numbers of `gvsrom linearize --json`, as arrays; A and B against central
+differences of `Robot.accelerations` (another entry to the engine) about a moving state; the static
+gain against differences of `Robot.statics`; a POD model's 2r states; errors."""
+
+import json
+
+import numpy as np
+import pytest
+
+import gvsrom
+from conftest import run_cli
+
+
+def cli_linearize(bin_path, tmp_path, *args):
+    out = tmp_path / "linearize.json"
+    p = run_cli(bin_path, "linearize", *args, "--json", str(out), "--force")
+    assert p.returncode == 0, p.stderr
+    return json.loads(out.read_text())
+
+
+def test_linearize_equals_the_cli_json(gvsrom_bin, tmp_path):
+    cli = cli_linearize(gvsrom_bin, tmp_path, "six-tendon", "--tension=-2,0,0,-1,0,0")
+    lin = gvsrom.Scenario.preset("six-tendon").build().linearize(u=[-2, 0, 0, -1, 0, 0])
+    for name, key in [("A", "a"), ("B", "b"), ("C", "c"), ("static_gain", "static_gain")]:
+        expected = np.array(cli[key])
+        np.testing.assert_allclose(lin[name], expected, rtol=0, atol=1e-12 * np.abs(expected).max(),
+                                   err_msg=name)
+    np.testing.assert_allclose(lin["x0"], cli["q"] + cli["qd"], rtol=0, atol=1e-14)
+    poles = np.array([complex(p["re"], p["im"]) for p in cli["poles"]])
+    assert lin["poles"].dtype == np.complex128
+    np.testing.assert_allclose(lin["poles"], poles, rtol=1e-12)
+    assert lin["about"] == "equilibrium" and lin["unstable_poles"] == 0
+    assert lin["A"].shape == (56, 56) and lin["B"].shape == (56, 6) and lin["C"].shape == (3, 56)
+
+
+def accelerations_fd(robot, q, qd, u, h=1e-4):
+    """Central differences of [q̇; q̈(q, q̇, u)] in x = [q; q̇] and in u. Each q̈ is a solve with M
+    (IV-A's order-10 basis makes it ill-conditioned), so its rounding grows in the difference as
+    1/h: at h = 1e-4 (relative) these differences are good to ~5e-7 of ‖A‖ on IV-A, at 1e-6 only
+    to ~7e-5 (measured). `linearize` differences the residual before the solve, and is not
+    affected."""
+    n = len(q)
+
+    def f(x, uu):
+        return np.concatenate([x[n:], robot.accelerations(x[:n], x[n:], uu)])
+
+    x = np.concatenate([q, qd])
+    A = np.empty((2 * n, 2 * n))
+    for j in range(2 * n):
+        s = h * (1 + abs(x[j]))
+        e = np.zeros(2 * n)
+        e[j] = s
+        A[:, j] = (f(x + e, u) - f(x - e, u)) / (2 * s)
+    B = np.empty((2 * n, len(u)))
+    for k in range(len(u)):
+        e = np.zeros(len(u))
+        e[k] = 1e-4
+        B[:, k] = (f(x, u + e) - f(x, u - e)) / 2e-4
+    return A, B
+
+
+def test_a_and_b_about_a_moving_state_are_the_derivatives_of_the_accelerations():
+    robot = gvsrom.Scenario.preset("single-tendon").build()
+    q0 = robot.statics(u=[-3.0]).q
+    rng = np.random.default_rng(7)
+    q = q0 + 0.02 * np.abs(q0).max() * rng.standard_normal(len(q0))
+    qd = 2.0 * np.abs(q0).max() * rng.standard_normal(len(q0))
+    u = np.array([-2.5])
+    lin = robot.linearize(u=u, q=q, qd=qd)
+    assert lin["about"] == "state" and lin["static_gain"] is None
+    A, B = accelerations_fd(robot, q, qd, u)
+    assert np.linalg.norm(lin["A"] - A) < 2e-6 * np.linalg.norm(A)
+    assert np.linalg.norm(lin["B"] - B) < 2e-6 * np.linalg.norm(B)
+    np.testing.assert_allclose(lin["xdot"][len(q):], robot.accelerations(q, qd, u), rtol=1e-12)
+    # the tip output matrix is the tip Jacobian's translation, rotated to the world
+    R = robot.forward(q)["rotation"][-1]
+    J = robot.jacobian(q, -1)
+    np.testing.assert_allclose(lin["C"][:, :len(q)], R @ J[3:], rtol=0, atol=1e-12 * np.abs(J).max())
+    np.testing.assert_array_equal(lin["C"][:, len(q):], 0.0)
+
+
+def test_static_gain_is_the_equilibriums_derivative_in_the_tensions():
+    robot = gvsrom.Scenario.preset("six-tendon").build()
+    u = np.array([-3.0, 0, 0, -1.0, 0, 0])
+    lin = robot.linearize(u=u)
+    G = lin["static_gain"]
+    h = 0.01
+    for k in [0, 3, 4]:
+        e = np.zeros(6)
+        e[k] = h
+        fd = (robot.statics(u + e).tip_position - robot.statics(u - e).tip_position) / (2 * h)
+        np.testing.assert_allclose(G[:, k], fd, rtol=0, atol=1e-5 * np.linalg.norm(fd))
+
+
+@pytest.fixture(scope="module")
+def pod_robot(gvsrom_bin, tmp_path_factory):
+    ds = tmp_path_factory.mktemp("lin-ds") / "sweep"
+    p = run_cli(gvsrom_bin, "dataset", "single-tendon", "--sweep", "tendons.0.tension=-6:0",
+            "--samples", "7", "--out", str(ds))
+    assert p.returncode == 0, p.stderr
+    model = gvsrom.pod(ds, 2, tmp_path_factory.mktemp("lin-pod") / "model")
+    return gvsrom.Scenario.preset("single-tendon").build().with_model(model)
+
+
+def test_a_reduced_models_linearization_has_2r_states(pod_robot):
+    lin = pod_robot.linearize(u=[-3.0])
+    assert lin["A"].shape == (4, 4) and lin["B"].shape == (4, 1) and lin["C"].shape == (3, 4)
+    # its slow pole near the full model's (2 POD modes hold the first bending mode well)
+    full = gvsrom.Scenario.preset("single-tendon").build().linearize(u=[-3.0])
+    assert lin["natural_frequency_hz"][0] == pytest.approx(full["natural_frequency_hz"][0], rel=0.05)
+    A, B = accelerations_fd(pod_robot, lin["x0"][:2], np.array([0.3, -0.2]), np.array([-3.0]))
+    moving = pod_robot.linearize(u=[-3.0], q=lin["x0"][:2], qd=[0.3, -0.2])
+    assert np.linalg.norm(moving["A"] - A) < 1e-6 * np.linalg.norm(A)
+
+
+def test_bad_arguments_are_clear_errors():
+    robot = gvsrom.Scenario.preset("single-tendon").build()
+    with pytest.raises(gvsrom.GvsromError, match="`qd` without `q`"):
+        robot.linearize(qd=np.zeros(robot.n_dof))
+    with pytest.raises(gvsrom.GvsromError, match="q"):
+        robot.linearize(q=np.zeros(3))
+    with pytest.raises(gvsrom.GvsromError, match="density"):
+        gvsrom.Scenario.preset("single-tendon").set("material.density", 0.0).build().linearize()
