@@ -39,7 +39,8 @@ impl Robot {
     ///     ``unstable_poles`` (count, conjugates counted), ``static_gain`` (3, n_actuators) [m/N]
     ///     ``−C A⁻¹ B`` about an equilibrium (``None`` about a given state), ``about``
     ///     (``"equilibrium"`` or ``"state"``), ``damping_time_s``, ``relaxation_poles``,
-    ///     ``equilibrium_residual_norm`` (about an equilibrium), ``model_extrapolated``.
+    ///     ``equilibrium_residual_norm`` (about an equilibrium), ``time_s`` (the linearization's
+    ///     wall time), ``model_extrapolated``.
     ///
     /// Raises
     /// ------
@@ -124,6 +125,7 @@ fn report_dict<'py>(py: Python<'py>, r: &Linearization) -> PyResult<Bound<'py, P
     }
     d.set_item("about", r.about)?;
     d.set_item("damping_time_s", r.damping_time_s)?;
+    d.set_item("time_s", r.time_s)?;
     d.set_item("relaxation_poles", r.relaxation_poles)?;
     d.set_item("equilibrium_residual_norm", r.equilibrium_residual_norm)?;
     Ok(d)

@@ -113,6 +113,8 @@ pub struct Linearization {
     /// Static gain `−C A⁻¹ B` (3 × n_actuators) \[m/N\] about an equilibrium; `None` about a state,
     /// or if `A` is singular.
     pub static_gain: Option<Vec<Vec<f64>>>,
+    /// Wall time of the linearization \[s\] (`A`, `B`, `C` and the poles; not the equilibrium).
+    pub time_s: f64,
     /// About an equilibrium, its solver's residual `‖R‖∞`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub equilibrium_residual_norm: Option<f64>,
@@ -187,6 +189,7 @@ fn on_model<P: StrainParam>(
     qd: &DVector<f64>,
     u: &[f64],
 ) -> Result<Linearization, LinearizeError> {
+    let start = std::time::Instant::now();
     let n = model.n_dof();
     let loads = model.prepare_loads(&built.loads)?;
     let mut ws = model.workspace();
@@ -224,6 +227,7 @@ fn on_model<P: StrainParam>(
         b: rows(&b),
         c: rows(&c),
         static_gain: None,
+        time_s: start.elapsed().as_secs_f64(),
         equilibrium_residual_norm: None,
     })
 }

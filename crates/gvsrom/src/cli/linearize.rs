@@ -59,8 +59,12 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
     writeln!(out, "tip        position {} m", fmt_vec(&eq.tip_position, 6))?;
     writeln!(
         out,
-        "system     δẋ = A δx + B δu, δy = C δx: x = [q; q̇] ({n_states} states), u the {} [N], y the tip position (world) [m]",
-        plural(lin.n_actuators, "tendon tension")
+        "system     δẋ = A δx + B δu, δy = C δx: x = [q; q̇] ({n_states} states), u {}, y the tip position (world) [m]; linearized in {:.2} ms",
+        match lin.n_actuators {
+            0 => "empty (no tendons: B has no columns)".to_string(),
+            k => format!("the {} [N]", plural(k, "tendon tension")),
+        },
+        lin.time_s * 1e3
     )?;
     let shown = count.min(lin.poles.len());
     writeln!(
@@ -103,6 +107,7 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
         )?;
     }
     match &lin.static_gain {
+        _ if lin.n_actuators == 0 => {}
         Some(g) => {
             writeln!(
                 out,
@@ -113,10 +118,9 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
                 writeln!(out, "  tendon {:<3} {}", k + 1, fmt_vec(&col, 4))?;
             }
         }
-        None if lin.n_actuators > 0 => {
+        None => {
             writeln!(out, "gain       none: A is singular at this equilibrium")?;
         }
-        None => {}
     }
     if let Some(json) = json {
         let doc = linearize::LinearizationJson {
