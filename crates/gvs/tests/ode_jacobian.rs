@@ -17,10 +17,10 @@
 //! poles its undamped modes imply.
 
 use gvs::actuation::{Tendon, DEFAULT_FRICTION_SMOOTHING};
+use gvs::discretize::{Discretization, MagnusOrder, Quadrature};
 use gvs::loads::{Frame, Loads, PointWrench};
 use gvs::model::{Model, PreparedLoads};
 use gvs::solve::statics::{solve_statics, StaticsOptions};
-use gvs::discretize::{Discretization, MagnusOrder, Quadrature};
 use gvs::strain::{LinearBasis, SigmoidBend, StrainParam};
 use nalgebra::{Complex, DMatrix, DVector};
 mod common;
@@ -239,10 +239,19 @@ fn linearization_matches_differences_of_the_right_hand_side_in_motion() {
     let fd = fd_jacobian(&m, &pl, &q, &qd);
     let share = (&fd - approx(&m, &q, &pl)).norm() / fd.norm();
     let err = (&lin.a - &fd).norm() / fd.norm();
-    assert!(share > 1e-3, "approximation's miss {share:e}: the state is too quiet to tell");
-    assert!(err < 1e-6, "A vs FD: {err:e} (the approximation misses {share:e})");
+    assert!(
+        share > 1e-3,
+        "approximation's miss {share:e}: the state is too quiet to tell"
+    );
+    assert!(
+        err < 1e-6,
+        "A vs FD: {err:e} (the approximation misses {share:e})"
+    );
     let f = rhs(&m, &pl, &q, &qd);
-    assert!((&lin.xdot - &f).amax() <= 1e-12 * f.amax(), "ẋ is not f(x, u)");
+    assert!(
+        (&lin.xdot - &f).amax() <= 1e-12 * f.amax(),
+        "ẋ is not f(x, u)"
+    );
     // the top blocks are exactly [0 I]
     for i in 0..n {
         for j in 0..2 * n {
@@ -289,11 +298,16 @@ fn linearization_at_an_equilibrium_at_rest_is_analytic() {
     let qe = solve_statics(&m, &U, &loads(), None, &tight).unwrap().q;
     let pl = m.prepare_loads(&loads()).unwrap();
     let mut ws = m.workspace();
-    let lin = m.linearize(&qe, &DVector::zeros(n), &U, &pl, &mut ws).unwrap();
+    let lin = m
+        .linearize(&qe, &DVector::zeros(n), &U, &pl, &mut ws)
+        .unwrap();
     assert!(lin.xdot.amax() < 1e-6, "not at rest: {:e}", lin.xdot.amax());
     let a = approx(&m, &qe, &pl);
     let err = (&lin.a - &a).norm() / a.norm();
-    assert!(err < 1e-9, "A vs the analytic approximation at rest: {err:e}");
+    assert!(
+        err < 1e-9,
+        "A vs the analytic approximation at rest: {err:e}"
+    );
 }
 
 /// On a nonlinear strain parameterization (a sigmoid bend, the decoder-like path of the reduced
@@ -353,8 +367,14 @@ fn linearization_of_a_kelvin_voigt_rod_has_the_poles_of_its_modes() {
             }
             let lv = v.map(|c| c * lambda);
             let res = (&a * &v - &lv).norm() / lv.norm();
-            assert!(res < 1e-8, "mode at ω² = {w2:e}, λ = {lambda}: residual {res:e}");
+            assert!(
+                res < 1e-8,
+                "mode at ω² = {w2:e}, λ = {lambda}: residual {res:e}"
+            );
         }
     }
-    assert!(kinds.0 > 0 && kinds.1 > 0, "under/overdamped modes {kinds:?}: both kinds wanted");
+    assert!(
+        kinds.0 > 0 && kinds.1 > 0,
+        "under/overdamped modes {kinds:?}: both kinds wanted"
+    );
 }

@@ -5,7 +5,7 @@ use crate::arrays::{self, matrix, vector};
 use crate::dynamics_quantities::state;
 use crate::errors::{self, invalid, scenario as err};
 use crate::robot::{build_with, Robot};
-use gvsrom::linearize::{self, LinearizeError, Linearization};
+use gvsrom::linearize::{self, Linearization, LinearizeError};
 use numpy::{Complex64, PyArray};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -90,8 +90,7 @@ impl Robot {
             }
         };
         let d = report_dict(py, &lin)?;
-        let extrapolated =
-            (self.built.reduced.as_ref()).map_or(vec![], |r| r.extrapolated.clone());
+        let extrapolated = (self.built.reduced.as_ref()).map_or(vec![], |r| r.extrapolated.clone());
         d.set_item("model_extrapolated", extrapolated)?;
         Ok(d)
     }

@@ -152,9 +152,7 @@ pub struct LinearizationJson<'a> {
 
 /// Solves the equilibrium of `built` (as `gvsrom statics` does, with the reduced model if one is
 /// attached) and linearizes about it, at rest.
-pub fn about_equilibrium(
-    built: &Built,
-) -> Result<(StaticsReport, Linearization), LinearizeError> {
+pub fn about_equilibrium(built: &Built) -> Result<(StaticsReport, Linearization), LinearizeError> {
     crate::simulate::require_mass(built)?;
     let eq = statics::solve(built)?;
     statics::check_reduced(built, &eq)?;

@@ -31,7 +31,14 @@ const ORDER: &[(&str, &[&str])] = &[
     ("build", &["build", "layout"]),
     (
         "runs",
-        &["statics", "simulate", "modes", "linearize", "dataset", "compare"],
+        &[
+            "statics",
+            "simulate",
+            "modes",
+            "linearize",
+            "dataset",
+            "compare",
+        ],
     ),
     ("reduction", &["reduce"]),
     ("figures", &["plot", "figures"]),

@@ -101,10 +101,19 @@ fn undamped_cantilever_poles_are_its_modes_frequencies() {
     let scale = p.iter().fold(0.0_f64, |m, (re, im)| m.max(re.hypot(*im)));
     for (k, ((re, im), f)) in p.iter().zip(&freqs).enumerate().take(12) {
         assert!(re.abs() < 1e-9 * scale, "pole {k}: Re λ = {re:e}");
-        assert!(rel(im / (2.0 * PI), *f) < 1e-7, "pole {k}: {im} rad/s vs mode {f} Hz");
+        assert!(
+            rel(im / (2.0 * PI), *f) < 1e-7,
+            "pole {k}: {im} rad/s vs mode {f} Hz"
+        );
     }
-    assert!(stdout.contains("(84 states)") && stdout.contains("1 tendon tension"), "{stdout}");
-    assert!(!stdout.contains("note"), "no relaxation cluster without damping: {stdout}");
+    assert!(
+        stdout.contains("(84 states)") && stdout.contains("1 tendon tension"),
+        "{stdout}"
+    );
+    assert!(
+        !stdout.contains("note"),
+        "no relaxation cluster without damping: {stdout}"
+    );
 }
 
 #[test]
@@ -199,7 +208,10 @@ fn static_gain_under_gravity_and_friction_is_the_equilibriums_derivative() {
         .map(|i| (0..n).map(|j| c[i][j] * xdot[n + j]).sum::<f64>().powi(2))
         .sum::<f64>()
         .sqrt();
-    assert!(tip_acc < 1e-6, "tip acceleration {tip_acc:e} m/s² at the equilibrium");
+    assert!(
+        tip_acc < 1e-6,
+        "tip acceleration {tip_acc:e} m/s² at the equilibrium"
+    );
 }
 
 #[test]
@@ -207,8 +219,16 @@ fn a_pod_models_linearization_has_2r_states_and_its_own_static_gain() {
     let ds = sweep_dataset("lin-pod-ds", "-6:0", 12);
     let pod = scratch("lin-pod3");
     let out = gvsrom(&["pod", s(&ds), "--modes", "3", "--out", s(&pod)]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let (stdout, lin) = run_json("linearize", "lin-rom", &["single-tendon", "--model", s(&pod)]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (stdout, lin) = run_json(
+        "linearize",
+        "lin-rom",
+        &["single-tendon", "--model", s(&pod)],
+    );
     assert_eq!(lin["n_dof"].as_u64(), Some(3));
     assert_eq!(matrix(&lin["a"]).len(), 6);
     assert_eq!(matrix(&lin["b"])[0].len(), 1);
@@ -224,7 +244,12 @@ fn a_pod_models_linearization_has_2r_states_and_its_own_static_gain() {
     );
     let norm = fd.iter().map(|v| v * v).sum::<f64>().sqrt();
     for i in 0..3 {
-        assert!((g[i][0] - fd[i]).abs() < 1e-5 * norm, "axis {i}: {} vs {}", g[i][0], fd[i]);
+        assert!(
+            (g[i][0] - fd[i]).abs() < 1e-5 * norm,
+            "axis {i}: {} vs {}",
+            g[i][0],
+            fd[i]
+        );
     }
 }
 
@@ -271,7 +296,11 @@ fn upright_rod_beyond_self_weight_buckling_has_one_unstable_pole_per_buckling_mo
             .replace("DAMPING", &format!("{damping:e}"))
             .replace("gravity = [0.0, 0.0, 0.0]", "gravity = [-9.81, 0.0, 0.0]");
         std::fs::write(&path, text).unwrap();
-        let (_, modes) = run_json("modes", &format!("{name}-modes"), &[s(&path), "--count", "42"]);
+        let (_, modes) = run_json(
+            "modes",
+            &format!("{name}-modes"),
+            &[s(&path), "--count", "42"],
+        );
         let negative = modes["modes"]
             .as_array()
             .unwrap()
@@ -280,7 +309,11 @@ fn upright_rod_beyond_self_weight_buckling_has_one_unstable_pole_per_buckling_mo
             .count();
         assert!(negative >= 2, "{modes}");
         let (stdout, lin) = run_json("linearize", name, &[s(&path)]);
-        assert_eq!(lin["unstable_poles"].as_u64(), Some(negative as u64), "{stdout}");
+        assert_eq!(
+            lin["unstable_poles"].as_u64(),
+            Some(negative as u64),
+            "{stdout}"
+        );
         assert!(
             stdout.contains(&format!("note       {negative} poles with Re λ > 0")),
             "{stdout}"

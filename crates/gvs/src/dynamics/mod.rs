@@ -26,11 +26,11 @@ mod analysis;
 mod cholesky;
 mod linearize;
 pub use analysis::{Energy, Mode};
-pub use linearize::{StateSpace, LINEARIZATION_STEP};
 pub use cholesky::{
     cholesky_factor_in_place, cholesky_solve_factored, cholesky_solve_in_place, CHOLESKY_BLOCK,
     MASS_PIVOT_FLOOR,
 };
+pub use linearize::{StateSpace, LINEARIZATION_STEP};
 
 #[derive(Debug, Clone, Error, PartialEq)]
 pub enum DynamicsError {

@@ -56,7 +56,11 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
         plural(eq.load_stages, "load stage"),
         eq.residual_norm,
     )?;
-    writeln!(out, "tip        position {} m", fmt_vec(&eq.tip_position, 6))?;
+    writeln!(
+        out,
+        "tip        position {} m",
+        fmt_vec(&eq.tip_position, 6)
+    )?;
     writeln!(
         out,
         "system     δẋ = A δx + B δu, δy = C δx: x = [q; q̇] ({n_states} states), u {}, y the tip position (world) [m]; linearized in {:.2} ms",
