@@ -3,8 +3,8 @@
 
 use crate::arrays::{self, matrix, vector};
 use crate::dynamics_quantities::state;
-use crate::errors::{self, invalid, scenario as err};
-use crate::robot::{build_with, Robot};
+use crate::errors::{self, invalid};
+use crate::robot::Robot;
 use gvsrom::linearize::{self, Linearization, LinearizeError};
 use numpy::{Complex64, PyArray};
 use pyo3::prelude::*;
@@ -69,14 +69,7 @@ impl Robot {
                 ))
             }
             (None, None) => {
-                let rebuilt = match &u {
-                    None => None,
-                    Some(u) => {
-                        let mut scenario = self.scenario.clone();
-                        scenario.scenario.set_tensions(&u.values()).map_err(err)?;
-                        Some(build_with(py, &scenario, self.attached.as_ref(), false)?)
-                    }
-                };
+                let rebuilt = self.built_at(py, u.as_ref())?;
                 let built = rebuilt.as_ref().unwrap_or(&self.built);
                 py.detach(|| linearize::about_equilibrium(built))
                     .map_err(to_py)?

@@ -2,8 +2,8 @@
 //! `gvsrom modes` computes them ([`gvsrom::modes::compute`]), as NumPy arrays.
 
 use crate::arrays::{self, shaped, vector};
-use crate::errors::{self, scenario as err};
-use crate::robot::{build_with, Robot};
+use crate::errors;
+use crate::robot::Robot;
 use gvsrom::modes::{self, ModesError, ModesReport};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -46,14 +46,7 @@ impl Robot {
         #[pyo3(from_py_with = arrays::whole)] count: i128,
         u: Option<arrays::Tensions<'_>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let rebuilt = match &u {
-            None => None,
-            Some(u) => {
-                let mut scenario = self.scenario.clone();
-                scenario.scenario.set_tensions(&u.values()).map_err(err)?;
-                Some(build_with(py, &scenario, self.attached.as_ref(), false)?)
-            }
-        };
+        let rebuilt = self.built_at(py, u.as_ref())?;
         let built = rebuilt.as_ref().unwrap_or(&self.built);
         let (count, _clipped) = modes::parse_count(Some(&count.to_string()), built.n_dof())
             .map_err(|e| errors::any(e.into()))?;

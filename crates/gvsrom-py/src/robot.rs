@@ -177,6 +177,27 @@ impl Robot {
         Ok(q)
     }
 
+    /// The scenario built again at the tensions `u` (`--tension`) with the attached model, as the
+    /// command line would build it, for a result about the equilibrium under `u` (`modes`,
+    /// `linearize`); `None` without `u`: this robot's own build serves.
+    pub(crate) fn built_at(
+        &self,
+        py: Python<'_>,
+        u: Option<&Tensions<'_>>,
+    ) -> PyResult<Option<Built>> {
+        let Some(u) = u else {
+            return Ok(None);
+        };
+        let mut scenario = self.scenario.clone();
+        scenario.scenario.set_tensions(&u.values()).map_err(err)?;
+        Ok(Some(build_with(
+            py,
+            &scenario,
+            self.attached.as_ref(),
+            false,
+        )?))
+    }
+
     /// Tensions of a model quantity: the scenario's, or `u` (one per tendon or one for all),
     /// finite, and with a reduced model attached where it answers (as `statics(u)` refuses
     /// tensions its training never came near: the model's verdict, unless attached with

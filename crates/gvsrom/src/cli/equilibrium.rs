@@ -57,16 +57,8 @@ pub struct ModesArgs {
 }
 
 pub(super) fn statics_cmd(args: &StaticsArgs, out: &mut impl Write) -> Result<()> {
-    super::extrapolate_needs_model(&args.scenario, args.model.as_deref())?;
-    if let Some(path) = &args.json {
-        let inputs = scenario_inputs(&args.scenario, args.model.as_ref());
-        gvsrom::output::refuse_overlap("--json", path, &inputs)?;
-    }
-    let mut r = load(&args.scenario)?;
-    if let Some(dir) = &args.model {
-        attach_model(&mut r, &args.scenario, dir, false)?;
-    }
-    let provenance = r.provenance.clone().solver(&r.built.options);
+    let (r, provenance) =
+        load_for_equilibrium(&args.scenario, args.model.as_ref(), args.json.as_ref())?;
     // the output is checked, locked and staged before the solve, so a bad path fails at once
     let json = match &args.json {
         Some(path) => Some(OutputFile::create("--json", path, "statics", args.force)?),
@@ -99,17 +91,9 @@ pub(super) fn statics_cmd(args: &StaticsArgs, out: &mut impl Write) -> Result<()
 }
 
 pub(super) fn modes_cmd(args: &ModesArgs, out: &mut impl Write) -> Result<()> {
-    super::extrapolate_needs_model(&args.scenario, args.model.as_deref())?;
     use gvsrom::modes;
-    if let Some(path) = &args.json {
-        let inputs = scenario_inputs(&args.scenario, args.model.as_ref());
-        gvsrom::output::refuse_overlap("--json", path, &inputs)?;
-    }
-    let mut r = load(&args.scenario)?;
-    if let Some(dir) = &args.model {
-        attach_model(&mut r, &args.scenario, dir, false)?;
-    }
-    let provenance = r.provenance.clone().solver(&r.built.options);
+    let (r, provenance) =
+        load_for_equilibrium(&args.scenario, args.model.as_ref(), args.json.as_ref())?;
     let (scenario, built) = (&r.scenario, &r.built);
     let n_dof = built.n_dof();
     let (count, clipped) = modes::parse_count(args.count.as_deref(), n_dof)?;

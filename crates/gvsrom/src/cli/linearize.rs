@@ -28,17 +28,9 @@ pub struct LinearizeArgs {
 }
 
 pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Result<()> {
-    super::extrapolate_needs_model(&args.scenario, args.model.as_deref())?;
     use gvsrom::linearize;
-    if let Some(path) = &args.json {
-        let inputs = scenario_inputs(&args.scenario, args.model.as_ref());
-        gvsrom::output::refuse_overlap("--json", path, &inputs)?;
-    }
-    let mut r = load(&args.scenario)?;
-    if let Some(dir) = &args.model {
-        attach_model(&mut r, &args.scenario, dir, false)?;
-    }
-    let provenance = r.provenance.clone().solver(&r.built.options);
+    let (r, provenance) =
+        load_for_equilibrium(&args.scenario, args.model.as_ref(), args.json.as_ref())?;
     let (scenario, built) = (&r.scenario, &r.built);
     let n_states = 2 * built.n_dof();
     let count = linearize::parse_count(args.count.as_deref(), n_states)?;

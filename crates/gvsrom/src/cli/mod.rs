@@ -233,6 +233,26 @@ fn check_cmd(args: &ScenarioArgs, out: &mut impl Write) -> Result<()> {
 
 /// The command's input files and directories that an output must not replace: the scenario file
 /// (not a preset name, which is resolved first) and `model`, with their option names.
+/// What `statics`, `modes` and `linearize` do before they solve: `--extrapolate` only with
+/// `--model`, a `--json` FILE that is none of the inputs, the scenario resolved and the model
+/// attached; returns it with the provenance of the run (scenario and solver).
+fn load_for_equilibrium(
+    args: &ScenarioArgs,
+    model: Option<&PathBuf>,
+    json: Option<&PathBuf>,
+) -> Result<(Resolved, gvsrom::provenance::Provenance)> {
+    extrapolate_needs_model(args, model.map(PathBuf::as_path))?;
+    if let Some(path) = json {
+        gvsrom::output::refuse_overlap("--json", path, &scenario_inputs(args, model))?;
+    }
+    let mut r = load(args)?;
+    if let Some(dir) = model {
+        attach_model(&mut r, args, dir, false)?;
+    }
+    let provenance = r.provenance.clone().solver(&r.built.options);
+    Ok((r, provenance))
+}
+
 fn scenario_inputs<'a>(
     args: &'a ScenarioArgs,
     model: Option<&'a PathBuf>,
