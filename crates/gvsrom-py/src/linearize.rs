@@ -28,6 +28,9 @@ impl Robot {
     ///     shape (n_dof,).
     /// qd : array_like of float, optional
     ///     The state's velocities (with ``q`` only); default zero.
+    /// dt : float, optional
+    ///     Also discretize with a zero-order hold of ``dt`` seconds (``--sample-time``):
+    ///     ``Ad`` = e^(A dt), ``Bd`` = ∫₀^dt e^(A s) ds B, ``spectral_radius`` max |e^(λ dt)|.
     ///
     /// Returns
     /// -------
@@ -40,21 +43,32 @@ impl Robot {
     ///     ``−C A⁻¹ B`` about an equilibrium (``None`` about a given state), ``about``
     ///     (``"equilibrium"`` or ``"state"``), ``damping_time_s``, ``relaxation_poles``,
     ///     ``equilibrium_residual_norm`` (about an equilibrium), ``time_s`` (the linearization's
-    ///     wall time), ``model_extrapolated``.
+    ///     wall time), ``model_extrapolated``; with ``dt``: ``Ad`` (2n, 2n), ``Bd``
+    ///     (2n, n_actuators), ``dt``, ``spectral_radius``.
     ///
     /// Raises
     /// ------
     /// GvsromError
     ///     For bad tensions or states, ``qd`` without ``q``, a massless rod, or an equilibrium
     ///     that fails (``ConvergenceError``).
-    #[pyo3(signature = (u=None, q=None, qd=None))]
+    #[pyo3(signature = (u=None, q=None, qd=None, dt=None))]
     fn linearize<'py>(
         &self,
         py: Python<'py>,
         u: Option<arrays::Tensions<'_>>,
         q: Option<arrays::In1<'_>>,
         qd: Option<arrays::In1<'_>>,
+        dt: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        if let Some(h) = dt {
+            if !(h.is_finite() && h > 0.0) {
+                return Err(invalid(
+                    LinearizeError::SampleTime { value: h }
+                        .to_string()
+                        .replacen("--sample-time", "`dt`", 1),
+                ));
+            }
+        }
         let to_py = |e: LinearizeError| {
             let message = errors::chain(&e);
             match &e {
@@ -62,7 +76,7 @@ impl Robot {
                 _ => invalid(message),
             }
         };
-        let lin = match (&q, &qd) {
+        let mut lin = match (&q, &qd) {
             (None, Some(_)) => {
                 return Err(invalid(
                     "`qd` without `q`: give the state's `q` too, or neither to linearize about the equilibrium at rest",
@@ -82,6 +96,9 @@ impl Robot {
                     .map_err(to_py)?
             }
         };
+        if let Some(h) = dt {
+            lin.discretize(h).map_err(to_py)?;
+        }
         let d = report_dict(py, &lin)?;
         let extrapolated = (self.built.reduced.as_ref()).map_or(vec![], |r| r.extrapolated.clone());
         d.set_item("model_extrapolated", extrapolated)?;
@@ -120,5 +137,14 @@ fn report_dict<'py>(py: Python<'py>, r: &Linearization) -> PyResult<Bound<'py, P
     d.set_item("time_s", r.time_s)?;
     d.set_item("relaxation_poles", r.relaxation_poles)?;
     d.set_item("equilibrium_residual_norm", r.equilibrium_residual_norm)?;
+    if let Some(disc) = &r.discrete {
+        let n2 = disc.ad.len();
+        let ad = nalgebra::DMatrix::from_fn(n2, n2, |i, j| disc.ad[i][j]);
+        let bd = nalgebra::DMatrix::from_fn(n2, r.n_actuators, |i, j| disc.bd[i][j]);
+        d.set_item("Ad", matrix(py, &ad)?)?;
+        d.set_item("Bd", matrix(py, &bd)?)?;
+        d.set_item("dt", disc.sample_time_s)?;
+        d.set_item("spectral_radius", disc.spectral_radius)?;
+    }
     Ok(d)
 }

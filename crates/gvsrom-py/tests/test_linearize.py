@@ -121,3 +121,40 @@ def test_bad_arguments_are_clear_errors():
         robot.linearize(q=np.zeros(3))
     with pytest.raises(gvsrom.GvsromError, match="density"):
         gvsrom.Scenario.preset("single-tendon").set("material.density", 0.0).build().linearize()
+
+
+def test_zero_order_hold_predicts_one_held_sample_of_the_nonlinear_simulation():
+    # From the equilibrium at u0, tensions u0 ± δu held for one sample h: the simulated state after
+    # h (integrator at rtol 1e-8) differs by 2 B_d δu + O(δu³); from a perturbed state x0 ± δx
+    # with u0 held, by 2 A_d δx. The central difference removes the quadratic terms. Measured:
+    # 2.8e-7 relative for B_d at rtol 1e-6 … 1e-8 (2026-12-06); an Euler step B h is 4e4 × off.
+    robot = gvsrom.Scenario.preset("single-tendon").build()
+    u0, h = -3.0, 0.02
+    lin = robot.linearize(u=[u0], dt=h)
+    assert lin["Ad"].shape == (66, 66) and lin["Bd"].shape == (66, 1) and lin["dt"] == h
+    assert 0 < lin["spectral_radius"] < 1
+    n = robot.n_dof
+    q0 = lin["x0"][:n]
+
+    def after(q, qd, u):
+        tr = robot.simulate(h, sample_rate=1 / h, input=np.array([[0.0, u]]), q0=q, qd0=qd,
+                            rtol=1e-8, atol=1e-11)
+        assert tr["t"][-1] == pytest.approx(h)
+        return np.concatenate([tr["q"][-1], tr["qd"][-1]])
+
+    du = 0.01
+    bd = (after(q0, np.zeros(n), u0 + du) - after(q0, np.zeros(n), u0 - du)) / (2 * du)
+    assert np.linalg.norm(lin["Bd"][:, 0] - bd) < 1e-5 * np.linalg.norm(bd)
+    # a velocity kick along the first mode's shape
+    phi = robot.modes(1, u=[u0])["shape"][0]
+    dx = 1e-3 * phi
+    ad_dx = (after(q0, dx, u0) - after(q0, -dx, u0)) / 2
+    pred = lin["Ad"][:, n:] @ dx
+    assert np.linalg.norm(pred - ad_dx) < 1e-5 * np.linalg.norm(ad_dx)
+
+
+def test_a_bad_sample_time_is_refused_naming_dt():
+    robot = gvsrom.Scenario.preset("single-tendon").build()
+    for bad in [0.0, -0.01, float("nan"), float("inf")]:
+        with pytest.raises(gvsrom.GvsromError, match="`dt`"):
+            robot.linearize(dt=bad)

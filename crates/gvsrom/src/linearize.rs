@@ -34,6 +34,8 @@ pub const DEFAULT_COUNT: usize = 10;
 
 #[derive(Debug, Error)]
 pub enum LinearizeError {
+    #[error("--sample-time `{value}`: expected a duration in seconds, finite and > 0 (the hold of the zero-order-hold discretization, e.g. 0.01 for a 100 Hz controller)")]
+    SampleTime { value: f64 },
     #[error("--count `{value}`: expected an integer ≥ 1 (the number of slowest poles to print; the linearization has {n_poles} states, so at most {n_poles} poles)")]
     Count { value: String, n_poles: usize },
     #[error("the equilibrium: {0}")]
@@ -115,6 +117,9 @@ pub struct Linearization {
     pub static_gain: Option<Vec<Vec<f64>>>,
     /// Wall time of the linearization \[s\] (`A`, `B`, `C` and the poles; not the equilibrium).
     pub time_s: f64,
+    /// With a sample time: the zero-order-hold discretization `x_{k+1} = A_d x_k + B_d u_k`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub discrete: Option<Discrete>,
     /// About an equilibrium, its solver's residual `‖R‖∞`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub equilibrium_residual_norm: Option<f64>,
@@ -134,6 +139,55 @@ impl Linearization {
     /// `C` as a matrix.
     pub fn c_matrix(&self) -> DMatrix<f64> {
         from_rows(&self.c)
+    }
+}
+
+/// The zero-order-hold discretization of a linearization: `δx_{k+1} = A_d δx_k + B_d δu_k` for
+/// tensions held over each sample time `h` (Van Loan): `exp([A B; 0 0] h) = [A_d B_d; 0 I]`, so
+/// `A_d = e^{A h}` and `B_d = ∫₀^h e^{A s} ds B`. Its poles are `e^{λ h}`.
+#[derive(Debug, Clone, Serialize)]
+pub struct Discrete {
+    /// `h` \[s\].
+    pub sample_time_s: f64,
+    /// `A_d` (2n × 2n), rows.
+    pub ad: Vec<Vec<f64>>,
+    /// `B_d` (2n × n_actuators), rows.
+    pub bd: Vec<Vec<f64>>,
+    /// `max |e^{λ h}|` over the poles: below 1 for a stable operating point.
+    pub spectral_radius: f64,
+}
+
+impl Linearization {
+    /// Adds the zero-order-hold discretization at the sample time `h` \[s\] ([`Discrete`]).
+    pub fn discretize(&mut self, h: f64) -> Result<(), LinearizeError> {
+        if !(h.is_finite() && h > 0.0) {
+            return Err(LinearizeError::SampleTime { value: h });
+        }
+        let (a, b) = (self.a_matrix(), self.b_matrix());
+        let (n2, na) = (a.nrows(), b.ncols());
+        let mut m = DMatrix::zeros(n2 + na, n2 + na);
+        m.view_mut((0, 0), (n2, n2)).copy_from(&(&a * h));
+        m.view_mut((0, n2), (n2, na)).copy_from(&(&b * h));
+        let e = m.exp();
+        let ad = e.view((0, 0), (n2, n2)).into_owned();
+        let bd = e.view((0, n2), (n2, na)).into_owned();
+        if ad.iter().chain(bd.iter()).any(|v| !v.is_finite()) {
+            return Err(DynamicsError::NonFinite {
+                what: "zero-order-hold discretization",
+            }
+            .into());
+        }
+        let spectral_radius = self
+            .poles
+            .iter()
+            .fold(0.0_f64, |r, p| r.max((p.re * h).exp()));
+        self.discrete = Some(Discrete {
+            sample_time_s: h,
+            ad: rows(&ad),
+            bd: rows(&bd),
+            spectral_radius,
+        });
+        Ok(())
     }
 }
 
@@ -226,6 +280,7 @@ fn on_model<P: StrainParam>(
         c: rows(&c),
         static_gain: None,
         time_s: start.elapsed().as_secs_f64(),
+        discrete: None,
         equilibrium_residual_norm: None,
     })
 }

@@ -322,3 +322,41 @@ fn upright_rod_beyond_self_weight_buckling_has_one_unstable_pole_per_buckling_mo
         assert!(lin["static_gain"].is_array());
     }
 }
+
+#[test]
+fn zero_order_hold_composes_as_two_half_samples_and_refuses_a_bad_sample_time() {
+    // exact ZOH matrices compose: A_d(2h) = A_d(h)², B_d(2h) = A_d(h) B_d(h) + B_d(h) (the
+    // prediction against the nonlinear simulation is in the Python tests)
+    let one = |h: &str, name: &str| {
+        let (stdout, lin) = run_json(
+            "linearize",
+            name,
+            &["six-tendon", "--tension=-4,0,0,-1,0,0", "--sample-time", h],
+        );
+        assert!(
+            stdout.contains(&format!("zero-order hold of {h} s")),
+            "{stdout}"
+        );
+        let d = &lin["discrete"];
+        (
+            nalgebra::DMatrix::from_row_slice(56, 56, &matrix(&d["ad"]).concat()),
+            nalgebra::DMatrix::from_row_slice(56, 6, &matrix(&d["bd"]).concat()),
+            d["spectral_radius"].as_f64().unwrap(),
+        )
+    };
+    let (ad1, bd1, rho1) = one("0.01", "lin-zoh-1");
+    let (ad2, bd2, rho2) = one("0.02", "lin-zoh-2");
+    let ea = (&ad1 * &ad1 - &ad2).norm() / ad2.norm();
+    let eb = (&ad1 * &bd1 + &bd1 - &bd2).norm() / bd2.norm();
+    assert!(ea < 1e-10 && eb < 1e-10, "A_d {ea:e}, B_d {eb:e}");
+    assert!(
+        rho1 < 1.0 && (rho2 - rho1 * rho1).abs() < 1e-12,
+        "{rho1} {rho2}"
+    );
+    for bad in ["0", "-0.01", "nan", "inf"] {
+        expect_error(
+            &["linearize", "six-tendon", "--sample-time", bad],
+            &["--sample-time", "finite and > 0"],
+        );
+    }
+}

@@ -356,7 +356,11 @@ class Robot:
     def energy(self, q: ArrayLike, qd: ArrayLike | None = None) -> dict[str, float]: ...
     def modes(self, count: int = 10, u: ArrayLike | None = None) -> dict[str, Any]: ...
     def linearize(
-        self, u: ArrayLike | None = None, q: ArrayLike | None = None, qd: ArrayLike | None = None
+        self,
+        u: ArrayLike | None = None,
+        q: ArrayLike | None = None,
+        qd: ArrayLike | None = None,
+        dt: float | None = None,
     ) -> dict[str, Any]: ...
     def simulate(
         self,

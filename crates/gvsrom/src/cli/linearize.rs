@@ -12,6 +12,11 @@ pub struct LinearizeArgs {
     #[arg(long, value_name = "K", allow_hyphen_values = true)]
     pub count: Option<String>,
 
+    /// Also discretize with a zero-order hold of H seconds (tensions held over each sample):
+    /// `δx_{k+1} = A_d δx_k + B_d δu_k`, written to the JSON as `discrete`.
+    #[arg(long, value_name = "H", allow_hyphen_values = true)]
+    pub sample_time: Option<f64>,
+
     /// Also write the operating point, `A`, `B`, `C`, the poles and the static gain as JSON to FILE
     /// (a new file; see `--force`).
     #[arg(long, value_name = "FILE")]
@@ -39,8 +44,17 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
         Some(path) => Some(OutputFile::create("--json", path, "linearize", args.force)?),
         None => None,
     };
+    if let Some(h) = args.sample_time {
+        // refused before the solve, as a bad count is
+        if !(h.is_finite() && h > 0.0) {
+            return Err(linearize::LinearizeError::SampleTime { value: h }.into());
+        }
+    }
     print_model(scenario, &args.scenario, built, None, out)?;
-    let (eq, lin) = linearize::about_equilibrium(built)?;
+    let (eq, mut lin) = linearize::about_equilibrium(built)?;
+    if let Some(h) = args.sample_time {
+        lin.discretize(h)?;
+    }
     writeln!(
         out,
         "solved     equilibrium in {} and {}, ‖R‖∞ = {:.3e} (as `gvsrom statics`)",
@@ -117,6 +131,15 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
         None => {
             writeln!(out, "gain       none: A is singular at this equilibrium")?;
         }
+    }
+    if let Some(d) = &lin.discrete {
+        writeln!(
+            out,
+            "discrete   zero-order hold of {} s: δx_k+1 = A_d δx_k + B_d δu_k, poles e^(λh) within |z| ≤ {:.6}{}",
+            d.sample_time_s,
+            d.spectral_radius,
+            if args.json.is_some() { " (A_d, B_d in the JSON)" } else { " (--json writes A_d, B_d)" }
+        )?;
     }
     if let Some(json) = json {
         let doc = linearize::LinearizationJson {
