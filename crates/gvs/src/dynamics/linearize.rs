@@ -43,6 +43,70 @@ pub struct StateSpace {
 }
 
 impl<P: StrainParam> Model<P> {
+    /// `∂ε/∂q` and `∂ε/∂q̇` of the residual `ε(q, q̇, q̈, u)` of eq. (8) ([`Self::dynamics_residual`])
+    /// at `q̈` held fixed, into `de_dq` and `de_dqd` (`n × n`): the analytic static part, the
+    /// inertial and damping part by central differences in `q` (none at rest), the exact central
+    /// difference in `q̇` (module documentation). With them the iteration matrix of the NDF in
+    /// second-order form would hold every term, `M + c_v ∂ε/∂q̇ + c_q ∂ε/∂q`; measured on the
+    /// six-tendon babbling (10 s, seed 1, 2026-12-06) it did not pay: 2691 steps with 383 Newton
+    /// failures and 110 Jacobians in 0.43 s, against 2924, 308 and 12 in 0.21 s with
+    /// [`Self::iteration_parts`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn residual_jacobians(
+        &self,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        qdd: &DVector<f64>,
+        u: &[f64],
+        loads: &PreparedLoads,
+        ws: &mut Workspace,
+        de_dq: &mut DMatrix<f64>,
+        de_dqd: &mut DMatrix<f64>,
+    ) {
+        let n = self.n_dof();
+        let na = self.n_actuators();
+        // ∂ε/∂q: the static part, analytic ...
+        self.statics_jacobian(q, u, loads, ws, de_dq);
+        de_dq.neg_mut();
+        // ... and the inertial and damping part I(q), by central differences
+        let none = self.no_loads();
+        let zero_u = vec![0.0; na];
+        let zero = DVector::zeros(n);
+        let mut r1 = DVector::zeros(n);
+        let mut r0 = DVector::zeros(n);
+        let mut inertial = |q: &DVector<f64>, ws: &mut Workspace, out: &mut DVector<f64>| {
+            self.dynamics_residual(q, qd, qdd, &zero_u, &none, ws, &mut r1);
+            self.dynamics_residual(q, &zero, &zero, &zero_u, &none, ws, &mut r0);
+            out.copy_from(&(&r1 - &r0));
+        };
+        let at_rest = qd.iter().all(|v| *v == 0.0) && qdd.iter().all(|v| *v == 0.0);
+        let (mut plus, mut minus) = (DVector::zeros(n), DVector::zeros(n));
+        if !at_rest {
+            let mut qs = q.clone();
+            for j in 0..n {
+                let h = LINEARIZATION_STEP * (1.0 + q[j].abs());
+                qs[j] = q[j] + h;
+                inertial(&qs, ws, &mut plus);
+                qs[j] = q[j] - h;
+                inertial(&qs, ws, &mut minus);
+                qs[j] = q[j];
+                let mut col = de_dq.column_mut(j);
+                col += (&plus - &minus) / (2.0 * h);
+            }
+        }
+        // ∂ε/∂q̇: exact central differences of a quadratic in q̇ (step 1 + |q̇_j|)
+        let mut qds = qd.clone();
+        for j in 0..n {
+            let s = 1.0 + qd[j].abs();
+            qds[j] = qd[j] + s;
+            self.dynamics_residual(q, &qds, qdd, &zero_u, &none, ws, &mut plus);
+            qds[j] = qd[j] - s;
+            self.dynamics_residual(q, &qds, qdd, &zero_u, &none, ws, &mut minus);
+            qds[j] = qd[j];
+            de_dqd.set_column(j, &((&plus - &minus) / (2.0 * s)));
+        }
+    }
+
     /// The state-space linearization of the equations of motion at `(q, q̇, u)` under `loads`
     /// (module documentation). Cost: one statics Jacobian, one mass matrix, `n` actuation columns
     /// and `6n` dynamics residuals (`2n` when `q̇ = 0`).
@@ -58,53 +122,9 @@ impl<P: StrainParam> Model<P> {
         let na = self.n_actuators();
         let mut qdd = DVector::zeros(n);
         self.accelerations(q, qd, u, loads, ws, &mut qdd)?;
-
-        // ∂ε/∂q: the static part, analytic ...
         let mut de_dq = DMatrix::zeros(n, n);
-        self.statics_jacobian(q, u, loads, ws, &mut de_dq);
-        de_dq.neg_mut();
-        // ... and the inertial and damping part I(q), by central differences
-        let none = self.no_loads();
-        let zero_u = vec![0.0; na];
-        let zero = DVector::zeros(n);
-        let mut r1 = DVector::zeros(n);
-        let mut r0 = DVector::zeros(n);
-        let mut inertial = |q: &DVector<f64>, ws: &mut Workspace, out: &mut DVector<f64>| {
-            self.dynamics_residual(q, qd, &qdd, &zero_u, &none, ws, &mut r1);
-            self.dynamics_residual(q, &zero, &zero, &zero_u, &none, ws, &mut r0);
-            out.copy_from(&(&r1 - &r0));
-        };
-        let at_rest = qd.iter().all(|v| *v == 0.0) && qdd.iter().all(|v| *v == 0.0);
-        if !at_rest {
-            let (mut plus, mut minus) = (DVector::zeros(n), DVector::zeros(n));
-            let mut qs = q.clone();
-            for j in 0..n {
-                let h = LINEARIZATION_STEP * (1.0 + q[j].abs());
-                qs[j] = q[j] + h;
-                inertial(&qs, ws, &mut plus);
-                qs[j] = q[j] - h;
-                inertial(&qs, ws, &mut minus);
-                qs[j] = q[j];
-                let mut col = de_dq.column_mut(j);
-                col += (&plus - &minus) / (2.0 * h);
-            }
-        }
-
-        // ∂ε/∂q̇: exact central differences of a quadratic in q̇ (step 1 + |q̇_j|)
         let mut de_dqd = DMatrix::zeros(n, n);
-        {
-            let (mut plus, mut minus) = (DVector::zeros(n), DVector::zeros(n));
-            let mut qds = qd.clone();
-            for j in 0..n {
-                let s = 1.0 + qd[j].abs();
-                qds[j] = qd[j] + s;
-                self.dynamics_residual(q, &qds, &qdd, &zero_u, &none, ws, &mut plus);
-                qds[j] = qd[j] - s;
-                self.dynamics_residual(q, &qds, &qdd, &zero_u, &none, ws, &mut minus);
-                qds[j] = qd[j];
-                de_dqd.set_column(j, &((&plus - &minus) / (2.0 * s)));
-            }
-        }
+        self.residual_jacobians(q, qd, &qdd, u, loads, ws, &mut de_dq, &mut de_dqd);
 
         let actuation = self.actuation_matrix(q, ws);
         let mut mass = self.mass_matrix(q, ws);
