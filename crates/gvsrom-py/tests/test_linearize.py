@@ -158,3 +158,26 @@ def test_a_bad_sample_time_is_refused_naming_dt():
     for bad in [0.0, -0.01, float("nan"), float("inf")]:
         with pytest.raises(gvsrom.GvsromError, match="`dt`"):
             robot.linearize(dt=bad)
+
+
+@pytest.fixture(scope="module")
+def ae_robot(gvsrom_bin, tmp_path_factory):
+    ds = tmp_path_factory.mktemp("lin-ae-ds") / "sweep"
+    p = run_cli(gvsrom_bin, "dataset", "single-tendon", "--sweep", "tendons.0.tension=-6:0",
+                "--samples", "7", "--out", str(ds))
+    assert p.returncode == 0, p.stderr
+    model = gvsrom.train(ds, tmp_path_factory.mktemp("lin-ae") / "model", latent=1, hidden_layers=3,
+                         epochs=40, patience=0, lbfgs_iterations=20, seed=3)
+    return gvsrom.Scenario.preset("single-tendon").build().with_model(model)
+
+
+def test_an_autoencoders_linearization_is_the_derivative_of_its_accelerations(ae_robot):
+    # the decoder's path of the engine (Ψ(q) nonlinear, M(q) varying with the code)
+    eq = ae_robot.linearize(u=[-3.0])
+    assert eq["A"].shape == (2, 2) and eq["B"].shape == (2, 1)
+    q = eq["x0"][:1]
+    for qd in [0.0, 0.5]:
+        lin = ae_robot.linearize(u=[-3.0], q=q, qd=[qd])
+        A, B = accelerations_fd(ae_robot, q, np.array([qd]), np.array([-3.0]))
+        assert np.linalg.norm(lin["A"] - A) < 2e-6 * np.linalg.norm(A), (lin["A"], A)
+        assert np.linalg.norm(lin["B"] - B) < 2e-6 * np.linalg.norm(B)
