@@ -308,10 +308,21 @@ fn linearization_at_an_equilibrium_at_rest_is_analytic() {
         err < 1e-9,
         "A vs the analytic approximation at rest: {err:e}"
     );
+    // about the equilibrium with q̈ = 0 held: the approximation itself, to rounding, and the same
+    // ẋ (the residual's acceleration) and B
+    let eq = m.linearize_equilibrium(&qe, &U, &pl, &mut ws).unwrap();
+    let err = (&eq.a - &a).norm() / a.norm();
+    assert!(
+        err < 1e-13,
+        "A at the equilibrium vs the approximation: {err:e}"
+    );
+    assert_eq!(eq.xdot, lin.xdot);
+    assert_eq!(eq.b, lin.b);
 }
 
 /// On a nonlinear strain parameterization (a sigmoid bend, the decoder-like path of the reduced
-/// models) in motion under gravity: `A` against central differences of `f`, ≤ 1e-6.
+/// models) under gravity, moving and momentarily still: `A` against central differences of `f`,
+/// ≤ 1e-6.
 #[test]
 fn linearization_of_a_nonlinear_parameterization_matches_differences() {
     let rod = common::iva_rod(1e4);
@@ -322,14 +333,23 @@ fn linearization_of_a_nonlinear_parameterization_matches_differences() {
     // amplitude 1.2, steepness 7, centre 0.4: M's condition number ~1e6 (a flat sigmoid, amplitude
     // near 0, makes M nearly singular, 1e13, and differences of f meaningless)
     let q = DVector::from_vec(vec![1.2, 7.0, 0.4]);
-    let qd = DVector::from_vec(vec![0.8, -4.0, 0.3]);
     let pl = m.prepare_loads(&loads()).unwrap();
     let mut ws = m.workspace();
-    let lin = m.linearize(&q, &qd, &[], &pl, &mut ws).unwrap();
-    let fd = fd_jacobian_at(&m, &pl, &q, &qd, &[]);
-    let err = (&lin.a - &fd).norm() / fd.norm();
-    assert!(err < 1e-6, "A vs FD on the sigmoid bend: {err:e}");
-    assert_eq!(lin.b.ncols(), 0);
+    // moving, and momentarily still (q̇ = 0, q̈ ≠ 0: ∂ε/∂q̇ is then the damping matrix D(q))
+    for qd in [DVector::from_vec(vec![0.8, -4.0, 0.3]), DVector::zeros(3)] {
+        let lin = m.linearize(&q, &qd, &[], &pl, &mut ws).unwrap();
+        let fd = fd_jacobian_at(&m, &pl, &q, &qd, &[]);
+        let err = (&lin.a - &fd).norm() / fd.norm();
+        assert!(
+            err < 1e-6,
+            "A vs FD on the sigmoid bend at q̇ = {qd:?}: {err:e}"
+        );
+        assert!(
+            lin.xdot.rows(3, 3).amax() > 1.0,
+            "not a still state: the test is vacuous"
+        );
+        assert_eq!(lin.b.ncols(), 0);
+    }
 }
 
 /// A straight Kelvin–Voigt rod (ν = ½: `Ds = t_d Es` in every component, `t_d = 3η/E`) without

@@ -5,7 +5,8 @@
 //! decoder's coordinates.
 //!
 //! * `A`, `B`: the engine's [`Model::linearize`] (gvs-spec §9.3): exact static part, the inertial
-//!   terms that vanish at rest included in motion.
+//!   terms that vanish at rest included in motion; about an equilibrium
+//!   [`Model::linearize_equilibrium`] (`q̈ = 0` held: analytic throughout).
 //! * `C = [R_tip J_tip,v  0]` (3 × 2n): the tip's world velocity per unit `q̇` (rows 4–6 of the tip
 //!   Jacobian, body frame, rotated to the world).
 //! * Poles: the eigenvalues of `A`, each with its natural frequency `|λ|/2π` and damping ratio
@@ -212,7 +213,10 @@ pub fn about_equilibrium(built: &Built) -> Result<(StaticsReport, Linearization)
     statics::check_reduced(built, &eq)?;
     let q = DVector::from_column_slice(&eq.q);
     let qd = DVector::zeros(q.len());
-    let mut lin = about_state(built, &q, &qd, &built.u)?;
+    let mut lin = match &built.reduced {
+        Some(r) => on_model(built, &r.model, &q, &qd, &built.u, true)?,
+        None => on_model(built, &built.model, &q, &qd, &built.u, true)?,
+    };
     lin.about = "equilibrium";
     lin.equilibrium_residual_norm = Some(eq.residual_norm);
     lin.static_gain = static_gain(&lin);
@@ -229,8 +233,8 @@ pub fn about_state(
 ) -> Result<Linearization, LinearizeError> {
     crate::simulate::require_mass(built)?;
     match &built.reduced {
-        Some(r) => on_model(built, &r.model, q, qd, u),
-        None => on_model(built, &built.model, q, qd, u),
+        Some(r) => on_model(built, &r.model, q, qd, u, false),
+        None => on_model(built, &built.model, q, qd, u, false),
     }
 }
 
@@ -240,12 +244,17 @@ fn on_model<P: StrainParam>(
     q: &DVector<f64>,
     qd: &DVector<f64>,
     u: &[f64],
+    equilibrium: bool,
 ) -> Result<Linearization, LinearizeError> {
     let start = std::time::Instant::now();
     let n = model.n_dof();
     let loads = model.prepare_loads(&built.loads)?;
     let mut ws = model.workspace();
-    let StateSpace { a, b, xdot } = model.linearize(q, qd, u, &loads, &mut ws)?;
+    let StateSpace { a, b, xdot } = if equilibrium {
+        model.linearize_equilibrium(q, u, &loads, &mut ws)?
+    } else {
+        model.linearize(q, qd, u, &loads, &mut ws)?
+    };
     let t_d = model.damping_time();
     let poles = poles(&a);
 

@@ -94,7 +94,16 @@ impl<P: StrainParam> Model<P> {
                 col += (&plus - &minus) / (2.0 * h);
             }
         }
-        // ∂ε/∂q̇: exact central differences of a quadratic in q̇ (step 1 + |q̇_j|)
+        // ∂ε/∂q̇ = ∂(C q̇)/∂q̇ + D(q): at q̇ = 0 the quadratic's derivative vanishes and it is the
+        // damping matrix, from Ψ_q at q (a forward pass's parameterization evaluation) ...
+        if qd.iter().all(|v| *v == 0.0) {
+            self.param.eval(q, &mut ws.ev);
+            ws.ev.motion = false;
+            ws.ev.psi_q_stale = false;
+            self.damping_matrix_into(ws, de_dqd);
+            return;
+        }
+        // ... else exact central differences of a quadratic in q̇ (step 1 + |q̇_j|)
         let mut qds = qd.clone();
         for j in 0..n {
             let s = 1.0 + qd[j].abs();
@@ -118,13 +127,46 @@ impl<P: StrainParam> Model<P> {
         loads: &PreparedLoads,
         ws: &mut Workspace,
     ) -> Result<StateSpace, DynamicsError> {
+        self.linearize_holding(q, qd, u, loads, ws, false)
+    }
+
+    /// [`Self::linearize`] about a static equilibrium `q` at rest, with `q̈ = 0` held in the
+    /// derivatives: a solved equilibrium's residual `R` leaves `q̈ = M⁻¹R` small but not zero, and
+    /// the linearization about the equilibrium is the one at the exact `q̈ = 0`, where every term is
+    /// analytic (the inertial part vanishes; no differences in `q`). `ẋ` is still `f(x, u)`, so
+    /// the residual stays visible. Cost: one statics Jacobian, one mass matrix and `B`.
+    pub fn linearize_equilibrium(
+        &self,
+        q: &DVector<f64>,
+        u: &[f64],
+        loads: &PreparedLoads,
+        ws: &mut Workspace,
+    ) -> Result<StateSpace, DynamicsError> {
+        let rest = DVector::zeros(self.n_dof());
+        self.linearize_holding(q, &rest, u, loads, ws, true)
+    }
+
+    fn linearize_holding(
+        &self,
+        q: &DVector<f64>,
+        qd: &DVector<f64>,
+        u: &[f64],
+        loads: &PreparedLoads,
+        ws: &mut Workspace,
+        still: bool,
+    ) -> Result<StateSpace, DynamicsError> {
         let n = self.n_dof();
         let na = self.n_actuators();
         let mut qdd = DVector::zeros(n);
         self.accelerations(q, qd, u, loads, ws, &mut qdd)?;
+        let held = if still {
+            DVector::zeros(n)
+        } else {
+            qdd.clone()
+        };
         let mut de_dq = DMatrix::zeros(n, n);
         let mut de_dqd = DMatrix::zeros(n, n);
-        self.residual_jacobians(q, qd, &qdd, u, loads, ws, &mut de_dq, &mut de_dqd);
+        self.residual_jacobians(q, qd, &held, u, loads, ws, &mut de_dq, &mut de_dqd);
 
         let actuation = self.actuation_matrix(q, ws);
         let mut mass = self.mass_matrix(q, ws);
