@@ -181,3 +181,51 @@ def test_an_autoencoders_linearization_is_the_derivative_of_its_accelerations(ae
         A, B = accelerations_fd(ae_robot, q, np.array([qd]), np.array([-3.0]))
         assert np.linalg.norm(lin["A"] - A) < 2e-6 * np.linalg.norm(A), (lin["A"], A)
         assert np.linalg.norm(lin["B"] - B) < 2e-6 * np.linalg.norm(B)
+
+
+def discrete_lqr(Ad, Bd, Q, R, iterations=5000):
+    """The gain K of u = −K x minimising Σ xᵀQx + uᵀRu for x⁺ = Ad x + Bd u (Riccati iteration)."""
+    P = Q.copy()
+    for _ in range(iterations):
+        K = np.linalg.solve(R + Bd.T @ P @ Bd, Bd.T @ P @ Ad)
+        P_next = Q + Ad.T @ P @ (Ad - Bd @ K)
+        if np.abs(P_next - P).max() < 1e-12 * np.abs(P).max():
+            return K
+        P = P_next
+    raise AssertionError("the Riccati iteration did not converge")
+
+
+def test_an_lqr_designed_on_the_linearization_damps_the_nonlinear_arm():
+    # IV-A at −3 N, its tip kicked at 0.5 m/s along the first mode: a discrete LQR on (Ad, Bd) with
+    # the tip position weighted (C), applied every 10 ms to the nonlinear model (`simulate` with the
+    # tension held over each period), against the tension held at −3 N. Measured over 1 s
+    # (2026-12-06): tip error RMS 12.4 → 1.12 mm, at 0.5 s 6.8 mm → 3.9 µm, tensions in
+    # [−8.13, −2.81] N (the tendon only pulls). Checked here over the first 0.5 s.
+    robot = gvsrom.Scenario.preset("single-tendon").build()
+    u0, h, steps = -3.0, 0.01, 50
+    lin = robot.linearize(u=[u0], dt=h)
+    Ad, Bd, C, x0 = lin["Ad"], lin["Bd"], lin["C"], lin["x0"]
+    K = discrete_lqr(Ad, Bd, 1e4 * C.T @ C + 1e-8 * np.eye(len(x0)), np.array([[1e-3]]))
+    assert max(abs(np.linalg.eigvals(Ad - Bd @ K))) < lin["spectral_radius"]
+    n = robot.n_dof
+    phi = robot.modes(1, u=[u0])["shape"][0]
+    qd_kick = 0.5 * phi / np.abs(C[:, :n] @ phi).max()
+    tip0 = lin["tip_position"]
+
+    def run(control):
+        q, qd = x0[:n].copy(), qd_kick.copy()
+        err, us = [], []
+        for _ in range(steps):
+            u = u0 - (K @ (np.concatenate([q, qd]) - x0))[0] if control else u0
+            tr = robot.simulate(h, sample_rate=1 / h, input=np.array([[0.0, u]]), q0=q, qd0=qd)
+            q, qd = tr["q"][-1], tr["qd"][-1]
+            err.append(np.linalg.norm(tr["tip_position"][-1] - tip0))
+            us.append(u)
+        return np.array(err), np.array(us)
+
+    open_err, _ = run(False)
+    closed_err, us = run(True)
+    rms = lambda e: np.sqrt((e ** 2).mean())  # noqa: E731
+    assert rms(closed_err) < 0.2 * rms(open_err), (rms(closed_err), rms(open_err))
+    assert closed_err[-1] < 0.01 * open_err[-1], (closed_err[-1], open_err[-1])
+    assert (us < 0).all(), "the controller asked the tendon to push"
