@@ -77,7 +77,8 @@ impl<P: StrainParam> Model<P> {
         let mut inertial = |q: &DVector<f64>, ws: &mut Workspace, out: &mut DVector<f64>| {
             self.dynamics_residual(q, qd, qdd, &zero_u, &none, ws, &mut r1);
             self.dynamics_residual(q, &zero, &zero, &zero_u, &none, ws, &mut r0);
-            out.copy_from(&(&r1 - &r0));
+            out.copy_from(&r1);
+            *out -= &r0;
         };
         let at_rest = qd.iter().all(|v| *v == 0.0) && qdd.iter().all(|v| *v == 0.0);
         let (mut plus, mut minus) = (DVector::zeros(n), DVector::zeros(n));
@@ -90,8 +91,8 @@ impl<P: StrainParam> Model<P> {
                 qs[j] = q[j] - h;
                 inertial(&qs, ws, &mut minus);
                 qs[j] = q[j];
-                let mut col = de_dq.column_mut(j);
-                col += (&plus - &minus) / (2.0 * h);
+                plus -= &minus;
+                de_dq.column_mut(j).axpy(0.5 / h, &plus, 1.0);
             }
         }
         // ∂ε/∂q̇ = ∂(C q̇)/∂q̇ + D(q): at q̇ = 0 the quadratic's derivative vanishes and it is the
@@ -112,7 +113,8 @@ impl<P: StrainParam> Model<P> {
             qds[j] = qd[j] - s;
             self.dynamics_residual(q, &qds, qdd, &zero_u, &none, ws, &mut minus);
             qds[j] = qd[j];
-            de_dqd.set_column(j, &((&plus - &minus) / (2.0 * s)));
+            plus -= &minus;
+            de_dqd.column_mut(j).axpy(0.5 / s, &plus, 0.0);
         }
     }
 
