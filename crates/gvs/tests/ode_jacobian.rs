@@ -78,18 +78,8 @@ fn approx(m: &Model<LinearBasis>, q: &DVector<f64>, pl: &PreparedLoads) -> DMatr
     a
 }
 
-/// `f(q, q̇) = [q̇; M⁻¹ τ]`.
-fn rhs(
-    m: &Model<LinearBasis>,
-    pl: &PreparedLoads,
-    q: &DVector<f64>,
-    qd: &DVector<f64>,
-) -> DVector<f64> {
-    rhs_at(m, pl, q, qd, &U)
-}
-
-/// `f(q, q̇, u) = [q̇; M⁻¹ τ]` for any parameterization and tensions.
-fn rhs_at<P: StrainParam>(
+/// `f(q, q̇, u) = [q̇; M⁻¹ τ]`.
+fn rhs<P: StrainParam>(
     m: &Model<P>,
     pl: &PreparedLoads,
     q: &DVector<f64>,
@@ -107,16 +97,7 @@ fn rhs_at<P: StrainParam>(
 }
 
 /// Central differences of `f` in the `2n` state coordinates (step `h (1 + |y_j|)`).
-fn fd_jacobian(
-    m: &Model<LinearBasis>,
-    pl: &PreparedLoads,
-    q: &DVector<f64>,
-    qd: &DVector<f64>,
-) -> DMatrix<f64> {
-    fd_jacobian_at(m, pl, q, qd, &U)
-}
-
-fn fd_jacobian_at<P: StrainParam>(
+fn fd_jacobian<P: StrainParam>(
     m: &Model<P>,
     pl: &PreparedLoads,
     q: &DVector<f64>,
@@ -138,7 +119,7 @@ fn fd_jacobian_at<P: StrainParam>(
             qdp[j - n] += h;
             qdm[j - n] -= h;
         }
-        let col = (rhs_at(m, pl, &qp, &qdp, u) - rhs_at(m, pl, &qm, &qdm, u)) / (2.0 * h);
+        let col = (rhs(m, pl, &qp, &qdp, u) - rhs(m, pl, &qm, &qdm, u)) / (2.0 * h);
         jf.set_column(j, &col);
     }
     jf
@@ -158,9 +139,9 @@ fn ode_jacobian_approx_is_exact_at_an_equilibrium_at_rest() {
     let pl = m.prepare_loads(&loads()).unwrap();
     let zero = DVector::zeros(n);
     // at rest at the equilibrium the accelerations vanish (to the statics tolerance)
-    assert!(rhs(&m, &pl, &qe, &zero).amax() < 1e-6);
+    assert!(rhs(&m, &pl, &qe, &zero, &U).amax() < 1e-6);
     let a = approx(&m, &qe, &pl);
-    let fd = fd_jacobian(&m, &pl, &qe, &zero);
+    let fd = fd_jacobian(&m, &pl, &qe, &zero, &U);
     let err = (&a - &fd).norm() / fd.norm();
     assert!(err < 1e-6, "approximate vs FD Jacobian at rest: {err:e}");
 }
@@ -178,8 +159,8 @@ fn ode_jacobian_approx_neglects_only_the_inertial_terms_in_motion() {
     let qd = pseudo_random(n, 52, 3.0);
     let pl = m.prepare_loads(&loads()).unwrap();
     let a = approx(&m, &q, &pl);
-    let fd = fd_jacobian(&m, &pl, &q, &qd);
-    let qdd = rhs(&m, &pl, &q, &qd).rows(n, n).into_owned();
+    let fd = fd_jacobian(&m, &pl, &q, &qd, &U);
+    let qdd = rhs(&m, &pl, &q, &qd, &U).rows(n, n).into_owned();
 
     let mut ws = m.workspace();
     let mass = m.mass_matrix(&q, &mut ws);
@@ -236,7 +217,7 @@ fn linearization_matches_differences_of_the_right_hand_side_in_motion() {
     let pl = m.prepare_loads(&loads()).unwrap();
     let mut ws = m.workspace();
     let lin = m.linearize(&q, &qd, &U, &pl, &mut ws).unwrap();
-    let fd = fd_jacobian(&m, &pl, &q, &qd);
+    let fd = fd_jacobian(&m, &pl, &q, &qd, &U);
     let share = (&fd - approx(&m, &q, &pl)).norm() / fd.norm();
     let err = (&lin.a - &fd).norm() / fd.norm();
     assert!(
@@ -247,7 +228,7 @@ fn linearization_matches_differences_of_the_right_hand_side_in_motion() {
         err < 1e-6,
         "A vs FD: {err:e} (the approximation misses {share:e})"
     );
-    let f = rhs(&m, &pl, &q, &qd);
+    let f = rhs(&m, &pl, &q, &qd, &U);
     assert!(
         (&lin.xdot - &f).amax() <= 1e-12 * f.amax(),
         "ẋ is not f(x, u)"
@@ -278,7 +259,7 @@ fn linearization_input_matrix_matches_differences_in_the_tensions() {
         let h = 1e-4;
         up[k] += h;
         um[k] -= h;
-        let col = (rhs_at(&m, &pl, &q, &qd, &up) - rhs_at(&m, &pl, &q, &qd, &um)) / (2.0 * h);
+        let col = (rhs(&m, &pl, &q, &qd, &up) - rhs(&m, &pl, &q, &qd, &um)) / (2.0 * h);
         let err = (lin.b.column(k) - &col).norm() / col.norm();
         assert!(col.norm() > 0.0 && err < 1e-7, "B column {k}: {err:e}");
         assert!(lin.b.column(k).rows(0, n).iter().all(|v| *v == 0.0));
@@ -338,7 +319,7 @@ fn linearization_of_a_nonlinear_parameterization_matches_differences() {
     // moving, and momentarily still (q̇ = 0, q̈ ≠ 0: ∂ε/∂q̇ is then the damping matrix D(q))
     for qd in [DVector::from_vec(vec![0.8, -4.0, 0.3]), DVector::zeros(3)] {
         let lin = m.linearize(&q, &qd, &[], &pl, &mut ws).unwrap();
-        let fd = fd_jacobian_at(&m, &pl, &q, &qd, &[]);
+        let fd = fd_jacobian(&m, &pl, &q, &qd, &[]);
         let err = (&lin.a - &fd).norm() / fd.norm();
         assert!(
             err < 1e-6,

@@ -61,13 +61,8 @@ impl Robot {
         dt: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
         if let Some(h) = dt {
-            if !(h.is_finite() && h > 0.0) {
-                return Err(invalid(
-                    LinearizeError::SampleTime { value: h }
-                        .to_string()
-                        .replacen("--sample-time", "`dt`", 1),
-                ));
-            }
+            linearize::check_sample_time(h)
+                .map_err(|e| invalid(e.to_string().replacen("--sample-time", "`dt`", 1)))?;
         }
         let to_py = |e: LinearizeError| {
             let message = errors::chain(&e);
@@ -125,11 +120,8 @@ fn report_dict<'py>(py: Python<'py>, r: &Linearization) -> PyResult<Bound<'py, P
     )?;
     d.set_item("damping_ratio", vector(py, &col(&|p| p.damping_ratio)))?;
     d.set_item("unstable_poles", r.unstable_poles)?;
-    match &r.static_gain {
-        Some(g) => {
-            let m = nalgebra::DMatrix::from_fn(3, r.n_actuators, |i, j| g[i][j]);
-            d.set_item("static_gain", matrix(py, &m)?)?
-        }
+    match r.static_gain_matrix() {
+        Some(g) => d.set_item("static_gain", matrix(py, &g)?)?,
         None => d.set_item("static_gain", py.None())?,
     }
     d.set_item("about", r.about)?;
@@ -138,11 +130,8 @@ fn report_dict<'py>(py: Python<'py>, r: &Linearization) -> PyResult<Bound<'py, P
     d.set_item("relaxation_poles", r.relaxation_poles)?;
     d.set_item("equilibrium_residual_norm", r.equilibrium_residual_norm)?;
     if let Some(disc) = &r.discrete {
-        let n2 = disc.ad.len();
-        let ad = nalgebra::DMatrix::from_fn(n2, n2, |i, j| disc.ad[i][j]);
-        let bd = nalgebra::DMatrix::from_fn(n2, r.n_actuators, |i, j| disc.bd[i][j]);
-        d.set_item("Ad", matrix(py, &ad)?)?;
-        d.set_item("Bd", matrix(py, &bd)?)?;
+        d.set_item("Ad", matrix(py, &disc.ad_matrix())?)?;
+        d.set_item("Bd", matrix(py, &disc.bd_matrix())?)?;
         d.set_item("dt", disc.sample_time_s)?;
         d.set_item("spectral_radius", disc.spectral_radius)?;
     }

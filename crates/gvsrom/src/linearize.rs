@@ -64,6 +64,16 @@ pub fn parse_count(text: Option<&str>, n_states: usize) -> Result<usize, Lineari
     }
 }
 
+/// A sample time `h` \[s\] of [`Linearization::discretize`]: finite and > 0, else an error naming it
+/// (checked before the equilibrium is solved, as a bad `--count` is).
+pub fn check_sample_time(h: f64) -> Result<(), LinearizeError> {
+    if h.is_finite() && h > 0.0 {
+        Ok(())
+    } else {
+        Err(LinearizeError::SampleTime { value: h })
+    }
+}
+
 /// One pole of the linearization (an eigenvalue `λ` of `A`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Pole {
@@ -141,6 +151,23 @@ impl Linearization {
     pub fn c_matrix(&self) -> DMatrix<f64> {
         from_rows(&self.c)
     }
+
+    /// The static gain (3 × n_actuators) as a matrix, if there is one.
+    pub fn static_gain_matrix(&self) -> Option<DMatrix<f64>> {
+        self.static_gain.as_deref().map(from_rows)
+    }
+}
+
+impl Discrete {
+    /// `A_d` as a matrix.
+    pub fn ad_matrix(&self) -> DMatrix<f64> {
+        from_rows(&self.ad)
+    }
+
+    /// `B_d` as a matrix.
+    pub fn bd_matrix(&self) -> DMatrix<f64> {
+        from_rows(&self.bd)
+    }
 }
 
 /// The zero-order-hold discretization of a linearization: `δx_{k+1} = A_d δx_k + B_d δu_k` for
@@ -161,9 +188,7 @@ pub struct Discrete {
 impl Linearization {
     /// Adds the zero-order-hold discretization at the sample time `h` \[s\] ([`Discrete`]).
     pub fn discretize(&mut self, h: f64) -> Result<(), LinearizeError> {
-        if !(h.is_finite() && h > 0.0) {
-            return Err(LinearizeError::SampleTime { value: h });
-        }
+        check_sample_time(h)?;
         let (a, b) = (self.a_matrix(), self.b_matrix());
         let (n2, na) = (a.nrows(), b.ncols());
         let mut m = DMatrix::zeros(n2 + na, n2 + na);

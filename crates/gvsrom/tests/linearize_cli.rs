@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{expect_error, gvsrom, s, scratch, sweep_dataset};
+use common::{expect_error, f64s, gvsrom, run_json, s, scratch, sweep_dataset};
 use std::f64::consts::PI;
 use std::path::PathBuf;
 
@@ -44,31 +44,6 @@ fn rod_file(name: &str, damping: f64) -> PathBuf {
     let path = scratch(&format!("{name}.toml"));
     std::fs::write(&path, ROD.replace("DAMPING", &format!("{damping:e}"))).unwrap();
     path
-}
-
-/// Runs `gvsrom CMD ARGS --json FILE`, expects success; returns stdout and the JSON.
-fn run_json(cmd: &str, name: &str, args: &[&str]) -> (String, serde_json::Value) {
-    let file = scratch(&format!("{name}.json"));
-    let mut all = vec![cmd];
-    all.extend_from_slice(args);
-    all.extend(["--json", s(&file)]);
-    let out = gvsrom(&all);
-    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
-    assert!(
-        out.status.success(),
-        "gvsrom {all:?} failed: {}{stdout}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let json = serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
-    (stdout, json)
-}
-
-fn f64s(v: &serde_json::Value) -> Vec<f64> {
-    v.as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x.as_f64().unwrap())
-        .collect()
 }
 
 fn matrix(v: &serde_json::Value) -> Vec<Vec<f64>> {

@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{expect_error, gvsrom, s, scratch};
+use common::{expect_error, f64s, gvsrom, run_json, s, scratch};
 use nalgebra::{DMatrix, DVector};
 use std::f64::consts::PI;
 use std::path::PathBuf;
@@ -42,27 +42,7 @@ fn rod_file(name: &str, text: &str) -> PathBuf {
 
 /// Runs `gvsrom modes ARGS --json FILE`, expects success; returns stdout and the JSON.
 fn modes_json(name: &str, args: &[&str]) -> (String, serde_json::Value) {
-    let file = scratch(&format!("{name}.json"));
-    let mut all = vec!["modes"];
-    all.extend_from_slice(args);
-    all.extend(["--json", s(&file)]);
-    let out = gvsrom(&all);
-    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
-    assert!(
-        out.status.success(),
-        "gvsrom {all:?} failed: {}{stdout}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let json = serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
-    (stdout, json)
-}
-
-fn f64s(v: &serde_json::Value) -> Vec<f64> {
-    v.as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x.as_f64().unwrap())
-        .collect()
+    run_json("modes", name, args)
 }
 
 /// Frequencies [Hz] of the modes whose dominant strain component is `component`, ascending.

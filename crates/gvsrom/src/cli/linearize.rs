@@ -45,10 +45,7 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
         None => None,
     };
     if let Some(h) = args.sample_time {
-        // refused before the solve, as a bad count is
-        if !(h.is_finite() && h > 0.0) {
-            return Err(linearize::LinearizeError::SampleTime { value: h }.into());
-        }
+        linearize::check_sample_time(h)?;
     }
     print_model(scenario, &args.scenario, built, None, out)?;
     let (eq, mut lin) = linearize::about_equilibrium(built)?;

@@ -59,6 +59,32 @@ pub fn json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
+/// Runs `gvsrom CMD ARGS --json FILE` with FILE the fresh scratch path `NAME.json`, expects
+/// success; returns stdout and the JSON document.
+pub fn run_json(cmd: &str, name: &str, args: &[&str]) -> (String, serde_json::Value) {
+    let file = scratch(&format!("{name}.json"));
+    let mut all = vec![cmd];
+    all.extend_from_slice(args);
+    all.extend(["--json", s(&file)]);
+    let out = gvsrom(&all);
+    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(
+        out.status.success(),
+        "gvsrom {all:?} failed: {}{stdout}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (stdout, json(&file))
+}
+
+/// A JSON array of numbers.
+pub fn f64s(v: &serde_json::Value) -> Vec<f64> {
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect()
+}
+
 /// Shape and values of a little-endian f64 `.npy` file (read with npyz, as numpy would).
 pub fn npy(path: &Path) -> (Vec<usize>, Vec<f64>) {
     let bytes = std::fs::read(path).unwrap();
