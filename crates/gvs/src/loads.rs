@@ -68,33 +68,69 @@ impl DistributedWrench {
     /// Density `[m; f]` at `x` and its frame.
     pub fn density_at(&self, x: f64) -> (V6, Frame) {
         match *self {
-            DistributedWrench::Uniform {
-                x_start,
-                x_end,
-                density,
-                frame,
-            } => {
-                if x >= x_start && x <= x_end {
-                    (V6::from_row_slice(&density), frame)
-                } else {
-                    (V6::zeros(), frame)
-                }
+            DistributedWrench::Uniform { density, frame, .. } => {
+                (V6::from_row_slice(&density) * self.profile(x), frame)
             }
             DistributedWrench::TriangularPulse {
-                center,
                 width,
                 magnitude,
                 axis,
                 convention,
+                ..
             } => {
                 let peak = match convention {
                     PulseMagnitude::Peak => magnitude,
                     PulseMagnitude::Total => 2.0 * magnitude / width,
                 };
-                let m = peak * (1.0 - (x - center).abs() / (0.5 * width)).max(0.0);
+                let m = peak * self.profile(x);
                 let a = V3::from_row_slice(&axis).normalize() * m;
                 (V6::new(a[0], a[1], a[2], 0.0, 0.0, 0.0), Frame::Local)
             }
+        }
+    }
+
+    /// The load's shape along the rod, `s(X) ∈ [0, 1]` with `density(X) = s(X) · density_max`: the
+    /// indicator of `[x_start, x_end]` for a uniform load, `max(0, 1 − |X − X₀|/(w/2))` for the pulse.
+    pub fn profile(&self, x: f64) -> f64 {
+        match *self {
+            DistributedWrench::Uniform { x_start, x_end, .. } => {
+                f64::from(u8::from(x >= x_start && x <= x_end))
+            }
+            DistributedWrench::TriangularPulse { center, width, .. } => {
+                (1.0 - (x - center).abs() / (0.5 * width)).max(0.0)
+            }
+        }
+    }
+
+    /// `∫_lo^hi s(X) dX` of [`Self::profile`], in closed form: the overlap with `[x_start, x_end]`
+    /// for a uniform load; for the pulse, linear on each half `[X₀ − w/2, X₀]`, `[X₀, X₀ + w/2]`,
+    /// the overlap `[a, b]` with each half gives `(b − a) s((a + b)/2)` (exact for a linear
+    /// profile, and free of the cancellation of a cumulative `(X − X₀ + w/2)²/w` at large `w`).
+    pub fn profile_integral(&self, lo: f64, hi: f64) -> f64 {
+        let overlap = |a: f64, b: f64| (lo.max(a), hi.min(b));
+        match *self {
+            DistributedWrench::Uniform { x_start, x_end, .. } => {
+                let (a, b) = overlap(x_start, x_end);
+                (b - a).max(0.0)
+            }
+            DistributedWrench::TriangularPulse { center, width, .. } => {
+                let h = 0.5 * width;
+                [(center - h, center), (center, center + h)]
+                    .into_iter()
+                    .map(|(a, b)| overlap(a, b))
+                    .filter(|(a, b)| b > a)
+                    .map(|(a, b)| (b - a) * self.profile(0.5 * (a + b)))
+                    .sum()
+            }
+        }
+    }
+
+    /// The field whose value sets how finely the load must be resolved (the pulse's `width`, a
+    /// uniform load's `x_end`), and that value.
+    pub fn extent_field(&self) -> (&'static str, f64) {
+        match *self {
+            DistributedWrench::Uniform { x_end, .. } => ("x_end", x_end),
+            DistributedWrench::TriangularPulse { width, .. } => ("width", width),
         }
     }
 
@@ -249,6 +285,38 @@ mod tests {
                 .sum();
             assert!((s - total).abs() < 1e-6 * total, "{conv:?}: {s} vs {total}");
         }
+    }
+
+    #[test]
+    fn profile_integral_is_the_exact_integral_of_the_profile() {
+        let pulse = DistributedWrench::TriangularPulse {
+            center: 0.03,
+            width: 0.1,
+            magnitude: 1.0,
+            axis: [0.0, 1.0, 0.0],
+            convention: PulseMagnitude::Total,
+        };
+        let uniform = DistributedWrench::Uniform {
+            x_start: 0.1,
+            x_end: 0.35,
+            density: [1.0; 6],
+            frame: Frame::Local,
+        };
+        // the pulse is cut by X = 0; both against a fine midpoint rule
+        for (d, lo, hi) in [(pulse, 0.0, 0.8), (pulse, 0.01, 0.05), (uniform, 0.0, 0.2)] {
+            let n = 400_000;
+            let dx = (hi - lo) / n as f64;
+            let s: f64 = (0..n)
+                .map(|i| d.profile(lo + (i as f64 + 0.5) * dx) * dx)
+                .sum();
+            let exact = d.profile_integral(lo, hi);
+            assert!(
+                (s - exact).abs() < 1e-6 * exact,
+                "{d:?} on [{lo}, {hi}]: {s} vs {exact}"
+            );
+        }
+        assert!((pulse.profile_integral(-1.0, 1.0) - 0.05).abs() < 1e-15);
+        assert!((uniform.profile_integral(0.0, 0.8) - 0.25).abs() < 1e-15);
     }
 
     #[test]

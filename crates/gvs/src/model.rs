@@ -49,7 +49,7 @@ mod statics;
 mod workspace;
 
 pub use kinematics::ZANNA_C;
-pub use loads::PreparedLoads;
+pub use loads::{PreparedLoads, DISTRIBUTED_QUADRATURE_TOLERANCE};
 pub use workspace::Workspace;
 pub(crate) use workspace::{zeros6_lazy, zeros_lazy};
 

@@ -327,7 +327,7 @@ mod tests {
             ],
             distributed: vec![DistributedWrench::TriangularPulse {
                 center: 0.12,
-                width: 0.05,
+                width: 0.2,
                 magnitude: 0.2,
                 axis: [0.0, 1.0, 0.3],
                 convention: PulseMagnitude::Peak,

@@ -3,9 +3,21 @@
 //! kept apart.
 
 use super::Model;
-use crate::error::ModelError;
+use crate::error::{fmt_value, ModelError};
 use crate::lie::{V3, V6};
+use crate::loads::DistributedWrench;
 use crate::loads::{Frame, Loads};
+
+/// Largest relative error accepted in the resultant of a distributed load as the computational
+/// points integrate it (`Σ W_i s(X_i)` against the exact `∫ s dX` of its profile, [`Model::prepare_loads`]):
+/// a guard against loads the points do not resolve. A load narrower than their spacing falls
+/// between them and is lost, or lands on one and is inflated: a 4 N·m pulse of width 0.005 m on the
+/// IV-B beam (points ≤ 9.4 mm apart) was applied as 0–3.3× its total depending on its centre, and
+/// bent the beam 49 rad instead of 20. Smaller errors are the quadrature's ordinary error on a
+/// profile with kinks or jumps, as in SoRoSim: the paper's pulse (width 0.08 m) is integrated within
+/// 0.82 % at every centre (mean 0.54 %, 801 centres), 0.04 m within 4.1 %, 0.02 m within 14 %; a
+/// uniform load whose ends fall between points is off by up to the points' spacing over its span.
+pub const DISTRIBUTED_QUADRATURE_TOLERANCE: f64 = 0.05;
 use crate::strain::StrainParam;
 
 /// Loads resolved onto the computational points.
@@ -52,7 +64,8 @@ impl<P: StrainParam> Model<P> {
                 Frame::Global => global[i] += w,
             }
         }
-        for d in &loads.distributed {
+        for (k, d) in loads.distributed.iter().enumerate() {
+            self.check_resolved(k, d)?;
             for (i, p) in self.disc.points.iter().enumerate() {
                 if p.weight == 0.0 {
                     continue;
@@ -69,5 +82,40 @@ impl<P: StrainParam> Model<P> {
             local,
             global,
         })
+    }
+
+    /// Checks that the computational points resolve distributed load `k`: their quadrature of its
+    /// profile, `Σ W_i s(X_i)`, is within [`DISTRIBUTED_QUADRATURE_TOLERANCE`] of `∫₀ᴸ s dX`. Names
+    /// the field that sets the load's extent (the pulse's width, a uniform load's end) otherwise.
+    fn check_resolved(&self, k: usize, d: &DistributedWrench) -> Result<(), ModelError> {
+        let points = &self.disc.points;
+        let quadrature: f64 = (points.iter().filter(|p| p.weight > 0.0))
+            .map(|p| p.weight * d.profile(p.x))
+            .sum();
+        let exact = d.profile_integral(0.0, self.disc.length());
+        let error = (quadrature - exact).abs() / exact;
+        if error <= DISTRIBUTED_QUADRATURE_TOLERANCE {
+            return Ok(());
+        }
+        // the widest gap between weighted points where the load acts (or around it)
+        let xs: Vec<f64> = (points.iter().filter(|p| p.weight > 0.0))
+            .map(|p| p.x)
+            .collect();
+        let gap = (xs.windows(2))
+            .filter(|w| d.profile_integral(w[0], w[1]) > 0.0 || d.profile(w[0]) > 0.0)
+            .map(|w| w[1] - w[0])
+            .fold(0.0, f64::max);
+        let (field, value) = d.extent_field();
+        Err(ModelError::invalid(
+            format!("loads.distributed[{k}].{field}"),
+            format!(
+                "{} m is not resolved by the computational points: their quadrature applies {:.3}× the load's resultant ({:.1} % off; accepted ≤ {} %). The points are up to {:.2} mm apart where it acts: make the load wider, or refine the discretization (more elements or Gauss points)",
+                fmt_value(value),
+                quadrature / exact,
+                100.0 * error,
+                100.0 * DISTRIBUTED_QUADRATURE_TOLERANCE,
+                1e3 * gap,
+            ),
+        ))
     }
 }

@@ -171,14 +171,15 @@ fn all_loads() -> Loads {
         distributed: vec![
             DistributedWrench::TriangularPulse {
                 center: 0.12,
-                width: 0.05,
+                width: 0.2,
                 magnitude: 0.2,
                 axis: [0.0, 1.0, 0.3],
                 convention: PulseMagnitude::Peak,
             },
+            // over the whole rod: a partial span's jumps are not resolved by these points
             DistributedWrench::Uniform {
-                x_start: 0.05,
-                x_end: 0.2,
+                x_start: 0.0,
+                x_end: 0.25,
                 density: [0.0, 0.0, 0.01, 0.0, 0.3, 0.1],
                 frame: Frame::Global,
             },
@@ -301,7 +302,7 @@ fn statics_jacobian_matches_finite_differences_for_nonlinear_sigmoid_basis() {
         }],
         distributed: vec![DistributedWrench::TriangularPulse {
             center: 0.3,
-            width: 0.08,
+            width: 0.3,
             magnitude: 2.0,
             axis: [0.0, 1.0, 0.0],
             convention: PulseMagnitude::Peak,

@@ -86,7 +86,7 @@ frame = "local"
 [[loads.distributed]]
 kind = "triangular_pulse"
 center = 0.25
-width = 0.1
+width = 0.2
 magnitude = 0.01
 axis = [0.0, 0.0, 1.0]
 convention = "total"
