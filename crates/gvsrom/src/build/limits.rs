@@ -18,8 +18,11 @@ pub const MAX_DOF: usize = 2000;
 /// Accepted Young's modulus E \[Pa\]: from the softest hydrogels (≈ 1 kPa) with three decades of
 /// room below, to stiffer than diamond (1.2e12 Pa).
 pub const YOUNGS_MODULUS_RANGE: (f64, f64) = (1.0, 1e13);
-/// Accepted density ρ [kg/m³]: 0 (massless) to 1e5, five times the densest element (osmium 2.26e4).
-pub const DENSITY_RANGE: (f64, f64) = (0.0, 1e5);
+/// Accepted density ρ [kg/m³] of a rod with mass: 1e-2, sixteen times below the lightest solid
+/// (graphene aerogel, 0.16), to 1e5, five times the densest element (osmium 2.26e4). 0 (massless)
+/// is accepted too, for statics. Below the range the mass matrix underflows: at ρ = 1e-300 `modes`
+/// printed frequencies of 7e152 Hz beside 0 Hz.
+pub const DENSITY_RANGE: (f64, f64) = (1e-2, 1e5);
 /// Accepted capstan friction coefficient μ of a tendon: 0 (frictionless) to 10, five times the
 /// grippiest pairs (rubber on dry rubber, μ ≈ 1–2; the paper's 0.88). A tension decays as
 /// `exp(−μ θ)` along the wrap angle θ: at μ = 1e9 it vanishes at the first bend.

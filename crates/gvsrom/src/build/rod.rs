@@ -21,7 +21,19 @@ pub(super) fn material(s: &Scenario) -> Result<Material, ScenarioError> {
             "a number in (-1, 0.5]",
         ));
     }
-    in_range("material.density", m.density, DENSITY_RANGE, "kg/m^3")?;
+    if m.density != 0.0 {
+        in_range("material.density", m.density, DENSITY_RANGE, "kg/m^3").map_err(|_| {
+            ScenarioError::value(
+                "material.density",
+                m.density,
+                format!(
+                    "0 (massless, for statics) or a number in [{}, {}] kg/m^3",
+                    num(DENSITY_RANGE.0),
+                    num(DENSITY_RANGE.1)
+                ),
+            )
+        })?;
+    }
     non_negative("material.damping", m.damping, "Pa*s")?;
     Ok(Material {
         youngs_modulus: m.youngs_modulus,
