@@ -19,6 +19,7 @@ use crate::build::Built;
 use crate::error::{ScenarioError, StaticsFailure};
 use crate::statics::{self, StaticsReport};
 use gvs::dynamics::{DynamicsError, StateSpace};
+use gvs::error::fmt_value;
 use gvs::model::Model;
 use gvs::strain::StrainParam;
 use gvs::ModelError;
@@ -35,18 +36,38 @@ pub const DEFAULT_COUNT: usize = 10;
 
 #[derive(Debug, Error)]
 pub enum LinearizeError {
-    #[error("--sample-time `{value}`: expected a duration in seconds, finite and > 0 (the hold of the zero-order-hold discretization, e.g. 0.01 for a 100 Hz controller)")]
+    #[error("--sample-time `{}`: expected a duration in seconds, finite and > 0, at most {MAX_SAMPLE_TIME} (the hold of the zero-order-hold discretization, e.g. 0.01 for a 100 Hz controller)", fmt_value(*value))]
     SampleTime { value: f64 },
+    #[error("--sample-time `{}`: the zero-order-hold matrices over it are not finite ({why}); accepted: a shorter hold{}", fmt_value(*value), match most { Some(h) => format!(", below {} s", fmt_value(*h)), None => String::new() })]
+    HoldOverflow {
+        value: f64,
+        why: String,
+        most: Option<f64>,
+    },
     #[error("--count `{value}`: expected an integer ≥ 1 (the number of slowest poles to print; the linearization has {n_poles} states, so at most {n_poles} poles)")]
     Count { value: String, n_poles: usize },
     #[error("the equilibrium: {0}")]
-    Statics(#[from] StaticsFailure),
+    Statics(StaticsFailure),
     #[error(transparent)]
     Scenario(#[from] ScenarioError),
     #[error(transparent)]
     Model(#[from] ModelError),
     #[error("the linearization: {0}")]
-    Dynamics(#[from] DynamicsError),
+    Dynamics(DynamicsError),
+}
+
+// The prefixed variants hold their cause in the message and not as a `source`: `{:#}` (the CLI)
+// would print it twice, `to_string` (Python) not at all.
+impl From<StaticsFailure> for LinearizeError {
+    fn from(e: StaticsFailure) -> Self {
+        LinearizeError::Statics(e)
+    }
+}
+
+impl From<DynamicsError> for LinearizeError {
+    fn from(e: DynamicsError) -> Self {
+        LinearizeError::Dynamics(e)
+    }
 }
 
 /// How many poles to print for `--count text` (`None`: [`DEFAULT_COUNT`]): an integer ≥ 1, else an
@@ -64,10 +85,15 @@ pub fn parse_count(text: Option<&str>, n_states: usize) -> Result<usize, Lineari
     }
 }
 
-/// A sample time `h` \[s\] of [`Linearization::discretize`]: finite and > 0, else an error naming it
-/// (checked before the equilibrium is solved, as a bad `--count` is).
+/// Longest sample time \[s\] accepted: far beyond any controller's (ms to s) and any soft arm's
+/// slowest time constant; the hold of 1e300 s that was accepted before overflowed `A h`.
+pub const MAX_SAMPLE_TIME: f64 = 1e4;
+
+/// A sample time `h` \[s\] of [`Linearization::discretize`]: finite, > 0 and at most
+/// [`MAX_SAMPLE_TIME`], else an error naming it (checked before the equilibrium is solved, as a bad
+/// `--count` is).
 pub fn check_sample_time(h: f64) -> Result<(), LinearizeError> {
-    if h.is_finite() && h > 0.0 {
+    if h.is_finite() && h > 0.0 && h <= MAX_SAMPLE_TIME {
         Ok(())
     } else {
         Err(LinearizeError::SampleTime { value: h })
@@ -198,10 +224,23 @@ impl Linearization {
         let ad = e.view((0, 0), (n2, n2)).into_owned();
         let bd = e.view((0, n2), (n2, na)).into_owned();
         if ad.iter().chain(bd.iter()).any(|v| !v.is_finite()) {
-            return Err(DynamicsError::NonFinite {
-                what: "zero-order-hold discretization",
-            }
-            .into());
+            // e^{λh} beyond the largest float (e^709.78) for an unstable pole λ
+            let fastest = (self.poles.iter().map(|p| p.re)).fold(f64::NEG_INFINITY, f64::max);
+            let (why, most) = match fastest > 0.0 {
+                true => (
+                    format!(
+                        "e^(λh) of the unstable pole λ = {} 1/s overflows",
+                        fmt_value(fastest)
+                    ),
+                    Some(f64::MAX.ln() / fastest),
+                ),
+                false => ("e^(Ah) overflows in floating point".to_string(), None),
+            };
+            return Err(LinearizeError::HoldOverflow {
+                value: h,
+                why,
+                most,
+            });
         }
         let spectral_radius = self
             .poles

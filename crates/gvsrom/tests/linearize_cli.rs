@@ -295,6 +295,29 @@ fn upright_rod_beyond_self_weight_buckling_has_one_unstable_pole_per_buckling_mo
         );
         // about an unstable equilibrium the static gain still exists (A is regular)
         assert!(lin["static_gain"].is_array());
+        // a hold long enough for e^(λh) of an unstable pole to overflow is refused, with the
+        // longest hold that stays finite, ln(f64::MAX)/λ
+        let re = lin["poles"].as_array().unwrap()[0]["re"].as_f64().unwrap();
+        let stderr = expect_error(
+            &["linearize", s(&path), "--sample-time", "1e4"],
+            &[
+                "--sample-time `10000`",
+                "not finite",
+                "unstable pole",
+                "a shorter hold, below",
+            ],
+        );
+        let most = f64::MAX.ln()
+            / lin["poles"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|p| p["re"].as_f64().unwrap())
+                .fold(re, f64::max);
+        assert!(
+            stderr.contains(&gvs::error::fmt_value(most)),
+            "{stderr} (expected {most})"
+        );
     }
 }
 
@@ -328,10 +351,10 @@ fn zero_order_hold_composes_as_two_half_samples_and_refuses_a_bad_sample_time() 
         rho1 < 1.0 && (rho2 - rho1 * rho1).abs() < 1e-12,
         "{rho1} {rho2}"
     );
-    for bad in ["0", "-0.01", "nan", "inf"] {
+    for bad in ["0", "-0.01", "nan", "inf", "1e300"] {
         expect_error(
             &["linearize", "six-tendon", "--sample-time", bad],
-            &["--sample-time", "finite and > 0"],
+            &["--sample-time", "finite and > 0, at most 10000"],
         );
     }
 }
