@@ -218,8 +218,14 @@ pub fn unsigned(name: &str, value: i128) -> PyResult<u64> {
     })
 }
 
-/// [`unsigned`] as a size or count.
-pub fn size(name: &str, value: i128) -> PyResult<usize> {
+/// [`unsigned`] as a size or count whose least accepted value is `min`: a negative value is refused
+/// here saying so; the library checks the rest of its range (0 included), naming it.
+pub fn size(name: &str, value: i128, min: usize) -> PyResult<usize> {
+    if value < 0 {
+        return Err(invalid(format!(
+            "`{name}` = {value}: expected a whole number ≥ {min}"
+        )));
+    }
     let v = unsigned(name, value)?;
     usize::try_from(v).map_err(|_| invalid(format!("`{name}` = {value}: too large")))
 }

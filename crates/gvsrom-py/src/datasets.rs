@@ -361,10 +361,10 @@ pub fn dataset(
     atol: Option<f64>,
 ) -> PyResult<Dataset> {
     use crate::arrays::{size, unsigned};
-    let samples = samples.map(|v| size("samples", v)).transpose()?;
+    let samples = samples.map(|v| size("samples", v, 1)).transpose()?;
     let seed = seed.map(|v| unsigned("seed", v)).transpose()?;
-    let chunk_size = size("chunk_size", chunk_size)?;
-    let threads = threads.map(|v| size("threads", v)).transpose()?;
+    let chunk_size = size("chunk_size", chunk_size, 1)?;
+    let threads = threads.map(|v| size("threads", v, 1)).transpose()?;
     let (scenario, mut overrides) = scenario_arg(scenario)?;
     overrides.extend(set.unwrap_or_default());
     dynamic_only(

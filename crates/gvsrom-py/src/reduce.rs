@@ -40,7 +40,7 @@ pub fn pod(
     force: bool,
     norm: &str,
 ) -> PyResult<Model> {
-    let modes = crate::arrays::size("modes", modes)?;
+    let modes = crate::arrays::size("modes", modes, 1)?;
     let norm = gvsrom::reduce::named("norm", norm).map_err(errors::scenario)?;
     let dataset = dataset_paths(dataset)?;
     let summary = py
@@ -189,16 +189,16 @@ pub fn train(
 ) -> PyResult<Model> {
     use crate::arrays::{size, unsigned};
     use gvsrom::reduce::{self, TrainChoices};
-    let latent = latent.map(|v| size("latent", v)).transpose()?;
+    let latent = latent.map(|v| size("latent", v, 1)).transpose()?;
     let hidden_layers = hidden_layers
-        .map(|v| size("hidden_layers", v))
+        .map(|v| size("hidden_layers", v, 1))
         .transpose()?;
     let seed = seed.map(|v| unsigned("seed", v)).transpose()?;
-    let epochs = size("epochs", epochs)?;
-    let batch_size = size("batch_size", batch_size)?;
-    let patience = size("patience", patience)?;
-    let lr_reductions = size("lr_reductions", lr_reductions)?;
-    let lbfgs_iterations = size("lbfgs_iterations", lbfgs_iterations)?;
+    let epochs = size("epochs", epochs, 1)?;
+    let batch_size = size("batch_size", batch_size, 1)?;
+    let patience = size("patience", patience, 0)?;
+    let lr_reductions = size("lr_reductions", lr_reductions, 0)?;
+    let lbfgs_iterations = size("lbfgs_iterations", lbfgs_iterations, 0)?;
     let init = match init {
         Some(m) => Some(reduce::start_model(&model_path(m)?).map_err(errors::any)?),
         None => None,

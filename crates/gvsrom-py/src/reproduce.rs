@@ -92,7 +92,9 @@ pub fn reproduce<'py>(
     noise: f64,
     test_sizes: bool,
 ) -> PyResult<Vec<Bound<'py, PyDict>>> {
-    let jobs = jobs.map(|v| crate::arrays::size("jobs", v)).transpose()?;
+    let jobs = jobs
+        .map(|v| crate::arrays::size("jobs", v, 1))
+        .transpose()?;
     let opts = Options {
         cases: cases(study)?,
         quick: quick || test_sizes,

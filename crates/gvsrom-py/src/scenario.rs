@@ -46,7 +46,16 @@ fn toml_value(value: &Bound<'_, PyAny>) -> PyResult<toml::Value> {
         return Ok(toml::Value::Boolean(value.extract()?));
     }
     if value.is_instance_of::<PyInt>() {
-        return Ok(toml::Value::Integer(value.extract()?));
+        // TOML integers are 64-bit: a larger int is the number it denotes, as a float, so that the
+        // scenario's checks name the field and its range (not a bare `OverflowError`)
+        return match (value.extract::<i64>(), value.extract::<f64>()) {
+            (Ok(i), _) => Ok(toml::Value::Integer(i)),
+            (Err(_), Ok(f)) => Ok(toml::Value::Float(f)),
+            (Err(_), Err(_)) => Err(invalid(format!(
+                "the int {} is beyond every number a scenario holds (a float's range, ±1.8e308)",
+                value.repr()?
+            ))),
+        };
     }
     if value.is_instance_of::<PyFloat>() {
         return Ok(toml::Value::Float(value.extract()?));
@@ -170,7 +179,9 @@ impl Scenario {
         path: &str,
         value: &Bound<'py, PyAny>,
     ) -> PyResult<PyRefMut<'py, Self>> {
-        let spec = format!("{path}={}", toml_text(value)?);
+        let text =
+            toml_text(value).map_err(|e| invalid(format!("`{path}`: {}", e.value(value.py()))))?;
+        let spec = format!("{path}={text}");
         let mut overrides = slf.overrides.clone();
         overrides.push(spec);
         let next = Scenario::load(slf.src.clone(), overrides)?;

@@ -68,21 +68,33 @@ def test_training_options_are_named_as_keyword_arguments(tmp_path, dataset):
     assert not (tmp_path / "m").exists()
 
 
-@pytest.mark.parametrize("name", ["patience", "lbfgs_iterations", "lr_reductions", "batch_size",
-                                  "epochs", "seed", "latent", "hidden_layers"])
-def test_a_negative_count_of_train_is_a_value_error_naming_it(tmp_path, dataset, name):
+@pytest.mark.parametrize("name, least", [("patience", 0), ("lbfgs_iterations", 0),
+                                         ("lr_reductions", 0), ("batch_size", 1), ("epochs", 1),
+                                         ("seed", 0), ("latent", 1), ("hidden_layers", 1)])
+def test_a_negative_count_of_train_is_a_value_error_naming_it(tmp_path, dataset, name, least):
+    # the least value the argument accepts, not a generic "≥ 0" where 0 is refused next
     kw = {"latent": 1, "epochs": 2, name: -1}
     text = message(lambda: gvsrom.train(dataset, tmp_path / "m", **kw))
-    assert text == f"`{name}` = -1: expected a whole number ≥ 0"
+    assert text == f"`{name}` = -1: expected a whole number ≥ {least}"
+
+
+def test_an_int_beyond_64_bits_in_a_scenario_is_checked_as_the_number_it_is():
+    # not a bare OverflowError: 10**30 is the number 1e30, refused by the field's own range
+    def preset():
+        return gvsrom.Scenario.preset("single-tendon")
+    text = message(lambda: preset().set("material.youngs_modulus", 10**30).build())
+    assert "material.youngs_modulus" in text and "1e30" in text and "[1, 1e13] Pa" in text, text
+    text = message(lambda: preset().set("tendons.0.tension", 10**400))
+    assert text.startswith("`tendons.0.tension`: the int 1000") and "±1.8e308" in text, text
 
 
 def test_a_negative_count_elsewhere_is_a_value_error_naming_it(tmp_path, dataset):
     beam = gvsrom.Scenario.preset("single-tendon")
     plan = dict(sweep=["tendons.0.tension=-6:0"], samples=3)
     assert message(lambda: gvsrom.pod(dataset, -2, tmp_path / "p")).startswith("`modes` = -2")
-    for name in ["samples", "seed", "chunk_size", "threads"]:
+    for name, least in [("samples", 1), ("seed", 0), ("chunk_size", 1), ("threads", 1)]:
         text = message(lambda: gvsrom.dataset(beam, tmp_path / "d", **{**plan, name: -1}))
-        assert text.startswith(f"`{name}` = -1"), text
+        assert text == f"`{name}` = -1: expected a whole number ≥ {least}", text
     assert message(lambda: gvsrom.reproduce("iv-a", tmp_path / "r", jobs=-1)
                    ).startswith("`jobs` = -1")
     assert "≤ 18446744073709551615" in message(
