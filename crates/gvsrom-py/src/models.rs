@@ -104,7 +104,10 @@ impl Model {
         let (x, one) = rows_of(name, a, cols, what)?;
         let y = py
             .detach(|| f(&self.model, &x))
-            .map_err(|e| invalid(crate::errors::chain(&e)))?;
+            // the way out as Python spells it
+            .map_err(|e| {
+                invalid(crate::errors::chain(&e).replace("--extrapolate", "extrapolate=True"))
+            })?;
         if one {
             Ok(vector(py, &y))
         } else {

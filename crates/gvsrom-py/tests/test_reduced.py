@@ -248,6 +248,31 @@ def test_codes_far_outside_the_training_encodings_are_refused_unless_extrapolati
         pod_model.encode(bad)
 
 
+def test_a_snapshot_far_larger_than_any_trained_is_refused_by_the_encoder(dataset, ae_model,
+                                                                          pod_model):
+    # A tanh encoder saturates on a snapshot 1000× a training one and returns a code inside its
+    # training encodings, so the code cannot tell; the snapshot's norm against the largest
+    # training snapshot's (recorded in the model) does.
+    x = gvsrom.load_dataset(dataset).strain
+    norms = np.linalg.norm(x, axis=1)
+    largest = x[np.argmax(norms)][None, :]
+    big = 1000 * largest
+    assert ae_model.meta["snapshot_norm_max"] == pytest.approx(norms.max(), rel=1e-12)
+    lo, hi = ae_model.latent_range[0]
+    code = ae_model.encode(big, extrapolate=True)[0, 0]
+    assert lo - 0.5 * (hi - lo) <= code <= hi + 0.5 * (hi - lo), "the code alone looks ordinary"
+    for model in (ae_model, pod_model):
+        for snapshot in (big, np.full((1, model.features), 1e300)):
+            with pytest.raises(gvsrom.GvsromError,
+                               match=r"row 0: the snapshot's norm ‖x‖ = .*× the largest training "
+                                     r"snapshot's .*accepted: ‖x‖ ≤ 2 × that, or "
+                                     r"extrapolate=True$"):
+                model.reconstruct(snapshot)
+    # within the margin it is encoded as before
+    np.testing.assert_array_equal(ae_model.encode(1.9 * largest),
+                                  ae_model.encode(1.9 * largest, extrapolate=True))
+
+
 def test_a_reduced_run_starts_inside_the_training_encodings_but_not_far_outside_them(ae_model):
     # q0 is in the reduced model's coordinates: a code inside the autoencoder's training encodings
     # is a valid start (the run's first sample is that code), one far outside them is refused — its

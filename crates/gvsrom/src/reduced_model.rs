@@ -27,7 +27,7 @@ use thiserror::Error;
 
 mod codec;
 mod weights_file;
-pub use codec::{outside_range, CodecError};
+pub use codec::{outside_range, oversized_row, CodecError, SNAPSHOT_NORM_MARGIN};
 
 /// The manifest format of a model directory.
 pub const MODEL_FORMAT: &str = "reduced-model";
@@ -175,6 +175,12 @@ pub struct ModelMeta {
     /// solution far outside it is off the learned manifold and is reported as an error.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub latent_range: Vec<[f64; 2]>,
+    /// The largest norm `‖x‖` of a training snapshot (its features as stored, Euclidean): an
+    /// encoding refuses a snapshot more than [`SNAPSHOT_NORM_MARGIN`] times larger, which a
+    /// tanh encoder would map into its training range by saturating (absent in models from before
+    /// it was recorded: no such check).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub snapshot_norm_max: Option<f64>,
     /// Per training input, its range over the usable samples: `--model` refuses a scenario whose
     /// inputs lie outside (`reduce::validity`). Empty in models from before it was recorded, which
     /// are refused too.

@@ -9,7 +9,7 @@ use super::invalid;
 use crate::build::reduced::{at_held, inside};
 use crate::dataset::Dataset;
 use crate::error::ScenarioError;
-use crate::reduced_model::{outside_range, same_abscissae, ReducedModel};
+use crate::reduced_model::{outside_range, oversized_row, same_abscissae, ReducedModel};
 use crate::scenario::{number_at, Scenario};
 
 /// The reconstruction errors of a model on a dataset's solved snapshots.
@@ -27,8 +27,9 @@ pub struct Reconstruction {
     pub worst: Option<(usize, f64, f64)>,
     /// The largest `‖x‖` of the snapshots, for scale.
     pub largest_norm: f64,
-    /// Snapshots whose code lies far outside the training encodings (the model extrapolates
-    /// there; their errors are included above).
+    /// Snapshots whose code lies far outside the training encodings, or whose norm is more than
+    /// [`SNAPSHOT_NORM_MARGIN`](crate::reduced_model::SNAPSHOT_NORM_MARGIN) times the largest
+    /// training snapshot's (the model extrapolates there; their errors are included above).
     pub outside: usize,
     /// Snapshots whose inputs lie outside what the model was trained on — an input outside its
     /// training range, a combination far from the training inputs (`reduce::coverage`), or an
@@ -72,7 +73,9 @@ pub fn reconstruction(model: &ReducedModel, ds: &Dataset) -> Result<Reconstructi
         let q = model
             .encode(x, true)
             .map_err(|e| invalid("MODEL", e.to_string()))?;
-        if outside_range(&model.meta.latent_range, &q).is_some() {
+        if outside_range(&model.meta.latent_range, &q).is_some()
+            || oversized_row(model.meta.snapshot_norm_max, x, x.len()).is_some()
+        {
             outside += 1;
         }
         let rec = model

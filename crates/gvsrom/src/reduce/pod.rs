@@ -87,6 +87,7 @@ pub fn pod<P: AsRef<Path>>(
         more_datasets: refs.1,
         rest: vec![0.0; modes],
         latent_range,
+        snapshot_norm_max: Some(super::largest_norm(x, features)),
         input_range: src.input_ranges(),
         anchor_parameters: src.first().meta.parameters.clone(),
         anchor_equilibria: 0,

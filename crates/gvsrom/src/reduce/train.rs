@@ -225,6 +225,7 @@ pub fn train<P: AsRef<Path>>(
         more_datasets: refs.1,
         rest: rest.iter().copied().collect(),
         latent_range: range,
+        snapshot_norm_max: Some(super::largest_norm(x, features)),
         input_range: src.input_ranges(),
         anchor_parameters: src.first().meta.parameters.clone(),
         anchor_equilibria: 0,

@@ -44,6 +44,21 @@ pub enum CodecError {
     Network(String),
 }
 
+/// How many times the largest training snapshot's norm an encoding accepts (unless `extrapolate`):
+/// a tanh encoder saturates on a larger snapshot and returns a code inside its training range, so
+/// the code alone cannot tell (an autoencoder of IV-A encoded 1000× a training snapshot, and a
+/// snapshot of 1e300 everywhere, to ordinary codes).
+pub const SNAPSHOT_NORM_MARGIN: f64 = 2.0;
+
+/// The first row of the row-major snapshots `x` whose norm exceeds [`SNAPSHOT_NORM_MARGIN`] ×
+/// `largest` (or is not finite), with that norm; `None` without a recorded `largest`.
+pub fn oversized_row(largest: Option<f64>, x: &[f64], features: usize) -> Option<(usize, f64)> {
+    let largest = largest?;
+    (x.chunks_exact(features).enumerate())
+        .map(|(row, v)| (row, v.iter().map(|a| a * a).sum::<f64>().sqrt()))
+        .find(|(_, n)| n.is_nan() || *n > SNAPSHOT_NORM_MARGIN * largest)
+}
+
 /// The first coordinate of `q` outside `range` widened by half its width on each side (or not
 /// finite); `None` if every coordinate lies inside (always, for an empty range: a model written
 /// before ranges were recorded).
@@ -94,6 +109,17 @@ impl ReducedModel {
     pub fn encode(&self, x: &[f64], extrapolate: bool) -> Result<Vec<f64>, CodecError> {
         let n = self.features();
         check_rows("strain", x, n, "snapshots of the model's layout")?;
+        if !extrapolate {
+            if let Some((row, norm)) = oversized_row(self.meta.snapshot_norm_max, x, n) {
+                let largest = self.meta.snapshot_norm_max.unwrap_or(0.0);
+                return Err(CodecError::OutsideRange(format!(
+                    "row {row}: the snapshot's norm ‖x‖ = {} is {}× the largest training snapshot's ({}): the snapshot is unlike the training data, and an encoder saturates on it; accepted: ‖x‖ ≤ {SNAPSHOT_NORM_MARGIN} × that, or --extrapolate",
+                    gvs::error::fmt_value(norm),
+                    gvs::error::fmt_value(norm / largest),
+                    gvs::error::fmt_value(largest),
+                )));
+            }
+        }
         let q = match &self.weights {
             ModelWeights::Pod {
                 modes,
