@@ -83,7 +83,7 @@ impl DistributedWrench {
                     PulseMagnitude::Total => 2.0 * magnitude / width,
                 };
                 let m = peak * self.profile(x);
-                let a = V3::from_row_slice(&axis).normalize() * m;
+                let a = unit_axis(&axis).unwrap_or_else(V3::zeros) * m;
                 (V6::new(a[0], a[1], a[2], 0.0, 0.0, 0.0), Frame::Local)
             }
         }
@@ -183,18 +183,31 @@ impl DistributedWrench {
                     "a finite width > 0 m",
                 )?;
                 check_finite(&f("magnitude"), magnitude)?;
-                let n = V3::from_row_slice(&axis).norm();
-                if !(n.is_finite() && n > 0.0) {
-                    return Err(ModelError::value(
+                for (i, v) in axis.iter().enumerate() {
+                    check_finite(&f(&format!("axis[{i}]")), *v)?;
+                }
+                if unit_axis(&axis).is_none() {
+                    return Err(ModelError::invalid(
                         f("axis"),
-                        n,
-                        "a finite non-zero axis vector",
+                        "[0, 0, 0] has no direction: expected a non-zero axis vector",
                     ));
                 }
             }
         }
         Ok(())
     }
+}
+
+/// The unit vector along `axis`, scaled by its largest component first so that neither tiny
+/// (1e-300) nor huge (1e300) components under- or overflow the norm; `None` for the zero vector
+/// or a non-finite one.
+pub fn unit_axis(axis: &[f64; 3]) -> Option<V3> {
+    let big = axis.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    if !(axis.iter().all(|v| v.is_finite()) && big > 0.0) {
+        return None;
+    }
+    let v = V3::from_row_slice(axis) / big;
+    Some(v / v.norm())
 }
 
 /// Everything that loads the rod besides its tendons. Scaling by a load factor λ scales every entry.
@@ -317,6 +330,16 @@ mod tests {
         }
         assert!((pulse.profile_integral(-1.0, 1.0) - 0.05).abs() < 1e-15);
         assert!((uniform.profile_integral(0.0, 0.8) - 0.25).abs() < 1e-15);
+    }
+
+    #[test]
+    fn an_axis_of_tiny_or_huge_components_has_its_direction() {
+        for scale in [1e-300, 1.0, 1e300] {
+            let u = unit_axis(&[0.0, 3.0 * scale, -4.0 * scale]).unwrap();
+            assert!((u - V3::new(0.0, 0.6, -0.8)).norm() < 1e-15, "{scale}: {u}");
+        }
+        assert!(unit_axis(&[0.0; 3]).is_none());
+        assert!(unit_axis(&[f64::NAN, 1.0, 0.0]).is_none());
     }
 
     #[test]

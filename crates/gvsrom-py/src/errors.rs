@@ -64,14 +64,7 @@ pub fn any(e: anyhow::Error) -> PyErr {
 
 /// An error with its causes joined by `: `, as the command line prints it (anyhow's `{:#}`).
 pub fn chain(e: &dyn std::error::Error) -> String {
-    let mut message = e.to_string();
-    let mut source = e.source();
-    while let Some(cause) = source {
-        message.push_str(": ");
-        message.push_str(&cause.to_string());
-        source = cause.source();
-    }
-    message
+    gvsrom::error::message_chain(e)
 }
 
 /// A statics failure: `ConvergenceError` with its diagnostics for a non-convergence, else

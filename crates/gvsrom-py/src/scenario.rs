@@ -131,7 +131,9 @@ impl Scenario {
             Ok(s) => {
                 let s = s.to_str()?;
                 let one_line = !s.contains('\n');
-                if one_line && (s.ends_with(".toml") || std::path::Path::new(s).is_file()) {
+                // a one-line string naming something on disk is a path (a directory is then
+                // refused as one, not parsed as TOML text)
+                if one_line && (s.ends_with(".toml") || std::path::Path::new(s).exists()) {
                     file_source(s)?
                 } else {
                     Source {

@@ -60,6 +60,13 @@ def test_missing_file_is_a_value_error():
         gvsrom.Scenario.from_toml("no/such/file.toml")
 
 
+def test_a_directory_given_as_str_is_refused_as_a_path_not_parsed_as_toml(tmp_path):
+    # it was read as TOML text and failed with "<string>: not valid TOML … column 5"
+    for given in (str(tmp_path), tmp_path):
+        with pytest.raises(gvsrom.GvsromError, match=f"`{tmp_path}` is a directory"):
+            gvsrom.Scenario.from_toml(given)
+
+
 @pytest.mark.parametrize(
     "path, value, spec",
     [

@@ -89,3 +89,65 @@ pub struct StaticsFailure {
     /// Empty, or `"; "`-separated context appended to the engine's message.
     pub hint: String,
 }
+
+/// `e` and its causes as one line, `"e: cause: cause…"`, each cause once: a cause whose text
+/// already ends the message (an error that shows its `source` in its own text, as
+/// `OutputError::Io` shows the I/O error) is not repeated. The front-ends' error line.
+pub fn message_chain(e: &dyn std::error::Error) -> String {
+    let mut message = e.to_string();
+    let mut source = e.source();
+    while let Some(cause) = source {
+        let text = cause.to_string();
+        if !message.ends_with(&text) {
+            message.push_str(": ");
+            message.push_str(&text);
+        }
+        source = cause.source();
+    }
+    message
+}
+
+#[cfg(test)]
+mod chain_tests {
+    use super::message_chain;
+    use std::fmt;
+
+    #[derive(Debug)]
+    struct Shows(std::io::Error);
+    impl fmt::Display for Shows {
+        fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+            write!(f, "cannot create `x`: {}", self.0)
+        }
+    }
+    impl std::error::Error for Shows {
+        fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+            Some(&self.0)
+        }
+    }
+
+    #[derive(Debug)]
+    struct Hides(std::io::Error);
+    impl fmt::Display for Hides {
+        fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+            write!(f, "cannot create `x`")
+        }
+    }
+    impl std::error::Error for Hides {
+        fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+            Some(&self.0)
+        }
+    }
+
+    #[test]
+    fn a_cause_is_shown_once_whether_or_not_the_error_shows_it() {
+        let io = || std::io::Error::new(std::io::ErrorKind::NotFound, "no such file");
+        assert_eq!(
+            message_chain(&Shows(io())),
+            "cannot create `x`: no such file"
+        );
+        assert_eq!(
+            message_chain(&Hides(io())),
+            "cannot create `x`: no such file"
+        );
+    }
+}

@@ -26,7 +26,7 @@ fn main() -> ExitCode {
             if broken_pipe {
                 return ExitCode::SUCCESS;
             }
-            let msg = format!("{e:#}").replace('\n', " ");
+            let msg = gvsrom::error::message_chain(e.as_ref()).replace('\n', " ");
             if let Some(i) = e.downcast_ref::<cli::Interrupted>() {
                 gvsrom::progress::stderr_line(format_args!("interrupted: {msg}"));
                 return ExitCode::from((128 + i.signal).clamp(0, 255) as u8);

@@ -689,3 +689,32 @@ fn absurd_positions_are_refused_and_extreme_numbers_print_in_exponent_form() {
     assert!(stdout.contains("u = [-1e-320] N"), "{stdout}");
     assert!(stdout.lines().all(|l| l.len() < 200), "{stdout}");
 }
+
+#[test]
+fn an_axis_of_tiny_or_huge_components_keeps_its_direction_and_zero_has_none() {
+    // its norm under- or overflowed (0, inf) and the axis was refused as zero or infinite
+    let tip = |axis: &str| {
+        let out = common::run_ok(&[
+            "statics",
+            "soft-beam",
+            "--set",
+            &format!("loads.distributed.0.axis={axis}"),
+        ]);
+        out.lines()
+            .find(|l| l.starts_with("tip"))
+            .unwrap()
+            .to_string()
+    };
+    let unit = tip("[0, 1, 0]");
+    assert_eq!(tip("[0, 1e-300, 0]"), unit);
+    assert_eq!(tip("[0, 1e300, 0]"), unit);
+    expect_error(
+        &[
+            "statics",
+            "soft-beam",
+            "--set",
+            "loads.distributed.0.axis=[0, 0, 0]",
+        ],
+        &["loads.distributed[0].axis", "[0, 0, 0] has no direction"],
+    );
+}

@@ -98,3 +98,17 @@ pub(super) fn non_negative(field: &str, v: f64, unit: &str) -> Result<f64, Scena
         ))
     }
 }
+
+/// The unit vector along the axis `field` ([`gvs::loads::unit_axis`]: tiny and huge components
+/// keep their direction), else an error naming the first non-finite component or the zero vector.
+pub(super) fn direction(field: &str, axis: &[f64; 3]) -> Result<gvs::lie::V3, ScenarioError> {
+    for (i, v) in axis.iter().enumerate() {
+        finite(&format!("{field}[{i}]"), *v)?;
+    }
+    gvs::loads::unit_axis(axis).ok_or_else(|| {
+        ScenarioError::invalid(
+            field,
+            "[0, 0, 0] has no direction: expected a non-zero axis vector",
+        )
+    })
+}

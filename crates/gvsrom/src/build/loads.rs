@@ -3,7 +3,6 @@
 use super::limits::*;
 use crate::error::ScenarioError;
 use crate::scenario::{default_pulse_axis, DistributedKind, Scenario};
-use gvs::lie::V3;
 use gvs::loads::{DistributedWrench, Loads, PointWrench};
 
 pub(super) fn wrench(moment: [f64; 3], force: [f64; 3]) -> [f64; 6] {
@@ -146,14 +145,7 @@ pub fn loads(s: &Scenario, l: f64) -> Result<Loads, ScenarioError> {
                     required("magnitude", d.magnitude, "N*m/m peak, or N*m total")?,
                 )?;
                 let axis = d.axis.unwrap_or_else(default_pulse_axis);
-                let n = V3::from_row_slice(&axis).norm();
-                if !(n.is_finite() && n > 0.0) {
-                    return Err(ScenarioError::value(
-                        f("axis"),
-                        n,
-                        "a finite non-zero axis vector (its norm is shown)",
-                    ));
-                }
+                direction(&f("axis"), &axis)?;
                 DistributedWrench::TriangularPulse {
                     center,
                     width,

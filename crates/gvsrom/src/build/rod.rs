@@ -145,17 +145,9 @@ pub(super) fn base_pose(s: &Scenario) -> Result<Pose, ScenarioError> {
             m
         }
         (None, Some(axis), Some(angle)) => {
-            let a = V3::from_row_slice(&axis);
-            let n = a.norm();
-            if !(n.is_finite() && n > 0.0) {
-                return Err(ScenarioError::value(
-                    "base.axis",
-                    n,
-                    "a finite non-zero axis vector (its norm is shown)",
-                ));
-            }
+            let a = direction("base.axis", &axis)?;
             let angle = finite("base.angle_deg", angle)?.to_radians();
-            *nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(a), angle).matrix()
+            *nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_unchecked(a), angle).matrix()
         }
         (None, Some(_), None) => {
             return Err(ScenarioError::invalid(
