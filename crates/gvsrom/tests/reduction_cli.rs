@@ -169,6 +169,37 @@ fn a_decaying_learning_rate_is_recorded_and_a_bad_factor_refused() {
 }
 
 #[test]
+fn a_penalty_that_empties_the_network_or_a_split_that_leaves_one_row_is_refused() {
+    // the audit trained at λ = 1e300 and on 1 of 200 rows ("RMSE 0 training") without a word
+    let refused = scratch("red-ae-option-refused");
+    for (option, value, needles) in [
+        (
+            "--lambda",
+            "2",
+            &["--lambda", "lambda = 2", "in [0, 1]"][..],
+        ),
+        ("--lambda", "1e300", &["--lambda", "in [0, 1]"][..]),
+        (
+            "--validation-fraction",
+            "0.99",
+            &[
+                "--validation-fraction",
+                "holds out 39 of the 40 rows and leaves 1",
+                "at least 2",
+            ][..],
+        ),
+    ] {
+        #[rustfmt::skip]
+        expect_error(
+            &["train", s(dataset40()), "--latent", "1", "--hidden-layers", "3", "--epochs", "5",
+              option, value, "--out", s(&refused)],
+            needles,
+        );
+        assert!(!refused.exists(), "a refused run writes nothing");
+    }
+}
+
+#[test]
 fn a_pod_rom_with_all_modes_reproduces_the_hom_equilibrium() {
     let (model, rank) = pod_full();
     // sample k = 13 of the sweep: -6 + 9·13/39 = -3 N

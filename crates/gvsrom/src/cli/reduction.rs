@@ -63,7 +63,7 @@ pub struct TrainArgs {
     /// Adam learning rate.
     #[arg(long, default_value_t = reduce::TrainRequest::DEFAULT.learning_rate)]
     pub learning_rate: f64,
-    /// L2 weight regularization λ of eq. (15) (paper: 1e-4).
+    /// L2 weight regularization λ of eq. (15), in [0, 1] (paper: 1e-4).
     #[arg(long, default_value_t = reduce::TrainRequest::DEFAULT.lambda)]
     pub lambda: f64,
     /// Fraction of the snapshots held out for validation and early stopping [default: 0.1; with

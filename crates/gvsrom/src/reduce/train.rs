@@ -390,6 +390,7 @@ pub(super) fn train_error(e: &rom::nn::NnError) -> ScenarioError {
             "--kinetic-weight".to_string()
         }
         NnError::InvalidOption { field, .. } => format!("--{}", field.replace('_', "-")),
+        NnError::TooFewTrainingRows { .. } => "--validation-fraction".to_string(),
         NnError::EmptyData | NnError::NonFiniteData { .. } => "DATASET".to_string(),
         NnError::Diverged { .. } => "--learning-rate".to_string(),
         _ => "train".to_string(),

@@ -38,6 +38,10 @@ pub struct Autoencoder {
 /// is allocated.
 pub const MAX_HIDDEN_LAYERS: usize = 63;
 
+/// Fewest rows a training keeps after holding out its validation rows: one snapshot defines no
+/// map (the audit trained on 1 row of 200 and wrote "RMSE 0 training").
+pub const MIN_TRAINING_ROWS: usize = 2;
+
 impl Autoencoder {
     /// Layer sizes `[n, …, r, …, n]` (`hidden_layers + 2` values) of the symmetric architecture in the
     /// module docs. Errors: `latent ∉ 1..n_features`, `hidden_layers` even, zero or above
@@ -251,6 +255,14 @@ impl Autoencoder {
                 .collect();
         }
         let (train, val) = split_rows(rows, opts.validation_fraction, &mut rng);
+        if train.len() < MIN_TRAINING_ROWS {
+            return Err(NnError::TooFewTrainingRows {
+                fraction: opts.validation_fraction,
+                rows,
+                held: val.len(),
+                left: train.len(),
+            });
+        }
         let mut scaling = match start_from {
             Some(init) => init.scaling.clone(),
             None => Scaling::from_rows(data, n_features, &train, &opts.weighting),

@@ -163,6 +163,13 @@ pub enum NnError {
         value: f64,
         expected: &'static str,
     },
+    #[error("invalid option validation_fraction = {fraction}: it holds out {held} of the {rows} rows and leaves {left} to train on; expected a fraction that leaves at least {least} (at most {most})", least = autoencoder::MIN_TRAINING_ROWS, most = 1.0 - autoencoder::MIN_TRAINING_ROWS as f64 / *rows as f64)]
+    TooFewTrainingRows {
+        fraction: f64,
+        rows: usize,
+        held: usize,
+        left: usize,
+    },
     #[error("scaling {what}[{index}] = {value}: expected {expected}")]
     InvalidScaling {
         what: &'static str,
