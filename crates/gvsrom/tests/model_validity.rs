@@ -31,30 +31,46 @@ fn pod2() -> &'static Path {
 fn zero_epochs_and_a_diverging_training_leave_no_model() {
     let out = scratch("val-ae-failed");
     let train = |extra: &[&str], needles: &[&str]| {
-        let args = [
-            &[
-                "train",
-                s(dataset12()),
-                "--hidden-layers",
-                "3",
-                "--out",
-                s(&out),
-            ][..],
-            extra,
-        ]
-        .concat();
+        let args = [&["train", s(dataset12()), "--out", s(&out)][..], extra].concat();
         expect_error(&args, needles);
         assert!(!out.exists(), "a failed training wrote a model");
     };
-    train(&["--epochs", "0"], &["--epochs", "≥ 1"]);
-    // a learning rate 10⁶× the default: the loss explodes
     train(
-        &["--epochs", "200", "--learning-rate", "1000"],
+        &["--hidden-layers", "3", "--epochs", "0"],
+        &["--epochs", "≥ 1"],
+    );
+    // the largest learning rate accepted, 10³× the default, on a deeper network: the loss explodes
+    // (by epoch 3)
+    train(
+        &[
+            "--epochs",
+            "200",
+            "--learning-rate",
+            "1",
+            "--patience",
+            "0",
+            "--hidden-layers",
+            "7",
+        ],
         &["--learning-rate", "diverged", "lower the learning rate"],
+    );
+    // beyond it, refused before any epoch
+    train(
+        &[
+            "--hidden-layers",
+            "3",
+            "--epochs",
+            "200",
+            "--learning-rate",
+            "1000",
+        ],
+        &["--learning-rate", "learning_rate = 1000", "in (0, 1]"],
     );
     // a rate too small to move any weight: the loss never falls below the initial weights'
     train(
         &[
+            "--hidden-layers",
+            "3",
             "--epochs",
             "3",
             "--learning-rate",

@@ -42,6 +42,11 @@ fn negative_duration_and_sample_rate_are_rejected() {
         &["simulate", "six-tendon", "--duration", "-1"],
         &["--duration", "-1", "> 0"],
     );
+    // a run shorter than a microsecond took no step and wrote the start alone
+    expect_error(
+        &["simulate", "six-tendon", "--duration", "1e-300"],
+        &["--duration", "1e-300", "at least 1e-6 s"],
+    );
     expect_error(
         &[
             "simulate",

@@ -133,7 +133,7 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
         writeln!(
             out,
             "discrete   zero-order hold of {} s: δx_k+1 = A_d δx_k + B_d δu_k, poles e^(λh) within |z| ≤ {:.6}{}",
-            d.sample_time_s,
+            gvs::error::fmt_value(d.sample_time_s),
             d.spectral_radius,
             if args.json.is_some() { " (A_d, B_d in the JSON)" } else { " (--json writes A_d, B_d)" }
         )?;

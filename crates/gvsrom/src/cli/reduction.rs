@@ -60,7 +60,7 @@ pub struct TrainArgs {
     /// Mini-batch size.
     #[arg(long, default_value_t = reduce::TrainRequest::DEFAULT.batch_size)]
     pub batch_size: usize,
-    /// Adam learning rate.
+    /// Adam learning rate, in (0, 1].
     #[arg(long, default_value_t = reduce::TrainRequest::DEFAULT.learning_rate)]
     pub learning_rate: f64,
     /// L2 weight regularization λ of eq. (15), in [0, 1] (paper: 1e-4).

@@ -8,7 +8,7 @@ pub struct SimulateArgs {
     #[command(flatten)]
     pub scenario: ScenarioArgs,
 
-    /// Simulated time [s].
+    /// Simulated time [s], at least 1e-6.
     #[arg(long, value_name = "T", allow_hyphen_values = true)]
     pub duration: f64,
 

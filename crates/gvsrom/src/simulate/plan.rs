@@ -19,10 +19,21 @@ pub const MAX_FIXED_STEPS: f64 = 1e7;
 /// Most input switches of a random-step or babbling signal (`--duration / period`).
 pub const MAX_INPUT_SWITCHES: f64 = 1e7;
 
+/// Shortest run \[s\]: a microsecond, below every time scale of a soft arm's motion that matters;
+/// at 1e-300 s the run took no step and wrote the start alone.
+pub const MIN_DURATION: f64 = 1e-6;
+
 /// The output times `t_k = k / rate` for `t_k ≤ duration`, followed by `duration` itself when it is
 /// not a multiple of the sample period, so the last sample is always at `duration`.
 pub fn sample_times(duration: f64, rate: f64) -> Result<Vec<f64>, ScenarioError> {
     positive("--duration", duration, "s")?;
+    if duration < MIN_DURATION {
+        return Err(ScenarioError::value(
+            "--duration",
+            duration,
+            format!("at least {MIN_DURATION:e} s (a microsecond)"),
+        ));
+    }
     positive("--sample-rate", rate, "Hz")?;
     let periods = (duration * rate * (1.0 + 4.0 * f64::EPSILON)).floor();
     if !periods.is_finite() || periods >= (MAX_SAMPLES - 1) as f64 {

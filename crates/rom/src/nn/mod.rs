@@ -157,7 +157,7 @@ pub enum NnError {
     InvalidLatent { latent: usize, n_features: usize },
     #[error("hidden_layers = {value}: expected an odd number from 1 to {max} (1, 3, 5, 7, …; the paper's deepest has 7)", max = autoencoder::MAX_HIDDEN_LAYERS)]
     InvalidHiddenLayers { value: usize },
-    #[error("invalid option {field} = {value}: expected {expected}")]
+    #[error("invalid option {field} = {}: expected {expected}", gvs::error::fmt_value(*value))]
     InvalidOption {
         field: &'static str,
         value: f64,
@@ -178,7 +178,7 @@ pub enum NnError {
         expected: &'static str,
     },
     #[error(
-        "the training diverged at epoch {epoch}: its loss became {loss:e} (the initial weights' was {initial:.3e}); lower the learning rate (it was {learning_rate}); no model is kept"
+        "the training diverged at epoch {epoch}: its loss became {loss:.3e} (the initial weights' was {initial:.3e}); lower the learning rate (it was {}); no model is kept", gvs::error::fmt_value(*learning_rate)
     )]
     Diverged {
         epoch: usize,

@@ -154,8 +154,12 @@ impl TrainOptions {
                 "in [0, 1] (the paper: 1e-4; at 1 the penalty already pulls the weights so far toward 0 that an IV-A autoencoder's RMSE is 20× that at 1e-4)",
             );
         }
-        if !(self.learning_rate.is_finite() && self.learning_rate > 0.0) {
-            return bad("learning_rate", self.learning_rate, "finite and > 0");
+        if !(self.learning_rate > 0.0 && self.learning_rate <= 1.0) {
+            return bad(
+                "learning_rate",
+                self.learning_rate,
+                "in (0, 1] (the paper: 1e-3; Adam moves each weight by about the rate per step)",
+            );
         }
         if !(0.0..1.0).contains(&self.validation_fraction) {
             return bad("validation_fraction", self.validation_fraction, "in [0, 1)");
