@@ -717,4 +717,15 @@ fn an_axis_of_tiny_or_huge_components_keeps_its_direction_and_zero_has_none() {
         ],
         &["loads.distributed[0].axis", "[0, 0, 0] has no direction"],
     );
+    expect_error(
+        &[
+            "statics",
+            "single-tendon",
+            "--set",
+            "base.axis=[0, 0, 1]",
+            "--set",
+            "base.angle_deg=1e308",
+        ],
+        &["base.angle_deg", "1e308", "[-1e6, 1e6] deg"],
+    );
 }

@@ -37,6 +37,9 @@ pub const MAX_BASE_POSITION: f64 = 1e3;
 pub const DIVISION_LENGTH_RANGE: (f64, f64) = (1e-6, 1e3);
 /// Smallest radius \[m\] (0.1 µm); the largest is the rod's total length L (a rod is slender).
 pub const MIN_RADIUS: f64 = 1e-7;
+/// Accepted angle in degrees (a base rotation, a tendon's polar angle): ±1e6, thousands of turns;
+/// the angle's rounding is 1e-10° there (1e308 was accepted, and rounded to whole turns).
+pub const ANGLE_RANGE_DEG: (f64, f64) = (-1e6, 1e6);
 /// Largest number of centreline samples.
 pub const MAX_CENTERLINE_POINTS: usize = 100_000;
 

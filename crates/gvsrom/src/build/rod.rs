@@ -146,7 +146,7 @@ pub(super) fn base_pose(s: &Scenario) -> Result<Pose, ScenarioError> {
         }
         (None, Some(axis), Some(angle)) => {
             let a = direction("base.axis", &axis)?;
-            let angle = finite("base.angle_deg", angle)?.to_radians();
+            let angle = in_range("base.angle_deg", angle, ANGLE_RANGE_DEG, "deg")?.to_radians();
             *nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_unchecked(a), angle).matrix()
         }
         (None, Some(_), None) => {

@@ -97,7 +97,7 @@ pub(super) fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, Scen
                     "missing: `radial_fraction` needs `angle_deg`",
                 ));
             };
-            let theta = finite(&f("angle_deg"), angle)?.to_radians();
+            let theta = in_range(&f("angle_deg"), angle, ANGLE_RANGE_DEG, "deg")?.to_radians();
             let c = t.radial_fraction.unwrap_or(1.0);
             if !(c.is_finite() && (0.0..=1.0).contains(&c)) {
                 return Err(ScenarioError::value(
