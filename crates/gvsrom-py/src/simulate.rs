@@ -496,6 +496,10 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
         }
         Ending::Interrupted { reason } => return Err(invalid(reason.clone())),
     }
+    for o in &outcome.model_extrapolated {
+        warn(py, o)?;
+        extrapolated.push(o.clone());
+    }
     let d = trajectory(py, built, &buffer, &outcome)?;
     d.set_item("model_extrapolated", extrapolated)?;
     Ok(d)

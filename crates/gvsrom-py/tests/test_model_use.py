@@ -140,3 +140,22 @@ def test_a_state_no_rod_holds_is_refused_not_answered_with_nan(robot):
     # a large but physical state is answered
     q[0] = 0.5
     assert np.all(np.isfinite(robot.mass_matrix(q)))
+
+
+def test_a_pod_run_that_leaves_its_training_encodings_says_so_once(robot, pod):
+    # A POD basis is linear and defined everywhere, so the run goes on; but no snapshot checked
+    # the motion there, and the result (and a warning) says where it left them.
+    reduced = robot.with_model(pod)
+    lo, hi = pod.latent_range[0]
+    inside = np.array([0.5 * (lo + hi), 0.5 * sum(pod.latent_range[1])])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        tr = reduced.simulate(0.02, sample_rate=100, q0=inside)
+    assert tr["model_extrapolated"] == []
+    far = inside.copy()
+    far[0] = hi + 2 * (hi - lo)
+    with pytest.warns(UserWarning, match=r"left the training encodings at t = 0\.0000 s: q_r\[0\]"):
+        tr = reduced.simulate(0.02, sample_rate=100, q0=far)
+    notes = [n for n in tr["model_extrapolated"] if "left the training encodings" in n]
+    assert len(notes) == 1 and "its basis is linear" in notes[0], tr["model_extrapolated"]
+    assert tr["t"][-1] == pytest.approx(0.02)

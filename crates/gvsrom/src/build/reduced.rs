@@ -43,8 +43,12 @@ pub struct Reduced {
     /// The initial guesses at other tensions ([`Self::initial_at`]; the reduction layer's
     /// anchors).
     pub guess: Option<Box<dyn GuessAt>>,
-    /// The training encodings' range per coordinate.
+    /// The training encodings' range per coordinate, for a decoder: beyond it (by half its width)
+    /// a solve or a run is refused ([`Self::range_violation`]). Empty for POD.
     pub latent_range: Vec<[f64; 2]>,
+    /// A POD model's training encodings' range: its basis is linear and defined everywhere, so a
+    /// run that leaves it is only noted ([`Self::data_range_violation`]). Empty for a decoder.
+    pub data_range: Vec<[f64; 2]>,
     /// How the scenario lies outside what the model was trained on, when used with
     /// `--extrapolate` (empty: inside; see [`InputRange`]).
     pub extrapolated: Vec<String>,
@@ -172,8 +176,18 @@ impl Reduced {
     /// of the training data `[lo, hi]` of `MODEL`"; `None` inside (always, for models without a
     /// recorded range).
     pub fn range_violation(&self, q: &[f64]) -> Option<String> {
-        outside_range(&self.latent_range, q).map(|d| {
-            let (v, [lo, hi]) = (q[d], self.latent_range[d]);
+        self.violation_of(&self.latent_range, q)
+    }
+
+    /// [`Self::range_violation`] for a POD model's [`Self::data_range`]: where its run has left the
+    /// snapshots it was made from (the mechanics are the projection's there, unchecked by data).
+    pub fn data_range_violation(&self, q: &[f64]) -> Option<String> {
+        self.violation_of(&self.data_range, q)
+    }
+
+    fn violation_of(&self, range: &[[f64; 2]], q: &[f64]) -> Option<String> {
+        outside_range(range, q).map(|d| {
+            let (v, [lo, hi]) = (q[d], range[d]);
             // six decimals as the range, in exponent form far from it (not 300 digits for 1e300)
             let v = match v.abs() < 1e15 {
                 true => format!("{v:.6}"),

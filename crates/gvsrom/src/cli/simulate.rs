@@ -276,6 +276,9 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
             fmt_vec(&[g.pos[0], g.pos[1], g.pos[2]], 6),
         )?;
     }
+    for o in &outcome.model_extrapolated {
+        writeln!(out, "note       {o}")?;
+    }
     let written = match writer {
         Some(w) => {
             let samples = w.samples();

@@ -174,6 +174,10 @@ pub fn attach(
             ModelWeights::Autoencoder(_) => model.meta.latent_range.clone(),
             ModelWeights::Pod { .. } => vec![],
         },
+        data_range: match &model.weights {
+            ModelWeights::Autoencoder(_) => vec![],
+            ModelWeights::Pod { .. } => model.meta.latent_range.clone(),
+        },
         extrapolated: outside,
         warnings,
         input_range: model.meta.input_range.clone(),

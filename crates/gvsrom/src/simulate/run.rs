@@ -36,6 +36,9 @@ pub struct Outcome {
     pub left_training_region: bool,
     /// The wall time of every timed run \[s\]: this one's, then those of [`Outcome::time_again`].
     pub wall_times_s: Vec<f64>,
+    /// How the run used its reduced model outside what the model was made from, found while it
+    /// ran: a POD trajectory that left its training encodings (the first time).
+    pub model_extrapolated: Vec<String>,
 }
 
 impl Outcome {
@@ -161,6 +164,7 @@ pub fn run_into(
     let mut write_error: Option<std::io::Error> = None;
     let mut off_manifold = None;
     let mut non_physical = None;
+    let mut off_data = None::<String>;
     let x: Vec<f64> = built.model.disc.points.iter().map(|p| p.x).collect();
     // `control` is called from the sink and from the integrator's per-attempt poll, never nested
     let control = std::cell::RefCell::new(control);
@@ -203,6 +207,15 @@ pub fn run_into(
             );
             off_manifold = Some(msg.clone());
             return ControlFlow::Break(msg);
+        }
+        // A POD basis is linear and defined everywhere: leaving its data is noted, not refused
+        if off_data.is_none() {
+            off_data = (built.reduced.as_ref().and_then(|r| r.data_range_violation(s.q))).map(|v| {
+                format!(
+                    "the POD trajectory left the training encodings at t = {:.4} s: {v}; its basis is linear and holds there, but no snapshot checked it",
+                    s.t
+                )
+            });
         }
         check(s.t)
     };
@@ -270,5 +283,6 @@ pub fn run_into(
         ending,
         last_tip,
         left_training_region,
+        model_extrapolated: off_data.into_iter().collect(),
     })
 }

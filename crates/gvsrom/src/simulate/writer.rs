@@ -337,6 +337,7 @@ impl TrajectoryWriter {
                 .iter()
                 .flat_map(|r| r.extrapolated.iter())
                 .chain(&plan.model_extrapolated)
+                .chain(&outcome.model_extrapolated)
                 .cloned()
                 .collect(),
             centerline_x: shape.x,
