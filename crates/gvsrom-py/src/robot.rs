@@ -116,7 +116,7 @@ pub fn warn(py: Python<'_>, message: &str) -> PyResult<()> {
 impl Robot {
     pub fn new(py: Python<'_>, scenario: Scenario, attached: Option<Attached>) -> PyResult<Robot> {
         let built = build_with(py, &scenario, attached.as_ref(), false)?;
-        for w in gvsrom::build::uncovered_tendon_components(&built.model) {
+        for w in gvsrom::build::warnings(&scenario.scenario, &built) {
             warn(py, &w)?;
         }
         Ok(Robot {

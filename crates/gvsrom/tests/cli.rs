@@ -729,3 +729,15 @@ fn an_axis_of_tiny_or_huge_components_keeps_its_direction_and_zero_has_none() {
         &["base.angle_deg", "1e308", "[-1e6, 1e6] deg"],
     );
 }
+
+#[test]
+fn check_refuses_a_distributed_load_the_points_do_not_resolve_as_statics_does() {
+    // `check` said "the scenario is valid" for a load `statics` then refused
+    let set = "loads.distributed.0.width=0.005";
+    for cmd in ["check", "statics"] {
+        expect_error(
+            &[cmd, "soft-beam", "--set", set],
+            &["loads.distributed[0].width", "0.005 m", "not resolved"],
+        );
+    }
+}

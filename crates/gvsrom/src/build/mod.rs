@@ -20,7 +20,7 @@ pub use reduced::Reduced;
 pub use resolve::{resolve, Request, Resolved};
 pub use tendons::uncovered_tendon_components;
 
-use basis::{basis, quadrature};
+use basis::{basis, kinematics_resolution, quadrature};
 use rod::{base_pose, geometry, material, radius_range, reference_strain};
 use tendons::tendon;
 
@@ -162,6 +162,8 @@ pub fn build(s: &Scenario) -> Result<Built, ScenarioError> {
     let model = Model::new(rod, disc, basis, tendons)?
         .with_base(base)
         .with_reference_strain(|_, div| reference[div]);
+    // the loads as the points take them (`check` too: a distributed load they do not resolve)
+    model.prepare_loads(&loads)?;
     let built = Built {
         name: s.name.clone().unwrap_or_else(|| "scenario".to_string()),
         model,
@@ -174,6 +176,28 @@ pub fn build(s: &Scenario) -> Result<Built, ScenarioError> {
     let u_abs: Vec<f64> = built.u.iter().map(|v| v.abs()).collect();
     crate::plausibility::check(&built, &u_abs, 1.0)?;
     Ok(built)
+}
+
+/// The divisions of `s` whose basis the kinematics integrate less exactly than the stiffness
+/// (`basis::kinematics_resolution`): one sentence each, for the front-ends to warn with, as
+/// [`uncovered_tendon_components`]. Empty for a scenario that does not build (its error says why).
+pub fn under_integrated_divisions(s: &Scenario) -> Vec<String> {
+    (s.divisions.iter().enumerate())
+        .filter_map(|(j, d)| {
+            let b = basis(j, d).ok()?;
+            let q = quadrature(j, d, &b).ok()?;
+            kinematics_resolution(j, &b, &q, s.magnus)
+        })
+        .collect()
+}
+
+/// Every build warning of `s` built as `built`: tendon loads the basis cannot hold
+/// ([`uncovered_tendon_components`]) and divisions the kinematics under-integrate
+/// ([`under_integrated_divisions`]).
+pub fn warnings(s: &Scenario, built: &Built) -> Vec<String> {
+    let mut w = uncovered_tendon_components(&built.model);
+    w.extend(under_integrated_divisions(s));
+    w
 }
 
 impl<'a> From<&'a Built> for crate::plausibility::Subject<'a> {

@@ -163,8 +163,9 @@ pub fn run(cli: Cli, out: &mut impl Write) -> Result<()> {
     }
 }
 
-/// The scenario of `args` resolved by the library ([`gvsrom::build::resolve`]); a tendon whose
-/// load the basis cannot hold is warned about on stderr.
+/// The scenario of `args` resolved by the library ([`gvsrom::build::resolve`]); its build
+/// warnings ([`gvsrom::build::warnings`]: a tendon whose load the basis cannot hold, a division
+/// the kinematics under-integrate) go to stderr.
 fn load(args: &ScenarioArgs) -> Result<Resolved> {
     let r = resolve(&Request {
         source: &args.scenario,
@@ -172,7 +173,7 @@ fn load(args: &ScenarioArgs) -> Result<Resolved> {
         tensions: args.tension.as_deref(),
         centerline_points: args.centerline_points,
     })?;
-    for w in gvsrom::build::uncovered_tendon_components(&r.built.model) {
+    for w in gvsrom::build::warnings(&r.scenario, &r.built) {
         gvsrom::progress::stderr_line(format_args!("warning: {w}"));
     }
     Ok(r)

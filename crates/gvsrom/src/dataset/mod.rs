@@ -389,7 +389,10 @@ pub fn run(args: &DatasetRequest, interrupt: &AtomicUsize) -> Result<Outcome, Da
     }
     let seed = args.seed.unwrap_or(0);
     let (table, built, scenario_toml, provenance) = load_scenario(args)?;
-    let warnings = crate::build::uncovered_tendon_components(&built.model);
+    let mut warnings = crate::build::uncovered_tendon_components(&built.model);
+    if let Ok(scenario) = crate::scenario::from_table(table.clone()) {
+        warnings.extend(crate::build::under_integrated_divisions(&scenario));
+    }
     if args.duration.is_some() {
         let provenance = provenance.seed("input", seed);
         return dynamic::run(args, &built, scenario_toml, interrupt, provenance, t0)
