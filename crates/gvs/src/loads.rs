@@ -5,7 +5,7 @@
 //! Wrenches are 6-vectors `[m; f]` (moment first). A *local* (follower) wrench is expressed in the
 //! cross-section frame and turns with it; a *global* one keeps its world components.
 
-use crate::error::{check_finite, check_range, ModelError};
+use crate::error::{check_finite, check_range, fmt_value, ModelError};
 use crate::lie::{V3, V6};
 use serde::{Deserialize, Serialize};
 
@@ -126,11 +126,24 @@ impl DistributedWrench {
     }
 
     /// The field whose value sets how finely the load must be resolved (the pulse's `width`, a
-    /// uniform load's `x_end`), and that value.
-    pub fn extent_field(&self) -> (&'static str, f64) {
+    /// uniform load's `x_end`), its value, and the load's extent in words for a message.
+    pub fn extent(&self) -> (&'static str, f64, String) {
         match *self {
-            DistributedWrench::Uniform { x_end, .. } => ("x_end", x_end),
-            DistributedWrench::TriangularPulse { width, .. } => ("width", width),
+            DistributedWrench::Uniform { x_start, x_end, .. } => (
+                "x_end",
+                x_end,
+                format!(
+                    "the span [x_start, x_end] = [{}, {}] m, {:.3e} m long,",
+                    fmt_value(x_start),
+                    fmt_value(x_end),
+                    x_end - x_start
+                ),
+            ),
+            DistributedWrench::TriangularPulse { width, center, .. } => (
+                "width",
+                width,
+                format!("the pulse at {} m", fmt_value(center)),
+            ),
         }
     }
 

@@ -5,8 +5,8 @@
 use super::Model;
 use crate::error::{fmt_value, ModelError};
 use crate::lie::{V3, V6};
-use crate::loads::DistributedWrench;
-use crate::loads::{Frame, Loads};
+use crate::loads::{DistributedWrench, Frame, Loads};
+use crate::strain::StrainParam;
 
 /// Largest relative error accepted in the resultant of a distributed load as the computational
 /// points integrate it (`Σ W_i s(X_i)` against the exact `∫ s dX` of its profile, [`Model::prepare_loads`]):
@@ -18,7 +18,6 @@ use crate::loads::{Frame, Loads};
 /// 0.82 % at every centre (mean 0.54 %, 801 centres), 0.04 m within 4.1 %, 0.02 m within 14 %; a
 /// uniform load whose ends fall between points is off by up to the points' spacing over its span.
 pub const DISTRIBUTED_QUADRATURE_TOLERANCE: f64 = 0.05;
-use crate::strain::StrainParam;
 
 /// Loads resolved onto the computational points.
 #[derive(Debug, Clone)]
@@ -92,24 +91,34 @@ impl<P: StrainParam> Model<P> {
         let quadrature: f64 = (points.iter().filter(|p| p.weight > 0.0))
             .map(|p| p.weight * d.profile(p.x))
             .sum();
-        let exact = d.profile_integral(0.0, self.disc.length());
+        let length = self.disc.length();
+        let exact = d.profile_integral(0.0, length);
+        let (field, value, what) = d.extent();
+        let field = format!("loads.distributed[{k}].{field}");
+        if exact.is_nan() || exact <= 0.0 {
+            // narrower than the floats' resolution where it stands: X₀ ± w/2 round to X₀
+            return Err(ModelError::invalid(
+                field,
+                format!("{} m: {what} has no extent in floating point at its position; accepted: a width that the positions along the rod resolve", fmt_value(value)),
+            ));
+        }
         let error = (quadrature - exact).abs() / exact;
         if error <= DISTRIBUTED_QUADRATURE_TOLERANCE {
             return Ok(());
         }
-        // the widest gap between weighted points where the load acts (or around it)
-        let xs: Vec<f64> = (points.iter().filter(|p| p.weight > 0.0))
-            .map(|p| p.x)
+        // the widest gap between weighted points (and the rod's ends) where the load acts
+        let xs: Vec<f64> = std::iter::once(0.0)
+            .chain((points.iter().filter(|p| p.weight > 0.0)).map(|p| p.x))
+            .chain(std::iter::once(length))
             .collect();
         let gap = (xs.windows(2))
             .filter(|w| d.profile_integral(w[0], w[1]) > 0.0 || d.profile(w[0]) > 0.0)
             .map(|w| w[1] - w[0])
             .fold(0.0, f64::max);
-        let (field, value) = d.extent_field();
         Err(ModelError::invalid(
-            format!("loads.distributed[{k}].{field}"),
+            field,
             format!(
-                "{} m is not resolved by the computational points: their quadrature applies {:.3}× the load's resultant ({:.1} % off; accepted ≤ {} %). The points are up to {:.2} mm apart where it acts: make the load wider, or refine the discretization (more elements or Gauss points)",
+                "{} m: {what} is not resolved by the computational points: their quadrature applies {:.3}× the load's resultant ({:.1} % off; accepted ≤ {} %). The points are up to {:.2} mm apart where it acts: make the load wider, or refine the discretization (more elements or Gauss points; a uniform load whose ends lie on element or division ends is integrated exactly)",
                 fmt_value(value),
                 quadrature / exact,
                 100.0 * error,

@@ -89,6 +89,25 @@ fn a_pulse_narrower_than_the_points_is_refused_naming_its_width() {
 }
 
 #[test]
+fn a_pulse_below_the_floats_resolution_or_at_the_rods_end_is_refused_with_what_it_is() {
+    let m = beam();
+    // X₀ ± w/2 round to X₀: no extent at all, said so (not a NaN ratio)
+    let e = m
+        .prepare_loads(&pulse(0.3, 1e-300))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("1e-300 m: the pulse at 0.3 m has no extent in floating point"),
+        "{e}"
+    );
+    assert!(!e.contains("NaN") && !e.contains("inf"), "{e}");
+    // at the clamped end the gap to the first point counts (it was reported as 0.00 mm)
+    let e = m.prepare_loads(&pulse(0.0, 0.005)).unwrap_err().to_string();
+    assert!(e.contains("the pulse at 0 m"), "{e}");
+    assert!(!e.contains("up to 0.00 mm"), "{e}");
+}
+
+#[test]
 fn a_uniform_load_between_two_points_is_refused_naming_its_end() {
     let m = beam();
     let loads = Loads {
@@ -103,7 +122,8 @@ fn a_uniform_load_between_two_points_is_refused_naming_its_end() {
     };
     let e = m.prepare_loads(&loads).unwrap_err().to_string();
     assert!(
-        e.contains("loads.distributed[0].x_end") && e.contains("0.1001 m"),
+        e.contains("loads.distributed[0].x_end")
+            && e.contains("the span [x_start, x_end] = [0.1, 0.1001] m, 1.000e-4 m long"),
         "{e}"
     );
 }

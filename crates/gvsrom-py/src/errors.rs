@@ -56,13 +56,14 @@ pub fn scenario(e: ScenarioError) -> PyErr {
 pub fn any(e: anyhow::Error) -> PyErr {
     if let Some(f) = e.downcast_ref::<StaticsFailure>() {
         if let StaticsError::NotConverged { .. } = f.error {
-            return Python::attach(|py| statics_with_message(py, f, &format!("{e:#}")));
+            return Python::attach(|py| statics_with_message(py, f, &chain(e.as_ref())));
         }
     }
-    invalid(format!("{e:#}"))
+    invalid(chain(e.as_ref()))
 }
 
-/// An error with its causes joined by `: `, as the command line prints it (anyhow's `{:#}`).
+/// An error with its causes joined by `: `, each once, as the command line prints it
+/// ([`gvsrom::error::message_chain`]).
 pub fn chain(e: &dyn std::error::Error) -> String {
     gvsrom::error::message_chain(e)
 }
@@ -95,7 +96,11 @@ pub fn statics_with_message(py: Python<'_>, f: &StaticsFailure, message: &str) -
 
 /// Flags of the command line whose Python keyword argument has another spelling than the flag's
 /// with `-` → `_`.
-const RENAMED: [(&str, &str); 2] = [("lambda", "lambda_"), ("tension", "u")];
+const RENAMED: [(&str, &str); 3] = [
+    ("lambda", "lambda_"),
+    ("tension", "u"),
+    ("sample-time", "dt"),
+];
 
 /// Flags of the command line that are switches, spelled `name=True` in Python.
 const SWITCHES: [&str; 6] = [

@@ -61,8 +61,7 @@ impl Robot {
         dt: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
         if let Some(h) = dt {
-            linearize::check_sample_time(h)
-                .map_err(|e| invalid(e.to_string().replacen("--sample-time", "`dt`", 1)))?;
+            linearize::check_sample_time(h).map_err(|e| invalid(e.to_string()))?;
         }
         let to_py = |e: LinearizeError| {
             let message = errors::chain(&e);

@@ -104,10 +104,7 @@ impl Model {
         let (x, one) = rows_of(name, a, cols, what)?;
         let y = py
             .detach(|| f(&self.model, &x))
-            // the way out as Python spells it
-            .map_err(|e| {
-                invalid(crate::errors::chain(&e).replace("--extrapolate", "extrapolate=True"))
-            })?;
+            .map_err(|e| invalid(crate::errors::chain(&e)))?;
         if one {
             Ok(vector(py, &y))
         } else {
@@ -160,8 +157,9 @@ impl Model {
     ///     Snapshots as a dataset stores them (:attr:`Dataset.strain`): ``ξ − ξ*`` of the active
     ///     components at the model's points, point-major.
     /// extrapolate : bool, optional
-    ///     Encode a snapshot whose code lies far outside the training encodings (default: the
-    ///     model's own ``extrapolate``).
+    ///     Encode a snapshot whose code lies far outside the training encodings, or whose norm
+    ///     is over twice the largest training snapshot's (default: the model's own
+    ///     ``extrapolate``).
     ///
     /// Returns
     /// -------
@@ -171,7 +169,8 @@ impl Model {
     /// ------
     /// GvsromError
     ///     On a wrong shape or a non-finite value, or a code far outside the training encodings
-    ///     (the snapshot is unlike the training data) unless ``extrapolate``.
+    ///     or a norm over twice the largest training snapshot's (the snapshot is unlike the
+    ///     training data) unless ``extrapolate``.
     #[pyo3(signature = (strain, extrapolate=None))]
     fn encode<'py>(
         &self,

@@ -74,7 +74,8 @@ pub enum DatasetArg<'py> {
 /// largest_norm : float
 ///     The largest ``‖x‖``, for scale.
 /// outside : int
-///     Snapshots whose code lies far outside the training encodings.
+///     Snapshots outside the training data: their code far outside the training encodings,
+///     or their norm over twice the largest training snapshot's.
 /// unseen_inputs : int or None
 ///     Snapshots whose inputs lie outside what the model was trained on: an input outside its
 ///     training range, or a combination far from the training inputs (as ``model=`` refuses
@@ -101,7 +102,8 @@ pub struct Reconstruction {
     /// The largest ``‖x‖`` of the snapshots.
     #[pyo3(get)]
     largest_norm: f64,
-    /// Snapshots whose code lies far outside the training encodings.
+    /// Snapshots outside the training data: their code far outside the training encodings, or
+    /// their norm over twice the largest training snapshot's.
     #[pyo3(get)]
     outside: usize,
     /// Snapshots whose inputs lie outside what the model was trained on, or None.

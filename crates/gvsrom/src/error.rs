@@ -98,7 +98,10 @@ pub fn message_chain(e: &dyn std::error::Error) -> String {
     let mut source = e.source();
     while let Some(cause) = source {
         let text = cause.to_string();
-        if !message.ends_with(&text) {
+        // shown already when the message ends with it as a whole clause (after ": "), not when a
+        // trailing word merely matches
+        let shown = message == text || message.ends_with(&format!(": {text}"));
+        if !shown {
             message.push_str(": ");
             message.push_str(&text);
         }
@@ -149,5 +152,8 @@ mod chain_tests {
             message_chain(&Hides(io())),
             "cannot create `x`: no such file"
         );
+        // a cause equal to the message's last word only is still shown
+        let word = || std::io::Error::other("x`");
+        assert_eq!(message_chain(&Hides(word())), "cannot create `x`: x`");
     }
 }

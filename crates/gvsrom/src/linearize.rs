@@ -38,7 +38,7 @@ pub const DEFAULT_COUNT: usize = 10;
 pub enum LinearizeError {
     #[error("--sample-time `{}`: expected a duration in seconds, finite and > 0, at most {MAX_SAMPLE_TIME} (the hold of the zero-order-hold discretization, e.g. 0.01 for a 100 Hz controller)", fmt_value(*value))]
     SampleTime { value: f64 },
-    #[error("--sample-time `{}`: the zero-order-hold matrices over it are not finite ({why}); accepted: a shorter hold{}", fmt_value(*value), match most { Some(h) => format!(", below {} s", fmt_value(*h)), None => String::new() })]
+    #[error("--sample-time `{}`: the zero-order-hold matrices over it are not finite ({why}); accepted: a shorter hold{}", fmt_value(*value), match most { Some(h) => format!(", below about {} s, where e^(λh) reaches the largest float", fmt_value(*h)), None => String::new() })]
     HoldOverflow {
         value: f64,
         why: String,
@@ -47,27 +47,13 @@ pub enum LinearizeError {
     #[error("--count `{value}`: expected an integer ≥ 1 (the number of slowest poles to print; the linearization has {n_poles} states, so at most {n_poles} poles)")]
     Count { value: String, n_poles: usize },
     #[error("the equilibrium: {0}")]
-    Statics(StaticsFailure),
+    Statics(#[from] StaticsFailure),
     #[error(transparent)]
     Scenario(#[from] ScenarioError),
     #[error(transparent)]
     Model(#[from] ModelError),
     #[error("the linearization: {0}")]
-    Dynamics(DynamicsError),
-}
-
-// The prefixed variants hold their cause in the message and not as a `source`: `{:#}` (the CLI)
-// would print it twice, `to_string` (Python) not at all.
-impl From<StaticsFailure> for LinearizeError {
-    fn from(e: StaticsFailure) -> Self {
-        LinearizeError::Statics(e)
-    }
-}
-
-impl From<DynamicsError> for LinearizeError {
-    fn from(e: DynamicsError) -> Self {
-        LinearizeError::Dynamics(e)
-    }
+    Dynamics(#[from] DynamicsError),
 }
 
 /// How many poles to print for `--count text` (`None`: [`DEFAULT_COUNT`]): an integer ≥ 1, else an

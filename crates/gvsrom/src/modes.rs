@@ -38,27 +38,13 @@ pub enum ModesError {
     #[error("--count `{value}`: expected an integer ≥ 1 (the number of lowest modes to report; the model has {n_dof} DOF, a larger count reports them all)")]
     Count { value: String, n_dof: usize },
     #[error("the equilibrium: {0}")]
-    Statics(StaticsFailure),
+    Statics(#[from] StaticsFailure),
     #[error(transparent)]
     Scenario(#[from] ScenarioError),
     #[error(transparent)]
     Model(#[from] ModelError),
     #[error("the modes: {0}")]
-    Dynamics(DynamicsError),
-}
-
-// The prefixed variants hold their cause in the message and not as a `source`: `{:#}` (the CLI)
-// would print it twice, `to_string` (Python) not at all.
-impl From<StaticsFailure> for ModesError {
-    fn from(e: StaticsFailure) -> Self {
-        ModesError::Statics(e)
-    }
-}
-
-impl From<DynamicsError> for ModesError {
-    fn from(e: DynamicsError) -> Self {
-        ModesError::Dynamics(e)
-    }
+    Dynamics(#[from] DynamicsError),
 }
 
 /// How many modes to report for `--count text` (`None`: [`DEFAULT_COUNT`]) on an `n_dof` model: an

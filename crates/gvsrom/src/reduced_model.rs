@@ -27,7 +27,7 @@ use thiserror::Error;
 
 mod codec;
 mod weights_file;
-pub use codec::{outside_range, oversized_row, CodecError, SNAPSHOT_NORM_MARGIN};
+pub use codec::{outside_range, oversized_row, row_norm, CodecError, SNAPSHOT_NORM_MARGIN};
 
 /// The manifest format of a model directory.
 pub const MODEL_FORMAT: &str = "reduced-model";

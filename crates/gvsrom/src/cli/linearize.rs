@@ -132,9 +132,12 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
     if let Some(d) = &lin.discrete {
         writeln!(
             out,
-            "discrete   zero-order hold of {} s: δx_k+1 = A_d δx_k + B_d δu_k, poles e^(λh) within |z| ≤ {:.6}{}",
+            "discrete   zero-order hold of {} s: δx_k+1 = A_d δx_k + B_d δu_k, poles e^(λh) within |z| ≤ {}{}",
             gvs::error::fmt_value(d.sample_time_s),
-            d.spectral_radius,
+            match d.spectral_radius {
+                r if (1e-4..1e6).contains(&r) => format!("{r:.6}"),
+                r => format!("{r:.3e}"),
+            },
             if args.json.is_some() { " (A_d, B_d in the JSON)" } else { " (--json writes A_d, B_d)" }
         )?;
     }

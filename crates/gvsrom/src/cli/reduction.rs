@@ -374,7 +374,7 @@ fn reconstruction_lines(
     }
     writeln!(
         out,
-        "outside    {} of {} snapshots encode far outside the training encodings{}",
+        "outside    {} of {} snapshots lie outside the training data (a code far outside the training encodings, or a norm over twice the largest training snapshot's){}",
         r.outside,
         r.rows,
         if r.outside > 0 {

@@ -268,15 +268,15 @@ pub(super) fn equilibrium_anchors(
     ))
 }
 
-/// Per coordinate, the `[min, max]` of `latent` (`n × r`, row-major).
 /// The largest Euclidean norm of the row-major snapshots `x` of `features` values
 /// ([`ModelMeta::snapshot_norm_max`](crate::reduced_model::ModelMeta::snapshot_norm_max)).
 pub(super) fn largest_norm(x: &[f64], features: usize) -> f64 {
     (x.chunks_exact(features))
-        .map(|row| row.iter().map(|v| v * v).sum::<f64>().sqrt())
+        .map(crate::reduced_model::row_norm)
         .fold(0.0, f64::max)
 }
 
+/// Per coordinate, the `[min, max]` of `latent` (`n × r`, row-major).
 pub(super) fn latent_range(latent: &[f64], r: usize) -> Vec<[f64; 2]> {
     let mut range = vec![[f64::INFINITY, f64::NEG_INFINITY]; r];
     for z in latent.chunks_exact(r.max(1)) {

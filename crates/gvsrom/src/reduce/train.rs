@@ -391,7 +391,9 @@ pub(super) fn train_error(e: &rom::nn::NnError) -> ScenarioError {
         }
         NnError::InvalidOption { field, .. } => format!("--{}", field.replace('_', "-")),
         NnError::TooFewTrainingRows { .. } => "--validation-fraction".to_string(),
-        NnError::EmptyData | NnError::NonFiniteData { .. } => "DATASET".to_string(),
+        NnError::EmptyData | NnError::NonFiniteData { .. } | NnError::TooFewRows { .. } => {
+            "DATASET".to_string()
+        }
         NnError::Diverged { .. } => "--learning-rate".to_string(),
         _ => "train".to_string(),
     };

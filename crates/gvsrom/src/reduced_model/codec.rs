@@ -50,12 +50,25 @@ pub enum CodecError {
 /// snapshot of 1e300 everywhere, to ordinary codes).
 pub const SNAPSHOT_NORM_MARGIN: f64 = 2.0;
 
+/// The Euclidean norm of a snapshot, scaled by its largest entry first so that entries of 1e200
+/// do not overflow it (NaN for a non-finite entry).
+pub fn row_norm(x: &[f64]) -> f64 {
+    if x.iter().any(|v| !v.is_finite()) {
+        return f64::NAN;
+    }
+    let big = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    match big > 0.0 {
+        true => big * x.iter().map(|v| (v / big) * (v / big)).sum::<f64>().sqrt(),
+        false => 0.0,
+    }
+}
+
 /// The first row of the row-major snapshots `x` whose norm exceeds [`SNAPSHOT_NORM_MARGIN`] ×
 /// `largest` (or is not finite), with that norm; `None` without a recorded `largest`.
 pub fn oversized_row(largest: Option<f64>, x: &[f64], features: usize) -> Option<(usize, f64)> {
     let largest = largest?;
     (x.chunks_exact(features).enumerate())
-        .map(|(row, v)| (row, v.iter().map(|a| a * a).sum::<f64>().sqrt()))
+        .map(|(row, v)| (row, row_norm(v)))
         .find(|(_, n)| n.is_nan() || *n > SNAPSHOT_NORM_MARGIN * largest)
 }
 

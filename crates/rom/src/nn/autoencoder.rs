@@ -254,6 +254,9 @@ impl Autoencoder {
                 .cloned()
                 .collect();
         }
+        if rows < MIN_TRAINING_ROWS {
+            return Err(NnError::TooFewRows { rows });
+        }
         let (train, val) = split_rows(rows, opts.validation_fraction, &mut rng);
         if train.len() < MIN_TRAINING_ROWS {
             return Err(NnError::TooFewTrainingRows {

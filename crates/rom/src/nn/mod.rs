@@ -163,7 +163,9 @@ pub enum NnError {
         value: f64,
         expected: &'static str,
     },
-    #[error("invalid option validation_fraction = {fraction}: it holds out {held} of the {rows} rows and leaves {left} to train on; expected a fraction that leaves at least {least} (at most {most})", least = autoencoder::MIN_TRAINING_ROWS, most = 1.0 - autoencoder::MIN_TRAINING_ROWS as f64 / *rows as f64)]
+    #[error("{rows} row(s) of data: a training needs at least {least} (one snapshot defines no map)", least = autoencoder::MIN_TRAINING_ROWS)]
+    TooFewRows { rows: usize },
+    #[error("invalid option validation_fraction = {fraction}: it holds out {held} of the {rows} rows and leaves {left} to train on; expected a fraction that leaves at least {least} (below {most})", least = autoencoder::MIN_TRAINING_ROWS, most = (*rows as f64 - 1.0) / *rows as f64)]
     TooFewTrainingRows {
         fraction: f64,
         rows: usize,

@@ -148,15 +148,7 @@ pub enum SimulationError {
     #[error(transparent)]
     Model(#[from] ModelError),
     #[error("initial equilibrium: {0}")]
-    Initial(StaticsError),
-}
-
-// The prefixed variants hold their cause in the message and not as a `source`: `{:#}` (the CLI)
-// would print it twice, `to_string` (Python) not at all.
-impl From<StaticsError> for SimulationError {
-    fn from(e: StaticsError) -> Self {
-        SimulationError::Initial(e)
-    }
+    Initial(#[from] StaticsError),
 }
 
 /// The rod as a first-order ODE system.

@@ -127,6 +127,11 @@ impl Default for TrainOptions {
 /// pulled to 0, the snapshots' mean returned).
 pub const MAX_LAMBDA: f64 = 1.0;
 
+/// Largest Adam learning rate accepted ([`TrainOptions::learning_rate`]): 1e3 times the paper's
+/// 1e-3. Adam moves each weight by about the rate per step; at 1 a 7-layer autoencoder of IV-A
+/// strains already explodes by its third epoch (1e300 was accepted).
+pub const MAX_LEARNING_RATE: f64 = 1.0;
+
 impl TrainOptions {
     /// Checks the numeric options (the architecture is checked by `Autoencoder::architecture`).
     pub(crate) fn validate(&self) -> Result<(), NnError> {
@@ -154,7 +159,7 @@ impl TrainOptions {
                 "in [0, 1] (the paper: 1e-4; at 1 the penalty already pulls the weights so far toward 0 that an IV-A autoencoder's RMSE is 20× that at 1e-4)",
             );
         }
-        if !(self.learning_rate > 0.0 && self.learning_rate <= 1.0) {
+        if !(self.learning_rate > 0.0 && self.learning_rate <= MAX_LEARNING_RATE) {
             return bad(
                 "learning_rate",
                 self.learning_rate,
