@@ -93,6 +93,11 @@ impl<P: StrainParam> Model<P> {
             .sum();
         let length = self.disc.length();
         let exact = d.profile_integral(0.0, length);
+        let error = (quadrature - exact).abs() / exact;
+        if error <= DISTRIBUTED_QUADRATURE_TOLERANCE {
+            return Ok(()); // a load with no extent (error NaN or inf) falls through
+        }
+        // the message's parts, formatted only for a refused load
         let (field, value, what) = d.extent();
         let field = format!("loads.distributed[{k}].{field}");
         if exact.is_nan() || exact <= 0.0 {
@@ -101,10 +106,6 @@ impl<P: StrainParam> Model<P> {
                 field,
                 format!("{} m: {what} has no extent in floating point at its position; accepted: a width that the positions along the rod resolve", fmt_value(value)),
             ));
-        }
-        let error = (quadrature - exact).abs() / exact;
-        if error <= DISTRIBUTED_QUADRATURE_TOLERANCE {
-            return Ok(());
         }
         // the widest gap between weighted points (and the rod's ends) where the load acts
         let xs: Vec<f64> = std::iter::once(0.0)
