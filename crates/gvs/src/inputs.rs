@@ -78,6 +78,9 @@ impl Signal {
                     format!("times in ascending order (>= {})", self.times[k - 1]),
                 ));
             }
+            if let Some(why) = self.repeated_time(k) {
+                return Err(ModelError::invalid(format!("{field}.times[{k}]"), why));
+            }
             if v.len() != channels {
                 return Err(ModelError::invalid(
                     format!("{field}.values[{k}]"),
@@ -95,6 +98,24 @@ impl Signal {
             }
         }
         Ok(())
+    }
+
+    /// Why knot `k` may not repeat the time of the knots before it, if it may not: held piecewise
+    /// constant, two knots at one time would lose the first (only the last value at a time is
+    /// applied); interpolated linearly, two knots at one time are a step (the value before and the
+    /// value after) and a third would never be applied.
+    pub fn repeated_time(&self, k: usize) -> Option<String> {
+        let t = self.times[k];
+        let same = |j: usize| k >= j && self.times[k - j] == t;
+        match self.interpolation {
+            Interpolation::Hold if same(1) => Some(format!(
+                "t = {t} repeats the time of the knot before: held piecewise constant, only the last value at one time is applied and the one before would be lost; give each time once"
+            )),
+            Interpolation::Linear if same(1) && same(2) => Some(format!(
+                "t = {t} is the third knot at one time: interpolated linearly, two knots at one time make a step (the value before and the value after) and a third would never be applied; give a time at most twice"
+            )),
+            _ => None,
+        }
     }
 
     /// `u(t)` into `out`.
@@ -275,6 +296,39 @@ mod tests {
         r.eval(0.0, &mut u);
         assert_eq!(u[0], 0.0);
         assert_eq!(s.breakpoints(0.0, 10.0), vec![1.0, 2.0]);
+    }
+
+    #[test]
+    fn a_repeated_time_is_a_step_when_linear_and_refused_when_held() {
+        let step = Signal {
+            times: vec![0.0, 1.0, 1.0, 2.0],
+            values: vec![vec![0.0], vec![0.0], vec![4.0], vec![4.0]],
+            interpolation: Interpolation::Linear,
+        };
+        step.validate("input", 1).unwrap();
+        let mut u = [0.0];
+        step.eval(1.0 - 1e-12, &mut u);
+        assert!(u[0].abs() < 1e-15, "before the step: {}", u[0]);
+        step.eval(1.0, &mut u);
+        assert_eq!(u[0], 4.0);
+        assert_eq!(step.breakpoints(0.0, 2.0), vec![1.0]);
+        let mut triple = step.clone();
+        triple.times.insert(2, 1.0);
+        triple.values.insert(2, vec![2.0]);
+        let e = triple.validate("input", 1).unwrap_err().to_string();
+        assert!(
+            e.contains("input.times[3]") && e.contains("third knot"),
+            "{e}"
+        );
+        let held = Signal {
+            interpolation: Interpolation::Hold,
+            ..step
+        };
+        let e = held.validate("input", 1).unwrap_err().to_string();
+        assert!(
+            e.contains("input.times[2]") && e.contains("t = 1 repeats"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -68,7 +68,8 @@ fn detect(line: &str) -> Result<Option<Delimiter>, String> {
 }
 
 /// Reads a CSV signal with `n_values` columns after `t` (see the module doc), times ascending,
-/// every number finite.
+/// every number finite; a time given twice is a step when `interpolation` is linear and refused
+/// when it is a hold ([`Signal::repeated_time`]).
 pub fn read_csv_signal(
     path: &Path,
     n_values: usize,
@@ -88,6 +89,8 @@ pub fn read_csv_signal(
     let mut first_line = true;
     let mut header = false;
     let mut last_line = 0;
+    // the line of each row
+    let mut lines = vec![];
     for (i, raw) in text.lines().enumerate() {
         let ln = i + 1;
         let line = raw.trim_start_matches('\u{feff}').trim();
@@ -163,6 +166,7 @@ pub fn read_csv_signal(
             }
         }
         last_line = ln;
+        lines.push(ln);
         times.push(row[0]);
         values.push(row[1..].to_vec());
     }
@@ -181,6 +185,13 @@ pub fn read_csv_signal(
         values,
         interpolation,
     };
+    if let Some(k) = (1..s.times.len()).find(|&k| s.repeated_time(k).is_some()) {
+        let why = s.repeated_time(k).unwrap_or_default();
+        return Err(ScenarioError::invalid(
+            format!("{file}:{} column 1", lines[k]),
+            format!("{why} (line {} has it too)", lines[k - 1]),
+        ));
+    }
     s.validate(&file, n_values).map_err(ScenarioError::from)?;
     Ok(s)
 }
@@ -227,6 +238,29 @@ mod tests {
             .copied()
             .zip(s.values.iter().cloned())
             .collect()
+    }
+
+    #[test]
+    fn a_time_given_twice_names_both_lines_when_held_and_is_a_step_when_linear() {
+        let text = "t,u\n0,0\n# the step\n1,0\n1,4\n2,4\n";
+        let e = read("twice.csv", text, 1).unwrap_err();
+        assert!(
+            e.contains("twice.csv:5 column 1") && e.contains("line 4 has it too"),
+            "{e}"
+        );
+        let dir = std::env::temp_dir().join(format!("gvsrom-csv-{}", std::process::id()));
+        let linear = read_csv_signal(&dir.join("twice.csv"), 1, Interpolation::Linear).unwrap();
+        assert_eq!(linear.times, vec![0.0, 1.0, 1.0, 2.0]);
+        let thrice = "0,0\n1,0\n1,2\n1,4\n";
+        read("thrice.csv", thrice, 1).unwrap_err();
+        let path = dir.join("thrice.csv");
+        let e = read_csv_signal(&path, 1, Interpolation::Linear)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("thrice.csv:4 column 1") && e.contains("third knot"),
+            "{e}"
+        );
     }
 
     #[test]
