@@ -328,6 +328,27 @@ impl Discretization {
     pub fn tip(&self) -> usize {
         self.points.len() - 1
     }
+
+    /// The cell `[a_i, b_i]` of each point: the partition of each division by the cumulative
+    /// quadrature weights, `b_i − a_i = W_i` (empty at the points of weight 0). The cells of an
+    /// element's Gauss points tile the element, and each Gauss point lies inside its own (the
+    /// Stieltjes separation of the nodes by the cumulative weights), so `Σ W_i s(X_i)` reads as each
+    /// point standing for its cell: what a load with jumps inside a cell is applied over
+    /// ([`crate::loads::DistributedWrench::Uniform`]).
+    pub fn cells(&self) -> Vec<(f64, f64)> {
+        let mut cells = Vec::with_capacity(self.points.len());
+        let mut edge = self.div_start[0];
+        let mut div = usize::MAX;
+        for p in &self.points {
+            if p.div != div {
+                div = p.div;
+                edge = self.div_start[div];
+            }
+            cells.push((edge, edge + p.weight));
+            edge += p.weight;
+        }
+        cells
+    }
 }
 
 #[cfg(test)]
@@ -419,6 +440,55 @@ mod tests {
         let p = d.point_at(0.123).unwrap();
         assert_eq!(d.points[p].weight, 0.0);
         assert!(d.points.windows(2).all(|w| w[0].x <= w[1].x));
+    }
+
+    #[test]
+    fn the_cells_tile_each_element_and_hold_their_gauss_point() {
+        let d = Discretization::new(
+            &rod(&[0.5, 0.3]),
+            &[
+                Quadrature::Elements {
+                    elements: 7,
+                    gauss_per_element: 3,
+                },
+                Quadrature::Gauss { n: 11 },
+            ],
+            MagnusOrder::Z4,
+            &[0.123, 0.6],
+        )
+        .unwrap();
+        let cells = d.cells();
+        let weighted: Vec<(usize, &Point)> = (d.points.iter().enumerate())
+            .filter(|(_, p)| p.weight > 0.0)
+            .collect();
+        assert_eq!(weighted.len(), 7 * 3 + 11);
+        for (i, p) in &weighted {
+            let (a, b) = cells[*i];
+            assert!(
+                a < p.x && p.x < b,
+                "point {i} at {} outside [{a}, {b}]",
+                p.x
+            );
+        }
+        // element ends, then the second division's ends, are cell edges
+        let h = 0.5 / 7.0;
+        for e in 0..7 {
+            let (a, _) = cells[weighted[3 * e].0];
+            let (_, b) = cells[weighted[3 * e + 2].0];
+            assert!(
+                (a - e as f64 * h).abs() < 1e-15,
+                "element {e} starts at {a}"
+            );
+            assert!(
+                (b - (e + 1) as f64 * h).abs() < 1e-15,
+                "element {e} ends at {b}"
+            );
+        }
+        assert!((cells[weighted[21].0].0 - 0.5).abs() < 1e-15);
+        assert!((cells[weighted[31].0].1 - 0.8).abs() < 1e-15);
+        for (i, p) in d.points.iter().enumerate().filter(|(_, p)| p.weight == 0.0) {
+            assert_eq!(cells[i].0, cells[i].1, "point {i} at {} of weight 0", p.x);
+        }
     }
 
     #[test]

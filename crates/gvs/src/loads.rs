@@ -65,11 +65,18 @@ pub enum DistributedWrench {
 }
 
 impl DistributedWrench {
-    /// Density `[m; f]` at `x` and its frame.
+    /// Density `[m; f]` at `x` and its frame: `s(x)` × [`Self::peak_density`].
     pub fn density_at(&self, x: f64) -> (V6, Frame) {
+        let (peak, frame) = self.peak_density();
+        (peak * self.profile(x), frame)
+    }
+
+    /// The density where the profile is 1 (`density` of a uniform load; the pulse's peak moment
+    /// density `m̂` about its unit axis) and its frame.
+    pub fn peak_density(&self) -> (V6, Frame) {
         match *self {
             DistributedWrench::Uniform { density, frame, .. } => {
-                (V6::from_row_slice(&density) * self.profile(x), frame)
+                (V6::from_row_slice(&density), frame)
             }
             DistributedWrench::TriangularPulse {
                 width,
@@ -82,8 +89,7 @@ impl DistributedWrench {
                     PulseMagnitude::Peak => magnitude,
                     PulseMagnitude::Total => 2.0 * magnitude / width,
                 };
-                let m = peak * self.profile(x);
-                let a = unit_axis(&axis).unwrap_or_else(V3::zeros) * m;
+                let a = unit_axis(&axis).unwrap_or_else(V3::zeros) * peak;
                 (V6::new(a[0], a[1], a[2], 0.0, 0.0, 0.0), Frame::Local)
             }
         }

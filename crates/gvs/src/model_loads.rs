@@ -1,6 +1,13 @@
 //! External loads resolved onto the computational points ([`PreparedLoads`]): point wrenches on
-//! their points, distributed densities × quadrature weight, gravity; follower and world-fixed parts
-//! kept apart.
+//! their points, distributed densities × the share of the load each point stands for, gravity;
+//! follower and world-fixed parts kept apart.
+//!
+//! A distributed density `s(X) f̂` applies `f̂ ∫ s dX` over the rod. Point `i` takes the share
+//! `W_i s(X_i)` (the quadrature of the stiffness, gvs-spec §7.5), except a uniform load's, which
+//! jumps at its ends: point `i` takes the length of its cell ([`crate::discretize::Discretization::cells`])
+//! inside the span, so the resultant is exact wherever the ends fall (with `W_i s(X_i)` an end
+//! between two points moved the resultant by up to a point's weight: 6.1 % of a 0.1 m span on the
+//! soft beam), and a span whose ends are element or division ends is applied as before.
 
 use super::Model;
 use crate::error::{fmt_value, ModelError};
@@ -15,8 +22,8 @@ use crate::strain::StrainParam;
 /// IV-B beam (points ≤ 9.4 mm apart) was applied as 0–3.3× its total depending on its centre, and
 /// bent the beam 49 rad instead of 20. Smaller errors are the quadrature's ordinary error on a
 /// profile with kinks or jumps, as in SoRoSim: the paper's pulse (width 0.08 m) is integrated within
-/// 0.82 % at every centre (mean 0.54 %, 801 centres), 0.04 m within 4.1 %, 0.02 m within 14 %; a
-/// uniform load whose ends fall between points is off by up to the points' spacing over its span.
+/// 0.82 % at every centre (mean 0.54 %, 801 centres), 0.04 m within 4.1 %, 0.02 m within 14 %. A
+/// uniform load's shares are exact ([`Model::load_shares`]): it always passes.
 pub const DISTRIBUTED_QUADRATURE_TOLERANCE: f64 = 0.05;
 
 /// Loads resolved onto the computational points.
@@ -63,16 +70,19 @@ impl<P: StrainParam> Model<P> {
                 Frame::Global => global[i] += w,
             }
         }
+        let cells = self.disc.cells();
+        let mut shares = vec![0.0; np];
         for (k, d) in loads.distributed.iter().enumerate() {
-            self.check_resolved(k, d)?;
-            for (i, p) in self.disc.points.iter().enumerate() {
-                if p.weight == 0.0 {
-                    continue;
-                }
-                let (f, frame) = d.density_at(p.x);
-                match frame {
-                    Frame::Local => local[i] += f * p.weight,
-                    Frame::Global => global[i] += f * p.weight,
+            self.load_shares(d, &cells, &mut shares);
+            self.check_resolved(k, d, &shares)?;
+            let (peak, frame) = d.peak_density();
+            let applied = match frame {
+                Frame::Local => &mut local,
+                Frame::Global => &mut global,
+            };
+            for (a, share) in applied.iter_mut().zip(&shares) {
+                if *share != 0.0 {
+                    *a += peak * *share;
                 }
             }
         }
@@ -83,14 +93,29 @@ impl<P: StrainParam> Model<P> {
         })
     }
 
-    /// Checks that the computational points resolve distributed load `k`: their quadrature of its
-    /// profile, `Σ W_i s(X_i)`, is within [`DISTRIBUTED_QUADRATURE_TOLERANCE`] of `∫₀ᴸ s dX`. Names
-    /// the field that sets the load's extent (the pulse's width, a uniform load's end) otherwise.
-    fn check_resolved(&self, k: usize, d: &DistributedWrench) -> Result<(), ModelError> {
+    /// The share of `∫ s dX` of load `d` that each point applies, into `shares` (the module doc):
+    /// `W_i s(X_i)`, or for a uniform load the length of `cells[i]` inside its span.
+    pub fn load_shares(&self, d: &DistributedWrench, cells: &[(f64, f64)], shares: &mut [f64]) {
+        for ((share, p), &(a, b)) in shares.iter_mut().zip(&self.disc.points).zip(cells) {
+            *share = match d {
+                _ if p.weight == 0.0 => 0.0,
+                DistributedWrench::Uniform { .. } => d.profile_integral(a, b),
+                DistributedWrench::TriangularPulse { .. } => p.weight * d.profile(p.x),
+            };
+        }
+    }
+
+    /// Checks that the computational points resolve distributed load `k`: the sum of their
+    /// `shares` of its profile is within [`DISTRIBUTED_QUADRATURE_TOLERANCE`] of `∫₀ᴸ s dX`. Names
+    /// the field that sets the load's extent (the pulse's width) otherwise.
+    fn check_resolved(
+        &self,
+        k: usize,
+        d: &DistributedWrench,
+        shares: &[f64],
+    ) -> Result<(), ModelError> {
         let points = &self.disc.points;
-        let quadrature: f64 = (points.iter().filter(|p| p.weight > 0.0))
-            .map(|p| p.weight * d.profile(p.x))
-            .sum();
+        let quadrature: f64 = shares.iter().sum();
         let length = self.disc.length();
         let exact = d.profile_integral(0.0, length);
         let error = (quadrature - exact).abs() / exact;
@@ -119,7 +144,7 @@ impl<P: StrainParam> Model<P> {
         Err(ModelError::invalid(
             field,
             format!(
-                "{} m: {what} is not resolved by the computational points: their quadrature applies {:.3}× the load's resultant ({:.1} % off; accepted ≤ {} %). The points are up to {:.2} mm apart where it acts: make the load wider, or refine the discretization (more elements or Gauss points; a uniform load whose ends lie on element or division ends is integrated exactly)",
+                "{} m: {what} is not resolved by the computational points: their quadrature applies {:.3}× the load's resultant ({:.1} % off; accepted ≤ {} %). The points are up to {:.2} mm apart where it acts: make the load wider, or refine the discretization (more elements or Gauss points)",
                 fmt_value(value),
                 quadrature / exact,
                 100.0 * error,
