@@ -6,7 +6,7 @@ use super::{Model, Workspace, STEP_MATRIX_COLUMNS};
 use crate::discretize::MagnusOrder;
 use crate::lie::{ad_mul, exp_tangent, Pose, V3, V6};
 use crate::strain::StrainParam;
-use nalgebra::DVector;
+use nalgebra::{DVector, Matrix3xX};
 
 /// `c = √3/12` of the Zanna step.
 pub const ZANNA_C: f64 = 0.144_337_567_297_406_43;
@@ -191,6 +191,53 @@ impl<P: StrainParam> Model<P> {
             + ta * ((t3 - 2.0 * t2 + t) * hx)
             + ws.g[i + 1].pos * (-2.0 * t3 + 3.0 * t2)
             + tb * ((t3 - t2) * hx)
+    }
+
+    /// [`Self::position_at`] and its derivative in `q`, `∂p/∂q` (3 × n, world axes), after a
+    /// forward pass with Jacobians: the derivative of the same Hermite interpolant, whose nodes
+    /// move as `δp_i = R_i J_v,i δq` and whose tangents `t_i = R_i ν_i` as
+    /// `δt_i = R_i (∂ν_i/∂q − [ν_i]× J_ω,i) δq` (`δR = R [δθ]×`, `δθ = J_ω δq`). At a point it is
+    /// `R_i J_v,i`, the output matrix of the tip's position.
+    pub fn position_jacobian_at(&self, ws: &Workspace, x: f64) -> (V3, Matrix3xX<f64>) {
+        let pts = &self.disc.points;
+        let n = self.n_dof();
+        // δp_i and δt_i of point i
+        let node = |i: usize| {
+            let rot = ws.g[i].rot;
+            let j = ws.jac.columns(i * n, n);
+            let dp = rot * j.fixed_rows::<3>(3);
+            let nu = V3::new(ws.xi[i][3], ws.xi[i][4], ws.xi[i][5]);
+            let mut dnu = Matrix3xX::zeros(n);
+            let cols = ws.ev.stored_columns(i);
+            dnu.columns_mut(cols.start, cols.len())
+                .copy_from(&ws.ev.psi_q_at(i, &cols).fixed_rows::<3>(3));
+            let dt = rot * (dnu - nu.cross_matrix() * j.fixed_rows::<3>(0));
+            (dp, dt)
+        };
+        let i = match pts.iter().position(|p| p.x > x) {
+            Some(0) => 0,
+            Some(i) => i - 1,
+            None => {
+                let tip = pts.len() - 1;
+                return (ws.g[tip].pos, node(tip).0);
+            }
+        };
+        let (a, b) = (pts[i], pts[i + 1]);
+        let hx = b.x - a.x;
+        if hx <= 0.0 {
+            return (ws.g[i].pos, node(i).0);
+        }
+        let t = ((x - a.x) / hx).clamp(0.0, 1.0);
+        let (t2, t3) = (t * t, t * t * t);
+        let (h00, h10, h01, h11) = (
+            2.0 * t3 - 3.0 * t2 + 1.0,
+            (t3 - 2.0 * t2 + t) * hx,
+            -2.0 * t3 + 3.0 * t2,
+            (t3 - t2) * hx,
+        );
+        let ((dpa, dta), (dpb, dtb)) = (node(i), node(i + 1));
+        let d = dpa * h00 + dta * h10 + dpb * h01 + dtb * h11;
+        (self.position_at(ws, x), d)
     }
 
     /// Position of tendon `k`'s thread at `x`, `p = r + R d(X)`, by cubic Hermite interpolation

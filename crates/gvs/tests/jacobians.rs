@@ -1,5 +1,6 @@
 //! Analytic derivatives against central finite differences (gvs-spec §10.2, §10.3.9):
-//! the geometric Jacobian `J_i` at every point and the statics Jacobian `∂R/∂q` with gravity,
+//! the geometric Jacobian `J_i` at every point, the centreline position's between the points, and
+//! the statics Jacobian `∂R/∂q` with gravity,
 //! follower and world-fixed wrenches, distributed loads, tendons with and without friction, two
 //! divisions, Z2 and Z4, and a nonlinear (sigmoid) strain parameterization; the Jacobian that
 //! reuses a residual's forward pass is the same matrix.
@@ -62,6 +63,43 @@ fn check_geometric_jacobian<P: StrainParam>(model: &Model<P>, q: &DVector<f64>) 
         worst < 1e-7,
         "J vs central differences: worst relative error {worst:e}"
     );
+}
+
+/// `∂p/∂q` of the centreline between the points ([`Model::position_jacobian_at`]) against central
+/// differences of [`Model::position_at`]: at every point, half-way and a quarter of the way
+/// between neighbours (junctions of divisions included), the ends and beyond the tip.
+fn check_position_jacobian<P: StrainParam>(model: &Model<P>, q: &DVector<f64>) {
+    let n = model.n_dof();
+    let mut ws = model.workspace();
+    model.forward(q, &mut ws, true);
+    let (mut wp, mut wm) = (model.workspace(), model.workspace());
+    let pts = &model.disc.points;
+    let length = model.disc.length();
+    let mut xs: Vec<f64> = pts.iter().map(|p| p.x).collect();
+    for w in pts.windows(2) {
+        xs.push(0.5 * (w[0].x + w[1].x));
+        xs.push(0.75 * w[0].x + 0.25 * w[1].x);
+    }
+    xs.extend([0.0, length, 1.1 * length]);
+    let h = 1e-6;
+    let mut worst: f64 = 0.0;
+    for &x in &xs {
+        let (p, an) = model.position_jacobian_at(&ws, x);
+        assert!((p - model.position_at(&ws, x)).norm() == 0.0, "X = {x}");
+        for j in 0..n {
+            let mut qp = q.clone();
+            qp[j] += h;
+            let mut qm = q.clone();
+            qm[j] -= h;
+            model.forward(&qp, &mut wp, false);
+            model.forward(&qm, &mut wm, false);
+            let fd = (model.position_at(&wp, x) - model.position_at(&wm, x)) / (2.0 * h);
+            for a in 0..3 {
+                worst = worst.max((fd[a] - an[(a, j)]).abs() / (1.0 + an[(a, j)].abs()));
+            }
+        }
+    }
+    assert!(worst < 1e-7, "centreline position Jacobian: worst relative error {worst:.3e}");
 }
 
 fn check_statics_jacobian<P: StrainParam>(
@@ -196,6 +234,7 @@ fn geometric_jacobian_matches_finite_differences_z4_and_z2() {
         ));
         let q = pseudo_random(m.n_dof(), 1, 0.6);
         check_geometric_jacobian(&m, &q);
+        check_position_jacobian(&m, &q);
     }
 }
 
@@ -262,6 +301,7 @@ fn statics_jacobian_matches_finite_differences_two_divisions_half_tendon() {
     let m = Model::new(rod, disc, basis, tendons).unwrap();
     let q = pseudo_random(m.n_dof(), 3, 0.4);
     check_geometric_jacobian(&m, &q);
+    check_position_jacobian(&m, &q);
     let loads = Loads {
         gravity: [0.0, 3.0, -9.81],
         point: vec![PointWrench {
@@ -293,6 +333,7 @@ fn statics_jacobian_matches_finite_differences_for_nonlinear_sigmoid_basis() {
     let m = Model::new(rod, disc, p, tendons).unwrap();
     let q = DVector::from_vec(vec![1.1, 8.0, 0.45]);
     check_geometric_jacobian(&m, &q);
+    check_position_jacobian(&m, &q);
     let loads = Loads {
         gravity: [0.0, 0.0, -9.81],
         point: vec![PointWrench {
