@@ -99,7 +99,10 @@ fn check_position_jacobian<P: StrainParam>(model: &Model<P>, q: &DVector<f64>) {
             }
         }
     }
-    assert!(worst < 1e-7, "centreline position Jacobian: worst relative error {worst:.3e}");
+    assert!(
+        worst < 1e-7,
+        "centreline position Jacobian: worst relative error {worst:.3e}"
+    );
 }
 
 fn check_statics_jacobian<P: StrainParam>(

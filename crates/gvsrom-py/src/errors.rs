@@ -96,10 +96,11 @@ pub fn statics_with_message(py: Python<'_>, f: &StaticsFailure, message: &str) -
 
 /// Flags of the command line whose Python keyword argument has another spelling than the flag's
 /// with `-` → `_`.
-const RENAMED: [(&str, &str); 3] = [
+const RENAMED: [(&str, &str); 4] = [
     ("lambda", "lambda_"),
     ("tension", "u"),
     ("sample-time", "dt"),
+    ("output-at", "outputs"),
 ];
 
 /// Flags of the command line that are switches, spelled `name=True` in Python.

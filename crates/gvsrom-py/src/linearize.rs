@@ -14,8 +14,8 @@ use pyo3::types::PyDict;
 impl Robot {
     /// The equations of motion linearized for control design, as ``gvsrom linearize`` computes
     /// them (the same numbers as its ``--json``): ``δẋ = A δx + B δu`` and ``δy = C δx`` with the
-    /// state ``x = [q; q̇]``, the tendon tensions ``u`` [N] and the tip position ``y`` (world axes,
-    /// m). ``A`` keeps every term of the dynamics (gvs-spec §9.3), the inertial ones that vanish at
+    /// state ``x = [q; q̇]``, the tendon tensions ``u`` [N] and the output ``y``, the tip position
+    /// or the positions at ``outputs`` (world axes, m). ``A`` keeps every term of the dynamics (gvs-spec §9.3), the inertial ones that vanish at
     /// rest included. With a reduced model attached, its ``2r``-state linearization.
     ///
     /// Parameters
@@ -28,6 +28,10 @@ impl Robot {
     ///     shape (n_dof,).
     /// qd : array_like of float, optional
     ///     The state's velocities (with ``q`` only); default zero.
+    /// outputs : array_like of float, optional
+    ///     Abscissae [m] along the rod whose world positions make ``y`` (``--output-at``), 3 rows
+    ///     of ``C`` each in this order, between the computational points by the centreline's
+    ///     interpolant; default: the tip.
     /// dt : float, optional
     ///     Also discretize with a zero-order hold of ``dt`` seconds (``--sample-time``):
     ///     ``Ad`` = e^(A dt), ``Bd`` = ∫₀^dt e^(A s) ds B, ``spectral_radius`` max |e^(λ dt)|.
@@ -35,11 +39,12 @@ impl Robot {
     /// Returns
     /// -------
     /// dict
-    ///     ``A`` (2n, 2n), ``B`` (2n, n_actuators), ``C`` (3, 2n), ``x0`` (2n,) the operating
+    ///     ``A`` (2n, 2n), ``B`` (2n, n_actuators), ``C`` (3k, 2n) for k outputs, ``outputs``
+    ///     (k,) their abscissae, ``output_positions`` (k, 3), ``x0`` (2n,) the operating
     ///     point, ``u`` (n_actuators,), ``xdot`` (2n,) ``f(x0, u)`` (≈ 0 about an equilibrium),
     ///     ``tip_position`` (3,), ``poles`` (complex, the eigenvalues of A with ``Im ≥ 0``,
     ///     conjugates once, slowest first), ``natural_frequency_hz`` and ``damping_ratio`` per pole,
-    ///     ``unstable_poles`` (count, conjugates counted), ``static_gain`` (3, n_actuators) [m/N]
+    ///     ``unstable_poles`` (count, conjugates counted), ``static_gain`` (3k, n_actuators) [m/N]
     ///     ``−C A⁻¹ B`` about an equilibrium (``None`` about a given state), ``about``
     ///     (``"equilibrium"`` or ``"state"``), ``damping_time_s``, ``relaxation_poles``,
     ///     ``equilibrium_residual_norm`` (about an equilibrium), ``time_s`` (the linearization's
@@ -51,7 +56,7 @@ impl Robot {
     /// GvsromError
     ///     For bad tensions or states, ``qd`` without ``q``, a massless rod, or an equilibrium
     ///     that fails (``ConvergenceError``).
-    #[pyo3(signature = (u=None, q=None, qd=None, dt=None))]
+    #[pyo3(signature = (u=None, q=None, qd=None, dt=None, outputs=None))]
     fn linearize<'py>(
         &self,
         py: Python<'py>,
@@ -59,10 +64,16 @@ impl Robot {
         q: Option<arrays::In1<'_>>,
         qd: Option<arrays::In1<'_>>,
         dt: Option<f64>,
+        outputs: Option<arrays::In1<'_>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         if let Some(h) = dt {
             linearize::check_sample_time(h).map_err(|e| invalid(e.to_string()))?;
         }
+        let outputs = match &outputs {
+            None => linearize::Outputs::tip(&self.built),
+            Some(xs) => linearize::Outputs::at(&self.built, &arrays::vec1(xs))
+                .map_err(|e| invalid(e.to_string()))?,
+        };
         let to_py = |e: LinearizeError| {
             let message = errors::chain(&e);
             match &e {
@@ -79,14 +90,14 @@ impl Robot {
             (None, None) => {
                 let rebuilt = self.built_at(py, u.as_ref())?;
                 let built = rebuilt.as_ref().unwrap_or(&self.built);
-                py.detach(|| linearize::about_equilibrium(built))
+                py.detach(|| linearize::about_equilibrium(built, &outputs))
                     .map_err(to_py)?
                     .1
             }
             (Some(q), qd) => {
                 let (q, qd) = state(self, q, qd.as_ref())?;
                 let u = self.quantity_tensions(py, u)?;
-                py.detach(|| linearize::about_state(&self.built, &q, &qd, &u))
+                py.detach(|| linearize::about_state(&self.built, &q, &qd, &u, &outputs))
                     .map_err(to_py)?
             }
         };
@@ -110,6 +121,10 @@ fn report_dict<'py>(py: Python<'py>, r: &Linearization) -> PyResult<Bound<'py, P
     d.set_item("u", vector(py, &r.u))?;
     d.set_item("xdot", vector(py, &r.xdot))?;
     d.set_item("tip_position", vector(py, &r.tip_position))?;
+    d.set_item("outputs", vector(py, &r.outputs))?;
+    let positions =
+        nalgebra::DMatrix::from_fn(r.output_positions.len(), 3, |i, j| r.output_positions[i][j]);
+    d.set_item("output_positions", matrix(py, &positions)?)?;
     let poles: Vec<Complex64> = r.poles.iter().map(|p| Complex64::new(p.re, p.im)).collect();
     d.set_item("poles", PyArray::from_vec(py, poles))?;
     let col = |f: &dyn Fn(&linearize::Pole) -> f64| -> Vec<f64> { r.poles.iter().map(f).collect() };

@@ -79,6 +79,39 @@ def test_a_and_b_about_a_moving_state_are_the_derivatives_of_the_accelerations()
     np.testing.assert_array_equal(lin["C"][:, len(q):], 0.0)
 
 
+def test_output_points_stack_their_position_jacobians_in_c():
+    robot = gvsrom.Scenario.preset("single-tendon").build()
+    q = robot.statics(u=[-3.0]).q
+    fwd = robot.forward(q)
+    i = 40  # a computational point inside the rod
+    x = float(fwd["x"][i])
+    lin = robot.linearize(u=[-3.0], q=q, outputs=[x, 0.1, 0.25])
+    n = len(q)
+    assert lin["C"].shape == (9, 2 * n)
+    np.testing.assert_array_equal(lin["outputs"], [x, 0.1, 0.25])
+    np.testing.assert_allclose(lin["output_positions"][0], fwd["position"][i], rtol=0, atol=1e-15)
+    J = robot.jacobian(q, i)
+    np.testing.assert_allclose(lin["C"][:3, :n], fwd["rotation"][i] @ J[3:], rtol=0,
+                               atol=1e-12 * np.abs(J).max())
+    # the tip's block is the default output
+    tip = robot.linearize(u=[-3.0], q=q)
+    np.testing.assert_array_equal(lin["C"][6:], tip["C"])
+    # between points: central differences of the state's position there, read as an output
+    # position of states q ± h e_j
+    h = 1e-6
+    for j in [0, 5, 17]:
+        e = np.zeros(n)
+        e[j] = h
+        at = [robot.linearize(u=[-3.0], q=q + s * e, outputs=[0.1])["output_positions"][0]
+              for s in (1, -1)]
+        np.testing.assert_allclose(lin["C"][3:6, j], (at[0] - at[1]) / (2 * h), rtol=0,
+                                   atol=1e-6 * np.abs(lin["C"][3:6]).max())
+    with pytest.raises(gvsrom.GvsromError, match=r"outputs `0.3`.*within \[0, 0.25\] m"):
+        robot.linearize(outputs=[0.1, 0.3])
+    with pytest.raises(gvsrom.GvsromError, match="outputs: no abscissa given"):
+        robot.linearize(outputs=[])
+
+
 def test_static_gain_is_the_equilibriums_derivative_in_the_tensions():
     robot = gvsrom.Scenario.preset("six-tendon").build()
     u = np.array([-3.0, 0, 0, -1.0, 0, 0])

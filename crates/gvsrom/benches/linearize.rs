@@ -17,7 +17,9 @@ use std::hint::black_box;
 fn bench_preset(c: &mut Criterion, label: &str, preset: &str) {
     let scenario = gvsrom::presets::load(preset, &[]).expect("preset");
     let built = gvsrom::build(&scenario).expect("build");
-    let (_, lin) = gvsrom::linearize::about_equilibrium(&built).expect("linearizes");
+    let (_, lin) =
+        gvsrom::linearize::about_equilibrium(&built, &gvsrom::linearize::Outputs::tip(&built))
+            .expect("linearizes");
     let model = &built.model;
     let n = model.n_dof();
     let q = DVector::from_column_slice(&lin.q);
@@ -40,7 +42,14 @@ fn bench_preset(c: &mut Criterion, label: &str, preset: &str) {
     });
     c.bench_function(
         &format!("linearize/{label} report about the equilibrium"),
-        |b| b.iter(|| black_box(gvsrom::linearize::about_equilibrium(&built))),
+        |b| {
+            b.iter(|| {
+                black_box(gvsrom::linearize::about_equilibrium(
+                    &built,
+                    &gvsrom::linearize::Outputs::tip(&built),
+                ))
+            })
+        },
     );
     let a = lin.a_matrix();
     c.bench_function(&format!("linearize/{label} poles alone"), |b| {

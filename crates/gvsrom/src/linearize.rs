@@ -1,5 +1,6 @@
 //! A scenario's equations of motion linearized for control: `δẋ = A δx + B δu`, `δy = C δx` with the
-//! state `x = [q; q̇]`, the tendon tensions `u` and the tip position `y` in world axes, about the
+//! state `x = [q; q̇]`, the tendon tensions `u` and the output `y`, the positions of the tip (by
+//! default) or of points along the rod in world axes ([`Outputs`]), about the
 //! static equilibrium under the scenario's tensions (as `gvsrom statics` solves it) or about any
 //! state. With a reduced model attached, its `2r`-state linearization: the same engine on the
 //! decoder's coordinates.
@@ -8,12 +9,14 @@
 //!   terms that vanish at rest included in motion; about an equilibrium
 //!   [`Model::linearize_equilibrium`] (`q̈ = 0` held: analytic throughout).
 //! * `C = [R_tip J_tip,v  0]` (3 × 2n): the tip's world velocity per unit `q̇` (rows 4–6 of the tip
-//!   Jacobian, body frame, rotated to the world).
+//!   Jacobian, body frame, rotated to the world); with several output points, their 3 rows each,
+//!   `∂p(X)/∂q` of the centreline between the computational points
+//!   ([`Model::position_jacobian_at`]; `R_i J_v,i` at a point).
 //! * Poles: the eigenvalues of `A`, each with its natural frequency `|λ|/2π` and damping ratio
 //!   `ζ = −Re λ / |λ|`; conjugate pairs listed once (`Im λ ≥ 0`), slowest (`|λ|` smallest) first.
-//! * Static gain (about an equilibrium): `G = −C A⁻¹ B` (3 × n_actuators), the tip displacement per
-//!   newton of each tendon once the motion has settled; it equals the derivative of the
-//!   equilibrium's tip position in the tensions.
+//! * Static gain (about an equilibrium): `G = −C A⁻¹ B` (3 × n_actuators per output point), the
+//!   displacement per newton of each tendon once the motion has settled; it equals the derivative
+//!   of the equilibrium's output positions in the tensions.
 
 use crate::build::Built;
 use crate::error::{ScenarioError, StaticsFailure};
@@ -44,6 +47,10 @@ pub enum LinearizeError {
         why: String,
         most: Option<f64>,
     },
+    #[error("--output-at `{}`: expected abscissae along the rod, each finite and within [0, {}] m (the rod's length; the tip is {})", fmt_value(*value), fmt_value(*length), fmt_value(*length))]
+    OutputAt { value: f64, length: f64 },
+    #[error("--output-at: no abscissa given; expected at least one (the tip is {} m)", fmt_value(*length))]
+    NoOutput { length: f64 },
     #[error("--count `{value}`: expected an integer ≥ 1 (the number of slowest poles to print; the linearization has {n_poles} states, so at most {n_poles} poles)")]
     Count { value: String, n_poles: usize },
     #[error("the equilibrium: {0}")]
@@ -116,11 +123,15 @@ pub struct Linearization {
     pub xdot: Vec<f64>,
     /// Tip position at `q` (world) \[m\].
     pub tip_position: [f64; 3],
+    /// The abscissae \[m\] of the output points, in the order of `C`'s row triples.
+    pub outputs: Vec<f64>,
+    /// Their positions at `q` (world) \[m\].
+    pub output_positions: Vec<[f64; 3]>,
     /// `A` (2n × 2n), rows.
     pub a: Vec<Vec<f64>>,
     /// `B` (2n × n_actuators), rows.
     pub b: Vec<Vec<f64>>,
-    /// `C` (3 × 2n), rows: the tip position's output matrix.
+    /// `C` (3k × 2n for k output points), rows: the output positions' matrix.
     pub c: Vec<Vec<f64>>,
     /// Every pole (`n` with `Im λ ≥ 0` for an underdamped model; real poles each listed), by `|λ|`.
     pub poles: Vec<Pole>,
@@ -135,7 +146,7 @@ pub struct Linearization {
     /// operating point is unstable. An undamped model's poles lie on the imaginary axis, up to
     /// rounding (`|Re λ| ~ 1e-12 |λ|`), and count as stable.
     pub unstable_poles: usize,
-    /// Static gain `−C A⁻¹ B` (3 × n_actuators) \[m/N\] about an equilibrium; `None` about a state,
+    /// Static gain `−C A⁻¹ B` (3k × n_actuators) \[m/N\] about an equilibrium; `None` about a state,
     /// or if `A` is singular.
     pub static_gain: Option<Vec<Vec<f64>>>,
     /// Wall time of the linearization \[s\] (`A`, `B`, `C` and the poles; not the equilibrium).
@@ -164,7 +175,7 @@ impl Linearization {
         from_rows(&self.c)
     }
 
-    /// The static gain (3 × n_actuators) as a matrix, if there is one.
+    /// The static gain (3k × n_actuators) as a matrix, if there is one.
     pub fn static_gain_matrix(&self) -> Option<DMatrix<f64>> {
         self.static_gain.as_deref().map(from_rows)
     }
@@ -255,17 +266,52 @@ pub struct LinearizationJson<'a> {
     pub provenance: Option<&'a crate::provenance::Provenance>,
 }
 
+/// Where the output `y` is read: the positions of points along the rod, by abscissa.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Outputs(Vec<f64>);
+
+impl Outputs {
+    /// The tip's position alone (the default).
+    pub fn tip(built: &Built) -> Self {
+        Outputs(vec![built.model.disc.length()])
+    }
+
+    /// The positions at the abscissae `xs` \[m\] (world axes, 3 rows of `C` each, in this order),
+    /// each finite and within `[0, L]`; at least one.
+    pub fn at(built: &Built, xs: &[f64]) -> Result<Self, LinearizeError> {
+        let length = built.model.disc.length();
+        if xs.is_empty() {
+            return Err(LinearizeError::NoOutput { length });
+        }
+        match xs
+            .iter()
+            .find(|x| !(x.is_finite() && (0.0..=length).contains(*x)))
+        {
+            Some(&value) => Err(LinearizeError::OutputAt { value, length }),
+            None => Ok(Outputs(xs.to_vec())),
+        }
+    }
+
+    /// The abscissae.
+    pub fn abscissae(&self) -> &[f64] {
+        &self.0
+    }
+}
+
 /// Solves the equilibrium of `built` (as `gvsrom statics` does, with the reduced model if one is
 /// attached) and linearizes about it, at rest.
-pub fn about_equilibrium(built: &Built) -> Result<(StaticsReport, Linearization), LinearizeError> {
+pub fn about_equilibrium(
+    built: &Built,
+    outputs: &Outputs,
+) -> Result<(StaticsReport, Linearization), LinearizeError> {
     crate::simulate::require_mass(built)?;
     let eq = statics::solve(built)?;
     statics::check_reduced(built, &eq)?;
     let q = DVector::from_column_slice(&eq.q);
     let qd = DVector::zeros(q.len());
     let mut lin = match &built.reduced {
-        Some(r) => on_model(built, &r.model, &q, &qd, &built.u, true)?,
-        None => on_model(built, &built.model, &q, &qd, &built.u, true)?,
+        Some(r) => on_model(built, &r.model, &q, &qd, &built.u, outputs, true)?,
+        None => on_model(built, &built.model, &q, &qd, &built.u, outputs, true)?,
     };
     lin.about = "equilibrium";
     lin.equilibrium_residual_norm = Some(eq.residual_norm);
@@ -280,11 +326,12 @@ pub fn about_state(
     q: &DVector<f64>,
     qd: &DVector<f64>,
     u: &[f64],
+    outputs: &Outputs,
 ) -> Result<Linearization, LinearizeError> {
     crate::simulate::require_mass(built)?;
     match &built.reduced {
-        Some(r) => on_model(built, &r.model, q, qd, u, false),
-        None => on_model(built, &built.model, q, qd, u, false),
+        Some(r) => on_model(built, &r.model, q, qd, u, outputs, false),
+        None => on_model(built, &built.model, q, qd, u, outputs, false),
     }
 }
 
@@ -294,6 +341,7 @@ fn on_model<P: StrainParam>(
     q: &DVector<f64>,
     qd: &DVector<f64>,
     u: &[f64],
+    outputs: &Outputs,
     equilibrium: bool,
 ) -> Result<Linearization, LinearizeError> {
     let start = std::time::Instant::now();
@@ -309,12 +357,15 @@ fn on_model<P: StrainParam>(
     let poles = poles(&a);
 
     model.forward(q, &mut ws, true);
-    let tip = model.disc.tip();
-    let rot = ws.g[tip].rot;
-    let pos = ws.g[tip].pos;
-    let jv = rot * ws.jac.columns(tip * n, n).fixed_rows::<3>(3);
-    let mut c = DMatrix::zeros(3, 2 * n);
-    c.view_mut((0, 0), (3, n)).copy_from(&jv);
+    let pos = ws.g[model.disc.tip()].pos;
+    let xs = outputs.abscissae();
+    let mut c = DMatrix::zeros(3 * xs.len(), 2 * n);
+    let mut output_positions = Vec::with_capacity(xs.len());
+    for (k, &x) in xs.iter().enumerate() {
+        let (p, dp) = model.position_jacobian_at(&ws, x);
+        c.view_mut((3 * k, 0), (3, n)).copy_from(&dp);
+        output_positions.push([p[0], p[1], p[2]]);
+    }
 
     Ok(Linearization {
         scenario: built.name.clone(),
@@ -326,6 +377,8 @@ fn on_model<P: StrainParam>(
         qd: qd.iter().copied().collect(),
         xdot: xdot.iter().copied().collect(),
         tip_position: [pos[0], pos[1], pos[2]],
+        outputs: xs.to_vec(),
+        output_positions,
         relaxation_poles: relaxation_poles(&poles, t_d),
         unstable_poles: poles
             .iter()

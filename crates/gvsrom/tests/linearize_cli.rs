@@ -143,6 +143,87 @@ fn static_gain_of_a_straight_tendon_is_the_uniform_moments_closed_form() {
     assert!(stdout.contains("  tendon 1"), "{stdout}");
 }
 
+#[test]
+fn output_points_along_the_rod_have_the_uniform_moments_closed_form_gain() {
+    // Along the rod the same uniform moment moves the section at X by δz = −d X²/(2EI) u and
+    // δx = X/(EA) u; X between the computational points (21 Gauss points), at one and at the tip
+    let path = rod_file("lin-outputs", 1e3);
+    let xs = [0.1234, 0.25, 0.5];
+    let (stdout, lin) = run_json(
+        "linearize",
+        "lin-outputs",
+        &[s(&path), "--output-at", "0.1234,0.25,0.5"],
+    );
+    assert_eq!(f64s(&lin["outputs"]), xs.to_vec());
+    let g = matrix(&lin["static_gain"]);
+    let c = matrix(&lin["c"]);
+    assert_eq!((g.len(), c.len()), (9, 9));
+    let (area, inertia) = (PI * R * R, PI * R.powi(4) / 4.0);
+    for (k, x) in xs.iter().enumerate() {
+        let gz = -D * x * x / (2.0 * E * inertia);
+        let gx = x / (E * area);
+        assert!(
+            rel(g[3 * k + 2][0], gz) < 1e-9,
+            "X = {x}: δz/δu = {} vs {gz}",
+            g[3 * k + 2][0]
+        );
+        assert!(
+            rel(g[3 * k][0], gx) < 1e-9,
+            "X = {x}: δx/δu = {} vs {gx}",
+            g[3 * k][0]
+        );
+        assert!(g[3 * k + 1][0].abs() < 1e-12 * gz.abs());
+        assert!(
+            stdout.contains(&format!("gain       settled X = {x} m displacement")),
+            "{stdout}"
+        );
+    }
+    // the tip's rows are the default output's
+    let (_, tip) = run_json("linearize", "lin-outputs-tip", &[s(&path)]);
+    assert_eq!(matrix(&tip["c"]), c[6..].to_vec());
+    assert_eq!(f64s(&tip["outputs"]), vec![L]);
+    for bad in ["--output-at=-0.1", "--output-at=0.6", "--output-at=nan"] {
+        expect_error(
+            &["linearize", s(&path), bad],
+            &["--output-at `", "within [0, 0.5] m"],
+        );
+    }
+}
+
+#[test]
+fn output_point_gain_under_gravity_and_friction_is_the_equilibriums_derivative() {
+    // IV-A bent by gravity and friction, X = L/2 (between points): −C A⁻¹ B against central
+    // differences of the centreline sample at L/2 of `gvsrom statics --json` (21 samples)
+    let (_, lin) = run_json(
+        "linearize",
+        "lin-iva-mid",
+        &["single-tendon", "--output-at", "0.125"],
+    );
+    let g = matrix(&lin["static_gain"]);
+    let mid = |t: f64, tag: &str| {
+        let tension = format!("--tension={t}");
+        let (_, json) = run_json(
+            "statics",
+            &format!("lin-iva-mid-{tag}"),
+            &["single-tendon", &tension],
+        );
+        assert_eq!(json["centerline_x"][10].as_f64(), Some(0.125));
+        f64s(&json["centerline"][10])
+    };
+    let (p, m) = (mid(-2.99, "plus"), mid(-3.01, "minus"));
+    let fd: Vec<f64> = (0..3).map(|i| (p[i] - m[i]) / 0.02).collect();
+    let norm = fd.iter().map(|v| v * v).sum::<f64>().sqrt();
+    assert!(norm > 0.0);
+    for i in 0..3 {
+        assert!(
+            (g[i][0] - fd[i]).abs() < 1e-5 * norm,
+            "axis {i}: gain {} vs statics {}",
+            g[i][0],
+            fd[i]
+        );
+    }
+}
+
 /// `δy/δu` by central differences of `gvsrom statics --json` tip positions at `u ± h`.
 fn statics_gain(scenario: &[&str], u: f64, h: f64, name: &str) -> [f64; 3] {
     let tip = |t: f64, tag: &str| {

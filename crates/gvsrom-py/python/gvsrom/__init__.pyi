@@ -361,6 +361,7 @@ class Robot:
         q: ArrayLike | None = None,
         qd: ArrayLike | None = None,
         dt: float | None = None,
+        outputs: ArrayLike | None = None,
     ) -> dict[str, Any]: ...
     def simulate(
         self,

@@ -12,6 +12,17 @@ pub struct LinearizeArgs {
     #[arg(long, value_name = "K", allow_hyphen_values = true)]
     pub count: Option<String>,
 
+    /// The output `y`: the world positions of the points at these abscissae [m] along the rod,
+    /// 3 rows of `C` each, e.g. `--output-at 0.3,0.6` (between the computational points, the
+    /// centreline's interpolant); default: the tip.
+    #[arg(
+        long,
+        value_name = "X[,X...]",
+        allow_hyphen_values = true,
+        value_delimiter = ','
+    )]
+    pub output_at: Option<Vec<f64>>,
+
     /// Also discretize with a zero-order hold of H seconds (tensions held over each sample):
     /// `δx_{k+1} = A_d δx_k + B_d δu_k`, written to the JSON as `discrete`.
     #[arg(long, value_name = "H", allow_hyphen_values = true)]
@@ -47,8 +58,12 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
     if let Some(h) = args.sample_time {
         linearize::check_sample_time(h)?;
     }
+    let outputs = match &args.output_at {
+        Some(xs) => linearize::Outputs::at(built, xs)?,
+        None => linearize::Outputs::tip(built),
+    };
     print_model(scenario, &args.scenario, built, None, out)?;
-    let (eq, mut lin) = linearize::about_equilibrium(built)?;
+    let (eq, mut lin) = linearize::about_equilibrium(built, &outputs)?;
     if let Some(h) = args.sample_time {
         lin.discretize(h)?;
     }
@@ -64,15 +79,34 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
         "tip        position {} m",
         fmt_vec(&eq.tip_position, 6)
     )?;
+    let y = match args.output_at {
+        None => "the tip position".to_string(),
+        Some(_) => format!(
+            "the positions at X = {} m",
+            (lin.outputs.iter().map(|x| gvs::error::fmt_value(*x)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    };
     writeln!(
         out,
-        "system     δẋ = A δx + B δu, δy = C δx: x = [q; q̇] ({n_states} states), u {}, y the tip position (world) [m]; linearized in {:.2} ms",
+        "system     δẋ = A δx + B δu, δy = C δx: x = [q; q̇] ({n_states} states), u {}, y {y} (world) [m]; linearized in {:.2} ms",
         match lin.n_actuators {
             0 => "empty (no tendons: B has no columns)".to_string(),
             k => format!("the {} [N]", plural(k, "tendon tension")),
         },
         lin.time_s * 1e3
     )?;
+    if args.output_at.is_some() {
+        for (x, p) in lin.outputs.iter().zip(&lin.output_positions) {
+            writeln!(
+                out,
+                "output     X = {} m at {} m",
+                gvs::error::fmt_value(*x),
+                fmt_vec(p, 6)
+            )?;
+        }
+    }
     let shown = count.min(lin.poles.len());
     writeln!(
         out,
@@ -116,13 +150,20 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
     match &lin.static_gain {
         _ if lin.n_actuators == 0 => {}
         Some(g) => {
-            writeln!(
-                out,
-                "gain       settled tip displacement per newton of tension, −C A⁻¹ B (world x, y, z) [mm/N]"
-            )?;
-            for k in 0..lin.n_actuators {
-                let col: Vec<f64> = g.iter().map(|row| row[k] * 1e3).collect();
-                writeln!(out, "  tendon {:<3} {}", k + 1, fmt_vec(&col, 4))?;
+            for (o, x) in lin.outputs.iter().enumerate() {
+                let at = match args.output_at {
+                    None => "tip".to_string(),
+                    Some(_) => format!("X = {} m", gvs::error::fmt_value(*x)),
+                };
+                writeln!(
+                    out,
+                    "gain       settled {at} displacement per newton of tension, −C A⁻¹ B (world x, y, z) [mm/N]"
+                )?;
+                for k in 0..lin.n_actuators {
+                    let col: Vec<f64> =
+                        g[3 * o..3 * o + 3].iter().map(|row| row[k] * 1e3).collect();
+                    writeln!(out, "  tendon {:<3} {}", k + 1, fmt_vec(&col, 4))?;
+                }
             }
         }
         None => {
