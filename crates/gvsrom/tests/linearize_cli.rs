@@ -200,18 +200,40 @@ fn output_point_gain_under_gravity_and_friction_is_the_equilibriums_derivative()
         &["single-tendon", "--output-at", "0.125"],
     );
     let g = matrix(&lin["static_gain"]);
-    let mid = |t: f64, tag: &str| {
-        let tension = format!("--tension={t}");
-        let (_, json) = run_json(
-            "statics",
-            &format!("lin-iva-mid-{tag}"),
-            &["single-tendon", &tension],
-        );
+    let fd = statics_gain(&["single-tendon"], -3.0, 0.01, "lin-iva-mid", |json| {
         assert_eq!(json["centerline_x"][10].as_f64(), Some(0.125));
         f64s(&json["centerline"][10])
+    });
+    assert_gain_is(&g, fd);
+}
+
+/// `δy/δu` by central differences of the position that `read` takes from `gvsrom statics --json`
+/// at `u ± h`.
+fn statics_gain(
+    scenario: &[&str],
+    u: f64,
+    h: f64,
+    name: &str,
+    read: impl Fn(&serde_json::Value) -> Vec<f64>,
+) -> [f64; 3] {
+    let at = |t: f64, tag: &str| {
+        let mut args = scenario.to_vec();
+        let tension = format!("--tension={t}");
+        args.push(&tension);
+        let (_, json) = run_json("statics", &format!("{name}-{tag}"), &args);
+        read(&json)
     };
-    let (p, m) = (mid(-2.99, "plus"), mid(-3.01, "minus"));
-    let fd: Vec<f64> = (0..3).map(|i| (p[i] - m[i]) / 0.02).collect();
+    let (p, m) = (at(u + h, "plus"), at(u - h, "minus"));
+    [0, 1, 2].map(|i| (p[i] - m[i]) / (2.0 * h))
+}
+
+fn tip(json: &serde_json::Value) -> Vec<f64> {
+    f64s(&json["tip_position"])
+}
+
+/// The first column of the gain rows `g` equals the differences `fd` within 1e-5 of their norm
+/// (the differences' error O(h²) ≈ 1e-6).
+fn assert_gain_is(g: &[Vec<f64>], fd: [f64; 3]) {
     let norm = fd.iter().map(|v| v * v).sum::<f64>().sqrt();
     assert!(norm > 0.0);
     for i in 0..3 {
@@ -224,19 +246,6 @@ fn output_point_gain_under_gravity_and_friction_is_the_equilibriums_derivative()
     }
 }
 
-/// `δy/δu` by central differences of `gvsrom statics --json` tip positions at `u ± h`.
-fn statics_gain(scenario: &[&str], u: f64, h: f64, name: &str) -> [f64; 3] {
-    let tip = |t: f64, tag: &str| {
-        let mut args = scenario.to_vec();
-        let tension = format!("--tension={t}");
-        args.push(&tension);
-        let (_, json) = run_json("statics", &format!("{name}-{tag}"), &args);
-        f64s(&json["tip_position"])
-    };
-    let (p, m) = (tip(u + h, "plus"), tip(u - h, "minus"));
-    [0, 1, 2].map(|i| (p[i] - m[i]) / (2.0 * h))
-}
-
 #[test]
 fn static_gain_under_gravity_and_friction_is_the_equilibriums_derivative() {
     // IV-A: gravity, a tapered arm bent to 5 % of its length, friction 0.88; the equilibrium's tip
@@ -245,16 +254,10 @@ fn static_gain_under_gravity_and_friction_is_the_equilibriums_derivative() {
     assert_eq!(lin["about"], "equilibrium");
     assert!(lin["equilibrium_residual_norm"].as_f64().unwrap() < 1e-8);
     let g = matrix(&lin["static_gain"]);
-    let fd = statics_gain(&["single-tendon"], -3.0, 0.01, "lin-iva-statics");
-    let norm = fd.iter().map(|v| v * v).sum::<f64>().sqrt();
-    for i in 0..3 {
-        assert!(
-            (g[i][0] - fd[i]).abs() < 1e-5 * norm,
-            "axis {i}: gain {} vs statics {}",
-            g[i][0],
-            fd[i]
-        );
-    }
+    assert_gain_is(
+        &g,
+        statics_gain(&["single-tendon"], -3.0, 0.01, "lin-iva-statics", tip),
+    );
     // at the solved equilibrium q̇ = 0, and the residual's q̈ moves the tip by a tiny acceleration
     let xdot = f64s(&lin["xdot"]);
     let c = matrix(&lin["c"]);
@@ -297,16 +300,9 @@ fn a_pod_models_linearization_has_2r_states_and_its_own_static_gain() {
         -3.0,
         0.01,
         "lin-rom-statics",
+        tip,
     );
-    let norm = fd.iter().map(|v| v * v).sum::<f64>().sqrt();
-    for i in 0..3 {
-        assert!(
-            (g[i][0] - fd[i]).abs() < 1e-5 * norm,
-            "axis {i}: {} vs {}",
-            g[i][0],
-            fd[i]
-        );
-    }
+    assert_gain_is(&g, fd);
 }
 
 #[test]
