@@ -94,8 +94,9 @@ impl<P: StrainParam> Model<P> {
     }
 
     /// The share of `∫ s dX` of load `d` that each point applies, into `shares` (the module doc):
-    /// `W_i s(X_i)`, or for a uniform load the length of `cells[i]` inside its span.
-    pub fn load_shares(&self, d: &DistributedWrench, cells: &[(f64, f64)], shares: &mut [f64]) {
+    /// `W_i s(X_i)`, or for a uniform load the length of `cells[i]` inside its span (`cells` of
+    /// this model's discretization, [`crate::discretize::Discretization::cells`]).
+    fn load_shares(&self, d: &DistributedWrench, cells: &[(f64, f64)], shares: &mut [f64]) {
         for ((share, p), &(a, b)) in shares.iter_mut().zip(&self.disc.points).zip(cells) {
             *share = match d {
                 _ if p.weight == 0.0 => 0.0,

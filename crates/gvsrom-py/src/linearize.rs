@@ -28,13 +28,13 @@ impl Robot {
     ///     shape (n_dof,).
     /// qd : array_like of float, optional
     ///     The state's velocities (with ``q`` only); default zero.
+    /// dt : float, optional
+    ///     Also discretize with a zero-order hold of ``dt`` seconds (``--sample-time``):
+    ///     ``Ad`` = e^(A dt), ``Bd`` = ∫₀^dt e^(A s) ds B, ``spectral_radius`` max |e^(λ dt)|.
     /// outputs : array_like of float, optional
     ///     Abscissae [m] along the rod whose world positions make ``y`` (``--output-at``), 3 rows
     ///     of ``C`` each in this order, between the computational points by the centreline's
     ///     interpolant; default: the tip.
-    /// dt : float, optional
-    ///     Also discretize with a zero-order hold of ``dt`` seconds (``--sample-time``):
-    ///     ``Ad`` = e^(A dt), ``Bd`` = ∫₀^dt e^(A s) ds B, ``spectral_radius`` max |e^(λ dt)|.
     ///
     /// Returns
     /// -------

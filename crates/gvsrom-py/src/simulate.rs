@@ -44,8 +44,8 @@ impl Robot {
     /// sample_rate : float
     ///     Output samples per second [Hz].
     /// input : array_like of float, shape (k, 1 + n_actuators), or callable, optional
-    ///     Rows ``t, u_1, …, u_na`` (times ascending from 0), held piecewise constant (or linear
-    ///     with ``interpolate``, where a time given twice is a step; held, each time once); or a callable ``u(t) -> array of n_actuators tensions`` (or one
+    ///     Rows ``t, u_1, …, u_na`` (times ascending from 0), held piecewise constant (each
+    ///     time once) or linear with ``interpolate`` (a time given twice is a step); or a callable ``u(t) -> array of n_actuators tensions`` (or one
     ///     number for all), called by the integrator at every time it evaluates (in any order: a
     ///     rejected step goes back in time); an exception it raises stops the run and propagates.
     ///     Its values are checked as rows are: finite, and within the rod's elastic range (a

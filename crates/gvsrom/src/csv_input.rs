@@ -187,9 +187,13 @@ pub fn read_csv_signal(
     };
     if let Some(k) = (1..s.times.len()).find(|&k| s.repeated_time(k).is_some()) {
         let why = s.repeated_time(k).unwrap_or_default();
+        let others = match s.times.get(k.wrapping_sub(2)) == Some(&s.times[k]) {
+            true => format!("lines {} and {} have it too", lines[k - 2], lines[k - 1]),
+            false => format!("line {} has it too", lines[k - 1]),
+        };
         return Err(ScenarioError::invalid(
             format!("{file}:{} column 1", lines[k]),
-            format!("{why} (line {} has it too)", lines[k - 1]),
+            format!("{why} ({others})"),
         ));
     }
     s.validate(&file, n_values).map_err(ScenarioError::from)?;
@@ -258,7 +262,9 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(
-            e.contains("thrice.csv:4 column 1") && e.contains("third knot"),
+            e.contains("thrice.csv:4 column 1")
+                && e.contains("third knot")
+                && e.contains("lines 2 and 3 have it too"),
             "{e}"
         );
     }

@@ -47,7 +47,7 @@ pub enum LinearizeError {
         why: String,
         most: Option<f64>,
     },
-    #[error("--output-at `{}`: expected abscissae along the rod, each finite and within [0, {}] m (the rod's length; the tip is {})", fmt_value(*value), fmt_value(*length), fmt_value(*length))]
+    #[error("--output-at `{}`: expected abscissae along the rod, each finite and within [0, {}] m (0 the base, {} m the tip)", fmt_value(*value), fmt_value(*length), fmt_value(*length))]
     OutputAt { value: f64, length: f64 },
     #[error("--output-at: no abscissa given; expected at least one (the tip is {} m)", fmt_value(*length))]
     NoOutput { length: f64 },

@@ -303,6 +303,23 @@ fn a_pod_models_linearization_has_2r_states_and_its_own_static_gain() {
         tip,
     );
     assert_gain_is(&g, fd);
+    // an output point of the reduced model: 3 rows of its 6 states, its gain the derivative of
+    // its own equilibria's centreline there
+    let (_, mid) = run_json(
+        "linearize",
+        "lin-rom-mid",
+        &["single-tendon", "--model", s(&pod), "--output-at", "0.125"],
+    );
+    let c = matrix(&mid["c"]);
+    assert_eq!((c.len(), c[0].len()), (3, 6));
+    let fd = statics_gain(
+        &["single-tendon", "--model", s(&pod)],
+        -3.0,
+        0.01,
+        "lin-rom-mid-statics",
+        |json| f64s(&json["centerline"][10]),
+    );
+    assert_gain_is(&matrix(&mid["static_gain"]), fd);
 }
 
 #[test]

@@ -856,4 +856,27 @@ fn a_linear_input_signal_is_checked_between_its_knots() {
     );
     // held, the signal only takes the two trained combinations
     run_ok(&args(false));
+    // a ramp past the trained -10 N that steps back at its end (a time given twice): the value
+    // before the step is the ramp's end, which `u(t)` at the step's time does not give
+    let step = scratch("val-ramp-step.csv");
+    std::fs::write(
+        &step,
+        "t,u0,u1,u2,u3,u4,u5\n0,0,0,0,0,0,0\n0.1,-10.5,0,0,0,0,0\n0.1,0,0,0,0,0,0\n",
+    )
+    .unwrap();
+    let e = expect_error(
+        &[
+            "simulate",
+            "six-tendon-no-gravity",
+            "--model",
+            s(&m),
+            "--input",
+            s(&step),
+            "--interpolate",
+            "--duration",
+            "0.2",
+        ],
+        &["tendons.0.tension reaches -10.5 at t = 0.1 s, outside the training inputs"],
+    );
+    assert!(!e.contains("0.0999"), "{e}");
 }

@@ -116,7 +116,7 @@ impl Reduced {
                 // the first time of the largest distance
                 .reduce(|a, b| if b.0 > a.0 { b } else { a });
             if let Some((_, t, why)) = farthest {
-                outside.push(format!("at t = {t} s {why}"));
+                outside.push(format!("at t = {} s {why}", shown_time(t)));
             }
         }
         if outside.is_empty() {
@@ -247,11 +247,18 @@ pub fn signal_outside(
                 ),
             };
             out.push(format!(
-                "the input signal's tendons.{k}.tension reaches {v} at t = {t} s, {how}"
+                "the input signal's tendons.{k}.tension reaches {v} at t = {} s, {how}",
+                shown_time(*t)
             ));
         }
     }
     out
+}
+
+/// A time of an input check as printed: to the picosecond, since a left limit is checked at the
+/// float just below its knot (0.09999999999999999 for 0.1).
+fn shown_time(t: f64) -> f64 {
+    (t * 1e12).round() / 1e12
 }
 
 /// Whether the tensions `u` lie where the attach check passed the scenario's own tensions `u0`:

@@ -160,18 +160,26 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
                 .collect();
             times.sort_by(f64::total_cmp);
             // a linear signal between two knots passes combinations neither knot is: the joint
-            // check is not convex, so each segment is checked at interior points too
+            // check is not convex, so each segment is checked at interior points too, and just
+            // before each knot (a time given twice is a step: `eval` at it gives the value after,
+            // the integrator runs up to the value before)
             if signal.interpolation == gvs::inputs::Interpolation::Linear && times.len() > 1 {
                 let per = (MAX_SIGNAL_CHECKS / times.len()).clamp(1, SEGMENT_CHECKS);
                 let knots = times.clone();
                 for w in knots.windows(2) {
                     times.extend((1..per).map(|i| w[0] + (w[1] - w[0]) * i as f64 / per as f64));
                 }
+                times.extend(knots.iter().filter(|t| **t > 0.0).map(|t| t.next_down()));
                 times.sort_by(f64::total_cmp);
             }
             let mut u = vec![0.0; signal.channels()];
             r.check_signal(&times, |t| {
-                signal.eval(t, &mut u);
+                // just before a knot: the knot's own value, the left limit of a linear signal
+                let k = signal.times.partition_point(|&tk| tk < t.next_up());
+                match signal.times.get(k) {
+                    Some(&tk) if tk == t.next_up() => u.copy_from_slice(&signal.values[k]),
+                    _ => signal.eval(t, &mut u),
+                }
                 u.clone()
             })?
         }
