@@ -23,7 +23,7 @@ use crate::strain::StrainParam;
 /// bent the beam 49 rad instead of 20. Smaller errors are the quadrature's ordinary error on a
 /// profile with kinks or jumps, as in SoRoSim: the paper's pulse (width 0.08 m) is integrated within
 /// 0.82 % at every centre (mean 0.54 %, 801 centres), 0.04 m within 4.1 %, 0.02 m within 14 %. A
-/// uniform load's shares are exact ([`Model::load_shares`]): it always passes.
+/// uniform load's shares (the module documentation) are exact: it always passes.
 pub const DISTRIBUTED_QUADRATURE_TOLERANCE: f64 = 0.05;
 
 /// Loads resolved onto the computational points.
