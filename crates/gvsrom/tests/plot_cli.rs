@@ -1,5 +1,5 @@
 //! `gvsrom plot` end to end (issue 22): figures of a statics result, a trajectory (with and without
-//! per-sample centrelines), a dataset, a POD model and an autoencoder. Every SVG must be well-formed
+//! per-sample centrelines), a dataset, a POD model, an autoencoder and a linearization. Every SVG must be well-formed
 //! XML, every PNG must decode to a picture of several distinct colours, the rod animation must be a
 //! GIF of more than one frame; bad inputs are one-line errors naming the file.
 //!
@@ -193,6 +193,55 @@ fn statics_result_gives_rod_views_and_strain_profiles() {
         let svg = std::fs::read_to_string(dir.join(view)).unwrap();
         assert!(svg.contains("tendon 0"), "{view} lacks the tendon");
     }
+}
+
+#[test]
+fn linearization_gives_poles_and_a_static_gain_panel_per_output_point() {
+    let f = scratch("plot-lin.json");
+    run_ok(&[
+        "linearize",
+        "six-tendon",
+        "--tension=-5,0,0,0,0,0",
+        "--output-at",
+        "0.3,0.6",
+        "--json",
+        s(&f),
+    ]);
+    let (dir, stdout) = plot(&f, "plot-out-lin", &[]);
+    check_figures(&dir, &stdout, &refs(&both(&["poles", "static_gain"])));
+    assert!(stdout.contains("linearization"), "{stdout}");
+    let gain = std::fs::read_to_string(dir.join("static_gain.svg")).unwrap();
+    for text in ["X = 0.3 m", "X = 0.6 m", "[mm/N]", "world z"] {
+        assert!(gain.contains(text), "static_gain.svg lacks {text}");
+    }
+    assert!(!gain.contains("unstable"));
+    let poles = std::fs::read_to_string(dir.join("poles.svg")).unwrap();
+    assert!(poles.contains("damping ratio") && poles.contains("stable"));
+    assert!(
+        !poles.contains("unstable"),
+        "the arm's equilibrium is stable"
+    );
+    // the arm standing against gravity (soft enough to buckle): its unstable poles apart, its gain
+    // said to settle nowhere
+    let up = scratch("plot-lin-up.json");
+    run_ok(&[
+        "linearize",
+        "six-tendon-hanging",
+        "--set",
+        "loads.gravity=[0.0,0.0,9.81]",
+        "--set",
+        "material.youngs_modulus=1e5",
+        "--tension",
+        "0",
+        "--json",
+        s(&up),
+    ]);
+    assert!(json(&up)["unstable_poles"].as_u64().unwrap() > 0);
+    let (dir, _) = plot(&up, "plot-out-lin-up", &["--format", "svg"]);
+    let poles = std::fs::read_to_string(dir.join("poles.svg")).unwrap();
+    assert!(poles.contains("unstable (ζ &lt; 0)") || poles.contains("unstable (ζ < 0)"));
+    let gain = std::fs::read_to_string(dir.join("static_gain.svg")).unwrap();
+    assert!(gain.contains("an unstable equilibrium"));
 }
 
 #[test]

@@ -1,0 +1,216 @@
+//! Figures of a `gvsrom linearize --json` result: the poles (`poles`: each pole's natural
+//! frequency `|λ|/2π` on a log scale against its damping ratio `ζ = −Re λ/|λ|`, the unstable ones
+//! apart), and the static gain (`static_gain`: per output point, the settled displacement along
+//! world x, y and z per newton of each tendon, in mm/N, as markers: the tendons are categories).
+
+use super::{input_error, FiguresError, Sink};
+use crate::plot::{palette, Figure, LineChart, Series, SeriesStyle};
+use serde::Deserialize;
+use std::path::Path;
+
+/// One pole as `linearize --json` writes it.
+#[derive(Debug, Clone, Deserialize)]
+pub struct PoleDoc {
+    pub natural_frequency_hz: f64,
+    pub damping_ratio: f64,
+}
+
+/// The fields of a `linearize --json` document the figures use.
+#[derive(Debug, Clone, Deserialize)]
+pub struct LinearizationDoc {
+    pub scenario: String,
+    #[serde(default)]
+    pub u: Vec<f64>,
+    pub n_actuators: usize,
+    pub poles: Vec<PoleDoc>,
+    /// Poles with `Re λ > 0` (conjugates counted).
+    #[serde(default)]
+    pub unstable_poles: usize,
+    /// `−C A⁻¹ B`, 3 rows per output point (absent about a state, or for a singular `A`).
+    #[serde(default)]
+    pub static_gain: Option<Vec<Vec<f64>>>,
+    /// The output points' abscissae (a result written before they were recorded: the tip alone).
+    #[serde(default)]
+    pub outputs: Option<Vec<f64>>,
+    #[serde(default)]
+    pub model: Option<String>,
+    #[serde(skip)]
+    pub origin: Option<crate::provenance::DirOrigin>,
+}
+
+impl LinearizationDoc {
+    /// Reads and checks the document at `path`: poles to draw, a gain of 3 rows per output point
+    /// and one column per tendon.
+    pub fn load(path: &Path) -> Result<LinearizationDoc, FiguresError> {
+        let text = crate::output::read::read_regular_to_string(path)
+            .map_err(|e| input_error(path, format!("cannot read it: {e}")))?;
+        let mut doc: LinearizationDoc = serde_json::from_str(&text).map_err(|e| {
+            input_error(
+                path,
+                format!("not a `linearize --json` result the figures can read: {e}"),
+            )
+        })?;
+        if let Some(g) = &doc.static_gain {
+            let points = doc.outputs.as_ref().map_or(1, Vec::len);
+            if g.len() != 3 * points || g.iter().any(|row| row.len() != doc.n_actuators) {
+                return Err(input_error(
+                    path,
+                    format!(
+                        "static_gain has {} rows of {:?} values; expected {} rows (3 per output point) of {} (one per tendon)",
+                        g.len(),
+                        g.first().map(Vec::len),
+                        3 * points,
+                        doc.n_actuators
+                    ),
+                ));
+            }
+        }
+        doc.origin = Some(crate::provenance::DirOrigin::of_file(path, text.as_bytes()));
+        Ok(doc)
+    }
+
+    /// The figure titles' description: scenario, tensions and model.
+    fn caption(&self) -> String {
+        let mut s = self.scenario.clone();
+        if !self.u.is_empty() {
+            let u: Vec<String> = (self.u.iter())
+                .map(|v| format!("{}", (v * 1e3).round() / 1e3 + 0.0))
+                .collect();
+            s.push_str(&format!(", u = [{}] N", u.join(", ")));
+        }
+        if let Some(m) = &self.model {
+            let name = Path::new(m)
+                .file_name()
+                .map_or(m.clone(), |n| n.to_string_lossy().into_owned());
+            s.push_str(&format!(", model {name}"));
+        }
+        s
+    }
+}
+
+/// `poles` and, about an equilibrium with tendons, `static_gain` of the result at `path`.
+pub(crate) fn figures(path: &Path, sink: &mut Sink) -> Result<(), FiguresError> {
+    let doc = LinearizationDoc::load(path)?;
+    sink.origin = doc.origin.clone();
+    let caption = doc.caption();
+    poles(&doc, &caption, sink)?;
+    match &doc.static_gain {
+        _ if doc.n_actuators == 0 => sink.note("static_gain: the rod has no tendons"),
+        Some(g) => static_gain(&doc, g, &caption, sink)?,
+        None => {
+            sink.note("static_gain: none in the result (linearized about a state, or A singular)")
+        }
+    }
+    Ok(())
+}
+
+/// `poles`: frequency against damping ratio; poles at 0 Hz (a free rigid motion) cannot sit on
+/// the log scale and are counted in a note.
+fn poles(doc: &LinearizationDoc, caption: &str, sink: &mut Sink) -> Result<(), FiguresError> {
+    let at_zero = doc
+        .poles
+        .iter()
+        .filter(|p| p.natural_frequency_hz <= 0.0)
+        .count();
+    if at_zero > 0 {
+        sink.note(format!(
+            "poles: {at_zero} at 0 Hz left out of the log scale"
+        ));
+    }
+    let series = |label: &str, unstable: bool| {
+        let (x, y): (Vec<f64>, Vec<f64>) = (doc.poles.iter())
+            .filter(|p| p.natural_frequency_hz > 0.0 && (p.damping_ratio < 0.0) == unstable)
+            .map(|p| (p.damping_ratio, p.natural_frequency_hz))
+            .unzip();
+        (!x.is_empty()).then(|| Series::new(label, x, y, SeriesStyle::Markers))
+    };
+    let mut series: Vec<Series> = [
+        series("stable", false).map(|s| s.with_color(palette::POD_ALT)),
+        series("unstable (ζ < 0)", true).map(|s| s.with_color(palette::POD)),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    // ζ from 0 (undamped) to 1 (critical) on the scale whatever the poles
+    if let Some(&f) = series.first().and_then(|s| s.y.first()) {
+        series.push(Series::new(
+            "",
+            vec![0.0, 1.0],
+            vec![f, f],
+            SeriesStyle::Bounds,
+        ));
+    }
+    if series.is_empty() {
+        return Err(input_error(
+            Path::new(&doc.scenario),
+            "the result holds no pole with a frequency above 0 Hz to plot",
+        ));
+    }
+    let chart = Figure::Line(LineChart {
+        title: format!("Poles of the linearization — {caption}"),
+        x_label: "damping ratio ζ = −Re λ / |λ|".into(),
+        y_label: "natural frequency |λ|/2π [Hz]".into(),
+        series,
+        log_y: true,
+        equal_aspect: false,
+    });
+    sink.figure("poles", &chart, (1000, 700))
+}
+
+/// `static_gain`: one panel per output point, the x, y and z rows against the tendon number.
+fn static_gain(
+    doc: &LinearizationDoc,
+    g: &[Vec<f64>],
+    caption: &str,
+    sink: &mut Sink,
+) -> Result<(), FiguresError> {
+    let tendons: Vec<f64> = (1..=doc.n_actuators).map(|k| k as f64).collect();
+    let points = doc.outputs.clone();
+    let panels: Vec<Figure> = (0..g.len() / 3)
+        .map(|o| {
+            let at = match &points {
+                Some(xs) => format!("X = {} m", gvs::error::fmt_value(xs[o])),
+                None => "the tip".to_string(),
+            };
+            // half a tendon of margin on either side, and 0 on the scale
+            let margin = Series::new(
+                "",
+                vec![0.5, doc.n_actuators as f64 + 0.5],
+                vec![0.0, 0.0],
+                SeriesStyle::Bounds,
+            );
+            let series = (0..3)
+                .map(|axis| {
+                    let y = g[3 * o + axis].iter().map(|v| v * 1e3).collect();
+                    Series::new(
+                        ["world x", "world y", "world z"][axis],
+                        tendons.clone(),
+                        y,
+                        SeriesStyle::Markers,
+                    )
+                    .with_color(palette::EXTRA[axis])
+                })
+                .chain(std::iter::once(margin))
+                .collect();
+            Figure::Line(LineChart {
+                title: format!("settled displacement of {at}"),
+                x_label: "tendon".into(),
+                y_label: "per newton of tension [mm/N]".into(),
+                series,
+                log_y: false,
+                equal_aspect: false,
+            })
+        })
+        .collect();
+    let n = panels.len();
+    let unstable = match doc.unstable_poles {
+        0 => "",
+        _ => " (an unstable equilibrium: no motion settles there)",
+    };
+    let grid = Figure::Grid {
+        title: format!("Static gain −C A⁻¹ B{unstable} — {caption}"),
+        cols: 1,
+        panels,
+    };
+    sink.figure("static_gain", &grid, (1000, 300 + 400 * n as u32))
+}
