@@ -115,6 +115,29 @@ pub fn jacobians(
     })
 }
 
+/// The centreline's world positions at the abscissae `xs` (k × 3) and their derivatives in `q`
+/// (k × 3 × n), row-major: [`gvs::model::Model::position_jacobian_at`].
+pub fn position_jacobians(
+    built: &Built,
+    cache: &WorkspaceCache,
+    q: &DVector<f64>,
+    xs: &[f64],
+) -> (Vec<f64>, Vec<f64>) {
+    with_model!(built, cache, m, ws => {
+        let n = m.n_dof();
+        m.forward(q, ws, true);
+        let (mut pos, mut jac) = (Vec::with_capacity(3 * xs.len()), Vec::with_capacity(3 * n * xs.len()));
+        for &x in xs {
+            let (p, d) = m.position_jacobian_at(ws, x);
+            pos.extend(p.iter().copied());
+            for a in 0..3 {
+                jac.extend(d.row(a).iter().copied());
+            }
+        }
+        (pos, jac)
+    })
+}
+
 /// Body twists `η_i` (p × 6, row-major) at `(q, q̇)` by the engine's velocity recursion.
 pub fn velocities(
     built: &Built,

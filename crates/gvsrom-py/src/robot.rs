@@ -592,6 +592,62 @@ impl Robot {
         }
     }
 
+    /// World position of the centreline at abscissa ``x`` and its Jacobian ``∂p/∂q`` (world
+    /// axes): ``δp = J δq``, the output matrix of a position sensor or a task-space controller at
+    /// ``x``. At a computational point ``J`` is ``R_i`` times rows 3–5 of ``jacobian(q, i)``;
+    /// between points, the derivative of the centreline's cubic Hermite interpolant (the one
+    /// ``statics`` samples). ``linearize(outputs=…)`` stacks the same rows into ``C``.
+    ///
+    /// Parameters
+    /// ----------
+    /// q : array_like of float, shape (n_dof,)
+    /// x : float or array_like of float
+    ///     Abscissa(e) [m] within [0, length].
+    ///
+    /// Returns
+    /// -------
+    /// tuple of numpy.ndarray
+    ///     ``(position, jacobian)``: shapes (3,) and (3, n_dof) for one ``x``, (k, 3) and
+    ///     (k, 3, n_dof) for k of them.
+    fn position_jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        q: In1<'_>,
+        x: &Bound<'py, PyAny>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let q = self.coordinates(&q)?;
+        let (xs, one) = match x.extract::<f64>() {
+            Ok(v) => (vec![v], true),
+            Err(_) => (arrays::vec1(&x.extract::<In1<'_>>()?), false),
+        };
+        let length = self.built.model.disc.length();
+        if let Some(bad) = xs
+            .iter()
+            .find(|v| !(v.is_finite() && (0.0..=length).contains(*v)))
+        {
+            return Err(invalid(format!(
+                "`x` = {}: expected abscissae within [0, {}] m (0 the base, {} m the tip)",
+                gvs::error::fmt_value(*bad),
+                gvs::error::fmt_value(length),
+                gvs::error::fmt_value(length)
+            )));
+        }
+        let n = self.built.n_dof();
+        let k = xs.len();
+        let (pos, jac) =
+            py.detach(|| quantities::position_jacobians(&self.built, &self.workspaces, &q, &xs));
+        match one {
+            true => Ok((
+                arrays::shaped(py, pos, [3])?,
+                arrays::shaped(py, jac, [3, n])?,
+            )),
+            false => Ok((
+                arrays::shaped(py, pos, [k, 3])?,
+                arrays::shaped(py, jac, [k, 3, n])?,
+            )),
+        }
+    }
+
     /// Section twists ``η_i`` at the points (angular then linear velocity, section frame) at
     /// ``(q, q̇)``, by the engine's velocity recursion.
     ///

@@ -63,6 +63,33 @@ def test_geometric_jacobian_matches_differences_of_the_forward_kinematics(robot,
     np.testing.assert_array_equal(robot.jacobian(q, point=-1), J[-1])
 
 
+def test_position_jacobian_is_the_point_jacobian_at_points_and_the_positions_derivative_between(
+        robot, state):
+    q, qd = state
+    n = robot.n_dof
+    fwd = robot.forward(q)
+    i = robot.n_points // 2
+    p, J = robot.position_jacobian(q, float(fwd["x"][i]))
+    assert p.shape == (3,) and J.shape == (3, n)
+    np.testing.assert_allclose(p, fwd["position"][i], rtol=0, atol=1e-15)
+    Jb = robot.jacobian(q, i)
+    np.testing.assert_allclose(J, fwd["rotation"][i] @ Jb[3:], rtol=0, atol=1e-12 * np.abs(Jb).max())
+    # between points: the derivative of the interpolated position along q̇
+    xs = 0.5 * (fwd["x"][1:4] + fwd["x"][2:5])
+    P, Js = robot.position_jacobian(q, xs)
+    assert P.shape == (3, 3) and Js.shape == (3, 3, n)
+    h = 1e-6
+    fd = (robot.position_jacobian(q + h * qd, xs)[0] - robot.position_jacobian(q - h * qd, xs)[0]) / (2 * h)
+    np.testing.assert_allclose(Js @ qd, fd, rtol=0, atol=1e-6 * np.abs(fd).max())
+    # the rows linearize stacks into C
+    C = robot.linearize(q=q, outputs=xs)["C"]
+    np.testing.assert_array_equal(C[:, :n], Js.reshape(9, n))
+    length = robot.length
+    for bad in [-0.01, length * 1.01, float("nan")]:
+        with pytest.raises(gvsrom.GvsromError, match=r"`x` = .*within \[0, "):
+            robot.position_jacobian(q, [0.0, bad])
+
+
 def test_point_velocities_are_the_jacobians_times_qd(robot, state):
     q, qd = state
     eta = robot.point_velocities(q, qd)
