@@ -117,6 +117,15 @@ fn describe(ob: &Borrowed<'_, '_, PyAny>) -> String {
         .unwrap_or_else(|_| "an object".into())
 }
 
+/// A number or a 1-D array-like of them: the values, and whether a single number was given (a
+/// result then drops the axis of the values).
+pub fn one_or_more(ob: &Bound<'_, PyAny>) -> PyResult<(Vec<f64>, bool)> {
+    match ob.extract::<f64>() {
+        Ok(v) => Ok((vec![v], true)),
+        Err(_) => Ok((vec1(&ob.extract::<In1<'_>>()?), false)),
+    }
+}
+
 /// The values of a 1-D input.
 pub fn vec1(a: &In1<'_>) -> Vec<f64> {
     a.as_array().iter().copied().collect()

@@ -15,8 +15,9 @@ impl Robot {
     /// The equations of motion linearized for control design, as ``gvsrom linearize`` computes
     /// them (the same numbers as its ``--json``): ``δẋ = A δx + B δu`` and ``δy = C δx`` with the
     /// state ``x = [q; q̇]``, the tendon tensions ``u`` [N] and the output ``y``, the tip position
-    /// or the positions at ``outputs`` (world axes, m). ``A`` keeps every term of the dynamics (gvs-spec §9.3), the inertial ones that vanish at
-    /// rest included. With a reduced model attached, its ``2r``-state linearization.
+    /// or the positions at ``outputs`` (world axes, m). ``A`` keeps every term of the dynamics
+    /// (gvs-spec §9.3), the inertial ones that vanish at rest included. With a reduced model
+    /// attached, its ``2r``-state linearization.
     ///
     /// Parameters
     /// ----------
@@ -31,7 +32,7 @@ impl Robot {
     /// dt : float, optional
     ///     Also discretize with a zero-order hold of ``dt`` seconds (``--sample-time``):
     ///     ``Ad`` = e^(A dt), ``Bd`` = ∫₀^dt e^(A s) ds B, ``spectral_radius`` max |e^(λ dt)|.
-    /// outputs : array_like of float, optional
+    /// outputs : float or array_like of float, optional
     ///     Abscissae [m] along the rod whose world positions make ``y`` (``--output-at``), 3 rows
     ///     of ``C`` each in this order, between the computational points by the centreline's
     ///     interpolant; default: the tip.
@@ -64,14 +65,14 @@ impl Robot {
         q: Option<arrays::In1<'_>>,
         qd: Option<arrays::In1<'_>>,
         dt: Option<f64>,
-        outputs: Option<arrays::In1<'_>>,
+        outputs: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         if let Some(h) = dt {
             linearize::check_sample_time(h).map_err(|e| invalid(e.to_string()))?;
         }
         let outputs = match &outputs {
             None => linearize::Outputs::tip(&self.built),
-            Some(xs) => linearize::Outputs::at(&self.built, &arrays::vec1(xs))
+            Some(xs) => linearize::Outputs::at(&self.built, &arrays::one_or_more(xs)?.0)
                 .map_err(|e| invalid(e.to_string()))?,
         };
         let to_py = |e: LinearizeError| {

@@ -616,10 +616,7 @@ impl Robot {
         x: &Bound<'py, PyAny>,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         let q = self.coordinates(&q)?;
-        let (xs, one) = match x.extract::<f64>() {
-            Ok(v) => (vec![v], true),
-            Err(_) => (arrays::vec1(&x.extract::<In1<'_>>()?), false),
-        };
+        let (xs, one) = arrays::one_or_more(x)?;
         let length = self.built.model.disc.length();
         if let Some(bad) = xs
             .iter()

@@ -93,9 +93,10 @@ def test_output_points_stack_their_position_jacobians_in_c():
     J = robot.jacobian(q, i)
     np.testing.assert_allclose(lin["C"][:3, :n], fwd["rotation"][i] @ J[3:], rtol=0,
                                atol=1e-12 * np.abs(J).max())
-    # the tip's block is the default output
+    # the tip's block is the default output, and one number is one output
     tip = robot.linearize(u=[-3.0], q=q)
     np.testing.assert_array_equal(lin["C"][6:], tip["C"])
+    np.testing.assert_array_equal(robot.linearize(u=[-3.0], q=q, outputs=0.25)["C"], tip["C"])
     # between points: central differences of the state's position there, read as an output
     # position of states q ± h e_j
     h = 1e-6

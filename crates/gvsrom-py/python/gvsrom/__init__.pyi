@@ -362,7 +362,7 @@ class Robot:
         q: ArrayLike | None = None,
         qd: ArrayLike | None = None,
         dt: float | None = None,
-        outputs: ArrayLike | None = None,
+        outputs: float | ArrayLike | None = None,
     ) -> dict[str, Any]: ...
     def simulate(
         self,
