@@ -617,18 +617,8 @@ impl Robot {
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         let q = self.coordinates(&q)?;
         let (xs, one) = arrays::one_or_more(x)?;
-        let length = self.built.model.disc.length();
-        if let Some(bad) = xs
-            .iter()
-            .find(|v| !(v.is_finite() && (0.0..=length).contains(*v)))
-        {
-            return Err(invalid(format!(
-                "`x` = {}: expected abscissae within [0, {}] m (0 the base, {} m the tip)",
-                gvs::error::fmt_value(*bad),
-                gvs::error::fmt_value(length),
-                gvs::error::fmt_value(length)
-            )));
-        }
+        gvsrom::linearize::check_abscissae("x", &xs, self.built.model.disc.length())
+            .map_err(|e| invalid(e.to_string()))?;
         let n = self.built.n_dof();
         let k = xs.len();
         let (pos, jac) =

@@ -86,7 +86,7 @@ def test_position_jacobian_is_the_point_jacobian_at_points_and_the_positions_der
     np.testing.assert_array_equal(C[:, :n], Js.reshape(9, n))
     length = robot.length
     for bad in [-0.01, length * 1.01, float("nan")]:
-        with pytest.raises(gvsrom.GvsromError, match=r"`x` = .*within \[0, "):
+        with pytest.raises(gvsrom.GvsromError, match=r"^x `.*`: expected abscissae .*within \[0, "):
             robot.position_jacobian(q, [0.0, bad])
 
 

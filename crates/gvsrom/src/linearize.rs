@@ -47,10 +47,14 @@ pub enum LinearizeError {
         why: String,
         most: Option<f64>,
     },
-    #[error("--output-at `{}`: expected abscissae along the rod, each finite and within [0, {}] m (0 the base, {} m the tip)", fmt_value(*value), fmt_value(*length), fmt_value(*length))]
-    OutputAt { value: f64, length: f64 },
-    #[error("--output-at: no abscissa given; expected at least one (the tip is {} m)", fmt_value(*length))]
-    NoOutput { length: f64 },
+    #[error("{field} `{}`: expected abscissae along the rod, each finite and within [0, {}] m (0 the base, {} m the tip)", fmt_value(*value), fmt_value(*length), fmt_value(*length))]
+    OutputAt {
+        field: &'static str,
+        value: f64,
+        length: f64,
+    },
+    #[error("{field}: no abscissa given; expected at least one (the tip is {} m)", fmt_value(*length))]
+    NoOutput { field: &'static str, length: f64 },
     #[error("--count `{value}`: expected an integer ≥ 1 (the number of slowest poles to print; the linearization has {n_poles} states, so at most {n_poles} poles)")]
     Count { value: String, n_poles: usize },
     #[error("the equilibrium: {0}")]
@@ -279,22 +283,29 @@ impl Outputs {
     /// The positions at the abscissae `xs` \[m\] (world axes, 3 rows of `C` each, in this order),
     /// each finite and within `[0, L]`; at least one.
     pub fn at(built: &Built, xs: &[f64]) -> Result<Self, LinearizeError> {
-        let length = built.model.disc.length();
-        if xs.is_empty() {
-            return Err(LinearizeError::NoOutput { length });
-        }
-        match xs
-            .iter()
-            .find(|x| !(x.is_finite() && (0.0..=length).contains(*x)))
-        {
-            Some(&value) => Err(LinearizeError::OutputAt { value, length }),
-            None => Ok(Outputs(xs.to_vec())),
-        }
+        check_abscissae("--output-at", xs, built.model.disc.length())?;
+        Ok(Outputs(xs.to_vec()))
     }
 
     /// The abscissae.
     pub fn abscissae(&self) -> &[f64] {
         &self.0
+    }
+}
+
+/// Checks the abscissae `xs` of option `field` (at least one, each finite and within `[0, length]`):
+/// where positions along the rod are read.
+pub fn check_abscissae(field: &'static str, xs: &[f64], length: f64) -> Result<(), LinearizeError> {
+    if xs.is_empty() {
+        return Err(LinearizeError::NoOutput { field, length });
+    }
+    match (xs.iter()).find(|x| !(x.is_finite() && (0.0..=length).contains(*x))) {
+        Some(&value) => Err(LinearizeError::OutputAt {
+            field,
+            value,
+            length,
+        }),
+        None => Ok(()),
     }
 }
 
