@@ -30,7 +30,9 @@ impl Robot {
     ///     [1/s²] (negative: unstable), ``shape`` (k, n_dof), ``strain`` (k, n_points, 6) the
     ///     modal strain per unit modal coordinate, ``strain_energy_share`` (k, 6),
     ///     ``dominant_strain`` (list of k names), ``tip_displacement`` and ``tip_rotation``
-    ///     (k, 3) world axes, ``all_frequencies_hz`` (n_dof,), ``q0`` (n_dof,), ``u``,
+    ///     (k, 3) world axes, ``centerline_x`` (c,) and ``centerline`` (c, 3) the equilibrium's
+    ///     centreline, ``centerline_shape`` (k, c, 3) its displacement per unit modal coordinate
+    ///     (world axes), ``all_frequencies_hz`` (n_dof,), ``q0`` (n_dof,), ``u``,
     ///     ``strain_x`` (n_points,), ``equilibrium_tip_position`` (3,),
     ///     ``equilibrium_residual_norm``, ``model_extrapolated`` (list of str: how the reduced
     ///     model was used outside its training, ``extrapolate=True``; empty otherwise).
@@ -98,6 +100,16 @@ fn report_dict<'py>(py: Python<'py>, r: &ModesReport) -> PyResult<Bound<'py, PyD
     d.set_item(
         "tip_rotation",
         shaped(py, rows(&|m| m.tip_rotation.to_vec()), [k, 3])?,
+    )?;
+    let c = r.centerline_x.len();
+    d.set_item("centerline_x", vector(py, &r.centerline_x))?;
+    d.set_item(
+        "centerline",
+        shaped(py, arrays::flat(&r.centerline), [c, 3])?,
+    )?;
+    d.set_item(
+        "centerline_shape",
+        shaped(py, rows(&|m| arrays::flat(&m.centerline_shape)), [k, c, 3])?,
     )?;
     d.set_item("all_frequencies_hz", vector(py, &r.all_frequencies_hz))?;
     d.set_item("q0", vector(py, &r.q0))?;

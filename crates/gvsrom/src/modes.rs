@@ -90,6 +90,9 @@ pub struct ModeReport {
     pub tip_rotation: [f64; 3],
     /// Modal strain `δξ` at the computational points (`strain_x`), per unit modal coordinate.
     pub strain: Vec<[f64; 6]>,
+    /// Displacement of the centreline at the report's `centerline_x`, world axes, per unit modal
+    /// coordinate: `∂p(X)/∂q φ` ([`Model::position_jacobian_at`]), the shape `gvsrom plot` draws.
+    pub centerline_shape: Vec<[f64; 3]>,
 }
 
 /// The modes of a scenario about its equilibrium (this is also the `--json` output, with the
@@ -109,6 +112,10 @@ pub struct ModesReport {
     pub all_frequencies_hz: Vec<f64>,
     /// Abscissae of the computational points \[m\].
     pub strain_x: Vec<f64>,
+    /// The equilibrium's centreline: its samples' abscissae \[m\] (`output.centerline_points`, as
+    /// `gvsrom statics`) and world positions \[m\].
+    pub centerline_x: Vec<f64>,
+    pub centerline: Vec<[f64; 3]>,
     /// The lowest `--count` modes.
     pub modes: Vec<ModeReport>,
 }
@@ -217,6 +224,12 @@ fn modes_on<P: StrainParam>(
             dp = -dp;
             strain.iter_mut().for_each(|s| *s = -*s);
         }
+        let centerline_shape = (eq.centerline_x.iter())
+            .map(|&x| {
+                let d = model.position_jacobian_at(&ws, x).1 * &phi;
+                [d[0], d[1], d[2]]
+            })
+            .collect();
         let energy = component_energy(model, &strain);
         let total: f64 = energy.iter().sum();
         let share = energy.map(|e| if total > 0.0 { e / total } else { 0.0 });
@@ -237,6 +250,7 @@ fn modes_on<P: StrainParam>(
                 .iter()
                 .map(|s| [s[0], s[1], s[2], s[3], s[4], s[5]])
                 .collect(),
+            centerline_shape,
         });
     }
     Ok(ModesReport {
@@ -249,6 +263,8 @@ fn modes_on<P: StrainParam>(
         equilibrium_residual_norm: eq.residual_norm,
         all_frequencies_hz,
         strain_x: model.disc.points.iter().map(|p| p.x).collect(),
+        centerline_x: eq.centerline_x.clone(),
+        centerline: eq.centerline.clone(),
         modes,
     })
 }

@@ -358,7 +358,28 @@ fn json_holds_the_shapes_with_the_manifest_and_is_never_overwritten_without_forc
         assert!((share - 1.0).abs() < 1e-12);
         let f = m["frequency_hz"].as_f64().unwrap();
         assert!(rel(m["period_s"].as_f64().unwrap(), 1.0 / f) < 1e-12);
+        // the centreline's modal displacement: zero at the clamp, the tip's (another path: the
+        // tip Jacobian) at the last sample, L
+        let shape = m["centerline_shape"].as_array().unwrap();
+        assert_eq!(shape.len(), json["centerline_x"].as_array().unwrap().len());
+        let (base, end, tip) = (
+            f64s(&shape[0]),
+            f64s(shape.last().unwrap()),
+            f64s(&m["tip_displacement"]),
+        );
+        let scale = tip.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+        for a in 0..3 {
+            assert!(
+                base[a].abs() <= 1e-12 * scale,
+                "mode {k}: base moves {base:?}"
+            );
+            assert!(
+                (end[a] - tip[a]).abs() <= 1e-12 * scale,
+                "mode {k}: {end:?} vs {tip:?}"
+            );
+        }
     }
+    assert_eq!(json["centerline"].as_array().unwrap().len(), 21);
     // a second run to the same file needs --force; a file gvsrom did not write is never replaced
     let file = scratch("modes-six.json");
     std::fs::write(&file, "{}").unwrap();

@@ -1,5 +1,5 @@
 //! `gvsrom plot` end to end (issue 22): figures of a statics result, a trajectory (with and without
-//! per-sample centrelines), a dataset, a POD model, an autoencoder and a linearization. Every SVG must be well-formed
+//! per-sample centrelines), a dataset, a POD model, an autoencoder, a linearization and modes. Every SVG must be well-formed
 //! XML, every PNG must decode to a picture of several distinct colours, the rod animation must be a
 //! GIF of more than one frame; bad inputs are one-line errors naming the file.
 //!
@@ -242,6 +242,33 @@ fn linearization_gives_poles_and_a_static_gain_panel_per_output_point() {
     assert!(poles.contains("unstable (ζ &lt; 0)") || poles.contains("unstable (ζ < 0)"));
     let gain = std::fs::read_to_string(dir.join("static_gain.svg")).unwrap();
     assert!(gain.contains("an unstable equilibrium"));
+}
+
+#[test]
+fn modes_give_the_spectrum_and_the_shapes_in_the_views_they_move_in() {
+    // the six-tendon arm moves in 3-D: both side views; the planar IV-A arm only in x–z
+    for (scenario, views) in [
+        ("six-tendon", &["(x–z)", "(x–y)"][..]),
+        ("single-tendon", &["(x–z)"][..]),
+    ] {
+        let f = scratch(&format!("plot-modes-{scenario}.json"));
+        run_ok(&["modes", scenario, "--count", "3", "--json", s(&f)]);
+        let (dir, stdout) = plot(&f, &format!("plot-out-modes-{scenario}"), &[]);
+        check_figures(&dir, &stdout, &refs(&both(&["frequencies", "mode_shapes"])));
+        let shapes = std::fs::read_to_string(dir.join("mode_shapes.svg")).unwrap();
+        for v in views {
+            assert!(
+                shapes.contains("mode 3: ") && shapes.contains(v),
+                "{scenario}: {v}"
+            );
+        }
+        if views.len() == 1 {
+            assert!(
+                !shapes.contains("(x–y)"),
+                "{scenario}: a view across which nothing moves"
+            );
+        }
+    }
 }
 
 #[test]

@@ -5,8 +5,8 @@ use super::*;
 /// `gvsrom plot INPUT --out DIR`.
 #[derive(Debug, Args)]
 pub struct PlotArgs {
-    /// A `statics --json` or `linearize --json` file, or a directory written by `simulate --out`,
-    /// `dataset`, `pod` or `train`
+    /// A `statics --json`, `modes --json` or `linearize --json` file, or a directory written by
+    /// `simulate --out`, `dataset`, `pod` or `train`
     pub input: PathBuf,
     /// New directory for the figures
     #[arg(long, value_name = "DIR")]

@@ -3,7 +3,8 @@
 //!
 //! The kind of INPUT is read from its manifest ([`detect`]): a `statics --json` file ([`statics`]), a
 //! `simulate --out` trajectory ([`trajectory`]), a `dataset` directory ([`dataset`]), a `pod` /
-//! `train` model ([`model`]) or a `linearize --json` file ([`linearization`]). Each figure is written as SVG and/or PNG under a descriptive name
+//! `train` model ([`model`]), a `linearize --json` file ([`linearization`]) or a `modes --json`
+//! file ([`modes`]). Each figure is written as SVG and/or PNG under a descriptive name
 //! (`rod_3d.svg`, `strain.png`, …); a trajectory with centrelines also gets `rod_animation.gif`.
 //! What cannot be drawn from the input (an older trajectory without centrelines, a model without
 //! training curves) is skipped with a note, never an error; an input with nothing to draw is one.
@@ -11,6 +12,7 @@
 pub mod dataset;
 pub mod linearization;
 pub mod model;
+pub mod modes;
 pub mod statics;
 pub mod trajectory;
 mod views;
@@ -26,7 +28,7 @@ use thiserror::Error;
 pub const FIGURES_FORMAT: &str = "figures";
 
 /// What `gvsrom plot` accepts, for error messages.
-pub const ACCEPTED: &str = "a `statics --json` or `linearize --json` file, or a directory written by `simulate --out`, `dataset`, `pod` or `train`";
+pub const ACCEPTED: &str = "a `statics --json`, `modes --json` or `linearize --json` file, or a directory written by `simulate --out`, `dataset`, `pod` or `train`";
 
 #[derive(Debug, Error)]
 pub enum FiguresError {
@@ -64,6 +66,7 @@ pub enum InputKind {
     Dataset,
     Model,
     Linearization,
+    Modes,
 }
 
 impl InputKind {
@@ -74,6 +77,7 @@ impl InputKind {
             InputKind::Dataset => "dataset",
             InputKind::Model => "reduced model",
             InputKind::Linearization => "linearization",
+            InputKind::Modes => "modes",
         }
     }
 }
@@ -116,6 +120,7 @@ pub fn detect(path: &Path) -> Result<InputKind, FiguresError> {
     match (format.as_str(), md.is_dir()) {
         ("statics", false) => Ok(InputKind::Statics),
         ("linearize", false) => Ok(InputKind::Linearization),
+        ("modes", false) => Ok(InputKind::Modes),
         ("trajectory", true) => Ok(InputKind::Trajectory),
         ("dataset", true) => Ok(InputKind::Dataset),
         (crate::reduced_model::MODEL_FORMAT, true) => Ok(InputKind::Model),
@@ -248,6 +253,7 @@ pub fn plot_outputs(
         InputKind::Dataset => dataset::figures(input, &mut sink)?,
         InputKind::Model => model::figures(input, &mut sink)?,
         InputKind::Linearization => linearization::figures(input, &mut sink)?,
+        InputKind::Modes => modes::figures(input, &mut sink)?,
     }
     if sink.written.is_empty() {
         return Err(input_error(input, "nothing to plot"));
