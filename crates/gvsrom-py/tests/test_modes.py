@@ -25,12 +25,13 @@ def test_modes_equal_the_cli_json(gvsrom_bin, tmp_path, preset, tension):
     m = robot.modes(4, u=[float(tension)]) if tension else robot.modes(4)
     assert len(m["frequency_hz"]) == 4 == len(cli["modes"])
     for name in ["frequency_hz", "omega_squared", "shape", "strain_energy_share", "tip_displacement",
-                 "tip_rotation", "strain"]:
+                 "tip_rotation", "strain", "centerline_shape"]:
         expected = np.array([mode[name] for mode in cli["modes"]])
         np.testing.assert_allclose(m[name], expected, rtol=0, atol=1e-12 * max(1.0, np.abs(expected).max()),
                                    err_msg=name)
     assert m["dominant_strain"] == [mode["dominant_strain"] for mode in cli["modes"]]
-    for name in ["all_frequencies_hz", "q0", "u", "strain_x", "equilibrium_tip_position"]:
+    for name in ["all_frequencies_hz", "q0", "u", "strain_x", "equilibrium_tip_position", "centerline_x",
+                 "centerline"]:
         np.testing.assert_allclose(m[name], cli[name], rtol=0, atol=1e-12 * max(1.0, np.abs(cli[name]).max()),
                                    err_msg=name)
 
@@ -46,6 +47,10 @@ def test_each_mode_solves_k_phi_equals_omega_squared_m_phi():
         assert phi @ M @ phi == pytest.approx(1.0, rel=1e-9)
         np.testing.assert_allclose(KT @ phi, w2 * (M @ phi), rtol=0, atol=1e-7 * np.abs(KT @ phi).max())
     assert np.all(np.diff(m["frequency_hz"]) >= 0)
+    # the centreline's modal displacement is the position Jacobian times the shape
+    _, Jp = robot.position_jacobian(q0, m["centerline_x"])
+    np.testing.assert_allclose(m["centerline_shape"], np.einsum("can,kn->kca", Jp, m["shape"]),
+                               rtol=0, atol=1e-12 * np.abs(m["centerline_shape"]).max())
 
 
 def test_a_count_below_one_is_refused_with_the_cli_message(gvsrom_bin):
