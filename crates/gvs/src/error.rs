@@ -42,6 +42,16 @@ pub fn fmt_value(v: f64) -> String {
     }
 }
 
+/// `v` in exponent form with `digits` decimals, the exponent left out where it is 0: `1.0881e-2`,
+/// `1.0878` (not `1.0878e0`), `3.2000e5`.
+pub fn fmt_sci(v: f64, digits: usize) -> String {
+    let s = format!("{v:.digits$e}");
+    match s.strip_suffix("e0") {
+        Some(plain) => plain.to_string(),
+        None => s,
+    }
+}
+
 /// Checks `value` is finite and inside `(lo, hi)` with the given openness; names `field` on failure.
 pub(crate) fn check_range(
     field: &str,
@@ -77,4 +87,19 @@ pub(crate) fn check_positive(field: &str, value: f64, unit: &str) -> Result<f64,
 
 pub(crate) fn check_finite(field: &str, value: f64) -> Result<f64, ModelError> {
     check_range(field, value, None, None, "a finite number")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fmt_sci;
+
+    #[test]
+    fn fmt_sci_leaves_out_a_zero_exponent_only() {
+        assert_eq!(fmt_sci(1.08781, 4), "1.0878");
+        assert_eq!(fmt_sci(0.0108812, 4), "1.0881e-2");
+        assert_eq!(fmt_sci(320000.0, 4), "3.2000e5");
+        assert_eq!(fmt_sci(-2.5, 2), "-2.50");
+        assert_eq!(fmt_sci(0.0, 4), "0.0000");
+        assert_eq!(fmt_sci(1e10, 1), "1.0e10");
+    }
 }

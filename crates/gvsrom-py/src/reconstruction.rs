@@ -121,10 +121,10 @@ pub struct Reconstruction {
 impl Reconstruction {
     fn __repr__(&self) -> String {
         format!(
-            "Reconstruction(rows={}, rmse={:.4e}, relative={:.4e}, outside={}, unseen_inputs={})",
+            "Reconstruction(rows={}, rmse={}, relative={}, outside={}, unseen_inputs={})",
             self.rows,
-            self.rmse,
-            self.relative,
+            gvs::error::fmt_sci(self.rmse, 4),
+            gvs::error::fmt_sci(self.relative, 4),
             self.outside,
             self.unseen_inputs
                 .map_or("None".to_string(), |n| n.to_string())

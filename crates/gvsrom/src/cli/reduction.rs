@@ -1,6 +1,7 @@
 //! `gvsrom pod`, `gvsrom train` and `gvsrom reconstruct`.
 
 use super::*;
+use gvs::error::fmt_sci;
 
 #[derive(Debug, Args)]
 pub struct PodArgs {
@@ -148,7 +149,7 @@ pub(super) fn pod_cmd(args: &PodArgs, out: &mut impl Write) -> Result<()> {
         .singular_values
         .iter()
         .take(10)
-        .map(|v| format!("{v:.4e}"))
+        .map(|v| fmt_sci(*v, 4))
         .collect();
     writeln!(
         out,
@@ -281,10 +282,10 @@ pub(super) fn train_cmd(args: &TrainArgs, out: &mut impl Write) -> Result<()> {
     )?;
     writeln!(
         out,
-        "RMSE       {:.4e} training{}",
-        r.final_train_rmse,
+        "RMSE       {} training{}",
+        fmt_sci(r.final_train_rmse, 4),
         r.final_val_rmse
-            .map(|v| format!(", {v:.4e} validation"))
+            .map(|v| format!(", {} validation", fmt_sci(v, 4)))
             .unwrap_or_default()
     )?;
     writeln!(
@@ -334,8 +335,8 @@ pub(super) fn reconstruct_cmd(args: &ReconstructArgs, out: &mut impl Write) -> R
     if args.datasets.len() > 1 {
         writeln!(
             out,
-            "all        RMSE {:.4e} over the {} datasets' {entries} values",
-            (err2 / entries as f64).sqrt(),
+            "all        RMSE {} over the {} datasets' {entries} values",
+            fmt_sci((err2 / entries as f64).sqrt(), 4),
             args.datasets.len()
         )?;
     }
@@ -356,8 +357,8 @@ fn reconstruction_lines(
     )?;
     writeln!(
         out,
-        "RMSE       {:.4e} (every entry of every snapshot, Table I's measure)",
-        r.rmse
+        "RMSE       {} (every entry of every snapshot, Table I's measure)",
+        fmt_sci(r.rmse, 4)
     )?;
     writeln!(
         out,
@@ -367,9 +368,10 @@ fn reconstruction_lines(
     if let Some((row, e, norm)) = r.worst {
         writeln!(
             out,
-            "worst      row {row}: {:.4} % of its norm ‖x‖ = {norm:.4e} (the largest ‖x‖ is {:.4e})",
+            "worst      row {row}: {:.4} % of its norm ‖x‖ = {} (the largest ‖x‖ is {})",
             100.0 * e,
-            r.largest_norm
+            fmt_sci(norm, 4),
+            fmt_sci(r.largest_norm, 4)
         )?;
     }
     writeln!(
