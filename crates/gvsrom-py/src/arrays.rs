@@ -117,18 +117,46 @@ fn describe(ob: &Borrowed<'_, '_, PyAny>) -> String {
         .unwrap_or_else(|_| "an object".into())
 }
 
-/// A number or a 1-D array-like of them: the values, and whether a single number was given (a
-/// result then drops the axis of the values).
-pub fn one_or_more(ob: &Bound<'_, PyAny>) -> PyResult<(Vec<f64>, bool)> {
-    match ob.extract::<f64>() {
-        Ok(v) => Ok((vec![v], true)),
-        Err(_) => Ok((vec1(&ob.extract::<In1<'_>>()?), false)),
-    }
-}
-
 /// The values of a 1-D input.
 pub fn vec1(a: &In1<'_>) -> Vec<f64> {
     a.as_array().iter().copied().collect()
+}
+
+/// Abscissae along the rod as a Python caller gives them: one number (a float, an int, a NumPy
+/// scalar or 0-d array; a result then drops the axis of the values) or a 1-D array-like of them.
+/// A bool is refused (it would read as 0 or 1 m).
+pub struct Abscissae {
+    pub values: Vec<f64>,
+    pub one: bool,
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for Abscissae {
+    type Error = PyErr;
+
+    fn extract(ob: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        const WHAT: &str = "one abscissa [m] or a 1-D array-like of them";
+        if ob.is_instance_of::<pyo3::types::PyBool>() {
+            return Err(PyTypeError::new_err(format!(
+                "expected {WHAT}; got a `bool`"
+            )));
+        }
+        // an array of at least one dimension is an array (NumPy before 2.4 turns a 1-element one
+        // into a number with only a deprecation warning)
+        let is_array = ob.cast::<PyUntypedArray>().is_ok_and(|a| a.ndim() > 0);
+        if !is_array {
+            if let Ok(x) = ob.extract::<f64>() {
+                return Ok(Abscissae {
+                    values: vec![x],
+                    one: true,
+                });
+            }
+        }
+        let a: In1<'py> = Real::extract_as(ob, WHAT)?;
+        Ok(Abscissae {
+            values: vec1(&a),
+            one: false,
+        })
+    }
 }
 
 /// Tendon tensions as a Python caller gives them: an array-like (one per tendon, or one for all)

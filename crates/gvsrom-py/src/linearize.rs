@@ -65,14 +65,14 @@ impl Robot {
         q: Option<arrays::In1<'_>>,
         qd: Option<arrays::In1<'_>>,
         dt: Option<f64>,
-        outputs: Option<&Bound<'py, PyAny>>,
+        outputs: Option<arrays::Abscissae>,
     ) -> PyResult<Bound<'py, PyDict>> {
         if let Some(h) = dt {
             linearize::check_sample_time(h).map_err(|e| invalid(e.to_string()))?;
         }
         let outputs = match &outputs {
             None => linearize::Outputs::tip(&self.built),
-            Some(xs) => linearize::Outputs::at(&self.built, &arrays::one_or_more(xs)?.0)
+            Some(xs) => linearize::Outputs::at(&self.built, &xs.values)
                 .map_err(|e| invalid(e.to_string()))?,
         };
         let to_py = |e: LinearizeError| {

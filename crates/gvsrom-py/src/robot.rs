@@ -613,10 +613,10 @@ impl Robot {
         &self,
         py: Python<'py>,
         q: In1<'_>,
-        x: &Bound<'py, PyAny>,
+        x: arrays::Abscissae,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         let q = self.coordinates(&q)?;
-        let (xs, one) = arrays::one_or_more(x)?;
+        let arrays::Abscissae { values: xs, one } = x;
         gvsrom::linearize::check_abscissae("x", &xs, self.built.model.disc.length())
             .map_err(|e| invalid(e.to_string()))?;
         let n = self.built.n_dof();

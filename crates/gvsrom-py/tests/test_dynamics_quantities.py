@@ -129,7 +129,8 @@ def test_bad_states_name_the_argument(robot):
     # every quantity refuses a non-finite state or tension, none returns NaN (the kinematic and
     # statics ones once did)
     at_q = [robot.forward, robot.jacobian, robot.mass_matrix, robot.statics_residual,
-            robot.statics_jacobian, robot.elastic_force, robot.external_force]
+            robot.statics_jacobian, robot.elastic_force, robot.external_force,
+            lambda q: robot.position_jacobian(q, 0.1)]
     for f in at_q:
         with pytest.raises(gvsrom.GvsromError, match=r"`q\[4\]` = NaN: expected a finite number"):
             f(q)

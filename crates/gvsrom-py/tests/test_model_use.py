@@ -129,7 +129,8 @@ def test_a_state_no_rod_holds_is_refused_not_answered_with_nan(robot):
     n = robot.n_dof
     q = np.zeros(n)
     q[0] = 1e24
-    for f in (robot.mass_matrix, robot.elastic_force, robot.forward, robot.external_force):
+    for f in (robot.mass_matrix, robot.elastic_force, robot.forward, robot.external_force,
+              lambda q: robot.position_jacobian(q, 0.1)):
         with pytest.raises(gvsrom.GvsromError, match="`q` is no state of an elastic rod"):
             f(q)
     fast = np.full(n, 1e200)

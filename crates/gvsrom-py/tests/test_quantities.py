@@ -84,6 +84,13 @@ def test_position_jacobian_is_the_point_jacobian_at_points_and_the_positions_der
     # the rows linearize stacks into C
     C = robot.linearize(q=q, outputs=xs)["C"]
     np.testing.assert_array_equal(C[:, :n], Js.reshape(9, n))
+    # a 1-element array is an array (not one number); a bool, a string or a 2-D array is refused
+    P1, J1 = robot.position_jacobian(q, np.array([xs[0]]))
+    assert P1.shape == (1, 3) and J1.shape == (1, 3, n)
+    np.testing.assert_array_equal(robot.position_jacobian(q, np.float64(xs[0]))[1], J1[0])
+    for bad in [True, "0.1", [[0.1]]]:
+        with pytest.raises(TypeError, match="one abscissa .m. or a 1-D array-like of them"):
+            robot.position_jacobian(q, bad)
     length = robot.length
     for bad in [-0.01, length * 1.01, float("nan")]:
         with pytest.raises(gvsrom.GvsromError, match=r"^x `.*`: expected abscissae .*within \[0, "):

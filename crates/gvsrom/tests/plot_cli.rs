@@ -239,9 +239,48 @@ fn linearization_gives_poles_and_a_static_gain_panel_per_output_point() {
     assert!(json(&up)["unstable_poles"].as_u64().unwrap() > 0);
     let (dir, _) = plot(&up, "plot-out-lin-up", &["--format", "svg"]);
     let poles = std::fs::read_to_string(dir.join("poles.svg")).unwrap();
-    assert!(poles.contains("unstable (ζ &lt; 0)") || poles.contains("unstable (ζ < 0)"));
+    assert!(poles.contains("unstable (Re λ &gt; 0)") || poles.contains("unstable (Re λ > 0)"));
     let gain = std::fs::read_to_string(dir.join("static_gain.svg")).unwrap();
     assert!(gain.contains("an unstable equilibrium"));
+    // an undamped arm: its poles on the imaginary axis up to rounding (ζ ≈ ±1e-15) are stable,
+    // as linearize counts them
+    let undamped = scratch("plot-lin-undamped.json");
+    run_ok(&[
+        "linearize",
+        "single-tendon",
+        "--set",
+        "material.damping=0.0",
+        "--json",
+        s(&undamped),
+    ]);
+    assert_eq!(json(&undamped)["unstable_poles"].as_u64(), Some(0));
+    let (dir, _) = plot(&undamped, "plot-out-lin-undamped", &["--format", "svg"]);
+    let poles = std::fs::read_to_string(dir.join("poles.svg")).unwrap();
+    assert!(!poles.contains("unstable"), "rounding drawn as instability");
+    // results with nothing to draw or of inconsistent sizes: one-line errors naming the file
+    for (name, body, needle) in [
+        (
+            "plot-lin-nopoles.json",
+            r#""n_actuators": 0, "poles": []"#,
+            "no pole with a frequency above 0 Hz",
+        ),
+        (
+            "plot-lin-nooutputs.json",
+            r#""n_actuators": 1, "poles": [], "outputs": [], "static_gain": []"#,
+            "outputs is empty",
+        ),
+        (
+            "plot-lin-rows.json",
+            r#""n_actuators": 2, "poles": [], "static_gain": [[1, 2], [1], [3, 4]]"#,
+            "static_gain row 1 has 1 values; expected 2",
+        ),
+    ] {
+        let f = scratch(name);
+        let text = format!(r#"{{"gvsrom": {{"format": "linearize"}}, "scenario": "x", {body}}}"#);
+        std::fs::write(&f, text).unwrap();
+        let out = scratch(&format!("{name}-figs"));
+        expect_error(&["plot", s(&f), "--out", s(&out)], &[s(&f), needle]);
+    }
 }
 
 #[test]

@@ -50,16 +50,28 @@ impl LinearizationDoc {
                 format!("not a `linearize --json` result the figures can read: {e}"),
             )
         })?;
+        if doc.outputs.as_ref().is_some_and(Vec::is_empty) {
+            return Err(input_error(path, "outputs is empty: no output point"));
+        }
         if let Some(g) = &doc.static_gain {
             let points = doc.outputs.as_ref().map_or(1, Vec::len);
-            if g.len() != 3 * points || g.iter().any(|row| row.len() != doc.n_actuators) {
+            if g.len() != 3 * points {
                 return Err(input_error(
                     path,
                     format!(
-                        "static_gain has {} rows of {:?} values; expected {} rows (3 per output point) of {} (one per tendon)",
+                        "static_gain has {} rows; expected {} (3 per output point)",
                         g.len(),
-                        g.first().map(Vec::len),
-                        3 * points,
+                        3 * points
+                    ),
+                ));
+            }
+            if let Some((i, row)) = (g.iter().enumerate()).find(|(_, r)| r.len() != doc.n_actuators)
+            {
+                return Err(input_error(
+                    path,
+                    format!(
+                        "static_gain row {i} has {} values; expected {} (one per tendon)",
+                        row.len(),
                         doc.n_actuators
                     ),
                 ));
@@ -93,7 +105,7 @@ pub(crate) fn figures(path: &Path, sink: &mut Sink) -> Result<(), FiguresError> 
     let doc = LinearizationDoc::load(path)?;
     sink.origin = doc.origin.clone();
     let caption = doc.caption();
-    poles(&doc, &caption, sink)?;
+    poles(path, &doc, &caption, sink)?;
     match &doc.static_gain {
         _ if doc.n_actuators == 0 => sink.note("static_gain: the rod has no tendons"),
         Some(g) => static_gain(&doc, g, &caption, sink)?,
@@ -106,7 +118,12 @@ pub(crate) fn figures(path: &Path, sink: &mut Sink) -> Result<(), FiguresError> 
 
 /// `poles`: frequency against damping ratio; poles at 0 Hz (a free rigid motion) cannot sit on
 /// the log scale and are counted in a note.
-fn poles(doc: &LinearizationDoc, caption: &str, sink: &mut Sink) -> Result<(), FiguresError> {
+fn poles(
+    path: &Path,
+    doc: &LinearizationDoc,
+    caption: &str,
+    sink: &mut Sink,
+) -> Result<(), FiguresError> {
     let at_zero = doc
         .poles
         .iter()
@@ -119,14 +136,14 @@ fn poles(doc: &LinearizationDoc, caption: &str, sink: &mut Sink) -> Result<(), F
     }
     let series = |label: &str, unstable: bool| {
         let (x, y): (Vec<f64>, Vec<f64>) = (doc.poles.iter())
-            .filter(|p| p.natural_frequency_hz > 0.0 && (p.damping_ratio < 0.0) == unstable)
+            .filter(|p| p.natural_frequency_hz > 0.0 && is_unstable(p) == unstable)
             .map(|p| (p.damping_ratio, p.natural_frequency_hz))
             .unzip();
         (!x.is_empty()).then(|| Series::new(label, x, y, SeriesStyle::Markers))
     };
     let mut series: Vec<Series> = [
         series("stable", false).map(|s| s.with_color(palette::POD_ALT)),
-        series("unstable (ζ < 0)", true).map(|s| s.with_color(palette::POD)),
+        series("unstable (Re λ > 0)", true).map(|s| s.with_color(palette::POD)),
     ]
     .into_iter()
     .flatten()
@@ -142,7 +159,7 @@ fn poles(doc: &LinearizationDoc, caption: &str, sink: &mut Sink) -> Result<(), F
     }
     if series.is_empty() {
         return Err(input_error(
-            Path::new(&doc.scenario),
+            path,
             "the result holds no pole with a frequency above 0 Hz to plot",
         ));
     }
@@ -155,6 +172,12 @@ fn poles(doc: &LinearizationDoc, caption: &str, sink: &mut Sink) -> Result<(), F
         equal_aspect: false,
     });
     sink.figure("poles", &chart, (1000, 700))
+}
+
+/// Unstable as `linearize` counts it: `Re λ > UNSTABLE_RATIO |λ|` (an undamped rod's poles lie on
+/// the imaginary axis up to rounding, ζ ≈ ±1e-15, and are stable).
+fn is_unstable(p: &PoleDoc) -> bool {
+    p.damping_ratio < -crate::linearize::UNSTABLE_RATIO
 }
 
 /// `static_gain`: one panel per output point, the x, y and z rows against the tendon number.

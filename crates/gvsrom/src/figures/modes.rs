@@ -34,6 +34,8 @@ pub struct ModesDoc {
     #[serde(default)]
     pub centerline: Vec<[f64; 3]>,
     pub modes: Vec<ModeDoc>,
+    #[serde(default)]
+    pub model: Option<String>,
     #[serde(skip)]
     pub origin: Option<crate::provenance::DirOrigin>,
 }
@@ -88,6 +90,12 @@ impl ModesDoc {
                 .collect();
             s.push_str(&format!(", u = [{}] N", u.join(", ")));
         }
+        if let Some(m) = &self.model {
+            let name = Path::new(m)
+                .file_name()
+                .map_or(m.clone(), |n| n.to_string_lossy().into_owned());
+            s.push_str(&format!(", model {name}"));
+        }
         s
     }
 }
@@ -97,23 +105,31 @@ pub(crate) fn figures(path: &Path, sink: &mut Sink) -> Result<(), FiguresError> 
     let doc = ModesDoc::load(path)?;
     sink.origin = doc.origin.clone();
     let caption = doc.caption();
-    frequencies(&doc, &caption, sink)?;
-    let drawable =
-        doc.centerline.len() >= 2 && doc.modes.iter().any(|m| !m.centerline_shape.is_empty());
-    match drawable {
-        true => mode_shapes(&doc, &caption, sink),
-        false => {
-            sink.note(
-                "mode_shapes: the result holds no centreline shapes (written by an earlier gvsrom)",
-            );
-            Ok(())
-        }
+    frequencies(path, &doc, &caption, sink)?;
+    if doc.centerline.len() < 2 {
+        sink.note(match doc.centerline.is_empty() {
+            true => "mode_shapes: the result holds no centreline (written by an earlier gvsrom)",
+            false => "mode_shapes: the centreline has one sample (at least 2 are needed)",
+        });
+        return Ok(());
     }
+    if doc.modes.iter().all(|m| m.centerline_shape.is_empty()) {
+        sink.note(
+            "mode_shapes: the result holds no centreline shapes (written by an earlier gvsrom)",
+        );
+        return Ok(());
+    }
+    mode_shapes(&doc, &caption, sink)
 }
 
 /// `frequencies`: every mode's frequency against its number, log scale; modes at 0 Hz (unstable
 /// or free directions) are counted in a note.
-fn frequencies(doc: &ModesDoc, caption: &str, sink: &mut Sink) -> Result<(), FiguresError> {
+fn frequencies(
+    path: &Path,
+    doc: &ModesDoc,
+    caption: &str,
+    sink: &mut Sink,
+) -> Result<(), FiguresError> {
     let zero = doc.all_frequencies_hz.iter().filter(|f| **f <= 0.0).count();
     if zero > 0 {
         sink.note(format!(
@@ -126,7 +142,7 @@ fn frequencies(doc: &ModesDoc, caption: &str, sink: &mut Sink) -> Result<(), Fig
         .unzip();
     if x.is_empty() {
         return Err(input_error(
-            Path::new(&doc.scenario),
+            path,
             "the result holds no mode above 0 Hz to plot",
         ));
     }
@@ -159,10 +175,15 @@ fn mode_shapes(doc: &ModesDoc, caption: &str, sink: &mut Sink) -> Result<(), Fig
         .take(MAX_SHAPES)
         .collect();
     // a view across which nothing moves (y of a planar rod) is left out
+    // (the centreline within 1e-9 L of the plane, every shape within 1e-9 of the largest
+    // displacement: mass-normalized shapes have no length scale of their own)
+    let largest = (shown.iter().flat_map(|m| m.centerline_shape.iter()))
+        .flat_map(|d| d.iter())
+        .fold(0.0_f64, |a, v| a.max(v.abs()));
     let flat = |a: usize| {
-        let tiny = 1e-9 * length;
-        doc.centerline.iter().all(|p| p[a].abs() <= tiny)
-            && (shown.iter()).all(|m| m.centerline_shape.iter().all(|d| d[a].abs() <= tiny))
+        doc.centerline.iter().all(|p| p[a].abs() <= 1e-9 * length)
+            && (shown.iter())
+                .all(|m| (m.centerline_shape.iter()).all(|d| d[a].abs() <= 1e-9 * largest))
     };
     let views: Vec<(usize, usize, &str)> = [(0, 2, "x–z"), (0, 1, "x–y")]
         .into_iter()
@@ -178,6 +199,12 @@ fn mode_shapes(doc: &ModesDoc, caption: &str, sink: &mut Sink) -> Result<(), Fig
             .map(|d| (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt())
             .fold(0.0, f64::max);
         let scale = if peak > 0.0 { 0.1 * length / peak } else { 0.0 };
+        if peak == 0.0 {
+            sink.note(format!(
+                "mode_shapes: mode {} moves no centreline sample (drawn at rest)",
+                m.mode
+            ));
+        }
         let displaced = |sign: f64| -> Vec<[f64; 3]> {
             (doc.centerline.iter().zip(&m.centerline_shape))
                 .map(|(p, d)| [0, 1, 2].map(|a| p[a] + sign * scale * d[a]))
