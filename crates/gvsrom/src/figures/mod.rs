@@ -82,6 +82,45 @@ impl InputKind {
     }
 }
 
+/// A gvsrom JSON result at `path` (`statics`, `modes`, `linearize --json`) read as `T`, with its
+/// origin (the file by the SHA-256 of the bytes read); `what` names the command in the error.
+pub(crate) fn read_json_result<T: serde::de::DeserializeOwned>(
+    path: &Path,
+    what: &str,
+) -> Result<(T, crate::provenance::DirOrigin), FiguresError> {
+    let text = crate::output::read::read_regular_to_string(path)
+        .map_err(|e| input_error(path, format!("cannot read it: {e}")))?;
+    let doc = serde_json::from_str(&text).map_err(|e| {
+        input_error(
+            path,
+            format!("not a `{what} --json` result the figures can read: {e}"),
+        )
+    })?;
+    Ok((
+        doc,
+        crate::provenance::DirOrigin::of_file(path, text.as_bytes()),
+    ))
+}
+
+/// The figure titles' description of a run: its scenario, its tensions to the millinewton without
+/// trailing zeros (`u = [-20, -2.5] N`) and the reduced model's directory name.
+pub(crate) fn run_caption(scenario: &str, u: &[f64], model: Option<&str>) -> String {
+    let mut s = scenario.to_string();
+    if !u.is_empty() {
+        let u: Vec<String> = (u.iter())
+            .map(|v| format!("{}", (v * 1e3).round() / 1e3 + 0.0))
+            .collect();
+        s.push_str(&format!(", u = [{}] N", u.join(", ")));
+    }
+    if let Some(m) = model {
+        let name = Path::new(m)
+            .file_name()
+            .map_or(m.to_string(), |n| n.to_string_lossy().into_owned());
+        s.push_str(&format!(", model {name}"));
+    }
+    s
+}
+
 /// The manifest format of the gvsrom output at `path` (the `"gvsrom"` object of the JSON file, or
 /// of `meta.json` in the directory).
 fn manifest_format(path: &Path, json: &Path) -> Result<String, FiguresError> {

@@ -47,14 +47,7 @@ impl ModesDoc {
     /// Reads and checks the document at `path`: each mode's shape has a value per centreline
     /// sample.
     pub fn load(path: &Path) -> Result<ModesDoc, FiguresError> {
-        let text = crate::output::read::read_regular_to_string(path)
-            .map_err(|e| input_error(path, format!("cannot read it: {e}")))?;
-        let mut doc: ModesDoc = serde_json::from_str(&text).map_err(|e| {
-            input_error(
-                path,
-                format!("not a `modes --json` result the figures can read: {e}"),
-            )
-        })?;
+        let (mut doc, origin): (ModesDoc, _) = super::read_json_result(path, "modes")?;
         let c = doc.centerline.len();
         if doc.centerline_x.len() != c {
             return Err(input_error(
@@ -77,26 +70,13 @@ impl ModesDoc {
                 ));
             }
         }
-        doc.origin = Some(crate::provenance::DirOrigin::of_file(path, text.as_bytes()));
+        doc.origin = Some(origin);
         Ok(doc)
     }
 
     /// The figure titles' description: scenario and tensions.
     fn caption(&self) -> String {
-        let mut s = self.scenario.clone();
-        if !self.u.is_empty() {
-            let u: Vec<String> = (self.u.iter())
-                .map(|v| format!("{}", (v * 1e3).round() / 1e3 + 0.0))
-                .collect();
-            s.push_str(&format!(", u = [{}] N", u.join(", ")));
-        }
-        if let Some(m) = &self.model {
-            let name = Path::new(m)
-                .file_name()
-                .map_or(m.clone(), |n| n.to_string_lossy().into_owned());
-            s.push_str(&format!(", model {name}"));
-        }
-        s
+        super::run_caption(&self.scenario, &self.u, self.model.as_deref())
     }
 }
 

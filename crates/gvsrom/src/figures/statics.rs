@@ -38,14 +38,7 @@ pub struct StaticsDoc {
 impl StaticsDoc {
     /// Reads and checks the document at `path`: sizes agree, something to draw.
     pub fn load(path: &Path) -> Result<StaticsDoc, FiguresError> {
-        let text = crate::output::read::read_regular_to_string(path)
-            .map_err(|e| input_error(path, format!("cannot read it: {e}")))?;
-        let mut doc: StaticsDoc = serde_json::from_str(&text).map_err(|e| {
-            input_error(
-                path,
-                format!("not a `statics --json` result the figures can read: {e}"),
-            )
-        })?;
+        let (mut doc, origin): (StaticsDoc, _) = super::read_json_result(path, "statics")?;
         let mismatch = |what: &str, a: usize, b: usize| {
             input_error(path, format!("{what}: {a} abscissae but {b} values"))
         };
@@ -73,29 +66,13 @@ impl StaticsDoc {
                 ),
             ));
         }
-        doc.origin = Some(crate::provenance::DirOrigin::of_file(path, text.as_bytes()));
+        doc.origin = Some(origin);
         Ok(doc)
     }
 
     /// The figure titles' description of the solve: scenario, tensions and model.
     fn caption(&self) -> String {
-        let mut s = self.scenario.clone();
-        if !self.u.is_empty() {
-            // to the millinewton, without trailing zeros: "-20", "-2.5"
-            let u: Vec<String> = self
-                .u
-                .iter()
-                .map(|v| format!("{}", (v * 1e3).round() / 1e3 + 0.0))
-                .collect();
-            s.push_str(&format!(", u = [{}] N", u.join(", ")));
-        }
-        if let Some(m) = &self.model {
-            let name = Path::new(m)
-                .file_name()
-                .map_or(m.clone(), |n| n.to_string_lossy().into_owned());
-            s.push_str(&format!(", model {name}"));
-        }
-        s
+        super::run_caption(&self.scenario, &self.u, self.model.as_deref())
     }
 }
 
