@@ -13,6 +13,7 @@ mod interrupt;
 mod linearize;
 mod models;
 mod modes;
+mod plot;
 mod quantities;
 mod reconstruction;
 mod reduce;
@@ -52,5 +53,6 @@ fn _gvsrom(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(datasets::dataset, m)?)?;
     m.add_function(wrap_pyfunction!(datasets::load_dataset, m)?)?;
     m.add_function(wrap_pyfunction!(reproduce::reproduce, m)?)?;
+    m.add_function(wrap_pyfunction!(plot::plot, m)?)?;
     Ok(())
 }

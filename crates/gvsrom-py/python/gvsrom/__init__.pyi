@@ -23,6 +23,7 @@ __all__ = [
     "dataset",
     "load_dataset",
     "load_model",
+    "plot",
     "pod",
     "presets",
     "reproduce",
@@ -272,6 +273,12 @@ def reproduce(
     noise: float = 0.02,
     test_sizes: bool = False,
 ) -> list[dict[str, Any]]: ...
+def plot(
+    output: _Path,
+    out: _Path,
+    formats: Sequence[str] | None = None,
+    force: bool = False,
+) -> dict[str, Any]: ...
 def load_model(path: _Path, extrapolate: bool = False) -> Model: ...
 def pod(
     dataset: Dataset | _Path | Sequence[Dataset | _Path],
