@@ -122,6 +122,14 @@ pub fn vec1(a: &In1<'_>) -> Vec<f64> {
     a.as_array().iter().copied().collect()
 }
 
+/// `ob` as one real number (a float, an int, a NumPy scalar or 0-d array), if it is one. An array
+/// of at least one dimension is not, even of one element (NumPy before 2.4 turns that into a number
+/// with only a deprecation warning).
+fn one_number(ob: Borrowed<'_, '_, PyAny>) -> Option<f64> {
+    let is_array = ob.cast::<PyUntypedArray>().is_ok_and(|a| a.ndim() > 0);
+    (!is_array).then(|| ob.extract::<f64>().ok()).flatten()
+}
+
 /// Abscissae along the rod as a Python caller gives them: one number (a float, an int, a NumPy
 /// scalar or 0-d array; a result then drops the axis of the values) or a 1-D array-like of them.
 /// A bool is refused (it would read as 0 or 1 m).
@@ -140,16 +148,11 @@ impl<'a, 'py> FromPyObject<'a, 'py> for Abscissae {
                 "expected {WHAT}; got a `bool`"
             )));
         }
-        // an array of at least one dimension is an array (NumPy before 2.4 turns a 1-element one
-        // into a number with only a deprecation warning)
-        let is_array = ob.cast::<PyUntypedArray>().is_ok_and(|a| a.ndim() > 0);
-        if !is_array {
-            if let Ok(x) = ob.extract::<f64>() {
-                return Ok(Abscissae {
-                    values: vec![x],
-                    one: true,
-                });
-            }
+        if let Some(x) = one_number(ob) {
+            return Ok(Abscissae {
+                values: vec![x],
+                one: true,
+            });
         }
         let a: In1<'py> = Real::extract_as(ob, WHAT)?;
         Ok(Abscissae {
@@ -173,11 +176,8 @@ impl<'a, 'py> FromPyObject<'a, 'py> for Tensions<'py> {
     /// number with a deprecation warning); anything else that is a real number is one; the rest
     /// is read as an array-like, whose error says what is accepted.
     fn extract(ob: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
-        let is_array = ob.cast::<PyUntypedArray>().is_ok_and(|a| a.ndim() > 0);
-        if !is_array {
-            if let Ok(x) = ob.extract::<f64>() {
-                return Ok(Tensions::Scalar(x));
-            }
+        if let Some(x) = one_number(ob) {
+            return Ok(Tensions::Scalar(x));
         }
         Real::extract_as(
             ob,

@@ -74,7 +74,7 @@ impl ModesDoc {
         Ok(doc)
     }
 
-    /// The figure titles' description: scenario and tensions.
+    /// The figure titles' description: scenario, tensions and model.
     fn caption(&self) -> String {
         super::run_caption(&self.scenario, &self.u, self.model.as_deref())
     }
