@@ -45,6 +45,8 @@ mod kinematics;
 mod loads;
 #[path = "model_statics.rs"]
 mod statics;
+#[path = "model_tendons.rs"]
+mod tendons;
 #[path = "model_workspace.rs"]
 mod workspace;
 
@@ -68,6 +70,8 @@ pub struct Model<P: StrainParam> {
     pub(crate) props: Vec<SectionProps>,
     xi_star: Vec<V6>,
     tendon_points: Vec<Vec<usize>>,
+    /// Per tendon, the length of its span each of its points stands for ([`tendon_weight_list`]).
+    tendon_weights: Vec<Vec<f64>>,
     /// Per point: its block in the workspace's `dyp` (`∂y_i/∂q` of tendons), `usize::MAX` for the
     /// points no tendon acts on.
     dy_slot: Vec<usize>,
@@ -109,10 +113,19 @@ impl<P: StrainParam> Model<P> {
             .iter()
             .map(|t| tendon_point_list(&disc, t))
             .collect();
+        let tendon_weights: Vec<Vec<f64>> = tendons
+            .iter()
+            .zip(&tendon_points)
+            .map(|(t, pts)| tendon_weight_list(&disc, t, pts))
+            .collect();
         let mut dy_slot = vec![usize::MAX; disc.n_points()];
         let mut slots = 0;
-        for &i in tendon_points.iter().flatten() {
-            if dy_slot[i] == usize::MAX && disc.points[i].weight > 0.0 {
+        let weighted = tendon_points
+            .iter()
+            .flatten()
+            .zip(tendon_weights.iter().flatten());
+        for (&i, &w) in weighted {
+            if dy_slot[i] == usize::MAX && w > 0.0 {
                 (dy_slot[i], slots) = (slots, slots + 1);
             }
         }
@@ -125,6 +138,7 @@ impl<P: StrainParam> Model<P> {
             props,
             xi_star,
             tendon_points,
+            tendon_weights,
             dy_slot,
             k_lin: None,
         };
@@ -210,6 +224,13 @@ impl<P: StrainParam> Model<P> {
         &self.tendon_points[k]
     }
 
+    /// The length \[m\] of tendon `k`'s span that each of its points ([`Model::tendon_points`])
+    /// stands for: its quadrature weight `W_i`, or its share of a span that ends between points
+    /// ([`tendon_weight_list`]). They sum to the span's length.
+    pub fn tendon_weights(&self, k: usize) -> &[f64] {
+        &self.tendon_weights[k]
+    }
+
     /// Abscissae `[X_first, X_last]` \[m\] of tendon `k`'s first and last computational points
     /// (where [`Model::tendon_position_at`] interpolates); `None` for a tendon with no point.
     pub fn tendon_extent(&self, k: usize) -> Option<(f64, f64)> {
@@ -219,6 +240,41 @@ impl<P: StrainParam> Model<P> {
             self.disc.points[*pts.last()?].x,
         ))
     }
+}
+
+/// The length of tendon `t`'s span `[X_s, X_e]` each of its points `pts` stands for, the weight
+/// of its wrench `Φ_a α u` in `B(q) u` (gvs-spec §7.6) and of its speed in the tendon's length.
+///
+/// A span made of whole divisions (the spec's tendon domain) takes the quadrature weights `W_i`,
+/// as the stiffness does. A span with an end inside a division is partitioned among its points at
+/// the boundaries of their cells ([`Discretization::cells`]), the first point's share starting at
+/// `X_s` and the last's ending at `X_e`: the weights then sum to `X_e − X_s` wherever the ends fall.
+/// With `W_i` the points inside the span carried up to a point's weight more or less than its
+/// length: a tendon ending at 0.1 m inside a 0.25 m division of 33 Gauss points turned the tip by
+/// 0.012217 rad instead of the closed form's 0.012732 (4 % off).
+fn tendon_weight_list(disc: &Discretization, t: &Tendon, pts: &[usize]) -> Vec<f64> {
+    let tol = 1e-12 * disc.length().max(1.0);
+    let on_boundary = |x: f64| {
+        (x - disc.length()).abs() <= tol || disc.div_start.iter().any(|&s| (x - s).abs() <= tol)
+    };
+    if on_boundary(t.x_start) && on_boundary(t.x_end) {
+        return pts.iter().map(|&i| disc.points[i].weight).collect();
+    }
+    let cells = disc.cells();
+    let m = pts.len();
+    (0..m)
+        .map(|j| {
+            let lo = match j {
+                0 => t.x_start,
+                _ => cells[pts[j]].0.clamp(t.x_start, t.x_end),
+            };
+            let hi = match j + 1 {
+                e if e == m => t.x_end,
+                _ => cells[pts[j + 1]].0.clamp(t.x_start, t.x_end),
+            };
+            (hi - lo).max(0.0)
+        })
+        .collect()
 }
 
 /// The computational points on a tendon's span. At a termination (or start) on a division junction

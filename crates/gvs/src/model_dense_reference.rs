@@ -204,10 +204,7 @@ impl<P: StrainParam> Model<P> {
                 dy += ws.dyp.columns(slot * n, n);
             }
         }
-        for (i, p) in self.disc.points.iter().enumerate() {
-            if p.weight == 0.0 {
-                continue;
-            }
+        for i in 0..self.disc.n_points() {
             let c = self.param.columns(i);
             let dy = dyp.columns(i * n, n);
             if dy.iter().all(|v| *v == 0.0) {

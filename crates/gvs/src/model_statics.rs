@@ -149,11 +149,12 @@ impl<P: StrainParam> Model<P> {
                         std::mem::swap(&mut ws.dtau, &mut ws.dtau_prev);
                     }
                 }
-                if p.weight == 0.0 {
+                let weight = self.tendon_weights[k][m];
+                if weight == 0.0 {
                     continue;
                 }
                 let alpha = (-mu * theta).exp();
-                let scale = p.weight * alpha * uk;
+                let scale = weight * alpha * uk;
                 ws.y[i] += tl.phi_a * scale;
                 if jac {
                     let c = self.param.columns(i);
@@ -423,9 +424,9 @@ impl<P: StrainParam> Model<P> {
         }
         // tendons: Ψ_qᵀ ∂y_i/∂q at the points they reach
         self.tendon_forces(u, ws, true);
-        for (i, p) in self.disc.points.iter().enumerate() {
+        for i in 0..self.disc.n_points() {
             let hi = ws.dy_hi[i];
-            if p.weight == 0.0 || hi == 0 {
+            if hi == 0 {
                 continue;
             }
             let c = self.param.columns(i);

@@ -189,6 +189,18 @@ fn single_division_model(order: MagnusOrder, friction: f64) -> Model<LinearBasis
             turns: 0.0,
             path: Vec::new(),
         },
+        // a span inside the division, ending on the weight-0 extra point at 0.1: its points
+        // share the span by their cells (`Model::tendon_weights`), that extra point included
+        Tendon {
+            offset_start: [-0.004, 0.002],
+            offset_end: [-0.003, -0.001],
+            x_start: 0.047,
+            x_end: 0.1,
+            friction: 0.5,
+            friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
+            turns: 0.0,
+            path: Vec::new(),
+        },
     ];
     Model::new(rod, disc, basis, tendons).unwrap()
 }
@@ -250,7 +262,7 @@ fn statics_jacobian_matches_finite_differences_with_all_loads_and_friction() {
     for order in [MagnusOrder::Z4, MagnusOrder::Z2] {
         let m = single_division_model(order, 0.88);
         let q = pseudo_random(m.n_dof(), 2, 0.5);
-        check_statics_jacobian(&m, &q, &[-2.0, -0.7], &all_loads());
+        check_statics_jacobian(&m, &q, &[-2.0, -0.7, -1.5], &all_loads());
     }
 }
 

@@ -288,6 +288,14 @@ fn tendon_column_is_gradient_of_routed_length(tendon: Tendon) {
         "ℓ_h = {l_h} vs chord length {chord}: {geo_err:e}"
     );
 
+    // the engine's lengths are this one (up to this test's own d and d', a central difference:
+    // measured ≤ 7e-14 m)
+    let engine = m.tendon_lengths(&q, &mut ws)[0];
+    assert!(
+        (engine - l_h).abs() < 1e-12 * l_h,
+        "Model::tendon_lengths {engine} vs ℓ_h {l_h}"
+    );
+
     let b = m.actuation_matrix(&q, &mut ws);
     let grad = gradient(&q, 1e-6, |x| tendon_length(&m, 0, x, &mut ws));
     let col = b.column(0).into_owned();

@@ -337,6 +337,31 @@ fn a_tendon_loading_components_the_basis_lacks_is_named() {
 }
 
 #[test]
+fn a_tendon_ending_inside_a_division_is_named_with_the_split() {
+    let warnings = |set: &[&str]| {
+        let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
+        let s = presets::load("single-tendon", &set).expect("preset loads");
+        gvsrom::build::model_warnings(&gvsrom::build(&s).unwrap().model)
+    };
+    // the preset's tendon spans its one division
+    assert!(warnings(&[]).is_empty());
+    let w = warnings(&["tendons.0.x_start=0.05", "tendons.0.x_end=0.1"]);
+    assert_eq!(w.len(), 2, "{w:?}");
+    assert!(
+        w[0].starts_with("tendons[0].x_start = 0.05 m lies inside divisions[0] ([0, 0.25] m)")
+            && w[0].contains("lengths 0.05 and 0.2 m"),
+        "{w:?}"
+    );
+    assert!(
+        w[1].starts_with("tendons[0].x_end = 0.1 m lies inside divisions[0]")
+            && w[1].contains(
+                "split the division at 0.1 m (two [[divisions]] of lengths 0.1 and 0.15 m)"
+            ),
+        "{w:?}"
+    );
+}
+
+#[test]
 fn a_precurved_division_rests_on_its_arc_and_is_bounded() {
     // reference_strain bends the unloaded rod into the arc of curvature κ*: tip (sin κL/κ, 0,
     // −(1 − cos κL)/κ) for a curvature about y (gvs-spec §10.3.1's circle, here with no load)

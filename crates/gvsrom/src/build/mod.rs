@@ -18,7 +18,7 @@ pub use limits::*;
 pub use loads::loads;
 pub use reduced::Reduced;
 pub use resolve::{resolve, Request, Resolved};
-pub use tendons::uncovered_tendon_components;
+pub use tendons::{tendon_ends_inside_divisions, uncovered_tendon_components};
 
 use basis::{basis, kinematics_resolution, quadrature};
 use rod::{base_pose, geometry, material, radius_range, reference_strain};
@@ -191,11 +191,19 @@ pub fn under_integrated_divisions(s: &Scenario) -> Vec<String> {
         .collect()
 }
 
-/// Every build warning of `s` built as `built`: tendon loads the basis cannot hold
-/// ([`uncovered_tendon_components`]) and divisions the kinematics under-integrate
-/// ([`under_integrated_divisions`]).
+/// The warnings of a built model alone: tendon loads the basis cannot hold
+/// ([`uncovered_tendon_components`]) and tendon ends inside divisions
+/// ([`tendon_ends_inside_divisions`]).
+pub fn model_warnings(model: &Model<LinearBasis>) -> Vec<String> {
+    let mut w = uncovered_tendon_components(model);
+    w.extend(tendon_ends_inside_divisions(model));
+    w
+}
+
+/// Every build warning of `s` built as `built`: [`model_warnings`] and divisions the kinematics
+/// under-integrate ([`under_integrated_divisions`]).
 pub fn warnings(s: &Scenario, built: &Built) -> Vec<String> {
-    let mut w = uncovered_tendon_components(&built.model);
+    let mut w = model_warnings(&built.model);
     w.extend(under_integrated_divisions(s));
     w
 }

@@ -236,7 +236,7 @@ pub struct Outcome {
     /// Chunks taken over from the resumed dataset.
     pub resumed_chunks: usize,
     /// What the scenario's model cannot do that the user may expect
-    /// ([`crate::build::uncovered_tendon_components`]), for the front-end to warn with.
+    /// ([`crate::build::model_warnings`]), for the front-end to warn with.
     pub warnings: Vec<String>,
 }
 
@@ -389,7 +389,7 @@ pub fn run(args: &DatasetRequest, interrupt: &AtomicUsize) -> Result<Outcome, Da
     }
     let seed = args.seed.unwrap_or(0);
     let (table, built, scenario_toml, provenance) = load_scenario(args)?;
-    let mut warnings = crate::build::uncovered_tendon_components(&built.model);
+    let mut warnings = crate::build::model_warnings(&built.model);
     if let Ok(scenario) = crate::scenario::from_table(table.clone()) {
         warnings.extend(crate::build::under_integrated_divisions(&scenario));
     }

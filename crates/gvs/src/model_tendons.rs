@@ -1,0 +1,75 @@
+//! Tendon lengths (gvs-spec §7.6): what an actuator's encoder reads, and their derivative in `q`.
+//!
+//! Tendon `k`'s thread `p = r + R d(X)` has the speed `‖dp/dX‖ = ‖t_u‖`, `t_u = ν + k × d + d'`, so
+//! its length is `ℓ_k = ∫ ‖t_u‖ dX` over its span, here `ℓ_k(q) = Σ_i w_{k,i} ‖t_u(X_i)‖` over its
+//! points with the weights of its wrench ([`Model::tendon_weights`]). Since `∂‖t_u‖/∂ξ = [d × t; t]
+//! = Φ_a`, the derivative is `∂ℓ_k/∂q = Σ_i w_{k,i} Ψ_q,iᵀ Φ_a,k(X_i)`: the column `B_k` of the
+//! actuation matrix of a frictionless tendon (the virtual work of its tension, `u δℓ`). With
+//! friction `B_k` weights each point by `α ≤ 1` and is no longer a gradient; `∂ℓ/∂q` is still this.
+
+use super::{Model, Workspace};
+use crate::actuation::tendon_local;
+use crate::lie::V6;
+use crate::strain::StrainParam;
+use nalgebra::{DMatrix, DVector};
+
+impl<P: StrainParam> Model<P> {
+    /// The tendons' lengths `ℓ_k(q) = Σ_i w_{k,i} ‖t_u(X_i)‖` \[m\] (the module documentation), one
+    /// per tendon, at `q`. A tendon is shortened by pulling it: `ℓ_k(q) < ℓ_k(rest)` as it bends
+    /// the rod toward itself.
+    pub fn tendon_lengths(&self, q: &DVector<f64>, ws: &mut Workspace) -> Vec<f64> {
+        let xi = self.strains_at(q, ws);
+        (0..self.tendons.len())
+            .map(|k| self.tendon_length_of(k, |i| xi[i]))
+            .collect()
+    }
+
+    /// The tendons' lengths \[m\] at rest, the reference strain `ξ*` (the straight, unstretched
+    /// rod's `[0, 0, 0, 1, 0, 0]` unless the rod is precurved): what the lengths of
+    /// [`Self::tendon_lengths`] are shortened from.
+    pub fn tendon_rest_lengths(&self) -> Vec<f64> {
+        (0..self.tendons.len())
+            .map(|k| self.tendon_length_of(k, |i| self.xi_star(i)))
+            .collect()
+    }
+
+    /// `∂ℓ/∂q` (n × tendons): column `k` is `∇_q ℓ_k = Σ_i w_{k,i} Ψ_q,iᵀ Φ_a,k(X_i)`, the
+    /// frictionless tendon's column of the actuation matrix (the module documentation).
+    pub fn tendon_length_jacobian(&self, q: &DVector<f64>, ws: &mut Workspace) -> DMatrix<f64> {
+        let (n, na) = (self.n_dof(), self.n_actuators());
+        self.param.eval(q, &mut ws.ev);
+        ws.ev.motion = false;
+        ws.ev.psi_q_stale = false;
+        for s in 0..ws.xi.len() {
+            ws.xi[s] = ws.ev.psi[s] + self.xi_star[s];
+        }
+        let mut jac = DMatrix::zeros(n, na);
+        let mut col = DVector::zeros(n);
+        for (k, td) in self.tendons.iter().enumerate() {
+            ws.y.iter_mut().for_each(|y| *y = V6::zeros());
+            for (&i, &w) in self.tendon_points[k].iter().zip(&self.tendon_weights[k]) {
+                if w == 0.0 {
+                    continue;
+                }
+                let (d, dp) = td.offset_and_rate(self.disc.points[i].x);
+                ws.y[i] += tendon_local(&ws.xi[i], &d, &dp).phi_a * w;
+            }
+            col.fill(0.0);
+            self.project(ws, &mut col);
+            jac.set_column(k, &col);
+        }
+        jac
+    }
+
+    /// `Σ_i w_{k,i} ‖t_u(X_i)‖` of tendon `k` with the strain `xi(i)` at point `i`.
+    fn tendon_length_of(&self, k: usize, xi: impl Fn(usize) -> V6) -> f64 {
+        let td = &self.tendons[k];
+        (self.tendon_points[k].iter().zip(&self.tendon_weights[k]))
+            .filter(|(_, &w)| w != 0.0)
+            .map(|(&i, &w)| {
+                let (d, dp) = td.offset_and_rate(self.disc.points[i].x);
+                w * tendon_local(&xi(i), &d, &dp).nt
+            })
+            .sum()
+    }
+}
