@@ -18,10 +18,18 @@ impl<P: StrainParam> Model<P> {
     /// per tendon, at `q`. A tendon is shortened by pulling it: `ℓ_k(q) < ℓ_k(rest)` as it bends
     /// the rod toward itself.
     pub fn tendon_lengths(&self, q: &DVector<f64>, ws: &mut Workspace) -> Vec<f64> {
+        let mut out = vec![0.0; self.tendons.len()];
+        self.tendon_lengths_into(q, ws, &mut out);
+        out
+    }
+
+    /// [`Self::tendon_lengths`] into `out` (one per tendon), allocating nothing: for a trajectory's
+    /// every sample.
+    pub fn tendon_lengths_into(&self, q: &DVector<f64>, ws: &mut Workspace, out: &mut [f64]) {
         let xi = self.strains_at(q, ws);
-        (0..self.tendons.len())
-            .map(|k| self.tendon_length_of(k, |i| xi[i]))
-            .collect()
+        for (k, l) in out.iter_mut().enumerate().take(self.tendons.len()) {
+            *l = self.tendon_length_of(k, |i| xi[i]);
+        }
     }
 
     /// The tendons' lengths \[m\] at rest, the reference strain `ξ*` (the straight, unstretched

@@ -22,6 +22,7 @@ mod robot;
 mod scenario;
 mod simulate;
 mod statics;
+mod tendon_quantities;
 
 use pyo3::prelude::*;
 

@@ -75,7 +75,9 @@ impl Robot {
     ///     ``t`` (k,), ``q``/``qd`` (k, n), ``u`` (k, n_a), ``tip_position`` (k, 3),
     ///     ``tip_rotation`` (k, 3, 3), ``strain`` (k, p, 6), ``strain_x`` (p,), ``centerline``
     ///     (k, c, 3), ``centerline_x`` (c,), ``tendon_paths`` (k, n_a, c, 3: each tendon's thread
-    ///     at ``centerline_x`` clamped to its span), ``steps``, ``failed_steps``, ``wall_time_s``, and
+    ///     at ``centerline_x`` clamped to its span), ``tendon_lengths`` (k, n_a: each tendon's
+    ///     length [m] along its thread; at rest :attr:`Robot.tendon_rest_lengths`), ``steps``,
+    ///     ``failed_steps``, ``wall_time_s``, and
     ///     ``model_extrapolated`` (list of str): how the reduced model was used outside what it
     ///     was trained on (``extrapolate=True``; the scenario, a signal's tensions, the values a
     ///     callable ``input`` returned), empty otherwise.
@@ -534,6 +536,10 @@ fn trajectory<'py>(
     d.set_item(
         "tendon_paths",
         shaped(py, b.tendon_paths.clone(), [k, na, c, 3])?,
+    )?;
+    d.set_item(
+        "tendon_lengths",
+        shaped(py, b.tendon_lengths.clone(), [k, na])?,
     )?;
     let s = &outcome.summary;
     d.set_item("steps", s.stats.steps)?;

@@ -35,6 +35,11 @@ use pyo3::types::PyDict;
 /// tendon_paths : tuple of numpy.ndarray, each shape (m_k, 3)
 ///     Each tendon's thread ``r + R d(X)`` in the world frame [m], from its start to its end (at
 ///     its ends and at the ``centerline_x`` between them).
+/// tendon_lengths : numpy.ndarray, shape (n_actuators,)
+///     Each tendon's length [m] along its thread, ``∫ ‖t_u‖ dX`` over its span: what an encoder on
+///     its actuator reads, up to a constant.
+/// tendon_rest_lengths : numpy.ndarray, shape (n_actuators,)
+///     The same at rest: ``tendon_rest_lengths - tendon_lengths`` is how far each is pulled in.
 /// iterations, load_stages, residual_evaluations, jacobian_evaluations : int
 ///     Solver statistics.
 /// residual_norm : float
@@ -72,6 +77,10 @@ pub struct Statics {
     strain_reference: Py<PyAny>,
     /// Each tendon's thread in the world frame [m], a `(m_k, 3)` array per tendon.
     tendon_paths: Py<PyAny>,
+    /// Each tendon's length [m] along its thread.
+    tendon_lengths: Py<PyAny>,
+    /// Each tendon's length [m] at rest.
+    tendon_rest_lengths: Py<PyAny>,
     /// Dogleg iterations over all load stages.
     iterations: usize,
     /// Load stages of the ramp.
@@ -120,6 +129,8 @@ impl Statics {
             )?
             .into_any()
             .unbind(),
+            tendon_lengths: held(vector(py, &r.tendon_lengths))?,
+            tendon_rest_lengths: held(vector(py, &r.tendon_rest_lengths))?,
             iterations: r.iterations,
             load_stages: r.load_stages,
             residual_evaluations: r.residual_evaluations,
@@ -150,6 +161,8 @@ impl Statics {
             ("strain", &self.strain),
             ("strain_reference", &self.strain_reference),
             ("tendon_paths", &self.tendon_paths),
+            ("tendon_lengths", &self.tendon_lengths),
+            ("tendon_rest_lengths", &self.tendon_rest_lengths),
         ] {
             d.set_item(k, v.bind(py))?;
         }
@@ -188,6 +201,8 @@ impl Statics {
 /// centerline : numpy.ndarray, shape (m, c, 3)
 /// strain_x : numpy.ndarray, shape (p,)
 /// strain : numpy.ndarray, shape (m, p, 6)
+/// tendon_lengths : numpy.ndarray, shape (m, n_actuators)
+///     Each tendon's length [m] along its thread (at rest: :attr:`Robot.tendon_rest_lengths`).
 /// iterations : numpy.ndarray of int64, shape (m,)
 /// residual_norm : numpy.ndarray, shape (m,)
 /// solve_time_s : numpy.ndarray, shape (m,)
@@ -210,6 +225,8 @@ pub struct StaticsBatch {
     strain_x: Py<PyAny>,
     /// ξ at the points, `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]`.
     strain: Py<PyAny>,
+    /// Each tendon's length [m] along its thread.
+    tendon_lengths: Py<PyAny>,
     /// Dogleg iterations over all load stages.
     iterations: Py<PyAny>,
     /// `‖R(q)‖∞` at the solution.
@@ -241,6 +258,7 @@ impl StaticsBatch {
             centerline: held(shaped(py, cat(&|r| flat(&r.centerline)), [m, c.len(), 3])?)?,
             strain_x: held(vector(py, &x))?,
             strain: held(shaped(py, cat(&|r| flat(&r.strain)), [m, x.len(), 6])?)?,
+            tendon_lengths: held(shaped(py, cat(&|r| r.tendon_lengths.clone()), [m, na])?)?,
             iterations: held(PyArray::from_vec(py, iterations).into_any())?,
             residual_norm: held(vector(
                 py,

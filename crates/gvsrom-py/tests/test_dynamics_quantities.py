@@ -130,7 +130,8 @@ def test_bad_states_name_the_argument(robot):
     # statics ones once did)
     at_q = [robot.forward, robot.jacobian, robot.mass_matrix, robot.statics_residual,
             robot.statics_jacobian, robot.elastic_force, robot.external_force,
-            lambda q: robot.position_jacobian(q, 0.1)]
+            lambda q: robot.position_jacobian(q, 0.1), robot.tendon_lengths,
+            robot.tendon_length_jacobian]
     for f in at_q:
         with pytest.raises(gvsrom.GvsromError, match=r"`q\[4\]` = NaN: expected a finite number"):
             f(q)

@@ -130,7 +130,8 @@ def test_a_state_no_rod_holds_is_refused_not_answered_with_nan(robot):
     q = np.zeros(n)
     q[0] = 1e24
     for f in (robot.mass_matrix, robot.elastic_force, robot.forward, robot.external_force,
-              lambda q: robot.position_jacobian(q, 0.1)):
+              lambda q: robot.position_jacobian(q, 0.1), robot.tendon_lengths,
+              robot.tendon_length_jacobian):
         with pytest.raises(gvsrom.GvsromError, match="`q` is no state of an elastic rod"):
             f(q)
     fast = np.full(n, 1e200)

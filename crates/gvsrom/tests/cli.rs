@@ -258,6 +258,7 @@ fn statics_prints_summary_and_writes_json_atomically() {
         " ms",
         "tip        position",
         "rotation axis",
+        "tendons    length [",
     ] {
         assert!(
             stdout.contains(needle),
@@ -287,6 +288,19 @@ fn statics_prints_summary_and_writes_json_atomically() {
     for i in 0..3 {
         assert!((tip[i].as_f64().unwrap() - last[i].as_f64().unwrap()).abs() < 1e-12);
     }
+    // the tendon at rest is the line from offset 10 mm to 3 mm over 0.25 m; the summary prints
+    // how far the equilibrium's length is from it
+    let rest = json["tendon_rest_lengths"][0].as_f64().unwrap();
+    assert!(
+        (rest - 0.25f64.hypot(0.007)).abs() < 1e-15,
+        "rest length {rest}"
+    );
+    let length = json["tendon_lengths"][0].as_f64().unwrap();
+    let line = format!(
+        "tendons    length [{length:.6}] m, pulled in [{:.3}] mm from rest",
+        1e3 * (rest - length)
+    );
+    assert!(stdout.contains(&line), "summary lacks `{line}`:\n{stdout}");
 }
 
 #[test]

@@ -241,6 +241,28 @@ fn simulation_writes_numpy_arrays_with_consistent_shapes() {
             "{got:?} vs {want:?}"
         );
     }
+    // each tendon's length: at rest the straight lines, √(0.6² + 0.01²) for the full tendons
+    // (radius 0.02 → 0.01 m) and √(0.3² + 0.005²) for the half ones (0.02 → 0.015 m), as
+    // `meta.json` records them; the babbling pulls every tendon in at some time
+    assert_eq!(npy_shape(&out_dir.join("tendon_lengths.npy")), vec![51, 6]);
+    let lengths = npy_values(&out_dir.join("tendon_lengths.npy"));
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("meta.json")).unwrap()).unwrap();
+    let (full, half) = (0.6f64.hypot(0.01), 0.3f64.hypot(0.005));
+    for k in 0..6 {
+        let line = if k % 2 == 0 { full } else { half };
+        let rest = meta["tendon_rest_lengths"][k].as_f64().unwrap();
+        assert!(
+            (lengths[k] - line).abs() < 1e-14 && (rest - line).abs() < 1e-14,
+            "tendon {k}: first sample {}, rest {rest}, line {line}",
+            lengths[k]
+        );
+        let shortest = (0..51).map(|s| lengths[6 * s + k]).fold(f64::MAX, f64::min);
+        assert!(
+            shortest < line - 1e-4,
+            "tendon {k} never pulled in: {shortest}"
+        );
+    }
     // babbled tensions stay in range and the same seed gives the same signal
     let u = npy_values(&out_dir.join("u.npy"));
     assert!(u.iter().all(|v| (-15.0..0.0).contains(v)));

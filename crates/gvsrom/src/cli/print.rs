@@ -138,6 +138,17 @@ pub(super) fn print_solution(r: &StaticsReport, out: &mut impl Write) -> Result<
         let label = if i == 0 { "R =" } else { "   " };
         writeln!(out, "           {label} {}", fmt_vec(row, 6))?;
     }
+    if !r.tendon_lengths.is_empty() {
+        let pulled: Vec<f64> = (r.tendon_rest_lengths.iter().zip(&r.tendon_lengths))
+            .map(|(rest, l)| 1e3 * (rest - l))
+            .collect();
+        writeln!(
+            out,
+            "tendons    length {} m, pulled in {} mm from rest",
+            fmt_vec(&r.tendon_lengths, 6),
+            fmt_vec(&pulled, 3)
+        )?;
+    }
     Ok(())
 }
 

@@ -25,6 +25,8 @@ pub struct TrajectoryBuffer {
     /// `samples × tendons × c × 3`: each tendon's thread at [`Self::centerline_x`] clamped to its
     /// span (`tendon_paths.npy` of a written trajectory).
     pub tendon_paths: Vec<f64>,
+    /// `samples × tendons`: each tendon's length \[m\] (`tendon_lengths.npy`).
+    pub tendon_lengths: Vec<f64>,
     shape: Centerline,
 }
 
@@ -41,6 +43,7 @@ impl TrajectoryBuffer {
             strain: vec![],
             centerline: vec![],
             tendon_paths: vec![],
+            tendon_lengths: vec![],
             shape: Centerline::new(built),
         }
     }
@@ -62,6 +65,7 @@ impl SampleSink for TrajectoryBuffer {
         self.shape.sample(built, s.q);
         self.centerline.extend_from_slice(&self.shape.points);
         self.tendon_paths.extend_from_slice(&self.shape.tendons);
+        self.tendon_lengths.extend_from_slice(&self.shape.lengths);
         self.t.push(s.t);
         self.q.extend_from_slice(s.q);
         self.qd.extend_from_slice(s.qd);

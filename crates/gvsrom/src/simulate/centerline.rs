@@ -16,6 +16,8 @@ pub(super) struct Centerline {
     /// `tendons × c × 3`: each tendon's thread `r + R d(X)` at the abscissae `x` clamped to its
     /// span ([`gvs::model::Model::tendon_position_at`]), of the current sample.
     pub(super) tendons: Vec<f64>,
+    /// Each tendon's length \[m\] ([`gvs::model::Model::tendon_lengths`]) of the current sample.
+    pub(super) lengths: Vec<f64>,
 }
 
 impl Centerline {
@@ -31,10 +33,11 @@ impl Centerline {
             ws,
             points: vec![0.0; 3 * c],
             tendons: vec![0.0; 3 * c * built.model.n_actuators()],
+            lengths: vec![0.0; built.model.n_actuators()],
         }
     }
 
-    /// The centreline at `q` into [`Self::points`].
+    /// The centreline at `q` into [`Self::points`], the tendons' threads and lengths.
     pub(super) fn sample(&mut self, built: &Built, q: &[f64]) {
         self.q.as_mut_slice().copy_from_slice(q);
         match &built.reduced {
@@ -60,5 +63,7 @@ impl Centerline {
                 self.tendons[o..o + 3].copy_from_slice(&[p[0], p[1], p[2]]);
             }
         }
+        // last: it evaluates the strains alone and leaves the poses stale
+        model.tendon_lengths_into(&self.q, &mut self.ws, &mut self.lengths);
     }
 }

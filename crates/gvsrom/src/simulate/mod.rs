@@ -17,7 +17,9 @@
 //! | `strain.npy` | (N, p, 6) | ξ at the p computational points, `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]` |
 //! | `strain_x.npy` | (p,) | abscissae of the computational points \[m\] |
 //! | `centerline.npy` | (N, c, 3) | centreline positions \[m\] at the `c` abscissae `centerline_x` of `meta.json`, equally spaced in arc length from base to tip (`output.centerline_points`, `--centerline-points`), in the world frame as `statics --json` |
-//! | `meta.json` | | manifest (`gvsrom`: format, version, files), scenario, `complete`, `reason`, `t_reached`, `t_requested`, `sample_rate`, sizes, integrator statistics, wall time, real-time factor, error, `input` ([`input_record`]), `physics` (material, geometry, base, tendon routing, loads), `centerline_x`, `provenance` ([`crate::provenance`]) |
+//! | `tendon_paths.npy` | (N, n_a, c, 3) | each tendon's thread `r + R d(X)` \[m\] at `centerline_x` clamped to its span (with tendons only) |
+//! | `tendon_lengths.npy` | (N, n_a) | each tendon's length \[m\] along its thread, `∫ ‖t_u‖ dX` (with tendons only; at rest: `meta.json`'s `tendon_rest_lengths`) |
+//! | `meta.json` | | manifest (`gvsrom`: format, version, files), scenario, `complete`, `reason`, `t_reached`, `t_requested`, `sample_rate`, sizes, integrator statistics, wall time, real-time factor, error, `input` ([`input_record`]), `physics` (material, geometry, base, tendon routing, loads), `centerline_x`, `tendon_rest_lengths`, `provenance` ([`crate::provenance`]) |
 //!
 //! The integrator is chosen here too ([`choose_integrator`]): by the rod's damping unless named,
 //! as `gvsrom simulate` and `gvsrom reproduce` both do.

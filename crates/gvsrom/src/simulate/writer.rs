@@ -18,6 +18,11 @@ use std::path::{Path, PathBuf};
 /// thread at the centreline abscissae clamped to its span (written only with tendons).
 pub const TENDON_PATHS_FILE: &str = "tendon_paths.npy";
 
+/// The file of per-sample tendon lengths in a trajectory: `[samples, tendons]` \[m\]
+/// ([`gvs::model::Model::tendon_lengths`]; written only with tendons, their rest lengths in
+/// `meta.json`'s `tendon_rest_lengths`).
+pub const TENDON_LENGTHS_FILE: &str = "tendon_lengths.npy";
+
 /// Largest trajectory one run writes \[bytes\] (16 GiB).
 pub const MAX_OUTPUT_BYTES: f64 = 16.0 * 1024.0 * 1024.0 * 1024.0;
 
@@ -112,13 +117,13 @@ pub fn run_to_dir(
     })
 }
 
-/// Bytes written per sample: `t`, `q`, `q̇`, `u`, tip position and rotation, strains, centreline
-/// and tendon paths (f64 each).
+/// Bytes written per sample: `t`, `q`, `q̇`, `u`, tip position and rotation, strains, centreline,
+/// tendon paths and lengths (f64 each).
 pub(super) fn bytes_per_sample(built: &Built) -> f64 {
     let m = &built.model;
     let c = built.centerline_points.max(2);
     let (na, np) = (m.n_actuators(), m.disc.n_points());
-    8.0 * (1 + 2 * built.n_dof() + na + 3 + 9 + 6 * np + 3 * c * (1 + na)) as f64
+    8.0 * (1 + 2 * built.n_dof() + 2 * na + 3 + 9 + 6 * np + 3 * c * (1 + na)) as f64
 }
 
 /// Refuses a trajectory larger than [`MAX_OUTPUT_BYTES`] before anything is computed.
@@ -151,8 +156,8 @@ pub struct TrajectoryWriter {
     tip_rotation: NpyRows,
     strain: NpyRows,
     centerline: NpyRows,
-    /// `tendon_paths.npy`, with tendons only.
-    tendon_paths: Option<NpyRows>,
+    /// `tendon_paths.npy` and `tendon_lengths.npy`, with tendons only.
+    tendon_paths: Option<(NpyRows, NpyRows)>,
     shape: Centerline,
     provenance: Option<serde_json::Value>,
 }
@@ -180,11 +185,16 @@ impl TrajectoryWriter {
         };
         let (t, q, qd, u, tip_position, tip_rotation, strain, centerline) =
             open(&mut dir).map_err(|e| dir.io_error("create the trajectory files", e))?;
+        let tendons = |dir: &mut OutputDir| -> std::io::Result<_> {
+            Ok((
+                NpyRows::new(dir, TENDON_PATHS_FILE, &[na, nc, 3])?,
+                NpyRows::new(dir, TENDON_LENGTHS_FILE, &[na])?,
+            ))
+        };
         let tendon_paths = match na {
             0 => None,
             _ => Some(
-                NpyRows::new(&mut dir, TENDON_PATHS_FILE, &[na, nc, 3])
-                    .map_err(|e| dir.io_error("create the trajectory files", e))?,
+                tendons(&mut dir).map_err(|e| dir.io_error("create the trajectory files", e))?,
             ),
         };
         Ok(TrajectoryWriter {
@@ -222,8 +232,9 @@ impl TrajectoryWriter {
         }
         self.shape.sample(built, s.q);
         self.centerline.push(self.shape.points.iter().copied())?;
-        if let Some(tp) = &mut self.tendon_paths {
-            tp.push(self.shape.tendons.iter().copied())?;
+        if let Some((paths, lengths)) = &mut self.tendon_paths {
+            paths.push(self.shape.tendons.iter().copied())?;
+            lengths.push(self.shape.lengths.iter().copied())?;
         }
         self.t.push([s.t])?;
         self.q.push(s.q.iter().copied())?;
@@ -269,7 +280,8 @@ impl TrajectoryWriter {
         let samples = t.rows();
         let arrays = [t, q, qd, u, tip_position, tip_rotation, strain, centerline];
         (|| -> std::io::Result<()> {
-            for a in arrays.into_iter().chain(tendon_paths) {
+            let tendons = tendon_paths.into_iter().flat_map(|(p, l)| [p, l]);
+            for a in arrays.into_iter().chain(tendons) {
                 a.finish(&mut dir)?;
             }
             crate::npy::write_array(
@@ -341,6 +353,7 @@ impl TrajectoryWriter {
                 .cloned()
                 .collect(),
             centerline_x: shape.x,
+            tendon_rest_lengths: built.model.tendon_rest_lengths(),
             provenance,
         };
         dir.commit(meta)
@@ -392,6 +405,9 @@ pub(super) struct Meta<'a> {
     model_extrapolated: Vec<String>,
     /// Abscissae of the centreline samples in `centerline.npy` [m].
     centerline_x: Vec<f64>,
+    /// Each tendon's length at rest \[m\], what `tendon_lengths.npy` is shortened from.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    tendon_rest_lengths: Vec<f64>,
     /// How the run was made ([`crate::provenance::Provenance`]), when the caller recorded it.
     #[serde(skip_serializing_if = "Option::is_none")]
     provenance: Option<serde_json::Value>,

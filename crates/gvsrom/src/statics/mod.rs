@@ -49,6 +49,14 @@ pub struct StaticsReport {
     /// computational points, as the centreline); empty without tendons.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub tendon_paths: Vec<Vec<[f64; 3]>>,
+    /// Each tendon's length \[m\] along its routed thread, `ℓ = ∫ ‖t_u‖ dX` over its span
+    /// ([`Model::tendon_lengths`]): what an encoder on its actuator reads, up to a constant.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub tendon_lengths: Vec<f64>,
+    /// Each tendon's length \[m\] at rest (the reference strain): `rest − length` is how far its
+    /// actuator has pulled it in.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub tendon_rest_lengths: Vec<f64>,
     /// Dogleg iterations over all load stages.
     pub iterations: usize,
     pub load_stages: usize,
@@ -300,7 +308,7 @@ fn report<P: StrainParam>(
     ws: &mut Workspace,
 ) -> StaticsReport {
     model.forward_pose(&sol.q, ws);
-    let tip = &ws.g[model.disc.tip()];
+    let tip = ws.g[model.disc.tip()];
     let length = model.disc.length();
     let centerline_x = centerline_abscissae(length, built.centerline_points);
     let centerline = centerline_x
@@ -313,6 +321,8 @@ fn report<P: StrainParam>(
         .iter()
         .map(|xi| [xi[0], xi[1], xi[2], xi[3], xi[4], xi[5]])
         .collect();
+    // after the poses are read: this evaluates the strains alone
+    let tendon_lengths = model.tendon_lengths(&sol.q, ws);
     StaticsReport {
         scenario: built.name.clone(),
         u: u.to_vec(),
@@ -332,6 +342,8 @@ fn report<P: StrainParam>(
             })
             .collect(),
         tendon_paths,
+        tendon_lengths,
+        tendon_rest_lengths: model.tendon_rest_lengths(),
         iterations: sol.iterations,
         load_stages: sol.load_stages,
         residual_evaluations: sol.residual_evaluations,
