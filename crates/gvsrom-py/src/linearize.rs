@@ -36,16 +36,22 @@ impl Robot {
     ///     Abscissae [m] along the rod whose world positions make ``y`` (``--output-at``), 3 rows
     ///     of ``C`` each in this order, between the computational points by the centreline's
     ///     interpolant; default: the tip.
+    /// tendon_lengths : bool
+    ///     Also output each tendon's length [m] along its thread (``--output-tendon-lengths``),
+    ///     one row of ``C`` each after the positions, for actuators under position control; the
+    ///     static gain's last rows are then the tendons' compliance ``∂ℓ/∂u``.
     ///
     /// Returns
     /// -------
     /// dict
     ///     ``A`` (2n, 2n), ``B`` (2n, n_actuators), ``C`` (3k, 2n) for k outputs, ``outputs``
-    ///     (k,) their abscissae, ``output_positions`` (k, 3), ``x0`` (2n,) the operating
+    ///     (k,) their abscissae, ``output_positions`` (k, 3), ``output_tendon_lengths``
+    ///     (n_actuators,) with ``tendon_lengths`` (empty otherwise; ``C`` then has
+    ///     3k + n_actuators rows), ``x0`` (2n,) the operating
     ///     point, ``u`` (n_actuators,), ``xdot`` (2n,) ``f(x0, u)`` (≈ 0 about an equilibrium),
     ///     ``tip_position`` (3,), ``poles`` (complex, the eigenvalues of A with ``Im ≥ 0``,
     ///     conjugates once, slowest first), ``natural_frequency_hz`` and ``damping_ratio`` per pole,
-    ///     ``unstable_poles`` (count, conjugates counted), ``static_gain`` (3k, n_actuators) [m/N]
+    ///     ``unstable_poles`` (count, conjugates counted), ``static_gain`` (C's rows, n_actuators) [m/N]
     ///     ``−C A⁻¹ B`` about an equilibrium (``None`` about a given state), ``about``
     ///     (``"equilibrium"`` or ``"state"``), ``damping_time_s``, ``relaxation_poles``,
     ///     ``equilibrium_residual_norm`` (about an equilibrium), ``time_s`` (the linearization's
@@ -57,7 +63,8 @@ impl Robot {
     /// GvsromError
     ///     For bad tensions or states, ``qd`` without ``q``, a massless rod, or an equilibrium
     ///     that fails (``ConvergenceError``).
-    #[pyo3(signature = (u=None, q=None, qd=None, dt=None, outputs=None))]
+    #[pyo3(signature = (u=None, q=None, qd=None, dt=None, outputs=None, tendon_lengths=false))]
+    #[allow(clippy::too_many_arguments)]
     fn linearize<'py>(
         &self,
         py: Python<'py>,
@@ -66,15 +73,20 @@ impl Robot {
         qd: Option<arrays::In1<'_>>,
         dt: Option<f64>,
         outputs: Option<arrays::Abscissae>,
+        tendon_lengths: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         if let Some(h) = dt {
             linearize::check_sample_time(h).map_err(|e| invalid(e.to_string()))?;
         }
-        let outputs = match &outputs {
+        let mut outputs = match &outputs {
             None => linearize::Outputs::tip(&self.built),
             Some(xs) => linearize::Outputs::at(&self.built, &xs.values)
                 .map_err(|e| invalid(e.to_string()))?,
         };
+        if tendon_lengths {
+            outputs =
+                (outputs.with_tendon_lengths(&self.built)).map_err(|e| invalid(e.to_string()))?;
+        }
         let to_py = |e: LinearizeError| {
             let message = errors::chain(&e);
             match &e {
@@ -126,6 +138,10 @@ fn report_dict<'py>(py: Python<'py>, r: &Linearization) -> PyResult<Bound<'py, P
     let positions =
         nalgebra::DMatrix::from_fn(r.output_positions.len(), 3, |i, j| r.output_positions[i][j]);
     d.set_item("output_positions", matrix(py, &positions)?)?;
+    d.set_item(
+        "output_tendon_lengths",
+        vector(py, &r.output_tendon_lengths),
+    )?;
     let poles: Vec<Complex64> = r.poles.iter().map(|p| Complex64::new(p.re, p.im)).collect();
     d.set_item("poles", PyArray::from_vec(py, poles))?;
     let col = |f: &dyn Fn(&linearize::Pole) -> f64| -> Vec<f64> { r.poles.iter().map(f).collect() };

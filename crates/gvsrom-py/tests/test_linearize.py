@@ -263,3 +263,23 @@ def test_an_lqr_designed_on_the_linearization_damps_the_nonlinear_arm():
     assert rms(closed_err) < 0.2 * rms(open_err), (rms(closed_err), rms(open_err))
     assert closed_err[-1] < 0.01 * open_err[-1], (closed_err[-1], open_err[-1])
     assert (us < 0).all(), "the controller asked the tendon to push"
+
+
+def test_tendon_lengths_as_outputs_add_their_jacobian_rows_and_compliance():
+    robot = gvsrom.Scenario.preset("six-tendon").build()
+    lin = robot.linearize(tendon_lengths=True)
+    q = lin["x0"][: robot.n_dof]
+    n, na = robot.n_dof, robot.n_actuators
+    assert lin["C"].shape == (3 + na, 2 * n)
+    np.testing.assert_array_equal(lin["C"][3:, :n], robot.tendon_length_jacobian(q))
+    np.testing.assert_array_equal(lin["C"][3:, n:], 0.0)
+    np.testing.assert_allclose(lin["output_tendon_lengths"], robot.tendon_lengths(q), rtol=1e-14)
+    # frictionless tendons: the compliance ∂ℓ/∂u is symmetric (Maxwell–Betti)
+    g = lin["static_gain"][3:]
+    np.testing.assert_allclose(g, g.T, rtol=0, atol=1e-9 * np.abs(g).max())
+    # the position rows are the default output's
+    np.testing.assert_array_equal(lin["C"][:3], robot.linearize()["C"])
+    assert robot.linearize()["output_tendon_lengths"].shape == (0,)
+    bare = gvsrom.Scenario.preset("soft-beam").build()
+    with pytest.raises(gvsrom.GvsromError, match=r"^tendon_lengths=True: the rod has no tendons"):
+        bare.linearize(tendon_lengths=True)

@@ -11,12 +11,14 @@
 //! * `C = [R_tip J_tip,v  0]` (3 × 2n): the tip's world velocity per unit `q̇` (rows 4–6 of the tip
 //!   Jacobian, body frame, rotated to the world); with several output points, their 3 rows each,
 //!   `∂p(X)/∂q` of the centreline between the computational points
-//!   ([`Model::position_jacobian_at`]; `R_i J_v,i` at a point).
+//!   ([`Model::position_jacobian_at`]; `R_i J_v,i` at a point); with tendon lengths as outputs,
+//!   a row `[∂ℓ_k/∂q  0]` per tendon after them ([`Model::tendon_length_jacobian`]).
 //! * Poles: the eigenvalues of `A`, each with its natural frequency `|λ|/2π` and damping ratio
 //!   `ζ = −Re λ / |λ|`; conjugate pairs listed once (`Im λ ≥ 0`), slowest (`|λ|` smallest) first.
 //! * Static gain (about an equilibrium): `G = −C A⁻¹ B` (3 × n_actuators per output point), the
 //!   displacement per newton of each tendon once the motion has settled; it equals the derivative
-//!   of the equilibrium's output positions in the tensions.
+//!   of the equilibrium's output positions in the tensions (and of its tendon lengths: the
+//!   tendons' compliance, `∂ℓ/∂u = X_e (1/EA + d²/EI)` for a straight tendon on a straight rod).
 
 use crate::build::Built;
 use crate::error::{ScenarioError, StaticsFailure};
@@ -55,6 +57,8 @@ pub enum LinearizeError {
     },
     #[error("{field}: no abscissa given; expected at least one (the tip is {} m)", fmt_value(*length))]
     NoOutput { field: &'static str, length: f64 },
+    #[error("--output-tendon-lengths: the rod has no tendons, so no tendon length to output; accepted with tendons only")]
+    NoTendons,
     #[error("--count `{value}`: expected an integer ≥ 1 (the number of slowest poles to print; the linearization has {n_poles} states, so at most {n_poles} poles)")]
     Count { value: String, n_poles: usize },
     #[error("the equilibrium: {0}")]
@@ -131,11 +135,16 @@ pub struct Linearization {
     pub outputs: Vec<f64>,
     /// Their positions at `q` (world) \[m\].
     pub output_positions: Vec<[f64; 3]>,
+    /// With tendon lengths as outputs (`--output-tendon-lengths`), each tendon's length at `q` \[m\]:
+    /// `C`'s last rows (`∂ℓ/∂q`, one per tendon, after the positions' triples); empty otherwise.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub output_tendon_lengths: Vec<f64>,
     /// `A` (2n × 2n), rows.
     pub a: Vec<Vec<f64>>,
     /// `B` (2n × n_actuators), rows.
     pub b: Vec<Vec<f64>>,
-    /// `C` (3k × 2n for k output points), rows: the output positions' matrix.
+    /// `C` (3k × 2n for k output points, and a row per tendon after them with tendon lengths as
+    /// outputs), rows.
     pub c: Vec<Vec<f64>>,
     /// Every pole (`n` with `Im λ ≥ 0` for an underdamped model; real poles each listed), by `|λ|`.
     pub poles: Vec<Pole>,
@@ -150,8 +159,8 @@ pub struct Linearization {
     /// operating point is unstable. An undamped model's poles lie on the imaginary axis, up to
     /// rounding (`|Re λ| ~ 1e-12 |λ|`), and count as stable.
     pub unstable_poles: usize,
-    /// Static gain `−C A⁻¹ B` (3k × n_actuators) \[m/N\] about an equilibrium; `None` about a state,
-    /// or if `A` is singular.
+    /// Static gain `−C A⁻¹ B` (C's rows × n_actuators) \[m/N\] about an equilibrium; `None` about
+    /// a state, or if `A` is singular. The tendon rows are the tendons' compliance `∂ℓ_j/∂u_k`.
     pub static_gain: Option<Vec<Vec<f64>>>,
     /// Wall time of the linearization \[s\] (`A`, `B`, `C` and the poles; not the equilibrium).
     pub time_s: f64,
@@ -270,26 +279,54 @@ pub struct LinearizationJson<'a> {
     pub provenance: Option<&'a crate::provenance::Provenance>,
 }
 
-/// Where the output `y` is read: the positions of points along the rod, by abscissa.
+/// Where the output `y` is read: the positions of points along the rod, by abscissa, and, if
+/// asked, the tendons' lengths after them (one row of `C` each).
 #[derive(Debug, Clone, PartialEq)]
-pub struct Outputs(Vec<f64>);
+pub struct Outputs {
+    xs: Vec<f64>,
+    tendon_lengths: bool,
+}
 
 impl Outputs {
     /// The tip's position alone (the default).
     pub fn tip(built: &Built) -> Self {
-        Outputs(vec![built.model.disc.length()])
+        Outputs {
+            xs: vec![built.model.disc.length()],
+            tendon_lengths: false,
+        }
     }
 
     /// The positions at the abscissae `xs` \[m\] (world axes, 3 rows of `C` each, in this order),
     /// each finite and within `[0, L]`; at least one.
     pub fn at(built: &Built, xs: &[f64]) -> Result<Self, LinearizeError> {
         check_abscissae("--output-at", xs, built.model.disc.length())?;
-        Ok(Outputs(xs.to_vec()))
+        Ok(Outputs {
+            xs: xs.to_vec(),
+            tendon_lengths: false,
+        })
+    }
+
+    /// Adds the tendons' lengths \[m\] after the positions, one row of `C` each
+    /// ([`gvs::model::Model::tendon_length_jacobian`]): for actuators under position control, and
+    /// the tendons' compliance `∂ℓ/∂u` in the static gain. Refused for a rod without tendons.
+    pub fn with_tendon_lengths(self, built: &Built) -> Result<Self, LinearizeError> {
+        match built.model.n_actuators() {
+            0 => Err(LinearizeError::NoTendons),
+            _ => Ok(Outputs {
+                tendon_lengths: true,
+                ..self
+            }),
+        }
     }
 
     /// The abscissae.
     pub fn abscissae(&self) -> &[f64] {
-        &self.0
+        &self.xs
+    }
+
+    /// Whether the tendons' lengths are outputs too.
+    pub fn tendon_lengths(&self) -> bool {
+        self.tendon_lengths
     }
 }
 
@@ -370,12 +407,24 @@ fn on_model<P: StrainParam>(
     model.forward(q, &mut ws, true);
     let pos = ws.g[model.disc.tip()].pos;
     let xs = outputs.abscissae();
-    let mut c = DMatrix::zeros(3 * xs.len(), 2 * n);
+    let na = if outputs.tendon_lengths() {
+        model.n_actuators()
+    } else {
+        0
+    };
+    let mut c = DMatrix::zeros(3 * xs.len() + na, 2 * n);
     let mut output_positions = Vec::with_capacity(xs.len());
     for (k, &x) in xs.iter().enumerate() {
         let (p, dp) = model.position_jacobian_at(&ws, x);
         c.view_mut((3 * k, 0), (3, n)).copy_from(&dp);
         output_positions.push([p[0], p[1], p[2]]);
+    }
+    // after the positions: these evaluate the strains again
+    let mut output_tendon_lengths = vec![];
+    if na > 0 {
+        let dl = model.tendon_length_jacobian(q, &mut ws);
+        c.view_mut((3 * xs.len(), 0), (na, n)).tr_copy_from(&dl);
+        output_tendon_lengths = model.tendon_lengths(q, &mut ws);
     }
 
     Ok(Linearization {
@@ -390,6 +439,7 @@ fn on_model<P: StrainParam>(
         tip_position: [pos[0], pos[1], pos[2]],
         outputs: xs.to_vec(),
         output_positions,
+        output_tendon_lengths,
         relaxation_poles: relaxation_poles(&poles, t_d),
         unstable_poles: poles
             .iter()

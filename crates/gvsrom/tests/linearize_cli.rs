@@ -191,6 +191,96 @@ fn output_points_along_the_rod_have_the_uniform_moments_closed_form_gain() {
 }
 
 #[test]
+fn tendon_length_output_gain_is_the_tendons_compliance_l_over_ea_plus_d2_l_over_ei() {
+    // About the straight rod a tension u stretches the rod by u/EA and bends it by κ = u d/EI, so
+    // the tendon at the constant offset d is ℓ = L (1 + u/EA + κ d): ∂ℓ/∂u = L (1/EA + d²/EI),
+    // exactly (uniform strains); its row follows the tip's three
+    let path = rod_file("lin-tendon", 1e3);
+    let (stdout, lin) = run_json(
+        "linearize",
+        "lin-tendon",
+        &[s(&path), "--output-tendon-lengths"],
+    );
+    let (area, inertia) = (PI * R * R, PI * R.powi(4) / 4.0);
+    let compliance = L * (1.0 / (E * area) + D * D / (E * inertia));
+    let g = matrix(&lin["static_gain"]);
+    assert_eq!((g.len(), matrix(&lin["c"]).len()), (4, 4));
+    assert!(
+        rel(g[3][0], compliance) < 1e-9,
+        "∂ℓ/∂u = {} vs {compliance}",
+        g[3][0]
+    );
+    // at the straight equilibrium the tendon is as long as the rod (the Gauss weights' sum)
+    let length = f64s(&lin["output_tendon_lengths"]);
+    assert!(length.len() == 1 && rel(length[0], L) < 1e-14, "{length:?}");
+    for needle in [
+        "y the tip position (world) and the tendon lengths",
+        "output     tendon lengths [0.500000] m",
+        "gain       settled change of each tendon length per newton of tension",
+    ] {
+        assert!(stdout.contains(needle), "lacks `{needle}`:\n{stdout}");
+    }
+    // without tendons there is no length to output
+    let bare = scratch("lin-bare.toml");
+    let text = ROD.replace("DAMPING", "1e3");
+    let cut = text.find("[[tendons]]").unwrap()..text.find("[loads]").unwrap();
+    std::fs::write(&bare, text.replace(&text[cut], "")).unwrap();
+    expect_error(
+        &["linearize", s(&bare), "--output-tendon-lengths"],
+        &["--output-tendon-lengths: the rod has no tendons"],
+    );
+}
+
+#[test]
+fn frictionless_tendons_compliance_is_symmetric_and_the_equilibriums_derivative() {
+    // six-tendon under gravity, frictionless: the tendons' lengths are the gradients' potentials
+    // of their tensions (B = (∂ℓ/∂q)ᵀ), so the compliance ∂ℓ_j/∂u_k = Bᵀ K_t⁻¹ B is symmetric
+    // (Maxwell–Betti) with a positive diagonal; its first column against central differences of
+    // the lengths `gvsrom statics --json` writes (another path: the nonlinear solver)
+    let (_, lin) = run_json(
+        "linearize",
+        "lin-six-tendons",
+        &["six-tendon", "--output-tendon-lengths"],
+    );
+    let g = matrix(&lin["static_gain"]);
+    assert_eq!(g.len(), 3 + 6);
+    let t = &g[3..];
+    let scale = (0..6).map(|k| t[k][k]).fold(0.0, f64::max);
+    for j in 0..6 {
+        assert!(t[j][j] > 0.0, "∂ℓ_{j}/∂u_{j} = {}", t[j][j]);
+        for k in 0..j {
+            assert!(
+                (t[j][k] - t[k][j]).abs() < 1e-9 * scale,
+                "∂ℓ_{j}/∂u_{k} = {} vs ∂ℓ_{k}/∂u_{j} = {}",
+                t[j][k],
+                t[k][j]
+            );
+        }
+    }
+    // about the preset's tensions, [-10, 0, 0, 0, 0, 0] N
+    assert_eq!(f64s(&lin["u"]), vec![-10.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+    let h = 0.01;
+    let lengths = |u0: f64, tag: &str| {
+        let tension = format!("--tension={u0},0,0,0,0,0");
+        let (_, json) = run_json(
+            "statics",
+            &format!("lin-six-{tag}"),
+            &["six-tendon", &tension],
+        );
+        f64s(&json["tendon_lengths"])
+    };
+    let (p, m) = (lengths(-10.0 + h, "plus"), lengths(-10.0 - h, "minus"));
+    for j in 0..6 {
+        let fd = (p[j] - m[j]) / (2.0 * h);
+        assert!(
+            (t[j][0] - fd).abs() < 1e-5 * scale,
+            "∂ℓ_{j}/∂u_0 = {} vs statics {fd}",
+            t[j][0]
+        );
+    }
+}
+
+#[test]
 fn output_point_gain_under_gravity_and_friction_is_the_equilibriums_derivative() {
     // IV-A bent by gravity and friction, X = L/2 (between points): −C A⁻¹ B against central
     // differences of the centreline sample at L/2 of `gvsrom statics --json` (21 samples)

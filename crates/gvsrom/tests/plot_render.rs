@@ -368,6 +368,30 @@ fn grid_draws_overall_title_and_every_panel() {
 }
 
 #[test]
+fn a_long_grid_title_is_shrunk_inside_the_figure() {
+    // a tall, narrow grid scales its title font with its area: this caption was 1.2× the width
+    // of a 1000 × 1500 figure and ran off both edges; now it keeps a margin on either side
+    let title =
+        "Static gain −C A⁻¹ B — six-tendon, u = [-10, 0, 0, 0, 0, 0] N, and a longer caption";
+    let fig = Figure::Grid {
+        title: title.into(),
+        cols: 1,
+        panels: vec![Figure::Line(strain_chart()), Figure::Line(rod_chart())],
+    };
+    let out = render(&fig, 1000, 1500).expect("renders");
+    let img = decode(&out.png, 1000, 1500);
+    assert!(svg_has_text(&out.svg, title), "SVG lacks the title");
+    // the title strip: dark text, none in the outer 1 % on either side
+    let strip = 0..40;
+    assert!(dark_in_rows(&img, strip.clone()) > 500, "no title drawn");
+    let edge_ink = strip
+        .flat_map(|y| (0..10).chain(990..1000).map(move |x| (x, y)))
+        .filter(|&(x, y)| non_white(img.get_pixel(x, y)))
+        .count();
+    assert_eq!(edge_ink, 0, "the title reaches the figure's edges");
+}
+
+#[test]
 fn constant_and_single_point_data_render() {
     let c = LineChart {
         title: "flat".into(),

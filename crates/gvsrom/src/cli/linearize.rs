@@ -23,6 +23,12 @@ pub struct LinearizeArgs {
     )]
     pub output_at: Option<Vec<f64>>,
 
+    /// Also output each tendon's length [m] along its thread, one row of `C` each after the
+    /// positions: for actuators under position control; the static gain's tendon rows are then the
+    /// tendons' compliance, the settled change of each length per newton of each tension.
+    #[arg(long)]
+    pub output_tendon_lengths: bool,
+
     /// Also discretize with a zero-order hold of H seconds (tensions held over each sample):
     /// `δx_{k+1} = A_d δx_k + B_d δu_k`, written to the JSON as `discrete`.
     #[arg(long, value_name = "H", allow_hyphen_values = true)]
@@ -58,10 +64,13 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
     if let Some(h) = args.sample_time {
         linearize::check_sample_time(h)?;
     }
-    let outputs = match &args.output_at {
+    let mut outputs = match &args.output_at {
         Some(xs) => linearize::Outputs::at(built, xs)?,
         None => linearize::Outputs::tip(built),
     };
+    if args.output_tendon_lengths {
+        outputs = outputs.with_tendon_lengths(built)?;
+    }
     print_model(scenario, &args.scenario, built, None, out)?;
     let (eq, mut lin) = linearize::about_equilibrium(built, &outputs)?;
     if let Some(h) = args.sample_time {
@@ -79,7 +88,7 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
         "tip        position {} m",
         fmt_vec(&eq.tip_position, 6)
     )?;
-    let y = match args.output_at {
+    let mut y = match args.output_at {
         None => "the tip position".to_string(),
         Some(_) => format!(
             "the positions at X = {} m",
@@ -88,6 +97,9 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
                 .join(", ")
         ),
     };
+    if !lin.output_tendon_lengths.is_empty() {
+        y += " (world) and the tendon lengths";
+    }
     writeln!(
         out,
         "system     δẋ = A δx + B δu, δy = C δx: x = [q; q̇] ({n_states} states), u {}, y {y} (world) [m]; linearized in {:.2} ms",
@@ -106,6 +118,13 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
                 fmt_vec(p, 6)
             )?;
         }
+    }
+    if !lin.output_tendon_lengths.is_empty() {
+        writeln!(
+            out,
+            "output     tendon lengths {} m",
+            fmt_vec(&lin.output_tendon_lengths, 6)
+        )?;
     }
     let shown = count.min(lin.poles.len());
     writeln!(
@@ -162,6 +181,18 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
                 for k in 0..lin.n_actuators {
                     let col: Vec<f64> =
                         g[3 * o..3 * o + 3].iter().map(|row| row[k] * 1e3).collect();
+                    writeln!(out, "  tendon {:<3} {}", k + 1, fmt_vec(&col, 4))?;
+                }
+            }
+            let rows = &g[3 * lin.outputs.len()..];
+            if !rows.is_empty() {
+                writeln!(
+                    out,
+                    "gain       settled change of each tendon length per newton of tension, −C A⁻¹ B (tendons' compliance, lengths 1…{}) [mm/N]",
+                    rows.len()
+                )?;
+                for k in 0..lin.n_actuators {
+                    let col: Vec<f64> = rows.iter().map(|row| row[k] * 1e3).collect();
                     writeln!(out, "  tendon {:<3} {}", k + 1, fmt_vec(&col, 4))?;
                 }
             }

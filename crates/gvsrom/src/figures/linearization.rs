@@ -1,7 +1,9 @@
 //! Figures of a `gvsrom linearize --json` result: the poles (`poles`: each pole's natural
 //! frequency `|λ|/2π` on a log scale against its damping ratio `ζ = −Re λ/|λ|`, the unstable ones
 //! apart), and the static gain (`static_gain`: per output point, the settled displacement along
-//! world x, y and z per newton of each tendon, in mm/N, as markers: the tendons are categories).
+//! world x, y and z per newton of each tendon, in mm/N, as markers: the tendons are categories;
+//! with tendon lengths as outputs, a panel of their settled change per newton, the tendons'
+//! compliance).
 
 use super::{input_error, FiguresError, Sink};
 use crate::plot::{palette, Figure, LineChart, Series, SeriesStyle};
@@ -32,6 +34,9 @@ pub struct LinearizationDoc {
     /// The output points' abscissae (a result written before they were recorded: the tip alone).
     #[serde(default)]
     pub outputs: Option<Vec<f64>>,
+    /// With tendon lengths as outputs, their values: one gain row per tendon after the points'.
+    #[serde(default)]
+    pub output_tendon_lengths: Vec<f64>,
     #[serde(default)]
     pub model: Option<String>,
     #[serde(skip)]
@@ -48,13 +53,18 @@ impl LinearizationDoc {
         }
         if let Some(g) = &doc.static_gain {
             let points = doc.outputs.as_ref().map_or(1, Vec::len);
-            if g.len() != 3 * points {
+            let lengths = doc.output_tendon_lengths.len();
+            if g.len() != 3 * points + lengths {
                 return Err(input_error(
                     path,
                     format!(
-                        "static_gain has {} rows; expected {} (3 per output point)",
+                        "static_gain has {} rows; expected {} (3 per output point{})",
                         g.len(),
-                        3 * points
+                        3 * points + lengths,
+                        match lengths {
+                            0 => String::new(),
+                            m => format!(", and {m} tendon lengths"),
+                        }
                     ),
                 ));
             }
@@ -160,7 +170,8 @@ fn is_unstable(p: &PoleDoc) -> bool {
     p.damping_ratio < -crate::linearize::UNSTABLE_RATIO
 }
 
-/// `static_gain`: one panel per output point, the x, y and z rows against the tendon number.
+/// `static_gain`: one panel per output point, the x, y and z rows against the tendon number, and
+/// one of the tendon lengths' rows if there are any.
 fn static_gain(
     doc: &LinearizationDoc,
     g: &[Vec<f64>],
@@ -169,7 +180,8 @@ fn static_gain(
 ) -> Result<(), FiguresError> {
     let tendons: Vec<f64> = (1..=doc.n_actuators).map(|k| k as f64).collect();
     let points = doc.outputs.clone();
-    let panels: Vec<Figure> = (0..g.len() / 3)
+    let n_points = (g.len() - doc.output_tendon_lengths.len()) / 3;
+    let panels: Vec<Figure> = (0..n_points)
         .map(|o| {
             let at = match &points {
                 Some(xs) => format!("X = {} m", gvs::error::fmt_value(xs[o])),
@@ -204,6 +216,10 @@ fn static_gain(
                 equal_aspect: false,
             })
         })
+        .chain(tendon_compliance(
+            doc,
+            &g[g.len() - doc.output_tendon_lengths.len()..],
+        ))
         .collect();
     let n = panels.len();
     let unstable = match doc.unstable_poles {
@@ -216,4 +232,39 @@ fn static_gain(
         panels,
     };
     sink.figure("static_gain", &grid, (1000, 300 + 400 * n as u32))
+}
+
+/// The panel of the tendon-length rows `rows` of the gain (none without them): each length's
+/// settled change per newton of each tendon's tension, a series per length.
+fn tendon_compliance(doc: &LinearizationDoc, rows: &[Vec<f64>]) -> Option<Figure> {
+    if rows.is_empty() {
+        return None;
+    }
+    let tendons: Vec<f64> = (1..=doc.n_actuators).map(|k| k as f64).collect();
+    let margin = Series::new(
+        "",
+        vec![0.5, doc.n_actuators as f64 + 0.5],
+        vec![0.0, 0.0],
+        SeriesStyle::Bounds,
+    );
+    let series = (rows.iter().enumerate())
+        .map(|(j, row)| {
+            Series::new(
+                format!("length {}", j + 1),
+                tendons.clone(),
+                row.iter().map(|v| v * 1e3).collect(),
+                SeriesStyle::Markers,
+            )
+            .with_color(palette::EXTRA[j % palette::EXTRA.len()])
+        })
+        .chain(std::iter::once(margin))
+        .collect();
+    Some(Figure::Line(LineChart {
+        title: "settled change of the tendon lengths (the tendons' compliance)".into(),
+        x_label: "tendon".into(),
+        y_label: "per newton of tension [mm/N]".into(),
+        series,
+        log_y: false,
+        equal_aspect: false,
+    }))
 }

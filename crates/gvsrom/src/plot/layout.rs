@@ -29,18 +29,29 @@ impl<T, E: std::error::Error + Send + Sync> OrPlotError<T> for Result<T, Drawing
 }
 
 /// Draws `title` centred in a strip at the top of `area` (1.7 × the font size high) and returns the
-/// rest of the area; an empty title takes no space.
+/// rest of the area; an empty title takes no space. A title wider than 96 % of the area is drawn
+/// in a font shrunk to fit it (a long caption on a narrow, tall grid ran off both edges).
 pub(crate) fn titled<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     title: &str,
-    font: &TextStyle,
+    font: &TextStyle<'static>,
     theme: &Theme,
 ) -> Result<DrawingArea<DB, Shift>, PlotError> {
     if title.trim().is_empty() {
         return Ok(area.clone());
     }
-    let strip = (font.font.get_size() * 1.7).round() as i32 + theme.px(4.0);
     let (w, _) = area.dim_in_pixel();
+    let wide = area.estimate_text_size(title, font).or_plot(title)?.0 as f64;
+    let room = 0.96 * w as f64;
+    let shrunk;
+    let font = match wide > room {
+        true => {
+            shrunk = Theme::resized(font, font.font.get_size() * room / wide);
+            &shrunk
+        }
+        false => font,
+    };
+    let strip = (font.font.get_size() * 1.7).round() as i32 + theme.px(4.0);
     let (top, rest) = area.split_vertically(strip);
     let centred = font.clone().pos(Pos::new(HPos::Center, VPos::Center));
     top.draw_text(title, &centred, (w as i32 / 2, strip / 2 + theme.px(2.0)))

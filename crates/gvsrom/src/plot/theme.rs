@@ -85,6 +85,14 @@ impl Theme {
     }
 
     /// Black text in [`FAMILY`] of `base` pixels scaled.
+    /// The font of `style` at `size` pixels (its family and colour): a title shrunk to fit.
+    pub fn resized(style: &TextStyle<'static>, size: f64) -> TextStyle<'static> {
+        TextStyle {
+            font: (FAMILY, size).into_font(),
+            ..style.clone()
+        }
+    }
+
     fn font(&self, base: f64) -> TextStyle<'static> {
         (FAMILY, base * self.scale)
             .into_font()
