@@ -294,6 +294,11 @@ fn a_pod_rom_trajectory_follows_the_hom() {
         "{report}"
     );
     assert!(report.contains("strain     error mean 0.000 %"), "{report}");
+    // and the tendon's length, which both runs record, agrees to well below 0.1 µm
+    assert!(
+        report.contains("tendons    length error mean 0.0000 mm, max 0.0000 mm"),
+        "{report}"
+    );
     // the other way round with another sample rate is refused
     let coarse = scratch("red-sim-hom-coarse");
     run_ok(&[

@@ -109,6 +109,13 @@ pub(super) fn compare_cmd(args: &CompareArgs, out: &mut impl Write) -> Result<()
         )?,
         _ => writeln!(out, "strain     the reference is straight at every sample")?,
     }
+    if let Some(e) = &c.tendon_length_mm {
+        writeln!(
+            out,
+            "tendons    length error mean {:.4} mm, max {:.4} mm at t = {} s (|ℓ_run − ℓ_ref| over the samples and tendons)",
+            e.mean, e.max, e.max_t
+        )?;
+    }
     if let Some(json) = json {
         let report = compared.report()?;
         let path = json.commit_json(&report)?;

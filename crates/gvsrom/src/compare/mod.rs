@@ -9,6 +9,9 @@
 //!   sample; mean and maximum over the samples where the reference is not straight. A component is
 //!   active if it is nonzero somewhere in either run (components that stay zero would only dilute
 //!   the mean). `ξ* = [0, 0, 0, 1, 0, 0]`, the straight unstretched rod of every scenario;
+//! - **tendon length error** `|ℓ_run − ℓ_ref|` \[mm\] per sample and tendon, when both
+//!   trajectories record the lengths (`tendon_lengths.npy`): mean, maximum (and when) — the error an
+//!   actuator under position control would see;
 //! - **wall times** of both runs (from their `meta.json`); the CLI prints the ratio of simulated time
 //!   per wall time, which is fair to a partial run ([`speed_ratio`]; none when a wall time is zero
 //!   or not recorded).
@@ -63,6 +66,19 @@ pub struct Comparison {
     /// Strain components (0 torsion … 5 shear z) compared.
     #[serde(default)]
     pub active: Vec<usize>,
+    /// Tendon length error `|ℓ_run − ℓ_ref|` \[mm\] over the samples and tendons: mean, maximum
+    /// and the time of the maximum (`None` unless both trajectories record the lengths).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tendon_length_mm: Option<TendonLengthError>,
+}
+
+/// [`Comparison::tendon_length_mm`].
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct TendonLengthError {
+    pub mean: f64,
+    pub max: f64,
+    /// Time \[s\] of the largest error.
+    pub max_t: f64,
 }
 
 /// One trajectory of a [`Report`], as `compare` describes it.
@@ -245,6 +261,7 @@ pub fn compare(reference: &Trajectory, run: &Trajectory) -> Result<Comparison, S
         }
     }
     Ok(Comparison {
+        tendon_length_mm: tendon_length_error(reference, run, n),
         samples: n,
         tip_mean: tip_sum / n as f64,
         tip_max,
@@ -253,6 +270,37 @@ pub fn compare(reference: &Trajectory, run: &Trajectory) -> Result<Comparison, S
         strain_mean: (strained > 0).then(|| strain_sum / strained as f64),
         strain_max: (strained > 0).then_some(strain_max),
         active,
+    })
+}
+
+/// [`Comparison::tendon_length_mm`] over the first `n` samples, if both record the same tendons'
+/// lengths.
+fn tendon_length_error(
+    reference: &Trajectory,
+    run: &Trajectory,
+    n: usize,
+) -> Option<TendonLengthError> {
+    let ((na, a), (nb, b)) = (
+        reference.tendon_lengths.as_ref()?,
+        run.tendon_lengths.as_ref()?,
+    );
+    if na != nb || *na == 0 {
+        return None;
+    }
+    let (mut sum, mut max, mut max_t) = (0.0, 0.0f64, reference.t[0]);
+    for k in 0..n {
+        for j in 0..*na {
+            let e = 1e3 * (a[k * na + j] - b[k * na + j]).abs();
+            sum += e;
+            if e > max {
+                (max, max_t) = (e, reference.t[k]);
+            }
+        }
+    }
+    Some(TendonLengthError {
+        mean: sum / (n * na) as f64,
+        max,
+        max_t,
     })
 }
 
@@ -293,6 +341,7 @@ mod tests {
             centerline_x: None,
             centerline: None,
             tendon_paths: None,
+            tendon_lengths: None,
             provenance: None,
             extrapolated: vec![],
         }
@@ -316,6 +365,33 @@ mod tests {
         // a run compared with itself
         let same = compare(&reference, &reference).unwrap();
         assert_eq!((same.tip_max, same.strain_max), (0.0, Some(0.0)));
+        // no tendon lengths recorded: none compared
+        assert_eq!(c.tendon_length_mm, None);
+    }
+
+    #[test]
+    fn tendon_length_errors_are_the_absolute_differences_in_mm_by_hand() {
+        // two tendons, three samples: |Δℓ| = 0, 0 | 1 mm, 3 mm | 0, 2 mm
+        let with = |lengths: [f64; 6]| Trajectory {
+            tendon_lengths: Some((2, lengths.to_vec())),
+            ..trajectory([0.5, 0.4, 0.3], [[0.0, 0.0], [2.0, 4.0], [1.0, 1.0]])
+        };
+        let reference = with([0.3, 0.2, 0.299, 0.197, 0.298, 0.2]);
+        let run = with([0.3, 0.2, 0.298, 0.2, 0.298, 0.198]);
+        let e = compare(&reference, &run).unwrap().tendon_length_mm.unwrap();
+        assert!((e.mean - 1.0).abs() < 1e-9, "mean {} mm", e.mean);
+        assert!((e.max - 3.0).abs() < 1e-9 && e.max_t == 0.1, "{e:?}");
+        // another tendon count, or lengths on one side only: not compared
+        let three = Trajectory {
+            tendon_lengths: Some((3, vec![0.3; 9])),
+            ..run.clone()
+        };
+        assert_eq!(compare(&reference, &three).unwrap().tendon_length_mm, None);
+        let bare = Trajectory {
+            tendon_lengths: None,
+            ..run
+        };
+        assert_eq!(compare(&reference, &bare).unwrap().tendon_length_mm, None);
     }
 
     /// `tr` as a rod pre-curved by `kappa` 1/m in bend-y: its reference strain and every strain

@@ -49,6 +49,9 @@ pub struct Trajectory {
     /// (`tendon_paths.npy`; with tendons, in trajectories written since it was recorded), and the
     /// number of tendons.
     pub tendon_paths: Option<(usize, Vec<f64>)>,
+    /// `samples × tendons`: each tendon's length \[m\] (`tendon_lengths.npy`; with tendons, in
+    /// trajectories written since it was recorded), and the number of tendons.
+    pub tendon_lengths: Option<(usize, Vec<f64>)>,
     /// How the run was made (`provenance`), if recorded.
     pub provenance: Option<Value>,
     /// How its reduced model was used outside what it was trained on (`model_extrapolated`,
@@ -145,6 +148,14 @@ impl Trajectory {
             }
             _ => None,
         };
+        let file = crate::simulate::TENDON_LENGTHS_FILE;
+        let tendon_lengths = match files.lists(file) {
+            true => {
+                let na = count("n_actuators")?;
+                Some((na, read(file, &[n, na])?))
+            }
+            false => None,
+        };
         Ok(Trajectory {
             dir: dir.to_path_buf(),
             origin,
@@ -165,6 +176,7 @@ impl Trajectory {
             centerline_x,
             centerline,
             tendon_paths,
+            tendon_lengths,
             provenance: meta.get("provenance").filter(|v| v.is_object()).cloned(),
             extrapolated: (meta["model_extrapolated"].as_array().into_iter().flatten())
                 .filter_map(|v| v.as_str().map(str::to_string))
