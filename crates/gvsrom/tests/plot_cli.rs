@@ -318,11 +318,18 @@ fn trajectory_with_centerlines_gives_tip_strain_rod_figures_and_animation() {
         "tip_path_side",
         "tip_position",
         "strain_time",
+        "tendon_lengths",
         "rod_3d",
         "rod_side",
     ]);
     expected.push("rod_animation.gif".into());
     check_figures(&dir, &stdout, &refs(&expected));
+    // the tendon's pull-in from its rest length (`meta.json`), one line per tendon
+    let svg = std::fs::read_to_string(dir.join("tendon_lengths.svg")).unwrap();
+    assert!(
+        svg.contains("Tendons pulled in") && svg.contains("rest length − length [mm]"),
+        "tendon_lengths.svg"
+    );
     let gif = std::fs::metadata(dir.join("rod_animation.gif"))
         .unwrap()
         .len();

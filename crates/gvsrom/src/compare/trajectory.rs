@@ -52,6 +52,9 @@ pub struct Trajectory {
     /// `samples × tendons`: each tendon's length \[m\] (`tendon_lengths.npy`; with tendons, in
     /// trajectories written since it was recorded), and the number of tendons.
     pub tendon_lengths: Option<(usize, Vec<f64>)>,
+    /// Each tendon's length at rest \[m\] (`meta.json`'s `tendon_rest_lengths`; empty when not
+    /// recorded).
+    pub tendon_rest_lengths: Vec<f64>,
     /// How the run was made (`provenance`), if recorded.
     pub provenance: Option<Value>,
     /// How its reduced model was used outside what it was trained on (`model_extrapolated`,
@@ -177,6 +180,9 @@ impl Trajectory {
             centerline,
             tendon_paths,
             tendon_lengths,
+            tendon_rest_lengths: (meta["tendon_rest_lengths"].as_array().into_iter().flatten())
+                .filter_map(|v| v.as_f64())
+                .collect(),
             provenance: meta.get("provenance").filter(|v| v.is_object()).cloned(),
             extrapolated: (meta["model_extrapolated"].as_array().into_iter().flatten())
                 .filter_map(|v| v.as_str().map(str::to_string))

@@ -1,6 +1,8 @@
 //! Figures of a `gvsrom simulate --out` trajectory: the tip's path in 3-D (`tip_path_3d`) and in side
 //! views (`tip_path_side`), the tip's coordinates over time (`tip_position`), the strain over time
-//! at a few points along the rod (`strain_time`), and, when the trajectory stores its centrelines
+//! at a few points along the rod (`strain_time`), how far each tendon is pulled in over time
+//! (`tendon_lengths`, from `tendon_lengths.npy` and the rest lengths), and, when the trajectory
+//! stores its centrelines
 //! (`centerline.npy`, shape `[samples, N, 3]`, with `centerline_x` in `meta.json`), the rod at a
 //! few instants (`rod_3d`, `rod_side`) and an animation of it (`rod_animation.gif`).
 
@@ -93,6 +95,7 @@ pub(crate) fn figures(dir: &Path, sink: &mut Sink) -> Result<(), FiguresError> {
     let centerlines = centerlines(&tr)?;
     tip_figures(&tr, &caption, sink)?;
     strain_time(&tr, &caption, sink)?;
+    tendon_lengths(&tr, &caption, sink)?;
     match &centerlines {
         Some(c) => rod_figures(&tr, c, &caption, sink)?,
         None => sink.note(format!(
@@ -148,6 +151,45 @@ fn tip_figures(tr: &Trajectory, caption: &str, sink: &mut Sink) -> Result<(), Fi
         panels,
     };
     sink.figure("tip_position", &fig, (1000, 900))
+}
+
+/// `tendon_lengths`: each tendon's pull-in `ℓ_rest − ℓ(t)` \[mm\] over time (its length if the
+/// rest lengths are not recorded); nothing without recorded lengths.
+fn tendon_lengths(tr: &Trajectory, caption: &str, sink: &mut Sink) -> Result<(), FiguresError> {
+    let Some((na, lengths)) = &tr.tendon_lengths else {
+        return Ok(());
+    };
+    let rest = (tr.tendon_rest_lengths.len() == *na).then_some(&tr.tendon_rest_lengths);
+    let series = (0..*na)
+        .map(|j| {
+            let y = (0..tr.samples())
+                .map(|k| match rest {
+                    Some(r) => 1e3 * (r[j] - lengths[k * na + j]),
+                    None => 1e3 * lengths[k * na + j],
+                })
+                .collect();
+            Series::new(
+                format!("tendon {}", j + 1),
+                tr.t.clone(),
+                y,
+                SeriesStyle::Line,
+            )
+            .with_color(palette::EXTRA[j % palette::EXTRA.len()])
+        })
+        .collect();
+    let (title, y_label) = match rest {
+        Some(_) => ("Tendons pulled in", "rest length − length [mm]"),
+        None => ("Tendon lengths", "length [mm]"),
+    };
+    let fig = Figure::Line(LineChart {
+        title: format!("{title} — {caption}"),
+        x_label: "t [s]".into(),
+        y_label: y_label.into(),
+        series,
+        log_y: false,
+        equal_aspect: false,
+    });
+    sink.figure("tendon_lengths", &fig, (1000, 600))
 }
 
 /// `strain_time`: each strain component that moves, at a few points along the rod, over time.
