@@ -159,8 +159,9 @@ impl Robot {
 
     /// The coordinates `q` of a model quantity: `n_dof` finite values, for a reduced model attached
     /// without `extrapolate` inside its training encodings, where its decoder answers (as
-    /// `simulate(q0=…)` and `Model.decode` refuse a code far outside them), and a state of an
-    /// elastic rod ([`quantities::state_violation`], as a simulation's samples are checked).
+    /// `simulate(q0=…)` and `Model.decode` refuse a code far outside them; a POD model's far
+    /// outside its data is answered with a `UserWarning`, as its simulation notes it), and a state
+    /// of an elastic rod ([`quantities::state_violation`], as a simulation's samples are checked).
     pub(crate) fn coordinates(&self, q: &In1<'_>) -> PyResult<nalgebra::DVector<f64>> {
         let q = arrays::dvec("q", q, self.built.n_dof())?;
         let reduced = self.built.reduced.as_ref().filter(|r| !r.extrapolate);
@@ -168,6 +169,15 @@ impl Robot {
             return Err(invalid(format!(
                 "`q`: {v}: the decoder extrapolates there and its quantities are not to be trusted; accepted: a state inside the training region, or the model attached with extrapolate=True"
             )));
+        }
+        // a POD basis is linear and answers everywhere: leaving its data is said, not refused
+        if let Some(v) = reduced.and_then(|r| r.data_range_violation(q.as_slice())) {
+            Python::attach(|py| {
+                warn(
+                    py,
+                    &format!("`q`: {v}: the POD basis is linear and answers there, but no snapshot checked its quantities"),
+                )
+            })?;
         }
         if let Some(v) = quantities::state_violation(&self.built, &self.workspaces, &q) {
             return Err(invalid(format!(

@@ -161,3 +161,25 @@ def test_a_pod_run_that_leaves_its_training_encodings_says_so_once(robot, pod):
     notes = [n for n in tr["model_extrapolated"] if "left the training encodings" in n]
     assert len(notes) == 1 and "its basis is linear" in notes[0], tr["model_extrapolated"]
     assert tr["t"][-1] == pytest.approx(0.02)
+
+
+def test_pod_quantities_far_outside_the_data_say_so_and_answer(robot, pod):
+    # A POD basis is linear: its quantities are defined everywhere and answered, but far from
+    # the snapshots a UserWarning says no snapshot checked them (as a simulation notes it)
+    reduced = robot.with_model(pod)
+    inside = np.array([0.5 * sum(r) for r in pod.latent_range])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        reduced.mass_matrix(inside)
+        reduced.tendon_lengths(inside)
+    lo, hi = pod.latent_range[0]
+    far = inside.copy()
+    far[0] = hi + 2 * (hi - lo)
+    for f in (reduced.mass_matrix, reduced.tendon_lengths, reduced.elastic_force):
+        with pytest.warns(UserWarning, match=r"`q`: q_r\[0\] = .* lies far outside the range of the training data.*no snapshot checked"):
+            assert np.all(np.isfinite(f(far)))
+    # attached with extrapolate=True the user said so: no warning
+    loose = robot.with_model(pod, extrapolate=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        loose.mass_matrix(far)
