@@ -221,6 +221,15 @@ fn a_pod_rom_with_all_modes_reproduces_the_hom_equilibrium() {
         "the comparison's HOM tip is the HOM statics' tip"
     );
     assert!(err <= 1e-8 * L, "tip error {err:e} m > 1e-8 L");
+    // the tendon length error is the difference of the two reports' lengths, in mm
+    let length = |r: &serde_json::Value| r["tendon_lengths"][0].as_f64().unwrap();
+    let dl = 1e3 * (length(&rom) - length(&hom)).abs();
+    let reported = c["tendon_length_error_mm"].as_f64().unwrap();
+    assert!(
+        (reported - dl).abs() <= 1e-12,
+        "comparison.tendon_length_error_mm {reported:e} vs {dl:e}"
+    );
+    assert!(dl < 1e-5, "POD with all modes: tendon length {dl:e} mm off");
     let strain = c["strain_error_percent"].as_f64().unwrap();
     assert!(strain < 1e-6, "strain error {strain:e} %");
 }

@@ -79,8 +79,13 @@ pub(super) fn statics_cmd(args: &StaticsArgs, out: &mut impl Write) -> Result<()
         )?;
         writeln!(
             out,
-            "error      strain {:.3} % (MAE / peak |ξ − ξ*|), tip {:.4} % of the length",
-            c.strain_error_percent, c.tip_error_percent
+            "error      strain {:.3} % (MAE / peak |ξ − ξ*|), tip {:.4} % of the length{}",
+            c.strain_error_percent,
+            c.tip_error_percent,
+            match c.tendon_length_error_mm {
+                Some(e) => format!(", tendon lengths within {e:.4} mm"),
+                None => String::new(),
+            }
         )?;
     }
     if let Some(json) = json {

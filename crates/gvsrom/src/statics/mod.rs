@@ -405,6 +405,10 @@ pub struct Comparison {
     pub strain_error_percent: f64,
     /// Tip position error, % of the rod length.
     pub tip_error_percent: f64,
+    /// Largest tendon length error `max_k |ℓ_k,rom − ℓ_k,hom|` \[mm\]: what an actuator under
+    /// position control would see (`None` without tendons).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tendon_length_error_mm: Option<f64>,
     pub hom_tip_position: [f64; 3],
     pub hom_solve_time_s: f64,
     pub rom_solve_time_s: f64,
@@ -440,6 +444,9 @@ pub fn compare(built: &Built, hom: &StaticsReport, rom: &StaticsReport) -> Compa
             &rom.tip_position,
             length,
         ),
+        tendon_length_error_mm: (hom.tendon_lengths.iter().zip(&rom.tendon_lengths))
+            .map(|(a, b)| 1e3 * (a - b).abs())
+            .reduce(f64::max),
         hom_tip_position: hom.tip_position,
         hom_solve_time_s: hom.solve_time_s,
         rom_solve_time_s: rom.solve_time_s,
