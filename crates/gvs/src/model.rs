@@ -225,8 +225,10 @@ impl<P: StrainParam> Model<P> {
     }
 
     /// The length \[m\] of tendon `k`'s span that each of its points ([`Model::tendon_points`])
-    /// stands for: its quadrature weight `W_i`, or its share of a span that ends between points
-    /// ([`tendon_weight_list`]). They sum to the span's length.
+    /// stands for: its quadrature weight `W_i` on a span of whole divisions; on a span with an end
+    /// inside a division, its share of the span by the points' cells
+    /// ([`Discretization::cells`]), the first point's from `X_s`, the last's to `X_e`. They sum to
+    /// the span's length.
     pub fn tendon_weights(&self, k: usize) -> &[f64] {
         &self.tendon_weights[k]
     }
