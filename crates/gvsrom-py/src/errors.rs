@@ -96,12 +96,13 @@ pub fn statics_with_message(py: Python<'_>, f: &StaticsFailure, message: &str) -
 
 /// Flags of the command line whose Python keyword argument has another spelling than the flag's
 /// with `-` → `_`.
-const RENAMED: [(&str, &str); 5] = [
+const RENAMED: [(&str, &str); 6] = [
     ("lambda", "lambda_"),
     ("tension", "u"),
     ("sample-time", "dt"),
     ("output-at", "outputs"),
     ("output-tendon-lengths", "tendon_lengths=True"),
+    ("output-tip-orientation", "tip_orientation=True"),
 ];
 
 /// Flags of the command line that are switches, spelled `name=True` in Python.

@@ -36,6 +36,9 @@ impl Robot {
     ///     Abscissae [m] along the rod whose world positions make ``y`` (``--output-at``), 3 rows
     ///     of ``C`` each in this order, between the computational points by the centreline's
     ///     interpolant; default: the tip.
+    /// tip_orientation : bool
+    ///     Also output the tip's orientation (``--output-tip-orientation``): 3 rows of ``C`` after
+    ///     the positions, the tip section's small rotation in world axes [rad].
     /// tendon_lengths : bool
     ///     Also output each tendon's length [m] along its thread (``--output-tendon-lengths``),
     ///     one row of ``C`` each after the positions, for actuators under position control; the
@@ -45,9 +48,10 @@ impl Robot {
     /// -------
     /// dict
     ///     ``A`` (2n, 2n), ``B`` (2n, n_actuators), ``C`` (3k, 2n) for k outputs, ``outputs``
-    ///     (k,) their abscissae, ``output_positions`` (k, 3), ``output_tendon_lengths``
-    ///     (n_actuators,) with ``tendon_lengths`` (empty otherwise; ``C`` then has
-    ///     3k + n_actuators rows), ``x0`` (2n,) the operating
+    ///     (k,) their abscissae, ``output_positions`` (k, 3), ``output_tip_rotation`` (3, 3)
+    ///     the tip's rotation with ``tip_orientation`` (``None`` otherwise), ``output_tendon_lengths``
+    ///     (n_actuators,) with ``tendon_lengths`` (empty otherwise; ``C`` has 3k rows, 3 more
+    ///     with ``tip_orientation``, then n_actuators with ``tendon_lengths``), ``x0`` (2n,) the operating
     ///     point, ``u`` (n_actuators,), ``xdot`` (2n,) ``f(x0, u)`` (≈ 0 about an equilibrium),
     ///     ``tip_position`` (3,), ``poles`` (complex, the eigenvalues of A with ``Im ≥ 0``,
     ///     conjugates once, slowest first), ``natural_frequency_hz`` and ``damping_ratio`` per pole,
@@ -63,7 +67,7 @@ impl Robot {
     /// GvsromError
     ///     For bad tensions or states, ``qd`` without ``q``, a massless rod, or an equilibrium
     ///     that fails (``ConvergenceError``).
-    #[pyo3(signature = (u=None, q=None, qd=None, dt=None, outputs=None, tendon_lengths=false))]
+    #[pyo3(signature = (u=None, q=None, qd=None, dt=None, outputs=None, tip_orientation=false, tendon_lengths=false))]
     #[allow(clippy::too_many_arguments)]
     fn linearize<'py>(
         &self,
@@ -73,6 +77,7 @@ impl Robot {
         qd: Option<arrays::In1<'_>>,
         dt: Option<f64>,
         outputs: Option<arrays::Abscissae>,
+        tip_orientation: bool,
         tendon_lengths: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         if let Some(h) = dt {
@@ -83,6 +88,9 @@ impl Robot {
             Some(xs) => linearize::Outputs::at(&self.built, &xs.values)
                 .map_err(|e| invalid(e.to_string()))?,
         };
+        if tip_orientation {
+            outputs = outputs.with_tip_orientation();
+        }
         if tendon_lengths {
             outputs =
                 (outputs.with_tendon_lengths(&self.built)).map_err(|e| invalid(e.to_string()))?;
@@ -138,6 +146,13 @@ fn report_dict<'py>(py: Python<'py>, r: &Linearization) -> PyResult<Bound<'py, P
     let positions =
         nalgebra::DMatrix::from_fn(r.output_positions.len(), 3, |i, j| r.output_positions[i][j]);
     d.set_item("output_positions", matrix(py, &positions)?)?;
+    match &r.output_tip_rotation {
+        Some(rot) => {
+            let m = nalgebra::DMatrix::from_fn(3, 3, |i, j| rot[i][j]);
+            d.set_item("output_tip_rotation", matrix(py, &m)?)?
+        }
+        None => d.set_item("output_tip_rotation", py.None())?,
+    }
     d.set_item(
         "output_tendon_lengths",
         vector(py, &r.output_tendon_lengths),

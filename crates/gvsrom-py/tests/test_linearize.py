@@ -283,3 +283,26 @@ def test_tendon_lengths_as_outputs_add_their_jacobian_rows_and_compliance():
     bare = gvsrom.Scenario.preset("soft-beam").build()
     with pytest.raises(gvsrom.GvsromError, match=r"^tendon_lengths=True: the rod has no tendons"):
         bare.linearize(tendon_lengths=True)
+
+
+def test_tip_orientation_rows_are_the_tip_angular_jacobian_in_world_axes():
+    robot = gvsrom.Scenario.preset("six-tendon").build()
+    q = robot.statics(u=[-10.0, 0, 0, -4.0, 0, 0]).q
+    n = robot.n_dof
+    lin = robot.linearize(u=[-10.0, 0, 0, -4.0, 0, 0], q=q, tip_orientation=True)
+    assert lin["C"].shape == (6, 2 * n)
+    rot = robot.forward(q)["rotation"][-1]
+    np.testing.assert_allclose(lin["output_tip_rotation"], rot, rtol=0, atol=1e-15)
+    J = robot.jacobian(q, -1)
+    np.testing.assert_allclose(lin["C"][3:, :n], rot @ J[:3], rtol=0, atol=1e-12 * np.abs(J).max())
+    # against differences of the tip's rotation: δθ = vee(log(R(q + h e_j) R(q)ᵀ))
+    h = 1e-6
+    for j in (0, 7, 20):
+        e = np.zeros(n)
+        e[j] = h
+        rp, rm = (robot.forward(q + s * e)["rotation"][-1] for s in (1, -1))
+        d = (rp - rm) / (2 * h) @ rot.T  # the skew matrix [δθ]× per unit q_j
+        dtheta = np.array([d[2, 1], d[0, 2], d[1, 0]])
+        np.testing.assert_allclose(lin["C"][3:, j], dtheta, rtol=0,
+                                   atol=1e-6 * np.abs(lin["C"][3:]).max())
+    assert robot.linearize()["output_tip_rotation"] is None

@@ -11,8 +11,9 @@
 //! * `C = [R_tip J_tip,v  0]` (3 × 2n): the tip's world velocity per unit `q̇` (rows 4–6 of the tip
 //!   Jacobian, body frame, rotated to the world); with several output points, their 3 rows each,
 //!   `∂p(X)/∂q` of the centreline between the computational points
-//!   ([`Model::position_jacobian_at`]; `R_i J_v,i` at a point); with tendon lengths as outputs,
-//!   a row `[∂ℓ_k/∂q  0]` per tendon after them ([`Model::tendon_length_jacobian`]).
+//!   ([`Model::position_jacobian_at`]; `R_i J_v,i` at a point); with the tip's orientation as an
+//!   output, 3 rows `[R_tip J_tip,ω  0]` after them (its small rotation in world axes); with
+//!   tendon lengths, a row `[∂ℓ_k/∂q  0]` per tendon last ([`Model::tendon_length_jacobian`]).
 //! * Poles: the eigenvalues of `A`, each with its natural frequency `|λ|/2π` and damping ratio
 //!   `ζ = −Re λ / |λ|`; conjugate pairs listed once (`Im λ ≥ 0`), slowest (`|λ|` smallest) first.
 //! * Static gain (about an equilibrium): `G = −C A⁻¹ B` (3 × n_actuators per output point), the
@@ -135,8 +136,14 @@ pub struct Linearization {
     pub outputs: Vec<f64>,
     /// Their positions at `q` (world) \[m\].
     pub output_positions: Vec<[f64; 3]>,
+    /// With the tip's orientation as an output (`--output-tip-orientation`), the tip's rotation
+    /// matrix at `q` (rows, section → world): `C`'s 3 rows after the positions are its small
+    /// rotation `δθ` in world axes \[rad\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub output_tip_rotation: Option<[[f64; 3]; 3]>,
     /// With tendon lengths as outputs (`--output-tendon-lengths`), each tendon's length at `q` \[m\]:
-    /// `C`'s last rows (`∂ℓ/∂q`, one per tendon, after the positions' triples); empty otherwise.
+    /// `C`'s last rows (`∂ℓ/∂q`, one per tendon, after the positions and the orientation); empty
+    /// otherwise.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub output_tendon_lengths: Vec<f64>,
     /// `A` (2n × 2n), rows.
@@ -284,6 +291,7 @@ pub struct LinearizationJson<'a> {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Outputs {
     xs: Vec<f64>,
+    tip_orientation: bool,
     tendon_lengths: bool,
 }
 
@@ -292,6 +300,7 @@ impl Outputs {
     pub fn tip(built: &Built) -> Self {
         Outputs {
             xs: vec![built.model.disc.length()],
+            tip_orientation: false,
             tendon_lengths: false,
         }
     }
@@ -302,6 +311,7 @@ impl Outputs {
         check_abscissae("--output-at", xs, built.model.disc.length())?;
         Ok(Outputs {
             xs: xs.to_vec(),
+            tip_orientation: false,
             tendon_lengths: false,
         })
     }
@@ -317,6 +327,21 @@ impl Outputs {
                 ..self
             }),
         }
+    }
+
+    /// Adds the tip's orientation after the positions, 3 rows of `C`: the small rotation `δθ`
+    /// of the tip section in world axes, `R_tip J_tip,ω δq` (its rotation turns by `exp([δθ]×)`),
+    /// for a controller that points the tip.
+    pub fn with_tip_orientation(self) -> Self {
+        Outputs {
+            tip_orientation: true,
+            ..self
+        }
+    }
+
+    /// Whether the tip's orientation is an output.
+    pub fn tip_orientation(&self) -> bool {
+        self.tip_orientation
     }
 
     /// The abscissae.
@@ -412,18 +437,28 @@ fn on_model<P: StrainParam>(
     } else {
         0
     };
-    let mut c = DMatrix::zeros(3 * xs.len() + na, 2 * n);
+    let turns = if outputs.tip_orientation() { 3 } else { 0 };
+    let mut c = DMatrix::zeros(3 * xs.len() + turns + na, 2 * n);
     let mut output_positions = Vec::with_capacity(xs.len());
     for (k, &x) in xs.iter().enumerate() {
         let (p, dp) = model.position_jacobian_at(&ws, x);
         c.view_mut((3 * k, 0), (3, n)).copy_from(&dp);
         output_positions.push([p[0], p[1], p[2]]);
     }
-    // after the positions: these evaluate the strains again
+    let tip = model.disc.tip();
+    let rot = ws.g[tip].rot;
+    let output_tip_rotation = (turns > 0).then(|| {
+        let j = ws.jac.columns(tip * n, n);
+        c.view_mut((3 * xs.len(), 0), (3, n))
+            .copy_from(&(rot * j.fixed_rows::<3>(0)));
+        std::array::from_fn(|i| std::array::from_fn(|k| rot[(i, k)]))
+    });
+    // after the kinematics: these evaluate the strains again
     let mut output_tendon_lengths = vec![];
     if na > 0 {
         let dl = model.tendon_length_jacobian(q, &mut ws);
-        c.view_mut((3 * xs.len(), 0), (na, n)).tr_copy_from(&dl);
+        c.view_mut((3 * xs.len() + turns, 0), (na, n))
+            .tr_copy_from(&dl);
         output_tendon_lengths = model.tendon_lengths(q, &mut ws);
     }
 
@@ -439,6 +474,7 @@ fn on_model<P: StrainParam>(
         tip_position: [pos[0], pos[1], pos[2]],
         outputs: xs.to_vec(),
         output_positions,
+        output_tip_rotation,
         output_tendon_lengths,
         relaxation_poles: relaxation_poles(&poles, t_d),
         unstable_poles: poles

@@ -214,7 +214,7 @@ fn tendon_length_output_gain_is_the_tendons_compliance_l_over_ea_plus_d2_l_over_
     let length = f64s(&lin["output_tendon_lengths"]);
     assert!(length.len() == 1 && rel(length[0], L) < 1e-14, "{length:?}");
     for needle in [
-        "y the tip position (world) and the tendon lengths",
+        "y the tip position (world) [m] and the tendon lengths [m];",
         "output     tendon lengths [0.500000] m",
         "gain       settled change of each tendon length per newton of tension",
     ] {
@@ -228,6 +228,46 @@ fn tendon_length_output_gain_is_the_tendons_compliance_l_over_ea_plus_d2_l_over_
     expect_error(
         &["linearize", s(&bare), "--output-tendon-lengths"],
         &["--output-tendon-lengths: the rod has no tendons"],
+    );
+}
+
+#[test]
+fn tip_orientation_output_gain_is_the_uniform_moments_turn_d_l_over_ei() {
+    // the uniform moment u d about y turns the tip by κ L = u d L/EI about world y (positive θ
+    // turns +x toward −z, as δz = −d L²/(2EI) u says); its 3 rows follow the tip's position
+    // and precede the tendon length's
+    let path = rod_file("lin-turn", 1e3);
+    let (stdout, lin) = run_json(
+        "linearize",
+        "lin-turn",
+        &[
+            s(&path),
+            "--output-tip-orientation",
+            "--output-tendon-lengths",
+        ],
+    );
+    let inertia = PI * R.powi(4) / 4.0;
+    let turn = D * L / (E * inertia);
+    let g = matrix(&lin["static_gain"]);
+    assert_eq!(g.len(), 3 + 3 + 1);
+    assert!(rel(g[4][0], turn) < 1e-9, "δθ_y/δu = {} vs {turn}", g[4][0]);
+    assert!(g[3][0].abs() < 1e-12 * turn && g[5][0].abs() < 1e-12 * turn);
+    // the position rows as without it, the length's last
+    let gz = -D * L * L / (2.0 * E * inertia);
+    assert!(rel(g[2][0], gz) < 1e-9);
+    let area = PI * R * R;
+    assert!(rel(g[6][0], L * (1.0 / (E * area) + D * D / (E * inertia))) < 1e-9);
+    // at the straight equilibrium the tip's rotation is the identity
+    let rot = matrix(&lin["output_tip_rotation"]);
+    for i in 0..3 {
+        for j in 0..3 {
+            let id = if i == j { 1.0 } else { 0.0 };
+            assert!((rot[i][j] - id).abs() < 1e-12, "{rot:?}");
+        }
+    }
+    assert!(
+        stdout.contains("gain       settled tip rotation per newton of tension"),
+        "{stdout}"
     );
 }
 

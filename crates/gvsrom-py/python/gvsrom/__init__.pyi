@@ -380,6 +380,7 @@ class Robot:
         qd: ArrayLike | None = None,
         dt: float | None = None,
         outputs: float | ArrayLike | None = None,
+        tip_orientation: bool = False,
         tendon_lengths: bool = False,
     ) -> dict[str, Any]: ...
     def simulate(

@@ -23,6 +23,11 @@ pub struct LinearizeArgs {
     )]
     pub output_at: Option<Vec<f64>>,
 
+    /// Also output the tip's orientation: 3 rows of `C` after the positions, the tip section's
+    /// small rotation in world axes [rad] (for a controller that points the tip).
+    #[arg(long)]
+    pub output_tip_orientation: bool,
+
     /// Also output each tendon's length [m] along its thread, one row of `C` each after the
     /// positions: for actuators under position control; the static gain's tendon rows are then the
     /// tendons' compliance, the settled change of each length per newton of each tension.
@@ -68,6 +73,9 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
         Some(xs) => linearize::Outputs::at(built, xs)?,
         None => linearize::Outputs::tip(built),
     };
+    if args.output_tip_orientation {
+        outputs = outputs.with_tip_orientation();
+    }
     if args.output_tendon_lengths {
         outputs = outputs.with_tendon_lengths(built)?;
     }
@@ -97,12 +105,23 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
                 .join(", ")
         ),
     };
+    y += " (world) [m]";
+    let mut more = vec![];
+    if lin.output_tip_rotation.is_some() {
+        more.push("the tip's orientation (small rotation, world) [rad]");
+    }
     if !lin.output_tendon_lengths.is_empty() {
-        y += " (world) and the tendon lengths";
+        more.push("the tendon lengths [m]");
+    }
+    if let Some((last, rest)) = more.split_last() {
+        for m in rest {
+            y = format!("{y}, {m}");
+        }
+        y = format!("{y} and {last}");
     }
     writeln!(
         out,
-        "system     δẋ = A δx + B δu, δy = C δx: x = [q; q̇] ({n_states} states), u {}, y {y} (world) [m]; linearized in {:.2} ms",
+        "system     δẋ = A δx + B δu, δy = C δx: x = [q; q̇] ({n_states} states), u {}, y {y}; linearized in {:.2} ms",
         match lin.n_actuators {
             0 => "empty (no tendons: B has no columns)".to_string(),
             k => format!("the {} [N]", plural(k, "tendon tension")),
@@ -184,7 +203,18 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
                     writeln!(out, "  tendon {:<3} {}", k + 1, fmt_vec(&col, 4))?;
                 }
             }
-            let rows = &g[3 * lin.outputs.len()..];
+            let mut rows = &g[3 * lin.outputs.len()..];
+            if lin.output_tip_rotation.is_some() {
+                writeln!(
+                    out,
+                    "gain       settled tip rotation per newton of tension, −C A⁻¹ B (about world x, y, z) [mrad/N]"
+                )?;
+                for k in 0..lin.n_actuators {
+                    let col: Vec<f64> = rows[..3].iter().map(|row| row[k] * 1e3).collect();
+                    writeln!(out, "  tendon {:<3} {}", k + 1, fmt_vec(&col, 4))?;
+                }
+                rows = &rows[3..];
+            }
             if !rows.is_empty() {
                 writeln!(
                     out,

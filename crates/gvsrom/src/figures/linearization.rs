@@ -34,7 +34,10 @@ pub struct LinearizationDoc {
     /// The output points' abscissae (a result written before they were recorded: the tip alone).
     #[serde(default)]
     pub outputs: Option<Vec<f64>>,
-    /// With tendon lengths as outputs, their values: one gain row per tendon after the points'.
+    /// With the tip's orientation as an output, its rotation: 3 gain rows after the points'.
+    #[serde(default)]
+    pub output_tip_rotation: Option<[[f64; 3]; 3]>,
+    /// With tendon lengths as outputs, their values: one gain row per tendon, last.
     #[serde(default)]
     pub output_tendon_lengths: Vec<f64>,
     #[serde(default)]
@@ -54,13 +57,18 @@ impl LinearizationDoc {
         if let Some(g) = &doc.static_gain {
             let points = doc.outputs.as_ref().map_or(1, Vec::len);
             let lengths = doc.output_tendon_lengths.len();
-            if g.len() != 3 * points + lengths {
+            let turns = doc.tip_rotation_rows();
+            if g.len() != 3 * points + turns + lengths {
                 return Err(input_error(
                     path,
                     format!(
-                        "static_gain has {} rows; expected {} (3 per output point{})",
+                        "static_gain has {} rows; expected {} (3 per output point{}{})",
                         g.len(),
-                        3 * points + lengths,
+                        3 * points + turns + lengths,
+                        match turns {
+                            0 => "",
+                            _ => ", 3 of the tip's orientation",
+                        },
                         match lengths {
                             0 => String::new(),
                             m => format!(", and {m} tendon lengths"),
@@ -82,6 +90,15 @@ impl LinearizationDoc {
         }
         doc.origin = Some(origin);
         Ok(doc)
+    }
+
+    /// Rows of the tip's orientation in `C` and the gain: 3 if it is an output, else 0.
+    fn tip_rotation_rows(&self) -> usize {
+        if self.output_tip_rotation.is_some() {
+            3
+        } else {
+            0
+        }
     }
 
     /// The figure titles' description: scenario, tensions and model.
@@ -180,7 +197,8 @@ fn static_gain(
 ) -> Result<(), FiguresError> {
     let tendons: Vec<f64> = (1..=doc.n_actuators).map(|k| k as f64).collect();
     let points = doc.outputs.clone();
-    let n_points = (g.len() - doc.output_tendon_lengths.len()) / 3;
+    let (turns, lengths) = (doc.tip_rotation_rows(), doc.output_tendon_lengths.len());
+    let n_points = (g.len() - turns - lengths) / 3;
     let panels: Vec<Figure> = (0..n_points)
         .map(|o| {
             let at = match &points {
@@ -216,10 +234,8 @@ fn static_gain(
                 equal_aspect: false,
             })
         })
-        .chain(tendon_compliance(
-            doc,
-            &g[g.len() - doc.output_tendon_lengths.len()..],
-        ))
+        .chain(tip_rotation(doc, &g[3 * n_points..3 * n_points + turns]))
+        .chain(tendon_compliance(doc, &g[g.len() - lengths..]))
         .collect();
     let n = panels.len();
     let unstable = match doc.unstable_poles {
@@ -263,6 +279,41 @@ fn tendon_compliance(doc: &LinearizationDoc, rows: &[Vec<f64>]) -> Option<Figure
         title: "settled change of the tendon lengths (the tendons' compliance)".into(),
         x_label: "tendon".into(),
         y_label: "per newton of tension [mm/N]".into(),
+        series,
+        log_y: false,
+        equal_aspect: false,
+    }))
+}
+
+/// The panel of the tip-orientation rows `rows` of the gain (none without them): the tip's
+/// settled rotation about world x, y and z per newton of each tendon \[mrad/N\].
+fn tip_rotation(doc: &LinearizationDoc, rows: &[Vec<f64>]) -> Option<Figure> {
+    if rows.len() != 3 {
+        return None;
+    }
+    let tendons: Vec<f64> = (1..=doc.n_actuators).map(|k| k as f64).collect();
+    let margin = Series::new(
+        "",
+        vec![0.5, doc.n_actuators as f64 + 0.5],
+        vec![0.0, 0.0],
+        SeriesStyle::Bounds,
+    );
+    let series = (0..3)
+        .map(|axis| {
+            Series::new(
+                ["about world x", "about world y", "about world z"][axis],
+                tendons.clone(),
+                rows[axis].iter().map(|v| v * 1e3).collect(),
+                SeriesStyle::Markers,
+            )
+            .with_color(palette::EXTRA[axis])
+        })
+        .chain(std::iter::once(margin))
+        .collect();
+    Some(Figure::Line(LineChart {
+        title: "settled rotation of the tip".into(),
+        x_label: "tendon".into(),
+        y_label: "per newton of tension [mrad/N]".into(),
         series,
         log_y: false,
         equal_aspect: false,
