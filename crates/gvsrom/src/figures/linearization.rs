@@ -187,56 +187,48 @@ fn is_unstable(p: &PoleDoc) -> bool {
     p.damping_ratio < -crate::linearize::UNSTABLE_RATIO
 }
 
-/// `static_gain`: one panel per output point, the x, y and z rows against the tendon number, and
-/// one of the tendon lengths' rows if there are any.
+/// `static_gain`: one panel per output point, the x, y and z rows against the tendon number, then
+/// one of the tip's rotation and one of the tendon lengths' rows if they are outputs.
 fn static_gain(
     doc: &LinearizationDoc,
     g: &[Vec<f64>],
     caption: &str,
     sink: &mut Sink,
 ) -> Result<(), FiguresError> {
-    let tendons: Vec<f64> = (1..=doc.n_actuators).map(|k| k as f64).collect();
     let points = doc.outputs.clone();
     let (turns, lengths) = (doc.tip_rotation_rows(), doc.output_tendon_lengths.len());
     let n_points = (g.len() - turns - lengths) / 3;
-    let panels: Vec<Figure> = (0..n_points)
+    let world = |prefix: &str| -> Vec<String> {
+        ["x", "y", "z"]
+            .map(|a| format!("{prefix}world {a}"))
+            .to_vec()
+    };
+    let mut panels: Vec<Figure> = (0..n_points)
         .map(|o| {
             let at = match &points {
                 Some(xs) => format!("X = {} m", gvs::error::fmt_value(xs[o])),
                 None => "the tip".to_string(),
             };
-            // half a tendon of margin on either side, and 0 on the scale
-            let margin = Series::new(
-                "",
-                vec![0.5, doc.n_actuators as f64 + 0.5],
-                vec![0.0, 0.0],
-                SeriesStyle::Bounds,
-            );
-            let series = (0..3)
-                .map(|axis| {
-                    let y = g[3 * o + axis].iter().map(|v| v * 1e3).collect();
-                    Series::new(
-                        ["world x", "world y", "world z"][axis],
-                        tendons.clone(),
-                        y,
-                        SeriesStyle::Markers,
-                    )
-                    .with_color(palette::EXTRA[axis])
-                })
-                .chain(std::iter::once(margin))
-                .collect();
-            Figure::Line(LineChart {
-                title: format!("settled displacement of {at}"),
-                x_label: "tendon".into(),
-                y_label: "per newton of tension [mm/N]".into(),
-                series,
-                log_y: false,
-                equal_aspect: false,
-            })
+            let title = format!("settled displacement of {at}");
+            gain_panel(doc, title, "mm/N", &g[3 * o..3 * o + 3], world(""))
         })
-        .chain(tip_rotation(doc, &g[3 * n_points..3 * n_points + turns]))
-        .chain(tendon_compliance(doc, &g[g.len() - lengths..]))
         .collect();
+    if turns > 0 {
+        let rows = &g[3 * n_points..3 * n_points + 3];
+        let title = "settled rotation of the tip".to_string();
+        panels.push(gain_panel(doc, title, "mrad/N", rows, world("about ")));
+    }
+    if lengths > 0 {
+        let names = (1..=lengths).map(|j| format!("length {j}")).collect();
+        let title = "settled change of the tendon lengths (the tendons' compliance)".to_string();
+        panels.push(gain_panel(
+            doc,
+            title,
+            "mm/N",
+            &g[g.len() - lengths..],
+            names,
+        ));
+    }
     let n = panels.len();
     let unstable = match doc.unstable_poles {
         0 => "",
@@ -250,12 +242,15 @@ fn static_gain(
     sink.figure("static_gain", &grid, (1000, 300 + 400 * n as u32))
 }
 
-/// The panel of the tendon-length rows `rows` of the gain (none without them): each length's
-/// settled change per newton of each tendon's tension, a series per length.
-fn tendon_compliance(doc: &LinearizationDoc, rows: &[Vec<f64>]) -> Option<Figure> {
-    if rows.is_empty() {
-        return None;
-    }
+/// One panel of the gain: each of `rows` (×1000, in `unit`) as markers against the tendon number,
+/// named by `names`, with half a tendon of margin on either side and 0 on the scale.
+fn gain_panel(
+    doc: &LinearizationDoc,
+    title: String,
+    unit: &str,
+    rows: &[Vec<f64>],
+    names: Vec<String>,
+) -> Figure {
     let tendons: Vec<f64> = (1..=doc.n_actuators).map(|k| k as f64).collect();
     let margin = Series::new(
         "",
@@ -263,10 +258,10 @@ fn tendon_compliance(doc: &LinearizationDoc, rows: &[Vec<f64>]) -> Option<Figure
         vec![0.0, 0.0],
         SeriesStyle::Bounds,
     );
-    let series = (rows.iter().enumerate())
-        .map(|(j, row)| {
+    let series = (rows.iter().zip(names).enumerate())
+        .map(|(j, (row, name))| {
             Series::new(
-                format!("length {}", j + 1),
+                name,
                 tendons.clone(),
                 row.iter().map(|v| v * 1e3).collect(),
                 SeriesStyle::Markers,
@@ -275,47 +270,12 @@ fn tendon_compliance(doc: &LinearizationDoc, rows: &[Vec<f64>]) -> Option<Figure
         })
         .chain(std::iter::once(margin))
         .collect();
-    Some(Figure::Line(LineChart {
-        title: "settled change of the tendon lengths (the tendons' compliance)".into(),
+    Figure::Line(LineChart {
+        title,
         x_label: "tendon".into(),
-        y_label: "per newton of tension [mm/N]".into(),
+        y_label: format!("per newton of tension [{unit}]"),
         series,
         log_y: false,
         equal_aspect: false,
-    }))
-}
-
-/// The panel of the tip-orientation rows `rows` of the gain (none without them): the tip's
-/// settled rotation about world x, y and z per newton of each tendon \[mrad/N\].
-fn tip_rotation(doc: &LinearizationDoc, rows: &[Vec<f64>]) -> Option<Figure> {
-    if rows.len() != 3 {
-        return None;
-    }
-    let tendons: Vec<f64> = (1..=doc.n_actuators).map(|k| k as f64).collect();
-    let margin = Series::new(
-        "",
-        vec![0.5, doc.n_actuators as f64 + 0.5],
-        vec![0.0, 0.0],
-        SeriesStyle::Bounds,
-    );
-    let series = (0..3)
-        .map(|axis| {
-            Series::new(
-                ["about world x", "about world y", "about world z"][axis],
-                tendons.clone(),
-                rows[axis].iter().map(|v| v * 1e3).collect(),
-                SeriesStyle::Markers,
-            )
-            .with_color(palette::EXTRA[axis])
-        })
-        .chain(std::iter::once(margin))
-        .collect();
-    Some(Figure::Line(LineChart {
-        title: "settled rotation of the tip".into(),
-        x_label: "tendon".into(),
-        y_label: "per newton of tension [mrad/N]".into(),
-        series,
-        log_y: false,
-        equal_aspect: false,
-    }))
+    })
 }
