@@ -23,7 +23,7 @@ use crate::actuation::{
     wrench_jacobian, Tendon,
 };
 use crate::discretize::{Discretization, MagnusOrder};
-use crate::error::ModelError;
+use crate::error::{fmt_value, ModelError};
 use crate::lie::{ad_mul, coad, coad_mul, coadbar, tilde, Pose, M6, V3, V6};
 use crate::rod::{Rod, SectionProps};
 use crate::strain::StrainParam;
@@ -113,6 +113,11 @@ impl<P: StrainParam> Model<P> {
             .iter()
             .map(|t| tendon_point_list(&disc, t))
             .collect();
+        for (k, (t, pts)) in tendons.iter().zip(&tendon_points).enumerate() {
+            if pts.is_empty() {
+                return Err(no_point_on_span(&disc, k, t));
+            }
+        }
         let tendon_weights: Vec<Vec<f64>> = tendons
             .iter()
             .zip(&tendon_points)
@@ -277,6 +282,27 @@ fn tendon_weight_list(disc: &Discretization, t: &Tendon, pts: &[usize]) -> Vec<f
             (hi - lo).max(0.0)
         })
         .collect()
+}
+
+/// The error of tendon `k` whose span holds no computational point: it would act on nothing (its
+/// load and length would be lost silently). Names the points on either side of it.
+fn no_point_on_span(disc: &Discretization, k: usize, t: &Tendon) -> ModelError {
+    let xs: Vec<f64> = disc.points.iter().map(|p| p.x).collect();
+    let below = xs.iter().rev().find(|&&x| x < t.x_start).copied();
+    let above = xs.iter().find(|&&x| x > t.x_end).copied();
+    let around = match (below, above) {
+        (Some(a), Some(b)) => format!("between the points at X = {a:.6} and {b:.6} m"),
+        _ => "between two points".to_string(),
+    };
+    ModelError::invalid(
+        format!("tendons[{k}].x_end"),
+        format!(
+            "{} m: the span [{}, {}] m lies {around} and holds none, so the tendon would act on nothing; accepted: a span that holds a computational point (longer, or with more points: more Gauss points, or a division junction inside it)",
+            fmt_value(t.x_end),
+            fmt_value(t.x_start),
+            fmt_value(t.x_end),
+        ),
+    )
 }
 
 /// The computational points on a tendon's span. At a termination (or start) on a division junction

@@ -54,6 +54,24 @@ fn rod_model(
     Model::new(rod, disc, b, tendons).unwrap()
 }
 
+/// [`rod_model`]'s parts before the model: the rod, its points and basis.
+fn rod_parts(length: f64, gauss: usize) -> (Rod, Discretization, LinearBasis) {
+    let rod = Rod::tapered(material(), length, R, R);
+    let disc = Discretization::new(
+        &rod,
+        &[Quadrature::Gauss { n: gauss }],
+        MagnusOrder::Z4,
+        &[],
+    )
+    .unwrap();
+    let basis = DivisionBasis::Legendre {
+        modes: [true; 6],
+        orders: [1; 6],
+    };
+    let b = LinearBasis::per_division(&disc, &[basis]).unwrap();
+    (rod, disc, b)
+}
+
 /// A frictionless tendon from offset `d0` to `d1` (`[d_y, d_z]`) over `[xs, xe]`.
 fn tendon(d0: [f64; 2], d1: [f64; 2], xs: f64, xe: f64) -> Tendon {
     Tendon {
@@ -217,4 +235,39 @@ fn tendon_length_jacobian_is_the_gradient_and_the_frictionless_actuation_column(
     }
     let err = (b.column(1) - jac.column(1)).amax() / jac.column(1).amax();
     assert!(err > 1e-3, "friction makes B_1 differ from ∇ℓ_1: {err:e}");
+}
+
+/// A span between two computational points holds none: the tendon would act on nothing, its
+/// length would be 0. It is refused, naming the field and the points around it.
+#[test]
+fn a_tendon_span_between_two_points_is_refused_naming_them() {
+    let (rod, disc, basis) = rod_parts(0.25, 10);
+    let e = Model::new(
+        rod,
+        disc,
+        basis,
+        vec![tendon([0.0, 0.005], [0.0, 0.005], 0.1001, 0.1002)],
+    )
+    .err()
+    .expect("refused")
+    .to_string();
+    assert!(
+        e.contains("tendons[0].x_end")
+            && e.contains(
+                "[0.1001, 0.1002] m lies between the points at X = 0.070826 and 0.106391 m"
+            )
+            && e.contains("act on nothing"),
+        "{e}"
+    );
+    // the same span with a point inside is accepted, and its length is the span's
+    let (rod, disc, basis) = rod_parts(0.25, 10);
+    let x = disc.points[5].x;
+    let m = Model::new(
+        rod,
+        disc,
+        basis,
+        vec![tendon([0.0, 0.005], [0.0, 0.005], x - 1e-4, x + 1e-4)],
+    )
+    .unwrap();
+    assert!((m.tendon_rest_lengths()[0] - 2e-4).abs() < 1e-15);
 }
