@@ -118,10 +118,10 @@ pub(super) fn modes_cmd(args: &ModesArgs, out: &mut impl Write) -> Result<()> {
     let (eq, report) = modes::compute(built, count)?;
     writeln!(
         out,
-        "solved     equilibrium in {} and {}, ‖R‖∞ = {:.3e} (as `gvsrom statics`)",
+        "solved     equilibrium in {} and {}, ‖R‖∞ = {} (as `gvsrom statics`)",
         plural(eq.iterations, "iteration"),
         plural(eq.load_stages, "load stage"),
-        eq.residual_norm,
+        gvs::error::fmt_sci(eq.residual_norm, 3),
     )?;
     writeln!(
         out,

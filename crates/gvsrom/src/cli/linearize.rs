@@ -86,10 +86,10 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
     }
     writeln!(
         out,
-        "solved     equilibrium in {} and {}, ‖R‖∞ = {:.3e} (as `gvsrom statics`)",
+        "solved     equilibrium in {} and {}, ‖R‖∞ = {} (as `gvsrom statics`)",
         plural(eq.iterations, "iteration"),
         plural(eq.load_stages, "load stage"),
-        eq.residual_norm,
+        gvs::error::fmt_sci(eq.residual_norm, 3),
     )?;
     writeln!(
         out,

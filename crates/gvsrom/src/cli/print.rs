@@ -104,10 +104,10 @@ pub(super) fn print_model(
 pub(super) fn print_solution(r: &StaticsReport, out: &mut impl Write) -> Result<()> {
     writeln!(
         out,
-        "solved     {} in {}, ‖R‖∞ = {:.3e}, {:.2} ms",
+        "solved     {} in {}, ‖R‖∞ = {}, {:.2} ms",
         plural(r.iterations, "iteration"),
         plural(r.load_stages, "load stage"),
-        r.residual_norm,
+        gvs::error::fmt_sci(r.residual_norm, 3),
         r.solve_time_s * 1e3
     )?;
     if let Some(c) = &r.continuation {
