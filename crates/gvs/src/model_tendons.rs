@@ -18,17 +18,18 @@ impl<P: StrainParam> Model<P> {
     /// per tendon, at `q`. A tendon is shortened by pulling it: `ℓ_k(q) < ℓ_k(rest)` as it bends
     /// the rod toward itself.
     pub fn tendon_lengths(&self, q: &DVector<f64>, ws: &mut Workspace) -> Vec<f64> {
+        self.strains_at(q, ws);
         let mut out = vec![0.0; self.tendons.len()];
-        self.tendon_lengths_into(q, ws, &mut out);
+        self.tendon_lengths_after_forward(ws, &mut out);
         out
     }
 
-    /// [`Self::tendon_lengths`] into `out` (one per tendon), allocating nothing: for a trajectory's
-    /// every sample.
-    pub fn tendon_lengths_into(&self, q: &DVector<f64>, ws: &mut Workspace, out: &mut [f64]) {
-        let xi = self.strains_at(q, ws);
+    /// [`Self::tendon_lengths`] into `out` (one per tendon) from the strains a forward pass (or
+    /// [`Self::strains_at`]) left in `ws`, allocating nothing: a trajectory's every sample and a
+    /// report read them after the poses without evaluating the strains (a decoder) again.
+    pub fn tendon_lengths_after_forward(&self, ws: &Workspace, out: &mut [f64]) {
         for (k, l) in out.iter_mut().enumerate().take(self.tendons.len()) {
-            *l = self.tendon_length_of(k, |i| xi[i]);
+            *l = self.tendon_length_of(k, |i| ws.xi[i]);
         }
     }
 
@@ -42,15 +43,12 @@ impl<P: StrainParam> Model<P> {
     }
 
     /// `∂ℓ/∂q` (n × tendons): column `k` is `∇_q ℓ_k = Σ_i w_{k,i} Ψ_q,iᵀ Φ_a,k(X_i)`, the
-    /// frictionless tendon's column of the actuation matrix (the module documentation).
+    /// frictionless tendon's column of the actuation matrix (the module documentation). Leaves the
+    /// forward pass at `q` in `ws` ([`Self::tendon_lengths_after_forward`] reads the lengths).
     pub fn tendon_length_jacobian(&self, q: &DVector<f64>, ws: &mut Workspace) -> DMatrix<f64> {
         let (n, na) = (self.n_dof(), self.n_actuators());
-        self.param.eval(q, &mut ws.ev);
-        ws.ev.motion = false;
-        ws.ev.psi_q_stale = false;
-        for s in 0..ws.xi.len() {
-            ws.xi[s] = ws.ev.psi[s] + self.xi_star[s];
-        }
+        // the strains and their tangents Ψ_q that `project` needs (as `actuation_matrix`)
+        self.forward(q, ws, false);
         let mut jac = DMatrix::zeros(n, na);
         let mut col = DVector::zeros(n);
         for (k, td) in self.tendons.iter().enumerate() {

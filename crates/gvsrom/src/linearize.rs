@@ -16,8 +16,8 @@
 //!   tendon lengths, a row `[∂ℓ_k/∂q  0]` per tendon last ([`Model::tendon_length_jacobian`]).
 //! * Poles: the eigenvalues of `A`, each with its natural frequency `|λ|/2π` and damping ratio
 //!   `ζ = −Re λ / |λ|`; conjugate pairs listed once (`Im λ ≥ 0`), slowest (`|λ|` smallest) first.
-//! * Static gain (about an equilibrium): `G = −C A⁻¹ B` (3 × n_actuators per output point), the
-//!   displacement per newton of each tendon once the motion has settled; it equals the derivative
+//! * Static gain (about an equilibrium): `G = −C A⁻¹ B` (C's rows × n_actuators), the settled
+//!   change of each output per newton of each tendon; it equals the derivative
 //!   of the equilibrium's output positions in the tensions (and of its tendon lengths: the
 //!   tendons' compliance, `∂ℓ/∂u = X_e (1/EA + d²/EI)` for a straight tendon on a straight rod).
 
@@ -150,8 +150,8 @@ pub struct Linearization {
     pub a: Vec<Vec<f64>>,
     /// `B` (2n × n_actuators), rows.
     pub b: Vec<Vec<f64>>,
-    /// `C` (3k × 2n for k output points, and a row per tendon after them with tendon lengths as
-    /// outputs), rows.
+    /// `C` (3k × 2n for k output points; then 3 rows of the tip's orientation and a row per tendon
+    /// when they are outputs), rows.
     pub c: Vec<Vec<f64>>,
     /// Every pole (`n` with `Im λ ≥ 0` for an underdamped model; real poles each listed), by `|λ|`.
     pub poles: Vec<Pole>,
@@ -287,7 +287,7 @@ pub struct LinearizationJson<'a> {
 }
 
 /// Where the output `y` is read: the positions of points along the rod, by abscissa, and, if
-/// asked, the tendons' lengths after them (one row of `C` each).
+/// asked, the tip's orientation (3 rows of `C`) and the tendons' lengths (one row each) after them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Outputs {
     xs: Vec<f64>,
@@ -453,13 +453,12 @@ fn on_model<P: StrainParam>(
             .copy_from(&(rot * j.fixed_rows::<3>(0)));
         std::array::from_fn(|i| std::array::from_fn(|k| rot[(i, k)]))
     });
-    // after the kinematics: these evaluate the strains again
-    let mut output_tendon_lengths = vec![];
+    let mut output_tendon_lengths = vec![0.0; na];
     if na > 0 {
         let dl = model.tendon_length_jacobian(q, &mut ws);
         c.view_mut((3 * xs.len() + turns, 0), (na, n))
             .tr_copy_from(&dl);
-        output_tendon_lengths = model.tendon_lengths(q, &mut ws);
+        model.tendon_lengths_after_forward(&ws, &mut output_tendon_lengths);
     }
 
     Ok(Linearization {

@@ -63,7 +63,6 @@ impl Centerline {
                 self.tendons[o..o + 3].copy_from_slice(&[p[0], p[1], p[2]]);
             }
         }
-        // last: it evaluates the strains alone and leaves the poses stale
-        model.tendon_lengths_into(&self.q, &mut self.ws, &mut self.lengths);
+        model.tendon_lengths_after_forward(&self.ws, &mut self.lengths);
     }
 }

@@ -321,8 +321,8 @@ fn report<P: StrainParam>(
         .iter()
         .map(|xi| [xi[0], xi[1], xi[2], xi[3], xi[4], xi[5]])
         .collect();
-    // after the poses are read: this evaluates the strains alone
-    let tendon_lengths = model.tendon_lengths(&sol.q, ws);
+    let mut tendon_lengths = vec![0.0; model.n_actuators()];
+    model.tendon_lengths_after_forward(ws, &mut tendon_lengths);
     StaticsReport {
         scenario: built.name.clone(),
         u: u.to_vec(),
