@@ -4,8 +4,16 @@ use super::*;
 
 pub(super) fn fmt_vec(v: &[f64], prec: usize) -> String {
     // fixed-point, or the exponent form for a magnitude whose digits would run to hundreds
+    // a tiny negative that rounds to zero prints as 0.000, not -0.000 (a sign with no digit to
+    // carry it reads as a result)
     let one = |x: &f64| match x.abs() < 1e15 {
-        true => format!("{x:.prec$}"),
+        true => {
+            let s = format!("{x:.prec$}");
+            match s.strip_prefix('-') {
+                Some(rest) if rest.bytes().all(|b| b == b'0' || b == b'.') => rest.to_string(),
+                _ => s,
+            }
+        }
         false => format!("{x:.prec$e}"),
     };
     let items: Vec<String> = v.iter().map(one).collect();
@@ -182,5 +190,17 @@ mod tests {
         }
         assert_eq!(plural(1, "thread"), "1 thread");
         assert_eq!(plural(2, "thread"), "2 threads");
+    }
+
+    #[test]
+    fn a_tiny_negative_prints_without_a_sign() {
+        assert_eq!(
+            fmt_vec(&[-1e-9, 1e-9, -0.0, 0.0], 6),
+            "[0.000000, 0.000000, 0.000000, 0.000000]"
+        );
+        assert_eq!(
+            fmt_vec(&[-6e-7, -0.25, -2e15], 6),
+            "[-0.000001, -0.250000, -2.000000e15]"
+        );
     }
 }
