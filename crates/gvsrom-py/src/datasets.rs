@@ -41,6 +41,10 @@ use std::path::PathBuf;
 ///     [m]
 /// t : numpy.ndarray or None
 ///     Sample times [s] of a dynamic dataset.
+/// tendon_lengths : numpy.ndarray or None, shape (N, n_tendons)
+///     The tendons' lengths [m], what a position-controlled actuator reads (NaN rows for failed
+///     samples); ``None`` for a dataset written before they were recorded (compute them with
+///     ``Robot.tendon_lengths(q)``).
 /// complete : bool
 ///     False for an interrupted dataset.
 /// meta : dict
@@ -102,6 +106,10 @@ pub struct Dataset {
     /// Sample times [s] of a dynamic dataset, else ``None``.
     #[pyo3(get)]
     t: Option<Py<PyAny>>,
+    /// The tendons' lengths [m], shape (N, n_tendons); ``None`` for a dataset written before
+    /// they were recorded.
+    #[pyo3(get)]
+    tendon_lengths: Option<Py<PyAny>>,
     /// ``meta.json`` as the loader verified it.
     meta_json: serde_json::Value,
 }
@@ -200,6 +208,10 @@ pub fn load_dataset(py: Python<'_>, path: PathBuf) -> PyResult<Dataset> {
         t: d.t
             .map(|t| held(PyArray::from_vec(py, t).into_any()))
             .transpose()?,
+        tendon_lengths: match (d.tendon_lengths, m.n_tendons) {
+            (Some(l), Some(na)) => Some(held(shaped(py, l, [n, na])?)?),
+            _ => None,
+        },
         meta_json: d.meta_json,
         // absolute: `pod`, `train` and `reconstruction` read the directory again, maybe after a
         // change of the working directory

@@ -13,7 +13,7 @@ import gvsrom
 from conftest import cli_error, run_cli
 
 FILES = ["inputs", "strain", "q", "tip_position", "tip_rotation", "status", "iterations", "residual",
-         "strain_x"]
+         "strain_x", "tendon_lengths"]
 
 
 def cli_dataset(bin_path, out, *args):
@@ -64,6 +64,13 @@ def test_load_dataset_reads_the_files_and_the_metadata(sweep):
     np.testing.assert_array_equal(ds.inputs[:, 0], np.linspace(-6, 0, 7))
     assert ds.meta["samples"] == 7 and ds.meta["counts"]["ok"] == 7
     assert ds.t is None
+    # the tendon's lengths are its length at each row's q, as the robot computes it
+    robot = gvsrom.Scenario.preset("single-tendon").build()
+    assert ds.tendon_lengths.shape == (7, 1) and ds.meta["n_tendons"] == 1
+    for k in range(7):
+        np.testing.assert_allclose(ds.tendon_lengths[k], robot.tendon_lengths(ds.q[k]), rtol=1e-14)
+    # pulled harder (−6 N first), shorter
+    assert np.all(np.diff(ds.tendon_lengths[:, 0]) > 0)
 
 
 def test_a_python_dataset_trains_models_whose_arrays_and_statics_hold(sweep, tmp_path):

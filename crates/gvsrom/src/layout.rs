@@ -11,6 +11,8 @@ pub struct Layout {
     pub strain_x: Vec<f64>,
     /// Indices (0..6) of the active strain components.
     pub active: Vec<usize>,
+    /// Tendons, whose lengths a sample row records.
+    pub n_tendons: usize,
 }
 
 impl Layout {
@@ -21,6 +23,7 @@ impl Layout {
             n_dof: m.n_dof(),
             strain_x: m.disc.points.iter().map(|p| p.x).collect(),
             active: rom::reduced::PointLayout::active_in(&m.param, &m.disc).active,
+            n_tendons: m.n_actuators(),
         }
     }
 

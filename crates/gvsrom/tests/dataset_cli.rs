@@ -8,7 +8,7 @@ use common::{copy_dir, expect_error, gvsrom, json, run_ok, scratch, sweep_datase
 use gvsrom::dataset::Dataset;
 use std::path::Path;
 
-const ARRAYS: [&str; 9] = [
+const ARRAYS: [&str; 10] = [
     "inputs.npy",
     "strain.npy",
     "q.npy",
@@ -18,6 +18,7 @@ const ARRAYS: [&str; 9] = [
     "iterations.npy",
     "residual.npy",
     "strain_x.npy",
+    "tendon_lengths.npy",
 ];
 
 /// A 9-sample single-tendon sweep over [-6, 3] N (one chunk).
@@ -82,7 +83,20 @@ fn single_tendon_sweep_writes_306_strain_columns_and_matches_statics() {
             let d = (ds.tip_position[3 * k + i] - tip[i].as_f64().unwrap()).abs();
             assert!(d < 1e-10, "sample {k}: tip differs by {d:e}");
         }
+        // the tendon's length, what its actuator reads: as the statics report gives it
+        let length = sol["tendon_lengths"][0].as_f64().unwrap();
+        let row = ds.tendon_lengths_row(k).unwrap();
+        assert_eq!(row.len(), 1);
+        assert!(
+            (row[0] - length).abs() < 1e-10,
+            "sample {k}: {} against {length}",
+            row[0]
+        );
     }
+    // the more it is pulled (u from −6 to 3 N) the shorter it is
+    assert_eq!(ds.meta.n_tendons, Some(1));
+    let lengths = ds.tendon_lengths.as_ref().unwrap();
+    assert!(lengths.windows(2).all(|w| w[0] < w[1]), "{lengths:?}");
 }
 
 #[test]
@@ -105,6 +119,10 @@ fn a_dataset_read_back_holds_exactly_the_bytes_written() {
     assert!(same(&ds.inputs, &raw("inputs.npy")));
     assert!(same(&ds.tip_rotation, &raw("tip_rotation.npy")));
     assert!(same(&ds.strain_x, &raw("strain_x.npy")));
+    assert!(same(
+        ds.tendon_lengths.as_ref().unwrap(),
+        &raw("tendon_lengths.npy")
+    ));
     assert_eq!(ds.status, vec![0u8; 9]);
     // and loading twice gives the same dataset
     assert_eq!(Dataset::load(&dir).unwrap(), ds);
@@ -354,6 +372,66 @@ fn a_resumed_run_equals_an_uninterrupted_one() {
     for e in std::fs::read_dir(parent).unwrap() {
         let n = e.unwrap().file_name().to_string_lossy().into_owned();
         assert!(!n.starts_with(".ds-resume-part."), "left behind: {n}");
+    }
+}
+
+/// A dataset written before the tendons' lengths were recorded (no `tendon_lengths.npy`, no
+/// `n_tendons`) resumes: the kept rows' lengths are computed from their `q`, and the result equals
+/// an uninterrupted run's.
+#[test]
+fn a_dataset_from_before_tendon_lengths_resumes_with_its_lengths_computed() {
+    let whole = random_six("ds-legacy-whole", &[]);
+    let part = random_six("ds-legacy-part", &["--stop-after-chunks", "2"]);
+    std::fs::remove_file(part.join("tendon_lengths.npy")).unwrap();
+    let meta_path = part.join("meta.json");
+    let mut legacy = json(&meta_path);
+    legacy.as_object_mut().unwrap().remove("n_tendons").unwrap();
+    let files = legacy["gvsrom"]["files"].as_array_mut().unwrap();
+    files.retain(|f| f != "tendon_lengths.npy");
+    std::fs::write(&meta_path, serde_json::to_string(&legacy).unwrap()).unwrap();
+    common::reseal::reseal(&part);
+    let old = Dataset::load(&part).unwrap();
+    assert_eq!(
+        (old.meta.n_tendons, old.tendon_lengths_row(0)),
+        (None, None)
+    );
+    run_ok(&[
+        "dataset",
+        "six-tendon",
+        "--random",
+        "tendons.*.tension=-30:30",
+        "--samples",
+        "40",
+        "--chunk-size",
+        "8",
+        "--seed",
+        "7",
+        "--out",
+        part.to_str().unwrap(),
+        "--resume",
+    ]);
+    let (resumed, uninterrupted) = (
+        Dataset::load(&part).unwrap(),
+        Dataset::load(&whole).unwrap(),
+    );
+    assert_eq!(resumed.meta.n_tendons, Some(6));
+    let (a, b) = (
+        resumed.tendon_lengths.as_ref().unwrap(),
+        uninterrupted.tendon_lengths.as_ref().unwrap(),
+    );
+    assert_eq!(a.len(), 40 * 6);
+    // the kept rows (chunks 0 and 1: rows 0..16) from q, the others solved: as the whole run's
+    for (k, (x, y)) in a.iter().zip(b).enumerate() {
+        assert!(
+            (x - y).abs() <= 1e-12 * y,
+            "row {}, tendon {}: {x} against {y}",
+            k / 6,
+            k % 6
+        );
+    }
+    for f in &ARRAYS[..9] {
+        let same = std::fs::read(part.join(f)).unwrap() == std::fs::read(whole.join(f)).unwrap();
+        assert!(same, "{f} differs from the uninterrupted run's");
     }
 }
 

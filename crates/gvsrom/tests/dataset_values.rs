@@ -95,6 +95,29 @@ fn a_non_finite_value_in_an_ok_row_is_refused_naming_file_and_row() {
 }
 
 #[test]
+fn a_tendon_length_that_is_not_a_length_is_refused_naming_file_and_row() {
+    for (at, value, shown) in [
+        (1, f64::NAN, "NaN"),
+        (2, 0.0, "length 0 "),
+        (0, -0.2, "-0.2"),
+    ] {
+        let msg = refused(&format!("values-tendon-length-{at}"), |d| {
+            write_f64(d, "tendon_lengths.npy", at, &[value])
+        });
+        assert_names(
+            &msg,
+            &[
+                "tendon_lengths.npy",
+                &format!("row {at} has status ok"),
+                shown,
+                "tendon 0",
+                "> 0 m",
+            ],
+        );
+    }
+}
+
+#[test]
 fn a_negative_residual_is_refused_naming_file_and_row() {
     let msg = refused("values-negative-residual", |d| {
         write_f64(d, "residual.npy", 2, &[-1e-9])

@@ -50,7 +50,7 @@ fn the_untouched_dataset_is_accepted() {
         String::from_utf8_lossy(&out.stderr)
     );
     let m = &meta(dataset())["gvsrom"];
-    assert_eq!(m["sha256"].as_object().unwrap().len(), 9, "{m}");
+    assert_eq!(m["sha256"].as_object().unwrap().len(), 10, "{m}");
     assert_eq!(m["meta_sha256"].as_str().unwrap().len(), 64, "{m}");
 }
 

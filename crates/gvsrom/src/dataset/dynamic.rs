@@ -111,7 +111,7 @@ pub fn run(
     let model = &built.model;
     let na = model.n_actuators();
     let n_max = plan.t_out.len();
-    let per_sample = (na + 1 + layout.row_len() + layout.n_dof + 14) as f64 * 8.0;
+    let per_sample = (2 * na + 1 + layout.row_len() + layout.n_dof + 14) as f64 * 8.0;
     if n_max as f64 * per_sample > MAX_DATASET_BYTES {
         return Err(DatasetError::Plan(format!(
             "--duration {duration}: {n_max} samples would take {:.1} GB in memory (accepted <= {:.1} GB); lower --duration or --sample-rate",
@@ -127,6 +127,7 @@ pub fn run(
     let mut stopped = None;
     let mut non_physical = None;
     let x = layout.strain_x.clone();
+    let mut ws = model.workspace();
     // polled before every step attempt too, not only at samples: with tight tolerances the next
     // sample may be far away
     let stop = || match interrupt.load(Ordering::SeqCst) {
@@ -148,6 +149,8 @@ pub fn run(
                 return ControlFlow::Break(msg);
             }
             let mut strain = Vec::with_capacity(layout.row_len());
+            let q = nalgebra::DVector::from_column_slice(s.q);
+            let tendon_lengths = model.tendon_lengths(&q, &mut ws);
             for (j, xi) in s.strain.iter().enumerate() {
                 let dev = xi - model.xi_star(j);
                 strain.extend(layout.active.iter().map(|&a| dev[a]));
@@ -158,6 +161,7 @@ pub fn run(
                 q: s.q.to_vec(),
                 tip_position: [s.tip.pos[0], s.tip.pos[1], s.tip.pos[2]],
                 tip_rotation: std::array::from_fn(|i| s.tip.rot[(i / 3, i % 3)]),
+                tendon_lengths,
                 iterations: 0,
                 residual: f64::NAN,
                 warm_started: false,
@@ -236,6 +240,7 @@ pub fn run(
         failures: vec![],
         crate_version: env!("CARGO_PKG_VERSION").into(),
         q_order: gvs::strain::COORDINATE_ORDER.into(),
+        n_tendons: Some(layout.n_tendons),
         wall_time_s: t0.elapsed().as_secs_f64(),
         threads: 1,
         noise: None,

@@ -37,6 +37,8 @@ pub struct SampleResult {
     pub tip_position: [f64; 3],
     /// Row-major 3×3.
     pub tip_rotation: [f64; 9],
+    /// The tendons' lengths ℓ_k(q) \[m\] ([`gvs::model::Model::tendon_lengths`]; NaN if failed).
+    pub tendon_lengths: Vec<f64>,
     pub iterations: u32,
     pub residual: f64,
     pub warm_started: bool,
@@ -51,6 +53,7 @@ impl SampleResult {
             q: vec![f64::NAN; layout.n_dof],
             tip_position: [f64::NAN; 3],
             tip_rotation: [f64::NAN; 9],
+            tendon_lengths: vec![f64::NAN; layout.n_tendons],
             iterations: 0,
             residual: f64::NAN,
             warm_started: false,
@@ -158,6 +161,18 @@ impl Generator<'_> {
         Ok(Setup::Rebuilt(Box::new(built)))
     }
 
+    /// The tendons' lengths of sample `k` at its solution `q` (NaN unless `status` is ok): for a
+    /// dataset resumed from one written before the lengths were recorded.
+    pub fn tendon_lengths_at(&self, k: usize, status: u8, q: &[f64]) -> Vec<f64> {
+        let q = DVector::from_column_slice(q);
+        let at = |m: &Model<LinearBasis>| m.tendon_lengths(&q, &mut m.workspace());
+        match (status, self.setup(k)) {
+            (STATUS_OK, Ok(Setup::Shared(_) | Setup::Loads(..))) => at(&self.base.model),
+            (STATUS_OK, Ok(Setup::Rebuilt(b))) => at(&b.model),
+            _ => vec![f64::NAN; self.layout.n_tendons],
+        }
+    }
+
     /// Solves chunk `c`; results in plan order. `stop` is polled before every load stage of every
     /// solve: `None` if it asked to stop (the chunk is then not done and none of its results kept).
     /// The samples are solved along the chunk's warm-start chain ([`statics::along_chain`],
@@ -215,12 +230,15 @@ fn record(
         strain.extend(layout.active.iter().map(|&a| dev[a]));
     }
     let tip = model.tip_pose(ws);
+    let mut tendon_lengths = vec![0.0; model.n_actuators()];
+    model.tendon_lengths_after_forward(ws, &mut tendon_lengths);
     SampleResult {
         status: STATUS_OK,
         strain,
         q: sol.q.iter().copied().collect(),
         tip_position: [tip.pos[0], tip.pos[1], tip.pos[2]],
         tip_rotation: std::array::from_fn(|i| tip.rot[(i / 3, i % 3)]),
+        tendon_lengths,
         iterations: sol.iterations as u32,
         residual: sol.residual_norm,
         warm_started: warm,

@@ -12,6 +12,7 @@
 //! | `iterations.npy` | (N,) | u32 | dogleg iterations of the successful solve |
 //! | `residual.npy` | (N,) | f64 | ‖R‖∞ at the solution |
 //! | `strain_x.npy` | (p,) | f64 | abscissae of the computational points \[m\] |
+//! | `tendon_lengths.npy` | (N, n_a) | f64 | the tendons' lengths ℓ_k(q) \[m\] (what a position-controlled actuator reads; NaN rows for failed samples); `n_tendons` in meta.json (datasets written before it have neither) |
 //! | `meta.json` | | | manifest, scenario TOML (after `--set`), plan, seed, parameters, point layout, active components, chunking and `chunk_done`, counts, failures, `complete`, crate version, wall time |
 //!
 //! A strain component is *active* if the scenario's basis can excite it at some site; the others are
@@ -59,6 +60,10 @@ pub const STRAIN_LAYOUT: &str = "point-major: column j*len(components) + c holds
 
 /// The sample times of a dynamic dataset.
 pub const T_FILE: &str = "t.npy";
+
+/// The tendons' lengths, `samples × n_tendons` (absent from datasets written before they were
+/// recorded: `n_tendons` is then absent from meta.json).
+pub const TENDON_LENGTHS_FILE: &str = "tendon_lengths.npy";
 
 /// Samples per chunk unless `--chunk-size` says otherwise.
 pub const DEFAULT_CHUNK_SIZE: usize = 128;
@@ -215,6 +220,10 @@ pub struct Meta {
     /// before it was recorded used `"fem-mode-major"`.
     #[serde(default = "legacy_q_order")]
     pub q_order: String,
+    /// Columns of `tendon_lengths.npy`, one per tendon (`None`: a dataset written before the
+    /// lengths were recorded, which has no such file).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub n_tendons: Option<usize>,
     /// Wall time of this run (a resumed run: of its own part).
     pub wall_time_s: f64,
     pub threads: usize,
@@ -422,7 +431,9 @@ pub fn run(args: &DatasetRequest, interrupt: &AtomicUsize) -> Result<Outcome, Da
     check_plan(&plan, &table, &built)?;
     let layout = Layout::of(&built);
     let n = plan.samples;
-    let per_sample = (plan.parameters.len() + layout.row_len() + layout.n_dof + 14) as f64 * 8.0;
+    let per_sample =
+        (plan.parameters.len() + layout.row_len() + layout.n_dof + layout.n_tendons + 14) as f64
+            * 8.0;
     if n as f64 * per_sample > MAX_DATASET_BYTES {
         return Err(plan_err(format!(
             "--samples {n}: the dataset would take {:.1} GB in memory (accepted <= {:.1} GB); use fewer samples",
@@ -460,6 +471,7 @@ pub fn run(args: &DatasetRequest, interrupt: &AtomicUsize) -> Result<Outcome, Da
         failures: vec![],
         crate_version: env!("CARGO_PKG_VERSION").into(),
         q_order: gvs::strain::COORDINATE_ORDER.into(),
+        n_tendons: Some(layout.n_tendons),
         wall_time_s: 0.0,
         threads: 0,
         plan: Some(plan.clone()),
@@ -481,7 +493,11 @@ pub fn run(args: &DatasetRequest, interrupt: &AtomicUsize) -> Result<Outcome, Da
             if prev.meta.chunk_done[c] {
                 results[c] = Some(
                     gen.chunk_range(c)
-                        .map(|k| resume::from_previous(&prev, k))
+                        .map(|k| {
+                            resume::from_previous(&prev, k, |k, q| {
+                                gen.tendon_lengths_at(k, prev.status[k], q)
+                            })
+                        })
                         .collect(),
                 );
                 resumed_chunks += 1;

@@ -108,6 +108,9 @@ pub fn with_noise(
                     ds.tip_position[3 * k + 2],
                 ],
                 tip_rotation,
+                tendon_lengths: ds
+                    .tendon_lengths_row(k)
+                    .map_or_else(Vec::new, <[f64]>::to_vec),
                 iterations: ds.iterations[k],
                 residual: ds.residual[k],
                 warm_started: false,
@@ -134,6 +137,7 @@ pub fn with_noise(
                     .unwrap_or(0)
             })
             .collect(),
+        n_tendons: ds.meta.n_tendons.unwrap_or(0),
     };
     let mut meta: Meta = ds.meta.clone();
     meta.noise = Some(info.clone());

@@ -5,7 +5,7 @@
 //! directory in place of a file is refused by name, never waited on.
 
 use super::generate::{STATUS_FAILED, STATUS_NOT_COMPUTED, STATUS_OK};
-use super::{DatasetError, Meta, FILES, T_FILE};
+use super::{DatasetError, Meta, FILES, TENDON_LENGTHS_FILE, T_FILE};
 use crate::output::integrity::{recorded_hashes, sha256_hex, Integrity, IntegrityError, Problem};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -35,6 +35,9 @@ pub struct Dataset {
     pub strain_x: Vec<f64>,
     /// Sample times of a dynamic dataset.
     pub t: Option<Vec<f64>>,
+    /// `samples × n_tendons`: the tendons' lengths \[m\] (`None` for a dataset written before they
+    /// were recorded).
+    pub tendon_lengths: Option<Vec<f64>>,
     /// Whether the files were checked against recorded hashes ([`Integrity::Unhashed`]: a dataset
     /// written before gvsrom recorded them; a front-end may warn).
     pub integrity: Integrity,
@@ -235,6 +238,10 @@ impl Dataset {
                 "dynamics" => Some(arrays.read(T_FILE, f8, &[n])?),
                 _ => None,
             },
+            tendon_lengths: match meta.n_tendons {
+                Some(na) => Some(arrays.read(TENDON_LENGTHS_FILE, f8, &[n, na])?),
+                None => None,
+            },
             meta,
             integrity,
             strain_sha256,
@@ -353,6 +360,21 @@ impl Dataset {
                 ));
             }
         }
+        if let (Some(lengths), Some(na)) = (&self.tendon_lengths, self.meta.n_tendons) {
+            let row = &lengths[k * na..(k + 1) * na];
+            if let Some((j, v)) = row
+                .iter()
+                .enumerate()
+                .find(|(_, v)| !(v.is_finite() && **v > 0.0))
+            {
+                return Err(file_error(
+                    &at(TENDON_LENGTHS_FILE),
+                    format!(
+                        "row {k} has status ok but holds the length {v} for tendon {j} (expected a finite length > 0 m)"
+                    ),
+                ));
+            }
+        }
         if let Err((orthogonality, det)) = is_rotation(rotation) {
             return Err(file_error(
                 &at(FILES[4]),
@@ -371,6 +393,12 @@ impl Dataset {
     /// Values per strain row.
     pub fn row_len(&self) -> usize {
         self.strain_x.len() * self.meta.components.len()
+    }
+
+    /// The tendons' lengths of sample `k` (`None` for a dataset written before they were recorded).
+    pub fn tendon_lengths_row(&self, k: usize) -> Option<&[f64]> {
+        let na = self.meta.n_tendons?;
+        Some(&self.tendon_lengths.as_ref()?[k * na..(k + 1) * na])
     }
 
     /// The strain row of sample `k`.

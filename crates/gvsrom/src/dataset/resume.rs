@@ -129,8 +129,13 @@ fn difference_at(a: &Value, b: &Value, path: String) -> Option<(String, String, 
     }
 }
 
-/// Sample `k` as stored in a previous dataset.
-pub(super) fn from_previous(prev: &Dataset, k: usize) -> SampleResult {
+/// Sample `k` as stored in a previous dataset. `lengths_of(k, q)`: the tendons' lengths of a solved
+/// sample that a dataset written before they were recorded does not hold.
+pub(super) fn from_previous(
+    prev: &Dataset,
+    k: usize,
+    lengths_of: impl Fn(usize, &[f64]) -> Vec<f64>,
+) -> SampleResult {
     let r = prev.row_len();
     let n = prev.meta.n_dof;
     let reason = prev
@@ -139,10 +144,16 @@ pub(super) fn from_previous(prev: &Dataset, k: usize) -> SampleResult {
         .iter()
         .find(|f| f.index == k)
         .map(|f| f.reason.clone());
+    let q = &prev.q[k * n..(k + 1) * n];
+    let tendon_lengths = match prev.tendon_lengths_row(k) {
+        Some(row) => row.to_vec(),
+        None => lengths_of(k, q),
+    };
     SampleResult {
         status: prev.status[k],
         strain: prev.strain[k * r..(k + 1) * r].to_vec(),
-        q: prev.q[k * n..(k + 1) * n].to_vec(),
+        q: q.to_vec(),
+        tendon_lengths,
         tip_position: std::array::from_fn(|i| prev.tip_position[3 * k + i]),
         tip_rotation: std::array::from_fn(|i| prev.tip_rotation[9 * k + i]),
         iterations: prev.iterations[k],

@@ -3,7 +3,7 @@
 use super::generate::{
     Generator, Layout, SampleResult, STATUS_FAILED, STATUS_NOT_COMPUTED, STATUS_OK,
 };
-use super::{Counts, DatasetError, Failure, Meta, FILES, T_FILE};
+use super::{Counts, DatasetError, Failure, Meta, FILES, TENDON_LENGTHS_FILE, T_FILE};
 use crate::output::OutputDir;
 
 /// Writes the arrays of all samples (missing chunks as not computed) and fills the counts.
@@ -43,6 +43,7 @@ pub(crate) fn write_arrays(
     let mut status = Vec::with_capacity(n);
     let mut iterations = Vec::with_capacity(n);
     let mut residual = Vec::with_capacity(n);
+    let mut tendon_lengths = Vec::with_capacity(n * layout.n_tendons);
     let mut counts = Counts::default();
     let mut failures = vec![];
     for (k, s) in rows.iter().enumerate() {
@@ -65,8 +66,16 @@ pub(crate) fn write_arrays(
         status.push(s.status);
         iterations.push(s.iterations);
         residual.push(s.residual);
+        tendon_lengths.extend_from_slice(&s.tendon_lengths);
     }
     meta.counts = counts;
+    // a dataset from one written before the lengths were recorded has none to write
+    if rows
+        .iter()
+        .any(|s| s.tendon_lengths.len() != layout.n_tendons)
+    {
+        meta.n_tendons = None;
+    }
     meta.failures = failures;
     let d = meta.parameters.len();
     let p = layout.strain_x.len();
@@ -83,6 +92,14 @@ pub(crate) fn write_arrays(
         write_array(dir, FILES[8], &[p], &layout.strain_x)?;
         if let Some(t) = t {
             write_array(dir, T_FILE, &[n], t)?;
+        }
+        if meta.n_tendons.is_some() {
+            write_array(
+                dir,
+                TENDON_LENGTHS_FILE,
+                &[n, layout.n_tendons],
+                &tendon_lengths,
+            )?;
         }
         Ok(())
     })()
