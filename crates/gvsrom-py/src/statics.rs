@@ -44,6 +44,10 @@ use pyo3::types::PyDict;
 ///     Solver statistics.
 /// residual_norm : float
 ///     ``‖R(q)‖∞`` at the solution.
+/// divergence : float or None
+///     ``ω²`` [1/s²], the real eigenvalue ``< 0`` of ``M⁻¹ K_T``, if the equilibrium is unstable
+///     (no stable one connected to the straight rod was found; a ``UserWarning`` says so too);
+///     ``None`` for a stable one.
 /// solve_time_s : float
 ///     Wall-clock time of the solve [s].
 /// model_extrapolated : list of str
@@ -91,6 +95,8 @@ pub struct Statics {
     jacobian_evaluations: usize,
     /// `‖R(q)‖∞` at the solution.
     residual_norm: f64,
+    /// `ω² < 0` [1/s²] if the equilibrium diverges, else `None`.
+    divergence: Option<f64>,
     /// Wall-clock time of the solve [s].
     solve_time_s: f64,
     /// How the reduced model was used outside what it was trained on (`--extrapolate`).
@@ -103,6 +109,14 @@ impl Statics {
         r: &StaticsReport,
         model_extrapolated: Vec<String>,
     ) -> PyResult<Statics> {
+        if let Some(w2) = r.divergence {
+            crate::robot::warn(
+                py,
+                &format!(
+                    "the equilibrium is unstable: M⁻¹K_T has the real eigenvalue ω² = {w2:.4e} 1/s² < 0, and no stable equilibrium connected to the straight rod was found (Statics.divergence)"
+                ),
+            )?;
+        }
         Ok(Statics {
             scenario: r.scenario.clone(),
             n_dof: r.n_dof,
@@ -136,6 +150,7 @@ impl Statics {
             residual_evaluations: r.residual_evaluations,
             jacobian_evaluations: r.jacobian_evaluations,
             residual_norm: r.residual_norm,
+            divergence: r.divergence,
             solve_time_s: r.solve_time_s,
             model_extrapolated,
         })
@@ -171,6 +186,7 @@ impl Statics {
         d.set_item("residual_evaluations", self.residual_evaluations)?;
         d.set_item("jacobian_evaluations", self.jacobian_evaluations)?;
         d.set_item("residual_norm", self.residual_norm)?;
+        d.set_item("divergence", self.divergence)?;
         d.set_item("solve_time_s", self.solve_time_s)?;
         d.set_item("model_extrapolated", &self.model_extrapolated)?;
         Ok(d)

@@ -112,3 +112,34 @@ def test_tendon_paths_start_at_the_offsets_and_follow_the_rod():
     # and it stays within the section's radius (12.5 → 5 mm) of the centreline
     gap = np.linalg.norm(path - eq.centerline, axis=1)
     assert np.all(gap <= 0.0125 + 1e-9) and np.all(gap > 0.0029)
+
+
+SOFT_CANTILEVER = """
+name = "soft-cantilever"
+[material]
+youngs_modulus = 3.3e5
+poisson_ratio = 0.5
+density = 1000.0
+[[divisions]]
+length = 1.0
+radius = 0.01
+basis = { kind = "legendre", modes = ["torsion","bend_y","bend_z","elongation","shear_y","shear_z"], order = 3 }
+[loads]
+gravity = [0.0, 0.0, -9.81]
+"""
+
+
+def test_a_soft_cantilever_under_gravity_hangs_down_and_is_stable():
+    # one full-load step from straight lands on an equilibrium curled up above the clamp, which
+    # diverges; the solver then follows the equilibria from the straight rod to the hanging one
+    s = gvsrom.Scenario.from_toml(SOFT_CANTILEVER).build().statics()
+    assert s.tip_position[2] < -0.9 and s.divergence is None
+    assert s.to_dict()["divergence"] is None
+
+
+def test_an_unstable_equilibrium_warns_and_reports_its_divergence():
+    # the same rod with continuation forbidden (solver.min_increment = 1): the curled equilibrium
+    scenario = gvsrom.Scenario.from_toml(SOFT_CANTILEVER).set("solver.min_increment", 1.0)
+    with pytest.warns(UserWarning, match="unstable.*divergence"):
+        s = scenario.build().statics()
+    assert s.tip_position[2] > 0.1 and s.divergence < -1e3

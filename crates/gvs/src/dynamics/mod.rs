@@ -23,7 +23,7 @@ use nalgebra::{DMatrix, DVector};
 use thiserror::Error;
 
 mod analysis;
-mod cholesky;
+pub(crate) mod cholesky;
 mod linearize;
 pub use analysis::{Energy, Mode};
 pub use cholesky::{

@@ -6,6 +6,7 @@ pub mod continuation;
 pub mod dogleg;
 pub mod dynamics;
 pub mod ode;
+pub mod stability;
 pub mod statics;
 
 /// A check polled by long solver loops (before every step attempt of a simulation, every load stage

@@ -177,8 +177,15 @@ pub struct StaticsSolution {
     pub residual_norm: f64,
     /// Load stages solved (including retries after halving).
     pub load_stages: usize,
-    /// The continuation from the straight rod, if the ramp stalled (its q was then polished at λ = 1).
+    /// The continuation from the straight rod, if the ramp stalled or converged onto an unstable
+    /// equilibrium (its q was then polished at λ = 1).
     pub continuation: Option<ContinuationStats>,
+    /// `Some(ω²)`, the most negative real eigenvalue of `M⁻¹ K_T` \[1/s²\], if the equilibrium
+    /// diverges ([`super::stability`]): no stable equilibrium was found, and the front-end says so.
+    pub divergence: Option<f64>,
+    /// `Some(ω²)` if the step from the straight rod first converged onto an equilibrium that
+    /// diverges (with that eigenvalue): why the continuation then ran.
+    pub unstable_start: Option<f64>,
 }
 
 /// What pseudo-arc-length continuation did in a solve that did not converge
@@ -387,6 +394,8 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
             residual_norm: f64::NAN,
             load_stages: 0,
             continuation: None,
+            divergence: None,
+            unstable_start: None,
         };
         let differences = match self.options.jacobian {
             StaticsJacobian::Auto => n <= DIFFERENCE_MAX_DOF,
@@ -397,15 +406,21 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
         let mut inc = 1.0 / self.options.ramp_steps as f64;
         // ‖R‖∞ and its tolerance at the end of the last stage (converged or not)
         let mut last_tolerance = f64::NAN;
-        while lambda < 1.0 {
-            if let Some(reason) = stop() {
-                return Err(StaticsError::Stopped {
-                    load_factor: lambda,
-                    reason,
-                });
-            }
-            if total.load_stages >= max_stages || total.iterations >= max_total_iterations {
-                return Err(StaticsError::NotConverged {
+        // the first equilibrium found, if it diverges and a continuation from the straight rod
+        // follows
+        let mut unstable: Option<StaticsSolution> = None;
+        // the ramp (and continuation after a failure); then, if its equilibrium diverges, once more
+        // by continuation from the straight rod
+        loop {
+            while lambda < 1.0 {
+                if let Some(reason) = stop() {
+                    return Err(StaticsError::Stopped {
+                        load_factor: lambda,
+                        reason,
+                    });
+                }
+                if total.load_stages >= max_stages || total.iterations >= max_total_iterations {
+                    return Err(StaticsError::NotConverged {
                     load_factor: lambda,
                     iterations: total.iterations,
                     residual_norm: total.residual_norm,
@@ -419,110 +434,177 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                         None => ContinuationOutcome::NotTried,
                     },
                 });
-            }
-            let target = (lambda + inc).min(1.0);
-            let loads_l = if target == 1.0 {
-                loads.clone()
-            } else {
-                loads.scaled(target)
-            };
-            let mut sys = System {
-                model: self.model,
-                ws: &mut self.ws,
-                u: u.iter().map(|v| v * target).collect(),
-                loads: self.model.prepare_loads(&loads_l)?,
-                at: &mut self.at,
-                fresh: false,
-                differences,
-                xh: &mut self.xh,
-                fh: &mut self.fh,
-            };
-            total.load_stages += 1;
-            match dogleg::solve(&mut sys, &q, &opts, &mut self.dws) {
-                Ok(rep) => {
-                    total.iterations += rep.iterations;
-                    // the differences' residuals included
-                    total.residual_evaluations += rep.residual_evaluations
-                        + if differences {
-                            n * rep.jacobian_evaluations
-                        } else {
-                            0
-                        };
-                    total.jacobian_evaluations += rep.jacobian_evaluations;
-                    total.residual_norm = rep.residual_norm;
-                    last_tolerance = self.options.ftol * self.ws.residual_scale;
-                    q = rep.x;
-                    lambda = target;
                 }
-                Err(e) => {
-                    let (iterations, residual_norm, tolerance, reason) = match e {
-                        DoglegError::NotConverged {
-                            iterations,
+                let target = (lambda + inc).min(1.0);
+                let loads_l = if target == 1.0 {
+                    loads.clone()
+                } else {
+                    loads.scaled(target)
+                };
+                let mut sys = System {
+                    model: self.model,
+                    ws: &mut self.ws,
+                    u: u.iter().map(|v| v * target).collect(),
+                    loads: self.model.prepare_loads(&loads_l)?,
+                    at: &mut self.at,
+                    fresh: false,
+                    differences,
+                    xh: &mut self.xh,
+                    fh: &mut self.fh,
+                };
+                total.load_stages += 1;
+                match dogleg::solve(&mut sys, &q, &opts, &mut self.dws) {
+                    Ok(rep) => {
+                        total.iterations += rep.iterations;
+                        // the differences' residuals included
+                        total.residual_evaluations += rep.residual_evaluations
+                            + if differences {
+                                n * rep.jacobian_evaluations
+                            } else {
+                                0
+                            };
+                        total.jacobian_evaluations += rep.jacobian_evaluations;
+                        total.residual_norm = rep.residual_norm;
+                        last_tolerance = self.options.ftol * self.ws.residual_scale;
+                        q = rep.x;
+                        lambda = target;
+                    }
+                    Err(e) => {
+                        let (iterations, residual_norm, tolerance, reason) = match e {
+                            DoglegError::NotConverged {
+                                iterations,
+                                residual_norm,
+                                tolerance,
+                                reason,
+                                ..
+                            } => (iterations, residual_norm, tolerance, reason),
+                            other => (0, f64::NAN, f64::NAN, other.to_string()),
+                        };
+                        total.iterations += iterations;
+                        total.residual_norm = residual_norm;
+                        last_tolerance = tolerance;
+                        if inc / 2.0 >= self.options.min_increment * (1.0 - 1e-12)
+                            && total.continuation.is_none()
+                        {
+                            inc /= 2.0;
+                            continue;
+                        }
+                        let mut reason =
+                            format!("{reason} (load increment already reduced to {inc})");
+                        // only from the straight rod (a warm start's caller has its own fallback) and
+                        // with ramping allowed (min_increment = 1 asks for one stage)
+                        let may_continue = q0.is_none() && self.options.min_increment < 1.0;
+                        let mut outcome = match total.continuation {
+                            Some(_) => ContinuationOutcome::Reached,
+                            None => ContinuationOutcome::NotTried,
+                        };
+                        if may_continue && total.continuation.is_none() {
+                            outcome = ContinuationOutcome::Stopped;
+                            let ws = &mut self.ws;
+                            match continuation::follow_statics(
+                                self.model, ws, u, loads, &opts, stop,
+                            ) {
+                                Ok((path, residuals, jacobians)) => {
+                                    total.iterations += path.stats.iterations;
+                                    total.residual_evaluations += residuals;
+                                    total.jacobian_evaluations += jacobians;
+                                    total.continuation = Some(path.stats);
+                                    q = path.x;
+                                    inc = 1.0; // a last stage at λ = 1 polishes q
+                                    continue;
+                                }
+                                Err(continuation::ContinuationError::Stopped {
+                                    why: continuation::Stop::Requested(reason),
+                                    lambda,
+                                    ..
+                                }) => {
+                                    return Err(StaticsError::Stopped {
+                                        load_factor: lambda,
+                                        reason,
+                                    })
+                                }
+                                Err(e) => {
+                                    reason = format!("{reason}; then from the straight rod, {e}")
+                                }
+                            }
+                        } else if let Some(mut first) = unstable.take() {
+                            // the continuation's end did not converge: the unstable equilibrium stands
+                            first.iterations = total.iterations;
+                            first.residual_evaluations = total.residual_evaluations;
+                            first.jacobian_evaluations = total.jacobian_evaluations;
+                            first.load_stages = total.load_stages;
+                            first.divergence = self.divergence(&first.q, u, loads)?;
+                            return Ok(first);
+                        } else if total.continuation.is_some() {
+                            reason = format!("{reason}, at λ = 1 after the continuation");
+                        }
+                        return Err(StaticsError::NotConverged {
+                            load_factor: target,
+                            iterations: total.iterations,
                             residual_norm,
                             tolerance,
                             reason,
-                            ..
-                        } => (iterations, residual_norm, tolerance, reason),
-                        other => (0, f64::NAN, f64::NAN, other.to_string()),
-                    };
-                    total.iterations += iterations;
-                    total.residual_norm = residual_norm;
-                    last_tolerance = tolerance;
-                    if inc / 2.0 >= self.options.min_increment * (1.0 - 1e-12)
-                        && total.continuation.is_none()
-                    {
-                        inc /= 2.0;
-                        continue;
+                            continuation: outcome,
+                        });
                     }
-                    let mut reason = format!("{reason} (load increment already reduced to {inc})");
-                    // only from the straight rod (a warm start's caller has its own fallback) and
-                    // with ramping allowed (min_increment = 1 asks for one stage)
-                    let may_continue = q0.is_none() && self.options.min_increment < 1.0;
-                    let mut outcome = match total.continuation {
-                        Some(_) => ContinuationOutcome::Reached,
-                        None => ContinuationOutcome::NotTried,
-                    };
-                    if may_continue && total.continuation.is_none() {
-                        outcome = ContinuationOutcome::Stopped;
-                        let ws = &mut self.ws;
-                        match continuation::follow_statics(self.model, ws, u, loads, &opts, stop) {
-                            Ok((path, residuals, jacobians)) => {
-                                total.iterations += path.stats.iterations;
-                                total.residual_evaluations += residuals;
-                                total.jacobian_evaluations += jacobians;
-                                total.continuation = Some(path.stats);
-                                q = path.x;
-                                inc = 1.0; // a last stage at λ = 1 polishes q
-                                continue;
-                            }
-                            Err(continuation::ContinuationError::Stopped {
-                                why: continuation::Stop::Requested(reason),
-                                lambda,
-                                ..
-                            }) => {
-                                return Err(StaticsError::Stopped {
-                                    load_factor: lambda,
-                                    reason,
-                                })
-                            }
-                            Err(e) => reason = format!("{reason}; then from the straight rod, {e}"),
-                        }
-                    } else if total.continuation.is_some() {
-                        reason = format!("{reason}, at λ = 1 after the continuation");
-                    }
-                    return Err(StaticsError::NotConverged {
-                        load_factor: target,
-                        iterations: total.iterations,
-                        residual_norm,
-                        tolerance,
-                        reason,
-                        continuation: outcome,
-                    });
                 }
+            }
+            total.divergence = self.divergence(&q, u, loads)?;
+            // A step from the straight rod (the one equilibrium without load) can converge onto an
+            // unstable equilibrium at full load: follow the equilibria from it instead, as after a
+            // failure, and polish at λ = 1. A warm start's caller has its own fallback.
+            let may_continue = q0.is_none() && self.options.min_increment < 1.0;
+            if total.divergence.is_none() || !may_continue || total.continuation.is_some() {
+                break;
+            }
+            match continuation::follow_statics(self.model, &mut self.ws, u, loads, &opts, stop) {
+                Ok((path, residuals, jacobians)) => {
+                    // kept if the continuation's equilibrium does not converge at λ = 1
+                    unstable = Some(StaticsSolution {
+                        q: q.clone(),
+                        ..total.clone()
+                    });
+                    total.iterations += path.stats.iterations;
+                    total.residual_evaluations += residuals;
+                    total.jacobian_evaluations += jacobians;
+                    total.continuation = Some(path.stats);
+                    total.unstable_start = total.divergence;
+                    q = path.x;
+                    (lambda, inc) = (0.0, 1.0); // one stage at λ = 1 polishes q
+                }
+                Err(continuation::ContinuationError::Stopped {
+                    why: continuation::Stop::Requested(reason),
+                    lambda,
+                    ..
+                }) => {
+                    return Err(StaticsError::Stopped {
+                        load_factor: lambda,
+                        reason,
+                    })
+                }
+                // no path from the straight rod: the unstable equilibrium is all there is
+                Err(_) => break,
             }
         }
         total.q = q;
         Ok(total)
+    }
+
+    /// [`super::stability::divergence_at`] at the equilibrium `q` of the full load.
+    fn divergence(
+        &mut self,
+        q: &DVector<f64>,
+        u: &[f64],
+        loads: &Loads,
+    ) -> Result<Option<f64>, StaticsError> {
+        let prepared = self.model.prepare_loads(loads)?;
+        Ok(super::stability::divergence_at(
+            self.model,
+            q,
+            u,
+            &prepared,
+            &mut self.ws,
+        ))
     }
 
     /// The workspace of the last evaluation (poses, strains at the solution after [`Self::solve`]).

@@ -125,13 +125,27 @@ pub(super) fn print_solution(r: &StaticsReport, out: &mut impl Write) -> Result<
             .map(|l| format!("{l:.4}"))
             .collect::<Vec<_>>()
             .join(", ");
+        let why = match c.after_unstable {
+            Some(w2) => format!(
+                "the full-load step converged onto an unstable equilibrium (ω² = {} 1/s²)",
+                gvs::error::fmt_sci(w2, 3)
+            ),
+            None => "the load ramp stalled".to_string(),
+        };
         writeln!(
             out,
-            "continued  the load ramp stalled: followed the equilibria from the straight rod by arc-length continuation in {} ({} rejected), through {}{}",
+            "continued  {why}: followed the equilibria from the straight rod by arc-length continuation in {} ({} rejected), through {}{}",
             plural(c.steps, "step"),
             c.rejected_steps,
             plural(c.folds.len(), "fold"),
             if folds.is_empty() { String::new() } else { format!(" at load factor {folds}") }
+        )?;
+    }
+    if let Some(w2) = r.divergence {
+        writeln!(
+            out,
+            "unstable   the equilibrium diverges: M⁻¹K_T has the real eigenvalue ω² = {} 1/s² < 0, and no stable equilibrium connected to the straight rod was found; a small disturbance moves the rod away from it (`gvsrom modes` shows the direction)",
+            gvs::error::fmt_sci(w2, 3)
         )?;
     }
     writeln!(out, "tip        position {} m", fmt_vec(&r.tip_position, 6))?;

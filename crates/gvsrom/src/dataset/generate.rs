@@ -222,6 +222,10 @@ fn record(
         Ok(s) => s,
         Err(e) => return SampleResult::missing(layout, STATUS_FAILED, Some(e.to_string())),
     };
+    // an equilibrium the rod cannot rest on is no snapshot of it
+    if let Some(w2) = sol.divergence {
+        return SampleResult::missing(layout, STATUS_FAILED, Some(unstable_reason(w2)));
+    }
     model.forward_pose(&sol.q, ws);
     let xi = model.point_strains(ws);
     let mut strain = Vec::with_capacity(layout.row_len());
@@ -244,4 +248,12 @@ fn record(
         warm_started: warm,
         reason: None,
     }
+}
+
+/// Why a sample whose only equilibrium found diverges is failed.
+pub fn unstable_reason(w2: f64) -> String {
+    format!(
+        "only an unstable equilibrium was found (M⁻¹K_T has the real eigenvalue ω² = {} 1/s² < 0: the rod moves away from it), none connected to the straight rod by a stable path",
+        gvs::error::fmt_sci(w2, 3)
+    )
 }

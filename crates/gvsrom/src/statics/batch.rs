@@ -181,9 +181,12 @@ pub fn warm_or_ramp<P: StrainParam>(
             ..options.clone()
         };
         match solver.solve_interruptible(u, loads, Some(q0), stop) {
-            Ok(s) => return Some(Ok((s, true))),
+            // a neighbour's solution can lead onto an equilibrium that diverges (the neighbour's
+            // own branch past its end): then solve from straight, whose solver follows the
+            // equilibria connected to the straight rod
+            Ok(s) if s.divergence.is_none() => return Some(Ok((s, true))),
             Err(StaticsError::Stopped { .. }) => return None,
-            Err(_) => {}
+            Ok(_) | Err(_) => {}
         }
     }
     solver.options = options.clone();

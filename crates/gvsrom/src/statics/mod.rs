@@ -66,9 +66,13 @@ pub struct StaticsReport {
     pub residual_norm: f64,
     /// Wall-clock time of the solve alone \[s\].
     pub solve_time_s: f64,
-    /// Set when the load ramp stalled and the equilibrium was reached by arc-length continuation
-    /// from the straight rod.
+    /// Set when the load ramp stalled, or its equilibrium diverged, and the equilibrium was reached
+    /// by arc-length continuation from the straight rod.
     pub continuation: Option<ContinuationSummary>,
+    /// `Some(ω²)` \[1/s²\] if the equilibrium is unstable: `M⁻¹ K_T` has the real eigenvalue
+    /// `ω² < 0` ([`gvs::solve::stability`]); no stable one connected to the straight rod was found.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub divergence: Option<f64>,
 }
 
 /// How the arc-length continuation reached the equilibrium ([`gvs::solve::continuation`]).
@@ -81,6 +85,11 @@ pub struct ContinuationSummary {
     pub folds: Vec<f64>,
     /// The largest load factor on the path before it reached 1.
     pub lambda_max: f64,
+    /// `Some(ω²)` \[1/s²\] if it ran because the step from the straight rod converged onto an
+    /// unstable equilibrium (the real eigenvalue `ω² < 0` of `M⁻¹ K_T` there), not because the
+    /// ramp stalled.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub after_unstable: Option<f64>,
 }
 
 impl StaticsReport {
@@ -355,7 +364,9 @@ fn report<P: StrainParam>(
             rejected_steps: c.rejected,
             folds: c.folds.clone(),
             lambda_max: c.lambda_max,
+            after_unstable: sol.unstable_start,
         }),
+        divergence: sol.divergence,
     }
 }
 

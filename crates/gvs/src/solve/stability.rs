@@ -1,0 +1,109 @@
+//! Static stability of an equilibrium: does it diverge?
+//!
+//! About an equilibrium `q*` the undamped motion obeys `M δq̈ + K_T δq = 0`, with the tangent
+//! stiffness `K_T = −∂R/∂q` (elastic, load and tendon stiffness; gvs-spec §8.2). A real eigenvalue
+//! `ω² < 0` of `M⁻¹ K_T` is a *divergence*: a direction in which the rod leaves the equilibrium as
+//! `e^{√(−ω²) t}` (an upside-down pendulum; a soft cantilever curled up against gravity). A full
+//! Newton or dogleg step from the straight rod can converge onto such an equilibrium: it solves
+//! `R(q) = 0`, which holds at stable and unstable equilibria alike.
+//!
+//! The test, cheap first:
+//! 1. `sym(K_T) = −(J + Jᵀ)/2` positive definite (a Cholesky factorization succeeds) ⇒ no
+//!    eigenvalue of `M⁻¹ K_T` has a negative real part (`xᴴ K_T x = ω² xᴴ M x` with
+//!    `Re xᴴ K_T x > 0`): stable. This decides every conservative load (symmetric `K_T`) and almost
+//!    every other equilibrium.
+//! 2. Otherwise (friction and follower loads make `K_T` non-symmetric, and its symmetric part may be
+//!    indefinite at a stable equilibrium) the eigenvalues of `L⁻¹ K_T L⁻ᵀ`, `M = L Lᵀ` (similar to
+//!    `M⁻¹ K_T`): divergent if one is real and below `−DIVERGENCE_TOLERANCE · max |ω²|`. Complex
+//!    pairs (flutter of the undamped linearization, e.g. Beck's column) are not divergence; their
+//!    static equilibrium is the one a damped rod settles on or oscillates about.
+
+use crate::dynamics::cholesky::cholesky_factor_in_place;
+use crate::model::{Model, PreparedLoads, Workspace};
+use crate::strain::StrainParam;
+use nalgebra::DMatrix;
+
+/// Relative size of a negative eigenvalue of `M⁻¹ K_T` (against the largest `|ω²|`, the stiffest
+/// mode's) below which it counts as divergence; above it, round-off of the eigensolver
+/// (`~ε max |ω²|`) and neutral directions.
+pub const DIVERGENCE_TOLERANCE: f64 = 1e-10;
+
+/// Largest imaginary part, relative to the largest `|ω²|`, of an eigenvalue taken as real (a double
+/// real eigenvalue splits by `~√ε` into a complex pair).
+const REAL_TOLERANCE: f64 = 1e-6;
+
+/// The most negative real eigenvalue `ω²` \[1/s²\] of `M⁻¹ K_T` at the equilibrium `q`, `K_T = −jac`
+/// (`jac = ∂R/∂q` there), if the equilibrium diverges; `None` if it is stable against divergence
+/// (the module documentation). `ws` is left with the forward pass at `q`.
+pub fn divergence<P: StrainParam>(
+    model: &Model<P>,
+    q: &nalgebra::DVector<f64>,
+    jac: &DMatrix<f64>,
+    ws: &mut Workspace,
+) -> Option<f64> {
+    let n = jac.nrows();
+    if n == 0 {
+        return None;
+    }
+    let mut ks = (jac + jac.transpose()) * -0.5;
+    if ks.iter().any(|v| !v.is_finite()) {
+        return None; // not an equilibrium to judge; the solver reports non-finite values itself
+    }
+    if positive_definite(&mut ks) {
+        return None;
+    }
+    let mut l = model.mass_matrix(q, ws);
+    let k = -jac;
+    // A = L⁻¹ K_T L⁻ᵀ (or K_T itself if M cannot be factored: the same signs of real eigenvalues
+    // for a symmetric K_T, the best available otherwise)
+    let a = match cholesky_factor_in_place(&mut l) {
+        Ok(()) => {
+            let l = l.lower_triangle();
+            let x = l.solve_lower_triangular(&k)?; // L⁻¹ K
+            let xt = l.solve_lower_triangular(&x.transpose())?; // L⁻¹ (L⁻¹ K)ᵀ = L⁻¹ Kᵀ L⁻ᵀ
+            xt.transpose()
+        }
+        Err(_) => k,
+    };
+    let eig = a.complex_eigenvalues();
+    let scale = eig.iter().map(|z| z.norm()).fold(0.0, f64::max);
+    if !(scale.is_finite() && scale > 0.0) {
+        return None;
+    }
+    eig.iter()
+        .filter(|z| z.im.abs() <= REAL_TOLERANCE * scale && z.re < -DIVERGENCE_TOLERANCE * scale)
+        .map(|z| z.re)
+        .min_by(f64::total_cmp)
+}
+
+/// [`divergence`] at the equilibrium `q` under tensions `u` and `loads`: evaluates `∂R/∂q` there.
+pub fn divergence_at<P: StrainParam>(
+    model: &Model<P>,
+    q: &nalgebra::DVector<f64>,
+    u: &[f64],
+    loads: &PreparedLoads,
+    ws: &mut Workspace,
+) -> Option<f64> {
+    let n = model.n_dof();
+    let mut jac = DMatrix::zeros(n, n);
+    model.statics_jacobian(q, u, loads, ws, &mut jac);
+    divergence(model, q, &jac, ws)
+}
+
+/// Whether the symmetric `a` is positive definite: scaled to a unit diagonal (`D^{-1/2} a D^{-1/2}`,
+/// so that a soft bending coordinate is judged against its own stiffness, not the axial one's),
+/// its Cholesky factorization (in place) meets no pivot clearly below zero
+/// ([`cholesky_factor_in_place`]: pivots within `1e-8` of zero, neutral to round-off, pass).
+fn positive_definite(a: &mut DMatrix<f64>) -> bool {
+    let n = a.nrows();
+    if !(0..n).all(|j| a[(j, j)] > 0.0) {
+        return false;
+    }
+    let d: Vec<f64> = (0..n).map(|j| a[(j, j)].sqrt().recip()).collect();
+    for j in 0..n {
+        for i in 0..n {
+            a[(i, j)] *= d[i] * d[j];
+        }
+    }
+    cholesky_factor_in_place(a).is_ok()
+}

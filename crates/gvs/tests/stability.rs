@@ -1,0 +1,129 @@
+//! Static stability of equilibria (`gvs::solve::stability`), against a closed form and on the case
+//! that made it necessary: a full-load step from the straight rod converging onto an equilibrium
+//! the rod cannot rest on.
+
+use gvs::discretize::{Discretization, MagnusOrder, Quadrature};
+use gvs::loads::Loads;
+use gvs::model::Model;
+use gvs::rod::{Material, Rod, SectionProps};
+use gvs::solve::stability::divergence_at;
+use gvs::solve::statics::{solve_statics, StaticsOptions};
+use gvs::strain::{DivisionBasis, LinearBasis};
+
+fn rod(e: f64, rho: f64, l: f64, r: f64) -> Rod {
+    let mat = Material {
+        youngs_modulus: e,
+        poisson_ratio: 0.5,
+        density: rho,
+        damping: 0.0,
+    };
+    Rod::tapered(mat, l, r, r)
+}
+
+fn model(rod: Rod, gauss: usize, modes: [bool; 6], order: usize) -> Model<LinearBasis> {
+    let disc = Discretization::new(
+        &rod,
+        &[Quadrature::Gauss { n: gauss }],
+        MagnusOrder::Z4,
+        &[],
+    )
+    .unwrap();
+    let basis = DivisionBasis::Legendre {
+        modes,
+        orders: [order; 6],
+    };
+    let b = LinearBasis::per_division(&disc, &[basis]).unwrap();
+    Model::new(rod, disc, b, vec![]).unwrap()
+}
+
+fn gravity(g: [f64; 3]) -> Loads {
+    Loads {
+        gravity: g,
+        ..Loads::default()
+    }
+}
+
+/// Greenhill (1881): a column clamped at its foot and free at its top, standing under its own
+/// weight `w` per length, buckles when `w L³ / EI` exceeds 7.8373 (the first zero of the Bessel
+/// function J₋₁/₃ of `(2/3)√(w L³/EI)`). Below, the straight compressed column is stable; above,
+/// it diverges. The rod stands along +x with gravity along −x; bending, elongation and shear in
+/// the x–z plane (Legendre order 6, 12 Gauss points).
+#[test]
+fn greenhill_column_standing_under_its_own_weight_diverges_above_7_837_ei_over_l3() {
+    let (e, l, r, g): (f64, f64, f64, f64) = (1e6, 1.0, 0.01, 9.81);
+    let s = SectionProps::circular(
+        &Material {
+            youngs_modulus: e,
+            poisson_ratio: 0.5,
+            density: 1.0,
+            damping: 0.0,
+        },
+        r,
+    );
+    let ei = s.es[1];
+    // the density at which w L³/EI = 7.8373, w = ρ g A
+    let rho_c = 7.8373 * ei / (g * s.area * l.powi(3));
+    // one full-load step from the straight rod: it stays straight (the bending residual is zero
+    // there by symmetry), the equilibrium whose stability is judged
+    let one_step = StaticsOptions {
+        min_increment: 1.0,
+        ..StaticsOptions::default()
+    };
+    let planar = [false, true, false, true, false, true];
+    for (factor, diverges) in [(0.9, false), (0.97, false), (1.03, true), (1.1, true)] {
+        let m = model(rod(e, factor * rho_c, l, r), 12, planar, 6);
+        let loads = gravity([-g, 0.0, 0.0]);
+        let sol = solve_statics(&m, &[], &loads, None, &one_step).unwrap();
+        let mut ws = m.workspace();
+        m.forward(&sol.q, &mut ws, false);
+        let tip = ws.g.last().unwrap().pos;
+        assert!(
+            tip[2].abs() < 1e-12,
+            "factor {factor}: the column bent: {tip:?}"
+        );
+        let prepared = m.prepare_loads(&loads).unwrap();
+        let w2 = divergence_at(&m, &sol.q, &[], &prepared, &mut m.workspace());
+        assert_eq!(
+            w2.is_some(),
+            diverges,
+            "w L³/EI = {:.3}: {w2:?}",
+            7.8373 * factor
+        );
+        // the solver reports the same verdict
+        assert_eq!(sol.divergence.is_some(), diverges);
+        if let Some(w2) = w2 {
+            assert!(w2 < 0.0);
+        }
+    }
+}
+
+/// A soft cantilever (1 m, r = 1 cm, E = 3.3e5 Pa, 1000 kg/m³) held horizontal under gravity droops
+/// to nearly vertical. One full-load dogleg step from the straight rod converges instead onto an
+/// equilibrium curled up above the clamp (tip 0.16 m above it), which diverges; the solver then
+/// follows the equilibria from the straight rod and lands on the hanging one, which is stable.
+#[test]
+fn a_soft_cantilever_under_gravity_hangs_down_rather_than_curls_up() {
+    let m = model(rod(3.3e5, 1000.0, 1.0, 0.01), 5, [true; 6], 3);
+    let loads = gravity([0.0, 0.0, -9.81]);
+    let tip_z = |q: &nalgebra::DVector<f64>| {
+        let mut ws = m.workspace();
+        m.forward(q, &mut ws, false);
+        ws.g.last().unwrap().pos[2]
+    };
+    // no continuation allowed: the full-load step's equilibrium, curled up and divergent
+    let one_step = StaticsOptions {
+        min_increment: 1.0,
+        ..StaticsOptions::default()
+    };
+    let curled = solve_statics(&m, &[], &loads, None, &one_step).unwrap();
+    assert!(tip_z(&curled.q) > 0.1, "tip z {}", tip_z(&curled.q));
+    let w2 = curled.divergence.expect("the curled equilibrium diverges");
+    assert!(w2 < -1e3, "ω² = {w2}");
+    // the default solve: the hanging equilibrium, stable, reached by continuation after the
+    // unstable one
+    let sol = solve_statics(&m, &[], &loads, None, &StaticsOptions::default()).unwrap();
+    assert!(tip_z(&sol.q) < -0.9, "tip z {}", tip_z(&sol.q));
+    assert_eq!(sol.divergence, None);
+    assert_eq!(sol.unstable_start, Some(w2));
+    assert!(sol.continuation.is_some());
+}
