@@ -396,7 +396,7 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
         (Some(obj), None) => {
             let rows: arrays::In2<'_> = obj.extract().map_err(|_| {
                 invalid(format!(
-                    "`input` must be rows `t, u_1, …, u_{na}` (a 2-D array) or a callable `u(t)`; got `{}`",
+                    "`input` must be rows `t, u_1, …, u_na` ({na} + 1 columns: a 2-D array) or a callable `u(t)`; got `{}`",
                     obj.get_type().name().map(|n| n.to_string()).unwrap_or_default()
                 ))
             })?;

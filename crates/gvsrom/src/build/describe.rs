@@ -11,14 +11,19 @@ use gvs::strain::FemDegree;
 pub fn describe(s: &Scenario, built: &Built) -> String {
     let m = &built.model;
     let g = &m.rod.divisions;
-    let tapered = g.iter().any(|d| d.radius_start != d.radius_end)
-        || g.windows(2).any(|w| w[0].radius_end != w[1].radius_start);
+    // tapered within a division; a step in radius between uniform divisions is "stepped"
+    let tapered = g.iter().any(|d| d.radius_start != d.radius_end);
+    let stepped = g.windows(2).any(|w| w[0].radius_end != w[1].radius_start);
     // from the model, so that a reference strain given as the straight rod is not called one
     let precurved = (0..m.disc.n_sites()).any(|site| m.xi_star(site) != super::rod::STRAIGHT);
     let mut parts = vec![format!(
         "{} m {}{} rod{}",
         m.rod.length(),
-        if tapered { "tapered" } else { "uniform" },
+        match (tapered, stepped) {
+            (true, _) => "tapered",
+            (false, true) => "stepped",
+            (false, false) => "uniform",
+        },
         if precurved { ", pre-strained" } else { "" },
         match g.len() {
             1 => String::new(),

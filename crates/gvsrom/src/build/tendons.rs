@@ -68,7 +68,7 @@ pub(super) fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, Scen
         (false, false) => {
             return Err(ScenarioError::invalid(
                 f("offset_start"),
-                "missing: give `offset_start` and `offset_end` ([y, z] in m), or `angle_deg`",
+                "missing: give `offset_start` and `offset_end` ([y, z] in m), or `angle_deg`, or `path` (knots [X, d_y, d_z] in m)",
             ))
         }
         (true, false) => {

@@ -125,7 +125,8 @@ pub struct ScenarioArgs {
     )]
     pub tension: Option<Vec<f64>>,
 
-    /// Number of centreline samples, equally spaced in arc length, in the JSON output and per
+    /// Number of centreline samples, at equally spaced material abscissae X (the arc length of the
+    /// undeformed rod; a stretched rod's samples are as far apart as it stretched), in the JSON output and per
     /// sample of a trajectory (`centerline.npy`); overrides `output.centerline_points`, default 21.
     #[arg(long, value_name = "N")]
     pub centerline_points: Option<usize>,

@@ -16,7 +16,7 @@
 //! | `tip_rotation.npy` | (N, 3, 3) | tip rotation matrices (section → world) |
 //! | `strain.npy` | (N, p, 6) | ξ at the p computational points, `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]` |
 //! | `strain_x.npy` | (p,) | abscissae of the computational points \[m\] |
-//! | `centerline.npy` | (N, c, 3) | centreline positions \[m\] at the `c` abscissae `centerline_x` of `meta.json`, equally spaced in arc length from base to tip (`output.centerline_points`, `--centerline-points`), in the world frame as `statics --json` |
+//! | `centerline.npy` | (N, c, 3) | centreline positions \[m\] at the `c` abscissae `centerline_x` of `meta.json`, at equally spaced material abscissae X (the undeformed arc length) from base to tip (`output.centerline_points`, `--centerline-points`), in the world frame as `statics --json` |
 //! | `tendon_paths.npy` | (N, n_a, c, 3) | each tendon's thread `r + R d(X)` \[m\] at `centerline_x` clamped to its span (with tendons only) |
 //! | `tendon_lengths.npy` | (N, n_a) | each tendon's length \[m\] along its thread, `∫ ‖t_u‖ dX` (with tendons only; at rest: `meta.json`'s `tendon_rest_lengths`) |
 //! | `meta.json` | | manifest (`gvsrom`: format, version, files), scenario, `complete`, `reason`, `t_reached`, `t_requested`, `sample_rate`, sizes, integrator statistics, wall time, real-time factor, error, `input` ([`input_record`]), `physics` (material, geometry, base, tendon routing, loads), `centerline_x`, `tendon_rest_lengths`, `provenance` ([`crate::provenance`]) |

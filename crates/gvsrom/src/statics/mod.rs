@@ -493,7 +493,7 @@ fn failure(built: &Built, u: &[f64], error: StaticsError) -> StaticsFailure {
     StaticsFailure { error, hint }
 }
 
-/// `c` abscissae equally spaced in arc length on `[0, L]`, both ends included (`c ≥ 2`): the
+/// `c` material abscissae X equally spaced on `[0, L]` (the undeformed arc length), both ends included (`c ≥ 2`): the
 /// centreline samples of `statics --json` and of a trajectory.
 pub fn centerline_abscissae(length: f64, c: usize) -> Vec<f64> {
     let c = c.max(2);
