@@ -76,6 +76,14 @@ pub fn divergence<P: StrainParam>(
         .min_by(f64::total_cmp)
 }
 
+/// Whether `jac`'s tangent stiffness `K_T = −jac` has a positive definite symmetric part: the
+/// first, sufficient test of [`divergence`] alone, for a screen with an approximate `∂R/∂q` (a
+/// solver's last, Broyden-updated Jacobian) before an exact one is evaluated.
+pub fn surely_stable(jac: &DMatrix<f64>) -> bool {
+    let mut ks = (jac + jac.transpose()) * -0.5;
+    ks.iter().all(|v| v.is_finite()) && positive_definite(&mut ks)
+}
+
 /// [`divergence`] at the equilibrium `q` under tensions `u` and `loads`: evaluates `∂R/∂q` there.
 pub fn divergence_at<P: StrainParam>(
     model: &Model<P>,

@@ -549,7 +549,7 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                     }
                 }
             }
-            total.divergence = self.divergence(&q, u, loads)?;
+            total.divergence = self.divergence_screened(&q, u, loads)?;
             // A step from the straight rod (the one equilibrium without load) can converge onto an
             // unstable equilibrium at full load: follow the equilibria from it instead, as after a
             // failure, and polish at λ = 1. A warm start's caller has its own fallback.
@@ -588,6 +588,23 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
         }
         total.q = q;
         Ok(total)
+    }
+
+    /// [`super::stability::divergence_at`] at the equilibrium `q` of the full load, screened first
+    /// with the last dogleg solve's Jacobian (at `q`, Broyden-updated): when its tangent stiffness
+    /// has a positive definite symmetric part, the equilibrium is taken as stable without
+    /// evaluating `∂R/∂q` again (that evaluation cost as much as the rest of a solve on the
+    /// presets). Call it right after the dogleg converged at `q`.
+    fn divergence_screened(
+        &mut self,
+        q: &DVector<f64>,
+        u: &[f64],
+        loads: &Loads,
+    ) -> Result<Option<f64>, StaticsError> {
+        if super::stability::surely_stable(self.dws.jacobian()) {
+            return Ok(None);
+        }
+        self.divergence(q, u, loads)
     }
 
     /// [`super::stability::divergence_at`] at the equilibrium `q` of the full load.

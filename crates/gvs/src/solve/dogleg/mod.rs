@@ -176,6 +176,12 @@ pub struct DoglegWorkspace {
 }
 
 impl DoglegWorkspace {
+    /// The Jacobian at the end of the last solve: analytic, or Broyden-updated since its last
+    /// evaluation (an approximation at the solution).
+    pub fn jacobian(&self) -> &DMatrix<f64> {
+        &self.jac
+    }
+
     /// Buffers for systems of `n` unknowns.
     pub fn new(n: usize) -> Self {
         let (v, m) = (|| DVector::zeros(n), || zeros_lazy(n, n));
