@@ -266,20 +266,21 @@ pub(super) fn estimates(built: &Subject<'_>, u: &[f64], scale: f64, bound: bool)
         let mut eps: f64 = 0.0;
         for (i, iv) in grid.iter().enumerate() {
             theta += 0.5 * (iv.b - iv.a) * (m_end[i][0] / iv.ei[0] + m_end[i][1] / iv.ei[1]);
-            eps = eps
-                .max(n_end[i][0] / iv.ea_ga[0])
-                .max(n_end[i][1] / iv.ea_ga[1]);
+            eps = eps.max(n_end[i][0] / iv.ea[0]).max(n_end[i][1] / iv.ea[1]);
         }
         let w = mul(mul(scale, g), rho);
+        // A dead load turns the rod at most until it hangs along it: the linear beam's angle
+        // (thousands of radians for a soft horizontal cantilever, which merely droops) bounds
+        // nothing, so it is capped at π; the rod then hangs, stretched by its weight (N / EA).
         out.push(Estimate {
             name: format!(
                 "loads.gravity = {} m/s^2 (with material.density = {} kg/m^3){scaled}",
                 vec3(&loads.gravity),
                 fmt_value(rho)
             ),
-            bending: mul(w, theta),
+            bending: mul(w, theta).min(PI),
             strain: mul(w, eps),
-            strain_kind: "an axial/shear strain",
+            strain_kind: "an axial strain (hanging)",
         });
     }
     out

@@ -18,10 +18,12 @@
 //! | point wrench at X: force F, moment M | `|M| + |F| (X − s)` | `|F|` |
 //! | uniform density f, m on `[a, b]` | `|m| ℓ(s) + |f| ((b − s)² − (max(s, a) − s)²)/2` | `|f| ℓ(s)`, `ℓ(s) = b − max(s, a)` |
 //! | triangular pulse, peak m̂ | `m̂ ∫ₛᴸ tri(x) dx` | 0 |
-//! | gravity g, density ρ | `∫ₛᴸ ρ A(x) |g| (x − s) dx` | `∫ₛᴸ ρ A(x) |g| dx` |
+//! | gravity g, density ρ | `∫ₛᴸ ρ A(x) |g| (x − s) dx`, `θ` capped at π | `∫ₛᴸ ρ A(x) |g| dx` (on `EA`) |
 //!
 //! (The pulse's peak is `magnitude` or `2·magnitude/width` by its convention; friction only lowers a
-//! tendon's tension and is ignored.) The integrals are evaluated on a grid of [`GRID_POINTS`]
+//! tendon's tension and is ignored. Gravity, a dead load, turns the rod at most until it hangs
+//! along it, so its bending counts at most π whatever the linear beam says — a soft cantilever
+//! held horizontal droops, it does not coil — and its strain is the hanging rod's stretch, `N/EA`.) The integrals are evaluated on a grid of [`GRID_POINTS`]
 //! intervals per division with the sections of that division (trapezoid rule), which also uses the
 //! taper: a thin tip and a thick base each count where they are.
 //!
