@@ -281,8 +281,10 @@ fn a_second_writer_of_the_same_out_is_refused_while_the_first_runs() {
         &[
             "simulate",
             "single-tendon",
+            // long enough to still hold its lock when the second run, started on a loaded
+            // machine, looks for it (1 s was not always)
             "--duration",
-            "1",
+            "4",
             "--out",
             "shared",
         ],
