@@ -127,3 +127,57 @@ fn a_soft_cantilever_under_gravity_hangs_down_rather_than_curls_up() {
     assert_eq!(sol.unstable_start, Some(w2));
     assert!(sol.continuation.is_some());
 }
+
+/// Beck's column (1952): a cantilever under a compressive *follower* force `P` at its tip keeps its
+/// straight equilibrium, and its undamped vibration turns into flutter — two frequencies merge into
+/// a complex pair of `ω²` — at `P L²/EI = 20.05`, not at Euler's `π²/4` of a dead force. Below,
+/// the follower force raises the first frequency (the symmetric part of `K_T`, which `modes` used
+/// to take, lowers it: 21 % low at `P = 5 EI/L²`). The modes of the non-symmetric `M⁻¹ K_T`
+/// (`Model::linearized_modes`) against that closed form, planar (bending, elongation, shear;
+/// Legendre order 8, 24 Gauss points), and against the unloaded column.
+#[test]
+fn becks_column_under_a_follower_force_flutters_above_20_05_ei_over_l2() {
+    use gvs::loads::{Frame, PointWrench};
+    let (e, l, r): (f64, f64, f64) = (1e6, 1.0, 0.01);
+    let m = model(
+        rod(e, 1000.0, l, r),
+        24,
+        [false, true, false, true, false, true],
+        8,
+    );
+    let ei = e * std::f64::consts::PI * r.powi(4) / 4.0;
+    let follower = |p: f64| Loads {
+        point: vec![PointWrench {
+            x: l,
+            wrench: [0.0, 0.0, 0.0, -p, 0.0, 0.0],
+            frame: Frame::Local,
+        }],
+        ..Loads::default()
+    };
+    let lowest = |p: f64| {
+        let loads = follower(p);
+        let sol = solve_statics(&m, &[], &loads, None, &StaticsOptions::default()).unwrap();
+        let prepared = m.prepare_loads(&loads).unwrap();
+        let modes = m
+            .linearized_modes(&sol.q, &[], &prepared, &mut m.workspace())
+            .unwrap();
+        (modes[0].omega_squared, modes[0].omega_squared_imag)
+    };
+    let (w0, i0) = lowest(0.0);
+    assert_eq!(i0, 0.0);
+    // below the flutter load: real, and raised by the follower force
+    let (w5, i5) = lowest(5.0 * ei / (l * l));
+    assert_eq!(i5, 0.0);
+    assert!(
+        w5 > 1.3 * w0,
+        "ω² {w5} at P = 5 EI/L² against {w0} unloaded"
+    );
+    let (w18, i18) = lowest(18.0 * ei / (l * l));
+    assert!(
+        i18 == 0.0 && w18 > 0.0,
+        "P = 18 EI/L²: ω² = {w18} + {i18} i"
+    );
+    // above it: a complex pair
+    let (_, i22) = lowest(22.0 * ei / (l * l));
+    assert!(i22 != 0.0, "P = 22 EI/L²: no complex ω²");
+}

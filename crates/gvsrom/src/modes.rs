@@ -3,7 +3,8 @@
 //!
 //! The equilibrium `q₀` is solved exactly as `gvsrom statics` does ([`crate::statics::solve`]); the
 //! modes are the engine's [`Model::linearized_modes`]: `(K_T − ω² M) φ = 0` with the tangent
-//! stiffness `K_T = −∂R/∂q` (elastic plus load and tendon stiffness, symmetrized) and mass-normalized
+//! stiffness `K_T = −∂R/∂q` (elastic plus load and tendon stiffness; non-symmetric under tendon
+//! friction and follower loads, whose modes are then the eigenpairs of `M⁻¹K_T`) and mass-normalized
 //! shapes `φᵀ M φ = 1`, so that `q = q₀ + φ η` with the modal coordinate `η` [√kg·m] has kinetic energy
 //! `½ η̇²` and elastic energy `½ ω² η²`. Damping is ignored (undamped modes).
 //!
@@ -75,8 +76,13 @@ pub struct ModeReport {
     pub frequency_hz: f64,
     /// `1/f` \[s\]; `null` when the frequency is 0.
     pub period_s: Option<f64>,
-    /// `φᵀ K_T φ` [1/s²]; negative: the equilibrium is unstable along this shape.
+    /// `φᵀ K_T φ` [1/s²]; negative: the equilibrium is unstable along this shape (the real part of
+    /// a complex eigenvalue of a non-symmetric `K_T`).
     pub omega_squared: f64,
+    /// The imaginary part of `ω²`, non-zero for a complex pair of a non-symmetric `K_T` (flutter of
+    /// the undamped linearization); absent when zero.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub omega_squared_imag: f64,
     /// The strain component with the largest share of the modal strain energy.
     pub dominant_strain: &'static str,
     /// Share of the modal strain energy per component, `[torsion, bend-y, bend-z, elongation,
@@ -110,6 +116,10 @@ pub struct ModesReport {
     pub equilibrium_residual_norm: f64,
     /// Frequencies of all `n_dof` modes, ascending \[Hz\].
     pub all_frequencies_hz: Vec<f64>,
+    /// `‖K_T − K_Tᵀ‖_F / ‖K_T‖_F`: above [`gvs::dynamics::SYMMETRY_TOLERANCE`] (tendon friction,
+    /// follower loads) the modes are the eigenpairs of the non-symmetric `M⁻¹ K_T`, whose shapes
+    /// are not `M`-orthogonal ([`Model::linearized_modes`]).
+    pub stiffness_asymmetry: f64,
     /// Abscissae of the computational points \[m\].
     pub strain_x: Vec<f64>,
     /// The equilibrium's centreline: its samples' abscissae \[m\] (`output.centerline_points`, as
@@ -145,14 +155,26 @@ fn modes_on<P: StrainParam>(
     let mut ws = model.workspace();
     let raw = model.linearized_modes(&q0, &built.u, &loads, &mut ws)?;
 
-    // Signed ω² (the engine reports 0 Hz for ω² < 0): the Rayleigh quotient with K_T = −sym(∂R/∂q).
-    // Ascending ω², so that unstable directions (ω² < 0, all at 0 Hz) are ordered too.
+    // Signed ω² (the engine reports 0 Hz for ω² < 0): the Rayleigh quotient with K_T = −sym(∂R/∂q),
+    // which is the eigenvalue of a real eigenvector whether K_T is symmetric or not (φᵀ K φ =
+    // φᵀ sym(K) φ = ω² φᵀ M φ); a complex pair's is the engine's real part. Ascending ω², so that
+    // unstable directions (ω² < 0, all at 0 Hz) are ordered too.
     let mut dr = DMatrix::zeros(n, n);
     model.statics_jacobian(&q0, &built.u, &loads, &mut ws, &mut dr);
+    let stiffness_asymmetry = (&dr - dr.transpose()).norm() / dr.norm();
     let kt = (&dr + dr.transpose()) * -0.5;
+    let imag: Vec<(u64, f64)> = raw
+        .iter()
+        .filter(|m| m.omega_squared_imag != 0.0)
+        .map(|m| (m.omega_squared.to_bits(), m.omega_squared_imag))
+        .collect();
+    let imag_of = |w2: f64| imag.iter().find(|(b, _)| *b == w2.to_bits()).map(|p| p.1);
     let mut raw: Vec<(f64, DVector<f64>)> = raw
         .into_iter()
-        .map(|m| (m.shape.dot(&(&kt * &m.shape)), m.shape))
+        .map(|m| match m.omega_squared_imag {
+            0.0 => (m.shape.dot(&(&kt * &m.shape)), m.shape),
+            _ => (m.omega_squared, m.shape),
+        })
         .collect();
     raw.sort_by(|a, b| a.0.total_cmp(&b.0));
     let lam: Vec<f64> = raw.iter().map(|m| m.0).collect();
@@ -234,13 +256,18 @@ fn modes_on<P: StrainParam>(
         let total: f64 = energy.iter().sum();
         let share = energy.map(|e| if total > 0.0 { e / total } else { 0.0 });
         let dominant = (0..6).fold(0, |best, c| if share[c] > share[best] { c } else { best });
-        let omega_squared = phi.dot(&(&kt * &phi));
+        let omega_squared_imag = imag_of(lam[k]).unwrap_or(0.0);
+        let omega_squared = match omega_squared_imag {
+            0.0 => phi.dot(&(&kt * &phi)),
+            _ => lam[k],
+        };
         let f = frequency(omega_squared);
         modes.push(ModeReport {
             mode: k + 1,
             frequency_hz: f,
             period_s: (f > 0.0).then(|| 1.0 / f),
             omega_squared,
+            omega_squared_imag,
             dominant_strain: StrainMode::ALL[dominant].name(),
             strain_energy_share: share,
             shape: phi.iter().copied().collect(),
@@ -262,11 +289,16 @@ fn modes_on<P: StrainParam>(
         equilibrium_tip_position: eq.tip_position,
         equilibrium_residual_norm: eq.residual_norm,
         all_frequencies_hz,
+        stiffness_asymmetry,
         strain_x: model.disc.points.iter().map(|p| p.x).collect(),
         centerline_x: eq.centerline_x.clone(),
         centerline: eq.centerline.clone(),
         modes,
     })
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 /// `f = √ω² / 2π` [Hz], 0 for `ω² ≤ 0`.

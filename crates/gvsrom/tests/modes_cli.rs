@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{expect_error, f64s, gvsrom, run_json, s, scratch};
+use common::{expect_error, f64s, gvsrom, json as json_file, run_json, run_ok, s, scratch};
 use nalgebra::{DMatrix, DVector};
 use std::f64::consts::PI;
 use std::path::PathBuf;
@@ -187,7 +187,7 @@ fn first_bending_frequency_converges_as_the_elements_double() {
     }
 }
 
-/// The engine's `M(q₀)` and `K_T = −sym(∂R/∂q)(q₀)` of a scenario (computed here, not by the command).
+/// The engine's `M(q₀)` and `K_T = −∂R/∂q(q₀)` of a scenario (computed here, not by the command).
 fn mass_and_tangent_stiffness(scenario: &str, q0: &[f64]) -> (DMatrix<f64>, DMatrix<f64>) {
     let built = gvsrom::build(&gvsrom::presets::load(scenario, &[]).unwrap()).unwrap();
     let m = &built.model;
@@ -197,16 +197,16 @@ fn mass_and_tangent_stiffness(scenario: &str, q0: &[f64]) -> (DMatrix<f64>, DMat
     let loads = m.prepare_loads(&built.loads).unwrap();
     let mut dr = DMatrix::zeros(m.n_dof(), m.n_dof());
     m.statics_jacobian(&q0, &built.u, &loads, &mut ws, &mut dr);
-    (mass, (&dr + dr.transpose()) * -0.5)
+    (mass, -dr)
 }
 
 #[test]
 fn modes_are_ascending_m_orthonormal_and_k_orthogonal() {
     // φᵢᵀ M φⱼ = δᵢⱼ and φᵢᵀ K_T φⱼ = ω²ᵢ δᵢⱼ with M and K_T from the engine: on the straight rod
-    // (degenerate pairs, rotated by the command), under gravity and a tendon with friction
-    // (single-tendon: non-symmetric K_T) and under tendon loads in 3-D (six-tendon).
+    // (degenerate pairs, rotated by the command) and under tendon loads and gravity in 3-D
+    // (six-tendon, frictionless: a symmetric K_T).
     let rod = rod_file("modes-rod-ortho", ROD);
-    for scenario in [s(&rod), "single-tendon", "six-tendon"] {
+    for scenario in [s(&rod), "six-tendon"] {
         let (_, json) = modes_json("modes-ortho", &[scenario, "--count", "1000"]);
         let n = json["n_dof"].as_u64().unwrap() as usize;
         let modes = json["modes"].as_array().unwrap();
@@ -218,6 +218,8 @@ fn modes_are_ascending_m_orthonormal_and_k_orthogonal() {
         let f = f64s(&json["all_frequencies_hz"]);
         assert!(f.windows(2).all(|w| w[0] <= w[1]), "{scenario}: {f:?}");
         let (mass, kt) = mass_and_tangent_stiffness(scenario, &f64s(&json["q0"]));
+        assert!(json["stiffness_asymmetry"].as_f64().unwrap() < 1e-10);
+        let kt = (&kt + kt.transpose()) * 0.5;
         let phi = DMatrix::from_fn(n, n, |r, c| modes[c]["shape"][r].as_f64().unwrap());
         let m = phi.transpose() * &mass * &phi;
         let k = phi.transpose() * &kt * &phi;
@@ -249,6 +251,61 @@ fn modes_are_ascending_m_orthonormal_and_k_orthogonal() {
                 );
             }
         }
+    }
+}
+
+#[test]
+fn a_non_symmetric_tangent_stiffness_gives_the_eigenpairs_of_m_inv_k_and_linearizes_poles() {
+    // single-tendon: friction makes K_T non-symmetric (‖K − Kᵀ‖/‖K‖ ≈ 5e-2); each mode solves
+    // K_T φ = ω² M φ with the unsymmetrized K_T, φᵀ M φ = 1, and its frequency is an undamped pole
+    // of `linearize` (computed by another path: the eigenvalues of the state matrix A)
+    let (stdout, json) = modes_json("modes-friction", &["single-tendon", "--count", "1000"]);
+    assert!(
+        stdout.contains("the tangent stiffness is not symmetric"),
+        "{stdout}"
+    );
+    let asymmetry = json["stiffness_asymmetry"].as_f64().unwrap();
+    assert!(asymmetry > 1e-3, "{asymmetry}");
+    let n = json["n_dof"].as_u64().unwrap() as usize;
+    let modes = json["modes"].as_array().unwrap();
+    let (mass, kt) = mass_and_tangent_stiffness("single-tendon", &f64s(&json["q0"]));
+    let w2_max = modes
+        .iter()
+        .map(|m| m["omega_squared"].as_f64().unwrap().abs())
+        .fold(0.0, f64::max);
+    for (i, md) in modes.iter().enumerate() {
+        assert!(
+            md.get("omega_squared_imag").is_none(),
+            "mode {i} is complex"
+        );
+        let phi = DVector::from_iterator(n, (0..n).map(|r| md["shape"][r].as_f64().unwrap()));
+        let w2 = md["omega_squared"].as_f64().unwrap();
+        let residual = (&kt * &phi - w2 * (&mass * &phi)).norm();
+        let scale = w2_max * (&mass * &phi).norm();
+        assert!(
+            residual < 1e-8 * scale,
+            "mode {i}: ‖Kφ − ω²Mφ‖ = {residual:e} ({scale:e})"
+        );
+        assert!((phi.dot(&(&mass * &phi)) - 1.0).abs() < 1e-9, "mode {i}");
+    }
+    // the lowest two against linearize's undamped poles
+    let lin = scratch("modes-friction-lin.json");
+    run_ok(&[
+        "linearize",
+        "single-tendon",
+        "--set",
+        "material.damping=0",
+        "--json",
+        s(&lin),
+    ]);
+    let lin = json_file(&lin);
+    for k in 0..2 {
+        let pole = lin["poles"][k]["natural_frequency_hz"].as_f64().unwrap();
+        let mode = modes[k]["frequency_hz"].as_f64().unwrap();
+        assert!(
+            rel(pole, mode) < 1e-6,
+            "mode {k}: {mode} Hz against the pole's {pole} Hz"
+        );
     }
 }
 

@@ -17,15 +17,63 @@ pub struct Energy {
     pub gravitational: f64,
 }
 
+/// Relative asymmetry `‖K_T − K_Tᵀ‖_F / ‖K_T‖_F` of the tangent stiffness below which it is taken
+/// as symmetric (the round-off of the analytic Jacobian of a conservative load, ~1e-15).
+pub const SYMMETRY_TOLERANCE: f64 = 1e-10;
+
 /// A linearized vibration mode.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Mode {
-    /// The eigenvalue `ω²` [rad²/s²], negative for a direction in which the equilibrium is unstable.
+    /// The eigenvalue `ω²` [rad²/s²], negative for a direction in which the equilibrium is unstable
+    /// (its real part for a complex eigenvalue).
     pub omega_squared: f64,
+    /// The imaginary part of the eigenvalue `ω²`: non-zero only for a complex pair of eigenvalues
+    /// of a non-symmetric `M⁻¹ K_T` (flutter of the undamped linearization, e.g. a follower load
+    /// beyond Beck's critical one).
+    pub omega_squared_imag: f64,
     /// Natural frequency `√max(ω², 0) / 2π` \[Hz\] (0 for an unstable direction).
     pub frequency_hz: f64,
     /// Mode shape in `q`, mass-normalized.
     pub shape: DVector<f64>,
+}
+
+/// The modes of the non-symmetric `a = L⁻¹ K_T L⁻ᵀ` ([`Model::linearized_modes`]), `linv = L⁻¹`:
+/// each eigenvector `u` (complex) is turned so that its largest entry is real and positive, its
+/// real part `v` normalized (`|v| = 1`, so `φ = L⁻ᵀ v` has `φᵀ M φ = 1`); ascending real part of
+/// `ω²`.
+fn non_symmetric_modes(a: &DMatrix<f64>, linv: &DMatrix<f64>) -> Result<Vec<Mode>, DynamicsError> {
+    let n = a.nrows();
+    let eig = faer::Mat::<f64>::from_fn(n, n, |i, j| a[(i, j)])
+        .eigen()
+        .map_err(|_| DynamicsError::NonFinite {
+            what: "eigendecomposition of M⁻¹K_T",
+        })?;
+    let (u, s) = (eig.U(), eig.S().column_vector());
+    let mut modes = Vec::with_capacity(n);
+    for j in 0..n {
+        let w2 = s[j];
+        let col = u.col(j);
+        let big = (0..n)
+            .max_by(|&x, &y| col[x].norm().total_cmp(&col[y].norm()))
+            .unwrap_or(0);
+        let turn = col[big].conj() / col[big].norm();
+        let mut v = DVector::from_fn(n, |i, _| (col[i] * turn).re);
+        let norm = v.norm();
+        if !(norm.is_finite() && norm > 0.0 && w2.re.is_finite() && w2.im.is_finite()) {
+            return Err(DynamicsError::NonFinite {
+                what: "eigendecomposition of M⁻¹K_T",
+            });
+        }
+        v /= norm;
+        modes.push(Mode {
+            omega_squared: w2.re,
+            omega_squared_imag: w2.im,
+            frequency_hz: w2.re.max(0.0).sqrt() / (2.0 * std::f64::consts::PI),
+            shape: linv.transpose() * v,
+        });
+    }
+    modes.sort_by(|a, b| a.omega_squared.total_cmp(&b.omega_squared));
+    Ok(modes)
 }
 
 impl Energy {
@@ -36,9 +84,20 @@ impl Energy {
 
 impl<P: StrainParam> Model<P> {
     /// Linearized undamped vibration modes about `q0` (spec §10.5): `(K_T − ω² M) φ = 0` with the
-    /// tangent stiffness `K_T = −∂R/∂q` (elastic plus load stiffness; symmetrized, since follower
-    /// loads and tendons make it slightly non-symmetric). Returned in ascending `ω²` (directions in
-    /// which the equilibrium is unstable, `ω² < 0`, first), shapes mass-normalized (`φᵀ M φ = 1`).
+    /// tangent stiffness `K_T = −∂R/∂q` (elastic plus load and tendon stiffness). Returned in
+    /// ascending `ω²` (directions in which the equilibrium is unstable, `ω² < 0`, first), shapes
+    /// mass-normalized (`φᵀ M φ = 1`).
+    ///
+    /// A symmetric `K_T` (conservative loads: gravity, frictionless tendons, dead loads; relative
+    /// asymmetry ≤ [`SYMMETRY_TOLERANCE`]) gives the symmetric problem `L⁻¹ K_T L⁻ᵀ`, `M = L Lᵀ`,
+    /// with `M`-orthonormal shapes. Tendon friction and follower loads make `K_T` non-symmetric:
+    /// the modes are then the eigenpairs of the non-symmetric `L⁻¹ K_T L⁻ᵀ` (faer's
+    /// eigendecomposition), the poles of the undamped linearization that `linearize` computes,
+    /// not those of its symmetric part (which put Beck's column's first frequency 21 % low, and
+    /// moved it down under the follower load that raises it). Their shapes are not
+    /// `M`-orthogonal; a complex pair (flutter) is reported with its real part in `omega_squared`,
+    /// its imaginary part in `omega_squared_imag`, and the real part of its (phase-aligned) vector
+    /// as the shape.
     pub fn linearized_modes(
         &self,
         q0: &DVector<f64>,
@@ -47,9 +106,10 @@ impl<P: StrainParam> Model<P> {
         ws: &mut Workspace,
     ) -> Result<Vec<Mode>, DynamicsError> {
         let n = self.n_dof();
-        let mut kt = DMatrix::zeros(n, n);
-        self.statics_jacobian(q0, u, loads, ws, &mut kt);
-        let kt = (&kt + kt.transpose()) * -0.5;
+        let mut k = DMatrix::zeros(n, n);
+        self.statics_jacobian(q0, u, loads, ws, &mut k);
+        k.neg_mut();
+        let asymmetry = (&k - k.transpose()).norm() / k.norm();
         self.assemble_mass(ws);
         let mut l = ws.mass.clone();
         cholesky_factor_in_place(&mut l)?;
@@ -57,6 +117,10 @@ impl<P: StrainParam> Model<P> {
         let linv = l.try_inverse().ok_or(DynamicsError::NonFinite {
             what: "mass factor",
         })?;
+        if asymmetry > SYMMETRY_TOLERANCE {
+            return non_symmetric_modes(&(&linv * &k * linv.transpose()), &linv);
+        }
+        let kt = (&k + k.transpose()) * 0.5;
         let a = &linv * kt * linv.transpose();
         let eig = nalgebra::SymmetricEigen::new((&a + a.transpose()) * 0.5);
         let mut modes: Vec<Mode> = eig
@@ -65,6 +129,7 @@ impl<P: StrainParam> Model<P> {
             .zip(eig.eigenvectors.column_iter())
             .map(|(w2, v)| Mode {
                 omega_squared: *w2,
+                omega_squared_imag: 0.0,
                 frequency_hz: w2.max(0.0).sqrt() / (2.0 * std::f64::consts::PI),
                 shape: linv.transpose() * v,
             })

@@ -165,6 +165,23 @@ pub(super) fn modes_cmd(args: &ModesArgs, out: &mut impl Write) -> Result<()> {
             plural(unstable, "mode")
         )?;
     }
+    if report.stiffness_asymmetry > gvs::dynamics::SYMMETRY_TOLERANCE {
+        let complex = report
+            .modes
+            .iter()
+            .filter(|m| m.omega_squared_imag != 0.0)
+            .count();
+        writeln!(
+            out,
+            "note       the tangent stiffness is not symmetric (‖K_T − K_Tᵀ‖/‖K_T‖ = {}: tendon friction or follower loads): the modes are the eigenpairs of M⁻¹K_T, the undamped poles of `gvsrom linearize`, and their shapes are not M-orthogonal{}",
+            gvs::error::fmt_sci(report.stiffness_asymmetry, 2),
+            if complex > 0 {
+                format!("; {complex} of the modes shown have a complex ω² (flutter of the undamped linearization): shown by its real part, with the real part of its vector as the shape")
+            } else {
+                String::new()
+            }
+        )?;
+    }
     if let Some(json) = json {
         let doc = modes::ModesJson {
             report: &report,
