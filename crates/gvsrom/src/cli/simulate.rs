@@ -276,6 +276,17 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
             fmt_vec(&[g.pos[0], g.pos[1], g.pos[2]], 6),
         )?;
     }
+    // a fixed step halves where Newton fails: say so when that set the cost
+    if let Some(h) = args.fixed_step {
+        let nominal = (t_last / h).ceil().max(1.0) as usize;
+        if sm.stats.failed_steps > 0 && sm.stats.steps > nominal + nominal / 2 {
+            writeln!(
+                out,
+                "note       --fixed-step {h} s: Newton failed {} times at that step, which was halved there (up to 10 times) and took {} steps against {nominal} nominal; a smaller --fixed-step runs at a steady cost",
+                sm.stats.failed_steps, sm.stats.steps
+            )?;
+        }
+    }
     for o in &outcome.model_extrapolated {
         writeln!(out, "note       {o}")?;
     }

@@ -51,6 +51,10 @@ enum Newton {
     Converged,
     Stalled,
     NonFinite,
+    /// The right-hand side refused a Newton iterate (e.g. a trial `q` whose mass matrix is not
+    /// positive definite, far from the solution of a step too long): the step fails and is halved
+    /// like a stalled one; the error is reported only if the halvings do not help.
+    Refused(OdeError),
 }
 
 /// Integrates `y' = f(t, y)` from `(t0, y0)` to the last of `t_out` with fixed steps `opts.h` of
@@ -69,9 +73,10 @@ enum Newton {
 ///   steps. The
 ///   Jacobian (analytic, or forward differences with increment `√eps·max(|y_j|, 1)`) is evaluated
 ///   at the start and re-evaluated, at most once per step, only when Newton stalls (`ρ > 0.9` or no
-///   convergence within `max_newton`); if it still fails, the step is split in halves (up to 10
+///   convergence within `max_newton`); if it still fails, or the right-hand side refuses a Newton
+///   iterate (a trial state far from the step's solution), the step is split in halves (up to 10
 ///   times) before giving up with [`OdeError::NewtonFailure`] (or [`OdeError::NonFinite`] when the
-///   failure is a NaN/∞ right-hand side).
+///   failure is a NaN/∞ right-hand side, or the right-hand side's own error).
 /// * Output: same contract as [`super::integrate_ndf`]; values between steps come from the
 ///   quadratic through `y_{n−1}, y_n, y_{n+1}` (the linear interpolant on backward Euler steps):
 ///   second-order accurate, and built from values only (no derivatives), so a stiff transient
@@ -261,6 +266,7 @@ fn advance<S: OdeSystem>(
                 cs.stats.newton_failures += 1;
                 if halvings >= MAX_HALVINGS {
                     return Err(match failure {
+                        Newton::Refused(e) => e,
                         Newton::NonFinite => OdeError::NonFinite { t },
                         _ => OdeError::NewtonFailure {
                             t,
@@ -295,8 +301,11 @@ fn newton<S: OdeSystem>(
     let mut rate = st.rate.map(|r| r.max(f64::EPSILON).powf(0.8));
     st.rate = rate;
     for it in 1..=opts.max_newton {
-        if !cs.f(t, tn, &w.z, &mut w.f)? {
-            return Ok(Newton::NonFinite);
+        match cs.f(t, tn, &w.z, &mut w.f) {
+            Ok(true) => {}
+            Ok(false) => return Ok(Newton::NonFinite),
+            Err(e @ OdeError::Rhs { .. }) => return Ok(Newton::Refused(e)),
+            Err(e) => return Err(e),
         }
         for i in 0..n {
             w.del[i] = w.s[i] + beta * w.f[i] - w.z[i];

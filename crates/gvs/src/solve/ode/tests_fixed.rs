@@ -275,3 +275,49 @@ fn fixed_step_failures_and_bad_options() {
         );
     }
 }
+
+/// A model that refuses a trial state (as the rod's right-hand side refuses a `q` whose mass matrix
+/// is not positive definite): a step too long for it is halved, as after a Newton failure, and the
+/// run goes on; the refusal is reported only when halving cannot help. `y' = −y`, refused more than
+/// 0.5 away from the exact `e^{−t}` — the first backward-Euler predictor of a 1 s step is 0.63 away.
+#[test]
+fn a_refused_newton_iterate_halves_the_step_instead_of_ending_the_run() {
+    struct Picky;
+    impl OdeSystem for Picky {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn rhs(&mut self, t: f64, y: &DVector<f64>, dy: &mut DVector<f64>) -> Result<(), RhsError> {
+            if (y[0] - (-t).exp()).abs() > 0.5 {
+                return Err(RhsError("trial state refused".into()));
+            }
+            dy[0] = -y[0];
+            Ok(())
+        }
+    }
+    let (out, r) = fixed(&mut Picky, &[1.0], &[0.0, 3.0], &[], &opts(1.0));
+    let stats = r.unwrap();
+    assert!(stats.failed_steps >= 1, "{stats:?}");
+    let y3 = out.last().unwrap().1[0];
+    assert!((y3 - (-3.0f64).exp()).abs() < 0.05, "y(3) = {y3}");
+    // refused everywhere but at the start: no halving helps, the model's error is reported
+    struct Never;
+    impl OdeSystem for Never {
+        fn dim(&self) -> usize {
+            1
+        }
+        fn rhs(&mut self, t: f64, y: &DVector<f64>, dy: &mut DVector<f64>) -> Result<(), RhsError> {
+            if t > 0.0 {
+                return Err(RhsError("model failed".into()));
+            }
+            dy[0] = -y[0];
+            Ok(())
+        }
+    }
+    let (_, r) = fixed(&mut Never, &[1.0], &[0.0, 1.0], &[], &opts(0.1));
+    let e = r.unwrap_err();
+    assert!(
+        matches!(&e, OdeError::Rhs { source, .. } if source.0 == "model failed"),
+        "{e}"
+    );
+}
