@@ -221,6 +221,9 @@ impl Statics {
 ///     Each tendon's length [m] along its thread (at rest: :attr:`Robot.tendon_rest_lengths`).
 /// iterations : numpy.ndarray of int64, shape (m,)
 /// residual_norm : numpy.ndarray, shape (m,)
+/// divergence : numpy.ndarray, shape (m,)
+///     ``ω² < 0`` [1/s²] of a row whose equilibrium is unstable (no stable one connected to the
+///     straight rod was found; a ``UserWarning`` names the rows), NaN for a stable one.
 /// solve_time_s : numpy.ndarray, shape (m,)
 ///     Each solve's own wall-clock time [s] (the solves run in parallel).
 #[pyclass(module = "gvsrom", frozen, get_all)]
@@ -247,6 +250,8 @@ pub struct StaticsBatch {
     iterations: Py<PyAny>,
     /// `‖R(q)‖∞` at the solution.
     residual_norm: Py<PyAny>,
+    /// `ω² < 0` [1/s²] of an unstable equilibrium, NaN for a stable one.
+    divergence: Py<PyAny>,
     /// Wall-clock time of the solve [s].
     solve_time_s: Py<PyAny>,
 }
@@ -265,6 +270,23 @@ impl StaticsBatch {
             built.centerline_points,
         );
         let iterations: Vec<i64> = rs.iter().map(|r| r.iterations as i64).collect();
+        let divergence: Vec<f64> = rs
+            .iter()
+            .map(|r| r.divergence.unwrap_or(f64::NAN))
+            .collect();
+        let unstable: Vec<String> = (divergence.iter().enumerate())
+            .filter(|(_, w2)| !w2.is_nan())
+            .map(|(k, _)| k.to_string())
+            .collect();
+        if !unstable.is_empty() {
+            crate::robot::warn(
+                py,
+                &format!(
+                    "the equilibria of rows [{}] are unstable (M⁻¹K_T has a real ω² < 0) and no stable one connected to the straight rod was found (StaticsBatch.divergence)",
+                    unstable.join(", ")
+                ),
+            )?;
+        }
         Ok(StaticsBatch {
             u: held(shaped(py, cat(&|r| r.u.clone()), [m, na])?)?,
             q: held(shaped(py, cat(&|r| r.q.clone()), [m, n])?)?,
@@ -280,6 +302,7 @@ impl StaticsBatch {
                 py,
                 &rs.iter().map(|r| r.residual_norm).collect::<Vec<_>>(),
             ))?,
+            divergence: held(vector(py, &divergence))?,
             solve_time_s: held(vector(
                 py,
                 &rs.iter().map(|r| r.solve_time_s).collect::<Vec<_>>(),

@@ -143,3 +143,16 @@ def test_an_unstable_equilibrium_warns_and_reports_its_divergence():
     with pytest.warns(UserWarning, match="unstable.*divergence"):
         s = scenario.build().statics()
     assert s.tip_position[2] > 0.1 and s.divergence < -1e3
+
+
+def test_a_batch_row_on_an_unstable_equilibrium_warns_and_reports_its_divergence():
+    # the soft cantilever with a slack tendon: each row a full-load solve from straight
+    text = SOFT_CANTILEVER + "[[tendons]]\noffset_start = [0.0, 0.005]\noffset_end = [0.0, 0.005]\ntension = 0.0\n"
+    robot = gvsrom.Scenario.from_toml(text).set("solver.min_increment", 1.0).build()
+    # continuation forbidden: the curled equilibrium
+    with pytest.warns(UserWarning, match=r"rows \[0\] are unstable"):
+        b = robot.statics_batch(np.zeros((1, 1)), warm_start=False)
+    assert b.divergence.shape == (1,) and b.divergence[0] < -1e3
+    # the default solver: stable, NaN
+    b = gvsrom.Scenario.from_toml(text).build().statics_batch(np.zeros((1, 1)))
+    assert np.isnan(b.divergence[0]) and b.tip_position[0, 2] < -0.9
