@@ -97,6 +97,38 @@ fn greenhill_column_standing_under_its_own_weight_diverges_above_7_837_ei_over_l
     }
 }
 
+/// Past Greenhill's load the straight column diverges, and the continuation from the straight rod
+/// follows the straight branch through the bifurcation; the solver then displaces the column along
+/// its divergent mode and finds the buckled equilibrium beside it, stable, bent to one side.
+#[test]
+fn greenhill_column_past_its_critical_weight_settles_buckled_to_one_side() {
+    let (e, l, r, g): (f64, f64, f64, f64) = (1e6, 1.0, 0.01, 9.81);
+    let ei = e * std::f64::consts::PI * r.powi(4) / 4.0;
+    let area = std::f64::consts::PI * r * r;
+    let rho = 1.3 * 7.8373 * ei / (g * area * l.powi(3));
+    let m = model(
+        rod(e, rho, l, r),
+        12,
+        [false, true, false, true, false, true],
+        6,
+    );
+    let loads = gravity([-g, 0.0, 0.0]);
+    let sol = solve_statics(&m, &[], &loads, None, &StaticsOptions::default()).unwrap();
+    assert_eq!(sol.divergence, None);
+    let w2 = sol.buckled.expect("the straight column buckled");
+    assert!(w2 < 0.0);
+    let mut ws = m.workspace();
+    m.forward(&sol.q, &mut ws, false);
+    let tip = ws.g.last().unwrap().pos;
+    // bent sideways (in z, the plane of the basis), not by a hair
+    assert!(tip[2].abs() > 0.05 * l, "tip {tip:?}");
+    let prepared = m.prepare_loads(&loads).unwrap();
+    assert_eq!(
+        divergence_at(&m, &sol.q, &[], &prepared, &mut m.workspace()),
+        None
+    );
+}
+
 /// A soft cantilever (1 m, r = 1 cm, E = 3.3e5 Pa, 1000 kg/m³) held horizontal under gravity droops
 /// to nearly vertical. One full-load dogleg step from the straight rod converges instead onto an
 /// equilibrium curled up above the clamp (tip 0.16 m above it), which diverges; the solver then

@@ -76,6 +76,47 @@ pub fn divergence<P: StrainParam>(
         .min_by(f64::total_cmp)
 }
 
+/// The divergent mode at the equilibrium `q` (tensions `u`, `loads`): the most negative real
+/// eigenvalue `ω²` of `M⁻¹ K_T` and its eigenvector in `q` (the real part of `L⁻ᵀ v`, scaled to
+/// `‖φ‖∞ = 1`), the direction along which the rod leaves the equilibrium; `None` if it does not
+/// diverge or `M` cannot be factored. A bifurcation (a compressed straight column) is left along
+/// it onto the buckled branch.
+pub fn divergent_mode<P: StrainParam>(
+    model: &Model<P>,
+    q: &nalgebra::DVector<f64>,
+    u: &[f64],
+    loads: &PreparedLoads,
+    ws: &mut Workspace,
+) -> Option<(f64, nalgebra::DVector<f64>)> {
+    let n = model.n_dof();
+    let mut jac = DMatrix::zeros(n, n);
+    model.statics_jacobian(q, u, loads, ws, &mut jac);
+    let mut l = model.mass_matrix(q, ws);
+    cholesky_factor_in_place(&mut l).ok()?;
+    let l = l.lower_triangle();
+    let k = -jac;
+    let x = l.solve_lower_triangular(&k)?;
+    let a = l.solve_lower_triangular(&x.transpose())?.transpose();
+    let eig = faer::Mat::<f64>::from_fn(n, n, |i, j| a[(i, j)])
+        .eigen()
+        .ok()?;
+    let (vectors, values) = (eig.U(), eig.S().column_vector());
+    let scale = (0..n).map(|j| values[j].norm()).fold(0.0, f64::max);
+    let j = (0..n)
+        .filter(|&j| {
+            let w = values[j];
+            w.im.abs() <= REAL_TOLERANCE * scale && w.re < -DIVERGENCE_TOLERANCE * scale
+        })
+        .min_by(|&a, &b| values[a].re.total_cmp(&values[b].re))?;
+    let col = vectors.col(j);
+    let big = (0..n).max_by(|&x, &y| col[x].norm().total_cmp(&col[y].norm()))?;
+    let turn = col[big].conj() / col[big].norm();
+    let v = nalgebra::DVector::from_fn(n, |i, _| (col[i] * turn).re);
+    let phi = l.transpose().solve_upper_triangular(&v)?;
+    let size = phi.amax();
+    (size.is_finite() && size > 0.0).then(|| (values[j].re, phi / size))
+}
+
 /// Whether `jac`'s tangent stiffness `K_T = −jac` has a positive definite symmetric part: the
 /// first, sufficient test of [`divergence`] alone, for a screen with an approximate `∂R/∂q` (a
 /// solver's last, Broyden-updated Jacobian) before an exact one is evaluated.

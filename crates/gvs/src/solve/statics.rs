@@ -62,6 +62,10 @@ pub struct StaticsSolution {
     /// `Some(ω²)` if the step from the straight rod first converged onto an equilibrium that
     /// diverges (with that eigenvalue): why the continuation then ran.
     pub unstable_start: Option<f64>,
+    /// `Some(ω²)` if the equilibrium on the path from the straight rod diverged (with that
+    /// eigenvalue; a bifurcation, e.g. a straight column compressed past buckling) and the rod,
+    /// displaced along its divergent mode, settled on this stable equilibrium instead.
+    pub buckled: Option<f64>,
 }
 
 /// What pseudo-arc-length continuation did in a solve that did not converge
@@ -272,6 +276,7 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
             continuation: None,
             divergence: None,
             unstable_start: None,
+            buckled: None,
         };
         let differences = match self.options.jacobian {
             StaticsJacobian::Auto => n <= DIFFERENCE_MAX_DOF,
@@ -432,8 +437,85 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                 Err(_) => break,
             }
         }
+        // still diverging from the straight rod's path: a bifurcation the continuation passes
+        // straight through; leave it along the divergent mode
+        if total.divergence.is_some() && q0.is_none() && self.options.min_increment < 1.0 {
+            if let Some(x) =
+                self.leave_along_divergent_mode(&q, &mut total, u, loads, &opts, stop)?
+            {
+                q = x;
+            }
+        }
         total.q = q;
         Ok(total)
+    }
+
+    /// From the diverging equilibrium `q`, one full-load dogleg solve from `q ± a φ` (`φ` its
+    /// divergent mode, `‖φ‖∞ = 1`; `a` = 0.2, 0.5, 1, 2, 5, 10, 20, each sign: a small step returns to
+    /// the diverging root; Greenhill's column at 1.3× its critical weight needs 2, at 6.5× 10): the first stable
+    /// equilibrium reached, with `total` updated (`buckled`, `divergence`, statistics); `None` if
+    /// none is.
+    fn leave_along_divergent_mode(
+        &mut self,
+        q: &DVector<f64>,
+        total: &mut StaticsSolution,
+        u: &[f64],
+        loads: &Loads,
+        opts: &DoglegOptions,
+        stop: &StopCheck<'_>,
+    ) -> Result<Option<DVector<f64>>, StaticsError> {
+        let prepared = self.model.prepare_loads(loads)?;
+        let Some((w2, phi)) =
+            super::stability::divergent_mode(self.model, q, u, &prepared, &mut self.ws)
+        else {
+            return Ok(None);
+        };
+        let differences = match self.options.jacobian {
+            StaticsJacobian::Auto => self.model.n_dof() <= DIFFERENCE_MAX_DOF,
+            StaticsJacobian::Analytic => false,
+            StaticsJacobian::Differences => true,
+        };
+        for a in [0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0] {
+            for sign in [1.0, -1.0] {
+                if let Some(reason) = stop() {
+                    return Err(StaticsError::Stopped {
+                        load_factor: 1.0,
+                        reason,
+                    });
+                }
+                let start = q + &phi * (sign * a);
+                let mut sys = System {
+                    model: self.model,
+                    ws: &mut self.ws,
+                    u: u.to_vec(),
+                    loads: prepared.clone(),
+                    at: &mut self.at,
+                    fresh: false,
+                    differences,
+                    xh: &mut self.xh,
+                    fh: &mut self.fh,
+                };
+                total.load_stages += 1;
+                match dogleg::solve(&mut sys, &start, opts, &mut self.dws) {
+                    Ok(rep) => {
+                        total.iterations += rep.iterations;
+                        total.residual_evaluations += rep.residual_evaluations;
+                        total.jacobian_evaluations += rep.jacobian_evaluations;
+                        if self.divergence_screened(&rep.x, u, loads)?.is_none() {
+                            total.buckled = Some(w2);
+                            total.divergence = None;
+                            total.residual_norm = rep.residual_norm;
+                            return Ok(Some(rep.x));
+                        }
+                    }
+                    Err(DoglegError::NotConverged { iterations, .. }) => {
+                        total.iterations += iterations;
+                    }
+                    Err(_) => {}
+                }
+            }
+        }
+        Ok(None)
     }
 
     /// Follows the equilibria from the straight rod to the full load by pseudo-arc-length

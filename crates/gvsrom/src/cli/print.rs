@@ -141,6 +141,13 @@ pub(super) fn print_solution(r: &StaticsReport, out: &mut impl Write) -> Result<
             if folds.is_empty() { String::new() } else { format!(" at load factor {folds}") }
         )?;
     }
+    if let Some(w2) = r.buckled {
+        writeln!(
+            out,
+            "buckled    the equilibrium on the path from the straight rod diverges (ω² = {} 1/s²: a bifurcation, e.g. a column compressed past buckling); displaced along its divergent mode, the rod settled on this stable one (its mirror image is another when rod and loads are symmetric)",
+            gvs::error::fmt_sci(w2, 3)
+        )?;
+    }
     if let Some(w2) = r.divergence {
         writeln!(
             out,

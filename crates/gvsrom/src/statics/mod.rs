@@ -73,6 +73,11 @@ pub struct StaticsReport {
     /// `ω² < 0` ([`gvs::solve::stability`]); no stable one connected to the straight rod was found.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub divergence: Option<f64>,
+    /// `Some(ω²)` \[1/s²\] if the equilibrium on the path from the straight rod diverged (a
+    /// bifurcation: a column compressed past buckling) and this stable one was reached by
+    /// displacing the rod along its divergent mode.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub buckled: Option<f64>,
 }
 
 /// How the arc-length continuation reached the equilibrium ([`gvs::solve::continuation`]).
@@ -367,6 +372,7 @@ fn report<P: StrainParam>(
             after_unstable: sol.unstable_start,
         }),
         divergence: sol.divergence,
+        buckled: sol.buckled,
     }
 }
 
