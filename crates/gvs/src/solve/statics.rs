@@ -278,11 +278,7 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
             unstable_start: None,
             buckled: None,
         };
-        let differences = match self.options.jacobian {
-            StaticsJacobian::Auto => n <= DIFFERENCE_MAX_DOF,
-            StaticsJacobian::Analytic => false,
-            StaticsJacobian::Differences => true,
-        };
+        let differences = self.differences();
         let mut lambda = 0.0;
         let mut inc = 1.0 / self.options.ramp_steps as f64;
         // ‖R‖∞ and its tolerance at the end of the last stage (converged or not)
@@ -322,19 +318,12 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                 } else {
                     loads.scaled(target)
                 };
-                let mut sys = System {
-                    model: self.model,
-                    ws: &mut self.ws,
-                    u: u.iter().map(|v| v * target).collect(),
-                    loads: self.model.prepare_loads(&loads_l)?,
-                    at: &mut self.at,
-                    fresh: false,
-                    differences,
-                    xh: &mut self.xh,
-                    fh: &mut self.fh,
-                };
+                let (u_l, loads_l) = (
+                    u.iter().map(|v| v * target).collect(),
+                    self.model.prepare_loads(&loads_l)?,
+                );
                 total.load_stages += 1;
-                match dogleg::solve(&mut sys, &q, &opts, &mut self.dws) {
+                match self.stage(u_l, loads_l, &q, &opts) {
                     Ok(rep) => {
                         total.iterations += rep.iterations;
                         // the differences' residuals included
@@ -470,11 +459,6 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
         else {
             return Ok(None);
         };
-        let differences = match self.options.jacobian {
-            StaticsJacobian::Auto => self.model.n_dof() <= DIFFERENCE_MAX_DOF,
-            StaticsJacobian::Analytic => false,
-            StaticsJacobian::Differences => true,
-        };
         for a in [0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0] {
             for sign in [1.0, -1.0] {
                 if let Some(reason) = stop() {
@@ -484,19 +468,8 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                     });
                 }
                 let start = q + &phi * (sign * a);
-                let mut sys = System {
-                    model: self.model,
-                    ws: &mut self.ws,
-                    u: u.to_vec(),
-                    loads: prepared.clone(),
-                    at: &mut self.at,
-                    fresh: false,
-                    differences,
-                    xh: &mut self.xh,
-                    fh: &mut self.fh,
-                };
                 total.load_stages += 1;
-                match dogleg::solve(&mut sys, &start, opts, &mut self.dws) {
+                match self.stage(u.to_vec(), prepared.clone(), &start, opts) {
                     Ok(rep) => {
                         total.iterations += rep.iterations;
                         total.residual_evaluations += rep.residual_evaluations;
@@ -516,6 +489,38 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
             }
         }
         Ok(None)
+    }
+
+    /// Whether `∂R/∂q` is taken by forward differences ([`StaticsJacobian`]).
+    fn differences(&self) -> bool {
+        match self.options.jacobian {
+            StaticsJacobian::Auto => self.model.n_dof() <= DIFFERENCE_MAX_DOF,
+            StaticsJacobian::Analytic => false,
+            StaticsJacobian::Differences => true,
+        }
+    }
+
+    /// One dogleg solve of `R(q) = 0` under tensions `u` and `loads` from `start` (a load stage).
+    fn stage(
+        &mut self,
+        u: Vec<f64>,
+        loads: PreparedLoads,
+        start: &DVector<f64>,
+        opts: &DoglegOptions,
+    ) -> Result<dogleg::DoglegReport, DoglegError> {
+        let differences = self.differences();
+        let mut sys = System {
+            model: self.model,
+            ws: &mut self.ws,
+            u,
+            loads,
+            at: &mut self.at,
+            fresh: false,
+            differences,
+            xh: &mut self.xh,
+            fh: &mut self.fh,
+        };
+        dogleg::solve(&mut sys, start, opts, &mut self.dws)
     }
 
     /// Follows the equilibria from the straight rod to the full load by pseudo-arc-length
