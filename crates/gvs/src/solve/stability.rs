@@ -77,10 +77,10 @@ pub fn divergence<P: StrainParam>(
 }
 
 /// The divergent mode at the equilibrium `q` (tensions `u`, `loads`): the most negative real
-/// eigenvalue `ω²` of `M⁻¹ K_T` and its eigenvector in `q` (the real part of `L⁻ᵀ v`, scaled to
-/// `‖φ‖∞ = 1`), the direction along which the rod leaves the equilibrium; `None` if it does not
-/// diverge or `M` cannot be factored. A bifurcation (a compressed straight column) is left along
-/// it onto the buckled branch.
+/// eigenvalue `ω²` of `M⁻¹ K_T` and its eigenvector in `q` (of [`Model::linearized_modes`], scaled
+/// to `‖φ‖∞ = 1`), the direction along which the rod leaves the equilibrium; `None` if it does not
+/// diverge or the modes cannot be computed. A bifurcation (a compressed straight column) is left
+/// along it onto the buckled branch.
 pub fn divergent_mode<P: StrainParam>(
     model: &Model<P>,
     q: &nalgebra::DVector<f64>,
@@ -88,33 +88,18 @@ pub fn divergent_mode<P: StrainParam>(
     loads: &PreparedLoads,
     ws: &mut Workspace,
 ) -> Option<(f64, nalgebra::DVector<f64>)> {
-    let n = model.n_dof();
-    let mut jac = DMatrix::zeros(n, n);
-    model.statics_jacobian(q, u, loads, ws, &mut jac);
-    let mut l = model.mass_matrix(q, ws);
-    cholesky_factor_in_place(&mut l).ok()?;
-    let l = l.lower_triangle();
-    let k = -jac;
-    let x = l.solve_lower_triangular(&k)?;
-    let a = l.solve_lower_triangular(&x.transpose())?.transpose();
-    let eig = faer::Mat::<f64>::from_fn(n, n, |i, j| a[(i, j)])
-        .eigen()
-        .ok()?;
-    let (vectors, values) = (eig.U(), eig.S().column_vector());
-    let scale = (0..n).map(|j| values[j].norm()).fold(0.0, f64::max);
-    let j = (0..n)
-        .filter(|&j| {
-            let w = values[j];
-            w.im.abs() <= REAL_TOLERANCE * scale && w.re < -DIVERGENCE_TOLERANCE * scale
+    let modes = model.linearized_modes(q, u, loads, ws).ok()?;
+    let scale = (modes.iter())
+        .map(|m| m.omega_squared.hypot(m.omega_squared_imag))
+        .fold(0.0, f64::max);
+    let mode = (modes.iter())
+        .filter(|m| {
+            m.omega_squared_imag.abs() <= REAL_TOLERANCE * scale
+                && m.omega_squared < -DIVERGENCE_TOLERANCE * scale
         })
-        .min_by(|&a, &b| values[a].re.total_cmp(&values[b].re))?;
-    let col = vectors.col(j);
-    let big = (0..n).max_by(|&x, &y| col[x].norm().total_cmp(&col[y].norm()))?;
-    let turn = col[big].conj() / col[big].norm();
-    let v = nalgebra::DVector::from_fn(n, |i, _| (col[i] * turn).re);
-    let phi = l.transpose().solve_upper_triangular(&v)?;
-    let size = phi.amax();
-    (size.is_finite() && size > 0.0).then(|| (values[j].re, phi / size))
+        .min_by(|a, b| a.omega_squared.total_cmp(&b.omega_squared))?;
+    let size = mode.shape.amax();
+    (size.is_finite() && size > 0.0).then(|| (mode.omega_squared, &mode.shape / size))
 }
 
 /// Whether `jac`'s tangent stiffness `K_T = −jac` has a positive definite symmetric part: the
