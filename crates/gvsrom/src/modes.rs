@@ -163,21 +163,17 @@ fn modes_on<P: StrainParam>(
     model.statics_jacobian(&q0, &built.u, &loads, &mut ws, &mut dr);
     let stiffness_asymmetry = (&dr - dr.transpose()).norm() / dr.norm();
     let kt = (&dr + dr.transpose()) * -0.5;
-    let imag: Vec<(u64, f64)> = raw
-        .iter()
-        .filter(|m| m.omega_squared_imag != 0.0)
-        .map(|m| (m.omega_squared.to_bits(), m.omega_squared_imag))
-        .collect();
-    let imag_of = |w2: f64| imag.iter().find(|(b, _)| *b == w2.to_bits()).map(|p| p.1);
-    let mut raw: Vec<(f64, DVector<f64>)> = raw
+    // (ω², its imaginary part, φ)
+    let mut raw: Vec<(f64, f64, DVector<f64>)> = raw
         .into_iter()
         .map(|m| match m.omega_squared_imag {
-            0.0 => (m.shape.dot(&(&kt * &m.shape)), m.shape),
-            _ => (m.omega_squared, m.shape),
+            0.0 => (m.shape.dot(&(&kt * &m.shape)), 0.0, m.shape),
+            im => (m.omega_squared, im, m.shape),
         })
         .collect();
     raw.sort_by(|a, b| a.0.total_cmp(&b.0));
     let lam: Vec<f64> = raw.iter().map(|m| m.0).collect();
+    let lam_imag: Vec<f64> = raw.iter().map(|m| m.1).collect();
     let all_frequencies_hz: Vec<f64> = lam.iter().map(|&l| frequency(l)).collect();
     let count = count.min(raw.len());
 
@@ -188,7 +184,7 @@ fn modes_on<P: StrainParam>(
     while taken < raw.len() && same(lam[taken - 1], lam[taken]) {
         taken += 1;
     }
-    let mut shapes: Vec<DVector<f64>> = raw[..taken].iter().map(|m| m.1.clone()).collect();
+    let mut shapes: Vec<DVector<f64>> = raw[..taken].iter().map(|m| m.2.clone()).collect();
     let mut strains: Vec<Vec<V6>> = shapes
         .iter()
         .map(|phi| modal_strain(model, &q0, phi, &mut ws))
@@ -256,7 +252,7 @@ fn modes_on<P: StrainParam>(
         let total: f64 = energy.iter().sum();
         let share = energy.map(|e| if total > 0.0 { e / total } else { 0.0 });
         let dominant = (0..6).fold(0, |best, c| if share[c] > share[best] { c } else { best });
-        let omega_squared_imag = imag_of(lam[k]).unwrap_or(0.0);
+        let omega_squared_imag = lam_imag[k];
         let omega_squared = match omega_squared_imag {
             0.0 => phi.dot(&(&kt * &phi)),
             _ => lam[k],

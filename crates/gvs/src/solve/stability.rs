@@ -45,11 +45,8 @@ pub fn divergence<P: StrainParam>(
     if n == 0 {
         return None;
     }
-    let mut ks = (jac + jac.transpose()) * -0.5;
-    if ks.iter().any(|v| !v.is_finite()) {
-        return None; // not an equilibrium to judge; the solver reports non-finite values itself
-    }
-    if positive_definite(&mut ks) {
+    // a non-finite Jacobian is no equilibrium to judge: the solver reports non-finite values itself
+    if jac.iter().any(|v| !v.is_finite()) || surely_stable(jac) {
         return None;
     }
     let mut l = model.mass_matrix(q, ws);
