@@ -8,7 +8,7 @@ use gvs::model::Model;
 use gvs::rod::{Material, Rod, SectionProps};
 use gvs::solve::stability::divergence_at;
 use gvs::solve::statics::{solve_statics, StaticsOptions};
-use gvs::strain::{DivisionBasis, LinearBasis};
+use gvs::strain::{DivisionBasis, LinearBasis, StrainParam};
 
 fn rod(e: f64, rho: f64, l: f64, r: f64) -> Rod {
     let mat = Material {
@@ -102,10 +102,21 @@ fn greenhill_column_standing_under_its_own_weight_diverges_above_7_837_ei_over_l
 /// its divergent mode and finds the buckled equilibrium beside it, stable, bent to one side.
 #[test]
 fn greenhill_column_past_its_critical_weight_settles_buckled_to_one_side() {
+    let tip = greenhill_buckled(1.3);
+    // bent sideways (in z, the plane of the basis), not by a hair, and still standing
+    assert!(tip[2].abs() > 0.5 && tip[0] > 0.0, "tip {tip:?}");
+    // far past it the column cannot stand at all: it falls over and hangs below its clamp
+    let tip = greenhill_buckled(6.5);
+    assert!(tip[0] < -0.5, "tip {tip:?}");
+}
+
+/// Greenhill's column of `factor` times its critical weight, solved from the straight rod: it
+/// buckled onto a stable equilibrium of lower potential than the straight column's. Its tip.
+fn greenhill_buckled(factor: f64) -> [f64; 3] {
     let (e, l, r, g): (f64, f64, f64, f64) = (1e6, 1.0, 0.01, 9.81);
     let ei = e * std::f64::consts::PI * r.powi(4) / 4.0;
     let area = std::f64::consts::PI * r * r;
-    let rho = 1.3 * 7.8373 * ei / (g * area * l.powi(3));
+    let rho = factor * 7.8373 * ei / (g * area * l.powi(3));
     let m = model(
         rod(e, rho, l, r),
         12,
@@ -120,13 +131,25 @@ fn greenhill_column_past_its_critical_weight_settles_buckled_to_one_side() {
     let mut ws = m.workspace();
     m.forward(&sol.q, &mut ws, false);
     let tip = ws.g.last().unwrap().pos;
-    // bent sideways (in z, the plane of the basis), not by a hair
-    assert!(tip[2].abs() > 0.05 * l, "tip {tip:?}");
     let prepared = m.prepare_loads(&loads).unwrap();
     assert_eq!(
         divergence_at(&m, &sol.q, &[], &prepared, &mut m.workspace()),
         None
     );
+    // gravity is conservative: the rod came down the potential, below the straight column's
+    let zero = nalgebra::DVector::zeros(m.n_dof());
+    let potential = |q: &nalgebra::DVector<f64>| {
+        let e = m.energy(q, &zero, &[-g, 0.0, 0.0], &mut m.workspace());
+        e.elastic + e.gravitational
+    };
+    let straight = m.param.rest_coordinates();
+    let (v_buckled, v_straight) = (potential(&sol.q), potential(&straight));
+    assert!(v_buckled < v_straight, "{v_buckled} against {v_straight}");
+    eprintln!(
+        "{factor}×: tip {tip:?}, V {v_buckled} < {v_straight}, descent {} steps",
+        sol.descent_steps
+    );
+    [tip[0] / l, tip[1] / l, tip[2] / l]
 }
 
 /// A soft cantilever (1 m, r = 1 cm, E = 3.3e5 Pa, 1000 kg/m³) held horizontal under gravity droops

@@ -48,6 +48,13 @@ use pyo3::types::PyDict;
 ///     ``ω²`` [1/s²], the real eigenvalue ``< 0`` of ``M⁻¹ K_T``, if the equilibrium is unstable
 ///     (no stable one connected to the straight rod was found; a ``UserWarning`` says so too);
 ///     ``None`` for a stable one.
+/// buckled : float or None
+///     ``ω²`` [1/s²] of the equilibrium on the path from the straight rod, if that one diverged
+///     (a bifurcation: a column compressed past buckling) and the rod, released along its
+///     divergent mode, settled on this stable one instead; ``None`` otherwise.
+/// continued : bool
+///     Whether the equilibrium was reached by arc-length continuation from the straight rod (the
+///     load ramp stalled, or its equilibrium diverged).
 /// solve_time_s : float
 ///     Wall-clock time of the solve [s].
 /// model_extrapolated : list of str
@@ -97,6 +104,10 @@ pub struct Statics {
     residual_norm: f64,
     /// `ω² < 0` [1/s²] if the equilibrium diverges, else `None`.
     divergence: Option<f64>,
+    /// `ω² < 0` [1/s²] of the diverging equilibrium the rod was released from, if it buckled.
+    buckled: Option<f64>,
+    /// Reached by arc-length continuation from the straight rod.
+    continued: bool,
     /// Wall-clock time of the solve [s].
     solve_time_s: f64,
     /// How the reduced model was used outside what it was trained on (`--extrapolate`).
@@ -151,6 +162,8 @@ impl Statics {
             jacobian_evaluations: r.jacobian_evaluations,
             residual_norm: r.residual_norm,
             divergence: r.divergence,
+            buckled: r.buckled,
+            continued: r.continuation.is_some(),
             solve_time_s: r.solve_time_s,
             model_extrapolated,
         })
@@ -187,6 +200,8 @@ impl Statics {
         d.set_item("jacobian_evaluations", self.jacobian_evaluations)?;
         d.set_item("residual_norm", self.residual_norm)?;
         d.set_item("divergence", self.divergence)?;
+        d.set_item("buckled", self.buckled)?;
+        d.set_item("continued", self.continued)?;
         d.set_item("solve_time_s", self.solve_time_s)?;
         d.set_item("model_extrapolated", &self.model_extrapolated)?;
         Ok(d)

@@ -156,3 +156,34 @@ def test_a_batch_row_on_an_unstable_equilibrium_warns_and_reports_its_divergence
     # the default solver: stable, NaN
     b = gvsrom.Scenario.from_toml(text).build().statics_batch(np.zeros((1, 1)))
     assert np.isnan(b.divergence[0]) and b.tip_position[0, 2] < -0.9
+
+
+def test_a_soft_cantilever_reached_by_continuation_says_so_and_did_not_buckle():
+    s = gvsrom.Scenario.from_toml(SOFT_CANTILEVER).build().statics()
+    assert s.continued and s.buckled is None
+    assert s.to_dict()["continued"] is True and s.to_dict()["buckled"] is None
+
+
+def test_six_tendon_pushed_on_every_tendon_buckles_onto_an_equilibrium_numpy_finds_stable():
+    # +30 N on every tendon: the path from the straight rod stays in the arm's plane of symmetry
+    # (y = 0) and ends on an equilibrium that diverges with two modes; released, the arm leaves
+    # that plane and settles beside it
+    robot = gvsrom.Scenario.preset("six-tendon").build()
+    u = np.full(6, 30.0)
+    s = robot.statics(u)
+    assert s.divergence is None and s.buckled is not None and s.buckled < -1e3
+    assert abs(s.tip_position[1]) > 0.005
+    # an equilibrium: ‖R‖∞ at the tolerance of the solve's own test
+    assert np.max(np.abs(robot.statics_residual(s.q, u))) < 1e-7
+    # and stable, judged here by NumPy: every eigenvalue of M⁻¹K_T, K_T = −∂R/∂q, has Re > 0
+    k_t = -robot.statics_jacobian(s.q, u)
+    w2 = np.linalg.eigvals(np.linalg.solve(robot.mass_matrix(s.q), k_t))
+    assert w2.real.min() > 1.0, w2.real.min()
+    # the in-plane equilibrium it left is one too, but diverges
+    straight = gvsrom.Scenario.preset("six-tendon").set("solver.min_increment", 1.0).build()
+    with pytest.warns(UserWarning, match="unstable"):
+        flat = straight.statics(u)
+    assert abs(flat.tip_position[1]) < 1e-5
+    k_t = -robot.statics_jacobian(flat.q, u)
+    w2 = np.linalg.eigvals(np.linalg.solve(robot.mass_matrix(flat.q), k_t))
+    assert w2.real.min() < -1e3

@@ -125,7 +125,7 @@ pub fn divergence_at<P: StrainParam>(
 /// so that a soft bending coordinate is judged against its own stiffness, not the axial one's),
 /// its Cholesky factorization (in place) meets no pivot clearly below zero
 /// ([`cholesky_factor_in_place`]: pivots within `1e-8` of zero, neutral to round-off, pass).
-fn positive_definite(a: &mut DMatrix<f64>) -> bool {
+pub(crate) fn positive_definite(a: &mut DMatrix<f64>) -> bool {
     let n = a.nrows();
     if !(0..n).all(|j| a[(j, j)] > 0.0) {
         return false;

@@ -37,6 +37,7 @@ use crate::strain::StrainParam;
 use nalgebra::{DMatrix, DVector};
 use thiserror::Error;
 
+mod descent;
 mod options;
 pub use options::*;
 
@@ -66,6 +67,9 @@ pub struct StaticsSolution {
     /// eigenvalue; a bifurcation, e.g. a straight column compressed past buckling) and the rod,
     /// displaced along its divergent mode, settled on this stable equilibrium instead.
     pub buckled: Option<f64>,
+    /// Pseudo-time steps of the descent along the rod's overdamped motion from a diverging
+    /// equilibrium (0 if none ran), each with one `∂R/∂q` and one mass matrix.
+    pub descent_steps: usize,
 }
 
 /// What pseudo-arc-length continuation did in a solve that did not converge
@@ -277,6 +281,7 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
             divergence: None,
             unstable_start: None,
             buckled: None,
+            descent_steps: 0,
         };
         let differences = self.differences();
         let mut lambda = 0.0;
@@ -387,6 +392,14 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                             first.jacobian_evaluations = total.jacobian_evaluations;
                             first.load_stages = total.load_stages;
                             first.divergence = self.divergence(&first.q, u, loads)?;
+                            if first.divergence.is_some() {
+                                let at = first.q.clone();
+                                if let Some(x) = self.leave_along_divergent_mode(
+                                    &at, &mut first, u, loads, &opts, stop,
+                                )? {
+                                    first.q = x;
+                                }
+                            }
                             return Ok(first);
                         } else if total.continuation.is_some() {
                             reason = format!("{reason}, at λ = 1 after the continuation");
@@ -439,11 +452,11 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
         Ok(total)
     }
 
-    /// From the diverging equilibrium `q`, one full-load dogleg solve from `q ± a φ` (`φ` its
-    /// divergent mode, `‖φ‖∞ = 1`; `a` = 0.2, 0.5, 1, 2, 5, 10, 20, each sign: a small step returns to
-    /// the diverging root; Greenhill's column at 1.3× its critical weight needs 2, at 6.5× 10): the first stable
-    /// equilibrium reached, with `total` updated (`buckled`, `divergence`, statistics); `None` if
-    /// none is.
+    /// From the diverging equilibrium `q`, the rod's own way off it: displaced by `±ε φ` (`φ` its
+    /// divergent mode, `‖φ‖∞ = 1`, `ε = 0.01 max(1, ‖q‖∞)`; `+` first) and released, it follows
+    /// its overdamped motion `M q̇ = R(q)` ([`descent`]) onto a stable equilibrium, which a
+    /// full-load dogleg stage then polishes. The first stable equilibrium reached, with `total`
+    /// updated (`buckled`, `divergence`, statistics); `None` if none is.
     fn leave_along_divergent_mode(
         &mut self,
         q: &DVector<f64>,
@@ -459,33 +472,40 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
         else {
             return Ok(None);
         };
-        for a in [0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0] {
-            for sign in [1.0, -1.0] {
-                if let Some(reason) = stop() {
-                    return Err(StaticsError::Stopped {
-                        load_factor: 1.0,
-                        reason,
-                    });
-                }
-                let start = q + &phi * (sign * a);
-                total.load_stages += 1;
-                match self.stage(u.to_vec(), prepared.clone(), &start, opts) {
-                    Ok(rep) => {
-                        total.iterations += rep.iterations;
-                        total.residual_evaluations += rep.residual_evaluations;
-                        total.jacobian_evaluations += rep.jacobian_evaluations;
-                        if self.divergence_screened(&rep.x, u, loads)?.is_none() {
-                            total.buckled = Some(w2);
-                            total.divergence = None;
-                            total.residual_norm = rep.residual_norm;
-                            return Ok(Some(rep.x));
-                        }
+        let eps = 0.01 * q.amax().max(1.0);
+        for sign in [1.0, -1.0] {
+            let start = q + &phi * (sign * eps);
+            let (end, work) = descent::descend(
+                self.model,
+                &mut self.ws,
+                &start,
+                u,
+                &prepared,
+                0.5 / w2.abs(),
+                self.options.ftol,
+                stop,
+            )?;
+            total.residual_evaluations += work.residual_evaluations;
+            total.jacobian_evaluations += work.jacobian_evaluations;
+            total.descent_steps += work.steps;
+            let Some(end) = end else { continue };
+            total.load_stages += 1;
+            match self.stage(u.to_vec(), prepared.clone(), &end, opts) {
+                Ok(rep) => {
+                    total.iterations += rep.iterations;
+                    total.residual_evaluations += rep.residual_evaluations;
+                    total.jacobian_evaluations += rep.jacobian_evaluations;
+                    if self.divergence_screened(&rep.x, u, loads)?.is_none() {
+                        total.buckled = Some(w2);
+                        total.divergence = None;
+                        total.residual_norm = rep.residual_norm;
+                        return Ok(Some(rep.x));
                     }
-                    Err(DoglegError::NotConverged { iterations, .. }) => {
-                        total.iterations += iterations;
-                    }
-                    Err(_) => {}
                 }
+                Err(DoglegError::NotConverged { iterations, .. }) => {
+                    total.iterations += iterations;
+                }
+                Err(_) => {}
             }
         }
         Ok(None)

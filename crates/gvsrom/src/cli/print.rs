@@ -144,8 +144,9 @@ pub(super) fn print_solution(r: &StaticsReport, out: &mut impl Write) -> Result<
     if let Some(w2) = r.buckled {
         writeln!(
             out,
-            "buckled    the equilibrium on the path from the straight rod diverges (ω² = {} 1/s²: a bifurcation, e.g. a column compressed past buckling); displaced along its divergent mode, the rod settled on this stable one (its mirror image is another when rod and loads are symmetric)",
-            gvs::error::fmt_sci(w2, 3)
+            "buckled    the equilibrium on the path from the straight rod diverges (ω² = {} 1/s²: a bifurcation, e.g. a column compressed past buckling); released along its divergent mode, the rod's overdamped motion settled in {} on this stable one (its mirror image is another when rod and loads are symmetric)",
+            gvs::error::fmt_sci(w2, 3),
+            plural(r.descent_steps, "step")
         )?;
     }
     if let Some(w2) = r.divergence {

@@ -75,9 +75,17 @@ pub struct StaticsReport {
     pub divergence: Option<f64>,
     /// `Some(ω²)` \[1/s²\] if the equilibrium on the path from the straight rod diverged (a
     /// bifurcation: a column compressed past buckling) and this stable one was reached by
-    /// displacing the rod along its divergent mode.
+    /// releasing the rod displaced along its divergent mode (its overdamped motion).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub buckled: Option<f64>,
+    /// Pseudo-time steps of the rod's overdamped motion from the diverging equilibrium to the
+    /// stable one (with `buckled`; also counted when that descent found nothing stable).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub descent_steps: usize,
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 /// How the arc-length continuation reached the equilibrium ([`gvs::solve::continuation`]).
@@ -373,6 +381,7 @@ fn report<P: StrainParam>(
         }),
         divergence: sol.divergence,
         buckled: sol.buckled,
+        descent_steps: sol.descent_steps,
     }
 }
 
