@@ -227,11 +227,16 @@ pub fn max_abs_per_column(signal: &Signal) -> Vec<f64> {
 mod tests {
     use super::*;
 
+    /// The folder of the files `read` writes (made once per process, shared by the tests).
+    fn csv_dir() -> std::path::PathBuf {
+        static DIR: std::sync::OnceLock<std::path::PathBuf> = std::sync::OnceLock::new();
+        DIR.get_or_init(|| crate::output::test_util::sandbox("csv", "files"))
+            .clone()
+    }
+
     /// Writes `text` to a file unique to `name` and reads it with `n` value columns.
     fn read(name: &str, text: &str, n: usize) -> Result<Signal, String> {
-        let dir = std::env::temp_dir().join(format!("gvsrom-csv-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join(name);
+        let path = csv_dir().join(name);
         std::fs::write(&path, text).unwrap();
         read_csv_signal(&path, n, Interpolation::Hold).map_err(|e| e.to_string())
     }
@@ -252,7 +257,7 @@ mod tests {
             e.contains("twice.csv:5 column 1") && e.contains("line 4 has it too"),
             "{e}"
         );
-        let dir = std::env::temp_dir().join(format!("gvsrom-csv-{}", std::process::id()));
+        let dir = csv_dir();
         let linear = read_csv_signal(&dir.join("twice.csv"), 1, Interpolation::Linear).unwrap();
         assert_eq!(linear.times, vec![0.0, 1.0, 1.0, 2.0]);
         let thrice = "0,0\n1,0\n1,2\n1,4\n";
@@ -368,8 +373,7 @@ mod tests {
 
     #[test]
     fn a_directory_or_device_is_refused_before_it_is_read() {
-        let dir = std::env::temp_dir().join(format!("gvsrom-csv-dir-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::output::test_util::sandbox("csv", "a-directory");
         let e = read_csv_signal(&dir, 1, Interpolation::Hold)
             .unwrap_err()
             .to_string();

@@ -7,15 +7,44 @@ use std::fs;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-/// A fresh empty directory `name` under the system's temporary directory, in a folder of this
-/// process named by `suite` (never the current directory).
+/// The unit tests' folder under the system's temporary directory: one sub-folder per test process.
+const UNIT_ROOT: &str = "gvsrom-unit-tests";
+
+/// A fresh empty directory `name` of the unit-test suite `suite`, under the system's temporary
+/// directory in a folder of this process (never the current directory). The first call of a
+/// process removes the folders of earlier test processes that have ended, so that repeated test
+/// runs do not pile up scratch directories.
 pub(crate) fn sandbox(suite: &str, name: &str) -> PathBuf {
-    let d = std::env::temp_dir()
-        .join(format!("gvsrom-{suite}-unit-{}", std::process::id()))
+    static SWEPT: std::sync::Once = std::sync::Once::new();
+    let root = std::env::temp_dir().join(UNIT_ROOT);
+    SWEPT.call_once(|| remove_ended(&root));
+    let d = root
+        .join(std::process::id().to_string())
+        .join(suite)
         .join(name);
     let _ = fs::remove_dir_all(&d);
     fs::create_dir_all(&d).unwrap();
     d
+}
+
+/// Removes the folders under `root` named by the id of a process that no longer runs (Linux's
+/// `/proc`; elsewhere nothing is removed).
+fn remove_ended(root: &Path) {
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    let Ok(entries) = fs::read_dir(root) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name();
+        let Some(pid) = name.to_str().and_then(|s| s.parse::<u32>().ok()) else {
+            continue;
+        };
+        if pid != std::process::id() && !Path::new("/proc").join(pid.to_string()).exists() {
+            let _ = fs::remove_dir_all(e.path());
+        }
+    }
 }
 
 /// The entries of `dir`, sorted.
