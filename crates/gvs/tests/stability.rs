@@ -181,6 +181,15 @@ fn a_soft_cantilever_under_gravity_hangs_down_rather_than_curls_up() {
     assert_eq!(sol.divergence, None);
     assert_eq!(sol.unstable_start, Some(w2));
     assert!(sol.continuation.is_some());
+    // with the check turned off (`solver.check_stability = false`), the full-load step's curled
+    // equilibrium is returned as it is, unjudged
+    let unchecked = StaticsOptions {
+        check_stability: false,
+        ..StaticsOptions::default()
+    };
+    let sol = solve_statics(&m, &[], &loads, None, &unchecked).unwrap();
+    assert!(tip_z(&sol.q) > 0.1, "tip z {}", tip_z(&sol.q));
+    assert_eq!((sol.divergence, sol.continuation.is_none()), (None, true));
 }
 
 /// Beck's column (1952): a cantilever under a compressive *follower* force `P` at its tip keeps its

@@ -415,7 +415,11 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                     }
                 }
             }
-            total.divergence = self.divergence_screened(&q, u, loads)?;
+            total.divergence = if self.options.check_stability {
+                self.divergence_screened(&q, u, loads)?
+            } else {
+                None
+            };
             // A step from the straight rod (the one equilibrium without load) can converge onto an
             // unstable equilibrium at full load: follow the equilibria from it instead, as after a
             // failure, and polish at λ = 1. A warm start's caller has its own fallback.

@@ -141,6 +141,12 @@ pub(super) fn print_solution(r: &StaticsReport, out: &mut impl Write) -> Result<
             if folds.is_empty() { String::new() } else { format!(" at load factor {folds}") }
         )?;
     }
+    if !r.stability_checked {
+        writeln!(
+            out,
+            "stability  not checked (solver.check_stability = false): this may be an equilibrium the rod cannot rest on"
+        )?;
+    }
     if let Some(w2) = r.buckled {
         writeln!(
             out,

@@ -82,6 +82,9 @@ pub struct StaticsReport {
     /// stable one (with `buckled`; also counted when that descent found nothing stable).
     #[serde(skip_serializing_if = "is_zero")]
     pub descent_steps: usize,
+    /// Whether the equilibrium's stability was judged (`solver.check_stability`, default true);
+    /// without it, `divergence` is never set.
+    pub stability_checked: bool,
 }
 
 fn is_zero(n: &usize) -> bool {
@@ -382,6 +385,7 @@ fn report<P: StrainParam>(
         divergence: sol.divergence,
         buckled: sol.buckled,
         descent_steps: sol.descent_steps,
+        stability_checked: built.options.check_stability,
     }
 }
 
