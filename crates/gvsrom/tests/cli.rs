@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{expect_error, gvsrom, scratch};
+use common::{expect_error, gvsrom, run_json, run_ok, scratch};
 use std::path::PathBuf;
 
 #[test]
@@ -754,4 +754,41 @@ fn check_refuses_a_distributed_load_the_points_do_not_resolve_as_statics_does() 
             &["loads.distributed[0].width", "0.005 m", "not resolved"],
         );
     }
+}
+
+/// Every tendon of the six-tendon arm pushed at +30 N: the path from the straight rod ends in the
+/// arm's plane of symmetry on an equilibrium that diverges; `statics` releases the arm from it and
+/// reports the stable one it settles on beside that plane (`buckled`, with the descent's steps, in
+/// the summary and the JSON). With `solver.check_stability = false` the in-plane one is returned,
+/// and the summary says it was not judged.
+#[test]
+fn six_tendon_pushed_on_every_tendon_is_reported_buckled_and_unjudged_without_the_check() {
+    let (stdout, v) = run_json("statics", "buckled", &["six-tendon", "--tension=30"]);
+    assert!(
+        stdout.contains("buckled    the equilibrium on the path from the straight rod diverges")
+            && stdout.contains("overdamped motion settled in")
+            && !stdout.contains("\nunstable "),
+        "{stdout}"
+    );
+    assert!(v["buckled"].as_f64().unwrap() < -1e3, "{v}");
+    assert!(v["descent_steps"].as_u64().unwrap() > 0, "{v}");
+    assert!(
+        v.get("divergence").is_none() && v["stability_checked"] == true,
+        "{v}"
+    );
+    assert!(v["tip_position"][1].as_f64().unwrap().abs() > 0.005, "{v}");
+    let stdout = run_ok(&[
+        "statics",
+        "six-tendon",
+        "--tension=30",
+        "--set",
+        "solver.check_stability=false",
+    ]);
+    assert!(
+        stdout.contains("stability  not checked (solver.check_stability = false)")
+            && !stdout.contains("buckled")
+            && !stdout.contains("\nunstable ")
+            && !stdout.contains("continued"),
+        "{stdout}"
+    );
 }
