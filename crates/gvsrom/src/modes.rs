@@ -404,7 +404,12 @@ pub fn tip_motion(mode: &ModeReport, length: f64) -> String {
                 return (*axis).to_string();
             }
         }
-        format!("[{:.2}, {:.2}, {:.2}]", v[0] / n, v[1] / n, v[2] / n)
+        // a component that rounds to zero prints as 0.00, whatever its sign's round-off
+        let c = |x: f64| match format!("{x:.2}") {
+            z if z == "-0.00" => "0.00".to_string(),
+            z => z,
+        };
+        format!("[{}, {}, {}]", c(v[0] / n), c(v[1] / n), c(v[2] / n))
     };
     let mut parts = vec![];
     if t >= 0.01 * big {
@@ -452,5 +457,24 @@ mod tests {
         assert_eq!(parse_count(Some("9"), 5).unwrap(), (5, true));
         assert_eq!(parse_count(None, 50).unwrap(), (DEFAULT_COUNT, false));
         assert_eq!(parse_count(None, 4).unwrap(), (4, false));
+    }
+
+    #[test]
+    fn a_tip_motion_off_the_axes_prints_a_component_that_rounds_to_zero_without_a_sign() {
+        let mode = ModeReport {
+            mode: 1,
+            frequency_hz: 1.0,
+            period_s: Some(1.0),
+            omega_squared: 1.0,
+            omega_squared_imag: 0.0,
+            dominant_strain: "bend_y",
+            strain_energy_share: [0.0, 1.0, 0.0, 0.0, 0.0, 0.0],
+            shape: vec![],
+            tip_displacement: [-0.7, -1e-9, -0.71],
+            tip_rotation: [0.0; 3],
+            strain: vec![],
+            centerline_shape: vec![],
+        };
+        assert_eq!(tip_motion(&mode, 1.0), "translation [-0.70, 0.00, -0.71]");
     }
 }

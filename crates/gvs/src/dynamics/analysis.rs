@@ -37,43 +37,103 @@ pub struct Mode {
     pub shape: DVector<f64>,
 }
 
-/// The modes of the non-symmetric `a = L⁻¹ K_T L⁻ᵀ` ([`Model::linearized_modes`]), `linv = L⁻¹`:
-/// each eigenvector `u` (complex) is turned so that its largest entry is real and positive, its
-/// real part `v` normalized (`|v| = 1`, so `φ = L⁻ᵀ v` has `φᵀ M φ = 1`); ascending real part of
-/// `ω²`.
-fn non_symmetric_modes(a: &DMatrix<f64>, linv: &DMatrix<f64>) -> Result<Vec<Mode>, DynamicsError> {
+/// `A = L⁻¹ K L⁻ᵀ` for the lower-triangular `l` (`M = L Lᵀ`, as
+/// [`cholesky_factor_in_place`] leaves it: its strictly upper part is not read), by two blocked
+/// triangular solves of faer: `L⁻¹ K`, then `L⁻¹ (L⁻¹ K)ᵀ = Aᵀ`, transposed back. Similar to
+/// `M⁻¹ K` (`A = Lᵀ (M⁻¹ K) L⁻ᵀ`), symmetric if `K` is.
+pub(crate) fn mass_similar(k: &DMatrix<f64>, l: &DMatrix<f64>) -> faer::Mat<f64> {
+    use faer::{Mat, MatRef, Par};
+    let n = k.nrows();
+    let l = MatRef::from_column_major_slice(l.as_slice(), n, n);
+    let mut x = Mat::<f64>::from_fn(n, n, |i, j| k[(i, j)]);
+    faer::linalg::triangular_solve::solve_lower_triangular_in_place(l, x.as_mut(), Par::Seq);
+    let mut at = x.transpose().to_owned();
+    faer::linalg::triangular_solve::solve_lower_triangular_in_place(l, at.as_mut(), Par::Seq);
+    at.transpose().to_owned()
+}
+
+/// `L⁻ᵀ v` for every column `v` of `v` (the mode shapes in `q` of the eigenvectors of
+/// [`mass_similar`]'s `A`), `l` as there.
+fn shapes(l: &DMatrix<f64>, mut v: faer::Mat<f64>) -> faer::Mat<f64> {
+    let n = l.nrows();
+    let l = faer::MatRef::from_column_major_slice(l.as_slice(), n, n);
+    faer::linalg::triangular_solve::solve_upper_triangular_in_place(
+        l.transpose(),
+        v.as_mut(),
+        faer::Par::Seq,
+    );
+    v
+}
+
+/// The modes of the symmetric `a` ([`mass_similar`] of a symmetric `K_T`): faer's self-adjoint
+/// eigendecomposition; shapes `L⁻ᵀ v`, `M`-orthonormal.
+fn symmetric_modes(a: &faer::Mat<f64>, l: &DMatrix<f64>) -> Result<Vec<Mode>, DynamicsError> {
     let n = a.nrows();
-    let eig = faer::Mat::<f64>::from_fn(n, n, |i, j| a[(i, j)])
-        .eigen()
+    // the symmetric part, so that round-off cannot make the two triangles disagree
+    let sym = faer::Mat::<f64>::from_fn(n, n, |i, j| 0.5 * (a[(i, j)] + a[(j, i)]));
+    let eig = sym
+        .self_adjoint_eigen(faer::Side::Lower)
         .map_err(|_| DynamicsError::NonFinite {
             what: "eigendecomposition of M⁻¹K_T",
         })?;
-    let (u, s) = (eig.U(), eig.S().column_vector());
+    let phi = shapes(l, eig.U().to_owned());
+    let s = eig.S().column_vector();
     let mut modes = Vec::with_capacity(n);
     for j in 0..n {
         let w2 = s[j];
-        let col = u.col(j);
+        if !w2.is_finite() {
+            return Err(DynamicsError::NonFinite {
+                what: "eigendecomposition of M⁻¹K_T",
+            });
+        }
+        modes.push(Mode {
+            omega_squared: w2,
+            omega_squared_imag: 0.0,
+            frequency_hz: w2.max(0.0).sqrt() / (2.0 * std::f64::consts::PI),
+            shape: DVector::from_fn(n, |i, _| phi[(i, j)]),
+        });
+    }
+    Ok(modes)
+}
+
+/// The modes of the non-symmetric `a = L⁻¹ K_T L⁻ᵀ` ([`Model::linearized_modes`]): each
+/// eigenvector `u` (complex) is turned so that its largest entry is real and positive, its real
+/// part `v` normalized (`|v| = 1`, so `φ = L⁻ᵀ v` has `φᵀ M φ = 1`).
+fn non_symmetric_modes(a: &faer::Mat<f64>, l: &DMatrix<f64>) -> Result<Vec<Mode>, DynamicsError> {
+    let n = a.nrows();
+    let eig = a.eigen().map_err(|_| DynamicsError::NonFinite {
+        what: "eigendecomposition of M⁻¹K_T",
+    })?;
+    let (u, s) = (eig.U(), eig.S().column_vector());
+    let mut v = faer::Mat::<f64>::zeros(n, n);
+    for j in 0..n {
+        let (w2, col) = (s[j], u.col(j));
         let big = (0..n)
             .max_by(|&x, &y| col[x].norm().total_cmp(&col[y].norm()))
             .unwrap_or(0);
         let turn = col[big].conj() / col[big].norm();
-        let mut v = DVector::from_fn(n, |i, _| (col[i] * turn).re);
-        let norm = v.norm();
+        let norm = (0..n)
+            .map(|i| (col[i] * turn).re.powi(2))
+            .sum::<f64>()
+            .sqrt();
         if !(norm.is_finite() && norm > 0.0 && w2.re.is_finite() && w2.im.is_finite()) {
             return Err(DynamicsError::NonFinite {
                 what: "eigendecomposition of M⁻¹K_T",
             });
         }
-        v /= norm;
-        modes.push(Mode {
-            omega_squared: w2.re,
-            omega_squared_imag: w2.im,
-            frequency_hz: w2.re.max(0.0).sqrt() / (2.0 * std::f64::consts::PI),
-            shape: linv.transpose() * v,
-        });
+        for i in 0..n {
+            v[(i, j)] = (col[i] * turn).re / norm;
+        }
     }
-    modes.sort_by(|a, b| a.omega_squared.total_cmp(&b.omega_squared));
-    Ok(modes)
+    let phi = shapes(l, v);
+    Ok((0..n)
+        .map(|j| Mode {
+            omega_squared: s[j].re,
+            omega_squared_imag: s[j].im,
+            frequency_hz: s[j].re.max(0.0).sqrt() / (2.0 * std::f64::consts::PI),
+            shape: DVector::from_fn(n, |i, _| phi[(i, j)]),
+        })
+        .collect())
 }
 
 impl Energy {
@@ -113,27 +173,12 @@ impl<P: StrainParam> Model<P> {
         self.assemble_mass(ws);
         let mut l = ws.mass.clone();
         cholesky_factor_in_place(&mut l)?;
-        let l = l.lower_triangle();
-        let linv = l.try_inverse().ok_or(DynamicsError::NonFinite {
-            what: "mass factor",
-        })?;
-        if asymmetry > SYMMETRY_TOLERANCE {
-            return non_symmetric_modes(&(&linv * &k * linv.transpose()), &linv);
-        }
-        let kt = (&k + k.transpose()) * 0.5;
-        let a = &linv * kt * linv.transpose();
-        let eig = nalgebra::SymmetricEigen::new((&a + a.transpose()) * 0.5);
-        let mut modes: Vec<Mode> = eig
-            .eigenvalues
-            .iter()
-            .zip(eig.eigenvectors.column_iter())
-            .map(|(w2, v)| Mode {
-                omega_squared: *w2,
-                omega_squared_imag: 0.0,
-                frequency_hz: w2.max(0.0).sqrt() / (2.0 * std::f64::consts::PI),
-                shape: linv.transpose() * v,
-            })
-            .collect();
+        let a = mass_similar(&k, &l);
+        let mut modes = if asymmetry > SYMMETRY_TOLERANCE {
+            non_symmetric_modes(&a, &l)?
+        } else {
+            symmetric_modes(&a, &l)?
+        };
         // unstable directions (ω² < 0) first, then by frequency
         modes.sort_by(|a, b| a.omega_squared.total_cmp(&b.omega_squared));
         Ok(modes)

@@ -25,6 +25,7 @@ use thiserror::Error;
 mod analysis;
 pub(crate) mod cholesky;
 mod linearize;
+pub(crate) use analysis::mass_similar;
 pub use analysis::{Energy, Mode, SYMMETRY_TOLERANCE};
 pub use cholesky::{
     cholesky_factor_in_place, cholesky_solve_factored, cholesky_solve_in_place, CHOLESKY_BLOCK,

@@ -19,6 +19,7 @@
 //!    static equilibrium is the one a damped rod settles on or oscillates about.
 
 use crate::dynamics::cholesky::cholesky_factor_in_place;
+use crate::dynamics::mass_similar;
 use crate::model::{Model, PreparedLoads, Workspace};
 use crate::strain::StrainParam;
 use nalgebra::DMatrix;
@@ -93,22 +94,11 @@ pub fn divergent_mode<P: StrainParam>(
 /// triangular solves and eigenvalue solver: on an 1806-coordinate rod they take a few seconds
 /// where nalgebra's unblocked ones took 35 s. `None` if the eigenvalue solver fails.
 fn pencil_eigenvalues(jac: &DMatrix<f64>, m: &mut DMatrix<f64>) -> Option<Vec<faer::c64>> {
-    use faer::reborrow::ReborrowMut;
-    use faer::{Mat, MatRef, Par};
-    let n = jac.nrows();
-    let mut a = Mat::<f64>::from_fn(n, n, |i, j| -jac[(i, j)]);
-    if cholesky_factor_in_place(m).is_ok() {
-        let l = MatRef::from_column_major_slice(m.as_slice(), n, n);
-        // L⁻¹ K, then L⁻¹ (L⁻¹ K)ᵀ = L⁻¹ Kᵀ L⁻ᵀ = Aᵀ, whose eigenvalues are A's
-        faer::linalg::triangular_solve::solve_lower_triangular_in_place(l, a.as_mut(), Par::Seq);
-        let mut at = a.transpose().to_owned();
-        faer::linalg::triangular_solve::solve_lower_triangular_in_place(
-            l,
-            at.as_mut().rb_mut(),
-            Par::Seq,
-        );
-        a = at;
-    }
+    let k = -jac;
+    let a = match cholesky_factor_in_place(m) {
+        Ok(()) => mass_similar(&k, m),
+        Err(_) => faer::Mat::<f64>::from_fn(k.nrows(), k.ncols(), |i, j| k[(i, j)]),
+    };
     a.eigenvalues().ok()
 }
 
