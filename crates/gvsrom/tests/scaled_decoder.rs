@@ -145,46 +145,35 @@ fn a_spurious_straight_rod_under_load_is_refused_not_returned() {
     // vanishes (c̃ ⊥ f); the straight rod is not the full model's equilibrium there. In one
     // full-load stage (solver.min_increment = 1: no continuation, no descent) that root stands
     let poor = train("scaled-ae-40", 40);
-    let (m, c) = (
-        "loads.distributed.0.magnitude=2",
-        "loads.distributed.0.center=0.4",
-    );
-    let one_stage = "solver.min_increment=1";
+    let solve = |command: &str, solver: &[&str], needles: &[&str]| {
+        let mut args = vec![
+            command,
+            "soft-beam",
+            "--set",
+            "loads.distributed.0.magnitude=2",
+            "--set",
+            "loads.distributed.0.center=0.4",
+            "--model",
+            s(&poor),
+        ];
+        args.extend_from_slice(solver);
+        expect_error(&args, needles);
+    };
     for command in ["statics", "modes"] {
-        expect_error(
-            &[
-                command,
-                "soft-beam",
-                "--set",
-                m,
-                "--set",
-                c,
-                "--set",
-                one_stage,
-                "--model",
-                s(&poor),
-            ],
+        solve(
+            command,
+            &["--set", "solver.min_increment=1"],
             &[
                 "straight rod",
                 "not an equilibrium of the full model",
                 "spurious",
             ],
         );
-    }
-    // with the default solver that root diverges, and the reduced model released from it settles
-    // on a stable root of its own far outside its training data: refused as well
-    for command in ["statics", "modes"] {
-        expect_error(
-            &[
-                command,
-                "soft-beam",
-                "--set",
-                m,
-                "--set",
-                c,
-                "--model",
-                s(&poor),
-            ],
+        // with the default solver that root diverges, and the reduced model released from it
+        // settles on a stable root of its own far outside its training data: refused as well
+        solve(
+            command,
+            &[],
             &[
                 "outside the range of the training data",
                 "spurious",
