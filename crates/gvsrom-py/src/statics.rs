@@ -239,6 +239,9 @@ impl Statics {
 /// divergence : numpy.ndarray, shape (m,)
 ///     ``ω² < 0`` [1/s²] of a row whose equilibrium is unstable (no stable one connected to the
 ///     straight rod was found; a ``UserWarning`` names the rows), NaN for a stable one.
+/// buckled : numpy.ndarray, shape (m,)
+///     ``ω² < 0`` [1/s²] of the diverging equilibrium a row's rod was released from onto its
+///     stable one (:attr:`Statics.buckled`), NaN for a row that did not buckle.
 /// solve_time_s : numpy.ndarray, shape (m,)
 ///     Each solve's own wall-clock time [s] (the solves run in parallel).
 #[pyclass(module = "gvsrom", frozen, get_all)]
@@ -267,6 +270,8 @@ pub struct StaticsBatch {
     residual_norm: Py<PyAny>,
     /// `ω² < 0` [1/s²] of an unstable equilibrium, NaN for a stable one.
     divergence: Py<PyAny>,
+    /// `ω² < 0` [1/s²] of the equilibrium a buckled row left, NaN otherwise.
+    buckled: Py<PyAny>,
     /// Wall-clock time of the solve [s].
     solve_time_s: Py<PyAny>,
 }
@@ -318,6 +323,12 @@ impl StaticsBatch {
                 &rs.iter().map(|r| r.residual_norm).collect::<Vec<_>>(),
             ))?,
             divergence: held(vector(py, &divergence))?,
+            buckled: held(vector(
+                py,
+                &rs.iter()
+                    .map(|r| r.buckled.unwrap_or(f64::NAN))
+                    .collect::<Vec<_>>(),
+            ))?,
             solve_time_s: held(vector(
                 py,
                 &rs.iter().map(|r| r.solve_time_s).collect::<Vec<_>>(),

@@ -187,3 +187,13 @@ def test_six_tendon_pushed_on_every_tendon_buckles_onto_an_equilibrium_numpy_fin
     k_t = -robot.statics_jacobian(flat.q, u)
     w2 = np.linalg.eigvals(np.linalg.solve(robot.mass_matrix(flat.q), k_t))
     assert w2.real.min() < -1e3
+
+
+def test_a_batch_row_that_buckled_says_so_and_matches_the_single_solve():
+    robot = gvsrom.Scenario.preset("six-tendon").build()
+    U = np.array([np.zeros(6), np.full(6, 30.0)])
+    b = robot.statics_batch(U, warm_start=False)
+    assert np.isnan(b.buckled[0]) and b.buckled[1] < -1e3
+    assert np.all(np.isnan(b.divergence))
+    single = robot.statics(U[1])
+    np.testing.assert_allclose(b.tip_position[1], single.tip_position, atol=1e-9)
