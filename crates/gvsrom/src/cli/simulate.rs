@@ -287,6 +287,25 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
             )?;
         }
     }
+    if let Some(e) = &outcome.energy {
+        writeln!(
+            out,
+            "energy     conservative run (no damping, friction or work by the loads): the total energy moved from {} J by +{} / −{} J at most, {:.3} % / {:.3} % of the largest kinetic energy ({} J)",
+            gvs::error::fmt_sci(e.initial, 4),
+            gvs::error::fmt_sci(e.largest_gain, 3),
+            gvs::error::fmt_sci(e.largest_loss, 3),
+            100.0 * e.relative_gain(),
+            100.0 * e.relative_loss(),
+            gvs::error::fmt_sci(e.kinetic_max, 3),
+        )?;
+        if e.relative_gain() > gvsrom::simulate::GAIN_NOTE {
+            writeln!(
+                out,
+                "note       the integration added energy that no force supplies ({:.1} % of the largest kinetic energy): the motion is not to be trusted; tighten --rtol and --atol together, or give the rod some damping (material.damping)",
+                100.0 * e.relative_gain()
+            )?;
+        }
+    }
     for o in &outcome.model_extrapolated {
         writeln!(out, "note       {o}")?;
     }

@@ -24,11 +24,13 @@
 //! The integrator is chosen here too ([`choose_integrator`]): by the rod's damping unless named,
 //! as `gvsrom simulate` and `gvsrom reproduce` both do.
 //!
-//! Files, each using only those before it: `integrator`, `options`, `plan`, `run` (the integration
-//! loop), `centerline`, `buffer` (samples in memory), `writer` (samples to a directory).
+//! Files, each using only those before it: `integrator`, `options`, `plan`, `energy` (the energy
+//! balance of a conservative run), `run` (the integration loop), `centerline`, `buffer` (samples
+//! in memory), `writer` (samples to a directory).
 
 mod buffer;
 mod centerline;
+mod energy;
 mod integrator;
 mod options;
 mod plan;
@@ -36,6 +38,7 @@ mod run;
 mod writer;
 
 pub use buffer::*;
+pub use energy::{not_conservative, EnergyBalance, GAIN_NOTE};
 pub use integrator::*;
 pub use options::*;
 pub use plan::*;

@@ -1,6 +1,7 @@
 //! Running a plan: the integrator streams samples to a [`SampleSink`] (a trajectory directory or a
 //! buffer in memory) and ends complete, failed or interrupted ([`Outcome`]).
 
+use super::energy::{not_conservative, EnergyBalance, EnergyMonitor};
 use super::plan::*;
 use crate::build::Built;
 use crate::error::ScenarioError;
@@ -39,6 +40,10 @@ pub struct Outcome {
     /// How the run used its reduced model outside what the model was made from, found while it
     /// ran: a POD trajectory that left its training encodings (the first time).
     pub model_extrapolated: Vec<String>,
+    /// The energy balance over the samples, for a conservative run (no damping, no tendon
+    /// friction, no point or distributed loads, no load schedule, constant tensions;
+    /// [`not_conservative`]): `None` otherwise.
+    pub energy: Option<EnergyBalance>,
 }
 
 impl Outcome {
@@ -181,12 +186,24 @@ pub fn run_into(
         ControlFlow::Break(reason) => Some(reason),
         ControlFlow::Continue(()) => None,
     };
+    let mut energy = not_conservative(built, plan.schedule.is_some())
+        .is_none()
+        .then(|| match &built.reduced {
+            Some(r) => EnergyMonitor::new(&r.model),
+            None => EnergyMonitor::new(&built.model),
+        });
     let mut sink = |s: &Sample<'_>| {
         // a state no elastic rod holds (a diverged integration, a load the estimate underrated)
         // ends the run before it is written: its samples would be taken for a motion
         if let Some(msg) = non_physical_state(built, &x, s) {
             non_physical = Some(msg.clone());
             return ControlFlow::Break(msg);
+        }
+        if let Some(e) = energy.as_mut() {
+            match &built.reduced {
+                Some(r) => e.push(&r.model, &built.loads.gravity, s),
+                None => e.push(&built.model, &built.loads.gravity, s),
+            }
         }
         last_t.set(s.t);
         last_tip = Some(*s.tip);
@@ -277,7 +294,9 @@ pub fn run_into(
             error: e.to_string(),
         },
     };
+    let energy = energy.and_then(|e| e.finish(summary.samples));
     Ok(Outcome {
+        energy,
         wall_times_s: vec![summary.wall_time_s],
         summary,
         ending,

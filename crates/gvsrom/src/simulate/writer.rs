@@ -354,6 +354,7 @@ impl TrajectoryWriter {
                 .collect(),
             centerline_x: shape.x,
             tendon_rest_lengths: built.model.tendon_rest_lengths(),
+            energy_balance: outcome.energy,
             provenance,
         };
         dir.commit(meta)
@@ -408,6 +409,9 @@ pub(super) struct Meta<'a> {
     /// Each tendon's length at rest \[m\], what `tendon_lengths.npy` is shortened from.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     tendon_rest_lengths: Vec<f64>,
+    /// The total energy over the samples of a conservative run ([`super::EnergyBalance`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    energy_balance: Option<super::EnergyBalance>,
     /// How the run was made ([`crate::provenance::Provenance`]), when the caller recorded it.
     #[serde(skip_serializing_if = "Option::is_none")]
     provenance: Option<serde_json::Value>,

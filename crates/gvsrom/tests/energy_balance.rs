@@ -1,0 +1,143 @@
+//! The energy balance `gvsrom simulate` reports for a conservative run (undamped, frictionless,
+//! no work by the loads, constant tensions): `E = T + U_e + U_g − Σ u ℓ` is conserved by the
+//! motion, so an integration that resolves it keeps it within a small fraction of the largest
+//! kinetic energy; a damped run gets no balance.
+
+mod common;
+
+use common::{gvsrom, json, scratch};
+use std::path::PathBuf;
+
+/// A 0.5 m undamped cantilever, planar, 4 quadratic elements (27 DOF), with `extra` appended.
+fn scenario(name: &str, extra: &str) -> PathBuf {
+    let path = scratch(&format!("{name}.toml"));
+    let text = format!(
+        r#"
+name = "{name}"
+[material]
+youngs_modulus = 1e6
+poisson_ratio = 0.5
+density = 1000.0
+damping = 0.0
+[[divisions]]
+length = 0.5
+radius = 0.01
+basis = {{ kind = "fem", modes = ["bend_y", "elongation", "shear_z"], elements = 4, degree = "quadratic" }}
+quadrature = {{ gauss_per_element = 3, elements = 4 }}
+{extra}
+"#
+    );
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// Runs `simulate SCENARIO ARGS --out DIR`, expects success; stdout and `meta.json`.
+fn simulate(scenario: &PathBuf, name: &str, args: &[&str]) -> (String, serde_json::Value) {
+    let out = scratch(name);
+    let _ = std::fs::remove_dir_all(&out);
+    let mut all = vec!["simulate", scenario.to_str().unwrap()];
+    all.extend_from_slice(args);
+    all.extend(["--out", out.to_str().unwrap()]);
+    let run = gvsrom(&all);
+    let stdout = String::from_utf8_lossy(&run.stdout).to_string();
+    assert!(
+        run.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    (stdout, json(&out.join("meta.json")))
+}
+
+/// The balance of `meta`: (initial, largest gain, largest loss, largest kinetic energy).
+fn balance(meta: &serde_json::Value) -> (f64, f64, f64, f64) {
+    let b = &meta["energy_balance"];
+    let f = |k: &str| {
+        b[k].as_f64()
+            .unwrap_or_else(|| panic!("energy_balance.{k} in {meta}"))
+    };
+    (
+        f("initial"),
+        f("largest_gain"),
+        f("largest_loss"),
+        f("kinetic_max"),
+    )
+}
+
+#[test]
+fn an_undamped_rod_falling_under_gravity_keeps_its_energy_at_a_tight_tolerance() {
+    let s = scenario("falling", "[loads]\ngravity = [0.0, 0.0, -9.81]\n");
+    let (stdout, meta) = simulate(
+        &s,
+        "falling",
+        &[
+            "--duration",
+            "0.4",
+            "--sample-rate",
+            "50",
+            "--rtol",
+            "1e-6",
+            "--atol",
+            "1e-9",
+        ],
+    );
+    let (initial, gain, loss, kinetic) = balance(&meta);
+    // the straight rod at rest along x, gravity along z: T = U_e = U_g = 0
+    assert!(initial.abs() < 1e-12, "{initial}");
+    // it falls: of the most it can release (ρ A g L²/2 = 0.385 J) a good part is motion by 0.4 s
+    assert!(kinetic > 0.05, "{kinetic}");
+    assert!(gain < 0.01 * kinetic && loss < 0.01 * kinetic, "{gain} {loss} {kinetic}");
+    assert!(
+        stdout.contains("energy     conservative run") && !stdout.contains("added energy"),
+        "{stdout}"
+    );
+}
+
+#[test]
+fn an_undamped_rod_under_a_constant_tendon_tension_keeps_its_energy_with_the_tendons_potential() {
+    // released straight, the rod swings about the arc the tendon bends it to; without the tendon's
+    // potential −u ℓ in E the balance would swing by 2 u Δℓ, as much as the kinetic energy
+    let s = scenario(
+        "tendon",
+        "[loads]\ngravity = [0.0, 0.0, 0.0]\n[[tendons]]\noffset_start = [0.0, 0.005]\noffset_end = [0.0, 0.005]\ntension = -0.05\n",
+    );
+    let (stdout, meta) = simulate(
+        &s,
+        "tendon",
+        &[
+            "--duration",
+            "1",
+            "--sample-rate",
+            "50",
+            "--rtol",
+            "1e-6",
+            "--atol",
+            "1e-9",
+        ],
+    );
+    let (initial, gain, loss, kinetic) = balance(&meta);
+    assert!(kinetic > 1e-6, "{kinetic}");
+    assert!(
+        gain < 0.01 * kinetic && loss < 0.01 * kinetic,
+        "E0 {initial}, +{gain} / −{loss} against T {kinetic}"
+    );
+    assert!(stdout.contains("energy     conservative run"), "{stdout}");
+}
+
+#[test]
+fn a_damped_run_has_no_energy_balance() {
+    let s = scenario("damped", "[loads]\ngravity = [0.0, 0.0, -9.81]\n");
+    let (stdout, meta) = simulate(
+        &s,
+        "damped",
+        &[
+            "--duration",
+            "0.1",
+            "--sample-rate",
+            "50",
+            "--set",
+            "material.damping=100",
+        ],
+    );
+    assert!(meta.get("energy_balance").is_none(), "{meta}");
+    assert!(!stdout.contains("energy     "), "{stdout}");
+}
