@@ -85,7 +85,10 @@ fn an_undamped_rod_falling_under_gravity_keeps_its_energy_at_a_tight_tolerance()
     assert!(initial.abs() < 1e-12, "{initial}");
     // it falls: of the most it can release (ρ A g L²/2 = 0.385 J) a good part is motion by 0.4 s
     assert!(kinetic > 0.05, "{kinetic}");
-    assert!(gain < 0.01 * kinetic && loss < 0.01 * kinetic, "{gain} {loss} {kinetic}");
+    assert!(
+        gain < 0.01 * kinetic && loss < 0.01 * kinetic,
+        "{gain} {loss} {kinetic}"
+    );
     assert!(
         stdout.contains("energy     conservative run") && !stdout.contains("added energy"),
         "{stdout}"
