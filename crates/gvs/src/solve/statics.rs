@@ -391,6 +391,9 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                             first.residual_evaluations = total.residual_evaluations;
                             first.jacobian_evaluations = total.jacobian_evaluations;
                             first.load_stages = total.load_stages;
+                            // the continuation ran (to λ = 1) after this equilibrium diverged
+                            first.continuation = total.continuation.clone();
+                            first.unstable_start = total.unstable_start;
                             first.divergence = self.divergence(&first.q, u, loads)?;
                             if first.divergence.is_some() {
                                 let at = first.q.clone();
@@ -486,6 +489,7 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                 u,
                 &prepared,
                 0.5 / w2.abs(),
+                eps,
                 self.options.ftol,
                 stop,
             )?;
@@ -499,7 +503,9 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                     total.iterations += rep.iterations;
                     total.residual_evaluations += rep.residual_evaluations;
                     total.jacobian_evaluations += rep.jacobian_evaluations;
-                    if self.divergence_screened(&rep.x, u, loads)?.is_none() {
+                    // the exact test: the dogleg's Jacobian, if the polish took no step, is
+                    // an earlier solve's at another point
+                    if self.divergence(&rep.x, u, loads)?.is_none() {
                         total.buckled = Some(w2);
                         total.divergence = None;
                         total.residual_norm = rep.residual_norm;

@@ -31,6 +31,14 @@ pub(super) const MAX_STEPS: usize = 200;
 /// nonlinear region can land anywhere (measured on the six-tendon arm pushed at 30 N: 20 steps at
 /// 0.5, where an uncapped first step leaves the range of an elastic rod).
 const STEP_CAP: f64 = 0.5;
+/// Largest growth of `‖δ‖∞` from one step to the next: the motion away from a saddle grows
+/// geometrically, and a step far longer than the last one is a jump, not that motion.
+const STEP_GROWTH: f64 = 4.0;
+/// The margin of the step rule: `sym(M/(MARGIN Δτ) + K_T)` must be positive definite, not merely
+/// `sym(M/Δτ + K_T)`, whose factorization passes pivots within round-off of zero. Without it
+/// the second step from a saddle (`Δτ = 1/|ω²|` after one doubling) was taken with a singular
+/// matrix and jumped as far as the cap allowed (a review, 2026-12-06).
+const MARGIN: f64 = 2.0;
 /// Halvings of `Δτ` (to make `M/Δτ + K_T` positive definite, or after a non-finite residual)
 /// allowed in one step before the descent gives up.
 const MAX_HALVINGS: usize = 60;
@@ -45,8 +53,10 @@ pub(super) struct DescentStats {
 
 /// Descends from `start` along `M q̇ = R(q)` (tensions `u`, `loads`) until
 /// `‖R‖∞ ≤ ftol · scale` (the dogleg's test, `scale = ws.residual_scale`): `Ok((Some(q), stats))`
-/// there, `Ok((None, stats))` if it did not within [`MAX_STEPS`]. `tau` is the first pseudo-time
-/// step, `~ 1/|ω²|` of the divergence left. Whether the end is stable is the caller's to check.
+/// there, `Ok((None, stats))` if it did not within [`MAX_STEPS`] or ended where the rod is turned
+/// inside out (a stretch `ν ≤ 0` at a point: no state of a rod). `tau` is the first pseudo-time
+/// step, `~ 1/|ω²|` of the divergence left; `first_step` the size of the displacement that
+/// started it, the scale of the first step. Whether the end is stable is the caller's to check.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn descend<P: StrainParam>(
     model: &Model<P>,
@@ -55,6 +65,7 @@ pub(super) fn descend<P: StrainParam>(
     u: &[f64],
     loads: &PreparedLoads,
     mut tau: f64,
+    first_step: f64,
     ftol: f64,
     stop: &StopCheck<'_>,
 ) -> Result<(Option<DVector<f64>>, DescentStats), StaticsError> {
@@ -70,9 +81,15 @@ pub(super) fn descend<P: StrainParam>(
     if !r.iter().all(|v| v.is_finite()) {
         return Ok((None, stats));
     }
-    while stats.steps < MAX_STEPS {
+    let mut last_step = first_step;
+    loop {
         if r.amax() <= ftol * ws.residual_scale {
-            return Ok((Some(q), stats));
+            // an equilibrium; one with a stretch ν ≤ 0 somewhere is no state of a rod
+            let inside_out = model.strains_at(&q, ws).iter().any(|xi| !(xi[3] > 0.0));
+            return Ok((if inside_out { None } else { Some(q) }, stats));
+        }
+        if stats.steps >= MAX_STEPS {
+            return Ok((None, stats));
         }
         if let Some(reason) = stop() {
             return Err(StaticsError::Stopped {
@@ -85,9 +102,10 @@ pub(super) fn descend<P: StrainParam>(
         let mass = model.mass_matrix(&q, ws);
         let mut accepted = false;
         for _ in 0..MAX_HALVINGS {
-            // A = M/Δτ + K_T = M/Δτ − ∂R/∂q
+            // A = M/Δτ + K_T = M/Δτ − ∂R/∂q, with sym(M/(2Δτ) + K_T) positive definite
             let a = &mass / tau - &jac;
-            let mut sym = (&a + a.transpose()) * 0.5;
+            let mut sym =
+                (&mass / (MARGIN * tau) - &jac) + (&mass / (MARGIN * tau) - &jac).transpose();
             if !positive_definite(&mut sym) {
                 tau *= 0.5;
                 continue;
@@ -96,7 +114,7 @@ pub(super) fn descend<P: StrainParam>(
                 tau *= 0.5;
                 continue;
             };
-            let cap = STEP_CAP * q.amax().max(1.0);
+            let cap = (STEP_CAP * q.amax().max(1.0)).min(STEP_GROWTH * last_step);
             let size = delta.amax();
             if size > cap {
                 delta *= cap / size;
@@ -114,10 +132,10 @@ pub(super) fn descend<P: StrainParam>(
         if !accepted {
             return Ok((None, stats));
         }
+        last_step = (&trial - &q).amax();
         std::mem::swap(&mut q, &mut trial);
         std::mem::swap(&mut r, &mut r_trial);
         stats.steps += 1;
         tau *= 2.0;
     }
-    Ok((None, stats))
 }
