@@ -244,4 +244,42 @@ fn becks_column_under_a_follower_force_flutters_above_20_05_ei_over_l2() {
     // above it: a complex pair
     let (_, i22) = lowest(22.0 * ei / (l * l));
     assert!(i22 != 0.0, "P = 22 EI/L²: no complex ω²");
+    // whose two shapes (the real and imaginary parts of its eigenvector, each with φᵀMφ = 1)
+    // differ and span a plane that M⁻¹K_T maps into itself: the plane of the flutter motion
+    let loads = follower(22.0 * ei / (l * l));
+    let sol = solve_statics(&m, &[], &loads, None, &StaticsOptions::default()).unwrap();
+    let prepared = m.prepare_loads(&loads).unwrap();
+    let mut ws = m.workspace();
+    let modes = m.linearized_modes(&sol.q, &[], &prepared, &mut ws).unwrap();
+    let (a, b) = (&modes[0].shape, &modes[1].shape);
+    assert_eq!(modes[0].omega_squared_imag, -modes[1].omega_squared_imag);
+    let n = m.n_dof();
+    let mut jac = nalgebra::DMatrix::zeros(n, n);
+    m.statics_jacobian(&sol.q, &[], &prepared, &mut ws, &mut jac);
+    let mass = m.mass_matrix(&sol.q, &mut ws);
+    for phi in [a, b] {
+        assert!((phi.dot(&(&mass * phi)) - 1.0).abs() < 1e-8);
+    }
+    let basis = nalgebra::DMatrix::from_columns(&[a.clone(), b.clone()]);
+    let gram = basis.transpose() * &basis;
+    assert!(
+        gram.determinant() > 1e-6 * gram[(0, 0)] * gram[(1, 1)],
+        "the pair's shapes are parallel"
+    );
+    for phi in [a, b] {
+        let image = mass.clone().lu().solve(&(-&jac * phi)).unwrap(); // M⁻¹ K_T φ
+        let coef = gram
+            .clone()
+            .lu()
+            .solve(&(basis.transpose() * &image))
+            .unwrap();
+        let rest = &image - &basis * coef;
+        // (the pair is near its flutter onset, where its two vectors merge: ill-conditioned)
+        assert!(
+            rest.norm() < 1e-4 * image.norm(),
+            "{} of {}",
+            rest.norm(),
+            image.norm()
+        );
+    }
 }

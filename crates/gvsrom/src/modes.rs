@@ -179,9 +179,12 @@ fn modes_on<P: StrainParam>(
 
     // Take whole clusters of equal ω², so that the alignment sees every partner.
     let lam_max = lam.iter().fold(0.0, |a: f64, b| a.max(b.abs()));
-    let same = |a: f64, b: f64| (a - b).abs() <= 1e-7 * a.abs().max(b.abs()) + 1e-11 * lam_max;
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-7 * a.abs().max(b.abs()) + 1e-11 * lam_max;
+    // equal ω², imaginary parts included: the members of a complex pair (conjugates) are not a
+    // cluster of equal frequencies, and mixing their shapes would zero one of them
+    let same = |a: usize, b: usize| close(lam[a], lam[b]) && close(lam_imag[a], lam_imag[b]);
     let mut taken = count;
-    while taken < raw.len() && same(lam[taken - 1], lam[taken]) {
+    while taken < raw.len() && same(taken - 1, taken) {
         taken += 1;
     }
     let mut shapes: Vec<DVector<f64>> = raw[..taken].iter().map(|m| m.2.clone()).collect();
@@ -194,7 +197,7 @@ fn modes_on<P: StrainParam>(
     let mut start = 0;
     while start < taken {
         let mut end = start + 1;
-        while end < taken && same(lam[end - 1], lam[end]) {
+        while end < taken && same(end - 1, end) {
             end += 1;
         }
         if end - start > 1 {

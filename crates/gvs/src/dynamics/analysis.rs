@@ -98,7 +98,8 @@ fn symmetric_modes(a: &faer::Mat<f64>, l: &DMatrix<f64>) -> Result<Vec<Mode>, Dy
 
 /// The modes of the non-symmetric `a = L⁻¹ K_T L⁻ᵀ` ([`Model::linearized_modes`]): each
 /// eigenvector `u` (complex) is turned so that its largest entry is real and positive, its real
-/// part `v` normalized (`|v| = 1`, so `φ = L⁻ᵀ v` has `φᵀ M φ = 1`).
+/// part `v` (its imaginary part for the member of a complex pair with `Im ω² < 0`) normalized
+/// (`|v| = 1`, so `φ = L⁻ᵀ v` has `φᵀ M φ = 1`).
 fn non_symmetric_modes(a: &faer::Mat<f64>, l: &DMatrix<f64>) -> Result<Vec<Mode>, DynamicsError> {
     let n = a.nrows();
     let eig = a.eigen().map_err(|_| DynamicsError::NonFinite {
@@ -112,8 +113,15 @@ fn non_symmetric_modes(a: &faer::Mat<f64>, l: &DMatrix<f64>) -> Result<Vec<Mode>
             .max_by(|&x, &y| col[x].norm().total_cmp(&col[y].norm()))
             .unwrap_or(0);
         let turn = col[big].conj() / col[big].norm();
+        // the two members of a complex pair have conjugate vectors, whose turned real parts are
+        // equal: the second (Im ω² < 0) takes the imaginary part, so that the pair spans the
+        // plane of its motion
+        let part = |z: faer::c64| match w2.im < 0.0 {
+            true => z.im,
+            false => z.re,
+        };
         let norm = (0..n)
-            .map(|i| (col[i] * turn).re.powi(2))
+            .map(|i| part(col[i] * turn).powi(2))
             .sum::<f64>()
             .sqrt();
         if !(norm.is_finite() && norm > 0.0 && w2.re.is_finite() && w2.im.is_finite()) {
@@ -122,7 +130,7 @@ fn non_symmetric_modes(a: &faer::Mat<f64>, l: &DMatrix<f64>) -> Result<Vec<Mode>
             });
         }
         for i in 0..n {
-            v[(i, j)] = (col[i] * turn).re / norm;
+            v[(i, j)] = part(col[i] * turn) / norm;
         }
     }
     let phi = shapes(l, v);
