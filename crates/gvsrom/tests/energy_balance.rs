@@ -6,7 +6,7 @@
 mod common;
 
 use common::{gvsrom, json, scratch};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// A 0.5 m undamped cantilever, planar, 4 quadratic elements (27 DOF), with `extra` appended.
 fn scenario(name: &str, extra: &str) -> PathBuf {
@@ -32,7 +32,7 @@ quadrature = {{ gauss_per_element = 3, elements = 4 }}
 }
 
 /// Runs `simulate SCENARIO ARGS --out DIR`, expects success; stdout and `meta.json`.
-fn simulate(scenario: &PathBuf, name: &str, args: &[&str]) -> (String, serde_json::Value) {
+fn simulate(scenario: &Path, name: &str, args: &[&str]) -> (String, serde_json::Value) {
     let out = scratch(name);
     let _ = std::fs::remove_dir_all(&out);
     let mut all = vec!["simulate", scenario.to_str().unwrap()];

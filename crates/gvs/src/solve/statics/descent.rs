@@ -85,7 +85,8 @@ pub(super) fn descend<P: StrainParam>(
     loop {
         if r.amax() <= ftol * ws.residual_scale {
             // an equilibrium; one with a stretch ν ≤ 0 somewhere is no state of a rod
-            let inside_out = model.strains_at(&q, ws).iter().any(|xi| !(xi[3] > 0.0));
+            let inside_out =
+                (model.strains_at(&q, ws).iter()).any(|xi| xi[3].is_nan() || xi[3] <= 0.0);
             return Ok((if inside_out { None } else { Some(q) }, stats));
         }
         if stats.steps >= MAX_STEPS {
