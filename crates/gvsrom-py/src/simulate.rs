@@ -30,6 +30,8 @@ pub struct Args<'a> {
     pub atol: Option<f64>,
     /// A fixed step \[s\]: the fixed-step BDF2 instead of an adaptive method (`--fixed-step`).
     pub fixed_step: Option<f64>,
+    /// A CSV file `t, λ` scaling the loads and gravity over time (`--load-schedule`).
+    pub load_schedule: Option<std::path::PathBuf>,
 }
 
 #[pymethods]
@@ -68,6 +70,10 @@ impl Robot {
     /// fixed_step : float, optional
     ///     A fixed step [s]: the fixed-step BDF2 (``--fixed-step``) instead of an adaptive method;
     ///     its cost is set by the number of steps, its accuracy by the step (not checked).
+    /// load_schedule : str or os.PathLike, optional
+    ///     A CSV file of rows ``t, λ`` scaling every external load and gravity over time (linear
+    ///     between rows; ``--load-schedule``), e.g. a release: ``from_equilibrium=True`` with
+    ///     ``0,0``.
     ///
     /// Returns
     /// -------
@@ -80,13 +86,17 @@ impl Robot {
     ///     ``failed_steps``, ``wall_time_s``, and
     ///     ``model_extrapolated`` (list of str): how the reduced model was used outside what it
     ///     was trained on (``extrapolate=True``; the scenario, a signal's tensions, the values a
-    ///     callable ``input`` returned), empty otherwise.
+    ///     callable ``input`` returned), empty otherwise; for a conservative run (no damping,
+    ///     tendon friction, loads or schedule; constant tensions) ``energy_balance``, a dict of
+    ///     ``initial``, ``last``, ``largest_gain``, ``largest_loss``, ``kinetic_max`` [J] of
+    ///     ``T + U_e + U_g − Σ u ℓ`` over the samples, with a ``UserWarning`` when it rose by more
+    ///     than 1 % of the largest kinetic energy (the integration added energy).
     ///
     /// Raises
     /// ------
     /// GvsromError
     ///     For bad options or input, or an integrator failure (with the samples computed).
-    #[pyo3(signature = (duration, sample_rate=100.0, input=None, interpolate=false, from_equilibrium=false, q0=None, qd0=None, method="auto", rtol=None, atol=None, fixed_step=None))]
+    #[pyo3(signature = (duration, sample_rate=100.0, input=None, interpolate=false, from_equilibrium=false, q0=None, qd0=None, method="auto", rtol=None, atol=None, fixed_step=None, load_schedule=None))]
     #[allow(clippy::too_many_arguments)]
     fn simulate<'py>(
         &self,
@@ -102,6 +112,7 @@ impl Robot {
         rtol: Option<f64>,
         atol: Option<f64>,
         fixed_step: Option<f64>,
+        load_schedule: Option<std::path::PathBuf>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let args = Args {
             duration,
@@ -115,6 +126,7 @@ impl Robot {
             rtol,
             atol,
             fixed_step,
+            load_schedule,
         };
         run(self, py, args)
     }
@@ -432,7 +444,7 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
             sample_rate: a.sample_rate,
             input,
             start,
-            load_schedule: None,
+            load_schedule: a.load_schedule.clone(),
             integrator: choice,
         },
     )
@@ -504,6 +516,24 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
     }
     let d = trajectory(py, built, &buffer, &outcome)?;
     d.set_item("model_extrapolated", extrapolated)?;
+    if let Some(e) = &outcome.energy {
+        let b = PyDict::new(py);
+        b.set_item("initial", e.initial)?;
+        b.set_item("last", e.last)?;
+        b.set_item("largest_gain", e.largest_gain)?;
+        b.set_item("largest_loss", e.largest_loss)?;
+        b.set_item("kinetic_max", e.kinetic_max)?;
+        d.set_item("energy_balance", b)?;
+        if e.relative_gain() > simulate::GAIN_NOTE {
+            warn(
+                py,
+                &format!(
+                    "the integration added energy that no force supplies ({:.1} % of the largest kinetic energy): the motion is not to be trusted; tighten rtol and atol together, or give the rod some damping (material.damping)",
+                    100.0 * e.relative_gain()
+                ),
+            )?;
+        }
+    }
     Ok(d)
 }
 

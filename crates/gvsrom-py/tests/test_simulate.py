@@ -61,3 +61,47 @@ def test_ctrl_c_interrupts_a_long_simulation(sigint_raises):
     with pytest.raises(KeyboardInterrupt):
         robot.simulate(1000.0, sample_rate=1, input=rows)
     assert time.monotonic() - t0 < 30
+
+
+EXAMPLES = os.path.join(os.path.dirname(__file__), "..", "..", "..", "examples")
+
+
+def test_a_load_schedule_release_equals_the_cli(gvsrom_bin, tmp_path):
+    # the release of examples/undamped-release.toml: held at its tip-loaded equilibrium, the load
+    # dropped to zero at t = 0 by the schedule
+    scenario = os.path.join(EXAMPLES, "undamped-release.toml")
+    schedule = os.path.join(EXAMPLES, "release-zero.csv")
+    out = tmp_path / "release"
+    p = run_cli(gvsrom_bin, "simulate", scenario, "--duration", "0.05", "--sample-rate", "200",
+                "--from-equilibrium", "--load-schedule", schedule, "--out", str(out))
+    assert p.returncode == 0, p.stderr
+    robot = gvsrom.Scenario.from_toml(scenario).build()
+    tr = robot.simulate(0.05, sample_rate=200, from_equilibrium=True, load_schedule=schedule)
+    for name in ["t", "q", "qd", "tip_position"]:
+        np.testing.assert_allclose(tr[name], np.load(out / f"{name}.npy"), rtol=0, atol=1e-12,
+                                   err_msg=name)
+    # it moves: the tip rises from its loaded deflection once the load is gone
+    assert tr["tip_position"][-1, 2] > tr["tip_position"][0, 2] + 1e-4
+    # a schedule does work: no energy balance
+    assert "energy_balance" not in tr
+    with pytest.raises(gvsrom.GvsromError, match="load_schedule|load-schedule|cannot read"):
+        robot.simulate(0.05, from_equilibrium=True, load_schedule=str(tmp_path / "missing.csv"))
+
+
+def test_a_conservative_run_reports_its_energy_balance():
+    # the undamped rod of the example without its tip force, falling under gravity
+    robot = (gvsrom.Scenario.from_toml(os.path.join(EXAMPLES, "undamped-release.toml"))
+             .set("loads.point.0.force", [0.0, 0.0, 0.0])
+             .set("loads.gravity", [0.0, 0.0, -9.81])
+             .set("divisions.0.basis.elements", 4)
+             .set("divisions.0.quadrature.elements", 4)
+             .build())
+    tr = robot.simulate(0.3, sample_rate=50, rtol=1e-6, atol=1e-9)
+    b = tr["energy_balance"]
+    assert b["kinetic_max"] > 0.01
+    assert b["largest_gain"] < 0.01 * b["kinetic_max"] and b["largest_loss"] < 0.01 * b["kinetic_max"]
+    # E at the last sample, from the energies Robot.energy gives, the tendon-free rod's total
+    e = robot.energy(tr["q"][-1], tr["qd"][-1])
+    assert abs(e["total"] - b["last"]) < 1e-12 * max(1.0, abs(b["last"])) + 1e-12
+    # a damped preset: none
+    assert "energy_balance" not in gvsrom.Scenario.preset("single-tendon").build().simulate(0.01)

@@ -408,4 +408,5 @@ class Robot:
         rtol: float | None = None,
         atol: float | None = None,
         fixed_step: float | None = None,
+        load_schedule: _Path | None = None,
     ) -> dict[str, Any]: ...
