@@ -32,6 +32,12 @@ pub struct Args<'a> {
     pub fixed_step: Option<f64>,
     /// A CSV file `t, λ` scaling the loads and gravity over time (`--load-schedule`).
     pub load_schedule: Option<std::path::PathBuf>,
+    /// Random steps `lo, hi, period` (`--steps`).
+    pub steps: Option<Vec<f64>>,
+    /// Actuator babbling `lo, hi, hold_min, hold_max` (`--babble`).
+    pub babble: Option<Vec<f64>>,
+    /// Seed of `steps` and `babble` (`--seed`).
+    pub seed: u64,
 }
 
 #[pymethods]
@@ -74,6 +80,14 @@ impl Robot {
     ///     A CSV file of rows ``t, λ`` scaling every external load and gravity over time (linear
     ///     between rows; ``--load-schedule``), e.g. a release: ``from_equilibrium=True`` with
     ///     ``0,0``.
+    /// steps : sequence of 3 floats, optional
+    ///     ``(lo, hi, period)``: new uniform random tensions in ``[lo, hi]`` [N] on every tendon
+    ///     every ``period`` seconds (``--steps``; the paper's IV-C2 test input).
+    /// babble : sequence of 4 floats, optional
+    ///     ``(lo, hi, hold_min, hold_max)``: each tendon holds a uniform random tension in
+    ///     ``[lo, hi]`` for a uniform random time in ``[hold_min, hold_max]`` (``--babble``).
+    /// seed : int
+    ///     Seed of ``steps`` and ``babble`` (same seed, same signal as the command line's).
     ///
     /// Returns
     /// -------
@@ -96,7 +110,7 @@ impl Robot {
     /// ------
     /// GvsromError
     ///     For bad options or input, or an integrator failure (with the samples computed).
-    #[pyo3(signature = (duration, sample_rate=100.0, input=None, interpolate=false, from_equilibrium=false, q0=None, qd0=None, method="auto", rtol=None, atol=None, fixed_step=None, load_schedule=None))]
+    #[pyo3(signature = (duration, sample_rate=100.0, input=None, interpolate=false, from_equilibrium=false, q0=None, qd0=None, method="auto", rtol=None, atol=None, fixed_step=None, load_schedule=None, steps=None, babble=None, seed=0))]
     #[allow(clippy::too_many_arguments)]
     fn simulate<'py>(
         &self,
@@ -113,6 +127,9 @@ impl Robot {
         atol: Option<f64>,
         fixed_step: Option<f64>,
         load_schedule: Option<std::path::PathBuf>,
+        steps: Option<Vec<f64>>,
+        babble: Option<Vec<f64>>,
+        seed: u64,
     ) -> PyResult<Bound<'py, PyDict>> {
         let args = Args {
             duration,
@@ -127,6 +144,9 @@ impl Robot {
             atol,
             fixed_step,
             load_schedule,
+            steps,
+            babble,
+            seed,
         };
         run(self, py, args)
     }
@@ -402,7 +422,17 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
             "`interpolate` applies to an `input` of rows: give one (without it the tensions are constant)",
         ));
     }
+    let random = a.steps.is_some() || a.babble.is_some();
+    if random && a.input.is_some() {
+        return Err(invalid(
+            "`input`, `steps` and `babble` each give the tensions: give at most one",
+        ));
+    }
     let input = match (&a.input, &callable) {
+        (None, _) if random => {
+            InputSource::from_options(None, false, a.steps.as_deref(), a.babble.as_deref(), a.seed)
+                .map_err(err)?
+        }
         (None, _) => InputSource::Constant,
         (Some(_), Some(c)) => InputSource::Function(InputFunction(c.clone())),
         (Some(obj), None) => {
@@ -427,6 +457,7 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
     // a reduced model checks a signal's tensions, not the scenario's (`simulate --model`)
     // (from an equilibrium, the scenario's tensions are the start's: checked as attached)
     let built = match a.input {
+        _ if random && !a.from_equilibrium => robot.built_for_signal(py)?,
         Some(_) if !a.from_equilibrium => robot.built_for_signal(py)?,
         _ => &robot.built,
     };

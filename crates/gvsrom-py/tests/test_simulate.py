@@ -105,3 +105,23 @@ def test_a_conservative_run_reports_its_energy_balance():
     assert abs(e["total"] - b["last"]) < 1e-12 * max(1.0, abs(b["last"])) + 1e-12
     # a damped preset: none
     assert "energy_balance" not in gvsrom.Scenario.preset("single-tendon").build().simulate(0.01)
+
+
+def test_random_steps_and_babbling_equal_the_cli(gvsrom_bin, tmp_path):
+    robot = gvsrom.Scenario.preset("six-tendon").build()
+    for option, values in [("--steps", [-15.0, 0.0, 0.1]), ("--babble", [-15.0, 0.0, 0.05, 0.1])]:
+        out = tmp_path / option.strip("-")
+        p = run_cli(gvsrom_bin, "simulate", "six-tendon", "--duration", "0.3", "--sample-rate", "100",
+                    f"{option}={','.join(map(str, values))}", "--seed", "3", "--out", str(out))
+        assert p.returncode == 0, p.stderr
+        tr = robot.simulate(0.3, **{option.strip("-"): values}, seed=3)
+        for name in ["t", "u", "q", "tip_position"]:
+            np.testing.assert_allclose(tr[name], np.load(out / f"{name}.npy"), rtol=0, atol=1e-12,
+                                       err_msg=f"{option} {name}")
+        # the tensions change within the run, inside [lo, hi]
+        assert len(np.unique(tr["u"][:, 0])) > 1
+        assert tr["u"].min() >= -15.0 and tr["u"].max() <= 0.0
+    with pytest.raises(gvsrom.GvsromError, match="at most one"):
+        robot.simulate(0.1, input=np.zeros((1, 7)), steps=[-1.0, 0.0, 0.1])
+    with pytest.raises(gvsrom.GvsromError, match="steps"):
+        robot.simulate(0.1, steps=[-1.0, 0.0])

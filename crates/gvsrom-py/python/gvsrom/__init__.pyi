@@ -409,4 +409,7 @@ class Robot:
         atol: float | None = None,
         fixed_step: float | None = None,
         load_schedule: _Path | None = None,
+        steps: Sequence[float] | None = None,
+        babble: Sequence[float] | None = None,
+        seed: int = 0,
     ) -> dict[str, Any]: ...
