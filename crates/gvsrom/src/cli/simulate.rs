@@ -61,7 +61,10 @@ pub struct SimulateArgs {
     pub from_equilibrium: bool,
 
     /// Relative tolerance of the adaptive integrator, in [1e-12, 1). Default 1e-3 (ode15s), or
-    /// 1e-4 when the automatic method is SDIRK4 for a lightly damped rod (see `--method`).
+    /// 1e-4 when the automatic method is SDIRK4 for a lightly damped rod (see `--method`). The
+    /// error test is `|e| ≤ atol + rtol |y|`: below about `atol / |y|` the absolute part decides,
+    /// so to tighten a run lower `--atol` with it (an undamped release: rtol 1e-6 and 1e-8 gave the
+    /// same energy drift at the default atol, 1e-8 with atol 1e-12 a 40× smaller one)
     #[arg(long, allow_hyphen_values = true)]
     pub rtol: Option<f64>,
 
