@@ -742,3 +742,28 @@ fn options_that_would_be_ignored_are_refused_naming_them() {
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
+
+/// A signal whose tensions lie far beyond the rod's elastic range is refused naming the signal,
+/// the tension and the first time it reaches it, not the scenario's `tendons[k].tension`.
+#[test]
+fn a_signal_beyond_the_elastic_range_is_refused_naming_the_file_the_tension_and_the_time() {
+    let csv = scratch("beyond.csv");
+    std::fs::write(&csv, "t,u\n0,-1\n0.5,-1e9\n1,-1e9\n").unwrap();
+    let e = expect_error(
+        &[
+            "simulate",
+            "single-tendon",
+            "--duration",
+            "0.1",
+            "--input",
+            csv.to_str().unwrap(),
+        ],
+        &[
+            "invalid `--input`",
+            "beyond.csv",
+            "u[0] = -1000000000 N at t = 0.5 s",
+            "elastic range",
+        ],
+    );
+    assert!(!e.contains("t = 1 s"), "{e}");
+}

@@ -227,7 +227,33 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
         .as_ref()
         .map(|s| crate::csv_input::max_abs_per_column(s)[0])
         .unwrap_or(1.0);
-    crate::plausibility::check(built, &u_max, lambda_max)?;
+    crate::plausibility::check(built, &u_max, lambda_max).map_err(|e| {
+        // a signal's tensions: name the signal and when it reaches the largest of them (the
+        // scenario's `tendons[k].tension` was not what was given)
+        let option = match &opts.input {
+            InputSource::Csv { .. } => "--input",
+            InputSource::Steps { .. } => "--steps",
+            InputSource::Babble { .. } => "--babble",
+            InputSource::Rows(_) => "input",
+            InputSource::Constant | InputSource::Function(_) => return e,
+        };
+        let largest = (signal.times.iter().zip(&signal.values))
+            .flat_map(|(t, v)| v.iter().enumerate().map(move |(k, u)| (*t, k, *u)))
+            // the first time it is reached
+            .fold(None::<(f64, usize, f64)>, |best, x| match best {
+                Some(b) if b.2.abs() >= x.2.abs() => Some(b),
+                _ => Some(x),
+            });
+        let at = match largest {
+            Some((t, k, u)) => format!(
+                " reaches u[{k}] = {} N at t = {t} s:",
+                gvs::error::fmt_value(u)
+            ),
+            None => ":".into(),
+        };
+        let what = opts.input.describe().unwrap_or_default();
+        ScenarioError::invalid(option, format!("{what}{at} {e}"))
+    })?;
     let initial = match &opts.start {
         Start::Rest => InitialState::Rest,
         // the equilibrium `gvsrom statics` finds under the scenario's tensions and loads (with a
