@@ -18,7 +18,7 @@ pub const SM_MIN_SIGMA: f64 = 1e-3;
 
 /// `P J₀ = L U` of a Jacobian `J₀` (unit lower L below the diagonal, U on and above) and the
 /// Broyden updates `u_i v_iᵀ` since, as Sherman–Morrison factors `w_i = J_i⁻¹u_i`, `v_i`, `σ_i`.
-pub(super) struct Lu {
+pub(crate) struct Lu {
     /// `Some(nonsingular)` once `factors` holds the LU of `J₀`; `None` when `J` must be factored.
     pub(super) state: Option<bool>,
     factors: DMatrix<f64>,
@@ -31,7 +31,7 @@ pub(super) struct Lu {
 }
 
 impl Lu {
-    pub(super) fn new(n: usize) -> Self {
+    pub(crate) fn new(n: usize) -> Self {
         let par = Par::Seq;
         let req = StackReq::any_of(&[
             factor::lu_in_place_scratch::<usize, f64>(n, n, par, Default::default()),
@@ -51,7 +51,7 @@ impl Lu {
 
     /// Factors `a` (finite) with partial pivoting; returns false when `a` is zero or a pivot is
     /// at most `n ε max|a|` (numerically singular).
-    pub(super) fn factor(&mut self, a: &DMatrix<f64>) -> bool {
+    pub(crate) fn factor(&mut self, a: &DMatrix<f64>) -> bool {
         let n = a.nrows();
         self.factors.copy_from(a);
         self.sigma.clear();
@@ -79,7 +79,7 @@ impl Lu {
     }
 
     /// `b ← J⁻¹ b` for the current `J = J₀ + Σ u_i v_iᵀ` (nonsingular LU).
-    pub(super) fn solve(&mut self, b: &mut DVector<f64>) {
+    pub(crate) fn solve(&mut self, b: &mut DVector<f64>) {
         let n = b.len();
         let lu = MatRef::from_column_major_slice(self.factors.as_slice(), n, n);
         let perm = PermRef::new_checked(&self.perm, &self.perm_inv, n);

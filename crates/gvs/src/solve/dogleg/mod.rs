@@ -57,7 +57,7 @@
 //!
 //! The LU kept across Broyden updates and the overflow-safe norms are in the submodule `linalg`.
 
-mod linalg;
+pub(crate) mod linalg;
 
 use crate::model::zeros_lazy;
 use linalg::{all_finite, column_norm, norm2, scaled_norm, Lu};

@@ -18,6 +18,7 @@
 //! Newton's and converges quadratically. This is pseudo-transient continuation (Kelley & Keyes,
 //! SIAM J. Numer. Anal. 35, 1998) with the positivity of the shifted matrix as its step rule.
 
+use super::super::dogleg::linalg::Lu;
 use super::super::stability::positive_definite;
 use super::super::StopCheck;
 use super::StaticsError;
@@ -76,6 +77,8 @@ pub(super) fn descend<P: StrainParam>(
     let mut trial = DVector::zeros(n);
     let mut r_trial = DVector::zeros(n);
     let mut jac = DMatrix::zeros(n, n);
+    let mut lu = Lu::new(n);
+    let mut delta = DVector::zeros(n);
     model.statics_residual(&q, u, loads, ws, &mut r);
     stats.residual_evaluations += 1;
     if !r.iter().all(|v| v.is_finite()) {
@@ -111,10 +114,13 @@ pub(super) fn descend<P: StrainParam>(
                 tau *= 0.5;
                 continue;
             }
-            let Some(mut delta) = a.lu().solve(&r) else {
+            // faer's blocked LU (the dogleg's): nalgebra's took 1 s per step at 1806 DOF
+            if !lu.factor(&a) {
                 tau *= 0.5;
                 continue;
-            };
+            }
+            delta.copy_from(&r);
+            lu.solve(&mut delta);
             let cap = (STEP_CAP * q.amax().max(1.0)).min(STEP_GROWTH * last_step);
             let size = delta.amax();
             if size > cap {
