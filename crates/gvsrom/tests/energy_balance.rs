@@ -31,11 +31,22 @@ quadrature = {{ gauss_per_element = 3, elements = 4 }}
     path
 }
 
-/// Runs `simulate SCENARIO ARGS --out DIR`, expects success; stdout and `meta.json`.
-fn simulate(scenario: &Path, name: &str, args: &[&str]) -> (String, serde_json::Value) {
+/// The tolerances at which the integration resolves the energy (`--rtol` alone would leave the
+/// default `--atol` deciding).
+const TIGHT: [&str; 4] = ["--rtol", "1e-6", "--atol", "1e-9"];
+
+/// Runs `simulate SCENARIO --duration D --sample-rate 50 ARGS --out DIR`, expects success;
+/// stdout and `meta.json`.
+fn simulate(
+    scenario: &Path,
+    name: &str,
+    duration: &str,
+    args: &[&str],
+) -> (String, serde_json::Value) {
     let out = scratch(name);
     let _ = std::fs::remove_dir_all(&out);
     let mut all = vec!["simulate", scenario.to_str().unwrap()];
+    all.extend(["--duration", duration, "--sample-rate", "50"]);
     all.extend_from_slice(args);
     all.extend(["--out", out.to_str().unwrap()]);
     let run = gvsrom(&all);
@@ -66,20 +77,7 @@ fn balance(meta: &serde_json::Value) -> (f64, f64, f64, f64) {
 #[test]
 fn an_undamped_rod_falling_under_gravity_keeps_its_energy_at_a_tight_tolerance() {
     let s = scenario("falling", "[loads]\ngravity = [0.0, 0.0, -9.81]\n");
-    let (stdout, meta) = simulate(
-        &s,
-        "falling",
-        &[
-            "--duration",
-            "0.4",
-            "--sample-rate",
-            "50",
-            "--rtol",
-            "1e-6",
-            "--atol",
-            "1e-9",
-        ],
-    );
+    let (stdout, meta) = simulate(&s, "falling", "0.4", &TIGHT);
     let (initial, gain, loss, kinetic) = balance(&meta);
     // the straight rod at rest along x, gravity along z: T = U_e = U_g = 0
     assert!(initial.abs() < 1e-12, "{initial}");
@@ -103,20 +101,7 @@ fn an_undamped_rod_under_a_constant_tendon_tension_keeps_its_energy_with_the_ten
         "tendon",
         "[loads]\ngravity = [0.0, 0.0, 0.0]\n[[tendons]]\noffset_start = [0.0, 0.005]\noffset_end = [0.0, 0.005]\ntension = -0.05\n",
     );
-    let (stdout, meta) = simulate(
-        &s,
-        "tendon",
-        &[
-            "--duration",
-            "1",
-            "--sample-rate",
-            "50",
-            "--rtol",
-            "1e-6",
-            "--atol",
-            "1e-9",
-        ],
-    );
+    let (stdout, meta) = simulate(&s, "tendon", "1", &TIGHT);
     let (initial, gain, loss, kinetic) = balance(&meta);
     assert!(kinetic > 1e-6, "{kinetic}");
     assert!(
@@ -129,18 +114,7 @@ fn an_undamped_rod_under_a_constant_tendon_tension_keeps_its_energy_with_the_ten
 #[test]
 fn a_damped_run_has_no_energy_balance() {
     let s = scenario("damped", "[loads]\ngravity = [0.0, 0.0, -9.81]\n");
-    let (stdout, meta) = simulate(
-        &s,
-        "damped",
-        &[
-            "--duration",
-            "0.1",
-            "--sample-rate",
-            "50",
-            "--set",
-            "material.damping=100",
-        ],
-    );
+    let (stdout, meta) = simulate(&s, "damped", "0.1", &["--set", "material.damping=100"]);
     assert!(meta.get("energy_balance").is_none(), "{meta}");
     assert!(!stdout.contains("energy     "), "{stdout}");
 }
