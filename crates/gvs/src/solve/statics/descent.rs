@@ -107,13 +107,13 @@ pub(super) fn descend<P: StrainParam>(
         let mut accepted = false;
         for _ in 0..MAX_HALVINGS {
             // A = M/Δτ + K_T = M/Δτ − ∂R/∂q, with sym(M/(2Δτ) + K_T) positive definite
-            let a = &mass / tau - &jac;
-            let mut sym =
-                (&mass / (MARGIN * tau) - &jac) + (&mass / (MARGIN * tau) - &jac).transpose();
+            let margin = &mass / (MARGIN * tau) - &jac;
+            let mut sym = &margin + margin.transpose();
             if !positive_definite(&mut sym) {
                 tau *= 0.5;
                 continue;
             }
+            let a = &mass / tau - &jac;
             // faer's blocked LU (the dogleg's): nalgebra's took 1 s per step at 1806 DOF
             if !lu.factor(&a) {
                 tau *= 0.5;
