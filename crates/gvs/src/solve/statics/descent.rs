@@ -11,9 +11,11 @@
 //! (M/Δτ + K_T) δ = R(q),   q ← q + δ,
 //! ```
 //!
-//! with `Δτ` kept small enough that `sym(M/Δτ + K_T)` is positive definite: then each step is one
-//! of a damped motion, which a saddle repels (a longer implicit step would be attracted back to it,
-//! since backward Euler damps a growing mode with `Δτ |ω²| > 2`). `Δτ` doubles after every step,
+//! with `Δτ` kept small enough that `sym(M/(2Δτ) + K_T)` is positive definite (so `M/Δτ + K_T` is,
+//! with a margin: `Δτ |ω²| < 1/2` along a divergent mode): then each step is one of a damped
+//! motion, which a saddle repels (a longer implicit step would be attracted back to it, since
+//! backward Euler damps a growing mode with `Δτ |ω²| > 2`, and at `Δτ |ω²| = 1` its matrix is
+//! singular). Steps grow at most 4× from one to the next, and stay below half of `max(1, ‖q‖∞)`. `Δτ` doubles after every step,
 //! so that near the stable equilibrium (where `K_T` is positive definite) the step becomes
 //! Newton's and converges quadratically. This is pseudo-transient continuation (Kelley & Keyes,
 //! SIAM J. Numer. Anal. 35, 1998) with the positivity of the shifted matrix as its step rule.
