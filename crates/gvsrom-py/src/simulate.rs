@@ -456,10 +456,10 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
     };
     // a reduced model checks a signal's tensions, not the scenario's (`simulate --model`)
     // (from an equilibrium, the scenario's tensions are the start's: checked as attached)
-    let built = match a.input {
-        _ if random && !a.from_equilibrium => robot.built_for_signal(py)?,
-        Some(_) if !a.from_equilibrium => robot.built_for_signal(py)?,
-        _ => &robot.built,
+    let signal = random || a.input.is_some();
+    let built = match signal && !a.from_equilibrium {
+        true => robot.built_for_signal(py)?,
+        false => &robot.built,
     };
     let choice = IntegratorChoice {
         method: method(a.method)?,
