@@ -104,10 +104,10 @@ mod error;
 mod fixed;
 mod galpha;
 mod lu;
-mod mass_norm;
 mod ndf;
 mod one_step;
 mod options;
+mod scaled_norm;
 mod sdirk;
 #[cfg(test)]
 mod tests;

@@ -5,7 +5,7 @@
 //! simplified-Newton convergence test, the first step, and what a failed attempt does.
 
 use super::galpha::MechanicalSystem;
-use super::mass_norm::MassNorm;
+use super::scaled_norm::{ScaledNorm, STIFFNESS_WEIGHT};
 use super::{invalid, next_down, next_up, rhs_err, ErrorNorm, Lu, OdeError, OdeFailure, OdeStats};
 use nalgebra::{DMatrix, DVector};
 
@@ -100,8 +100,10 @@ pub(super) struct Parts {
     lu: Lu,
     /// The `h` the factored `S` was built with (`None`: not factored).
     lu_h: Option<f64>,
-    /// `‖·‖_M̂` of the `M` in `m` (with [`ErrorNorm::Mass`]) and the count of `M` evaluations.
-    mnorm: Option<MassNorm>,
+    /// `‖·‖_M̂` of the `M` in `m` and `‖·‖_K̂` of the `K` in `k` (with [`ErrorNorm::Mass`]), and
+    /// the count of `M, D, K` evaluations.
+    mnorm: Option<ScaledNorm>,
+    knorm: Option<ScaledNorm>,
     m_count: usize,
     /// `M, D, K` are those of the current point (no step accepted since they were evaluated).
     pub(super) current: bool,
@@ -116,13 +118,14 @@ impl Parts {
             k: mat(),
             lu: Lu::new(n),
             lu_h: None,
-            mnorm: (norm == ErrorNorm::Mass).then(|| MassNorm::new(n)),
+            mnorm: (norm == ErrorNorm::Mass).then(|| ScaledNorm::new(n)),
+            knorm: (norm == ErrorNorm::Mass).then(|| ScaledNorm::new(n)),
             m_count: 0,
             current: false,
         }
     }
 
-    /// `M, D, K` at `(t, q, q̇)` (and the mass norm of the new `M`); `S` is to be refactored.
+    /// `M, D, K` at `(t, q, q̇)` (and the norms of the new `M` and `K`); `S` is to be refactored.
     pub(super) fn eval<S: MechanicalSystem>(
         &mut self,
         sys: &mut S,
@@ -137,6 +140,9 @@ impl Parts {
         self.m_count += 1;
         if let Some(mn) = &mut self.mnorm {
             mn.set(&self.m, self.m_count);
+        }
+        if let Some(kn) = &mut self.knorm {
+            kn.set(&self.k, self.m_count);
         }
         self.current = true;
         self.lu_h = None;
@@ -163,6 +169,37 @@ impl Parts {
                 let s = mn.half(x.as_slice()).max(mn.half(y.as_slice()));
                 mn.half(v.as_slice()) / (rtol * s + atol)
             }
+        }
+    }
+
+    /// The norm of a Newton correction's displacement `v` in units of the error test: with the
+    /// mass norm, the larger of [`Self::weighted`] and `w_K·‖v‖_K̂ / (rtol·max(‖x‖_K̂, ‖y‖_K̂) +
+    /// atol)` in the norm of the stiffness `K` (`K̂ = K·m/tr K`, [`STIFFNESS_WEIGHT`] `w_K`): a
+    /// correction must be small both as a mass-weighted displacement and as a strain energy,
+    /// relative to the state's. The mass norm alone hardly sees the stiff shear and elongation
+    /// coordinates, which move little mass; a Newton iterate stopped with them unconverged acts
+    /// as a force no physics supplies and feeds energy into an undamped rod. Componentwise, as
+    /// [`Self::weighted`] (each coordinate is already held to its own size).
+    pub(super) fn newton_weighted(
+        &self,
+        v: &DVector<f64>,
+        x: &DVector<f64>,
+        y: &DVector<f64>,
+        rtol: f64,
+        atol: f64,
+    ) -> f64 {
+        let by_mass = self.weighted(v, x, y, rtol, atol);
+        match &self.knorm {
+            Some(kn) if kn.is_set() => {
+                let s = kn.half(x.as_slice()).max(kn.half(y.as_slice()));
+                let by_stiffness = STIFFNESS_WEIGHT * kn.half(v.as_slice()) / (rtol * s + atol);
+                if by_mass.is_nan() || by_stiffness.is_nan() {
+                    f64::NAN
+                } else {
+                    by_mass.max(by_stiffness)
+                }
+            }
+            _ => by_mass,
         }
     }
 
@@ -346,4 +383,66 @@ pub(super) fn next_step(h: f64, err: f64, e: f64, hmax: f64) -> f64 {
         h * ratio
     };
     h.min(hmax)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests_galpha::Oscillators;
+    use super::*;
+
+    /// Two unit masses, one soft (`k = 1`) and one stiff (`k = 10⁶`, like a shear or elongation
+    /// coordinate): a correction along the stiff one that the mass norm passes is held to its
+    /// strain energy; one along the soft one is measured as before.
+    #[test]
+    fn the_newton_norm_weighs_a_stiff_correction_by_its_strain_energy() {
+        let mut sys = Oscillators {
+            m: 1.0,
+            c: 0.0,
+            k: vec![1.0, 1e6],
+            f_after: 0.0,
+            t_step: f64::INFINITY,
+        };
+        let (rtol, atol) = (1e-3, 1e-9);
+        let x = DVector::from_column_slice(&[1.0, 1e-3]);
+        let zero = DVector::zeros(2);
+        let mut stats = OdeStats::default();
+        let mut parts = Parts::new(2, ErrorNorm::Mass);
+        parts.eval(&mut sys, 0.0, &x, &zero, &mut stats).unwrap();
+        // M̂ = I; K̂ = K·2/tr K = diag(2/(1+10⁶), 2·10⁶/(1+10⁶))
+        let kh = [2.0 / (1.0 + 1e6), 2e6 / (1.0 + 1e6)];
+        let k_norm = |v: &[f64]| (kh[0] * v[0] * v[0] + kh[1] * v[1] * v[1]).sqrt();
+        let sx = k_norm(&[1.0, 1e-3]);
+        let mass_test =
+            |v: &[f64]| (v[0] * v[0] + v[1] * v[1]).sqrt() / (rtol * (1.0f64 + 1e-6).sqrt() + atol);
+        for (v, stiff_decides) in [([0.0, 1e-6], true), ([1e-4, 0.0], false)] {
+            let by_mass = mass_test(&v);
+            let by_stiffness = 0.1 * k_norm(&v) / (rtol * sx + atol);
+            let dv = DVector::from_column_slice(&v);
+            let weighted = parts.weighted(&dv, &x, &x, rtol, atol);
+            let newton = parts.newton_weighted(&dv, &x, &x, rtol, atol);
+            assert!(
+                (weighted - by_mass).abs() <= 1e-12 * by_mass,
+                "{weighted} {by_mass}"
+            );
+            let want = by_mass.max(by_stiffness);
+            assert!(
+                (newton - want).abs() <= 1e-12 * want,
+                "{v:?}: {newton} vs {want}"
+            );
+            assert_eq!(by_stiffness > by_mass, stiff_decides, "{v:?}");
+        }
+        // the stiff correction: 70 times what the mass norm alone reads
+        let dv = DVector::from_column_slice(&[0.0, 1e-6]);
+        let ratio = parts.newton_weighted(&dv, &x, &x, rtol, atol)
+            / parts.weighted(&dv, &x, &x, rtol, atol);
+        assert!(ratio > 50.0, "{ratio}");
+        // componentwise: each coordinate is already held to its own size, nothing is added
+        let mut parts = Parts::new(2, ErrorNorm::Componentwise);
+        parts.eval(&mut sys, 0.0, &x, &zero, &mut stats).unwrap();
+        let (w, n) = (
+            parts.weighted(&dv, &x, &x, rtol, atol),
+            parts.newton_weighted(&dv, &x, &x, rtol, atol),
+        );
+        assert_eq!(w, n);
+    }
 }

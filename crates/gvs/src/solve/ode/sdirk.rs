@@ -29,7 +29,8 @@
 //! `h` moves more than 20 % from the `h` it was built with. The predictor of `A_i` extrapolates `q̈`
 //! (from the last step for stage 1, through `q̈_n` and `A_1` for stage 2, by the quadratic through
 //! `q̈_n, A_1, A_2` for the others). A correction `δA` moves `Q_i` by `(hγ)² δA` and, through `V_i`,
-//! the later stages by up to `h·hγ·δA`; that displacement, in the units of the error test, must
+//! the later stages by up to `h·hγ·δA`; that displacement, in the units of the error test (with
+//! [`ErrorNorm::Mass`], also in the stiffness norm: [`Parts::newton_weighted`]), must
 //! satisfy `ρ/(1−ρ)·‖δ_i‖ ≤ κ = 10⁻³` (or `‖δ₀‖ ≤ κ/10` after one iteration), where `ρ` is the
 //! contraction rate; `ρ > 0.9` or 7 iterations fail the step, which re-evaluates `M, D, K` if they
 //! are stale and otherwise cuts `h` by 4. (`κ` is small because the embedded estimate overstates
@@ -310,7 +311,7 @@ fn stages<S: MechanicalSystem>(
             w.eps.neg_mut();
             w.parts.solve(&mut w.eps);
             w.acc[i] += &w.eps;
-            let norm = w.parts.weighted(&w.eps, &w.q, &w.qs, tol.0, tol.1) * cq;
+            let norm = w.parts.newton_weighted(&w.eps, &w.q, &w.qs, tol.0, tol.1) * cq;
             most = most.max(it + 1);
             match newton_test(it, norm, prev, KAPPA) {
                 Newton::Converged => {

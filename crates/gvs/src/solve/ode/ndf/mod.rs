@@ -3,7 +3,7 @@
 //! of the parent module.
 
 use super::corrector::{Corrector, FirstOrder, SecondOrder};
-use super::mass_norm::MassNorm;
+use super::scaled_norm::ScaledNorm;
 use super::{
     check_common, check_tolerances, deliver, invalid, mechanical_state, ulp, Clamp, ErrorNorm,
     MechanicalSystem, NdfOptions, OdeError, OdeFailure, OdeStats, OdeSystem, Output,
@@ -205,7 +205,7 @@ fn integrate<C: Corrector>(
             .into());
         }
         w.mass_norm = true;
-        w.mnorm = MassNorm::new(n / 2);
+        w.mnorm = ScaledNorm::new(n / 2);
     }
     w.y.copy_from(y0);
     let mut next = 0;

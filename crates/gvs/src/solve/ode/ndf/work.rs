@@ -1,6 +1,6 @@
 //! The buffers of one NDF integration and its error norms (componentwise, or the mass norm).
 
-use super::super::mass_norm::MassNorm;
+use super::super::scaled_norm::ScaledNorm;
 use super::super::wnorm;
 use nalgebra::{DMatrix, DVector};
 
@@ -23,7 +23,7 @@ pub(super) struct Work {
     pub(super) dif: DMatrix<f64>,
     /// [`ErrorNorm::Mass`](super::super::ErrorNorm::Mass): the norm of `M̂`, the scales of the `q` and `q̇` halves, and a buffer.
     pub(super) mass_norm: bool,
-    pub(super) mnorm: MassNorm,
+    pub(super) mnorm: ScaledNorm,
     pub(super) scale_q: f64,
     pub(super) scale_v: f64,
     /// `(mhat_of, ‖y_q‖, ‖y_v‖)` of the current `y` (the same for every attempt at a step).
@@ -52,7 +52,7 @@ impl Work {
             out: v(),
             dif: DMatrix::zeros(n, 7),
             mass_norm: false,
-            mnorm: MassNorm::new(0),
+            mnorm: ScaledNorm::new(0),
             scale_q: 1.0,
             scale_v: 1.0,
             ynorm: None,
