@@ -279,6 +279,25 @@ pub fn rows(name: &str, a: &In2<'_>, cols: usize, what: &str) -> PyResult<Vec<Ve
     Ok(v.rows().into_iter().map(|r| r.to_vec()).collect())
 }
 
+/// Every entry of `rows` finite; else a `GvsromError` naming the array's own index
+/// (`name[k, j]`) and what column `j` holds (`column(j)`).
+pub fn finite_rows(
+    name: &str,
+    rows: &[Vec<f64>],
+    column: impl Fn(usize) -> String,
+) -> PyResult<()> {
+    for (k, row) in rows.iter().enumerate() {
+        if let Some(j) = row.iter().position(|x| !x.is_finite()) {
+            return Err(invalid(format!(
+                "`{name}[{k}, {j}]` = {}: expected a finite number (column {j} is {})",
+                row[j],
+                column(j)
+            )));
+        }
+    }
+    Ok(())
+}
+
 /// A flat row-major buffer as an array of `shape`.
 pub fn shaped<'py, const D: usize>(
     py: Python<'py>,

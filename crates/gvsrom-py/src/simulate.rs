@@ -443,6 +443,10 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
                 ))
             })?;
             let rows = arrays::rows("input", &rows, 1 + na, "t, then one tension per tendon")?;
+            arrays::finite_rows("input", &rows, |j| match j {
+                0 => "the time t in s".to_string(),
+                _ => format!("the tension u_{j} of tendon {} in N", j - 1),
+            })?;
             InputSource::Rows(Signal {
                 times: rows.iter().map(|r| r[0]).collect(),
                 values: rows.iter().map(|r| r[1..].to_vec()).collect(),

@@ -49,6 +49,14 @@ def test_an_input_of_the_wrong_width_or_start_is_a_value_error():
         robot.simulate(-1.0)
 
 
+def test_a_non_finite_input_entry_is_named_by_its_index_in_the_array():
+    robot = gvsrom.Scenario.preset("single-tendon").build()
+    with pytest.raises(gvsrom.GvsromError, match=r"`input\[1, 1\]` = NaN: .*column 1 is the tension u_1 of tendon 0 in N"):
+        robot.simulate(0.01, input=np.array([[0.0, -1.0], [0.005, np.nan]]))
+    with pytest.raises(gvsrom.GvsromError, match=r"`input\[1, 0\]` = inf: .*the time t in s"):
+        robot.simulate(0.01, input=np.array([[0.0, -1.0], [np.inf, -1.0]]))
+
+
 @pytest.mark.skipif(os.name != "posix", reason="SIGINT to self")
 def test_ctrl_c_interrupts_a_long_simulation(sigint_raises):
     robot = gvsrom.Scenario.preset("single-tendon").build()
