@@ -165,10 +165,7 @@ impl Parts {
                 .zip(x.iter().zip(y.iter()))
                 .map(|(v, (x, y))| v.abs() / (rtol * x.abs().max(y.abs()) + atol))
                 .fold(0.0, f64::max),
-            Some(mn) => {
-                let s = mn.half(x.as_slice()).max(mn.half(y.as_slice()));
-                mn.half(v.as_slice()) / (rtol * s + atol)
-            }
+            Some(mn) => mn.relative(v, [x, y], (rtol, atol)),
         }
     }
 
@@ -183,16 +180,14 @@ impl Parts {
     pub(super) fn newton_weighted(
         &self,
         v: &DVector<f64>,
-        x: &DVector<f64>,
-        y: &DVector<f64>,
-        rtol: f64,
-        atol: f64,
+        states: [&DVector<f64>; 2],
+        (rtol, atol): (f64, f64),
     ) -> f64 {
+        let [x, y] = states;
         let by_mass = self.weighted(v, x, y, rtol, atol);
         match &self.knorm {
             Some(kn) if kn.is_set() => {
-                let s = kn.half(x.as_slice()).max(kn.half(y.as_slice()));
-                let by_stiffness = STIFFNESS_WEIGHT * kn.half(v.as_slice()) / (rtol * s + atol);
+                let by_stiffness = STIFFNESS_WEIGHT * kn.relative(v, states, (rtol, atol));
                 if by_mass.is_nan() || by_stiffness.is_nan() {
                     f64::NAN
                 } else {
@@ -419,7 +414,7 @@ mod tests {
             let by_stiffness = 0.1 * k_norm(&v) / (rtol * sx + atol);
             let dv = DVector::from_column_slice(&v);
             let weighted = parts.weighted(&dv, &x, &x, rtol, atol);
-            let newton = parts.newton_weighted(&dv, &x, &x, rtol, atol);
+            let newton = parts.newton_weighted(&dv, [&x, &x], (rtol, atol));
             assert!(
                 (weighted - by_mass).abs() <= 1e-12 * by_mass,
                 "{weighted} {by_mass}"
@@ -433,7 +428,7 @@ mod tests {
         }
         // the stiff correction: 70 times what the mass norm alone reads
         let dv = DVector::from_column_slice(&[0.0, 1e-6]);
-        let ratio = parts.newton_weighted(&dv, &x, &x, rtol, atol)
+        let ratio = parts.newton_weighted(&dv, [&x, &x], (rtol, atol))
             / parts.weighted(&dv, &x, &x, rtol, atol);
         assert!(ratio > 50.0, "{ratio}");
         // componentwise: each coordinate is already held to its own size, nothing is added
@@ -441,7 +436,7 @@ mod tests {
         parts.eval(&mut sys, 0.0, &x, &zero, &mut stats).unwrap();
         let (w, n) = (
             parts.weighted(&dv, &x, &x, rtol, atol),
-            parts.newton_weighted(&dv, &x, &x, rtol, atol),
+            parts.newton_weighted(&dv, [&x, &x], (rtol, atol)),
         );
         assert_eq!(w, n);
     }

@@ -4,7 +4,7 @@
 //! Newton tests of the second-order forms add to it (see [`super::one_step::Parts::newton_weighted`]).
 
 use crate::dynamics::cholesky_factor_in_place;
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 
 /// The weight `w_K` of the stiffness norm in the Newton tests of the second-order forms with the
 /// mass norm (`max(‖δ‖_M̂-test, w_K·‖δ‖_K̂-test)`, [`super::one_step::Parts::newton_weighted`]).
@@ -70,6 +70,17 @@ impl ScaledNorm {
             self.l.copy_from(mass);
             self.l *= mass.nrows() as f64 / tr;
         }
+    }
+
+    /// `‖v‖_Â / (rtol·max(‖x‖_Â, ‖y‖_Â) + atol)`: `v` relative to the larger of two states.
+    pub(super) fn relative(
+        &self,
+        v: &DVector<f64>,
+        [x, y]: [&DVector<f64>; 2],
+        (rtol, atol): (f64, f64),
+    ) -> f64 {
+        let s = self.half(x.as_slice()).max(self.half(y.as_slice()));
+        self.half(v.as_slice()) / (rtol * s + atol)
     }
 
     /// `‖x‖_Â = ‖Lᵀ x‖` (`m²/2` products), or `√max(0, xᵀÂx)`.

@@ -311,7 +311,7 @@ fn stages<S: MechanicalSystem>(
             w.eps.neg_mut();
             w.parts.solve(&mut w.eps);
             w.acc[i] += &w.eps;
-            let norm = w.parts.newton_weighted(&w.eps, &w.q, &w.qs, tol.0, tol.1) * cq;
+            let norm = w.parts.newton_weighted(&w.eps, [&w.q, &w.qs], tol) * cq;
             most = most.max(it + 1);
             match newton_test(it, norm, prev, KAPPA) {
                 Newton::Converged => {
