@@ -10,9 +10,9 @@
 //! On failure the samples computed so far are kept and the error carries the time reached.
 
 use super::ode::{
-    integrate_fixed, integrate_generalized_alpha, integrate_ndf, integrate_ndf_second_order,
-    integrate_sdirk, FixedStepOptions, GeneralizedAlphaOptions, MechanicalSystem, NdfOptions,
-    OdeError, OdeStats, OdeSystem, RhsError, SdirkOptions,
+    integrate_fixed, integrate_fixed_second_order, integrate_generalized_alpha, integrate_ndf,
+    integrate_ndf_second_order, integrate_sdirk, FixedStepOptions, GeneralizedAlphaOptions,
+    MechanicalSystem, NdfOptions, OdeError, OdeStats, OdeSystem, RhsError, SdirkOptions,
 };
 use super::statics::{StaticsError, StaticsOptions, StaticsSolver};
 use crate::error::ModelError;
@@ -88,9 +88,8 @@ pub enum OdeJacobian {
     /// The structured parts `M`, `D`, `K_T` ([`Model::iteration_parts`]: the analytic statics
     /// Jacobian and the damping matrix). The NDF then runs in second-order form
     /// ([`super::ode::integrate_ndf_second_order`]): each Newton iteration is one recursive
-    /// residual `M q̈ − τ` ([`Model::dynamics_residual`]) and an `n × n` solve. The fixed-step
-    /// method uses the first-order form with `[0 I; M⁻¹∂R/∂q  −M⁻¹D]`
-    /// ([`Model::ode_jacobian_approx`]).
+    /// residual `M q̈ − τ` ([`Model::dynamics_residual`]) and an `n × n` solve; so does the
+    /// fixed-step method ([`super::ode::integrate_fixed_second_order`]).
     #[default]
     Structured,
 }
@@ -524,7 +523,19 @@ pub fn simulate_streaming_interruptible<P: StrainParam>(
             }
             _ => integrate_ndf(&mut sys, t0, &y0, t_out, &breaks, o, &mut record),
         },
-        Method::Fixed(o) => integrate_fixed(&mut sys, t0, &y0, t_out, &breaks, o, &mut record),
+        Method::Fixed(o) => match options.jacobian {
+            OdeJacobian::Structured => integrate_fixed_second_order(
+                &mut sys,
+                t0,
+                &q0,
+                &qd0,
+                t_out,
+                &breaks,
+                o,
+                &mut record,
+            ),
+            _ => integrate_fixed(&mut sys, t0, &y0, t_out, &breaks, o, &mut record),
+        },
         Method::GeneralizedAlpha(o) => {
             integrate_generalized_alpha(&mut sys, t0, &q0, &qd0, t_out, &breaks, o, &mut record)
         }

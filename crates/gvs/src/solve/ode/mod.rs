@@ -80,7 +80,10 @@
 //! `y_{n+1} − (1+ω)²/(1+2ω) y_n + ω²/(1+2ω) y_{n−1} = h_n (1+ω)/(1+2ω) f(t_{n+1}, y_{n+1})`
 //! (`4/3, 1/3, 2/3` at `ω = 1`): second order, A- and L-stable (stiff components are damped, not
 //! left ringing as with the trapezoidal rule), one implicit solve per step. It is started, and
-//! restarted after every breakpoint, by one backward Euler step. See [`integrate_fixed`].
+//! restarted after every breakpoint, by one backward Euler step. See [`integrate_fixed`]; a
+//! mechanical system runs it in second-order form with the NDF's corrector
+//! ([`integrate_fixed_second_order`]: the same discrete solution, an `n × n` Newton iteration with
+//! `M` renewed where it contracts slowly).
 //!
 //! # Failures
 //!
@@ -129,7 +132,7 @@ use error::{invalid, rhs_err};
 use lu::Lu;
 
 pub use error::{OdeError, OdeFailure, RhsError};
-pub use fixed::integrate_fixed;
+pub use fixed::{integrate_fixed, integrate_fixed_second_order};
 pub use galpha::{integrate_generalized_alpha, GeneralizedAlphaOptions, MechanicalSystem};
 
 /// The output callback of the integrators: called with every output time and the solution there;

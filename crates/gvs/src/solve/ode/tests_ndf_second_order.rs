@@ -9,7 +9,7 @@ use super::*;
 use nalgebra::{DMatrix, DVector};
 use std::ops::ControlFlow;
 
-struct Bead {
+pub(super) struct Bead {
     k: f64,
     /// Linear damping coefficient.
     c: f64,
@@ -103,7 +103,7 @@ impl OdeSystem for Bead {
     }
 }
 
-fn bead(c: f64, f_after: f64, exact_parts: bool) -> Bead {
+pub(super) fn bead(c: f64, f_after: f64, exact_parts: bool) -> Bead {
     Bead {
         k: 4.0,
         c,
