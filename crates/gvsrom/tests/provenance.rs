@@ -489,6 +489,28 @@ fn an_autoencoder_modes_and_a_comparison_record_where_they_came_from() {
     assert_eq!(p["dataset"]["path"], s(&ds));
     assert_eq!(p["dataset"]["sha256"], ds_meta["gvsrom"]["sha256"]);
 
+    // the fixed step keeps the first-order form for a decoder (its M(q) can be nearly singular
+    // where the decoder flattens), the second-order form for the full model and a POD-ROM
+    let fixed = |name: &str, model: Option<&Path>| {
+        let out = scratch(name);
+        let mut a = vec!["simulate", "single-tendon", "--duration", "0.05"];
+        a.extend([
+            "--from-equilibrium",
+            "--fixed-step",
+            "0.01",
+            "--out",
+            s(&out),
+        ]);
+        if let Some(m) = model {
+            a.extend(["--model", s(m)]);
+        }
+        run_ok(&a);
+        let meta = json(&out.join("meta.json"));
+        meta["provenance"]["integrator"]["form"].clone()
+    };
+    assert_eq!(fixed("prov-fixed-ae", Some(&model)), "first_order");
+    assert_eq!(fixed("prov-fixed-hom", None), "second_order");
+
     // modes about an equilibrium: the scenario as run, the solver
     let modes = scratch("prov-modes.json");
     let modes_args = [
@@ -532,6 +554,7 @@ fn an_autoencoder_modes_and_a_comparison_record_where_they_came_from() {
     };
     sim(&hom, None);
     sim(&rom, Some(&pod));
+    assert_eq!(fixed("prov-fixed-pod", Some(&pod)), "second_order");
     let report = scratch("prov-compare.json");
     let cmp_args = ["compare", s(&hom), s(&rom), "--json", s(&report)];
     run_ok(&cmp_args);

@@ -161,6 +161,8 @@ pub fn choose_integrator(
     let method = match (choice.fixed_step, choice.method) {
         (Some(h), _) => Method::Fixed(FixedStepOptions {
             h,
+            // a decoder's M(q): see `FixedStepOptions::second_order`
+            second_order: !decoder,
             ..FixedStepOptions::default()
         }),
         (None, MethodChoice::Galpha) => Method::GeneralizedAlpha(GeneralizedAlphaOptions {
@@ -233,19 +235,26 @@ pub fn integrator_record(
         ErrorNorm::Componentwise => "componentwise",
         ErrorNorm::Mass => "mass",
     };
+    let renewal = |r: MassRenewal| match r {
+        MassRenewal::WhenSlow => "when_slow",
+        MassRenewal::EveryAttempt => "every_attempt",
+    };
     let mut v = match &options.method {
         Method::Ndf(o) => json!({
             "rtol": o.rtol, "atol": o.atol, "max_order": o.max_order, "bdf": o.bdf,
             "error_norm": norm(o.error_norm),
-            "mass_renewal": match o.mass_renewal {
-                MassRenewal::WhenSlow => "when_slow",
-                MassRenewal::EveryAttempt => "every_attempt",
-            },
+            "mass_renewal": renewal(o.mass_renewal),
             "max_steps": o.max_steps,
         }),
-        Method::Fixed(o) => {
-            json!({"h": o.h, "newton_tol": o.newton_tol, "max_newton": o.max_newton})
-        }
+        Method::Fixed(o) => json!({
+            "h": o.h, "newton_tol": o.newton_tol, "max_newton": o.max_newton,
+            "form": if o.second_order && options.jacobian == OdeJacobian::Structured {
+                "second_order"
+            } else {
+                "first_order"
+            },
+            "mass_renewal": renewal(o.mass_renewal),
+        }),
         Method::GeneralizedAlpha(o) => json!({
             "rtol": o.rtol, "atol": o.atol, "rho_inf": o.rho_inf,
             "error_norm": norm(o.error_norm), "max_steps": o.max_steps,

@@ -89,7 +89,9 @@ pub enum OdeJacobian {
     /// Jacobian and the damping matrix). The NDF then runs in second-order form
     /// ([`super::ode::integrate_ndf_second_order`]): each Newton iteration is one recursive
     /// residual `M q̈ − τ` ([`Model::dynamics_residual`]) and an `n × n` solve; so does the
-    /// fixed-step method ([`super::ode::integrate_fixed_second_order`]).
+    /// fixed-step method ([`super::ode::integrate_fixed_second_order`]) unless its options say
+    /// otherwise (`FixedStepOptions::second_order`), when it uses the first-order form with
+    /// `[0 I; −M⁻¹K_T −M⁻¹D]` ([`Model::ode_jacobian_approx`]).
     #[default]
     Structured,
 }
@@ -524,7 +526,7 @@ pub fn simulate_streaming_interruptible<P: StrainParam>(
             _ => integrate_ndf(&mut sys, t0, &y0, t_out, &breaks, o, &mut record),
         },
         Method::Fixed(o) => match options.jacobian {
-            OdeJacobian::Structured => integrate_fixed_second_order(
+            OdeJacobian::Structured if o.second_order => integrate_fixed_second_order(
                 &mut sys,
                 t0,
                 &q0,

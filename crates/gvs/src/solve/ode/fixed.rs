@@ -7,8 +7,8 @@
 use super::corrector::{Corrector, FirstOrder, SecondOrder};
 use super::galpha::MechanicalSystem;
 use super::{
-    check_common, deliver, invalid, mechanical_state, ulp, Clamp, FixedStepOptions, MassRenewal,
-    OdeError, OdeFailure, OdeStats, OdeSystem, Output,
+    check_common, deliver, invalid, mechanical_state, ulp, Clamp, FixedStepOptions, OdeError,
+    OdeFailure, OdeStats, OdeSystem, Output,
 };
 use nalgebra::DVector;
 
@@ -114,7 +114,7 @@ pub fn integrate_fixed<S: OdeSystem>(
 /// but Newton runs as the NDF's second-order corrector — each iteration one residual `ε = M q̈ − τ`
 /// and a solve with the `n × n` matrix `S = M + βD + β²K` ([`MechanicalSystem::iteration_parts`]),
 /// `M` renewed at the predicted configuration after a slow contraction (`ρ > 0.2`) or a failed
-/// iteration, before `D` and `K` are. The first-order form's Jacobian `[0 I; −M⁻¹K −M⁻¹D]` keeps
+/// iteration, before `D` and `K` are (or at every attempt: `opts.mass_renewal`). The first-order form's Jacobian `[0 I; −M⁻¹K −M⁻¹D]` keeps
 /// `M` of the configuration where it was evaluated; on the six-tendon arm released under gravity
 /// (1 s, h = 0.01 / 0.002 s) its Newton failed 465 / 298 times. `output` receives `[q; q̇]`.
 #[allow(clippy::too_many_arguments)]
@@ -131,7 +131,7 @@ pub fn integrate_fixed_second_order<S: MechanicalSystem>(
     let n = sys.dim();
     let y0 = mechanical_state(n, q0, qd0)?;
     integrate(
-        &mut SecondOrder::new(sys, MassRenewal::WhenSlow),
+        &mut SecondOrder::new(sys, opts.mass_renewal),
         2 * n,
         t0,
         &y0,

@@ -131,6 +131,18 @@ pub struct FixedStepOptions {
     /// Maximum Newton iterations per attempt (default 5, at least 1; with 1, an attempt is
     /// accepted only if its first correction already meets `newton_tol`).
     pub max_newton: usize,
+    /// When the second-order form ([`integrate_fixed_second_order`](super::integrate_fixed_second_order))
+    /// renews `M` in its iteration matrix (default [`MassRenewal::WhenSlow`]; the first-order
+    /// form ignores it).
+    pub mass_renewal: MassRenewal,
+    /// Whether the dynamics driver ([`crate::solve::dynamics::simulate`]) runs a mechanical system
+    /// in second-order form (default `true`, with the structured Jacobian). `false` keeps the
+    /// first-order form with the approximate Jacobian `[0 I; −M⁻¹K −M⁻¹D]`: for a decoder's
+    /// reduced model, whose `M(q)` is nearly singular where the decoder flattens, the
+    /// second-order Newton from the linear predictor jumped to a spurious far root (IV-C2's
+    /// AE-7 from rest, h = 0.01 s: left its training region at t = 0.02 s), while the first-order
+    /// form stays within 1.3 mm of the adaptive run's tip over 3 s of random steps.
+    pub second_order: bool,
 }
 
 impl Default for FixedStepOptions {
@@ -139,6 +151,8 @@ impl Default for FixedStepOptions {
             h: 1e-3,
             newton_tol: 1e-8,
             max_newton: 5,
+            mass_renewal: MassRenewal::WhenSlow,
+            second_order: true,
         }
     }
 }

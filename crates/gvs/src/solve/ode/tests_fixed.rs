@@ -32,6 +32,7 @@ fn opts(h: f64) -> FixedStepOptions {
         h,
         newton_tol: 1e-12,
         max_newton: 8,
+        ..FixedStepOptions::default()
     }
 }
 
@@ -325,7 +326,8 @@ fn a_refused_newton_iterate_halves_the_step_instead_of_ending_the_run() {
 /// The fixed step in second-order form solves the same BDF2 equations as in first-order form: on
 /// a bead whose mass depends on its position (`(1 + q²) q̈ + q q̇² + k q = f(t)`), damped, forced
 /// from a breakpoint, both give the same samples to the Newton tolerance, whether the
-/// second-order iteration matrix is exact or `M` alone (`D = K = 0`).
+/// second-order iteration matrix is exact or `M` alone (`D = K = 0`), with `M` renewed when slow
+/// or at every attempt.
 #[test]
 fn second_order_form_takes_the_same_bdf2_steps_as_the_first_order_form() {
     use super::tests_ndf_second_order::bead;
@@ -347,7 +349,10 @@ fn second_order_form_takes_the_same_bdf2_steps_as_the_first_order_form() {
     .unwrap();
     let first_ys = ys;
     assert_eq!(first.failed_steps, 0, "{first:?}");
-    for exact in [true, false] {
+    let cases = [true, false].map(|exact| {
+        [MassRenewal::WhenSlow, MassRenewal::EveryAttempt].map(|mass_renewal| (exact, mass_renewal))
+    });
+    for (exact, mass_renewal) in cases.into_iter().flatten() {
         let mut ys2 = Vec::new();
         let stats = integrate_fixed_second_order(
             &mut bead(0.3, 2.0, exact),
@@ -356,7 +361,10 @@ fn second_order_form_takes_the_same_bdf2_steps_as_the_first_order_form() {
             &DVector::from_element(1, 0.0),
             &t,
             &[1.5],
-            &o,
+            &FixedStepOptions {
+                mass_renewal,
+                ..o.clone()
+            },
             &mut |_, y| {
                 ys2.push(y.clone());
                 std::ops::ControlFlow::Continue(())
@@ -365,13 +373,14 @@ fn second_order_form_takes_the_same_bdf2_steps_as_the_first_order_form() {
         .unwrap();
         assert_eq!(ys2.len(), t.len());
         // the same steps: 300 of 0.01 s, none halved
-        assert_eq!(stats.steps, first.steps, "exact parts {exact}: {stats:?}");
+        let case = format!("exact parts {exact}, {mass_renewal:?}");
+        assert_eq!(stats.steps, first.steps, "{case}: {stats:?}");
         let err = first_ys
             .iter()
             .zip(&ys2)
             .map(|(a, b)| (a - b).amax())
             .fold(0.0, f64::max);
-        assert!(err < 1e-9, "exact parts {exact}: max |Δy| = {err:e}");
+        assert!(err < 1e-9, "{case}: max |Δy| = {err:e}");
         // the forcing moved the bead: the comparison is not of two resting states
         assert!((ys2[60][0] - ys2[30][0]).abs() > 0.1, "{:?}", ys2[60]);
     }
