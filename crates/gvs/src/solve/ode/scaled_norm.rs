@@ -12,8 +12,8 @@ use nalgebra::{DMatrix, DVector};
 /// horizontal under gravity for 4 s (SDIRK4, rtol 1e-4; energy gained, of the largest kinetic
 /// energy 0.261 J): without the stiffness term +40.6 %; with `w_K` = 1, 0.3, 0.1: +0.21, +0.19,
 /// +0.10 %. On the undamped release of that file (6 s) the Jacobians it costs went from 50 to
-/// 114, 94, 72, the tip error stayed 0.064–0.073 % L. The smallest weight that stops the leak is
-/// kept.
+/// 114, 94, 72, the tip error stayed 0.064–0.073 % L. The smallest of the three weights tried
+/// is kept (smaller ones were not measured).
 pub(super) const STIFFNESS_WEIGHT: f64 = 0.1;
 
 /// `‖·‖_Â` for one half (`q` or `q̇`, `m` entries) of a mechanical state.
