@@ -37,10 +37,38 @@
 //!   way Newton reaches it differs.
 
 use super::{
-    rhs_err, Clamp, Counted, JacWork, Lu, MassRenewal, MechanicalSystem, OdeError, OdeStats,
-    OdeSystem,
+    mechanical_state, rhs_err, Clamp, Counted, JacWork, Lu, MassRenewal, MechanicalSystem,
+    OdeError, OdeFailure, OdeStats, OdeSystem,
 };
 use nalgebra::{DMatrix, DVector};
+
+/// Runs `integrate(corrector, dim, y0)` with the first-order corrector of `sys` and `y0` as given:
+/// the entry points of the first-order form.
+pub(super) fn in_first_order<S: OdeSystem>(
+    sys: &mut S,
+    y0: &DVector<f64>,
+    integrate: impl FnOnce(&mut FirstOrder<'_, S>, usize, &DVector<f64>) -> Result<OdeStats, OdeFailure>,
+) -> Result<OdeStats, OdeFailure> {
+    let n = sys.dim();
+    integrate(&mut FirstOrder::new(sys), n, y0)
+}
+
+/// Runs `integrate(corrector, 2n, [q0; q̇0])` with the second-order corrector of `sys` (`M`
+/// renewed as `renewal` says): the entry points of the second-order form.
+pub(super) fn in_second_order<S: MechanicalSystem>(
+    sys: &mut S,
+    (q0, qd0): (&DVector<f64>, &DVector<f64>),
+    renewal: MassRenewal,
+    integrate: impl FnOnce(
+        &mut SecondOrder<'_, S>,
+        usize,
+        &DVector<f64>,
+    ) -> Result<OdeStats, OdeFailure>,
+) -> Result<OdeStats, OdeFailure> {
+    let n = sys.dim();
+    let y0 = mechanical_state(n, q0, qd0)?;
+    integrate(&mut SecondOrder::new(sys, renewal), 2 * n, &y0)
+}
 
 /// One Newton iteration of the NDF corrector and what it needs (see the module documentation).
 pub(super) trait Corrector {

@@ -4,11 +4,11 @@
 //! first-order system `y' = f(t, y)` ([`integrate_fixed`]) or, with the NDF's second-order
 //! corrector, for a mechanical system `M(q) q̈ = τ` ([`integrate_fixed_second_order`]).
 
-use super::corrector::{Corrector, FirstOrder, SecondOrder};
+use super::corrector::{in_first_order, in_second_order, Corrector};
 use super::galpha::MechanicalSystem;
 use super::{
-    check_common, deliver, invalid, mechanical_state, ulp, Clamp, FixedStepOptions, OdeError,
-    OdeFailure, OdeStats, OdeSystem, Output,
+    check_common, deliver, invalid, ulp, Clamp, FixedStepOptions, OdeError, OdeFailure, OdeStats,
+    OdeSystem, Output,
 };
 use nalgebra::DVector;
 
@@ -96,17 +96,9 @@ pub fn integrate_fixed<S: OdeSystem>(
     opts: &FixedStepOptions,
     output: &mut Output<'_>,
 ) -> Result<OdeStats, OdeFailure> {
-    let n = sys.dim();
-    integrate(
-        &mut FirstOrder::new(sys),
-        n,
-        t0,
-        y0,
-        t_out,
-        breakpoints,
-        opts,
-        output,
-    )
+    in_first_order(sys, y0, |cs, n, y0| {
+        integrate(cs, n, t0, y0, t_out, breakpoints, opts, output)
+    })
 }
 
 /// [`integrate_fixed`] for a mechanical system `M(q) q̈ = τ(t, q, q̇)` in second-order form, with the
@@ -114,9 +106,10 @@ pub fn integrate_fixed<S: OdeSystem>(
 /// but Newton runs as the NDF's second-order corrector — each iteration one residual `ε = M q̈ − τ`
 /// and a solve with the `n × n` matrix `S = M + βD + β²K` ([`MechanicalSystem::iteration_parts`]),
 /// `M` renewed at the predicted configuration after a slow contraction (`ρ > 0.2`) or a failed
-/// iteration, before `D` and `K` are (or at every attempt: `opts.mass_renewal`). The first-order form's Jacobian `[0 I; −M⁻¹K −M⁻¹D]` keeps
-/// `M` of the configuration where it was evaluated; on the six-tendon arm released under gravity
-/// (1 s, h = 0.01 / 0.002 s) its Newton failed 465 / 298 times. `output` receives `[q; q̇]`.
+/// iteration, before `D` and `K` are (or at every attempt: `opts.mass_renewal`). The first-order
+/// form's Jacobian `[0 I; −M⁻¹K −M⁻¹D]` keeps `M` of the configuration where it was evaluated; on
+/// the six-tendon arm released under gravity (1 s, h = 0.01 / 0.002 s) its Newton failed 465 /
+/// 298 times. `output` receives `[q; q̇]`.
 #[allow(clippy::too_many_arguments)]
 pub fn integrate_fixed_second_order<S: MechanicalSystem>(
     sys: &mut S,
@@ -128,18 +121,9 @@ pub fn integrate_fixed_second_order<S: MechanicalSystem>(
     opts: &FixedStepOptions,
     output: &mut Output<'_>,
 ) -> Result<OdeStats, OdeFailure> {
-    let n = sys.dim();
-    let y0 = mechanical_state(n, q0, qd0)?;
-    integrate(
-        &mut SecondOrder::new(sys, opts.mass_renewal),
-        2 * n,
-        t0,
-        &y0,
-        t_out,
-        breakpoints,
-        opts,
-        output,
-    )
+    in_second_order(sys, (q0, qd0), opts.mass_renewal, |cs, n, y0| {
+        integrate(cs, n, t0, y0, t_out, breakpoints, opts, output)
+    })
 }
 
 #[allow(clippy::too_many_arguments)]

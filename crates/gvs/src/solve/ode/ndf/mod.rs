@@ -2,11 +2,11 @@
 //! differences), after `ode15s` (Shampine & Reichelt 1997). The formulas are in the documentation
 //! of the parent module.
 
-use super::corrector::{Corrector, FirstOrder, SecondOrder};
+use super::corrector::{in_first_order, in_second_order, Corrector};
 use super::scaled_norm::ScaledNorm;
 use super::{
-    check_common, check_tolerances, deliver, invalid, mechanical_state, ulp, Clamp, ErrorNorm,
-    MechanicalSystem, NdfOptions, OdeError, OdeFailure, OdeStats, OdeSystem, Output,
+    check_common, check_tolerances, deliver, invalid, ulp, Clamp, ErrorNorm, MechanicalSystem,
+    NdfOptions, OdeError, OdeFailure, OdeStats, OdeSystem, Output,
 };
 use nalgebra::DVector;
 
@@ -138,17 +138,9 @@ pub fn integrate_ndf<S: OdeSystem>(
     opts: &NdfOptions,
     output: &mut Output<'_>,
 ) -> Result<OdeStats, OdeFailure> {
-    let n = sys.dim();
-    integrate(
-        &mut FirstOrder::new(sys),
-        n,
-        t0,
-        y0,
-        t_out,
-        breakpoints,
-        opts,
-        output,
-    )
+    in_first_order(sys, y0, |cs, n, y0| {
+        integrate(cs, n, t0, y0, t_out, breakpoints, opts, output)
+    })
 }
 
 /// [`integrate_ndf`] for a mechanical system `M(q) q̈ = τ(t, q, q̇)` in second-order form, with the
@@ -167,18 +159,9 @@ pub fn integrate_ndf_second_order<S: MechanicalSystem>(
     opts: &NdfOptions,
     output: &mut Output<'_>,
 ) -> Result<OdeStats, OdeFailure> {
-    let n = sys.dim();
-    let y0 = mechanical_state(n, q0, qd0)?;
-    integrate(
-        &mut SecondOrder::new(sys, opts.mass_renewal),
-        2 * n,
-        t0,
-        &y0,
-        t_out,
-        breakpoints,
-        opts,
-        output,
-    )
+    in_second_order(sys, (q0, qd0), opts.mass_renewal, |cs, n, y0| {
+        integrate(cs, n, t0, y0, t_out, breakpoints, opts, output)
+    })
 }
 
 #[allow(clippy::too_many_arguments)]
