@@ -246,15 +246,16 @@ pub fn integrator_record(
             "mass_renewal": renewal(o.mass_renewal),
             "max_steps": o.max_steps,
         }),
-        Method::Fixed(o) => json!({
-            "h": o.h, "newton_tol": o.newton_tol, "max_newton": o.max_newton,
-            "form": if o.second_order && options.jacobian == OdeJacobian::Structured {
-                "second_order"
+        Method::Fixed(o) => {
+            let mut v = json!({"h": o.h, "newton_tol": o.newton_tol, "max_newton": o.max_newton});
+            if o.second_order && options.jacobian == OdeJacobian::Structured {
+                v["form"] = json!("second_order");
+                v["mass_renewal"] = json!(renewal(o.mass_renewal));
             } else {
-                "first_order"
-            },
-            "mass_renewal": renewal(o.mass_renewal),
-        }),
+                v["form"] = json!("first_order");
+            }
+            v
+        }
         Method::GeneralizedAlpha(o) => json!({
             "rtol": o.rtol, "atol": o.atol, "rho_inf": o.rho_inf,
             "error_norm": norm(o.error_norm), "max_steps": o.max_steps,

@@ -297,7 +297,9 @@ fn advance<C: Corrector>(
                 st.jac_fresh = false;
             }
             // a cheaper remedy first (the second-order form: `M` at the predicted configuration)
-            Newton::Stalled if cs.renew_cheaply() => {
+            // (only after an iteration ran: a singular matrix the remedy never reached would be
+            // refactored unchanged, for ever)
+            Newton::Stalled if st.lu_ok && cs.renew_cheaply() => {
                 cs.stats().failed_steps += 1;
                 cs.stats().newton_failures += 1;
             }
@@ -394,6 +396,9 @@ fn newton<C: Corrector>(
         };
         if converged {
             st.rate = rate;
+            // the rate in use, inflated where it was carried over: it renews `M` more often than
+            // the rate measured in this step would (six-tendon under gravity, h = 2 ms: 89 failed
+            // attempts against 463)
             cs.converged(rate.unwrap_or(0.0));
             return Ok(Newton::Converged);
         }

@@ -214,7 +214,7 @@ impl Work {
             eps: v(),
             e: v(),
             me: v(),
-            parts: Parts::new(n, norm),
+            parts: Parts::new(n, norm, false),
             out: DVector::zeros(2 * n),
         }
     }

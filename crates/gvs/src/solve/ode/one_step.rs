@@ -110,7 +110,9 @@ pub(super) struct Parts {
 }
 
 impl Parts {
-    pub(super) fn new(n: usize, norm: ErrorNorm) -> Self {
+    /// `newton_stiffness`: the Newton test also weighs the stiffness norm
+    /// ([`Self::newton_weighted`], with the mass norm only).
+    pub(super) fn new(n: usize, norm: ErrorNorm, newton_stiffness: bool) -> Self {
         let mat = || DMatrix::zeros(n, n);
         Parts {
             m: mat(),
@@ -119,7 +121,7 @@ impl Parts {
             lu: Lu::new(n),
             lu_h: None,
             mnorm: (norm == ErrorNorm::Mass).then(|| ScaledNorm::new(n)),
-            knorm: (norm == ErrorNorm::Mass).then(|| ScaledNorm::new(n)),
+            knorm: (norm == ErrorNorm::Mass && newton_stiffness).then(|| ScaledNorm::new(n)),
             m_count: 0,
             current: false,
         }
@@ -401,7 +403,7 @@ mod tests {
         let x = DVector::from_column_slice(&[1.0, 1e-3]);
         let zero = DVector::zeros(2);
         let mut stats = OdeStats::default();
-        let mut parts = Parts::new(2, ErrorNorm::Mass);
+        let mut parts = Parts::new(2, ErrorNorm::Mass, true);
         parts.eval(&mut sys, 0.0, &x, &zero, &mut stats).unwrap();
         // M̂ = I; K̂ = K·2/tr K = diag(2/(1+10⁶), 2·10⁶/(1+10⁶))
         let kh = [2.0 / (1.0 + 1e6), 2e6 / (1.0 + 1e6)];
@@ -432,7 +434,7 @@ mod tests {
             / parts.weighted(&dv, &x, &x, rtol, atol);
         assert!(ratio > 50.0, "{ratio}");
         // componentwise: each coordinate is already held to its own size, nothing is added
-        let mut parts = Parts::new(2, ErrorNorm::Componentwise);
+        let mut parts = Parts::new(2, ErrorNorm::Componentwise, true);
         parts.eval(&mut sys, 0.0, &x, &zero, &mut stats).unwrap();
         let (w, n) = (
             parts.weighted(&dv, &x, &x, rtol, atol),

@@ -62,13 +62,21 @@ impl ScaledNorm {
             return; // keep the last one
         }
         self.set_once = true;
-        self.l.copy_from(mass);
-        self.l *= mass.nrows() as f64 / tr;
+        // the symmetric part (a tangent stiffness with friction or a follower load is not
+        // symmetric; `xᵀAx` sees only its symmetric part), scaled
+        let scale = mass.nrows() as f64 / tr;
+        let symmetric = |l: &mut DMatrix<f64>| {
+            for j in 0..l.ncols() {
+                for i in 0..l.nrows() {
+                    l[(i, j)] = 0.5 * scale * (mass[(i, j)] + mass[(j, i)]);
+                }
+            }
+        };
+        symmetric(&mut self.l);
         // the mass matrix's own (blocked) factorization: `L` in the lower triangle
         self.chol = cholesky_factor_in_place(&mut self.l).is_ok();
         if !self.chol {
-            self.l.copy_from(mass);
-            self.l *= mass.nrows() as f64 / tr;
+            symmetric(&mut self.l);
         }
     }
 
@@ -151,6 +159,28 @@ mod tests {
         assert!(!mn.chol);
         for x in [[1.0, 1.0], [1.0, -1.0]] {
             assert!((mn.half(&x) - direct(&mass, &x)).abs() < 1e-14, "{x:?}");
+        }
+    }
+
+    #[test]
+    fn a_non_symmetric_matrix_is_measured_by_its_symmetric_part_whichever_triangle_holds_it() {
+        // a tangent stiffness with friction or a follower load: xᵀAx sees (A + Aᵀ)/2 only
+        let upper = DMatrix::from_row_slice(2, 2, &[2.0, 2.0, 0.0, 2.0]);
+        let lower = upper.transpose();
+        let sym = (&upper + &lower) * 0.5;
+        for x in [[1.0, 0.3], [0.2, -1.0], [1.0, -1.0]] {
+            let norms: Vec<f64> = [&upper, &lower, &sym]
+                .iter()
+                .map(|a| {
+                    let mut n = ScaledNorm::new(2);
+                    n.set(a, 0);
+                    n.half(&x)
+                })
+                .collect();
+            let want = direct(&sym, &x);
+            for got in &norms {
+                assert!((got - want).abs() < 1e-14, "{x:?}: {norms:?} vs {want}");
+            }
         }
     }
 }

@@ -171,7 +171,7 @@ impl Work {
             eq: v(),
             ev: v(),
             tmp: v(),
-            parts: Parts::new(n, norm),
+            parts: Parts::new(n, norm, true),
             out: DVector::zeros(2 * n),
         }
     }

@@ -385,3 +385,52 @@ fn second_order_form_takes_the_same_bdf2_steps_as_the_first_order_form() {
         assert!((ys2[60][0] - ys2[30][0]).abs() > 0.1, "{:?}", ys2[60]);
     }
 }
+
+/// A singular iteration matrix (`M = D = K = 0`) ends both second-order integrators with an
+/// error: the cheap remedy (renewing `M`) is not retried for ever on a matrix it never reached
+/// (it was, until a review on 2026-12-06 found the loop).
+#[test]
+fn a_singular_iteration_matrix_stops_the_second_order_forms_instead_of_looping() {
+    use super::tests_galpha::Oscillators;
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let singular = || Oscillators {
+            m: 0.0,
+            c: 0.0,
+            k: vec![0.0],
+            f_after: 1.0,
+            t_step: 0.0,
+        };
+        let (q0, v0) = (DVector::from_element(1, 0.0), DVector::from_element(1, 0.0));
+        let t = [0.0, 0.1];
+        let mut out = |_: f64, _: &DVector<f64>| std::ops::ControlFlow::Continue(());
+        let fixed = integrate_fixed_second_order(
+            &mut singular(),
+            0.0,
+            &q0,
+            &v0,
+            &t,
+            &[],
+            &opts(0.01),
+            &mut out,
+        )
+        .map_err(|f| f.error);
+        let ndf = integrate_ndf_second_order(
+            &mut singular(),
+            0.0,
+            &q0,
+            &v0,
+            &t,
+            &[],
+            &NdfOptions::default(),
+            &mut out,
+        )
+        .map_err(|f| f.error);
+        tx.send((fixed.is_err(), ndf.is_err(), format!("{fixed:?} / {ndf:?}")))
+            .unwrap();
+    });
+    let (fixed, ndf, what) = rx
+        .recv_timeout(std::time::Duration::from_secs(30))
+        .expect("an integrator with a singular iteration matrix did not return within 30 s");
+    assert!(fixed && ndf, "{what}");
+}

@@ -411,7 +411,9 @@ fn integrate_piece<C: Corrector>(
                 // the current one is stale, else a smaller step.
                 cs.stats().failed_steps += 1;
                 cs.stats().newton_failures += 1;
-                if !nonfinite && cs.renew_cheaply() {
+                // (only after an iteration ran: a singular matrix the remedy never reached
+                // would be refactored unchanged, for ever)
+                if !nonfinite && lu_ok && cs.renew_cheaply() {
                     // retry the step with the cheap remedy first
                 } else if !nonfinite && !jcurrent {
                     if !cs.refresh(t, &w.y, &w.thresh)? {
