@@ -61,8 +61,8 @@ pub struct NdfOptions {
     pub max_step: f64,
     /// Maximum number of successful steps (default 1 000 000).
     pub max_steps: usize,
-    /// How local errors (and Newton corrections) are measured (default componentwise, as
-    /// `ode15s`).
+    /// How local errors are measured (default componentwise, as `ode15s`; Newton corrections
+    /// are measured componentwise with either).
     pub error_norm: ErrorNorm,
     /// When the second-order form renews the mass matrix of its iteration matrix (default
     /// [`MassRenewal::WhenSlow`]; the first-order form ignores it).
@@ -97,7 +97,11 @@ pub enum ErrorNorm {
     /// state (`atol` as a floor): the mass-weighted displacement of the cross-sections, not
     /// each coordinate. A high-frequency mode that moves little mass (shear, elongation, a
     /// coordinate at the tip) does not force the step to resolve it; with an A-stable order
-    /// (`max_order ≤ 2`) the method damps it instead.
+    /// (`max_order ≤ 2`) the method damps it instead. The NDF's Newton test stays componentwise:
+    /// the damping holds only where the corrector equation is solved, and with a mass-norm Newton
+    /// test an undamped rod falling under gravity gained 164 % of its largest kinetic energy
+    /// (SDIRK4 and generalized-α measure their Newton corrections in their own ways, see
+    /// `one_step::Parts::newton_weighted`).
     Mass,
 }
 

@@ -342,13 +342,9 @@ fn integrate_piece<C: Corrector>(
                 }
                 w.ynew.copy_from(&w.pred);
                 w.difkp1.fill(0.0);
-                let minnrm = 100.0
-                    * f64::EPSILON
-                    * if w.mass_norm {
-                        w.pred_norm // ynew = y⁽⁰⁾ here
-                    } else {
-                        w.norm(&w.ynew)
-                    };
+                // Newton is measured componentwise whatever the error test's norm (see
+                // `Work::newton_norm`)
+                let minnrm = 100.0 * f64::EPSILON * w.newton_norm(&w.ynew);
 
                 let mut converged = false;
                 let mut nonfinite = false;
@@ -365,7 +361,7 @@ fn integrate_piece<C: Corrector>(
                             break;
                         }
                         cs.stats().newton_iterations += 1;
-                        let newnrm = w.norm(&w.del);
+                        let newnrm = w.newton_norm(&w.del);
                         w.difkp1 += &w.del;
                         w.ynew.copy_from(&w.pred);
                         w.ynew += &w.difkp1;
