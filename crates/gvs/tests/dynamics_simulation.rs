@@ -12,10 +12,12 @@ use gvs::inputs::Signal;
 use gvs::loads::Loads;
 use gvs::model::Model;
 use gvs::rod::SectionProps;
-use gvs::solve::dynamics::{simulate, InitialState, IntegratorOptions, Method, OdeJacobian};
+use gvs::solve::dynamics::{
+    fixed_step_in_second_order, simulate, InitialState, IntegratorOptions, Method, OdeJacobian,
+};
 use gvs::solve::ode::{FixedStepOptions, NdfOptions};
 use gvs::solve::statics::{solve_statics, StaticsOptions};
-use gvs::strain::{DivisionBasis, LinearBasis};
+use gvs::strain::{DivisionBasis, LinearBasis, SigmoidBend, StrainParam};
 use nalgebra::DVector;
 use std::f64::consts::PI;
 
@@ -247,6 +249,81 @@ fn fixed_step_method_tracks_the_adaptive_solution() {
         .fold(0.0, f64::max);
     // BDF2 with h = 1 ms on a motion with a ~0.05 s time scale: O(h²) ≈ 1e-4 relative of 0.1 m
     assert!(dz < 2e-4, "max tip distance fixed vs adaptive {dz:e} m");
+}
+
+/// Runs `m` from `initial` for 0.1 s with the fixed step `h = 2 ms` in the form `second_order`
+/// asks for; the trajectory's `q`.
+fn fixed_run<P: StrainParam>(
+    m: &Model<P>,
+    initial: &InitialState,
+    second_order: bool,
+) -> Vec<DVector<f64>> {
+    let opts = IntegratorOptions {
+        method: Method::Fixed(FixedStepOptions {
+            h: 2e-3,
+            second_order,
+            ..FixedStepOptions::default()
+        }),
+        jacobian: OdeJacobian::Structured,
+    };
+    let u = vec![0.0; m.n_actuators()];
+    let sim = simulate(
+        m,
+        &Signal::constant(&u),
+        &gravity(),
+        None,
+        initial,
+        &samples(0.1, 10),
+        &opts,
+    )
+    .unwrap();
+    assert!(sim.error.is_none(), "{:?}", sim.error);
+    sim.trajectory.q
+}
+
+#[test]
+fn a_nonlinear_strain_parameterization_runs_the_fixed_step_in_first_order_form() {
+    // a decoder's reduced model jumped to a spurious root in the second-order form: the driver
+    // keeps the first-order form for any nonlinear parameterization, whatever the options say
+    let rod = common::iva_rod(1e4);
+    let disc =
+        Discretization::new(&rod, &[Quadrature::Gauss { n: 12 }], MagnusOrder::Z4, &[]).unwrap();
+    let p = SigmoidBend::new(&disc);
+    let sigmoid = Model::new(rod, disc, p, vec![]).unwrap();
+    let given = InitialState::Given {
+        q: DVector::from_vec(vec![1.2, 7.0, 0.4]),
+        qd: DVector::zeros(3),
+    };
+    assert!(!fixed_step_in_second_order(
+        &sigmoid,
+        &FixedStepOptions::default()
+    ));
+    let (asked_second, first) = (
+        fixed_run(&sigmoid, &given, true),
+        fixed_run(&sigmoid, &given, false),
+    );
+    assert!(
+        (&first[10] - &first[0]).amax() > 1e-3,
+        "the rod does not move: the test is vacuous"
+    );
+    for (a, b) in asked_second.iter().zip(&first) {
+        assert_eq!(a, b, "the same form, the same iterates");
+    }
+    // a linear basis does run the two forms (the same discrete solution, reached otherwise)
+    let linear = arm(1e4, 0.0);
+    assert!(fixed_step_in_second_order(
+        &linear,
+        &FixedStepOptions::default()
+    ));
+    let (second, first) = (
+        fixed_run(&linear, &InitialState::Rest, true),
+        fixed_run(&linear, &InitialState::Rest, false),
+    );
+    let differ = second.iter().zip(&first).any(|(a, b)| a != b);
+    assert!(
+        differ,
+        "the two forms gave identical iterates on a linear basis"
+    );
 }
 
 /// Free vibration of a uniform clamped rod (spec §10.5) started in a single eigenmode; the period is

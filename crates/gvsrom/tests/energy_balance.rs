@@ -130,7 +130,10 @@ fn the_ndf_on_an_undamped_arm_gains_no_energy_at_its_default_tolerance() {
             "ndf",
         ],
     );
-    assert!(stdout.contains("NDF orders ≤ 2 with the mass-norm error test"), "{stdout}");
+    assert!(
+        stdout.contains("NDF orders ≤ 2 with the mass-norm error test"),
+        "{stdout}"
+    );
     let (_, gain, _, kinetic) = balance(&meta);
     assert!(kinetic > 1e-3, "{kinetic}");
     assert!(gain < 3e-3 * kinetic, "+{gain} J of {kinetic} J\n{stdout}");

@@ -342,6 +342,17 @@ pub struct RunSummary {
     pub error: Option<OdeError>,
 }
 
+/// Whether [`simulate`] runs the fixed-step method of `options` on `model` in second-order form
+/// (with the structured Jacobian): as [`FixedStepOptions::second_order`] asks, except for a
+/// nonlinear strain parameterization (a decoder's reduced model), which always runs in the
+/// first-order form (see that field: the second-order Newton jumped to a spurious root there).
+pub fn fixed_step_in_second_order<P: StrainParam>(
+    model: &Model<P>,
+    options: &FixedStepOptions,
+) -> bool {
+    options.second_order && model.param.is_linear()
+}
+
 /// Simulates `model` under actuation `actuation(t)` and `loads` scaled by `load_scale(t)` (1 if
 /// `None`) from `initial`, sampling at `t_out` (ascending, the first is the start time), and keeps
 /// the samples in memory. See [`simulate_streaming`] for runs too long to hold.
@@ -526,16 +537,18 @@ pub fn simulate_streaming_interruptible<P: StrainParam>(
             _ => integrate_ndf(&mut sys, t0, &y0, t_out, &breaks, o, &mut record),
         },
         Method::Fixed(o) => match options.jacobian {
-            OdeJacobian::Structured if o.second_order => integrate_fixed_second_order(
-                &mut sys,
-                t0,
-                &q0,
-                &qd0,
-                t_out,
-                &breaks,
-                o,
-                &mut record,
-            ),
+            OdeJacobian::Structured if fixed_step_in_second_order(model, o) => {
+                integrate_fixed_second_order(
+                    &mut sys,
+                    t0,
+                    &q0,
+                    &qd0,
+                    t_out,
+                    &breaks,
+                    o,
+                    &mut record,
+                )
+            }
             _ => integrate_fixed(&mut sys, t0, &y0, t_out, &breaks, o, &mut record),
         },
         Method::GeneralizedAlpha(o) => {

@@ -141,11 +141,13 @@ pub struct FixedStepOptions {
     pub mass_renewal: MassRenewal,
     /// Whether the dynamics driver ([`crate::solve::dynamics::simulate`]) runs a mechanical system
     /// in second-order form (default `true`, with the structured Jacobian). `false` keeps the
-    /// first-order form with the approximate Jacobian `[0 I; −M⁻¹K −M⁻¹D]`: for a decoder's
-    /// reduced model, whose `M(q)` is nearly singular where the decoder flattens, the
-    /// second-order Newton from the linear predictor jumped to a spurious far root (IV-C2's
-    /// AE-7 from rest, h = 0.01 s: left its training region at t = 0.02 s), while the first-order
-    /// form stays within 1.3 mm of the adaptive run's tip over 3 s of random steps.
+    /// first-order form with the approximate Jacobian `[0 I; −M⁻¹K −M⁻¹D]`. The driver keeps the
+    /// first-order form for a nonlinear strain parameterization whatever this says
+    /// ([`crate::solve::dynamics::fixed_step_in_second_order`]): for a decoder's reduced model,
+    /// whose `M(q)` is nearly singular where the decoder flattens, the second-order Newton from
+    /// the linear predictor jumped to a spurious far root (IV-C2's AE-7 from rest, h = 0.01 s:
+    /// left its training region at t = 0.02 s), while the first-order form stays within 1.3 mm
+    /// of the adaptive run's tip over 3 s of random steps.
     pub second_order: bool,
 }
 
