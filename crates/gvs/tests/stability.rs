@@ -190,6 +190,21 @@ fn a_soft_cantilever_under_gravity_hangs_down_rather_than_curls_up() {
     let sol = solve_statics(&m, &[], &loads, None, &unchecked).unwrap();
     assert!(tip_z(&sol.q) > 0.1, "tip z {}", tip_z(&sol.q));
     assert_eq!((sol.divergence, sol.continuation.is_none()), (None, true));
+    // the same solve checked (no continuation) judged the curled equilibrium with one evaluation
+    // of ∂R/∂q more (the last dogleg Jacobian's screen did not pass it): counted in its work
+    let unchecked_one_step = StaticsOptions {
+        check_stability: false,
+        ..one_step
+    };
+    let same = solve_statics(&m, &[], &loads, None, &unchecked_one_step).unwrap();
+    assert_eq!(same.q, curled.q);
+    assert_eq!(
+        curled.jacobian_evaluations,
+        same.jacobian_evaluations + 1,
+        "checked {} against unchecked {}",
+        curled.jacobian_evaluations,
+        same.jacobian_evaluations
+    );
 }
 
 /// Beck's column (1952): a cantilever under a compressive *follower* force `P` at its tip keeps its

@@ -394,7 +394,12 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                             // the continuation ran (to λ = 1) after this equilibrium diverged
                             first.continuation = total.continuation.clone();
                             first.unstable_start = total.unstable_start;
-                            first.divergence = self.divergence(&first.q, u, loads)?;
+                            first.divergence = self.divergence(
+                                &first.q,
+                                u,
+                                loads,
+                                &mut first.jacobian_evaluations,
+                            )?;
                             if first.divergence.is_some() {
                                 let at = first.q.clone();
                                 if let Some(x) = self.leave_along_divergent_mode(
@@ -419,7 +424,7 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                 }
             }
             total.divergence = if self.options.check_stability {
-                self.divergence_screened(&q, u, loads)?
+                self.divergence_screened(&q, u, loads, &mut total.jacobian_evaluations)?
             } else {
                 None
             };
@@ -474,6 +479,8 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
         stop: &StopCheck<'_>,
     ) -> Result<Option<DVector<f64>>, StaticsError> {
         let prepared = self.model.prepare_loads(loads)?;
+        // the modes evaluate `∂R/∂q` (and `M`) at `q`
+        total.jacobian_evaluations += 1;
         let Some((w2, phi)) =
             super::stability::divergent_mode(self.model, q, u, &prepared, &mut self.ws)
         else {
@@ -505,7 +512,8 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                     total.jacobian_evaluations += rep.jacobian_evaluations;
                     // the exact test: the dogleg's Jacobian, if the polish took no step, is
                     // an earlier solve's at another point
-                    if self.divergence(&rep.x, u, loads)?.is_none() {
+                    let jacobians = &mut total.jacobian_evaluations;
+                    if self.divergence(&rep.x, u, loads, jacobians)?.is_none() {
                         total.buckled = Some(w2);
                         total.divergence = None;
                         total.residual_norm = rep.residual_norm;
@@ -588,26 +596,31 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
     /// with the last dogleg solve's Jacobian (at `q`, Broyden-updated): when its tangent stiffness
     /// has a positive definite symmetric part, the equilibrium is taken as stable without
     /// evaluating `∂R/∂q` again (that evaluation cost as much as the rest of a solve on the
-    /// presets). Call it right after the dogleg converged at `q`.
+    /// presets). Call it right after the dogleg converged at `q`. `jacobians` counts the
+    /// evaluation if there is one.
     fn divergence_screened(
         &mut self,
         q: &DVector<f64>,
         u: &[f64],
         loads: &Loads,
+        jacobians: &mut usize,
     ) -> Result<Option<f64>, StaticsError> {
         if super::stability::surely_stable(self.dws.jacobian()) {
             return Ok(None);
         }
-        self.divergence(q, u, loads)
+        self.divergence(q, u, loads, jacobians)
     }
 
-    /// [`super::stability::divergence_at`] at the equilibrium `q` of the full load.
+    /// [`super::stability::divergence_at`] at the equilibrium `q` of the full load (one evaluation
+    /// of `∂R/∂q`, added to `jacobians`).
     fn divergence(
         &mut self,
         q: &DVector<f64>,
         u: &[f64],
         loads: &Loads,
+        jacobians: &mut usize,
     ) -> Result<Option<f64>, StaticsError> {
+        *jacobians += 1;
         let prepared = self.model.prepare_loads(loads)?;
         Ok(super::stability::divergence_at(
             self.model,
