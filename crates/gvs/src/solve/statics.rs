@@ -49,6 +49,8 @@ pub struct StaticsSolution {
     pub iterations: usize,
     /// Residual evaluations, those of forward-difference Jacobians included.
     pub residual_evaluations: usize,
+    /// Evaluations of `∂R/∂q`, by forward differences or analytic: the solver's, the
+    /// continuation's and the descent's, and the stability check's (which costs no residual).
     pub jacobian_evaluations: usize,
     /// `‖R(q)‖∞` at the solution [generalized force units].
     pub residual_norm: f64,
@@ -394,12 +396,7 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                             // the continuation ran (to λ = 1) after this equilibrium diverged
                             first.continuation = total.continuation.clone();
                             first.unstable_start = total.unstable_start;
-                            first.divergence = self.divergence(
-                                &first.q,
-                                u,
-                                loads,
-                                &mut first.jacobian_evaluations,
-                            )?;
+                            // (`first.divergence` is the exact check's at `first.q`)
                             if first.divergence.is_some() {
                                 let at = first.q.clone();
                                 if let Some(x) = self.leave_along_divergent_mode(
@@ -508,7 +505,13 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
             match self.stage(u.to_vec(), prepared.clone(), &end, opts) {
                 Ok(rep) => {
                     total.iterations += rep.iterations;
-                    total.residual_evaluations += rep.residual_evaluations;
+                    // the differences' residuals included, as in `solve`
+                    total.residual_evaluations += rep.residual_evaluations
+                        + if self.differences() {
+                            self.model.n_dof() * rep.jacobian_evaluations
+                        } else {
+                            0
+                        };
                     total.jacobian_evaluations += rep.jacobian_evaluations;
                     // the exact test: the dogleg's Jacobian, if the polish took no step, is
                     // an earlier solve's at another point

@@ -161,7 +161,8 @@ pub fn choose_integrator(
     let method = match (choice.fixed_step, choice.method) {
         (Some(h), _) => Method::Fixed(FixedStepOptions {
             h,
-            // a decoder's M(q): see `FixedStepOptions::second_order`
+            // a decoder's M(q): see `FixedStepOptions::second_order`; the same test as the
+            // driver's `fixed_step_in_second_order`, which `integrator_record`'s `form` relies on
             second_order: !decoder,
             ..FixedStepOptions::default()
         }),

@@ -90,7 +90,8 @@ pub enum OdeJacobian {
     /// ([`super::ode::integrate_ndf_second_order`]): each Newton iteration is one recursive
     /// residual `M q̈ − τ` ([`Model::dynamics_residual`]) and an `n × n` solve; so does the
     /// fixed-step method ([`super::ode::integrate_fixed_second_order`]) unless its options say
-    /// otherwise (`FixedStepOptions::second_order`), when it uses the first-order form with
+    /// otherwise (`FixedStepOptions::second_order`) or the strain parameterization is nonlinear
+    /// ([`fixed_step_in_second_order`]), when it uses the first-order form with
     /// `[0 I; −M⁻¹K_T −M⁻¹D]` ([`Model::ode_jacobian_approx`]).
     #[default]
     Structured,
