@@ -285,7 +285,6 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
             buckled: None,
             descent_steps: 0,
         };
-        let differences = self.differences();
         let mut lambda = 0.0;
         let mut inc = 1.0 / self.options.ramp_steps as f64;
         // ‖R‖∞ and its tolerance at the end of the last stage (converged or not)
@@ -333,13 +332,7 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
                 match self.stage(u_l, loads_l, &q, &opts) {
                     Ok(rep) => {
                         total.iterations += rep.iterations;
-                        // the differences' residuals included
-                        total.residual_evaluations += rep.residual_evaluations
-                            + if differences {
-                                n * rep.jacobian_evaluations
-                            } else {
-                                0
-                            };
+                        total.residual_evaluations += self.residuals_of(&rep);
                         total.jacobian_evaluations += rep.jacobian_evaluations;
                         total.residual_norm = rep.residual_norm;
                         last_tolerance = self.options.ftol * self.ws.residual_scale;
@@ -505,13 +498,7 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
             match self.stage(u.to_vec(), prepared.clone(), &end, opts) {
                 Ok(rep) => {
                     total.iterations += rep.iterations;
-                    // the differences' residuals included, as in `solve`
-                    total.residual_evaluations += rep.residual_evaluations
-                        + if self.differences() {
-                            self.model.n_dof() * rep.jacobian_evaluations
-                        } else {
-                            0
-                        };
+                    total.residual_evaluations += self.residuals_of(&rep);
                     total.jacobian_evaluations += rep.jacobian_evaluations;
                     // the exact test: the dogleg's Jacobian, if the polish took no step, is
                     // an earlier solve's at another point
@@ -530,6 +517,17 @@ impl<'m, P: StrainParam> StaticsSolver<'m, P> {
             }
         }
         Ok(None)
+    }
+
+    /// The residual evaluations of a load stage, its forward-difference Jacobians' (`n` each)
+    /// included.
+    fn residuals_of(&self, rep: &dogleg::DoglegReport) -> usize {
+        rep.residual_evaluations
+            + if self.differences() {
+                self.model.n_dof() * rep.jacobian_evaluations
+            } else {
+                0
+            }
     }
 
     /// Whether `∂R/∂q` is taken by forward differences ([`StaticsJacobian`]).

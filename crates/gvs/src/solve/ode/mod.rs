@@ -28,9 +28,10 @@
 //! ```
 //!
 //! solved by simplified Newton, `(I − h/((1−κ_k)γ_k) J) Δ = h/((1−κ_k)γ_k) f(t_{n+1}, y⁽ⁱ⁾) − ψ − d⁽ⁱ⁾`,
-//! at most 4 iterations (8 with the mass-norm error test), with the iteration matrix LU-factored once and reused for as long as `h`,
-//! `k` and `J` do not change (across steps). With `ρ = ‖Δ_i‖/‖Δ_{i−1}‖` (in the componentwise norm
-//! below, whichever norm the error test uses: see [`ErrorNorm::Mass`]) the iteration is accepted when
+//! at most 4 iterations (8 with the mass-norm error test), with the iteration matrix LU-factored
+//! once and reused for as long as `h`, `k` and `J` do not change (across steps). With
+//! `ρ = ‖Δ_i‖/‖Δ_{i−1}‖` (in the componentwise norm below, whichever norm the error test uses: see
+//! [`ErrorNorm::Mass`]) the iteration is accepted when
 //! `ρ/(1−ρ)·‖Δ_i‖ ≤ rtol/2` (after one iteration using the previous rate: `≤ rtol/20`), and declared
 //! too slow when `ρ > 0.9` or it cannot reach that within those iterations. Too slow: if `J` was not
 //! evaluated at the current point `(t_n, y_n)` it is re-evaluated there, else `h ← 0.3 h`. The
