@@ -370,6 +370,7 @@ fn integrate_piece<S: MechanicalSystem>(
                 qd,
                 &mut h,
                 &mut fails_here,
+                false,
                 stats,
             )?;
             continue;

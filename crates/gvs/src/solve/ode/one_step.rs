@@ -225,14 +225,37 @@ impl Parts {
         self.lu_h
     }
 
+    /// `M` has been renewed in place (at a stage's configuration, by
+    /// [`MechanicalSystem::residual_and_mass`]): refactors `S = M + c_v D + c_q K` for `h` with the
+    /// `D`, `K` already held. Returns the `h` of the factored `S` (`None`: singular or not finite).
+    pub(super) fn refactor_with_new_mass(
+        &mut self,
+        h: f64,
+        coefficients: impl Fn(f64) -> (f64, f64),
+        stats: &mut OdeStats,
+    ) -> Option<f64> {
+        if !self.m.iter().all(|x| x.is_finite()) {
+            self.lu_h = None;
+            return None;
+        }
+        self.lu_h = None;
+        self.factor_for(h, coefficients, stats)
+    }
+
+    /// The `h` the factored `S` belongs to (`None`: not factored).
+    pub(super) fn factored_for(&self) -> Option<f64> {
+        self.lu_h
+    }
+
     /// `x ← S⁻¹ x` with the factored `S`.
     pub(super) fn solve(&mut self, x: &mut DVector<f64>) {
         self.lu.solve(x);
     }
 
-    /// After a failed attempt (Newton diverged, or `S` singular): renews `M, D, K` at the current
-    /// point `(t, q, q̇)` if they are stale, else cuts `h` by 4; stops after 40 failures in a row,
-    /// naming the tolerances `tol = (rtol, atol)`.
+    /// After a failed attempt (Newton diverged, or `S` singular): unless the caller has a cheaper
+    /// `remedy` for the next attempt (it then retries at the same `h`), renews `M, D, K` at the
+    /// current point `(t, q, q̇)` if they are stale, else cuts `h` by 4; stops after 40 failures in a
+    /// row, naming the tolerances `tol = (rtol, atol)`.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn after_failure<S: MechanicalSystem>(
         &mut self,
@@ -244,6 +267,7 @@ impl Parts {
         qd: &DVector<f64>,
         h: &mut f64,
         fails: &mut usize,
+        remedy: bool,
         stats: &mut OdeStats,
     ) -> Result<(), OdeError> {
         stats.failed_steps += 1;
@@ -255,7 +279,9 @@ impl Parts {
                 tolerances: Some(tol),
             });
         }
-        if self.current {
+        if remedy {
+            // the caller's remedy first, at the same step
+        } else if self.current {
             *h *= 0.25;
         } else {
             self.eval(sys, t_eval, q, qd, stats)?;

@@ -137,7 +137,7 @@ fn run_second(
     (ys, stats)
 }
 
-fn run_first(
+pub(super) fn run_first(
     sys: &mut Bead,
     t_out: &[f64],
     breaks: &[f64],
@@ -160,11 +160,11 @@ fn run_first(
     ys
 }
 
-fn t_out() -> Vec<f64> {
+pub(super) fn t_out() -> Vec<f64> {
     (0..=120).map(|i| i as f64 * 0.05).collect()
 }
 
-fn tight() -> NdfOptions {
+pub(super) fn tight() -> NdfOptions {
     NdfOptions {
         rtol: 1e-9,
         atol: 1e-11,
