@@ -301,12 +301,8 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
             100.0 * e.relative_loss(),
             gvs::error::fmt_sci(e.kinetic_max, 3),
         )?;
-        if e.relative_gain() > gvsrom::simulate::GAIN_NOTE {
-            writeln!(
-                out,
-                "note       the integration added energy that no force supplies ({:.1} % of the largest kinetic energy): the motion is not to be trusted; tighten --rtol and --atol together, or give the rod some damping (material.damping)",
-                100.0 * e.relative_gain()
-            )?;
+        for note in e.notes(["--rtol", "--atol"]) {
+            writeln!(out, "note       {note}")?;
         }
     }
     for o in &outcome.model_extrapolated {
