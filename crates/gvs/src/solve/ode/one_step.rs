@@ -105,7 +105,8 @@ pub(super) struct Parts {
     mnorm: Option<ScaledNorm>,
     knorm: Option<ScaledNorm>,
     m_count: usize,
-    /// `M, D, K` are those of the current point (no step accepted since they were evaluated).
+    /// `D, K` (and `M`, unless a stage renewed it since: [`Self::refactor_with_new_mass`]) are
+    /// those of the current point: no step accepted since they were evaluated.
     pub(super) current: bool,
 }
 
@@ -201,8 +202,8 @@ impl Parts {
     }
 
     /// Factors `S = M + c_v D + c_q K` with `(c_v, c_q) = coefficients(h)` unless it is factored for
-    /// a step within 20 % of `h`; `false` if `S` is singular or not finite. Returns the `h` the
-    /// factored `S` belongs to in `Ok`.
+    /// a step within 20 % of `h`. Returns the `h` the factored `S` belongs to (`None`: `S` is
+    /// singular or not finite).
     pub(super) fn factor_for(
         &mut self,
         h: f64,
@@ -234,10 +235,6 @@ impl Parts {
         coefficients: impl Fn(f64) -> (f64, f64),
         stats: &mut OdeStats,
     ) -> Option<f64> {
-        if !self.m.iter().all(|x| x.is_finite()) {
-            self.lu_h = None;
-            return None;
-        }
         self.lu_h = None;
         self.factor_for(h, coefficients, stats)
     }

@@ -29,19 +29,20 @@
 //! `h` moves more than 20 % from the `h` it was built with. **`M` follows the stages** where it
 //! changes within a step: for [`TRACK_STEPS`] steps after a Newton failure, each stage's first
 //! residual also gives `M(Q_i)` at its predicted configuration (one pass,
-//! [`MechanicalSystem::residual_and_mass`]) and `S` is refactored with it; a failure while `M` was
-//! not followed retries the same step with it before anything else. (On a whipping, undamped rod,
-//! `M` moves enough within a step of a few milliseconds that `S` built with the step's first `M`
-//! contracted by up to 0.54 per iteration, against at most 0.10 with `M(Q_i)`: the spectral radius
-//! of `I − S⁻¹ ∂ε/∂A` at the stages of a 4-element fall, with `∂ε/∂A` by finite differences; `K`
-//! at `Q_i` changed nothing. Following `M` also after a merely slow contraction,
-//! `ρ > 0.2`, cost 18 % more time on the undamped release, where `M` changes slowly.) The predictor of `A_i` extrapolates `q̈`
-//! (from the last step for stage 1, through `q̈_n` and `A_1` for stage 2, by the quadratic through
-//! `q̈_n, A_1, A_2` for the others). A correction `δA` moves `Q_i` by `(hγ)² δA` and, through `V_i`,
-//! the later stages by up to `h·hγ·δA`; that displacement, in the units of the error test (with
-//! [`ErrorNorm::Mass`], also in the stiffness norm: [`Parts::newton_weighted`]), must
-//! satisfy `ρ/(1−ρ)·‖δ_i‖ ≤ κ = 10⁻³` (or `‖δ₀‖ ≤ κ/10` after one iteration), where `ρ` is the
-//! contraction rate; `ρ > 0.9` or 7 iterations fail the step, which re-evaluates `M, D, K` if they
+//! [`MechanicalSystem::residual_and_mass`]) and `S` is refactored with it. (On a whipping,
+//! undamped rod, `M` moves enough within a step of a few milliseconds that `S` built with the
+//! step's first `M` contracted by up to 0.54 per iteration, against at most 0.10 with `M(Q_i)`:
+//! the spectral radius of `I − S⁻¹ ∂ε/∂A` at the stages of a 4-element fall, with `∂ε/∂A` by
+//! finite differences; `K` at `Q_i` changed nothing. Following `M` also after a merely slow
+//! contraction, `ρ > 0.2`, cost 18 % more time on the undamped release, where `M` changes
+//! slowly.) The predictor of `A_i` extrapolates `q̈` (from the last step for stage 1, through
+//! `q̈_n` and `A_1` for stage 2, by the quadratic through `q̈_n, A_1, A_2` for the others). A
+//! correction `δA` moves `Q_i` by `(hγ)² δA` and, through `V_i`, the later stages by up to
+//! `h·hγ·δA`; that displacement, in the units of the error test (with [`ErrorNorm::Mass`], also
+//! in the stiffness norm: [`Parts::newton_weighted`]), must satisfy `ρ/(1−ρ)·‖δ_i‖ ≤ κ = 10⁻³`
+//! (or `‖δ₀‖ ≤ κ/10` after one iteration), where `ρ` is the contraction rate; `ρ > 0.9` or 7
+//! iterations fail the step. A failure while `M` does not follow
+//! the stages retries the same `h` with it following; a later one re-evaluates `M, D, K` if they
 //! are stale and otherwise cuts `h` by 4. (`κ` is small because the embedded estimate overstates
 //! the fourth-order solution's error: with `κ = 10⁻²` the Newton residue dominated the tip error
 //! of the undamped release.)
