@@ -96,14 +96,19 @@ def test_a_load_schedule_release_equals_the_cli(gvsrom_bin, tmp_path):
         robot.simulate(0.05, from_equilibrium=True, load_schedule=str(tmp_path / "missing.csv"))
 
 
+def falling_rod():
+    """The undamped rod of examples/undamped-release.toml without its tip force, falling under
+    gravity, on 4 elements."""
+    return (gvsrom.Scenario.from_toml(os.path.join(EXAMPLES, "undamped-release.toml"))
+            .set("loads.point.0.force", [0.0, 0.0, 0.0])
+            .set("loads.gravity", [0.0, 0.0, -9.81])
+            .set("divisions.0.basis.elements", 4)
+            .set("divisions.0.quadrature.elements", 4)
+            .build())
+
+
 def test_a_conservative_run_reports_its_energy_balance():
-    # the undamped rod of the example without its tip force, falling under gravity
-    robot = (gvsrom.Scenario.from_toml(os.path.join(EXAMPLES, "undamped-release.toml"))
-             .set("loads.point.0.force", [0.0, 0.0, 0.0])
-             .set("loads.gravity", [0.0, 0.0, -9.81])
-             .set("divisions.0.basis.elements", 4)
-             .set("divisions.0.quadrature.elements", 4)
-             .build())
+    robot = falling_rod()
     tr = robot.simulate(0.3, sample_rate=50, rtol=1e-6, atol=1e-9)
     b = tr["energy_balance"]
     assert b["kinetic_max"] > 0.01
@@ -135,31 +140,12 @@ def test_random_steps_and_babbling_equal_the_cli(gvsrom_bin, tmp_path):
         robot.simulate(0.1, steps=[-1.0, 0.0])
 
 
-FALL4 = """
-name = "fall4"
-[material]
-youngs_modulus = 1e6
-poisson_ratio = 0.5
-density = 1000.0
-damping = 0.0
-[[divisions]]
-length = 0.5
-radius = 0.01
-basis = { kind = "fem", modes = ["bend_y", "elongation", "shear_z"], elements = 4, degree = "quadratic" }
-quadrature = { gauss_per_element = 3, elements = 4 }
-[loads]
-gravity = [0.0, 0.0, -9.81]
-"""
-
-
-def test_an_undamped_run_the_integrator_damps_strongly_warns_with_the_balance(tmp_path):
+def test_an_undamped_run_the_integrator_damps_strongly_warns_with_the_balance():
     # an undamped rod falling from horizontal, at a loose tolerance: the L-stable SDIRK4 damps the
     # whip's vibrations its steps do not resolve (the CLI measured 40 % of the largest kinetic
     # energy; it also gained 3.8 %, warned of as well); the result's energy_balance shows it and
     # a warning names the option to tighten, in Python's spelling
-    path = tmp_path / "fall4.toml"
-    path.write_text(FALL4)
-    robot = gvsrom.Scenario.from_toml(str(path)).build()
+    robot = falling_rod()
     with pytest.warns(UserWarning) as caught:
         tr = robot.simulate(2.0, sample_rate=50, method="sdirk", rtol=1e-2)
     messages = [str(w.message) for w in caught]
