@@ -9,7 +9,7 @@ mod division;
 #[cfg(test)]
 mod tests;
 
-pub use division::{DivisionBasis, FemDegree, COORDINATE_ORDER};
+pub use division::{fem_shape, DivisionBasis, FemDegree, COORDINATE_ORDER};
 
 use super::{SiteJacobian, StrainEval, StrainParam};
 use crate::discretize::Discretization;

@@ -22,7 +22,7 @@
 mod bases;
 mod sigmoid;
 
-pub use bases::{DivisionBasis, FemDegree, LinearBasis, COORDINATE_ORDER};
+pub use bases::{fem_shape, DivisionBasis, FemDegree, LinearBasis, COORDINATE_ORDER};
 pub use sigmoid::SigmoidBend;
 
 use crate::lie::V6;

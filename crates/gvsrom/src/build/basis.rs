@@ -1,5 +1,6 @@
 //! Each division's strain basis (Legendre or FEM-like, with its active modes) and quadrature.
 
+use super::fem_points;
 use super::limits::*;
 use crate::error::ScenarioError;
 use crate::scenario::{BasisKind, DivisionSpec, StrainMode};
@@ -128,12 +129,13 @@ pub(super) fn quadrature(
     Ok(quadrature)
 }
 
-/// Refuses a quadrature with fewer points than the basis has functions per strain: the stiffness
-/// `Σ W Φᵀ Es Φ` then has rank at most the number of points and is singular, so the equilibrium
-/// is not unique (zero-energy modes) and the solver returns one of many, silently wrong
-/// (`single-tendon` with 8 Gauss points for its order-10 basis: tip 0.13 m off). Legendre of
-/// highest order `p` needs `p + 1` points in all, FEM of degree `d` `d + 1` per element (its
-/// `d · elements + 1` functions against `g · elements` points).
+/// Refuses a quadrature whose points do not determine the basis: the stiffness `Σ W Φᵀ Es Φ` is
+/// then singular, so the equilibrium is not unique (zero-energy modes) and the solver returns one
+/// of many, silently wrong (`single-tendon` with 8 Gauss points for its order-10 basis: tip 0.13 m
+/// off; a 10-element FEM basis on 5 quadrature elements: the tip a rod's length off, at the
+/// base). Legendre of highest order `p` needs `p + 1` points in all; a FEM basis, points
+/// under which every combination of its functions keeps a tenth of its exact stiffness
+/// ([`fem_points`]; `p + 1` per element when the quadrature's elements are the basis's).
 fn resolves(
     j: usize,
     q: &crate::scenario::QuadratureSpec,
@@ -141,53 +143,64 @@ fn resolves(
     quadrature: &Quadrature,
 ) -> Result<(), ScenarioError> {
     let points = weighted_points(quadrature);
-    let (field, given, needed, why) = match (basis, quadrature) {
-        (DivisionBasis::Legendre { modes, orders }, _) => {
+    let field = match q.gauss {
+        Some(_) => "gauss",
+        None => "gauss_per_element",
+    };
+    match basis {
+        DivisionBasis::Legendre { modes, orders } => {
             let p = highest_order(modes, orders);
-            let field = match q.gauss {
-                Some(_) => "gauss",
-                None => "gauss_per_element",
-            };
-            (
-                field,
-                points,
-                p + 1,
+            if points > p {
+                return Ok(());
+            }
+            Err(ScenarioError::invalid(
+                format!("divisions[{j}].quadrature.{field}"),
                 format!(
-                    "the basis's highest order {p} has {} Legendre functions per strain",
+                    "{points} points resolve too few functions: the basis's highest order {p} has {} Legendre functions per strain, so the stiffness would be singular (zero-energy modes) and the equilibrium not unique; accepted: at least {}",
+                    p + 1,
                     p + 1
                 ),
-            )
+            ))
         }
-        (
-            DivisionBasis::Fem { degree, .. },
-            Quadrature::Elements {
-                gauss_per_element, ..
-            },
-        ) => {
+        DivisionBasis::Fem {
+            elements, degree, ..
+        } => {
+            let x = fem_points::points(quadrature);
+            let Some(node) = fem_points::under_resolved(*elements, *degree, &x) else {
+                return Ok(());
+            };
             let d = match degree {
                 FemDegree::Linear => 1,
                 FemDegree::Quadratic => 2,
             };
-            (
-                "gauss_per_element",
-                *gauss_per_element,
-                d + 1,
-                format!("a FEM basis of degree {d} has {d} · elements + 1 functions per strain, which fewer than {} points per element cannot tell apart", d + 1),
-            )
+            // the element of that node with the fewest points, to show where
+            let e = [node.saturating_sub(1) / d, (node / d).min(elements - 1)]
+                .into_iter()
+                .min_by_key(|&e| fem_points::points_in_element(e, *elements, &x))
+                .unwrap_or(0);
+            let held = fem_points::points_in_element(e, *elements, &x);
+            let how = match quadrature {
+                Quadrature::Elements { .. } => format!(
+                    "`elements` = {elements} (the basis's) and `gauss_per_element` ≥ {}",
+                    d + 1
+                ),
+                Quadrature::Gauss { .. } => format!(
+                    "per-element points: `elements` = {elements} (the basis's) and `gauss_per_element` ≥ {}",
+                    d + 1
+                ),
+            };
+            Err(ScenarioError::invalid(
+                format!("divisions[{j}].quadrature"),
+                format!(
+                    "its {points} points do not resolve the {elements}-element FEM basis of degree {d} ({} functions per strain): a combination of the functions nearly vanishes at every point (near element {e}, X̄ in [{:.4}, {:.4}], which holds {held} of them) and keeps less than {} of its stiffness, a near zero-energy mode that leaves the equilibrium all but undetermined; accepted: points that resolve every function, e.g. {how}",
+                    d * elements + 1,
+                    e as f64 / *elements as f64,
+                    (e + 1) as f64 / *elements as f64,
+                    fem_points::TAU,
+                ),
+            ))
         }
-        // whole-division Gauss points on a FEM basis: each element needs its own points, which
-        // the engine checks when it lays them out
-        (DivisionBasis::Fem { .. }, Quadrature::Gauss { .. }) => return Ok(()),
-    };
-    if given >= needed {
-        return Ok(());
     }
-    Err(ScenarioError::invalid(
-        format!("divisions[{j}].quadrature.{field}"),
-        format!(
-            "{given} points resolve too few functions: {why}, so the stiffness would be singular (zero-energy modes) and the equilibrium not unique; accepted: at least {needed}"
-        ),
-    ))
 }
 
 /// The quadrature `q` asks for (its defaults filled in), each count in range.

@@ -6,6 +6,7 @@
 
 mod basis;
 mod describe;
+mod fem_points;
 mod limits;
 mod loads;
 pub mod reduced;

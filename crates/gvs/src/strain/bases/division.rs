@@ -158,7 +158,7 @@ impl DivisionBasis {
 /// The FEM-like shape functions at `X̄` (spec §4.3): the first node of the element holding `X̄` and
 /// the values of its `p + 1` nodal functions (element `e = ⌊n_e X̄⌋`, `χ = n_e X̄ − e`; linear
 /// `1 − χ, χ`; quadratic `2(χ − ½)(χ − 1), −4χ(χ − 1), 2χ(χ − ½)`).
-fn fem_shape(x_bar: f64, ne: usize, degree: FemDegree) -> (usize, [f64; 3]) {
+pub fn fem_shape(x_bar: f64, ne: usize, degree: FemDegree) -> (usize, [f64; 3]) {
     let e = ((x_bar * ne as f64 + 1e-12).floor() as usize).min(ne - 1);
     let chi = x_bar * ne as f64 - e as f64;
     match degree {
