@@ -2,13 +2,14 @@
 //! that made it necessary: a full-load step from the straight rod converging onto an equilibrium
 //! the rod cannot rest on.
 
-use gvs::discretize::{Discretization, MagnusOrder, Quadrature};
+mod common;
+
 use gvs::loads::Loads;
 use gvs::model::Model;
 use gvs::rod::{Material, Rod, SectionProps};
 use gvs::solve::stability::divergence_at;
 use gvs::solve::statics::{solve_statics, StaticsOptions};
-use gvs::strain::{DivisionBasis, LinearBasis, StrainParam};
+use gvs::strain::{LinearBasis, StrainParam};
 
 fn rod(e: f64, rho: f64, l: f64, r: f64) -> Rod {
     let mat = Material {
@@ -21,19 +22,7 @@ fn rod(e: f64, rho: f64, l: f64, r: f64) -> Rod {
 }
 
 fn model(rod: Rod, gauss: usize, modes: [bool; 6], order: usize) -> Model<LinearBasis> {
-    let disc = Discretization::new(
-        &rod,
-        &[Quadrature::Gauss { n: gauss }],
-        MagnusOrder::Z4,
-        &[],
-    )
-    .unwrap();
-    let basis = DivisionBasis::Legendre {
-        modes,
-        orders: [order; 6],
-    };
-    let b = LinearBasis::per_division(&disc, &[basis]).unwrap();
-    Model::new(rod, disc, b, vec![]).unwrap()
+    common::legendre_model(rod, gauss, modes, order)
 }
 
 fn gravity(g: [f64; 3]) -> Loads {

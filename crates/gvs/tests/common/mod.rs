@@ -7,6 +7,29 @@ use gvs::rod::{Material, Rod};
 use gvs::strain::{DivisionBasis, LinearBasis};
 use nalgebra::DVector;
 
+/// `rod` clamped at X = 0 with a Legendre basis of order `order` on the active `modes`, `gauss`
+/// Gauss points over its one division, Magnus Z4.
+pub fn legendre_model(
+    rod: Rod,
+    gauss: usize,
+    modes: [bool; 6],
+    order: usize,
+) -> Model<LinearBasis> {
+    let disc = Discretization::new(
+        &rod,
+        &[Quadrature::Gauss { n: gauss }],
+        MagnusOrder::Z4,
+        &[],
+    )
+    .unwrap();
+    let basis = DivisionBasis::Legendre {
+        modes,
+        orders: [order; 6],
+    };
+    let b = LinearBasis::per_division(&disc, &[basis]).unwrap();
+    Model::new(rod, disc, b, vec![]).unwrap()
+}
+
 /// The uniform clamped rod of gvs-spec §10.5: L = 0.5 m, r = 5 mm, E = 1e6 Pa, ρ = 1000 kg/m³, no
 /// damping, Legendre orders [2, 6, 6, 2, 2, 2] on all six modes, N = 12 Gauss points.
 pub fn clamped_rod_10_5() -> (Model<LinearBasis>, Material) {
