@@ -496,6 +496,13 @@ fn statics_json_refuses_links_special_files_and_foreign_files() {
         fs::read_to_string(dir.join("own.txt")).unwrap(),
         "the user's data"
     );
+    // a path ending in `/` names a directory: no file `newdir` is written for it
+    let err = String::from_utf8_lossy(&run("newdir/", false).stderr).into_owned();
+    assert!(
+        err.contains("ends in `/`") && err.contains("--json"),
+        "{err}"
+    );
+    assert!(!dir.join("newdir").exists());
     // its own earlier output: refused without --force, replaced with it
     assert!(run("sol.json", false).status.success());
     assert!(String::from_utf8_lossy(&run("sol.json", false).stderr).contains("pass --force"));

@@ -125,6 +125,24 @@ impl ListedFiles {
     }
 }
 
+/// Whether the JSON file output `value` (e.g. a `statics --json` result, a `reproduce` step record)
+/// was edited since gvsrom wrote it: its manifest records a `meta_sha256` that its values no longer
+/// have. `false` for one without a recorded hash (an output of an earlier version) or without a
+/// manifest (which no reader accepts as gvsrom's anyway).
+pub fn json_file_edited(value: &serde_json::Value) -> bool {
+    use super::hashes::META_SHA256_KEY;
+    let Some(obj) = value.as_object() else {
+        return false;
+    };
+    let Some(hash) = (obj.get(MANIFEST_KEY))
+        .and_then(|m| m.get(META_SHA256_KEY))
+        .and_then(recorded)
+    else {
+        return false;
+    };
+    meta_sha256(obj) != hash
+}
+
 /// Checks the directory output `dir` against its manifest before it is read: `meta.json` holds a
 /// manifest of format `expected_format`; every file it lists exists as a regular file; and, if the
 /// output records hashes, every listed file and meta.json itself match them. Never panics; an error

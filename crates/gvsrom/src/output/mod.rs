@@ -50,7 +50,8 @@ pub(crate) mod test_util;
 pub use dir::OutputDir;
 pub use file::OutputFile;
 pub use integrity::{
-    verify_dir, verify_dir_meta, Integrity, IntegrityError, ListedFiles, Problem, Verified,
+    json_file_edited, verify_dir, verify_dir_meta, Integrity, IntegrityError, ListedFiles, Problem,
+    Verified,
 };
 pub use read::{read_regular, read_regular_to_string};
 pub use run_dir::{RunDir, RUN_FORMAT};

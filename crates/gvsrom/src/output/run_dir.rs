@@ -7,14 +7,18 @@
 //! - Inside it, outputs are ordinary gvsrom outputs ([`super::OutputDir`], [`super::OutputFile`])
 //!   under their own names, each replaced atomically; loose files written by
 //!   [`RunDir::write_file`] (e.g. `index.html`) are staged, fsynced and renamed into place, and are
-//!   listed in the manifest: a file the manifest does not list is never replaced.
+//!   listed in the manifest with the SHA-256 of what was written (`files_sha256`): a file the
+//!   manifest does not list, or whose content no longer has a recorded hash (edited since), is
+//!   never replaced. While a file is replaced both its old and its new hash are recorded, so a
+//!   crash between the rename and the manifest's update leaves it replaceable.
 
 use super::lock::TargetLock;
 use super::manifest::{manifest, with_manifest};
 use super::staging::{sync_dir, unique_sibling};
 use super::target::{refuse_special, split_target};
 use super::{Named, OutputError, MANIFEST_FILE, MANIFEST_KEY};
-use serde_json::{json, Value};
+use serde_json::{json, Map, Value};
+use std::collections::BTreeMap;
 use std::fs::{self, OpenOptions};
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
@@ -28,6 +32,9 @@ pub struct RunDir {
     named: Named,
     path: PathBuf,
     files: Vec<String>,
+    /// The SHA-256 of each loose file's content as written (two while it is replaced); a file
+    /// listed without any (a run directory of an earlier version) is replaced as before.
+    hashes: FileHashes,
     _lock: TargetLock,
 }
 
@@ -43,10 +50,10 @@ impl RunDir {
         refuse_special(&named, &parent, &name)?;
         let lock = TargetLock::acquire(&named, &parent, &name)?;
         let target = parent.join(&name);
-        let files = match fs::symlink_metadata(&target) {
+        let (files, hashes) = match fs::symlink_metadata(&target) {
             Err(e) if e.kind() == io::ErrorKind::NotFound => {
                 fs::create_dir(&target).map_err(named.io("create it"))?;
-                vec![]
+                (vec![], BTreeMap::new())
             }
             Err(e) => return Err(named.io("inspect it")(e)),
             Ok(m) if m.file_type().is_symlink() => {
@@ -60,7 +67,7 @@ impl RunDir {
                 ))
             }
             Ok(_) => match read_run_manifest(&target.join(MANIFEST_FILE)) {
-                Some(files) => files,
+                Some(listed) => listed,
                 None => {
                     return Err(named.refused(format!(
                         "exists and is not a gvsrom run directory (no `{MANIFEST_KEY}` manifest of format `{RUN_FORMAT}` in meta.json); gvsrom writes only into run directories it created: choose a new path"
@@ -72,6 +79,7 @@ impl RunDir {
             named,
             path: target,
             files,
+            hashes,
             _lock: lock,
         };
         dir.write_manifest()?;
@@ -102,26 +110,49 @@ impl RunDir {
         match fs::symlink_metadata(&target) {
             Err(e) if e.kind() == io::ErrorKind::NotFound => {}
             Err(e) => return Err(shown.io("inspect it")(e)),
-            Ok(m) if m.is_file() && self.files.iter().any(|f| f == name) => {}
+            Ok(m) if m.is_file() && self.files.iter().any(|f| f == name) => {
+                if let Some(recorded) = self.hashes.get(name).filter(|h| !h.is_empty()) {
+                    let now = super::hashes::file_sha256(&target).map_err(shown.io("read it"))?;
+                    if !recorded.contains(&now) {
+                        return Err(shown.refused(
+                            "was changed after gvsrom wrote it (its SHA-256 is not the one the run directory recorded); gvsrom never replaces what it did not write: move it away, or restore it",
+                        ));
+                    }
+                }
+            }
             Ok(_) => {
                 return Err(shown.refused(
                     "exists and was not written by this run directory; gvsrom never replaces what it did not write: move it away",
                 ))
             }
         }
+        // listed, with the new content's hash beside the old, before it exists: a crash in between
+        // leaves a listed name whose content has a recorded hash, never an unlisted file
+        let new = super::hashes::sha256_hex(bytes);
         if !self.files.iter().any(|f| f == name) {
-            // listed before it exists: a crash in between leaves a listed name, never an unlisted file
             self.files.push(name.to_string());
-            self.write_manifest()?;
         }
+        let hashes = self.hashes.entry(name.to_string()).or_default();
+        hashes.retain(|h| h != &new);
+        hashes.push(new.clone());
+        self.write_manifest()?;
         write_atomically(&self.path, name, bytes).map_err(shown.io("write it"))?;
+        self.hashes.insert(name.to_string(), vec![new]);
+        self.write_manifest()?;
         Ok(target)
     }
 
     fn write_manifest(&self) -> Result<(), OutputError> {
+        let mut m = manifest(RUN_FORMAT, Some(&self.files));
+        if let Value::Object(map) = &mut m {
+            let hashes: Map<String, Value> = (self.hashes.iter())
+                .map(|(name, h)| (name.clone(), json!(h)))
+                .collect();
+            map.insert(FILE_HASHES_KEY.into(), Value::Object(hashes));
+        }
         let value = with_manifest(
             json!({ "note": "a gvsrom reproduce run: steps/ holds each step's output, one directory per case holds its report" }),
-            manifest(RUN_FORMAT, Some(&self.files)),
+            m,
         )
         .map_err(self.named.io("write its meta.json"))?;
         let text = serde_json::to_string_pretty(&value).map_err(io::Error::from);
@@ -150,19 +181,40 @@ fn write_atomically(dir: &Path, name: &str, bytes: &[u8]) -> io::Result<()> {
     result
 }
 
-/// The files listed by a run directory's manifest, if `path` is one.
-fn read_run_manifest(path: &Path) -> Option<Vec<String>> {
+/// The manifest's key of the loose files' hashes: `{name: [sha256, …]}`.
+const FILE_HASHES_KEY: &str = "files_sha256";
+
+/// The recorded SHA-256 hashes of each loose file, by name.
+type FileHashes = BTreeMap<String, Vec<String>>;
+
+/// The files listed by a run directory's manifest and their recorded hashes, if `path` is one
+/// (hashes that are not lists of strings are read as none).
+fn read_run_manifest(path: &Path) -> Option<(Vec<String>, FileHashes)> {
     let value: Value =
         serde_json::from_str(&super::read::read_regular_to_string(path).ok()?).ok()?;
     let m = value.get(MANIFEST_KEY)?.as_object()?;
     if m.get("format")?.as_str()? != RUN_FORMAT {
         return None;
     }
-    m.get("files")?
+    let files = m
+        .get("files")?
         .as_array()?
         .iter()
         .map(|f| f.as_str().map(str::to_string))
-        .collect()
+        .collect::<Option<Vec<_>>>()?;
+    let hashes = (m
+        .get(FILE_HASHES_KEY)
+        .and_then(Value::as_object)
+        .into_iter())
+    .flatten()
+    .filter_map(|(name, h)| {
+        let list: Option<Vec<String>> = (h.as_array()?.iter())
+            .map(|x| x.as_str().map(str::to_string))
+            .collect();
+        Some((name.clone(), list?))
+    })
+    .collect();
+    Some((files, hashes))
 }
 
 #[cfg(test)]
@@ -208,6 +260,61 @@ mod tests {
         assert_eq!(fs::read_to_string(p.join("user.html")).unwrap(), "keep");
         assert!(r.write_file("../escape.html", b"x").is_err());
         assert!(r.write_file(".hidden", b"x").is_err());
+    }
+
+    #[test]
+    fn a_listed_file_edited_since_it_was_written_is_refused_and_kept() {
+        let d = sandbox("edited");
+        let p = d.join("results");
+        {
+            let mut r = RunDir::open("--out", &p).unwrap();
+            r.write_file("index.html", b"one").unwrap();
+        }
+        fs::write(p.join("index.html"), "one <!-- my notes -->").unwrap();
+        let mut r = RunDir::open("--out", &p).unwrap();
+        let e = r.write_file("index.html", b"two").unwrap_err().to_string();
+        assert!(e.contains("was changed after gvsrom wrote it"), "{e}");
+        assert_eq!(
+            fs::read_to_string(p.join("index.html")).unwrap(),
+            "one <!-- my notes -->"
+        );
+        // restored, it is ours again
+        fs::write(p.join("index.html"), "one").unwrap();
+        r.write_file("index.html", b"two").unwrap();
+        assert_eq!(fs::read(p.join("index.html")).unwrap(), b"two");
+        // the manifest records the content written, one hash once the write is done
+        let m: Value =
+            serde_json::from_str(&fs::read_to_string(p.join(MANIFEST_FILE)).unwrap()).unwrap();
+        assert_eq!(
+            m[MANIFEST_KEY][FILE_HASHES_KEY]["index.html"],
+            json!([super::super::hashes::sha256_hex(b"two")])
+        );
+    }
+
+    #[test]
+    fn a_crash_between_the_manifest_and_the_rename_leaves_the_file_replaceable() {
+        // the manifest lists the old and the new content while a file is replaced: whichever is
+        // on disk after a crash, the next run replaces it
+        let d = sandbox("crash");
+        let p = d.join("results");
+        {
+            let mut r = RunDir::open("--out", &p).unwrap();
+            r.write_file("index.html", b"one").unwrap();
+        }
+        let path = p.join(MANIFEST_FILE);
+        let mut m: Value = serde_json::from_str(&fs::read_to_string(&path).unwrap()).unwrap();
+        let both = json!([
+            super::super::hashes::sha256_hex(b"one"),
+            super::super::hashes::sha256_hex(b"two")
+        ]);
+        m[MANIFEST_KEY][FILE_HASHES_KEY]["index.html"] = both;
+        fs::write(&path, serde_json::to_string(&m).unwrap()).unwrap();
+        for on_disk in ["one", "two"] {
+            fs::write(p.join("index.html"), on_disk).unwrap();
+            let mut r = RunDir::open("--out", &p).unwrap();
+            r.write_file("index.html", b"two").unwrap();
+            fs::write(&path, serde_json::to_string(&m).unwrap()).unwrap();
+        }
     }
 
     #[test]

@@ -54,6 +54,13 @@ impl Prepared {
             option: option.into(),
             path: path.to_path_buf(),
         };
+        // `out/` names a directory: a file written there under the name `out` would surprise
+        let trailing = path.as_os_str().as_encoded_bytes().last() == Some(&b'/');
+        if kind == Kind::File && trailing {
+            return Err(named.refused(
+                "ends in `/`, which names a directory; this output is one file: name it, e.g. `results/statics.json`",
+            ));
+        }
         let (parent, name) = split_target(&named)?;
         refuse_special(&named, &parent, &name)?;
         let lock = TargetLock::acquire(&named, &parent, &name)?;

@@ -173,7 +173,7 @@ impl Run {
         let key = step_key(name, config)?;
         let path = self.step_path(name);
         let record_path = self.record_path(name);
-        if let Some((value, wall_time_s)) = read_record::<T>(&record_path, &key) {
+        if let Some((value, wall_time_s)) = read_record::<T>(&record_path, &key)? {
             if valid(&path) {
                 return Ok(self.finish(name, key, wall_time_s, true, value, path));
             }
@@ -265,18 +265,32 @@ fn canonical(v: &Value) -> String {
 
 /// The value of the step record at `path` and its wall time (0 if not recorded), if the record
 /// holds `key`. A record that cannot be used (missing, not a regular file, not JSON, another key)
-/// is `None`: the step is computed again.
-fn read_record<T: DeserializeOwned>(path: &Path, key: &str) -> Option<(T, f64)> {
-    let mut v: Value =
-        serde_json::from_str(&crate::output::read_regular_to_string(path).ok()?).ok()?;
-    if v.get("key")?.as_str()? != key {
-        return None;
+/// is `None`: the step is computed again. One edited since gvsrom wrote it (its values no longer
+/// match its manifest's `meta_sha256`) is an error: it is neither reused nor replaced.
+fn read_record<T: DeserializeOwned>(path: &Path, key: &str) -> anyhow::Result<Option<(T, f64)>> {
+    let Some(mut v) = crate::output::read_regular_to_string(path)
+        .ok()
+        .and_then(|text| serde_json::from_str::<Value>(&text).ok())
+    else {
+        return Ok(None);
+    };
+    if crate::output::json_file_edited(&v) {
+        anyhow::bail!(
+            "the step record `{}` was changed after gvsrom wrote it (its values no longer match the `meta_sha256` of its manifest): reproduce neither reuses nor replaces it; move it away (or restore it) and the step is computed again",
+            path.display()
+        );
+    }
+    if v.get("key").and_then(Value::as_str) != Some(key) {
+        return Ok(None);
     }
     let wall_time_s = v.get("wall_time_s").and_then(Value::as_f64).unwrap_or(0.0);
-    Some((
-        serde_json::from_value(v.get_mut("value")?.take()).ok()?,
-        wall_time_s,
-    ))
+    let Some(value) = v
+        .get_mut("value")
+        .and_then(|x| serde_json::from_value(x.take()).ok())
+    else {
+        return Ok(None);
+    };
+    Ok(Some((value, wall_time_s)))
 }
 
 #[cfg(test)]
@@ -339,16 +353,41 @@ mod tests {
         let text = json!({"step": "s", "key": "k1", "wall_time_s": 2.5, "value": [1, 2]});
         std::fs::write(&record, text.to_string()).unwrap();
         assert_eq!(
-            read_record::<Vec<u32>>(&record, "k1"),
+            read_record::<Vec<u32>>(&record, "k1").unwrap(),
             Some((vec![1, 2], 2.5))
         );
-        assert_eq!(read_record::<Vec<u32>>(&record, "k2"), None);
+        assert_eq!(read_record::<Vec<u32>>(&record, "k2").unwrap(), None);
         #[cfg(target_os = "linux")]
         {
             let pipe = dir.join("p.step.json");
             crate::output::test_util::fifo(&pipe);
             // no writer ever opens it: a plain read would block this test forever
-            assert_eq!(read_record::<Vec<u32>>(&pipe, "k1"), None);
+            assert_eq!(read_record::<Vec<u32>>(&pipe, "k1").unwrap(), None);
         }
+    }
+
+    #[test]
+    fn a_record_edited_since_it_was_written_is_neither_reused_nor_replaced() {
+        // a review edited a tip in a record of `reproduce v`, and the report then showed it
+        let dir = crate::output::test_util::sandbox("step", "edited");
+        let record = dir.join("s.step.json");
+        let out = OutputFile::create("--out", &record, "reproduce-step", true).unwrap();
+        out.commit_json(json!({"step": "s", "key": "k1", "wall_time_s": 2.5, "value": [1, 2]}))
+            .unwrap();
+        assert_eq!(
+            read_record::<Vec<u32>>(&record, "k1").unwrap(),
+            Some((vec![1, 2], 2.5))
+        );
+        let text = std::fs::read_to_string(&record).unwrap();
+        let edited = text.replacen("2.5", "2.25", 1);
+        assert_ne!(edited, text);
+        std::fs::write(&record, &edited).unwrap();
+        let e = read_record::<Vec<u32>>(&record, "k1")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("was changed after gvsrom wrote it"), "{e}");
+        // nor does another key make it replaceable
+        assert!(read_record::<Vec<u32>>(&record, "k2").is_err());
+        assert_eq!(std::fs::read_to_string(&record).unwrap(), edited);
     }
 }
