@@ -236,6 +236,26 @@ pub fn whole(ob: &Bound<'_, PyAny>) -> PyResult<i128> {
     }
 }
 
+/// A list of strings as an optional argument: one `str` is a list of one, `None` an empty list; a
+/// `TypeError` naming `name` for anything else (pyo3's own says "Can't extract `str` to `Vec`" for
+/// a `str`, which `Sequence[str]` in the stubs lets through).
+pub fn strings(name: &str, ob: Option<&Bound<'_, PyAny>>) -> PyResult<Vec<String>> {
+    let Some(ob) = ob.filter(|o| !o.is_none()) else {
+        return Ok(vec![]);
+    };
+    if let Ok(s) = ob.extract::<String>() {
+        return Ok(vec![s]);
+    }
+    ob.extract::<Vec<String>>().map_err(|_| {
+        PyTypeError::new_err(format!(
+            "`{name}`: expected a str or a list of str; got {}",
+            ob.get_type()
+                .name()
+                .map_or_else(|_| "an object".to_string(), |n| n.to_string())
+        ))
+    })
+}
+
 /// [`whole`] for an optional argument (`None` as it is).
 pub fn whole_or_none(ob: &Bound<'_, PyAny>) -> PyResult<Option<i128>> {
     match ob.is_none() {

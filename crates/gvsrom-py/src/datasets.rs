@@ -36,7 +36,10 @@ use std::path::PathBuf;
 /// status : numpy.ndarray of uint8, shape (N,)
 ///     0 ok, 1 failed, 2 not computed.
 /// iterations : numpy.ndarray of uint32, shape (N,)
+///     The statics solver's iterations per sample (0 in a dynamic dataset: no solve).
 /// residual : numpy.ndarray, shape (N,)
+///     ‖R‖∞ (generalized forces) at each equilibrium; NaN where nothing was solved (failed samples, and every row
+///     of a dynamic dataset: its snapshots are states of a motion, not equilibria).
 /// strain_x : numpy.ndarray, shape (n_points,)
 ///     [m]
 /// t : numpy.ndarray or None
@@ -94,10 +97,11 @@ pub struct Dataset {
     /// 0 ok, 1 failed, 2 not computed (uint8), shape (N,).
     #[pyo3(get)]
     status: Py<PyAny>,
-    /// Solver iterations (uint32), shape (N,).
+    /// Statics solver iterations (uint32), shape (N,); 0 in a dynamic dataset.
     #[pyo3(get)]
     iterations: Py<PyAny>,
-    /// ‖R‖∞ at the solutions, shape (N,).
+    /// ‖R‖∞ at the equilibria, shape (N,); NaN where nothing was solved (failed samples, every row
+    /// of a dynamic dataset).
     #[pyo3(get)]
     residual: Py<PyAny>,
     /// Abscissae of the computational points [m], shape (n_points,).
@@ -313,7 +317,7 @@ fn dynamic_only(duration: Option<f64>, given: &[(&str, bool)]) -> PyResult<()> {
 /// seed : int, optional
 ///     Seed of ``random`` (and of a dynamic dataset's ``steps``/``babble``); default 0. Refused
 ///     with a plan that draws nothing (``sweep``, ``grid``, ``input``).
-/// set : list of str, optional
+/// set : str or list of str, optional
 ///     ``"PATH=VALUE"`` overrides (``--set``).
 /// chunk_size : int
 ///     Samples per chunk (part of the plan).
@@ -357,7 +361,7 @@ pub fn dataset(
     random: Option<&Bound<'_, PyAny>>,
     #[pyo3(from_py_with = crate::arrays::whole_or_none)] samples: Option<i128>,
     #[pyo3(from_py_with = crate::arrays::whole_or_none)] seed: Option<i128>,
-    set: Option<Vec<String>>,
+    set: Option<&Bound<'_, PyAny>>,
     #[pyo3(from_py_with = crate::arrays::whole)] chunk_size: i128,
     #[pyo3(from_py_with = crate::arrays::whole_or_none)] threads: Option<i128>,
     force: bool,
@@ -378,7 +382,7 @@ pub fn dataset(
     let chunk_size = size("chunk_size", chunk_size, 1)?;
     let threads = threads.map(|v| size("threads", v, 1)).transpose()?;
     let (scenario, mut overrides) = scenario_arg(scenario)?;
-    overrides.extend(set.unwrap_or_default());
+    overrides.extend(crate::arrays::strings("set", set)?);
     dynamic_only(
         duration,
         &[
@@ -433,7 +437,7 @@ pub fn dataset(
     if let Some(e) = caught {
         return Err(e);
     }
-    for w in &outcome.warnings {
+    for w in outcome.warnings.iter().chain(&outcome.failure_message()) {
         crate::robot::warn(py, w)?;
     }
     load_dataset(py, outcome.path)

@@ -5,7 +5,9 @@
 //! - `GvsromError(ValueError)`: bad input of any kind (a scenario field, an override, a tension,
 //!   an array's shape, a model directory);
 //! - `ConvergenceError(GvsromError)`: a statics solve that did not converge, with `iterations`,
-//!   `residual_norm` and `load_factor` as attributes (also in the message).
+//!   `residual_norm` and `load_factor` as attributes (also in the message);
+//! - `IntegrationError(GvsromError)`: a simulation whose integrator failed, with the samples it
+//!   computed before as the attribute `trajectory`.
 
 use gvs::solve::statics::StaticsError;
 use gvsrom::error::StaticsFailure;
@@ -27,10 +29,18 @@ create_exception!(
     "A statics solve that did not converge; `iterations`, `residual_norm` and `load_factor` say how far it got."
 );
 
+create_exception!(
+    gvsrom,
+    IntegrationError,
+    GvsromError,
+    "A simulation whose integrator failed; `trajectory` holds the samples computed before, as `simulate` returns them."
+);
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add("GvsromError", py.get_type::<GvsromError>())?;
     m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
+    m.add("IntegrationError", py.get_type::<IntegrationError>())?;
     m.add_function(wrap_pyfunction!(_python_spelling, m)?)?;
     Ok(())
 }
@@ -45,6 +55,14 @@ fn _python_spelling(message: &str) -> String {
 /// A message as a `GvsromError`.
 pub fn invalid(message: impl Into<String>) -> PyErr {
     GvsromError::new_err(python_spelling(&message.into()))
+}
+
+/// An integrator failure as an `IntegrationError` whose `trajectory` is the samples computed.
+pub fn integration(message: &str, trajectory: &Bound<'_, pyo3::types::PyDict>) -> PyErr {
+    let err = IntegrationError::new_err(python_spelling(message));
+    // setting an attribute on a fresh exception instance cannot fail short of memory
+    let _ = err.value(trajectory.py()).setattr("trajectory", trajectory);
+    err
 }
 
 /// A scenario error (`{e}`, as `error: {e}` of the command line).
@@ -116,8 +134,9 @@ const SWITCHES: [&str; 6] = [
 ];
 
 /// Flags of the command line that are keyword arguments of the same name in Python.
-const SAME: [&str; 41] = [
+const SAME: [&str; 42] = [
     "out",
+    "load-schedule",
     "model",
     "set",
     "duration",
@@ -171,9 +190,20 @@ fn keyword(flag: &str) -> Option<String> {
     SAME.contains(&flag).then(|| flag.replace('-', "_"))
 }
 
+/// The command line's positional arguments (their value names, upper case) and the Python
+/// argument of the same meaning.
+const POSITIONAL: [(&str, &str); 4] = [
+    ("SCENARIO", "scenario"),
+    ("DATASET", "dataset"),
+    ("MODEL", "model"),
+    // `gvsrom plot INPUT` is `gvsrom.plot(output, …)`
+    ("INPUT", "output"),
+];
+
 /// `message` as a Python user reads it: each `--flag` of the command line that is a keyword
 /// argument in Python is named as that argument (`--sample-rate` → `sample_rate`, `--lambda` →
-/// `lambda_`, `--tension` → `u`, `--force` → `force=True`); other flags stay. A command quoted in
+/// `lambda_`, `--tension` → `u`, `--force` → `force=True`); other flags stay; a positional
+/// argument's value name is the Python argument's (`DATASET` → `dataset`). A command quoted in
 /// backticks (`` `gvsrom …` ``) is kept as written: it is meant for a shell.
 pub fn python_spelling(message: &str) -> String {
     message
@@ -182,11 +212,36 @@ pub fn python_spelling(message: &str) -> String {
         .map(
             |(i, part)| match i % 2 == 1 && part.starts_with("gvsrom ") {
                 true => part.to_string(),
-                false => flags_as_keywords(part),
+                false => positionals_as_arguments(&flags_as_keywords(part)),
             },
         )
         .collect::<Vec<_>>()
         .join("`")
+}
+
+/// Every whole word of `text` that is a positional argument's value name ([`POSITIONAL`]),
+/// renamed.
+fn positionals_as_arguments(text: &str) -> String {
+    let is_word_char = |c: char| c.is_alphanumeric() || c == '_' || c == '-';
+    let mut out = String::with_capacity(text.len());
+    let mut word = String::new();
+    let flush = |word: &mut String, out: &mut String| {
+        match POSITIONAL.iter().find(|(cli, _)| *cli == word.as_str()) {
+            Some((_, python)) => out.push_str(python),
+            None => out.push_str(word),
+        }
+        word.clear();
+    };
+    for c in text.chars() {
+        if is_word_char(c) {
+            word.push(c);
+        } else {
+            flush(&mut word, &mut out);
+            out.push(c);
+        }
+    }
+    flush(&mut word, &mut out);
+    out
 }
 
 /// Every `--flag` of `text` that is a Python keyword argument, renamed ([`keyword`]).

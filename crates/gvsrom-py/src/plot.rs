@@ -18,8 +18,8 @@ use std::path::PathBuf;
 ///     The gvsrom output to draw.
 /// out : str or os.PathLike
 ///     New directory for the figures (an earlier gvsrom output there only with ``force``).
-/// formats : list of str, optional
-///     ``"svg"`` and/or ``"png"``; default both.
+/// formats : str or list of str, optional
+///     ``"svg"`` and/or ``"png"``; default (``None``) both.
 /// force : bool
 ///     Replace ``out`` if it is an earlier gvsrom output (never anything else).
 ///
@@ -41,10 +41,17 @@ pub fn plot<'py>(
     py: Python<'py>,
     output: PathBuf,
     out: PathBuf,
-    formats: Option<Vec<String>>,
+    formats: Option<&Bound<'_, PyAny>>,
     force: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let formats = (formats.unwrap_or_default().iter())
+    let given = formats.is_some_and(|f| !f.is_none());
+    let formats = crate::arrays::strings("formats", formats)?;
+    if given && formats.is_empty() {
+        return Err(invalid(
+            "`formats`: an empty list draws nothing (accepted: \"svg\", \"png\", or both; None for both)",
+        ));
+    }
+    let formats = (formats.iter())
         .map(|f| match f.as_str() {
             "svg" => Ok(FigureFormat::Svg),
             "png" => Ok(FigureFormat::Png),

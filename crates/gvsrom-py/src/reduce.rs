@@ -119,7 +119,7 @@ fn dataset_paths(arg: &Bound<'_, PyAny>) -> PyResult<Vec<PathBuf>> {
 /// latent : int, optional
 ///     Latent size r (reduced coordinates); default 1, or the ``init`` model's.
 /// hidden_layers : int, optional
-///     Hidden layers of the whole autoencoder (odd: 3, 5, 7…); default 7, or the ``init`` model's.
+///     Hidden layers of the whole autoencoder (odd: 1, 3, 5, 7…, at most 63); default 7, or the ``init`` model's.
 /// epochs, batch_size, learning_rate, lambda_, patience, lr_reductions, lbfgs_iterations
 ///     As the ``gvsrom train`` options of the same names (``lambda_`` is ``--lambda``; patience 0:
 ///     never stop early).
@@ -132,8 +132,9 @@ fn dataset_paths(arg: &Bound<'_, PyAny>) -> PyResult<Vec<PathBuf>> {
 /// sample_weighting : str
 ///     ``"uniform"`` (eq. 15) or ``"relative"``: each snapshot's squared error over its own
 ///     squared norm, so that small loads are fitted as closely as large ones.
-/// relative_floor : float
-///     The relative weighting's floor, a fraction of the largest snapshot norm in (0, 1].
+/// relative_floor : float, optional
+///     The relative weighting's floor, a fraction of the largest snapshot norm in (0, 1]
+///     (default 0.1); only with ``sample_weighting="relative"``.
 /// decoder : str, optional
 ///     Default ``"plain"``, or the ``init`` model's: ``"plain"`` (the paper's, x̂ = D(z)) or ``"scaled"`` (x̂ = z₁ D(z): every code with z₁ = 0
 ///     decodes to the straight rod, for snapshots that shrink to rest as their load vanishes).
@@ -160,7 +161,7 @@ fn dataset_paths(arg: &Bound<'_, PyAny>) -> PyResult<Vec<PathBuf>> {
 // the defaults are literals, so that Python's signature shows them; tests/test_reduced.py checks
 // them against `gvsrom train --help` (the library's `TrainRequest::DEFAULT`)
 #[pyfunction]
-#[pyo3(signature = (dataset, out, latent=None, hidden_layers=None, epochs=2000, batch_size=64, learning_rate=1e-3, lambda_=1e-4, validation_fraction=None, patience=50, lr_reductions=4, lbfgs_iterations=300, seed=None, loss=None, sample_weighting="uniform", relative_floor=0.1, decoder=None, rate_weight=0.0, lr_decay=None, kinetic_weight=0.0, init=None, force=false))]
+#[pyo3(signature = (dataset, out, latent=None, hidden_layers=None, epochs=2000, batch_size=64, learning_rate=1e-3, lambda_=1e-4, validation_fraction=None, patience=50, lr_reductions=4, lbfgs_iterations=300, seed=None, loss=None, sample_weighting="uniform", relative_floor=None, decoder=None, rate_weight=0.0, lr_decay=None, kinetic_weight=0.0, init=None, force=false))]
 #[allow(clippy::too_many_arguments)]
 pub fn train(
     py: Python<'_>,
@@ -179,7 +180,7 @@ pub fn train(
     #[pyo3(from_py_with = crate::arrays::whole_or_none)] seed: Option<i128>,
     loss: Option<&str>,
     sample_weighting: &str,
-    relative_floor: f64,
+    relative_floor: Option<f64>,
     decoder: Option<&str>,
     rate_weight: f64,
     lr_decay: Option<f64>,

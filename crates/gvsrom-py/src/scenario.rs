@@ -239,7 +239,10 @@ impl Scenario {
         self.clone()
     }
 
-    fn __deepcopy__(&self, _memo: &Bound<'_, PyAny>) -> Scenario {
+    /// A copy (a `Scenario` holds no shared state; `memo` is not needed).
+    #[pyo3(signature = (memo))]
+    fn __deepcopy__(&self, memo: &Bound<'_, PyAny>) -> Scenario {
+        let _ = memo;
         self.clone()
     }
 

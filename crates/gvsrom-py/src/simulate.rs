@@ -108,8 +108,12 @@ impl Robot {
     ///
     /// Raises
     /// ------
+    /// IntegrationError
+    ///     When the integrator failed (a reduced model that left its training region, a step
+    ///     that could not converge): its ``trajectory`` attribute is the dict above for the
+    ///     samples computed before (``energy_balance`` left out).
     /// GvsromError
-    ///     For bad options or input, or an integrator failure (with the samples computed).
+    ///     For bad options or input.
     #[pyo3(signature = (duration, sample_rate=100.0, input=None, interpolate=false, from_equilibrium=false, q0=None, qd0=None, method="auto", rtol=None, atol=None, fixed_step=None, load_schedule=None, steps=None, babble=None, seed=0))]
     #[allow(clippy::too_many_arguments)]
     fn simulate<'py>(
@@ -436,10 +440,11 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
         (None, _) => InputSource::Constant,
         (Some(_), Some(c)) => InputSource::Function(InputFunction(c.clone())),
         (Some(obj), None) => {
-            let rows: arrays::In2<'_> = obj.extract().map_err(|_| {
-                invalid(format!(
-                    "`input` must be rows `t, u_1, …, u_na` ({na} + 1 columns: a 2-D array) or a callable `u(t)`; got `{}`",
-                    obj.get_type().name().map(|n| n.to_string()).unwrap_or_default()
+            // a TypeError, as for every array argument, that says what was given
+            let rows: arrays::In2<'_> = obj.extract().map_err(|e: PyErr| {
+                pyo3::exceptions::PyTypeError::new_err(format!(
+                    "`input` must be rows `t, u_1, …, u_{na}` (1 + {na} columns: a 2-D array) or a callable `u(t)`: {}",
+                    e.value(py)
                 ))
             })?;
             let rows = arrays::rows("input", &rows, 1 + na, "t, then one tension per tendon")?;
@@ -538,10 +543,15 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
     match &outcome.ending {
         Ending::Complete => {}
         Ending::Failed { error } => {
-            return Err(invalid(format!(
-                "{error} ({} samples computed)",
-                buffer.t.len()
-            )))
+            let partial = trajectory(py, built, &buffer, &outcome)?;
+            partial.set_item("model_extrapolated", extrapolated)?;
+            return Err(crate::errors::integration(
+                &format!(
+                    "{error} ({} samples computed: the exception's `trajectory`)",
+                    buffer.t.len()
+                ),
+                &partial,
+            ));
         }
         Ending::Interrupted { reason } => return Err(invalid(reason.clone())),
     }

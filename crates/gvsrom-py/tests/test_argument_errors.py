@@ -63,8 +63,11 @@ def test_training_options_are_named_as_keyword_arguments(tmp_path, dataset):
     assert "invalid `rate_weight`" in message(train(rate_weight=-1.0))
     assert "invalid `kinetic_weight`" in message(train(kinetic_weight=-1.0))
     assert "invalid `sample_weighting`" in message(train(sample_weighting="per-row"))
-    # a floor outside (0, 1] is refused even with the uniform weighting, which does not read it
-    assert "invalid `relative_floor`: -1" in message(train(relative_floor=-1.0))
+    # a floor outside (0, 1] is refused; with the uniform weighting, which would ignore it, any
+    assert "invalid `relative_floor`: -1" in message(
+        train(sample_weighting="relative", relative_floor=-1.0))
+    assert "invalid `relative_floor`: applies to the relative weighting only" in message(
+        train(relative_floor=0.5))
     assert not (tmp_path / "m").exists()
 
 
@@ -168,6 +171,12 @@ def test_a_command_quoted_for_the_shell_keeps_its_flags():
     # a flag with no Python argument, a word with a dash inside and a bare `--` stay as they are
     assert spell("--json x, well-known--set, a -- b, --") == "--json x, well-known--set, a -- b, --"
     assert spell("`--lambda`; `--lr-reductions`") == "`lambda_`; `lr_reductions`"
+    # a positional argument's value name is the Python argument's, whole words only
+    assert spell("invalid `DATASET`: no dataset given; the input DATASET `d`, INPUT `x`") == (
+        "invalid `dataset`: no dataset given; the input dataset `d`, output `x`")
+    assert spell("`SCENARIO`, MODEL_X, DATASETS, `gvsrom pod DATASET --modes 2`") == (
+        "`scenario`, MODEL_X, DATASETS, `gvsrom pod DATASET --modes 2`")
+    assert spell("invalid `--load-schedule`: a directory") == "invalid `load_schedule`: a directory"
 
 
 def test_integrator_tolerances_of_a_static_dataset_are_refused(tmp_path):
@@ -178,3 +187,20 @@ def test_integrator_tolerances_of_a_static_dataset_are_refused(tmp_path):
         assert message(lambda: gvsrom.dataset(beam, tmp_path / "d", **plan, **kw)) == (
             f"`{name}` is an option of a dynamic dataset: give `duration` too")
     assert not (tmp_path / "d").exists()
+
+
+def test_an_input_array_of_the_wrong_kind_says_what_it_got():
+    robot = gvsrom.Scenario.preset("single-tendon").build()
+    for bad, got in [(np.array([0.0, -1.0]), "shape (2,)"), (np.zeros((1, 1, 2)), "shape (1, 1, 2)"),
+                     (np.array([[0, -1 + 1j]]), "dtype complex128")]:
+        with pytest.raises(TypeError, match=r"`input` must be rows `t, u_1, …, u_1` \(1 \+ 1 "
+                           r"columns: a 2-D array\) or a callable `u\(t\)`: expected a 2-D .*" + re.escape(got)):
+            robot.simulate(0.01, input=bad)
+
+
+def test_deepcopy_takes_its_memo_by_the_stubs_name():
+    import copy
+    s = gvsrom.Scenario.preset("single-tendon").set("tendons.0.tension", -2.0)
+    assert s.__deepcopy__(memo={}).to_toml() == s.to_toml()
+    assert copy.deepcopy(s).to_toml() == s.to_toml()
+

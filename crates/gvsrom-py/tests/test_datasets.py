@@ -5,6 +5,7 @@ bad input refused with the command line's message; Ctrl-C keeps the finished sam
 import os
 import signal
 import threading
+import warnings
 
 import numpy as np
 import pytest
@@ -233,3 +234,35 @@ def test_a_seed_with_a_plan_that_draws_nothing_is_refused(tmp_path):
     a = gvsrom.dataset("single-tendon", tmp_path / "a", random="tendons.0.tension=-2:0", samples=2)
     b = gvsrom.dataset("single-tendon", tmp_path / "b", random="tendons.0.tension=-2:0", samples=2, seed=0)
     np.testing.assert_array_equal(a.inputs, b.inputs)
+
+
+def test_failed_samples_are_warned_of_by_dataset_and_left_out_by_pod_with_a_warning(tmp_path):
+    # one solver iteration: most equilibria fail; the command line lists them, Python warns
+    beam = gvsrom.Scenario.preset("single-tendon").set("solver.max_iterations", 1)
+    with pytest.warns(UserWarning, match=r"(\d+) of the 12 samples failed \(sample \d+: .*\); their "
+                      r"rows are NaN with status 1, and pod and train leave them out") as caught:
+        ds = gvsrom.dataset(beam, tmp_path / "d", sweep="tendons.0.tension=-6:0", samples=12)
+    failed = int((ds.status == 1).sum())
+    assert 0 < failed < 12
+    assert any(f"{failed} of the 12 samples failed" in str(w.message) for w in caught)
+    assert np.isnan(ds.strain[ds.status == 1]).all()
+    with pytest.warns(UserWarning, match=rf"dataset `.*`: {failed} of its 12 samples are left out, "
+                      r"failed or not computed \(sample \d+: failed: "):
+        model = gvsrom.pod(ds, 1, tmp_path / "pod")
+    assert model.kind == "pod"
+    # a dataset without failures: no such warning
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        gvsrom.dataset("single-tendon", tmp_path / "ok", sweep="tendons.0.tension=-6:0", samples=3)
+
+
+def test_a_single_override_may_be_a_str(tmp_path):
+    one = gvsrom.dataset("single-tendon", tmp_path / "a", sweep="tendons.0.tension=-6:0", samples=2,
+                         set="loads.gravity=[0, 0, 0]")
+    listed = gvsrom.dataset("single-tendon", tmp_path / "b", sweep="tendons.0.tension=-6:0",
+                            samples=2, set=["loads.gravity=[0, 0, 0]"])
+    np.testing.assert_array_equal(one.strain, listed.strain)
+    with pytest.raises(TypeError, match=r"`set`: expected a str or a list of str; got int"):
+        gvsrom.dataset("single-tendon", tmp_path / "c", sweep="tendons.0.tension=-6:0", samples=2,
+                       set=3)
+

@@ -55,3 +55,22 @@ def test_bad_input_is_a_clear_error(tmp_path):
         gvsrom.plot(tmp_path / "x.json", tmp_path / "out")
     with pytest.raises(gvsrom.GvsromError, match=r"`formats`: unknown image format `jpg`"):
         gvsrom.plot(tmp_path / "x.json", tmp_path / "out", formats=["jpg"])
+    # the input is named as Python names it, not as the command line's INPUT
+    with pytest.raises(gvsrom.GvsromError, match=r"^output `.*missing.json`"):
+        gvsrom.plot(tmp_path / "missing.json", tmp_path / "out")
+    # one format as a str is a list of one; an empty list draws nothing and is refused, not taken
+    # as the default; a list of something else is a TypeError naming `formats`
+    with pytest.raises(gvsrom.GvsromError, match=r"`formats`: unknown image format `jpg`"):
+        gvsrom.plot(tmp_path / "x.json", tmp_path / "out", formats="jpg")
+    with pytest.raises(gvsrom.GvsromError, match=r"`formats`: an empty list draws nothing"):
+        gvsrom.plot(tmp_path / "x.json", tmp_path / "out", formats=[])
+    with pytest.raises(TypeError, match=r"`formats`: expected a str or a list of str; got int"):
+        gvsrom.plot(tmp_path / "x.json", tmp_path / "out", formats=3)
+    assert not (tmp_path / "out").exists()
+
+
+def test_one_format_given_as_a_str_draws_only_it(tmp_path):
+    ds = gvsrom.dataset("single-tendon", tmp_path / "ds", sweep="tendons.0.tension=-6:0", samples=4)
+    r = gvsrom.plot(ds.path, tmp_path / "figs", formats="svg")
+    assert r["figures"] and all(f.endswith(".svg") for f in r["figures"]), r["figures"]
+

@@ -344,7 +344,7 @@ def test_datasets_of_other_physics_are_refused_naming_the_field(gvsrom_bin, data
     p = run_cli(gvsrom_bin, "dataset", "single-tendon", "--set", "material.youngs_modulus=2e6",
                 "--random", "tendons.0.tension=-2:0", "--samples", "3", "--out", str(other))
     assert p.returncode == 0, p.stderr
-    with pytest.raises(ValueError, match=r"invalid `DATASET`.*material\.youngs_modulus"):
+    with pytest.raises(ValueError, match=r"invalid `dataset`.*material\.youngs_modulus"):
         gvsrom.pod([dataset, other], 2, tmp_path / "pod")
 
 
@@ -370,7 +370,7 @@ def test_reconstruction_of_its_own_data_is_what_pod_discards(dataset, pod_model,
     p = run_cli(gvsrom_bin, "dataset", "soft-beam", "--random", "loads.distributed.0.magnitude=-1:1",
                 "--samples", "2", "--out", str(beam))
     assert p.returncode == 0, p.stderr
-    with pytest.raises(ValueError, match=r"invalid `DATASET`.*soft-beam.*single-tendon"):
+    with pytest.raises(ValueError, match=r"invalid `dataset`.*soft-beam.*single-tendon"):
         pod_model.reconstruction(beam)
     # tensions beyond the training's [-6, 0] N on a stiffer rod: the inputs and the physics named
     beyond = tmp_path / "beyond"
@@ -453,3 +453,29 @@ def test_the_python_defaults_are_the_command_lines(gvsrom_bin, command):
         compared.append(name)
     # every plain default of the command line has its Python counterpart (not a vacuous test)
     assert len(compared) == len(cli), (sorted(compared), sorted(cli))
+
+
+def test_a_failed_reduced_run_raises_with_the_samples_it_computed(ae_model):
+    # a step to the largest trained tension from rest: the undamped-enough swing overshoots the
+    # training encodings and the run stops there; the samples before are on the exception, as
+    # simulate returns them
+    reduced = (gvsrom.Scenario.preset("single-tendon").set("tendons.0.tension", -6.0).build()
+               .with_model(ae_model))
+    with pytest.raises(gvsrom.IntegrationError, match=r"left the training region at t = ([0-9.]+) s"
+                       r".* \((\d+) samples computed: the exception's `trajectory`\)") as e:
+        reduced.simulate(0.5, sample_rate=100)
+    assert isinstance(e.value, gvsrom.GvsromError)
+    tr = e.value.trajectory
+    k = len(tr["t"])
+    assert f"({k} samples computed" in str(e.value)
+    assert 0 < k < 51
+    t_stop = float(str(e.value).split("at t = ")[1].split(" s")[0])
+    assert tr["t"][-1] <= t_stop
+    np.testing.assert_allclose(np.diff(tr["t"]), 0.01, rtol=1e-12)
+    assert tr["q"].shape == (k, 1) and tr["tip_position"].shape == (k, 3)
+    assert np.isfinite(tr["q"]).all()
+    lo, hi = ae_model.latent_range[0]
+    span = hi - lo
+    assert (tr["q"][:, 0] >= lo - span).all() and (tr["q"][:, 0] <= hi + span).all()
+    assert "energy_balance" not in tr
+

@@ -69,16 +69,18 @@ fn detect(line: &str) -> Result<Option<Delimiter>, String> {
 
 /// Reads a CSV signal with `n_values` columns after `t` (see the module doc), times ascending,
 /// every number finite; a time given twice is a step when `interpolation` is linear and refused
-/// when it is a hold ([`Signal::repeated_time`]).
+/// when it is a hold ([`Signal::repeated_time`]). `field` names the file where it cannot be read
+/// (`--input`); a line's error names the file and line.
 pub fn read_csv_signal(
+    field: &str,
     path: &Path,
     n_values: usize,
     interpolation: Interpolation,
 ) -> Result<Signal, ScenarioError> {
     let file = path.display().to_string();
     let text = crate::output::read_regular_to_string(path).map_err(|e| {
-        crate::scenario::read_error(&file, path, e, |e| {
-            ScenarioError::invalid(&file, format!("cannot read the input file: {e}"))
+        crate::scenario::read_error(field, path, e, |e| {
+            ScenarioError::invalid(field, format!("cannot read the input file `{file}`: {e}"))
         })
     })?;
     let expected = n_values + 1;
@@ -238,7 +240,7 @@ mod tests {
     fn read(name: &str, text: &str, n: usize) -> Result<Signal, String> {
         let path = csv_dir().join(name);
         std::fs::write(&path, text).unwrap();
-        read_csv_signal(&path, n, Interpolation::Hold).map_err(|e| e.to_string())
+        read_csv_signal("--input", &path, n, Interpolation::Hold).map_err(|e| e.to_string())
     }
 
     fn rows(s: &Signal) -> Vec<(f64, Vec<f64>)> {
@@ -258,12 +260,13 @@ mod tests {
             "{e}"
         );
         let dir = csv_dir();
-        let linear = read_csv_signal(&dir.join("twice.csv"), 1, Interpolation::Linear).unwrap();
+        let linear =
+            read_csv_signal("--input", &dir.join("twice.csv"), 1, Interpolation::Linear).unwrap();
         assert_eq!(linear.times, vec![0.0, 1.0, 1.0, 2.0]);
         let thrice = "0,0\n1,0\n1,2\n1,4\n";
         read("thrice.csv", thrice, 1).unwrap_err();
         let path = dir.join("thrice.csv");
-        let e = read_csv_signal(&path, 1, Interpolation::Linear)
+        let e = read_csv_signal("--input", &path, 1, Interpolation::Linear)
             .unwrap_err()
             .to_string();
         assert!(
@@ -362,11 +365,16 @@ mod tests {
                 && e.contains("ascending"),
             "{e}"
         );
-        let e = read_csv_signal(Path::new("/nonexistent/in.csv"), 1, Interpolation::Hold)
-            .unwrap_err()
-            .to_string();
+        let e = read_csv_signal(
+            "--input",
+            Path::new("/nonexistent/in.csv"),
+            1,
+            Interpolation::Hold,
+        )
+        .unwrap_err()
+        .to_string();
         assert!(
-            e.contains("/nonexistent/in.csv") && e.contains("cannot read"),
+            e.contains("/nonexistent/in.csv") && e.contains("cannot read") && e.contains("--input"),
             "{e}"
         );
     }
@@ -374,11 +382,11 @@ mod tests {
     #[test]
     fn a_directory_or_device_is_refused_before_it_is_read() {
         let dir = crate::output::test_util::sandbox("csv", "a-directory");
-        let e = read_csv_signal(&dir, 1, Interpolation::Hold)
+        let e = read_csv_signal("--input", &dir, 1, Interpolation::Hold)
             .unwrap_err()
             .to_string();
         assert!(e.contains("a directory, not a regular file"), "{e}");
-        let e = read_csv_signal(Path::new("/dev/zero"), 1, Interpolation::Hold)
+        let e = read_csv_signal("--input", Path::new("/dev/zero"), 1, Interpolation::Hold)
             .unwrap_err()
             .to_string();
         assert!(e.contains("a character device"), "{e}");
@@ -397,7 +405,7 @@ mod tests {
         let pipe = crate::output::test_util::sandbox("csv", "fifo").join("in.csv");
         crate::output::test_util::fifo(&pipe);
         // no writer ever opens it: a reader that opened it plainly would block this test forever
-        let e = read_csv_signal(&pipe, 1, Interpolation::Hold)
+        let e = read_csv_signal("--input", &pipe, 1, Interpolation::Hold)
             .unwrap_err()
             .to_string();
         let shown = format!(

@@ -64,7 +64,7 @@ fn zero_epochs_and_a_diverging_training_leave_no_model() {
             "--learning-rate",
             "1000",
         ],
-        &["--learning-rate", "learning_rate = 1000", "in (0, 1]"],
+        &["--learning-rate", "`--learning-rate`: 1000:", "in (0, 1]"],
     );
     // a rate too small to move any weight: the loss never falls below the initial weights'
     train(

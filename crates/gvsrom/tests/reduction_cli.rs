@@ -176,7 +176,7 @@ fn a_penalty_that_empties_the_network_or_a_split_that_leaves_one_row_is_refused(
         (
             "--lambda",
             "2",
-            &["--lambda", "lambda = 2", "in [0, 1]"][..],
+            &["--lambda", "`--lambda`: 2:", "in [0, 1]"][..],
         ),
         ("--lambda", "1e300", &["--lambda", "in [0, 1]"][..]),
         (

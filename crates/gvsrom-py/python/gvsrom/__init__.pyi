@@ -13,6 +13,7 @@ __all__ = [
     "ConvergenceError",
     "Dataset",
     "GvsromError",
+    "IntegrationError",
     "Model",
     "Reconstruction",
     "Robot",
@@ -43,6 +44,11 @@ class ConvergenceError(GvsromError):
     iterations: int
     residual_norm: float
     load_factor: float
+
+class IntegrationError(GvsromError):
+    """A simulation whose integrator failed; ``trajectory`` holds the samples computed before."""
+
+    trajectory: dict[str, Any]
 
 def presets() -> dict[str, str]:
     """The built-in presets: ``{name: summary}``."""
@@ -268,7 +274,7 @@ def dataset(
     random: _Specs | None = None,
     samples: int | None = None,
     seed: int | None = None,
-    set: Sequence[str] | None = None,
+    set: str | Sequence[str] | None = None,
     chunk_size: int = 128,
     threads: int | None = None,
     force: bool = False,
@@ -294,7 +300,7 @@ def reproduce(
 def plot(
     output: _Path,
     out: _Path,
-    formats: Sequence[str] | None = None,
+    formats: str | Sequence[str] | None = None,
     force: bool = False,
 ) -> dict[str, Any]: ...
 def load_model(path: _Path, extrapolate: bool = False) -> Model: ...
@@ -321,7 +327,7 @@ def train(
     seed: int | None = None,
     loss: str | None = None,
     sample_weighting: str = "uniform",
-    relative_floor: float = 0.1,
+    relative_floor: float | None = None,
     decoder: str | None = None,
     rate_weight: float = 0.0,
     lr_decay: float | None = None,

@@ -51,7 +51,7 @@ pub struct TrainArgs {
     /// Latent size r (reduced coordinates) [default: 1; with `--init`, the model's].
     #[arg(long, value_name = "R")]
     pub latent: Option<usize>,
-    /// Hidden layers of the whole autoencoder (odd: 3, 5, 7…); layer sizes halve from the snapshot
+    /// Hidden layers of the whole autoencoder (odd: 1, 3, 5, 7…, at most 63); layer sizes halve from the snapshot
     /// size towards the latent size (paper Section III) [default: 7; with `--init`, the model's].
     #[arg(long, value_name = "N")]
     pub hidden_layers: Option<usize>,
@@ -102,9 +102,9 @@ pub struct TrainArgs {
     #[arg(long, default_value = "uniform", value_parser = reduce::SAMPLE_WEIGHTINGS)]
     pub sample_weighting: String,
     /// The floor of `--sample-weighting relative`, as a fraction of the largest snapshot norm, in
-    /// (0, 1].
-    #[arg(long, default_value_t = rom::nn::SampleWeighting::DEFAULT_FLOOR)]
-    pub relative_floor: f64,
+    /// (0, 1] [default: 0.1].
+    #[arg(long)]
+    pub relative_floor: Option<f64>,
     /// The decoder's form: `plain` (the paper's, x̂ = D(z)) or `scaled` (x̂ = z₁ D(z): every code with
     /// z₁ = 0 decodes to the straight rod, for snapshot families that shrink to rest as their load
     /// vanishes, such as a load of varying magnitude and position) [default: plain; with `--init`,
@@ -360,11 +360,18 @@ fn reconstruction_lines(
         "RMSE       {} (every entry of every snapshot, Table I's measure)",
         fmt_sci(r.rmse, 4)
     )?;
-    writeln!(
-        out,
-        "relative   {:.4} % (‖X̂ − X‖ / ‖X‖)",
-        100.0 * r.relative
-    )?;
+    if r.relative.is_finite() {
+        writeln!(
+            out,
+            "relative   {:.4} % (‖X̂ − X‖ / ‖X‖)",
+            100.0 * r.relative
+        )?;
+    } else {
+        writeln!(
+            out,
+            "relative   none: every snapshot is zero (‖X‖ = 0) and the reconstruction is not; the RMSE above is its absolute error"
+        )?;
+    }
     if let Some((row, e, norm)) = r.worst {
         writeln!(
             out,

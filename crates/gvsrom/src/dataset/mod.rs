@@ -250,6 +250,25 @@ pub struct Outcome {
 }
 
 impl Outcome {
+    /// What to tell of the samples that failed (`None` if none did): how many, the first's reason,
+    /// and what became of their rows, for a front-end that does not list them as `gvsrom dataset`
+    /// does.
+    pub fn failure_message(&self) -> Option<String> {
+        let c = &self.meta.counts;
+        let first = self.meta.failures.first()?;
+        Some(format!(
+            "{} of the {} samples failed (sample {}: {}{}); their rows are NaN with status 1, and pod and train leave them out",
+            c.failed,
+            self.meta.samples,
+            first.index,
+            first.reason,
+            match self.meta.failures.len() - 1 {
+                0 => String::new(),
+                more => format!("; {more} more in meta.json"),
+            }
+        ))
+    }
+
     /// What to tell of an interrupted run (`None` if it finished): why it stopped and where its
     /// finished samples were written, as `gvsrom dataset` prints it.
     pub fn interruption_message(&self) -> Option<String> {

@@ -28,7 +28,7 @@ use thiserror::Error;
 pub const FIGURES_FORMAT: &str = "figures";
 
 /// What `gvsrom plot` accepts, for error messages.
-pub const ACCEPTED: &str = "a `statics --json`, `modes --json` or `linearize --json` file, or a directory written by `simulate --out`, `dataset`, `pod` or `train`";
+pub const ACCEPTED: &str = "a `gvsrom statics --json`, `gvsrom modes --json` or `gvsrom linearize --json` file, or a directory written by `gvsrom simulate --out`, `gvsrom dataset`, `gvsrom pod` or `gvsrom train`";
 
 #[derive(Debug, Error)]
 pub enum FiguresError {

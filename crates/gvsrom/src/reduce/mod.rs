@@ -287,16 +287,31 @@ pub(super) fn latent_range(latent: &[f64], r: usize) -> Vec<[f64; 2]> {
     range
 }
 
-/// What a front-end should tell the user about the dataset `ds` read from `dir` (one written before
-/// content hashes could not be checked for edits).
+/// What a front-end should tell the user about the dataset `ds` read from `dir`: the samples left
+/// out (failed or not computed: their rows are NaN), and that one written before content hashes
+/// could not be checked for edits.
 pub(super) fn dataset_warnings(ds: &Dataset, dir: &Path) -> Vec<String> {
-    match ds.integrity {
-        crate::output::Integrity::Checked => vec![],
-        crate::output::Integrity::Unhashed => vec![format!(
+    let mut warnings = vec![];
+    let problems = ds.problems();
+    if let Some(first) = problems.first() {
+        warnings.push(format!(
+            "dataset `{}`: {} of its {} samples are left out, failed or not computed ({first}{})",
+            dir.display(),
+            problems.len(),
+            ds.samples(),
+            match problems.len() - 1 {
+                0 => String::new(),
+                more => format!("; {more} more in its meta.json"),
+            }
+        ));
+    }
+    if let crate::output::Integrity::Unhashed = ds.integrity {
+        warnings.push(format!(
             "dataset `{}` was written before gvsrom recorded content hashes: its files could not be checked for edits",
             dir.display()
-        )],
+        ));
     }
+    warnings
 }
 
 /// The strain-energy norm's weight of every snapshot feature of `layout` (point `j`, active

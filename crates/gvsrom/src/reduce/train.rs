@@ -328,7 +328,14 @@ pub const SAMPLE_WEIGHTINGS: [&str; 2] = ["uniform", "relative"];
 /// snapshot norm, in (0, 1]) bounds the relative weighting's weights. A floor outside (0, 1] is
 /// refused with either weighting: a value given by mistake is not passed over because the uniform
 /// weighting does not read it.
-pub fn sample_weighting(name: &str, floor: f64) -> Result<SampleWeighting, ScenarioError> {
+pub fn sample_weighting(name: &str, floor: Option<f64>) -> Result<SampleWeighting, ScenarioError> {
+    if floor.is_some() && name == "uniform" {
+        return Err(invalid(
+            "--relative-floor",
+            "applies to the relative weighting only (accepted: with --sample-weighting relative, or not given)",
+        ));
+    }
+    let floor = floor.unwrap_or(SampleWeighting::DEFAULT_FLOOR);
     if !(floor > 0.0 && floor <= 1.0) {
         return Err(invalid(
             "--relative-floor",
@@ -397,7 +404,16 @@ pub(super) fn train_error(e: &rom::nn::NnError) -> ScenarioError {
         NnError::Diverged { .. } => "--learning-rate".to_string(),
         _ => "train".to_string(),
     };
-    invalid(&option, e.to_string())
+    match e {
+        // named once, by the option: "invalid `--lambda`: NaN: expected …"
+        NnError::InvalidOption {
+            value, expected, ..
+        } => invalid(
+            &option,
+            format!("{}: expected {expected}", gvs::error::fmt_value(*value)),
+        ),
+        _ => invalid(&option, e.to_string()),
+    }
 }
 
 #[cfg(test)]
@@ -417,28 +433,34 @@ mod tests {
     }
 
     #[test]
-    fn sample_weightings_are_named_and_a_bad_name_or_floor_is_refused_by_its_option_whatever_the_weighting(
-    ) {
+    fn sample_weightings_are_named_and_a_bad_name_or_floor_is_refused_by_its_option() {
         assert_eq!(
-            sample_weighting("uniform", 0.1).unwrap(),
+            sample_weighting("uniform", None).unwrap(),
             SampleWeighting::Uniform
         );
         assert_eq!(
-            sample_weighting("relative", 0.25).unwrap(),
+            sample_weighting("relative", Some(0.25)).unwrap(),
             SampleWeighting::Relative { floor: 0.25 }
         );
+        assert_eq!(
+            sample_weighting("relative", None).unwrap(),
+            SampleWeighting::Relative {
+                floor: SampleWeighting::DEFAULT_FLOOR
+            }
+        );
         for (name, floor, field) in [
-            ("relative", 0.0, "--relative-floor"),
-            ("relative", 1.5, "--relative-floor"),
-            ("relative", f64::NAN, "--relative-floor"),
-            ("uniform", -1.0, "--relative-floor"),
-            ("uniform", f64::NAN, "--relative-floor"),
-            ("per-row", 0.1, "--sample-weighting"),
+            ("relative", Some(0.0), "--relative-floor"),
+            ("relative", Some(1.5), "--relative-floor"),
+            ("relative", Some(f64::NAN), "--relative-floor"),
+            // a floor without the weighting it belongs to would be ignored
+            ("uniform", Some(0.1), "--relative-floor"),
+            ("uniform", Some(f64::NAN), "--relative-floor"),
+            ("per-row", None, "--sample-weighting"),
         ] {
             let e = sample_weighting(name, floor).unwrap_err().to_string();
             assert!(
                 e.starts_with(&format!("invalid `{field}`")),
-                "{name} {floor}: {e}"
+                "{name} {floor:?}: {e}"
             );
             assert!(e.contains("accepted"), "{e}");
         }

@@ -238,7 +238,7 @@ pub fn input_signal(built: &Built, opts: &SimulateOptions) -> Result<Signal, Sce
             interpolation,
         } => {
             crate::scenario::check_regular_file("--input", path)?;
-            let signal = crate::csv_input::read_csv_signal(path, na, *interpolation)?;
+            let signal = crate::csv_input::read_csv_signal("--input", path, na, *interpolation)?;
             covers_start("--input", path, &signal, RUN_START)?;
             signal
         }

@@ -188,7 +188,12 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
     let schedule = match &opts.load_schedule {
         Some(path) => {
             crate::scenario::check_regular_file("--load-schedule", path)?;
-            let s = crate::csv_input::read_csv_signal(path, 1, Interpolation::Linear)?;
+            let s = crate::csv_input::read_csv_signal(
+                "--load-schedule",
+                path,
+                1,
+                Interpolation::Linear,
+            )?;
             covers_start("--load-schedule", path, &s, t_out[0])?;
             Some(s)
         }
