@@ -222,7 +222,9 @@ fn unreachable_load_reports_iterations_and_residual() {
             "3 iterations",
             "‖R‖∞",
             "the largest load is tendons[0].tension = -30 N (implied bending ~24 rad",
-            "try solver.ramp_steps = 10",
+            // the scenario's own cap stopped the solve: raise it first, then a finer ramp
+            "solver.max_iterations = 3 stopped the solves (the default is 400): raise it",
+            "then, if it still fails, try solver.ramp_steps = 10",
         ],
     );
     assert!(msg.contains("tolerance"), "{msg}");
@@ -791,4 +793,43 @@ fn six_tendon_pushed_on_every_tendon_is_reported_buckled_and_unjudged_without_th
             && !stdout.contains("continued"),
         "{stdout}"
     );
+}
+
+#[test]
+fn a_negative_number_reaches_its_option_instead_of_reading_as_a_flag() {
+    // clap took `-1` for an unknown flag ("unexpected argument '-1' found", with the tip `-- -1`);
+    // each command now accepts negative values, and the option's own check names it
+    let run = gvsrom(&[
+        "simulate",
+        "single-tendon",
+        "--duration",
+        "0.1",
+        "--seed",
+        "-1",
+    ]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("invalid value '-1' for '--seed <SEED>'")
+            && !stderr.contains("unexpected argument"),
+        "{stderr}"
+    );
+    let out = scratch("negative-samples");
+    let run = gvsrom(&[
+        "dataset",
+        "single-tendon",
+        "--sweep",
+        "tendons.0.tension=-1:0",
+        "--samples",
+        "-1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        stderr.contains("invalid value '-1' for '--samples <N>'")
+            && !stderr.contains("unexpected argument"),
+        "{stderr}"
+    );
+    assert!(!out.exists());
 }

@@ -902,3 +902,52 @@ fn interrupted_training_keeps_the_best_weights() {
     let (strain, _) = ae_strain_error(&dir, "red-ae-interrupted-rom", -3.0);
     assert!(strain.is_finite());
 }
+
+#[test]
+fn all_zero_snapshots_give_no_pod_and_no_relative_error() {
+    // a dataset whose snapshots are all zero (no gravity, no tension): a POD of it is refused
+    // (it was written, "capturing 1.00000000 of the energy", 0/0 read as 1), and a model's
+    // reconstruction of it has no relative error, rather than "inf %"
+    let zero = scratch("red-zero-ds");
+    let _ = std::fs::remove_dir_all(&zero);
+    run_ok(&[
+        "dataset",
+        "single-tendon",
+        "--set",
+        "loads.gravity=[0,0,0]",
+        "--sweep",
+        "tendons.0.tension=0:0",
+        "--samples",
+        "2",
+        "--out",
+        s(&zero),
+    ]);
+    let pod = scratch("red-zero-pod");
+    let _ = std::fs::remove_dir_all(&pod);
+    expect_error(
+        &["pod", s(&zero), "--modes", "1", "--out", s(&pod)],
+        &["all 2 snapshots are zero: there is no strain to reduce"],
+    );
+    assert!(!pod.exists());
+    let out = run_ok(&["reconstruct", s(ae_small()), s(&zero)]);
+    assert!(
+        out.contains("relative   none: every snapshot is zero (‖X‖ = 0)") && !out.contains("inf"),
+        "{out}"
+    );
+}
+
+#[test]
+fn a_one_snapshot_pod_is_plotted_without_its_empty_energy_panel() {
+    let ds = sweep("red-one-ds", -2.0, -2.0, 1);
+    let pod = scratch("red-one-pod");
+    let _ = std::fs::remove_dir_all(&pod);
+    run_ok(&["pod", s(&ds), "--modes", "1", "--out", s(&pod)]);
+    let figs = scratch("red-one-figs");
+    let _ = std::fs::remove_dir_all(&figs);
+    let out = run_ok(&["plot", s(&pod), "--out", s(&figs)]);
+    assert!(figs.join("pod_spectrum.png").exists(), "{out}");
+    assert!(
+        out.contains("the first mode holds all the snapshot energy"),
+        "{out}"
+    );
+}

@@ -90,6 +90,12 @@ impl Pod {
                 i % n_features
             )));
         }
+        if rows.iter().all(|v| *v == 0.0) {
+            // the SVD of a zero matrix has σ = 0 and arbitrary directions: no modes to learn
+            return Err(PodError::Data(format!(
+                "all {n} snapshots are zero: there is no strain to reduce (loads or tensions that do not deform the rod?)"
+            )));
+        }
         let rank_max = n.min(n_features);
         if modes == 0 || modes > rank_max {
             return Err(PodError::Modes {
@@ -123,7 +129,8 @@ impl Pod {
         })
     }
 
-    /// Fraction of the snapshot energy `Σ σ²` captured by the first `k` modes, for k = 1..=all.
+    /// Fraction of the snapshot energy `Σ σ²` captured by the first `k` modes, for k = 1..=all (a
+    /// POD is never of all-zero snapshots: [`Pod::compute`] refuses them).
     pub fn captured_energy(&self) -> Vec<f64> {
         let total: f64 = self.singular_values.iter().map(|s| s * s).sum();
         let mut acc = 0.0;
@@ -229,6 +236,19 @@ mod tests {
         }
         // the leading singular value: Σ (3t)² over the rows dominates
         assert!(pod.singular_values[0] > pod.singular_values[1]);
+    }
+
+    #[test]
+    fn all_zero_snapshots_are_refused_rather_than_given_arbitrary_modes() {
+        // σ = 0 and any direction: a review's all-zero dataset was reported as "1 mode captures
+        // 1.00000000 of the snapshot energy" (0/0 read as 1)
+        let e = Pod::compute(&[0.0; 12], 4, 1).unwrap_err().to_string();
+        assert!(e.contains("all 3 snapshots are zero"), "{e}");
+        assert!(Pod::compute_weighted(&[0.0; 12], 4, 1, &[1.0; 4]).is_err());
+        // one nonzero value is data
+        let mut rows = [0.0; 12];
+        rows[5] = 1e-12;
+        assert_eq!(Pod::compute(&rows, 4, 1).unwrap().captured_energy()[0], 1.0);
     }
 
     #[test]

@@ -51,47 +51,60 @@ pub struct Cli {
     pub command: Command,
 }
 
+/// Every command takes a negative number as an option's value (`--seed -1` reaches the option's
+/// own check, which names it and what it accepts, rather than clap's "unexpected argument").
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Solve the static equilibrium of a preset or a scenario file and print a summary.
+    #[command(allow_negative_numbers = true)]
     Statics(StaticsArgs),
     /// Simulate the dynamics of a preset or scenario file (stiff NDF integrator, ode15s class) and
     /// write the trajectory as NumPy arrays.
+    #[command(allow_negative_numbers = true)]
     Simulate(SimulateArgs),
     /// Natural frequencies and mode shapes about the static equilibrium under the scenario's loads
     /// and tensions (undamped, linearized; see docs/modes.md).
+    #[command(allow_negative_numbers = true)]
     Modes(ModesArgs),
     /// The equations of motion linearized about the static equilibrium, for control design:
     /// `δẋ = A δx + B δu`, `δy = C δx` (state `[q; q̇]`, tendon tensions, tip position), its poles
     /// and the static gain from tensions to tip (see docs/linearize.md).
+    #[command(allow_negative_numbers = true)]
     Linearize(LinearizeArgs),
     /// Generate a strain snapshot dataset: solve the statics over a sampling plan (`--sweep`,
     /// `--grid`, `--random`) in parallel and write NumPy arrays (see docs/datasets.md).
+    #[command(allow_negative_numbers = true)]
     Dataset(DatasetArgs),
     /// POD of a dataset's strain snapshots: K modes become a reduced model (`--model` on `statics`
     /// and `simulate`).
+    #[command(allow_negative_numbers = true)]
     Pod(PodArgs),
     /// Train a tanh autoencoder on a dataset's strain snapshots; its decoder becomes a nonlinear
     /// reduced model (`--model` on `statics` and `simulate`).
+    #[command(allow_negative_numbers = true)]
     Train(TrainArgs),
     /// How closely a reduced model reconstructs a dataset's snapshots, `D(E(x))`: Table I's RMSE,
     /// the relative error and the worst snapshot, e.g. on data the model was not trained on.
     /// Prints; writes nothing.
+    #[command(allow_negative_numbers = true)]
     Reconstruct(ReconstructArgs),
     /// Compare a trajectory with a reference one (e.g. `simulate --model` against the full model)
     /// of the same scenario, input and sample times: tip and strain errors over the common samples,
     /// and the speed ratio (simulated time per wall time).
+    #[command(allow_negative_numbers = true)]
     Compare(CompareArgs),
     /// Reproduce the paper's studies end to end (data, training, reduced models, evaluation) with
     /// their tables beside the paper's, figures and one HTML page `OUT/index.html`; finished steps
     /// are kept and reused by the next run.
+    #[command(allow_negative_numbers = true)]
     Reproduce(ReproduceArgs),
     /// Validate a preset or scenario file and print the model's size, without solving.
-    #[command(mut_arg("extrapolate", |a| a.hide(true)))]
+    #[command(mut_arg("extrapolate", |a| a.hide(true)), allow_negative_numbers = true)]
     Check(ScenarioArgs),
     /// Figures (SVG and PNG) of a gvsrom output: a `statics --json` file, or a `simulate --out`,
     /// `dataset`, `pod` or `train` directory (rod shapes, tip paths, strain, an animation of the
     /// rod, input coverage, POD spectra, training curves, reduced coordinates).
+    #[command(allow_negative_numbers = true)]
     Plot(PlotArgs),
     /// List the built-in presets.
     Presets,

@@ -29,7 +29,8 @@ pub(super) fn resumable(path: &Path, meta: &Meta) -> Result<Dataset, DatasetErro
             "the {what} differs from the incomplete dataset's ({old} there, {new} now); rerun with the same arguments, or use --force instead of --resume to start again"
         ))
     };
-    if p.scenario_toml != meta.scenario_toml {
+    if p.scenario_toml != meta.scenario_toml && !same_tables(&p.scenario_toml, &meta.scenario_toml)
+    {
         let what = match toml_difference(&p.scenario_toml, &meta.scenario_toml) {
             Some((path, old, new)) => format!(
                 "scenario (after --set): `{path}` differs from the incomplete dataset's ({old} there, {new} now)"
@@ -105,6 +106,18 @@ fn toml_difference(old: &str, new: &str) -> Option<(String, String, String)> {
     difference_at(&old, &new, String::new())
 }
 
+/// Whether two scenario TOMLs hold the same values (an integer equal to a float, `1000` and
+/// `1000.0`, counts as the same: the scenario reads both as the real number), though their texts
+/// differ.
+fn same_tables(old: &str, new: &str) -> bool {
+    match (old.parse::<Table>(), new.parse::<Table>()) {
+        (Ok(a), Ok(b)) => {
+            difference_at(&Value::Table(a), &Value::Table(b), String::new()).is_none()
+        }
+        _ => false,
+    }
+}
+
 fn difference_at(a: &Value, b: &Value, path: String) -> Option<(String, String, String)> {
     let shown = |v: Option<&Value>| v.map_or_else(|| "missing".to_string(), |v| v.to_string());
     let child = |key: &str| match path.is_empty() {
@@ -124,6 +137,11 @@ fn difference_at(a: &Value, b: &Value, path: String) -> Option<(String, String, 
             .zip(y)
             .enumerate()
             .find_map(|(i, (u, v))| difference_at(u, v, format!("{path}[{i}]"))),
+        (Value::Integer(i), Value::Float(f)) | (Value::Float(f), Value::Integer(i))
+            if *i as f64 == *f =>
+        {
+            None
+        }
         _ if a == b => None,
         _ => Some((path, shown(Some(a)), shown(Some(b)))),
     }
@@ -181,5 +199,17 @@ mod tests {
             Some(("material.damping".into(), "missing".into(), "3.0".into()))
         );
         assert_eq!(toml_difference(a, a), None);
+        // an integer and the equal float are the same value: the first real difference is named
+        let d = a.replace("density = 1121.0", "density = 1121\ngravity = [0, 0, -5]");
+        let e = a.replace(
+            "density = 1121.0",
+            "density = 1121.0\ngravity = [0.0, 0.0, 0.0]",
+        );
+        assert_eq!(
+            toml_difference(&e, &d),
+            Some(("material.gravity[2]".into(), "0.0".into(), "-5".into()))
+        );
+        assert!(super::same_tables(a, &a.replace("1121.0", "1121")));
+        assert!(!super::same_tables(a, &a.replace("1121.0", "1121.5")));
     }
 }

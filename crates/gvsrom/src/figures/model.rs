@@ -102,24 +102,29 @@ fn pod_spectrum(
             equal_aspect: false,
         })
     };
+    let mut panels = vec![panel("Singular values", "σ_k / σ_1", rel)];
+    if left.iter().any(|&e| e > 0.0) {
+        panels.push(panel(
+            match model.meta.pod_norm.unwrap_or_default() {
+                crate::reduced_model::PodNorm::Plain => "Energy left out by the first k modes",
+                crate::reduced_model::PodNorm::Energy => {
+                    "Strain energy left out by the first k modes (energy norm)"
+                }
+            },
+            "1 − E_k",
+            left,
+        ));
+    } else {
+        // a log axis has nothing to draw: one snapshot, or snapshots of rank 1
+        sink.note("pod_spectrum: the first mode holds all the snapshot energy (one snapshot, or snapshots along one direction): the panel of the energy left out, 0 for every k, is left out");
+    }
+    let cols = panels.len();
     let fig = Figure::Grid {
         title: format!("POD spectrum — {caption}"),
-        cols: 2,
-        panels: vec![
-            panel("Singular values", "σ_k / σ_1", rel),
-            panel(
-                match model.meta.pod_norm.unwrap_or_default() {
-                    crate::reduced_model::PodNorm::Plain => "Energy left out by the first k modes",
-                    crate::reduced_model::PodNorm::Energy => {
-                        "Strain energy left out by the first k modes (energy norm)"
-                    }
-                },
-                "1 − E_k",
-                left,
-            ),
-        ],
+        cols,
+        panels,
     };
-    sink.figure("pod_spectrum", &fig, (1400, 600))
+    sink.figure("pod_spectrum", &fig, (700 * cols as u32, 600))
 }
 
 /// `training_curves`: training and validation loss per epoch (log scale), the best epoch marked.

@@ -174,7 +174,7 @@ pub fn run(run: &Run, opts: &Options) -> anyhow::Result<(CaseReport, Vec<Rendere
         "autoencoders trained on noisy snapshots (paper Section IV-B, last paragraph)",
     );
     report.setup = vec![
-        format!("noise: Gaussian, independent per snapshot entry, σ_c = {level} × the RMS of each strain component c of the clean snapshots (`--noise`; the paper does not give its level), seed {NOISE_SEED}"),
+        format!("noise: Gaussian, independent per snapshot entry, σ_c = {} × the RMS of each strain component c of the clean snapshots (`--noise`; the paper does not give its level), seed {NOISE_SEED}", gvs::error::fmt_value(level)),
         "IV-A: its dataset and test tensions; ROM autoencoder r = 1, 7 hidden layers; latent plots r = 2 and 3, 3 hidden layers — trained again on the noisy snapshots with the same settings".into(),
         "IV-B: its dataset (total moment in N·m) and the two Fig. 6 loads; ROM autoencoder r = 2, 7 hidden layers; latent plots as IV-A".into(),
     ];

@@ -487,12 +487,31 @@ pub fn compare(built: &Built, hom: &StaticsReport, rom: &StaticsReport) -> Compa
 /// The engine's error with, for a non-convergence, the largest load and a remedy.
 fn failure(built: &Built, u: &[f64], error: StaticsError) -> StaticsFailure {
     let mut hint = String::new();
-    if let StaticsError::NotConverged { continuation, .. } = error {
+    if let StaticsError::NotConverged {
+        continuation,
+        ref reason,
+        ..
+    } = error
+    {
         if let Some(load) = crate::plausibility::largest_load(built, u, 1.0) {
             hint.push_str(&format!("; {load}"));
         }
         let steps = built.options.ramp_steps;
+        let cap = built.options.max_iterations;
+        let default_cap = gvs::solve::statics::StaticsOptions::default().max_iterations;
+        // the scenario's own iteration cap stopped the solves: that, not the load, is the remedy
+        let capped = cap < default_cap
+            && reason.contains(&format!("maximum number of iterations ({cap}) reached"));
         match continuation {
+            _ if capped => {
+                hint.push_str(&format!(
+                    "; solver.max_iterations = {cap} stopped the solves (the default is {default_cap}): raise it"
+                ));
+                if continuation == ContinuationOutcome::NotTried && steps < MAX_RAMP_STEPS {
+                    let more = (steps * 10).clamp(10, MAX_RAMP_STEPS);
+                    hint.push_str(&format!(", then, if it still fails, try solver.ramp_steps = {more}"));
+                }
+            }
             // continuation from the straight rod already failed (the reason says where and why)
             ContinuationOutcome::Stopped => hint.push_str(
                 "; the equilibria from the straight rod were followed by continuation and do not reach the full load: a finer ramp will not help; lower the load",
@@ -562,6 +581,20 @@ mod tests {
             h.contains("loosen solver.ftol") && !h.contains("ramp_steps ="),
             "{h}"
         );
+        // the scenario's own iteration cap stopped every solve (a load the defaults solve): the
+        // remedy is to raise it, not to lower the load
+        let mut capped = crate::presets::load("single-tendon", &[]).unwrap();
+        capped.solver.max_iterations = 1;
+        let e = crate::statics::solve_checked(&crate::build(&capped).unwrap(), &[-5.0])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(
+                "solver.max_iterations = 1 stopped the solves (the default is 400): raise it"
+            ) && !e.contains("lower the load"),
+            "{e}"
+        );
+        assert!(crate::statics::solve_checked(&built, &[-5.0]).is_ok());
         // a load continuation cannot follow to the end, through the CLI
         let e = crate::statics::solve_checked(&built6(), &[-200.0, 0.0, 0.0, 0.0, 0.0, 0.0])
             .unwrap_err()
