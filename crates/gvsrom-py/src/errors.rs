@@ -124,7 +124,8 @@ const RENAMED: [(&str, &str); 6] = [
 ];
 
 /// Flags of the command line that are switches, spelled `name=True` in Python.
-const SWITCHES: [&str; 6] = [
+const SWITCHES: [&str; 7] = [
+    "fd-jacobian",
     "force",
     "resume",
     "extrapolate",
@@ -134,8 +135,11 @@ const SWITCHES: [&str; 6] = [
 ];
 
 /// Flags of the command line that are keyword arguments of the same name in Python.
-const SAME: [&str; 42] = [
+const SAME: [&str; 45] = [
     "out",
+    "max-order",
+    "error-norm",
+    "rho-inf",
     "load-schedule",
     "model",
     "set",

@@ -8,7 +8,8 @@ use crate::robot::{warn, Robot};
 use gvs::error::ModelError;
 use gvs::inputs::{Actuation, Interpolation, Signal};
 use gvsrom::simulate::{
-    self, Ending, InputFunction, InputSource, IntegratorChoice, MethodChoice, TrajectoryBuffer,
+    self, Ending, ErrorNormChoice, InputFunction, InputSource, IntegratorChoice, MethodChoice,
+    TrajectoryBuffer,
 };
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -38,6 +39,14 @@ pub struct Args<'a> {
     pub babble: Option<Vec<f64>>,
     /// Seed of `steps` and `babble` (`--seed`).
     pub seed: u64,
+    /// Highest NDF order (`--max-order`).
+    pub max_order: Option<usize>,
+    /// The adaptive methods' error test, `componentwise` or `mass` (`--error-norm`).
+    pub error_norm: Option<&'a str>,
+    /// Generalized-α's spectral radius at infinite frequency (`--rho-inf`).
+    pub rho_inf: Option<f64>,
+    /// Finite differences for the integrator's Jacobian (`--fd-jacobian`).
+    pub fd_jacobian: bool,
 }
 
 #[pymethods]
@@ -88,6 +97,19 @@ impl Robot {
     ///     ``[lo, hi]`` for a uniform random time in ``[hold_min, hold_max]`` (``--babble``).
     /// seed : int
     ///     Seed of ``steps`` and ``babble`` (same seed, same signal as the command line's).
+    /// max_order : int, optional
+    ///     Highest order of the NDF, 1–5 (``--max-order``; default 5, or 2 for a lightly damped
+    ///     rod).
+    /// error_norm : str, optional
+    ///     The adaptive methods' error test (``--error-norm``): ``"componentwise"`` (ode15s) or
+    ///     ``"mass"`` (positions and velocities in the norm of the mass matrix); default chosen
+    ///     by the method and the rod's damping.
+    /// rho_inf : float, optional
+    ///     Generalized-α's spectral radius at infinite frequency in [0, 1] (``--rho-inf``; default
+    ///     0.8; only with ``method="galpha"``).
+    /// fd_jacobian : bool
+    ///     Finite differences of the right-hand side for the integrator's Jacobian instead of the
+    ///     structured analytic one (``--fd-jacobian``; the NDF and the fixed step).
     ///
     /// Returns
     /// -------
@@ -114,7 +136,7 @@ impl Robot {
     ///     samples computed before (``energy_balance`` left out).
     /// GvsromError
     ///     For bad options or input.
-    #[pyo3(signature = (duration, sample_rate=100.0, input=None, interpolate=false, from_equilibrium=false, q0=None, qd0=None, method="auto", rtol=None, atol=None, fixed_step=None, load_schedule=None, steps=None, babble=None, seed=0))]
+    #[pyo3(signature = (duration, sample_rate=100.0, input=None, interpolate=false, from_equilibrium=false, q0=None, qd0=None, method="auto", rtol=None, atol=None, fixed_step=None, load_schedule=None, steps=None, babble=None, seed=0, max_order=None, error_norm=None, rho_inf=None, fd_jacobian=false))]
     #[allow(clippy::too_many_arguments)]
     fn simulate<'py>(
         &self,
@@ -134,7 +156,14 @@ impl Robot {
         steps: Option<Vec<f64>>,
         babble: Option<Vec<f64>>,
         seed: u64,
+        #[pyo3(from_py_with = crate::arrays::whole_or_none)] max_order: Option<i128>,
+        error_norm: Option<&str>,
+        rho_inf: Option<f64>,
+        fd_jacobian: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let max_order = max_order
+            .map(|v| arrays::size("max_order", v, 1))
+            .transpose()?;
         let args = Args {
             duration,
             sample_rate,
@@ -151,9 +180,25 @@ impl Robot {
             steps,
             babble,
             seed,
+            max_order,
+            error_norm,
+            rho_inf,
+            fd_jacobian,
         };
         run(self, py, args)
     }
+}
+
+fn error_norm(name: &str) -> PyResult<ErrorNormChoice> {
+    Ok(match name {
+        "componentwise" => ErrorNormChoice::Componentwise,
+        "mass" => ErrorNormChoice::Mass,
+        other => {
+            return Err(invalid(format!(
+                "invalid `error_norm`: `{other}` (accepted: componentwise, mass)"
+            )))
+        }
+    })
 }
 
 fn method(name: &str) -> PyResult<MethodChoice> {
@@ -475,7 +520,10 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
         rtol: a.rtol,
         atol: a.atol,
         fixed_step: a.fixed_step,
-        ..IntegratorChoice::default()
+        max_order: a.max_order,
+        error_norm: a.error_norm.map(error_norm).transpose()?,
+        rho_inf: a.rho_inf,
+        fd_jacobian: a.fd_jacobian,
     };
     let simulate::Prepared { opts, plan, .. } = simulate::prepare(
         built,

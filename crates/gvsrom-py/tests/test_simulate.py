@@ -1,5 +1,6 @@
 """simulate: the trajectory of `gvsrom simulate --out`, as arrays in memory; Ctrl-C stops it."""
 
+import json
 import os
 import signal
 import threading
@@ -26,6 +27,44 @@ def test_simulate_equals_the_cli_trajectory(gvsrom_bin, tmp_path):
         assert tr[name].shape == cli.shape, name
         np.testing.assert_allclose(tr[name], cli, rtol=0, atol=1e-12, err_msg=name)
     np.testing.assert_array_equal(tr["strain_x"], np.load(out / "strain_x.npy"))
+
+
+@pytest.mark.parametrize("options", [
+    ["--method", "galpha", "--rho-inf", "1", "--error-norm", "mass"],
+    ["--method", "ndf", "--max-order", "2", "--fd-jacobian"],
+])
+def test_the_integrators_options_equal_the_clis(gvsrom_bin, tmp_path, options):
+    out = tmp_path / "run"
+    p = run_cli(gvsrom_bin, "simulate", "single-tendon", "--duration", "0.05", "--sample-rate", "200",
+                "--tension=-4", *options, "--out", str(out))
+    assert p.returncode == 0, p.stderr
+    kw = {}
+    it = iter(options)
+    for flag in it:
+        name = flag[2:].replace("-", "_")
+        if name == "fd_jacobian":
+            kw[name] = True
+        else:
+            value = next(it)
+            kw[name] = {"rho_inf": float, "max_order": int}.get(name, str)(value)
+    robot = gvsrom.Scenario.preset("single-tendon").set("tendons.0.tension", -4).build()
+    tr = robot.simulate(0.05, sample_rate=200, **kw)
+    np.testing.assert_allclose(tr["q"], np.load(out / "q.npy"), rtol=0, atol=1e-12)
+    assert tr["steps"] == json.loads((out / "meta.json").read_text())["steps"]
+
+
+def test_bad_integrator_options_are_named_as_keyword_arguments():
+    robot = gvsrom.Scenario.preset("single-tendon").build()
+    with pytest.raises(gvsrom.GvsromError, match=r"`error_norm`: `l2` \(accepted: componentwise, mass\)"):
+        robot.simulate(0.01, error_norm="l2")
+    with pytest.raises(gvsrom.GvsromError, match=r"max_order"):
+        robot.simulate(0.01, method="ndf", max_order=7)
+    with pytest.raises(gvsrom.GvsromError, match=r"rho_inf"):
+        robot.simulate(0.01, method="galpha", rho_inf=2.0)
+    with pytest.raises(gvsrom.GvsromError, match=r"rho_inf"):
+        robot.simulate(0.01, method="ndf", rho_inf=0.5)
+    with pytest.raises(gvsrom.GvsromError, match=r"max_order` = -1"):
+        robot.simulate(0.01, max_order=-1)
 
 
 def test_an_input_array_holds_each_row():

@@ -418,4 +418,8 @@ class Robot:
         steps: Sequence[float] | None = None,
         babble: Sequence[float] | None = None,
         seed: int = 0,
+        max_order: int | None = None,
+        error_norm: str | None = None,
+        rho_inf: float | None = None,
+        fd_jacobian: bool = False,
     ) -> dict[str, Any]: ...
