@@ -269,6 +269,8 @@ impl Robot {
     ) -> PyResult<Bound<'py, PyAny>> {
         let (q, qd) = state(self, &q, Some(&qd))?;
         let u = self.quantity_tensions(py, u)?;
+        // a massless rod has no accelerations: said as `simulate`, `modes` and `linearize` say it
+        gvsrom::simulate::require_mass(&self.built).map_err(crate::errors::scenario)?;
         let a = py
             .detach(|| accelerations(&self.built, &self.workspaces, &q, &qd, &u))
             // `q` was checked as a state of the rod: what fails comes from `qd`, or `u`

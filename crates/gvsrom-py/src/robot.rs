@@ -481,7 +481,9 @@ impl Robot {
     /// Raises
     /// ------
     /// GvsromError, ConvergenceError
-    ///     For the first row that fails, named ``U[k]``.
+    ///     For the first row that fails, named ``U[k]``; a ``GvsromError`` for a robot with a
+    ///     reduced model attached (``with_model``): the batch solves the full model, so call
+    ///     ``statics(u)`` per row instead.
     #[allow(non_snake_case)]
     #[pyo3(signature = (U, warm_start=true))]
     fn statics_batch(

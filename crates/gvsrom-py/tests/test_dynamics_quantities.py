@@ -140,3 +140,16 @@ def test_bad_states_name_the_argument(robot):
     for f in (robot.statics_residual, robot.statics_jacobian):
         with pytest.raises(gvsrom.GvsromError, match=r"`u\[0\]` = NaN: expected a finite number"):
             f(np.zeros(n), u=[np.nan])
+
+
+def test_a_massless_rod_has_no_accelerations_said_as_simulate_says_it():
+    # it was "the mass matrix is not positive semi-definite (pivot 0 = 0e0)": the matrix is zero
+    massless = gvsrom.Scenario.preset("single-tendon").set("material.density", 0).build()
+    n = massless.n_dof
+    expected = "invalid `material.density`: 0: a motion needs a rod with mass"
+    with pytest.raises(gvsrom.GvsromError, match=expected):
+        massless.accelerations(np.zeros(n), np.zeros(n))
+    with pytest.raises(gvsrom.GvsromError, match=expected):
+        massless.simulate(0.01)
+    # its statics stand
+    assert np.isfinite(massless.statics().tip_position).all()
