@@ -19,6 +19,7 @@ mod reconstruction;
 mod reduce;
 mod reproduce;
 mod robot;
+mod robot_pickle;
 mod scenario;
 mod simulate;
 mod statics;

@@ -479,3 +479,33 @@ def test_a_failed_reduced_run_raises_with_the_samples_it_computed(ae_model):
     assert (tr["q"][:, 0] >= lo - span).all() and (tr["q"][:, 0] <= hi + span).all()
     assert "energy_balance" not in tr
 
+
+
+def test_a_pickled_robot_is_the_same_robot_in_another_process(dataset, pod_model, tmp_path):
+    # multiprocessing pickles what it sends: a robot is rebuilt from its scenario and its model's
+    # directory; in a worker process it solves as it does here
+    import concurrent.futures
+    import multiprocessing
+    import pickle
+
+    robot = gvsrom.Scenario.preset("single-tendon").set("tendons.0.tension", -2.0).build()
+    reduced = robot.with_model(pod_model)
+    for r in (robot, reduced):
+        again = pickle.loads(pickle.dumps(r))
+        assert repr(again) == repr(r)
+        np.testing.assert_array_equal(again.statics().q, r.statics().q)
+    ctx = multiprocessing.get_context("spawn")
+    with concurrent.futures.ProcessPoolExecutor(1, mp_context=ctx) as pool:
+        q = pool.submit(_reduced_statics_q, reduced).result(timeout=120)
+    np.testing.assert_array_equal(q, reduced.statics().q)
+    # a model directory written again between pickling and unpickling is refused, as with_model
+    # refuses one changed since load_model
+    copy = gvsrom.pod(dataset, 1, tmp_path / "m")
+    blob = pickle.dumps(robot.with_model(copy))
+    gvsrom.pod(dataset, 2, tmp_path / "m", force=True)
+    with pytest.raises(gvsrom.GvsromError, match="changed since"):
+        pickle.loads(blob)
+
+
+def _reduced_statics_q(robot):
+    return robot.statics().q

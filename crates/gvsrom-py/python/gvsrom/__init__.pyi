@@ -340,6 +340,10 @@ def train(
 class Robot:
     """A built scenario, with a reduced model attached or not."""
 
+    def __reduce__(self) -> tuple[Any, tuple[Scenario, Path | None, bool, str | None]]: ...
+    @staticmethod
+    def _restore(scenario: Scenario, model: Path | None, extrapolate: bool, origin: str | None) -> Robot: ...
+
     @property
     def name(self) -> str: ...
     @property
