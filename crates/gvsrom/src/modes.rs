@@ -133,7 +133,8 @@ pub struct ModesReport {
 /// Solves the equilibrium of `built` (as `gvsrom statics` does, with the reduced model if one is
 /// attached) and returns it with the lowest `count` modes about it.
 pub fn compute(built: &Built, count: usize) -> Result<(StaticsReport, ModesReport), ModesError> {
-    crate::simulate::require_mass(built)?;
+    // the modes are undamped: any damping is fine here
+    crate::simulate::require_mass_only(built)?;
     let eq = statics::solve(built)?;
     statics::check_reduced(built, &eq)?;
     let modes = match &built.reduced {

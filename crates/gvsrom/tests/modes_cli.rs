@@ -489,3 +489,37 @@ fn bad_count_scenario_and_values_are_one_line_errors() {
     );
     assert!(stdout.contains("\n  28  "), "{stdout}");
 }
+
+#[test]
+fn the_undamped_modes_ignore_a_damping_a_motion_refuses() {
+    // modes are undamped: a damping beyond what a motion accepts does not change them, and they
+    // are computed (they were refused with the motion's bound); a simulation still refuses it
+    let (_, plain) = modes_json("modes-damped-0", &["single-tendon", "--count", "3"]);
+    let (_, heavy) = modes_json(
+        "modes-damped-1e12",
+        &[
+            "single-tendon",
+            "--count",
+            "3",
+            "--set",
+            "material.damping=1e12",
+        ],
+    );
+    let bending = frequencies_of(&plain, "bend_y");
+    assert!(!bending.is_empty(), "{plain}");
+    assert_eq!(bending, frequencies_of(&heavy, "bend_y"));
+    let out = scratch("modes-damped-sim");
+    expect_error(
+        &[
+            "simulate",
+            "single-tendon",
+            "--set",
+            "material.damping=1e12",
+            "--duration",
+            "0.01",
+            "--out",
+            s(&out),
+        ],
+        &["material.damping", "in a motion"],
+    );
+}

@@ -434,6 +434,8 @@ fn a_precurved_division_rests_on_its_arc_and_is_bounded() {
     // out-of-range values name their entry
     for (set, field) in [
         ("[0, 0, 0, 0, 0, 0]", "reference_strain[3]"),
+        ("[0, 0, 0, 1e-300, 0, 0]", "reference_strain[3]"),
+        ("[0, 0, 0, 0.09, 0, 0]", "reference_strain[3]"),
         ("[0, 1000, 0, 1, 0, 0]", "reference_strain[1]"),
         ("[0, 0, 0, 1, 2, 0]", "reference_strain[4]"),
     ] {

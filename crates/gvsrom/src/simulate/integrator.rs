@@ -77,11 +77,9 @@ impl Default for IntegratorChoice {
     }
 }
 
-/// Refuses a rod without mass for a motion (`material.density = 0`, which statics accept): its mass
-/// matrix is zero, and the motion it would define has no meaning. Refuses too a damping whose
-/// relaxation time `η / E` exceeds [`MAX_RELAXATION_TIME`] (statics ignore the damping). Checked before anything reads
-/// the mass matrix: [`choose_integrator`] (every simulation), dynamic datasets and `modes`.
-pub fn require_mass(built: &Built) -> Result<(), ScenarioError> {
+/// Refuses a rod without mass (`material.density = 0`, which statics accept) for what reads its
+/// mass matrix, zero there; the damping is not looked at (`modes` are undamped).
+pub fn require_mass_only(built: &Built) -> Result<(), ScenarioError> {
     let model = &built.model;
     let massless = (0..model.disc.n_points()).any(|j| {
         let ms = model.section(j).ms;
@@ -93,8 +91,18 @@ pub fn require_mass(built: &Built) -> Result<(), ScenarioError> {
             "0: a motion needs a rod with mass (a positive density); statics take density 0",
         ));
     }
+    Ok(())
+}
+
+/// Refuses a rod without mass for a motion (`material.density = 0`, which statics accept): its mass
+/// matrix is zero, and the motion it would define has no meaning. Refuses too a damping whose
+/// relaxation time `η / E` exceeds [`MAX_RELAXATION_TIME`] (statics ignore the damping). Checked before anything reads
+/// the mass matrix: [`choose_integrator`] (every simulation), dynamic datasets and `linearize`;
+/// `modes`, undamped, checks the mass alone ([`require_mass_only`]).
+pub fn require_mass(built: &Built) -> Result<(), ScenarioError> {
+    require_mass_only(built)?;
     // a damping no material has: checked for motions only, as statics ignore it
-    let m = &model.rod.material;
+    let m = &built.model.rod.material;
     let most = MAX_RELAXATION_TIME * m.youngs_modulus;
     if m.damping > most {
         return Err(ScenarioError::value(
