@@ -194,6 +194,9 @@ def test_an_unknown_study_is_refused_naming_it_and_the_accepted(tmp_path):
         gvsrom.reproduce("iv-z", tmp_path / "run")
     with pytest.raises(gvsrom.GvsromError, match=r"noise 2: expected a number in \[0, 1\]"):
         gvsrom.reproduce(["v"], tmp_path / "run", noise=2.0)
+    with pytest.raises(gvsrom.GvsromError, match=r"noise 0.5: only the noise study reads it"):
+        gvsrom.reproduce(["v"], tmp_path / "run", noise=0.5)
+    assert not (tmp_path / "run").exists()
 
 
 @pytest.mark.skipif(os.name != "posix", reason="SIGINT to self")

@@ -4,7 +4,7 @@
 //! seconds keeping what is finished, and the run directory refuses what gvsrom did not create.
 
 mod common;
-use common::{gvsrom, scratch};
+use common::{expect_error, gvsrom, scratch};
 use serde_json::Value;
 use std::path::Path;
 use std::process::{Command, Stdio};
@@ -308,4 +308,27 @@ fn a_directory_gvsrom_did_not_create_is_refused_as_the_run_directory() {
         ],
         &["--jobs 0"],
     );
+}
+
+#[test]
+fn a_noise_level_no_case_reads_is_refused_before_anything_is_written() {
+    // `--noise` is the noise study's: with IV-A alone it was ignored without a word
+    let out = scratch("repro-noise-ignored");
+    let _ = std::fs::remove_dir_all(&out);
+    expect_error(
+        &[
+            "reproduce",
+            "iv-a",
+            "--quick",
+            "--noise",
+            "0.05",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &[
+            "--noise 0.05: only the noise study reads it",
+            "(iv-a) do not",
+        ],
+    );
+    assert!(!out.exists());
 }

@@ -154,10 +154,17 @@ pub fn run(
     anyhow::ensure!(
         opts.noise.is_finite() && (0.0..=1.0).contains(&opts.noise),
         "--noise {}: expected a number in [0, 1] (σ relative to each strain component's RMS)",
-        opts.noise
+        gvs::error::fmt_value(opts.noise)
     );
     let cases = opts.case_list();
     anyhow::ensure!(!cases.is_empty(), "no case to reproduce");
+    // a level no case reads would be ignored without a word
+    anyhow::ensure!(
+        opts.noise == DEFAULT_NOISE || cases.contains(&Case::Noise),
+        "--noise {}: only the noise study reads it (`gvsrom reproduce noise`, or `all`); the cases asked for ({}) do not",
+        gvs::error::fmt_value(opts.noise),
+        cases.iter().map(|c| c.name()).collect::<Vec<_>>().join(", ")
+    );
     let dir = crate::output::RunDir::open("--out", &opts.out)?;
     let mut run = Run::new(dir, interrupt);
     let pool = rayon::ThreadPoolBuilder::new()
