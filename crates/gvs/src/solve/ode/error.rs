@@ -2,6 +2,12 @@
 
 use super::OdeStats;
 
+/// A time in a message as [`crate::error::fmt_value`] writes numbers: `0.16`, `5.06e299` (not
+/// 300 digits).
+fn shown(t: &f64) -> String {
+    crate::error::fmt_value(*t)
+}
+
 /// An error reported by the right-hand side (or its Jacobian); it stops the integration.
 #[derive(Debug, Clone, thiserror::Error, PartialEq)]
 #[error("{0}")]
@@ -13,7 +19,7 @@ pub struct RhsError(pub String);
 pub enum OdeError {
     /// The error test (or Newton, for the one-step methods) failed at the smallest step the time
     /// resolution allows; the tolerances in use are named, since too tight ones are a cause.
-    #[error("integration stopped at t = {t}: step size {h:e} below the minimum {h_min:e} with rtol = {rtol:e}, atol = {atol:e} (tolerances too tight for the problem, or a singularity)")]
+    #[error("integration stopped at t = {}: step size {h:e} below the minimum {h_min:e} with rtol = {rtol:e}, atol = {atol:e} (tolerances too tight for the problem, or a singularity)", shown(.t))]
     StepSizeUnderflow {
         t: f64,
         h: f64,
@@ -26,7 +32,8 @@ pub enum OdeError {
     /// `rtol`, so too tight tolerances are a cause, and `tolerances` names them) or after its
     /// retries (the fixed step: `tolerances` is `None`).
     #[error(
-        "integration stopped at t = {t}: Newton iteration failed to converge repeatedly{}",
+        "integration stopped at t = {}: Newton iteration failed to converge repeatedly{}",
+        shown(.t),
         tolerances.map_or(String::new(), |(rtol, atol)| format!(
             " with rtol = {rtol:e}, atol = {atol:e} (tolerances too tight for the problem, or a singularity)"
         ))
@@ -37,17 +44,18 @@ pub enum OdeError {
         tolerances: Option<(f64, f64)>,
     },
     #[error(
-        "integration stopped at t = {t}: non-finite value (NaN or infinity) in the solution or the right-hand side"
+        "integration stopped at t = {}: non-finite value (NaN or infinity) in the solution or the right-hand side",
+        shown(.t)
     )]
     NonFinite { t: f64 },
-    #[error("integration stopped at t = {t}: right-hand side failed: {source}")]
+    #[error("integration stopped at t = {}: right-hand side failed: {source}", shown(.t))]
     Rhs { t: f64, source: RhsError },
-    #[error("integration stopped at t = {t}: maximum number of steps {max_steps} reached")]
+    #[error("integration stopped at t = {}: maximum number of steps {max_steps} reached", shown(.t))]
     TooManySteps { t: f64, max_steps: usize },
     /// The output callback asked to stop after delivering the sample at `t` (an interrupt, a full
     /// disk), or the system did ([`OdeSystem::stop_requested`](super::OdeSystem::stop_requested)) after the step that reached `t`:
     /// not a failure of the method.
-    #[error("integration stopped at t = {t}: {reason}")]
+    #[error("integration stopped at t = {}: {reason}", shown(.t))]
     Stopped { t: f64, reason: String },
     #[error("invalid input `{field}`: {message}")]
     Invalid {
@@ -115,5 +123,26 @@ pub(super) fn invalid(field: &'static str, message: impl Into<String>) -> OdeErr
     OdeError::Invalid {
         field,
         message: message.into(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_time_is_shown_as_a_number_not_hundreds_of_digits() {
+        // a review's 1e300 s run failed with a 300-digit time in its message
+        let e = OdeError::NonFinite { t: 5.062e299 }.to_string();
+        assert!(
+            e.starts_with("integration stopped at t = 5.062e299: "),
+            "{e}"
+        );
+        let e = OdeError::TooManySteps {
+            t: 0.16,
+            max_steps: 10,
+        }
+        .to_string();
+        assert!(e.starts_with("integration stopped at t = 0.16: "), "{e}");
     }
 }
