@@ -213,38 +213,53 @@ pub fn python_spelling(message: &str) -> String {
     message
         .split('`')
         .enumerate()
-        .map(
-            |(i, part)| match i % 2 == 1 && part.starts_with("gvsrom ") {
-                true => part.to_string(),
-                false => positionals_as_arguments(&flags_as_keywords(part)),
+        .map(|(i, part)| match i % 2 == 1 {
+            // quoted: a command for the shell, or a path, as written; a flag or a value name
+            // standing alone renamed
+            true if part.starts_with("gvsrom ") || part.contains(['/', '\\']) => part.to_string(),
+            true => match POSITIONAL.iter().find(|(cli, _)| *cli == part) {
+                Some((_, python)) => python.to_string(),
+                None => flags_as_keywords(part),
             },
-        )
+            false => positionals_as_arguments(&flags_as_keywords(part)),
+        })
         .collect::<Vec<_>>()
         .join("`")
 }
 
 /// Every whole word of `text` that is a positional argument's value name ([`POSITIONAL`]),
-/// renamed.
+/// renamed, unless it is part of a path or a file name (next to `/`, `\`, or a `.` inside a
+/// name).
 fn positionals_as_arguments(text: &str) -> String {
     let is_word_char = |c: char| c.is_alphanumeric() || c == '_' || c == '-';
-    let mut out = String::with_capacity(text.len());
-    let mut word = String::new();
-    let flush = |word: &mut String, out: &mut String| {
-        match POSITIONAL.iter().find(|(cli, _)| *cli == word.as_str()) {
-            Some((_, python)) => out.push_str(python),
-            None => out.push_str(word),
-        }
-        word.clear();
+    let chars: Vec<char> = text.chars().collect();
+    let pathlike = |at: Option<&char>, beyond: Option<&char>| match at {
+        Some('/' | '\\') => true,
+        // `DATASET.toml`, `x.DATASET`: a name; a full stop ends a sentence
+        Some('.') => beyond.is_some_and(|c| c.is_alphanumeric()),
+        _ => false,
     };
-    for c in text.chars() {
-        if is_word_char(c) {
-            word.push(c);
-        } else {
-            flush(&mut word, &mut out);
-            out.push(c);
+    let mut out = String::with_capacity(text.len());
+    let mut i = 0;
+    while i < chars.len() {
+        if !is_word_char(chars[i]) {
+            out.push(chars[i]);
+            i += 1;
+            continue;
+        }
+        let start = i;
+        while i < chars.len() && is_word_char(chars[i]) {
+            i += 1;
+        }
+        let word: String = chars[start..i].iter().collect();
+        let before = start.checked_sub(1).map(|k| &chars[k]);
+        let before2 = start.checked_sub(2).map(|k| &chars[k]);
+        let in_path = pathlike(before, before2) || pathlike(chars.get(i), chars.get(i + 1));
+        match POSITIONAL.iter().find(|(cli, _)| *cli == word) {
+            Some((_, python)) if !in_path => out.push_str(python),
+            _ => out.push_str(&word),
         }
     }
-    flush(&mut word, &mut out);
     out
 }
 

@@ -2,7 +2,8 @@
 //! from, built again when unpickled — the scenario (pickled as `Scenario` pickles: its source
 //! text and overrides), and the attached model's directory (absolute), `extrapolate` and the
 //! content it was read with, so that a model directory written again in between is refused as
-//! `with_model` refuses one changed since `load_model`.
+//! `with_model` refuses one changed since `load_model` (a model that records content hashes: every
+//! one written since they were recorded). Build warnings are raised again where it is unpickled.
 
 use crate::errors::invalid;
 use crate::robot::{Attached, Robot};

@@ -177,6 +177,13 @@ def test_a_command_quoted_for_the_shell_keeps_its_flags():
     assert spell("`SCENARIO`, MODEL_X, DATASETS, `gvsrom pod DATASET --modes 2`") == (
         "`scenario`, MODEL_X, DATASETS, `gvsrom pod DATASET --modes 2`")
     assert spell("invalid `--load-schedule`: a directory") == "invalid `load_schedule`: a directory"
+    # never inside a path or a file name, quoted or not; a sentence's full stop is not a name
+    for kept in ["cannot read `/home/u/INPUT.csv`", "dataset `/runs/DATASET`", "`C:\\DATASET`"]:
+        assert spell(kept) == kept
+    assert spell("INPUT `/data/INPUT/run.json`: no such file") == (
+        "output `/data/INPUT/run.json`: no such file")
+    assert spell("`SCENARIO.toml`, data/DATASET, DATASET.npy") == "`SCENARIO.toml`, data/DATASET, DATASET.npy"
+    assert spell("give a DATASET.") == "give a dataset."
 
 
 def test_integrator_tolerances_of_a_static_dataset_are_refused(tmp_path):

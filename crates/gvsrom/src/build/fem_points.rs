@@ -16,11 +16,13 @@
 //!
 //! every combination keeping at least a tenth of its exact stiffness. `G` and `M` are banded
 //! (bandwidth `p`: functions `i`, `j` share an element only if `|i − j| ≤ p`), so a banded Cholesky
-//! factorization of `O(p² n_e)` decides it. Measured `λ_min` (10 elements): 1 for the engine's
-//! defaults (`p + 1` points per basis element) or any finer per-element quadrature; 0.6–0.95 for
-//! quadrature elements that straddle the basis's (7–24 of them, `p + 1` or fewer points each)
-//! or 13–40 Gauss points over the division (linear); 0.015, 2.7e-7 and 0.032 for 11, 12 and 14
-//! Gauss points; 0 (exactly singular) for fewer points than functions per element.
+//! factorization of `O(p² n_e)` decides it. Measured `λ_min` on a 10-element basis (numpy's
+//! generalized eigenvalues): 1 for the engine's defaults (`p + 1` points per basis element) and any
+//! finer per-element quadrature; 0.75–0.89 for quadrature elements that straddle the basis's (7 × 3,
+//! 15 × 1 and 20 × 1 points, linear); 0.35 (16), 0.66 (18) and up to 0.98 (40) for Gauss points
+//! over a linear division; 0.015, 2.7e-7 and 0.032 for 11, 12 and 14 of them; 0 (singular) with
+//! fewer points than functions per element. The check takes the section uniform: on a tapered
+//! division the stiffness `Es(X)` weighs the points unevenly, which it does not see.
 
 use gvs::discretize::{gauss_legendre, Quadrature};
 use gvs::strain::{fem_shape, FemDegree};

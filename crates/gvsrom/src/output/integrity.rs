@@ -126,21 +126,22 @@ impl ListedFiles {
 }
 
 /// Whether the JSON file output `value` (e.g. a `statics --json` result, a `reproduce` step record)
-/// was edited since gvsrom wrote it: its manifest records a `meta_sha256` that its values no longer
-/// have. `false` for one without a recorded hash (an output of an earlier version) or without a
-/// manifest (which no reader accepts as gvsrom's anyway).
+/// was edited since gvsrom wrote it: its manifest holds a `meta_sha256` that its values no longer
+/// have, or one that is not a SHA-256 (an edited manifest). `false` for one whose manifest records
+/// no `meta_sha256` (an output of an earlier version) or that has no manifest: a reader that
+/// needs one checks for it ([`crate::output::MANIFEST_KEY`]).
 pub fn json_file_edited(value: &serde_json::Value) -> bool {
     use super::hashes::META_SHA256_KEY;
     let Some(obj) = value.as_object() else {
         return false;
     };
-    let Some(hash) = (obj.get(MANIFEST_KEY))
-        .and_then(|m| m.get(META_SHA256_KEY))
-        .and_then(recorded)
-    else {
+    let Some(hash) = obj.get(MANIFEST_KEY).and_then(|m| m.get(META_SHA256_KEY)) else {
         return false;
     };
-    meta_sha256(obj) != hash
+    match recorded(hash) {
+        Some(hash) => meta_sha256(obj) != hash,
+        None => true,
+    }
 }
 
 /// Checks the directory output `dir` against its manifest before it is read: `meta.json` holds a

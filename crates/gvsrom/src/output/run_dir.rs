@@ -107,35 +107,46 @@ impl RunDir {
         if !plain {
             return Err(shown.refused("is not a plain file name inside the run directory"));
         }
-        match fs::symlink_metadata(&target) {
-            Err(e) if e.kind() == io::ErrorKind::NotFound => {}
+        // the content there now (a listed file), checked against the hashes recorded for it
+        let now = match fs::symlink_metadata(&target) {
+            Err(e) if e.kind() == io::ErrorKind::NotFound => None,
             Err(e) => return Err(shown.io("inspect it")(e)),
             Ok(m) if m.is_file() && self.files.iter().any(|f| f == name) => {
-                if let Some(recorded) = self.hashes.get(name).filter(|h| !h.is_empty()) {
-                    let now = super::hashes::file_sha256(&target).map_err(shown.io("read it"))?;
+                let now = super::hashes::file_sha256(&target).map_err(shown.io("read it"))?;
+                // none recorded: a run directory of an earlier version, whose file is replaced as
+                // before; a malformed entry recorded nothing it can match
+                if let Some(recorded) = self.hashes.get(name) {
                     if !recorded.contains(&now) {
                         return Err(shown.refused(
                             "was changed after gvsrom wrote it (its SHA-256 is not the one the run directory recorded); gvsrom never replaces what it did not write: move it away, or restore it",
                         ));
                     }
                 }
+                Some(now)
             }
             Ok(_) => {
                 return Err(shown.refused(
                     "exists and was not written by this run directory; gvsrom never replaces what it did not write: move it away",
                 ))
             }
-        }
-        // listed, with the new content's hash beside the old, before it exists: a crash in between
-        // leaves a listed name whose content has a recorded hash, never an unlisted file
+        };
+        // listed, with the hashes of the content there now and of the new one, before the rename:
+        // a crash in between leaves a listed name whose content has a recorded hash, whichever it
+        // is, never an unlisted file
         let new = super::hashes::sha256_hex(bytes);
         if !self.files.iter().any(|f| f == name) {
             self.files.push(name.to_string());
         }
-        let hashes = self.hashes.entry(name.to_string()).or_default();
-        hashes.retain(|h| h != &new);
-        hashes.push(new.clone());
+        let pending: Vec<String> = (now.into_iter())
+            .filter(|h| *h != new)
+            .chain([new.clone()])
+            .collect();
+        self.hashes.insert(name.to_string(), pending);
         self.write_manifest()?;
+        #[cfg(test)]
+        if tests::CRASH_BEFORE_RENAME.with(std::cell::Cell::get) {
+            return Err(shown.io("write it")(io::Error::other("a crash, simulated")));
+        }
         write_atomically(&self.path, name, bytes).map_err(shown.io("write it"))?;
         self.hashes.insert(name.to_string(), vec![new]);
         self.write_manifest()?;
@@ -187,8 +198,9 @@ const FILE_HASHES_KEY: &str = "files_sha256";
 /// The recorded SHA-256 hashes of each loose file, by name.
 type FileHashes = BTreeMap<String, Vec<String>>;
 
-/// The files listed by a run directory's manifest and their recorded hashes, if `path` is one
-/// (hashes that are not lists of strings are read as none).
+/// The files listed by a run directory's manifest and their recorded hashes, if `path` is one.
+/// A file without an entry recorded none (an earlier version); an entry that is not a list of
+/// SHA-256 hex digests records nothing it can match (an edited manifest protects no edit).
 fn read_run_manifest(path: &Path) -> Option<(Vec<String>, FileHashes)> {
     let value: Value =
         serde_json::from_str(&super::read::read_regular_to_string(path).ok()?).ok()?;
@@ -207,11 +219,12 @@ fn read_run_manifest(path: &Path) -> Option<(Vec<String>, FileHashes)> {
         .and_then(Value::as_object)
         .into_iter())
     .flatten()
-    .filter_map(|(name, h)| {
-        let list: Option<Vec<String>> = (h.as_array()?.iter())
-            .map(|x| x.as_str().map(str::to_string))
+    .map(|(name, h)| {
+        let list: Option<Vec<String>> = (h.as_array().into_iter().flatten())
+            .map(super::hashes::recorded)
             .collect();
-        Some((name.clone(), list?))
+        let list = list.filter(|_| h.is_array()).unwrap_or_default();
+        (name.clone(), list)
     })
     .collect();
     Some((files, hashes))
@@ -291,11 +304,65 @@ mod tests {
         );
     }
 
+    thread_local! {
+        /// Makes [`RunDir::write_file`] stop after the manifest lists the new content and before
+        /// the rename, as a crash there would.
+        pub(super) static CRASH_BEFORE_RENAME: std::cell::Cell<bool> =
+            const { std::cell::Cell::new(false) };
+    }
+
+    fn recorded_hashes(p: &Path) -> Value {
+        let m: Value =
+            serde_json::from_str(&fs::read_to_string(p.join(MANIFEST_FILE)).unwrap()).unwrap();
+        m[MANIFEST_KEY][FILE_HASHES_KEY]["index.html"].clone()
+    }
+
     #[test]
     fn a_crash_between_the_manifest_and_the_rename_leaves_the_file_replaceable() {
-        // the manifest lists the old and the new content while a file is replaced: whichever is
-        // on disk after a crash, the next run replaces it
-        let d = sandbox("crash");
+        // with a recorded hash (this version), and without (a run directory of an earlier one)
+        for earlier_version in [false, true] {
+            let d = sandbox(&format!("crash-{earlier_version}"));
+            let p = d.join("results");
+            {
+                let mut r = RunDir::open("--out", &p).unwrap();
+                r.write_file("index.html", b"one").unwrap();
+            }
+            if earlier_version {
+                let path = p.join(MANIFEST_FILE);
+                let mut m: Value =
+                    serde_json::from_str(&fs::read_to_string(&path).unwrap()).unwrap();
+                m[MANIFEST_KEY]
+                    .as_object_mut()
+                    .unwrap()
+                    .remove(FILE_HASHES_KEY);
+                fs::write(&path, serde_json::to_string(&m).unwrap()).unwrap();
+            }
+            {
+                let mut r = RunDir::open("--out", &p).unwrap();
+                CRASH_BEFORE_RENAME.with(|c| c.set(true));
+                let e = r.write_file("index.html", b"two");
+                CRASH_BEFORE_RENAME.with(|c| c.set(false));
+                assert!(e.is_err());
+            }
+            // the old content is on disk, the manifest lists both
+            assert_eq!(fs::read(p.join("index.html")).unwrap(), b"one");
+            let one = super::super::hashes::sha256_hex(b"one");
+            let two = super::super::hashes::sha256_hex(b"two");
+            assert_eq!(recorded_hashes(&p), json!([one, two]), "{earlier_version}");
+            // the next run replaces it
+            let mut r = RunDir::open("--out", &p).unwrap();
+            r.write_file("index.html", b"three").unwrap();
+            assert_eq!(fs::read(p.join("index.html")).unwrap(), b"three");
+            assert_eq!(
+                recorded_hashes(&p),
+                json!([super::super::hashes::sha256_hex(b"three")])
+            );
+        }
+    }
+
+    #[test]
+    fn a_malformed_hash_entry_protects_the_file_rather_than_dropping_its_check() {
+        let d = sandbox("malformed");
         let p = d.join("results");
         {
             let mut r = RunDir::open("--out", &p).unwrap();
@@ -303,18 +370,13 @@ mod tests {
         }
         let path = p.join(MANIFEST_FILE);
         let mut m: Value = serde_json::from_str(&fs::read_to_string(&path).unwrap()).unwrap();
-        let both = json!([
-            super::super::hashes::sha256_hex(b"one"),
-            super::super::hashes::sha256_hex(b"two")
-        ]);
-        m[MANIFEST_KEY][FILE_HASHES_KEY]["index.html"] = both;
+        m[MANIFEST_KEY][FILE_HASHES_KEY]["index.html"] = json!("not a list");
         fs::write(&path, serde_json::to_string(&m).unwrap()).unwrap();
-        for on_disk in ["one", "two"] {
-            fs::write(p.join("index.html"), on_disk).unwrap();
-            let mut r = RunDir::open("--out", &p).unwrap();
-            r.write_file("index.html", b"two").unwrap();
-            fs::write(&path, serde_json::to_string(&m).unwrap()).unwrap();
-        }
+        fs::write(p.join("index.html"), "edited").unwrap();
+        let mut r = RunDir::open("--out", &p).unwrap();
+        let e = r.write_file("index.html", b"two").unwrap_err().to_string();
+        assert!(e.contains("was changed after gvsrom wrote it"), "{e}");
+        assert_eq!(fs::read(p.join("index.html")).unwrap(), b"edited");
     }
 
     #[test]

@@ -325,10 +325,16 @@ pub fn train<P: AsRef<Path>>(
 pub const SAMPLE_WEIGHTINGS: [&str; 2] = ["uniform", "relative"];
 
 /// The snapshot weighting named `name` ([`SAMPLE_WEIGHTINGS`]); `floor` (a fraction of the largest
-/// snapshot norm, in (0, 1]) bounds the relative weighting's weights. A floor outside (0, 1] is
-/// refused with either weighting: a value given by mistake is not passed over because the uniform
-/// weighting does not read it.
+/// snapshot norm, in (0, 1]; default [`SampleWeighting::DEFAULT_FLOOR`]) bounds the relative
+/// weighting's weights. The name is checked first; a floor given with the uniform weighting, which
+/// would ignore it, is refused.
 pub fn sample_weighting(name: &str, floor: Option<f64>) -> Result<SampleWeighting, ScenarioError> {
+    if !SAMPLE_WEIGHTINGS.contains(&name) {
+        return Err(invalid(
+            "--sample-weighting",
+            format!("`{name}` (accepted: {})", SAMPLE_WEIGHTINGS.join(", ")),
+        ));
+    }
     if floor.is_some() && name == "uniform" {
         return Err(invalid(
             "--relative-floor",
@@ -456,6 +462,7 @@ mod tests {
             ("uniform", Some(0.1), "--relative-floor"),
             ("uniform", Some(f64::NAN), "--relative-floor"),
             ("per-row", None, "--sample-weighting"),
+            ("per-row", Some(5.0), "--sample-weighting"),
         ] {
             let e = sample_weighting(name, floor).unwrap_err().to_string();
             assert!(

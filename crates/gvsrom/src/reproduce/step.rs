@@ -180,7 +180,7 @@ impl Run {
         }
         // the record goes first: a record without its output is never trusted (key checked above,
         // `valid` below), an output without its record is recomputed
-        let record = OutputFile::create("--out", &record_path, "reproduce-step", true)?;
+        let record = OutputFile::create("--out", &record_path, RECORD_FORMAT, true)?;
         let t0 = Instant::now();
         let value = compute(&path)?;
         let wall_time_s = t0.elapsed().as_secs_f64();
@@ -224,6 +224,9 @@ impl Run {
     }
 }
 
+/// The manifest format of a step record.
+const RECORD_FORMAT: &str = "reproduce-step";
+
 /// The key of a step: FNV-1a of `{"step": name, "config": config, "version": crate version}` as
 /// canonical JSON (object keys sorted).
 pub fn step_key<C: Serialize + ?Sized>(name: &str, config: &C) -> Result<String, OutputError> {
@@ -263,10 +266,12 @@ fn canonical(v: &Value) -> String {
     }
 }
 
-/// The value of the step record at `path` and its wall time (0 if not recorded), if the record
-/// holds `key`. A record that cannot be used (missing, not a regular file, not JSON, another key)
-/// is `None`: the step is computed again. One edited since gvsrom wrote it (its values no longer
-/// match its manifest's `meta_sha256`) is an error: it is neither reused nor replaced.
+/// The value of the step record at `path` and its wall time (0 if not recorded), if gvsrom wrote
+/// it (a manifest of format `reproduce-step` with the `meta_sha256` of its values) and it holds
+/// `key`. A record that cannot be used (missing, not a regular file, not JSON, without that
+/// manifest, another key) is `None`: the step is computed again (and [`OutputFile::create`]
+/// refuses to replace one gvsrom did not write). One edited since gvsrom wrote it (its values no
+/// longer match its `meta_sha256`) is an error: it is neither reused nor replaced.
 fn read_record<T: DeserializeOwned>(path: &Path, key: &str) -> anyhow::Result<Option<(T, f64)>> {
     let Some(mut v) = crate::output::read_regular_to_string(path)
         .ok()
@@ -276,11 +281,17 @@ fn read_record<T: DeserializeOwned>(path: &Path, key: &str) -> anyhow::Result<Op
     };
     if crate::output::json_file_edited(&v) {
         anyhow::bail!(
-            "the step record `{}` was changed after gvsrom wrote it (its values no longer match the `meta_sha256` of its manifest): reproduce neither reuses nor replaces it; move it away (or restore it) and the step is computed again",
+            "the step record `{}` was changed after gvsrom wrote it (its values no longer match the `meta_sha256` of its manifest): reproduce neither reuses nor replaces it; restore it to reuse it, or move it away and the step is computed again",
             path.display()
         );
     }
-    if v.get("key").and_then(Value::as_str) != Some(key) {
+    let manifest = v.get(crate::output::MANIFEST_KEY);
+    let ours = manifest
+        .and_then(|m| m.get("format"))
+        .and_then(Value::as_str)
+        == Some(RECORD_FORMAT)
+        && manifest.is_some_and(|m| m.get("meta_sha256").is_some());
+    if !ours || v.get("key").and_then(Value::as_str) != Some(key) {
         return Ok(None);
     }
     let wall_time_s = v.get("wall_time_s").and_then(Value::as_f64).unwrap_or(0.0);
@@ -351,7 +362,14 @@ mod tests {
         let dir = crate::output::test_util::sandbox("step", "record");
         let record = dir.join("s.step.json");
         let text = json!({"step": "s", "key": "k1", "wall_time_s": 2.5, "value": [1, 2]});
+        // without gvsrom's manifest it is not a record: not reused
         std::fs::write(&record, text.to_string()).unwrap();
+        assert_eq!(read_record::<Vec<u32>>(&record, "k1").unwrap(), None);
+        std::fs::remove_file(&record).unwrap();
+        OutputFile::create("--out", &record, RECORD_FORMAT, true)
+            .unwrap()
+            .commit_json(text)
+            .unwrap();
         assert_eq!(
             read_record::<Vec<u32>>(&record, "k1").unwrap(),
             Some((vec![1, 2], 2.5))
@@ -389,5 +407,17 @@ mod tests {
         // nor does another key make it replaceable
         assert!(read_record::<Vec<u32>>(&record, "k2").is_err());
         assert_eq!(std::fs::read_to_string(&record).unwrap(), edited);
+        // a mangled or removed hash does not make the edit reusable
+        let mangled = edited.replacen("\"meta_sha256\":\"", "\"meta_sha256\":\"x", 1);
+        assert_ne!(mangled, edited);
+        std::fs::write(&record, &mangled).unwrap();
+        assert!(read_record::<Vec<u32>>(&record, "k1").is_err());
+        let mut v: Value = serde_json::from_str(&edited).unwrap();
+        v["gvsrom"].as_object_mut().unwrap().remove("meta_sha256");
+        std::fs::write(&record, v.to_string()).unwrap();
+        assert_eq!(read_record::<Vec<u32>>(&record, "k1").unwrap(), None);
+        v.as_object_mut().unwrap().remove("gvsrom");
+        std::fs::write(&record, v.to_string()).unwrap();
+        assert_eq!(read_record::<Vec<u32>>(&record, "k1").unwrap(), None);
     }
 }
