@@ -47,14 +47,17 @@ fn friction_smoothing_defaults_and_passes_through() {
 
 #[test]
 fn invalid_friction_smoothing_is_rejected_with_its_field() {
-    for v in ["-0.1", "nan", "inf", "-inf"] {
+    // a scale above the largest curvature a load may imply (200 rad over the 0.25 m arm: 800
+    // rad/m) smooths the friction away at every curvature: 1e300 once did so without a word
+    for v in ["-0.1", "nan", "inf", "-inf", "801", "1e300"] {
         let err = error(&[&format!("tendons.0.friction_smoothing={v}")]);
         assert!(
             err.contains("tendons[0].friction_smoothing")
-                && (err.contains(">= 0") || err.contains("finite")),
+                && (err.contains("a number in [0, 800]") || err.contains("finite")),
             "{v}: {err}"
         );
     }
+    assert!(build(&["tendons.0.friction_smoothing=800"]).is_ok());
     let err = error(&["tendons.0.friction_smoothing=\"small\""]);
     assert!(err.contains("friction_smoothing"), "{err}");
 }

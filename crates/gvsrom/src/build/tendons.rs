@@ -50,7 +50,7 @@ pub(super) fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, Scen
         ));
     }
     let x_end = x_end.min(l);
-    let (friction, friction_smoothing) = friction(k, t)?;
+    let (friction, friction_smoothing) = friction(k, t, l)?;
     let explicit = t.offset_start.is_some() || t.offset_end.is_some();
     let polar = t.angle_deg.is_some() || t.radial_fraction.is_some();
     let (offset_start, offset_end) = match (explicit, polar) {
@@ -165,8 +165,10 @@ pub(super) fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, Scen
     Ok(tendon)
 }
 
-/// The friction coefficient and smoothing of tendon `k`, checked.
-fn friction(k: usize, t: &TendonSpec) -> Result<(f64, f64), ScenarioError> {
+/// The friction coefficient and smoothing of tendon `k` on a rod of length `l`, checked. A
+/// smoothing scale above the largest curvature a load may imply (200 rad over the rod) would smooth
+/// the friction away at every curvature (1e300 was accepted and turned it off without a word).
+fn friction(k: usize, t: &TendonSpec, l: f64) -> Result<(f64, f64), ScenarioError> {
     let f = |n: &str| format!("tendons[{k}].{n}");
     let friction = in_range(
         &f("friction"),
@@ -174,10 +176,12 @@ fn friction(k: usize, t: &TendonSpec) -> Result<(f64, f64), ScenarioError> {
         FRICTION_RANGE,
         "(a capstan coefficient)",
     )?;
-    let smoothing = non_negative(
+    let most = crate::plausibility::MAX_BENDING / l;
+    let smoothing = in_range(
         &f("friction_smoothing"),
         t.friction_smoothing.unwrap_or(DEFAULT_FRICTION_SMOOTHING),
-        "rad/m (a curvature scale; 0 = no smoothing)",
+        (0.0, most),
+        &format!("rad/m (a curvature scale, at most 200 rad over the rod's {l} m: above, it smooths the friction away; 0 = no smoothing)"),
     )?;
     Ok((friction, smoothing))
 }
@@ -248,7 +252,7 @@ fn path_tendon(
             format!("an abscissa <= the rod's length {l} m (the tendon's end)"),
         ));
     }
-    let (friction, friction_smoothing) = friction(k, t)?;
+    let (friction, friction_smoothing) = friction(k, t, l)?;
     let tendon = Tendon {
         offset_start: [first[1], first[2]],
         offset_end: [last[1], last[2]],
