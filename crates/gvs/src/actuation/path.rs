@@ -91,8 +91,13 @@ pub fn offset_and_rate(path: &[[f64; 3]], x: f64) -> (V3, V3) {
     )
 }
 
+/// The least distance along the rod between two knots: closer ones make the curve's slope between
+/// them unbounded (knots 1e-300 m apart gave an infinite offset rate, reported as `inf`).
+pub const MIN_KNOT_SPACING: f64 = 1e-6;
+
 /// What is wrong with `path` as a routing, if anything: the number of knots, a value that is not
-/// finite, or abscissae that do not strictly increase; `(knot index or None, message)`.
+/// finite, or abscissae that do not increase by at least [`MIN_KNOT_SPACING`]; `(knot index or
+/// None, message)`.
 pub fn check(path: &[[f64; 3]]) -> Result<(), (Option<usize>, String)> {
     if !(MIN_KNOTS..=MAX_KNOTS).contains(&path.len()) {
         return Err((
@@ -115,8 +120,19 @@ pub fn check(path: &[[f64; 3]]) -> Result<(), (Option<usize>, String)> {
                 Some(i),
                 format!(
                     "X = {} m does not follow the knot before it (X = {} m): the abscissae must strictly increase",
-                    k[0],
-                    path[i - 1][0]
+                    crate::error::fmt_value(k[0]),
+                    crate::error::fmt_value(path[i - 1][0])
+                ),
+            ));
+        }
+        if i > 0 && k[0] - path[i - 1][0] < MIN_KNOT_SPACING {
+            return Err((
+                Some(i),
+                format!(
+                    "X = {} m is {} m after the knot before it (X = {} m): knots at least {MIN_KNOT_SPACING:e} m apart are accepted (closer, the path's slope between them is unbounded)",
+                    crate::error::fmt_value(k[0]),
+                    crate::error::fmt_value(k[0] - path[i - 1][0]),
+                    crate::error::fmt_value(path[i - 1][0])
                 ),
             ));
         }
@@ -162,6 +178,20 @@ mod tests {
             );
             assert_eq!((d[0], dp[0]), (0.0, 0.0));
         }
+    }
+
+    #[test]
+    fn knots_closer_than_a_micrometre_are_refused_with_readable_numbers() {
+        // a review's knots 1e-300 m apart: the offset rate between them was infinite, and the
+        // abscissa was printed with 300 digits
+        let (i, m) =
+            check(&[[0.0, 0.0, 0.01], [1e-300, 0.0, -0.01], [0.25, 0.0, 0.0]]).unwrap_err();
+        assert_eq!(i, Some(1));
+        assert!(
+            m.starts_with("X = 1e-300 m is 1e-300 m after the knot before it (X = 0 m)"),
+            "{m}"
+        );
+        assert!(check(&[[0.0, 0.0, 0.01], [1e-6, 0.0, -0.01], [0.25, 0.0, 0.0]]).is_ok());
     }
 
     #[test]
