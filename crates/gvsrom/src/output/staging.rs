@@ -2,7 +2,7 @@
 //! uniquely named staging directory or file in the same directory, so the final move is a rename.
 
 use super::lock::TargetLock;
-use super::target::{inspect, refuse_special, split_target};
+use super::target::{inspect, refuse_inside_output, refuse_special, split_target};
 use super::{Kind, Named, OutputError};
 use std::fs::{self, File, OpenOptions};
 use std::io;
@@ -63,6 +63,7 @@ impl Prepared {
         }
         let (parent, name) = split_target(&named)?;
         refuse_special(&named, &parent, &name)?;
+        refuse_inside_output(&named, &parent)?;
         let lock = TargetLock::acquire(&named, &parent, &name)?;
         let target = parent.join(&name);
         inspect(&named, &target, kind, force)?;

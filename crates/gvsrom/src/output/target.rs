@@ -89,6 +89,30 @@ pub fn refuse_overlap(
 }
 
 /// Refuses the home directory and the current directory or its ancestors (by canonical path).
+/// Refuses a target inside another gvsrom output directory (one whose `meta.json` holds a
+/// manifest), except a run directory ([`super::RUN_FORMAT`]), which holds outputs by design. The
+/// outer output's manifest would not list it, so gvsrom would later refuse to replace that output,
+/// saying it holds an entry gvsrom did not write (a review's `statics --json DATASET/extra.json`).
+pub(super) fn refuse_inside_output(n: &Named, parent: &Path) -> Result<(), OutputError> {
+    let Ok(mut dir) = fs::canonicalize(parent) else {
+        return Ok(());
+    };
+    loop {
+        if let Some((format, _)) = read_manifest(&dir.join(MANIFEST_FILE)) {
+            if format == super::RUN_FORMAT {
+                return Ok(());
+            }
+            return Err(n.refused(format!(
+                "lies inside the gvsrom output `{}` (format `{format}`), whose manifest would not list it: gvsrom could then no longer replace that output; choose a path outside it",
+                dir.display()
+            )));
+        }
+        if !dir.pop() {
+            return Ok(());
+        }
+    }
+}
+
 pub(super) fn refuse_special(n: &Named, parent: &Path, name: &str) -> Result<(), OutputError> {
     let Ok(target) = fs::canonicalize(parent).map(|p| p.join(name)) else {
         return Ok(());
@@ -234,6 +258,32 @@ mod tests {
 
     fn sandbox(name: &str) -> PathBuf {
         super::super::test_util::sandbox("output", name)
+    }
+
+    #[test]
+    fn an_output_inside_another_output_is_refused_but_not_inside_a_run_directory() {
+        use super::super::{OutputDir, OutputFile, RunDir};
+        let d = sandbox("nested");
+        let outer = d.join("data");
+        OutputDir::create("--out", &outer, "dataset", false)
+            .unwrap()
+            .commit(serde_json::json!({}))
+            .unwrap();
+        for inner in [outer.join("extra.json"), outer.join("deeper/extra.json")] {
+            let e = OutputFile::create("--json", &inner, "statics", false)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains("lies inside the gvsrom output") && e.contains("format `dataset`"),
+                "{e}"
+            );
+            assert!(!inner.exists());
+        }
+        // beside it, and inside a run directory (which holds outputs by design), it is written
+        OutputFile::create("--json", &d.join("extra.json"), "statics", false).unwrap();
+        let run = d.join("run");
+        drop(RunDir::open("--out", &run).unwrap());
+        OutputFile::create("--json", &run.join("steps/x.json"), "statics", false).unwrap();
     }
 
     #[test]
