@@ -329,13 +329,17 @@ pub const SAMPLE_WEIGHTINGS: [&str; 2] = ["uniform", "relative"];
 /// weighting's weights. The name is checked first; a floor given with the uniform weighting, which
 /// would ignore it, is refused.
 pub fn sample_weighting(name: &str, floor: Option<f64>) -> Result<SampleWeighting, ScenarioError> {
-    if !SAMPLE_WEIGHTINGS.contains(&name) {
-        return Err(invalid(
-            "--sample-weighting",
-            format!("`{name}` (accepted: {})", SAMPLE_WEIGHTINGS.join(", ")),
-        ));
-    }
-    if floor.is_some() && name == "uniform" {
+    let relative = match name {
+        "uniform" => false,
+        "relative" => true,
+        _ => {
+            return Err(invalid(
+                "--sample-weighting",
+                format!("`{name}` (accepted: {})", SAMPLE_WEIGHTINGS.join(", ")),
+            ))
+        }
+    };
+    if floor.is_some() && !relative {
         return Err(invalid(
             "--relative-floor",
             "applies to the relative weighting only (accepted: with --sample-weighting relative, or not given)",
@@ -348,14 +352,10 @@ pub fn sample_weighting(name: &str, floor: Option<f64>) -> Result<SampleWeightin
             format!("{floor} (accepted: a fraction of the largest snapshot norm in (0, 1])"),
         ));
     }
-    match name {
-        "uniform" => Ok(SampleWeighting::Uniform),
-        "relative" => Ok(SampleWeighting::Relative { floor }),
-        _ => Err(invalid(
-            "--sample-weighting",
-            format!("`{name}` (accepted: {})", SAMPLE_WEIGHTINGS.join(", ")),
-        )),
-    }
+    Ok(match relative {
+        true => SampleWeighting::Relative { floor },
+        false => SampleWeighting::Uniform,
+    })
 }
 
 /// A scaled decoder whose first coordinate keeps one sign over the training encodings (`z₁` in
