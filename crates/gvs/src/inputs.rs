@@ -160,6 +160,13 @@ pub trait Actuation {
     fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64>;
     /// Checks it for `channels` actuators before a run.
     fn validate(&self, field: &str, channels: usize) -> Result<(), ModelError>;
+    /// Called by the dynamics driver with the state `(q, q̇)` of every output sample at `t`, in
+    /// order, before `u(t)` is read for that sample: a sampled-data controller
+    /// ([`crate::feedback::SampledFeedback`]) renews its held value here. `Err(reason)` stops
+    /// the run with that reason. Default: nothing (an input that is a function of time alone).
+    fn observe(&self, _t: f64, _q: &[f64], _qd: &[f64]) -> Result<(), String> {
+        Ok(())
+    }
 }
 
 impl Actuation for Signal {

@@ -16,6 +16,7 @@ pub mod cpu;
 pub mod discretize;
 pub mod dynamics;
 pub mod error;
+pub mod feedback;
 pub mod inputs;
 pub mod lie;
 pub mod loads;

@@ -515,6 +515,10 @@ pub fn simulate_streaming_interruptible<P: StrainParam>(
     let mut samples = 0;
     let mut t_last = None;
     let mut record = |t: f64, y: &DVector<f64>| {
+        // a sampled-data controller reads the state before `u(t)` is read for the sample
+        if let Err(reason) = actuation.observe(t, &y.as_slice()[..n], &y.as_slice()[n..]) {
+            return ControlFlow::Break(reason);
+        }
         qbuf.copy_from(&y.rows(0, n));
         model.forward(&qbuf, &mut out_ws, false);
         actuation.eval(t, &mut ubuf);
