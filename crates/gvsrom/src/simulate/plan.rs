@@ -62,6 +62,39 @@ pub fn sample_times(duration: f64, rate: f64) -> Result<Vec<f64>, ScenarioError>
     Ok(t)
 }
 
+/// The control instants of a sampled-data controller running at `control_rate` in a run sampled
+/// at `sample_rate` for `duration` ([`sample_times`]): every `m`-th sample from the start,
+/// `m = sample_rate / control_rate`, which must be a whole number (within 1e-9), so that every
+/// instant is a sample at which the controller reads the state
+/// ([`gvs::feedback::SampledFeedback`]). The last sample is an instant only if it falls on the
+/// control period.
+pub fn control_instants(
+    duration: f64,
+    sample_rate: f64,
+    control_rate: f64,
+) -> Result<Vec<f64>, ScenarioError> {
+    let t = sample_times(duration, sample_rate)?;
+    positive("--control-rate", control_rate, "Hz")?;
+    let ratio = sample_rate / control_rate;
+    let m = ratio.round();
+    if !(m >= 1.0 && (ratio - m).abs() <= 1e-9 * ratio) {
+        return Err(ScenarioError::value(
+            "--control-rate",
+            control_rate,
+            format!(
+                "a whole fraction of --sample-rate {} Hz ({} Hz, {} Hz, …): the controller reads the state at output samples",
+                gvs::error::fmt_value(sample_rate),
+                gvs::error::fmt_value(sample_rate),
+                gvs::error::fmt_value(sample_rate / 2.0),
+            ),
+        ));
+    }
+    let m = m as usize;
+    // the samples on the grid k / rate (a last sample at `duration` off it is not an instant)
+    let on_grid = (duration * sample_rate * (1.0 + 4.0 * f64::EPSILON)).floor() as usize + 1;
+    Ok(t.iter().take(on_grid).step_by(m).copied().collect())
+}
+
 /// A run checked before anything is computed or written: its sample times, actuation, load schedule
 /// and initial state. Inputs whose loads or tensions lie far beyond the rod's elastic range are
 /// refused here (see [`crate::plausibility`]).
