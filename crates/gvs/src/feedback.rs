@@ -24,6 +24,12 @@ pub trait FeedbackLaw {
     fn tensions(&self, t: f64, q: &[f64], qd: &[f64], u: &mut [f64]) -> Result<(), String>;
 }
 
+impl<L: FeedbackLaw + ?Sized> FeedbackLaw for std::sync::Arc<L> {
+    fn tensions(&self, t: f64, q: &[f64], qd: &[f64], u: &mut [f64]) -> Result<(), String> {
+        (**self).tensions(t, q, qd, u)
+    }
+}
+
 /// A [`FeedbackLaw`] held over the periods between its control instants (an [`Actuation`]).
 pub struct SampledFeedback<L> {
     law: L,
@@ -65,7 +71,10 @@ impl<L: FeedbackLaw> SampledFeedback<L> {
 
     /// Control instants reached so far (calls of the law).
     pub fn calls(&self) -> usize {
-        self.held.lock().unwrap_or_else(PoisonError::into_inner).next
+        self.held
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .next
     }
 }
 
@@ -99,8 +108,9 @@ impl<L: FeedbackLaw> Actuation for SampledFeedback<L> {
         if self.instants.is_empty() {
             return Err(ModelError::invalid(field, "no control instant"));
         }
-        if let Some(w) = (self.instants.windows(2)).find(|w| !(w[1] > w[0]) || !w[1].is_finite())
-        {
+        if let Some(w) = (self.instants.windows(2)).find(|w| {
+            w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater) || !w[1].is_finite()
+        }) {
             return Err(ModelError::invalid(
                 field,
                 format!(

@@ -123,9 +123,9 @@ fn a_closed_loop_is_the_open_loop_run_of_the_tensions_it_applied() {
             assert_eq!(q, &closed.0[i].0, "{name}: the state handed at t = {tk}");
         }
         // the tensions vary (the test would not see a wrong hold otherwise)
-        let (lo, hi) = calls.iter().fold((f64::MAX, f64::MIN), |(a, b), c| {
-            (a.min(c.1), b.max(c.1))
-        });
+        let (lo, hi) = calls
+            .iter()
+            .fold((f64::MAX, f64::MIN), |(a, b), c| (a.min(c.1), b.max(c.1)));
         assert!(hi - lo > 0.05, "{name}: tensions {lo} … {hi}");
         // (the call at the end time applies to no step: a knot there would be read by the last
         // one, which ends on it)
@@ -147,7 +147,11 @@ fn a_closed_loop_is_the_open_loop_run_of_the_tensions_it_applied() {
         assert!(open.error.is_none(), "{name}");
         for (i, (q, u)) in closed.0.iter().enumerate() {
             let qo = open.trajectory.q[i].as_slice();
-            let dq = q.iter().zip(qo).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+            let dq = q
+                .iter()
+                .zip(qo)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
             let scale = qo.iter().fold(1.0f64, |a, b| a.max(b.abs()));
             assert!(
                 dq <= 1e-12 * scale,

@@ -135,8 +135,10 @@ const SWITCHES: [&str; 7] = [
 ];
 
 /// Flags of the command line that are keyword arguments of the same name in Python.
-const SAME: [&str; 45] = [
+const SAME: [&str; 46] = [
     "out",
+    // no flag of the command line: the library's name for `simulate(control_rate=…)`
+    "control-rate",
     "max-order",
     "error-norm",
     "rho-inf",

@@ -6,6 +6,7 @@
 //! into Python (PyO3 turns one into `PanicException`, and the library returns errors as values).
 
 mod arrays;
+mod callable;
 mod datasets;
 mod dynamics_quantities;
 mod errors;

@@ -3,10 +3,11 @@
 //! is the scenario's tensions, rows `t, u_1, …` or a Python callable `u(t)` ([`CallableInput`]).
 
 use crate::arrays::{self, shaped, vector};
+use crate::callable::{CallableInput, Kind};
 use crate::errors::{invalid, scenario as err};
 use crate::robot::{warn, Robot};
-use gvs::error::ModelError;
-use gvs::inputs::{Actuation, Interpolation, Signal};
+use gvs::feedback::SampledFeedback;
+use gvs::inputs::{Interpolation, Signal};
 use gvsrom::simulate::{
     self, Ending, ErrorNormChoice, InputFunction, InputSource, IntegratorChoice, MethodChoice,
     TrajectoryBuffer,
@@ -14,7 +15,7 @@ use gvsrom::simulate::{
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::ops::ControlFlow;
-use std::sync::{Arc, Mutex, PoisonError};
+use std::sync::Arc;
 
 /// The arguments of [`run`] (the options of `gvsrom simulate`).
 pub struct Args<'a> {
@@ -47,6 +48,10 @@ pub struct Args<'a> {
     pub rho_inf: Option<f64>,
     /// Finite differences for the integrator's Jacobian (`--fd-jacobian`).
     pub fd_jacobian: bool,
+    /// A controller `u(t, q, q̇)` called at the control instants, its tensions held between them.
+    pub controller: Option<Bound<'a, PyAny>>,
+    /// Its calls per second (default: the sample rate).
+    pub control_rate: Option<f64>,
 }
 
 #[pymethods]
@@ -110,6 +115,18 @@ impl Robot {
     /// fd_jacobian : bool
     ///     Finite differences of the right-hand side for the integrator's Jacobian instead of the
     ///     structured analytic one (``--fd-jacobian``; the NDF and the fixed step).
+    /// controller : callable, optional
+    ///     A sampled-data controller ``controller(t, q, qd) -> tensions``: called at ``t = 0`` and
+    ///     every ``1 / control_rate`` seconds with the state there (``q``, ``qd``: the coordinates
+    ///     of the model that runs, new arrays), its tensions held until the next call (a
+    ///     zero-order hold, as a digital controller drives a robot). The closed loop is one
+    ///     integration: the integrator restarts at each call as at a step of held rows, and keeps
+    ///     what it can (the fixed step's iteration matrix). Its values are checked as ``input``'s
+    ///     are; an exception it raises stops the run and propagates. Instead of ``input``,
+    ///     ``steps`` and ``babble``.
+    /// control_rate : float, optional
+    ///     The controller's calls per second [Hz]: ``sample_rate`` (default) or a whole fraction
+    ///     of it, so that every call is at an output sample.
     ///
     /// Returns
     /// -------
@@ -136,7 +153,7 @@ impl Robot {
     ///     samples computed before (``energy_balance`` left out).
     /// GvsromError
     ///     For bad options or input.
-    #[pyo3(signature = (duration, sample_rate=100.0, input=None, interpolate=false, from_equilibrium=false, q0=None, qd0=None, method="auto", rtol=None, atol=None, fixed_step=None, load_schedule=None, steps=None, babble=None, seed=0, max_order=None, error_norm=None, rho_inf=None, fd_jacobian=false))]
+    #[pyo3(signature = (duration, sample_rate=100.0, input=None, interpolate=false, from_equilibrium=false, q0=None, qd0=None, method="auto", rtol=None, atol=None, fixed_step=None, load_schedule=None, steps=None, babble=None, seed=0, max_order=None, error_norm=None, rho_inf=None, fd_jacobian=false, controller=None, control_rate=None))]
     #[allow(clippy::too_many_arguments)]
     fn simulate<'py>(
         &self,
@@ -160,6 +177,8 @@ impl Robot {
         error_norm: Option<&str>,
         rho_inf: Option<f64>,
         fd_jacobian: bool,
+        controller: Option<Bound<'_, PyAny>>,
+        control_rate: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let max_order = max_order
             .map(|v| arrays::size("max_order", v, 1))
@@ -184,6 +203,8 @@ impl Robot {
             error_norm,
             rho_inf,
             fd_jacobian,
+            controller,
+            control_rate,
         };
         run(self, py, args)
     }
@@ -215,214 +236,6 @@ fn method(name: &str) -> PyResult<MethodChoice> {
     })
 }
 
-/// A Python callable `u(t)` as the integrator's actuation: called with the GIL at every time the
-/// integrator evaluates, its value checked (one tension per tendon or one for all, finite). The
-/// first exception (the callable's own, or a `GvsromError` for a bad value) is kept and stops the
-/// run at its next step attempt; until then the actuation is zero. The largest |u| of each tendon
-/// so far is kept with the time it was returned: the run's control checks it against the rod's
-/// elastic range after each step ([`CallableInput::check_range`]), as `gvsrom simulate` checks a
-/// signal's tensions before it starts. With a reduced model attached, every value returned is
-/// checked too against what the model was trained on, as a signal of rows is
-/// ([`gvsrom::build::reduced::Reduced::check_signal`]): outside, the run stops with the model's
-/// verdict, or, with `extrapolate`, goes on and its result says so.
-pub struct CallableInput {
-    function: Py<PyAny>,
-    n_actuators: usize,
-    error: Mutex<Option<PyErr>>,
-    largest: Mutex<Largest>,
-    /// With a reduced model: the values returned since the last check, with their times.
-    returned: Option<Mutex<Returned>>,
-    /// How the values lay outside the model's training, with `extrapolate` (the first sentence
-    /// of each kind is kept).
-    extrapolated: Mutex<Vec<String>>,
-}
-
-/// The values `u` a callable input returned since the last check, each with the time `t` it was
-/// asked for (a value repeated over many evaluations, a held input, once), and the last one.
-#[derive(Default)]
-struct Returned {
-    unchecked: Vec<(f64, Vec<f64>)>,
-    last: Vec<f64>,
-}
-
-/// The largest |u| per tendon returned so far, the time of each, and whether it grew since the
-/// last check.
-#[derive(Default)]
-struct Largest {
-    abs: Vec<f64>,
-    at: Vec<f64>,
-    grown: bool,
-}
-
-impl CallableInput {
-    fn call(&self, py: Python<'_>, t: f64) -> PyResult<Vec<f64>> {
-        let value = self.function.bind(py).call1((t,))?;
-        let na = self.n_actuators;
-        let values = match value.extract::<arrays::Tensions<'_>>() {
-            Ok(u) => u.values(),
-            Err(_) => {
-                return Err(invalid(format!(
-                    "`input({t})` returned `{}`: expected {na} tensions [N] (an array, one per tendon, or one number for all)",
-                    value.repr()?
-                )))
-            }
-        };
-        let u = gvsrom::scenario::tensions_for(na, &values)
-            .map_err(|e| invalid(format!("`input({t})`: {e}")))?;
-        if let Some(k) = u.iter().position(|x| !x.is_finite()) {
-            return Err(invalid(format!(
-                "`input({t})` returned u[{k}] = {}: expected finite tensions [N]",
-                u[k]
-            )));
-        }
-        Ok(u)
-    }
-
-    /// Records `u`, returned at `t`, in the largest |u| per tendon (and for the model's check).
-    fn record(&self, t: f64, u: &[f64]) {
-        if let Some(r) = &self.returned {
-            let mut r = r.lock().unwrap_or_else(PoisonError::into_inner);
-            // a value held over many evaluations (a step input) is checked once
-            if r.last != u {
-                r.last = u.to_vec();
-                r.unchecked.push((t, u.to_vec()));
-            }
-        }
-        let mut l = self.largest.lock().unwrap_or_else(PoisonError::into_inner);
-        if l.abs.len() != u.len() {
-            l.abs = vec![0.0; u.len()];
-            l.at = vec![t; u.len()];
-        }
-        for (k, v) in u.iter().enumerate() {
-            if v.abs() > l.abs[k] {
-                l.abs[k] = v.abs();
-                l.at[k] = t;
-                l.grown = true;
-            }
-        }
-    }
-
-    /// If the largest |u| grew since the last call: checks it against the rod's elastic range
-    /// (`gvsrom::plausibility::check`, as for a signal given as rows); a value far beyond it
-    /// becomes the run's error, naming the time it was returned, and `false` is returned.
-    fn check_range(&self, built: &gvsrom::Built) -> bool {
-        self.check_model(built) && self.check_elastic_range(built)
-    }
-
-    /// The values returned since the last call against the reduced model's training
-    /// ([`gvsrom::build::reduced::Reduced::check_signal`] at their times): outside, the model's
-    /// verdict becomes the run's error and `false` is returned; with `extrapolate` the reasons are
-    /// kept for the result.
-    fn check_model(&self, built: &gvsrom::Built) -> bool {
-        let (Some(returned), Some(r)) = (&self.returned, &built.reduced) else {
-            return true;
-        };
-        let values = std::mem::take(
-            &mut returned
-                .lock()
-                .unwrap_or_else(PoisonError::into_inner)
-                .unchecked,
-        );
-        if values.is_empty() {
-            return true;
-        }
-        let times: Vec<f64> = values.iter().map(|(t, _)| *t).collect();
-        let verdict = r.check_signal(&times, |t| {
-            let at = values.iter().find(|(tv, _)| tv.to_bits() == t.to_bits());
-            at.map_or_else(Vec::new, |(_, u)| u.clone())
-        });
-        match verdict {
-            Ok(sentences) => {
-                let mut kept = self
-                    .extrapolated
-                    .lock()
-                    .unwrap_or_else(PoisonError::into_inner);
-                for s in sentences {
-                    // one sentence per way of lying outside (a tendon's range, the combination)
-                    let kind = match s.starts_with("at t = ") {
-                        true => "at t = ".to_string(),
-                        false => s.split(" reaches ").next().unwrap_or(&s).to_string(),
-                    };
-                    if !kept.iter().any(|k| k.starts_with(&kind)) {
-                        kept.push(s);
-                    }
-                }
-                true
-            }
-            Err(e) => {
-                // as for a signal of rows: the message names the tension, its value and time
-                let mut slot = self.error.lock().unwrap_or_else(PoisonError::into_inner);
-                slot.get_or_insert_with(|| invalid(e.to_string()));
-                false
-            }
-        }
-    }
-
-    /// The largest |u| against the rod's elastic range, if it grew since the last call.
-    fn check_elastic_range(&self, built: &gvsrom::Built) -> bool {
-        let (abs, at) = {
-            let mut l = self.largest.lock().unwrap_or_else(PoisonError::into_inner);
-            if !l.grown {
-                return true;
-            }
-            l.grown = false;
-            (l.abs.clone(), l.at.clone())
-        };
-        match gvsrom::plausibility::check(built, &abs, 1.0) {
-            Ok(()) => true,
-            Err(e) => {
-                let k = (0..abs.len())
-                    .max_by(|&i, &j| abs[i].total_cmp(&abs[j]))
-                    .unwrap_or(0);
-                // the error names the tendon and its largest |u|; the time says when it came
-                let message = format!("`input({})`: {e}", at[k]);
-                let mut slot = self.error.lock().unwrap_or_else(PoisonError::into_inner);
-                slot.get_or_insert_with(|| invalid(message));
-                false
-            }
-        }
-    }
-
-    /// Takes the error the callable raised, if any.
-    fn take_error(&self) -> Option<PyErr> {
-        self.error
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner)
-            .take()
-    }
-
-    fn failed(&self) -> bool {
-        self.error
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner)
-            .is_some()
-    }
-}
-
-impl Actuation for CallableInput {
-    fn eval(&self, t: f64, out: &mut [f64]) {
-        out.fill(0.0);
-        if self.failed() {
-            return;
-        }
-        match Python::attach(|py| self.call(py, t)) {
-            Ok(u) => {
-                self.record(t, &u);
-                out.copy_from_slice(&u)
-            }
-            Err(e) => *self.error.lock().unwrap_or_else(PoisonError::into_inner) = Some(e),
-        }
-    }
-
-    fn breakpoints(&self, _t0: f64, _t1: f64) -> Vec<f64> {
-        vec![]
-    }
-
-    fn validate(&self, _field: &str, _channels: usize) -> Result<(), ModelError> {
-        Ok(()) // every value is checked where it is returned
-    }
-}
-
 /// Where the run starts: `from_equilibrium`, a given state `q0` (`qd0`: zero if not given), or
 /// straight at rest.
 fn start(a: &Args<'_>) -> PyResult<simulate::Start> {
@@ -448,36 +261,72 @@ fn start(a: &Args<'_>) -> PyResult<simulate::Start> {
 pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'py, PyDict>> {
     let na = robot.built.model.n_actuators();
     let start = start(&a)?;
-    let callable = match &a.input {
-        Some(f) if f.is_callable() => {
+    let attached = robot.attached.is_some();
+    let callable = match (&a.input, &a.controller) {
+        (Some(_), Some(_)) => {
+            return Err(invalid(
+                "`input` and `controller` both give the tensions: give one",
+            ))
+        }
+        (_, Some(f)) if !f.is_callable() => {
+            return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                "`controller` must be a callable `controller(t, q, qd) -> tensions`, got `{}`",
+                f.repr()?
+            )))
+        }
+        (_, Some(f)) => Some(Arc::new(CallableInput::new(
+            f.clone().unbind(),
+            Kind::Controller,
+            na,
+            attached,
+        ))),
+        (Some(f), None) if f.is_callable() => {
             if a.interpolate {
                 return Err(invalid(
                     "`interpolate` applies to an input of rows, not to a callable `input`",
                 ));
             }
-            Some(Arc::new(CallableInput {
-                function: f.clone().unbind(),
-                n_actuators: na,
-                error: Mutex::new(None),
-                largest: Mutex::new(Largest::default()),
-                returned: robot.attached.as_ref().map(|_| Mutex::default()),
-                extrapolated: Mutex::new(vec![]),
-            }))
+            Some(Arc::new(CallableInput::new(
+                f.clone().unbind(),
+                Kind::Input,
+                na,
+                attached,
+            )))
         }
         _ => None,
     };
+    if a.control_rate.is_some() && a.controller.is_none() {
+        return Err(invalid(
+            "`control_rate` is the rate of a `controller`: give one (or leave `control_rate` out)",
+        ));
+    }
+    if a.interpolate && a.controller.is_some() {
+        return Err(invalid(
+            "`interpolate` applies to an input of rows; a controller's tensions are held",
+        ));
+    }
     if a.interpolate && a.input.is_none() {
         return Err(invalid(
             "`interpolate` applies to an `input` of rows: give one (without it the tensions are constant)",
         ));
     }
     let random = a.steps.is_some() || a.babble.is_some();
-    if random && a.input.is_some() {
+    if random && (a.input.is_some() || a.controller.is_some()) {
         return Err(invalid(
-            "`input`, `steps` and `babble` each give the tensions: give at most one",
+            "`input`, `controller`, `steps` and `babble` each give the tensions: give at most one",
         ));
     }
     let input = match (&a.input, &callable) {
+        (None, Some(c)) => {
+            let rate = a.control_rate.unwrap_or(a.sample_rate);
+            let instants =
+                simulate::control_instants(a.duration, a.sample_rate, rate).map_err(err)?;
+            InputSource::Function(InputFunction(Arc::new(SampledFeedback::new(
+                c.clone(),
+                instants,
+                na,
+            ))))
+        }
         (None, _) if random => {
             InputSource::from_options(None, false, a.steps.as_deref(), a.babble.as_deref(), a.seed)
                 .map_err(err)?
@@ -510,7 +359,7 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
     };
     // a reduced model checks a signal's tensions, not the scenario's (`simulate --model`)
     // (from an equilibrium, the scenario's tensions are the start's: checked as attached)
-    let signal = random || a.input.is_some();
+    let signal = random || a.input.is_some() || a.controller.is_some();
     let built = match signal && !a.from_equilibrium {
         true => robot.built_for_signal(py)?,
         false => &robot.built,
@@ -554,7 +403,7 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
                 .as_ref()
                 .is_some_and(|c| !c.check_range(built) || c.failed())
             {
-                return ControlFlow::Break("the input callable failed".to_string());
+                return ControlFlow::Break("the callable failed".to_string());
             }
             match signals.interrupted() {
                 false => ControlFlow::Continue(()),
@@ -573,13 +422,7 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
         return Err(e);
     }
     if let Some(c) = &callable {
-        let kept = std::mem::take(
-            &mut *c
-                .extrapolated
-                .lock()
-                .unwrap_or_else(PoisonError::into_inner),
-        );
-        for o in kept {
+        for o in c.take_extrapolated() {
             warn(py, &format!("extrapolating (--extrapolate): {o}"))?;
             extrapolated.push(o);
         }

@@ -19,9 +19,16 @@ fn control_instants_are_every_mth_sample_and_a_rate_off_the_samples_is_refused()
     // a last sample at the duration, off the sample grid, is not an instant
     let t = control_instants(0.105, 100.0, 50.0).unwrap();
     assert_eq!(*t.last().unwrap(), 0.1);
-    for (rate, why) in [(30.0, "whole fraction"), (200.0, "whole fraction"), (0.0, "> 0")] {
+    for (rate, why) in [
+        (30.0, "whole fraction"),
+        (200.0, "whole fraction"),
+        (0.0, "> 0"),
+    ] {
         let e = control_instants(0.1, 100.0, rate).unwrap_err().to_string();
-        assert!(e.contains("--control-rate") && e.contains(why), "{rate}: {e}");
+        assert!(
+            e.contains("--control-rate") && e.contains(why),
+            "{rate}: {e}"
+        );
     }
 }
 

@@ -426,4 +426,6 @@ class Robot:
         error_norm: str | None = None,
         rho_inf: float | None = None,
         fd_jacobian: bool = False,
+        controller: Callable[[float, _F, _F], ArrayLike | float] | None = None,
+        control_rate: float | None = None,
     ) -> dict[str, Any]: ...
