@@ -105,8 +105,15 @@ impl<L: FeedbackLaw> Actuation for SampledFeedback<L> {
                 ),
             ));
         }
-        if self.instants.is_empty() {
-            return Err(ModelError::invalid(field, "no control instant"));
+        match self.instants.first() {
+            None => return Err(ModelError::invalid(field, "no control instant")),
+            Some(t) if !t.is_finite() => {
+                return Err(ModelError::invalid(
+                    field,
+                    format!("control instants must be finite: the first is {t}"),
+                ))
+            }
+            Some(_) => {}
         }
         if let Some(w) = (self.instants.windows(2)).find(|w| {
             w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater) || !w[1].is_finite()

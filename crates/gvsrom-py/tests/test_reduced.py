@@ -509,3 +509,20 @@ def test_a_pickled_robot_is_the_same_robot_in_another_process(dataset, pod_model
 
 def _reduced_statics_q(robot):
     return robot.statics().q
+
+
+def test_a_controller_on_a_reduced_model_is_checked_against_its_training(pod_model):
+    robot = gvsrom.Scenario.preset("single-tendon").build().with_model(pod_model)
+    # inside the training tensions (−6 … 0 N): the closed loop runs in the model's coordinates
+    seen = []
+
+    def law(t, q, qd):
+        seen.append(q.shape)
+        return min(max(-3.0 - 0.05 * q[0], -5.5), -0.5)
+
+    tr = robot.simulate(0.1, sample_rate=100, controller=law)
+    assert tr["q"].shape == (11, 2) and set(seen) == {(2,)}, (tr["q"].shape, set(seen))
+    # a tension far outside them stops the run with the model's verdict, naming the controller
+    with pytest.raises(gvsrom.GvsromError, match=r"tendons.0.tension reaches -20 at t = 0.05 s, "
+                                                 r"outside the training inputs \[-6, 0\]"):
+        robot.simulate(0.1, sample_rate=100, controller=lambda t, q, qd: -3.0 if t < 0.05 else -20.0)
