@@ -268,9 +268,10 @@ impl gvs::feedback::FeedbackLaw for CallableInput {
                 Ok(())
             }
             Err(e) => {
+                let reason = format!("the controller raised {e}");
                 let mut slot = self.error.lock().unwrap_or_else(PoisonError::into_inner);
                 slot.get_or_insert(e);
-                Err("the controller failed".to_string())
+                Err(reason)
             }
         }
     }

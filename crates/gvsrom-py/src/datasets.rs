@@ -266,7 +266,7 @@ fn scenario_arg(value: &Bound<'_, PyAny>) -> PyResult<(String, Vec<String>)> {
             return Ok((s.src.default_name.clone(), s.overrides.clone()));
         }
         // a file's origin is its path; text given in Python has none
-        if s.src.origin == "<string>" {
+        if s.src.origin == gvsrom::presets::TEXT_ORIGIN {
             return Err(invalid(
                 "`scenario`: a Scenario from TOML text has no file to record in the dataset; write `scenario.to_toml()` to a file and pass its path",
             ));

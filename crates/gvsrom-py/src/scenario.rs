@@ -137,7 +137,7 @@ impl Scenario {
                     file_source(s)?
                 } else {
                     Source {
-                        origin: "<string>".into(),
+                        origin: gvsrom::presets::TEXT_ORIGIN.into(),
                         default_name: "scenario".into(),
                         text: s.to_string(),
                         preset: false,

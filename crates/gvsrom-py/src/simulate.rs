@@ -10,7 +10,7 @@ use gvs::feedback::SampledFeedback;
 use gvs::inputs::{Interpolation, Signal};
 use gvsrom::simulate::{
     self, Ending, ErrorNormChoice, InputFunction, InputSource, IntegratorChoice, MethodChoice,
-    TrajectoryBuffer,
+    SampleSink, TrajectoryBuffer, TrajectoryWriter,
 };
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -52,6 +52,10 @@ pub struct Args<'a> {
     pub controller: Option<Bound<'a, PyAny>>,
     /// Its calls per second (default: the sample rate).
     pub control_rate: Option<f64>,
+    /// A directory to write the trajectory to, as `gvsrom simulate --out` does.
+    pub out: Option<std::path::PathBuf>,
+    /// Replace an earlier gvsrom output at `out` (`--force`).
+    pub force: bool,
 }
 
 #[pymethods]
@@ -127,6 +131,14 @@ impl Robot {
     /// control_rate : float, optional
     ///     The controller's calls per second [Hz]: ``sample_rate`` (default) or a whole fraction
     ///     of it, so that every call is at an output sample.
+    /// out : str or os.PathLike, optional
+    ///     Also write the trajectory to this new directory, the files ``gvsrom simulate --out``
+    ///     writes (``t.npy``, ``q.npy``, …, ``meta.json`` with how the run was made), for
+    ///     :func:`plot`, ``gvsrom compare`` or a later session; a run that ended early is written
+    ///     too, marked incomplete. An existing path is refused unless it is an earlier gvsrom
+    ///     output and ``force`` is given.
+    /// force : bool
+    ///     Replace an earlier gvsrom output at ``out``.
     ///
     /// Returns
     /// -------
@@ -143,7 +155,8 @@ impl Robot {
     ///     tendon friction, loads or schedule; constant tensions) ``energy_balance``, a dict of
     ///     ``initial``, ``last``, ``largest_gain``, ``largest_loss``, ``kinetic_max`` [J] of
     ///     ``T + U_e + U_g − Σ u ℓ`` over the samples, with a ``UserWarning`` when it rose by more
-    ///     than 1 % of the largest kinetic energy (the integration added energy).
+    ///     than 1 % of the largest kinetic energy (the integration added energy); with ``out``,
+    ///     ``out``: the directory written.
     ///
     /// Raises
     /// ------
@@ -153,7 +166,7 @@ impl Robot {
     ///     samples computed before (``energy_balance`` left out).
     /// GvsromError
     ///     For bad options or input.
-    #[pyo3(signature = (duration, sample_rate=100.0, input=None, interpolate=false, from_equilibrium=false, q0=None, qd0=None, method="auto", rtol=None, atol=None, fixed_step=None, load_schedule=None, steps=None, babble=None, seed=0, max_order=None, error_norm=None, rho_inf=None, fd_jacobian=false, controller=None, control_rate=None))]
+    #[pyo3(signature = (duration, sample_rate=100.0, input=None, interpolate=false, from_equilibrium=false, q0=None, qd0=None, method="auto", rtol=None, atol=None, fixed_step=None, load_schedule=None, steps=None, babble=None, seed=0, max_order=None, error_norm=None, rho_inf=None, fd_jacobian=false, controller=None, control_rate=None, out=None, force=false))]
     #[allow(clippy::too_many_arguments)]
     fn simulate<'py>(
         &self,
@@ -179,6 +192,8 @@ impl Robot {
         fd_jacobian: bool,
         controller: Option<Bound<'_, PyAny>>,
         control_rate: Option<f64>,
+        out: Option<std::path::PathBuf>,
+        force: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
         let max_order = max_order
             .map(|v| arrays::size("max_order", v, 1))
@@ -205,6 +220,8 @@ impl Robot {
             fd_jacobian,
             controller,
             control_rate,
+            out,
+            force,
         };
         run(self, py, args)
     }
@@ -321,11 +338,10 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
             let rate = a.control_rate.unwrap_or(a.sample_rate);
             let instants =
                 simulate::control_instants(a.duration, a.sample_rate, rate).map_err(err)?;
-            InputSource::Function(InputFunction(Arc::new(SampledFeedback::new(
-                c.clone(),
-                instants,
-                na,
-            ))))
+            InputSource::Feedback {
+                function: InputFunction(Arc::new(SampledFeedback::new(c.clone(), instants, na))),
+                control_rate: rate,
+            }
         }
         (None, _) if random => {
             InputSource::from_options(None, false, a.steps.as_deref(), a.babble.as_deref(), a.seed)
@@ -374,7 +390,12 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
         rho_inf: a.rho_inf,
         fd_jacobian: a.fd_jacobian,
     };
-    let simulate::Prepared { opts, plan, .. } = simulate::prepare(
+    if a.force && a.out.is_none() {
+        return Err(invalid(
+            "`force` replaces an earlier output at `out`: give `out` (or leave `force` out)",
+        ));
+    }
+    let prepared = simulate::prepare(
         built,
         simulate::Request {
             duration: a.duration,
@@ -386,6 +407,20 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
         },
     )
     .map_err(err)?;
+    let (opts, plan) = (&prepared.opts, &prepared.plan);
+    // the output is staged before the run, as `gvsrom simulate --out` does
+    let mut writer = match &a.out {
+        Some(dir) => {
+            simulate::check_output_size(built, plan).map_err(err)?;
+            let mut w = TrajectoryWriter::create(dir, a.force, built)
+                .map_err(|e| crate::errors::any(e.into()))?;
+            w.set_provenance(
+                &prepared.record(provenance(robot, built)?.seed("input", a.seed), &choice),
+            );
+            Some(w)
+        }
+        None => None,
+    };
     for o in &plan.model_extrapolated {
         warn(py, &format!("extrapolating (--extrapolate): {o}"))?;
     }
@@ -397,7 +432,7 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
         .collect();
     let mut buffer = TrajectoryBuffer::new(built);
     let mut signals = crate::interrupt::SignalPoll::new();
-    let outcome = py.detach(|| {
+    let mut outcome = py.detach(|| {
         let mut control = |_t: f64| {
             if callable
                 .as_ref()
@@ -410,22 +445,35 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
                 true => ControlFlow::Break("interrupted".to_string()),
             }
         };
-        simulate::run_into(
-            built,
-            &plan,
-            &opts.integrator,
-            Some(&mut buffer),
-            &mut control,
-        )
+        let sink: &mut dyn SampleSink = match writer.as_mut() {
+            Some(w) => &mut (&mut buffer, w),
+            None => &mut buffer,
+        };
+        simulate::run_into(built, plan, &opts.integrator, Some(sink), &mut control)
     });
+    // what the callable's values lay outside the model's training, in the result and the files
+    let from_callable = callable
+        .as_ref()
+        .map(|c| c.take_extrapolated())
+        .unwrap_or_default();
+    // the trajectory is written (partial, if the run ended early) before any error is raised
+    let written = match (writer, outcome.as_mut()) {
+        (Some(w), Ok(o)) => {
+            // (recorded as the callable's first, as the result lists them)
+            o.model_extrapolated
+                .splice(0..0, from_callable.iter().cloned());
+            let dir = w.finish(built, plan, o);
+            o.model_extrapolated.drain(0..from_callable.len());
+            Some(dir.map_err(|e| crate::errors::any(e.into()))?)
+        }
+        _ => None,
+    };
     if let Some(e) = callable.as_ref().and_then(|c| c.take_error()) {
         return Err(e);
     }
-    if let Some(c) = &callable {
-        for o in c.take_extrapolated() {
-            warn(py, &format!("extrapolating (--extrapolate): {o}"))?;
-            extrapolated.push(o);
-        }
+    for o in from_callable {
+        warn(py, &format!("extrapolating (--extrapolate): {o}"))?;
+        extrapolated.push(o);
     }
     if let Some(e) = signals.caught() {
         return Err(e);
@@ -436,9 +484,16 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
         Ending::Failed { error } => {
             let partial = trajectory(py, built, &buffer, &outcome)?;
             partial.set_item("model_extrapolated", extrapolated)?;
+            if let Some(dir) = &written {
+                partial.set_item("out", dir)?;
+            }
+            let files = match &written {
+                Some(dir) => format!("; written to {}, marked incomplete", dir.display()),
+                None => String::new(),
+            };
             return Err(crate::errors::integration(
                 &format!(
-                    "{error} ({} samples computed: the exception's `trajectory`)",
+                    "{error} ({} samples computed: the exception's `trajectory`{files})",
                     buffer.t.len()
                 ),
                 &partial,
@@ -452,6 +507,9 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
     }
     let d = trajectory(py, built, &buffer, &outcome)?;
     d.set_item("model_extrapolated", extrapolated)?;
+    if let Some(dir) = &written {
+        d.set_item("out", dir)?;
+    }
     if let Some(e) = &outcome.energy {
         let b = PyDict::new(py);
         b.set_item("initial", e.initial)?;
@@ -506,4 +564,20 @@ fn trajectory<'py>(
     d.set_item("failed_steps", s.stats.failed_steps)?;
     d.set_item("wall_time_s", s.wall_time_s)?;
     Ok(d)
+}
+
+/// How a run of `robot` was made, for `meta.json` (`provenance`, as `gvsrom simulate` records
+/// it): the scenario as the robot read it (preset or file, overrides, the resolved TOML) and the
+/// reduced model it runs, by its manifest's hashes.
+fn provenance(robot: &Robot, built: &gvsrom::Built) -> PyResult<gvsrom::provenance::Provenance> {
+    let s = &robot.scenario;
+    let toml = s
+        .scenario
+        .to_toml()
+        .map_err(|e| crate::errors::any(e.into()))?;
+    let p = s.src.provenance(&s.overrides, toml);
+    Ok(match &built.reduced {
+        Some(r) => p.model(&r.origin),
+        None => p,
+    })
 }

@@ -66,6 +66,10 @@ pub fn names() -> String {
         .join(", ")
 }
 
+/// [`Source::origin`] of a scenario given as text, not read from a file (Python's
+/// `Scenario.from_toml(text)`): provenance records it as `"text"` (the resolved TOML holds it).
+pub const TEXT_ORIGIN: &str = "<string>";
+
 /// Where a scenario's text came from.
 #[derive(Debug, Clone)]
 pub struct Source {
@@ -81,10 +85,16 @@ pub struct Source {
 impl Source {
     /// Where the text came from, as provenance records it (with its SHA-256).
     pub fn origin_record(&self) -> ScenarioOrigin {
+        let text = !self.preset && self.origin == TEXT_ORIGIN;
         ScenarioOrigin {
-            source: if self.preset { "preset" } else { "file" }.into(),
+            source: match (self.preset, text) {
+                (true, _) => "preset",
+                (false, true) => "text",
+                (false, false) => "file",
+            }
+            .into(),
             name: self.preset.then(|| self.default_name.clone()),
-            path: (!self.preset).then(|| self.origin.clone()),
+            path: (!self.preset && !text).then(|| self.origin.clone()),
             sha256: sha256_hex(self.text.as_bytes()),
         }
     }

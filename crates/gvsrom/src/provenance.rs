@@ -7,7 +7,7 @@
 //! | `command` | the command line (argv, lossily UTF-8) |
 //! | `cwd` | the working directory it ran in, against which the relative paths of `command` and of the input directories below resolve |
 //! | `started` | wall-clock start, UTC, RFC 3339 (`2025-06-01T12:34:56Z`) |
-//! | `scenario` | where the scenario came from: `{"source": "preset", "name": …}` or `{"source": "file", "path": …}`, with the SHA-256 of its text (`sha256`) |
+//! | `scenario` | where the scenario came from: `{"source": "preset", "name": …}`, `{"source": "file", "path": …}` or `{"source": "text"}` (Python's `Scenario.from_toml(text)`), with the SHA-256 of its text (`sha256`) |
 //! | `overrides` | every `--set PATH=VALUE`, in order |
 //! | `scenario_toml` | the scenario as run (after `--set`, `--tension`, `--centerline-points`): `gvsrom statics FILE` on this text alone solves the same problem |
 //! | `seeds` | every seed, by what it seeds (`{"input": 1}`, `{"plan": 0}`, `{"training": 0}`) |
@@ -82,7 +82,7 @@ pub struct Sampling {
 /// Where a scenario's text came from.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ScenarioOrigin {
-    /// `"preset"` or `"file"`.
+    /// `"preset"`, `"file"`, or `"text"` (given as text in Python: `scenario_toml` holds it).
     pub source: String,
     /// The preset's name.
     #[serde(default, skip_serializing_if = "Option::is_none")]

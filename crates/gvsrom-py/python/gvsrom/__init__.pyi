@@ -428,4 +428,6 @@ class Robot:
         fd_jacobian: bool = False,
         controller: Callable[[float, _F, _F], ArrayLike | float] | None = None,
         control_rate: float | None = None,
+        out: _Path | None = None,
+        force: bool = False,
     ) -> dict[str, Any]: ...

@@ -52,6 +52,13 @@ pub enum InputSource {
     },
     /// A function of time ([`InputFunction`]).
     Function(InputFunction),
+    /// A sampled-data controller called `control_rate` times a second with the state, its
+    /// tensions held between calls (a [`gvs::feedback::SampledFeedback`] as the function, at the
+    /// instants of [`super::control_instants`]).
+    Feedback {
+        function: InputFunction,
+        control_rate: f64,
+    },
 }
 
 impl InputSource {
@@ -98,6 +105,9 @@ impl InputSource {
             ),
             InputSource::Rows(s) => format!("u(t) from {} rows", s.times.len()),
             InputSource::Function(_) => "u(t) from a function".into(),
+            InputSource::Feedback { control_rate, .. } => {
+                format!("u from a controller called at {} Hz", g(*control_rate))
+            }
         })
     }
 
@@ -214,7 +224,8 @@ pub(super) fn positive(field: &str, v: f64, unit: &str) -> Result<f64, ScenarioE
     }
 }
 
-/// Builds the actuation signal of a run. A function input ([`InputSource::Function`]) has none: the
+/// Builds the actuation signal of a run. A function input ([`InputSource::Function`], a
+/// controller) has none: the
 /// scenario's constant tensions stand for it in the checks before the run.
 pub fn input_signal(built: &Built, opts: &SimulateOptions) -> Result<Signal, ScenarioError> {
     let na = built.model.n_actuators();
@@ -281,7 +292,7 @@ pub fn input_signal(built: &Built, opts: &SimulateOptions) -> Result<Signal, Sce
             }
             babble(na, *lo, *hi, *hold_min, *hold_max, d, *seed)
         }
-        InputSource::Function(_) => Signal::constant(&built.u),
+        InputSource::Function(_) | InputSource::Feedback { .. } => Signal::constant(&built.u),
     })
 }
 
@@ -379,6 +390,9 @@ pub fn input_record(
             "seed": seed,
         }),
         InputSource::Function(_) => json!({"signal": "function"}),
+        InputSource::Feedback { control_rate, .. } => {
+            json!({"signal": "controller", "control_rate": control_rate})
+        }
     };
     match &opts.start {
         Start::Rest => signal["start"] = json!("rest"),

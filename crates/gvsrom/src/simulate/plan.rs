@@ -182,7 +182,12 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
     // a reduced model answers only for tensions it was trained on: the signal's, at its knots
     // (where a held or linear signal takes its extremes) and at both ends of the run
     let mut model_extrapolated = match (&built.reduced, &opts.input) {
-        (Some(r), input) if !matches!(input, InputSource::Constant | InputSource::Function(_)) => {
+        (Some(r), input)
+            if !matches!(
+                input,
+                InputSource::Constant | InputSource::Function(_) | InputSource::Feedback { .. }
+            ) =>
+        {
             let end = t_out.last().copied().unwrap_or(0.0);
             let mut times: Vec<f64> = signal
                 .times
@@ -273,7 +278,9 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
             InputSource::Steps { .. } => "--steps",
             InputSource::Babble { .. } => "--babble",
             InputSource::Rows(_) => "input",
-            InputSource::Constant | InputSource::Function(_) => return e,
+            InputSource::Constant | InputSource::Function(_) | InputSource::Feedback { .. } => {
+                return e
+            }
         };
         let largest = (signal.times.iter().zip(&signal.values))
             .flat_map(|(t, v)| v.iter().enumerate().map(move |(k, u)| (*t, k, *u)))
@@ -321,7 +328,7 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
         input,
         model_extrapolated,
         function: match &opts.input {
-            InputSource::Function(f) => Some(f.clone()),
+            InputSource::Function(f) | InputSource::Feedback { function: f, .. } => Some(f.clone()),
             _ => None,
         },
     })

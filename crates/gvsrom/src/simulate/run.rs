@@ -102,6 +102,14 @@ pub trait SampleSink {
     fn push(&mut self, built: &Built, s: &Sample<'_>) -> std::io::Result<()>;
 }
 
+/// Both sinks, the first first (a run kept in memory and written to a directory).
+impl<A: SampleSink + ?Sized, B: SampleSink + ?Sized> SampleSink for (&mut A, &mut B) {
+    fn push(&mut self, built: &Built, s: &Sample<'_>) -> std::io::Result<()> {
+        self.0.push(built, s)?;
+        self.1.push(built, s)
+    }
+}
+
 /// Refuses to start a reduced model's dynamics where its mass matrix `M = Ψ_qᵀ … Ψ_q` is not
 /// positive definite: its coordinates degenerate there (a scaled decoder's rest `z₁ = 0` decodes
 /// every `z₂` to the straight rod, so `∂ξ/∂z₂ = 0`) and no integrator can take a step. Checked at

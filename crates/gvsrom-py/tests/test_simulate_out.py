@@ -1,0 +1,93 @@
+"""simulate(out=…): the trajectory written as `gvsrom simulate --out` writes it (the same arrays,
+byte for byte), recording how the run was made, ready for `plot`; written even when the run ends
+early; the output rules of the command line (no overwrite without force, never a foreign path)."""
+
+import json
+
+import numpy as np
+import pytest
+
+import gvsrom
+from conftest import run_cli
+
+ARRAYS = ["t", "q", "qd", "u", "tip_position", "tip_rotation", "strain", "strain_x", "centerline",
+          "tendon_paths", "tendon_lengths"]
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return gvsrom.Scenario.preset("single-tendon").build()
+
+
+def test_the_files_are_the_command_lines_and_plot_draws_them(gvsrom_bin, robot, tmp_path):
+    rows = np.array([[0.0, -2.0], [0.05, -4.0]])
+    csv = tmp_path / "u.csv"
+    csv.write_text("0,-2\n0.05,-4\n")
+    tr = robot.simulate(0.1, sample_rate=100, input=rows, out=tmp_path / "py")
+    assert tr["out"] == tmp_path / "py" or str(tr["out"]) == str(tmp_path / "py")
+    p = run_cli(gvsrom_bin, "simulate", "single-tendon", "--duration", "0.1", "--input", str(csv),
+                "--out", str(tmp_path / "cli"))
+    assert p.returncode == 0, p.stderr
+    for name in ARRAYS:
+        a, b = (tmp_path / d / f"{name}.npy" for d in ("py", "cli"))
+        assert a.read_bytes() == b.read_bytes(), name
+        np.testing.assert_array_equal(np.load(a), np.load(b))
+    np.testing.assert_array_equal(np.load(tmp_path / "py" / "q.npy"), tr["q"])
+    meta = json.loads((tmp_path / "py" / "meta.json").read_text())
+    assert meta["complete"] is True and meta["sample_rate"] == 100
+    prov = meta["provenance"]
+    assert prov["scenario"]["source"] == "preset" and prov["scenario"]["name"] == "single-tendon"
+    assert prov["input"]["signal"] == "rows" and prov["integrator"]["method"]
+    figures = gvsrom.plot(tmp_path / "py", tmp_path / "figs")
+    assert figures["figures"], figures
+
+
+def test_a_controllers_run_records_its_rate_and_a_run_ended_early_is_written(robot, tmp_path):
+    robot.simulate(0.1, sample_rate=100, controller=lambda t, q, qd: -2.0, control_rate=50,
+                   out=tmp_path / "ctrl")
+    meta = json.loads((tmp_path / "ctrl" / "meta.json").read_text())
+    assert meta["provenance"]["input"]["signal"] == "controller"
+    assert meta["provenance"]["input"]["control_rate"] == 50
+
+    class Stop(Exception):
+        pass
+
+    def gives_up(t, q, qd):
+        if t > 0.05:
+            raise Stop("controller gave up")
+        return -2.0
+
+    with pytest.raises(Stop):
+        robot.simulate(0.1, sample_rate=100, controller=gives_up, out=tmp_path / "partial")
+    meta = json.loads((tmp_path / "partial" / "meta.json").read_text())
+    assert meta["complete"] is False, meta
+    assert meta["t_reached"] == 0.05 and "integration stopped at t = 0.06: the controller raised" in \
+        meta["error"] and meta["error"].endswith("Stop: controller gave up"), meta
+    t = np.load(tmp_path / "partial" / "t.npy")
+    np.testing.assert_allclose(t, np.arange(6) / 100, rtol=0, atol=1e-15)
+
+
+def test_the_output_rules_of_the_command_line(robot, tmp_path):
+    d = tmp_path / "run"
+    robot.simulate(0.02, out=d)
+    with pytest.raises(gvsrom.GvsromError,
+                       match=r"^out `.*`: exists \(a gvsrom trajectory output\); pass force=True"):
+        robot.simulate(0.02, out=d)
+    robot.simulate(0.02, out=d, force=True)
+    foreign = tmp_path / "mine"
+    foreign.mkdir()
+    (foreign / "notes.txt").write_text("keep me")
+    with pytest.raises(gvsrom.GvsromError, match=r"^out `.*`: .*not .*gvsrom"):
+        robot.simulate(0.02, out=foreign, force=True)
+    assert (foreign / "notes.txt").read_text() == "keep me"
+    with pytest.raises(gvsrom.GvsromError, match=r"`force` replaces an earlier output at `out`"):
+        robot.simulate(0.02, force=True)
+
+
+def test_a_scenario_given_as_text_is_recorded_as_text(tmp_path):
+    text = gvsrom.Scenario.preset("single-tendon").to_toml()
+    robot = gvsrom.Scenario.from_toml(text).build()
+    robot.simulate(0.02, out=tmp_path / "run")
+    prov = json.loads((tmp_path / "run" / "meta.json").read_text())["provenance"]
+    assert prov["scenario"]["source"] == "text" and "path" not in prov["scenario"], prov["scenario"]
+    assert prov["scenario_toml"] == gvsrom.Scenario.from_toml(text).to_toml()
