@@ -810,8 +810,9 @@ fn a_negative_number_reaches_its_option_instead_of_reading_as_a_flag() {
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert_eq!(run.status.code(), Some(2), "{stderr}");
     assert!(
-        stderr.contains("invalid value '-1' for '--seed <SEED>'")
-            && !stderr.contains("unexpected argument"),
+        stderr.contains(
+            "invalid value '-1' for '--seed <SEED>': expected a whole number ≥ 0, not a negative one"
+        ) && !stderr.contains("unexpected argument"),
         "{stderr}"
     );
     let out = scratch("negative-samples");
@@ -827,9 +828,38 @@ fn a_negative_number_reaches_its_option_instead_of_reading_as_a_flag() {
     ]);
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(
-        stderr.contains("invalid value '-1' for '--samples <N>'")
-            && !stderr.contains("unexpected argument"),
+        stderr.contains(
+            "invalid value '-1' for '--samples <N>': expected a whole number ≥ 0, not a negative one"
+        ) && !stderr.contains("unexpected argument"),
         "{stderr}"
     );
     assert!(!out.exists());
+}
+
+#[test]
+fn a_count_that_is_no_whole_number_says_what_is_expected() {
+    // clap's own message was "invalid digit found in string" for each of these
+    for (value, says) in [
+        ("2.5", "not a fraction"),
+        ("abc", "expected a whole number ≥ 0"),
+        ("99999999999999999999999", "not one this large"),
+    ] {
+        let run = gvsrom(&[
+            "train",
+            "nowhere",
+            "--out",
+            "nowhere-too",
+            "--epochs",
+            value,
+        ]);
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(2), "{stderr}");
+        assert!(
+            stderr.contains(&format!(
+                "invalid value '{value}' for '--epochs <EPOCHS>': expected a whole number ≥ 0"
+            )) && stderr.contains(says)
+                && !stderr.contains("invalid digit"),
+            "{value}: {stderr}"
+        );
+    }
 }

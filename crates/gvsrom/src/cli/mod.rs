@@ -141,7 +141,7 @@ pub struct ScenarioArgs {
     /// Number of centreline samples, at equally spaced material abscissae X (the arc length of the
     /// undeformed rod; a stretched rod's samples are as far apart as it stretched), in the JSON output and per
     /// sample of a trajectory (`centerline.npy`); overrides `output.centerline_points`, default 21.
-    #[arg(long, value_name = "N")]
+    #[arg(value_parser = whole::<usize>, long, value_name = "N")]
     pub centerline_points: Option<usize>,
 
     /// Use `--model` even where the scenario lies outside what the model was trained on (an input
@@ -180,6 +180,25 @@ pub fn run(cli: Cli, out: &mut impl Write) -> Result<()> {
 /// The scenario of `args` resolved by the library ([`gvsrom::build::resolve`]); its build
 /// warnings ([`gvsrom::build::warnings`]: a tendon whose load the basis cannot hold, a division
 /// the kinematics under-integrate) go to stderr.
+/// A count or a seed on the command line: a whole number (`T`'s range), with a message that says
+/// so for a negative or fractional value or one out of range (clap's own says "invalid digit found
+/// in string" for `-3` and `2.5`).
+fn whole<T: std::str::FromStr<Err = std::num::ParseIntError>>(
+    s: &str,
+) -> std::result::Result<T, String> {
+    use std::num::IntErrorKind;
+    s.trim().parse::<T>().map_err(|e| {
+        let accepted = match e.kind() {
+            _ if s.trim().starts_with('-') => "expected a whole number ≥ 0, not a negative one",
+            IntErrorKind::Empty => "expected a whole number ≥ 0, got nothing",
+            IntErrorKind::PosOverflow => "expected a whole number ≥ 0, not one this large",
+            _ if s.trim().parse::<f64>().is_ok() => "expected a whole number ≥ 0, not a fraction",
+            _ => "expected a whole number ≥ 0",
+        };
+        accepted.to_string()
+    })
+}
+
 fn load(args: &ScenarioArgs) -> Result<Resolved> {
     let r = resolve(&Request {
         source: &args.scenario,

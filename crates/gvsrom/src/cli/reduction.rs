@@ -10,7 +10,7 @@ pub struct PodArgs {
     #[arg(value_name = "DATASET", required = true)]
     pub datasets: Vec<PathBuf>,
     /// Number of POD modes kept (reduced coordinates).
-    #[arg(long, value_name = "K")]
+    #[arg(value_parser = super::whole::<usize>, long, value_name = "K")]
     pub modes: usize,
     /// The norm the modes are optimal in: `plain` (every strain value weighs 1: the paper's POD) or
     /// `energy` (each value weighted by the section stiffness, as `train --loss energy`: stiff
@@ -49,17 +49,17 @@ pub struct TrainArgs {
     #[arg(long, value_name = "MODEL")]
     pub init: Option<PathBuf>,
     /// Latent size r (reduced coordinates) [default: 1; with `--init`, the model's].
-    #[arg(long, value_name = "R")]
+    #[arg(value_parser = super::whole::<usize>, long, value_name = "R")]
     pub latent: Option<usize>,
     /// Hidden layers of the whole autoencoder (odd: 1, 3, 5, 7…, at most 63); layer sizes halve from the snapshot
     /// size towards the latent size (paper Section III) [default: 7; with `--init`, the model's].
-    #[arg(long, value_name = "N")]
+    #[arg(value_parser = super::whole::<usize>, long, value_name = "N")]
     pub hidden_layers: Option<usize>,
     /// Maximum Adam epochs.
-    #[arg(long, default_value_t = reduce::TrainRequest::DEFAULT.epochs)]
+    #[arg(value_parser = super::whole::<usize>, long, default_value_t = reduce::TrainRequest::DEFAULT.epochs)]
     pub epochs: usize,
     /// Mini-batch size.
-    #[arg(long, default_value_t = reduce::TrainRequest::DEFAULT.batch_size)]
+    #[arg(value_parser = super::whole::<usize>, long, default_value_t = reduce::TrainRequest::DEFAULT.batch_size)]
     pub batch_size: usize,
     /// Adam learning rate, in (0, 1].
     #[arg(long, default_value_t = reduce::TrainRequest::DEFAULT.learning_rate)]
@@ -72,11 +72,11 @@ pub struct TrainArgs {
     #[arg(long, value_name = "F")]
     pub validation_fraction: Option<f64>,
     /// Epochs without a better validation loss before stopping (0: never stop early).
-    #[arg(long, default_value_t = reduce::TrainRequest::DEFAULT.patience)]
+    #[arg(value_parser = super::whole::<usize>, long, default_value_t = reduce::TrainRequest::DEFAULT.patience)]
     pub patience: usize,
     /// Learning-rate reductions (× 0.3 each, from the best weights so far) at validation plateaus of
     /// `--patience` epochs before Adam stops.
-    #[arg(long, default_value_t = reduce::TrainRequest::DEFAULT.lr_reductions)]
+    #[arg(value_parser = super::whole::<usize>, long, default_value_t = reduce::TrainRequest::DEFAULT.lr_reductions)]
     pub lr_reductions: usize,
     /// An exponential decay of the Adam rate to this factor of it over `--epochs` (epoch e of E at
     /// rate × F^(e/E)), in (0, 1]; with `--patience 0 --lbfgs-iterations 0` it is the JAX reference
@@ -84,11 +84,11 @@ pub struct TrainArgs {
     #[arg(long, value_name = "F")]
     pub lr_decay: Option<f64>,
     /// Iterations of the full-batch L-BFGS phase that follows Adam from its best weights (0: none).
-    #[arg(long, default_value_t = reduce::TrainRequest::DEFAULT.lbfgs_iterations)]
+    #[arg(value_parser = super::whole::<usize>, long, default_value_t = reduce::TrainRequest::DEFAULT.lbfgs_iterations)]
     pub lbfgs_iterations: usize,
     /// Seed of the initialization, the split and the shuffles (same seed, same model) [default: 0;
     /// with `--init`, the model's, so that a continuation holds out the same rows].
-    #[arg(long, value_name = "SEED")]
+    #[arg(value_parser = super::whole::<u64>, long, value_name = "SEED")]
     pub seed: Option<u64>,
     /// How each strain value's error weighs in the loss: `standardized` (each point and component
     /// by its own spread), `physical` (plain squared error, the RMSE of Table I) or `energy`

@@ -16,7 +16,7 @@ pub struct ReproduceArgs {
     #[arg(long, value_name = "DIR", default_value = "results")]
     pub out: PathBuf,
     /// Worker threads (default: one per core).
-    #[arg(long, value_name = "N")]
+    #[arg(value_parser = super::whole::<usize>, long, value_name = "N")]
     pub jobs: Option<usize>,
     /// Testing aid: the smallest sizes that still run every step (implies --quick).
     #[arg(long, hide = true)]
@@ -97,20 +97,20 @@ pub struct DatasetArgs {
     pub random: Vec<String>,
 
     /// Number of samples.
-    #[arg(long, value_name = "N")]
+    #[arg(value_parser = super::whole::<usize>, long, value_name = "N")]
     pub samples: Option<usize>,
 
     /// Seed of `--random`, `--steps` and `--babble` (same seed, same dataset) [default: 0].
-    #[arg(long, requires = "seeded")]
+    #[arg(value_parser = super::whole::<u64>, long, requires = "seeded")]
     pub seed: Option<u64>,
 
     /// Samples per chunk: the unit of parallel work, of warm-start chains and of resuming. Part of
     /// the plan (a different chunk size gives slightly different last digits).
-    #[arg(long, value_name = "N", default_value_t = gvsrom::dataset::DEFAULT_CHUNK_SIZE, conflicts_with = "duration")]
+    #[arg(value_parser = super::whole::<usize>, long, value_name = "N", default_value_t = gvsrom::dataset::DEFAULT_CHUNK_SIZE, conflicts_with = "duration")]
     pub chunk_size: usize,
 
     /// Worker threads (default: one per core). The files do not depend on it.
-    #[arg(long, value_name = "N")]
+    #[arg(value_parser = super::whole::<usize>, long, value_name = "N")]
     pub threads: Option<usize>,
 
     /// Write the dataset into the new directory DIR.
@@ -182,7 +182,7 @@ pub struct DatasetArgs {
     pub atol: f64,
 
     /// Testing aid: stop (as if interrupted) once N chunks have been started.
-    #[arg(long, value_name = "N", hide = true)]
+    #[arg(value_parser = super::whole::<usize>, long, value_name = "N", hide = true)]
     pub stop_after_chunks: Option<usize>,
 }
 

@@ -52,7 +52,7 @@ pub struct SimulateArgs {
     pub babble: Option<Vec<f64>>,
 
     /// Seed of the random inputs `--steps` and `--babble` (same seed, same signal).
-    #[arg(long, default_value_t = 1, requires = "random_input")]
+    #[arg(value_parser = super::whole::<u64>, long, default_value_t = 1, requires = "random_input")]
     pub seed: u64,
 
     /// Start at the static equilibrium under the scenario's tensions and loads, then switch to the
@@ -86,7 +86,7 @@ pub struct SimulateArgs {
 
     /// Highest order of the NDF, 1–5 (orders ≤ 2 are A-stable). Default: 5, or 2 for a lightly
     /// damped rod (its stiffest mode underdamped), which also gets `--error-norm mass`.
-    #[arg(long)]
+    #[arg(value_parser = super::whole::<usize>, long)]
     pub max_order: Option<usize>,
 
     /// Error test of the adaptive methods: `componentwise` (ode15s) or `mass` (positions and
