@@ -3,15 +3,18 @@
 //! robot.
 //!
 //! ```text
-//!   u(t) = law(t_k, q(t_k), q̇(t_k))   for t ∈ [t_k, t_{k+1}),   t_0 < t_1 < … the control instants
+//!   u(t) = u_k = law(t_k, q(t_k), q̇(t_k); u_{k−1})   for t ∈ [t_k, t_{k+1}),   t_0 < t_1 < …
 //! ```
+//!
+//! with `t_0` the run's start (`u_{−1} = 0`: the law finds the last value it returned, e.g. to
+//! integrate an error). At a last output sample that is an instant the law is called too; that
+//! value is recorded with the sample but drives no step.
 //!
 //! The instants are breakpoints of the run (the integrator steps onto each and restarts there with
 //! the new value, as it does at a step of a held signal) and output samples of it: the dynamics
 //! driver hands the state of every output sample to [`Actuation::observe`] before it reads `u`
 //! there, and at a control instant the law is called. A closed loop is therefore one integration,
-//! not one per control period: the iteration matrix of the fixed-step method, for one, is kept
-//! across periods.
+//! not one per control period: the fixed-step method, for one, keeps its Jacobian across periods.
 
 use crate::error::ModelError;
 use crate::inputs::Actuation;
@@ -130,14 +133,25 @@ impl<L: FeedbackLaw> Actuation for SampledFeedback<L> {
     }
 
     /// At a control instant, calls the law with the state and holds what it returns; a sample past
-    /// an instant that was never a sample is an error (the law would have been skipped).
+    /// an instant that was never a sample is an error (the law would have been skipped), and so is
+    /// a first sample before the first instant (nothing would be held). The first instant seen
+    /// again starts over (another run of the same plan: the law is called afresh, from zeros).
     fn observe(&self, t: f64, q: &[f64], qd: &[f64]) -> Result<(), String> {
         let mut held = self.held.lock().unwrap_or_else(PoisonError::into_inner);
+        if held.next > 0 && self.instants.first() == Some(&t) {
+            held.next = 0;
+            held.u.fill(0.0);
+        }
         let Some(&tk) = self.instants.get(held.next) else {
             return Ok(());
         };
         if t < tk {
-            return Ok(());
+            return match held.next {
+                0 => Err(format!(
+                    "the run starts at t = {t} s, before the first control instant {tk} s: no tension is held until then"
+                )),
+                _ => Ok(()),
+            };
         }
         if t > tk {
             return Err(format!(
@@ -188,6 +202,25 @@ mod tests {
         assert_eq!(u[0], -2.1);
         assert_eq!(f.calls(), 2);
         assert_eq!(f.breakpoints(0.0, 0.2), vec![0.1]);
+    }
+
+    #[test]
+    fn a_second_run_starts_over_and_a_start_before_the_first_instant_is_an_error() {
+        let f = SampledFeedback::new(Law, vec![0.0, 0.1], 1);
+        let mut u = [0.0];
+        f.observe(0.0, &[1.0], &[0.0]).unwrap();
+        f.observe(0.1, &[2.0], &[0.0]).unwrap();
+        assert_eq!(f.calls(), 2);
+        // the same plan run again: the law is called at every instant again
+        f.observe(0.0, &[3.0], &[0.0]).unwrap();
+        f.eval(0.05, &mut u);
+        assert_eq!((f.calls(), u[0]), (1, -3.0));
+        let late = SampledFeedback::new(Law, vec![0.1, 0.2], 1);
+        let e = late.observe(0.0, &[0.0], &[0.0]).unwrap_err();
+        assert!(
+            e.contains("starts at t = 0 s, before the first control instant 0.1 s"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -226,6 +226,13 @@ impl CallableInput {
             .take()
     }
 
+    /// The message of the error the callable raised (or of the bad value it returned), if any:
+    /// the reason a run it stopped records.
+    pub fn error_message(&self) -> Option<String> {
+        let slot = self.error.lock().unwrap_or_else(PoisonError::into_inner);
+        slot.as_ref().map(|e| e.to_string())
+    }
+
     /// Whether the callable raised (or returned a bad value).
     pub fn failed(&self) -> bool {
         self.error

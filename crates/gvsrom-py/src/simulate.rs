@@ -6,11 +6,10 @@ use crate::arrays::{self, shaped, vector};
 use crate::callable::{CallableInput, Kind};
 use crate::errors::{invalid, scenario as err};
 use crate::robot::{warn, Robot};
-use gvs::feedback::SampledFeedback;
 use gvs::inputs::{Interpolation, Signal};
 use gvsrom::simulate::{
-    self, Ending, ErrorNormChoice, InputFunction, InputSource, IntegratorChoice, MethodChoice,
-    SampleSink, TrajectoryBuffer, TrajectoryWriter,
+    self, ControlLaw, Ending, ErrorNormChoice, InputFunction, InputSource, IntegratorChoice,
+    MethodChoice, SampleSink, TrajectoryBuffer, TrajectoryWriter,
 };
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -125,9 +124,10 @@ impl Robot {
     ///     of the model that runs, new arrays), its tensions held until the next call (a
     ///     zero-order hold, as a digital controller drives a robot). The closed loop is one
     ///     integration: the integrator restarts at each call as at a step of held rows, and keeps
-    ///     what it can (the fixed step's iteration matrix). Its values are checked as ``input``'s
-    ///     are; an exception it raises stops the run and propagates. Instead of ``input``,
-    ///     ``steps`` and ``babble``.
+    ///     what a restart need not renew (the fixed step's Jacobian). Its values are checked as ``input``'s
+    ///     are; an exception it raises stops the run and propagates. When the last sample falls
+    ///     on a control instant the controller is called there too (its value is the sample's
+    ///     ``u`` but drives no step). Instead of ``input``, ``steps`` and ``babble``.
     /// control_rate : float, optional
     ///     The controller's calls per second [Hz]: ``sample_rate`` (default) or a whole fraction
     ///     of it, so that every call is at an output sample.
@@ -334,15 +334,10 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
         ));
     }
     let input = match (&a.input, &callable) {
-        (None, Some(c)) => {
-            let rate = a.control_rate.unwrap_or(a.sample_rate);
-            let instants =
-                simulate::control_instants(a.duration, a.sample_rate, rate).map_err(err)?;
-            InputSource::Feedback {
-                function: InputFunction(Arc::new(SampledFeedback::new(c.clone(), instants, na))),
-                control_rate: rate,
-            }
-        }
+        (None, Some(c)) => InputSource::Feedback {
+            law: ControlLaw(c.clone()),
+            control_rate: a.control_rate,
+        },
         (None, _) if random => {
             InputSource::from_options(None, false, a.steps.as_deref(), a.babble.as_deref(), a.seed)
                 .map_err(err)?
@@ -434,11 +429,12 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
     let mut signals = crate::interrupt::SignalPoll::new();
     let mut outcome = py.detach(|| {
         let mut control = |_t: f64| {
-            if callable
-                .as_ref()
-                .is_some_and(|c| !c.check_range(built) || c.failed())
-            {
-                return ControlFlow::Break("the callable failed".to_string());
+            if let Some(c) = callable.as_ref() {
+                if !c.check_range(built) || c.failed() {
+                    // the reason a written trajectory records: the callable's error itself
+                    let why = c.error_message();
+                    return ControlFlow::Break(why.unwrap_or_else(|| "the callable failed".into()));
+                }
             }
             match signals.interrupted() {
                 false => ControlFlow::Continue(()),
@@ -464,13 +460,15 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
                 .splice(0..0, from_callable.iter().cloned());
             let dir = w.finish(built, plan, o);
             o.model_extrapolated.drain(0..from_callable.len());
-            Some(dir.map_err(|e| crate::errors::any(e.into()))?)
+            Some(dir)
         }
         _ => None,
     };
+    // the callable's own error first: a failure to write comes after it
     if let Some(e) = callable.as_ref().and_then(|c| c.take_error()) {
         return Err(e);
     }
+    let written = (written.transpose()).map_err(|e| crate::errors::any(e.into()))?;
     for o in from_callable {
         warn(py, &format!("extrapolating (--extrapolate): {o}"))?;
         extrapolated.push(o);

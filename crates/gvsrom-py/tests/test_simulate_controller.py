@@ -45,7 +45,8 @@ def test_the_closed_loop_is_the_run_of_the_held_rows_of_what_it_returned(robot):
 
 def test_the_closed_loop_is_the_loop_of_one_simulate_call_per_period(robot):
     # what a user writes without `controller`: the same restarts at each period, the same numbers
-    # up to roundoff (each call starts from the state the last one delivered)
+    # to the Newton tolerance (each call starts from the state the last one delivered and renews
+    # the Jacobian, which one run keeps)
     h = 0.02
     tr = robot.simulate(0.2, sample_rate=1 / h, controller=pd([]), fixed_step=2e-3)
     n = robot.n_dof

@@ -91,3 +91,11 @@ def test_a_scenario_given_as_text_is_recorded_as_text(tmp_path):
     prov = json.loads((tmp_path / "run" / "meta.json").read_text())["provenance"]
     assert prov["scenario"]["source"] == "text" and "path" not in prov["scenario"], prov["scenario"]
     assert prov["scenario_toml"] == gvsrom.Scenario.from_toml(text).to_toml()
+
+
+def test_a_refused_controller_value_is_the_recorded_reason(robot, tmp_path):
+    with pytest.raises(gvsrom.GvsromError, match=r"`controller\(0, q, qd\)`.*tendons\[0\]"):
+        robot.simulate(0.05, sample_rate=100, controller=lambda t, q, qd: -1e9, out=tmp_path / "far")
+    meta = json.loads((tmp_path / "far" / "meta.json").read_text())
+    assert meta["complete"] is False
+    assert "`controller(0, q, qd)`" in meta["reason"] and "tendons[0]" in meta["reason"], meta["reason"]

@@ -1,12 +1,13 @@
-//! A sampled-data controller through the library (`control_instants` and a
-//! `gvs::feedback::SampledFeedback` as the run's function input, Python's `controller=`): its
-//! instants, and an integral controller on the tip height of the IV-A arm, which must settle where
-//! the statics put the tip under the tension it settles at.
+//! A sampled-data controller through the library (`InputSource::Feedback`, Python's
+//! `controller=`, run at `control_instants`): its instants, and an integral controller on the tip
+//! height of the IV-A arm, which must settle where the statics put the tip under the tension it
+//! settles at.
 
-use gvs::feedback::{FeedbackLaw, SampledFeedback};
+use gvs::feedback::FeedbackLaw;
 use gvs::solve::statics::{solve_statics, StaticsOptions};
-use gvsrom::simulate::{self, control_instants, InputFunction, InputSource, IntegratorChoice};
+use gvsrom::simulate::{self, control_instants, ControlLaw, InputSource, IntegratorChoice};
 use nalgebra::DVector;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
 mod common;
@@ -38,6 +39,7 @@ struct Integral {
     ws: Mutex<gvs::model::Workspace>,
     z_target: f64,
     gain: f64,
+    calls: AtomicUsize,
 }
 
 impl FeedbackLaw for Integral {
@@ -47,6 +49,7 @@ impl FeedbackLaw for Integral {
         model.forward(&DVector::from_column_slice(q), &mut ws, false);
         let z = ws.g.last().unwrap().pos[2];
         u[0] += self.gain * (z - self.z_target);
+        self.calls.fetch_add(1, Ordering::Relaxed);
         Ok(())
     }
 }
@@ -58,23 +61,23 @@ fn an_integral_controller_settles_the_tip_where_the_statics_put_it_under_the_set
     let ws = Mutex::new(law_built.model.workspace());
     let z_target = -0.02;
     let (duration, sample_rate, control_rate) = (6.0, 100.0, 20.0);
-    let feedback = Arc::new(SampledFeedback::new(
-        Integral {
-            built: law_built,
-            ws,
-            z_target,
-            // the arm's static gain is about −0.05 m/N: a tenth of the error per period
-            gain: 2.0,
-        },
-        control_instants(duration, sample_rate, control_rate).unwrap(),
-        1,
-    ));
+    let law = Arc::new(Integral {
+        built: law_built,
+        ws,
+        z_target,
+        // the arm's static gain is about −0.05 m/N: a tenth of the error per period
+        gain: 2.0,
+        calls: AtomicUsize::new(0),
+    });
     let b = common::run_to_buffer(
         &built,
         simulate::Request {
             duration,
             sample_rate,
-            input: InputSource::Function(InputFunction(feedback.clone())),
+            input: InputSource::Feedback {
+                law: ControlLaw(law.clone()),
+                control_rate: Some(control_rate),
+            },
             start: simulate::Start::Rest,
             load_schedule: None,
             integrator: IntegratorChoice {
@@ -83,7 +86,8 @@ fn an_integral_controller_settles_the_tip_where_the_statics_put_it_under_the_set
             },
         },
     );
-    assert_eq!(feedback.calls(), 121);
+    // at 0, 0.05, … 6 s
+    assert_eq!(law.calls.load(Ordering::Relaxed), 121);
     let k = b.t.len();
     let z: Vec<f64> = (0..k).map(|i| b.tip_position[3 * i + 2]).collect();
     let u_end = b.u[k - 1];

@@ -4,20 +4,34 @@
 
 use crate::build::Built;
 use crate::error::ScenarioError;
+use gvs::feedback::FeedbackLaw;
 use gvs::inputs::{babble, random_steps, Actuation, Interpolation, Signal};
 use gvs::solve::dynamics::IntegratorOptions;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 /// An actuation given as a function of time (Python's `input=` callable): the integrator evaluates
-/// it wherever it needs `u(t)`, in any order; it checks its own values (count, finiteness) and has
-/// no breakpoints. Nothing about it is checked before the run (its extremes are unknown).
+/// it wherever it needs `u(t)`, in any order, and steps onto its breakpoints, if it has any; it
+/// checks its own values (count, finiteness). Nothing about it is checked before the run (its
+/// extremes are unknown).
 #[derive(Clone)]
 pub struct InputFunction(pub Arc<dyn Actuation + Send + Sync>);
 
 impl std::fmt::Debug for InputFunction {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str("InputFunction(..)")
+    }
+}
+
+/// A control law (Python's `controller=` callable), run by the plan as a sampled-data controller
+/// ([`gvs::feedback::SampledFeedback`] at [`super::control_instants`]). As for an
+/// [`InputFunction`], its values are its own to check.
+#[derive(Clone)]
+pub struct ControlLaw(pub Arc<dyn FeedbackLaw + Send + Sync>);
+
+impl std::fmt::Debug for ControlLaw {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("ControlLaw(..)")
     }
 }
 
@@ -52,12 +66,12 @@ pub enum InputSource {
     },
     /// A function of time ([`InputFunction`]).
     Function(InputFunction),
-    /// A sampled-data controller called `control_rate` times a second with the state, its
-    /// tensions held between calls (a [`gvs::feedback::SampledFeedback`] as the function, at the
-    /// instants of [`super::control_instants`]).
+    /// A sampled-data controller called `control_rate` times a second (default: at every
+    /// sample) with the state, its tensions held between calls: the plan runs it as a
+    /// [`gvs::feedback::SampledFeedback`] at the instants of [`super::control_instants`].
     Feedback {
-        function: InputFunction,
-        control_rate: f64,
+        law: ControlLaw,
+        control_rate: Option<f64>,
     },
 }
 
@@ -105,9 +119,10 @@ impl InputSource {
             ),
             InputSource::Rows(s) => format!("u(t) from {} rows", s.times.len()),
             InputSource::Function(_) => "u(t) from a function".into(),
-            InputSource::Feedback { control_rate, .. } => {
-                format!("u from a controller called at {} Hz", g(*control_rate))
-            }
+            InputSource::Feedback { control_rate, .. } => match control_rate {
+                Some(r) => format!("u from a controller called at {} Hz", g(*r)),
+                None => "u from a controller called at every sample".into(),
+            },
         })
     }
 
@@ -390,9 +405,10 @@ pub fn input_record(
             "seed": seed,
         }),
         InputSource::Function(_) => json!({"signal": "function"}),
-        InputSource::Feedback { control_rate, .. } => {
-            json!({"signal": "controller", "control_rate": control_rate})
-        }
+        InputSource::Feedback { control_rate, .. } => json!({
+            "signal": "controller",
+            "control_rate": control_rate.unwrap_or(opts.sample_rate),
+        }),
     };
     match &opts.start {
         Start::Rest => signal["start"] = json!("rest"),

@@ -5,10 +5,12 @@ use super::integrator::{choose_integrator, integrator_record, IntegratorChoice};
 use super::options::*;
 use crate::build::Built;
 use crate::error::ScenarioError;
+use gvs::feedback::SampledFeedback;
 use gvs::inputs::{Actuation, Interpolation, Signal};
 use gvs::solve::dynamics::{InitialState, Method};
 use nalgebra::DVector;
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// Most output samples of one run.
 pub const MAX_SAMPLES: usize = 10_000_000;
@@ -133,6 +135,21 @@ const MAX_SIGNAL_CHECKS: usize = 100_000;
 /// Validates `opts` against `built` and builds the [`Plan`] of the run.
 pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError> {
     let t_out = sample_times(opts.duration, opts.sample_rate)?;
+    // a controller's instants are output samples (checked before anything is computed)
+    let function = match &opts.input {
+        InputSource::Function(f) => Some(f.clone()),
+        InputSource::Feedback { law, control_rate } => {
+            let rate = control_rate.unwrap_or(opts.sample_rate);
+            let instants = control_instants(opts.duration, opts.sample_rate, rate)?;
+            let na = built.model.n_actuators();
+            Some(InputFunction(Arc::new(SampledFeedback::new(
+                law.0.clone(),
+                instants,
+                na,
+            ))))
+        }
+        _ => None,
+    };
     if let Method::Fixed(f) = &opts.integrator.method {
         let h = positive("--fixed-step", f.h, "s")?;
         if h > opts.duration {
@@ -327,10 +344,7 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
         sample_rate: opts.sample_rate,
         input,
         model_extrapolated,
-        function: match &opts.input {
-            InputSource::Function(f) | InputSource::Feedback { function: f, .. } => Some(f.clone()),
-            _ => None,
-        },
+        function,
     })
 }
 
