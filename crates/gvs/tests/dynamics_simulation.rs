@@ -6,7 +6,6 @@
 mod common;
 
 use common::clamped_rod_10_5;
-use gvs::actuation::{Tendon, DEFAULT_FRICTION_SMOOTHING};
 use gvs::discretize::{Discretization, MagnusOrder, Quadrature};
 use gvs::inputs::Signal;
 use gvs::loads::Loads;
@@ -17,33 +16,12 @@ use gvs::solve::dynamics::{
 };
 use gvs::solve::ode::{FixedStepOptions, NdfOptions};
 use gvs::solve::statics::{solve_statics, StaticsOptions};
-use gvs::strain::{DivisionBasis, LinearBasis, SigmoidBend, StrainParam};
+use gvs::strain::{LinearBasis, SigmoidBend, StrainParam};
 use nalgebra::DVector;
 use std::f64::consts::PI;
 
 fn arm(damping: f64, friction: f64) -> Model<LinearBasis> {
-    let rod = common::iva_rod(damping);
-    let disc =
-        Discretization::new(&rod, &[Quadrature::Gauss { n: 12 }], MagnusOrder::Z4, &[]).unwrap();
-    let b = LinearBasis::per_division(
-        &disc,
-        &[DivisionBasis::Legendre {
-            modes: [false, true, false, true, false, true],
-            orders: [0, 4, 0, 2, 0, 2],
-        }],
-    )
-    .unwrap();
-    let t = Tendon {
-        offset_start: [0.0, 0.01],
-        offset_end: [0.0, 0.003],
-        x_start: 0.0,
-        x_end: 0.25,
-        friction,
-        friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
-        turns: 0.0,
-        path: Vec::new(),
-    };
-    Model::new(rod, disc, b, vec![t]).unwrap()
+    common::iva_arm(damping, friction)
 }
 
 fn gravity() -> Loads {

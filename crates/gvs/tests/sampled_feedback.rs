@@ -5,8 +5,6 @@
 
 mod common;
 
-use gvs::actuation::{Tendon, DEFAULT_FRICTION_SMOOTHING};
-use gvs::discretize::{Discretization, MagnusOrder, Quadrature};
 use gvs::feedback::{FeedbackLaw, SampledFeedback};
 use gvs::inputs::{Interpolation, Signal};
 use gvs::loads::Loads;
@@ -18,34 +16,13 @@ use gvs::solve::dynamics::{
 use gvs::solve::ode::{
     FixedStepOptions, GeneralizedAlphaOptions, NdfOptions, OdeError, SdirkOptions,
 };
-use gvs::strain::{DivisionBasis, LinearBasis};
+use gvs::strain::LinearBasis;
 use std::ops::ControlFlow;
 use std::sync::Mutex;
 
-/// The IV-A rod (damped, 12 Gauss points) in the x-z plane with one tendon on its upper side.
+/// The IV-A arm in the x-z plane, damped, its tendon with friction.
 fn arm() -> Model<LinearBasis> {
-    let rod = common::iva_rod(1e4);
-    let disc =
-        Discretization::new(&rod, &[Quadrature::Gauss { n: 12 }], MagnusOrder::Z4, &[]).unwrap();
-    let b = LinearBasis::per_division(
-        &disc,
-        &[DivisionBasis::Legendre {
-            modes: [false, true, false, true, false, true],
-            orders: [0, 4, 0, 2, 0, 2],
-        }],
-    )
-    .unwrap();
-    let t = Tendon {
-        offset_start: [0.0, 0.01],
-        offset_end: [0.0, 0.003],
-        x_start: 0.0,
-        x_end: 0.25,
-        friction: 0.3,
-        friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
-        turns: 0.0,
-        path: Vec::new(),
-    };
-    Model::new(rod, disc, b, vec![t]).unwrap()
+    common::iva_arm(1e4, 0.3)
 }
 
 fn gravity() -> Loads {

@@ -107,3 +107,31 @@ pub fn iva_rod_3d(
     .unwrap();
     Model::new(rod, disc, b, tendons).unwrap()
 }
+
+/// The IV-A arm in the x-z plane ([`iva_rod`] with `damping`, 12 Gauss points, Z4): bending about
+/// y, elongation and shear along z (Legendre orders 4, 2, 2), one tendon on its upper side from
+/// 10 mm to 3 mm off the axis with capstan friction `friction`.
+pub fn iva_arm(damping: f64, friction: f64) -> Model<LinearBasis> {
+    let rod = iva_rod(damping);
+    let disc =
+        Discretization::new(&rod, &[Quadrature::Gauss { n: 12 }], MagnusOrder::Z4, &[]).unwrap();
+    let b = LinearBasis::per_division(
+        &disc,
+        &[DivisionBasis::Legendre {
+            modes: [false, true, false, true, false, true],
+            orders: [0, 4, 0, 2, 0, 2],
+        }],
+    )
+    .unwrap();
+    let t = gvs::actuation::Tendon {
+        offset_start: [0.0, 0.01],
+        offset_end: [0.0, 0.003],
+        x_start: 0.0,
+        x_end: 0.25,
+        friction,
+        friction_smoothing: gvs::actuation::DEFAULT_FRICTION_SMOOTHING,
+        turns: 0.0,
+        path: Vec::new(),
+    };
+    Model::new(rod, disc, b, vec![t]).unwrap()
+}
