@@ -318,12 +318,19 @@ fn trajectory_with_centerlines_gives_tip_strain_rod_figures_and_animation() {
         "tip_path_side",
         "tip_position",
         "strain_time",
+        "tensions",
         "tendon_lengths",
         "rod_3d",
         "rod_side",
     ]);
     expected.push("rod_animation.gif".into());
     check_figures(&dir, &stdout, &refs(&expected));
+    // the random steps every 0.1 s, held between samples
+    let svg = std::fs::read_to_string(dir.join("tensions.svg")).unwrap();
+    assert!(
+        svg.contains("Tendon tensions") && svg.contains("tension u [N]"),
+        "tensions.svg"
+    );
     // the tendon's pull-in from its rest length (`meta.json`), one line per tendon
     let svg = std::fs::read_to_string(dir.join("tendon_lengths.svg")).unwrap();
     assert!(

@@ -342,6 +342,7 @@ mod tests {
             centerline: None,
             tendon_paths: None,
             tendon_lengths: None,
+            tensions: None,
             tendon_rest_lengths: vec![],
             provenance: None,
             extrapolated: vec![],

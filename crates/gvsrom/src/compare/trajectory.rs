@@ -52,6 +52,9 @@ pub struct Trajectory {
     /// `samples × tendons`: each tendon's length \[m\] (`tendon_lengths.npy`; with tendons, in
     /// trajectories written since it was recorded), and the number of tendons.
     pub tendon_lengths: Option<(usize, Vec<f64>)>,
+    /// `samples × tendons`: each tendon's tension \[N\] at the samples (`u.npy`), and the number
+    /// of tendons (`None` without tendons).
+    pub tensions: Option<(usize, Vec<f64>)>,
     /// Each tendon's length at rest \[m\] (`meta.json`'s `tendon_rest_lengths`; empty when not
     /// recorded).
     pub tendon_rest_lengths: Vec<f64>,
@@ -159,6 +162,10 @@ impl Trajectory {
             }
             false => None,
         };
+        let tensions = match (count("n_actuators"), files.lists("u.npy")) {
+            (Ok(na), true) if na > 0 => Some((na, read("u.npy", &[n, na])?)),
+            _ => None,
+        };
         Ok(Trajectory {
             dir: dir.to_path_buf(),
             origin,
@@ -180,6 +187,7 @@ impl Trajectory {
             centerline,
             tendon_paths,
             tendon_lengths,
+            tensions,
             tendon_rest_lengths: (meta["tendon_rest_lengths"].as_array().into_iter().flatten())
                 .filter_map(|v| v.as_f64())
                 .collect(),

@@ -1,6 +1,7 @@
 //! Figures of a `gvsrom simulate --out` trajectory: the tip's path in 3-D (`tip_path_3d`) and in side
 //! views (`tip_path_side`), the tip's coordinates over time (`tip_position`), the strain over time
-//! at a few points along the rod (`strain_time`), how far each tendon is pulled in over time
+//! at a few points along the rod (`strain_time`), the tendons' tensions over time (`tensions`,
+//! from `u.npy`, when they vary), how far each tendon is pulled in over time
 //! (`tendon_lengths`, from `tendon_lengths.npy` and the rest lengths), and, when the trajectory
 //! stores its centrelines
 //! (`centerline.npy`, shape `[samples, N, 3]`, with `centerline_x` in `meta.json`), the rod at a
@@ -95,6 +96,7 @@ pub(crate) fn figures(dir: &Path, sink: &mut Sink) -> Result<(), FiguresError> {
     let centerlines = centerlines(&tr)?;
     tip_figures(&tr, &caption, sink)?;
     strain_time(&tr, &caption, sink)?;
+    tensions(&tr, &caption, sink)?;
     tendon_lengths(&tr, &caption, sink)?;
     match &centerlines {
         Some(c) => rod_figures(&tr, c, &caption, sink)?,
@@ -151,6 +153,51 @@ fn tip_figures(tr: &Trajectory, caption: &str, sink: &mut Sink) -> Result<(), Fi
         panels,
     };
     sink.figure("tip_position", &fig, (1000, 900))
+}
+
+/// `tensions`: each tendon's tension \[N\] at the samples, drawn as held from one sample to the
+/// next (a step of the input, a controller's period) unless the input was interpolated
+/// linearly; nothing without tendons, a note when no tension varies.
+fn tensions(tr: &Trajectory, caption: &str, sink: &mut Sink) -> Result<(), FiguresError> {
+    let Some((na, u)) = &tr.tensions else {
+        return Ok(());
+    };
+    let n = tr.samples();
+    let varies = (0..*na).any(|j| (1..n).any(|k| u[k * na + j] != u[j]));
+    if !varies {
+        sink.note("tensions: constant over the run (not drawn)");
+        return Ok(());
+    }
+    let linear = tr
+        .input
+        .as_ref()
+        .is_some_and(|i| i["interpolation"] == "linear");
+    let series = (0..*na)
+        .map(|j| {
+            let at = |k: usize| u[k * na + j];
+            let (t, y): (Vec<f64>, Vec<f64>) = match linear {
+                true => (tr.t.clone(), (0..n).map(at).collect()),
+                // held: each value runs to the next sample, where the next one starts
+                false => (0..n)
+                    .flat_map(|k| {
+                        let next = tr.t.get(k + 1).copied().unwrap_or(tr.t[k]);
+                        [(tr.t[k], at(k)), (next, at(k))]
+                    })
+                    .unzip(),
+            };
+            Series::new(format!("tendon {}", j + 1), t, y, SeriesStyle::Line)
+                .with_color(palette::EXTRA[j % palette::EXTRA.len()])
+        })
+        .collect();
+    let fig = Figure::Line(LineChart {
+        title: format!("Tendon tensions — {caption}"),
+        x_label: "t [s]".into(),
+        y_label: "tension u [N] (negative pulls)".into(),
+        series,
+        log_y: false,
+        equal_aspect: false,
+    });
+    sink.figure("tensions", &fig, (1000, 600))
 }
 
 /// `tendon_lengths`: each tendon's pull-in `ℓ_rest − ℓ(t)` \[mm\] over time (its length if the
