@@ -96,10 +96,15 @@ impl CallableInput {
         let values = match value.extract::<arrays::Tensions<'_>>() {
             Ok(u) => u.values(),
             Err(_) => {
+                let shape = match value.getattr("shape") {
+                    Ok(sh) => format!(" of shape {}", sh.repr()?),
+                    Err(_) => String::new(),
+                };
                 return Err(invalid(format!(
-                    "{named} returned `{}`: expected {na} tensions [N] (an array, one per tendon, or one number for all)",
-                    value.repr()?
-                )))
+                    "{named} returned `{}`{shape}: expected {na} tension{} [N] (a 1-D array or sequence, one per tendon, or one number for all)",
+                    value.repr()?,
+                    if na == 1 { "" } else { "s" },
+                )));
             }
         };
         let u = gvsrom::scenario::tensions_for(na, &values)
@@ -186,8 +191,14 @@ impl CallableInput {
             }
             Err(e) => {
                 // as for a signal of rows: the message names the tension, its value and time
+                let whose = match self.kind {
+                    Kind::Input => "`input(t)`",
+                    Kind::Controller => "`controller(t, q, qd)`",
+                };
+                let message =
+                    format!("{whose} returned tensions the reduced model was not trained for: {e}");
                 let mut slot = self.error.lock().unwrap_or_else(PoisonError::into_inner);
-                slot.get_or_insert_with(|| invalid(e.to_string()));
+                slot.get_or_insert_with(|| invalid(message));
                 false
             }
         }

@@ -125,7 +125,9 @@ impl Robot {
     ///     zero-order hold, as a digital controller drives a robot). The closed loop is one
     ///     integration: the integrator restarts at each call as at a step of held rows, and keeps
     ///     what a restart need not renew (the fixed step's Jacobian). Its values are checked as ``input``'s
-    ///     are; an exception it raises stops the run and propagates. When the last sample falls
+    ///     are; an exception it raises stops the run and propagates, with the samples computed
+    ///     before as its ``trajectory`` attribute. The tip from ``q``:
+    ///     ``robot.forward(q)["position"][-1]``. When the last sample falls
     ///     on a control instant the controller is called there too (its value is the sample's
     ///     ``u`` but drives no step). Instead of ``input``, ``steps`` and ``babble``.
     /// control_rate : float, optional
@@ -162,8 +164,10 @@ impl Robot {
     /// ------
     /// IntegrationError
     ///     When the integrator failed (a reduced model that left its training region, a step
-    ///     that could not converge): its ``trajectory`` attribute is the dict above for the
-    ///     samples computed before (``energy_balance`` left out).
+    ///     that could not converge), or a callable ``input`` or ``controller`` returned a value
+    ///     refused after the run began: its ``trajectory`` attribute is the dict above for the
+    ///     samples computed before (``energy_balance`` left out). An exception the callable
+    ///     raised propagates as it is, with that dict as its ``trajectory`` attribute.
     /// GvsromError
     ///     For bad options or input.
     #[pyo3(signature = (duration, sample_rate=100.0, input=None, interpolate=false, from_equilibrium=false, q0=None, qd0=None, method="auto", rtol=None, atol=None, fixed_step=None, load_schedule=None, steps=None, babble=None, seed=0, max_order=None, error_norm=None, rho_inf=None, fd_jacobian=false, controller=None, control_rate=None, out=None, force=false))]
@@ -464,15 +468,21 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
         }
         _ => None,
     };
-    // the callable's own error first: a failure to write comes after it
-    if let Some(e) = callable.as_ref().and_then(|c| c.take_error()) {
-        return Err(e);
-    }
-    let written = (written.transpose()).map_err(|e| crate::errors::any(e.into()))?;
     for o in from_callable {
         warn(py, &format!("extrapolating (--extrapolate): {o}"))?;
         extrapolated.push(o);
     }
+    // the callable's own error first, with the samples before it: a failure to write comes after
+    if let Some(e) = callable.as_ref().and_then(|c| c.take_error()) {
+        let dir = written.as_ref().and_then(|w| w.as_ref().ok());
+        let before = match &outcome {
+            // (a failure at the start, with its first sample alone, is raised as it is)
+            Ok(o) if buffer.t.len() > 1 => Some(trajectory(py, built, &buffer, o)?),
+            _ => None,
+        };
+        return Err(with_samples_before(py, e, before, extrapolated, dir)?);
+    }
+    let written = (written.transpose()).map_err(|e| crate::errors::any(e.into()))?;
     if let Some(e) = signals.caught() {
         return Err(e);
     }
@@ -578,4 +588,41 @@ fn provenance(robot: &Robot, built: &gvsrom::Built) -> PyResult<gvsrom::provenan
         Some(r) => p.model(&r.origin),
         None => p,
     })
+}
+
+/// The error a callable raised (or a `GvsromError` for a value it returned) after the run computed
+/// the samples `before`: a `GvsromError` becomes an `IntegrationError` whose `trajectory` is
+/// them (a subclass: `except GvsromError` still catches it); the callable's own exception is
+/// raised as it was, with them as its `trajectory` attribute and a note saying so.
+fn with_samples_before(
+    py: Python<'_>,
+    e: PyErr,
+    before: Option<Bound<'_, PyDict>>,
+    extrapolated: Vec<String>,
+    written: Option<&std::path::PathBuf>,
+) -> PyResult<PyErr> {
+    let Some(partial) = before else {
+        return Ok(e);
+    };
+    partial.set_item("model_extrapolated", extrapolated)?;
+    if let Some(dir) = written {
+        partial.set_item("out", dir)?;
+    }
+    let samples = partial.get_item("t")?.map_or(Ok(0), |t| t.len())?;
+    if e.is_instance_of::<crate::errors::GvsromError>(py) {
+        let message = e.value(py).to_string();
+        return Ok(crate::errors::integration(
+            &format!("{message} ({samples} samples computed before: the exception's `trajectory`)"),
+            &partial,
+        ));
+    }
+    let value = e.value(py);
+    // an exception that takes no attributes keeps none (its message is unchanged either way)
+    if value.setattr("trajectory", &partial).is_ok() {
+        let note = format!(
+            "gvsrom: the run stopped here; its {samples} samples before are this exception's `trajectory`"
+        );
+        let _ = value.call_method1("add_note", (note,));
+    }
+    Ok(e)
 }

@@ -75,7 +75,7 @@ def test_an_exception_in_the_controller_propagates_and_bad_values_are_named(robo
     with pytest.raises(gvsrom.GvsromError,
                        match=r"`controller\(0, q, qd\)` returned u\[0\] = NaN: expected finite"):
         robot.simulate(0.01, controller=lambda t, q, qd: float("nan"))
-    with pytest.raises(gvsrom.GvsromError, match=r"`controller\(0, q, qd\)`: .*2 tensions given for 1"):
+    with pytest.raises(gvsrom.GvsromError, match=r"`controller\(0, q, qd\)`: .*2 tensions given for 1 tendon \("):
         robot.simulate(0.01, controller=lambda t, q, qd: [1.0, 2.0])
     with pytest.raises(gvsrom.GvsromError, match=r"`controller\(0, q, qd\)`.*tendons\[0\]"):
         robot.simulate(0.01, controller=lambda t, q, qd: -1e9)
@@ -95,3 +95,29 @@ def test_bad_arguments_are_clear_errors(robot):
         robot.simulate(0.1, controller=law, steps=[-1.0, 0.0, 0.05])
     with pytest.raises(TypeError, match=r"`controller` must be a callable.*got `3`"):
         robot.simulate(0.1, controller=3)
+
+
+def test_a_run_the_controller_stops_hands_back_the_samples_before(robot):
+    class Stop(Exception):
+        pass
+
+    def gives_up(t, q, qd):
+        if t > 0.025:
+            raise Stop("controller gave up")
+        return -1.0
+
+    with pytest.raises(Stop) as e:
+        robot.simulate(0.05, sample_rate=100, controller=gives_up)
+    np.testing.assert_allclose(e.value.trajectory["t"], [0.0, 0.01, 0.02], rtol=0, atol=1e-15)
+    assert any("its 3 samples before" in n for n in e.value.__notes__)
+    # a refused value after the start: an IntegrationError (a GvsromError) with the samples
+    with pytest.raises(gvsrom.IntegrationError,
+                       match=r"`controller\(0.02, q, qd\)` returned u\[0\] = NaN.*2 samples computed before"
+                       ) as e:
+        robot.simulate(0.05, sample_rate=100,
+                       controller=lambda t, q, qd: float("nan") if t > 0.015 else -1.0)
+    assert e.value.trajectory["q"].shape == (2, robot.n_dof)
+    # a returned array of the wrong shape says its shape
+    with pytest.raises(gvsrom.GvsromError, match=r"returned `array\(\[\[-3.\]\]\)` of shape \(1, 1\): "
+                                                 r"expected 1 tension \[N\] \(a 1-D array"):
+        robot.simulate(0.01, controller=lambda t, q, qd: np.array([[-3.0]]))

@@ -31,8 +31,10 @@ pub fn tensions_for(n: usize, u: &[f64]) -> Result<Vec<f64>, ScenarioError> {
         return Err(ScenarioError::invalid(
             "tendons",
             format!(
-                "{} tensions given for {n} tendons (give 1 value for all, or {n})",
-                u.len()
+                "{} {} given for {n} {} (give 1 value for all, or {n})",
+                u.len(),
+                if u.len() == 1 { "tension" } else { "tensions" },
+                if n == 1 { "tendon" } else { "tendons" },
             ),
         ));
     }

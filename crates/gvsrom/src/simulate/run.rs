@@ -11,6 +11,7 @@ use gvs::solve::dynamics::InitialState;
 use gvs::solve::dynamics::{
     simulate_streaming_interruptible, IntegratorOptions, RunSummary, Sample, SimulationError,
 };
+use gvs::solve::ode::OdeError;
 use gvs::strain::StrainParam;
 use std::ops::ControlFlow;
 
@@ -19,7 +20,8 @@ use std::ops::ControlFlow;
 pub enum Ending {
     /// Every sample up to the requested duration was computed.
     Complete,
-    /// Stopped on request (an interrupt) after the last sample delivered.
+    /// Stopped on request after the last sample delivered: an interrupt, or the actuation itself
+    /// (a controller that raised, `gvs::inputs::Actuation::observe`), with its reason.
     Interrupted { reason: String },
     /// The integrator failed; the samples before the failure were delivered.
     Failed { error: String },
@@ -298,6 +300,10 @@ pub fn run_into(
         (None, _, _) => Ending::Complete,
         (Some(_), Some(error), _) => Ending::Failed { error },
         (Some(_), None, Some(reason)) => Ending::Interrupted { reason },
+        // the actuation stopped the run (a controller's error, `Actuation::observe`): its reason
+        (Some(OdeError::Stopped { reason, .. }), None, None) => Ending::Interrupted {
+            reason: reason.clone(),
+        },
         (Some(e), None, None) => Ending::Failed {
             error: e.to_string(),
         },
