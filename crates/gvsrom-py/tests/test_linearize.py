@@ -302,3 +302,25 @@ def test_tip_orientation_rows_are_the_tip_angular_jacobian_in_world_axes():
         np.testing.assert_allclose(lin["C"][3:, j], dtheta, rtol=0,
                                    atol=1e-6 * np.abs(lin["C"][3:]).max())
     assert robot.linearize()["output_tip_rotation"] is None
+
+
+def test_the_lqr_example_runs_and_prints_its_table(tmp_path):
+    # crates/gvsrom-py/examples/lqr_tip.py, over a tenth of its second (the table's figures are
+    # docs/linearize.md's over the full second)
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    script = Path(__file__).parents[1] / "examples" / "lqr_tip.py"
+    p = subprocess.run([sys.executable, str(script), str(tmp_path / "lqr"), "--duration", "0.1"],
+                       capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    assert "closed-loop spectral radius 0.858 (open loop 0.966)" in p.stdout, p.stdout
+    rows = [line for line in p.stdout.splitlines() if line.startswith("| held") or line.startswith("| lqr")]
+    assert len(rows) == 2, p.stdout
+    for name in ["held", "lqr"]:
+        assert (tmp_path / "lqr" / name / "meta.json").exists()
+        assert (tmp_path / "lqr" / f"{name}-figures" / "tip_position.png").exists()
+    # the LQR's tension varies (drawn), the held one does not (a note instead)
+    assert (tmp_path / "lqr" / "lqr-figures" / "tensions.png").exists()
+    assert not (tmp_path / "lqr" / "held-figures" / "tensions.png").exists()
