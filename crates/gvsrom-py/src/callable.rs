@@ -26,13 +26,29 @@ pub struct CallableInput {
     function: Py<PyAny>,
     kind: Kind,
     n_actuators: usize,
-    error: Mutex<Option<PyErr>>,
+    error: Mutex<Option<Failure>>,
     largest: Mutex<Largest>,
     /// With a reduced model: the values returned since the last check, with their times.
     returned: Option<Mutex<Returned>>,
     /// How the values lay outside the model's training, with `extrapolate` (the first sentence
     /// of each kind is kept).
     extrapolated: Mutex<Vec<String>>,
+}
+
+/// Why a callable stopped its run: an exception it raised (its own, kept as it is), or a value it
+/// returned that was refused (a `GvsromError` naming it).
+pub struct Failure {
+    pub err: PyErr,
+    pub raised: bool,
+}
+
+impl Failure {
+    fn raised(err: PyErr) -> Self {
+        Failure { err, raised: true }
+    }
+    fn refused(err: PyErr) -> Self {
+        Failure { err, raised: false }
+    }
 }
 
 /// What the callable is: the argument it came as, and what it is called with.
@@ -76,6 +92,11 @@ impl CallableInput {
         }
     }
 
+    /// What the callable is.
+    pub fn kind(&self) -> Kind {
+        self.kind
+    }
+
     /// How a call at `t` reads in a message: `input(t)` or `controller(t, q, qd)`.
     fn named(&self, t: f64) -> String {
         match self.kind {
@@ -85,35 +106,42 @@ impl CallableInput {
     }
 
     /// Calls the function at `t` (with the state `(q, q̇)` for a controller) and checks its value.
-    fn call(&self, py: Python<'_>, t: f64, state: Option<(&[f64], &[f64])>) -> PyResult<Vec<f64>> {
+    fn call(
+        &self,
+        py: Python<'_>,
+        t: f64,
+        state: Option<(&[f64], &[f64])>,
+    ) -> Result<Vec<f64>, Failure> {
         let f = self.function.bind(py);
         let value = match state {
-            None => f.call1((t,))?,
-            Some((q, qd)) => f.call1((t, arrays::vector(py, q), arrays::vector(py, qd)))?,
-        };
+            None => f.call1((t,)),
+            Some((q, qd)) => f.call1((t, arrays::vector(py, q), arrays::vector(py, qd))),
+        }
+        .map_err(Failure::raised)?;
+        let repr = |v: &Bound<'_, PyAny>| v.repr().map(|r| r.to_string()).unwrap_or_default();
         let na = self.n_actuators;
         let named = self.named(t);
         let values = match value.extract::<arrays::Tensions<'_>>() {
             Ok(u) => u.values(),
             Err(_) => {
                 let shape = match value.getattr("shape") {
-                    Ok(sh) => format!(" of shape {}", sh.repr()?),
+                    Ok(sh) => format!(" of shape {}", repr(&sh)),
                     Err(_) => String::new(),
                 };
-                return Err(invalid(format!(
+                return Err(Failure::refused(invalid(format!(
                     "{named} returned `{}`{shape}: expected {na} tension{} [N] (a 1-D array or sequence, one per tendon, or one number for all)",
-                    value.repr()?,
+                    repr(&value),
                     if na == 1 { "" } else { "s" },
-                )));
+                ))));
             }
         };
         let u = gvsrom::scenario::tensions_for(na, &values)
-            .map_err(|e| invalid(format!("{named}: {e}")))?;
+            .map_err(|e| Failure::refused(invalid(format!("{named}: {e}"))))?;
         if let Some(k) = u.iter().position(|x| !x.is_finite()) {
-            return Err(invalid(format!(
+            return Err(Failure::refused(invalid(format!(
                 "{named} returned u[{k}] = {}: expected finite tensions [N]",
                 u[k]
-            )));
+            ))));
         }
         Ok(u)
     }
@@ -198,7 +226,7 @@ impl CallableInput {
                 let message =
                     format!("{whose} returned tensions the reduced model was not trained for: {e}");
                 let mut slot = self.error.lock().unwrap_or_else(PoisonError::into_inner);
-                slot.get_or_insert_with(|| invalid(message));
+                slot.get_or_insert_with(|| Failure::refused(invalid(message)));
                 false
             }
         }
@@ -223,14 +251,14 @@ impl CallableInput {
                 // the error names the tendon and its largest |u|; the time says when it came
                 let message = format!("{}: {e}", self.named(at[k]));
                 let mut slot = self.error.lock().unwrap_or_else(PoisonError::into_inner);
-                slot.get_or_insert_with(|| invalid(message));
+                slot.get_or_insert_with(|| Failure::refused(invalid(message)));
                 false
             }
         }
     }
 
-    /// Takes the error the callable raised, if any.
-    pub fn take_error(&self) -> Option<PyErr> {
+    /// Takes the error the callable raised or its refused value, if any.
+    pub fn take_error(&self) -> Option<Failure> {
         self.error
             .lock()
             .unwrap_or_else(PoisonError::into_inner)
@@ -241,7 +269,7 @@ impl CallableInput {
     /// the reason a run it stopped records.
     pub fn error_message(&self) -> Option<String> {
         let slot = self.error.lock().unwrap_or_else(PoisonError::into_inner);
-        slot.as_ref().map(|e| e.to_string())
+        slot.as_ref().map(|f| f.err.to_string())
     }
 
     /// Whether the callable raised (or returned a bad value).
@@ -264,7 +292,16 @@ impl Actuation for CallableInput {
                 self.record(t, &u);
                 out.copy_from_slice(&u)
             }
-            Err(e) => *self.error.lock().unwrap_or_else(PoisonError::into_inner) = Some(e),
+            Err(f) => *self.error.lock().unwrap_or_else(PoisonError::into_inner) = Some(f),
+        }
+    }
+
+    /// Once the callable has failed, no further sample is delivered: the step under way evaluated
+    /// zero tensions after the failure.
+    fn observe(&self, _t: f64, _q: &[f64], _qd: &[f64]) -> Result<(), String> {
+        match self.error_message() {
+            Some(message) => Err(message),
+            None => Ok(()),
         }
     }
 
@@ -285,10 +322,13 @@ impl gvs::feedback::FeedbackLaw for CallableInput {
                 u.copy_from_slice(&v);
                 Ok(())
             }
-            Err(e) => {
-                let reason = format!("the controller raised {e}");
+            Err(f) => {
+                let reason = match f.raised {
+                    true => format!("the controller raised {}", f.err),
+                    false => f.err.to_string(),
+                };
                 let mut slot = self.error.lock().unwrap_or_else(PoisonError::into_inner);
-                slot.get_or_insert(e);
+                slot.get_or_insert(f);
                 Err(reason)
             }
         }

@@ -6,8 +6,9 @@
 //!   an array's shape, a model directory);
 //! - `ConvergenceError(GvsromError)`: a statics solve that did not converge, with `iterations`,
 //!   `residual_norm` and `load_factor` as attributes (also in the message);
-//! - `IntegrationError(GvsromError)`: a simulation whose integrator failed, with the samples it
-//!   computed before as the attribute `trajectory`.
+//! - `IntegrationError(GvsromError)`: a simulation whose integrator failed, or whose callable
+//!   input or controller returned a value refused after the start, with the samples it computed
+//!   before as the attribute `trajectory`.
 
 use gvs::solve::statics::StaticsError;
 use gvsrom::error::StaticsFailure;
@@ -33,7 +34,7 @@ create_exception!(
     gvsrom,
     IntegrationError,
     GvsromError,
-    "A simulation whose integrator failed; `trajectory` holds the samples computed before, as `simulate` returns them."
+    "A simulation that stopped early: its integrator failed, or a callable `input` or `controller` returned a value refused after the start; `trajectory` holds the samples computed before, as `simulate` returns them."
 );
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -473,14 +473,22 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
         extrapolated.push(o);
     }
     // the callable's own error first, with the samples before it: a failure to write comes after
-    if let Some(e) = callable.as_ref().and_then(|c| c.take_error()) {
-        let dir = written.as_ref().and_then(|w| w.as_ref().ok());
-        let before = match &outcome {
-            // (a failure at the start, with its first sample alone, is raised as it is)
-            Ok(o) if buffer.t.len() > 1 => Some(trajectory(py, built, &buffer, o)?),
-            _ => None,
-        };
-        return Err(with_samples_before(py, e, before, extrapolated, dir)?);
+    if let Some(c) = &callable {
+        if let Some(failure) = c.take_error() {
+            let dir = written.as_ref().and_then(|w| w.as_ref().ok());
+            // a controller's failure stops the run before the sample it was called at; an input
+            // callable's first sample is delivered before it is first called (the failure at
+            // the start is raised as it is)
+            let first = match c.kind() {
+                Kind::Controller => 1,
+                Kind::Input => 2,
+            };
+            let before = match &outcome {
+                Ok(o) if buffer.t.len() >= first => Some(trajectory(py, built, &buffer, o)?),
+                _ => None,
+            };
+            return Err(with_samples_before(py, failure, before, extrapolated, dir)?);
+        }
     }
     let written = (written.transpose()).map_err(|e| crate::errors::any(e.into()))?;
     if let Some(e) = signals.caught() {
@@ -596,11 +604,12 @@ fn provenance(robot: &Robot, built: &gvsrom::Built) -> PyResult<gvsrom::provenan
 /// raised as it was, with them as its `trajectory` attribute and a note saying so.
 fn with_samples_before(
     py: Python<'_>,
-    e: PyErr,
+    failure: crate::callable::Failure,
     before: Option<Bound<'_, PyDict>>,
     extrapolated: Vec<String>,
     written: Option<&std::path::PathBuf>,
 ) -> PyResult<PyErr> {
+    let e = failure.err;
     let Some(partial) = before else {
         return Ok(e);
     };
@@ -609,7 +618,7 @@ fn with_samples_before(
         partial.set_item("out", dir)?;
     }
     let samples = partial.get_item("t")?.map_or(Ok(0), |t| t.len())?;
-    if e.is_instance_of::<crate::errors::GvsromError>(py) {
+    if !failure.raised {
         let message = e.value(py).to_string();
         return Ok(crate::errors::integration(
             &format!("{message} ({samples} samples computed before: the exception's `trajectory`)"),
@@ -617,12 +626,17 @@ fn with_samples_before(
         ));
     }
     let value = e.value(py);
-    // an exception that takes no attributes keeps none (its message is unchanged either way)
-    if value.setattr("trajectory", &partial).is_ok() {
+    // an attribute of the exception's own is kept; an exception that takes none keeps none (its
+    // message is unchanged either way)
+    if !value.hasattr("trajectory")? && value.setattr("trajectory", &partial).is_ok() {
         let note = format!(
             "gvsrom: the run stopped here; its {samples} samples before are this exception's `trajectory`"
         );
-        let _ = value.call_method1("add_note", (note,));
+        // `add_note` from Python 3.11; before, the list it appends to
+        if value.call_method1("add_note", (note.clone(),)).is_err() {
+            let notes = pyo3::types::PyList::new(py, [note])?;
+            let _ = value.setattr("__notes__", notes);
+        }
     }
     Ok(e)
 }

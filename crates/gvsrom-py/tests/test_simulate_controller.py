@@ -121,3 +121,22 @@ def test_a_run_the_controller_stops_hands_back_the_samples_before(robot):
     with pytest.raises(gvsrom.GvsromError, match=r"returned `array\(\[\[-3.\]\]\)` of shape \(1, 1\): "
                                                  r"expected 1 tension \[N\] \(a 1-D array"):
         robot.simulate(0.01, controller=lambda t, q, qd: np.array([[-3.0]]))
+
+
+def test_an_error_the_users_own_code_raises_keeps_its_type_and_no_zero_tension_is_delivered(robot):
+    # a GvsromError from the user's own call inside the controller is the user's: not rewrapped
+    def law(t, q, qd):
+        if t > 0.015:
+            raise gvsrom.GvsromError("mine")
+        return -1.0
+
+    with pytest.raises(gvsrom.GvsromError) as e:
+        robot.simulate(0.05, sample_rate=100, controller=law)
+    assert type(e.value) is gvsrom.GvsromError and str(e.value) == "mine"
+    assert len(e.value.trajectory["t"]) == 2
+    # an input callable that fails mid-step: the samples handed back all carry its tensions, none
+    # the zeros the step evaluated after the failure
+    with pytest.raises(gvsrom.IntegrationError) as e:
+        robot.simulate(0.05, sample_rate=100, input=lambda t: -2.0 if t < 0.025 else float("nan"))
+    u = e.value.trajectory["u"]
+    assert len(u) >= 2 and (u == -2.0).all(), u

@@ -99,3 +99,10 @@ def test_a_refused_controller_value_is_the_recorded_reason(robot, tmp_path):
     meta = json.loads((tmp_path / "far" / "meta.json").read_text())
     assert meta["complete"] is False
     assert "`controller(0, q, qd)`" in meta["reason"] and "tendons[0]" in meta["reason"], meta["reason"]
+
+
+def test_a_constant_tension_is_named_in_a_note_instead_of_a_figure(robot, tmp_path):
+    robot.simulate(0.03, sample_rate=100, controller=lambda t, q, qd: -2.0, out=tmp_path / "run")
+    figures = gvsrom.plot(tmp_path / "run", tmp_path / "figs")
+    assert "tensions: held at -2 N over the run (not drawn)" in figures["notes"], figures["notes"]
+    assert not any(f.startswith("tensions") for f in figures["figures"])

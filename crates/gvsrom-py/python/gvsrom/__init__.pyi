@@ -46,7 +46,9 @@ class ConvergenceError(GvsromError):
     load_factor: float
 
 class IntegrationError(GvsromError):
-    """A simulation whose integrator failed; ``trajectory`` holds the samples computed before."""
+    """A simulation that stopped early: its integrator failed, or a callable ``input`` or
+    ``controller`` returned a value refused after the start; ``trajectory`` holds the samples
+    computed before."""
 
     trajectory: dict[str, Any]
 

@@ -156,8 +156,10 @@ fn tip_figures(tr: &Trajectory, caption: &str, sink: &mut Sink) -> Result<(), Fi
 }
 
 /// `tensions`: each tendon's tension \[N\] at the samples, drawn as held from one sample to the
-/// next (a step of the input, a controller's period) unless the input was interpolated
-/// linearly; nothing without tendons, a note when no tension varies.
+/// next (a step of the input, a controller's period; a switch between samples shows at the next
+/// one) unless the input was interpolated linearly or is a function of time; the value of the
+/// last sample, which drives no step of a held input, is left out of the steps. Nothing without
+/// tendons, a note naming the values when no tension varies.
 fn tensions(tr: &Trajectory, caption: &str, sink: &mut Sink) -> Result<(), FiguresError> {
     let Some((na, u)) = &tr.tensions else {
         return Ok(());
@@ -165,25 +167,31 @@ fn tensions(tr: &Trajectory, caption: &str, sink: &mut Sink) -> Result<(), Figur
     let n = tr.samples();
     let varies = (0..*na).any(|j| (1..n).any(|k| u[k * na + j] != u[j]));
     if !varies {
-        sink.note("tensions: constant over the run (not drawn)");
+        let values: Vec<String> = (0..*na).map(|j| format!("{} N", u[j])).collect();
+        sink.note(format!(
+            "tensions: held at {} over the run (not drawn)",
+            values.join(", ")
+        ));
         return Ok(());
     }
-    let linear = tr
-        .input
-        .as_ref()
-        .is_some_and(|i| i["interpolation"] == "linear");
+    let input = tr.input.as_ref();
+    let smooth = input.is_some_and(|i| i["interpolation"] == "linear" || i["signal"] == "function");
     let series = (0..*na)
         .map(|j| {
             let at = |k: usize| u[k * na + j];
-            let (t, y): (Vec<f64>, Vec<f64>) = match linear {
+            let (t, y): (Vec<f64>, Vec<f64>) = match smooth {
                 true => (tr.t.clone(), (0..n).map(at).collect()),
-                // held: each value runs to the next sample, where the next one starts
-                false => (0..n)
-                    .flat_map(|k| {
-                        let next = tr.t.get(k + 1).copied().unwrap_or(tr.t[k]);
-                        [(tr.t[k], at(k)), (next, at(k))]
-                    })
-                    .unzip(),
+                // held: a corner where the value changes, then on to the last sample
+                false => {
+                    let mut pts = vec![(tr.t[0], at(0))];
+                    for k in 1..n.saturating_sub(1) {
+                        if at(k) != at(k - 1) {
+                            pts.extend([(tr.t[k], at(k - 1)), (tr.t[k], at(k))]);
+                        }
+                    }
+                    pts.push((tr.t[n - 1], at(n.saturating_sub(2))));
+                    pts.into_iter().unzip()
+                }
             };
             Series::new(format!("tendon {}", j + 1), t, y, SeriesStyle::Line)
                 .with_color(palette::EXTRA[j % palette::EXTRA.len()])
