@@ -167,7 +167,8 @@ impl Robot {
     ///     that could not converge), or a callable ``input`` or ``controller`` returned a value
     ///     refused after the run began: its ``trajectory`` attribute is the dict above for the
     ///     samples computed before (``energy_balance`` left out). An exception the callable
-    ///     raised propagates as it is, with that dict as its ``trajectory`` attribute.
+    ///     raised propagates as it is, with that dict as its ``trajectory`` attribute, and so
+    ///     does ``KeyboardInterrupt`` (Ctrl-C).
     /// GvsromError
     ///     For bad options or input.
     #[pyo3(signature = (duration, sample_rate=100.0, input=None, interpolate=false, from_equilibrium=false, q0=None, qd0=None, method="auto", rtol=None, atol=None, fixed_step=None, load_schedule=None, steps=None, babble=None, seed=0, max_order=None, error_norm=None, rho_inf=None, fd_jacobian=false, controller=None, control_rate=None, out=None, force=false))]
@@ -491,8 +492,18 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
         }
     }
     let written = (written.transpose()).map_err(|e| crate::errors::any(e.into()))?;
+    // Ctrl-C (or another signal handler's exception): raised as it is, with the samples before
     if let Some(e) = signals.caught() {
-        return Err(e);
+        let before = match &outcome {
+            Ok(o) if !buffer.t.is_empty() => Some(trajectory(py, built, &buffer, o)?),
+            _ => None,
+        };
+        let failure = crate::callable::Failure {
+            err: e,
+            raised: true,
+        };
+        let dir = written.as_ref();
+        return Err(with_samples_before(py, failure, before, extrapolated, dir)?);
     }
     let outcome = outcome.map_err(err)?;
     match &outcome.ending {
