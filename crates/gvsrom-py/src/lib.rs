@@ -24,6 +24,7 @@ mod robot_pickle;
 mod scenario;
 mod simulate;
 mod statics;
+mod stepper;
 mod tendon_quantities;
 
 use pyo3::prelude::*;
@@ -45,6 +46,7 @@ fn _gvsrom(m: &Bound<'_, PyModule>) -> PyResult<()> {
     errors::register(m)?;
     m.add_class::<scenario::Scenario>()?;
     m.add_class::<robot::Robot>()?;
+    m.add_class::<stepper::Stepper>()?;
     m.add_class::<statics::Statics>()?;
     m.add_class::<statics::StaticsBatch>()?;
     m.add_class::<models::Model>()?;

@@ -142,6 +142,15 @@ impl Robot {
         Ok(self.signal_built.get_or_init(|| b))
     }
 
+    /// [`Self::built_for_signal`] once it has been called (the robot's own before): for a thread
+    /// that cannot build it.
+    pub fn built_for_signal_ready(&self) -> &Built {
+        match (&self.attached, self.signal_built.get()) {
+            (Some(_), Some(b)) => b,
+            _ => &self.built,
+        }
+    }
+
     /// The scenario with tensions `u` (`--tension`), built with the model attached: for the runs
     /// whose reduced model needs its initial guess at `u`.
     fn rebuilt_with(

@@ -244,7 +244,7 @@ fn error_norm(name: &str) -> PyResult<ErrorNormChoice> {
     })
 }
 
-fn method(name: &str) -> PyResult<MethodChoice> {
+pub fn method(name: &str) -> PyResult<MethodChoice> {
     Ok(match name {
         "auto" => MethodChoice::Auto,
         "ndf" => MethodChoice::Ndf,

@@ -20,6 +20,7 @@ __all__ = [
     "Scenario",
     "Statics",
     "StaticsBatch",
+    "Stepper",
     "__version__",
     "dataset",
     "load_dataset",
@@ -433,3 +434,34 @@ class Robot:
         out: _Path | None = None,
         force: bool = False,
     ) -> dict[str, Any]: ...
+    def stepper(
+        self,
+        dt: float,
+        horizon: float = 3600.0,
+        q0: ArrayLike | None = None,
+        qd0: ArrayLike | None = None,
+        from_equilibrium: bool = False,
+        method: str = "auto",
+        rtol: float | None = None,
+        atol: float | None = None,
+        fixed_step: float | None = None,
+    ) -> Stepper: ...
+
+@final
+class Stepper:
+    """A run advanced one control period per :meth:`step`, its tensions held over each."""
+
+    def step(self, u: ArrayLike | float) -> tuple[_F, _F]: ...
+    @property
+    def t(self) -> float: ...
+    @property
+    def dt(self) -> float: ...
+    @property
+    def q(self) -> _F: ...
+    @property
+    def qd(self) -> _F: ...
+    @property
+    def running(self) -> bool: ...
+    def close(self) -> None: ...
+    def __enter__(self) -> Stepper: ...
+    def __exit__(self, ty: Any, value: Any, tb: Any) -> bool: ...

@@ -1,0 +1,411 @@
+//! `Robot.stepper`: a run advanced one control period per call, for a loop the user drives
+//! (reinforcement learning's `env.step(action)`, a controller in another program).
+//!
+//! One integration, as `simulate(controller=…)` runs it, on a thread of its own: its controller
+//! ([`ChannelLaw`], a [`gvs::feedback::FeedbackLaw`]) hands the state at each control instant to
+//! [`Stepper::step`] and waits for the tensions of the next period. So the integrator keeps what
+//! a restart need not renew across periods, as in `simulate(controller=…)`, and the Python side
+//! sees a call per period. The thread holds the robot (a strong reference) and never touches
+//! Python; `step` waits for it with the GIL released.
+
+use crate::arrays;
+use crate::errors::{invalid, scenario as err};
+use crate::robot::{warn, Robot};
+use gvsrom::simulate::{self, ControlLaw, InputSource, IntegratorChoice, MethodChoice};
+use pyo3::prelude::*;
+use std::ops::ControlFlow;
+use std::sync::mpsc::{channel, Receiver, Sender};
+use std::sync::{Arc, Mutex, PoisonError};
+use std::thread::JoinHandle;
+
+/// What the run hands to the Python side.
+enum Event {
+    /// The state at a control instant; `notes`: how the last tensions lay outside a reduced
+    /// model's training (with `extrapolate`).
+    State {
+        t: f64,
+        q: Vec<f64>,
+        qd: Vec<f64>,
+        notes: Vec<String>,
+    },
+    /// The run ended: why.
+    Ended(String),
+}
+
+/// The control law of the run: the state out, the next period's tensions in (`None`: close).
+struct ChannelLaw {
+    events: Mutex<Sender<Event>>,
+    tensions: Mutex<Receiver<Option<Vec<f64>>>>,
+    robot: Py<Robot>,
+    notes: Mutex<Vec<String>>,
+}
+
+impl gvs::feedback::FeedbackLaw for ChannelLaw {
+    fn tensions(&self, t: f64, q: &[f64], qd: &[f64], u: &mut [f64]) -> Result<(), String> {
+        let notes = std::mem::take(&mut *self.notes.lock().unwrap_or_else(PoisonError::into_inner));
+        let state = Event::State {
+            t,
+            q: q.to_vec(),
+            qd: qd.to_vec(),
+            notes,
+        };
+        let events = self.events.lock().unwrap_or_else(PoisonError::into_inner);
+        events
+            .send(state)
+            .map_err(|_| "the stepper was closed".to_string())?;
+        let next = self
+            .tensions
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .recv();
+        let Ok(Some(v)) = next else {
+            return Err("the stepper was closed".into());
+        };
+        // checked as a signal's tensions are: the elastic range, a reduced model's training
+        let built = self.robot.get().built_for_signal_ready();
+        let abs: Vec<f64> = v.iter().map(|x| x.abs()).collect();
+        gvsrom::plausibility::check(built, &abs, 1.0)
+            .map_err(|e| format!("`step(u)` at t = {t} s: {e}"))?;
+        if let Some(r) = &built.reduced {
+            match r.check_signal(&[t], |_| v.clone()) {
+                Ok(sentences) => self
+                    .notes
+                    .lock()
+                    .unwrap_or_else(PoisonError::into_inner)
+                    .extend(sentences),
+                Err(e) => return Err(format!("`step(u)` at t = {t} s: {e}")),
+            }
+        }
+        u.copy_from_slice(&v);
+        Ok(())
+    }
+}
+
+/// The run on its thread and the two ends of its channels.
+struct Running {
+    tensions: Sender<Option<Vec<f64>>>,
+    events: Mutex<Receiver<Event>>,
+    handle: Option<JoinHandle<()>>,
+}
+
+impl Drop for Running {
+    fn drop(&mut self) {
+        let _ = self.tensions.send(None);
+        if let Some(h) = self.handle.take() {
+            let _ = h.join();
+        }
+    }
+}
+
+/// A run of a robot advanced one control period per :meth:`step`, its tensions held over each
+/// (a zero-order hold), from one integration: made by :meth:`Robot.stepper`.
+#[pyclass(module = "gvsrom")]
+pub struct Stepper {
+    running: Option<Running>,
+    dt: f64,
+    n_actuators: usize,
+    t: f64,
+    q: Vec<f64>,
+    qd: Vec<f64>,
+    /// Why the run ended, once it has.
+    ended: Option<String>,
+    warned: Vec<String>,
+}
+
+impl Stepper {
+    /// Waits for the run's next event with the GIL released, and takes it in.
+    fn receive(&mut self, py: Python<'_>) -> PyResult<()> {
+        let Some(r) = &self.running else {
+            return Err(self.ended_error());
+        };
+        let event = py.detach(|| (r.events.lock().unwrap_or_else(PoisonError::into_inner)).recv());
+        match event {
+            Ok(Event::State { t, q, qd, notes }) => {
+                (self.t, self.q, self.qd) = (t, q, qd);
+                for n in notes {
+                    if !self.warned.contains(&n) {
+                        warn(py, &format!("extrapolating (--extrapolate): {n}"))?;
+                        self.warned.push(n);
+                    }
+                }
+                Ok(())
+            }
+            Ok(Event::Ended(reason)) => {
+                self.ended = Some(reason);
+                self.running = None;
+                Err(self.ended_error())
+            }
+            Err(_) => {
+                self.ended.get_or_insert_with(|| "the run ended".into());
+                self.running = None;
+                Err(self.ended_error())
+            }
+        }
+    }
+
+    fn ended_error(&self) -> PyErr {
+        invalid(format!(
+            "the stepper's run has ended at t = {} s: {}",
+            self.t,
+            self.ended.as_deref().unwrap_or("it was closed")
+        ))
+    }
+}
+
+#[pymethods]
+impl Stepper {
+    /// Holds the tensions ``u`` [N] (one per tendon, or one number for all) for one period and
+    /// returns the state ``(q, qd)`` at its end; :attr:`t` advances by :attr:`dt`.
+    fn step<'py>(
+        &mut self,
+        py: Python<'py>,
+        u: arrays::Tensions<'_>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+        let Some(r) = &self.running else {
+            return Err(self.ended_error());
+        };
+        let u = gvsrom::scenario::tensions_for(self.n_actuators, &u.values())
+            .map_err(|e| invalid(format!("`u`: {e}")))?;
+        if let Some(k) = u.iter().position(|x| !x.is_finite()) {
+            return Err(invalid(format!(
+                "`u[{k}]` = {}: expected finite tensions [N]",
+                u[k]
+            )));
+        }
+        if r.tensions.send(Some(u)).is_err() {
+            self.running = None;
+        }
+        self.receive(py)?;
+        Ok((arrays::vector(py, &self.q), arrays::vector(py, &self.qd)))
+    }
+
+    /// The time of the state [s].
+    #[getter]
+    fn t(&self) -> f64 {
+        self.t
+    }
+
+    /// The control period [s].
+    #[getter]
+    fn dt(&self) -> f64 {
+        self.dt
+    }
+
+    /// The coordinates ``q`` of the model that runs at :attr:`t`.
+    #[getter]
+    fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        arrays::vector(py, &self.q)
+    }
+
+    /// The velocities ``qd`` at :attr:`t`.
+    #[getter]
+    fn qd<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        arrays::vector(py, &self.qd)
+    }
+
+    /// Whether the run still takes steps (not closed, not ended).
+    #[getter]
+    fn running(&self) -> bool {
+        self.running.is_some()
+    }
+
+    /// Ends the run (also when the stepper is garbage-collected, or leaves a ``with`` block).
+    fn close(&mut self, py: Python<'_>) {
+        let r = self.running.take();
+        self.ended.get_or_insert_with(|| "closed".into());
+        py.detach(|| drop(r));
+    }
+
+    fn __enter__(slf: Py<Self>) -> Py<Self> {
+        slf
+    }
+
+    fn __exit__(
+        &mut self,
+        py: Python<'_>,
+        _ty: Option<Bound<'_, PyAny>>,
+        _value: Option<Bound<'_, PyAny>>,
+        _tb: Option<Bound<'_, PyAny>>,
+    ) -> bool {
+        self.close(py);
+        false
+    }
+}
+
+/// The arguments of `Robot.stepper`.
+pub struct Args {
+    pub dt: f64,
+    pub horizon: f64,
+    pub q0: Option<Vec<f64>>,
+    pub qd0: Option<Vec<f64>>,
+    pub from_equilibrium: bool,
+    pub method: MethodChoice,
+    pub fixed_step: Option<f64>,
+    pub rtol: Option<f64>,
+    pub atol: Option<f64>,
+}
+
+#[pymethods]
+impl Robot {
+    /// A run advanced one control period per :meth:`Stepper.step`, for a loop you drive (a
+    /// reinforcement-learning environment's ``step(action)``, a controller elsewhere): each call
+    /// holds its tensions for ``dt`` seconds and returns the state at the end. One integration
+    /// on a thread of its own, as ``simulate(controller=…)`` runs it (the same numbers), so the
+    /// integrator keeps what a restart need not renew between periods.
+    ///
+    /// Parameters
+    /// ----------
+    /// dt : float
+    ///     The control period [s].
+    /// horizon : float
+    ///     The longest the run may go [s] (default one hour); a step past it is an error.
+    /// q0, qd0 : array_like of float, shape (n,), optional
+    ///     Start at this state (the coordinates of the model that runs); else straight at rest, or
+    ///     with ``from_equilibrium`` at the scenario's equilibrium.
+    /// from_equilibrium : bool
+    ///     Start at the static equilibrium under the scenario's tensions.
+    /// method, rtol, atol, fixed_step
+    ///     The integrator, as for :meth:`simulate` (``fixed_step=dt`` or a fraction of it for a
+    ///     fixed cost per period).
+    ///
+    /// Returns
+    /// -------
+    /// Stepper
+    ///     At ``t = 0`` (``stepper.q``, ``stepper.qd``); a context manager that ends the run.
+    #[pyo3(signature = (dt, horizon=3600.0, q0=None, qd0=None, from_equilibrium=false, method="auto", rtol=None, atol=None, fixed_step=None))]
+    #[allow(clippy::too_many_arguments)]
+    fn stepper(
+        slf: Py<Self>,
+        py: Python<'_>,
+        dt: f64,
+        horizon: f64,
+        q0: Option<arrays::In1<'_>>,
+        qd0: Option<arrays::In1<'_>>,
+        from_equilibrium: bool,
+        method: &str,
+        rtol: Option<f64>,
+        atol: Option<f64>,
+        fixed_step: Option<f64>,
+    ) -> PyResult<Stepper> {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(invalid(format!(
+                "invalid value for `dt`: {} (expected a finite number > 0 s, the control period)",
+                gvs::error::fmt_value(dt)
+            )));
+        }
+        if !(horizon.is_finite() && horizon >= dt) {
+            return Err(invalid(format!(
+                "invalid value for `horizon`: {} (expected a finite number of seconds ≥ dt = {})",
+                gvs::error::fmt_value(horizon),
+                gvs::error::fmt_value(dt)
+            )));
+        }
+        let args = Args {
+            dt,
+            horizon,
+            q0: q0.as_ref().map(arrays::vec1),
+            qd0: qd0.as_ref().map(arrays::vec1),
+            from_equilibrium,
+            method: crate::simulate::method(method)?,
+            fixed_step,
+            rtol,
+            atol,
+        };
+        start(slf, py, args)
+    }
+}
+
+/// Plans the run (everything checked before the thread starts), starts it and waits for its first
+/// state.
+pub fn start(robot: Py<Robot>, py: Python<'_>, a: Args) -> PyResult<Stepper> {
+    let r = robot.get();
+    let built = r.built_for_signal(py)?;
+    let na = built.model.n_actuators();
+    if na == 0 {
+        return Err(invalid(
+            "`stepper`: the robot has no tendons to set tensions on",
+        ));
+    }
+    let start = match (a.q0, a.qd0, a.from_equilibrium) {
+        (Some(_), _, true) => {
+            return Err(invalid(
+                "`from_equilibrium=True` and `q0` both say where the run starts: give one",
+            ))
+        }
+        (None, Some(_), _) => {
+            return Err(invalid(
+                "`qd0` given without `q0`: a start state needs its coordinates `q0` (`qd0` defaults to zeros)",
+            ))
+        }
+        (Some(q), qd, false) => {
+            let n = q.len();
+            simulate::Start::State { q, qd: qd.unwrap_or_else(|| vec![0.0; n]) }
+        }
+        (None, None, e) => simulate::Start::rest_or_equilibrium(e),
+    };
+    let (to_law, from_user) = channel::<Option<Vec<f64>>>();
+    let (to_user, from_law) = channel::<Event>();
+    let law = Arc::new(ChannelLaw {
+        events: Mutex::new(to_user.clone()),
+        tensions: Mutex::new(from_user),
+        robot: robot.clone_ref(py),
+        notes: Mutex::new(vec![]),
+    });
+    let prepared = simulate::prepare(
+        built,
+        simulate::Request {
+            duration: a.horizon,
+            sample_rate: 1.0 / a.dt,
+            input: InputSource::Feedback {
+                law: ControlLaw(law),
+                control_rate: None,
+            },
+            start,
+            load_schedule: None,
+            integrator: IntegratorChoice {
+                method: a.method,
+                rtol: a.rtol,
+                atol: a.atol,
+                fixed_step: a.fixed_step,
+                ..IntegratorChoice::default()
+            },
+        },
+    )
+    .map_err(err)?;
+    let thread_robot = robot.clone_ref(py);
+    let handle = std::thread::spawn(move || {
+        let built = thread_robot.get().built_for_signal_ready();
+        let outcome = simulate::run_into(
+            built,
+            &prepared.plan,
+            &prepared.opts.integrator,
+            None,
+            &mut |_| ControlFlow::Continue(()),
+        );
+        let why = match outcome {
+            Ok(o) => match o.ending {
+                simulate::Ending::Complete => "it reached its horizon".to_string(),
+                simulate::Ending::Interrupted { reason } => reason,
+                simulate::Ending::Failed { error } => error,
+            },
+            Err(e) => e.to_string(),
+        };
+        let _ = to_user.send(Event::Ended(why));
+    });
+    let mut stepper = Stepper {
+        running: Some(Running {
+            tensions: to_law,
+            events: Mutex::new(from_law),
+            handle: Some(handle),
+        }),
+        dt: a.dt,
+        n_actuators: na,
+        t: 0.0,
+        q: vec![],
+        qd: vec![],
+        ended: None,
+        warned: vec![],
+    };
+    stepper.receive(py)?;
+    Ok(stepper)
+}
