@@ -12,6 +12,14 @@ use super::{
 };
 use nalgebra::DVector;
 
+/// After a Jacobian kept across a breakpoint stalled Newton there, it is renewed up front at this
+/// many breakpoints, then kept again (and renewed for as many again if it stalls again): a model
+/// whose Jacobian every input jump spoils (a POD-4 model of the IV-A arm under a controller: 205
+/// failed attempts in 100 periods of one step each, 31 with the renewal, 11 when it renewed at
+/// every breakpoint) pays about one renewal per breakpoint, one whose Jacobian rarely is (the full
+/// IV-A model, whose renewal costs 1.2 ms) pays a few.
+pub(super) const REFRESH_AFTER_STALL: usize = 8;
+
 /// Step halvings allowed when Newton fails with a fresh Jacobian.
 const MAX_HALVINGS: u32 = 10;
 /// The iteration matrix `I − βJ` is refactored when `β` changes by more than this (relative);
@@ -50,6 +58,11 @@ struct State {
     jac_fresh: bool,
     /// Newton contraction rate of the previous solve with the current factorization.
     rate: Option<f64>,
+    /// No step accepted yet in the current piece, which starts at a breakpoint (not the first).
+    piece_start: bool,
+    /// Breakpoints at which to renew the Jacobian up front, because one kept across a breakpoint
+    /// stalled Newton there ([`REFRESH_AFTER_STALL`] after each such stall).
+    refresh_at_breaks: usize,
 }
 
 enum Newton {
@@ -79,7 +92,10 @@ enum Newton {
 ///   steps. The
 ///   Jacobian (analytic, or forward differences with increment `√eps·max(|y_j|, 1)`) is evaluated
 ///   at the start and re-evaluated, at most once per step, only when Newton stalls (`ρ > 0.9` or no
-///   convergence within `max_newton`); if it still fails, or the right-hand side refuses a Newton
+///   convergence within `max_newton`) — and up front at the next [`REFRESH_AFTER_STALL`]
+///   breakpoints once one kept across a breakpoint stalled there (the input's jump changes it: a
+///   tendon's load stiffness scales with its tension; a sampled-data controller's breakpoints come
+///   every period); if it still fails, or the right-hand side refuses a Newton
 ///   iterate (a trial state far from the step's solution), the step is split in halves (up to 10
 ///   times) before giving up with [`OdeError::NewtonFailure`] (or [`OdeError::NonFinite`] when the
 ///   failure is a NaN/∞ right-hand side, or the right-hand side's own error).
@@ -186,6 +202,8 @@ fn integrate<C: Corrector>(
         lu_ok: false,
         jac_fresh: false,
         rate: None,
+        piece_start: false,
+        refresh_at_breaks: 0,
     };
     let pieces = bounds.len().saturating_sub(1);
     let mut run = || -> Result<(), OdeError> {
@@ -200,6 +218,20 @@ fn integrate<C: Corrector>(
             let (a, b) = (bounds[p], bounds[p + 1]);
             cs.set_clamp(Clamp::piece(a, p > 0, b, p + 1 < pieces));
             st.have_prev = false;
+            st.piece_start = p > 0;
+            // the input jumped: Newton's rate measured before says nothing of the new piece (a
+            // tiny one carried over accepted a first correction far from the root)
+            st.rate = None;
+            // the input's jump changes the Jacobian (a tendon's load stiffness scales with its
+            // tension): once a kept one failed at a breakpoint, it is renewed at each up front
+            if p > 0 && st.refresh_at_breaks > 0 && !st.jac_fresh {
+                st.refresh_at_breaks -= 1;
+                if !cs.refresh(a, &w.y, &w.thresh)? {
+                    return Err(OdeError::NonFinite { t: a });
+                }
+                st.jac_fresh = true;
+                st.lu_beta = f64::NAN;
+            }
             // Number of steps: the last one is in [0.1h, 1.1h].
             let nsteps = ((b - a) / h - 0.1).ceil().max(1.0) as usize;
             for i in 1..=nsteps {
@@ -295,6 +327,7 @@ fn advance<C: Corrector>(
                 st.have_prev = true;
                 st.t = tn;
                 st.jac_fresh = false;
+                st.piece_start = false;
             }
             // a cheaper remedy first (the second-order form: `M` at the predicted configuration)
             // (only after an iteration ran: a singular matrix the remedy never reached would be
@@ -306,6 +339,9 @@ fn advance<C: Corrector>(
             Newton::Stalled if !st.jac_fresh => {
                 cs.stats().failed_steps += 1;
                 cs.stats().newton_failures += 1;
+                if st.piece_start {
+                    st.refresh_at_breaks = REFRESH_AFTER_STALL;
+                }
                 if !cs.refresh(t, &w.y, &w.thresh)? {
                     return Err(OdeError::NonFinite { t });
                 }

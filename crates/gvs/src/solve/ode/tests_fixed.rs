@@ -434,3 +434,41 @@ fn a_singular_iteration_matrix_stops_the_second_order_forms_instead_of_looping()
         .expect("an integrator with a singular iteration matrix did not return within 30 s");
     assert!(fixed && ndf, "{what}");
 }
+
+/// `y' = −k(t) y` with `k` switching between 1 and 10⁴ at every breakpoint, one step per piece
+/// (a sampled-data controller's pattern): a Jacobian kept across a breakpoint is off by 10⁴ and
+/// stalls Newton there, so after a stall it is renewed up front at the next
+/// [`super::fixed::REFRESH_AFTER_STALL`] breakpoints: 1 failed attempt and 10 Jacobians in all
+/// (without the renewal, 7 failures and the slow Newton iterations of the stale Jacobians leave
+/// 9e-11 of error at y = 9e-9). The discrete solution is the backward Euler step of each piece,
+/// `y_{n+1} = y_n / (1 + h k_n)`, to the Newton tolerance: the rate carried across a breakpoint
+/// once accepted a first correction of the wrong Jacobian (y = −97 for 0.0098 at t = 0.02, before
+/// 2026-12-07).
+#[test]
+fn a_jacobian_the_input_jumps_spoil_is_renewed_at_the_breakpoints_after_a_stall() {
+    let h = 0.01;
+    let k = |t: f64| {
+        if ((t / h).floor() as i64) % 2 == 0 {
+            1.0
+        } else {
+            1e4
+        }
+    };
+    let mut s = sys(1, |t, y, dy| dy[0] = -k(t) * y[0]);
+    let bps: Vec<f64> = (1..100).map(|i| i as f64 * h).collect();
+    let t_out = linspace(0.0, 1.0, 101);
+    let (out, r) = fixed(&mut s, &[1.0], &t_out, &bps, &opts(h));
+    let stats = r.unwrap();
+    assert_eq!(stats.steps, 100, "{stats:?}");
+    assert!(stats.newton_failures <= 15, "{stats:?}");
+    let mut y = 1.0;
+    for (i, (t, yi)) in out.iter().enumerate().skip(1) {
+        y /= 1.0 + h * k(t - 0.5 * h);
+        // (Newton's tolerance 1e-12 is absolute below |y| = 1)
+        assert!(
+            (yi[0] - y).abs() <= 1e-11,
+            "step {i}: {} against {y}",
+            yi[0]
+        );
+    }
+}
