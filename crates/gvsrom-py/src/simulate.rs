@@ -260,8 +260,12 @@ pub fn method(name: &str) -> PyResult<MethodChoice> {
 
 /// Where the run starts: `from_equilibrium`, a given state `q0` (`qd0`: zero if not given), or
 /// straight at rest.
-fn start(a: &Args<'_>) -> PyResult<simulate::Start> {
-    Ok(match (&a.q0, &a.qd0, a.from_equilibrium) {
+pub fn start(
+    q0: &Option<Vec<f64>>,
+    qd0: &Option<Vec<f64>>,
+    from_equilibrium: bool,
+) -> PyResult<simulate::Start> {
+    Ok(match (q0, qd0, from_equilibrium) {
         (Some(_), _, true) => {
             return Err(invalid(
                 "`from_equilibrium=True` and `q0` both say where the run starts: give one",
@@ -282,7 +286,7 @@ fn start(a: &Args<'_>) -> PyResult<simulate::Start> {
 
 pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'py, PyDict>> {
     let na = robot.built.model.n_actuators();
-    let start = start(&a)?;
+    let start = start(&a.q0, &a.qd0, a.from_equilibrium)?;
     let attached = robot.attached.is_some();
     let callable = match (&a.input, &a.controller) {
         (Some(_), Some(_)) => {

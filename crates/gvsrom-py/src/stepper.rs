@@ -326,23 +326,7 @@ pub fn start(robot: Py<Robot>, py: Python<'_>, a: Args) -> PyResult<Stepper> {
             "`stepper`: the robot has no tendons to set tensions on",
         ));
     }
-    let start = match (a.q0, a.qd0, a.from_equilibrium) {
-        (Some(_), _, true) => {
-            return Err(invalid(
-                "`from_equilibrium=True` and `q0` both say where the run starts: give one",
-            ))
-        }
-        (None, Some(_), _) => {
-            return Err(invalid(
-                "`qd0` given without `q0`: a start state needs its coordinates `q0` (`qd0` defaults to zeros)",
-            ))
-        }
-        (Some(q), qd, false) => {
-            let n = q.len();
-            simulate::Start::State { q, qd: qd.unwrap_or_else(|| vec![0.0; n]) }
-        }
-        (None, None, e) => simulate::Start::rest_or_equilibrium(e),
-    };
+    let start = crate::simulate::start(&a.q0, &a.qd0, a.from_equilibrium)?;
     let (to_law, from_user) = channel::<Option<Vec<f64>>>();
     let (to_user, from_law) = channel::<Event>();
     let law = Arc::new(ChannelLaw {

@@ -217,16 +217,19 @@ def test_an_autoencoders_linearization_is_the_derivative_of_its_accelerations(ae
         assert np.linalg.norm(lin["B"] - B) < 2e-6 * np.linalg.norm(B)
 
 
-def discrete_lqr(Ad, Bd, Q, R, iterations=5000):
-    """The gain K of u = −K x minimising Σ xᵀQx + uᵀRu for x⁺ = Ad x + Bd u (Riccati iteration)."""
-    P = Q.copy()
-    for _ in range(iterations):
-        K = np.linalg.solve(R + Bd.T @ P @ Bd, Bd.T @ P @ Ad)
-        P_next = Q + Ad.T @ P @ (Ad - Bd @ K)
-        if np.abs(P_next - P).max() < 1e-12 * np.abs(P).max():
-            return K
-        P = P_next
-    raise AssertionError("the Riccati iteration did not converge")
+def _lqr_example():
+    """crates/gvsrom-py/examples/lqr_tip.py as a module (its Riccati iteration is the tests')."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).parents[1] / "examples" / "lqr_tip.py"
+    spec = importlib.util.spec_from_file_location("lqr_tip", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+discrete_lqr = _lqr_example().discrete_lqr
 
 
 def test_an_lqr_designed_on_the_linearization_damps_the_nonlinear_arm():
