@@ -14,7 +14,8 @@ use crate::robot::{warn, Robot};
 use gvsrom::simulate::{self, ControlLaw, InputSource, IntegratorChoice, MethodChoice};
 use pyo3::prelude::*;
 use std::ops::ControlFlow;
-use std::sync::mpsc::{channel, Receiver, Sender};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{channel, Receiver, RecvTimeoutError, Sender};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::thread::JoinHandle;
 
@@ -86,10 +87,13 @@ struct Running {
     tensions: Sender<Option<Vec<f64>>>,
     events: Mutex<Receiver<Event>>,
     handle: Option<JoinHandle<()>>,
+    /// Set to stop the run within one step of its integrator (Ctrl-C during a step).
+    stop: Arc<AtomicBool>,
 }
 
 impl Drop for Running {
     fn drop(&mut self) {
+        self.stop.store(true, Ordering::SeqCst);
         let _ = self.tensions.send(None);
         if let Some(h) = self.handle.take() {
             let _ = h.join();
@@ -109,7 +113,9 @@ pub struct Stepper {
     qd: Vec<f64>,
     /// Why the run ended, once it has.
     ended: Option<String>,
-    warned: Vec<String>,
+    /// A reduced model's extrapolation was warned of (once per run: each step's sentence names
+    /// its own time and value).
+    warned: bool,
 }
 
 impl Stepper {
@@ -118,15 +124,38 @@ impl Stepper {
         let Some(r) = &self.running else {
             return Err(self.ended_error());
         };
-        let event = py.detach(|| (r.events.lock().unwrap_or_else(PoisonError::into_inner)).recv());
+        // waits in slices, running Python's signal handlers between them: Ctrl-C stops the run
+        // within one step of its integrator and is raised once the run has ended
+        let event = loop {
+            let e = py.detach(|| {
+                let events = r.events.lock().unwrap_or_else(PoisonError::into_inner);
+                events.recv_timeout(crate::interrupt::SIGNAL_POLL)
+            });
+            match e {
+                Err(RecvTimeoutError::Timeout) => {
+                    if let Err(interrupt) = py.check_signals() {
+                        r.stop.store(true, Ordering::SeqCst);
+                        // (and should the run reach an instant first, its law finds "close")
+                        let _ = r.tensions.send(None);
+                        py.detach(|| {
+                            let events = r.events.lock().unwrap_or_else(PoisonError::into_inner);
+                            while let Ok(Event::State { .. }) = events.recv() {}
+                        });
+                        self.running = None;
+                        self.ended = Some("interrupted (KeyboardInterrupt)".into());
+                        return Err(interrupt);
+                    }
+                }
+                Ok(event) => break Ok(event),
+                Err(RecvTimeoutError::Disconnected) => break Err(()),
+            }
+        };
         match event {
             Ok(Event::State { t, q, qd, notes }) => {
                 (self.t, self.q, self.qd) = (t, q, qd);
-                for n in notes {
-                    if !self.warned.contains(&n) {
-                        warn(py, &format!("extrapolating (--extrapolate): {n}"))?;
-                        self.warned.push(n);
-                    }
+                if let (Some(n), false) = (notes.first(), self.warned) {
+                    warn(py, &format!("extrapolating (--extrapolate): {n} (further values outside the training are not warned of)"))?;
+                    self.warned = true;
                 }
                 Ok(())
             }
@@ -257,8 +286,10 @@ impl Robot {
     /// ----------
     /// dt : float
     ///     The control period [s].
-    /// horizon : float
-    ///     The longest the run may go [s] (default one hour); a step past it is an error.
+    /// horizon : float, optional
+    ///     The longest the run may go [s]: the steps stop at its last whole period, and a step
+    ///     past it is an error. Default: an hour or 100 000 periods, whichever is shorter (the
+    ///     run's sample times are laid out up front: at most 10 000 000 periods).
     /// q0, qd0 : array_like of float, shape (n,), optional
     ///     Start at this state (the coordinates of the model that runs); else straight at rest, or
     ///     with ``from_equilibrium`` at the scenario's equilibrium.
@@ -272,13 +303,13 @@ impl Robot {
     /// -------
     /// Stepper
     ///     At ``t = 0`` (``stepper.q``, ``stepper.qd``); a context manager that ends the run.
-    #[pyo3(signature = (dt, horizon=3600.0, q0=None, qd0=None, from_equilibrium=false, method="auto", rtol=None, atol=None, fixed_step=None))]
+    #[pyo3(signature = (dt, horizon=None, q0=None, qd0=None, from_equilibrium=false, method="auto", rtol=None, atol=None, fixed_step=None))]
     #[allow(clippy::too_many_arguments)]
     fn stepper(
         slf: Py<Self>,
         py: Python<'_>,
         dt: f64,
-        horizon: f64,
+        horizon: Option<f64>,
         q0: Option<arrays::In1<'_>>,
         qd0: Option<arrays::In1<'_>>,
         from_equilibrium: bool,
@@ -293,11 +324,25 @@ impl Robot {
                 gvs::error::fmt_value(dt)
             )));
         }
-        if !(horizon.is_finite() && horizon >= dt) {
+        let horizon = horizon.unwrap_or((100_000.0 * dt).min(3600.0));
+        let periods = horizon / dt;
+        let most = (simulate::MAX_SAMPLES - 2) as f64;
+        let steps = fixed_step.map_or(0.0, |h| horizon / h);
+        if !(horizon.is_finite()
+            && horizon >= dt
+            && periods <= most
+            && steps <= simulate::MAX_FIXED_STEPS)
+        {
             return Err(invalid(format!(
-                "invalid value for `horizon`: {} (expected a finite number of seconds ≥ dt = {})",
+                "invalid value for `horizon`: {} (expected a finite number of seconds ≥ dt = {}, at most {} periods{}: {} s)",
                 gvs::error::fmt_value(horizon),
-                gvs::error::fmt_value(dt)
+                gvs::error::fmt_value(dt),
+                most,
+                match fixed_step {
+                    Some(_) => " and 10 000 000 fixed steps",
+                    None => "",
+                },
+                gvs::error::fmt_value((most * dt).min(fixed_step.map_or(f64::INFINITY, |h| simulate::MAX_FIXED_STEPS * h)))
             )));
         }
         let args = Args {
@@ -357,23 +402,38 @@ pub fn start(robot: Py<Robot>, py: Python<'_>, a: Args) -> PyResult<Stepper> {
     )
     .map_err(err)?;
     let thread_robot = robot.clone_ref(py);
+    let stop = Arc::new(AtomicBool::new(false));
+    let thread_stop = stop.clone();
     let handle = std::thread::spawn(move || {
-        let built = thread_robot.get().built_for_signal_ready();
-        let outcome = simulate::run_into(
-            built,
-            &prepared.plan,
-            &prepared.opts.integrator,
-            None,
-            &mut |_| ControlFlow::Continue(()),
-        );
-        let why = match outcome {
-            Ok(o) => match o.ending {
-                simulate::Ending::Complete => "it reached its horizon".to_string(),
-                simulate::Ending::Interrupted { reason } => reason,
-                simulate::Ending::Failed { error } => error,
-            },
-            Err(e) => e.to_string(),
-        };
+        let run = std::panic::AssertUnwindSafe(|| {
+            let built = thread_robot.get().built_for_signal_ready();
+            let mut control = |_t: f64| match thread_stop.load(Ordering::SeqCst) {
+                true => ControlFlow::Break("interrupted".to_string()),
+                false => ControlFlow::Continue(()),
+            };
+            let outcome = simulate::run_into(
+                built,
+                &prepared.plan,
+                &prepared.opts.integrator,
+                None,
+                &mut control,
+            );
+            match outcome {
+                Ok(o) => match o.ending {
+                    simulate::Ending::Complete => "it reached its horizon".to_string(),
+                    simulate::Ending::Interrupted { reason } => reason,
+                    simulate::Ending::Failed { error } => error,
+                },
+                Err(e) => e.to_string(),
+            }
+        });
+        // a panic of the run is its reason too (else `step` would only learn that it ended)
+        let why = std::panic::catch_unwind(run).unwrap_or_else(|p| {
+            let what = (p.downcast_ref::<String>().cloned())
+                .or_else(|| p.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_default();
+            format!("the run panicked (a bug of gvsrom; please report it): {what}")
+        });
         let _ = to_user.send(Event::Ended(why));
     });
     let mut stepper = Stepper {
@@ -381,6 +441,7 @@ pub fn start(robot: Py<Robot>, py: Python<'_>, a: Args) -> PyResult<Stepper> {
             tensions: to_law,
             events: Mutex::new(from_law),
             handle: Some(handle),
+            stop,
         }),
         dt: a.dt,
         n_actuators: na,
@@ -388,7 +449,7 @@ pub fn start(robot: Py<Robot>, py: Python<'_>, a: Args) -> PyResult<Stepper> {
         q: vec![],
         qd: vec![],
         ended: None,
-        warned: vec![],
+        warned: false,
     };
     stepper.receive(py)?;
     Ok(stepper)

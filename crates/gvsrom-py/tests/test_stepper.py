@@ -1,6 +1,11 @@
 """Robot.stepper: a run advanced one control period per `step(u)` (a loop the user drives), the
 same integration as `simulate(controller=…)`; its errors, its end, its horizon."""
 
+import os
+import signal
+import threading
+import time
+
 import numpy as np
 import pytest
 
@@ -77,3 +82,27 @@ def test_a_reduced_model_steps_in_its_coordinates_and_checks_its_training(gvsrom
         assert q.shape == (2,) and qd.shape == (2,)
         with pytest.raises(gvsrom.GvsromError, match=r"`step\(u\)` at t = 0.01 s: .*outside the training"):
             env.step(-20.0)
+
+
+def test_the_default_horizon_suits_a_small_period_and_a_long_one_is_refused_naming_it(robot):
+    # 100 000 periods at dt = 1e-4 (10 s), where an hour would lay out 36 million sample times
+    with robot.stepper(1e-4, fixed_step=1e-4) as env:
+        env.step(-1.0)
+        assert env.t == pytest.approx(1e-4)
+    with pytest.raises(gvsrom.GvsromError, match=r"invalid value for `horizon`: 3600 .*at most 9999998 periods"):
+        robot.stepper(1e-4, horizon=3600.0)
+
+
+@pytest.mark.skipif(os.name != "posix", reason="SIGINT to self")
+def test_ctrl_c_during_a_step_stops_the_run_at_once(robot, sigint_raises):
+    # a step of 10 s at a tiny fixed step takes far longer than the signal's 0.3 s
+    env = robot.stepper(10.0, horizon=10.0, fixed_step=1e-5)
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    t0 = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        env.step(-1.0)
+    assert time.monotonic() - t0 < 3.0
+    assert not env.running and env.t == 0.0
+    with pytest.raises(gvsrom.GvsromError, match=r"has ended at t = 0 s: interrupted"):
+        env.step(-1.0)

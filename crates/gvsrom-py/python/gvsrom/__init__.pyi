@@ -437,7 +437,7 @@ class Robot:
     def stepper(
         self,
         dt: float,
-        horizon: float = 3600.0,
+        horizon: float | None = None,
         q0: ArrayLike | None = None,
         qd0: ArrayLike | None = None,
         from_equilibrium: bool = False,

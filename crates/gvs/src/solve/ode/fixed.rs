@@ -426,9 +426,13 @@ fn newton<C: Corrector>(
             let r = nrm / oldnrm;
             rate = Some(rate.map_or(r, |q| r.max(0.9 * q)));
         }
+        // after a breakpoint with a Jacobian from before it, a second iteration measures how
+        // fast it still contracts: one small correction alone says nothing of that (with ρ near
+        // 1 the error is ρ/(1−ρ) times it)
+        let measure = it == 1 && st.piece_start && !st.jac_fresh;
         let converged = match rate {
             Some(r) => nrm * r / (1.0 - r) <= tol,
-            None => nrm <= tol,
+            None => nrm <= tol && !measure,
         };
         if converged {
             st.rate = rate;
