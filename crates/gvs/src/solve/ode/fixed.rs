@@ -92,7 +92,7 @@ enum Newton {
 ///   steps. The
 ///   Jacobian (analytic, or forward differences with increment `√eps·max(|y_j|, 1)`) is evaluated
 ///   at the start and re-evaluated, at most once per step, only when Newton stalls (`ρ > 0.9` or no
-///   convergence within `max_newton`) — and up front at the next [`REFRESH_AFTER_STALL`]
+///   convergence within `max_newton`) — and up front at the next 8 (`REFRESH_AFTER_STALL`)
 ///   breakpoints once one kept across a breakpoint stalled there (the input's jump changes it: a
 ///   tendon's load stiffness scales with its tension; a sampled-data controller's breakpoints come
 ///   every period); if it still fails, or the right-hand side refuses a Newton
