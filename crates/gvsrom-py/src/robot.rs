@@ -1,24 +1,18 @@
 //! `gvsrom.Robot`: a built scenario (the engine's model, loads, tensions and solver options), with
-//! a reduced model attached or not; its statics, dynamics and model quantities.
+//! a reduced model attached or not, and its description (the statics are in `robot_statics`, the
+//! model quantities in `robot_quantities` and `dynamics_quantities`, the runs in `simulate`).
 
-use crate::arrays::{self, In1, In2, Tensions};
+use crate::arrays::{self, In1, Tensions};
 use crate::errors::{self, invalid, scenario as err};
-use crate::interrupt;
 use crate::models::Model;
 use crate::quantities::{self, WorkspaceCache};
 use crate::scenario::Scenario;
-use crate::statics::{Statics, StaticsBatch};
-use gvsrom::dataset::DEFAULT_CHUNK_SIZE;
 use gvsrom::reduce::{self, AttachOptions};
-use gvsrom::statics::{self, StaticsReport};
 use gvsrom::Built;
 use pyo3::exceptions::PyUserWarning;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
-use rayon::prelude::*;
 use std::ffi::CString;
 use std::path::PathBuf;
-use std::sync::atomic::Ordering;
 use std::sync::OnceLock;
 
 /// A reduced model to attach: its directory, whether it may extrapolate (`--extrapolate`), and
@@ -153,7 +147,7 @@ impl Robot {
 
     /// The scenario with tensions `u` (`--tension`), built with the model attached: for the runs
     /// whose reduced model needs its initial guess at `u`.
-    fn rebuilt_with(
+    pub(crate) fn rebuilt_with(
         &self,
         py: Python<'_>,
         u: Option<&[f64]>,
@@ -240,60 +234,6 @@ impl Robot {
         }
         Ok(u)
     }
-
-    /// The equilibrium under `u` with this robot's reduced model as attached, without building
-    /// the scenario again: `None` if `u` is not accepted as it is (a bad count or value, a tension
-    /// outside the training inputs, a model that extrapolates), where [`Self::rebuilt_with`] gives
-    /// the command line's verdict.
-    fn solve_attached(&self, py: Python<'_>, u: Option<&[f64]>) -> Option<PyResult<StaticsReport>> {
-        let r = self.built.reduced.as_ref()?;
-        let u = match u {
-            Some(u) => self.built.tensions(u).ok()?,
-            None => self.built.u.clone(),
-        };
-        if !r.covers_tensions(&self.built.u, &u) {
-            return None;
-        }
-        let report = py.detach(|| statics::solve_checked(&self.built, &u));
-        Some(report.map_err(errors::any))
-    }
-
-    /// The equilibrium under `u` (the scenario's tensions if `None`) with `attached` (else this
-    /// robot's model): `gvsrom statics [--tension u] [--model DIR]`; with how the model was used
-    /// outside its training (`--extrapolate`'s sentences, the `--json`'s `model_extrapolated`).
-    fn solve(
-        &self,
-        py: Python<'_>,
-        u: Option<Vec<f64>>,
-        attached: Option<&Attached>,
-    ) -> PyResult<(StaticsReport, Vec<String>)> {
-        match attached.or(self.attached.as_ref()) {
-            None => {
-                let u = match u {
-                    Some(u) => self.built.tensions(&u).map_err(err)?,
-                    None => self.built.u.clone(),
-                };
-                let report = py
-                    .detach(|| statics::solve_under(&self.built, &u))
-                    .map_err(|f| errors::statics(py, f))?;
-                Ok((report, vec![]))
-            }
-            Some(a) => {
-                if attached.is_none() {
-                    // answered only where the model is not extrapolating
-                    if let Some(report) = self.solve_attached(py, u.as_deref()) {
-                        return Ok((report?, vec![]));
-                    }
-                }
-                let built = self.rebuilt_with(py, u.as_deref(), a)?;
-                let report = py
-                    .detach(|| statics::solve_checked(&built, &built.u))
-                    .map_err(errors::any)?;
-                let extrapolated = built.reduced.map(|r| r.extrapolated).unwrap_or_default();
-                Ok((report, extrapolated))
-            }
-        }
-    }
 }
 
 #[pymethods]
@@ -348,7 +288,7 @@ impl Robot {
 
     /// Abscissae X of the computational points [m], shape ``(n_points,)``.
     #[getter]
-    fn point_x<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+    pub(crate) fn point_x<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
         let x: Vec<f64> = self.built.model.disc.points.iter().map(|p| p.x).collect();
         arrays::vector(py, &x)
     }
@@ -430,298 +370,6 @@ impl Robot {
         extrapolate: Option<bool>,
     ) -> PyResult<Robot> {
         Robot::new(py, self.scenario.clone(), Some(model.attached(extrapolate)))
-    }
-
-    /// Static equilibrium under tendon tensions ``u``, as ``gvsrom statics`` solves it (same
-    /// numbers as its ``--json``).
-    ///
-    /// Parameters
-    /// ----------
-    /// u : array_like of float, optional
-    ///     Tensions [N] (negative pulls): one per tendon, or one for all. Default: the scenario's.
-    /// model : Model, optional
-    ///     A reduced model to solve with (``--model``); default: this robot's.
-    ///
-    /// Returns
-    /// -------
-    /// Statics
-    ///     ``q``, the tip pose, the centreline, the strains and the solver statistics.
-    ///
-    /// Raises
-    /// ------
-    /// GvsromError
-    ///     For tensions of the wrong count, not finite or implausible with the loads.
-    /// ConvergenceError
-    ///     If the solve does not converge (with its iterations and residual).
-    #[pyo3(signature = (u=None, model=None))]
-    fn statics(
-        &self,
-        py: Python<'_>,
-        u: Option<Tensions<'_>>,
-        model: Option<PyRef<'_, Model>>,
-    ) -> PyResult<Statics> {
-        let u = u.map(|a| a.values());
-        let attached = model.map(|m| m.attached(None));
-        let (report, extrapolated) = self.solve(py, u, attached.as_ref())?;
-        Statics::new(py, &report, extrapolated)
-    }
-
-    /// Static equilibria under many tensions, solved in parallel (all cores, the GIL released).
-    ///
-    /// As ``gvsrom dataset`` solves a plan of tensions: chunks of 128 consecutive rows in
-    /// parallel, each along a chain of nearest neighbours, every solve starting from the nearest
-    /// solution of its chunk (the scenario's load ramp from straight if that fails). Row ``k``
-    /// equals ``statics(U[k])`` to the solver's tolerance, and the dataset's sample ``k`` of the
-    /// same tensions exactly. With ``warm_start=False`` every row is solved from straight, as
-    /// ``statics(U[k])`` solves it (the same numbers; 1.2–1.4× the time on IV-A's sweep).
-    ///
-    /// Parameters
-    /// ----------
-    /// U : array_like of float, shape (m, n_actuators)
-    ///     One row of tensions [N] per equilibrium.
-    /// warm_start : bool
-    ///     Start each solve from a neighbouring row's solution (default).
-    ///
-    /// Returns
-    /// -------
-    /// StaticsBatch
-    ///     The solutions' arrays stacked along a first axis of length m.
-    ///
-    /// Raises
-    /// ------
-    /// GvsromError, ConvergenceError
-    ///     For the first row that fails, named ``U[k]``; a ``GvsromError`` for a robot with a
-    ///     reduced model attached (``with_model``): the batch solves the full model, so call
-    ///     ``statics(u)`` per row instead.
-    #[allow(non_snake_case)]
-    #[pyo3(signature = (U, warm_start=true))]
-    fn statics_batch(
-        &self,
-        py: Python<'_>,
-        U: In2<'_>,
-        warm_start: bool,
-    ) -> PyResult<StaticsBatch> {
-        if self.attached.is_some() {
-            return Err(invalid(
-                "statics_batch solves the full model; call statics(u) per row with a reduced model",
-            ));
-        }
-        let na = self.built.model.n_actuators();
-        let rows = arrays::rows("U", &U, na, "one tension per tendon")?;
-        let rows = rows
-            .iter()
-            .enumerate()
-            .map(|(k, u)| {
-                self.built
-                    .tensions(u)
-                    .map_err(|e| invalid(format!("U[{k}]: {e}")))
-            })
-            .collect::<PyResult<Vec<_>>>()?;
-        let built = &self.built;
-        let (results, caught) = interrupt::run(py, |flag| {
-            let stop =
-                || (flag.load(Ordering::SeqCst) != 0).then(|| "interrupted (Ctrl-C)".to_string());
-            if warm_start {
-                statics::solve_batch(built, &rows, DEFAULT_CHUNK_SIZE, &stop)
-            } else {
-                rows.par_iter()
-                    .map(|u| stop().is_none().then(|| statics::solve_under(built, u)))
-                    .collect::<Option<Vec<_>>>()
-            }
-        });
-        if let Some(e) = caught {
-            return Err(e);
-        }
-        let Some(results) = results else {
-            return Err(invalid("statics_batch was stopped before it finished"));
-        };
-        let mut reports = Vec::with_capacity(results.len());
-        for (k, r) in results.into_iter().enumerate() {
-            match r {
-                Ok(report) => reports.push(report),
-                Err(f) => {
-                    let message = format!("U[{k}]: {f}");
-                    return Err(errors::statics_with_message(py, &f, &message));
-                }
-            }
-        }
-        StaticsBatch::new(py, &reports, built)
-    }
-
-    /// Forward kinematics: the poses of the cross-sections at the computational points.
-    ///
-    /// Parameters
-    /// ----------
-    /// q : array_like of float, shape (n_dof,)
-    ///
-    /// Returns
-    /// -------
-    /// dict
-    ///     ``x`` (p,) abscissae [m], ``position`` (p, 3) [m], ``rotation`` (p, 3, 3) (section →
-    ///     world).
-    fn forward<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyDict>> {
-        let q = self.coordinates(&q)?;
-        let (pos, rot) = py.detach(|| quantities::forward(&self.built, &self.workspaces, &q));
-        let p = self.built.model.disc.n_points();
-        let d = PyDict::new(py);
-        d.set_item("x", self.point_x(py))?;
-        d.set_item("position", arrays::shaped(py, pos, [p, 3])?)?;
-        d.set_item("rotation", arrays::shaped(py, rot, [p, 3, 3])?)?;
-        Ok(d)
-    }
-
-    /// Geometric (body) Jacobian ``J_i`` of point ``i``: the section's twist is
-    /// ``η_i = J_i q̇`` (angular velocity first, then linear, both in the section frame): rows
-    /// 0–2 in rad/s and rows 3–5 in m/s per unit of ``q̇``.
-    ///
-    /// Parameters
-    /// ----------
-    /// q : array_like of float, shape (n_dof,)
-    /// point : int, optional
-    ///     Point index (negative counts from the tip); default: all points.
-    ///
-    /// Returns
-    /// -------
-    /// numpy.ndarray
-    ///     Shape (6, n_dof), or (n_points, 6, n_dof) for all points.
-    #[pyo3(signature = (q, point=None))]
-    fn jacobian<'py>(
-        &self,
-        py: Python<'py>,
-        q: In1<'_>,
-        #[pyo3(from_py_with = arrays::whole_or_none)] point: Option<i128>,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        let n = self.built.n_dof();
-        let q = self.coordinates(&q)?;
-        let p = self.built.model.disc.n_points();
-        let which: Vec<usize> = match point {
-            None => (0..p).collect(),
-            Some(i) => {
-                let j = if i < 0 { i + p as i128 } else { i };
-                if !(0..p as i128).contains(&j) {
-                    return Err(invalid(format!(
-                        "`point` = {i} is out of range: the rod has {p} points"
-                    )));
-                }
-                vec![j as usize]
-            }
-        };
-        let flat = py.detach(|| quantities::jacobians(&self.built, &self.workspaces, &q, &which));
-        match point {
-            None => arrays::shaped(py, flat, [p, 6, n]),
-            Some(_) => arrays::shaped(py, flat, [6, n]),
-        }
-    }
-
-    /// World position of the centreline at abscissa ``x`` and its Jacobian ``∂p/∂q`` (world
-    /// axes): ``δp = J δq``, the output matrix of a position sensor or a task-space controller at
-    /// ``x``. At a computational point ``J`` is ``R_i`` times rows 3–5 of ``jacobian(q, i)``;
-    /// between points, the derivative of the centreline's cubic Hermite interpolant (the one
-    /// ``statics`` samples). ``linearize(outputs=…)`` stacks the same rows into ``C``.
-    ///
-    /// Parameters
-    /// ----------
-    /// q : array_like of float, shape (n_dof,)
-    /// x : float or array_like of float
-    ///     Abscissa(e) [m] within [0, length].
-    ///
-    /// Returns
-    /// -------
-    /// tuple of numpy.ndarray
-    ///     ``(position, jacobian)``: shapes (3,) and (3, n_dof) for one ``x``, (k, 3) and
-    ///     (k, 3, n_dof) for k of them.
-    fn position_jacobian<'py>(
-        &self,
-        py: Python<'py>,
-        q: In1<'_>,
-        x: arrays::Abscissae,
-    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-        let q = self.coordinates(&q)?;
-        let arrays::Abscissae { values: xs, one } = x;
-        gvsrom::linearize::check_abscissae("x", &xs, self.built.model.disc.length())
-            .map_err(|e| invalid(e.to_string()))?;
-        let n = self.built.n_dof();
-        let k = xs.len();
-        let (pos, jac) =
-            py.detach(|| quantities::position_jacobians(&self.built, &self.workspaces, &q, &xs));
-        match one {
-            true => Ok((
-                arrays::shaped(py, pos, [3])?,
-                arrays::shaped(py, jac, [3, n])?,
-            )),
-            false => Ok((
-                arrays::shaped(py, pos, [k, 3])?,
-                arrays::shaped(py, jac, [k, 3, n])?,
-            )),
-        }
-    }
-
-    /// Section twists ``η_i`` at the points (angular then linear velocity, section frame) at
-    /// ``(q, q̇)``, by the engine's velocity recursion.
-    ///
-    /// Returns
-    /// -------
-    /// numpy.ndarray
-    ///     Shape (n_points, 6): rad/s, then m/s.
-    fn point_velocities<'py>(
-        &self,
-        py: Python<'py>,
-        q: In1<'_>,
-        qd: In1<'_>,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        let n = self.built.n_dof();
-        let (q, qd) = (self.coordinates(&q)?, arrays::dvec("qd", &qd, n)?);
-        let flat = py.detach(|| quantities::velocities(&self.built, &self.workspaces, &q, &qd));
-        crate::dynamics_quantities::finite_at("the point velocities", &flat, &qd)?;
-        arrays::shaped(py, flat, [self.built.model.disc.n_points(), 6])
-    }
-
-    /// The mass matrix ``M(q)`` (symmetric positive definite), shape (n_dof, n_dof):
-    /// ``½ q̇ᵀ M q̇`` is the kinetic energy [J] (units: see :class:`Robot`).
-    fn mass_matrix<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyAny>> {
-        let q = self.coordinates(&q)?;
-        let m = py.detach(|| quantities::mass_matrix(&self.built, &self.workspaces, &q));
-        arrays::matrix(py, &m)
-    }
-
-    /// The static residual ``R(q) = −K₁(q) + F(q) + B(q)u`` (paper eq. 9) under the scenario's
-    /// loads: zero at an equilibrium. A generalized force [J per unit of q].
-    ///
-    /// Parameters
-    /// ----------
-    /// q : array_like of float, shape (n_dof,)
-    /// u : array_like of float, optional
-    ///     Tensions [N], one per tendon or one for all; default: the scenario's.
-    #[pyo3(signature = (q, u=None))]
-    fn statics_residual<'py>(
-        &self,
-        py: Python<'py>,
-        q: In1<'_>,
-        u: Option<Tensions<'_>>,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        let q = self.coordinates(&q)?;
-        let u = self.quantity_tensions(py, u)?;
-        let r = py
-            .detach(|| quantities::statics_residual(&self.built, &self.workspaces, &q, &u))
-            .map_err(err)?;
-        Ok(arrays::vector(py, r.as_slice()))
-    }
-
-    /// The analytic Jacobian ``∂R/∂q`` of :meth:`statics_residual`, shape (n_dof, n_dof)
-    /// [J per unit of q²: ``δqᵀ (∂R/∂q) δq`` is in J].
-    #[pyo3(signature = (q, u=None))]
-    fn statics_jacobian<'py>(
-        &self,
-        py: Python<'py>,
-        q: In1<'_>,
-        u: Option<Tensions<'_>>,
-    ) -> PyResult<Bound<'py, PyAny>> {
-        let q = self.coordinates(&q)?;
-        let u = self.quantity_tensions(py, u)?;
-        let j = py
-            .detach(|| quantities::statics_jacobian(&self.built, &self.workspaces, &q, &u))
-            .map_err(err)?;
-        arrays::matrix(py, &j)
     }
 
     fn __repr__(&self) -> String {

@@ -3,59 +3,14 @@
 //! is the scenario's tensions, rows `t, u_1, …` or a Python callable `u(t)` ([`CallableInput`]).
 
 use crate::arrays::{self, shaped, vector};
-use crate::callable::{CallableInput, Kind};
+use crate::callable::Kind;
 use crate::errors::{invalid, scenario as err};
 use crate::robot::{warn, Robot};
-use gvs::inputs::{Interpolation, Signal};
-use gvsrom::simulate::{
-    self, ControlLaw, Ending, ErrorNormChoice, InputFunction, InputSource, IntegratorChoice,
-    MethodChoice, SampleSink, TrajectoryBuffer, TrajectoryWriter,
-};
+use crate::simulate_args::{start, Args, Drive};
+use gvsrom::simulate::{self, Ending, SampleSink, TrajectoryBuffer, TrajectoryWriter};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::ops::ControlFlow;
-use std::sync::Arc;
-
-/// The arguments of [`run`] (the options of `gvsrom simulate`).
-pub struct Args<'a> {
-    pub duration: f64,
-    pub sample_rate: f64,
-    pub input: Option<Bound<'a, PyAny>>,
-    pub interpolate: bool,
-    pub from_equilibrium: bool,
-    /// A given start `(q, q̇)` (`q̇ = 0` if only `q` is given).
-    pub q0: Option<Vec<f64>>,
-    pub qd0: Option<Vec<f64>>,
-    pub method: &'a str,
-    pub rtol: Option<f64>,
-    pub atol: Option<f64>,
-    /// A fixed step \[s\]: the fixed-step BDF2 instead of an adaptive method (`--fixed-step`).
-    pub fixed_step: Option<f64>,
-    /// A CSV file `t, λ` scaling the loads and gravity over time (`--load-schedule`).
-    pub load_schedule: Option<std::path::PathBuf>,
-    /// Random steps `lo, hi, period` (`--steps`).
-    pub steps: Option<Vec<f64>>,
-    /// Actuator babbling `lo, hi, hold_min, hold_max` (`--babble`).
-    pub babble: Option<Vec<f64>>,
-    /// Seed of `steps` and `babble` (`--seed`).
-    pub seed: u64,
-    /// Highest NDF order (`--max-order`).
-    pub max_order: Option<usize>,
-    /// The adaptive methods' error test, `componentwise` or `mass` (`--error-norm`).
-    pub error_norm: Option<&'a str>,
-    /// Generalized-α's spectral radius at infinite frequency (`--rho-inf`).
-    pub rho_inf: Option<f64>,
-    /// Finite differences for the integrator's Jacobian (`--fd-jacobian`).
-    pub fd_jacobian: bool,
-    /// A controller `u(t, q, q̇)` called at the control instants, its tensions held between them.
-    pub controller: Option<Bound<'a, PyAny>>,
-    /// Its calls per second (default: the sample rate).
-    pub control_rate: Option<f64>,
-    /// A directory to write the trajectory to, as `gvsrom simulate --out` does.
-    pub out: Option<std::path::PathBuf>,
-    /// Replace an earlier gvsrom output at `out` (`--force`).
-    pub force: bool,
-}
 
 #[pymethods]
 impl Robot {
@@ -232,168 +187,20 @@ impl Robot {
     }
 }
 
-fn error_norm(name: &str) -> PyResult<ErrorNormChoice> {
-    Ok(match name {
-        "componentwise" => ErrorNormChoice::Componentwise,
-        "mass" => ErrorNormChoice::Mass,
-        other => {
-            return Err(invalid(format!(
-                "invalid `error_norm`: `{other}` (accepted: componentwise, mass)"
-            )))
-        }
-    })
-}
-
-pub fn method(name: &str) -> PyResult<MethodChoice> {
-    Ok(match name {
-        "auto" => MethodChoice::Auto,
-        "ndf" => MethodChoice::Ndf,
-        "sdirk" => MethodChoice::Sdirk,
-        "galpha" => MethodChoice::Galpha,
-        other => {
-            return Err(invalid(format!(
-                "invalid `method`: `{other}` (accepted: auto, ndf, sdirk, galpha)"
-            )))
-        }
-    })
-}
-
-/// Where the run starts: `from_equilibrium`, a given state `q0` (`qd0`: zero if not given), or
-/// straight at rest.
-pub fn start(
-    q0: &Option<Vec<f64>>,
-    qd0: &Option<Vec<f64>>,
-    from_equilibrium: bool,
-) -> PyResult<simulate::Start> {
-    Ok(match (q0, qd0, from_equilibrium) {
-        (Some(_), _, true) => {
-            return Err(invalid(
-                "`from_equilibrium=True` and `q0` both say where the run starts: give one",
-            ))
-        }
-        (None, Some(_), _) => {
-            return Err(invalid(
-                "`qd0` given without `q0`: a start state needs its coordinates `q0` (`qd0` defaults to zeros)",
-            ))
-        }
-        (Some(q), qd, false) => simulate::Start::State {
-            q: q.clone(),
-            qd: qd.clone().unwrap_or_else(|| vec![0.0; q.len()]),
-        },
-        (None, None, from_equilibrium) => simulate::Start::rest_or_equilibrium(from_equilibrium),
-    })
-}
-
 pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'py, PyDict>> {
     let na = robot.built.model.n_actuators();
     let start = start(&a.q0, &a.qd0, a.from_equilibrium)?;
     let attached = robot.attached.is_some();
-    let callable = match (&a.input, &a.controller) {
-        (Some(_), Some(_)) => {
-            return Err(invalid(
-                "`input` and `controller` both give the tensions: give one",
-            ))
-        }
-        (_, Some(f)) if !f.is_callable() => {
-            return Err(pyo3::exceptions::PyTypeError::new_err(format!(
-                "`controller` must be a callable `controller(t, q, qd) -> tensions`, got `{}`",
-                f.repr()?
-            )))
-        }
-        (_, Some(f)) => Some(Arc::new(CallableInput::new(
-            f.clone().unbind(),
-            Kind::Controller,
-            na,
-            attached,
-        ))),
-        (Some(f), None) if f.is_callable() => {
-            if a.interpolate {
-                return Err(invalid(
-                    "`interpolate` applies to an input of rows, not to a callable `input`",
-                ));
-            }
-            Some(Arc::new(CallableInput::new(
-                f.clone().unbind(),
-                Kind::Input,
-                na,
-                attached,
-            )))
-        }
-        _ => None,
-    };
-    if a.control_rate.is_some() && a.controller.is_none() {
-        return Err(invalid(
-            "`control_rate` is the rate of a `controller`: give one (or leave `control_rate` out)",
-        ));
-    }
-    if a.interpolate && a.controller.is_some() {
-        return Err(invalid(
-            "`interpolate` applies to an input of rows; a controller's tensions are held",
-        ));
-    }
-    if a.interpolate && a.input.is_none() {
-        return Err(invalid(
-            "`interpolate` applies to an `input` of rows: give one (without it the tensions are constant)",
-        ));
-    }
-    let random = a.steps.is_some() || a.babble.is_some();
-    if random && (a.input.is_some() || a.controller.is_some()) {
-        return Err(invalid(
-            "`input`, `controller`, `steps` and `babble` each give the tensions: give at most one",
-        ));
-    }
-    let input = match (&a.input, &callable) {
-        (None, Some(c)) => InputSource::Feedback {
-            law: ControlLaw(c.clone()),
-            control_rate: a.control_rate,
-        },
-        (None, _) if random => {
-            InputSource::from_options(None, false, a.steps.as_deref(), a.babble.as_deref(), a.seed)
-                .map_err(err)?
-        }
-        (None, _) => InputSource::Constant,
-        (Some(_), Some(c)) => InputSource::Function(InputFunction(c.clone())),
-        (Some(obj), None) => {
-            // a TypeError, as for every array argument, that says what was given
-            let rows: arrays::In2<'_> = obj.extract().map_err(|e: PyErr| {
-                pyo3::exceptions::PyTypeError::new_err(format!(
-                    "`input` must be rows `t, u_1, …, u_{na}` (1 + {na} columns: a 2-D array) or a callable `u(t)`: {}",
-                    e.value(py)
-                ))
-            })?;
-            let rows = arrays::rows("input", &rows, 1 + na, "t, then one tension per tendon")?;
-            arrays::finite_rows("input", &rows, |j| match j {
-                0 => "the time t in s".to_string(),
-                _ => format!("the tension u_{j} of tendon {} in N", j - 1),
-            })?;
-            InputSource::Rows(Signal {
-                times: rows.iter().map(|r| r[0]).collect(),
-                values: rows.iter().map(|r| r[1..].to_vec()).collect(),
-                interpolation: if a.interpolate {
-                    Interpolation::Linear
-                } else {
-                    Interpolation::Hold
-                },
-            })
-        }
-    };
-    // a reduced model checks a signal's tensions, not the scenario's (`simulate --model`)
-    // (from an equilibrium, the scenario's tensions are the start's: checked as attached)
-    let signal = random || a.input.is_some() || a.controller.is_some();
+    let Drive {
+        input,
+        callable,
+        signal,
+    } = a.drive(py, na, attached)?;
     let built = match signal && !a.from_equilibrium {
         true => robot.built_for_signal(py)?,
         false => &robot.built,
     };
-    let choice = IntegratorChoice {
-        method: method(a.method)?,
-        rtol: a.rtol,
-        atol: a.atol,
-        fixed_step: a.fixed_step,
-        max_order: a.max_order,
-        error_norm: a.error_norm.map(error_norm).transpose()?,
-        rho_inf: a.rho_inf,
-        fd_jacobian: a.fd_jacobian,
-    };
+    let choice = a.integrator()?;
     if a.force && a.out.is_none() {
         return Err(invalid(
             "`force` replaces an earlier output at `out`: give `out` (or leave `force` out)",

@@ -351,7 +351,7 @@ impl Robot {
             q0: q0.as_ref().map(arrays::vec1),
             qd0: qd0.as_ref().map(arrays::vec1),
             from_equilibrium,
-            method: crate::simulate::method(method)?,
+            method: crate::simulate_args::method(method)?,
             fixed_step,
             rtol,
             atol,
@@ -371,7 +371,7 @@ pub fn start(robot: Py<Robot>, py: Python<'_>, a: Args) -> PyResult<Stepper> {
             "`stepper`: the robot has no tendons to set tensions on",
         ));
     }
-    let start = crate::simulate::start(&a.q0, &a.qd0, a.from_equilibrium)?;
+    let start = crate::simulate_args::start(&a.q0, &a.qd0, a.from_equilibrium)?;
     let (to_law, from_user) = channel::<Option<Vec<f64>>>();
     let (to_user, from_law) = channel::<Event>();
     let law = Arc::new(ChannelLaw {

@@ -1,0 +1,189 @@
+//! `Robot.statics` and `Robot.statics_batch`: the static equilibria of a robot, as `gvsrom
+//! statics` and `gvsrom dataset` solve them, with the reduced model attached or not.
+
+use crate::arrays::{self, In2, Tensions};
+use crate::errors::{self, invalid, scenario as err};
+use crate::interrupt;
+use crate::models::Model;
+use crate::robot::{Attached, Robot};
+use crate::statics::{Statics, StaticsBatch};
+use gvsrom::dataset::DEFAULT_CHUNK_SIZE;
+use gvsrom::statics::{self, StaticsReport};
+use pyo3::prelude::*;
+use rayon::prelude::*;
+use std::sync::atomic::Ordering;
+
+impl Robot {
+    /// The equilibrium under `u` with this robot's reduced model as attached, without building
+    /// the scenario again: `None` if `u` is not accepted as it is (a bad count or value, a tension
+    /// outside the training inputs, a model that extrapolates), where [`Self::rebuilt_with`] gives
+    /// the command line's verdict.
+    fn solve_attached(&self, py: Python<'_>, u: Option<&[f64]>) -> Option<PyResult<StaticsReport>> {
+        let r = self.built.reduced.as_ref()?;
+        let u = match u {
+            Some(u) => self.built.tensions(u).ok()?,
+            None => self.built.u.clone(),
+        };
+        if !r.covers_tensions(&self.built.u, &u) {
+            return None;
+        }
+        let report = py.detach(|| statics::solve_checked(&self.built, &u));
+        Some(report.map_err(errors::any))
+    }
+
+    /// The equilibrium under `u` (the scenario's tensions if `None`) with `attached` (else this
+    /// robot's model): `gvsrom statics [--tension u] [--model DIR]`; with how the model was used
+    /// outside its training (`--extrapolate`'s sentences, the `--json`'s `model_extrapolated`).
+    pub(crate) fn solve(
+        &self,
+        py: Python<'_>,
+        u: Option<Vec<f64>>,
+        attached: Option<&Attached>,
+    ) -> PyResult<(StaticsReport, Vec<String>)> {
+        match attached.or(self.attached.as_ref()) {
+            None => {
+                let u = match u {
+                    Some(u) => self.built.tensions(&u).map_err(err)?,
+                    None => self.built.u.clone(),
+                };
+                let report = py
+                    .detach(|| statics::solve_under(&self.built, &u))
+                    .map_err(|f| errors::statics(py, f))?;
+                Ok((report, vec![]))
+            }
+            Some(a) => {
+                if attached.is_none() {
+                    // answered only where the model is not extrapolating
+                    if let Some(report) = self.solve_attached(py, u.as_deref()) {
+                        return Ok((report?, vec![]));
+                    }
+                }
+                let built = self.rebuilt_with(py, u.as_deref(), a)?;
+                let report = py
+                    .detach(|| statics::solve_checked(&built, &built.u))
+                    .map_err(errors::any)?;
+                let extrapolated = built.reduced.map(|r| r.extrapolated).unwrap_or_default();
+                Ok((report, extrapolated))
+            }
+        }
+    }
+}
+
+#[pymethods]
+impl Robot {
+    /// Static equilibrium under tendon tensions ``u``, as ``gvsrom statics`` solves it (same
+    /// numbers as its ``--json``).
+    ///
+    /// Parameters
+    /// ----------
+    /// u : array_like of float, optional
+    ///     Tensions [N] (negative pulls): one per tendon, or one for all. Default: the scenario's.
+    /// model : Model, optional
+    ///     A reduced model to solve with (``--model``); default: this robot's.
+    ///
+    /// Returns
+    /// -------
+    /// Statics
+    ///     ``q``, the tip pose, the centreline, the strains and the solver statistics.
+    ///
+    /// Raises
+    /// ------
+    /// GvsromError
+    ///     For tensions of the wrong count, not finite or implausible with the loads.
+    /// ConvergenceError
+    ///     If the solve does not converge (with its iterations and residual).
+    #[pyo3(signature = (u=None, model=None))]
+    fn statics(
+        &self,
+        py: Python<'_>,
+        u: Option<Tensions<'_>>,
+        model: Option<PyRef<'_, Model>>,
+    ) -> PyResult<Statics> {
+        let u = u.map(|a| a.values());
+        let attached = model.map(|m| m.attached(None));
+        let (report, extrapolated) = self.solve(py, u, attached.as_ref())?;
+        Statics::new(py, &report, extrapolated)
+    }
+
+    /// Static equilibria under many tensions, solved in parallel (all cores, the GIL released).
+    ///
+    /// As ``gvsrom dataset`` solves a plan of tensions: chunks of 128 consecutive rows in
+    /// parallel, each along a chain of nearest neighbours, every solve starting from the nearest
+    /// solution of its chunk (the scenario's load ramp from straight if that fails). Row ``k``
+    /// equals ``statics(U[k])`` to the solver's tolerance, and the dataset's sample ``k`` of the
+    /// same tensions exactly. With ``warm_start=False`` every row is solved from straight, as
+    /// ``statics(U[k])`` solves it (the same numbers; 1.2–1.4× the time on IV-A's sweep).
+    ///
+    /// Parameters
+    /// ----------
+    /// U : array_like of float, shape (m, n_actuators)
+    ///     One row of tensions [N] per equilibrium.
+    /// warm_start : bool
+    ///     Start each solve from a neighbouring row's solution (default).
+    ///
+    /// Returns
+    /// -------
+    /// StaticsBatch
+    ///     The solutions' arrays stacked along a first axis of length m.
+    ///
+    /// Raises
+    /// ------
+    /// GvsromError, ConvergenceError
+    ///     For the first row that fails, named ``U[k]``; a ``GvsromError`` for a robot with a
+    ///     reduced model attached (``with_model``): the batch solves the full model, so call
+    ///     ``statics(u)`` per row instead.
+    #[allow(non_snake_case)]
+    #[pyo3(signature = (U, warm_start=true))]
+    fn statics_batch(
+        &self,
+        py: Python<'_>,
+        U: In2<'_>,
+        warm_start: bool,
+    ) -> PyResult<StaticsBatch> {
+        if self.attached.is_some() {
+            return Err(invalid(
+                "statics_batch solves the full model; call statics(u) per row with a reduced model",
+            ));
+        }
+        let na = self.built.model.n_actuators();
+        let rows = arrays::rows("U", &U, na, "one tension per tendon")?;
+        let rows = rows
+            .iter()
+            .enumerate()
+            .map(|(k, u)| {
+                self.built
+                    .tensions(u)
+                    .map_err(|e| invalid(format!("U[{k}]: {e}")))
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        let built = &self.built;
+        let (results, caught) = interrupt::run(py, |flag| {
+            let stop =
+                || (flag.load(Ordering::SeqCst) != 0).then(|| "interrupted (Ctrl-C)".to_string());
+            if warm_start {
+                statics::solve_batch(built, &rows, DEFAULT_CHUNK_SIZE, &stop)
+            } else {
+                rows.par_iter()
+                    .map(|u| stop().is_none().then(|| statics::solve_under(built, u)))
+                    .collect::<Option<Vec<_>>>()
+            }
+        });
+        if let Some(e) = caught {
+            return Err(e);
+        }
+        let Some(results) = results else {
+            return Err(invalid("statics_batch was stopped before it finished"));
+        };
+        let mut reports = Vec::with_capacity(results.len());
+        for (k, r) in results.into_iter().enumerate() {
+            match r {
+                Ok(report) => reports.push(report),
+                Err(f) => {
+                    let message = format!("U[{k}]: {f}");
+                    return Err(errors::statics_with_message(py, &f, &message));
+                }
+            }
+        }
+        StaticsBatch::new(py, &reports, built)
+    }
+}
