@@ -342,15 +342,20 @@ fn a_resumed_run_equals_an_uninterrupted_one() {
     let meta_text = std::fs::read_to_string(&meta_path).unwrap();
     let mut legacy = json(&meta_path);
     legacy.as_object_mut().unwrap().remove("q_order").unwrap();
-    // such a dataset predates the content hashes too
-    let m = legacy["gvsrom"].as_object_mut().unwrap();
-    m.shift_remove("sha256");
-    m.shift_remove("meta_sha256");
     std::fs::write(&meta_path, serde_json::to_string(&legacy).unwrap()).unwrap();
+    common::reseal::reseal(&part);
     expect_error(
         &same_args,
         &["--resume", "q_order", "`fem-mode-major` there"],
     );
+    // such a dataset predates the content hashes too: whether it was edited cannot be told, and
+    // the resumed run would build on it and replace it
+    let mut legacy = json(&meta_path);
+    let m = legacy["gvsrom"].as_object_mut().unwrap();
+    m.shift_remove("sha256");
+    m.shift_remove("meta_sha256");
+    std::fs::write(&meta_path, serde_json::to_string(&legacy).unwrap()).unwrap();
+    expect_error(&same_args, &["--out", "records no content hashes"]);
     std::fs::write(&meta_path, meta_text).unwrap();
     let out = gvsrom(&same_args);
     assert!(
@@ -819,7 +824,15 @@ fn bad_tolerances_of_a_dynamic_dataset_are_refused_before_an_earlier_dataset_is_
     // at --out stays as it was (once it was replaced by an unreadable, empty one)
     let dir = sweep_dataset("ds-bad-tolerances", "-5:0", 3);
     let before = std::fs::read(dir.join("meta.json")).unwrap();
-    for (opt, value) in [("--rtol", "NaN"), ("--atol", "NaN"), ("--rtol", "2")] {
+    let bad = [
+        ("--rtol", "NaN"),
+        ("--atol", "NaN"),
+        ("--rtol", "2"),
+        // looser than the motion allows: percents of the length off, passing as a normal run
+        ("--rtol", "0.5"),
+        ("--atol", "100"),
+    ];
+    for (opt, value) in bad {
         expect_error(
             &[
                 "dataset",

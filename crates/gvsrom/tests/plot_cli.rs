@@ -8,7 +8,8 @@
 
 mod common;
 
-use common::{copy_dir, expect_error, json, reseal::reseal, run_ok, s, scratch, sweep_dataset};
+use common::reseal::{reseal, reseal_json};
+use common::{copy_dir, expect_error, json, run_ok, s, scratch, sweep_dataset};
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -499,10 +500,20 @@ fn bad_inputs_are_one_line_errors_naming_the_file() {
     let mut v = json(statics_json());
     v["centerline"] = serde_json::json!([]);
     v["centerline_x"] = serde_json::json!([]);
+    reseal_json(&mut v);
     std::fs::write(&empty, v.to_string()).unwrap();
     expect_error(
         &["plot", s(&empty), "--out", s(&out)],
         &["plot-empty-statics.json", "centerline"],
+    );
+    // a statics result edited after it was written: a 1 km rod drawn as if computed
+    let edited = scratch("plot-edited-statics.json");
+    let mut v = json(statics_json());
+    v["tip_position"] = serde_json::json!([1e3, 0.0, 0.0]);
+    std::fs::write(&edited, v.to_string()).unwrap();
+    expect_error(
+        &["plot", s(&edited), "--out", s(&out)],
+        &["plot-edited-statics.json", "meta_sha256", "edited"],
     );
     // a centerline.npy of the wrong shape
     let bad = copy_dir(trajectory(), "plot-traj-bad-cl");

@@ -1069,6 +1069,24 @@ fn a_nan_input_of_a_usable_sample_is_refused() {
 }
 
 #[test]
+fn an_input_outside_its_plans_range_is_refused() {
+    // a corrupt input would widen the training inputs a model records, and so where it answers
+    // without a warning (the hashes catch it in a dataset that records them: this one is resealed)
+    let dir = resealed(dataset(), "rfuzz-case-input-range", |d| {
+        let path = d.join("inputs.npy");
+        let mut b = fs::read(&path).unwrap();
+        let i = data_start("inputs.npy", &b);
+        b[i..i + 8].copy_from_slice(&(-1e6f64).to_le_bytes());
+        fs::write(&path, b).unwrap();
+    });
+    let e = dataset_refused(dir, "inputs.npy");
+    assert!(
+        e.contains("row 0 holds the input -1000000") && e.contains("outside the range"),
+        "{e}"
+    );
+}
+
+#[test]
 fn a_nan_in_the_weights_of_a_pod_model_is_refused_naming_the_tensor() {
     // POD modes and anchors were read without a finiteness check (the MLPs' weights had one)
     let dir = resealed(pod_model(), "rfuzz-case-pod-nan", |d| {

@@ -338,6 +338,21 @@ impl Dataset {
                 format!("row {k} has status ok but holds the input {v} (expected finite values)"),
             ));
         }
+        // a plan's sample lies in its range (a corrupt input would widen what a model built on
+        // the dataset records as its training inputs, and so what it answers without a warning)
+        let columns = (self.meta.plan.iter()).flat_map(|p| &p.parameters);
+        for (p, &v) in columns.zip(&self.inputs[k * d..(k + 1) * d]) {
+            let slack = 1e-12 * p.lo.abs().max(p.hi.abs()).max(1.0);
+            if !(p.lo - slack..=p.hi + slack).contains(&v) {
+                return Err(file_error(
+                    &at(FILES[0]),
+                    format!(
+                        "row {k} holds the input {v} for `{}`, outside the range [{}, {}] of its plan (`{}`): a corrupt sample",
+                        p.path, p.lo, p.hi, p.spec
+                    ),
+                ));
+            }
+        }
         let n = self.meta.n_dof;
         let rotation = &self.tip_rotation[9 * k..9 * (k + 1)];
         let mut rows: Vec<(&str, &[f64])> = vec![

@@ -83,19 +83,31 @@ impl InputKind {
 }
 
 /// A gvsrom JSON result at `path` (`statics`, `modes`, `linearize --json`) read as `T`, with its
-/// origin (the file by the SHA-256 of the bytes read); `what` names the command in the error.
+/// origin (the file by the SHA-256 of the bytes read); `what` names the command in the error. A
+/// result whose values no longer match the `meta_sha256` its manifest records is refused
+/// ([`crate::output::json_file_edited`]): its figures would show what was never computed.
 pub(crate) fn read_json_result<T: serde::de::DeserializeOwned>(
     path: &Path,
     what: &str,
 ) -> Result<(T, crate::provenance::DirOrigin), FiguresError> {
     let text = crate::output::read::read_regular_to_string(path)
         .map_err(|e| input_error(path, format!("cannot read it: {e}")))?;
-    let doc = serde_json::from_str(&text).map_err(|e| {
+    let not_readable = |e: serde_json::Error| {
         input_error(
             path,
             format!("not a `{what} --json` result the figures can read: {e}"),
         )
-    })?;
+    };
+    let value: serde_json::Value = serde_json::from_str(&text).map_err(not_readable)?;
+    if crate::output::json_file_edited(&value) {
+        return Err(input_error(
+            path,
+            format!(
+                "its values no longer match the `meta_sha256` its manifest records: it was edited since `{what}` wrote it, and its figures would show what was never computed; compute it again"
+            ),
+        ));
+    }
+    let doc = serde_json::from_value(value).map_err(not_readable)?;
     Ok((
         doc,
         crate::provenance::DirOrigin::of_file(path, text.as_bytes()),

@@ -45,7 +45,7 @@ impl OutputDir {
             target,
             staging,
             lock,
-        } = Prepared::new(option, path, Kind::Dir, force)?;
+        } = Prepared::new(option, path, Kind::Dir, format, force)?;
         Ok(OutputDir {
             named,
             format: format.into(),
@@ -171,8 +171,8 @@ impl OutputDir {
         .map_err(named.io("write its files"))?;
         // From here on the staging holds the complete result: never removed on failure.
         self.committed = true;
-        let existing =
-            inspect(&named, &self.target, Kind::Dir, self.force).map_err(|e| keep(e, &staging))?;
+        let existing = inspect(&named, &self.target, Kind::Dir, &self.format, self.force)
+            .map_err(|e| keep(e, &staging))?;
         match existing {
             Existing::Nothing => {
                 fs::rename(&staging, &self.target)
@@ -314,6 +314,65 @@ mod tests {
         assert_eq!(fs::read_to_string(d.join("victim.txt")).unwrap(), "keep");
         assert_eq!(names(&target), ["b.bin", "meta.json"]);
         assert_eq!(names(&d), ["run", "victim.txt"]);
+    }
+
+    #[test]
+    fn force_replaces_an_output_only_by_one_of_its_kind() {
+        let d = sandbox("kind");
+        let target = d.join("model");
+        let mut out = OutputDir::create("--out", &target, "test", false).unwrap();
+        out.write_file("a.bin", |w| w.write_all(b"old")).unwrap();
+        out.commit(json!({})).unwrap();
+        let e = OutputDir::create("--out", &target, "dataset", true)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("a gvsrom test output") && e.contains("only by one of its kind"),
+            "{e}"
+        );
+        assert_eq!(fs::read(target.join("a.bin")).unwrap(), b"old");
+        let file = d.join("x.json");
+        OutputFile::create("--json", &file, "statics", false)
+            .unwrap()
+            .commit_json(json!({ "tip": 1 }))
+            .unwrap();
+        let e = OutputFile::create("--json", &file, "modes", true)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("only by one of its kind"), "{e}");
+    }
+
+    #[test]
+    fn an_output_that_records_no_hashes_is_not_replaced_even_with_force() {
+        // an older version's output, or a file that only looks like one: an edit cannot be told
+        let d = sandbox("unhashed");
+        let target = d.join("run");
+        let mut out = OutputDir::create("--out", &target, "test", false).unwrap();
+        out.write_file("a.bin", |w| w.write_all(b"old")).unwrap();
+        out.commit(json!({ "k": 1 })).unwrap();
+        let meta_path = target.join(MANIFEST_FILE);
+        let mut meta: Value =
+            serde_json::from_str(&fs::read_to_string(&meta_path).unwrap()).unwrap();
+        let m = meta[MANIFEST_KEY].as_object_mut().unwrap();
+        m.remove("sha256").unwrap();
+        m.remove("meta_sha256").unwrap();
+        fs::write(&meta_path, serde_json::to_string(&meta).unwrap()).unwrap();
+        fs::write(target.join("a.bin"), b"the user's processed data").unwrap();
+        let e = OutputDir::create("--out", &target, "test", true)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("records no content hashes"), "{e}");
+        assert_eq!(
+            fs::read(target.join("a.bin")).unwrap(),
+            b"the user's processed data"
+        );
+        let file = d.join("mine.json");
+        fs::write(&file, r#"{"gvsrom": {"format": "test"}, "mydata": 1}"#).unwrap();
+        let e = OutputFile::create("--json", &file, "test", true)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("records no content hashes"), "{e}");
+        assert!(fs::read_to_string(&file).unwrap().contains("mydata"));
     }
 
     #[test]

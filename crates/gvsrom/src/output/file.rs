@@ -41,7 +41,7 @@ impl OutputFile {
             staging,
             lock,
             ..
-        } = Prepared::new(option, path, Kind::File, force)?;
+        } = Prepared::new(option, path, Kind::File, format, force)?;
         Ok(OutputFile {
             named,
             format: format.into(),
@@ -72,7 +72,7 @@ impl OutputFile {
             w.into_inner().map_err(|e| e.into_error())?.sync_all()
         })()
         .map_err(named.io("write it"))?;
-        match inspect(&named, &self.target, Kind::File, self.force)? {
+        match inspect(&named, &self.target, Kind::File, &self.format, self.force)? {
             Existing::Previous { .. } => {
                 fs::rename(&self.staging, &self.target).map_err(named.io("move it into place"))?;
             }

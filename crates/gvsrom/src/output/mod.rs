@@ -10,8 +10,10 @@
 //! 2. **Never replace what gvsrom did not write.** An existing `P` is replaced only with `--force`, and
 //!    only if it is a gvsrom output recognised by its manifest: the `"gvsrom"` object in
 //!    `P/meta.json` (directories) or at the top of the JSON file. A directory is replaced only if
-//!    it holds nothing but the files its manifest lists, and an output only if it is as gvsrom
-//!    wrote it: its files and values match the hashes its manifest records.
+//!    it holds nothing but the files its manifest lists, an output only by one of its format (a
+//!    dataset never replaces a model: a mistyped path would lose it), and only if it is as gvsrom
+//!    wrote it: its files and values match the hashes its manifest records (one that records no
+//!    hashes, from an earlier version or only looking like gvsrom's, is not replaced).
 //! 3. **One writer at a time.** An advisory lock on `.P.gvsrom-lock` beside `P` is held from the
 //!    start of the run to the end of the commit; a second writer of the same `P` is refused at once.
 //!    The lock file is removed when the lock is released.

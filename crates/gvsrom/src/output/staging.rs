@@ -48,6 +48,7 @@ impl Prepared {
         option: &str,
         path: &Path,
         kind: Kind,
+        format: &str,
         force: bool,
     ) -> Result<Self, OutputError> {
         let named = Named {
@@ -66,7 +67,7 @@ impl Prepared {
         refuse_inside_output(&named, &parent)?;
         let lock = TargetLock::acquire(&named, &parent, &name)?;
         let target = parent.join(&name);
-        inspect(&named, &target, kind, force)?;
+        inspect(&named, &target, kind, format, force)?;
         let staging = loop {
             let s = unique_sibling(&parent, &name, "staging");
             let made = match kind {

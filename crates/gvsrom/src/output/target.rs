@@ -132,39 +132,60 @@ pub(super) fn refuse_special(n: &Named, parent: &Path, name: &str) -> Result<(),
     Ok(())
 }
 
+/// Whether a gvsrom output was changed since it was written.
+enum Edits {
+    /// As written, by the hashes its manifest records (or it only lacks files: nothing of the
+    /// user's is lost by replacing it).
+    None,
+    /// How it differs from what gvsrom wrote.
+    Found(String),
+    /// It records no hashes to tell: an output of an earlier version, or a file that only looks
+    /// like a gvsrom output.
+    Unknown,
+}
+
 /// How the gvsrom output at `target` of `format` differs from what gvsrom wrote, by the hashes its
 /// manifest records: a listed file's content, or the values of its meta.json (a JSON file output:
-/// its own values); `None` when it is as written, or records no hashes (an output of an earlier
-/// version), or only lacks files (nothing of the user's is lost by replacing it).
-fn edited_since_written(target: &Path, kind: Kind, format: &str) -> Option<String> {
-    use super::hashes::{meta_sha256, META_SHA256_KEY};
-    use super::integrity::{verify_dir, Problem};
+/// its own values).
+fn edited_since_written(target: &Path, kind: Kind, format: &str) -> Edits {
+    use super::hashes::META_SHA256_KEY;
+    use super::integrity::{json_file_edited, verify_dir, Integrity, Problem};
     match kind {
         Kind::Dir => match verify_dir(target, format) {
             Err(e) if matches!(e.problem, Problem::Changed | Problem::MetaEdited) => {
-                Some(e.to_string())
+                Edits::Found(e.to_string())
             }
-            _ => None,
+            Ok(Integrity::Unhashed) => Edits::Unknown,
+            _ => Edits::None,
         },
         Kind::File => {
-            let text = super::read::read_regular_to_string(target).ok()?;
-            let serde_json::Value::Object(obj) = serde_json::from_str(&text).ok()? else {
-                return None;
+            let value = super::read::read_regular_to_string(target)
+                .ok()
+                .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok());
+            let Some(value) = value else {
+                return Edits::Unknown;
             };
-            let recorded = obj.get(MANIFEST_KEY)?.get(META_SHA256_KEY)?.as_str()?;
-            (meta_sha256(&obj) != recorded).then(|| {
-                "its values no longer match the `meta_sha256` recorded in its manifest: it was edited"
-                    .to_string()
-            })
+            if value[MANIFEST_KEY].get(META_SHA256_KEY).is_none() {
+                return Edits::Unknown;
+            }
+            match json_file_edited(&value) {
+                true => Edits::Found(
+                    "its values no longer match the `meta_sha256` recorded in its manifest: it was edited"
+                        .to_string(),
+                ),
+                false => Edits::None,
+            }
         }
     }
 }
 
-/// Checks what is at the target now; see the module documentation for the rules.
+/// Checks what is at the target now, for an output of `format`; see the module documentation for
+/// the rules.
 pub(super) fn inspect(
     n: &Named,
     target: &Path,
     kind: Kind,
+    format_written: &str,
     force: bool,
 ) -> Result<Existing, OutputError> {
     let meta = match fs::symlink_metadata(target) {
@@ -217,10 +238,23 @@ pub(super) fn inspect(
             "exists (a gvsrom {format} output); pass --force to replace it, or choose another path"
         )));
     }
-    if let Some(why) = edited_since_written(target, kind, &format) {
+    if format != format_written {
         return Err(n.refused(format!(
-            "was changed after gvsrom wrote it ({why}); gvsrom never replaces what it did not write, even with --force: move it away or choose another path"
+            "is a gvsrom {format} output; this writes a {format_written}, and --force replaces an output only by one of its kind (a mistyped path would lose it): move it away or choose another path"
         )));
+    }
+    match edited_since_written(target, kind, &format) {
+        Edits::None => {}
+        Edits::Found(why) => {
+            return Err(n.refused(format!(
+                "was changed after gvsrom wrote it ({why}); gvsrom never replaces what it did not write, whatever the options: move it away or choose another path"
+            )))
+        }
+        Edits::Unknown => {
+            return Err(n.refused(
+                "records no content hashes (written by a gvsrom before it recorded them, or not by gvsrom): whether it was changed since cannot be told, so it is never replaced, whatever the options: move it away or choose another path",
+            ))
+        }
     }
     // Only the regular files actually present *and* listed are ever removed later: a manifest
     // naming `../elsewhere` or a missing file removes nothing outside the directory.
@@ -242,7 +276,7 @@ pub(super) fn inspect(
             foreign.sort();
             let shown: Vec<_> = foreign.iter().take(3).map(|f| format!("`{f}`")).collect();
             return Err(n.refused(format!(
-                "holds {} that gvsrom did not write ({}{}); it is not replaced even with --force: move them away or choose another path",
+                "holds {} that gvsrom did not write ({}{}); it is never replaced, whatever the options: move them away or choose another path",
                 if foreign.len() == 1 { "an entry" } else { "entries" },
                 shown.join(", "),
                 if foreign.len() > 3 { ", …" } else { "" }

@@ -38,3 +38,14 @@ pub fn reseal(dir: &Path) {
     manifest.insert("meta_sha256".into(), Value::from(meta_hash));
     std::fs::write(&path, serde_json::to_string_pretty(&meta).unwrap()).unwrap();
 }
+
+/// Recomputes `meta_sha256` of a JSON file output (`statics --json`, …) held as `value`.
+#[allow(dead_code)]
+pub fn reseal_json(value: &mut Value) {
+    let body: Map<String, Value> = (value.as_object().unwrap().iter())
+        .filter(|(k, _)| *k != "gvsrom")
+        .map(|(k, v)| (k.clone(), v.clone()))
+        .collect();
+    let meta_hash = hex(&Sha256::digest(serde_json::to_vec(&body).unwrap()));
+    value["gvsrom"]["meta_sha256"] = Value::from(meta_hash);
+}
