@@ -63,6 +63,24 @@ pub fn state_violation(
     None
 }
 
+/// Why the coordinates `q` of the model that runs in `built` (the HOM's, or the reduced model's
+/// attached) are no state of an elastic rod ([`state_violation`] of the strains they give), as a
+/// phrase; `None` for a physical state. It allocates a workspace: a check of a start, not of every
+/// sample.
+pub fn coordinates_violation(built: &crate::Built, q: &[f64]) -> Option<String> {
+    fn of<P: gvs::strain::StrainParam>(m: &gvs::model::Model<P>, q: &[f64]) -> Option<String> {
+        let x: Vec<f64> = m.disc.points.iter().map(|p| p.x).collect();
+        let mut ws = m.workspace();
+        let q = nalgebra::DVector::from_column_slice(q);
+        let strain = m.strains_at(&q, &mut ws);
+        state_violation(strain, &x, |j| m.xi_star(j), m.disc.length())
+    }
+    match &built.reduced {
+        Some(r) => of(&r.model, q),
+        None => of(&built.model, q),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -68,6 +68,22 @@ pub fn from_table(table: Table) -> Result<Scenario, ScenarioError> {
                 };
             }
         }
+        if field == "." || field.is_empty() {
+            // a required key missing at the top: name it, not the path `.`
+            match message
+                .strip_prefix("missing field `")
+                .and_then(|m| m.split('`').next())
+            {
+                Some(key) => {
+                    return ScenarioError::Format {
+                        field: key.to_string(),
+                        message: "missing: a required key at the top level of the scenario"
+                            .to_string(),
+                    }
+                }
+                None => field = "(top level)".to_string(),
+            }
+        }
         ScenarioError::Format { field, message }
     })
 }

@@ -21,6 +21,10 @@ impl Scenario {
 
 /// The tensions of `n` tendons from `u`: one value for every tendon, or one value per tendon.
 pub fn tensions_for(n: usize, u: &[f64]) -> Result<Vec<f64>, ScenarioError> {
+    if n == 0 && u.is_empty() {
+        // `u = zeros(n_actuators)` of a rod without tendons: nothing to set
+        return Ok(vec![]);
+    }
     if n == 0 {
         return Err(ScenarioError::invalid(
             "tendons",
@@ -31,14 +35,38 @@ pub fn tensions_for(n: usize, u: &[f64]) -> Result<Vec<f64>, ScenarioError> {
         return Err(ScenarioError::invalid(
             "tendons",
             format!(
-                "{} {} given for {n} {} (give 1 value for all, or {n})",
+                "{} {} given for {n} {} ({})",
                 u.len(),
                 if u.len() == 1 { "tension" } else { "tensions" },
                 if n == 1 { "tendon" } else { "tendons" },
+                match n {
+                    1 => "give 1".to_string(),
+                    _ => format!("give 1 value for all, or {n}"),
+                },
             ),
         ));
     }
     Ok((0..n)
         .map(|k| if u.len() == 1 { u[0] } else { u[k] })
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::tensions_for;
+
+    #[test]
+    fn one_value_is_for_every_tendon_and_none_is_for_a_rod_without_tendons() {
+        assert_eq!(tensions_for(3, &[-2.0]).unwrap(), [-2.0; 3]);
+        assert_eq!(tensions_for(2, &[-1.0, -3.0]).unwrap(), [-1.0, -3.0]);
+        // `u = zeros(n_actuators)` of a soft beam
+        assert!(tensions_for(0, &[]).unwrap().is_empty());
+        let e = tensions_for(0, &[-1.0]).unwrap_err().to_string();
+        assert!(e.contains("no tendons"), "{e}");
+        let e = tensions_for(1, &[-1.0, -2.0]).unwrap_err().to_string();
+        assert!(e.contains("2 tensions given for 1 tendon (give 1)"), "{e}");
+        let e = tensions_for(6, &[-1.0, -2.0]).unwrap_err().to_string();
+        assert!(e.contains("(give 1 value for all, or 6)"), "{e}");
+        assert!(tensions_for(2, &[]).is_err());
+    }
 }

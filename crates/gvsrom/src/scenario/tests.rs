@@ -219,3 +219,14 @@ fn override_numbers_toml_does_not_write_are_read_as_numbers() {
         assert_eq!(s.magnus, order);
     }
 }
+
+#[test]
+fn a_required_key_missing_at_the_top_level_is_named_not_the_path_dot() {
+    let e = Scenario::from_toml("t", "name = \"x\"\n", &[])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("`material`") && e.contains("top level") && !e.contains("`.`"),
+        "{e}"
+    );
+}

@@ -351,7 +351,8 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
 /// The given start `(q, q̇)` of a run ([`Start::State`]) as the integrator's initial state: `n`
 /// finite values each, `n` the degrees of freedom of the model that runs; for an autoencoder model,
 /// `q` inside its training encodings ([`crate::build::Reduced::range_violation`]), where its decoder
-/// answers (a POD basis is linear: its range is not bounded).
+/// answers (a POD basis is linear: its range is not bounded); and a state of an elastic rod
+/// ([`crate::plausibility::coordinates_violation`], the bounds that end a run at a sample).
 fn initial_state(built: &Built, q: &[f64], qd: &[f64]) -> Result<InitialState, ScenarioError> {
     let n = built.n_dof();
     for (field, v) in [("q0", q), ("qd0", qd)] {
@@ -377,6 +378,12 @@ fn initial_state(built: &Built, q: &[f64], qd: &[f64]) -> Result<InitialState, S
         return Err(ScenarioError::invalid(
             "q0",
             format!("{v}: the decoder extrapolates there; start inside the training region"),
+        ));
+    }
+    if let Some(v) = crate::plausibility::coordinates_violation(built, q) {
+        return Err(ScenarioError::invalid(
+            "q0",
+            format!("no state of an elastic rod: {v}; start within the bounds that end a run"),
         ));
     }
     Ok(InitialState::Given {
