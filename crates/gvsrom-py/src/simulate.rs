@@ -145,7 +145,7 @@ impl Robot {
         load_schedule: Option<std::path::PathBuf>,
         steps: Option<Vec<f64>>,
         babble: Option<Vec<f64>>,
-        seed: u64,
+        #[pyo3(from_py_with = crate::arrays::whole)] seed: i128,
         #[pyo3(from_py_with = crate::arrays::whole_or_none)] max_order: Option<i128>,
         error_norm: Option<&str>,
         rho_inf: Option<f64>,
@@ -155,6 +155,7 @@ impl Robot {
         out: Option<std::path::PathBuf>,
         force: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let seed = arrays::unsigned("seed", seed)?;
         let max_order = max_order
             .map(|v| arrays::size("max_order", v, 1))
             .transpose()?;

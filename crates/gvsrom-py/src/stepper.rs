@@ -21,34 +21,25 @@ use std::thread::JoinHandle;
 
 /// What the run hands to the Python side.
 enum Event {
-    /// The state at a control instant; `notes`: how the last tensions lay outside a reduced
-    /// model's training (with `extrapolate`).
-    State {
-        t: f64,
-        q: Vec<f64>,
-        qd: Vec<f64>,
-        notes: Vec<String>,
-    },
+    /// The state at a control instant.
+    State { t: f64, q: Vec<f64>, qd: Vec<f64> },
     /// The run ended: why.
     Ended(String),
 }
 
 /// The control law of the run: the state out, the next period's tensions in (`None`: close).
+/// The tensions were checked by [`Stepper::step`] before they were sent.
 struct ChannelLaw {
     events: Mutex<Sender<Event>>,
     tensions: Mutex<Receiver<Option<Vec<f64>>>>,
-    robot: Py<Robot>,
-    notes: Mutex<Vec<String>>,
 }
 
 impl gvs::feedback::FeedbackLaw for ChannelLaw {
     fn tensions(&self, t: f64, q: &[f64], qd: &[f64], u: &mut [f64]) -> Result<(), String> {
-        let notes = std::mem::take(&mut *self.notes.lock().unwrap_or_else(PoisonError::into_inner));
         let state = Event::State {
             t,
             q: q.to_vec(),
             qd: qd.to_vec(),
-            notes,
         };
         let events = self.events.lock().unwrap_or_else(PoisonError::into_inner);
         events
@@ -62,21 +53,6 @@ impl gvs::feedback::FeedbackLaw for ChannelLaw {
         let Ok(Some(v)) = next else {
             return Err("the stepper was closed".into());
         };
-        // checked as a signal's tensions are: the elastic range, a reduced model's training
-        let built = self.robot.get().built_for_signal_ready();
-        let abs: Vec<f64> = v.iter().map(|x| x.abs()).collect();
-        gvsrom::plausibility::check(built, &abs, 1.0)
-            .map_err(|e| format!("`step(u)` at t = {t} s: {e}"))?;
-        if let Some(r) = &built.reduced {
-            match r.check_signal(&[t], |_| v.clone()) {
-                Ok(sentences) => self
-                    .notes
-                    .lock()
-                    .unwrap_or_else(PoisonError::into_inner)
-                    .extend(sentences),
-                Err(e) => return Err(format!("`step(u)` at t = {t} s: {e}")),
-            }
-        }
         u.copy_from_slice(&v);
         Ok(())
     }
@@ -106,6 +82,8 @@ impl Drop for Running {
 #[pyclass(module = "gvsrom")]
 pub struct Stepper {
     running: Option<Running>,
+    /// The robot that runs (its scenario as built for a signal checks the tensions).
+    robot: Py<Robot>,
     dt: f64,
     n_actuators: usize,
     t: f64,
@@ -151,12 +129,8 @@ impl Stepper {
             }
         };
         match event {
-            Ok(Event::State { t, q, qd, notes }) => {
+            Ok(Event::State { t, q, qd }) => {
                 (self.t, self.q, self.qd) = (t, q, qd);
-                if let (Some(n), false) = (notes.first(), self.warned) {
-                    warn(py, &format!("extrapolating (--extrapolate): {n} (further values outside the training are not warned of)"))?;
-                    self.warned = true;
-                }
                 Ok(())
             }
             Ok(Event::Ended(reason)) => {
@@ -185,14 +159,22 @@ impl Stepper {
 impl Stepper {
     /// Holds the tensions ``u`` [N] (one per tendon, or one number for all) for one period and
     /// returns the state ``(q, qd)`` at its end; :attr:`t` advances by :attr:`dt`.
+    ///
+    /// Raises
+    /// ------
+    /// GvsromError
+    ///     For tensions of the wrong count, not finite, beyond the rod's elastic range or outside
+    ///     a reduced model's training (without ``extrapolate``): checked before the run sees
+    ///     them, so the run stays where it was and the next ``step`` goes on from there. Also
+    ///     once the run has ended (closed, past its horizon, or its integration failed).
     fn step<'py>(
         &mut self,
         py: Python<'py>,
         u: arrays::Tensions<'_>,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-        let Some(r) = &self.running else {
+        if self.running.is_none() {
             return Err(self.ended_error());
-        };
+        }
         let u = gvsrom::scenario::tensions_for(self.n_actuators, &u.values())
             .map_err(|e| invalid(format!("`u`: {e}")))?;
         if let Some(k) = u.iter().position(|x| !x.is_finite()) {
@@ -201,7 +183,29 @@ impl Stepper {
                 u[k]
             )));
         }
-        if r.tensions.send(Some(u)).is_err() {
+        // checked as a signal's tensions are (the elastic range, a reduced model's training),
+        // before the run sees them: a refused value leaves the run as it was
+        let t = self.t;
+        let refused = |e: &dyn std::fmt::Display| {
+            invalid(format!(
+                "`step(u)` at t = {t} s: {e}; the run goes on from there: step again with other tensions"
+            ))
+        };
+        let robot = self.robot.clone_ref(py);
+        let built = robot.get().built_for_signal_ready();
+        let abs: Vec<f64> = u.iter().map(|x| x.abs()).collect();
+        gvsrom::plausibility::check(built, &abs, 1.0).map_err(|e| refused(&e))?;
+        if let Some(model) = &built.reduced {
+            let notes = model
+                .check_signal(&[t], |_| u.clone())
+                .map_err(|e| refused(&e))?;
+            if let (Some(n), false) = (notes.first(), self.warned) {
+                warn(py, &format!("extrapolating (--extrapolate): {n} (further values outside the training are not warned of)"))?;
+                self.warned = true;
+            }
+        }
+        let sent = (self.running.as_ref()).is_some_and(|r| r.tensions.send(Some(u)).is_ok());
+        if !sent {
             self.running = None;
         }
         self.receive(py)?;
@@ -365,20 +369,14 @@ impl Robot {
 pub fn start(robot: Py<Robot>, py: Python<'_>, a: Args) -> PyResult<Stepper> {
     let r = robot.get();
     let built = r.built_for_signal(py)?;
+    // (a rod without tendons steps with `step([])`: its free motion under its loads)
     let na = built.model.n_actuators();
-    if na == 0 {
-        return Err(invalid(
-            "`stepper`: the robot has no tendons to set tensions on",
-        ));
-    }
     let start = crate::simulate_args::start(&a.q0, &a.qd0, a.from_equilibrium)?;
     let (to_law, from_user) = channel::<Option<Vec<f64>>>();
     let (to_user, from_law) = channel::<Event>();
     let law = Arc::new(ChannelLaw {
         events: Mutex::new(to_user.clone()),
         tensions: Mutex::new(from_user),
-        robot: robot.clone_ref(py),
-        notes: Mutex::new(vec![]),
     });
     let prepared = simulate::prepare(
         built,
@@ -443,6 +441,7 @@ pub fn start(robot: Py<Robot>, py: Python<'_>, a: Args) -> PyResult<Stepper> {
             handle: Some(handle),
             stop,
         }),
+        robot,
         dt: a.dt,
         n_actuators: na,
         t: 0.0,

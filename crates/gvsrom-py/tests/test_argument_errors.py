@@ -36,6 +36,18 @@ def test_simulation_options_are_named_as_keyword_arguments():
     assert "`fixed_step`: 0" in message(lambda: robot.simulate(0.1, fixed_step=0.0))
     assert "`rtol`" in message(lambda: robot.simulate(0.1, rtol=-1.0))
     assert "count `0`" in message(lambda: robot.modes(count=0))
+    # looser than the coordinates themselves: refused, not a motion off by the rod's length
+    assert "`atol`: 100" in message(lambda: robot.simulate(0.1, atol=100.0))
+    # a seed is a whole number ≥ 0 here as everywhere, not pyo3's bare OverflowError
+    assert "`seed` = -1" in message(lambda: robot.simulate(0.02, steps=[-1, 0, 0.01], seed=-1))
+    assert "`seed` = 1180591620717411303424" in message(
+        lambda: robot.simulate(0.02, steps=[-1, 0, 0.01], seed=2**70))
+
+
+def test_a_start_state_no_rod_holds_is_refused_naming_q0_before_anything_runs():
+    robot = gvsrom.Scenario.preset("single-tendon").build()
+    text = message(lambda: robot.simulate(0.05, q0=np.full(robot.n_dof, 1e3)))
+    assert "`q0`" in text and "no state of an elastic rod" in text, text
 
 
 def test_dataset_options_are_named_as_keyword_arguments(tmp_path, dataset):

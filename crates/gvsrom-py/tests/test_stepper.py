@@ -54,10 +54,12 @@ def test_bad_arguments_and_values_are_clear_errors(robot):
     # refused before the run used them: the run goes on
     q, _ = env.step(-1.0)
     assert env.running and env.t == pytest.approx(0.01)
-    # a tension far beyond the elastic range ends the run, naming it
-    with pytest.raises(gvsrom.GvsromError, match=r"`step\(u\)` at t = 0.01 s: tendons\[0\].tension"):
+    # a tension far beyond the elastic range is refused, naming it, and the run goes on as it was
+    with pytest.raises(gvsrom.GvsromError, match=r"`step\(u\)` at t = 0.01 s: tendons\[0\].tension.*the run goes on"):
         env.step(-1e9)
-    assert not env.running
+    assert env.running and env.t == pytest.approx(0.01)
+    q2, _ = env.step(-1.0)
+    assert env.t == pytest.approx(0.02) and np.all(np.isfinite(q2))
     env.close()
 
 
@@ -82,6 +84,10 @@ def test_a_reduced_model_steps_in_its_coordinates_and_checks_its_training(gvsrom
         assert q.shape == (2,) and qd.shape == (2,)
         with pytest.raises(gvsrom.GvsromError, match=r"`step\(u\)` at t = 0.01 s: .*outside the training"):
             env.step(-20.0)
+        # refused before the run used it: an agent's bad action does not end its environment
+        assert env.running and env.t == pytest.approx(0.01)
+        env.step(-3.0)
+        assert env.t == pytest.approx(0.02)
 
 
 def test_the_default_horizon_suits_a_small_period_and_a_long_one_is_refused_naming_it(robot):
@@ -106,3 +112,16 @@ def test_ctrl_c_during_a_step_stops_the_run_at_once(robot, sigint_raises):
     assert not env.running and env.t == 0.0
     with pytest.raises(gvsrom.GvsromError, match=r"has ended at t = 0 s: interrupted"):
         env.step(-1.0)
+
+
+def test_a_rod_without_tendons_steps_its_free_motion_with_no_tensions():
+    # `u = np.zeros(robot.n_actuators)` is the generic call, also where there are no tendons
+    beam = gvsrom.Scenario.preset("soft-beam").build()
+    assert beam.n_actuators == 0
+    np.testing.assert_array_equal(beam.statics(u=np.zeros(0)).q, beam.statics().q)
+    with beam.stepper(0.01, fixed_step=0.01) as env:
+        q, qd = env.step(np.zeros(beam.n_actuators))
+        assert env.t == pytest.approx(0.01) and q.shape == (beam.n_dof,)
+        with pytest.raises(gvsrom.GvsromError, match=r"no tendons"):
+            env.step([-1.0])
+        assert env.running
