@@ -54,7 +54,7 @@ use std::path::PathBuf;
 ///     ``meta.json`` (manifest, scenario TOML, plan, seed, counts, failures, …).
 #[pyclass(module = "gvsrom", frozen)]
 pub struct Dataset {
-    dir: PathBuf,
+    pub(crate) dir: PathBuf,
     /// ``"statics"`` or ``"dynamics"``.
     #[pyo3(get)]
     kind: String,
@@ -115,7 +115,7 @@ pub struct Dataset {
     #[pyo3(get)]
     tendon_lengths: Option<Py<PyAny>>,
     /// ``meta.json`` as the loader verified it.
-    meta_json: serde_json::Value,
+    pub(crate) meta_json: serde_json::Value,
 }
 
 impl Dataset {

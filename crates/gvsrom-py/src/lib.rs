@@ -19,6 +19,7 @@ mod quantities;
 mod reconstruction;
 mod reduce;
 mod reproduce;
+mod results_pickle;
 mod robot;
 mod robot_pickle;
 mod robot_quantities;

@@ -67,6 +67,30 @@ impl Model {
             loaded: self.model.origin(),
         }
     }
+
+    /// The `model` argument of `Robot.with_model` and `Robot.statics`, to attach with
+    /// `extrapolate` (default: the model's own setting): a `Model`, or a model directory (str or
+    /// os.PathLike) loaded as `load_model(path)` loads it (so without `extrapolate` of its own); a
+    /// `TypeError` naming `model` otherwise.
+    pub(crate) fn attached_from(
+        py: Python<'_>,
+        model: &Bound<'_, PyAny>,
+        extrapolate: Option<bool>,
+    ) -> PyResult<crate::robot::Attached> {
+        if let Ok(m) = model.cast::<Model>() {
+            return Ok(m.get().attached(extrapolate));
+        }
+        match model.extract::<PathBuf>() {
+            Ok(path) => Ok(load_model(py, path, false)?.attached(extrapolate)),
+            Err(_) => Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                "invalid `model`: got a {}; accepted: a Model or a model directory (str or os.PathLike)",
+                model
+                    .get_type()
+                    .name()
+                    .map_or_else(|_| "?".to_string(), |n| n.to_string())
+            ))),
+        }
+    }
 }
 
 /// The rows of a 1-D (one row) or 2-D input with `cols` columns each, row-major, and whether it was

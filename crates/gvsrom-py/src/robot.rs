@@ -350,26 +350,31 @@ impl Robot {
     ///
     /// Parameters
     /// ----------
-    /// model : Model
-    ///     From :func:`load_model`.
+    /// model : Model or str or os.PathLike
+    ///     From :func:`load_model`, or a model directory (loaded as ``load_model(path)`` loads
+    ///     it).
     /// extrapolate : bool, optional
     ///     Use the model where the scenario lies outside what it was trained on (``--extrapolate``);
     ///     the reasons are then warned about. Default: the model's own setting
-    ///     (``load_model(…, extrapolate=…)``).
+    ///     (``load_model(…, extrapolate=…)``; ``False`` for a directory).
     ///
     /// Raises
     /// ------
     /// GvsromError
     ///     If the model was not learned on this scenario's points, or the scenario lies outside
-    ///     its training (without ``extrapolate``).
+    ///     its training (without ``extrapolate``); for a directory that is not a model, or whose
+    ///     files were edited.
+    /// TypeError
+    ///     If ``model`` is neither a Model nor a path.
     #[pyo3(signature = (model, extrapolate=None))]
     fn with_model(
         &self,
         py: Python<'_>,
-        model: PyRef<'_, Model>,
+        model: &Bound<'_, PyAny>,
         extrapolate: Option<bool>,
     ) -> PyResult<Robot> {
-        Robot::new(py, self.scenario.clone(), Some(model.attached(extrapolate)))
+        let attached = Model::attached_from(py, model, extrapolate)?;
+        Robot::new(py, self.scenario.clone(), Some(attached))
     }
 
     fn __repr__(&self) -> String {

@@ -78,8 +78,9 @@ impl Robot {
     /// ----------
     /// u : array_like of float, optional
     ///     Tensions [N] (negative pulls): one per tendon, or one for all. Default: the scenario's.
-    /// model : Model, optional
-    ///     A reduced model to solve with (``--model``); default: this robot's.
+    /// model : Model or str or os.PathLike, optional
+    ///     A reduced model to solve with (``--model``), or its directory, loaded as
+    ///     ``load_model(path)`` loads it; default: this robot's.
     ///
     /// Returns
     /// -------
@@ -92,15 +93,17 @@ impl Robot {
     ///     For tensions of the wrong count, not finite or implausible with the loads.
     /// ConvergenceError
     ///     If the solve does not converge (with its iterations and residual).
+    /// TypeError
+    ///     If ``model`` is neither a Model nor a path.
     #[pyo3(signature = (u=None, model=None))]
     fn statics(
         &self,
         py: Python<'_>,
         u: Option<Tensions<'_>>,
-        model: Option<PyRef<'_, Model>>,
+        model: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Statics> {
         let u = u.map(|a| a.values());
-        let attached = model.map(|m| m.attached(None));
+        let attached = (model.map(|m| Model::attached_from(py, m, None))).transpose()?;
         let (report, extrapolated) = self.solve(py, u, attached.as_ref())?;
         Statics::new(py, &report, extrapolated)
     }

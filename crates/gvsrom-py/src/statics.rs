@@ -63,55 +63,55 @@ use pyo3::types::PyDict;
 #[pyclass(module = "gvsrom", frozen, get_all)]
 pub struct Statics {
     /// The scenario's name.
-    scenario: String,
+    pub(crate) scenario: String,
     /// Generalized coordinates n.
-    n_dof: usize,
+    pub(crate) n_dof: usize,
     /// Computational points p.
-    n_points: usize,
+    pub(crate) n_points: usize,
     /// Tendon tensions u [N].
-    u: Py<PyAny>,
+    pub(crate) u: Py<PyAny>,
     /// Generalized coordinates at equilibrium.
-    q: Py<PyAny>,
+    pub(crate) q: Py<PyAny>,
     /// Tip position in the world frame [m].
-    tip_position: Py<PyAny>,
+    pub(crate) tip_position: Py<PyAny>,
     /// Tip rotation matrix, section frame → world.
-    tip_rotation: Py<PyAny>,
+    pub(crate) tip_rotation: Py<PyAny>,
     /// Abscissae of the centreline samples [m].
-    centerline_x: Py<PyAny>,
+    pub(crate) centerline_x: Py<PyAny>,
     /// Centreline positions [m] at `centerline_x`.
-    centerline: Py<PyAny>,
+    pub(crate) centerline: Py<PyAny>,
     /// Abscissae of the computational points [m].
-    strain_x: Py<PyAny>,
+    pub(crate) strain_x: Py<PyAny>,
     /// ξ at the points, `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]`.
-    strain: Py<PyAny>,
+    pub(crate) strain: Py<PyAny>,
     /// The reference strain ξ* at the points.
-    strain_reference: Py<PyAny>,
+    pub(crate) strain_reference: Py<PyAny>,
     /// Each tendon's thread in the world frame [m], a `(m_k, 3)` array per tendon.
-    tendon_paths: Py<PyAny>,
+    pub(crate) tendon_paths: Py<PyAny>,
     /// Each tendon's length [m] along its thread.
-    tendon_lengths: Py<PyAny>,
+    pub(crate) tendon_lengths: Py<PyAny>,
     /// Each tendon's length [m] at rest.
-    tendon_rest_lengths: Py<PyAny>,
+    pub(crate) tendon_rest_lengths: Py<PyAny>,
     /// Dogleg iterations over all load stages.
-    iterations: usize,
+    pub(crate) iterations: usize,
     /// Load stages of the ramp.
-    load_stages: usize,
+    pub(crate) load_stages: usize,
     /// Residual evaluations.
-    residual_evaluations: usize,
+    pub(crate) residual_evaluations: usize,
     /// Jacobian evaluations.
-    jacobian_evaluations: usize,
+    pub(crate) jacobian_evaluations: usize,
     /// `‖R(q)‖∞` at the solution.
-    residual_norm: f64,
+    pub(crate) residual_norm: f64,
     /// `ω² < 0` [1/s²] if the equilibrium diverges, else `None`.
-    divergence: Option<f64>,
+    pub(crate) divergence: Option<f64>,
     /// `ω² < 0` [1/s²] of the diverging equilibrium the rod was released from, if it buckled.
-    buckled: Option<f64>,
+    pub(crate) buckled: Option<f64>,
     /// Reached by arc-length continuation from the straight rod.
-    continued: bool,
+    pub(crate) continued: bool,
     /// Wall-clock time of the solve [s].
-    solve_time_s: f64,
+    pub(crate) solve_time_s: f64,
     /// How the reduced model was used outside what it was trained on (`--extrapolate`).
-    model_extrapolated: Vec<String>,
+    pub(crate) model_extrapolated: Vec<String>,
 }
 
 impl Statics {
@@ -173,7 +173,7 @@ impl Statics {
 #[pymethods]
 impl Statics {
     /// The fields as a ``dict`` (the same read-only arrays, not copies).
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+    pub(crate) fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
         d.set_item("scenario", &self.scenario)?;
         d.set_item("n_dof", self.n_dof)?;
@@ -247,33 +247,33 @@ impl Statics {
 #[pyclass(module = "gvsrom", frozen, get_all)]
 pub struct StaticsBatch {
     /// Tendon tensions u [N].
-    u: Py<PyAny>,
+    pub(crate) u: Py<PyAny>,
     /// Generalized coordinates at equilibrium.
-    q: Py<PyAny>,
+    pub(crate) q: Py<PyAny>,
     /// Tip position in the world frame [m].
-    tip_position: Py<PyAny>,
+    pub(crate) tip_position: Py<PyAny>,
     /// Tip rotation matrix, section frame → world.
-    tip_rotation: Py<PyAny>,
+    pub(crate) tip_rotation: Py<PyAny>,
     /// Abscissae of the centreline samples [m].
-    centerline_x: Py<PyAny>,
+    pub(crate) centerline_x: Py<PyAny>,
     /// Centreline positions [m] at `centerline_x`.
-    centerline: Py<PyAny>,
+    pub(crate) centerline: Py<PyAny>,
     /// Abscissae of the computational points [m].
-    strain_x: Py<PyAny>,
+    pub(crate) strain_x: Py<PyAny>,
     /// ξ at the points, `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]`.
-    strain: Py<PyAny>,
+    pub(crate) strain: Py<PyAny>,
     /// Each tendon's length [m] along its thread.
-    tendon_lengths: Py<PyAny>,
+    pub(crate) tendon_lengths: Py<PyAny>,
     /// Dogleg iterations over all load stages.
-    iterations: Py<PyAny>,
+    pub(crate) iterations: Py<PyAny>,
     /// `‖R(q)‖∞` at the solution.
-    residual_norm: Py<PyAny>,
+    pub(crate) residual_norm: Py<PyAny>,
     /// `ω² < 0` [1/s²] of an unstable equilibrium, NaN for a stable one.
-    divergence: Py<PyAny>,
+    pub(crate) divergence: Py<PyAny>,
     /// `ω² < 0` [1/s²] of the equilibrium a buckled row left, NaN otherwise.
-    buckled: Py<PyAny>,
+    pub(crate) buckled: Py<PyAny>,
     /// Wall-clock time of the solve [s].
-    solve_time_s: Py<PyAny>,
+    pub(crate) solve_time_s: Py<PyAny>,
 }
 
 impl StaticsBatch {
