@@ -108,8 +108,13 @@ fn rows_of(name: &str, a: &InDyn<'_>, cols: usize, what: &str) -> PyResult<(Vec<
             1 => format!("({},)", dims[0]),
             _ => format!("({})", dims.join(", ")),
         };
+        // the strains of a result (`Statics.strain`): absolute, all six components per point
+        let hint = match (name, v.shape()) {
+            ("strain", [_, 6]) => "; a (points, 6) array of absolute strains, as `Statics.strain` gives them, converts to snapshot rows with `Robot.snapshot`",
+            _ => "",
+        };
         return Err(invalid(format!(
-            "`{name}` has shape {shape}; expected ({cols},) or (rows, {cols}) ({what})"
+            "`{name}` has shape {shape}; expected ({cols},) or (rows, {cols}) ({what}){hint}"
         )));
     }
     Ok((v.iter().copied().collect(), v.ndim() == 1))

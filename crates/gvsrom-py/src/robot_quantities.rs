@@ -187,4 +187,62 @@ impl Robot {
             .map_err(err)?;
         arrays::matrix(py, &j)
     }
+
+    /// Snapshot rows of absolute strains: ``ξ − ξ*`` of the components the scenario's strain
+    /// basis excites, point-major (``[point 0's components…, point 1's…, …]``) — the layout of a
+    /// dataset's ``strain`` rows and of :meth:`Model.encode`'s input — from the strains ``ξ`` at
+    /// the computational points as :attr:`Statics.strain` and ``simulate(…)["strain"]`` give
+    /// them. So a result of this robot, or of another robot of the same scenario, can be encoded:
+    /// ``model.encode(robot.snapshot(eq.strain))``.
+    ///
+    /// Parameters
+    /// ----------
+    /// strain : array_like of float, shape (n_points, 6) or (k, n_points, 6)
+    ///     ``[torsion, bend-y, bend-z, elongation, shear-y, shear-z]`` at each point (1/m, then
+    ///     dimensionless; the unloaded rod's elongation is 1).
+    ///
+    /// Returns
+    /// -------
+    /// numpy.ndarray
+    ///     Shape (n_points · n_components,), or (k, n_points · n_components).
+    fn snapshot<'py>(
+        &self,
+        py: Python<'py>,
+        strain: arrays::InDyn<'_>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let m = &self.built.model;
+        let p = m.disc.n_points();
+        let v = strain.as_array();
+        let shape = v.shape().to_vec();
+        let k = match shape[..] {
+            [rows, 6] if rows == p => None,
+            [k, rows, 6] if rows == p => Some(k),
+            _ => {
+                let dims: Vec<String> = shape.iter().map(usize::to_string).collect();
+                return Err(invalid(format!(
+                    "`strain` has shape ({}); expected ({p}, 6) or (k, {p}, 6): the 6 strain components at each of the {p} points, as `Statics.strain` gives them",
+                    dims.join(", ")
+                )));
+            }
+        };
+        let xi: Vec<f64> = v.iter().copied().collect();
+        if let Some(j) = xi.iter().position(|x| !x.is_finite()) {
+            return Err(invalid(format!(
+                "`strain` holds {} at flat index {j}: expected finite strains",
+                xi[j]
+            )));
+        }
+        let layout = rom::reduced::PointLayout::active_in(&m.param, &m.disc);
+        let mut rows = Vec::with_capacity(k.unwrap_or(1) * layout.len());
+        for sample in xi.chunks_exact(6 * p) {
+            for i in 0..p {
+                let star = m.xi_star(i);
+                rows.extend(layout.active.iter().map(|&a| sample[6 * i + a] - star[a]));
+            }
+        }
+        match k {
+            None => Ok(arrays::vector(py, &rows)),
+            Some(k) => arrays::shaped(py, rows, [k, layout.len()]),
+        }
+    }
 }

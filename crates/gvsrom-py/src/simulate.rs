@@ -388,6 +388,10 @@ fn trajectory<'py>(
     d.set_item("strain", shaped(py, b.strain.clone(), [k, p, 6])?)?;
     let x: Vec<f64> = built.model.disc.points.iter().map(|pt| pt.x).collect();
     d.set_item("strain_x", vector(py, &x))?;
+    let xi_star: Vec<f64> = (0..p)
+        .flat_map(|i| built.model.xi_star(i).iter().copied().collect::<Vec<_>>())
+        .collect();
+    d.set_item("strain_reference", shaped(py, xi_star, [p, 6])?)?;
     d.set_item("centerline", shaped(py, b.centerline.clone(), [k, c, 3])?)?;
     d.set_item("centerline_x", vector(py, b.centerline_x()))?;
     d.set_item(

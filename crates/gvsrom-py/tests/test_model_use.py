@@ -183,3 +183,32 @@ def test_pod_quantities_far_outside_the_data_say_so_and_answer(robot, pod):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         loose.mass_matrix(far)
+
+
+def test_a_results_strains_become_the_datasets_snapshot_rows_and_encode(robot, dataset, pod):
+    # a dataset row is ξ − ξ* of the basis's components, point-major: `snapshot` of the statics'
+    # absolute strains under the same tension gives it (to the solver's tolerance)
+    ds = dataset
+    for k in (0, 3, 6):
+        eq = robot.statics(u=ds.inputs[k])
+        row = robot.snapshot(eq.strain)
+        assert row.shape == (ds.strain.shape[1],)
+        np.testing.assert_allclose(row, ds.strain[k], rtol=0, atol=1e-7 * np.abs(ds.strain[k]).max())
+    # the layout spelled out independently: elongation is 1 at rest, so its snapshot value is ξ₄ − 1
+    names = ["torsion", "bend_y", "bend_z", "elongation", "shear_y", "shear_z"]
+    cols = [names.index(c) for c in ds.components]
+    by_hand = (eq.strain - eq.strain_reference)[:, cols].reshape(-1)
+    np.testing.assert_array_equal(robot.snapshot(eq.strain), by_hand)
+    # a trajectory's strains, sample by sample, and its reference strain as the statics' has it
+    run = robot.simulate(0.02, sample_rate=100)
+    np.testing.assert_array_equal(run["strain_reference"], robot.strain_reference)
+    rows = robot.snapshot(run["strain"])
+    assert rows.shape == (3, ds.strain.shape[1])
+    np.testing.assert_array_equal(rows[1], robot.snapshot(run["strain"][1]))
+    # Model.encode of a result: through snapshot, and the raw strains refused with that hint
+    np.testing.assert_allclose(pod.encode(robot.snapshot(eq.strain)), pod.encode(ds.strain[6]),
+                               rtol=0, atol=1e-6)
+    with pytest.raises(gvsrom.GvsromError, match=r"converts to snapshot rows with `Robot.snapshot`"):
+        pod.encode(eq.strain)
+    with pytest.raises(gvsrom.GvsromError, match=r"`strain` has shape \(3, 6\); expected \(102, 6\)"):
+        robot.snapshot(np.zeros((3, 6)))
