@@ -212,3 +212,13 @@ def test_a_results_strains_become_the_datasets_snapshot_rows_and_encode(robot, d
         pod.encode(eq.strain)
     with pytest.raises(gvsrom.GvsromError, match=r"`strain` has shape \(3, 6\); expected \(102, 6\)"):
         robot.snapshot(np.zeros((3, 6)))
+
+
+def test_snapshot_rows_of_six_components_on_two_divisions(tmp_path):
+    # the six-tendon arm: every strain component active, two divisions (a junction's points)
+    ds = gvsrom.dataset("six-tendon", tmp_path / "ds6", random="tendons.*.tension=-10:0", samples=3)
+    arm = gvsrom.Scenario.preset("six-tendon").build()
+    assert len(ds.components) == 6 and ds.strain.shape == (3, 6 * arm.n_points)
+    for k in range(3):
+        row = arm.snapshot(arm.statics(u=ds.inputs[k]).strain)
+        np.testing.assert_allclose(row, ds.strain[k], rtol=0, atol=1e-7 * np.abs(ds.strain[k]).max())
