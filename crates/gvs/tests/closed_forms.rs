@@ -868,6 +868,87 @@ fn helical_tendon_twists_and_bends_a_straight_rod_as_its_cut_wrench_says() {
 }
 
 #[test]
+fn helical_tendon_with_friction_loses_tension_by_the_capstan_law_of_its_helix() {
+    // The helical tendon above with Coulomb friction μ (the exact tangent rule, no smoothing) on a
+    // rod of ν = 0.3. Friction acts between tendon and rod, inside any cut: the cut at X balances
+    // the tension there, u α(X), so every strain is the frictionless one times
+    //   α(X) = exp(−μ Θ(X)),  Θ(X) = φ'² ρ X / n_t,
+    // the turning angle of the tendon's tangent τ = (e_x + φ' e_x × d)/n_t, which on the straight
+    // rod sweeps a cone at |τ'| = φ'² ρ / n_t (gvs-spec §7.7), to first order in u. The section's
+    // stiffness is written out here (G = E/(2(1 + ν)), shear factor 1), not taken from the code.
+    // A friction angle taken from the curvature of one bending plane, or one that misses the
+    // helix's own turning, would leave α = 1 here.
+    let (r, l, e, nu, rho, n, mu) = (0.01, 0.5, 1e6, 0.3, 0.006, 1.0, 0.5);
+    let u = -1e-4;
+    let tendon = Tendon {
+        offset_start: [rho, 0.0],
+        offset_end: [rho, 0.0],
+        x_start: 0.0,
+        x_end: l,
+        friction: mu,
+        friction_smoothing: 0.0,
+        turns: n,
+        path: Vec::new(),
+    };
+    let material = Material {
+        youngs_modulus: e,
+        poisson_ratio: nu,
+        density: 0.0,
+        damping: 0.0,
+    };
+    let m = model(
+        Rod::tapered(material, l, r, r),
+        96,
+        legendre([Some(2), Some(12), Some(12), Some(2), Some(12), Some(12)]),
+        vec![tendon],
+        &[],
+    );
+    let (_, ws) = solve(&m, &[u], &no_loads());
+    let g = e / (2.0 * (1.0 + nu));
+    let (area, inertia) = (PI * r * r, PI * r.powi(4) / 4.0);
+    let es = [
+        g * 2.0 * inertia,
+        e * inertia,
+        e * inertia,
+        e * area,
+        g * area,
+        g * area,
+    ];
+    let phi_rate = 2.0 * PI * n / l;
+    let nt = (1.0 + (phi_rate * rho).powi(2)).sqrt();
+    let strains = m.point_strains(&ws);
+    let peak = u.abs() * rho / (nt * es[1]);
+    let mut worst = 0.0f64;
+    for (p, xi) in m.disc.points.iter().zip(&strains) {
+        let ua = u * (-mu * phi_rate * phi_rate * rho * p.x / nt).exp();
+        let (s, c) = (phi_rate * p.x).sin_cos();
+        let expected = V6::new(
+            ua * phi_rate * rho * rho / (nt * es[0]),
+            ua * rho * s / (nt * es[1]),
+            -ua * rho * c / (nt * es[2]),
+            1.0 + ua / (nt * es[3]),
+            -ua * phi_rate * rho * s / (nt * es[4]),
+            ua * phi_rate * rho * c / (nt * es[5]),
+        );
+        worst = worst.max((xi - expected).amax() / peak);
+    }
+    // the tangent rule sums the angles between the tangents at consecutive points, chords of the
+    // cone's arc: measured 2.3e-4 of the peak with 48 Gauss points, 6.7e-5 with 96 (converging);
+    // second-order terms in u are 1e-6
+    assert!(
+        worst < 2e-4,
+        "largest strain error {worst:e} of the peak curvature"
+    );
+    // the friction is a real share of the response: the tip holds e^(−μΘ(L)) ≈ 0.79 of it
+    let tip = strains.last().unwrap();
+    let frictionless = -u * rho / (nt * es[2]);
+    assert!(
+        tip[2].abs() < 0.85 * frictionless.abs(),
+        "{tip} vs {frictionless}"
+    );
+}
+
+#[test]
 fn precurved_rod_is_stress_free_on_its_helix_and_an_end_moment_adds_m_over_ei() {
     // reference strain ξ* = [τ*, κ*, 0, 1, 0, 0] (gvs-spec §3.3): unloaded, the rod rests on the
     // helix exp(L ξ*̂) at q = 0 with no elastic force (constant strain, integrated exactly)
