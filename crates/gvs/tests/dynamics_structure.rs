@@ -138,7 +138,7 @@ fn fem_mass_matrix_is_its_definition_spd_and_mdot_minus_2c_is_skew() {
     let mut by_definition = DMatrix::<f64>::zeros(n, n);
     for (i, p) in m.disc.points.iter().enumerate() {
         let j = ws.jac.columns(i * n, n).into_owned();
-        let ms = nalgebra::Matrix6::from_diagonal(&m.section(i).ms.into());
+        let ms = nalgebra::Matrix6::from_diagonal(&m.section(i).ms);
         by_definition += j.transpose() * ms * j * p.weight;
     }
     let mass = m.mass_matrix(&q, &mut ws);
