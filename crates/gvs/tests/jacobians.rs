@@ -267,6 +267,22 @@ fn statics_jacobian_matches_finite_differences_with_all_loads_and_friction() {
 }
 
 #[test]
+fn jacobians_match_finite_differences_on_a_rod_precurved_along_its_length() {
+    // a reference strain ξ*(X) that varies along the rod (a curvature growing with X and a
+    // twist), evaluated at the Magnus sub-points too: it enters the kinematics, the elastic force
+    // and the tendon's path (t_u includes κ* × d), with friction, gravity and every load
+    let xi_star =
+        |x: f64, _div: usize| V6::new(0.8 * x, 2.0 + 12.0 * x, -3.0 * x * x, 1.0, 0.0, 0.0);
+    for order in [MagnusOrder::Z4, MagnusOrder::Z2] {
+        let m = single_division_model(order, 0.88).with_reference_strain(xi_star);
+        let q = pseudo_random(m.n_dof(), 5, 0.5);
+        check_geometric_jacobian(&m, &q);
+        check_position_jacobian(&m, &q);
+        check_statics_jacobian(&m, &q, &[-2.0, -0.7, -1.5], &all_loads());
+    }
+}
+
+#[test]
 fn statics_jacobian_matches_finite_differences_two_divisions_half_tendon() {
     let rod = Rod {
         material: Material {
