@@ -202,7 +202,7 @@ mod tests {
     }
 
     #[test]
-    fn every_inertia_and_damping_entry_matches_its_closed_form() {
+    fn every_stiffness_inertia_and_damping_entry_matches_its_closed_form() {
         // gvs-spec §3.4 for a solid circle of radius r: A = πr², I = πr⁴/4, J = 2I;
         // Ms = ρ diag(J, I, I, A, A, A), Ds = η diag(J, 3I, 3I, 3A, A, A) (§3.4), entry by entry
         let m = Material {
@@ -218,7 +218,16 @@ mod tests {
         let j = 2.0 * i;
         let ms = [j, i, i, a, a, a].map(|x| 1200.0 * x);
         let ds = [j, 3.0 * i, 3.0 * i, 3.0 * a, a, a].map(|x| 3e3 * x);
+        // Es = diag(GJ, EI, EI, EA, GA, GA), G = E/(2(1 + ν)) = E/2.6 here (shear factor 1)
+        let g = 2e6 / 2.6;
+        let es = [g * j, 2e6 * i, 2e6 * i, 2e6 * a, g * a, g * a];
         for k in 0..6 {
+            assert!(
+                rel(s.es[k], es[k]) < 1e-14,
+                "es[{k}] = {} against {}",
+                s.es[k],
+                es[k]
+            );
             assert!(
                 rel(s.ms[k], ms[k]) < 1e-14,
                 "ms[{k}] = {} against {}",
