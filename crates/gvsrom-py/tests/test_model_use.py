@@ -222,3 +222,18 @@ def test_snapshot_rows_of_six_components_on_two_divisions(tmp_path):
     for k in range(3):
         row = arm.snapshot(arm.statics(u=ds.inputs[k]).strain)
         np.testing.assert_allclose(row, ds.strain[k], rtol=0, atol=1e-7 * np.abs(ds.strain[k]).max())
+
+
+def test_pod_modes_and_singular_values_are_numpys_svd_of_the_snapshots(dataset, pod):
+    # an independent SVD (LAPACK through NumPy) of the snapshot matrix, rows = snapshots, not centred
+    X = dataset.strain
+    _, S, Vt = np.linalg.svd(X, full_matrices=False)
+    modes, sigma = pod.arrays["modes"], pod.arrays["singular_values"]
+    k = pod.latent
+    np.testing.assert_allclose(sigma, S[:len(sigma)], rtol=1e-10, atol=1e-12 * S[0])
+    V = modes if modes.shape[0] == X.shape[1] else modes.T
+    # each mode is numpy's up to its sign
+    overlap = np.abs(Vt[:k] @ V)
+    np.testing.assert_allclose(overlap, np.eye(k), rtol=0, atol=1e-9)
+    np.testing.assert_allclose(pod.meta["captured_energy"], (S[:k] ** 2).sum() / (S ** 2).sum(),
+                               rtol=1e-12)
