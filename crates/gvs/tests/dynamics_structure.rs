@@ -359,7 +359,8 @@ fn linearized_frequencies_of_clamped_rod_match_beam_theory() {
     let s = SectionProps::circular(&mat, r);
     let eb = |beta_l: f64| beta_l * beta_l / (2.0 * PI * l * l) * (s.es[1] / (rho * s.area)).sqrt();
     let (f1, f2) = (eb(1.875_104_068_711_96), eb(4.694_091_132_974_17));
-    let torsion = (mat.shear_modulus() / rho).sqrt() / (4.0 * l);
+    let g = e / (2.0 * (1.0 + mat.poisson_ratio));
+    let torsion = (g / rho).sqrt() / (4.0 * l);
     let axial = (e / rho).sqrt() / (4.0 * l);
     // first two bending modes, each doubly degenerate (y and z), within 1 % of Euler–Bernoulli
     for (k, fe) in [(0, f1), (2, f2)] {
@@ -382,13 +383,15 @@ fn linearized_frequencies_of_clamped_rod_match_beam_theory() {
             .map(|x| ((x - target) / target).abs())
             .fold(f64::MAX, f64::min)
     };
+    // the order-2 polynomial's Ritz error, measured 6.8e-5 for both: a mode within 1e-3 is theirs
+    // (the nearest others lie 12–22 % off), and G is written out here (not the code's)
     assert!(
-        near(torsion) < 0.01,
-        "no mode within 1 % of torsion {torsion} Hz: {f:?}"
+        near(torsion) < 1e-3,
+        "no mode within 1e-3 of torsion {torsion} Hz: {f:?}"
     );
     assert!(
-        near(axial) < 0.01,
-        "no mode within 1 % of axial {axial} Hz: {f:?}"
+        near(axial) < 1e-3,
+        "no mode within 1e-3 of axial {axial} Hz: {f:?}"
     );
 }
 
