@@ -59,7 +59,7 @@ L, R, E, NU, RHO, GRAV, T, FS = 0.5, 0.01, 1e7, 0.5, 1000.0, 9.81, 1.0, 100
 def build(a):
     mask = [c == "1" for c in a.strains]
     link = sx.LinkSpec.circular(length=L / a.segments, radius=R, density=RHO,
-                                reference_strain=[0, 0, 0, 1.0, 0, 0],
+                                reference_strain=[float(v) for v in a.reference_strain.split(",")],
                                 young_modulus=E, shear_modulus=E / (2 * (1 + NU)))
     kw = dict(gravity=jnp.array([0.0, 0.0, -GRAV]),
               base_pose=jnp.array([0, 0, 0, 1.0, 0, 0, 0]), backend="jax")
@@ -120,6 +120,9 @@ def main():
     p.add_argument("--max-steps", type=int, default=4_000_000)
     p.add_argument("--repeat", type=int, default=3, help="timed runs (0: use the first)")
     p.add_argument("--static", action="store_true")
+    p.add_argument("--reference-strain", default="0,0,0,1,0,0",
+                   help="the rod's rest strain [kx,ky,kz,sx,sy,sz] (default straight): e.g. "
+                        "2,0,3,1,0,0 rests on a helix, and gravity then moves it in 3-D")
     a = p.parse_args()
     if a.solver == "sie" and not a.dt:
         p.error("--solver sie needs --dt")
