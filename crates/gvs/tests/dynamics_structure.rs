@@ -2,7 +2,6 @@
 //! `Ṁ − 2C` skew-symmetric, the Coriolis matrix consistent with the force path, `J̇ q̇` against finite
 //! differences, and linearized natural frequencies against beam theory.
 
-use gvs::actuation::{Tendon, DEFAULT_FRICTION_SMOOTHING};
 use gvs::discretize::{Discretization, MagnusOrder, Quadrature};
 use gvs::loads::Loads;
 use gvs::model::Model;
@@ -10,7 +9,7 @@ use gvs::rod::{DivisionGeometry, Material, Rod, SectionProps};
 use gvs::strain::{DivisionBasis, FemDegree, LinearBasis, SigmoidBend, StrainParam};
 mod common;
 
-use common::{clamped_rod_10_5, pseudo_random};
+use common::{clamped_rod_10_5, iva_tendon, pseudo_random};
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 use std::f64::consts::PI;
 
@@ -34,17 +33,7 @@ fn linear_model(order: MagnusOrder, damping: f64) -> Model<LinearBasis> {
         }],
     )
     .unwrap();
-    let t = Tendon {
-        offset_start: [0.0, 0.01],
-        offset_end: [0.0, 0.003],
-        x_start: 0.0,
-        x_end: 0.25,
-        friction: 0.5,
-        friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
-        turns: 0.0,
-        path: Vec::new(),
-    };
-    Model::new(rod, disc, b, vec![t]).unwrap()
+    Model::new(rod, disc, b, vec![iva_tendon(0.5)]).unwrap()
 }
 
 fn sigmoid_model() -> Model<SigmoidBend> {
@@ -112,17 +101,7 @@ fn fem_model() -> Model<LinearBasis> {
         &[fem(3, FemDegree::Linear), fem(2, FemDegree::Quadratic)],
     )
     .unwrap();
-    let t = Tendon {
-        offset_start: [0.0, 0.01],
-        offset_end: [0.0, 0.003],
-        x_start: 0.0,
-        x_end: 0.25,
-        friction: 0.5,
-        friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
-        turns: 0.0,
-        path: Vec::new(),
-    };
-    Model::new(rod, disc, b, vec![t]).unwrap()
+    Model::new(rod, disc, b, vec![iva_tendon(0.5)]).unwrap()
 }
 
 #[test]

@@ -123,7 +123,13 @@ pub fn iva_arm(damping: f64, friction: f64) -> Model<LinearBasis> {
         }],
     )
     .unwrap();
-    let t = gvs::actuation::Tendon {
+    Model::new(rod, disc, b, vec![iva_tendon(friction)]).unwrap()
+}
+
+/// The IV-A arm's tendon: full length, on the upper side from 10 mm to 3 mm off the axis, with
+/// capstan friction `friction` (default smoothing).
+pub fn iva_tendon(friction: f64) -> gvs::actuation::Tendon {
+    gvs::actuation::Tendon {
         offset_start: [0.0, 0.01],
         offset_end: [0.0, 0.003],
         x_start: 0.0,
@@ -132,6 +138,5 @@ pub fn iva_arm(damping: f64, friction: f64) -> Model<LinearBasis> {
         friction_smoothing: gvs::actuation::DEFAULT_FRICTION_SMOOTHING,
         turns: 0.0,
         path: Vec::new(),
-    };
-    Model::new(rod, disc, b, vec![t]).unwrap()
+    }
 }
