@@ -33,11 +33,11 @@ const TENDON: &str = concat!(
     "/../../scripts/peers/tendon-statics.toml"
 );
 
-/// The fixture's static tip and its 101 rows `[t, x, y, z]`.
-fn soromox() -> ([f64; 3], Vec<[f64; 4]>) {
+/// A soromox fixture's static tip (if it records one) and its 101 rows `[t, x, y, z]`.
+fn fixture(text: &str) -> (Option<[f64; 3]>, Vec<[f64; 4]>) {
     let mut static_tip = None;
     let mut rows = Vec::new();
-    for line in FIXTURE.lines() {
+    for line in text.lines() {
         let values =
             |rest: &str| -> Vec<f64> { rest.split(',').map(|v| v.parse().unwrap()).collect() };
         if let Some(rest) = line.strip_prefix("# static_tip,") {
@@ -48,7 +48,49 @@ fn soromox() -> ([f64; 3], Vec<[f64; 4]>) {
             rows.push([v[0], v[1], v[2], v[3]]);
         }
     }
+    assert_eq!(rows.len(), 101);
+    (static_tip, rows)
+}
+
+/// The gravity release's fixture: its static tip and rows.
+fn soromox() -> ([f64; 3], Vec<[f64; 4]>) {
+    let (static_tip, rows) = fixture(FIXTURE);
     (static_tip.unwrap(), rows)
+}
+
+/// `gvsrom simulate` of the peer scenario at order 2 with the `--set` overrides `extra`, over 1 s
+/// at tight tolerances; the largest tip distance [m] to soromox's `expected` rows (whose times
+/// must be the run's).
+fn release_against(name: &str, extra: &[&str], expected: &[[f64; 4]]) -> f64 {
+    let dir = scratch(name);
+    let mut args = vec!["simulate", SCENARIO, "--set", "divisions.0.basis.order=2"];
+    for e in extra {
+        args.extend(["--set", e]);
+    }
+    args.extend([
+        "--duration",
+        "1",
+        "--rtol",
+        "1e-8",
+        "--atol",
+        "1e-10",
+        "--out",
+        s(&dir),
+    ]);
+    run_ok(&args);
+    let (shape, t) = npy(&dir.join("t.npy"));
+    assert_eq!(shape, vec![expected.len()]);
+    let (_, tip) = npy(&dir.join("tip_position.npy"));
+    let mut worst: f64 = 0.0;
+    for (i, row) in expected.iter().enumerate() {
+        assert!((t[i] - row[0]).abs() < 1e-12, "sample {i} at t = {}", t[i]);
+        let d = (0..3)
+            .map(|k| (tip[3 * i + k] - row[k + 1]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        worst = worst.max(d);
+    }
+    worst
 }
 
 #[test]
@@ -63,35 +105,8 @@ fn the_sagged_cantilever_agrees_with_soromox_to_a_tenth_of_a_micrometre() {
 #[test]
 fn the_undamped_release_under_gravity_agrees_with_soromox_over_a_second() {
     let (_, expected) = soromox();
-    let dir = scratch("peer-soromox-release");
-    run_ok(&[
-        "simulate",
-        SCENARIO,
-        "--set",
-        "divisions.0.basis.order=2",
-        "--duration",
-        "1",
-        "--rtol",
-        "1e-8",
-        "--atol",
-        "1e-10",
-        "--out",
-        s(&dir),
-    ]);
-    let (shape, t) = npy(&dir.join("t.npy"));
-    assert_eq!(shape, vec![expected.len()]);
-    let (_, tip) = npy(&dir.join("tip_position.npy"));
-    let mut worst: f64 = 0.0;
-    let mut deepest: f64 = 0.0;
-    for (i, row) in expected.iter().enumerate() {
-        assert!((t[i] - row[0]).abs() < 1e-12, "sample {i} at t = {}", t[i]);
-        let d = (0..3)
-            .map(|k| (tip[3 * i + k] - row[k + 1]).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        worst = worst.max(d);
-        deepest = deepest.min(row[3]);
-    }
+    let worst = release_against("peer-soromox-release", &[], &expected);
+    let deepest = expected.iter().map(|r| r[3]).fold(0.0, f64::min);
     // the swing is large (0.40 m of a 0.5 m rod) and the two agree to a micrometre (observed
     // 2.6e-7 m: the tolerances of the two integrators)
     assert!(deepest < -0.3, "fixture's deepest tip {deepest}");
@@ -104,47 +119,22 @@ fn a_precurved_rod_released_under_gravity_moves_in_3d_as_in_soromox() {
     // bending about z), released under gravity along −z: a motion in all three directions, with the
     // twist coupling bending about y and z, where the straight rod's release stays in its plane.
     // No coordinates are mapped between the codes: both start at q = 0, q̇ = 0.
-    let expected: Vec<[f64; 4]> = (PRECURVED.lines())
-        .filter(|l| !l.starts_with('#') && !l.starts_with("t,"))
-        .map(|l| {
-            let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-            [v[0], v[1], v[2], v[3]]
-        })
-        .collect();
-    assert_eq!(expected.len(), 101);
-    let dir = scratch("peer-soromox-precurved");
-    run_ok(&[
-        "simulate",
-        SCENARIO,
-        "--set",
-        "divisions.0.basis.order=2",
-        "--set",
-        "divisions.0.reference_strain=[2, 0, 3, 1, 0, 0]",
-        "--duration",
-        "1",
-        "--rtol",
-        "1e-8",
-        "--atol",
-        "1e-10",
-        "--out",
-        s(&dir),
-    ]);
-    let (_, tip) = npy(&dir.join("tip_position.npy"));
-    let mut worst: f64 = 0.0;
-    let (mut y, mut z) = ((f64::MAX, f64::MIN), (f64::MAX, f64::MIN));
-    for (i, row) in expected.iter().enumerate() {
-        let d = (0..3)
-            .map(|k| (tip[3 * i + k] - row[k + 1]).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        worst = worst.max(d);
-        y = (y.0.min(row[2]), y.1.max(row[2]));
-        z = (z.0.min(row[3]), z.1.max(row[3]));
-    }
+    let (_, expected) = fixture(PRECURVED);
+    let worst = release_against(
+        "peer-soromox-precurved",
+        &["divisions.0.reference_strain=[2, 0, 3, 1, 0, 0]"],
+        &expected,
+    );
+    let span = |k: usize| {
+        let v = expected.iter().map(|r| r[k]);
+        v.clone().fold(f64::MIN, f64::max) - v.fold(f64::MAX, f64::min)
+    };
     // the tip sweeps 0.12 m across and 0.46 m down; the two agree to 0.14 µm (observed 1.37e-7 m)
     assert!(
-        y.1 - y.0 > 0.1 && z.1 - z.0 > 0.4,
-        "fixture's sweep {y:?} {z:?}"
+        span(2) > 0.1 && span(3) > 0.4,
+        "fixture's sweep {} {}",
+        span(2),
+        span(3)
     );
     assert!(worst <= 1e-6, "tip {worst:.3e} m from soromox's at worst");
 }
