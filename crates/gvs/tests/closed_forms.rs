@@ -812,6 +812,22 @@ fn follower_axial_load_stretches_a_rotated_rod_by_f_l2_over_2ea() {
     assert!((ws.g.last().unwrap().pos - expected).norm() > 1e-3);
 }
 
+/// The strain at `x` of a straight rod (section stiffness `es`) whose cut there balances a
+/// helical tendon (radius `rho`, turning at `phi_rate` rad/m) pulling with `u`, to first order in
+/// `u` (see the test below): `t = (e_x + φ' e_x × d)/n_t`, `n_t = √(1 + (φ'ρ)²)`.
+fn helix_cut_strain(u: f64, x: f64, phi_rate: f64, rho: f64, es: &V6) -> V6 {
+    let nt = (1.0 + (phi_rate * rho).powi(2)).sqrt();
+    let (s, c) = (phi_rate * x).sin_cos();
+    V6::new(
+        u * phi_rate * rho * rho / (nt * es[0]),
+        u * rho * s / (nt * es[1]),
+        -u * rho * c / (nt * es[2]),
+        1.0 + u / (nt * es[3]),
+        -u * phi_rate * rho * s / (nt * es[4]),
+        u * phi_rate * rho * c / (nt * es[5]),
+    )
+}
+
 #[test]
 fn helical_tendon_twists_and_bends_a_straight_rod_as_its_cut_wrench_says() {
     // A frictionless tendon on a helix of radius ρ and n turns over a uniform rod,
@@ -847,15 +863,7 @@ fn helical_tendon_twists_and_bends_a_straight_rod_as_its_cut_wrench_says() {
     let strains = m.point_strains(&ws);
     let peak = u.abs() * rho / (nt * es[1]);
     for (p, xi) in m.disc.points.iter().zip(&strains) {
-        let (s, c) = (phi_rate * p.x).sin_cos();
-        let expected = V6::new(
-            u * phi_rate * rho * rho / (nt * es[0]),
-            u * rho * s / (nt * es[1]),
-            -u * rho * c / (nt * es[2]),
-            1.0 + u / (nt * es[3]),
-            -u * phi_rate * rho * s / (nt * es[4]),
-            u * phi_rate * rho * c / (nt * es[5]),
-        );
+        let expected = helix_cut_strain(u, p.x, phi_rate, rho, &es);
         // second-order terms are O(u²): relative 1e-6 of the peak curvature
         assert!(
             (xi - expected).amax() < 1e-6 * peak,
@@ -921,15 +929,7 @@ fn helical_tendon_with_friction_loses_tension_by_the_capstan_law_of_its_helix() 
     let mut worst = 0.0f64;
     for (p, xi) in m.disc.points.iter().zip(&strains) {
         let ua = u * (-mu * phi_rate * phi_rate * rho * p.x / nt).exp();
-        let (s, c) = (phi_rate * p.x).sin_cos();
-        let expected = V6::new(
-            ua * phi_rate * rho * rho / (nt * es[0]),
-            ua * rho * s / (nt * es[1]),
-            -ua * rho * c / (nt * es[2]),
-            1.0 + ua / (nt * es[3]),
-            -ua * phi_rate * rho * s / (nt * es[4]),
-            ua * phi_rate * rho * c / (nt * es[5]),
-        );
+        let expected = helix_cut_strain(ua, p.x, phi_rate, rho, &V6::from(es));
         worst = worst.max((xi - expected).amax() / peak);
     }
     // the tangent rule sums the angles between the tangents at consecutive points, chords of the
