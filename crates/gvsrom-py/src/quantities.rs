@@ -74,11 +74,7 @@ pub fn forward(built: &Built, cache: &WorkspaceCache, q: &DVector<f64>) -> (Vec<
 /// state. The model's quantities there mean nothing, and overflow to NaN far beyond.
 /// Only the strains are evaluated, without the kinematics ([`Model::strains_at`]).
 pub fn state_violation(built: &Built, cache: &WorkspaceCache, q: &DVector<f64>) -> Option<String> {
-    with_model!(built, cache, m, ws => {
-        let x: Vec<f64> = m.disc.points.iter().map(|pt| pt.x).collect();
-        let length = m.disc.length();
-        gvsrom::plausibility::state_violation(m.strains_at(q, ws), &x, |j| m.xi_star(j), length)
-    })
+    with_model!(built, cache, m, ws => gvsrom::plausibility::model_state_violation(m, q, ws))
 }
 
 fn poses(ws: &Workspace) -> (Vec<f64>, Vec<f64>) {

@@ -47,7 +47,10 @@ mod state;
 mod tests;
 mod verdict;
 
-pub use state::{coordinates_violation, state_violation, STATE_MAX_BENDING, STATE_MAX_STRAIN};
+pub use state::{
+    coordinates_violation, model_state_violation, state_violation, STATE_MAX_BENDING,
+    STATE_MAX_STRAIN,
+};
 pub use verdict::{check, largest_load};
 
 use gvs::loads::Loads;

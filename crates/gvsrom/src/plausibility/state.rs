@@ -68,17 +68,22 @@ pub fn state_violation(
 /// phrase; `None` for a physical state. It allocates a workspace: a check of a start, not of every
 /// sample.
 pub fn coordinates_violation(built: &crate::Built, q: &[f64]) -> Option<String> {
-    fn of<P: gvs::strain::StrainParam>(m: &gvs::model::Model<P>, q: &[f64]) -> Option<String> {
-        let x: Vec<f64> = m.disc.points.iter().map(|p| p.x).collect();
-        let mut ws = m.workspace();
-        let q = nalgebra::DVector::from_column_slice(q);
-        let strain = m.strains_at(&q, &mut ws);
-        state_violation(strain, &x, |j| m.xi_star(j), m.disc.length())
-    }
+    let q = nalgebra::DVector::from_column_slice(q);
     match &built.reduced {
-        Some(r) => of(&r.model, q),
-        None => of(&built.model, q),
+        Some(r) => model_state_violation(&r.model, &q, &mut r.model.workspace()),
+        None => model_state_violation(&built.model, &q, &mut built.model.workspace()),
     }
+}
+
+/// [`state_violation`] of the strains that `m` gives at `q` (evaluated in `ws`, without the
+/// kinematics).
+pub fn model_state_violation<P: gvs::strain::StrainParam>(
+    m: &gvs::model::Model<P>,
+    q: &nalgebra::DVector<f64>,
+    ws: &mut gvs::model::Workspace,
+) -> Option<String> {
+    let x: Vec<f64> = m.disc.points.iter().map(|p| p.x).collect();
+    state_violation(m.strains_at(q, ws), &x, |j| m.xi_star(j), m.disc.length())
 }
 
 #[cfg(test)]
