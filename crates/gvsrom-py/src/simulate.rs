@@ -59,7 +59,8 @@ impl Robot {
     ///     ``(lo, hi, hold_min, hold_max)``: each tendon holds a uniform random tension in
     ///     ``[lo, hi]`` for a uniform random time in ``[hold_min, hold_max]`` (``--babble``).
     /// seed : int
-    ///     Seed of ``steps`` and ``babble`` (same seed, same signal as the command line's).
+    ///     Seed of ``steps`` and ``babble`` (same seed, same signal as the command line's; 1 by
+    ///     default, as ``gvsrom simulate --seed``).
     /// max_order : int, optional
     ///     Highest order of the NDF, 1–5 (``--max-order``; default 5, or 2 for a lightly damped
     ///     rod).
@@ -126,7 +127,7 @@ impl Robot {
     ///     does ``KeyboardInterrupt`` (Ctrl-C).
     /// GvsromError
     ///     For bad options or input.
-    #[pyo3(signature = (duration, sample_rate=100.0, input=None, interpolate=false, from_equilibrium=false, q0=None, qd0=None, method="auto", rtol=None, atol=None, fixed_step=None, load_schedule=None, steps=None, babble=None, seed=0, max_order=None, error_norm=None, rho_inf=None, fd_jacobian=false, controller=None, control_rate=None, out=None, force=false))]
+    #[pyo3(signature = (duration, sample_rate=100.0, input=None, interpolate=false, from_equilibrium=false, q0=None, qd0=None, method="auto", rtol=None, atol=None, fixed_step=None, load_schedule=None, steps=None, babble=None, seed=1, max_order=None, error_norm=None, rho_inf=None, fd_jacobian=false, controller=None, control_rate=None, out=None, force=false))]
     #[allow(clippy::too_many_arguments)]
     fn simulate<'py>(
         &self,

@@ -176,6 +176,13 @@ def test_random_steps_and_babbling_equal_the_cli(gvsrom_bin, tmp_path):
         # the tensions change within the run, inside [lo, hi]
         assert len(np.unique(tr["u"][:, 0])) > 1
         assert tr["u"].min() >= -15.0 and tr["u"].max() <= 0.0
+    # without a seed, both draw the same signal (the command line's default seed, 1)
+    out = tmp_path / "default-seed"
+    p = run_cli(gvsrom_bin, "simulate", "six-tendon", "--duration", "0.3", "--steps=-15,0,0.1",
+                "--out", str(out))
+    assert p.returncode == 0, p.stderr
+    np.testing.assert_array_equal(robot.simulate(0.3, steps=[-15.0, 0.0, 0.1])["u"],
+                                  np.load(out / "u.npy"))
     with pytest.raises(gvsrom.GvsromError, match="at most one"):
         robot.simulate(0.1, input=np.zeros((1, 7)), steps=[-1.0, 0.0, 0.1])
     with pytest.raises(gvsrom.GvsromError, match="steps"):

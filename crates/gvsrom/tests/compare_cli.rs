@@ -142,6 +142,58 @@ fn runs_with_another_input_physics_or_duration_are_refused_naming_what_differs()
 }
 
 #[test]
+fn runs_that_start_apart_are_said_to_with_the_offset() {
+    // the preset's equilibrium (tendon 0 at −10 N, under gravity) against the straight rod at rest
+    let from_rest = simulate("cmp-start-rest", &[]);
+    let settled = simulate("cmp-start-eq", &["--from-equilibrium"]);
+    let stdout = compare_anyway(&from_rest, &settled);
+    let tip = |text: &str, key: &str| -> f64 {
+        let line = text.lines().find(|l| l.starts_with("tip error")).unwrap();
+        let after = &line[line.find(key).unwrap() + key.len()..];
+        after.split_whitespace().next().unwrap().parse().unwrap()
+    };
+    let note = stdout
+        .lines()
+        .find(|l| l.starts_with("note       the runs start "))
+        .unwrap_or_else(|| panic!("no start note: {stdout}"));
+    // the offset printed is the tip error at t = 0, which the max includes
+    let start: f64 = note["note       the runs start ".len()..]
+        .split_whitespace()
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(
+        start > 10.0,
+        "the equilibrium sags far from the straight rod: {note}"
+    );
+    assert!(start <= tip(&stdout, "max ") + 1e-3, "{stdout}");
+    assert!(note.contains("--from-equilibrium"), "{note}");
+    // the JSON report holds it too
+    let json = scratch("cmp-start.json");
+    let out = gvsrom(&[
+        "compare",
+        path(&from_rest),
+        path(&settled),
+        "--allow-different",
+        "--json",
+        path(&json),
+    ]);
+    assert!(out.status.success());
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let tip_start = report["comparison"]["tip_start"].as_f64().unwrap();
+    assert!(
+        (tip_start - start).abs() < 1e-3,
+        "{tip_start} against {start}"
+    );
+    // runs from one state: no note
+    let again = simulate("cmp-start-again", &[]);
+    let stdout = compare_anyway(&from_rest, &again);
+    assert!(!stdout.contains("the runs start"), "{stdout}");
+}
+
+#[test]
 fn a_zero_or_missing_wall_time_prints_n_a_never_inf() {
     let reference = simulate("cmp-wall-ref", &[]);
     let zero = copy_with_meta(&reference, "cmp-wall-zero", |m| {

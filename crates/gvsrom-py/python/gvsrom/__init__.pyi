@@ -441,7 +441,7 @@ class Robot:
         load_schedule: _Path | None = None,
         steps: Sequence[float] | None = None,
         babble: Sequence[float] | None = None,
-        seed: int = 0,
+        seed: int = 1,
         max_order: int | None = None,
         error_norm: str | None = None,
         rho_inf: float | None = None,

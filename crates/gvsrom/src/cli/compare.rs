@@ -96,6 +96,13 @@ pub(super) fn compare_cmd(args: &CompareArgs, out: &mut impl Write) -> Result<()
         "tip error  mean {:.3} %, max {:.3} % at t = {} s, last {:.3} % of the length {} m",
         c.tip_mean, c.tip_max, c.tip_max_t, c.tip_end, reference.length
     )?;
+    if c.starts_apart() {
+        writeln!(
+            out,
+            "note       the runs start {:.3} % of the length apart (their tips at t = {} s), and that offset is part of every error above: a reduced model's rest can decode away from the full model's (simulate prints it on its `start` line); start both with --from-equilibrium to compare from one state",
+            c.tip_start, reference.t[0]
+        )?;
+    }
     let active: Vec<&str> = c
         .active
         .iter()

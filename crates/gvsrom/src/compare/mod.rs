@@ -2,8 +2,9 @@
 //! against another (typically the full model's) over their common samples, with the measures of
 //! [`rom::metrics`] (paper Section IV-C2, Fig. 9):
 //!
-//! - **tip error** `100 · ‖p_run − p_ref‖ / L` per sample: mean, maximum (and when), and at the last
-//!   common sample;
+//! - **tip error** `100 · ‖p_run − p_ref‖ / L` per sample: mean, maximum (and when), and at the first
+//!   and last common samples (the first says how far apart the runs start: a reduced model whose
+//!   rest decodes away from the straight rod starts elsewhere, and that offset is in every error);
 //! - **strain error** per sample: the mean absolute difference of `ξ − ξ*` over the computational
 //!   points and the active components, as a percentage of the reference's largest `|ξ − ξ*|` at that
 //!   sample; mean and maximum over the samples where the reference is not straight. A component is
@@ -60,6 +61,10 @@ pub struct Comparison {
     /// Time of the largest tip error.
     pub tip_max_t: f64,
     pub tip_end: f64,
+    /// Tip error at the first common sample: how far apart the runs start (a reduced model's rest
+    /// that decodes away from the full model's, or another start state); part of every error.
+    #[serde(default)]
+    pub tip_start: f64,
     /// Over the samples where the reference is not straight (`None` if there are none).
     pub strain_mean: Option<f64>,
     pub strain_max: Option<f64>,
@@ -70,6 +75,18 @@ pub struct Comparison {
     /// and the time of the maximum (`None` unless both trajectories record the lengths).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tendon_length_mm: Option<TendonLengthError>,
+}
+
+impl Comparison {
+    /// Tip error at the first sample above which the runs are said to start apart, % of the
+    /// length: a reduced model's rest within the decoder's training fit starts well below it.
+    pub const START_APART_PERCENT: f64 = 0.1;
+
+    /// The runs start apart (their first tips more than [`Self::START_APART_PERCENT`] of the
+    /// length apart): every error then holds that offset.
+    pub fn starts_apart(&self) -> bool {
+        self.tip_start > Self::START_APART_PERCENT
+    }
 }
 
 /// [`Comparison::tendon_length_mm`].
@@ -235,6 +252,7 @@ pub fn compare(reference: &Trajectory, run: &Trajectory) -> Result<Comparison, S
         })
         .collect();
     let (mut tip_sum, mut tip_max, mut tip_max_t, mut tip_end) = (0.0, 0.0f64, 0.0, 0.0);
+    let mut tip_start = 0.0;
     let (mut strain_sum, mut strain_max, mut strained) = (0.0, 0.0f64, 0usize);
     let (mut a, mut b) = (Vec::new(), Vec::new());
     for k in 0..n {
@@ -245,6 +263,9 @@ pub fn compare(reference: &Trajectory, run: &Trajectory) -> Result<Comparison, S
             (tip_max, tip_max_t) = (e, reference.t[k]);
         }
         tip_end = e;
+        if k == 0 {
+            tip_start = e;
+        }
         a.clear();
         b.clear();
         for j in 0..points {
@@ -267,6 +288,7 @@ pub fn compare(reference: &Trajectory, run: &Trajectory) -> Result<Comparison, S
         tip_max,
         tip_max_t,
         tip_end,
+        tip_start,
         strain_mean: (strained > 0).then(|| strain_sum / strained as f64),
         strain_max: (strained > 0).then_some(strain_max),
         active,

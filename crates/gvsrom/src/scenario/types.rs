@@ -83,8 +83,9 @@ pub struct DivisionSpec {
     #[serde(default)]
     pub radius_end: Option<f64>,
     pub basis: BasisSpec,
-    /// Default: Legendre → `gauss = max(order) + 1`, at least 5 (SoRoSim); FEM → the basis's elements
-    /// with 2 (linear) or 3 (quadratic) Gauss points each.
+    /// Default: Legendre → `gauss = max(order) + 1`, at least 5 (SoRoSim), or `3 (max(order) + 1)`
+    /// above order 3 (what the Z4 kinematics needs); FEM → the basis's elements with 2 (linear) or
+    /// 3 (quadratic) Gauss points each.
     #[serde(default)]
     pub quadrature: Option<QuadratureSpec>,
     /// Reference strain ξ* `[torsion, bend_y, bend_z, elongation, shear_y, shear_z]` of the
