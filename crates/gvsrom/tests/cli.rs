@@ -24,6 +24,32 @@ fn negative_or_zero_length_is_rejected_with_field_and_range() {
 }
 
 #[test]
+fn the_summary_says_whether_a_wrench_follows_its_section() {
+    // IV-B's pulse is a follower moment; a point force is one too unless it says "global"
+    // (a dead weight): under large deflection the two bend the rod differently
+    let beam = run_ok(&["statics", "soft-beam"]);
+    assert!(
+        beam.contains(
+            "loads      gravity [0, 0, 0] m/s², 0 point wrenches, 1 distributed wrench (follower)"
+        ),
+        "{beam}"
+    );
+    let both = run_ok(&[
+        "statics",
+        "single-tendon",
+        "--set",
+        "loads.point=[{x=0.25,force=[0,0,-0.01],frame=\"global\"},{x=0.1,force=[0,0,-0.01]}]",
+    ]);
+    for line in ["scenario", "loads"] {
+        let l = both.lines().find(|l| l.starts_with(line)).unwrap();
+        assert!(
+            l.contains("2 point wrenches (1 follower, 1 world-fixed)"),
+            "{l}"
+        );
+    }
+}
+
+#[test]
 fn non_positive_radius_is_rejected() {
     expect_error(
         &[

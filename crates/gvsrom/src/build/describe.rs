@@ -2,6 +2,7 @@
 
 use super::Built;
 use crate::scenario::{BasisKind, Scenario};
+use gvs::loads::Frame;
 use gvs::strain::FemDegree;
 
 /// A one-line description of the scenario as built (after `--set` and `--tension`), for the
@@ -76,13 +77,12 @@ pub fn describe(s: &Scenario, built: &Built) -> String {
             )
         }
     });
-    let count = |n: usize, what: &str| match n {
-        0 => None,
-        1 => Some(format!("1 {what}")),
-        n => Some(format!("{n} {what}es")),
-    };
-    parts.extend(count(built.loads.point.len(), "point wrench"));
-    parts.extend(count(built.loads.distributed.len(), "distributed wrench"));
+    let (point, distributed) = wrench_frames(built);
+    for (frames, what) in [(point, "point wrench"), (distributed, "distributed wrench")] {
+        if !frames.is_empty() {
+            parts.push(wrench_count(&frames, what));
+        }
+    }
     let mut kinds: Vec<&str> = vec![];
     for d in &s.divisions {
         let kind = match (d.basis.kind, d.basis.degree) {
@@ -96,4 +96,53 @@ pub fn describe(s: &Scenario, built: &Built) -> String {
     }
     parts.push(format!("{}-DOF {} basis", m.n_dof(), kinds.join(" + ")));
     parts.join(", ")
+}
+
+/// The frames of the point and of the distributed wrenches of `built` (the pulse's: a follower).
+pub fn wrench_frames(built: &Built) -> (Vec<Frame>, Vec<Frame>) {
+    let l = &built.loads;
+    (
+        l.point.iter().map(|p| p.frame).collect(),
+        l.distributed.iter().map(|d| d.peak_density().1).collect(),
+    )
+}
+
+/// `n` wrenches of kind `what` and how their components turn: `1 point wrench (follower)`,
+/// `2 distributed wrenches (1 follower, 1 world-fixed)`, `0 point wrenches`. A follower wrench
+/// (`frame = "local"`, the default) turns with its section; a world-fixed one (`"global"`), e.g.
+/// a hanging weight, does not, and under large deflection the two bend a rod differently.
+pub fn wrench_count(frames: &[Frame], what: &str) -> String {
+    let n = frames.len();
+    let plural = if n == 1 { "" } else { "es" };
+    let local = frames.iter().filter(|f| **f == Frame::Local).count();
+    let kinds = match (local, n - local) {
+        (0, 0) => String::new(),
+        (_, 0) => " (follower)".to_string(),
+        (0, _) => " (world-fixed)".to_string(),
+        (l, g) => format!(" ({l} follower, {g} world-fixed)"),
+    };
+    format!("{n} {what}{plural}{kinds}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wrenches_are_counted_with_how_they_turn() {
+        use Frame::{Global, Local};
+        assert_eq!(wrench_count(&[], "point wrench"), "0 point wrenches");
+        assert_eq!(
+            wrench_count(&[Local], "point wrench"),
+            "1 point wrench (follower)"
+        );
+        assert_eq!(
+            wrench_count(&[Global, Global], "point wrench"),
+            "2 point wrenches (world-fixed)"
+        );
+        assert_eq!(
+            wrench_count(&[Global, Local, Local], "distributed wrench"),
+            "3 distributed wrenches (2 follower, 1 world-fixed)"
+        );
+    }
 }

@@ -14,7 +14,7 @@ mod resolve;
 mod rod;
 mod tendons;
 
-pub use describe::describe;
+pub use describe::{describe, wrench_count, wrench_frames};
 pub use limits::*;
 pub use loads::loads;
 pub use reduced::Reduced;

@@ -98,13 +98,13 @@ pub(super) fn print_model(
             fmt_g(&built.u)
         )?;
     }
-    let l = &built.loads;
+    let (point, distributed) = gvsrom::build::wrench_frames(built);
     writeln!(
         out,
         "loads      gravity {} m/s², {}, {}",
-        fmt_g(&l.gravity),
-        plural(l.point.len(), "point wrench").replace("wrenchs", "wrenches"),
-        plural(l.distributed.len(), "distributed wrench").replace("wrenchs", "wrenches"),
+        fmt_g(&built.loads.gravity),
+        gvsrom::build::wrench_count(&point, "point wrench"),
+        gvsrom::build::wrench_count(&distributed, "distributed wrench"),
     )?;
     Ok(())
 }
