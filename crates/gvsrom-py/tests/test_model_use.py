@@ -152,6 +152,8 @@ def test_a_pod_run_that_leaves_its_training_encodings_says_so_once(robot, pod):
     inside = np.array([0.5 * (lo + hi), 0.5 * sum(pod.latent_range[1])])
     with warnings.catch_warnings():
         warnings.simplefilter("error")
+        # (a model of equilibria says so in every motion: its own test, below)
+        warnings.filterwarnings("ignore", message=".*made from equilibria only")
         tr = reduced.simulate(0.02, sample_rate=100, q0=inside)
     assert tr["model_extrapolated"] == []
     far = inside.copy()
@@ -237,3 +239,13 @@ def test_pod_modes_and_singular_values_are_numpys_svd_of_the_snapshots(dataset, 
     np.testing.assert_allclose(overlap, np.eye(k), rtol=0, atol=1e-9)
     np.testing.assert_allclose(pod.meta["captured_energy"], (S[:k] ** 2).sum() / (S ** 2).sum(),
                                rtol=1e-12)
+
+
+def test_a_model_of_equilibria_only_warns_in_motion_not_in_statics(robot, pod):
+    rom = robot.with_model(pod)
+    for run in (lambda: rom.simulate(0.02), lambda: rom.stepper(dt=0.01).close()):
+        with pytest.warns(UserWarning, match="made from equilibria only"):
+            run()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        rom.statics([-3.0])

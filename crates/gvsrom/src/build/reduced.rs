@@ -55,6 +55,10 @@ pub struct Reduced {
     /// What a front-end should tell the user about this model (an interrupted training, an
     /// extrapolation).
     pub warnings: Vec<String>,
+    /// Whether any of its datasets holds a motion (a dynamic dataset's trajectory): `Some(false)`
+    /// for a model made from equilibria only, `None` when a dataset's record predates the
+    /// distinction ([`Self::motion_note`]).
+    pub trained_on_motion: Option<bool>,
     /// The training inputs' ranges ([`InputRange`]).
     pub input_range: Vec<InputRange>,
     /// Per tendon, the tension training held it at (`None`: a training input, in `input_range`).
@@ -154,6 +158,20 @@ impl Reduced {
             "--model",
             format!("the reduced solution {v}: {cause}"),
         ))
+    }
+
+    /// What a motion of this model should say when it was made from equilibria only: its
+    /// coordinates span the static responses, and its dynamics were never compared with the
+    /// full model's (an AE-1 of IV-A's equilibria vibrates at 2.36 Hz where the arm does at
+    /// 1.79 Hz, docs/linearize.md; a review's POD-8 of 1500 equilibria drifted to 11.6 % L in 3 s
+    /// of random steps, 0.14 % with 30 s of babbling added to its data).
+    pub fn motion_note(&self) -> Option<String> {
+        (self.trained_on_motion == Some(false)).then(|| {
+            format!(
+                "`{}` was made from equilibria only: its coordinates span the static responses, not the motions between them, so its dynamics may differ from the full model's (its frequencies, what a step excites); a dataset of motions (`gvsrom dataset --duration … --babble …`) covers them",
+                self.path.display()
+            )
+        })
     }
 
     /// How far the rest coordinates ([`StrainParam::rest_coordinates`], where a simulation from

@@ -108,6 +108,7 @@ pub(super) fn modes_cmd(args: &ModesArgs, out: &mut impl Write) -> Result<()> {
         None => None,
     };
     print_model(scenario, &args.scenario, built, None, out)?;
+    print_motion_note(built, out)?;
     if clipped {
         writeln!(
             out,

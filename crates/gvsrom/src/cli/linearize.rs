@@ -80,6 +80,7 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
         outputs = outputs.with_tendon_lengths(built)?;
     }
     print_model(scenario, &args.scenario, built, None, out)?;
+    print_motion_note(built, out)?;
     let (eq, mut lin) = linearize::about_equilibrium(built, &outputs)?;
     if let Some(h) = args.sample_time {
         lin.discretize(h)?;

@@ -109,6 +109,15 @@ pub(super) fn print_model(
     Ok(())
 }
 
+/// The `note` a motion, its modes or its linearization print for a reduced model made from
+/// equilibria only ([`gvsrom::build::Reduced::motion_note`]).
+pub(super) fn print_motion_note(built: &Built, out: &mut impl Write) -> Result<()> {
+    if let Some(note) = built.reduced.as_ref().and_then(|r| r.motion_note()) {
+        writeln!(out, "note       {note}")?;
+    }
+    Ok(())
+}
+
 pub(super) fn print_solution(r: &StaticsReport, out: &mut impl Write) -> Result<()> {
     writeln!(
         out,

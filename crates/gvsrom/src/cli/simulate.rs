@@ -208,6 +208,7 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
         None => None,
     };
     print_model(scenario, &args.scenario, built, signal.as_deref(), out)?;
+    print_motion_note(built, out)?;
     if let Some(note) = light {
         writeln!(out, "{note}")?;
     }

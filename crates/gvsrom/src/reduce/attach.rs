@@ -180,12 +180,28 @@ pub fn attach(
         },
         extrapolated: outside,
         warnings,
+        trained_on_motion: trained_on_motion(&model.meta),
         input_range: model.meta.input_range.clone(),
         held_tensions: super::validity::held_tensions(&model)?,
         extrapolate,
         joint: joint.map(|j| Box::new(j) as Box<dyn JointInputs>),
     });
     Ok(())
+}
+
+/// [`Reduced::trained_on_motion`] of a model: whether one of its datasets is a trajectory, or
+/// `None` if a dataset's record does not say.
+fn trained_on_motion(meta: &crate::reduced_model::ModelMeta) -> Option<bool> {
+    let all = std::iter::once(&meta.dataset).chain(&meta.more_datasets);
+    let mut known = true;
+    for d in all {
+        match d.trajectory {
+            Some(true) => return Some(true),
+            Some(false) => {}
+            None => known = false,
+        }
+    }
+    known.then_some(false)
 }
 
 /// [`attach`] for a scenario given as its source and `--set` overrides (the table the command line
