@@ -105,6 +105,55 @@ fn tendon_offset_outside_the_section_is_rejected() {
 }
 
 #[test]
+fn an_array_of_the_wrong_length_says_what_the_key_takes() {
+    // the spec writes a tendon's offset d(X) = [0, y, z]; the key takes [y, z]
+    expect_error(
+        &[
+            "statics",
+            "single-tendon",
+            "--set",
+            "tendons.0.offset_start=[0,0.012,0]",
+        ],
+        &[
+            "`tendons[0].offset_start`",
+            "3 values given",
+            "expected 2 values `[y, z]` [m]",
+        ],
+    );
+    expect_error(
+        &[
+            "statics",
+            "single-tendon",
+            "--set",
+            "tendons.0.offset_end=[0.01]",
+        ],
+        &["1 value given", "expected 2 values `[y, z]`"],
+    );
+    expect_error(
+        &[
+            "statics",
+            "single-tendon",
+            "--set",
+            "loads.gravity=[0,0,-9.81,0]",
+        ],
+        &[
+            "`loads.gravity`",
+            "4 values given",
+            "expected 3 values `[x, y, z]`",
+        ],
+    );
+    expect_error(
+        &[
+            "statics",
+            "single-tendon",
+            "--set",
+            "divisions.0.reference_strain=[0,1]",
+        ],
+        &["2 values given", "expected 6 values `[torsion, bend_y"],
+    );
+}
+
+#[test]
 fn empty_basis_is_rejected() {
     expect_error(
         &[

@@ -292,12 +292,18 @@ fn a_quadrature_that_does_not_resolve_the_basis_is_refused() {
 }
 
 #[test]
-fn quadrature_defaults_follow_sorosim() {
-    // Legendre order 2 → max(2 + 1, 5) = 5 Gauss points + 2 ends; FEM linear → 2 per element
-    let s = Scenario::from_toml("t", UNIFORM_ROD, &[]).unwrap();
-    assert_eq!(gvsrom::build(&s).unwrap().model.disc.n_points(), 7);
-    let s = Scenario::from_toml("t", UNIFORM_ROD, &["divisions.0.basis.order=10".into()]).unwrap();
-    assert_eq!(gvsrom::build(&s).unwrap().model.disc.n_points(), 13);
+fn quadrature_defaults_follow_sorosim_up_to_order_3() {
+    // Legendre order 2 → max(2 + 1, 5) = 5 Gauss points + 2 ends; order 3 → 5 + 2 as well;
+    // above order 3, 3(p + 1) (order 10: 33 + 2), what the Z4 kinematics needs; FEM linear → 2
+    // per element
+    let points = |order: &str| {
+        let s = Scenario::from_toml("t", UNIFORM_ROD, &[order.into()]).unwrap();
+        gvsrom::build(&s).unwrap().model.disc.n_points()
+    };
+    assert_eq!(points("divisions.0.basis.order=2"), 7);
+    assert_eq!(points("divisions.0.basis.order=3"), 7);
+    assert_eq!(points("divisions.0.basis.order=4"), 17);
+    assert_eq!(points("divisions.0.basis.order=10"), 35);
     let s = Scenario::from_toml(
         "t",
         UNIFORM_ROD,

@@ -68,6 +68,7 @@ pub fn from_table(table: Table) -> Result<Scenario, ScenarioError> {
                 };
             }
         }
+        let message = array_length_message(&field, message);
         if field == "." || field.is_empty() {
             // a required key missing at the top: name it, not the path `.`
             match message
@@ -86,6 +87,37 @@ pub fn from_table(table: Table) -> Result<Scenario, ScenarioError> {
         }
         ScenarioError::Format { field, message }
     })
+}
+
+/// serde's message for a fixed-size array of the wrong length, with the length and form the key
+/// takes: a list too long reads "expected fewer elements in array", which does not say how many;
+/// a tendon's offset, often given as the 3-vector `[0, y, z]` of the spec's `d(X)`, says that
+/// it is `[y, z]`.
+fn array_length_message(field: &str, message: String) -> String {
+    if !message.starts_with("invalid length ") {
+        return message;
+    }
+    // the key, and the index of a row in `path` or `rotation`
+    let leaf = field.rsplit('.').next().unwrap_or(field);
+    let leaf = leaf.split('[').next().unwrap_or(leaf);
+    let form = match leaf {
+        "offset_start" | "offset_end" => {
+            "2 values `[y, z]` [m]: the offset in the section's plane (y and z of the section frame; the tendon's abscissa is its x)"
+        }
+        "position" | "force" | "moment" | "gravity" | "axis" => "3 values `[x, y, z]`",
+        "path" => "rows of 3 values `[X, y, z]` [m]: the abscissa and the offset",
+        "rotation" => "3 rows of 3 values",
+        "reference_strain" => {
+            "6 values `[torsion, bend_y, bend_z, elongation, shear_y, shear_z]`"
+        }
+        _ => return message,
+    };
+    let given = message
+        .strip_prefix("invalid length ")
+        .and_then(|m| m.split(',').next())
+        .unwrap_or("?");
+    let values = if given == "1" { "value" } else { "values" };
+    format!("{given} {values} given; expected {form}")
 }
 
 /// Rejects NaN and ±inf anywhere in the tree (TOML allows `nan` and `inf`).
