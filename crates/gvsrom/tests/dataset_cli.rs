@@ -895,8 +895,10 @@ fn a_seed_no_part_of_the_plan_draws_from_is_refused_not_ignored() {
         ]);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success(), "{plan} with --seed accepted");
+        // the plan's reason, not clap's list of the options that would take a seed
         assert!(
-            stderr.contains("--seed") && stderr.contains("--random"),
+            stderr.contains("--seed 4: this plan draws nothing")
+                && stderr.contains("--seed applies to --random, --steps and --babble"),
             "{stderr}"
         );
         assert!(!dir.exists());

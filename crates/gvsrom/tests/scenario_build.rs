@@ -607,3 +607,51 @@ fn a_basis_the_magnus_rule_under_integrates_is_warned_about_and_its_remedy_conve
         );
     }
 }
+
+#[test]
+fn a_fem_basis_under_points_that_straddle_its_elements_is_warned_about_and_less_accurate() {
+    // a cantilever under a small world-fixed tip force on 16 linear elements: δ = PL³/3EI + PL/GA
+    // (ν = ½, G = E/3; the section's shear area taken as its area, as the model does)
+    let (e, r, l, p): (f64, f64, f64, f64) = (1e6, 0.01, 0.5, 1e-4);
+    let (area, inertia) = (
+        std::f64::consts::PI * r * r,
+        std::f64::consts::PI * r.powi(4) / 4.0,
+    );
+    let exact = p * l.powi(3) / (3.0 * e * inertia) + p * l / (e / 3.0 * area);
+    let deflection_error = |quadrature: Option<&str>| {
+        let mut set = vec![
+            "divisions.0.basis={ kind = \"fem\", modes = [\"bend_y\", \"elongation\", \"shear_z\"], elements = 16 }".to_string(),
+            "loads.point=[{x=0.5,force=[0,0,-1e-4],frame=\"global\"}]".to_string(),
+        ];
+        set.extend(quadrature.map(|q| format!("divisions.0.quadrature={q}")));
+        let s = Scenario::from_toml("t", UNIFORM_ROD, &set).unwrap();
+        let built = gvsrom::build(&s).unwrap();
+        let tip = solve(&built).unwrap().tip_position;
+        (
+            (-tip[2] - exact).abs() / exact,
+            gvsrom::build::warnings(&s, &built),
+        )
+    };
+    // the default: 2 Gauss points per element of the basis, quiet and exact to the discretization
+    let (aligned, quiet) = deflection_error(None);
+    assert!(aligned < 1e-3 && quiet.is_empty(), "{aligned:e} {quiet:?}");
+    let (subdivided, quiet) = deflection_error(Some("{ elements = 32, gauss_per_element = 2 }"));
+    assert!(
+        subdivided < 1e-3 && quiet.is_empty(),
+        "{subdivided:e} {quiet:?}"
+    );
+    // 30 points over the division, or 24 elements over 16: warned, and further off
+    for q in ["{ gauss = 30 }", "{ elements = 24, gauss_per_element = 2 }"] {
+        let (straddled, warned) = deflection_error(Some(q));
+        assert!(
+            straddled > 3.0 * aligned,
+            "{q}: {straddled:e} against {aligned:e}"
+        );
+        assert!(
+            warned.len() == 1
+                && warned[0].starts_with("divisions[0]: its fem basis of 16 elements")
+                && warned[0].contains("straddle the elements' ends"),
+            "{q}: {warned:?}"
+        );
+    }
+}

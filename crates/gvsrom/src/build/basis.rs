@@ -338,6 +338,35 @@ pub(super) fn kinematics_resolution(
     ))
 }
 
+/// A fem basis under a quadrature whose points straddle its elements' ends, where its functions
+/// have kinks: a Gauss rule is exact only for a smooth integrand, so the integrals converge
+/// slowly with the points (a review's cantilever, 16 linear elements under a tip force: tip
+/// 0.5 % off with 30 Gauss points over the division, 0.02 % with 64, exact with the default 2 per
+/// element). One sentence, or `None` when the quadrature's elements subdivide the basis's.
+pub(super) fn fem_alignment(
+    j: usize,
+    basis: &DivisionBasis,
+    quadrature: &Quadrature,
+) -> Option<String> {
+    let DivisionBasis::Fem { elements, .. } = basis else {
+        return None;
+    };
+    let rule = match *quadrature {
+        Quadrature::Elements {
+            elements: q_elements,
+            ..
+        } if q_elements % elements == 0 => return None,
+        Quadrature::Elements {
+            elements: q_elements,
+            ..
+        } => format!("over {q_elements} quadrature elements, which do not subdivide its elements: their Gauss points"),
+        Quadrature::Gauss { n } => format!("by {n} Gauss points over the whole division, which"),
+    };
+    Some(format!(
+        "divisions[{j}]: its fem basis of {elements} elements is integrated {rule} straddle the elements' ends, where the basis has kinks: a Gauss rule loses its order there, and the results converge slowly with the points (16 linear elements on 30 points: a tip 0.5 % off); omit `quadrature` (2 or 3 Gauss points per element of the basis) or give `gauss_per_element` with `elements` a multiple of {elements}"
+    ))
+}
+
 /// The highest Legendre order over the active modes.
 fn highest_order(modes: &[bool; 6], orders: &[usize; 6]) -> usize {
     (0..6)

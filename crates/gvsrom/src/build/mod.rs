@@ -21,7 +21,7 @@ pub use reduced::Reduced;
 pub use resolve::{resolve, Request, Resolved};
 pub use tendons::{tendon_ends_inside_divisions, uncovered_tendon_components};
 
-use basis::{basis, kinematics_resolution, quadrature};
+use basis::{basis, fem_alignment, kinematics_resolution, quadrature};
 use rod::{base_pose, geometry, material, radius_range, reference_strain};
 use tendons::tendon;
 
@@ -179,15 +179,27 @@ pub fn build(s: &Scenario) -> Result<Built, ScenarioError> {
     Ok(built)
 }
 
-/// The divisions of `s` whose basis the kinematics integrate less exactly than the stiffness
-/// (`basis::kinematics_resolution`): one sentence each, for the front-ends to warn with, as
-/// [`uncovered_tendon_components`]. Empty for a scenario that does not build (its error says why).
+/// The divisions of `s` whose points integrate their basis poorly: the kinematics less exactly
+/// than the stiffness (`basis::kinematics_resolution`), or a fem basis under a quadrature that
+/// straddles its elements' kinks (`basis::fem_alignment`). One sentence each, for the front-ends
+/// to warn with, as [`uncovered_tendon_components`]. Empty for a scenario that does not build
+/// (its error says why).
 pub fn under_integrated_divisions(s: &Scenario) -> Vec<String> {
     (s.divisions.iter().enumerate())
-        .filter_map(|(j, d)| {
-            let b = basis(j, d).ok()?;
-            let q = quadrature(j, d, &b).ok()?;
-            kinematics_resolution(j, &b, &q, s.magnus)
+        .flat_map(|(j, d)| {
+            let checked = basis(j, d)
+                .ok()
+                .and_then(|b| quadrature(j, d, &b).ok().map(|q| (b, q)));
+            let Some((b, q)) = checked else {
+                return vec![];
+            };
+            [
+                kinematics_resolution(j, &b, &q, s.magnus),
+                fem_alignment(j, &b, &q),
+            ]
+            .into_iter()
+            .flatten()
+            .collect()
         })
         .collect()
 }

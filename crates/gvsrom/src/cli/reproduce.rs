@@ -73,7 +73,6 @@ pub(super) fn dataset_cmd(args: &DatasetArgs, out: &mut impl Write) -> Result<()
 
 /// `gvsrom dataset`: the scenario, the plan and the output.
 #[derive(Debug, Args)]
-#[command(group(clap::ArgGroup::new("seeded").args(["random", "steps", "babble"]).multiple(true)))]
 pub struct DatasetArgs {
     /// A preset name (see `gvsrom presets`) or the path of a scenario TOML file.
     pub scenario: String,
@@ -101,7 +100,9 @@ pub struct DatasetArgs {
     pub samples: Option<usize>,
 
     /// Seed of `--random`, `--steps` and `--babble` (same seed, same dataset) [default: 0].
-    #[arg(value_parser = super::whole::<u64>, long, requires = "seeded")]
+    // (no `requires`: the plan refuses a seed it would not use, saying why, where clap's message
+    // only listed the options)
+    #[arg(value_parser = super::whole::<u64>, long)]
     pub seed: Option<u64>,
 
     /// Samples per chunk: the unit of parallel work, of warm-start chains and of resuming. Part of
