@@ -288,20 +288,46 @@ impl Robot {
     /// Energies at ``(q, q̇)`` [J]: kinetic ``½ q̇ᵀ M q̇``, elastic ``½ Σ W Ψᵀ Es Ψ`` (whose
     /// gradient is :meth:`elastic_force`), gravitational ``−Σ W ρA g·r``, and their total.
     ///
+    /// Parameters
+    /// ----------
+    /// u : array_like of float, shape (n_actuators,), optional
+    ///     Constant tendon tensions [N]: adds their potential ``tendons = −Σ u ℓ(q)`` (ℓ the
+    ///     lengths of :meth:`tendon_lengths`, whose gradient is the frictionless tendons' force
+    ///     ``B u``) to the total, which a conservative run under those tensions keeps (the
+    ///     ``energy_balance`` of :meth:`simulate`). Without it, no tendon term.
+    ///
     /// Returns
     /// -------
     /// dict
-    ///     ``kinetic``, ``elastic``, ``gravitational``, ``total`` (floats).
-    #[pyo3(signature = (q, qd=None))]
+    ///     ``kinetic``, ``elastic``, ``gravitational``, ``total`` (floats), and ``tendons`` when
+    ///     ``u`` is given.
+    #[pyo3(signature = (q, qd=None, u=None))]
     fn energy<'py>(
         &self,
         py: Python<'py>,
         q: In1<'_>,
         qd: Option<In1<'_>>,
+        u: Option<arrays::Tensions<'_>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let (q, qd) = state(self, &q, qd.as_ref())?;
-        let e = py.detach(|| energy(&self.built, &self.workspaces, &q, &qd));
+        let u = match u {
+            Some(u) => Some(self.quantity_tensions(py, Some(u))?),
+            None => None,
+        };
+        let (e, lengths) = py.detach(|| {
+            let e = energy(&self.built, &self.workspaces, &q, &qd);
+            let lengths = u.as_ref().map(|_| {
+                crate::tendon_quantities::tendon_lengths(&self.built, &self.workspaces, &q)
+            });
+            (e, lengths)
+        });
         finite_at("the kinetic energy", &[e.kinetic], &qd)?;
-        energy_dict(py, &e)
+        let d = energy_dict(py, &e)?;
+        if let (Some(u), Some(lengths)) = (&u, &lengths) {
+            let tendons = -(u.iter().zip(lengths)).map(|(u, l)| u * l).sum::<f64>();
+            d.set_item("tendons", tendons)?;
+            d.set_item("total", e.total() + tendons)?;
+        }
+        Ok(d)
     }
 }

@@ -80,6 +80,24 @@ def test_external_force_of_gravity_is_minus_the_gradient_of_its_energy(robot, st
     np.testing.assert_allclose(f, -grad, rtol=0, atol=1e-6 * np.abs(f).max())
 
 
+def test_frictionless_tendons_force_is_minus_the_gradient_of_their_potential():
+    # V = −Σ u ℓ(q), the `tendons` term of energy(u=…): B u = −∂V/∂q for frictionless tendons
+    # (six-tendon: six of them, three ending mid-way, in two divisions)
+    robot = gvsrom.Scenario.preset("six-tendon").build()
+    rng = np.random.default_rng(3)
+    u = np.array([-4.0, -1.0, 0.0, -7.0, -2.5, -0.5])
+    q = robot.statics(u).q + 0.02 * rng.standard_normal(robot.n_dof)
+    e = robot.energy(q, u=u)
+    assert e["tendons"] == pytest.approx(-(u @ robot.tendon_lengths(q)), rel=1e-14)
+    assert e["total"] == pytest.approx(e["kinetic"] + e["elastic"] + e["gravitational"] + e["tendons"],
+                                       rel=1e-14)
+    force = robot.actuation_matrix(q) @ u
+    grad = central(lambda x: robot.energy(x, u=u)["tendons"], q, 1e-6)
+    np.testing.assert_allclose(force, -grad, rtol=0, atol=1e-6 * np.abs(force).max())
+    # without u, no tendon term (as before)
+    assert "tendons" not in robot.energy(q)
+
+
 def test_actuation_matrix_is_the_residuals_derivative_in_u(robot, state):
     q, _ = state
     B = robot.actuation_matrix(q)

@@ -162,6 +162,22 @@ def test_a_conservative_run_reports_its_energy_balance():
     assert "energy_balance" not in gvsrom.Scenario.preset("single-tendon").build().simulate(0.01)
 
 
+def test_the_energy_a_run_keeps_under_constant_tensions_is_robot_energy_with_u():
+    # undamped, frictionless tendons pulling from rest: E = T + V_e + V_g − Σ u ℓ is conserved,
+    # and Robot.energy(q, qd, u) is the E the run's balance reports at its last sample
+    robot = (gvsrom.Scenario.preset("six-tendon-no-gravity").set("material.damping", 0.0)
+             .set("tendons.0.tension", -2.0).set("tendons.3.tension", -1.0).build())
+    tr = robot.simulate(0.1, sample_rate=100, rtol=1e-7, atol=1e-10)
+    b = tr["energy_balance"]
+    assert b["kinetic_max"] > 1e-4, b
+    assert b["largest_gain"] < 0.01 * b["kinetic_max"] and b["largest_loss"] < 0.01 * b["kinetic_max"]
+    e = robot.energy(tr["q"][-1], tr["qd"][-1], u=robot.tensions)
+    assert abs(e["total"] - b["last"]) < 1e-9 * max(1.0, abs(b["last"])), (e, b)
+    # without the tendons' potential the total is not kept: the pull turned it into motion
+    no_u = robot.energy(tr["q"][-1], tr["qd"][-1])["total"]
+    assert abs(no_u - b["initial"]) > 0.5 * b["kinetic_max"], (no_u, b)
+
+
 def test_random_steps_and_babbling_equal_the_cli(gvsrom_bin, tmp_path):
     robot = gvsrom.Scenario.preset("six-tendon").build()
     for option, values in [("--steps", [-15.0, 0.0, 0.1]), ("--babble", [-15.0, 0.0, 0.05, 0.1])]:
