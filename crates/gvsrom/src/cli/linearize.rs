@@ -149,8 +149,9 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
     let shown = count.min(lin.poles.len());
     writeln!(
         out,
-        "poles      slowest {shown} of {} (eigenvalues of A; conjugate pairs once)",
-        lin.poles.len()
+        "poles      slowest {shown} of {} (the {} eigenvalues of A, conjugate pairs listed once)",
+        lin.poles.len(),
+        2 * lin.n_dof
     )?;
     writeln!(
         out,
