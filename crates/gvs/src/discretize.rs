@@ -370,6 +370,7 @@ mod tests {
                     length: l,
                     radius_start: 0.01,
                     radius_end: 0.01,
+                    material: None,
                 })
                 .collect(),
         }

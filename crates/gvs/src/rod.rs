@@ -23,23 +23,29 @@ pub struct Material {
 
 impl Material {
     pub fn validate(&self) -> Result<(), ModelError> {
-        check_positive("material.youngs_modulus", self.youngs_modulus, "Pa")?;
+        self.validate_as("material")
+    }
+
+    /// [`Self::validate`] with the fields named under `prefix` (`divisions[1].material`).
+    pub fn validate_as(&self, prefix: &str) -> Result<(), ModelError> {
+        let f = |n: &str| format!("{prefix}.{n}");
+        check_positive(&f("youngs_modulus"), self.youngs_modulus, "Pa")?;
         check_range(
-            "material.poisson_ratio",
+            &f("poisson_ratio"),
             self.poisson_ratio,
             Some((-1.0, false)),
             Some((0.5, true)),
             "a number in (-1, 0.5]",
         )?;
         check_range(
-            "material.density",
+            &f("density"),
             self.density,
             Some((0.0, true)),
             None,
             "a finite number >= 0 kg/m^3",
         )?;
         check_range(
-            "material.damping",
+            &f("damping"),
             self.damping,
             Some((0.0, true)),
             None,
@@ -61,6 +67,10 @@ pub struct DivisionGeometry {
     pub length: f64,
     pub radius_start: f64,
     pub radius_end: f64,
+    /// The division's own material where it differs from the rod's (a stiff base and a soft tip,
+    /// SoRoSim's material per link); `None`: the rod's ([`Rod::material_of`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material: Option<Material>,
 }
 
 impl DivisionGeometry {
@@ -69,7 +79,8 @@ impl DivisionGeometry {
     }
 }
 
-/// Rod: material plus its divisions laid end to end along the local x-axis.
+/// Rod: material plus its divisions laid end to end along the local x-axis (a division may have
+/// a material of its own, [`DivisionGeometry::material`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Rod {
     pub material: Material,
@@ -85,12 +96,31 @@ impl Rod {
                 length,
                 radius_start,
                 radius_end,
+                material: None,
             }],
         }
     }
 
+    /// The material of division `j`: its own, or the rod's.
+    pub fn material_of(&self, j: usize) -> &Material {
+        self.divisions[j]
+            .material
+            .as_ref()
+            .unwrap_or(&self.material)
+    }
+
+    /// The materials of every division (the rod's where a division has none of its own).
+    pub fn materials(&self) -> impl Iterator<Item = &Material> {
+        (0..self.divisions.len()).map(|j| self.material_of(j))
+    }
+
     pub fn validate(&self) -> Result<(), ModelError> {
         self.material.validate()?;
+        for (j, d) in self.divisions.iter().enumerate() {
+            if let Some(m) = &d.material {
+                m.validate_as(&format!("rod.divisions[{j}].material"))?;
+            }
+        }
         if self.divisions.is_empty() {
             return Err(ModelError::invalid(
                 "rod.divisions",

@@ -342,6 +342,7 @@ fn capstan_curvature_holds_across_a_division_junction() {
         length,
         radius_start: r,
         radius_end: r,
+        material: None,
     };
     let rod = Rod {
         material: mat(e, 0.0),

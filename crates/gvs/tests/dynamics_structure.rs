@@ -80,6 +80,7 @@ fn fem_model() -> Model<LinearBasis> {
         length,
         radius_start,
         radius_end,
+        material: None,
     };
     let rod = Rod {
         material: material(0.0),

@@ -296,11 +296,13 @@ fn statics_jacobian_matches_finite_differences_two_divisions_half_tendon() {
                 length: 0.3,
                 radius_start: 0.02,
                 radius_end: 0.015,
+                material: None,
             },
             DivisionGeometry {
                 length: 0.3,
                 radius_start: 0.015,
                 radius_end: 0.01,
+                material: None,
             },
         ],
     };

@@ -41,6 +41,7 @@ fn rod_model(
                 length,
                 radius_start: R,
                 radius_end: R,
+                material: None,
             })
             .collect(),
     };

@@ -171,3 +171,23 @@ def test_a_precurved_rod_records_its_reference_strain_and_rests_on_it():
     eq = robot.statics()
     assert np.abs(eq.q).max() < 1e-12
     assert np.abs(eq.strain - star).max() < 1e-12
+
+
+def test_a_divisions_own_material_sets_its_sections():
+    # six-tendon: two divisions of 0.3 m, E = 1 MPa, ν = ½, ρ = 1000; the second at E = 5 MPa
+    # and ρ = 2000: its sections' stiffness and inertia follow, the first division's do not
+    base = gvsrom.Scenario.preset("six-tendon")
+    robot = (base.copy().set("divisions.1.material.youngs_modulus", 5e6)
+             .set("divisions.1.material.density", 2000.0).build())
+    plain = base.build()
+    second = robot.point_x > 0.3 + 1e-12
+    first = robot.point_x < 0.3 - 1e-12
+    np.testing.assert_array_equal(robot.section_stiffness[first], plain.section_stiffness[first])
+    np.testing.assert_allclose(robot.section_stiffness[second], 5 * plain.section_stiffness[second],
+                               rtol=1e-15)
+    np.testing.assert_allclose(robot.section_inertia[second], 2 * plain.section_inertia[second],
+                               rtol=1e-15)
+    np.testing.assert_array_equal(robot.section_inertia[first], plain.section_inertia[first])
+    assert "material" in robot.scenario.to_toml().split("[[divisions]]")[2]
+    with pytest.raises(gvsrom.GvsromError, match=r"divisions\[1\]\.material\.poisson_ratio"):
+        base.copy().set("divisions.1.material.poisson_ratio", 0.7).build()

@@ -655,3 +655,160 @@ fn a_fem_basis_under_points_that_straddle_its_elements_is_warned_about_and_less_
         );
     }
 }
+
+/// [`UNIFORM_ROD`] in two divisions, 0.2 m of the rod's material (E = 1 MPa) then 0.3 m of its own
+/// `material` (a table of overrides, TOML inline), both order 2; no gravity.
+fn two_material_rod(material: &str) -> String {
+    format!(
+        r#"
+    name = "two materials"
+    [material]
+    youngs_modulus = 1e6
+    poisson_ratio = 0.5
+    density = 1000
+    [[divisions]]
+    length = 0.2
+    radius = 0.01
+    basis = {{ kind = "legendre", modes = ["bend_y", "elongation", "shear_z"], order = 2 }}
+    [[divisions]]
+    length = 0.3
+    radius = 0.01
+    basis = {{ kind = "legendre", modes = ["bend_y", "elongation", "shear_z"], order = 2 }}
+    material = {material}
+    [loads]
+    gravity = [0, 0, 0]
+"#
+    )
+}
+
+#[test]
+fn a_two_material_rod_bends_as_its_closed_forms() {
+    let i = std::f64::consts::PI * 1e-8 / 4.0;
+    let a = std::f64::consts::PI * 1e-4;
+    let (e1, e2) = (1e6, 4e6);
+    let text = two_material_rod("{ youngs_modulus = 4e6 }");
+    // an end moment: two circular arcs, κ_k = M / E_k I, joined with a common tangent
+    let m = 0.01;
+    let (k1, k2) = (m / (e1 * i), m / (e2 * i));
+    let (t1, t2) = (k1 * 0.2, k1 * 0.2 + k2 * 0.3);
+    let expected = [
+        t1.sin() / k1 + (t2.sin() - t1.sin()) / k2,
+        0.0,
+        -(1.0 - t1.cos()) / k1 - (t1.cos() - t2.cos()) / k2,
+    ];
+    let r = run_text(
+        &text,
+        &["loads.point.0.x=0.5", "loads.point.0.moment=[0, 0.01, 0]"],
+    );
+    for c in 0..3 {
+        assert!(
+            (r.tip_position[c] - expected[c]).abs() < 1e-9,
+            "{:?} vs {expected:?}",
+            r.tip_position
+        );
+    }
+    // the stiff division bends a quarter as much: strain per division against M / E_k I
+    for (x, xi) in r.strain_x.iter().zip(&r.strain) {
+        let k = if *x < 0.2 - 1e-12 {
+            k1
+        } else if *x > 0.2 + 1e-12 {
+            k2
+        } else {
+            continue;
+        };
+        assert!((xi[1] - k).abs() < 1e-9 * k, "at {x}: {} vs {k}", xi[1]);
+    }
+    // a small world-fixed tip force: δ = P ∫ (L − x)²/EI(x) dx + P ∫ dx/GA(x), G = E/3 (ν = ½)
+    let p = 1e-4;
+    let bending =
+        |e: f64, x0: f64, x1: f64| ((0.5 - x0).powi(3) - (0.5 - x1).powi(3)) / (3.0 * e * i);
+    let shear = |e: f64, len: f64| len / (e / 3.0 * a);
+    let delta =
+        -p * (bending(e1, 0.0, 0.2) + bending(e2, 0.2, 0.5) + shear(e1, 0.2) + shear(e2, 0.3));
+    let r = run_text(
+        &text,
+        &[
+            "loads.point.0.x=0.5",
+            "loads.point.0.force=[0, 0, -1e-4]",
+            "loads.point.0.frame=\"global\"",
+        ],
+    );
+    // the uniform rod's tolerance (geometric nonlinearity O((δ/L)²), here smaller still)
+    assert!(
+        (r.tip_position[2] - delta).abs() < 5e-9,
+        "{} vs {delta}",
+        r.tip_position[2]
+    );
+    // 2.5× stiffer in bending over 0.3 m of 0.5: well apart from the uniform rod's deflection
+    let uniform = -p * (bending(e1, 0.0, 0.5) + shear(e1, 0.5));
+    assert!(
+        (delta - uniform).abs() > 0.1 * delta.abs(),
+        "{delta} {uniform}"
+    );
+}
+
+#[test]
+fn a_division_material_equal_to_the_rods_changes_nothing_and_a_bad_one_names_its_division() {
+    let loads = ["loads.point.0.x=0.5", "loads.point.0.force=[0, 0.3, -0.2]"];
+    let same = run_text(
+        &two_material_rod("{ youngs_modulus = 1e6, density = 1000 }"),
+        &loads,
+    );
+    let none = run_text(&two_material_rod("{}"), &loads);
+    assert_eq!(same.q, none.q);
+    assert_eq!(same.tip_position, none.tip_position);
+    // a division's density weighs its own length: a weak gravity (small deflection) on a tip
+    // division three times as dense, against δ = ∫ M(x)(L − x)/EI dx + ∫ V(x)/GA dx with the
+    // piecewise weight q(x) = ρ(x) A g, integrated here by the midpoint rule
+    let (g, area) = (9.81e-4, std::f64::consts::PI * 1e-4);
+    let inertia = area * 1e-4 / 4.0;
+    let q = |x: f64| if x < 0.2 { 1000.0 } else { 3000.0 } * area * g;
+    let n = 4000;
+    let h = 0.5 / n as f64;
+    let mid = |k: usize| (k as f64 + 0.5) * h;
+    let (mut delta, mut shear_part) = (0.0, 0.0);
+    for k in 0..n {
+        let x = mid(k);
+        // shear force and bending moment of the weight beyond x
+        let (mut v, mut m) = (0.0, 0.0);
+        for kk in k..n {
+            let s = mid(kk).max(x);
+            let w = if kk == k { 0.5 * h } else { h };
+            v += q(s) * w;
+            m += q(s) * (s - x) * w;
+        }
+        delta += m * (0.5 - x) / (1e6 * inertia) * h;
+        shear_part += v / (1e6 / 3.0 * area) * h;
+    }
+    let expected = -(delta + shear_part);
+    let heavy = run_text(
+        &two_material_rod("{ density = 3000 }"),
+        &["loads.gravity=[0, 0, -9.81e-4]"],
+    );
+    let light = run_text(&two_material_rod("{}"), &["loads.gravity=[0, 0, -9.81e-4]"]);
+    assert!(
+        // measured 2.5e-6 relative (the midpoint rule's O(h²) and the O((δ/L)²) nonlinearity)
+        (heavy.tip_position[2] - expected).abs() < 2e-5 * expected.abs(),
+        "{} vs {expected}",
+        heavy.tip_position[2]
+    );
+    assert!(heavy.tip_position[2] < 1.5 * light.tip_position[2]);
+    // each value checked as [material]'s, named by its division
+    for (material, field) in [
+        (
+            "{ youngs_modulus = -1 }",
+            "divisions[1].material.youngs_modulus",
+        ),
+        (
+            "{ poisson_ratio = 0.7 }",
+            "divisions[1].material.poisson_ratio",
+        ),
+        ("{ density = -5 }", "divisions[1].material.density"),
+        ("{ stiffness = 3 }", "divisions[1].material.stiffness"),
+    ] {
+        let s = Scenario::from_toml("t", &two_material_rod(material), &[])
+            .and_then(|s| gvsrom::build(&s).map(|_| ()));
+        let e = s.expect_err(material).to_string();
+        assert!(e.contains(field), "{material}: {e}");
+    }
+}

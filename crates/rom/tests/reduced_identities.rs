@@ -92,11 +92,13 @@ fn rod() -> Rod {
                 length: 0.15,
                 radius_start: 0.018,
                 radius_end: 0.014,
+                material: None,
             },
             DivisionGeometry {
                 length: 0.10,
                 radius_start: 0.014,
                 radius_end: 0.009,
+                material: None,
             },
         ],
     }

@@ -135,6 +135,7 @@ fn six_tendon() -> Model<crate::strain::LinearBasis> {
         length: 0.3,
         radius_start,
         radius_end,
+        material: None,
     };
     let rod = Rod {
         material,

@@ -22,7 +22,7 @@ pub use resolve::{resolve, Request, Resolved};
 pub use tendons::{tendon_ends_inside_divisions, uncovered_tendon_components};
 
 use basis::{basis, fem_alignment, kinematics_resolution, quadrature};
-use rod::{base_pose, geometry, material, radius_range, reference_strain};
+use rod::{base_pose, division_material, geometry, material, radius_range, reference_strain};
 use tendons::tendon;
 
 use crate::error::ScenarioError;
@@ -85,8 +85,12 @@ pub fn build(s: &Scenario) -> Result<Built, ScenarioError> {
         .divisions
         .iter()
         .enumerate()
-        .map(|(j, d)| geometry(j, d))
-        .collect::<Result<Vec<_>, _>>()?;
+        .map(|(j, d)| {
+            let mut g = geometry(j, d)?;
+            g.material = division_material(j, d, &material)?;
+            Ok(g)
+        })
+        .collect::<Result<Vec<_>, ScenarioError>>()?;
     let rod = Rod {
         material,
         divisions: geometry,

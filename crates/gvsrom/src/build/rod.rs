@@ -8,23 +8,57 @@ use gvs::rod::{DivisionGeometry, Material};
 
 pub(super) fn material(s: &Scenario) -> Result<Material, ScenarioError> {
     let m = &s.material;
+    checked_material(
+        "material",
+        Material {
+            youngs_modulus: m.youngs_modulus,
+            poisson_ratio: m.poisson_ratio,
+            density: m.density,
+            damping: m.damping,
+        },
+    )
+}
+
+/// Division `j`'s own material (`[divisions.material]`): the rod's `rod` with the keys `d` gives
+/// replaced, checked as `[material]` is, its fields named `divisions[j].material.*`; `None` when
+/// it gives none.
+pub(super) fn division_material(
+    j: usize,
+    d: &DivisionSpec,
+    rod: &Material,
+) -> Result<Option<Material>, ScenarioError> {
+    let Some(m) = &d.material else {
+        return Ok(None);
+    };
+    let own = Material {
+        youngs_modulus: m.youngs_modulus.unwrap_or(rod.youngs_modulus),
+        poisson_ratio: m.poisson_ratio.unwrap_or(rod.poisson_ratio),
+        density: m.density.unwrap_or(rod.density),
+        damping: m.damping.unwrap_or(rod.damping),
+    };
+    checked_material(&format!("divisions[{j}].material"), own).map(Some)
+}
+
+/// `m` if its values are a material's, else an error naming `{prefix}.field`.
+fn checked_material(prefix: &str, m: Material) -> Result<Material, ScenarioError> {
+    let f = |n: &str| format!("{prefix}.{n}");
     in_range(
-        "material.youngs_modulus",
+        &f("youngs_modulus"),
         m.youngs_modulus,
         YOUNGS_MODULUS_RANGE,
         "Pa",
     )?;
     if !(m.poisson_ratio.is_finite() && m.poisson_ratio > -1.0 && m.poisson_ratio <= 0.5) {
         return Err(ScenarioError::value(
-            "material.poisson_ratio",
+            f("poisson_ratio"),
             m.poisson_ratio,
             "a number in (-1, 0.5]",
         ));
     }
     if m.density != 0.0 {
-        in_range("material.density", m.density, DENSITY_RANGE, "kg/m^3").map_err(|_| {
+        in_range(&f("density"), m.density, DENSITY_RANGE, "kg/m^3").map_err(|_| {
             ScenarioError::value(
-                "material.density",
+                f("density"),
                 m.density,
                 format!(
                     "0 (massless, for statics) or a number in [{}, {}] kg/m^3",
@@ -34,13 +68,8 @@ pub(super) fn material(s: &Scenario) -> Result<Material, ScenarioError> {
             )
         })?;
     }
-    non_negative("material.damping", m.damping, "Pa*s")?;
-    Ok(Material {
-        youngs_modulus: m.youngs_modulus,
-        poisson_ratio: m.poisson_ratio,
-        density: m.density,
-        damping: m.damping,
-    })
+    non_negative(&f("damping"), m.damping, "Pa*s")?;
+    Ok(m)
 }
 
 pub(super) fn geometry(j: usize, d: &DivisionSpec) -> Result<DivisionGeometry, ScenarioError> {
@@ -83,6 +112,7 @@ pub(super) fn geometry(j: usize, d: &DivisionSpec) -> Result<DivisionGeometry, S
         length,
         radius_start: r0,
         radius_end: r1,
+        material: None,
     })
 }
 

@@ -55,15 +55,19 @@ struct Interval {
     ea_ga: [f64; 2],
     /// `πr²`.
     area: [f64; 2],
+    /// ρ of its division's material.
+    density: f64,
 }
 
 fn grid(built: &Subject<'_>) -> Vec<Interval> {
     let rod = &built.model.rod;
-    let e = rod.material.youngs_modulus;
-    let g = rod.material.shear_modulus();
     let per_div = (8192 / rod.divisions.len().max(1)).clamp(4, GRID_POINTS);
     let mut out = Vec::with_capacity(per_div * rod.divisions.len());
-    for (d, x0) in rod.divisions.iter().zip(rod.division_starts()) {
+    for ((d, x0), material) in (rod.divisions.iter())
+        .zip(rod.division_starts())
+        .zip(rod.materials())
+    {
+        let (e, g) = (material.youngs_modulus, material.shear_modulus());
         for i in 0..per_div {
             let (t0, t1) = (i as f64 / per_div as f64, (i + 1) as f64 / per_div as f64);
             let r = [d.radius_at(t0), d.radius_at(t1)];
@@ -75,6 +79,7 @@ fn grid(built: &Subject<'_>) -> Vec<Interval> {
                 ea: area.map(|a| e * a),
                 ea_ga: area.map(|a| e.min(g) * a),
                 area,
+                density: material.density,
             });
         }
     }
@@ -243,18 +248,19 @@ pub(super) fn estimates(built: &Subject<'_>, u: &[f64], scale: f64, bound: bool)
 
     let [gx, gy, gz] = loads.gravity;
     let g = gx.hypot(gy).hypot(gz);
-    let rho = model.rod.material.density;
+    // the heaviest division's density names the load; the resultants weigh each division's own
+    let rho = model.rod.materials().map(|m| m.density).fold(0.0, f64::max);
     if mul(g, rho) > 0.0 {
-        // resultants of the unit weight density A(x) at the grid's ends, from the tip backward:
-        // N_a = N_b + ∫_a^b A, M_a = M_b + N_b (b − a) + ∫_a^b A (x − a) dx (A linear-ish: trapezoid
-        // weights at the ends)
+        // resultants of the mass per length ρA(x) at the grid's ends, from the tip backward:
+        // N_a = N_b + ∫_a^b ρA, M_a = M_b + N_b (b − a) + ∫_a^b ρA (x − a) dx (A linear-ish:
+        // trapezoid weights at the ends)
         let n_iv = grid.len();
         let mut n_end = vec![[0.0; 2]; n_iv];
         let mut m_end = vec![[0.0; 2]; n_iv];
         let (mut n_next, mut m_next) = (0.0, 0.0);
         for (i, iv) in grid.iter().enumerate().rev() {
             let h = iv.b - iv.a;
-            let w = 0.5 * h * (iv.area[0] + iv.area[1]);
+            let w = 0.5 * h * (iv.area[0] + iv.area[1]) * iv.density;
             let moment_arm =
                 h * (iv.area[0] + 2.0 * iv.area[1]) / (3.0 * (iv.area[0] + iv.area[1]));
             n_end[i] = [n_next + w, n_next];
@@ -268,7 +274,7 @@ pub(super) fn estimates(built: &Subject<'_>, u: &[f64], scale: f64, bound: bool)
             theta += 0.5 * (iv.b - iv.a) * (m_end[i][0] / iv.ei[0] + m_end[i][1] / iv.ei[1]);
             eps = eps.max(n_end[i][0] / iv.ea[0]).max(n_end[i][1] / iv.ea[1]);
         }
-        let w = mul(mul(scale, g), rho);
+        let w = mul(scale, g);
         // A dead load turns the rod at most until it hangs along it: the linear beam's angle
         // (thousands of radians for a soft horizontal cantilever, which merely droops) bounds
         // nothing, so it is capped at π; the rod then hangs, stretched by its weight (N / EA).

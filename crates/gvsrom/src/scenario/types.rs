@@ -54,6 +54,21 @@ fn default_damping() -> f64 {
     1e4
 }
 
+/// A division's material where it differs from `[material]` (`[divisions.material]`): each key
+/// given replaces the rod's, the others are the rod's (a stiffer base: `youngs_modulus` alone).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DivisionMaterialSpec {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub youngs_modulus: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub poisson_ratio: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub damping: Option<f64>,
+}
+
 /// Base pose `g(0)`: position and rotation of the first cross-section in the world frame. The
 /// rotation is either a matrix (`rotation`, rows) or an axis and an angle in degrees; default identity.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
@@ -93,6 +108,10 @@ pub struct DivisionSpec {
     /// unstretched rod `[0, 0, 0, 1, 0, 0]`; not written when absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reference_strain: Option<[f64; 6]>,
+    /// The division's material where it differs from the rod's `[material]` (the keys given
+    /// replace the rod's); not written when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material: Option<DivisionMaterialSpec>,
 }
 
 /// A strain component, in the engine's order `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]`.

@@ -89,7 +89,7 @@ impl EnergyBalance {
 /// friction, point or distributed loads (follower ones do work), or a load schedule.
 pub fn not_conservative(built: &Built, scheduled: bool) -> Option<&'static str> {
     let m = &built.model;
-    if m.rod.material.damping != 0.0 {
+    if m.rod.materials().any(|material| material.damping != 0.0) {
         Some("material damping")
     } else if m.tendons.iter().any(|t| t.friction != 0.0) {
         Some("tendon friction")

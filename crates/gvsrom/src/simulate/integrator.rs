@@ -81,17 +81,26 @@ impl Default for IntegratorChoice {
 /// mass matrix, zero there; the damping is not looked at (`modes` are undamped).
 pub fn require_mass_only(built: &Built) -> Result<(), ScenarioError> {
     let model = &built.model;
-    let massless = (0..model.disc.n_points()).any(|j| {
+    let massless = (0..model.disc.n_points()).find(|&j| {
         let ms = model.section(j).ms;
         ms.iter().any(|m| m.is_nan() || *m <= 0.0)
     });
-    if massless {
+    if let Some(j) = massless {
         return Err(ScenarioError::invalid(
-            "material.density",
+            material_field(built, model.disc.points[j].div, "density"),
             "0: a motion needs a rod with mass (a positive density); statics take density 0",
         ));
     }
     Ok(())
+}
+
+/// The scenario field that sets `name` of division `div`'s material: its own
+/// (`divisions[1].material.density`) or the rod's (`material.density`).
+fn material_field(built: &Built, div: usize, name: &str) -> String {
+    match built.model.rod.divisions[div].material {
+        Some(_) => format!("divisions[{div}].material.{name}"),
+        None => format!("material.{name}"),
+    }
 }
 
 /// Refuses a rod without mass for a motion (`material.density = 0`, which statics accept): its mass
@@ -102,11 +111,13 @@ pub fn require_mass_only(built: &Built) -> Result<(), ScenarioError> {
 pub fn require_mass(built: &Built) -> Result<(), ScenarioError> {
     require_mass_only(built)?;
     // a damping no material has: checked for motions only, as statics ignore it
-    let m = &built.model.rod.material;
-    let most = MAX_RELAXATION_TIME * m.youngs_modulus;
-    if m.damping > most {
+    for (div, m) in built.model.rod.materials().enumerate() {
+        let most = MAX_RELAXATION_TIME * m.youngs_modulus;
+        if m.damping <= most {
+            continue;
+        }
         return Err(ScenarioError::value(
-            "material.damping",
+            material_field(built, div, "damping"),
             m.damping,
             format!(
                 "at most {most:e} Pa*s for this Young's modulus in a motion: a relaxation time η / E of {:.2e} s against {MAX_RELAXATION_TIME} s accepted (the paper's material: 0.016 s; statics ignore the damping)",

@@ -143,11 +143,13 @@ fn two_division_legendre() -> (Discretization, LinearBasis) {
                 length: 0.15,
                 radius_start: 0.02,
                 radius_end: 0.015,
+                material: None,
             },
             gvs::rod::DivisionGeometry {
                 length: 0.1,
                 radius_start: 0.015,
                 radius_end: 0.01,
+                material: None,
             },
         ],
     };

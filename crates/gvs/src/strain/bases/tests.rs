@@ -19,6 +19,7 @@ fn disc(lengths: &[f64], q: Quadrature) -> Discretization {
                 length: l,
                 radius_start: 0.01,
                 radius_end: 0.01,
+                material: None,
             })
             .collect(),
     };
