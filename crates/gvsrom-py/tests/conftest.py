@@ -61,3 +61,14 @@ def cli_statics(bin_path: Path, tmp_path: Path, *args: str) -> dict:
     p = run_cli(bin_path, "statics", *args, "--json", str(out), "--force")
     assert p.returncode == 0, p.stderr
     return json.loads(out.read_text())
+
+
+def load_example(name: str):
+    """crates/gvsrom-py/examples/NAME.py as a module, for the tests that run it or use its parts."""
+    import importlib.util
+
+    path = Path(__file__).parents[1] / "examples" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import gvsrom
-from conftest import run_cli
+from conftest import load_example, run_cli
 
 
 def cli_linearize(bin_path, tmp_path, *args):
@@ -217,19 +217,8 @@ def test_an_autoencoders_linearization_is_the_derivative_of_its_accelerations(ae
         assert np.linalg.norm(lin["B"] - B) < 2e-6 * np.linalg.norm(B)
 
 
-def _lqr_example():
-    """crates/gvsrom-py/examples/lqr_tip.py as a module (its Riccati iteration is the tests')."""
-    import importlib.util
-    from pathlib import Path
-
-    path = Path(__file__).parents[1] / "examples" / "lqr_tip.py"
-    spec = importlib.util.spec_from_file_location("lqr_tip", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-discrete_lqr = _lqr_example().discrete_lqr
+# crates/gvsrom-py/examples/lqr_tip.py's Riccati iteration is the tests'
+discrete_lqr = load_example("lqr_tip").discrete_lqr
 
 
 def test_an_lqr_designed_on_the_linearization_damps_the_nonlinear_arm():

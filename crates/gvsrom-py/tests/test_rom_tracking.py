@@ -1,15 +1,6 @@
 """crates/gvsrom-py/examples/rom_tracking.py: a reduced model's statics in the control loop."""
 
-import importlib.util
-from pathlib import Path
-
-
-def _example():
-    path = Path(__file__).parents[1] / "examples" / "rom_tracking.py"
-    spec = importlib.util.spec_from_file_location("rom_tracking", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+from conftest import load_example
 
 
 def test_the_roms_inverse_statics_tracks_the_tip_as_the_full_models_does(tmp_path, capsys):
@@ -17,7 +8,7 @@ def test_the_roms_inverse_statics_tracks_the_tip_as_the_full_models_does(tmp_pat
     # 2026-12-07: the AE-1's inverse statics within 5.7e-3 N of the full model's over the
     # reference; tip error RMS 2.96 % L with the ROM's feedforward alone, 0.322 % L with the PI,
     # and 0.322 % L with the full model's statics instead of the ROM's; 1.95 solves per call
-    rows, du = _example().main([str(tmp_path / "run"), "--duration", "1.5"])
+    rows, du = load_example("rom_tracking").main([str(tmp_path / "run"), "--duration", "1.5"])
     table = capsys.readouterr().out
     assert "| rom+pi |" in table and "| hom+pi |" in table, table
     # the ROM's equilibria put the tip where the full model's do: the tensions agree within
