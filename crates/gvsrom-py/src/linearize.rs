@@ -83,6 +83,7 @@ impl Robot {
         if let Some(h) = dt {
             linearize::check_sample_time(h).map_err(|e| invalid(e.to_string()))?;
         }
+        crate::robot::warn_motion_note(py, &self.built)?;
         let mut outputs = match &outputs {
             None => linearize::Outputs::tip(&self.built),
             Some(xs) => linearize::Outputs::at(&self.built, &xs.values)

@@ -50,6 +50,7 @@ impl Robot {
     ) -> PyResult<Bound<'py, PyDict>> {
         let rebuilt = self.built_at(py, u.as_ref())?;
         let built = rebuilt.as_ref().unwrap_or(&self.built);
+        crate::robot::warn_motion_note(py, built)?;
         let (count, _clipped) = modes::parse_count(Some(&count.to_string()), built.n_dof())
             .map_err(|e| errors::any(e.into()))?;
         let (_, report) = py.detach(|| modes::compute(built, count)).map_err(|e| {

@@ -107,6 +107,15 @@ pub fn warn(py: Python<'_>, message: &str) -> PyResult<()> {
     PyErr::warn(py, &py.get_type::<PyUserWarning>(), &text, 1)
 }
 
+/// A reduced model made from equilibria only, asked for a motion, its modes or its
+/// linearization, says so as a `UserWarning` (as the command line prints its `note`).
+pub fn warn_motion_note(py: Python<'_>, built: &gvsrom::Built) -> PyResult<()> {
+    match built.reduced.as_ref().and_then(|r| r.motion_note()) {
+        Some(note) => warn(py, &note),
+        None => Ok(()),
+    }
+}
+
 impl Robot {
     pub fn new(py: Python<'_>, scenario: Scenario, attached: Option<Attached>) -> PyResult<Robot> {
         let built = build_with(py, &scenario, attached.as_ref(), false)?;

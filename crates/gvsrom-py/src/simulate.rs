@@ -237,9 +237,7 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
     for o in &plan.model_extrapolated {
         warn(py, &format!("extrapolating (--extrapolate): {o}"))?;
     }
-    if let Some(note) = built.reduced.as_ref().and_then(|r| r.motion_note()) {
-        warn(py, &note)?;
-    }
+    crate::robot::warn_motion_note(py, built)?;
     // as `simulate --out`'s `model_extrapolated`: the scenario's, then the input's
     let mut extrapolated: Vec<String> = (built.reduced.iter())
         .flat_map(|r| r.extrapolated.iter())

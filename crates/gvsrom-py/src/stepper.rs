@@ -399,9 +399,7 @@ pub fn start(robot: Py<Robot>, py: Python<'_>, a: Args) -> PyResult<Stepper> {
         },
     )
     .map_err(err)?;
-    if let Some(note) = built.reduced.as_ref().and_then(|r| r.motion_note()) {
-        warn(py, &note)?;
-    }
+    crate::robot::warn_motion_note(py, built)?;
     let thread_robot = robot.clone_ref(py);
     let stop = Arc::new(AtomicBool::new(false));
     let thread_stop = stop.clone();

@@ -243,7 +243,8 @@ def test_pod_modes_and_singular_values_are_numpys_svd_of_the_snapshots(dataset, 
 
 def test_a_model_of_equilibria_only_warns_in_motion_not_in_statics(robot, pod):
     rom = robot.with_model(pod)
-    for run in (lambda: rom.simulate(0.02), lambda: rom.stepper(dt=0.01).close()):
+    for run in (lambda: rom.simulate(0.02), lambda: rom.stepper(dt=0.01).close(),
+                lambda: rom.modes(1), lambda: rom.linearize()):
         with pytest.warns(UserWarning, match="made from equilibria only"):
             run()
     with warnings.catch_warnings():

@@ -188,6 +188,13 @@ def test_a_divisions_own_material_sets_its_sections():
     np.testing.assert_allclose(robot.section_inertia[second], 2 * plain.section_inertia[second],
                                rtol=1e-15)
     np.testing.assert_array_equal(robot.section_inertia[first], plain.section_inertia[first])
+    # at the junction, two points: the first division's end, of its material, then the second's
+    # start, of the second's
+    at = np.flatnonzero(np.abs(robot.point_x - 0.3) < 1e-12)
+    assert len(at) == 2, robot.point_x
+    np.testing.assert_array_equal(robot.section_stiffness[at[0]], plain.section_stiffness[at[0]])
+    np.testing.assert_allclose(robot.section_stiffness[at[1]], 5 * plain.section_stiffness[at[1]],
+                               rtol=1e-15)
     assert "material" in robot.scenario.to_toml().split("[[divisions]]")[2]
     with pytest.raises(gvsrom.GvsromError, match=r"divisions\[1\]\.material\.poisson_ratio"):
         base.copy().set("divisions.1.material.poisson_ratio", 0.7).build()

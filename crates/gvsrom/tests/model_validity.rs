@@ -926,3 +926,61 @@ fn a_model_made_from_equilibria_only_says_so_in_motion_not_in_statics() {
     assert!(out.contains("simulated") || out.contains("steps"), "{out}");
     assert!(!out.contains(equilibria_only), "{out}");
 }
+
+#[test]
+fn a_division_material_is_physics_a_model_and_a_motion_name() {
+    // a model of the rod's material is refused for a division of another, naming it
+    expect_error(
+        &[
+            "statics",
+            "single-tendon",
+            "--set",
+            "divisions.0.material={youngs_modulus=2e6}",
+            "--model",
+            s(pod2()),
+        ],
+        &["--model", "divisions[0].material differs"],
+    );
+    // a motion's mass check names the key that set the density: the division's own ...
+    expect_error(
+        &[
+            "simulate",
+            "six-tendon",
+            "--duration",
+            "0.01",
+            "--set",
+            "divisions.1.material={density=0}",
+        ],
+        &[
+            "`divisions[1].material.density`",
+            "a motion needs a rod with mass",
+        ],
+    );
+    // ... or the rod's, which a division with a material of its own inherits
+    let e = expect_error(
+        &[
+            "simulate",
+            "six-tendon",
+            "--duration",
+            "0.01",
+            "--set",
+            "material.density=0",
+            "--set",
+            "divisions.0.material={youngs_modulus=2e6}",
+        ],
+        &["`material.density`", "a motion needs a rod with mass"],
+    );
+    assert!(!e.contains("divisions[0].material.density"), "{e}");
+    // a damping beyond what the division's stiffness admits
+    expect_error(
+        &[
+            "simulate",
+            "six-tendon",
+            "--duration",
+            "0.01",
+            "--set",
+            "divisions.1.material={damping=1e10}",
+        ],
+        &["`divisions[1].material.damping`", "relaxation time"],
+    );
+}

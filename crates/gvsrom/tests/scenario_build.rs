@@ -657,8 +657,13 @@ fn a_fem_basis_under_points_that_straddle_its_elements_is_warned_about_and_less_
 }
 
 /// [`UNIFORM_ROD`] in two divisions, 0.2 m of the rod's material (E = 1 MPa) then 0.3 m of its own
-/// `material` (a table of overrides, TOML inline), both order 2; no gravity.
+/// `material` (a table of overrides, TOML inline; `""`: no `material` key), both order 2; no
+/// gravity.
 fn two_material_rod(material: &str) -> String {
+    let material = match material {
+        "" => String::new(),
+        table => format!("material = {table}"),
+    };
     format!(
         r#"
     name = "two materials"
@@ -674,7 +679,7 @@ fn two_material_rod(material: &str) -> String {
     length = 0.3
     radius = 0.01
     basis = {{ kind = "legendre", modes = ["bend_y", "elongation", "shear_z"], order = 2 }}
-    material = {material}
+    {material}
     [loads]
     gravity = [0, 0, 0]
 "#
@@ -750,13 +755,20 @@ fn a_two_material_rod_bends_as_its_closed_forms() {
 #[test]
 fn a_division_material_equal_to_the_rods_changes_nothing_and_a_bad_one_names_its_division() {
     let loads = ["loads.point.0.x=0.5", "loads.point.0.force=[0, 0.3, -0.2]"];
-    let same = run_text(
-        &two_material_rod("{ youngs_modulus = 1e6, density = 1000 }"),
-        &loads,
-    );
-    let none = run_text(&two_material_rod("{}"), &loads);
-    assert_eq!(same.q, none.q);
-    assert_eq!(same.tip_position, none.tip_position);
+    let none = run_text(&two_material_rod(""), &loads);
+    for same in ["{ youngs_modulus = 1e6, density = 1000 }", "{}"] {
+        let text = two_material_rod(same);
+        let s = Scenario::from_toml("t", &text, &[]).unwrap();
+        // the rod's values are the rod's material: no division material, recorded or compared
+        assert!(gvsrom::build(&s).unwrap().model.rod.divisions[1]
+            .material
+            .is_none());
+        let same = run_text(&text, &loads);
+        assert_eq!(same.q, none.q);
+        assert_eq!(same.tip_position, none.tip_position);
+    }
+    let stiffer = run_text(&two_material_rod("{ youngs_modulus = 1.1e6 }"), &loads);
+    assert!((stiffer.tip_position[2] - none.tip_position[2]).abs() > 1e-6);
     // a division's density weighs its own length: a weak gravity (small deflection) on a tip
     // division three times as dense, against δ = ∫ M(x)(L − x)/EI dx + ∫ V(x)/GA dx with the
     // piecewise weight q(x) = ρ(x) A g, integrated here by the midpoint rule
@@ -785,7 +797,7 @@ fn a_division_material_equal_to_the_rods_changes_nothing_and_a_bad_one_names_its
         &two_material_rod("{ density = 3000 }"),
         &["loads.gravity=[0, 0, -9.81e-4]"],
     );
-    let light = run_text(&two_material_rod("{}"), &["loads.gravity=[0, 0, -9.81e-4]"]);
+    let light = run_text(&two_material_rod(""), &["loads.gravity=[0, 0, -9.81e-4]"]);
     assert!(
         // measured 2.5e-6 relative (the midpoint rule's O(h²) and the O((δ/L)²) nonlinearity)
         (heavy.tip_position[2] - expected).abs() < 2e-5 * expected.abs(),

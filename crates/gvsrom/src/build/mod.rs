@@ -217,8 +217,9 @@ pub fn model_warnings(model: &Model<LinearBasis>) -> Vec<String> {
     w
 }
 
-/// Every build warning of `s` built as `built`: [`model_warnings`] and divisions the kinematics
-/// under-integrate ([`under_integrated_divisions`]).
+/// Every build warning of `s` built as `built`: [`model_warnings`] and divisions whose points
+/// integrate their basis poorly ([`under_integrated_divisions`]: the kinematics, a fem basis's
+/// element ends).
 pub fn warnings(s: &Scenario, built: &Built) -> Vec<String> {
     let mut w = model_warnings(&built.model);
     w.extend(under_integrated_divisions(s));

@@ -21,7 +21,7 @@ pub(super) fn material(s: &Scenario) -> Result<Material, ScenarioError> {
 
 /// Division `j`'s own material (`[divisions.material]`): the rod's `rod` with the keys `d` gives
 /// replaced, checked as `[material]` is, its fields named `divisions[j].material.*`; `None` when
-/// it gives none.
+/// it gives none or the rod's values (the same physics, recorded and compared as the same).
 pub(super) fn division_material(
     j: usize,
     d: &DivisionSpec,
@@ -36,7 +36,8 @@ pub(super) fn division_material(
         density: m.density.unwrap_or(rod.density),
         damping: m.damping.unwrap_or(rod.damping),
     };
-    checked_material(&format!("divisions[{j}].material"), own).map(Some)
+    let own = checked_material(&format!("divisions[{j}].material"), own)?;
+    Ok((own != *rod).then_some(own))
 }
 
 /// `m` if its values are a material's, else an error naming `{prefix}.field`.

@@ -280,9 +280,12 @@ pub(super) fn estimates(built: &Subject<'_>, u: &[f64], scale: f64, bound: bool)
         // nothing, so it is capped at π; the rod then hangs, stretched by its weight (N / EA).
         out.push(Estimate {
             name: format!(
-                "loads.gravity = {} m/s^2 (with material.density = {} kg/m^3){scaled}",
+                "loads.gravity = {} m/s^2 (with {}){scaled}",
                 vec3(&loads.gravity),
-                fmt_value(rho)
+                match model.rod.divisions.iter().any(|d| d.material.is_some()) {
+                    false => format!("material.density = {} kg/m^3", fmt_value(rho)),
+                    true => format!("densities up to {} kg/m^3", fmt_value(rho)),
+                }
             ),
             bending: mul(w, theta).min(PI),
             strain: mul(w, eps),

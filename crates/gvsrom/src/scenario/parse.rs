@@ -98,14 +98,18 @@ fn array_length_message(field: &str, message: String) -> String {
         return message;
     }
     // the key, and the index of a row in `path` or `rotation`
-    let leaf = field.rsplit('.').next().unwrap_or(field);
-    let leaf = leaf.split('[').next().unwrap_or(leaf);
+    let last = field.rsplit('.').next().unwrap_or(field);
+    let leaf = last.split('[').next().unwrap_or(last);
+    // a row of `rotation` or `path` (`base.rotation[1]`), not the list of rows
+    let row = last.ends_with(']');
     let form = match leaf {
+        "rotation" if row => "3 values: a row of the rotation matrix",
+        "path" if row => "3 values `[X, y, z]` [m]: a knot's abscissa and offset",
         "offset_start" | "offset_end" => {
             "2 values `[y, z]` [m]: the offset in the section's plane (y and z of the section frame; the tendon's abscissa is its x)"
         }
         "position" | "force" | "moment" | "gravity" | "axis" => "3 values `[x, y, z]`",
-        "path" => "rows of 3 values `[X, y, z]` [m]: the abscissa and the offset",
+        "path" => "rows of 3 values `[X, y, z]` [m]: the knots' abscissae and offsets",
         "rotation" => "3 rows of 3 values",
         "reference_strain" => {
             "6 values `[torsion, bend_y, bend_z, elongation, shear_y, shear_z]`"

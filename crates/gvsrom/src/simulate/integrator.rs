@@ -94,12 +94,20 @@ pub fn require_mass_only(built: &Built) -> Result<(), ScenarioError> {
     Ok(())
 }
 
-/// The scenario field that sets `name` of division `div`'s material: its own
-/// (`divisions[1].material.density`) or the rod's (`material.density`).
+/// The scenario field that sets `name` (`density` or `damping`) of division `div`'s material: its
+/// own (`divisions[1].material.density`) where it differs from the rod's, else the rod's
+/// (`material.density`), which the division inherits.
 fn material_field(built: &Built, div: usize, name: &str) -> String {
-    match built.model.rod.divisions[div].material {
-        Some(_) => format!("divisions[{div}].material.{name}"),
-        None => format!("material.{name}"),
+    let rod = &built.model.rod;
+    let value = |m: &gvs::rod::Material| match name {
+        "density" => m.density,
+        _ => m.damping,
+    };
+    match &rod.divisions[div].material {
+        Some(own) if value(own) != value(&rod.material) => {
+            format!("divisions[{div}].material.{name}")
+        }
+        _ => format!("material.{name}"),
     }
 }
 
