@@ -640,6 +640,17 @@ fn a_fem_basis_under_points_that_straddle_its_elements_is_warned_about_and_less_
         subdivided < 1e-3 && quiet.is_empty(),
         "{subdivided:e} {quiet:?}"
     );
+    // one element has no kink inside the division: a Gauss rule over it is quiet
+    let s = Scenario::from_toml(
+        "t",
+        UNIFORM_ROD,
+        &[
+            "divisions.0.basis={ kind = \"fem\", modes = [\"bend_y\"], elements = 1 }".into(),
+            "divisions.0.quadrature={ gauss = 7 }".into(),
+        ],
+    )
+    .unwrap();
+    assert!(gvsrom::build::warnings(&s, &gvsrom::build(&s).unwrap()).is_empty());
     // 30 points over the division, or 24 elements over 16: warned, and further off
     for q in ["{ gauss = 30 }", "{ elements = 24, gauss_per_element = 2 }"] {
         let (straddled, warned) = deflection_error(Some(q));
