@@ -40,7 +40,7 @@ class Equilibria:
     starts the full model from the straight rod (its load ramp) and a reduced model from its
     training anchors at that tension. A Newton from the last equilibrium, written here with
     `statics_residual` and `statics_jacobian`, was slower for both models (7.1 and 1.8 ms per
-    call of the law, against 4.0 and 0.8): each of its iterations crosses into Python three
+    call of the law, against 4.1 and 0.7): each of its iterations crosses into Python three
     times, where a native solve runs whole."""
 
     def __init__(self, robot):
