@@ -6,12 +6,14 @@
 //!
 //! Layers: [`lie`] (SE(3) algebra) → [`rod`] (sections, material) → [`discretize`] (points, Magnus
 //! sites) → [`strain`] (the [`strain::StrainParam`] trait and bases) → [`model`] (kinematics,
-//! generalized forces) with [`actuation`] and [`loads`] → [`solve`] (statics).
+//! generalized forces) with [`actuation`], [`loads`] and [`bodies`] (rigid bodies fixed to the rod) →
+//! [`solve`] (statics).
 //!
 //! Conventions (gvs-spec §1): 6-vectors angular first, `[torsion, bend-y, bend-z, elongation,
 //! shear-y, shear-z]`; the rod runs along its local x-axis; SI units.
 
 pub mod actuation;
+pub mod bodies;
 pub mod cpu;
 pub mod discretize;
 pub mod dynamics;

@@ -22,6 +22,7 @@ use crate::actuation::{
     smoothed_turning_angle, smoothed_turning_angle_value, tangent_jacobian, tendon_local,
     wrench_jacobian, Tendon,
 };
+use crate::bodies::{AttachedBody, RigidBody};
 use crate::discretize::{Discretization, MagnusOrder};
 use crate::error::{fmt_value, ModelError};
 use crate::lie::{ad_mul, coad, coad_mul, coadbar, tilde, Pose, M6, V3, V6};
@@ -76,6 +77,8 @@ pub struct Model<P: StrainParam> {
     /// points no tendon acts on.
     dy_slot: Vec<usize>,
     k_lin: Option<DMatrix<f64>>,
+    /// Rigid bodies fixed to the rod ([`crate::bodies`]).
+    pub(crate) bodies: Vec<AttachedBody>,
 }
 
 impl<P: StrainParam> Model<P> {
@@ -151,6 +154,7 @@ impl<P: StrainParam> Model<P> {
             tendon_weights,
             dy_slot,
             k_lin: None,
+            bodies: Vec::new(),
         };
         if m.param.is_linear() {
             m.k_lin = Some(m.stiffness_linear());
@@ -173,6 +177,46 @@ impl<P: StrainParam> Model<P> {
             self.xi_star[s] = xi_star(site.x, site.div);
         }
         self
+    }
+
+    /// The model with rigid bodies fixed to the rod ([`crate::bodies`]): each adds its inertia to
+    /// the mass matrix and the inertial forces and its weight to the loads. Each body's `x` must be
+    /// a computational point (an extra point of the discretization, as a point load's).
+    pub fn with_bodies(mut self, bodies: Vec<RigidBody>) -> Result<Self, ModelError> {
+        let length = self.disc.length();
+        let mut attached = Vec::with_capacity(bodies.len());
+        for (k, b) in bodies.into_iter().enumerate() {
+            b.validate(k, length)?;
+            let point = self.disc.point_at(b.x).ok_or_else(|| {
+                ModelError::invalid(
+                    format!("bodies[{k}].x"),
+                    format!(
+                        "X = {} m is not a computational point; add it to the discretization's extra points",
+                        b.x
+                    ),
+                )
+            })?;
+            attached.push(AttachedBody::new(b, point));
+        }
+        self.bodies = attached;
+        Ok(self)
+    }
+
+    /// The bodies of another model built on the same discretization, carried to this one
+    /// ([`Model::with_bodies`]).
+    pub fn with_bodies_of<Q: StrainParam>(mut self, other: &Model<Q>) -> Self {
+        assert_eq!(
+            self.disc.n_points(),
+            other.disc.n_points(),
+            "bodies of a model on another discretization"
+        );
+        self.bodies = other.bodies.clone();
+        self
+    }
+
+    /// The rigid bodies fixed to the rod ([`Model::with_bodies`]).
+    pub fn bodies(&self) -> impl ExactSizeIterator<Item = &RigidBody> {
+        self.bodies.iter().map(|b| &b.body)
     }
 
     /// The same model's reference strain at every site, carried to a model of another

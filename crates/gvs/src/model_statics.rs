@@ -6,7 +6,9 @@ use super::*;
 
 impl<P: StrainParam> Model<P> {
     /// Per-point wrenches `w_i` (local frame) of the external loads and gravity at the current poses;
-    /// `wg_i` collects the world-fixed part `[Rᵀm; Rᵀf + W ρA Rᵀ g]` whose derivative is `[m̃; f̃] δθ`.
+    /// `wg_i` collects the world-fixed part `[Rᵀm; Rᵀf + W ρA Rᵀ g]` whose derivative is `[m̃; f̃] δθ`,
+    /// and the bodies' weights `[c × f_b; f_b]` (their extra derivative is added by
+    /// `add_body_weight_offsets`).
     pub(crate) fn point_wrenches(&self, loads: &PreparedLoads, ws: &mut Workspace) {
         for (i, p) in self.disc.points.iter().enumerate() {
             let rt = ws.g[i].rot.transpose();
@@ -18,6 +20,12 @@ impl<P: StrainParam> Model<P> {
             }
             ws.wg[i] = V6::new(m[0], m[1], m[2], f[0], f[1], f[2]);
             ws.w[i] = loads.local[i] + ws.wg[i];
+        }
+        // the bodies' weights `[c × f; f]`, world-fixed like gravity (`crate::bodies`)
+        for b in &self.bodies {
+            let wb = b.weight(&ws.g[b.point].rot.transpose(), &loads.gravity);
+            ws.wg[b.point] += wb;
+            ws.w[b.point] += wb;
         }
     }
 
@@ -361,6 +369,32 @@ impl<P: StrainParam> Model<P> {
         }
     }
 
+    /// `jac += J_angᵀ E J_ang` at each body's point, `E = f̃ c̃`: the derivative of an off-centre
+    /// body's weight moment `c × f` beyond the world-fixed kernel of the backward pass
+    /// ([`crate::bodies`]).
+    fn add_body_weight_offsets(
+        &self,
+        loads: &PreparedLoads,
+        ws: &Workspace,
+        jac: &mut DMatrix<f64>,
+    ) {
+        let n = self.n_dof();
+        for b in &self.bodies {
+            let h = ws.jac_bound(b.point);
+            if h == 0 || b.body.center == [0.0; 3] || loads.gravity == V3::zeros() {
+                continue;
+            }
+            let e = b.weight_offset_derivative(&ws.g[b.point].rot.transpose(), &loads.gravity);
+            let ja = ws.jac.fixed_rows::<3>(0);
+            for c in 0..h {
+                let ejc: V3 = e * ja.column(b.point * n + c);
+                for r in 0..h {
+                    jac[(r, c)] += ja.column(b.point * n + r).dot(&ejc);
+                }
+            }
+        }
+    }
+
     /// Analytic statics Jacobian `∂R/∂q` (spec §8.2, with `∂α/∂q` of friction) into `jac`.
     pub fn statics_jacobian(
         &self,
@@ -439,6 +473,7 @@ impl<P: StrainParam> Model<P> {
             }
         }
         self.backward(ws, Some(jac));
+        self.add_body_weight_offsets(loads, ws, jac);
         if !self.param.is_linear() {
             self.param.add_weighted_hessian(q, &ws.y, &mut ws.ev, jac);
         }

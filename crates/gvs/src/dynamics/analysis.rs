@@ -4,7 +4,7 @@
 
 use super::{cholesky_factor_in_place, DynamicsError};
 use crate::discretize::MagnusOrder;
-use crate::lie::{ad, V3, V6};
+use crate::lie::{ad, M6, V3, V6};
 use crate::model::{Model, PreparedLoads, Workspace, ZANNA_C};
 use crate::strain::StrainParam;
 use nalgebra::{DMatrix, DVector, Matrix6xX};
@@ -249,22 +249,25 @@ impl<P: StrainParam> Model<P> {
                     jds = et.g.adjoint_inv() * next;
                 }
             }
+            // the section's W Ms, plus the inertia of the bodies fixed here
             let w = self.disc.points[i].weight;
-            if w == 0.0 {
+            let mut mi = M6::from_diagonal(&(self.props[i].ms * w));
+            for b in self.bodies.iter().filter(|b| b.point == i) {
+                mi += b.mb;
+            }
+            if mi == M6::zeros() {
                 continue;
             }
-            let ms = self.props[i].ms;
             let j = ws.jac.columns(i * n, n).into_owned();
-            let msj = DMatrix::from_fn(6, n, |a, b| ms[a] * j[(a, b)]);
-            let msjd = DMatrix::from_fn(6, n, |a, b| ms[a] * jds[(a, b)]);
-            let inner = msjd + crate::lie::coad(&ws.eta[i]) * msj;
-            c += j.transpose() * inner * w;
+            let inner = &mi * &jds + crate::lie::coad(&ws.eta[i]) * &mi * &j;
+            c += j.transpose() * inner;
         }
         c
     }
 
     /// Kinetic, elastic and gravitational energies at `(q, q̇)` (spec §9.4):
-    /// `T = ½ q̇ᵀ M q̇`, `U_e = ½ Σ W Ψᵀ Es Ψ`, `U_g = −Σ W ρA g·r`.
+    /// `T = ½ q̇ᵀ M q̇`, `U_e = ½ Σ W Ψᵀ Es Ψ`, `U_g = −Σ W ρA g·r − Σ_b m_b g·(r_b + R_b c_b)` (the
+    /// bodies' centres of mass, [`crate::bodies`]).
     pub fn energy(
         &self,
         q: &DVector<f64>,
@@ -285,6 +288,11 @@ impl<P: StrainParam> Model<P> {
             let psi = ws.ev.psi[i];
             elastic += 0.5 * p.weight * psi.dot(&self.props[i].es.component_mul(&psi));
             gravitational -= p.weight * self.props[i].ms[3] * g.dot(&ws.g[i].pos);
+        }
+        for b in &self.bodies {
+            let pose = &ws.g[b.point];
+            let center = pose.pos + pose.rot * V3::from(b.body.center);
+            gravitational -= b.body.mass * g.dot(&center);
         }
         Energy {
             kinetic,

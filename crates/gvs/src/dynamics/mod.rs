@@ -176,7 +176,8 @@ impl<P: StrainParam> Model<P> {
     /// is allocated on first use), as `M = Σ_chunks Bᵀ B` with the rows `√(W_i Ms_i,a) J_i[a, :]`
     /// of [`MASS_CHUNK`] points stacked in `B` (one blocked product per chunk instead of a rank-6
     /// update per point). `J_i` is zero beyond its column bound `h_i`, so a chunk adds to the
-    /// leading `h × h` block only, `h` its largest bound. `Ms` is diagonal and non-negative.
+    /// leading `h × h` block only, `h` its largest bound. `Ms` is diagonal and non-negative. The
+    /// bodies add `J_bᵀ Mb J_b` ([`crate::bodies`]).
     pub fn assemble_mass(&self, ws: &mut Workspace) {
         let n = self.n_dof();
         if ws.mass.shape() != (n, n) {
@@ -224,6 +225,25 @@ impl<P: StrainParam> Model<P> {
                 matmul(dst, Accum::Add, bm.transpose(), bm, 1.0, Par::Seq);
             }
             start = end;
+        }
+        // each body's `J_bᵀ Mb J_b` as `Bᵀ B` with the rows `r_kᵀ J_b` (`Mb = Σ r_k r_kᵀ`)
+        for b in &self.bodies {
+            let h = ws.jac_bound(b.point);
+            if h == 0 || b.rank == 0 {
+                continue;
+            }
+            let rows = b.rank;
+            let bm = &mut ws.mass_b[..rows * h];
+            let j = ws.jac.columns(b.point * n, h);
+            for c in 0..h {
+                for (k, r) in b.rows[..rows].iter().enumerate() {
+                    bm[c * rows + k] = r.dot(&j.column(c));
+                }
+            }
+            let bm = MatRef::from_column_major_slice(&ws.mass_b[..rows * h], rows, h);
+            let dst =
+                MatMut::from_column_major_slice_with_stride_mut(ws.mass.as_mut_slice(), h, h, n);
+            matmul(dst, Accum::Add, bm.transpose(), bm, 1.0, Par::Seq);
         }
         crate::cpu::clear_upper_state();
     }
@@ -361,7 +381,8 @@ impl<P: StrainParam> Model<P> {
     }
 
     /// `w_i −= W_i (Ms ζ_i + coad_{η_i} Ms η_i)`: the inertial wrenches (with `ζ_i` the body
-    /// acceleration at `q̈ = 0`, or the full `η̇_i` after [`Self::velocities_with`] with `q̈`).
+    /// acceleration at `q̈ = 0`, or the full `η̇_i` after [`Self::velocities_with`] with `q̈`), and
+    /// the bodies' `Mb ζ_b + coad_{η_b} Mb η_b` at their points.
     fn subtract_inertial_wrenches(&self, ws: &mut Workspace) {
         for (i, p) in self.disc.points.iter().enumerate() {
             if p.weight == 0.0 {
@@ -371,6 +392,10 @@ impl<P: StrainParam> Model<P> {
             let inertial =
                 ms.component_mul(&ws.zeta[i]) + coad_mul(&ws.eta[i], &ms.component_mul(&ws.eta[i]));
             ws.w[i] -= inertial * p.weight;
+        }
+        for b in &self.bodies {
+            let (eta, zeta) = (ws.eta[b.point], ws.zeta[b.point]);
+            ws.w[b.point] -= b.mb * zeta + coad_mul(&eta, &(b.mb * eta));
         }
     }
 
@@ -418,6 +443,10 @@ impl<P: StrainParam> Model<P> {
                 w += (ms.component_mul(&eta_dot)
                     + coad_mul(&ws.eta[i], &ms.component_mul(&ws.eta[i])))
                     * p.weight;
+            }
+            for b in self.bodies.iter().filter(|b| b.point == i) {
+                let eta_dot: V6 = j * qdd + ws.zeta[i];
+                w += b.mb * eta_dot + coad_mul(&ws.eta[i], &(b.mb * ws.eta[i]));
             }
             id.gemv_tr(1.0, &j, &w, 1.0);
         }
