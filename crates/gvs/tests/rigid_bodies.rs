@@ -155,7 +155,7 @@ fn body_inertia_gives_the_kinetic_energy_of_its_centre_of_mass_and_spin() {
     let poses = |x: &DVector<f64>, ws: &mut gvs::model::Workspace| {
         m.forward(x, ws, false);
         m.bodies()
-            .map(|b| ws.g[m.disc.point_at(b.x).unwrap()].clone())
+            .map(|b| ws.g[m.disc.point_at(b.x).unwrap()])
             .collect::<Vec<_>>()
     };
     let (pp, pm) = (

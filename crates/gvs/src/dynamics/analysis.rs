@@ -259,7 +259,7 @@ impl<P: StrainParam> Model<P> {
                 continue;
             }
             let j = ws.jac.columns(i * n, n).into_owned();
-            let inner = &mi * &jds + crate::lie::coad(&ws.eta[i]) * &mi * &j;
+            let inner = mi * &jds + crate::lie::coad(&ws.eta[i]) * mi * &j;
             c += j.transpose() * inner;
         }
         c
