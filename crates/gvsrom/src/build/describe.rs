@@ -2,6 +2,7 @@
 
 use super::Built;
 use crate::scenario::{BasisKind, Scenario};
+use gvs::error::fmt_value;
 use gvs::loads::Frame;
 use gvs::strain::FemDegree;
 
@@ -83,6 +84,17 @@ pub fn describe(s: &Scenario, built: &Built) -> String {
             parts.push(wrench_count(&frames, what));
         }
     }
+    let bodies: Vec<_> = m.bodies().collect();
+    if !bodies.is_empty() {
+        let mass: f64 = bodies.iter().map(|b| b.mass).sum();
+        parts.push(format!(
+            "{} ({mass} kg)",
+            match bodies.len() {
+                1 => "1 rigid body".to_string(),
+                n => format!("{n} rigid bodies"),
+            }
+        ));
+    }
     let mut kinds: Vec<&str> = vec![];
     for d in &s.divisions {
         let kind = match (d.basis.kind, d.basis.degree) {
@@ -105,6 +117,39 @@ pub fn wrench_frames(built: &Built) -> (Vec<Frame>, Vec<Frame>) {
         l.point.iter().map(|p| p.frame).collect(),
         l.distributed.iter().map(|d| d.peak_density().1).collect(),
     )
+}
+
+/// The rigid bodies fixed to the rod, one per line without a prefix: `0.02 kg at X = 0.25 m,
+/// centre of mass [0.01, 0, 0] m, inertia [2e-6, 1.5e-6, 1.5e-6] kg·m²` (principal moments about
+/// it; `inertia …` left out for a point mass). Empty without bodies.
+pub fn body_lines(built: &Built) -> Vec<String> {
+    let list = |v: &[f64]| {
+        let parts: Vec<String> = v.iter().map(|x| fmt_value(*x)).collect();
+        format!("[{}]", parts.join(", "))
+    };
+    built
+        .model
+        .bodies()
+        .map(|b| {
+            let mut line = format!("{} kg at X = {} m", fmt_value(b.mass), b.x);
+            if b.center != [0.0; 3] {
+                line += &format!(", centre of mass {} m", list(&b.center));
+            }
+            let t = b.inertia;
+            let diagonal = [t[0][1], t[0][2], t[1][2]].iter().all(|v| *v == 0.0);
+            if t != [[0.0; 3]; 3] {
+                line += &if diagonal {
+                    format!(", inertia {} kg·m²", list(&[t[0][0], t[1][1], t[2][2]]))
+                } else {
+                    format!(
+                        ", inertia tensor {} kg·m²",
+                        list(&t.iter().flatten().copied().collect::<Vec<_>>())
+                    )
+                };
+            }
+            line
+        })
+        .collect()
 }
 
 /// `n` wrenches of kind `what` and how their components turn: `1 point wrench (follower)`,

@@ -14,7 +14,7 @@ mod resolve;
 mod rod;
 mod tendons;
 
-pub use describe::{describe, wrench_count, wrench_frames};
+pub use describe::{body_lines, describe, wrench_count, wrench_frames};
 pub use limits::*;
 pub use loads::loads;
 pub use reduced::Reduced;
@@ -27,6 +27,7 @@ use tendons::tendon;
 
 use crate::error::ScenarioError;
 use crate::scenario::Scenario;
+use gvs::bodies::RigidBody;
 use gvs::discretize::Discretization;
 use gvs::loads::Loads;
 use gvs::model::Model;
@@ -145,7 +146,21 @@ pub fn build(s: &Scenario) -> Result<Built, ScenarioError> {
         ));
     }
 
-    let extra_x = loads.point_abscissae();
+    let bodies = s
+        .bodies
+        .iter()
+        .map(|b| RigidBody {
+            x: b.x,
+            mass: b.mass,
+            center: b.center,
+            inertia: b.inertia.tensor(),
+        })
+        .collect::<Vec<_>>();
+    for (k, b) in bodies.iter().enumerate() {
+        b.validate(k, length)?;
+    }
+    let mut extra_x = loads.point_abscissae();
+    extra_x.extend(bodies.iter().map(|b| b.x));
     let disc = Discretization::new(&rod, &quads, s.magnus, &extra_x)?;
     if n_dof.saturating_mul(disc.n_sites()) > MAX_BASIS_SIZE {
         return Err(ScenarioError::invalid(
@@ -166,7 +181,8 @@ pub fn build(s: &Scenario) -> Result<Built, ScenarioError> {
         .collect::<Result<Vec<_>, _>>()?;
     let model = Model::new(rod, disc, basis, tendons)?
         .with_base(base)
-        .with_reference_strain(|_, div| reference[div]);
+        .with_reference_strain(|_, div| reference[div])
+        .with_bodies(bodies)?;
     // the loads as the points take them (`check` too: a distributed load they do not resolve)
     model.prepare_loads(&loads)?;
     let built = Built {

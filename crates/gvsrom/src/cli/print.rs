@@ -106,6 +106,10 @@ pub(super) fn print_model(
         gvsrom::build::wrench_count(&point, "point wrench"),
         gvsrom::build::wrench_count(&distributed, "distributed wrench"),
     )?;
+    for (k, line) in gvsrom::build::body_lines(built).iter().enumerate() {
+        let label = if k == 0 { "bodies" } else { "" };
+        writeln!(out, "{label:<10} {line}")?;
+    }
     Ok(())
 }
 

@@ -292,6 +292,32 @@ pub(super) fn estimates(built: &Subject<'_>, u: &[f64], scale: f64, bound: bool)
             strain_kind: "an axial strain (hanging)",
         });
     }
+    // the bodies' weights: dead loads like gravity (bending capped at π, strain the hanging one)
+    for (k, b) in model.bodies().enumerate() {
+        let weight = mul(mul(scale, g), b.mass);
+        if weight == 0.0 {
+            continue;
+        }
+        let arm = V3::from(b.center).norm();
+        let before = |s: f64| s <= b.x;
+        let (theta, _) = integrate(
+            &grid,
+            |s| if before(s) { arm + b.x - s } else { 0.0 },
+            |_| 0.0,
+            true,
+        );
+        let (_, eps) = integrate(&grid, |_| 0.0, |s| if before(s) { 1.0 } else { 0.0 }, false);
+        out.push(Estimate {
+            name: format!(
+                "bodies[{k}].mass = {} kg under gravity {} m/s^2{scaled}",
+                fmt_value(b.mass),
+                fmt_value(g)
+            ),
+            bending: mul(weight, theta).min(PI),
+            strain: mul(weight, eps),
+            strain_kind: "an axial strain (hanging)",
+        });
+    }
     out
 }
 

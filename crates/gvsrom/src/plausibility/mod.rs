@@ -19,6 +19,7 @@
 //! | uniform density f, m on `[a, b]` | `|m| ℓ(s) + |f| ((b − s)² − (max(s, a) − s)²)/2` | `|f| ℓ(s)`, `ℓ(s) = b − max(s, a)` |
 //! | triangular pulse, peak m̂ | `m̂ ∫ₛᴸ tri(x) dx` | 0 |
 //! | gravity g, density ρ | `∫ₛᴸ ρ A(x) |g| (x − s) dx`, `θ` capped at π | `∫ₛᴸ ρ A(x) |g| dx` (on `EA`) |
+//! | body of mass m at X, centre of mass c | `m |g| (|c| + X − s)`, `θ` capped at π | `m |g|` (on `EA`) |
 //!
 //! (The pulse's peak is `magnitude` or `2·magnitude/width` by its convention; friction only lowers a
 //! tendon's tension and is ignored. Gravity, a dead load, turns the rod at most until it hangs

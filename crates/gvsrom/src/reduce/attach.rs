@@ -95,7 +95,8 @@ pub(super) fn reduced_model(
         Model::new(m.rod.clone(), m.disc.clone(), param, m.tendons.clone())
             .map_err(ScenarioError::from)?
             .with_base(m.base)
-            .with_reference_strain_of(m),
+            .with_reference_strain_of(m)
+            .with_bodies_of(m),
     )
 }
 

@@ -29,7 +29,7 @@ pub use parse::{from_table, parse_table};
 pub use path::{lookup, number_at, parse_path, render_path, Seg};
 pub use tensions::tensions_for;
 pub use types::{
-    default_pulse_axis, BaseSpec, BasisKind, BasisSpec, DistributedKind, DistributedLoadSpec,
-    DivisionSpec, LoadsSpec, MaterialSpec, ModeOrders, OutputSpec, PointLoadSpec, QuadratureSpec,
-    Scenario, StrainMode, TendonSpec,
+    default_pulse_axis, BaseSpec, BasisKind, BasisSpec, BodySpec, DistributedKind,
+    DistributedLoadSpec, DivisionSpec, InertiaSpec, LoadsSpec, MaterialSpec, ModeOrders,
+    OutputSpec, PointLoadSpec, QuadratureSpec, Scenario, StrainMode, TendonSpec,
 };

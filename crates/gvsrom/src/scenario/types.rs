@@ -29,6 +29,9 @@ pub struct Scenario {
     pub tendons: Vec<TendonSpec>,
     #[serde(default)]
     pub loads: LoadsSpec,
+    /// Rigid bodies fixed to the rod (a payload, a gripper, discs).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub bodies: Vec<BodySpec>,
     #[serde(default)]
     pub solver: StaticsOptions,
     #[serde(default)]
@@ -283,6 +286,74 @@ impl Default for LoadsSpec {
 
 fn default_gravity() -> [f64; 3] {
     [0.0, 0.0, -9.81]
+}
+
+/// A rigid body fixed to the section at `x` (which becomes a computational point): its `mass`, its
+/// centre of mass `center` in the section frame and its `inertia` about that centre, in the
+/// section's axes: three principal values on the section's axes or a full symmetric tensor.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    pub x: f64,
+    pub mass: f64,
+    #[serde(default)]
+    pub center: [f64; 3],
+    #[serde(default)]
+    pub inertia: InertiaSpec,
+}
+
+/// A body's inertia tensor about its centre of mass: `[Ixx, Iyy, Izz]` on the section's axes, or
+/// the 3 × 3 tensor.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged, try_from = "toml::Value")]
+pub enum InertiaSpec {
+    Principal([f64; 3]),
+    Tensor([[f64; 3]; 3]),
+}
+
+impl Default for InertiaSpec {
+    fn default() -> Self {
+        InertiaSpec::Principal([0.0; 3])
+    }
+}
+
+impl TryFrom<toml::Value> for InertiaSpec {
+    type Error = String;
+
+    /// `[a, b, c]` or `[[..], [..], [..]]` of numbers (integers read as numbers), anything else an
+    /// error saying what is accepted.
+    fn try_from(v: toml::Value) -> Result<Self, String> {
+        let number = |v: &toml::Value| match v {
+            toml::Value::Float(x) => Some(*x),
+            toml::Value::Integer(i) => Some(*i as f64),
+            _ => None,
+        };
+        let row = |v: &toml::Value| -> Option<[f64; 3]> {
+            let a = v.as_array()?;
+            let xs: Vec<f64> = a.iter().map(number).collect::<Option<_>>()?;
+            xs.try_into().ok()
+        };
+        if let Some(p) = row(&v) {
+            return Ok(InertiaSpec::Principal(p));
+        }
+        let rows: Option<Vec<[f64; 3]>> = v.as_array().and_then(|a| a.iter().map(row).collect());
+        match rows.map(<[[f64; 3]; 3]>::try_from) {
+            Some(Ok(t)) => Ok(InertiaSpec::Tensor(t)),
+            _ => Err(format!(
+                "{v} is not an inertia: expected [Ixx, Iyy, Izz] (kg*m^2 about the centre of mass, on the section's axes) or the symmetric 3 x 3 tensor [[I11, I12, I13], [I12, I22, I23], [I13, I23, I33]] (its off-diagonal entries are the tensor's, -integral of x*y dm)"
+            )),
+        }
+    }
+}
+
+impl InertiaSpec {
+    /// The tensor.
+    pub fn tensor(&self) -> [[f64; 3]; 3] {
+        match *self {
+            InertiaSpec::Principal([a, b, c]) => [[a, 0.0, 0.0], [0.0, b, 0.0], [0.0, 0.0, c]],
+            InertiaSpec::Tensor(t) => t,
+        }
+    }
 }
 
 /// A concentrated wrench at abscissa `x` (which becomes a computational point).

@@ -1,0 +1,164 @@
+//! `[[bodies]]` of the scenario format (rigid bodies fixed to the rod) reached through the TOML:
+//! a tip payload against its weight as a world-fixed force and against the closed-form frequency
+//! of a cantilever carrying a tip mass, the point it adds, the summaries, and the errors of bad
+//! bodies naming the field.
+
+use gvsrom::statics::solve;
+use gvsrom::Scenario;
+use std::f64::consts::PI;
+
+/// A uniform rod, r = 5 mm, L = 0.5 m, E = 1 MPa, ρ = 1000 kg/m³ (39.3 g), bending in x-z only.
+const ROD: &str = r#"
+    name = "payload"
+    [material]
+    youngs_modulus = 1e6
+    poisson_ratio = 0.5
+    density = 1000
+    damping = 0
+    [[divisions]]
+    length = 0.5
+    radius = 0.005
+    basis = { kind = "legendre", modes = ["bend_y", "elongation", "shear_z"], order = 6 }
+    quadrature = { gauss = 16 }
+"#;
+
+const PAYLOAD: &str = r#"
+    [[bodies]]
+    x = 0.5
+    mass = 0.01
+"#;
+
+fn scenario(text: &str, overrides: &[&str]) -> Result<Scenario, String> {
+    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    Scenario::from_toml("test", text, &overrides).map_err(|e| e.to_string())
+}
+
+fn built(text: &str, overrides: &[&str]) -> Result<gvsrom::Built, String> {
+    gvsrom::build(&scenario(text, overrides)?).map_err(|e| e.to_string())
+}
+
+#[test]
+fn a_tip_payload_weighs_like_its_weight_as_a_world_fixed_tip_force() {
+    // stiffer than the preset rod, so that the payload moves the tip by centimetres
+    let stiff = "material.youngs_modulus=1e8";
+    let with_body = solve(&built(&format!("{ROD}{PAYLOAD}"), &[stiff]).unwrap()).unwrap();
+    let with_force = solve(
+        &built(
+            ROD,
+            &[
+                stiff,
+                "loads.point.0.x=0.5",
+                &format!("loads.point.0.force=[0, 0, {}]", -0.01 * 9.81),
+                "loads.point.0.frame=\"global\"",
+            ],
+        )
+        .unwrap(),
+    )
+    .unwrap();
+    let bare = solve(&built(ROD, &[stiff]).unwrap()).unwrap();
+    for i in 0..3 {
+        assert!(
+            (with_body.tip_position[i] - with_force.tip_position[i]).abs() < 1e-10,
+            "{:?} vs {:?}",
+            with_body.tip_position,
+            with_force.tip_position
+        );
+    }
+    let moved = (0..3).map(|i| (with_body.tip_position[i] - bare.tip_position[i]).abs());
+    assert!(
+        moved.fold(0.0, f64::max) > 0.01,
+        "{:?} vs {:?}",
+        with_body.tip_position,
+        bare.tip_position
+    );
+}
+
+/// Euler–Bernoulli cantilever with a tip mass `μ ρAL`: `ω = β² √(EI / ρAL⁴)`, β the least root of
+/// `1 + cos β cosh β + μ β (cos β sinh β − sin β cosh β) = 0`; `μ = 0.01 kg / 0.0393 kg = 0.255`.
+#[test]
+fn modes_of_a_cantilever_with_a_tip_mass_match_the_closed_form() {
+    let b = built(&format!("{ROD}{PAYLOAD}"), &["loads.gravity=[0, 0, 0]"]).unwrap();
+    let (_, modes) = gvsrom::modes::compute(&b, 3).unwrap();
+    let (l, r, e, rho) = (0.5, 0.005, 1e6, 1000.0);
+    let (area, inertia) = (PI * r * r, PI * r.powi(4) / 4.0);
+    let mu = 0.01 / (rho * area * l);
+    let f = |b: f64| 1.0 + b.cos() * b.cosh() + mu * b * (b.cos() * b.sinh() - b.sin() * b.cosh());
+    let (mut lo, mut hi) = (0.5, 1.875);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if f(lo) * f(mid) <= 0.0 {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    let beta = 0.5 * (lo + hi);
+    let f1 = beta * beta / (2.0 * PI) * (e * inertia / (rho * area * l.powi(4))).sqrt();
+    let got = modes.modes[0].frequency_hz;
+    assert!(
+        ((got - f1) / f1).abs() < 1e-3,
+        "f1 = {got} Hz, closed form {f1} Hz"
+    );
+}
+
+#[test]
+fn a_body_adds_its_point_and_the_summaries_name_it() {
+    let text = format!("{ROD}{PAYLOAD}");
+    let b = built(
+        &text,
+        &[
+            "bodies.0.x=0.3",
+            "bodies.0.center=[0.01, 0, 0]",
+            "bodies.0.inertia=[2e-6, 1.5e-6, 1.5e-6]",
+        ],
+    )
+    .unwrap();
+    let plain = built(ROD, &[]).unwrap();
+    assert_eq!(b.model.disc.n_points(), plain.model.disc.n_points() + 1);
+    assert!(b.model.disc.point_at(0.3).is_some());
+    let s = scenario(&text, &[]).unwrap();
+    let described = gvsrom::build::describe(&s, &built(&text, &[]).unwrap());
+    assert!(described.contains("1 rigid body (0.01 kg)"), "{described}");
+    assert_eq!(
+        gvsrom::build::body_lines(&b),
+        ["0.01 kg at X = 0.3 m, centre of mass [0.01, 0, 0] m, inertia [2e-6, 1.5e-6, 1.5e-6] kg·m²"]
+    );
+    let tensor = built(
+        &text,
+        &["bodies.0.inertia=[[2e-6, 1e-7, 0], [1e-7, 1.5e-6, 0], [0, 0, 1.5e-6]]"],
+    )
+    .unwrap();
+    assert!(gvsrom::build::body_lines(&tensor)[0].contains("inertia tensor [2e-6, 1e-7, 0,"));
+}
+
+#[test]
+fn bad_bodies_are_refused_naming_the_field() {
+    let text = format!("{ROD}{PAYLOAD}");
+    for (set, expected) in [
+        (
+            "bodies.0.x=0.7",
+            "`bodies[0].x`: 0.7 (expected an abscissa in [0, 0.5] m)",
+        ),
+        (
+            "bodies.0.mass=-1",
+            "`bodies[0].mass`: -1 (expected a finite number >= 0 kg)",
+        ),
+        (
+            "bodies.0.inertia=[1, 2]",
+            "`bodies[0].inertia`: [1, 2] is not an inertia",
+        ),
+        ("bodies.0.inertia=[1e-6, 1e-6, 5e-6]", "are not a solid's"),
+        (
+            "bodies.0.inertia=[[1e-6, 1e-7, 0], [0, 1e-6, 0], [0, 0, 1e-6]]",
+            "not symmetric",
+        ),
+        ("bodies.0.centre=[0, 0, 0]", "unknown field `centre`"),
+        (
+            "bodies.0.mass=1e6",
+            "bodies[0].mass = 1000000 kg under gravity 9.81 m/s^2 implies",
+        ),
+    ] {
+        let e = built(&text, &[set]).err().unwrap_or_default();
+        assert!(e.contains(expected), "{set}: {e}");
+    }
+}
