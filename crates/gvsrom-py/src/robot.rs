@@ -329,6 +329,32 @@ impl Robot {
         arrays::shaped(py, arrays::flat(&rows), [rows.len(), 6])
     }
 
+    /// The computational point of each rigid body (``[[bodies]]``), shape ``(n_bodies,)``, int64:
+    /// ``point_x[body_points[k]]`` is body k's ``x``.
+    #[getter]
+    fn body_points<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        let m = &self.built.model;
+        let points: Vec<i64> = m
+            .bodies()
+            .map(|b| m.disc.point_at(b.x).map_or(-1, |i| i as i64))
+            .collect();
+        numpy::PyArray::from_vec(py, points).into_any()
+    }
+
+    /// The spatial inertia ``Mb = [I_c − m c̃c̃, m c̃; −m c̃, m I]`` of each rigid body at its
+    /// section (angular first, body axes), shape ``(n_bodies, 6, 6)``: the mass matrix is
+    /// ``Σ W_i J_iᵀ Ms_i J_i + Σ_b J_bᵀ Mb J_b`` with ``J_b`` the Jacobian at ``body_points[b]``.
+    #[getter]
+    fn body_inertia<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let bodies: Vec<[f64; 36]> = (self.built.model.bodies())
+            .map(|b| {
+                let mb = b.spatial_inertia();
+                std::array::from_fn(|k| mb[(k / 6, k % 6)])
+            })
+            .collect();
+        arrays::shaped(py, arrays::flat(&bodies), [bodies.len(), 6, 6])
+    }
+
     /// Diagonal of the cross-section stiffness ``Es`` at each point
     /// ``[GJ, EI_y, EI_z, EA, GA, GA]``, shape ``(n_points, 6)``: N·m² for the first three, N
     /// for the last three.
