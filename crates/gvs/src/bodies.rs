@@ -17,9 +17,10 @@
 use crate::error::{check_range, fmt_value, ModelError};
 use crate::lie::{tilde, M3, M6, V3, V6};
 use nalgebra::SymmetricEigen;
+use serde::{Deserialize, Serialize};
 
 /// A rigid body fixed to the section at arc length `x` (SI units; frames of gvs-spec §1).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RigidBody {
     /// Arc length of the section it is fixed to \[m\].
     pub x: f64,

@@ -214,6 +214,18 @@ impl<P: StrainParam> Model<P> {
         self
     }
 
+    /// Per body, the world positions of the section it is fixed to and of its centre of mass
+    /// `r_b + R_b c` \[m\], after a forward pass in `ws`.
+    pub fn body_positions<'a>(
+        &'a self,
+        ws: &'a Workspace,
+    ) -> impl ExactSizeIterator<Item = (V3, V3)> + 'a {
+        self.bodies.iter().map(|b| {
+            let g = &ws.g[b.point];
+            (g.pos, g.pos + g.rot * V3::from(b.body.center))
+        })
+    }
+
     /// The rigid bodies fixed to the rod ([`Model::with_bodies`]).
     pub fn bodies(&self) -> impl ExactSizeIterator<Item = &RigidBody> {
         self.bodies.iter().map(|b| &b.body)

@@ -104,6 +104,7 @@ impl Statics {
             tendon_paths: PyTuple::new(state.py(), paths)?.into_any().unbind(),
             tendon_lengths: f.array("tendon_lengths")?,
             tendon_rest_lengths: f.array("tendon_rest_lengths")?,
+            body_positions: f.array("body_positions")?,
             iterations: f.get("iterations")?,
             load_stages: f.get("load_stages")?,
             residual_evaluations: f.get("residual_evaluations")?,

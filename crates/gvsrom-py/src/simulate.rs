@@ -105,7 +105,8 @@ impl Robot {
     ///     ``tip_rotation`` (k, 3, 3), ``strain`` (k, p, 6), ``strain_x`` (p,), ``centerline``
     ///     (k, c, 3), ``centerline_x`` (c,), ``tendon_paths`` (k, n_a, c, 3: each tendon's thread
     ///     at ``centerline_x`` clamped to its span), ``tendon_lengths`` (k, n_a: each tendon's
-    ///     length [m] along its thread; at rest :attr:`Robot.tendon_rest_lengths`), ``steps``,
+    ///     length [m] along its thread; at rest :attr:`Robot.tendon_rest_lengths`),
+    ///     ``body_positions`` (k, n_b, 2, 3: each rigid body's section and centre of mass), ``steps``,
     ///     ``failed_steps``, ``wall_time_s``, and
     ///     ``model_extrapolated`` (list of str): how the reduced model was used outside what it
     ///     was trained on (``extrapolate=True``; the scenario, a signal's tensions, the values a
@@ -403,6 +404,11 @@ fn trajectory<'py>(
     d.set_item(
         "tendon_lengths",
         shaped(py, b.tendon_lengths.clone(), [k, na])?,
+    )?;
+    let nb = built.model.bodies().len();
+    d.set_item(
+        "body_positions",
+        shaped(py, b.body_positions.clone(), [k, nb, 2, 3])?,
     )?;
     let s = &outcome.summary;
     d.set_item("steps", s.stats.steps)?;

@@ -40,6 +40,9 @@ use pyo3::types::PyDict;
 ///     its actuator reads, up to a constant.
 /// tendon_rest_lengths : numpy.ndarray, shape (n_actuators,)
 ///     The same at rest: ``tendon_rest_lengths - tendon_lengths`` is how far each is pulled in.
+/// body_positions : numpy.ndarray, shape (n_bodies, 2, 3)
+///     Each rigid body's section (``[:, 0]``) and centre of mass (``[:, 1]``) in the world frame
+///     [m] (``[[bodies]]``; empty without).
 /// iterations, load_stages, residual_evaluations, jacobian_evaluations : int
 ///     Solver statistics.
 /// residual_norm : float
@@ -92,6 +95,8 @@ pub struct Statics {
     pub(crate) tendon_lengths: Py<PyAny>,
     /// Each tendon's length [m] at rest.
     pub(crate) tendon_rest_lengths: Py<PyAny>,
+    /// Each rigid body's section and centre of mass [m], `(n_bodies, 2, 3)`.
+    pub(crate) body_positions: Py<PyAny>,
     /// Dogleg iterations over all load stages.
     pub(crate) iterations: usize,
     /// Load stages of the ramp.
@@ -156,6 +161,13 @@ impl Statics {
             .unbind(),
             tendon_lengths: held(vector(py, &r.tendon_lengths))?,
             tendon_rest_lengths: held(vector(py, &r.tendon_rest_lengths))?,
+            body_positions: held(shaped(
+                py,
+                (r.bodies.iter())
+                    .flat_map(|b| b.section.into_iter().chain(b.center))
+                    .collect(),
+                [r.bodies.len(), 2, 3],
+            )?)?,
             iterations: r.iterations,
             load_stages: r.load_stages,
             residual_evaluations: r.residual_evaluations,
@@ -191,6 +203,7 @@ impl Statics {
             ("tendon_paths", &self.tendon_paths),
             ("tendon_lengths", &self.tendon_lengths),
             ("tendon_rest_lengths", &self.tendon_rest_lengths),
+            ("body_positions", &self.body_positions),
         ] {
             d.set_item(k, v.bind(py))?;
         }

@@ -86,3 +86,15 @@ def test_a_robot_without_bodies_has_empty_body_arrays():
     robot = gvsrom.Scenario.preset("single-tendon").build()
     assert robot.body_points.shape == (0,) and robot.body_points.dtype == np.int64
     assert robot.body_inertia.shape == (0, 6, 6)
+
+
+def test_statics_and_simulate_return_where_the_payload_is(robot):
+    eq = robot.statics()
+    assert eq.body_positions.shape == (1, 2, 3)
+    section, centre = eq.body_positions[0]
+    np.testing.assert_allclose(section, eq.tip_position, rtol=0, atol=1e-15)
+    rotation = eq.tip_rotation
+    np.testing.assert_allclose(centre, section + rotation @ [0.01, 0.004, 0.0], rtol=0, atol=1e-15)
+    run = robot.simulate(duration=0.02)
+    assert run["body_positions"].shape == (len(run["t"]), 1, 2, 3)
+    np.testing.assert_allclose(run["body_positions"][:, 0, 0], run["tip_position"], rtol=0, atol=1e-15)

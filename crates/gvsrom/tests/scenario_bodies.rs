@@ -3,6 +3,9 @@
 //! of a cantilever carrying a tip mass, the point it adds, the summaries, and the errors of bad
 //! bodies naming the field.
 
+mod common;
+
+use common::{npy, run_json, run_ok, s as path_str, scratch};
 use gvsrom::statics::solve;
 use gvsrom::Scenario;
 use std::f64::consts::PI;
@@ -161,4 +164,68 @@ fn bad_bodies_are_refused_naming_the_field() {
         let e = built(&text, &[set]).err().unwrap_or_default();
         assert!(e.contains(expected), "{set}: {e}");
     }
+}
+
+/// The outputs say where the payload is: `statics --json`'s `bodies` (section and centre of mass,
+/// `center = section + R c` with the tip rotation), `simulate`'s `body_positions.npy` (samples ×
+/// bodies × 2 × 3, the section being the tip) with `n_bodies` and the bodies in `meta.json`'s
+/// physics, and `plot` draws both.
+#[test]
+fn outputs_record_where_the_payload_is_and_plot_draws_it() {
+    let file = scratch("payload.toml");
+    let text = format!("{ROD}{PAYLOAD}center = [0.02, 0.0, -0.01]\n");
+    std::fs::write(&file, text).unwrap();
+    let (_, doc) = run_json("statics", "payload-statics", &[path_str(&file)]);
+    let body = &doc["bodies"][0];
+    let v = |x: &serde_json::Value| -> Vec<f64> { common::f64s(x) };
+    let (section, center, tip) = (
+        v(&body["section"]),
+        v(&body["center"]),
+        v(&doc["tip_position"]),
+    );
+    let r: Vec<Vec<f64>> = doc["tip_rotation"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(v)
+        .collect();
+    for i in 0..3 {
+        assert!((section[i] - tip[i]).abs() < 1e-15);
+        let expected = section[i] + r[i][0] * 0.02 + r[i][2] * -0.01;
+        assert!(
+            (center[i] - expected).abs() < 1e-15,
+            "{center:?} vs section + R c"
+        );
+    }
+    assert_eq!(body["mass"].as_f64(), Some(0.01));
+    let figs = scratch("payload-statics-figures");
+    let json = scratch("payload-statics.json");
+    run_ok(&["statics", path_str(&file), "--json", path_str(&json)]);
+    run_ok(&["plot", path_str(&json), "--out", path_str(&figs)]);
+    assert!(figs.join("rod_side.png").is_file());
+
+    let out = scratch("payload-run");
+    run_ok(&[
+        "simulate",
+        path_str(&file),
+        "--duration",
+        "0.05",
+        "--out",
+        path_str(&out),
+    ]);
+    let (shape, bodies) = npy(&out.join("body_positions.npy"));
+    let (_, tips) = npy(&out.join("tip_position.npy"));
+    let samples = tips.len() / 3;
+    assert_eq!(shape, [samples, 1, 2, 3]);
+    for k in 0..samples {
+        for i in 0..3 {
+            assert!((bodies[6 * k + i] - tips[3 * k + i]).abs() < 1e-15);
+        }
+    }
+    let meta = common::json(&out.join("meta.json"));
+    assert_eq!(meta["n_bodies"], 1);
+    assert_eq!(meta["physics"]["bodies"][0]["mass"].as_f64(), Some(0.01));
+    let figs = scratch("payload-run-figures");
+    run_ok(&["plot", path_str(&out), "--out", path_str(&figs)]);
+    assert!(figs.join("rod_animation.gif").is_file());
 }

@@ -364,6 +364,7 @@ mod tests {
             centerline: None,
             tendon_paths: None,
             tendon_lengths: None,
+            body_positions: None,
             tensions: None,
             tendon_rest_lengths: vec![],
             provenance: None,

@@ -52,6 +52,10 @@ pub struct Trajectory {
     /// `samples × tendons`: each tendon's length \[m\] (`tendon_lengths.npy`; with tendons, in
     /// trajectories written since it was recorded), and the number of tendons.
     pub tendon_lengths: Option<(usize, Vec<f64>)>,
+    /// `samples × bodies × 2 × 3`: each rigid body's section and centre of mass \[m\]
+    /// (`body_positions.npy`; with bodies, in trajectories written since it was recorded), and
+    /// the number of bodies.
+    pub body_positions: Option<(usize, Vec<f64>)>,
     /// `samples × tendons`: each tendon's tension \[N\] at the samples (`u.npy`), and the number
     /// of tendons (`None` without tendons).
     pub tensions: Option<(usize, Vec<f64>)>,
@@ -162,6 +166,14 @@ impl Trajectory {
             }
             false => None,
         };
+        let file = crate::simulate::BODY_POSITIONS_FILE;
+        let body_positions = match files.lists(file) {
+            true => {
+                let nb = count("n_bodies")?;
+                Some((nb, read(file, &[n, nb, 2, 3])?))
+            }
+            false => None,
+        };
         let tensions = match (count("n_actuators"), files.lists("u.npy")) {
             (Ok(na), true) if na > 0 => Some((na, read("u.npy", &[n, na])?)),
             _ => None,
@@ -187,6 +199,7 @@ impl Trajectory {
             centerline,
             tendon_paths,
             tendon_lengths,
+            body_positions,
             tensions,
             tendon_rest_lengths: (meta["tendon_rest_lengths"].as_array().into_iter().flatten())
                 .filter_map(|v| v.as_f64())

@@ -28,11 +28,22 @@ pub struct StaticsDoc {
     /// and rods without tendons, have none).
     #[serde(default)]
     pub tendon_paths: Vec<Vec<[f64; 3]>>,
+    /// The rigid bodies (results without bodies, or written before they were recorded, have none).
+    #[serde(default)]
+    pub bodies: Vec<BodyDoc>,
     #[serde(default)]
     pub model: Option<String>,
     /// The file by the SHA-256 of the bytes read (what `plot` records of it).
     #[serde(skip)]
     pub origin: Option<crate::provenance::DirOrigin>,
+}
+
+/// A rigid body of a statics result: its mass, where its section is and its centre of mass.
+#[derive(Debug, Clone, Deserialize)]
+pub struct BodyDoc {
+    pub mass: f64,
+    pub section: [f64; 3],
+    pub center: [f64; 3],
 }
 
 impl StaticsDoc {
@@ -90,6 +101,7 @@ fn rod_series(doc: &StaticsDoc) -> Vec<Series3> {
             );
         }
     }
+    series.extend(body_series(&doc.bodies));
     series.push(
         Series3::new("base", vec![doc.centerline[0]], SeriesStyle::Markers)
             .with_color(palette::EXTRA[6]),
@@ -97,6 +109,28 @@ fn rod_series(doc: &StaticsDoc) -> Vec<Series3> {
     series.push(
         Series3::new("tip", vec![doc.tip_position], SeriesStyle::Markers).with_color(palette::POD),
     );
+    series
+}
+
+/// Each body as a marker at its centre of mass, joined to its section by a line where the two
+/// differ (an off-centre payload hangs from the rod by it).
+pub(crate) fn body_series(bodies: &[BodyDoc]) -> Vec<Series3> {
+    let color = palette::EXTRA[7];
+    let mut series = vec![];
+    for (k, b) in bodies.iter().enumerate() {
+        let name = format!("body {k} ({} kg)", gvs::error::fmt_value(b.mass));
+        if b.section != b.center {
+            series.push(
+                Series3::new(
+                    format!("{name}: offset"),
+                    vec![b.section, b.center],
+                    SeriesStyle::Line,
+                )
+                .with_color(color),
+            );
+        }
+        series.push(Series3::new(name, vec![b.center], SeriesStyle::Markers).with_color(color));
+    }
     series
 }
 

@@ -34,6 +34,9 @@ pub struct Centerlines {
     /// `samples`, each the tendons' threads at `x` clamped to their spans \[m\] (none in a
     /// trajectory written before they were recorded, or without tendons).
     pub tendons: Vec<Vec<Vec<[f64; 3]>>>,
+    /// `samples`, each the rigid bodies' sections and centres of mass \[m\] (none without
+    /// `[[bodies]]` or in a trajectory written before they were recorded).
+    pub bodies: Vec<Vec<[[f64; 3]; 2]>>,
 }
 
 /// The centrelines `Trajectory::load` read (and checked against their recorded hash): `None` for
@@ -66,10 +69,23 @@ pub fn centerlines(tr: &Trajectory) -> Result<Option<Centerlines>, FiguresError>
             .collect(),
         _ => vec![],
     };
+    let bodies = match &tr.body_positions {
+        Some((nb, v)) if *nb > 0 => v
+            .chunks_exact(6 * nb)
+            .map(|sample| {
+                sample
+                    .chunks_exact(6)
+                    .map(|b| [[b[0], b[1], b[2]], [b[3], b[4], b[5]]])
+                    .collect()
+            })
+            .collect(),
+        _ => vec![],
+    };
     Ok(Some(Centerlines {
         x: x.clone(),
         shapes,
         tendons,
+        bodies,
     }))
 }
 
@@ -312,6 +328,7 @@ fn run_bounds(tr: &Trajectory, c: &Centerlines) -> Vec<[f64; 3]> {
             .flatten()
             .copied()
             .chain((0..tr.samples()).map(|k| tip(tr, k)))
+            .chain(c.bodies.iter().flatten().map(|b| b[1]))
     };
     let ext = |i: usize| crate::plot::extent(all().map(|p| p[i])).unwrap_or((0.0, 0.0));
     let (x, y, z) = (ext(0), ext(1), ext(2));
@@ -327,7 +344,7 @@ fn rod_figures(
 ) -> Result<(), FiguresError> {
     let n = tr.samples();
     let shots = views::spread(n, SNAPSHOTS);
-    let series: Vec<Series3> = shots
+    let mut series: Vec<Series3> = shots
         .iter()
         .enumerate()
         .map(|(i, &k)| {
@@ -339,6 +356,11 @@ fn rod_figures(
             .with_color(palette::EXTRA[i % palette::EXTRA.len()])
         })
         .collect();
+    // each body at each instant, in the instant's colour
+    for (i, &k) in shots.iter().enumerate() {
+        let color = palette::EXTRA[i % palette::EXTRA.len()];
+        series.extend(body_marks(c.bodies.get(k), color));
+    }
     let fig = Figure::Line3(Line3 {
         title: format!("Rod shapes — {caption}"),
         labels: AXES.map(String::from),
@@ -365,6 +387,19 @@ fn rod_figures(
     sink.animation("rod_animation", &frames, (960, 440), delay_ms)
 }
 
+/// Unnamed series of one sample's bodies: each a marker at its centre of mass, joined to its
+/// section by a line where the two differ.
+fn body_marks(bodies: Option<&Vec<[[f64; 3]; 2]>>, color: crate::plot::Rgb) -> Vec<Series3> {
+    let mut out = vec![];
+    for &[section, center] in bodies.into_iter().flatten() {
+        if section != center {
+            out.push(Series3::new("", vec![section, center], SeriesStyle::Line).with_color(color));
+        }
+        out.push(Series3::new("", vec![center], SeriesStyle::Markers).with_color(color));
+    }
+    out
+}
+
 /// One frame: the rod at sample `k` (with its tendons, blue, when the trajectory records them) in
 /// 3-D and seen from the side (with the tip's path so far), on the axes of the whole run.
 fn animation_frame(tr: &Trajectory, c: &Centerlines, k: usize, bounds: &[[f64; 3]]) -> Figure {
@@ -382,6 +417,7 @@ fn animation_frame(tr: &Trajectory, c: &Centerlines, k: usize, bounds: &[[f64; 3
         series.push(Series3::new("", path.clone(), SeriesStyle::Line).with_color(palette::POD_ALT));
     }
     series.extend([rod, tip_now]);
+    series.extend(body_marks(c.bodies.get(k), palette::EXTRA[7]));
     let mut in_3d = series.clone();
     in_3d.push(box3);
     Figure::Grid {

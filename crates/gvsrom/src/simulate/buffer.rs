@@ -27,6 +27,9 @@ pub struct TrajectoryBuffer {
     pub tendon_paths: Vec<f64>,
     /// `samples × tendons`: each tendon's length \[m\] (`tendon_lengths.npy`).
     pub tendon_lengths: Vec<f64>,
+    /// `samples × bodies × 2 × 3`: each rigid body's section and centre of mass \[m\]
+    /// (`body_positions.npy`).
+    pub body_positions: Vec<f64>,
     shape: Centerline,
 }
 
@@ -44,6 +47,7 @@ impl TrajectoryBuffer {
             centerline: vec![],
             tendon_paths: vec![],
             tendon_lengths: vec![],
+            body_positions: vec![],
             shape: Centerline::new(built),
         }
     }
@@ -66,6 +70,7 @@ impl SampleSink for TrajectoryBuffer {
         self.centerline.extend_from_slice(&self.shape.points);
         self.tendon_paths.extend_from_slice(&self.shape.tendons);
         self.tendon_lengths.extend_from_slice(&self.shape.lengths);
+        self.body_positions.extend_from_slice(&self.shape.bodies);
         self.t.push(s.t);
         self.q.extend_from_slice(s.q);
         self.qd.extend_from_slice(s.qd);

@@ -18,6 +18,9 @@ pub(super) struct Centerline {
     pub(super) tendons: Vec<f64>,
     /// Each tendon's length \[m\] ([`gvs::model::Model::tendon_lengths`]) of the current sample.
     pub(super) lengths: Vec<f64>,
+    /// `bodies × 2 × 3`: each rigid body's section and centre of mass \[m\]
+    /// ([`gvs::model::Model::body_positions`]) of the current sample.
+    pub(super) bodies: Vec<f64>,
 }
 
 impl Centerline {
@@ -34,6 +37,7 @@ impl Centerline {
             points: vec![0.0; 3 * c],
             tendons: vec![0.0; 3 * c * built.model.n_actuators()],
             lengths: vec![0.0; built.model.n_actuators()],
+            bodies: vec![0.0; 6 * built.model.bodies().len()],
         }
     }
 
@@ -64,5 +68,9 @@ impl Centerline {
             }
         }
         model.tendon_lengths_after_forward(&self.ws, &mut self.lengths);
+        for (b, (section, center)) in model.body_positions(&self.ws).enumerate() {
+            self.bodies[6 * b..6 * b + 3].copy_from_slice(section.as_slice());
+            self.bodies[6 * b + 3..6 * b + 6].copy_from_slice(center.as_slice());
+        }
     }
 }

@@ -19,6 +19,7 @@
 //! | `centerline.npy` | (N, c, 3) | centreline positions \[m\] at the `c` abscissae `centerline_x` of `meta.json`, at equally spaced material abscissae X (the undeformed arc length) from base to tip (`output.centerline_points`, `--centerline-points`), in the world frame as `statics --json` |
 //! | `tendon_paths.npy` | (N, n_a, c, 3) | each tendon's thread `r + R d(X)` \[m\] at `centerline_x` clamped to its span (with tendons only) |
 //! | `tendon_lengths.npy` | (N, n_a) | each tendon's length \[m\] along its thread, `∫ ‖t_u‖ dX` (with tendons only; at rest: `meta.json`'s `tendon_rest_lengths`) |
+//! | `body_positions.npy` | (N, n_b, 2, 3) | each rigid body's section (`[:, :, 0]`) and centre of mass (`[:, :, 1]`) \[m\] (with `[[bodies]]` only; their count `n_bodies` in `meta.json`) |
 //! | `meta.json` | | manifest (`gvsrom`: format, version, files), scenario, `complete`, `reason`, `t_reached`, `t_requested`, `sample_rate`, sizes, integrator statistics, wall time, real-time factor, error, `input` ([`input_record`]), `physics` (material, geometry, base, tendon routing, loads), `centerline_x`, `tendon_rest_lengths`, `provenance` ([`crate::provenance`]) |
 //!
 //! The integrator is chosen here too ([`choose_integrator`]): by the rod's damping unless named,

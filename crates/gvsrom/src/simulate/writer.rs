@@ -23,25 +23,35 @@ pub const TENDON_PATHS_FILE: &str = "tendon_paths.npy";
 /// `meta.json`'s `tendon_rest_lengths`).
 pub const TENDON_LENGTHS_FILE: &str = "tendon_lengths.npy";
 
+/// The file of per-sample rigid-body positions in a trajectory: `[samples, bodies, 2, 3]`, each
+/// body's section and centre of mass \[m\] (written only with `[[bodies]]`).
+pub const BODY_POSITIONS_FILE: &str = "body_positions.npy";
+
 /// Largest trajectory one run writes \[bytes\] (16 GiB).
 pub const MAX_OUTPUT_BYTES: f64 = 16.0 * 1024.0 * 1024.0 * 1024.0;
 
 /// The scenario's physics as `meta.json` records it (`"physics"`), for `gvsrom compare`: the
 /// material, the divisions' geometry, the base pose, the tendons' routing and friction, and the
-/// loads (gravity, point and distributed wrenches). Not the tensions (the input), not the strain
+/// loads (gravity, point and distributed wrenches), and the rigid bodies where there are. Not the tensions (the input), not the strain
 /// basis nor the computational points (the discretization, which a reduced model replaces).
 pub(super) fn physics_record(built: &Built) -> serde_json::Value {
     let m = &built.model;
     let rot: Vec<[f64; 3]> = (0..3)
         .map(|i| [m.base.rot[(i, 0)], m.base.rot[(i, 1)], m.base.rot[(i, 2)]])
         .collect();
-    serde_json::json!({
+    let mut record = serde_json::json!({
         "material": m.rod.material,
         "divisions": m.rod.divisions,
         "base": {"position": [m.base.pos[0], m.base.pos[1], m.base.pos[2]], "rotation": rot},
         "tendons": m.tendons,
         "loads": built.loads,
-    })
+    });
+    // only with bodies, so that the record of a run without is that of a run before they existed
+    let bodies: Vec<_> = m.bodies().collect();
+    if !bodies.is_empty() {
+        record["bodies"] = serde_json::json!(bodies);
+    }
+    record
 }
 
 /// Runs the planned simulation, streaming each sample to `writer` (if any) and calling
@@ -158,6 +168,8 @@ pub struct TrajectoryWriter {
     centerline: NpyRows,
     /// `tendon_paths.npy` and `tendon_lengths.npy`, with tendons only.
     tendon_paths: Option<(NpyRows, NpyRows)>,
+    /// `body_positions.npy`, with bodies only.
+    body_positions: Option<NpyRows>,
     shape: Centerline,
     provenance: Option<serde_json::Value>,
 }
@@ -197,6 +209,14 @@ impl TrajectoryWriter {
                 tendons(&mut dir).map_err(|e| dir.io_error("create the trajectory files", e))?,
             ),
         };
+        let nb = m.bodies().len();
+        let body_positions = match nb {
+            0 => None,
+            _ => Some(
+                NpyRows::new(&mut dir, BODY_POSITIONS_FILE, &[nb, 2, 3])
+                    .map_err(|e| dir.io_error("create the trajectory files", e))?,
+            ),
+        };
         Ok(TrajectoryWriter {
             dir,
             t,
@@ -208,6 +228,7 @@ impl TrajectoryWriter {
             strain,
             centerline,
             tendon_paths,
+            body_positions,
             shape,
             provenance: None,
         })
@@ -235,6 +256,9 @@ impl TrajectoryWriter {
         if let Some((paths, lengths)) = &mut self.tendon_paths {
             paths.push(self.shape.tendons.iter().copied())?;
             lengths.push(self.shape.lengths.iter().copied())?;
+        }
+        if let Some(bodies) = &mut self.body_positions {
+            bodies.push(self.shape.bodies.iter().copied())?;
         }
         self.t.push([s.t])?;
         self.q.push(s.q.iter().copied())?;
@@ -274,6 +298,7 @@ impl TrajectoryWriter {
             strain,
             centerline,
             tendon_paths,
+            body_positions,
             shape,
             provenance,
         } = self;
@@ -281,7 +306,7 @@ impl TrajectoryWriter {
         let arrays = [t, q, qd, u, tip_position, tip_rotation, strain, centerline];
         (|| -> std::io::Result<()> {
             let tendons = tendon_paths.into_iter().flat_map(|(p, l)| [p, l]);
-            for a in arrays.into_iter().chain(tendons) {
+            for a in arrays.into_iter().chain(tendons).chain(body_positions) {
                 a.finish(&mut dir)?;
             }
             crate::npy::write_array(
@@ -328,6 +353,7 @@ impl TrajectoryWriter {
             n_dof: built.n_dof(),
             n_points: built.model.disc.n_points(),
             n_actuators: built.model.n_actuators(),
+            n_bodies: built.model.bodies().len(),
             length: built.model.rod.length(),
             wall_time_s: sm.wall_time_s,
             wall_times_s: match outcome.wall_times_s.len() {
@@ -378,6 +404,9 @@ pub(super) struct Meta<'a> {
     n_dof: usize,
     n_points: usize,
     n_actuators: usize,
+    /// Rigid bodies (`body_positions.npy` holds their positions); left out without bodies.
+    #[serde(skip_serializing_if = "is_zero")]
+    n_bodies: usize,
     /// Rod length [m].
     length: f64,
     /// Wall time of the integration \[s\]: with `--repeat`, the smallest of `wall_times_s`.
@@ -415,4 +444,8 @@ pub(super) struct Meta<'a> {
     /// How the run was made ([`crate::provenance::Provenance`]), when the caller recorded it.
     #[serde(skip_serializing_if = "Option::is_none")]
     provenance: Option<serde_json::Value>,
+}
+
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }

@@ -57,6 +57,10 @@ pub struct StaticsReport {
     /// actuator has pulled it in.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub tendon_rest_lengths: Vec<f64>,
+    /// Per rigid body (`[[bodies]]`), the world positions of the section it is fixed to and of
+    /// its centre of mass \[m\]; empty without bodies.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub bodies: Vec<BodyPosition>,
     /// Dogleg iterations over all load stages.
     pub iterations: usize,
     pub load_stages: usize,
@@ -369,6 +373,14 @@ fn report<P: StrainParam>(
         tendon_paths,
         tendon_lengths,
         tendon_rest_lengths: model.tendon_rest_lengths(),
+        bodies: (model.bodies().zip(model.body_positions(ws)))
+            .map(|(b, (section, center))| BodyPosition {
+                x: b.x,
+                mass: b.mass,
+                section: arr3(&section),
+                center: arr3(&center),
+            })
+            .collect(),
         iterations: sol.iterations,
         load_stages: sol.load_stages,
         residual_evaluations: sol.residual_evaluations,
@@ -408,6 +420,19 @@ fn tendon_paths<P: StrainParam>(
                 .collect()
         })
         .collect()
+}
+
+/// Where a rigid body is at an equilibrium ([`StaticsReport::bodies`]).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct BodyPosition {
+    /// The arc length of its section \[m\].
+    pub x: f64,
+    /// Its mass \[kg\].
+    pub mass: f64,
+    /// The world position of that section \[m\].
+    pub section: [f64; 3],
+    /// The world position of its centre of mass \[m\].
+    pub center: [f64; 3],
 }
 
 /// The `--json` document: the report, the reduced model used and the comparison with the full model.
