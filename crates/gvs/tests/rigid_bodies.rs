@@ -479,3 +479,73 @@ fn body_off_the_points_is_refused_by_name() {
         "{e}"
     );
 }
+
+/// A light column (E = 10 MPa, ρ = 1 kg/m³: 0.04 g) standing on its base and carrying a 10 g tip
+/// body at twice Euler's load `π²EI/4L²`: the straight equilibrium diverges, and the statics must
+/// say so and leave it for the buckled one, whose turn about the vertical is neutral (not
+/// divergent). The divergent `ω²` (−12.3 1/s², the payload's) is 2e-11 of the light rod's
+/// stiffest mode (6e11 1/s²); a threshold of 1e-10 of it missed it, and the solver reported the
+/// straight column as stable (a review, 2026-12-07).
+#[test]
+fn a_column_buckled_by_its_heavy_payload_is_found_unstable() {
+    let mat = Material {
+        youngs_modulus: 1e7,
+        poisson_ratio: 0.5,
+        density: 1.0,
+        damping: 1e4,
+    };
+    let rod = Rod::tapered(mat, 0.5, 0.005, 0.005);
+    let disc =
+        Discretization::new(&rod, &[Quadrature::Gauss { n: 21 }], MagnusOrder::Z4, &[]).unwrap();
+    let b = LinearBasis::per_division(
+        &disc,
+        &[DivisionBasis::Legendre {
+            modes: [false, true, true, true, true, true],
+            orders: [6; 6],
+        }],
+    )
+    .unwrap();
+    // local x along world +z
+    let up = nalgebra::Rotation3::from_axis_angle(&Vector3::y_axis(), -PI / 2.0).into_inner();
+    let s = SectionProps::circular(&mat, 0.005);
+    let euler = PI * PI * s.es[1] / (4.0 * 0.25);
+    let mass = 2.0 * euler / 9.81;
+    let m = Model::new(rod, disc, b, vec![])
+        .unwrap()
+        .with_base(gvs::lie::Pose::new(up, Vector3::zeros()))
+        .with_bodies(vec![RigidBody::point_mass(0.5, mass)])
+        .unwrap();
+    let loads = Loads {
+        gravity: [0.0, 0.0, -9.81],
+        ..Loads::default()
+    };
+    let prepared = m.prepare_loads(&loads).unwrap();
+    let mut ws = m.workspace();
+    let straight = DVector::zeros(m.n_dof());
+    // the straight column is an equilibrium (axial load only) that diverges
+    let w2 = gvs::solve::stability::divergence_at(&m, &straight, &[], &prepared, &mut ws);
+    let modes = m
+        .linearized_modes(&straight, &[], &prepared, &mut ws)
+        .unwrap();
+    let least = modes[0].omega_squared;
+    assert!(
+        least < 0.0 && least > -1e3,
+        "the payload's divergent ω² = {least}"
+    );
+    let w2 = w2.expect("the straight column diverges");
+    // (two eigensolvers: the general one of the check, the symmetric one of the modes)
+    assert!(
+        ((w2 - least) / least).abs() < 1e-5,
+        "divergence {w2} vs mode {least}"
+    );
+    let sol = solve_statics(&m, &[], &loads, None, &StaticsOptions::default()).unwrap();
+    assert!(
+        sol.buckled.is_some() && sol.divergence.is_none(),
+        "buckled {:?}, divergence {:?}",
+        sol.buckled,
+        sol.divergence
+    );
+    m.forward(&sol.q, &mut ws, false);
+    let tip = m.tip_pose(&ws).pos;
+    assert!(tip[0].hypot(tip[1]) > 0.2, "the column buckled: tip {tip}");
+}

@@ -12,14 +12,20 @@
 //!    eigenvalue of `M⁻¹ K_T` has a negative real part (`xᴴ K_T x = ω² xᴴ M x` with
 //!    `Re xᴴ K_T x > 0`): stable. This decides every conservative load (symmetric `K_T`) and almost
 //!    every other equilibrium.
-//! 2. Otherwise (friction and follower loads make `K_T` non-symmetric, and its symmetric part may be
+//! 2. For a symmetric `K_T` (conservative loads: gravity, bodies, world-fixed forces) the
+//!    eigenvalues of `L⁻¹ K_T L⁻ᵀ` are those of a symmetric matrix, exact to round-off
+//!    (`~n ε max |ω²|`): divergent if one is below `−SYMMETRIC_TOLERANCE · max |ω²|` (1e-13). The
+//!    looser threshold of step 3 missed a heavy payload on a light rod, whose divergent `ω²`
+//!    (−12.3 1/s²) is 2e-11 of the rod's stiffest mode (6e11 1/s²); a neutral direction (a buckled
+//!    column turning about the vertical, −5e-6 1/s² there) stays at round-off, 1e-17 of it.
+//! 3. Otherwise (friction and follower loads make `K_T` non-symmetric, and its symmetric part may be
 //!    indefinite at a stable equilibrium) the eigenvalues of `L⁻¹ K_T L⁻ᵀ`, `M = L Lᵀ` (similar to
 //!    `M⁻¹ K_T`): divergent if one is real and below `−DIVERGENCE_TOLERANCE · max |ω²|`. Complex
 //!    pairs (flutter of the undamped linearization, e.g. Beck's column) are not divergence; their
 //!    static equilibrium is the one a damped rod settles on or oscillates about.
 
 use crate::dynamics::cholesky::cholesky_factor_in_place;
-use crate::dynamics::mass_similar;
+use crate::dynamics::{mass_similar, SYMMETRY_TOLERANCE};
 use crate::model::{Model, PreparedLoads, Workspace};
 use crate::strain::StrainParam;
 use nalgebra::DMatrix;
@@ -28,6 +34,10 @@ use nalgebra::DMatrix;
 /// mode's) below which it counts as divergence; above it, round-off of the eigensolver
 /// (`~ε max |ω²|`) and neutral directions.
 pub const DIVERGENCE_TOLERANCE: f64 = 1e-10;
+
+/// [`DIVERGENCE_TOLERANCE`] of a symmetric `K_T`, whose eigenvalues are exact to round-off
+/// (the module documentation, step 2).
+pub const SYMMETRIC_TOLERANCE: f64 = 1e-13;
 
 /// Largest imaginary part, relative to the largest `|ω²|`, of an eigenvalue taken as real (a double
 /// real eigenvalue splits by `~√ε` into a complex pair).
@@ -56,10 +66,26 @@ pub fn divergence<P: StrainParam>(
     if !(scale.is_finite() && scale > 0.0) {
         return None;
     }
+    let threshold = divergence_threshold(jac, scale);
     eig.iter()
-        .filter(|z| z.im.abs() <= REAL_TOLERANCE * scale && z.re < -DIVERGENCE_TOLERANCE * scale)
+        .filter(|z| z.im.abs() <= REAL_TOLERANCE * scale && z.re < threshold)
         .map(|z| z.re)
         .min_by(f64::total_cmp)
+}
+
+/// Below which a real eigenvalue `ω²` of `M⁻¹ K_T` counts as divergence, after step 1 failed
+/// (the module documentation): `−SYMMETRIC_TOLERANCE · scale` for a symmetric `K_T` (step 2),
+/// `−DIVERGENCE_TOLERANCE · scale` otherwise (step 3; `scale` the largest `|ω²|`).
+fn divergence_threshold(jac: &DMatrix<f64>, scale: f64) -> f64 {
+    match is_symmetric(jac) {
+        true => -SYMMETRIC_TOLERANCE * scale,
+        false => -DIVERGENCE_TOLERANCE * scale,
+    }
+}
+
+/// `‖J − Jᵀ‖ ≤ SYMMETRY_TOLERANCE ‖J‖` (Frobenius), as [`Model::linearized_modes`] decides.
+fn is_symmetric(jac: &DMatrix<f64>) -> bool {
+    (jac - jac.transpose()).norm() <= SYMMETRY_TOLERANCE * jac.norm()
 }
 
 /// The divergent mode at the equilibrium `q` (tensions `u`, `loads`): the most negative real
@@ -78,10 +104,16 @@ pub fn divergent_mode<P: StrainParam>(
     let scale = (modes.iter())
         .map(|m| m.omega_squared.hypot(m.omega_squared_imag))
         .fold(0.0, f64::max);
+    let n = model.n_dof();
+    let mut jac = DMatrix::zeros(n, n);
+    model.statics_jacobian(q, u, loads, ws, &mut jac);
+    let threshold = match surely_stable(&jac) {
+        true => return None,
+        false => divergence_threshold(&jac, scale),
+    };
     let mode = (modes.iter())
         .filter(|m| {
-            m.omega_squared_imag.abs() <= REAL_TOLERANCE * scale
-                && m.omega_squared < -DIVERGENCE_TOLERANCE * scale
+            m.omega_squared_imag.abs() <= REAL_TOLERANCE * scale && m.omega_squared < threshold
         })
         .min_by(|a, b| a.omega_squared.total_cmp(&b.omega_squared))?;
     let size = mode.shape.amax();
