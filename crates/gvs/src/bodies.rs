@@ -14,10 +14,15 @@
 //! A body needs a computational point at its `x` (the front-ends add it to the discretization's
 //! extra points, as for point loads).
 
-use crate::error::{check_range, fmt_value, ModelError};
+use crate::error::{check_range, fmt_sci, fmt_value, ModelError};
 use crate::lie::{tilde, M3, M6, V3, V6};
 use nalgebra::SymmetricEigen;
 use serde::{Deserialize, Serialize};
+
+/// How far from its section a body's centre of mass, and its radius of gyration, may reach, in rod
+/// lengths: a gripper or a held tool reaches a few; a thousand is a typo (`1e300`), refused
+/// rather than left to a solver that cannot balance it.
+pub const MAX_BODY_REACH: f64 = 1e3;
 
 /// A rigid body fixed to the section at arc length `x` (SI units; frames of gvs-spec §1).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -80,13 +85,17 @@ impl RigidBody {
             None,
             "a finite number >= 0 kg",
         )?;
+        let reach = MAX_BODY_REACH * length;
         for (a, &c) in self.center.iter().enumerate() {
             check_range(
                 &f(&format!("center[{a}]")),
                 c,
-                None,
-                None,
-                "a finite offset in m",
+                Some((-reach, true)),
+                Some((reach, true)),
+                &format!(
+                    "an offset in m within {MAX_BODY_REACH} rod lengths of the section, |c| <= {}",
+                    fmt_value(reach)
+                ),
             )?;
         }
         for a in 0..3 {
@@ -117,14 +126,29 @@ impl RigidBody {
         let mut p = SymmetricEigen::new(i).eigenvalues;
         p.as_mut_slice().sort_by(f64::total_cmp);
         let tol = 1e-12 * scale;
+        let moments = || {
+            let m: Vec<String> = p.iter().map(|v| fmt_sci(*v, 4)).collect();
+            m.join(", ")
+        };
         if p[0] < -tol || p[2] > p[0] + p[1] + tol {
             return Err(ModelError::invalid(
                 f("inertia"),
                 format!(
-                    "principal moments {}, {}, {} kg*m^2 are not a solid's (each must be >= 0 and at most the sum of the other two)",
-                    fmt_value(p[0]),
-                    fmt_value(p[1]),
-                    fmt_value(p[2])
+                    "principal moments {} kg*m^2 are not a solid's (each must be >= 0 and at most the sum of the other two)",
+                    moments()
+                ),
+            ));
+        }
+        // I = ∫ r² dm: at most m (reach)² (a massless body is let through with any finite inertia:
+        // a sweep of the payload's mass from 0 keeps its tensor)
+        if self.mass > 0.0 && p[2] > self.mass * reach * reach * (1.0 + 1e-12) {
+            return Err(ModelError::invalid(
+                f("inertia"),
+                format!(
+                    "principal moments {} kg*m^2 for a mass of {} kg: a radius of gyration beyond {MAX_BODY_REACH} rod lengths (accepted: each <= mass * ({} m)^2)",
+                    moments(),
+                    fmt_value(self.mass),
+                    fmt_value(reach),
                 ),
             ));
         }
@@ -279,5 +303,29 @@ mod tests {
             .to_string()
             .contains("bodies[0].x"));
         assert!(body().validate(0, 1.0).is_ok());
+        // a typo's reach: a centre 1e300 m away, an inertia of 1e300 kg m²
+        let mut b = body();
+        b.center[2] = 1e300;
+        let e = b.validate(0, 1.0).unwrap_err().to_string();
+        assert!(
+            e.contains("bodies[0].center[2]") && e.contains("within 1000 rod lengths"),
+            "{e}"
+        );
+        let mut b = body();
+        b.inertia = [[1e300, 0.0, 0.0], [0.0, 1e300, 0.0], [0.0, 0.0, 1e300]];
+        let e = b.validate(0, 1.0).unwrap_err().to_string();
+        assert!(
+            e.contains("radius of gyration beyond 1000 rod lengths"),
+            "{e}"
+        );
+        // a sweep of the mass from 0 keeps its tensor
+        let mut b = body();
+        b.mass = 0.0;
+        assert!(b.validate(0, 1.0).is_ok());
+        // a long tool held at its end: centre 10 rod lengths out, gyration radius of that order
+        let mut b = body();
+        b.center = [10.0, 0.0, 0.0];
+        b.inertia = [[1e-4, 0.0, 0.0], [0.0, 2.0, 0.0], [0.0, 0.0, 2.0]];
+        assert!(b.validate(0, 1.0).is_ok());
     }
 }

@@ -22,7 +22,7 @@ const ROD: &str = r#"
     length = 0.5
     radius = 0.005
     basis = { kind = "legendre", modes = ["bend_y", "elongation", "shear_z"], order = 6 }
-    quadrature = { gauss = 16 }
+    quadrature = { gauss = 21 }
 "#;
 
 const PAYLOAD: &str = r#"
@@ -228,4 +228,51 @@ fn outputs_record_where_the_payload_is_and_plot_draws_it() {
     let figs = scratch("payload-run-figures");
     run_ok(&["plot", path_str(&out), "--out", path_str(&figs)]);
     assert!(figs.join("rod_animation.gif").is_file());
+}
+
+/// A reduced model over payloads: a dataset drawing the body's mass, its POD, used at a mass inside
+/// the range; a scenario whose body moved names the body behind the point the model lacks.
+#[test]
+fn a_model_over_payload_masses_names_a_moved_body() {
+    let file = scratch("payload-rom.toml");
+    std::fs::write(&file, format!("{ROD}{PAYLOAD}")).unwrap();
+    let (data, model) = (scratch("payload-rom-data"), scratch("payload-rom-model"));
+    let f = path_str(&file);
+    run_ok(&[
+        "dataset",
+        f,
+        "--random",
+        "bodies.0.mass=0:0.02",
+        "--samples",
+        "20",
+        "--out",
+        path_str(&data),
+    ]);
+    run_ok(&[
+        "pod",
+        path_str(&data),
+        "--modes",
+        "3",
+        "--out",
+        path_str(&model),
+    ]);
+    run_ok(&[
+        "statics",
+        f,
+        "--model",
+        path_str(&model),
+        "--set",
+        "bodies.0.mass=0.015",
+    ]);
+    common::expect_error(
+        &[
+            "statics",
+            f,
+            "--model",
+            path_str(&model),
+            "--set",
+            "bodies.0.x=0.3",
+        ],
+        &["this scenario has a point at X = 0.3 m (bodies[0].x) that the model's lacks"],
+    );
 }

@@ -88,11 +88,12 @@ pub fn describe(s: &Scenario, built: &Built) -> String {
     if !bodies.is_empty() {
         let mass: f64 = bodies.iter().map(|b| b.mass).sum();
         parts.push(format!(
-            "{} ({mass} kg)",
+            "{} ({} kg)",
             match bodies.len() {
                 1 => "1 rigid body".to_string(),
                 n => format!("{n} rigid bodies"),
-            }
+            },
+            significant(mass)
         ));
     }
     let mut kinds: Vec<&str> = vec![];
@@ -124,14 +125,14 @@ pub fn wrench_frames(built: &Built) -> (Vec<Frame>, Vec<Frame>) {
 /// it; `inertia …` left out for a point mass). Empty without bodies.
 pub fn body_lines(built: &Built) -> Vec<String> {
     let list = |v: &[f64]| {
-        let parts: Vec<String> = v.iter().map(|x| fmt_value(*x)).collect();
+        let parts: Vec<String> = v.iter().map(|x| significant(*x)).collect();
         format!("[{}]", parts.join(", "))
     };
     built
         .model
         .bodies()
         .map(|b| {
-            let mut line = format!("{} kg at X = {} m", fmt_value(b.mass), b.x);
+            let mut line = format!("{} kg at X = {} m", significant(b.mass), significant(b.x));
             if b.center != [0.0; 3] {
                 line += &format!(", centre of mass {} m", list(&b.center));
             }
@@ -150,6 +151,13 @@ pub fn body_lines(built: &Built) -> Vec<String> {
             line
         })
         .collect()
+}
+
+/// `v` to 6 significant digits, trailing zeros dropped, in exponent form where [`fmt_value`] uses
+/// it: `0.0600457`, `2e-6`, `1.5e-6` (a drawn mass, `0.0600457311465939`, is not printed whole).
+fn significant(v: f64) -> String {
+    let rounded = format!("{v:.5e}").parse::<f64>().unwrap_or(v);
+    fmt_value(rounded)
 }
 
 /// `n` wrenches of kind `what` and how their components turn: `1 point wrench (follower)`,

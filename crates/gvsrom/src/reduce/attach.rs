@@ -48,15 +48,67 @@ pub(super) fn check_layout(
                 l.strain_x.len(),
                 names.join(", "),
                 built.model.n_dof(),
-                if ml.strain_x.len() == l.strain_x.len() && !same_points {
-                    " (the points are at other abscissae)"
-                } else {
-                    ""
+                match point_difference(built, &ml.strain_x, &l.strain_x) {
+                    Some(why) => format!(" ({why})"),
+                    None if ml.strain_x.len() == l.strain_x.len() && !same_points => {
+                        " (the points are at other abscissae)".to_string()
+                    }
+                    None => String::new(),
                 }
             ),
         ));
     }
     Ok(())
+}
+
+/// Which points one layout has and the other lacks, with the scenario value that put each of
+/// this scenario's there (a point load's or a body's `x`): `this scenario has a point at X =
+/// 0.3 m (bodies[1].x) that the model's lacks`. `None` when the two differ otherwise.
+fn point_difference(built: &Built, model_x: &[f64], x: &[f64]) -> Option<String> {
+    let scale = model_x.iter().chain(x).fold(1.0f64, |m, v| m.max(v.abs()));
+    let missing_in = |a: &[f64], b: &[f64]| -> Vec<f64> {
+        (a.iter().copied())
+            .filter(|v| !b.iter().any(|w| (v - w).abs() <= 1e-12 * scale))
+            .collect()
+    };
+    let sources = |v: f64| -> Vec<String> {
+        let near = |w: f64| (v - w).abs() <= 1e-12 * scale;
+        let loads = (built.loads.point.iter().enumerate())
+            .filter(|(_, p)| near(p.x))
+            .map(|(k, _)| format!("loads.point[{k}].x"));
+        let bodies = (built.model.bodies().enumerate())
+            .filter(|(_, b)| near(b.x))
+            .map(|(k, _)| format!("bodies[{k}].x"));
+        loads.chain(bodies).collect()
+    };
+    let list = |xs: &[f64], named: bool| -> String {
+        let items: Vec<String> = (xs.iter())
+            .map(|&v| match (named, sources(v)) {
+                (true, s) if !s.is_empty() => format!("{v} m ({})", s.join(", ")),
+                _ => format!("{v} m"),
+            })
+            .collect();
+        format!(
+            "{} at X = {}",
+            if xs.len() == 1 { "a point" } else { "points" },
+            items.join(", ")
+        )
+    };
+    let (extra, lacking) = (missing_in(x, model_x), missing_in(model_x, x));
+    let mut parts = vec![];
+    if !extra.is_empty() {
+        parts.push(format!(
+            "this scenario has {} that the model's lacks",
+            list(&extra, true)
+        ));
+    }
+    if !lacking.is_empty() {
+        parts.push(format!(
+            "the model's has {} that this scenario lacks (a point load or body moved or removed?)",
+            list(&lacking, false)
+        ));
+    }
+    (!parts.is_empty()).then(|| parts.join("; "))
 }
 
 /// The reduced parameterization of `model` on the sites of `built`.
