@@ -122,7 +122,7 @@ pub(crate) fn body_series(bodies: &[BodyDoc]) -> Vec<Series3> {
         if b.section != b.center {
             series.push(
                 Series3::new(
-                    format!("{name}: offset"),
+                    format!("{name}: section to centre of mass"),
                     vec![b.section, b.center],
                     SeriesStyle::Line,
                 )
