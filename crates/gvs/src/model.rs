@@ -226,6 +226,11 @@ impl<P: StrainParam> Model<P> {
         })
     }
 
+    /// The computational point of each rigid body, in the order of [`Model::bodies`].
+    pub fn body_points(&self) -> impl ExactSizeIterator<Item = usize> + '_ {
+        self.bodies.iter().map(|b| b.point)
+    }
+
     /// The rigid bodies fixed to the rod ([`Model::with_bodies`]).
     pub fn bodies(&self) -> impl ExactSizeIterator<Item = &RigidBody> {
         self.bodies.iter().map(|b| &b.body)

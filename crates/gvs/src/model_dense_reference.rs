@@ -1,7 +1,8 @@
 //! The dense reference of the statics Jacobian, kept for tests: the assembly as it was before the
 //! support-aware path ([`Model::statics_jacobian_after_forward`]): every per-point product sweeps
 //! all `n` columns (`J_i`, `∂y/∂q` and `Ū` stored 6 × n, `Ψ_qᵀ (…)` added by `gemm_tr` into whole
-//! rows of the Jacobian), whatever the support of the basis.
+//! rows of the Jacobian), whatever the support of the basis. Without the rigid bodies' offset term
+//! (`add_body_weight_offsets`): it is the reference of models without off-centre bodies.
 
 use super::*;
 use crate::lie::ad;

@@ -7,6 +7,7 @@
 //! form) allocate nothing either.
 
 use gvs::actuation::{Tendon, DEFAULT_FRICTION_SMOOTHING};
+use gvs::bodies::RigidBody;
 use gvs::discretize::{Discretization, MagnusOrder, Quadrature};
 use gvs::loads::Loads;
 use gvs::model::Model;
@@ -51,7 +52,7 @@ fn arm(basis: DivisionBasis) -> Model<LinearBasis> {
             gauss_per_element: 3,
         }],
         MagnusOrder::Z4,
-        &[],
+        &[0.13],
     )
     .unwrap();
     let b = LinearBasis::per_division(&disc, &[basis]).unwrap();
@@ -74,7 +75,22 @@ fn arm(basis: DivisionBasis) -> Model<LinearBasis> {
         path: knots,
         ..t.clone()
     };
-    Model::new(rod, disc, b, vec![t, on_path]).unwrap()
+    // an off-centre payload at the tip and a disc at an extra point: their inertia, inertial
+    // wrenches and weights (with the offset's Jacobian term) join every pass
+    let payload = RigidBody {
+        x: 0.25,
+        mass: 0.02,
+        center: [0.01, 0.003, -0.002],
+        inertia: [[2e-6, 1e-7, 0.0], [1e-7, 1.5e-6, 0.0], [0.0, 0.0, 1.2e-6]],
+    };
+    let disc_body = RigidBody {
+        center: [0.0, 0.0, 0.001],
+        ..RigidBody::point_mass(0.13, 0.004)
+    };
+    Model::new(rod, disc, b, vec![t, on_path])
+        .unwrap()
+        .with_bodies(vec![payload, disc_body])
+        .unwrap()
 }
 
 fn allocations() -> usize {

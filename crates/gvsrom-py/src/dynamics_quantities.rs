@@ -232,8 +232,9 @@ impl Robot {
         arrays::matrix(py, &c)
     }
 
-    /// The external generalized force ``F(q) = Σ J_iᵀ w_i`` of gravity and the scenario's point
-    /// and distributed loads (gvs-spec §7.5), shape (n_dof,) [J per unit of q].
+    /// The external generalized force ``F(q) = Σ J_iᵀ w_i`` of gravity, the rigid bodies' weights
+    /// and the scenario's point and distributed loads (gvs-spec §7.5), shape (n_dof,) [J per unit
+    /// of q].
     fn external_force<'py>(&self, py: Python<'py>, q: In1<'_>) -> PyResult<Bound<'py, PyAny>> {
         let (q, _) = state(self, &q, None)?;
         let f = py
@@ -286,7 +287,8 @@ impl Robot {
     }
 
     /// Energies at ``(q, q̇)`` [J]: kinetic ``½ q̇ᵀ M q̇``, elastic ``½ Σ W Ψᵀ Es Ψ`` (whose
-    /// gradient is :meth:`elastic_force`), gravitational ``−Σ W ρA g·r``, and their total.
+    /// gradient is :meth:`elastic_force`), gravitational ``−Σ W ρA g·r`` (and ``−m g·(r + R c)``
+    /// of each rigid body), and their total.
     ///
     /// Parameters
     /// ----------

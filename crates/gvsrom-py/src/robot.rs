@@ -333,11 +333,7 @@ impl Robot {
     /// ``point_x[body_points[k]]`` is body k's ``x``.
     #[getter]
     fn body_points<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        let m = &self.built.model;
-        let points: Vec<i64> = m
-            .bodies()
-            .map(|b| m.disc.point_at(b.x).map_or(-1, |i| i as i64))
-            .collect();
+        let points: Vec<i64> = self.built.model.body_points().map(|i| i as i64).collect();
         numpy::PyArray::from_vec(py, points).into_any()
     }
 

@@ -235,7 +235,9 @@ fn outputs_record_where_the_payload_is_and_plot_draws_it() {
 #[test]
 fn a_model_over_payload_masses_names_a_moved_body() {
     let file = scratch("payload-rom.toml");
-    std::fs::write(&file, format!("{ROD}{PAYLOAD}")).unwrap();
+    // stiffer than ROD, so that the payload moves the tip by centimetres
+    let stiff = ROD.replace("youngs_modulus = 1e6", "youngs_modulus = 1e8");
+    std::fs::write(&file, format!("{stiff}{PAYLOAD}")).unwrap();
     let (data, model) = (scratch("payload-rom-data"), scratch("payload-rom-model"));
     let f = path_str(&file);
     run_ok(&[
@@ -256,14 +258,25 @@ fn a_model_over_payload_masses_names_a_moved_body() {
         "--out",
         path_str(&model),
     ]);
-    run_ok(&[
-        "statics",
-        f,
-        "--model",
-        path_str(&model),
-        "--set",
-        "bodies.0.mass=0.015",
-    ]);
+    // the reduced model carries the body: its tip is the full model's, not the bare rod's
+    let tip = |name: &str, extra: &[&str]| -> Vec<f64> {
+        let mut args = vec![f, "--set", "bodies.0.mass=0.015"];
+        args.extend_from_slice(extra);
+        common::f64s(&run_json("statics", name, &args).1["tip_position"])
+    };
+    let full = tip("payload-rom-full", &[]);
+    let reduced = tip("payload-rom-reduced", &["--model", path_str(&model)]);
+    let bare = tip("payload-rom-bare", &["--set", "bodies.0.mass=0"]);
+    let dist = |a: &[f64], b: &[f64]| (0..3).map(|i| (a[i] - b[i]).powi(2)).sum::<f64>().sqrt();
+    assert!(
+        dist(&full, &bare) > 0.02,
+        "the payload moves the tip: {full:?} vs {bare:?}"
+    );
+    // within 0.1 % of L = 0.5 m
+    assert!(
+        dist(&reduced, &full) < 5e-4,
+        "reduced {reduced:?} vs full {full:?}"
+    );
     common::expect_error(
         &[
             "statics",

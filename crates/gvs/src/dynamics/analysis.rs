@@ -52,6 +52,25 @@ pub(crate) fn mass_similar(k: &DMatrix<f64>, l: &DMatrix<f64>) -> faer::Mat<f64>
     at.transpose().to_owned()
 }
 
+/// The modes of `M⁻¹ K` from `a = L⁻¹ K L⁻ᵀ` ([`mass_similar`]; `l` the factor of `M`): those of
+/// the symmetric problem when `K` is symmetric (asymmetry ≤ [`SYMMETRY_TOLERANCE`]), of the
+/// non-symmetric one otherwise ([`Model::linearized_modes`]); unstable directions (`ω² < 0`) first,
+/// then by frequency.
+pub(crate) fn similar_modes(
+    k: &DMatrix<f64>,
+    a: &faer::Mat<f64>,
+    l: &DMatrix<f64>,
+) -> Result<Vec<Mode>, DynamicsError> {
+    let asymmetry = (k - k.transpose()).norm() / k.norm();
+    let mut modes = if asymmetry > SYMMETRY_TOLERANCE {
+        non_symmetric_modes(a, l)?
+    } else {
+        symmetric_modes(a, l)?
+    };
+    modes.sort_by(|a, b| a.omega_squared.total_cmp(&b.omega_squared));
+    Ok(modes)
+}
+
 /// `L⁻ᵀ v` for every column `v` of `v` (the mode shapes in `q` of the eigenvectors of
 /// [`mass_similar`]'s `A`), `l` as there.
 fn shapes(l: &DMatrix<f64>, mut v: faer::Mat<f64>) -> faer::Mat<f64> {
@@ -177,22 +196,14 @@ impl<P: StrainParam> Model<P> {
         let mut k = DMatrix::zeros(n, n);
         self.statics_jacobian(q0, u, loads, ws, &mut k);
         k.neg_mut();
-        let asymmetry = (&k - k.transpose()).norm() / k.norm();
         self.assemble_mass(ws);
         let mut l = ws.mass.clone();
         cholesky_factor_in_place(&mut l)?;
-        let a = mass_similar(&k, &l);
-        let mut modes = if asymmetry > SYMMETRY_TOLERANCE {
-            non_symmetric_modes(&a, &l)?
-        } else {
-            symmetric_modes(&a, &l)?
-        };
-        // unstable directions (ω² < 0) first, then by frequency
-        modes.sort_by(|a, b| a.omega_squared.total_cmp(&b.omega_squared));
-        Ok(modes)
+        similar_modes(&k, &mass_similar(&k, &l), &l)
     }
 
-    /// Coriolis matrix `C(q, q̇) = Σ W Jᵀ (Ms J̇ˢ + coad_η Ms J)` (spec §7.2); for tests and analysis.
+    /// Coriolis matrix `C(q, q̇) = Σ W Jᵀ (Ms J̇ˢ + coad_η Ms J)` (spec §7.2), the bodies' `Mb` added
+    /// at their points ([`crate::bodies`]); for tests and analysis.
     pub fn coriolis_matrix(
         &self,
         q: &DVector<f64>,

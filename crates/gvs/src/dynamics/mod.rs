@@ -25,7 +25,7 @@ use thiserror::Error;
 mod analysis;
 pub(crate) mod cholesky;
 mod linearize;
-pub(crate) use analysis::mass_similar;
+pub(crate) use analysis::{mass_similar, similar_modes};
 pub use analysis::{Energy, Mode, SYMMETRY_TOLERANCE};
 pub use cholesky::{
     cholesky_factor_in_place, cholesky_solve_factored, cholesky_solve_in_place, CHOLESKY_BLOCK,
@@ -420,7 +420,8 @@ impl<P: StrainParam> Model<P> {
     }
 
     /// Inverse dynamics `ID(q, q̇, q̈) = Σ_i J_iᵀ w_i` with `w_i = W_i (Ms η̇_i + coad_{η_i} Ms η_i) − w_i^ext`,
-    /// `η̇_i = J_i q̈ + J̇_i q̇` (spec §7.8); satisfies `ID = M q̈ + C q̇ − F`.
+    /// `η̇_i = J_i q̈ + J̇_i q̇` (spec §7.8), and each body's `Mb η̇_b + coad_{η_b} Mb η_b` at its
+    /// point ([`crate::bodies`]); satisfies `ID = M q̈ + C q̇ − F`.
     pub fn inverse_dynamics(
         &self,
         q: &DVector<f64>,

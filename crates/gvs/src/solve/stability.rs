@@ -12,32 +12,37 @@
 //!    eigenvalue of `M⁻¹ K_T` has a negative real part (`xᴴ K_T x = ω² xᴴ M x` with
 //!    `Re xᴴ K_T x > 0`): stable. This decides every conservative load (symmetric `K_T`) and almost
 //!    every other equilibrium.
-//! 2. For a symmetric `K_T` (conservative loads: gravity, bodies, world-fixed forces) the
-//!    eigenvalues of `L⁻¹ K_T L⁻ᵀ` are those of a symmetric matrix, exact to round-off
-//!    (`~n ε max |ω²|`): divergent if one is below `−SYMMETRIC_TOLERANCE · max |ω²|` (1e-13). The
-//!    looser threshold of step 3 missed a heavy payload on a light rod, whose divergent `ω²`
-//!    (−12.3 1/s²) is 2e-11 of the rod's stiffest mode (6e11 1/s²); a neutral direction (a buckled
-//!    column turning about the vertical, −5e-6 1/s² there) stays at round-off, 1e-17 of it.
-//! 3. Otherwise (friction and follower loads make `K_T` non-symmetric, and its symmetric part may be
-//!    indefinite at a stable equilibrium) the eigenvalues of `L⁻¹ K_T L⁻ᵀ`, `M = L Lᵀ` (similar to
-//!    `M⁻¹ K_T`): divergent if one is real and below `−DIVERGENCE_TOLERANCE · max |ω²|`. Complex
-//!    pairs (flutter of the undamped linearization, e.g. Beck's column) are not divergence; their
-//!    static equilibrium is the one a damped rod settles on or oscillates about.
+//! 2. Otherwise the eigenvalues of `A = L⁻¹ K_T L⁻ᵀ`, `M = L Lᵀ` (similar to `M⁻¹ K_T`): none real
+//!    and negative ⇒ stable. (Friction and follower loads make `K_T` non-symmetric, and its
+//!    symmetric part may be indefinite at a stable equilibrium; complex pairs, the flutter of the
+//!    undamped linearization as in Beck's column, are not divergence: their static equilibrium is
+//!    the one a damped rod settles on or oscillates about.)
+//! 3. Each real `ω² < 0` is judged by its mode `φ` (`K_T φ = ω² M φ`), against the stiffness
+//!    itself rather than the other eigenvalues: divergent if `φᵀ K_T φ < −NEUTRAL_TOLERANCE
+//!    |φ|ᵀ |K_T| |φ|` (the energy the direction releases, against the size of the terms that sum
+//!    to it). This does not depend on how the mass is spread: a heavy payload on a light rod
+//!    (a 10 g tip body on a 0.04 g column at twice Euler's load) diverges at `ω² = −12.3 1/s²`
+//!    beside the rod's own modes near 6e11 1/s², which a threshold relative to the largest `|ω²|`
+//!    missed; a neutral direction (the buckled column turning about the vertical) is round-off.
+//!
+//! Where `M` cannot be factored (a massless rod, `density = 0`, which statics accept) the signs of
+//! `K_T`'s own eigenvalues are judged, relative to the largest (`DIVERGENCE_TOLERANCE`); the value
+//! reported is then that eigenvalue, not an `ω²`.
 
 use crate::dynamics::cholesky::cholesky_factor_in_place;
-use crate::dynamics::{mass_similar, SYMMETRY_TOLERANCE};
+use crate::dynamics::{mass_similar, similar_modes, Mode};
 use crate::model::{Model, PreparedLoads, Workspace};
 use crate::strain::StrainParam;
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 
-/// Relative size of a negative eigenvalue of `M⁻¹ K_T` (against the largest `|ω²|`, the stiffest
-/// mode's) below which it counts as divergence; above it, round-off of the eigensolver
-/// (`~ε max |ω²|`) and neutral directions.
+/// Relative size of a negative eigenvalue of `K_T` (against the largest), for a rod without mass,
+/// below which it counts as divergence; above it, round-off and neutral directions.
 pub const DIVERGENCE_TOLERANCE: f64 = 1e-10;
 
-/// [`DIVERGENCE_TOLERANCE`] of a symmetric `K_T`, whose eigenvalues are exact to round-off
-/// (the module documentation, step 2).
-pub const SYMMETRIC_TOLERANCE: f64 = 1e-13;
+/// A real mode `φ` with `ω² < 0` diverges if `φᵀ K_T φ < −NEUTRAL_TOLERANCE |φ|ᵀ |K_T| |φ|`
+/// (the module documentation, step 3); above it, round-off of `K_T` and of the equilibrium
+/// (`ftol` 1e-10) along a neutral direction.
+pub const NEUTRAL_TOLERANCE: f64 = 1e-8;
 
 /// Largest imaginary part, relative to the largest `|ω²|`, of an eigenvalue taken as real (a double
 /// real eigenvalue splits by `~√ε` into a complex pair).
@@ -48,7 +53,7 @@ const REAL_TOLERANCE: f64 = 1e-6;
 /// (the module documentation). `ws` is left with the forward pass at `q`.
 pub fn divergence<P: StrainParam>(
     model: &Model<P>,
-    q: &nalgebra::DVector<f64>,
+    q: &DVector<f64>,
     jac: &DMatrix<f64>,
     ws: &mut Workspace,
 ) -> Option<f64> {
@@ -60,78 +65,83 @@ pub fn divergence<P: StrainParam>(
     if jac.iter().any(|v| !v.is_finite()) || surely_stable(jac) {
         return None;
     }
+    let k = -jac;
     let mut l = model.mass_matrix(q, ws);
-    let eig = pencil_eigenvalues(jac, &mut l)?;
+    if cholesky_factor_in_place(&mut l).is_err() {
+        return massless_divergence(&k);
+    }
+    let a = mass_similar(&k, &l);
+    let eig = a.eigenvalues().ok()?;
     let scale = eig.iter().map(|z| z.norm()).fold(0.0, f64::max);
     if !(scale.is_finite() && scale > 0.0) {
         return None;
     }
-    let threshold = divergence_threshold(jac, scale);
-    eig.iter()
-        .filter(|z| z.im.abs() <= REAL_TOLERANCE * scale && z.re < threshold)
+    let real_negative = |re: f64, im: f64| im.abs() <= REAL_TOLERANCE * scale && re < 0.0;
+    if !eig.iter().any(|z| real_negative(z.re, z.im)) {
+        return None;
+    }
+    let modes = similar_modes(&k, &a, &l).ok()?;
+    most_divergent(&k, &modes, scale).map(|m| m.omega_squared)
+}
+
+/// The most negative real `ω² < 0` among `modes` (of `M⁻¹ K`, `K = K_T`) whose mode the stiffness
+/// clearly pushes away (step 3 of the module documentation); `scale` the largest `|ω²|`.
+fn most_divergent<'a>(k: &DMatrix<f64>, modes: &'a [Mode], scale: f64) -> Option<&'a Mode> {
+    (modes.iter())
+        .filter(|m| m.omega_squared_imag.abs() <= REAL_TOLERANCE * scale && m.omega_squared < 0.0)
+        .filter(|m| releases_energy(k, &m.shape))
+        .min_by(|a, b| a.omega_squared.total_cmp(&b.omega_squared))
+}
+
+/// `φᵀ K φ < −NEUTRAL_TOLERANCE |φ|ᵀ |K| |φ|`: the direction `φ` releases energy beyond round-off.
+fn releases_energy(k: &DMatrix<f64>, phi: &DVector<f64>) -> bool {
+    let (mut quad, mut size) = (0.0, 0.0);
+    for j in 0..phi.len() {
+        for i in 0..phi.len() {
+            quad += phi[i] * k[(i, j)] * phi[j];
+            size += (phi[i] * k[(i, j)] * phi[j]).abs();
+        }
+    }
+    quad.is_finite() && quad < -NEUTRAL_TOLERANCE * size
+}
+
+/// A rod whose mass matrix cannot be factored: the most negative real eigenvalue of `K_T` itself
+/// below `−DIVERGENCE_TOLERANCE` times the largest (the module documentation).
+fn massless_divergence(k: &DMatrix<f64>) -> Option<f64> {
+    let a = faer::Mat::<f64>::from_fn(k.nrows(), k.ncols(), |i, j| k[(i, j)]);
+    let eig = a.eigenvalues().ok()?;
+    let scale = eig.iter().map(|z| z.norm()).fold(0.0, f64::max);
+    (eig.iter())
+        .filter(|z| z.im.abs() <= REAL_TOLERANCE * scale && z.re < -DIVERGENCE_TOLERANCE * scale)
         .map(|z| z.re)
         .min_by(f64::total_cmp)
 }
 
-/// Below which a real eigenvalue `ω²` of `M⁻¹ K_T` counts as divergence, after step 1 failed
-/// (the module documentation): `−SYMMETRIC_TOLERANCE · scale` for a symmetric `K_T` (step 2),
-/// `−DIVERGENCE_TOLERANCE · scale` otherwise (step 3; `scale` the largest `|ω²|`).
-fn divergence_threshold(jac: &DMatrix<f64>, scale: f64) -> f64 {
-    match is_symmetric(jac) {
-        true => -SYMMETRIC_TOLERANCE * scale,
-        false => -DIVERGENCE_TOLERANCE * scale,
-    }
-}
-
-/// `‖J − Jᵀ‖ ≤ SYMMETRY_TOLERANCE ‖J‖` (Frobenius), as [`Model::linearized_modes`] decides.
-fn is_symmetric(jac: &DMatrix<f64>) -> bool {
-    (jac - jac.transpose()).norm() <= SYMMETRY_TOLERANCE * jac.norm()
-}
-
 /// The divergent mode at the equilibrium `q` (tensions `u`, `loads`): the most negative real
-/// eigenvalue `ω²` of `M⁻¹ K_T` and its eigenvector in `q` (of [`Model::linearized_modes`], scaled
-/// to `‖φ‖∞ = 1`), the direction along which the rod leaves the equilibrium; `None` if it does not
-/// diverge or the modes cannot be computed. A bifurcation (a compressed straight column) is left
-/// along it onto the buckled branch.
+/// eigenvalue `ω²` of `M⁻¹ K_T` that [`divergence`] counts and its eigenvector in `q` (of
+/// [`Model::linearized_modes`], scaled to `‖φ‖∞ = 1`), the direction along which the rod leaves
+/// the equilibrium; `None` if it does not diverge or the modes cannot be computed. A bifurcation
+/// (a compressed straight column) is left along it onto the buckled branch.
 pub fn divergent_mode<P: StrainParam>(
     model: &Model<P>,
-    q: &nalgebra::DVector<f64>,
+    q: &DVector<f64>,
     u: &[f64],
     loads: &PreparedLoads,
     ws: &mut Workspace,
-) -> Option<(f64, nalgebra::DVector<f64>)> {
+) -> Option<(f64, DVector<f64>)> {
+    let n = model.n_dof();
+    let mut jac = DMatrix::zeros(n, n);
+    model.statics_jacobian(q, u, loads, ws, &mut jac);
+    if surely_stable(&jac) {
+        return None;
+    }
     let modes = model.linearized_modes(q, u, loads, ws).ok()?;
     let scale = (modes.iter())
         .map(|m| m.omega_squared.hypot(m.omega_squared_imag))
         .fold(0.0, f64::max);
-    let n = model.n_dof();
-    let mut jac = DMatrix::zeros(n, n);
-    model.statics_jacobian(q, u, loads, ws, &mut jac);
-    let threshold = match surely_stable(&jac) {
-        true => return None,
-        false => divergence_threshold(&jac, scale),
-    };
-    let mode = (modes.iter())
-        .filter(|m| {
-            m.omega_squared_imag.abs() <= REAL_TOLERANCE * scale && m.omega_squared < threshold
-        })
-        .min_by(|a, b| a.omega_squared.total_cmp(&b.omega_squared))?;
+    let mode = most_divergent(&-jac, &modes, scale)?;
     let size = mode.shape.amax();
     (size.is_finite() && size > 0.0).then(|| (mode.omega_squared, &mode.shape / size))
-}
-
-/// The eigenvalues of `M⁻¹ K_T`, `K_T = −jac`, as those of the similar `A = L⁻¹ K_T L⁻ᵀ`
-/// (`M = L Lᵀ`, factored in place in `m`), or of `K_T` itself if `M` cannot be factored (the same
-/// signs of real eigenvalues for a symmetric `K_T`, the best available otherwise). faer's blocked
-/// triangular solves and eigenvalue solver: on an 1806-coordinate rod they take a few seconds
-/// where nalgebra's unblocked ones took 35 s. `None` if the eigenvalue solver fails.
-fn pencil_eigenvalues(jac: &DMatrix<f64>, m: &mut DMatrix<f64>) -> Option<Vec<faer::c64>> {
-    let k = -jac;
-    let a = match cholesky_factor_in_place(m) {
-        Ok(()) => mass_similar(&k, m),
-        Err(_) => faer::Mat::<f64>::from_fn(k.nrows(), k.ncols(), |i, j| k[(i, j)]),
-    };
-    a.eigenvalues().ok()
 }
 
 /// Whether `jac`'s tangent stiffness `K_T = −jac` has a positive definite symmetric part: the

@@ -2,8 +2,11 @@
 //! frictionless tendon tensions keeps its total energy
 //!
 //! ```text
-//! E = T + U_e + U_g − Σ_k u_k ℓ_k(q),   T = ½ q̇ᵀ M q̇,  U_e = ½ Σ W Ψᵀ Es Ψ,  U_g = −Σ W ρA g·r
+//! E = T + U_e + U_g − Σ_k u_k ℓ_k(q),   T = ½ q̇ᵀ M q̇,  U_e = ½ Σ W Ψᵀ Es Ψ,
+//! U_g = −Σ W ρA g·r − Σ_b m_b g·(r_b + R_b c_b)
 //! ```
+//!
+//! (the rigid bodies' weights at their centres of mass, and their inertia in `M`, `gvs::bodies`)
 //!
 //! (spec §9.4; a frictionless tendon's generalized force is `B u` with `B = ∂ℓ/∂qᵀ`, the gradient
 //! of `u·ℓ`, so its potential is `−u·ℓ`). The integrators are implicit and dissipate a little of it;
