@@ -157,6 +157,10 @@ fn bad_bodies_are_refused_naming_the_field() {
         ),
         ("bodies.0.centre=[0, 0, 0]", "unknown field `centre`"),
         (
+            "bodies.0.center=[1, 2, 3, 4]",
+            "`bodies[0].center`: 4 values given; expected 3 values `[x, y, z]` [m]",
+        ),
+        (
             "bodies.0.mass=1e6",
             "bodies[0].mass = 1000000 kg under gravity 9.81 m/s^2 implies",
         ),

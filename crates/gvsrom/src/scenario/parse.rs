@@ -109,6 +109,7 @@ fn array_length_message(field: &str, message: String) -> String {
             "2 values `[y, z]` [m]: the offset in the section's plane (y and z of the section frame; the tendon's abscissa is its x)"
         }
         "position" | "force" | "moment" | "gravity" | "axis" => "3 values `[x, y, z]`",
+        "center" => "3 values `[x, y, z]` [m]: the centre of mass in the section frame (x along the rod)",
         "path" => "rows of 3 values `[X, y, z]` [m]: the knots' abscissae and offsets",
         "rotation" => "3 rows of 3 values",
         "reference_strain" => {
