@@ -57,40 +57,58 @@ pub fn divergence<P: StrainParam>(
     jac: &DMatrix<f64>,
     ws: &mut Workspace,
 ) -> Option<f64> {
-    let n = jac.nrows();
-    if n == 0 {
-        return None;
+    match judge(model, q, jac, ws) {
+        Verdict::Stable => None,
+        Verdict::Diverges(mode) => Some(mode.omega_squared),
+        Verdict::Massless(value) => Some(value),
     }
+}
+
+/// What [`judge`] finds at an equilibrium.
+enum Verdict {
+    Stable,
+    /// The most negative divergent mode of `M⁻¹ K_T`.
+    Diverges(Mode),
+    /// `M` cannot be factored: the most negative eigenvalue of `K_T` itself.
+    Massless(f64),
+}
+
+/// The test of the module documentation at the equilibrium `q` with `jac = ∂R/∂q` there.
+fn judge<P: StrainParam>(
+    model: &Model<P>,
+    q: &DVector<f64>,
+    jac: &DMatrix<f64>,
+    ws: &mut Workspace,
+) -> Verdict {
     // a non-finite Jacobian is no equilibrium to judge: the solver reports non-finite values itself
-    if jac.iter().any(|v| !v.is_finite()) || surely_stable(jac) {
-        return None;
+    if jac.nrows() == 0 || jac.iter().any(|v| !v.is_finite()) || surely_stable(jac) {
+        return Verdict::Stable;
     }
     let k = -jac;
     let mut l = model.mass_matrix(q, ws);
     if cholesky_factor_in_place(&mut l).is_err() {
-        return massless_divergence(&k);
+        return massless_divergence(&k).map_or(Verdict::Stable, Verdict::Massless);
     }
     let a = mass_similar(&k, &l);
-    let eig = a.eigenvalues().ok()?;
+    let Ok(eig) = a.eigenvalues() else {
+        return Verdict::Stable;
+    };
     let scale = eig.iter().map(|z| z.norm()).fold(0.0, f64::max);
     if !(scale.is_finite() && scale > 0.0) {
-        return None;
+        return Verdict::Stable;
     }
     let real_negative = |re: f64, im: f64| im.abs() <= REAL_TOLERANCE * scale && re < 0.0;
     if !eig.iter().any(|z| real_negative(z.re, z.im)) {
-        return None;
+        return Verdict::Stable;
     }
-    let modes = similar_modes(&k, &a, &l).ok()?;
-    most_divergent(&k, &modes, scale).map(|m| m.omega_squared)
-}
-
-/// The most negative real `ω² < 0` among `modes` (of `M⁻¹ K`, `K = K_T`) whose mode the stiffness
-/// clearly pushes away (step 3 of the module documentation); `scale` the largest `|ω²|`.
-fn most_divergent<'a>(k: &DMatrix<f64>, modes: &'a [Mode], scale: f64) -> Option<&'a Mode> {
-    (modes.iter())
-        .filter(|m| m.omega_squared_imag.abs() <= REAL_TOLERANCE * scale && m.omega_squared < 0.0)
-        .filter(|m| releases_energy(k, &m.shape))
+    let Ok(modes) = similar_modes(&k, &a, &l) else {
+        return Verdict::Stable;
+    };
+    (modes.into_iter())
+        .filter(|m| real_negative(m.omega_squared, m.omega_squared_imag))
+        .filter(|m| releases_energy(&k, &m.shape))
         .min_by(|a, b| a.omega_squared.total_cmp(&b.omega_squared))
+        .map_or(Verdict::Stable, Verdict::Diverges)
 }
 
 /// `φᵀ K φ < −NEUTRAL_TOLERANCE |φ|ᵀ |K| |φ|`: the direction `φ` releases energy beyond round-off.
@@ -118,9 +136,9 @@ fn massless_divergence(k: &DMatrix<f64>) -> Option<f64> {
 }
 
 /// The divergent mode at the equilibrium `q` (tensions `u`, `loads`): the most negative real
-/// eigenvalue `ω²` of `M⁻¹ K_T` that [`divergence`] counts and its eigenvector in `q` (of
-/// [`Model::linearized_modes`], scaled to `‖φ‖∞ = 1`), the direction along which the rod leaves
-/// the equilibrium; `None` if it does not diverge or the modes cannot be computed. A bifurcation
+/// eigenvalue `ω²` of `M⁻¹ K_T` that [`divergence`] counts and its eigenvector in `q` (as
+/// [`Model::linearized_modes`] gives it, scaled to `‖φ‖∞ = 1`), the direction along which the rod
+/// leaves the equilibrium; `None` if it does not diverge, or `M` cannot be factored. A bifurcation
 /// (a compressed straight column) is left along it onto the buckled branch.
 pub fn divergent_mode<P: StrainParam>(
     model: &Model<P>,
@@ -132,14 +150,9 @@ pub fn divergent_mode<P: StrainParam>(
     let n = model.n_dof();
     let mut jac = DMatrix::zeros(n, n);
     model.statics_jacobian(q, u, loads, ws, &mut jac);
-    if surely_stable(&jac) {
+    let Verdict::Diverges(mode) = judge(model, q, &jac, ws) else {
         return None;
-    }
-    let modes = model.linearized_modes(q, u, loads, ws).ok()?;
-    let scale = (modes.iter())
-        .map(|m| m.omega_squared.hypot(m.omega_squared_imag))
-        .fold(0.0, f64::max);
-    let mode = most_divergent(&-jac, &modes, scale)?;
+    };
     let size = mode.shape.amax();
     (size.is_finite() && size > 0.0).then(|| (mode.omega_squared, &mode.shape / size))
 }

@@ -101,7 +101,11 @@ fn rod_series(doc: &StaticsDoc) -> Vec<Series3> {
             );
         }
     }
-    series.extend(body_series(&doc.bodies));
+    let bodies = doc.bodies.iter().enumerate().map(|(k, b)| {
+        let name = format!("body {k} ({} kg)", gvs::error::fmt_value(b.mass));
+        (name, b.section, b.center)
+    });
+    series.extend(body_series(bodies, palette::EXTRA[7]));
     series.push(
         Series3::new("base", vec![doc.centerline[0]], SeriesStyle::Markers)
             .with_color(palette::EXTRA[6]),
@@ -114,22 +118,23 @@ fn rod_series(doc: &StaticsDoc) -> Vec<Series3> {
 
 /// Each body as a marker at its centre of mass, joined to its section by a line where the two
 /// differ (an off-centre payload hangs from the rod by it).
-pub(crate) fn body_series(bodies: &[BodyDoc]) -> Vec<Series3> {
-    let color = palette::EXTRA[7];
+/// `bodies` are `(name, section, centre)`; an empty name leaves both series out of the legend.
+pub(crate) fn body_series(
+    bodies: impl Iterator<Item = (String, [f64; 3], [f64; 3])>,
+    color: crate::plot::Rgb,
+) -> Vec<Series3> {
     let mut series = vec![];
-    for (k, b) in bodies.iter().enumerate() {
-        let name = format!("body {k} ({} kg)", gvs::error::fmt_value(b.mass));
-        if b.section != b.center {
+    for (name, section, center) in bodies {
+        if section != center {
+            let line = match name.is_empty() {
+                true => String::new(),
+                false => format!("{name}: section to centre of mass"),
+            };
             series.push(
-                Series3::new(
-                    format!("{name}: section to centre of mass"),
-                    vec![b.section, b.center],
-                    SeriesStyle::Line,
-                )
-                .with_color(color),
+                Series3::new(line, vec![section, center], SeriesStyle::Line).with_color(color),
             );
         }
-        series.push(Series3::new(name, vec![b.center], SeriesStyle::Markers).with_color(color));
+        series.push(Series3::new(name, vec![center], SeriesStyle::Markers).with_color(color));
     }
     series
 }

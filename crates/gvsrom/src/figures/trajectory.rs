@@ -387,17 +387,10 @@ fn rod_figures(
     sink.animation("rod_animation", &frames, (960, 440), delay_ms)
 }
 
-/// Unnamed series of one sample's bodies: each a marker at its centre of mass, joined to its
-/// section by a line where the two differ.
+/// Unnamed series of one sample's bodies ([`super::statics::body_series`]).
 fn body_marks(bodies: Option<&Vec<[[f64; 3]; 2]>>, color: crate::plot::Rgb) -> Vec<Series3> {
-    let mut out = vec![];
-    for &[section, center] in bodies.into_iter().flatten() {
-        if section != center {
-            out.push(Series3::new("", vec![section, center], SeriesStyle::Line).with_color(color));
-        }
-        out.push(Series3::new("", vec![center], SeriesStyle::Markers).with_color(color));
-    }
-    out
+    let each = bodies.into_iter().flatten();
+    super::statics::body_series(each.map(|&[s, c]| (String::new(), s, c)), color)
 }
 
 /// One frame: the rod at sample `k` (with its tendons, blue, when the trajectory records them) in
