@@ -5,9 +5,11 @@
 pub mod continuation;
 pub mod dogleg;
 pub mod dynamics;
+pub mod lcp;
 pub mod ode;
 pub mod stability;
 pub mod statics;
+pub mod tendon_drive;
 
 /// A check polled by long solver loops (before every step attempt of a simulation, every load stage
 /// of a statics ramp and every continuation step): `Some(reason)` stops the solver with that reason

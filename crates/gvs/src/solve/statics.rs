@@ -104,6 +104,14 @@ pub enum StaticsError {
         /// failure after it is not one a finer ramp would avoid.
         continuation: ContinuationOutcome,
     },
+    /// Tendons driven by displacement ([`super::tendon_drive`]) did not reach their lengths.
+    #[error("the tendons' displacements were not reached after {iterations} tension updates: the largest length error is {length_error:.3e} m (tolerance {tolerance:.1e} m); {reason}")]
+    DriveNotReached {
+        iterations: usize,
+        length_error: f64,
+        tolerance: f64,
+        reason: String,
+    },
     /// The caller's [`StopCheck`] asked to stop (an interrupt) before the load stage at
     /// `load_factor` or a continuation step.
     #[error("statics stopped at load factor {load_factor:.4}: {reason}")]
