@@ -40,6 +40,13 @@ impl Robot {
         u: Option<Vec<f64>>,
         attached: Option<&Attached>,
     ) -> PyResult<(StaticsReport, Vec<String>)> {
+        if u.is_none() && attached.is_none() && self.built.displacement_driven() {
+            // the tendons driven by displacement: their tensions are found
+            let report = py
+                .detach(|| statics::solve_as_built(&self.built))
+                .map_err(errors::any)?;
+            return Ok((report, vec![]));
+        }
         match attached.or(self.attached.as_ref()) {
             None => {
                 let u = match u {
@@ -60,7 +67,7 @@ impl Robot {
                 }
                 let built = self.rebuilt_with(py, u.as_deref(), a)?;
                 let report = py
-                    .detach(|| statics::solve_checked(&built, &built.u))
+                    .detach(|| statics::solve_as_built(&built))
                     .map_err(errors::any)?;
                 let extrapolated = built.reduced.map(|r| r.extrapolated).unwrap_or_default();
                 Ok((report, extrapolated))

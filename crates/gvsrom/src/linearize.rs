@@ -378,6 +378,7 @@ pub fn about_equilibrium(
     outputs: &Outputs,
 ) -> Result<(StaticsReport, Linearization), LinearizeError> {
     crate::simulate::require_mass(built)?;
+    built.tension_driven_for("linearize")?;
     let eq = statics::solve(built)?;
     statics::check_reduced(built, &eq)?;
     let q = DVector::from_column_slice(&eq.q);

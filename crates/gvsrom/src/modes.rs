@@ -135,6 +135,7 @@ pub struct ModesReport {
 pub fn compute(built: &Built, count: usize) -> Result<(StaticsReport, ModesReport), ModesError> {
     // the modes are undamped: any damping is fine here
     crate::simulate::require_mass_only(built)?;
+    built.tension_driven_for("modes")?;
     let eq = statics::solve(built)?;
     statics::check_reduced(built, &eq)?;
     let modes = match &built.reduced {

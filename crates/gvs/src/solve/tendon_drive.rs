@@ -101,6 +101,7 @@ pub fn solve_driven<P: StrainParam>(
     let rest = model.tendon_rest_lengths();
     let mut d = vec![]; // the displacement-driven actuators
     let mut target = vec![];
+    let mut asked = vec![];
     let mut u = vec![0.0; na];
     for (k, drive) in drives.iter().enumerate() {
         match *drive {
@@ -120,6 +121,7 @@ pub fn solve_driven<P: StrainParam>(
                 }
                 d.push(k);
                 target.push(rest[k] - delta);
+                asked.push(delta);
             }
         }
     }
@@ -137,6 +139,7 @@ pub fn solve_driven<P: StrainParam>(
                 &at,
                 tol,
                 "the tension updates did not converge".into(),
+                (&d, &asked),
             ));
         }
         iterations += 1;
@@ -149,7 +152,7 @@ pub fn solve_driven<P: StrainParam>(
             let why = match e {
                 LcpError::Singular | LcpError::Cycled => "the tendons' compliance S = ∂ℓ/∂u is not a P-matrix (two displacement-driven tendons along the same path, or an unstable equilibrium)",
             };
-            not_reached(iterations, &at, tol, why.into())
+            not_reached(iterations, &at, tol, why.into(), (&d, &asked))
         })?;
         let mut alpha = 1.0;
         let mut halvings = 0;
@@ -179,7 +182,8 @@ pub fn solve_driven<P: StrainParam>(
                     iterations,
                     &at,
                     tol,
-                    format!("no tension update lowered the length error, down to a step of {alpha:.1e} of the Newton step"),
+                    format!("no tension update lowered the length error, down to a step of {alpha:.1e} of the Newton step (a displacement beyond what the rod can take, or an equilibrium the statics cannot reach)"),
+                    (&d, &asked),
                 ));
             }
             alpha *= 0.5;
@@ -292,12 +296,30 @@ fn solve_from<P: StrainParam>(
     }
 }
 
-fn not_reached(iterations: usize, at: &Point, tol: f64, reason: String) -> StaticsError {
+/// The error of a drive that stopped at `at`, with each displacement-driven tendon's
+/// displacement there against the one asked (`drives`: the tendons and their displacements).
+fn not_reached(
+    iterations: usize,
+    at: &Point,
+    tol: f64,
+    reason: String,
+    (d, asked): (&[usize], &[f64]),
+) -> StaticsError {
+    let reached: Vec<String> = (d.iter().zip(asked).zip(&at.g))
+        .map(|((&k, &delta), &g)| {
+            format!(
+                "tendon {k} at {:.4} mm of the {:.4} mm asked (u = {:.4} N)",
+                1e3 * (delta - g),
+                1e3 * delta,
+                at.u[k]
+            )
+        })
+        .collect();
     StaticsError::DriveNotReached {
         iterations,
         length_error: at.violation,
         tolerance: tol,
-        reason,
+        reason: format!("{reason}; reached: {}", reached.join(", ")),
     }
 }
 

@@ -155,9 +155,22 @@ pub fn body_lines(built: &Built) -> Vec<String> {
 
 /// `v` to 6 significant digits, trailing zeros dropped, in exponent form where [`fmt_value`] uses
 /// it: `0.0600457`, `2e-6`, `1.5e-6` (a drawn mass, `0.0600457311465939`, is not printed whole).
-fn significant(v: f64) -> String {
+pub fn significant(v: f64) -> String {
     let rounded = format!("{v:.5e}").parse::<f64>().unwrap_or(v);
     fmt_value(rounded)
+}
+
+/// How each tendon is driven, for a scenario with a displacement-driven tendon: `wound in 5 mm`,
+/// `paid out 2 mm`, `held at its rest length`, or `u = -2 N` for a tension-driven one.
+pub fn drive_words(built: &super::Built) -> Vec<String> {
+    (built.u.iter().zip(&built.displacement))
+        .map(|(u, d)| match d {
+            Some(d) if *d > 0.0 => format!("wound in {} mm", significant(d * 1e3)),
+            Some(d) if *d < 0.0 => format!("paid out {} mm", significant(-d * 1e3)),
+            Some(_) => "held at its rest length".to_string(),
+            None => format!("u = {} N", significant(*u)),
+        })
+        .collect()
 }
 
 /// `n` wrenches of kind `what` and how their components turn: `1 point wrench (follower)`,

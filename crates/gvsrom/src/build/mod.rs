@@ -14,7 +14,7 @@ mod resolve;
 mod rod;
 mod tendons;
 
-pub use describe::{body_lines, describe, wrench_count, wrench_frames};
+pub use describe::{body_lines, describe, drive_words, significant, wrench_count, wrench_frames};
 pub use limits::*;
 pub use loads::loads;
 pub use reduced::Reduced;
@@ -40,8 +40,11 @@ pub struct Built {
     pub name: String,
     pub model: Model<LinearBasis>,
     pub loads: Loads,
-    /// Tendon tensions u \[N\], in tendon order.
+    /// Tendon tensions u \[N\], in tendon order (0 for a tendon driven by its displacement).
     pub u: Vec<f64>,
+    /// Per tendon, the displacement δ \[m\] it is driven by (wound in from its rest length), or
+    /// `None` for a tension-driven one ([`Built::drives`]).
+    pub displacement: Vec<Option<f64>>,
     pub options: StaticsOptions,
     pub centerline_points: usize,
     /// A reduced model (`--model`) that replaces the scenario's basis in statics and dynamics.
@@ -49,6 +52,37 @@ pub struct Built {
 }
 
 impl Built {
+    /// How each tendon is driven: by its displacement if the scenario gives one, else by its
+    /// tension.
+    pub fn drives(&self) -> Vec<gvs::solve::tendon_drive::Drive> {
+        use gvs::solve::tendon_drive::Drive;
+        (self.u.iter().zip(&self.displacement))
+            .map(|(&u, d)| match d {
+                Some(d) => Drive::Displacement(*d),
+                None => Drive::Tension(u),
+            })
+            .collect()
+    }
+
+    /// Whether a tendon is driven by its displacement.
+    pub fn displacement_driven(&self) -> bool {
+        self.displacement.iter().any(Option::is_some)
+    }
+
+    /// Refuses a scenario with a displacement-driven tendon for `what` (a command that drives
+    /// tendons by tension only): the error names the tendon and how to find its tension.
+    pub fn tension_driven_for(&self, what: &str) -> Result<(), ScenarioError> {
+        match self.displacement.iter().position(Option::is_some) {
+            None => Ok(()),
+            Some(k) => Err(ScenarioError::invalid(
+                format!("tendons[{k}].displacement"),
+                format!(
+                    "{what} drives tendons by their tension only (a tendon held at its length is a constraint on the motion, not modelled); `gvsrom statics` finds the tension that holds this displacement at rest: give it with `--tension`"
+                ),
+            )),
+        }
+    }
+
     /// Generalized coordinates of the model that runs: the reduced one if attached.
     pub fn n_dof(&self) -> usize {
         match &self.reduced {
@@ -70,6 +104,48 @@ impl Built {
         crate::plausibility::check(self, &u_abs, 1.0)?;
         Ok(u)
     }
+}
+
+/// Tendon `k`'s displacement, if it is driven by one: finite, and not with a tension.
+fn displacement(
+    k: usize,
+    t: &crate::scenario::TendonSpec,
+) -> Result<Option<f64>, ScenarioError> {
+    let Some(d) = t.displacement else {
+        return Ok(None);
+    };
+    finite(&format!("tendons[{k}].displacement"), d)?;
+    if t.tension != 0.0 {
+        return Err(ScenarioError::invalid(
+            format!("tendons[{k}]"),
+            format!(
+                "both `tension` ({} N) and `displacement` ({d} m) are given: a tendon is driven by one of them (statics finds the tension a displacement needs)",
+                t.tension
+            ),
+        ));
+    }
+    Ok(Some(d))
+}
+
+/// Each displacement less than its tendon's rest length in magnitude (a tendon cannot be wound
+/// in, or paid out, by its whole length).
+fn check_displacements(
+    model: &Model<LinearBasis>,
+    displacement: &[Option<f64>],
+) -> Result<(), ScenarioError> {
+    let rest = model.tendon_rest_lengths();
+    for (k, (d, rest)) in displacement.iter().zip(rest).enumerate() {
+        if let Some(d) = *d {
+            if d.abs() >= rest {
+                return Err(ScenarioError::value(
+                    format!("tendons[{k}].displacement"),
+                    d,
+                    format!("|δ| below the tendon's rest length, {rest:.6} m"),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Validates `s` and builds the engine's model, loads, tensions and solver options; the loads must
@@ -135,6 +211,12 @@ pub fn build(s: &Scenario) -> Result<Built, ScenarioError> {
         .enumerate()
         .map(|(k, t)| finite(&format!("tendons[{k}].tension"), t.tension))
         .collect::<Result<Vec<_>, _>>()?;
+    let displacement = s
+        .tendons
+        .iter()
+        .enumerate()
+        .map(|(k, t)| displacement(k, t))
+        .collect::<Result<Vec<_>, _>>()?;
     let loads = loads(s, length)?;
     s.solver.validate()?;
     let centerline_points = s.output.centerline_points;
@@ -185,11 +267,13 @@ pub fn build(s: &Scenario) -> Result<Built, ScenarioError> {
         .with_bodies(bodies)?;
     // the loads as the points take them (`check` too: a distributed load they do not resolve)
     model.prepare_loads(&loads)?;
+    check_displacements(&model, &displacement)?;
     let built = Built {
         name: s.name.clone().unwrap_or_else(|| "scenario".to_string()),
         model,
         loads,
         u,
+        displacement,
         options: s.solver.clone(),
         centerline_points,
         reduced: None,

@@ -1,5 +1,6 @@
 //! A scenario as a run asks for it — a preset name or a file, its `--set` overrides, then the
-//! tensions and centreline points of `--tension` and `--centerline-points` — read, built and
+//! tensions, displacements and centreline points of `--tension`, `--displacement` and
+//! `--centerline-points` — read, built and
 //! given the provenance of a run of it. Every front-end resolves scenarios this way.
 
 use super::{build, Built};
@@ -18,6 +19,9 @@ pub struct Request<'a> {
     /// Tendon tensions in place of the scenario's (one for every tendon or one per tendon),
     /// applied after the overrides.
     pub tensions: Option<&'a [f64]>,
+    /// Tendon displacements \[m\] driving the tendons in place of their tensions (one for every
+    /// tendon or one per tendon), applied after the overrides.
+    pub displacements: Option<&'a [f64]>,
     /// Centreline samples in place of `output.centerline_points`.
     pub centerline_points: Option<usize>,
 }
@@ -39,6 +43,9 @@ pub fn resolve(request: &Request) -> anyhow::Result<Resolved> {
     let mut scenario = presets::load_from(&source, request.overrides)?;
     if let Some(u) = request.tensions {
         scenario.set_tensions(u).context("--tension")?;
+    }
+    if let Some(d) = request.displacements {
+        scenario.set_displacements(d).context("--displacement")?;
     }
     if let Some(n) = request.centerline_points {
         scenario.output.centerline_points = n;

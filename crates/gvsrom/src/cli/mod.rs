@@ -138,6 +138,19 @@ pub struct ScenarioArgs {
     )]
     pub tension: Option<Vec<f64>>,
 
+    /// Drive the tendons by displacement instead: the length δ [m] each actuator has wound in from
+    /// the tendon's rest length (negative pays out); one value for every tendon, or one per
+    /// tendon, e.g. `--displacement=0.004,0`. `statics` finds the tensions (a cable pulls or goes
+    /// slack). Applied after `--set`.
+    #[arg(
+        long,
+        value_name = "D[,D...]",
+        allow_hyphen_values = true,
+        value_delimiter = ',',
+        conflicts_with = "tension"
+    )]
+    pub displacement: Option<Vec<f64>>,
+
     /// Number of centreline samples, at equally spaced material abscissae X (the arc length of the
     /// undeformed rod; a stretched rod's samples are as far apart as it stretched), in the JSON output and per
     /// sample of a trajectory (`centerline.npy`); overrides `output.centerline_points`, default 21.
@@ -204,6 +217,7 @@ fn load(args: &ScenarioArgs) -> Result<Resolved> {
         source: &args.scenario,
         overrides: &args.set,
         tensions: args.tension.as_deref(),
+        displacements: args.displacement.as_deref(),
         centerline_points: args.centerline_points,
     })?;
     for w in gvsrom::build::warnings(&r.scenario, &r.built) {

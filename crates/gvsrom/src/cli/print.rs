@@ -64,7 +64,8 @@ pub(super) fn print_model(
         built.name,
         gvsrom::build::describe(scenario, built)
     )?;
-    if let (Some(d), true, None) = (&scenario.description, args.set.is_empty(), &args.tension) {
+    let unchanged = args.set.is_empty() && args.tension.is_none() && args.displacement.is_none();
+    if let (Some(d), true) = (&scenario.description, unchanged) {
         writeln!(out, "           {d}")?;
     }
     writeln!(
@@ -90,6 +91,13 @@ pub(super) fn print_model(
         writeln!(out, "tendons    none")?;
     } else if let Some(signal) = signal {
         writeln!(out, "tendons    {}, {signal}", built.u.len())?;
+    } else if built.displacement_driven() {
+        writeln!(
+            out,
+            "tendons    {}, driven by displacement: {}",
+            built.u.len(),
+            gvsrom::build::drive_words(built).join("; ")
+        )?;
     } else {
         writeln!(
             out,
@@ -152,6 +160,25 @@ pub(super) fn print_solution(r: &StaticsReport, out: &mut impl Write) -> Result<
             c.rejected_steps,
             plural(c.folds.len(), "fold"),
             if folds.is_empty() { String::new() } else { format!(" at load factor {folds}") }
+        )?;
+    }
+    if !r.drives.is_empty() {
+        let slack: Vec<String> = (r.drives.iter().enumerate())
+            .filter(|(_, d)| d.slack)
+            .map(|(k, _)| k.to_string())
+            .collect();
+        writeln!(
+            out,
+            "tensions   u = [{}] N found in {}{}",
+            (r.u.iter().map(|u| gvsrom::build::significant(*u)))
+                .collect::<Vec<_>>()
+                .join(", "),
+            plural(r.drive_iterations, "tension update"),
+            match slack.len() {
+                0 => String::new(),
+                1 => format!("; tendon {} is slack (its path is shorter than the tendon paid out)", slack[0]),
+                _ => format!("; tendons {} are slack (their paths are shorter than the tendons paid out)", slack.join(", ")),
+            }
         )?;
     }
     if !r.stability_checked {

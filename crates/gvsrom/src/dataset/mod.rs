@@ -417,6 +417,9 @@ pub fn run(args: &DatasetRequest, interrupt: &AtomicUsize) -> Result<Outcome, Da
     }
     let seed = args.seed.unwrap_or(0);
     let (table, built, scenario_toml, provenance) = load_scenario(args)?;
+    built
+        .tension_driven_for("dataset")
+        .map_err(|e| plan_err(e.to_string()))?;
     let mut warnings = crate::build::model_warnings(&built.model);
     if let Ok(scenario) = crate::scenario::from_table(table.clone()) {
         warnings.extend(crate::build::under_integrated_divisions(&scenario));

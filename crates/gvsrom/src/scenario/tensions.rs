@@ -9,18 +9,41 @@ impl Scenario {
         self.tendons.iter().map(|t| t.tension).collect()
     }
 
-    /// Sets the tendon tensions: one value for every tendon, or one value per tendon.
+    /// Sets the tendon tensions: one value for every tendon, or one value per tendon. A tendon
+    /// driven by its displacement becomes driven by this tension.
     pub fn set_tensions(&mut self, u: &[f64]) -> Result<(), ScenarioError> {
         let u = tensions_for(self.tendons.len(), u)?;
         for (t, u) in self.tendons.iter_mut().zip(u) {
             t.tension = u;
+            t.displacement = None;
         }
         Ok(())
+    }
+
+    /// Drives the tendons by their displacements \[m\] (wound in from the rest length): one value
+    /// for every tendon, or one value per tendon; their tensions are cleared (statics finds them).
+    pub fn set_displacements(&mut self, d: &[f64]) -> Result<(), ScenarioError> {
+        let d = values_for(self.tendons.len(), d, "displacement")?;
+        for (t, d) in self.tendons.iter_mut().zip(d) {
+            t.tension = 0.0;
+            t.displacement = Some(d);
+        }
+        Ok(())
+    }
+
+    /// Whether a tendon is driven by its displacement.
+    pub fn displacement_driven(&self) -> bool {
+        self.tendons.iter().any(|t| t.displacement.is_some())
     }
 }
 
 /// The tensions of `n` tendons from `u`: one value for every tendon, or one value per tendon.
 pub fn tensions_for(n: usize, u: &[f64]) -> Result<Vec<f64>, ScenarioError> {
+    values_for(n, u, "tension")
+}
+
+/// One `noun` per tendon of `n` from `u`: one value for every tendon, or one value per tendon.
+fn values_for(n: usize, u: &[f64], noun: &str) -> Result<Vec<f64>, ScenarioError> {
     if n == 0 && u.is_empty() {
         // `u = zeros(n_actuators)` of a rod without tendons: nothing to set
         return Ok(vec![]);
@@ -28,16 +51,16 @@ pub fn tensions_for(n: usize, u: &[f64]) -> Result<Vec<f64>, ScenarioError> {
     if n == 0 {
         return Err(ScenarioError::invalid(
             "tendons",
-            "the scenario has no tendons to set a tension on",
+            format!("the scenario has no tendons to set a {noun} on"),
         ));
     }
     if u.len() != 1 && u.len() != n {
         return Err(ScenarioError::invalid(
             "tendons",
             format!(
-                "{} {} given for {n} {} ({})",
+                "{} {noun}{} given for {n} {} ({})",
                 u.len(),
-                if u.len() == 1 { "tension" } else { "tensions" },
+                if u.len() == 1 { "" } else { "s" },
                 if n == 1 { "tendon" } else { "tendons" },
                 match n {
                     1 => "give 1".to_string(),

@@ -259,6 +259,11 @@ pub struct TendonSpec {
     /// Tension u \[N\]; negative pulls (bends the rod toward the tendon).
     #[serde(default)]
     pub tension: f64,
+    /// Instead of `tension`: the length δ \[m\] its actuator has wound in from the rest length
+    /// (negative pays out); statics finds the tension, or the tendon goes slack
+    /// (`gvs::solve::tendon_drive`). Not written when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub displacement: Option<f64>,
 }
 
 /// Gravity, point wrenches and distributed wrenches.

@@ -134,6 +134,7 @@ const MAX_SIGNAL_CHECKS: usize = 100_000;
 
 /// Validates `opts` against `built` and builds the [`Plan`] of the run.
 pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError> {
+    built.tension_driven_for("simulate")?;
     let t_out = sample_times(opts.duration, opts.sample_rate)?;
     // a controller's instants are output samples (checked before anything is computed)
     let function = match &opts.input {

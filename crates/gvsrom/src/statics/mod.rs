@@ -8,6 +8,7 @@ use gvs::model::Model;
 use gvs::solve::statics::{
     ContinuationOutcome, StaticsError, StaticsOptions, StaticsSolver, MAX_RAMP_STEPS,
 };
+use gvs::solve::tendon_drive::solve_driven;
 use gvs::strain::StrainParam;
 use nalgebra::DVector;
 use serde::Serialize;
@@ -61,7 +62,15 @@ pub struct StaticsReport {
     /// its centre of mass \[m\]; empty without bodies.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub bodies: Vec<BodyPosition>,
-    /// Dogleg iterations over all load stages.
+    /// Per tendon, how it was driven, when one was driven by its displacement (`u` then holds the
+    /// tensions found); empty when every tendon is driven by its tension.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub drives: Vec<DriveReport>,
+    /// Tension updates of a displacement-driven solve ([`gvs::solve::tendon_drive`]); each
+    /// solves the statics again (their iterations are in `iterations`).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub drive_iterations: usize,
+    /// Dogleg iterations over all load stages (and, with displacement drives, all solves).
     pub iterations: usize,
     pub load_stages: usize,
     pub residual_evaluations: usize,
@@ -93,6 +102,16 @@ pub struct StaticsReport {
 
 fn is_zero(n: &usize) -> bool {
     *n == 0
+}
+
+/// How a tendon was driven ([`StaticsReport::drives`]).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct DriveReport {
+    /// The displacement δ \[m\] it was wound in by (negative: paid out), or `None` if it was
+    /// driven by its tension.
+    pub displacement: Option<f64>,
+    /// A displacement-driven tendon whose path is shorter than the tendon: slack, `u = 0`.
+    pub slack: bool,
 }
 
 /// How the arc-length continuation reached the equilibrium ([`gvs::solve::continuation`]).
@@ -128,7 +147,17 @@ impl StaticsReport {
 /// Solves the statics of `built` from the straight reference and samples the solution. A
 /// non-convergence names the scenario's largest load ([`crate::plausibility::largest_load`]) and
 /// suggests more ramp steps.
+///
+/// With a tendon driven by its displacement ([`Built::drives`]) the tensions are found
+/// ([`gvs::solve::tendon_drive`]): the report's `u` holds them and `drives` says which tendon is
+/// slack.
 pub fn solve(built: &Built) -> Result<StaticsReport, StaticsFailure> {
+    if built.displacement_driven() {
+        return match &built.reduced {
+            Some(r) => solve_driven_on(built, &r.model),
+            None => solve_driven_on(built, &built.model),
+        };
+    }
     solve_under(built, &built.u)
 }
 
@@ -148,6 +177,14 @@ pub fn solve_under(built: &Built, u: &[f64]) -> Result<StaticsReport, StaticsFai
 /// where the model was trained (`Reduced::check_range`), else the error names the likely cause.
 pub fn solve_checked(built: &Built, u: &[f64]) -> anyhow::Result<StaticsReport> {
     let report = solve_under(built, u)?;
+    check_reduced(built, &report)?;
+    Ok(report)
+}
+
+/// [`solve`] as a run answers it ([`solve_checked`] with the tendons driven as the scenario says:
+/// by displacement where it gives one).
+pub fn solve_as_built(built: &Built) -> anyhow::Result<StaticsReport> {
+    let report = solve(built)?;
     check_reduced(built, &report)?;
     Ok(report)
 }
@@ -231,6 +268,9 @@ fn repeated(
 /// The full model's equilibrium under the scenario's tensions, whether or not a reduced model
 /// is attached: the reference of `statics --model --compare`.
 pub fn solve_full(built: &Built, repeat: u32) -> Result<StaticsReport, StaticsFailure> {
+    if built.displacement_driven() {
+        return repeated(repeat, || solve_driven_on(built, &built.model));
+    }
     repeated(repeat, || solve_on(built, &built.model, &built.u, None))
 }
 
@@ -324,6 +364,41 @@ fn solve_on<P: StrainParam>(
         solve_time_s,
         &mut model.workspace(),
     ))
+}
+
+/// [`solve`] on `model` with the tendons driven as `built` says ([`Built::drives`]): the
+/// tensions of the displacement-driven ones found, from the straight rod.
+fn solve_driven_on<P: StrainParam>(
+    built: &Built,
+    model: &Model<P>,
+) -> Result<StaticsReport, StaticsFailure> {
+    let t0 = Instant::now();
+    let drives = built.drives();
+    let sol = solve_driven(
+        model,
+        &built.options,
+        &drives,
+        &built.loads,
+        &gvs::solve::never_stop,
+    )
+    .map_err(|error| failure(built, &built.u, error))?;
+    let solve_time_s = t0.elapsed().as_secs_f64();
+    let mut r = report(
+        built,
+        model,
+        &sol.u,
+        &sol.statics,
+        solve_time_s,
+        &mut model.workspace(),
+    );
+    r.drives = (built.displacement.iter().zip(&sol.slack))
+        .map(|(d, &slack)| DriveReport {
+            displacement: *d,
+            slack,
+        })
+        .collect();
+    r.drive_iterations = sol.drive_iterations;
+    Ok(r)
 }
 
 /// The `--json` document: the report, the reduced model used and the comparison with the full model.

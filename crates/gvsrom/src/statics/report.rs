@@ -65,6 +65,8 @@ pub(super) fn report<P: StrainParam>(
                 center: arr3(&center),
             })
             .collect(),
+        drives: vec![],
+        drive_iterations: 0,
         iterations: sol.iterations,
         load_stages: sol.load_stages,
         residual_evaluations: sol.residual_evaluations,

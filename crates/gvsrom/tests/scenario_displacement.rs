@@ -1,0 +1,163 @@
+//! Tendons driven by their displacement through the command line (`--displacement`, the TOML's
+//! `tendons[k].displacement`): statics finds the tension, which given back as `--tension` makes
+//! the same rod; slack tendons; a reduced model driven the same way; and the refusals of the
+//! commands that drive tendons by tension only, and of impossible displacements.
+
+mod common;
+
+use common::{expect_error, f64s, gvsrom, run_json, run_ok, s as path_str, scratch, sweep_dataset};
+
+fn dist(a: &[f64], b: &[f64]) -> f64 {
+    (0..3).map(|i| (a[i] - b[i]).powi(2)).sum::<f64>().sqrt()
+}
+
+/// The IV-A arm (friction 0.88, gravity) wound in by 5 mm: its tendon is 5 mm shorter than at
+/// rest, and the tension found, given as `--tension`, makes the same rod.
+#[test]
+fn a_tendon_wound_in_is_that_much_shorter_and_its_tension_makes_the_same_rod() {
+    let (stdout, j) = run_json(
+        "statics",
+        "drive-single",
+        &["single-tendon", "--displacement", "0.005"],
+    );
+    assert!(stdout.contains("driven by displacement: wound in 5 mm"), "{stdout}");
+    assert!(stdout.contains("tensions   u = [-2.52"), "{stdout}");
+    let (rest, length) = (
+        f64s(&j["tendon_rest_lengths"])[0],
+        f64s(&j["tendon_lengths"])[0],
+    );
+    // the drive's tolerance: 1e-9 of the 0.25 m rod
+    assert!(
+        ((rest - length) - 0.005).abs() < 2.5e-10,
+        "wound in {} m",
+        rest - length
+    );
+    let u = f64s(&j["u"])[0];
+    assert_eq!(j["drives"][0]["displacement"].as_f64(), Some(0.005));
+    assert_eq!(j["drives"][0]["slack"].as_bool(), Some(false));
+    assert!(j["drive_iterations"].as_u64().unwrap() >= 1);
+    // the scenario as run records the drive
+    let toml = j["provenance"]["scenario_toml"].as_str().unwrap();
+    assert!(toml.contains("displacement = 0.005"), "{toml}");
+    let tension = format!("--tension={u}");
+    let (_, by_tension) = run_json("statics", "drive-single-u", &["single-tendon", &tension]);
+    let (a, b) = (f64s(&j["tip_position"]), f64s(&by_tension["tip_position"]));
+    assert!(dist(&a, &b) < 1e-9, "{a:?} vs {b:?}");
+    assert!(by_tension.get("drives").is_none(), "a tension-driven run has no drives");
+}
+
+/// The six-tendon arm with one tendon wound in and the others paid out: those whose paths
+/// shorten more than they were paid out pull, the others are slack (u = 0) and say so.
+#[test]
+fn paid_out_tendons_go_slack_and_are_reported() {
+    let (stdout, j) = run_json(
+        "statics",
+        "drive-six",
+        &["six-tendon", "--displacement=0.01,-0.01,0,-0.01,-0.01,-0.01"],
+    );
+    let u = f64s(&j["u"]);
+    let (rest, length) = (f64s(&j["tendon_rest_lengths"]), f64s(&j["tendon_lengths"]));
+    for k in 0..6 {
+        let asked = j["drives"][k]["displacement"].as_f64().unwrap();
+        let wound = rest[k] - length[k];
+        if j["drives"][k]["slack"].as_bool().unwrap() {
+            assert_eq!(u[k], 0.0);
+            assert!(wound > asked, "tendon {k}: its path fits ({wound} > {asked})");
+        } else {
+            assert!(u[k] < 0.0, "tendon {k} pulls: {u:?}");
+            assert!((wound - asked).abs() < 6e-10, "tendon {k}: {wound} vs {asked}");
+        }
+    }
+    assert!(u.iter().filter(|&&u| u == 0.0).count() >= 1, "{u:?}");
+    assert!(stdout.contains("slack"), "{stdout}");
+    assert!(stdout.contains("held at its rest length"), "{stdout}");
+    assert!(stdout.contains("paid out 10 mm"), "{stdout}");
+}
+
+/// A POD model of the IV-A arm's tension sweep, driven by displacement: its tension and tip are
+/// the full model's within the reduction's error.
+#[test]
+fn a_reduced_model_is_driven_by_displacement_too() {
+    let data = sweep_dataset("drive-pod-data", "-3:0", 13);
+    let model = scratch("drive-pod-model");
+    run_ok(&[
+        "pod",
+        path_str(&data),
+        "--modes",
+        "4",
+        "--out",
+        path_str(&model),
+    ]);
+    let args = ["single-tendon", "--displacement", "0.004"];
+    let (_, full) = run_json("statics", "drive-pod-full", &args);
+    let mut with_model = args.to_vec();
+    with_model.extend(["--model", path_str(&model)]);
+    let (_, reduced) = run_json("statics", "drive-pod-reduced", &with_model);
+    let (uf, ur) = (f64s(&full["u"])[0], f64s(&reduced["u"])[0]);
+    assert!(uf < -1.0 && uf > -3.0, "inside the sweep: {uf}");
+    assert!(((ur - uf) / uf).abs() < 1e-3, "tension {ur} vs {uf}");
+    let (a, b) = (f64s(&full["tip_position"]), f64s(&reduced["tip_position"]));
+    assert!(dist(&a, &b) < 2.5e-4, "tip {b:?} vs {a:?} (0.1 % L)");
+    // the reduced model's tendon is wound in by the same 4 mm
+    let wound = f64s(&reduced["tendon_rest_lengths"])[0] - f64s(&reduced["tendon_lengths"])[0];
+    assert!((wound - 0.004).abs() < 2.5e-10, "{wound}");
+}
+
+/// The commands that drive tendons by tension only refuse a displacement, naming the tendon and
+/// where its tension comes from; a tension and a displacement on one tendon, a displacement of
+/// the whole tendon and one beyond what the rod can take are refused too.
+#[test]
+fn displacements_are_refused_where_they_cannot_be_honoured() {
+    for cmd in [
+        vec!["simulate", "single-tendon", "--duration", "0.1", "--out"],
+        vec!["modes", "single-tendon"],
+        vec!["linearize", "single-tendon"],
+        vec!["dataset", "single-tendon", "--samples", "2", "--out"],
+    ] {
+        let out = scratch(&format!("drive-refused-{}", cmd[0]));
+        let mut args = cmd.clone();
+        if args.last() == Some(&"--out") {
+            args.push(path_str(&out));
+        }
+        if cmd[0] == "dataset" {
+            // `dataset` sweeps scenario values; it takes no --tension or --displacement
+            args.extend([
+                "--set",
+                "tendons.0.tension=0",
+                "--set",
+                "tendons.0.displacement=0.004",
+            ]);
+        } else {
+            args.extend(["--displacement", "0.004"]);
+        }
+        expect_error(
+            &args,
+            &[
+                "tendons[0].displacement",
+                &format!("{} drives tendons by their tension only", cmd[0]),
+                "`gvsrom statics` finds the tension",
+            ],
+        );
+        assert!(!out.exists(), "{}: nothing written", cmd[0]);
+    }
+    expect_error(
+        &["statics", "single-tendon", "--set", "tendons.0.displacement=0.01"],
+        &["tendons[0]", "both `tension` (-3 N) and `displacement` (0.01 m)"],
+    );
+    expect_error(
+        &["statics", "single-tendon", "--displacement", "0.3"],
+        &["tendons[0].displacement", "0.3", "rest length"],
+    );
+    expect_error(
+        &["statics", "single-tendon", "--displacement", "0.2"],
+        &[
+            "the tendons' displacements were not reached",
+            "reached: tendon 0 at",
+            "of the 200.0000 mm asked",
+        ],
+    );
+    let out = gvsrom(&["statics", "single-tendon", "--displacement", "0.001", "--tension", "-1"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(stderr.contains("--displacement") && stderr.contains("--tension"), "{stderr}");
+}
