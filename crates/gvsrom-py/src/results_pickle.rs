@@ -93,6 +93,8 @@ impl Statics {
             n_dof: f.get("n_dof")?,
             n_points: f.get("n_points")?,
             u: f.array("u")?,
+            slack: f.array("slack")?,
+            drive_iterations: f.get("drive_iterations")?,
             q: f.array("q")?,
             tip_position: f.array("tip_position")?,
             tip_rotation: f.array("tip_rotation")?,

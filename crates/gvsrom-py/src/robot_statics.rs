@@ -84,10 +84,16 @@ impl Robot {
     /// Parameters
     /// ----------
     /// u : array_like of float, optional
-    ///     Tensions [N] (negative pulls): one per tendon, or one for all. Default: the scenario's.
+    ///     Tensions [N] (negative pulls): one per tendon, or one for all. Default: the scenario's
+    ///     drives (its tensions, or its ``displacement`` where a tendon has one).
     /// model : Model or str or os.PathLike, optional
     ///     A reduced model to solve with (``--model``), or its directory, loaded as
     ///     ``load_model(path)`` loads it; default: this robot's.
+    /// displacement : array_like of float, optional
+    ///     Instead of ``u`` (``--displacement``): the length [m] each tendon's actuator has wound
+    ///     in from its rest length (negative pays out), one per tendon or one for all. The
+    ///     tensions are found (``Statics.u``); a tendon that would have to push goes slack
+    ///     (``Statics.slack``).
     ///
     /// Returns
     /// -------
@@ -97,20 +103,42 @@ impl Robot {
     /// Raises
     /// ------
     /// GvsromError
-    ///     For tensions of the wrong count, not finite or implausible with the loads.
+    ///     For tensions of the wrong count, not finite or implausible with the loads; for both
+    ///     ``u`` and ``displacement``, or a displacement not reached (with how far each tendon
+    ///     got).
     /// ConvergenceError
     ///     If the solve does not converge (with its iterations and residual).
     /// TypeError
     ///     If ``model`` is neither a Model nor a path.
-    #[pyo3(signature = (u=None, model=None))]
+    #[pyo3(signature = (u=None, model=None, displacement=None))]
     fn statics(
         &self,
         py: Python<'_>,
         u: Option<Tensions<'_>>,
         model: Option<&Bound<'_, PyAny>>,
+        displacement: Option<Tensions<'_>>,
     ) -> PyResult<Statics> {
         let u = u.map(|a| a.values());
         let attached = (model.map(|m| Model::attached_from(py, m, None))).transpose()?;
+        if let Some(d) = displacement {
+            if u.is_some() {
+                return Err(invalid(
+                    "`u` and `displacement` both given: a tendon is driven by its tension or by its displacement (give one)",
+                ));
+            }
+            let mut scenario = self.scenario.clone();
+            scenario
+                .scenario
+                .set_displacements(&d.values())
+                .map_err(err)?;
+            let attached = attached.as_ref().or(self.attached.as_ref());
+            let built = crate::robot::build_with(py, &scenario, attached, false)?;
+            let report = py
+                .detach(|| statics::solve_as_built(&built))
+                .map_err(errors::any)?;
+            let extrapolated = built.reduced.map(|r| r.extrapolated).unwrap_or_default();
+            return Ok(Statics::new(py, &report, extrapolated)?);
+        }
         let (report, extrapolated) = self.solve(py, u, attached.as_ref())?;
         Statics::new(py, &report, extrapolated)
     }

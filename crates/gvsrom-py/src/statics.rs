@@ -15,7 +15,12 @@ use pyo3::types::PyDict;
 /// scenario : str
 ///     The scenario's name.
 /// u : numpy.ndarray, shape (n_actuators,)
-///     Tendon tensions [N].
+///     Tendon tensions [N]: those given, and those found for tendons driven by displacement.
+/// slack : numpy.ndarray of bool, shape (n_actuators,)
+///     Which tendons driven by displacement are slack (``u = 0``, their path shorter than the
+///     tendon paid out); all ``False`` when every tendon is driven by tension.
+/// drive_iterations : int
+///     Tension updates of a displacement-driven solve (0 without displacement drives).
 /// q : numpy.ndarray, shape (n_dof,)
 ///     Generalized coordinates at equilibrium.
 /// tip_position : numpy.ndarray, shape (3,)
@@ -73,6 +78,10 @@ pub struct Statics {
     pub(crate) n_points: usize,
     /// Tendon tensions u [N].
     pub(crate) u: Py<PyAny>,
+    /// Which displacement-driven tendons are slack, `(n_actuators,)` bool.
+    pub(crate) slack: Py<PyAny>,
+    /// Tension updates of a displacement-driven solve.
+    pub(crate) drive_iterations: usize,
     /// Generalized coordinates at equilibrium.
     pub(crate) q: Py<PyAny>,
     /// Tip position in the world frame [m].
@@ -138,6 +147,16 @@ impl Statics {
             n_dof: r.n_dof,
             n_points: r.n_points,
             u: held(vector(py, &r.u))?,
+            slack: held(
+                PyArray::from_vec(
+                    py,
+                    (0..r.u.len())
+                        .map(|k| r.drives.get(k).is_some_and(|d| d.slack))
+                        .collect(),
+                )
+                .into_any(),
+            )?,
+            drive_iterations: r.drive_iterations,
             q: held(vector(py, &r.q))?,
             tip_position: held(vector(py, &r.tip_position))?,
             tip_rotation: held(shaped(py, flat(&r.tip_rotation), [3, 3])?)?,
@@ -192,6 +211,7 @@ impl Statics {
         d.set_item("n_points", self.n_points)?;
         for (k, v) in [
             ("u", &self.u),
+            ("slack", &self.slack),
             ("q", &self.q),
             ("tip_position", &self.tip_position),
             ("tip_rotation", &self.tip_rotation),
@@ -207,6 +227,7 @@ impl Statics {
         ] {
             d.set_item(k, v.bind(py))?;
         }
+        d.set_item("drive_iterations", self.drive_iterations)?;
         d.set_item("iterations", self.iterations)?;
         d.set_item("load_stages", self.load_stages)?;
         d.set_item("residual_evaluations", self.residual_evaluations)?;

@@ -20,7 +20,10 @@ fn a_tendon_wound_in_is_that_much_shorter_and_its_tension_makes_the_same_rod() {
         "drive-single",
         &["single-tendon", "--displacement", "0.005"],
     );
-    assert!(stdout.contains("driven by displacement: wound in 5 mm"), "{stdout}");
+    assert!(
+        stdout.contains("driven by displacement: wound in 5 mm"),
+        "{stdout}"
+    );
     assert!(stdout.contains("tensions   u = [-2.52"), "{stdout}");
     let (rest, length) = (
         f64s(&j["tendon_rest_lengths"])[0],
@@ -43,7 +46,10 @@ fn a_tendon_wound_in_is_that_much_shorter_and_its_tension_makes_the_same_rod() {
     let (_, by_tension) = run_json("statics", "drive-single-u", &["single-tendon", &tension]);
     let (a, b) = (f64s(&j["tip_position"]), f64s(&by_tension["tip_position"]));
     assert!(dist(&a, &b) < 1e-9, "{a:?} vs {b:?}");
-    assert!(by_tension.get("drives").is_none(), "a tension-driven run has no drives");
+    assert!(
+        by_tension.get("drives").is_none(),
+        "a tension-driven run has no drives"
+    );
 }
 
 /// The six-tendon arm with one tendon wound in and the others paid out: those whose paths
@@ -53,7 +59,10 @@ fn paid_out_tendons_go_slack_and_are_reported() {
     let (stdout, j) = run_json(
         "statics",
         "drive-six",
-        &["six-tendon", "--displacement=0.01,-0.01,0,-0.01,-0.01,-0.01"],
+        &[
+            "six-tendon",
+            "--displacement=0.01,-0.01,0,-0.01,-0.01,-0.01",
+        ],
     );
     let u = f64s(&j["u"]);
     let (rest, length) = (f64s(&j["tendon_rest_lengths"]), f64s(&j["tendon_lengths"]));
@@ -62,10 +71,16 @@ fn paid_out_tendons_go_slack_and_are_reported() {
         let wound = rest[k] - length[k];
         if j["drives"][k]["slack"].as_bool().unwrap() {
             assert_eq!(u[k], 0.0);
-            assert!(wound > asked, "tendon {k}: its path fits ({wound} > {asked})");
+            assert!(
+                wound > asked,
+                "tendon {k}: its path fits ({wound} > {asked})"
+            );
         } else {
             assert!(u[k] < 0.0, "tendon {k} pulls: {u:?}");
-            assert!((wound - asked).abs() < 6e-10, "tendon {k}: {wound} vs {asked}");
+            assert!(
+                (wound - asked).abs() < 6e-10,
+                "tendon {k}: {wound} vs {asked}"
+            );
         }
     }
     assert!(u.iter().filter(|&&u| u == 0.0).count() >= 1, "{u:?}");
@@ -141,8 +156,16 @@ fn displacements_are_refused_where_they_cannot_be_honoured() {
         assert!(!out.exists(), "{}: nothing written", cmd[0]);
     }
     expect_error(
-        &["statics", "single-tendon", "--set", "tendons.0.displacement=0.01"],
-        &["tendons[0]", "both `tension` (-3 N) and `displacement` (0.01 m)"],
+        &[
+            "statics",
+            "single-tendon",
+            "--set",
+            "tendons.0.displacement=0.01",
+        ],
+        &[
+            "tendons[0]",
+            "both `tension` (-3 N) and `displacement` (0.01 m)",
+        ],
     );
     expect_error(
         &["statics", "single-tendon", "--displacement", "0.3"],
@@ -156,8 +179,18 @@ fn displacements_are_refused_where_they_cannot_be_honoured() {
             "of the 200.0000 mm asked",
         ],
     );
-    let out = gvsrom(&["statics", "single-tendon", "--displacement", "0.001", "--tension", "-1"]);
+    let out = gvsrom(&[
+        "statics",
+        "single-tendon",
+        "--displacement",
+        "0.001",
+        "--tension",
+        "-1",
+    ]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success());
-    assert!(stderr.contains("--displacement") && stderr.contains("--tension"), "{stderr}");
+    assert!(
+        stderr.contains("--displacement") && stderr.contains("--tension"),
+        "{stderr}"
+    );
 }

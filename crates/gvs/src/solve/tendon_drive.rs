@@ -18,8 +18,9 @@
 //! attenuations met in practice. The linearized complementarity, `u' ≤ 0`, `g + S(u' − u) ≤ 0`,
 //! complementary, is `LCP(S, S u − g)` in `v = −u'` ([`super::lcp`]). Its solution is the next
 //! tensions; a step that does not lower the largest violation (or whose statics fails) is halved.
-//! Each statics solve starts from the last equilibrium in one stage and, if that fails or diverges,
-//! solves from the straight rod with the options' ramp and continuation.
+//! Each statics solve starts in one stage from the last equilibrium moved along its tangent,
+//! `q + (dq/du) Δu` with `dq/du = −(∂R/∂q)⁻¹ B_D`, and, if that fails or diverges, solves from the
+//! straight rod with the options' ramp and continuation.
 //!
 //! **Stopping rule.** Every violation — `|g_k|` of a taut tendon, `max(g_k, 0)` of a slack one —
 //! at most `max(ftol, 1e-9) · L` ([`DRIVE_TOLERANCE`], `L` the rod's length), with the statics'
@@ -143,7 +144,7 @@ pub fn solve_driven<P: StrainParam>(
             ));
         }
         iterations += 1;
-        let s = sensitivity(model, &mut solver, &at, loads, &d)?;
+        let (s, dq_du) = sensitivity(model, &mut solver, &at, loads, &d)?;
         counts.jacobians += 1;
         let u_d = DVector::from_fn(d.len(), |i, _| at.u[d[i]]);
         let c = &s * &u_d - DVector::from_column_slice(&at.g);
@@ -158,15 +159,18 @@ pub fn solve_driven<P: StrainParam>(
         let mut halvings = 0;
         at = loop {
             let mut u_try = at.u.clone();
+            // the tangent predictor q + (dq/du) Δu starts the statics solve
+            let mut q_try = at.sol.q.clone();
             for (i, &k) in d.iter().enumerate() {
                 u_try[k] = at.u[k] + alpha * (-v[i] - at.u[k]);
+                q_try.axpy(u_try[k] - at.u[k], &dq_du.column(i), 1.0);
             }
             let tried = solve_from(
                 &mut solver,
                 options,
                 &u_try,
                 loads,
-                &at.sol.q,
+                &q_try,
                 stop,
                 &mut counts,
             )?;
@@ -227,14 +231,15 @@ fn point<P: StrainParam>(
     }
 }
 
-/// `S = −∇ℓ_Dᵀ (∂R/∂q)⁻¹ B_D` at the point (the module documentation).
+/// `S = −∇ℓ_Dᵀ (∂R/∂q)⁻¹ B_D` at the point (the module documentation), and the equilibrium's
+/// tangent `dq/du_D = −(∂R/∂q)⁻¹ B_D` (n × |D|).
 fn sensitivity<P: StrainParam>(
     model: &Model<P>,
     solver: &mut StaticsSolver<'_, P>,
     at: &Point,
     loads: &Loads,
     d: &[usize],
-) -> Result<DMatrix<f64>, StaticsError> {
+) -> Result<(DMatrix<f64>, DMatrix<f64>), StaticsError> {
     let n = model.n_dof();
     let q = &at.sol.q;
     let prepared = model.prepare_loads(loads)?;
@@ -244,18 +249,17 @@ fn sensitivity<P: StrainParam>(
     let b = model.actuation_matrix(q, ws);
     let grad = model.tendon_length_jacobian(q, ws);
     let b_d = DMatrix::from_fn(n, d.len(), |i, j| b[(i, d[j])]);
-    let x = jac.lu().solve(&b_d).ok_or_else(|| {
+    let x = -jac.lu().solve(&b_d).ok_or_else(|| {
         StaticsError::Model(ModelError::invalid(
             "drives",
             "the statics Jacobian is singular at the equilibrium: the tensions' effect on the lengths is undefined",
         ))
     })?;
-    Ok(DMatrix::from_fn(d.len(), d.len(), |i, j| {
-        -grad.column(d[i]).dot(&x.column(j))
-    }))
+    let s = DMatrix::from_fn(d.len(), d.len(), |i, j| grad.column(d[i]).dot(&x.column(j)));
+    Ok((s, x))
 }
 
-/// The equilibrium under `u`: from `q` in one stage, else (a failure, or an equilibrium that
+/// The equilibrium under `u`: from `q` (the tangent predictor) in one stage, else (a failure, or an equilibrium that
 /// diverges) from the straight rod with `options`. `Ok(None)` if neither converges.
 fn solve_from<P: StrainParam>(
     solver: &mut StaticsSolver<'_, P>,

@@ -107,10 +107,7 @@ impl Built {
 }
 
 /// Tendon `k`'s displacement, if it is driven by one: finite, and not with a tension.
-fn displacement(
-    k: usize,
-    t: &crate::scenario::TendonSpec,
-) -> Result<Option<f64>, ScenarioError> {
+fn displacement(k: usize, t: &crate::scenario::TendonSpec) -> Result<Option<f64>, ScenarioError> {
     let Some(d) = t.displacement else {
         return Ok(None);
     };

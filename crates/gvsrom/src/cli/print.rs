@@ -176,8 +176,14 @@ pub(super) fn print_solution(r: &StaticsReport, out: &mut impl Write) -> Result<
             plural(r.drive_iterations, "tension update"),
             match slack.len() {
                 0 => String::new(),
-                1 => format!("; tendon {} is slack (its path is shorter than the tendon paid out)", slack[0]),
-                _ => format!("; tendons {} are slack (their paths are shorter than the tendons paid out)", slack.join(", ")),
+                1 => format!(
+                    "; tendon {} is slack (its path is shorter than the tendon paid out)",
+                    slack[0]
+                ),
+                _ => format!(
+                    "; tendons {} are slack (their paths are shorter than the tendons paid out)",
+                    slack.join(", ")
+                ),
             }
         )?;
     }
