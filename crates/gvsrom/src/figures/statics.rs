@@ -31,11 +31,21 @@ pub struct StaticsDoc {
     /// The rigid bodies (results without bodies, or written before they were recorded, have none).
     #[serde(default)]
     pub bodies: Vec<BodyDoc>,
+    /// How each tendon was driven, when one was driven by its displacement (else none).
+    #[serde(default)]
+    pub drives: Vec<DriveDoc>,
     #[serde(default)]
     pub model: Option<String>,
     /// The file by the SHA-256 of the bytes read (what `plot` records of it).
     #[serde(skip)]
     pub origin: Option<crate::provenance::DirOrigin>,
+}
+
+/// How a tendon of a statics result was driven: slack ones are drawn dashed.
+#[derive(Debug, Clone, Deserialize)]
+pub struct DriveDoc {
+    #[serde(default)]
+    pub slack: bool,
 }
 
 /// A rigid body of a statics result: its mass, where its section is and its centre of mass.
@@ -95,10 +105,12 @@ fn rod_series(doc: &StaticsDoc) -> Vec<Series3> {
     ];
     for (k, path) in doc.tendon_paths.iter().enumerate() {
         if path.len() >= 2 {
-            series.push(
-                Series3::new(format!("tendon {k}"), path.clone(), SeriesStyle::Line)
-                    .with_color(palette::EXTRA[k % 6]),
-            );
+            let slack = doc.drives.get(k).is_some_and(|d| d.slack);
+            let (name, style) = match slack {
+                true => (format!("tendon {k} (slack)"), SeriesStyle::Dashed),
+                false => (format!("tendon {k}"), SeriesStyle::Line),
+            };
+            series.push(Series3::new(name, path.clone(), style).with_color(palette::EXTRA[k % 6]));
         }
     }
     let bodies = doc.bodies.iter().enumerate().map(|(k, b)| {
