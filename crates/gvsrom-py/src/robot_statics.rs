@@ -137,7 +137,7 @@ impl Robot {
                 .detach(|| statics::solve_as_built(&built))
                 .map_err(errors::any)?;
             let extrapolated = built.reduced.map(|r| r.extrapolated).unwrap_or_default();
-            return Ok(Statics::new(py, &report, extrapolated)?);
+            return Statics::new(py, &report, extrapolated);
         }
         let (report, extrapolated) = self.solve(py, u, attached.as_ref())?;
         Statics::new(py, &report, extrapolated)
