@@ -5,7 +5,7 @@
 use super::{Subject, GRID_POINTS, MAX_BENDING, MAX_STRAIN};
 use gvs::error::fmt_value;
 use gvs::lie::V3;
-use gvs::loads::{DistributedWrench, PulseMagnitude};
+use gvs::loads::{DistributedWrench, Frame, PulseMagnitude};
 use std::f64::consts::PI;
 
 /// The estimate of one load.
@@ -164,6 +164,7 @@ pub(super) fn estimates(built: &Subject<'_>, u: &[f64], scale: f64, bound: bool)
     for (k, p) in loads.point.iter().enumerate() {
         let m = V3::from_row_slice(&p.wrench[..3]).norm();
         let f = V3::from_row_slice(&p.wrench[3..]).norm();
+        let bends = bending_force(&p.wrench, p.frame);
         let before = |s: f64| s <= p.x;
         let (theta_m, _) = integrate(&grid, |s| if before(s) { 1.0 } else { 0.0 }, |_| 0.0, true);
         let (theta_f, eps_f) = integrate(
@@ -175,7 +176,7 @@ pub(super) fn estimates(built: &Subject<'_>, u: &[f64], scale: f64, bound: bool)
         let name = wrench_name(&format!("loads.point[{k}]"), &p.wrench, "N", "N*m");
         out.push(Estimate {
             name: name + &scaled,
-            bending: mul(scale, mul(m, theta_m) + mul(f, theta_f)),
+            bending: mul(scale, mul(m, theta_m)) + force_bending(mul(scale, bends), theta_f, p.frame),
             strain: mul(scale, mul(f, eps_f)),
             strain_kind: "an axial/shear strain",
         });
@@ -188,10 +189,11 @@ pub(super) fn estimates(built: &Subject<'_>, u: &[f64], scale: f64, bound: bool)
                 x_start: a,
                 x_end: b,
                 density,
-                ..
+                frame,
             } => {
                 let m = V3::from_row_slice(&density[..3]).norm();
                 let f = V3::from_row_slice(&density[3..]).norm();
+                let bends = bending_force(&density, frame);
                 let len = |s: f64| (b - s.max(a)).max(0.0);
                 let (theta_m, _) = integrate(&grid, len, |_| 0.0, true);
                 let (theta_f, eps_f) = integrate(
@@ -209,7 +211,8 @@ pub(super) fn estimates(built: &Subject<'_>, u: &[f64], scale: f64, bound: bool)
                 let name = wrench_name(&field, &density, "N/m", "N*m/m");
                 out.push(Estimate {
                     name: name + &scaled,
-                    bending: mul(scale, mul(m, theta_m) + mul(f, theta_f)),
+                    bending: mul(scale, mul(m, theta_m))
+                        + force_bending(mul(scale, bends), theta_f, frame),
                     strain: mul(scale, mul(f, eps_f)),
                     strain_kind: "an axial/shear strain",
                 });
@@ -319,6 +322,27 @@ pub(super) fn estimates(built: &Subject<'_>, u: &[f64], scale: f64, bound: bool)
         });
     }
     out
+}
+
+/// The part of a wrench's force that bends the reference rod: a follower force's component across
+/// the section (`√(F_y² + F_z²)`: one along the local axis only stretches or compresses the rod,
+/// whatever it does), a world-fixed force's whole magnitude (its direction against the rod changes
+/// as the rod turns).
+fn bending_force(wrench: &[f64; 6], frame: Frame) -> f64 {
+    match frame {
+        Frame::Local => wrench[4].hypot(wrench[5]),
+        Frame::Global => V3::from_row_slice(&wrench[3..]).norm(),
+    }
+}
+
+/// The bending angle of a force part `f` with unit angle `theta`: `f θ`, for a world-fixed force
+/// capped at π like gravity (a dead load turns the rod at most until it lies along the load: a
+/// hanging rod pulled down along its axis does not bend).
+fn force_bending(f: f64, theta: f64, frame: Frame) -> f64 {
+    match frame {
+        Frame::Local => mul(f, theta),
+        Frame::Global => mul(f, theta).min(PI),
+    }
 }
 
 /// `field.force = [..] N`, `field.moment = [..] N*m`, or both.

@@ -15,13 +15,15 @@
 //! | load | `M_b(s)` | `N(s)` |
 //! |---|---|---|
 //! | tendon k, tension u, offset d(X) on `[a, b]` | `|u| |d(s)|` on `[a, b]` | `|u|` on `[a, b]` |
-//! | point wrench at X: force F, moment M | `|M| + |F| (X − s)` | `|F|` |
-//! | uniform density f, m on `[a, b]` | `|m| ℓ(s) + |f| ((b − s)² − (max(s, a) − s)²)/2` | `|f| ℓ(s)`, `ℓ(s) = b − max(s, a)` |
+//! | point wrench at X: force F, moment M | `|M| + |F_b| (X − s)`, its force's `θ` capped at π if world-fixed | `|F|` |
+//! | uniform density f, m on `[a, b]` | `|m| ℓ(s) + |f_b| ((b − s)² − (max(s, a) − s)²)/2`, likewise | `|f| ℓ(s)`, `ℓ(s) = b − max(s, a)` |
 //! | triangular pulse, peak m̂ | `m̂ ∫ₛᴸ tri(x) dx` | 0 |
 //! | gravity g, density ρ | `∫ₛᴸ ρ A(x) |g| (x − s) dx`, `θ` capped at π | `∫ₛᴸ ρ A(x) |g| dx` (on `EA`) |
 //! | body of mass m at X, centre of mass c | `m |g| (|c| + X − s)`, `θ` capped at π | `m |g|` (on `EA`) |
 //!
-//! (The pulse's peak is `magnitude` or `2·magnitude/width` by its convention; friction only lowers a
+//! (`F_b` is the force that bends: a follower force's component across the section, a world-fixed
+//! force whole; a world-fixed force, a dead load like gravity, turns the rod at most until it lies
+//! along it. The pulse's peak is `magnitude` or `2·magnitude/width` by its convention; friction only lowers a
 //! tendon's tension and is ignored. Gravity, a dead load, turns the rod at most until it hangs
 //! along it, so its bending counts at most π whatever the linear beam says — a soft cantilever
 //! held horizontal droops, it does not coil — and its strain is the hanging rod's stretch, `N/EA`.) The integrals are evaluated on a grid of [`GRID_POINTS`]

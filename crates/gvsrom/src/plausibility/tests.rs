@@ -84,6 +84,32 @@ fn estimates_match_linear_beam_closed_forms_on_a_uniform_rod() {
     let e = only_estimate(&b);
     assert!((e.bending - 0.01 * L * L / (2.0 * ei())).abs() < 1e-8 * e.bending);
     assert!((e.strain - 0.01 / (ea() / 3.0)).abs() < 1e-8 * e.strain);
+    // a follower force along the rod's axis only compresses it: no bending, strain F / GA
+    let b = uniform(&["loads.point.0.x=0.5", "loads.point.0.force=[-0.3, 0, 0.01]"]).unwrap();
+    let e = only_estimate(&b);
+    assert!((e.bending - 0.01 * L * L / (2.0 * ei())).abs() < 1e-8 * e.bending);
+    let f = 0.3f64.hypot(0.01);
+    assert!((e.strain - f / (ea() / 3.0)).abs() < 1e-8 * e.strain);
+    // a world-fixed force turns the rod at most until it lies along it: the linear beam's
+    // F L² / (2 EI) = 80 rad is capped at π (a hanging rod pulled down along its axis, which was
+    // refused as ~80 turns of bending); its strain still counts whole
+    let world = |force: &str| {
+        uniform(&[
+            "loads.point.0.x=0.5",
+            force,
+            "loads.point.0.frame=\"global\"",
+        ])
+    };
+    let e = only_estimate(&world("loads.point.0.force=[-5, 0, 0]").unwrap());
+    assert!(5.0 * L * L / (2.0 * ei()) > 25.0 * PI);
+    assert_eq!(e.bending, PI);
+    assert!((e.strain - 5.0 / (ea() / 3.0)).abs() < 1e-8 * e.strain);
+    // below the cap, the linear beam's angle (the whole force, whatever its direction)
+    let e = only_estimate(&world("loads.point.0.force=[0.001, 0, 0]").unwrap());
+    assert!((e.bending - 0.001 * L * L / (2.0 * ei())).abs() < 1e-8 * e.bending);
+    // a world-fixed force too large for any rod is still refused, by its strain
+    let err = world("loads.point.0.force=[-500, 0, 0]").err().unwrap().to_string();
+    assert!(err.contains("loads.point[0].force") && err.contains("strain"), "{err}");
     // gravity: θ = ρ A g L³ / (6 EI) (trapezoid on a quadratic moment: O(h²) ≈ 1e-4 relative)
     // (a tenth of Earth's, so that it turns the rod by less than π, the cap below)
     let b = uniform(&["loads.gravity=[0, 0, -0.981]"]).unwrap();
