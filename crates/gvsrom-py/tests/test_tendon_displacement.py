@@ -56,8 +56,13 @@ def test_a_scenario_driven_by_displacement_solves_so_and_refuses_dynamics():
     assert abs((eq.tendon_rest_lengths - eq.tendon_lengths)[0] - 0.004) < TOL
     with pytest.raises(gvsrom.GvsromError, match=r"tendons\[0\]\.displacement.*simulate drives tendons by their tension only"):
         robot.simulate(duration=0.01)
-    with pytest.raises(gvsrom.GvsromError, match="modes drives tendons by their tension only"):
-        robot.modes()
+    # modes hold the taut tendon at its length: one mode fewer than the free arm's
+    held = robot.modes()
+    free = gvsrom.Scenario.preset("single-tendon").build().modes(u=eq.u)
+    assert held["held_tendons"] == [0]
+    assert len(held["all_frequencies_hz"]) == len(free["all_frequencies_hz"]) - 1
+    assert held["all_frequencies_hz"][0] > free["all_frequencies_hz"][0]
+    assert free["held_tendons"] == []
     # given tensions drive by tension, as --tension does
     assert robot.statics(u=eq.u).drive_iterations == 0
 

@@ -106,15 +106,20 @@ pub struct ModeReport {
 #[derive(Debug, Clone, Serialize)]
 pub struct ModesReport {
     pub scenario: String,
-    /// Tendon tensions u \[N\] of the equilibrium.
+    /// Tendon tensions u \[N\] of the equilibrium (those found for displacement drives).
     pub u: Vec<f64>,
+    /// The tendons held at their lengths (taut and driven by displacement: their motors locked),
+    /// whose lengths the modes keep ([`Model::held_modes`]): `n_dof − held` modes. Empty when
+    /// every tendon is driven by tension.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub held_tendons: Vec<usize>,
     pub n_dof: usize,
     pub n_points: usize,
     /// The equilibrium `q₀` and its statics report's tip position and residual.
     pub q0: Vec<f64>,
     pub equilibrium_tip_position: [f64; 3],
     pub equilibrium_residual_norm: f64,
-    /// Frequencies of all `n_dof` modes, ascending \[Hz\].
+    /// Frequencies of all `n_dof` modes (`n_dof − held` with held tendons), ascending \[Hz\].
     pub all_frequencies_hz: Vec<f64>,
     /// `‖K_T − K_Tᵀ‖_F / ‖K_T‖_F`: above [`gvs::dynamics::SYMMETRY_TOLERANCE`] (tendon friction,
     /// follower loads) the modes are the eigenpairs of the non-symmetric `M⁻¹ K_T`, whose shapes
@@ -135,41 +140,49 @@ pub struct ModesReport {
 pub fn compute(built: &Built, count: usize) -> Result<(StaticsReport, ModesReport), ModesError> {
     // the modes are undamped: any damping is fine here
     crate::simulate::require_mass_only(built)?;
-    built.tension_driven_for("modes")?;
     let eq = statics::solve(built)?;
     statics::check_reduced(built, &eq)?;
+    // the taut tendons driven by displacement are held at their lengths (their motors locked)
+    let held: Vec<usize> = (0..built.displacement.len())
+        .filter(|&k| built.displacement[k].is_some() && !eq.drives.get(k).is_some_and(|d| d.slack))
+        .collect();
     let modes = match &built.reduced {
-        Some(r) => modes_on(built, &r.model, &eq, count)?,
-        None => modes_on(built, &built.model, &eq, count)?,
+        Some(r) => modes_on(built, &r.model, &eq, count, &held)?,
+        None => modes_on(built, &built.model, &eq, count, &held)?,
     };
     Ok((eq, modes))
 }
 
+/// The modes of `model` about its equilibrium `eq` (under the tensions `eq.u`, those found for
+/// displacement drives), the tendons `held` at their lengths ([`Model::held_modes`]).
 fn modes_on<P: StrainParam>(
     built: &Built,
     model: &Model<P>,
     eq: &StaticsReport,
     count: usize,
+    held: &[usize],
 ) -> Result<ModesReport, ModesError> {
     let n = model.n_dof();
     let q0 = DVector::from_column_slice(&eq.q);
     let loads = model.prepare_loads(&built.loads)?;
     let mut ws = model.workspace();
-    let raw = model.linearized_modes(&q0, &built.u, &loads, &mut ws)?;
+    let raw = model.held_modes(&q0, &eq.u, &loads, held, &mut ws)?;
 
     // Signed ω² (the engine reports 0 Hz for ω² < 0): the Rayleigh quotient with K_T = −sym(∂R/∂q),
     // which is the eigenvalue of a real eigenvector whether K_T is symmetric or not (φᵀ K φ =
     // φᵀ sym(K) φ = ω² φᵀ M φ); a complex pair's is the engine's real part. Ascending ω², so that
     // unstable directions (ω² < 0, all at 0 Hz) are ordered too.
     let mut dr = DMatrix::zeros(n, n);
-    model.statics_jacobian(&q0, &built.u, &loads, &mut ws, &mut dr);
+    model.statics_jacobian(&q0, &eq.u, &loads, &mut ws, &mut dr);
     let stiffness_asymmetry = (&dr - dr.transpose()).norm() / dr.norm();
     let kt = (&dr + dr.transpose()) * -0.5;
     // (ω², its imaginary part, φ)
     let mut raw: Vec<(f64, f64, DVector<f64>)> = raw
         .into_iter()
         .map(|m| match m.omega_squared_imag {
-            0.0 => (m.shape.dot(&(&kt * &m.shape)), 0.0, m.shape),
+            // held tendons: the constrained problem's own ω² (with friction the Rayleigh
+            // quotient of K_T is not its eigenvalue)
+            0.0 if held.is_empty() => (m.shape.dot(&(&kt * &m.shape)), 0.0, m.shape),
             im => (m.omega_squared, im, m.shape),
         })
         .collect();
@@ -259,7 +272,7 @@ fn modes_on<P: StrainParam>(
         let dominant = (0..6).fold(0, |best, c| if share[c] > share[best] { c } else { best });
         let omega_squared_imag = lam_imag[k];
         let omega_squared = match omega_squared_imag {
-            0.0 => phi.dot(&(&kt * &phi)),
+            0.0 if held.is_empty() => phi.dot(&(&kt * &phi)),
             _ => lam[k],
         };
         let f = frequency(omega_squared);
@@ -283,7 +296,8 @@ fn modes_on<P: StrainParam>(
     }
     Ok(ModesReport {
         scenario: built.name.clone(),
-        u: built.u.clone(),
+        u: eq.u.clone(),
+        held_tendons: held.to_vec(),
         n_dof: n,
         n_points: model.disc.n_points(),
         q0: eq.q.clone(),

@@ -24,6 +24,7 @@ use thiserror::Error;
 
 mod analysis;
 pub(crate) mod cholesky;
+mod held_modes;
 mod linearize;
 pub(crate) use analysis::{mass_similar, similar_modes};
 pub use analysis::{Energy, Mode, SYMMETRY_TOLERANCE};

@@ -129,9 +129,26 @@ pub(super) fn modes_cmd(args: &ModesArgs, out: &mut impl Write) -> Result<()> {
         "tip        position {} m",
         fmt_vec(&eq.tip_position, 6)
     )?;
+    if !report.held_tendons.is_empty() {
+        let held: Vec<String> = report.held_tendons.iter().map(|k| k.to_string()).collect();
+        writeln!(
+            out,
+            "held       {} {} at {} length (driven by displacement, the motor locked): {} constraint{}, tensions u = [{}] N",
+            if held.len() == 1 { "tendon" } else { "tendons" },
+            held.join(", "),
+            if held.len() == 1 { "its" } else { "their" },
+            held.len(),
+            if held.len() == 1 { "" } else { "s" },
+            (report.u.iter().map(|u| gvsrom::build::significant(*u)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )?;
+    }
+    let n_modes = report.all_frequencies_hz.len();
     writeln!(
         out,
-        "modes      lowest {count} of {n_dof}, undamped, linearized about the equilibrium; each shape by its largest share of the strain energy and its tip motion (world axes)"
+        "modes      lowest {} of {n_modes}, undamped, linearized about the equilibrium; each shape by its largest share of the strain energy and its tip motion (world axes)",
+        count.min(n_modes)
     )?;
     writeln!(
         out,

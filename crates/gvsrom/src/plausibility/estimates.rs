@@ -176,7 +176,8 @@ pub(super) fn estimates(built: &Subject<'_>, u: &[f64], scale: f64, bound: bool)
         let name = wrench_name(&format!("loads.point[{k}]"), &p.wrench, "N", "N*m");
         out.push(Estimate {
             name: name + &scaled,
-            bending: mul(scale, mul(m, theta_m)) + force_bending(mul(scale, bends), theta_f, p.frame),
+            bending: mul(scale, mul(m, theta_m))
+                + force_bending(mul(scale, bends), theta_f, p.frame),
             strain: mul(scale, mul(f, eps_f)),
             strain_kind: "an axial/shear strain",
         });

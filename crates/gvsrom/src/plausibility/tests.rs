@@ -108,8 +108,14 @@ fn estimates_match_linear_beam_closed_forms_on_a_uniform_rod() {
     let e = only_estimate(&world("loads.point.0.force=[0.001, 0, 0]").unwrap());
     assert!((e.bending - 0.001 * L * L / (2.0 * ei())).abs() < 1e-8 * e.bending);
     // a world-fixed force too large for any rod is still refused, by its strain
-    let err = world("loads.point.0.force=[-500, 0, 0]").err().unwrap().to_string();
-    assert!(err.contains("loads.point[0].force") && err.contains("strain"), "{err}");
+    let err = world("loads.point.0.force=[-500, 0, 0]")
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        err.contains("loads.point[0].force") && err.contains("strain"),
+        "{err}"
+    );
     // gravity: θ = ρ A g L³ / (6 EI) (trapezoid on a quadratic moment: O(h²) ≈ 1e-4 relative)
     // (a tenth of Earth's, so that it turns the rod by less than π, the cap below)
     let b = uniform(&["loads.gravity=[0, 0, -0.981]"]).unwrap();

@@ -1,0 +1,98 @@
+//! Vibration modes about an equilibrium with tendons *held* at their lengths: motors that drive
+//! tendons by displacement ([`crate::solve::tendon_drive`]) and are locked, so that each taut held
+//! tendon `k` keeps `ℓ_k(q)` fixed while the rod vibrates.
+//!
+//! Linearized, a held tendon is the constraint `∇ℓ_kᵀ δq = 0` whose force is its tension's change
+//! along its column of the actuation matrix, `B_k δu_k`:
+//!
+//! ```text
+//! (K_T − ω² M) δq = B_H δu,   G_Hᵀ δq = 0,   G_H = ∂ℓ_H/∂q,   K_T = −∂R/∂q
+//! ```
+//!
+//! With `N` an orthonormal basis of `null(G_Hᵀ)` (`δq = N z`) and `W` one of `null(B_Hᵀ)` (which
+//! annihilates the unknown tension changes), `(Wᵀ K_T N) z = ω² (Wᵀ M N) z`. Frictionless tendons
+//! have `B_H = G_H` ([`Model::tendon_length_jacobian`]), so `W = N` and `M_c = Nᵀ M N` is positive
+//! definite: the modes of [`Model::linearized_modes`] on the constrained coordinates, shapes
+//! `φ = N z` mass-normalized. Friction (`B_H ≠ G_H`) leaves `Wᵀ M N` non-symmetric: the modes are
+//! the eigenpairs of `(Wᵀ M N)⁻¹ (Wᵀ K_T N)`, shapes scaled to `φᵀ M φ = 1`. A held tendon adds
+//! no frequency below the free rod's: by Rayleigh's theorem (frictionless, symmetric `K_T`) each
+//! constrained `ω²_j` lies between the free `ω²_j` and `ω²_{j+m}`.
+
+use super::{cholesky_factor_in_place, mass_similar, similar_modes, DynamicsError, Mode};
+use crate::model::{Model, PreparedLoads, Workspace};
+use crate::strain::StrainParam;
+use nalgebra::{DMatrix, DVector};
+
+/// Relative difference `‖B_H − G_H‖ / ‖G_H‖` below which the held tendons are taken as
+/// frictionless (`W = N`).
+const FRICTIONLESS: f64 = 1e-12;
+
+impl<P: StrainParam> Model<P> {
+    /// Linearized undamped modes about `q0` under the tensions `u` with the tendons `held` at
+    /// their lengths (the module documentation): ascending `ω²`, `n − |held|` of them, shapes in
+    /// `q` with `φᵀ M φ = 1`. Without held tendons, [`Model::linearized_modes`].
+    pub fn held_modes(
+        &self,
+        q0: &DVector<f64>,
+        u: &[f64],
+        loads: &PreparedLoads,
+        held: &[usize],
+        ws: &mut Workspace,
+    ) -> Result<Vec<Mode>, DynamicsError> {
+        if held.is_empty() {
+            return self.linearized_modes(q0, u, loads, ws);
+        }
+        let n = self.n_dof();
+        let grad = self.tendon_length_jacobian(q0, ws);
+        let b = self.actuation_matrix(q0, ws);
+        let g_h = DMatrix::from_fn(n, held.len(), |i, j| grad[(i, held[j])]);
+        let b_h = DMatrix::from_fn(n, held.len(), |i, j| b[(i, held[j])]);
+        let mut k = DMatrix::zeros(n, n);
+        self.statics_jacobian(q0, u, loads, ws, &mut k);
+        k.neg_mut();
+        self.assemble_mass(ws);
+        let mass = ws.mass.clone();
+        let big_n = null_basis(&g_h);
+        let frictionless = (&b_h - &g_h).norm() <= FRICTIONLESS * g_h.norm();
+        let modes = if frictionless {
+            let kc = big_n.transpose() * &k * &big_n;
+            let mut l = big_n.transpose() * &mass * &big_n;
+            cholesky_factor_in_place(&mut l)?;
+            similar_modes(&kc, &mass_similar(&kc, &l), &l)?
+        } else {
+            let w = null_basis(&b_h);
+            let kc = w.transpose() * &k * &big_n;
+            let mc = w.transpose() * &mass * &big_n;
+            let a = mc.lu().solve(&kc).ok_or(DynamicsError::NonFinite {
+                what: "constrained mass matrix Wᵀ M N of the held tendons",
+            })?;
+            // `a` is no symmetric matrix: the non-symmetric path, with the identity as the factor
+            let id = DMatrix::identity(a.nrows(), a.nrows());
+            let af = faer::Mat::<f64>::from_fn(a.nrows(), a.ncols(), |i, j| a[(i, j)]);
+            similar_modes(&a, &af, &id)?
+        };
+        Ok(modes
+            .into_iter()
+            .map(|m| {
+                let mut shape = &big_n * &m.shape;
+                let scale = shape.dot(&(&mass * &shape)).sqrt();
+                if scale > 0.0 {
+                    shape /= scale;
+                }
+                Mode { shape, ..m }
+            })
+            .collect())
+    }
+}
+
+/// An orthonormal basis (n × (n − m)) of `null(Aᵀ)`, the complement of the columns of `a`
+/// (n × m, full column rank): the eigenvectors of the projector `I − A (AᵀA)⁻¹ Aᵀ` of eigenvalue 1.
+fn null_basis(a: &DMatrix<f64>) -> DMatrix<f64> {
+    let n = a.nrows();
+    let qr = a.clone().qr();
+    let q = qr.q(); // n × m, orthonormal columns spanning range(A)
+    let p = DMatrix::identity(n, n) - &q * q.transpose();
+    let eig = nalgebra::SymmetricEigen::new(p);
+    let cols: Vec<usize> = (0..n).filter(|&j| eig.eigenvalues[j] > 0.5).collect();
+    DMatrix::from_fn(n, cols.len(), |i, j| eig.eigenvectors[(i, cols[j])])
+}
