@@ -156,7 +156,7 @@ impl Statics {
                 )
                 .into_any(),
             )?,
-            drive_iterations: r.drive_iterations,
+            drive_iterations: r.drive_iterations.unwrap_or(0),
             q: held(vector(py, &r.q))?,
             tip_position: held(vector(py, &r.tip_position))?,
             tip_rotation: held(shaped(py, flat(&r.tip_rotation), [3, 3])?)?,

@@ -84,7 +84,8 @@ fn paid_out_tendons_go_slack_and_are_reported() {
         }
     }
     assert!(u.iter().filter(|&&u| u == 0.0).count() >= 1, "{u:?}");
-    assert!(stdout.contains("slack"), "{stdout}");
+    assert!(stdout.contains("carry no tension (slack"), "{stdout}");
+    assert!(j["drive_iterations"].as_u64().is_some());
     assert!(stdout.contains("held at its rest length"), "{stdout}");
     assert!(stdout.contains("paid out 10 mm"), "{stdout}");
 }
@@ -190,6 +191,34 @@ fn displacements_are_refused_where_they_cannot_be_honoured() {
         );
         assert!(!out.exists(), "{}: nothing written", cmd[0]);
     }
+    let data = scratch("drive-refused-sweep");
+    expect_error(
+        &[
+            "dataset",
+            "single-tendon",
+            "--sweep",
+            "tendons.0.displacement=0:0.01",
+            "--samples",
+            "3",
+            "--out",
+            path_str(&data),
+        ],
+        &[
+            "tendons.0.displacement=0:0.01",
+            "dataset drives tendons by their tension only",
+        ],
+    );
+    assert!(!data.exists());
+    // a displacement reached only beyond the elastic range is refused as its tension would be
+    // (single-tendon refuses a tension above ~48 N: an axial strain past 1)
+    expect_error(
+        &["statics", "single-tendon", "--displacement", "0.045"],
+        &[
+            "tendons[0].displacement",
+            "0.045 m is reached only at the tensions u = [-63.9",
+            "axial strain of ~1.3 (accepted <= 1)",
+        ],
+    );
     expect_error(
         &[
             "statics",

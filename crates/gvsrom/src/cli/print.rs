@@ -173,15 +173,15 @@ pub(super) fn print_solution(r: &StaticsReport, out: &mut impl Write) -> Result<
             (r.u.iter().map(|u| gvsrom::build::significant(*u)))
                 .collect::<Vec<_>>()
                 .join(", "),
-            plural(r.drive_iterations, "tension update"),
+            plural(r.drive_iterations.unwrap_or(0), "tension update"),
             match slack.len() {
                 0 => String::new(),
                 1 => format!(
-                    "; tendon {} is slack (its path is shorter than the tendon paid out)",
+                    "; tendon {} carries no tension (slack: its path is no longer than the tendon)",
                     slack[0]
                 ),
                 _ => format!(
-                    "; tendons {} are slack (their paths are shorter than the tendons paid out)",
+                    "; tendons {} carry no tension (slack: their paths are no longer than the tendons)",
                     slack.join(", ")
                 ),
             }

@@ -416,6 +416,14 @@ pub fn run(args: &DatasetRequest, interrupt: &AtomicUsize) -> Result<Outcome, Da
         )));
     }
     let seed = args.seed.unwrap_or(0);
+    // a plan over displacements: refused before a sample builds (with its tension, "both given")
+    if let Some(path) = (args.sweep.iter().chain(&args.grid).chain(&args.random))
+        .find(|p| p.split('=').next().unwrap_or("").ends_with("displacement"))
+    {
+        return Err(plan_err(format!(
+            "`{path}`: dataset drives tendons by their tension only (its snapshots are samples of tensions and loads); sample the tensions instead, e.g. over the range `gvsrom statics --displacement` finds for the displacements"
+        )));
+    }
     let (table, built, scenario_toml, provenance) = load_scenario(args)?;
     built
         .tension_driven_for("dataset")

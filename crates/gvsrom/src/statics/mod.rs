@@ -66,10 +66,11 @@ pub struct StaticsReport {
     /// tensions found); empty when every tendon is driven by its tension.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub drives: Vec<DriveReport>,
-    /// Tension updates of a displacement-driven solve ([`gvs::solve::tendon_drive`]); each
-    /// solves the statics again (their iterations are in `iterations`).
-    #[serde(skip_serializing_if = "is_zero")]
-    pub drive_iterations: usize,
+    /// Tension updates of a displacement-driven solve ([`gvs::solve::tendon_drive`]), `None`
+    /// (not written) when every tendon is driven by its tension; each update solves the statics
+    /// again (their iterations are in `iterations`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub drive_iterations: Option<usize>,
     /// Dogleg iterations over all load stages (and, with displacement drives, all solves).
     pub iterations: usize,
     pub load_stages: usize,
@@ -383,6 +384,7 @@ fn solve_driven_on<P: StrainParam>(
     )
     .map_err(|error| failure(built, &built.u, error))?;
     let solve_time_s = t0.elapsed().as_secs_f64();
+    plausible_tensions(built, &sol.u)?;
     let mut r = report(
         built,
         model,
@@ -397,8 +399,37 @@ fn solve_driven_on<P: StrainParam>(
             slack,
         })
         .collect();
-    r.drive_iterations = sol.drive_iterations;
+    r.drive_iterations = Some(sol.drive_iterations);
     Ok(r)
+}
+
+/// The tensions found for displacement drives, held to the bounds a tension drive is held to
+/// ([`crate::plausibility::check`]): a displacement the model reaches only beyond the rod's
+/// elastic range (an axial strain past 1) is refused naming it, as its tension would be.
+fn plausible_tensions(built: &Built, u: &[f64]) -> Result<(), StaticsFailure> {
+    let u_abs: Vec<f64> = u.iter().map(|v| v.abs()).collect();
+    let Err(e) = crate::plausibility::check(built, &u_abs, 1.0) else {
+        return Ok(());
+    };
+    let k = (0..u.len())
+        .filter(|&k| built.displacement[k].is_some())
+        .max_by(|&a, &b| u_abs[a].total_cmp(&u_abs[b]))
+        .unwrap_or(0);
+    let delta = built.displacement.get(k).copied().flatten().unwrap_or(0.0);
+    Err(StaticsFailure {
+        error: gvs::error::ModelError::invalid(
+            format!("tendons[{k}].displacement"),
+            format!(
+                "{} m is reached only at the tensions u = [{}] N: {e}",
+                crate::build::significant(delta),
+                (u.iter().map(|v| crate::build::significant(*v)))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        )
+        .into(),
+        hint: String::new(),
+    })
 }
 
 /// The `--json` document: the report, the reduced model used and the comparison with the full model.

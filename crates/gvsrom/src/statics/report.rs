@@ -66,7 +66,7 @@ pub(super) fn report<P: StrainParam>(
             })
             .collect(),
         drives: vec![],
-        drive_iterations: 0,
+        drive_iterations: None,
         iterations: sol.iterations,
         load_stages: sol.load_stages,
         residual_evaluations: sol.residual_evaluations,
