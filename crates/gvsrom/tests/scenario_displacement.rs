@@ -117,6 +117,38 @@ fn a_reduced_model_is_driven_by_displacement_too() {
     // the reduced model's tendon is wound in by the same 4 mm
     let wound = f64s(&reduced["tendon_rest_lengths"])[0] - f64s(&reduced["tendon_lengths"])[0];
     assert!((wound - 0.004).abs() < 2.5e-10, "{wound}");
+    // the drive given in the TOML: the tension it replaces is no training input to check, the
+    // displacement no physics difference
+    let (_, in_toml) = run_json(
+        "statics",
+        "drive-pod-toml",
+        &[
+            "single-tendon",
+            "--set",
+            "tendons.0.tension=0",
+            "--set",
+            "tendons.0.displacement=0.004",
+            "--model",
+            path_str(&model),
+        ],
+    );
+    assert_eq!(f64s(&in_toml["u"]), f64s(&reduced["u"]));
+    // 12 mm needs about -4.4 N, outside the sweep's [-3, 0]: refused, naming the tension found
+    expect_error(
+        &[
+            "statics",
+            "single-tendon",
+            "--displacement",
+            "0.012",
+            "--model",
+            path_str(&model),
+        ],
+        &[
+            "was not trained for the tensions these displacements need",
+            "tendons.0.tension = -4.",
+            "(found) lies outside the training inputs [-3, 0]",
+        ],
+    );
 }
 
 /// `modes` about a displacement-driven equilibrium holds its taut tendons at their lengths (the

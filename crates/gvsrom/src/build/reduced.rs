@@ -4,6 +4,7 @@
 
 use crate::error::ScenarioError;
 use crate::reduced_model::{outside_range, InputRange};
+use gvs::error::fmt_value;
 use gvs::model::Model;
 use gvs::strain::StrainParam;
 use nalgebra::DVector;
@@ -102,6 +103,37 @@ impl Reduced {
         self.extrapolated.is_empty()
             && covers(&self.input_range, u0, u)
             && self.joint.as_ref().is_none_or(|j| j.outside(u).is_none())
+    }
+
+    /// How the tensions `u` a solve found for displacement drives lie outside what training saw,
+    /// one sentence each (empty: inside): a tension outside its training range, one training held
+    /// at another value, or, each inside, their combination far from the training inputs.
+    pub fn found_tensions_outside(&self, u: &[f64]) -> Vec<String> {
+        let mut outside = vec![];
+        for (k, &v) in u.iter().enumerate() {
+            let param = format!("tendons.{k}.tension");
+            match (self.input_range.iter()).find(|r| r.parameter == param) {
+                Some(r) if !inside(r, v) => outside.push(format!(
+                    "{param} = {} (found) lies outside the training inputs [{}, {}]",
+                    super::significant(v),
+                    fmt_value(r.min),
+                    fmt_value(r.max)
+                )),
+                Some(_) => {}
+                None => match self.held_tensions.get(k) {
+                    Some(Some(h)) if !at_held(v, *h) => outside.push(format!(
+                        "{param} = {} (found), but training held it at {}",
+                        super::significant(v),
+                        fmt_value(*h)
+                    )),
+                    _ => {}
+                },
+            }
+        }
+        if let (true, Some(joint)) = (outside.is_empty(), &self.joint) {
+            outside.extend(joint.outside(u).map(|(_, why)| why));
+        }
+        outside
     }
 
     /// Checks an input signal's tensions (`u_at(t)` at `times`) against the training ranges

@@ -100,8 +100,19 @@ pub fn check(
             "it records no range of training inputs (it was written before gvsrom recorded them): re-create it with `gvsrom pod` or `gvsrom train` from its dataset".to_string(),
         );
     }
-    let signal_driven =
-        |p: &str| tensions_from_signal && p.starts_with("tendons.") && p.ends_with(".tension");
+    // a tendon driven by displacement has no tension to check here: its tension is found by the
+    // solve, and checked after it (`statics::check_reduced`)
+    let by_displacement = |k: usize| built.displacement.get(k).is_some_and(Option::is_some);
+    let tendon_of = |p: &str| -> Option<usize> {
+        p.strip_prefix("tendons.")?
+            .strip_suffix(".tension")?
+            .parse()
+            .ok()
+    };
+    let signal_driven = |p: &str| match tendon_of(p) {
+        Some(k) => tensions_from_signal || by_displacement(k),
+        None => false,
+    };
     for r in &meta.input_range {
         if signal_driven(&r.parameter) {
             continue;
@@ -119,13 +130,16 @@ pub fn check(
         }
     }
     // each input in its range: their combination against the training inputs as a whole
-    if let (true, false, Some(joint)) = (outside.is_empty(), tensions_from_signal, joint) {
+    let found = built.displacement_driven();
+    if let (true, false, false, Some(joint)) =
+        (outside.is_empty(), tensions_from_signal, found, joint)
+    {
         outside.extend(joint.outside(&built.u).map(|(_, why)| why));
     }
     let trained = trained_scenario(model)?;
     // tensions training held fixed (not inputs) must be the trained ones
     for (k, held) in held_in(&trained, &meta.input_range).into_iter().enumerate() {
-        let (Some(h), false) = (held, tensions_from_signal) else {
+        let (Some(h), false, false) = (held, tensions_from_signal, by_displacement(k)) else {
             continue;
         };
         match built.u.get(k) {
@@ -143,11 +157,14 @@ pub fn check(
         .filter_map(|r| parse_path(&r.parameter).ok())
         .collect();
     for k in 0..trained.tendons.len().max(current.tendons.len()) {
-        skip.push(vec![
-            Seg::Key("tendons".into()),
-            Seg::Index(k),
-            Seg::Key("tension".into()),
-        ]);
+        // how a tendon is driven is an input, not physics
+        for key in ["tension", "displacement"] {
+            skip.push(vec![
+                Seg::Key("tendons".into()),
+                Seg::Index(k),
+                Seg::Key(key.into()),
+            ]);
+        }
     }
     let diffs = physics_differences(&trained, &current, &skip)?;
     outside.extend(diffs.into_iter().map(|(path, there, here)| {

@@ -196,6 +196,22 @@ pub fn solve_as_built(built: &Built) -> anyhow::Result<StaticsReport> {
 /// full model.
 pub fn check_reduced(built: &Built, report: &StaticsReport) -> Result<(), ScenarioError> {
     if let Some(r) = &built.reduced {
+        // tensions found for displacement drives: inside the training inputs, as given ones
+        // must be (with --extrapolate, said when the model was attached)
+        let outside = match built.displacement_driven() && !r.extrapolate {
+            true => r.found_tensions_outside(&report.u),
+            false => vec![],
+        };
+        if !outside.is_empty() {
+            return Err(ScenarioError::invalid(
+                "--model",
+                format!(
+                    "`{}` was not trained for the tensions these displacements need: {}; pass --extrapolate to use it anyway (its answer is then an extrapolation)",
+                    r.path.display(),
+                    outside.join("; ")
+                ),
+            ));
+        }
         r.check_range(&report.q)?;
         check_not_spurious_rest(built, report)?;
     }
