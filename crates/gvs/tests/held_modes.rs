@@ -174,3 +174,26 @@ fn held_frequencies_interlace_with_the_free_ones() {
     }
     assert!(modes[0].omega_squared > free[0].omega_squared * (1.0 + 1e-3));
 }
+
+/// A tendon held twice is a dependent constraint: refused by name, not a silently wrong count of
+/// modes.
+#[test]
+fn dependent_held_tendons_are_refused() {
+    let c = case(0.0);
+    let m = &c.model;
+    let loads = m.prepare_loads(&c.loads).unwrap();
+    let e = m
+        .held_modes(&c.q, &c.u, &loads, &[0, 0], &mut m.workspace())
+        .unwrap_err();
+    assert!(
+        matches!(
+            e,
+            gvs::dynamics::DynamicsError::DependentConstraints {
+                rank: 1,
+                count: 2,
+                ..
+            }
+        ),
+        "{e}"
+    );
+}

@@ -11,7 +11,7 @@ use gvs::model::Model;
 use gvs::rod::{DivisionGeometry, Material, Rod, SectionProps};
 use gvs::solve::never_stop;
 use gvs::solve::statics::{solve_statics, StaticsError, StaticsOptions};
-use gvs::solve::tendon_drive::{solve_driven, Drive};
+use gvs::solve::tendon_drive::{solve_driven, solve_driven_within, Drive};
 use gvs::strain::{DivisionBasis, LinearBasis};
 mod common;
 
@@ -120,6 +120,29 @@ fn a_tendon_wound_in_by_delta_pulls_delta_over_its_compliance() {
     assert_eq!(sol.u[0], 0.0);
     assert!(sol.slack[0]);
     assert!(sol.statics.q.amax() < 1e-12, "q = {}", sol.statics.q);
+    // held at its rest length on the unloaded rod: at its length without tension, taut, not slack
+    let sol = drive(&m, &[Drive::Displacement(0.0)]);
+    assert_eq!(sol.u[0], 0.0);
+    assert!(!sol.slack[0]);
+    // a tension limit below the 1.77 N that 5 mm needs: refused at the limit, in a few updates
+    let e = solve_driven_within(
+        &m,
+        &StaticsOptions::default(),
+        &[Drive::Displacement(5e-3)],
+        &Loads::default(),
+        &[1.0],
+        &never_stop,
+    )
+    .unwrap_err();
+    let text = e.to_string();
+    assert!(
+        text.contains("tendon 0 needs more than its tension limit |u| = 1.0000 N"),
+        "{text}"
+    );
+    assert!(
+        matches!(e, StaticsError::DriveNotReached { iterations, .. } if iterations <= 2),
+        "{e:?}"
+    );
 }
 
 /// Two tendons at `±d` over the same span: `ℓ_0,1 = X_e (1 + a (u₀ + u₁) ± b (u₀ − u₁))` with

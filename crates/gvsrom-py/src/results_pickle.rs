@@ -93,8 +93,18 @@ impl Statics {
             n_dof: f.get("n_dof")?,
             n_points: f.get("n_points")?,
             u: f.array("u")?,
-            slack: f.array("slack")?,
-            drive_iterations: f.get("drive_iterations")?,
+            // pickles written before displacement drives lack these two: no tendon was slack
+            slack: match state.get_item("slack")? {
+                Some(a) => f.held("slack", a)?,
+                None => {
+                    let n = f.item("u")?.len()?;
+                    held(numpy::PyArray1::from_vec(state.py(), vec![false; n]).into_any())?
+                }
+            },
+            drive_iterations: match state.get_item("drive_iterations")? {
+                Some(_) => f.get("drive_iterations")?,
+                None => 0,
+            },
             q: f.array("q")?,
             tip_position: f.array("tip_position")?,
             tip_rotation: f.array("tip_rotation")?,

@@ -230,6 +230,12 @@ impl Robot {
         u: Option<Tensions<'_>>,
     ) -> PyResult<Vec<f64>> {
         let Some(u) = u else {
+            // a tendon driven by displacement has no tension until a statics finds it
+            if let Some(k) = self.built.displacement.iter().position(Option::is_some) {
+                return Err(invalid(format!(
+                    "`u`: tendons[{k}] is driven by its displacement, so this robot has no tension to use: give `u` (e.g. `robot.statics().u`, the tensions that hold the displacements)"
+                )));
+            }
             return Ok(self.built.u.clone());
         };
         let u = gvsrom::scenario::tensions_for(self.built.model.n_actuators(), &u.values())
@@ -289,10 +295,24 @@ impl Robot {
         self.built.model.disc.length()
     }
 
-    /// The scenario's tendon tensions u [N].
+    /// The scenario's tendon tensions u [N]; NaN for a tendon driven by its displacement (its
+    /// tension is found by ``statics()``).
     #[getter]
     fn tensions<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
-        arrays::vector(py, &self.built.u)
+        let u: Vec<f64> = (self.built.u.iter().zip(&self.built.displacement))
+            .map(|(&u, d)| if d.is_some() { f64::NAN } else { u })
+            .collect();
+        arrays::vector(py, &u)
+    }
+
+    /// The displacements [m] the scenario drives its tendons by (wound in from the rest length);
+    /// NaN for a tendon driven by its tension.
+    #[getter]
+    fn displacements<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        let d: Vec<f64> = (self.built.displacement.iter())
+            .map(|d| d.unwrap_or(f64::NAN))
+            .collect();
+        arrays::vector(py, &d)
     }
 
     /// Abscissae X of the computational points [m], shape ``(n_points,)``.

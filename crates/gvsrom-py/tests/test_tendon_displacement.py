@@ -65,6 +65,11 @@ def test_a_scenario_driven_by_displacement_solves_so_and_refuses_dynamics():
     assert free["held_tendons"] == []
     # given tensions drive by tension, as --tension does
     assert robot.statics(u=eq.u).drive_iterations == 0
+    # the robot has no tension for the driven tendon until a statics finds it
+    assert np.isnan(robot.tensions[0]) and robot.displacements[0] == 0.004
+    with pytest.raises(gvsrom.GvsromError, match=r"tendons\[0\] is driven by its displacement.*robot.statics\(\).u"):
+        robot.statics_residual(eq.q)
+    np.testing.assert_allclose(robot.statics_residual(eq.q, u=eq.u), 0.0, atol=1e-9)
 
 
 def test_tension_and_displacement_together_or_impossible_are_refused(robot):

@@ -2,7 +2,8 @@
 //! shape looks like: which strain component carries its strain energy, how the tip moves.
 //!
 //! The equilibrium `q₀` is solved exactly as `gvsrom statics` does ([`crate::statics::solve`]); the
-//! modes are the engine's [`Model::linearized_modes`]: `(K_T − ω² M) φ = 0` with the tangent
+//! modes are the engine's [`Model::linearized_modes`] (with tendons driven by displacement, its
+//! [`Model::held_modes`]: the taut ones held at their lengths): `(K_T − ω² M) φ = 0` with the tangent
 //! stiffness `K_T = −∂R/∂q` (elastic plus load and tendon stiffness; non-symmetric under tendon
 //! friction and follower loads, whose modes are then the eigenpairs of `M⁻¹K_T`) and mass-normalized
 //! shapes `φᵀ M φ = 1`, so that `q = q₀ + φ η` with the modal coordinate `η` [√kg·m] has kinetic energy
@@ -76,8 +77,9 @@ pub struct ModeReport {
     pub frequency_hz: f64,
     /// `1/f` \[s\]; `null` when the frequency is 0.
     pub period_s: Option<f64>,
-    /// `φᵀ K_T φ` [1/s²]; negative: the equilibrium is unstable along this shape (the real part of
-    /// a complex eigenvalue of a non-symmetric `K_T`).
+    /// `φᵀ K_T φ` [1/s²] (with held tendons the constrained problem's eigenvalue); negative: the
+    /// equilibrium is unstable along this shape (the real part of a complex eigenvalue of a
+    /// non-symmetric `K_T`).
     pub omega_squared: f64,
     /// The imaginary part of `ω²`, non-zero for a complex pair of a non-symmetric `K_T` (flutter of
     /// the undamped linearization); absent when zero.

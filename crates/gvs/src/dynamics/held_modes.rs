@@ -52,7 +52,7 @@ impl<P: StrainParam> Model<P> {
         k.neg_mut();
         self.assemble_mass(ws);
         let mass = ws.mass.clone();
-        let big_n = null_basis(&g_h);
+        let big_n = null_basis(&g_h, "length gradients ∂ℓ/∂q")?;
         let frictionless = (&b_h - &g_h).norm() <= FRICTIONLESS * g_h.norm();
         let modes = if frictionless {
             let kc = big_n.transpose() * &k * &big_n;
@@ -60,7 +60,7 @@ impl<P: StrainParam> Model<P> {
             cholesky_factor_in_place(&mut l)?;
             similar_modes(&kc, &mass_similar(&kc, &l), &l)?
         } else {
-            let w = null_basis(&b_h);
+            let w = null_basis(&b_h, "actuation columns B")?;
             let kc = w.transpose() * &k * &big_n;
             let mc = w.transpose() * &mass * &big_n;
             let a = mc.lu().solve(&kc).ok_or(DynamicsError::NonFinite {
@@ -86,13 +86,29 @@ impl<P: StrainParam> Model<P> {
 }
 
 /// An orthonormal basis (n × (n − m)) of `null(Aᵀ)`, the complement of the columns of `a`
-/// (n × m, full column rank): the eigenvectors of the projector `I − A (AᵀA)⁻¹ Aᵀ` of eigenvalue 1.
-fn null_basis(a: &DMatrix<f64>) -> DMatrix<f64> {
-    let n = a.nrows();
+/// (n × m): the eigenvectors of the projector `I − Q Qᵀ` of eigenvalue 1, `Q` the orthonormal
+/// factor of `A`. Columns of `a` dependent to 1e-10 (a diagonal of `R` that small against the
+/// largest), or more of them than rows, are [`DynamicsError::DependentConstraints`] (`what`).
+fn null_basis(a: &DMatrix<f64>, what: &'static str) -> Result<DMatrix<f64>, DynamicsError> {
+    let (n, m) = a.shape();
     let qr = a.clone().qr();
+    let r = qr.r();
+    let big = (0..m.min(n)).map(|i| r[(i, i)].abs()).fold(0.0, f64::max);
+    let rank = (0..m.min(n))
+        .filter(|&i| r[(i, i)].abs() > 1e-10 * big)
+        .count();
+    if rank < m || m >= n {
+        return Err(DynamicsError::DependentConstraints {
+            what,
+            rank,
+            count: m,
+        });
+    }
     let q = qr.q(); // n × m, orthonormal columns spanning range(A)
     let p = DMatrix::identity(n, n) - &q * q.transpose();
     let eig = nalgebra::SymmetricEigen::new(p);
     let cols: Vec<usize> = (0..n).filter(|&j| eig.eigenvalues[j] > 0.5).collect();
-    DMatrix::from_fn(n, cols.len(), |i, j| eig.eigenvectors[(i, cols[j])])
+    Ok(DMatrix::from_fn(n, cols.len(), |i, j| {
+        eig.eigenvectors[(i, cols[j])]
+    }))
 }

@@ -40,6 +40,14 @@ pub enum DynamicsError {
     MassNotPositiveDefinite { pivot: usize, value: f64 },
     #[error("non-finite value in the {what}")]
     NonFinite { what: &'static str },
+    /// Held tendons whose constraints are dependent (two along one path, or more held tendons
+    /// than a reduced model has coordinates): the constrained modes are undefined.
+    #[error("the held tendons' {what} are dependent (rank {rank} of {count}): two held tendons along one path, or more held tendons than the model has coordinates")]
+    DependentConstraints {
+        what: &'static str,
+        rank: usize,
+        count: usize,
+    },
 }
 
 /// Points per blocked product in [`Model::assemble_mass`].

@@ -105,7 +105,7 @@ pub enum StaticsError {
         continuation: ContinuationOutcome,
     },
     /// Tendons driven by displacement ([`super::tendon_drive`]) did not reach their lengths.
-    #[error("the tendons' displacements were not reached after {iterations} tension updates: the largest length error is {length_error:.3e} m (tolerance {tolerance:.1e} m); {reason}")]
+    #[error("the tendons' displacements were not reached after {iterations} tension update{}: the largest length error is {length_error:.3e} m (tolerance {tolerance:.1e} m); {reason}", if *iterations == 1 { "" } else { "s" })]
     DriveNotReached {
         iterations: usize,
         length_error: f64,

@@ -56,6 +56,22 @@ pub use state::{
 };
 pub use verdict::{check, largest_load};
 
+/// The largest tension `|u_k|` \[N\] each tendon may carry on its own before [`check`] refuses
+/// it (`∞` for a tendon whose estimate vanishes): where the rod leaves its elastic range. A
+/// displacement drive stops there (`gvs::solve::tendon_drive::solve_driven_within`).
+pub fn tension_limits<'a>(subject: impl Into<Subject<'a>>) -> Vec<f64> {
+    let subject = subject.into();
+    let n = subject.model.n_actuators();
+    estimates::estimates(&subject, &vec![1.0; n], 1.0, false)
+        .iter()
+        .take(n)
+        .map(|e| match e.severity() {
+            s if s > 0.0 => 1.0 / s,
+            _ => f64::INFINITY,
+        })
+        .collect()
+}
+
 use gvs::loads::Loads;
 use gvs::model::Model;
 use gvs::strain::LinearBasis;

@@ -8,15 +8,17 @@ use gvs::model::Model;
 use gvs::solve::statics::{
     ContinuationOutcome, StaticsError, StaticsOptions, StaticsSolver, MAX_RAMP_STEPS,
 };
-use gvs::solve::tendon_drive::solve_driven;
 use gvs::strain::StrainParam;
 use nalgebra::DVector;
 use serde::Serialize;
 use std::time::Instant;
 
 mod batch;
+mod drive;
 mod report;
 pub use batch::{along_chain, solve_batch, warm_or_ramp, WARM_MAX_ITERATIONS};
+use drive::solve_driven_on;
+pub use drive::DriveReport;
 use report::report;
 pub use report::BodyPosition;
 
@@ -103,16 +105,6 @@ pub struct StaticsReport {
 
 fn is_zero(n: &usize) -> bool {
     *n == 0
-}
-
-/// How a tendon was driven ([`StaticsReport::drives`]).
-#[derive(Debug, Clone, Serialize, PartialEq)]
-pub struct DriveReport {
-    /// The displacement δ \[m\] it was wound in by (negative: paid out), or `None` if it was
-    /// driven by its tension.
-    pub displacement: Option<f64>,
-    /// A displacement-driven tendon whose path is shorter than the tendon: slack, `u = 0`.
-    pub slack: bool,
 }
 
 /// How the arc-length continuation reached the equilibrium ([`gvs::solve::continuation`]).
@@ -213,7 +205,10 @@ pub fn check_reduced(built: &Built, report: &StaticsReport) -> Result<(), Scenar
             ));
         }
         r.check_range(&report.q)?;
-        check_not_spurious_rest(built, report)?;
+        // held tendons may lock a reduced model straight: no sign of a spurious root there
+        if !built.displacement_driven() {
+            check_not_spurious_rest(built, report)?;
+        }
     }
     Ok(())
 }
@@ -383,71 +378,6 @@ fn solve_on<P: StrainParam>(
     ))
 }
 
-/// [`solve`] on `model` with the tendons driven as `built` says ([`Built::drives`]): the
-/// tensions of the displacement-driven ones found, from the straight rod.
-fn solve_driven_on<P: StrainParam>(
-    built: &Built,
-    model: &Model<P>,
-) -> Result<StaticsReport, StaticsFailure> {
-    let t0 = Instant::now();
-    let drives = built.drives();
-    let sol = solve_driven(
-        model,
-        &built.options,
-        &drives,
-        &built.loads,
-        &gvs::solve::never_stop,
-    )
-    .map_err(|error| failure(built, &built.u, error))?;
-    let solve_time_s = t0.elapsed().as_secs_f64();
-    plausible_tensions(built, &sol.u)?;
-    let mut r = report(
-        built,
-        model,
-        &sol.u,
-        &sol.statics,
-        solve_time_s,
-        &mut model.workspace(),
-    );
-    r.drives = (built.displacement.iter().zip(&sol.slack))
-        .map(|(d, &slack)| DriveReport {
-            displacement: *d,
-            slack,
-        })
-        .collect();
-    r.drive_iterations = Some(sol.drive_iterations);
-    Ok(r)
-}
-
-/// The tensions found for displacement drives, held to the bounds a tension drive is held to
-/// ([`crate::plausibility::check`]): a displacement the model reaches only beyond the rod's
-/// elastic range (an axial strain past 1) is refused naming it, as its tension would be.
-fn plausible_tensions(built: &Built, u: &[f64]) -> Result<(), StaticsFailure> {
-    let u_abs: Vec<f64> = u.iter().map(|v| v.abs()).collect();
-    let Err(e) = crate::plausibility::check(built, &u_abs, 1.0) else {
-        return Ok(());
-    };
-    let k = (0..u.len())
-        .filter(|&k| built.displacement[k].is_some())
-        .max_by(|&a, &b| u_abs[a].total_cmp(&u_abs[b]))
-        .unwrap_or(0);
-    let delta = built.displacement.get(k).copied().flatten().unwrap_or(0.0);
-    Err(StaticsFailure {
-        error: gvs::error::ModelError::invalid(
-            format!("tendons[{k}].displacement"),
-            format!(
-                "{} m is reached only at the tensions u = [{}] N: {e}",
-                crate::build::significant(delta),
-                (u.iter().map(|v| crate::build::significant(*v)))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ),
-        )
-        .into(),
-        hint: String::new(),
-    })
-}
-
 /// The `--json` document: the report, the reduced model used and the comparison with the full model.
 #[derive(Debug, Serialize)]
 pub struct StaticsJson<'a> {
@@ -525,6 +455,22 @@ pub fn compare(built: &Built, hom: &StaticsReport, rom: &StaticsReport) -> Compa
 /// The engine's error with, for a non-convergence, the largest load and a remedy.
 fn failure(built: &Built, u: &[f64], error: StaticsError) -> StaticsFailure {
     let mut hint = String::new();
+    if let StaticsError::DriveNotReached { .. } = error {
+        let asked: Vec<String> = (built.displacement.iter().enumerate())
+            .filter_map(|(k, d)| {
+                d.map(|d| {
+                    format!(
+                        "tendons[{k}].displacement = {} m",
+                        crate::build::significant(d)
+                    )
+                })
+            })
+            .collect();
+        hint.push_str(&format!(
+            "; asked: {} (lower it, or drive by tension)",
+            asked.join(", ")
+        ));
+    }
     if let StaticsError::NotConverged {
         continuation,
         ref reason,
