@@ -242,7 +242,13 @@ pub fn solve_driven_within<P: StrainParam>(
                     iterations,
                     &at,
                     tol,
-                    format!("no tension update lowered the length error, down to a step of {alpha:.1e} of the Newton step (a displacement beyond what the rod can take, or an equilibrium the statics cannot reach)"),
+                    format!(
+                        "no tension update lowered the length error, down to a step of {alpha:.1e} of the Newton step ({})",
+                        match d.len() > model.n_dof() {
+                            true => format!("the model has {} coordinates for {} tendons held at their lengths: a reduced model holds at most as many tendons taut as it has coordinates", model.n_dof(), d.len()),
+                            false => "a displacement beyond what the rod can take, or an equilibrium the statics cannot reach".into(),
+                        }
+                    ),
                     (&d, &asked),
                 ));
             }
