@@ -217,8 +217,8 @@ pub fn solve_driven_within<P: StrainParam>(
             // the tangent predictor q + (dq/du) Δu starts the statics solve
             let mut q_try = at.sol.q.clone();
             for (i, &k) in d.iter().enumerate() {
-                let target = (-v[i]).max(-limits[k]);
-                u_try[k] = at.u[k] + alpha * (target - at.u[k]);
+                let u_next = (-v[i]).max(-limits[k]);
+                u_try[k] = at.u[k] + alpha * (u_next - at.u[k]);
                 q_try.axpy(u_try[k] - at.u[k], &dq_du.column(i), 1.0);
             }
             let tried = solve_from(
