@@ -167,6 +167,12 @@ pub trait Actuation {
     fn observe(&self, _t: f64, _q: &[f64], _qd: &[f64]) -> Result<(), String> {
         Ok(())
     }
+    /// Per channel, whether it is the displacement `δ_k(t)` \[m\] of a tendon's motor rather than
+    /// a tension ([`crate::solve::dynamics::drive`]); empty (the default) when every channel is a
+    /// tension. [`crate::solve::dynamics::drive::DisplacementDriven`] marks channels so.
+    fn displacement_driven(&self) -> &[bool] {
+        &[]
+    }
 }
 
 impl Actuation for Signal {

@@ -294,6 +294,7 @@ mod tests {
                 friction_smoothing: crate::actuation::DEFAULT_FRICTION_SMOOTHING,
                 turns: 0.0,
                 path: Vec::new(),
+                axial_stiffness: None,
             },
             Tendon {
                 offset_start: [0.006, -0.002],
@@ -304,6 +305,7 @@ mod tests {
                 friction_smoothing: crate::actuation::DEFAULT_FRICTION_SMOOTHING,
                 turns: 0.0,
                 path: Vec::new(),
+                axial_stiffness: None,
             },
         ]
     }

@@ -83,16 +83,28 @@ impl<P: StrainParam> Model<P> {
         let mut b = DMatrix::zeros(n, na);
         let mut u = vec![0.0; na];
         let mut col = DVector::zeros(n);
-        for k in 0..na {
+        self.actuation_matrix_after_forward(ws, &mut b, &mut u, &mut col);
+        b
+    }
+
+    /// [`Self::actuation_matrix`] into `b` (n × n_actuators) after a forward pass at `q`, with
+    /// `u` (n_actuators) and `col` (n) as scratch: allocates nothing.
+    pub fn actuation_matrix_after_forward(
+        &self,
+        ws: &mut Workspace,
+        b: &mut DMatrix<f64>,
+        u: &mut [f64],
+        col: &mut DVector<f64>,
+    ) {
+        for k in 0..self.n_actuators() {
             u.fill(0.0);
             u[k] = 1.0;
             ws.y.iter_mut().for_each(|y| *y = V6::zeros());
-            self.tendon_forces(&u, ws, false);
+            self.tendon_forces(u, ws, false);
             col.fill(0.0);
-            self.project(ws, &mut col);
-            b.set_column(k, &col);
+            self.project(ws, col);
+            b.set_column(k, col);
         }
-        b
     }
 
     /// The Coriolis and centrifugal force `C(q, q̇) q̇ = Σ_i W_i J_iᵀ (Ms_i ζ_i + coad_{η_i} Ms_i η_i)`

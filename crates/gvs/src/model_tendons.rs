@@ -42,15 +42,38 @@ impl<P: StrainParam> Model<P> {
             .collect()
     }
 
+    /// Each tendon's compliance `c_k = ℓ_k,rest / EA_k` \[m/N\]: its stretch per newton of
+    /// tension, `ℓ_k,rest` from [`Self::tendon_rest_lengths`] and `EA_k` its
+    /// [`crate::actuation::Tendon::axial_stiffness`] (0 for an inextensible tendon). The thread
+    /// counted is its span along the rod; a free length up to the motor stretches too and folds
+    /// into `EA` (the compliance of the whole line is `ℓ_total / EA`).
+    pub fn tendon_compliances(&self) -> Vec<f64> {
+        let rest = self.tendon_rest_lengths();
+        (self.tendons.iter().zip(rest))
+            .map(|(t, l)| t.axial_stiffness.map_or(0.0, |ea| l / ea))
+            .collect()
+    }
+
     /// `∂ℓ/∂q` (n × tendons): column `k` is `∇_q ℓ_k = Σ_i w_{k,i} Ψ_q,iᵀ Φ_a,k(X_i)`, the
     /// frictionless tendon's column of the actuation matrix (the module documentation). Leaves the
     /// forward pass at `q` in `ws` ([`Self::tendon_lengths_after_forward`] reads the lengths).
     pub fn tendon_length_jacobian(&self, q: &DVector<f64>, ws: &mut Workspace) -> DMatrix<f64> {
-        let (n, na) = (self.n_dof(), self.n_actuators());
+        let mut jac = DMatrix::zeros(self.n_dof(), self.n_actuators());
+        let mut col = DVector::zeros(self.n_dof());
         // the strains and their tangents Ψ_q that `project` needs (as `actuation_matrix`)
         self.forward(q, ws, false);
-        let mut jac = DMatrix::zeros(n, na);
-        let mut col = DVector::zeros(n);
+        self.tendon_length_jacobian_after_forward(ws, &mut jac, &mut col);
+        jac
+    }
+
+    /// [`Self::tendon_length_jacobian`] into `jac` (n × tendons) after a forward pass at `q`,
+    /// with `col` (n) as scratch: allocates nothing.
+    pub fn tendon_length_jacobian_after_forward(
+        &self,
+        ws: &mut Workspace,
+        jac: &mut DMatrix<f64>,
+        col: &mut DVector<f64>,
+    ) {
         for (k, td) in self.tendons.iter().enumerate() {
             ws.y.iter_mut().for_each(|y| *y = V6::zeros());
             for (&i, &w) in self.tendon_points[k].iter().zip(&self.tendon_weights[k]) {
@@ -61,10 +84,9 @@ impl<P: StrainParam> Model<P> {
                 ws.y[i] += tendon_local(&ws.xi[i], &d, &dp).phi_a * w;
             }
             col.fill(0.0);
-            self.project(ws, &mut col);
-            jac.set_column(k, &col);
+            self.project(ws, col);
+            jac.set_column(k, col);
         }
-        jac
     }
 
     /// `Σ_i w_{k,i} ‖t_u(X_i)‖` of tendon `k` with the strain `xi(i)` at point `i`.

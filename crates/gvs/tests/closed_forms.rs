@@ -86,6 +86,7 @@ fn straight_tendon(d: [f64; 2], l: f64, mu: f64) -> Tendon {
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns: 0.0,
         path: Vec::new(),
+        axial_stiffness: None,
     }
 }
 
@@ -628,6 +629,7 @@ fn rotating_base_and_gravity_together_leaves_equilibrium_unchanged() {
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns: 0.0,
         path: Vec::new(),
+        axial_stiffness: None,
     };
     let m = model(
         rod.clone(),
@@ -691,6 +693,7 @@ fn planar_loading_keeps_out_of_plane_coordinates_exactly_zero() {
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns: 0.0,
         path: Vec::new(),
+        axial_stiffness: None,
     };
     let m = model(rod, 30, legendre([Some(3); 6]), vec![tendon], &[]);
     let loads = Loads {
@@ -849,6 +852,7 @@ fn helical_tendon_twists_and_bends_a_straight_rod_as_its_cut_wrench_says() {
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns: n,
         path: Vec::new(),
+        axial_stiffness: None,
     };
     let m = model(
         Rod::tapered(mat(e, 0.0), l, r, r),
@@ -898,6 +902,7 @@ fn helical_tendon_with_friction_loses_tension_by_the_capstan_law_of_its_helix() 
         friction_smoothing: 0.0,
         turns: n,
         path: Vec::new(),
+        axial_stiffness: None,
     };
     let material = Material {
         youngs_modulus: e,

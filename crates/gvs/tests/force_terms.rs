@@ -47,6 +47,7 @@ fn tendon_model() -> Model<LinearBasis> {
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns: 0.0,
         path: Vec::new(),
+        axial_stiffness: None,
     };
     Model::new(
         rod,

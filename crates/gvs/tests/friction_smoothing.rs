@@ -42,6 +42,7 @@ fn arm(friction_smoothing: f64) -> Model<LinearBasis> {
         friction_smoothing,
         turns: 0.0,
         path: Vec::new(),
+        axial_stiffness: None,
     };
     Model::new(rod, disc, basis, vec![tendon]).unwrap()
 }

@@ -16,6 +16,11 @@ use nalgebra::{DMatrix, DVector};
 mod common;
 
 fn arm(friction: f64) -> Model<LinearBasis> {
+    arm_with(friction, None)
+}
+
+/// [`arm`] with tendon 0's axial stiffness `ea0`.
+fn arm_with(friction: f64, ea0: Option<f64>) -> Model<LinearBasis> {
     let tendon = |d0: [f64; 2], d1: [f64; 2]| Tendon {
         offset_start: d0,
         offset_end: d1,
@@ -25,9 +30,13 @@ fn arm(friction: f64) -> Model<LinearBasis> {
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns: 0.0,
         path: Vec::new(),
+        axial_stiffness: None,
     };
     let tendons = vec![
-        tendon([0.0, 0.01], [0.0, 0.003]),
+        Tendon {
+            axial_stiffness: ea0,
+            ..tendon([0.0, 0.01], [0.0, 0.003])
+        },
         tendon([0.008, 0.0], [0.003, 0.0]),
         tendon([0.0, -0.01], [0.0, -0.003]),
     ];
@@ -45,7 +54,10 @@ struct Case {
 }
 
 fn case(friction: f64) -> Case {
-    let model = arm(friction);
+    case_with(arm(friction))
+}
+
+fn case_with(model: Model<LinearBasis>) -> Case {
     let loads = Loads {
         gravity: [0.0, 0.0, -9.81],
         ..Loads::default()
@@ -75,6 +87,11 @@ fn case(friction: f64) -> Case {
 
 /// `ω²` of `M⁻¹ (K_T + κ B_H G_Hᵀ)` by nalgebra's general eigenvalues, ascending by real part.
 fn spring_held(c: &Case, kappa: f64) -> Vec<f64> {
+    spring_held_each(c, &vec![kappa; c.held.len()])
+}
+
+/// [`spring_held`] with the stiffness `kappa[i]` on held tendon `i`.
+fn spring_held_each(c: &Case, kappa: &[f64]) -> Vec<f64> {
     let m = &c.model;
     let n = m.n_dof();
     let mut ws = m.workspace();
@@ -84,7 +101,7 @@ fn spring_held(c: &Case, kappa: f64) -> Vec<f64> {
     k.neg_mut();
     let b = m.actuation_matrix(&c.q, &mut ws);
     let g = m.tendon_length_jacobian(&c.q, &mut ws);
-    for &h in &c.held {
+    for (&h, &kappa) in c.held.iter().zip(kappa) {
         k += b.column(h) * g.column(h).transpose() * kappa;
     }
     let mass = m.mass_matrix(&c.q, &mut ws);
@@ -196,4 +213,41 @@ fn dependent_held_tendons_are_refused() {
         ),
         "{e}"
     );
+}
+
+/// An elastic held tendon (EA = 30 N: stiffness `1/c = EA/ℓ_rest` ≈ 120 N/m) is the spring it
+/// is, not a constraint: with tendon 0 elastic and tendon 1 inextensible, the held modes are
+/// `n − 1` and match the spring-held rod with `κ₀ = 1/c₀` and a stiff `κ₁`, with friction too.
+#[test]
+fn an_elastic_held_tendon_is_its_own_spring() {
+    for friction in [0.0, 0.88] {
+        let c = case_with(arm_with(friction, Some(30.0)));
+        let modes = held(&c);
+        let n = c.model.n_dof();
+        assert_eq!(
+            modes.len(),
+            n - 1,
+            "only the inextensible tendon constrains"
+        );
+        let c0 = c.model.tendon_compliances()[0];
+        assert!((c0 - c.model.tendon_rest_lengths()[0] / 30.0).abs() < 1e-15);
+        let springs = spring_held_each(&c, &[1.0 / c0, 1e9]);
+        let rigid = spring_held(&c, 1e9);
+        for (j, mode) in modes.iter().take(6).enumerate() {
+            let rel = (mode.omega_squared - springs[j]).abs() / springs[j].abs();
+            assert!(
+                rel < 1e-4,
+                "friction {friction}, mode {j}: held ω² = {} vs spring-held {} ({rel:e})",
+                mode.omega_squared,
+                springs[j]
+            );
+        }
+        // the thread's give is felt: the first mode sits well below the inextensible one's
+        assert!(
+            modes[0].omega_squared < rigid[0] * 0.99,
+            "friction {friction}: {} vs {}",
+            modes[0].omega_squared,
+            rigid[0]
+        );
+    }
 }

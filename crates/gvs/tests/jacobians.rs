@@ -178,6 +178,7 @@ fn single_division_model(order: MagnusOrder, friction: f64) -> Model<LinearBasis
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
             turns: 0.0,
             path: Vec::new(),
+            axial_stiffness: None,
         },
         Tendon {
             offset_start: [0.006, -0.002],
@@ -188,6 +189,7 @@ fn single_division_model(order: MagnusOrder, friction: f64) -> Model<LinearBasis
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
             turns: 0.0,
             path: Vec::new(),
+            axial_stiffness: None,
         },
         // a span inside the division, ending on the weight-0 extra point at 0.1: its points
         // share the span by their cells (`Model::tendon_weights`), that extra point included
@@ -200,6 +202,7 @@ fn single_division_model(order: MagnusOrder, friction: f64) -> Model<LinearBasis
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
             turns: 0.0,
             path: Vec::new(),
+            axial_stiffness: None,
         },
     ];
     Model::new(rod, disc, basis, tendons).unwrap()
@@ -323,6 +326,7 @@ fn statics_jacobian_matches_finite_differences_two_divisions_half_tendon() {
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
             turns: 0.0,
             path: Vec::new(),
+            axial_stiffness: None,
         },
         Tendon {
             offset_start: [0.01, 0.0173],
@@ -333,6 +337,7 @@ fn statics_jacobian_matches_finite_differences_two_divisions_half_tendon() {
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
             turns: 0.0,
             path: Vec::new(),
+            axial_stiffness: None,
         },
     ];
     let m = Model::new(rod, disc, basis, tendons).unwrap();
@@ -366,6 +371,7 @@ fn statics_jacobian_matches_finite_differences_for_nonlinear_sigmoid_basis() {
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns: 0.0,
         path: Vec::new(),
+        axial_stiffness: None,
     }];
     let m = Model::new(rod, disc, p, tendons).unwrap();
     let q = DVector::from_vec(vec![1.1, 8.0, 0.45]);

@@ -65,6 +65,7 @@ fn arm(basis: DivisionBasis) -> Model<LinearBasis> {
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns: 0.0,
         path: Vec::new(),
+        axial_stiffness: None,
     };
     // a second tendon on a custom path: its offset is interpolated at every evaluation
     let knots = vec![[0.0, 0.0, -0.01], [0.1, 0.004, -0.004], [0.25, 0.0, -0.003]];
@@ -73,6 +74,7 @@ fn arm(basis: DivisionBasis) -> Model<LinearBasis> {
         offset_end: [0.0, -0.003],
         friction: 0.3,
         path: knots,
+        axial_stiffness: None,
         ..t.clone()
     };
     // an off-centre payload at the tip and a disc at an extra point: their inertia, inertial

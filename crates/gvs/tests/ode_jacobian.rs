@@ -42,6 +42,7 @@ fn model() -> Model<LinearBasis> {
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
             turns: 0.0,
             path: Vec::new(),
+            axial_stiffness: None,
         },
         Tendon {
             offset_start: [0.006, -0.002],
@@ -52,6 +53,7 @@ fn model() -> Model<LinearBasis> {
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
             turns: 0.0,
             path: Vec::new(),
+            axial_stiffness: None,
         },
     ];
     common::iva_rod_3d(1e4, 10, &[], tendons)

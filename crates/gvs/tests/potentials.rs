@@ -42,6 +42,7 @@ fn skew_tendon() -> Tendon {
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns: 0.0,
         path: Vec::new(),
+        axial_stiffness: None,
     }
 }
 

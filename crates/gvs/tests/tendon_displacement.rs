@@ -64,6 +64,7 @@ fn straight_tendon(d: f64) -> Tendon {
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns: 0.0,
         path: Vec::new(),
+        axial_stiffness: None,
     }
 }
 
@@ -143,6 +144,43 @@ fn a_tendon_wound_in_by_delta_pulls_delta_over_its_compliance() {
         matches!(e, StaticsError::DriveNotReached { iterations, .. } if iterations <= 2),
         "{e:?}"
     );
+}
+
+/// An elastic thread (axial stiffness `EA_t`) stretches by `c_t |u|`, `c_t = X_e / EA_t`
+/// ([`Model::tendon_compliances`]): wound in by `δ`, the path is `X_e − δ + c_t |u|` long, so the
+/// tendon pulls `u = −δ / (X_e (1/EA + d²/EI) + c_t)`, the rod and the thread springs in series;
+/// paid out it is slack, as the inextensible one.
+#[test]
+fn an_elastic_tendon_wound_in_pulls_through_rod_and_thread_in_series() {
+    let d = 0.005;
+    let ea_t = 150.0;
+    let m = two_division_rod(vec![Tendon {
+        axial_stiffness: Some(ea_t),
+        ..straight_tendon(d)
+    }]);
+    let (a, b) = compliances(d);
+    let c_t = XE / ea_t;
+    assert!((m.tendon_compliances()[0] - c_t).abs() < 1e-15);
+    // the thread is as compliant as the rod here: a quarter to three quarters of δ is stretch
+    assert!(c_t > 0.3 * XE * (a + b) && c_t < 3.0 * XE * (a + b));
+    for delta in [1e-4, 3e-3] {
+        let sol = drive(&m, &[Drive::Displacement(delta)]);
+        let exact = -delta / (XE * (a + b) + c_t);
+        assert!(
+            ((sol.u[0] - exact) / exact).abs() < 1e-8,
+            "δ = {delta}: u = {} vs {exact}",
+            sol.u[0]
+        );
+        let length = m.tendon_lengths(&sol.statics.q, &mut m.workspace())[0];
+        let stretched = XE - delta - c_t * sol.u[0];
+        assert!(
+            (length - stretched).abs() <= 1e-9 * 0.25,
+            "δ = {delta}: ℓ = {length} vs {stretched}"
+        );
+    }
+    let sol = drive(&m, &[Drive::Displacement(-1e-3)]);
+    assert_eq!(sol.u[0], 0.0);
+    assert!(sol.slack[0]);
 }
 
 /// Two tendons at `±d` over the same span: `ℓ_0,1 = X_e (1 + a (u₀ + u₁) ± b (u₀ − u₁))` with
@@ -226,6 +264,7 @@ fn displacements_of_a_tension_driven_equilibrium_give_back_its_tensions() {
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns,
         path: Vec::new(),
+        axial_stiffness: None,
     };
     let tendons = vec![
         tendon([0.0, 0.01], [0.0, 0.003], 0.0),

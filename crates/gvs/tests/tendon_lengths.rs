@@ -84,6 +84,7 @@ fn tendon(d0: [f64; 2], d1: [f64; 2], xs: f64, xe: f64) -> Tendon {
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns: 0.0,
         path: Vec::new(),
+        axial_stiffness: None,
     }
 }
 

@@ -74,6 +74,7 @@ fn hom(damping: f64) -> Model<LinearBasis> {
         friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
         turns: 0.0,
         path: Vec::new(),
+        axial_stiffness: None,
     };
     Model::new(rod, disc, basis, vec![tendon]).unwrap()
 }

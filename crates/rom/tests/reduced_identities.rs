@@ -124,6 +124,7 @@ fn tendons() -> Vec<Tendon> {
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
             turns: 0.0,
             path: Vec::new(),
+            axial_stiffness: None,
         },
         // first division only, frictionless
         Tendon {
@@ -135,6 +136,7 @@ fn tendons() -> Vec<Tendon> {
             friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
             turns: 0.0,
             path: Vec::new(),
+            axial_stiffness: None,
         },
     ]
 }

@@ -79,6 +79,14 @@ pub struct Tendon {
     /// `turns`.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub path: Vec<[f64; 3]>,
+    /// Axial stiffness `EA` \[N\] of the thread (Young's modulus times its section: 20 kN for a
+    /// 0.5 mm Dyneema line, 30 kN for a 0.45 mm steel wire); `None` (the default) for an
+    /// inextensible tendon. It matters only for a tendon driven by its displacement: a tension `u`
+    /// stretches it by `c |u|` with the compliance `c = ℓ_rest / EA`
+    /// ([`crate::model::Model::tendon_compliances`]), and in dynamics that spring is what carries
+    /// the motor's displacement to the rod ([`crate::solve::dynamics::drive`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axial_stiffness: Option<f64>,
 }
 
 impl Tendon {
@@ -178,6 +186,15 @@ impl Tendon {
             None,
             "a finite curvature scale >= 0 in rad/m",
         )?;
+        if let Some(ea) = self.axial_stiffness {
+            check_range(
+                &f("axial_stiffness"),
+                ea,
+                Some((0.0, false)),
+                None,
+                "a finite axial stiffness EA > 0 in N (omit it for an inextensible tendon)",
+            )?;
+        }
         check_range(
             &f("turns"),
             self.turns,

@@ -17,6 +17,11 @@
 //! the eigenpairs of `(Wᵀ M N)⁻¹ (Wᵀ K_T N)`, shapes scaled to `φᵀ M φ = 1`. A held tendon adds
 //! no frequency below the free rod's: by Rayleigh's theorem (frictionless, symmetric `K_T`) each
 //! constrained `ω²_j` lies between the free `ω²_j` and `ω²_{j+m}`.
+//!
+//! An elastic held tendon (axial stiffness `EA_k`, compliance `c_k = ℓ_k,rest / EA_k`,
+//! [`Model::tendon_compliances`]) is no constraint but a spring: its tension changes by
+//! `δu_k = −∇ℓ_kᵀ δq / c_k`, which adds `B_k ∇ℓ_kᵀ / c_k` to `K_T` (as in the dynamics,
+//! [`crate::solve::dynamics::drive`]); only the inextensible held tendons constrain `δq`.
 
 use super::{cholesky_factor_in_place, mass_similar, similar_modes, DynamicsError, Mode};
 use crate::model::{Model, PreparedLoads, Workspace};
@@ -29,8 +34,9 @@ const FRICTIONLESS: f64 = 1e-12;
 
 impl<P: StrainParam> Model<P> {
     /// Linearized undamped modes about `q0` under the tensions `u` with the tendons `held` at
-    /// their lengths (the module documentation): ascending `ω²`, `n − |held|` of them, shapes in
-    /// `q` with `φᵀ M φ = 1`. Without held tendons, [`Model::linearized_modes`].
+    /// their lengths (the module documentation): ascending `ω²`, `n − m` of them (`m` the
+    /// inextensible held tendons; an elastic one is a spring), shapes in `q` with `φᵀ M φ = 1`.
+    /// Without held tendons, [`Model::linearized_modes`].
     pub fn held_modes(
         &self,
         q0: &DVector<f64>,
@@ -45,15 +51,24 @@ impl<P: StrainParam> Model<P> {
         let n = self.n_dof();
         let grad = self.tendon_length_jacobian(q0, ws);
         let b = self.actuation_matrix(q0, ws);
-        let g_h = DMatrix::from_fn(n, held.len(), |i, j| grad[(i, held[j])]);
-        let b_h = DMatrix::from_fn(n, held.len(), |i, j| b[(i, held[j])]);
+        let compliance = self.tendon_compliances();
+        let (elastic, rigid): (Vec<usize>, Vec<usize>) =
+            held.iter().partition(|&&k| compliance[k] > 0.0);
+        let g_h = DMatrix::from_fn(n, rigid.len(), |i, j| grad[(i, rigid[j])]);
+        let b_h = DMatrix::from_fn(n, rigid.len(), |i, j| b[(i, rigid[j])]);
         let mut k = DMatrix::zeros(n, n);
         self.statics_jacobian(q0, u, loads, ws, &mut k);
         k.neg_mut();
+        for &e in &elastic {
+            k.ger(1.0 / compliance[e], &b.column(e), &grad.column(e), 1.0);
+        }
         self.assemble_mass(ws);
         let mass = ws.mass.clone();
         let big_n = null_basis(&g_h, "length gradients ∂ℓ/∂q")?;
-        let frictionless = (&b_h - &g_h).norm() <= FRICTIONLESS * g_h.norm();
+        // every held column frictionless: the springs' share is symmetric, W = N
+        let frictionless = held.iter().all(|&h| {
+            (b.column(h) - grad.column(h)).norm() <= FRICTIONLESS * grad.column(h).norm()
+        });
         let modes = if frictionless {
             let kc = big_n.transpose() * &k * &big_n;
             let mut l = big_n.transpose() * &mass * &big_n;
@@ -86,11 +101,14 @@ impl<P: StrainParam> Model<P> {
 }
 
 /// An orthonormal basis (n × (n − m)) of `null(Aᵀ)`, the complement of the columns of `a`
-/// (n × m): the eigenvectors of the projector `I − Q Qᵀ` of eigenvalue 1, `Q` the orthonormal
+/// (n × m; the identity for none): the eigenvectors of the projector `I − Q Qᵀ` of eigenvalue 1, `Q` the orthonormal
 /// factor of `A`. Columns of `a` dependent to 1e-10 (a diagonal of `R` that small against the
 /// largest), or more of them than rows, are [`DynamicsError::DependentConstraints`] (`what`).
 fn null_basis(a: &DMatrix<f64>, what: &'static str) -> Result<DMatrix<f64>, DynamicsError> {
     let (n, m) = a.shape();
+    if m == 0 {
+        return Ok(DMatrix::identity(n, n));
+    }
     let qr = a.clone().qr();
     let r = qr.r();
     let big = (0..m.min(n)).map(|i| r[(i, i)].abs()).fold(0.0, f64::max);

@@ -9,7 +9,11 @@
 //!
 //! taut (`u_k < 0`) at exactly its length, or slack (`u_k = 0`) with the thread's path shorter
 //! than the tendon paid out (one at its length without tension is taut at zero tension, not
-//! slack: [`Model::held_modes`] holds it).
+//! slack: [`Model::held_modes`] holds it). An elastic tendon (axial stiffness `EA_k`,
+//! [`crate::actuation::Tendon::axial_stiffness`]) stretches under its tension: its length is
+//! `ℓ*_k + c_k |u_k|` with the compliance `c_k = ℓ_k,rest / EA_k`
+//! ([`Model::tendon_compliances`]), so `g_k = ℓ_k(q) − ℓ*_k + c_k u_k` and `∂g/∂u = S + diag(c)`
+//! below; an inextensible one has `c_k = 0`.
 //!
 //! **The iteration** (Newton on the tensions, with the statics solver inside). At the equilibrium
 //! `q(u)`, the tensions' effect on the lengths is `S = ∂ℓ_D/∂u_D = −∇ℓ_Dᵀ (∂R/∂q)⁻¹ B_D`, from
@@ -133,8 +137,10 @@ pub fn solve_driven_within<P: StrainParam>(
         });
     }
     let rest = model.tendon_rest_lengths();
+    let compliance = model.tendon_compliances();
     let mut d = vec![]; // the displacement-driven actuators
     let mut target = vec![];
+    let mut stretch = vec![];
     let mut asked = vec![];
     let mut u = vec![0.0; na];
     for (k, drive) in drives.iter().enumerate() {
@@ -155,6 +161,7 @@ pub fn solve_driven_within<P: StrainParam>(
                 }
                 d.push(k);
                 target.push(rest[k] - delta);
+                stretch.push(compliance[k]);
                 asked.push(delta);
             }
         }
@@ -164,7 +171,12 @@ pub fn solve_driven_within<P: StrainParam>(
     let mut counts = Counts::default();
     let first = solver.solve_interruptible(&u, loads, None, stop)?;
     counts.add(&first);
-    let mut at = point(model, &mut solver, first, u, &d, &target);
+    let tendons = Driven {
+        d: &d,
+        target: &target,
+        compliance: &stretch,
+    };
+    let mut at = point(model, &mut solver, first, u, &tendons);
     let mut iterations = 0;
     while at.violation > tol {
         if iterations == MAX_DRIVE_ITERATIONS {
@@ -193,6 +205,10 @@ pub fn solve_driven_within<P: StrainParam>(
         }
         iterations += 1;
         let (mut s, dq_du) = sensitivity(model, &mut solver, &at, loads, &d)?;
+        // an elastic tendon stretches by c_k |u_k|: `∂g/∂u = S + diag(c)`
+        for (i, c) in stretch.iter().enumerate() {
+            s[(i, i)] += c;
+        }
         // a relative 1e-10 on the diagonal: a compliance only semi-definite (a reduced model with
         // fewer coordinates than pulling tendons, two tendons along one path) still has a solution
         // the pivoting finds, the tension shared by the regularization
@@ -231,7 +247,7 @@ pub fn solve_driven_within<P: StrainParam>(
                 &mut counts,
             )?;
             if let Some(sol) = tried {
-                let next = point(model, &mut solver, sol, u_try, &d, &target);
+                let next = point(model, &mut solver, sol, u_try, &tendons);
                 if next.violation < at.violation {
                     break next;
                 }
@@ -276,17 +292,27 @@ pub fn solve_driven_within<P: StrainParam>(
     })
 }
 
-/// The tendons' lengths, their errors and the largest violation at the equilibrium `sol` under `u`.
+/// The displacement-driven tendons: their actuators, unstretched lengths `ℓ*_k` and compliances.
+struct Driven<'a> {
+    d: &'a [usize],
+    target: &'a [f64],
+    compliance: &'a [f64],
+}
+
+/// The tendons' lengths, their errors `g_k = ℓ_k(q) − ℓ*_k + c_k u_k` (the path against the
+/// tendon stretched by its tension) and the largest violation at the equilibrium `sol` under `u`.
 fn point<P: StrainParam>(
     model: &Model<P>,
     solver: &mut StaticsSolver<'_, P>,
     sol: StaticsSolution,
     u: Vec<f64>,
-    d: &[usize],
-    target: &[f64],
+    tendons: &Driven<'_>,
 ) -> Point {
     let lengths = model.tendon_lengths(&sol.q, solver.workspace());
-    let g: Vec<f64> = d.iter().zip(target).map(|(&k, t)| lengths[k] - t).collect();
+    let d = tendons.d;
+    let g: Vec<f64> = (d.iter().zip(tendons.target).zip(tendons.compliance))
+        .map(|((&k, t), c)| lengths[k] - t + c * u[k])
+        .collect();
     let violation = d
         .iter()
         .zip(&g)

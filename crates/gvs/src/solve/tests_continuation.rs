@@ -165,6 +165,7 @@ fn six_tendon() -> Model<crate::strain::LinearBasis> {
                 friction_smoothing: DEFAULT_FRICTION_SMOOTHING,
                 turns: 0.0,
                 path: Vec::new(),
+                axial_stiffness: None,
             }
         })
         .collect();

@@ -138,5 +138,6 @@ pub fn iva_tendon(friction: f64) -> gvs::actuation::Tendon {
         friction_smoothing: gvs::actuation::DEFAULT_FRICTION_SMOOTHING,
         turns: 0.0,
         path: Vec::new(),
+        axial_stiffness: None,
     }
 }

@@ -69,6 +69,20 @@ impl Built {
         self.displacement.iter().any(Option::is_some)
     }
 
+    /// Per tendon, whether it is driven by its displacement.
+    pub fn drive_flags(&self) -> Vec<bool> {
+        self.displacement.iter().map(Option::is_some).collect()
+    }
+
+    /// The actuation channels of a run under the scenario's drives: each tendon's tension \[N\],
+    /// or the displacement \[m\] its motor has wound in where it is driven by one
+    /// (`gvs::solve::dynamics::drive`).
+    pub fn channels(&self) -> Vec<f64> {
+        (self.u.iter().zip(&self.displacement))
+            .map(|(&u, d)| d.unwrap_or(u))
+            .collect()
+    }
+
     /// Refuses a scenario with a displacement-driven tendon for `what` (a command that drives
     /// tendons by tension only): the error names the tendon and how to find its tension.
     pub fn tension_driven_for(&self, what: &str) -> Result<(), ScenarioError> {

@@ -126,6 +126,7 @@ pub(super) fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, Scen
             "(helical turns about the rod's axis over the span; 0 = oblique)",
         )?,
         path: Vec::new(),
+        axial_stiffness: t.axial_stiffness,
     };
     // |d(X)| is convex along the span and r(X) linear per division: checking the span's ends and
     // the division junctions inside it covers the whole path.
@@ -262,6 +263,7 @@ fn path_tendon(
         friction_smoothing,
         turns: 0.0,
         path: path.to_vec(),
+        axial_stiffness: t.axial_stiffness,
     };
     tendon.validate_path(rod, k)?;
     Ok(tendon)

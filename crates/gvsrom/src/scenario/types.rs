@@ -264,6 +264,12 @@ pub struct TendonSpec {
     /// (`gvs::solve::tendon_drive`). Not written when absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub displacement: Option<f64>,
+    /// Axial stiffness `EA` \[N\] of the thread (`gvs::actuation::Tendon::axial_stiffness`);
+    /// absent for an inextensible tendon. A tendon driven by `displacement` stretches by
+    /// `ℓ_rest |u| / EA` under its tension; `simulate` needs it for such a tendon (the stretch is
+    /// the spring through which the motor moves the rod). Not written when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axial_stiffness: Option<f64>,
 }
 
 /// Gravity, point wrenches and distributed wrenches.

@@ -9,7 +9,9 @@
 //! (the rigid bodies' weights at their centres of mass, and their inertia in `M`, `gvs::bodies`)
 //!
 //! (spec §9.4; a frictionless tendon's generalized force is `B u` with `B = ∂ℓ/∂qᵀ`, the gradient
-//! of `u·ℓ`, so its potential is `−u·ℓ`). The integrators are implicit and dissipate a little of it;
+//! of `u·ℓ`, so its potential is `−u·ℓ`). A tendon driven by a constant displacement is a spring
+//! (`gvs::solve::dynamics::drive`): its term is the energy its thread stores,
+//! `½ max(0, ℓ_k − ℓ*_k)² / c_k` ([`ThreadSprings`]), in place of `−u_k ℓ_k`. The integrators are implicit and dissipate a little of it;
 //! one that *adds* energy is wrong in a way the samples do not show — an undamped rod falling
 //! under gravity was integrated at +2.6 J of a possible 0.4 J, with every sample written and the
 //! run reported complete. The balance is measured at every sample and reported with the run.
@@ -107,6 +109,34 @@ pub fn not_conservative(built: &Built, scheduled: bool) -> Option<&'static str> 
     }
 }
 
+/// The threads of tendons driven by constant displacements: per tendon whether it is driven, its
+/// unstretched length `ℓ*_k = ℓ_k,rest − δ_k` \[m\] and its compliance `c_k` \[m/N\].
+pub struct ThreadSprings {
+    driven: Vec<bool>,
+    target: Vec<f64>,
+    compliance: Vec<f64>,
+}
+
+impl ThreadSprings {
+    /// The threads of `model`'s tendons `driven` at the displacements `channels[k]` \[m\].
+    pub fn new<P: StrainParam>(model: &Model<P>, driven: &[bool], channels: &[f64]) -> Self {
+        let rest = model.tendon_rest_lengths();
+        ThreadSprings {
+            driven: driven.to_vec(),
+            target: (rest.iter().zip(channels)).map(|(l, d)| l - d).collect(),
+            compliance: model.tendon_compliances(),
+        }
+    }
+
+    /// The energy the threads store at the path lengths `lengths` \[J\].
+    fn energy(&self, lengths: &[f64]) -> f64 {
+        (0..self.driven.len())
+            .filter(|&k| self.driven[k] && self.compliance[k] > 0.0)
+            .map(|k| (lengths[k] - self.target[k]).max(0.0).powi(2) / (2.0 * self.compliance[k]))
+            .sum()
+    }
+}
+
 /// Measures `E` at each sample of a conservative run; stops measuring (and reports nothing) once
 /// the tensions change, since they then do work.
 pub(super) struct EnergyMonitor {
@@ -117,10 +147,12 @@ pub(super) struct EnergyMonitor {
     u0: Option<Vec<f64>>,
     balance: Option<EnergyBalance>,
     changed_input: bool,
+    /// The threads of the tendons driven by constant displacements.
+    springs: Option<ThreadSprings>,
 }
 
 impl EnergyMonitor {
-    pub(super) fn new<P: StrainParam>(model: &Model<P>) -> Self {
+    pub(super) fn new<P: StrainParam>(model: &Model<P>, springs: Option<ThreadSprings>) -> Self {
         let n = model.n_dof();
         EnergyMonitor {
             ws: model.workspace(),
@@ -130,6 +162,7 @@ impl EnergyMonitor {
             u0: None,
             balance: None,
             changed_input: false,
+            springs,
         }
     }
 
@@ -143,9 +176,11 @@ impl EnergyMonitor {
         if self.changed_input {
             return;
         }
+        // a driven tendon's tension follows its stretch: only the given tensions must hold
+        let driven = |k: usize| self.springs.as_ref().is_some_and(|s| s.driven[k]);
         match &self.u0 {
             None => self.u0 = Some(s.u.to_vec()),
-            Some(u0) if u0.as_slice() != s.u => {
+            Some(u0) if (0..u0.len()).any(|k| !driven(k) && u0[k] != s.u[k]) => {
                 self.changed_input = true;
                 return;
             }
@@ -156,8 +191,12 @@ impl EnergyMonitor {
         let e = model.energy(&self.q, &self.qd, gravity, &mut self.ws);
         // `energy` left the forward pass at q in the workspace
         model.tendon_lengths_after_forward(&self.ws, &mut self.lengths);
-        let tendons: f64 = (s.u.iter().zip(&self.lengths)).map(|(u, l)| u * l).sum();
-        let total = e.total() - tendons;
+        let tendons: f64 = (s.u.iter().zip(&self.lengths).enumerate())
+            .filter(|(k, _)| !driven(*k))
+            .map(|(_, (u, l))| u * l)
+            .sum();
+        let threads = self.springs.as_ref().map_or(0.0, |s| s.energy(&self.lengths));
+        let total = e.total() - tendons + threads;
         if !(total.is_finite() && e.kinetic.is_finite()) {
             return;
         }

@@ -258,7 +258,7 @@ pub fn input_signal(built: &Built, opts: &SimulateOptions) -> Result<Signal, Sce
         ));
     }
     Ok(match &opts.input {
-        InputSource::Constant => Signal::constant(&built.u),
+        InputSource::Constant => Signal::constant(&built.channels()),
         InputSource::Csv {
             path,
             interpolation,
@@ -365,6 +365,11 @@ pub fn input_record(
         }))
     };
     let mut signal = match &opts.input {
+        InputSource::Constant if built.displacement_driven() => json!({
+            "signal": "constant",
+            "tensions": built.u,
+            "displacements": built.displacement,
+        }),
         InputSource::Constant => json!({"signal": "constant", "tensions": built.u}),
         InputSource::Csv {
             path,
@@ -415,12 +420,22 @@ pub fn input_record(
         Start::Equilibrium => {
             signal["start"] = json!("equilibrium");
             signal["start_tensions"] = json!(built.u);
+            if built.displacement_driven() {
+                signal["start_displacements"] = json!(built.displacement);
+            }
         }
         Start::State { q, qd } => {
             signal["start"] = json!("state");
             signal["start_q"] = json!(q);
             signal["start_qd"] = json!(qd);
         }
+    }
+    // which channels are displacements [m] of their tendons' motors, not tensions
+    if built.displacement_driven() {
+        let driven: Vec<usize> = (0..built.displacement.len())
+            .filter(|&k| built.displacement[k].is_some())
+            .collect();
+        signal["displacement_channels"] = json!(driven);
     }
     signal["load_schedule"] = match &opts.load_schedule {
         Some(path) => file("--load-schedule", path)?,

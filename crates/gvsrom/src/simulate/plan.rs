@@ -126,6 +126,24 @@ impl Plan {
     }
 }
 
+impl Plan {
+    /// The threads of the tendons driven by displacement, when every such displacement is
+    /// constant over the run (an input signal, not a function): their springs then store energy
+    /// and do no work, and the run's energy balance holds with them
+    /// ([`super::energy::ThreadSprings`]).
+    pub fn constant_displacements(&self, built: &Built) -> Option<super::energy::ThreadSprings> {
+        if !built.displacement_driven() || self.function.is_some() {
+            return None;
+        }
+        let first = self.signal.values.first()?;
+        let driven = built.drive_flags();
+        let constant = self.signal.values.iter().all(|row| {
+            (row.iter().zip(first).zip(&driven)).all(|((a, b), &d)| !d || a == b)
+        });
+        constant.then(|| super::energy::ThreadSprings::new(&built.model, &driven, first))
+    }
+}
+
 /// A linear input signal is checked against a model's training inputs at this many points per
 /// segment between knots (the knots included).
 const SEGMENT_CHECKS: usize = 16;
@@ -134,7 +152,7 @@ const MAX_SIGNAL_CHECKS: usize = 100_000;
 
 /// Validates `opts` against `built` and builds the [`Plan`] of the run.
 pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError> {
-    built.tension_driven_for("simulate")?;
+    check_drives(built, opts)?;
     let t_out = sample_times(opts.duration, opts.sample_rate)?;
     // a controller's instants are output samples (checked before anything is computed)
     let function = match &opts.input {
@@ -283,7 +301,14 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
             model_extrapolated.push(sentence);
         }
     }
-    let u_max = crate::csv_input::max_abs_per_column(&signal);
+    check_displacements(built, opts, &signal)?;
+    // a displacement channel is no tension: its tension is found as the run goes
+    let mut u_max = crate::csv_input::max_abs_per_column(&signal);
+    for (u, d) in u_max.iter_mut().zip(&built.displacement) {
+        if d.is_some() {
+            *u = 0.0;
+        }
+    }
     let lambda_max = schedule
         .as_ref()
         .map(|s| crate::csv_input::max_abs_per_column(s)[0])
@@ -323,7 +348,9 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
         // reduced model: from its anchors, and checked against its training encodings), not the
         // engine's ramp from rest, which a decoder can lead to a spurious root
         Start::Equilibrium => {
-            let report = crate::statics::solve_checked(built, &built.u).map_err(|e| {
+            // under the scenario's drives: where a tendon is driven by its displacement, the
+            // equilibrium of its elastic thread at that displacement (the run's own rest)
+            let report = crate::statics::solve_as_built(built).map_err(|e| {
                 ScenarioError::invalid(
                     "--from-equilibrium",
                     format!("the start, the static equilibrium under the scenario's tensions and loads, failed: {e:#}"),
@@ -347,6 +374,90 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
         model_extrapolated,
         function,
     })
+}
+
+/// A run with tendons driven by their displacement (`tendons[k].displacement`; the law in
+/// `gvs::solve::dynamics::drive`): each such tendon needs its thread's axial stiffness (an
+/// inextensible one is a constraint the integrators do not impose), the full model runs it (a
+/// reduced model was trained on tensions), and its input channel is a displacement, which random
+/// tension steps and babbling are not.
+fn check_drives(built: &Built, opts: &SimulateOptions) -> Result<(), ScenarioError> {
+    let Some(first) = built.displacement.iter().position(Option::is_some) else {
+        return Ok(());
+    };
+    if let Some(r) = &built.reduced {
+        return Err(ScenarioError::invalid(
+            format!("tendons[{first}].displacement"),
+            format!(
+                "`{}` runs tendons driven by their tension only in dynamics (it was trained on tensions, and the tensions a displacement needs are known only as the run goes); run the full model, or give the tension (`gvsrom statics --model` finds the one that holds this displacement at rest)",
+                r.path.display()
+            ),
+        ));
+    }
+    for (k, d) in built.displacement.iter().enumerate() {
+        if d.is_some() && built.model.tendons[k].axial_stiffness.is_none() {
+            return Err(ScenarioError::invalid(
+                format!("tendons[{k}].axial_stiffness"),
+                "missing: in dynamics a tendon driven by its displacement is an elastic thread whose stretch carries the motor's displacement to the rod; give its axial stiffness EA in N (Young's modulus times the thread's section: about 20000 for a 0.5 mm Dyneema line) — an inextensible tendon held at its length is a constraint the integrators do not impose",
+            ));
+        }
+    }
+    match &opts.input {
+        InputSource::Steps { .. } | InputSource::Babble { .. } => {
+            let option = match &opts.input {
+                InputSource::Steps { .. } => "--steps",
+                _ => "--babble",
+            };
+            Err(ScenarioError::invalid(
+                option,
+                format!(
+                    "random tension steps drive every tendon by its tension, but tendons[{first}] is driven by its displacement; give the displacements over time as --input (a CSV whose column k is tendon k's displacement in m, or its tension in N for a tendon driven by tension)"
+                ),
+            ))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// The displacements of a signal's driven channels at its knots: finite, and shorter than the
+/// tendon (a motor cannot wind a tendon in by its whole length, nor pay out as much).
+fn check_displacements(
+    built: &Built,
+    opts: &SimulateOptions,
+    signal: &Signal,
+) -> Result<(), ScenarioError> {
+    let function = matches!(
+        opts.input,
+        InputSource::Function(_) | InputSource::Feedback { .. }
+    );
+    if !built.displacement_driven() || function {
+        return Ok(());
+    }
+    let rest = built.model.tendon_rest_lengths();
+    let option = match &opts.input {
+        InputSource::Csv { .. } => "--input",
+        InputSource::Rows(_) => "input",
+        _ => "displacement",
+    };
+    for (t, row) in signal.times.iter().zip(&signal.values) {
+        for (k, (&v, d)) in row.iter().zip(&built.displacement).enumerate() {
+            if d.is_some() && !(v.is_finite() && v.abs() < rest[k]) {
+                let field = match option {
+                    "displacement" => format!("tendons[{k}].displacement"),
+                    o => format!("{o} (column {k}, t = {t} s)"),
+                };
+                return Err(ScenarioError::value(
+                    field,
+                    v,
+                    format!(
+                        "a displacement in m within ±{:.6} m, the tendon's rest length",
+                        rest[k]
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The given start `(q, q̇)` of a run ([`Start::State`]) as the integrator's initial state: `n`

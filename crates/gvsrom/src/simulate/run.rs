@@ -5,8 +5,10 @@ use super::energy::{not_conservative, EnergyBalance, EnergyMonitor};
 use super::plan::*;
 use crate::build::Built;
 use crate::error::ScenarioError;
+use gvs::inputs::Actuation;
 use gvs::lie::Pose;
 use gvs::model::Model;
+use gvs::solve::dynamics::drive::DisplacementDriven;
 use gvs::solve::dynamics::InitialState;
 use gvs::solve::dynamics::{
     simulate_streaming_interruptible, IntegratorOptions, RunSummary, Sample, SimulationError,
@@ -199,8 +201,9 @@ pub fn run_into(
     let mut energy = not_conservative(built, plan.schedule.is_some())
         .is_none()
         .then(|| match &built.reduced {
-            Some(r) => EnergyMonitor::new(&r.model),
-            None => EnergyMonitor::new(&built.model),
+            Some(r) => EnergyMonitor::new(&r.model, None),
+            // constant displacements keep the threads' springs conservative
+            None => EnergyMonitor::new(&built.model, plan.constant_displacements(built)),
         });
     let mut sink = |s: &Sample<'_>| {
         // a state no elastic rod holds (a diverged integration, a load the estimate underrated)
@@ -249,10 +252,16 @@ pub fn run_into(
     if let Some(r) = &built.reduced {
         check_start_mass(&r.model, &plan.initial)?;
     }
+    // the channels of tendons driven by displacement are their motors' displacements
+    let driven = DisplacementDriven::new(plan.actuation(), built.drive_flags());
+    let actuation: &dyn Actuation = match built.displacement_driven() {
+        true => &driven,
+        false => plan.actuation(),
+    };
     let summary = match &built.reduced {
         Some(r) => simulate_streaming_interruptible(
             &r.model,
-            plan.actuation(),
+            actuation,
             &built.loads,
             plan.schedule.as_ref(),
             &plan.initial,
@@ -263,7 +272,7 @@ pub fn run_into(
         ),
         None => simulate_streaming_interruptible(
             &built.model,
-            plan.actuation(),
+            actuation,
             &built.loads,
             plan.schedule.as_ref(),
             &plan.initial,

@@ -25,7 +25,11 @@ use nalgebra::DVector;
 use std::ops::ControlFlow;
 use std::time::Instant;
 
+pub mod drive;
 mod regime;
+#[cfg(test)]
+mod tests_drive;
+use drive::TendonSprings;
 pub use regime::{
     damping_regime, method_for_rod, ndf_for_regime, ndf_for_rod, DampingRegime, LIGHT_DAMPING_RTOL,
 };
@@ -116,7 +120,8 @@ pub struct Trajectory {
     pub t: Vec<f64>,
     pub q: Vec<DVector<f64>>,
     pub qd: Vec<DVector<f64>>,
-    /// Actuation at each sample.
+    /// Tensions at each sample: the actuation's, and a displacement-driven tendon's from its
+    /// stretch ([`drive`]).
     pub u: Vec<Vec<f64>>,
     pub tip: Vec<Pose>,
     /// Strain `ξ` at the computational points at each sample (point-major).
@@ -167,6 +172,8 @@ struct RodOde<'m, P: StrainParam> {
     qd: DVector<f64>,
     qdd: DVector<f64>,
     jacobian: OdeJacobian,
+    /// The displacement-driven tendons' springs ([`drive`]), `None` when every channel is a tension.
+    springs: Option<TendonSprings>,
     /// Polled before every step attempt ([`simulate_streaming_interruptible`]).
     stop: &'m StopCheck<'m>,
 }
@@ -190,9 +197,20 @@ impl<P: StrainParam> OdeSystem for RodOde<'_, P> {
         let n = self.model.n_dof();
         self.q.copy_from(&y.rows(0, n));
         self.inputs_at(t);
+        let taut = match &mut self.springs {
+            Some(s) => {
+                s.tensions(self.model, &self.q, &mut self.ws, &mut self.u);
+                s.evaluate(self.model, &self.q, &self.u, &mut self.ws)
+            }
+            None => false,
+        };
         self.model
             .ode_jacobian_approx(&self.q, &self.u, &self.loads, &mut self.ws, jac)
             .map_err(|e| RhsError(e.to_string()))?;
+        if let (true, Some(s)) = (taut, &mut self.springs) {
+            // `ws.mass` holds the Cholesky factor of `M` the approximation left
+            s.add_to_first_order(&self.u, &self.ws.mass, jac);
+        }
         Ok(true)
     }
 
@@ -205,6 +223,9 @@ impl<P: StrainParam> OdeSystem for RodOde<'_, P> {
         self.q.copy_from(&y.rows(0, n));
         self.qd.copy_from(&y.rows(n, n));
         self.inputs_at(t);
+        if let Some(s) = &mut self.springs {
+            s.tensions(self.model, &self.q, &mut self.ws, &mut self.u);
+        }
         self.model
             .accelerations(
                 &self.q,
@@ -230,6 +251,14 @@ impl<P: StrainParam> RodOde<'_, P> {
             self.loads.scale_from(&self.base_loads, self.lambda[0]);
         }
     }
+
+    /// The driven tendons' tensions at `q` in place of their displacements in `self.u` (after
+    /// [`Self::inputs_at`]).
+    fn tensions_at(&mut self, q: &DVector<f64>) {
+        if let Some(s) = &mut self.springs {
+            s.tensions(self.model, q, &mut self.ws, &mut self.u);
+        }
+    }
 }
 
 impl<P: StrainParam> MechanicalSystem for RodOde<'_, P> {
@@ -250,6 +279,7 @@ impl<P: StrainParam> MechanicalSystem for RodOde<'_, P> {
         eps: &mut DVector<f64>,
     ) -> Result<(), RhsError> {
         self.inputs_at(t);
+        self.tensions_at(q);
         self.model
             .dynamics_residual(q, qd, qdd, &self.u, &self.loads, &mut self.ws, eps);
         Ok(())
@@ -263,6 +293,7 @@ impl<P: StrainParam> MechanicalSystem for RodOde<'_, P> {
         qdd: &mut DVector<f64>,
     ) -> Result<(), RhsError> {
         self.inputs_at(t);
+        self.tensions_at(q);
         self.model
             .accelerations(q, qd, &self.u, &self.loads, &mut self.ws, qdd)
             .map_err(|e| RhsError(e.to_string()))
@@ -291,6 +322,7 @@ impl<P: StrainParam> MechanicalSystem for RodOde<'_, P> {
         m: &mut nalgebra::DMatrix<f64>,
     ) -> Result<(), RhsError> {
         self.inputs_at(t);
+        self.tensions_at(q);
         self.model
             .dynamics_residual_and_mass(q, qd, qdd, &self.u, &self.loads, &mut self.ws, eps);
         m.copy_from(&self.ws.mass);
@@ -307,8 +339,14 @@ impl<P: StrainParam> MechanicalSystem for RodOde<'_, P> {
         k: &mut nalgebra::DMatrix<f64>,
     ) -> Result<(), RhsError> {
         self.inputs_at(t);
+        self.tensions_at(q);
         self.model
             .iteration_parts(q, &self.u, &self.loads, &mut self.ws, m, d, k);
+        if let Some(s) = &mut self.springs {
+            if s.evaluate(self.model, q, &self.u, &mut self.ws) {
+                s.add_stiffness(&self.u, k);
+            }
+        }
         Ok(())
     }
 }
@@ -319,7 +357,8 @@ pub struct Sample<'a> {
     pub t: f64,
     pub q: &'a [f64],
     pub qd: &'a [f64],
-    /// Actuation `u(t)`.
+    /// Tensions `u(t)`: the actuation's, and a displacement-driven tendon's from its stretch at
+    /// this `q` ([`drive`]).
     pub u: &'a [f64],
     /// Tip pose `g(L)`.
     pub tip: &'a Pose,
@@ -424,7 +463,8 @@ pub fn simulate_streaming<P: StrainParam>(
 /// an interrupt stops the run within one step even when the next sample is far away (tight
 /// tolerances, a stiff transient); the summary then reports [`OdeError::Stopped`] with `stop`'s
 /// reason, and the samples before it were delivered. The actuation is a [`Signal`] or any other
-/// [`Actuation`] (a function of time).
+/// [`Actuation`] (a function of time); its channels marked by [`Actuation::displacement_driven`]
+/// are tendon displacements ([`drive`]: an elastic tendon's tension follows from its stretch).
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_streaming_interruptible<P: StrainParam>(
     model: &Model<P>,
@@ -483,6 +523,7 @@ pub fn simulate_streaming_interruptible<P: StrainParam>(
         }
     };
     let base_loads = model.prepare_loads(loads)?;
+    let mut springs = TendonSprings::new(model, actuation.displacement_driven())?;
     let mut sys = RodOde {
         model,
         ws: model.workspace(),
@@ -496,6 +537,7 @@ pub fn simulate_streaming_interruptible<P: StrainParam>(
         qd: DVector::zeros(n),
         qdd: DVector::zeros(n),
         jacobian: options.jacobian,
+        springs: springs.clone(),
         stop,
     };
     let mut y0 = DVector::zeros(2 * n);
@@ -522,6 +564,10 @@ pub fn simulate_streaming_interruptible<P: StrainParam>(
         qbuf.copy_from(&y.rows(0, n));
         model.forward(&qbuf, &mut out_ws, false);
         actuation.eval(t, &mut ubuf);
+        // a driven tendon's sample is its tension, not the displacement asked
+        if let Some(s) = &mut springs {
+            s.tensions_after_forward(model, &out_ws, &mut ubuf);
+        }
         samples += 1;
         t_last = Some(t);
         sink(&Sample {
