@@ -1,6 +1,7 @@
 //! Tendons driven by their displacement through the command line (`--displacement`, the TOML's
 //! `tendons[k].displacement`): statics finds the tension, which given back as `--tension` makes
-//! the same rod; slack tendons; a reduced model driven the same way; and the refusals of the
+//! the same rod; slack tendons; a reduced model driven the same way; a run whose elastic thread
+//! (`tendons[k].axial_stiffness`) carries the motor's displacement; and the refusals of the
 //! commands that drive tendons by tension only, and of impossible displacements.
 
 mod common;
@@ -133,6 +134,29 @@ fn a_reduced_model_is_driven_by_displacement_too() {
         ],
     );
     assert_eq!(f64s(&in_toml["u"]), f64s(&reduced["u"]));
+    // the thread's stiffness is no physics the model was trained on: statics uses it (part of
+    // the displacement is now stretch, so the rod bends less and pulls less), `simulate`
+    // refuses the drive
+    let mut elastic = with_model.clone();
+    elastic.extend(["--set", THREAD]);
+    let (_, thread) = run_json("statics", "drive-pod-thread", &elastic);
+    assert!(
+        f64s(&thread["u"])[0] > ur * 0.9,
+        "{:?} vs {ur}",
+        f64s(&thread["u"])
+    );
+    let run = scratch("drive-pod-run");
+    let mut run_args = vec!["simulate"];
+    run_args.extend(&elastic);
+    run_args.extend(["--duration", "0.1", "--out", path_str(&run)]);
+    expect_error(
+        &run_args,
+        &[
+            "tendons[0].displacement",
+            "runs tendons driven by their tension only in dynamics",
+        ],
+    );
+    assert!(!run.exists());
     // 12 mm needs about -4.4 N, outside the sweep's [-3, 0]: refused, naming the tension found
     expect_error(
         &[
@@ -193,7 +217,6 @@ fn modes_hold_the_taut_displacement_driven_tendons() {
 #[test]
 fn displacements_are_refused_where_they_cannot_be_honoured() {
     for cmd in [
-        vec!["simulate", "single-tendon", "--duration", "0.1", "--out"],
         vec!["linearize", "single-tendon"],
         vec!["dataset", "single-tendon", "--samples", "2", "--out"],
     ] {
@@ -289,4 +312,172 @@ fn displacements_are_refused_where_they_cannot_be_honoured() {
         stderr.contains("--displacement") && stderr.contains("--tension"),
         "{stderr}"
     );
+}
+
+/// The IV-A arm's thread with `EA` = 200 N (`--set tendons.0.axial_stiffness=200`).
+const THREAD: &str = "tendons.0.axial_stiffness=200";
+
+/// In dynamics a tendon driven by its displacement is an elastic thread: the IV-A arm wound in by
+/// 4 mm settles, under its damping, onto the equilibrium `statics` finds for the same drive and
+/// thread — tip and tension —, `u.npy` holds the tension found as the run goes (from the
+/// thread stretched by the whole 4 mm at the straight start), and the record names the
+/// displacement channel.
+#[test]
+fn a_run_driven_by_displacement_settles_on_the_statics_drive() {
+    let (_, eq) = run_json(
+        "statics",
+        "drive-thread-statics",
+        &["single-tendon", "--displacement", "0.004", "--set", THREAD],
+    );
+    let u_eq = f64s(&eq["u"])[0];
+    let out = scratch("drive-thread-run");
+    let stdout = run_ok(&[
+        "simulate",
+        "single-tendon",
+        "--displacement",
+        "0.004",
+        "--set",
+        THREAD,
+        "--duration",
+        "4",
+        "--sample-rate",
+        "10",
+        "--out",
+        path_str(&out),
+    ]);
+    assert!(
+        stdout.contains("driven by displacement: wound in 4 mm"),
+        "{stdout}"
+    );
+    let (_, tip) = common::npy(&out.join("tip_position.npy"));
+    let last = &tip[tip.len() - 3..];
+    let target = f64s(&eq["tip_position"]);
+    assert!(dist(last, &target) < 1e-6 * 0.25, "{last:?} vs {target:?}");
+    let (shape, u) = common::npy(&out.join("u.npy"));
+    assert_eq!(shape, [41, 1]);
+    assert!(
+        ((u[40] - u_eq) / u_eq).abs() < 1e-4,
+        "u = {} vs {u_eq}",
+        u[40]
+    );
+    // at the straight start the path is the rest length: the thread is stretched by 4 mm,
+    // u = −δ EA / ℓ_rest
+    let rest = f64s(&eq["tendon_rest_lengths"])[0];
+    let start = -0.004 * 200.0 / rest;
+    assert!(
+        ((u[0] - start) / start).abs() < 1e-9,
+        "u(0) = {} vs {start}",
+        u[0]
+    );
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("meta.json")).unwrap()).unwrap();
+    let input = &meta["input"];
+    assert_eq!(
+        input["displacement_channels"],
+        serde_json::json!([0]),
+        "{input}"
+    );
+    assert_eq!(
+        input["displacements"],
+        serde_json::json!([0.004]),
+        "{input}"
+    );
+}
+
+/// Undamped and frictionless, a tendon held at a constant displacement is a spring that does no
+/// work: the run's energy, with the thread's `½ (ℓ − ℓ*)² / c` in place of a tension's `−u ℓ`,
+/// keeps within 1 % of the largest kinetic energy — the spring stores about a quarter of it, so
+/// a law or an energy off by the thread would show.
+#[test]
+fn an_undamped_run_at_a_held_displacement_keeps_its_energy() {
+    let out = scratch("drive-thread-energy");
+    let stdout = run_ok(&[
+        "simulate",
+        "single-tendon",
+        "--displacement",
+        "0.004",
+        "--set",
+        THREAD,
+        "--set",
+        "material.damping=0",
+        "--set",
+        "tendons.0.friction=0",
+        "--set",
+        "divisions.0.basis.order=4",
+        "--set",
+        "divisions.0.quadrature.gauss=20",
+        "--duration",
+        "0.5",
+        "--rtol",
+        "1e-6",
+        "--atol",
+        "1e-10",
+        "--out",
+        path_str(&out),
+    ]);
+    assert!(stdout.contains("energy     conservative run"), "{stdout}");
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("meta.json")).unwrap()).unwrap();
+    let e = &meta["energy_balance"];
+    let kinetic = e["kinetic_max"].as_f64().unwrap();
+    for key in ["largest_gain", "largest_loss"] {
+        let v = e[key].as_f64().unwrap();
+        assert!(v < 0.01 * kinetic, "{key} {v} J of {kinetic} J");
+    }
+    // the thread's energy at the start: the whole 4 mm stretched, ½ δ² EA / ℓ_rest
+    let (_, lengths) = common::npy(&out.join("tendon_lengths.npy"));
+    let rest = lengths[0]; // the straight start
+    let thread = 0.5 * 0.004f64.powi(2) * 200.0 / rest;
+    assert!(
+        thread > 0.2 * kinetic,
+        "the thread holds {thread} J of {kinetic} J"
+    );
+}
+
+/// What a run cannot honour with a displacement drive is refused before anything is written,
+/// naming the field: an inextensible thread, a reduced model, random tension steps, and an input
+/// whose displacement exceeds the tendon.
+#[test]
+fn displacement_runs_are_refused_where_they_cannot_be_honoured() {
+    let out = scratch("drive-run-refused");
+    let o = path_str(&out);
+    let base = [
+        "simulate",
+        "single-tendon",
+        "--displacement",
+        "0.004",
+        "--duration",
+        "0.1",
+    ];
+    let with = |extra: &[&str]| -> Vec<String> {
+        base.iter().chain(extra).map(|s| s.to_string()).collect()
+    };
+    let cases: Vec<(Vec<String>, Vec<&str>)> = vec![
+        (
+            with(&["--out", o]),
+            vec!["tendons[0].axial_stiffness", "missing", "EA in N"],
+        ),
+        (
+            with(&["--set", THREAD, "--steps", "-1,0,0.1", "--out", o]),
+            vec![
+                "--steps",
+                "tendons[0] is driven by its displacement",
+                "--input",
+            ],
+        ),
+    ];
+    for (args, needles) in cases {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        expect_error(&args, &needles);
+        assert!(!out.exists(), "{args:?}: nothing written");
+    }
+    let csv = scratch("drive-run-too-far.csv");
+    std::fs::write(&csv, "t,u0\n0,0\n0.05,0.3\n").unwrap();
+    let args = with(&["--set", THREAD, "--input", path_str(&csv), "--out", o]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    expect_error(
+        &args,
+        &["--input (column 0, t = 0.05 s)", "0.3", "rest length"],
+    );
+    assert!(!out.exists());
 }

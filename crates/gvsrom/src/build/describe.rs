@@ -161,16 +161,28 @@ pub fn significant(v: f64) -> String {
 }
 
 /// How each tendon is driven, for a scenario with a displacement-driven tendon: `wound in 5 mm`,
-/// `paid out 2 mm`, `held at its rest length`, or `u = -2 N` for a tension-driven one.
+/// `paid out 2 mm`, `held at its rest length` (with `(thread EA 200 N)` for an elastic thread), or
+/// `u = -2 N` for a tension-driven one.
 pub fn drive_words(built: &super::Built) -> Vec<String> {
-    (built.u.iter().zip(&built.displacement))
-        .map(|(u, d)| match d {
+    (built
+        .u
+        .iter()
+        .zip(&built.displacement)
+        .zip(&built.model.tendons))
+    .map(|((u, d), t)| {
+        let words = match d {
             Some(d) if *d > 0.0 => format!("wound in {} mm", significant(d * 1e3)),
             Some(d) if *d < 0.0 => format!("paid out {} mm", significant(-d * 1e3)),
             Some(_) => "held at its rest length".to_string(),
-            None => format!("u = {} N", significant(*u)),
-        })
-        .collect()
+            None => return format!("u = {} N", significant(*u)),
+        };
+        // an elastic thread stretches under its tension (it matters only for a drive)
+        match t.axial_stiffness {
+            Some(ea) => format!("{words} (thread EA {} N)", significant(ea)),
+            None => words,
+        }
+    })
+    .collect()
 }
 
 /// `n` wrenches of kind `what` and how their components turn: `1 point wrench (follower)`,

@@ -141,7 +141,9 @@ pub struct ScenarioArgs {
     /// Drive the tendons by displacement instead: the length δ [m] each actuator has wound in from
     /// the tendon's rest length (negative pays out); one value for every tendon, or one per
     /// tendon, e.g. `--displacement=0.004,0`. `statics` finds the tensions (a cable pulls or goes
-    /// slack). Applied after `--set`.
+    /// slack); `simulate` needs each such tendon's thread stiffness (`--set
+    /// tendons.0.axial_stiffness=EA`, in N) and finds its tension from the stretch as it runs.
+    /// Applied after `--set`.
     #[arg(
         long,
         value_name = "D[,D...]",

@@ -165,6 +165,9 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
         args.seed,
     )?;
     let signal = input.describe().map(|d| match args.from_equilibrium {
+        true if built.displacement_driven() => {
+            format!("{d}, from the equilibrium under the scenario's drives")
+        }
         true => format!(
             "{d}, from the equilibrium under the scenario's u = {} N",
             fmt_g(&built.u)
@@ -278,6 +281,28 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
             out,
             "tip        position {} m at t = {t_last:.3} s",
             fmt_vec(&[g.pos[0], g.pos[1], g.pos[2]], 6),
+        )?;
+    }
+    // the tensions the displacement drives found, as statics prints them
+    if built.displacement_driven() && !outcome.last_u.is_empty() {
+        let u: Vec<String> = outcome
+            .last_u
+            .iter()
+            .map(|&v| gvsrom::build::significant(v))
+            .collect();
+        let slack: Vec<String> = (0..outcome.last_u.len())
+            .filter(|&k| built.displacement[k].is_some() && outcome.last_u[k] == 0.0)
+            .map(|k| k.to_string())
+            .collect();
+        writeln!(
+            out,
+            "tensions   u = [{}] N at t = {t_last:.3} s, the driven tendons' from their threads' stretch{}",
+            u.join(", "),
+            match slack.len() {
+                0 => String::new(),
+                1 => format!("; tendon {} is slack", slack[0]),
+                _ => format!("; tendons {} are slack", slack.join(", ")),
+            }
         )?;
     }
     // a fixed step halves where Newton fails: say so when that set the cost

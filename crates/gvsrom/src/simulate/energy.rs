@@ -195,7 +195,10 @@ impl EnergyMonitor {
             .filter(|(k, _)| !driven(*k))
             .map(|(_, (u, l))| u * l)
             .sum();
-        let threads = self.springs.as_ref().map_or(0.0, |s| s.energy(&self.lengths));
+        let threads = self
+            .springs
+            .as_ref()
+            .map_or(0.0, |s| s.energy(&self.lengths));
         let total = e.total() - tendons + threads;
         if !(total.is_finite() && e.kinetic.is_finite()) {
             return;

@@ -365,9 +365,12 @@ pub fn input_record(
         }))
     };
     let mut signal = match &opts.input {
+        // per tendon its tension or its displacement, the other null
         InputSource::Constant if built.displacement_driven() => json!({
             "signal": "constant",
-            "tensions": built.u,
+            "tensions": (built.u.iter().zip(&built.displacement))
+                .map(|(u, d)| d.is_none().then_some(*u))
+                .collect::<Vec<_>>(),
             "displacements": built.displacement,
         }),
         InputSource::Constant => json!({"signal": "constant", "tensions": built.u}),

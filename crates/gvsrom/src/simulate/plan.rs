@@ -137,9 +137,11 @@ impl Plan {
         }
         let first = self.signal.values.first()?;
         let driven = built.drive_flags();
-        let constant = self.signal.values.iter().all(|row| {
-            (row.iter().zip(first).zip(&driven)).all(|((a, b), &d)| !d || a == b)
-        });
+        let constant = self
+            .signal
+            .values
+            .iter()
+            .all(|row| (row.iter().zip(first).zip(&driven)).all(|((a, b), &d)| !d || a == b));
         constant.then(|| super::energy::ThreadSprings::new(&built.model, &driven, first))
     }
 }

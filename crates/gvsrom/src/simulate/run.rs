@@ -36,6 +36,9 @@ pub struct Outcome {
     pub ending: Ending,
     /// Tip pose of the last sample.
     pub last_tip: Option<Pose>,
+    /// Tensions \[N\] at the last sample (empty if none was delivered): a displacement-driven
+    /// tendon's found from its thread's stretch.
+    pub last_u: Vec<f64>,
     /// The run failed because a reduced trajectory left its training region (the decoder would
     /// extrapolate), not because the integrator did.
     pub left_training_region: bool,
@@ -178,6 +181,7 @@ pub fn run_into(
     control: &mut dyn FnMut(f64) -> ControlFlow<String>,
 ) -> Result<Outcome, ScenarioError> {
     let mut last_tip = None;
+    let mut last_u = Vec::with_capacity(built.model.n_actuators());
     let mut write_error: Option<std::io::Error> = None;
     let mut off_manifold = None;
     let mut non_physical = None;
@@ -220,6 +224,8 @@ pub fn run_into(
         }
         last_t.set(s.t);
         last_tip = Some(*s.tip);
+        last_u.clear();
+        last_u.extend_from_slice(s.u);
         if let Some(w) = writer.as_deref_mut() {
             if let Err(e) = w.push(built, s) {
                 let msg = format!("cannot write the trajectory: {e}");
@@ -324,6 +330,7 @@ pub fn run_into(
         summary,
         ending,
         last_tip,
+        last_u,
         left_training_region,
         model_extrapolated: off_data.into_iter().collect(),
     })
