@@ -30,7 +30,9 @@ impl Robot {
     ///     rejected step goes back in time); an exception it raises stops the run and propagates.
     ///     Its values are checked as rows are: finite, and within the rod's elastic range (a
     ///     tension far beyond it stops the run after the step it was returned in, naming it).
-    ///     Default: the scenario's tensions, constant.
+    ///     Default: the scenario's tensions, constant. A tendon the scenario drives by its
+    ///     ``displacement`` (with the thread's ``axial_stiffness``) takes its displacement [m]
+    ///     in its column instead, and its tension follows from the thread's stretch.
     /// interpolate : bool
     ///     Interpolate ``input`` rows linearly.
     /// from_equilibrium : bool
@@ -101,7 +103,8 @@ impl Robot {
     /// Returns
     /// -------
     /// dict
-    ///     ``t`` (k,), ``q``/``qd`` (k, n), ``u`` (k, n_a), ``tip_position`` (k, 3),
+    ///     ``t`` (k,), ``q``/``qd`` (k, n), ``u`` (k, n_a: the tensions, a displacement-driven
+    ///     tendon's found from its thread's stretch), ``tip_position`` (k, 3),
     ///     ``tip_rotation`` (k, 3, 3), ``strain`` (k, p, 6), ``strain_x`` (p,), ``centerline``
     ///     (k, c, 3), ``centerline_x`` (c,), ``tendon_paths`` (k, n_a, c, 3: each tendon's thread
     ///     at ``centerline_x`` clamped to its span), ``tendon_lengths`` (k, n_a: each tendon's

@@ -158,7 +158,9 @@ impl Stepper {
 #[pymethods]
 impl Stepper {
     /// Holds the tensions ``u`` [N] (one per tendon, or one number for all) for one period and
-    /// returns the state ``(q, qd)`` at its end; :attr:`t` advances by :attr:`dt`.
+    /// returns the state ``(q, qd)`` at its end; :attr:`t` advances by :attr:`dt`. A tendon the
+    /// scenario drives by its ``displacement`` takes its displacement [m] here instead (its
+    /// tension follows from the thread's stretch).
     ///
     /// Raises
     /// ------
@@ -193,7 +195,13 @@ impl Stepper {
         };
         let robot = self.robot.clone_ref(py);
         let built = robot.get().built_for_signal_ready();
-        let abs: Vec<f64> = u.iter().map(|x| x.abs()).collect();
+        // a tendon driven by its displacement: its entry is that displacement [m], whose
+        // tension the run finds from the thread's stretch
+        gvsrom::simulate::check_channel_displacements(built, &u, &|k| format!("u[{k}]"))
+            .map_err(|e| refused(&e))?;
+        let abs: Vec<f64> = (u.iter().zip(&built.displacement))
+            .map(|(x, d)| if d.is_some() { 0.0 } else { x.abs() })
+            .collect();
         gvsrom::plausibility::check(built, &abs, 1.0).map_err(|e| refused(&e))?;
         if let Some(model) = &built.reduced {
             let notes = model

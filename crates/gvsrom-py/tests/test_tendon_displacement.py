@@ -1,7 +1,8 @@
 """Tendons driven by their displacement through the Python API (``Robot.statics(displacement=…)``
 and a scenario's ``tendons[k].displacement``): the tendon is wound in by exactly that length, the
-tension found makes the same rod when given back as ``u``, a paid-out tendon goes slack, and the
-commands that drive tendons by tension only refuse a displacement."""
+tension found makes the same rod when given back as ``u``, a paid-out tendon goes slack, a run
+on an elastic thread settles where statics puts it, and the commands that drive tendons by
+tension only refuse a displacement."""
 
 import numpy as np
 import pytest
@@ -45,7 +46,7 @@ def test_a_tendon_paid_out_past_its_path_is_slack_and_the_rod_hangs_as_without_i
     assert eq.tip_position[2] > free.tip_position[2]
 
 
-def test_a_scenario_driven_by_displacement_solves_so_and_refuses_dynamics():
+def test_a_scenario_driven_by_displacement_solves_so_and_needs_a_thread_to_move():
     s = (
         gvsrom.Scenario.preset("single-tendon")
         .set("tendons.0.tension", 0)
@@ -54,7 +55,8 @@ def test_a_scenario_driven_by_displacement_solves_so_and_refuses_dynamics():
     robot = s.build()
     eq = robot.statics()
     assert abs((eq.tendon_rest_lengths - eq.tendon_lengths)[0] - 0.004) < TOL
-    with pytest.raises(gvsrom.GvsromError, match=r"tendons\[0\]\.displacement.*simulate drives tendons by their tension only"):
+    # an inextensible tendon held at its length is a constraint the integrators do not impose
+    with pytest.raises(gvsrom.GvsromError, match=r"tendons\[0\]\.axial_stiffness.*missing.*EA in N"):
         robot.simulate(duration=0.01)
     # modes hold the taut tendon at its length: one mode fewer than the free arm's
     held = robot.modes()
@@ -79,3 +81,37 @@ def test_tension_and_displacement_together_or_impossible_are_refused(robot):
         robot.statics(displacement=0.3)
     with pytest.raises(gvsrom.GvsromError, match="2 displacements given for 1 tendon"):
         robot.statics(displacement=[0.001, 0.002])
+
+
+def test_a_run_on_an_elastic_thread_settles_where_statics_puts_it():
+    """The IV-A arm's thread with EA = 200 N wound in by 4 mm: the run's tensions follow the
+    stretch (all 4 mm of it at the straight start, ``u = −δ EA / ℓ_rest``) and settle, with the
+    tip, on the statics drive of the same thread; an ``input`` column of a driven tendon is its
+    displacement, ramped here from 0 to 4 mm over the first second to the same end."""
+    robot = (
+        gvsrom.Scenario.preset("single-tendon")
+        .set("tendons.0.tension", 0)
+        .set("tendons.0.displacement", 0.004)
+        .set("tendons.0.axial_stiffness", 200.0)
+        .build()
+    )
+    eq = robot.statics()
+    run = robot.simulate(4.0, sample_rate=10)
+    rest = robot.tendon_rest_lengths[0]
+    assert run["u"][0, 0] == pytest.approx(-0.004 * 200.0 / rest, rel=1e-9)
+    assert run["u"][-1, 0] == pytest.approx(eq.u[0], rel=1e-4)
+    np.testing.assert_allclose(run["tip_position"][-1], eq.tip_position, atol=1e-6 * 0.25)
+    ramp = robot.simulate(4.0, sample_rate=10, input=[[0.0, 0.0], [1.0, 0.004]], interpolate=True)
+    assert ramp["u"][0, 0] == 0.0, "no displacement yet: the thread is at its length"
+    np.testing.assert_allclose(ramp["tip_position"][-1], eq.tip_position, atol=1e-6 * 0.25)
+    # a displacement past the tendon's length is refused before the run
+    with pytest.raises(gvsrom.GvsromError, match=r"column 0.*rest length"):
+        robot.simulate(1.0, input=[[0.0, 0.0], [0.5, 0.3]])
+    # the stepper's entry for the driven tendon is its displacement too
+    stepper = robot.stepper(0.1)
+    with pytest.raises(gvsrom.GvsromError, match=r"u\[0\].*rest length"):
+        stepper.step([0.3])
+    for _ in range(40):
+        q, _ = stepper.step([0.004])
+    assert np.linalg.norm(q - eq.q) < 1e-4 * np.linalg.norm(eq.q)
+    stepper.close()

@@ -435,28 +435,42 @@ fn check_displacements(
     if !built.displacement_driven() || function {
         return Ok(());
     }
-    let rest = built.model.tendon_rest_lengths();
     let option = match &opts.input {
         InputSource::Csv { .. } => "--input",
         InputSource::Rows(_) => "input",
         _ => "displacement",
     };
     for (t, row) in signal.times.iter().zip(&signal.values) {
-        for (k, (&v, d)) in row.iter().zip(&built.displacement).enumerate() {
-            if d.is_some() && !(v.is_finite() && v.abs() < rest[k]) {
-                let field = match option {
-                    "displacement" => format!("tendons[{k}].displacement"),
-                    o => format!("{o} (column {k}, t = {t} s)"),
-                };
-                return Err(ScenarioError::value(
-                    field,
-                    v,
-                    format!(
-                        "a displacement in m within ±{:.6} m, the tendon's rest length",
-                        rest[k]
-                    ),
-                ));
-            }
+        check_channel_displacements(built, row, &|k| match option {
+            "displacement" => format!("tendons[{k}].displacement"),
+            o => format!("{o} (column {k}, t = {t} s)"),
+        })?;
+    }
+    Ok(())
+}
+
+/// The displacement channels of one row of actuation channels (`row[k]` for each tendon driven
+/// by its displacement, `built.displacement[k]` set): finite, and shorter than the tendon; the
+/// error names the channel by `field(k)`.
+pub fn check_channel_displacements(
+    built: &Built,
+    row: &[f64],
+    field: &dyn Fn(usize) -> String,
+) -> Result<(), ScenarioError> {
+    if !built.displacement_driven() {
+        return Ok(());
+    }
+    let rest = built.model.tendon_rest_lengths();
+    for (k, (&v, d)) in row.iter().zip(&built.displacement).enumerate() {
+        if d.is_some() && !(v.is_finite() && v.abs() < rest[k]) {
+            return Err(ScenarioError::value(
+                field(k),
+                v,
+                format!(
+                    "a displacement in m within ±{:.6} m, the tendon's rest length",
+                    rest[k]
+                ),
+            ));
         }
     }
     Ok(())
