@@ -2,8 +2,9 @@
 //! elastic thread whose motor sets its unstretched length. A damped run settles onto the
 //! equilibrium the statics drive finds with the same compliance ([`gvs::solve::tendon_drive`],
 //! itself checked against closed forms in `tendon_displacement.rs`), by every integrator and
-//! Jacobian path; a tendon paid out stays slack and leaves the rod at rest; an inextensible
-//! tendon is refused, naming its axial stiffness.
+//! Jacobian path; a tendon paid out stays slack and leaves the rod at rest; the linearization in
+//! the displacement has the statics drive's gain; an inextensible tendon is refused, naming its
+//! axial stiffness.
 
 use gvs::actuation::Tendon;
 use gvs::inputs::Signal;
@@ -194,4 +195,62 @@ fn an_inextensible_tendon_driven_in_dynamics_is_refused() {
     .unwrap()
     .to_string();
     assert!(e.contains("tendons[0].axial_stiffness"), "{e}");
+}
+
+/// Linearized about the driven equilibrium with the displacement as the input
+/// ([`Model::linearize_equilibrium_driven`]), the settled response `−A⁻¹ B` of `q` per metre wound
+/// in is the statics drive's own `dq/dδ`, by central differences of two drives 1 µm apart; a
+/// slack channel has no column, and an inextensible thread is refused.
+#[test]
+fn the_linearization_in_the_displacement_has_the_statics_drive_s_gain() {
+    use gvs::dynamics::Channel;
+    let m = arm(Some(40.0));
+    let drive = |delta: f64| {
+        solve_driven(
+            &m,
+            &StaticsOptions::default(),
+            &[Drive::Displacement(delta), Drive::Tension(-0.2)],
+            &gravity(),
+            &never_stop,
+        )
+        .unwrap()
+    };
+    let (delta, h) = (4e-3, 1e-6);
+    let eq = drive(delta);
+    let n = m.n_dof();
+    let loads = m.prepare_loads(&gravity()).unwrap();
+    let channels = [Channel::Displacement { taut: true }, Channel::Tension];
+    let lin = m
+        .linearize_equilibrium_driven(&eq.statics.q, &eq.u, &channels, &loads, &mut m.workspace())
+        .unwrap();
+    let gain = -lin.a.clone().lu().solve(&lin.b).unwrap();
+    let dq = (drive(delta + h).statics.q - drive(delta - h).statics.q) / (2.0 * h);
+    let err = (gain.view((0, 0), (n, 1)) - &dq).amax() / dq.amax();
+    assert!(err < 1e-5, "dq/dδ off by {err:e} of its largest entry");
+    // the tension channel is the plain tendon's: its column is M⁻¹ B_1
+    let by_tension = m
+        .linearize_equilibrium(&eq.statics.q, &eq.u, &loads, &mut m.workspace())
+        .unwrap();
+    assert!((lin.b.column(1) - by_tension.b.column(1)).amax() < 1e-12 * by_tension.b.amax());
+    let slack = m
+        .linearize_equilibrium_driven(
+            &eq.statics.q,
+            &eq.u,
+            &[Channel::Displacement { taut: false }, Channel::Tension],
+            &loads,
+            &mut m.workspace(),
+        )
+        .unwrap();
+    assert_eq!(slack.b.column(0).amax(), 0.0);
+    let rigid = arm(None);
+    let e = rigid
+        .linearize_equilibrium_driven(
+            &eq.statics.q,
+            &eq.u,
+            &channels,
+            &loads,
+            &mut rigid.workspace(),
+        )
+        .unwrap_err();
+    assert!(e.to_string().contains("tendons[0].axial_stiffness"), "{e}");
 }

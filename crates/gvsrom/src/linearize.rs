@@ -24,7 +24,7 @@
 use crate::build::Built;
 use crate::error::{ScenarioError, StaticsFailure};
 use crate::statics::{self, StaticsReport};
-use gvs::dynamics::{DynamicsError, StateSpace};
+use gvs::dynamics::{Channel, DynamicsError, StateSpace};
 use gvs::error::fmt_value;
 use gvs::model::Model;
 use gvs::strain::StrainParam;
@@ -146,6 +146,13 @@ pub struct Linearization {
     /// otherwise.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub output_tendon_lengths: Vec<f64>,
+    /// The actuators whose channel is their motor's displacement \[m\] through the elastic
+    /// thread (`tendons[k].displacement` with its `axial_stiffness`,
+    /// `gvs::dynamics::Channel`): `B`'s and the static gain's columns are per metre wound in
+    /// there, per newton of tension elsewhere; empty (and not written) when every channel is a
+    /// tension.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub displacement_channels: Vec<usize>,
     /// `A` (2n × 2n), rows.
     pub a: Vec<Vec<f64>>,
     /// `B` (2n × n_actuators), rows.
@@ -378,14 +385,39 @@ pub fn about_equilibrium(
     outputs: &Outputs,
 ) -> Result<(StaticsReport, Linearization), LinearizeError> {
     crate::simulate::require_mass(built)?;
-    built.tension_driven_for("linearize")?;
+    // a tendon driven by its displacement is an input through its elastic thread
+    for (k, d) in built.displacement.iter().enumerate() {
+        if d.is_some() && built.model.tendons[k].axial_stiffness.is_none() {
+            return Err(ScenarioError::invalid(
+                format!("tendons[{k}].axial_stiffness"),
+                "missing: linearized, a tendon driven by its displacement is an elastic thread whose stretch carries the motor's displacement to the rod; give its axial stiffness EA in N (Young's modulus times the thread's section: about 20000 for a 0.5 mm Dyneema line) — an inextensible tendon held at its length is a constraint the state-space model does not impose",
+            )
+            .into());
+        }
+    }
     let eq = statics::solve(built)?;
     statics::check_reduced(built, &eq)?;
     let q = DVector::from_column_slice(&eq.q);
     let qd = DVector::zeros(q.len());
+    // the tensions found for the drives, and each channel's kind (a slack tendon's motor moves
+    // nothing to first order)
+    let channels: Vec<Channel> = (built.displacement.iter().enumerate())
+        .map(|(k, d)| match d {
+            None => Channel::Tension,
+            Some(_) => Channel::Displacement {
+                taut: !eq.drives.get(k).is_some_and(|r| r.slack),
+            },
+        })
+        .collect();
+    let at = Point {
+        q: &q,
+        qd: &qd,
+        u: &eq.u,
+        channels: &channels,
+    };
     let mut lin = match &built.reduced {
-        Some(r) => on_model(built, &r.model, &q, &qd, &built.u, outputs, true)?,
-        None => on_model(built, &built.model, &q, &qd, &built.u, outputs, true)?,
+        Some(r) => on_model(built, &r.model, &at, outputs, true)?,
+        None => on_model(built, &built.model, &at, outputs, true)?,
     };
     lin.about = "equilibrium";
     lin.equilibrium_residual_norm = Some(eq.residual_norm);
@@ -403,30 +435,48 @@ pub fn about_state(
     outputs: &Outputs,
 ) -> Result<Linearization, LinearizeError> {
     crate::simulate::require_mass(built)?;
+    let at = Point {
+        q,
+        qd,
+        u,
+        channels: &[],
+    };
     match &built.reduced {
-        Some(r) => on_model(built, &r.model, q, qd, u, outputs, false),
-        None => on_model(built, &built.model, q, qd, u, outputs, false),
+        Some(r) => on_model(built, &r.model, &at, outputs, false),
+        None => on_model(built, &built.model, &at, outputs, false),
     }
+}
+
+/// An operating point: the state, every tension there, and how each channel enters (empty: all
+/// by tension).
+struct Point<'a> {
+    q: &'a DVector<f64>,
+    qd: &'a DVector<f64>,
+    u: &'a [f64],
+    channels: &'a [Channel],
 }
 
 fn on_model<P: StrainParam>(
     built: &Built,
     model: &Model<P>,
-    q: &DVector<f64>,
-    qd: &DVector<f64>,
-    u: &[f64],
+    at: &Point<'_>,
     outputs: &Outputs,
     equilibrium: bool,
 ) -> Result<Linearization, LinearizeError> {
+    let Point { q, qd, u, channels } = *at;
     let start = std::time::Instant::now();
     let n = model.n_dof();
     let loads = model.prepare_loads(&built.loads)?;
     let mut ws = model.workspace();
     let StateSpace { a, b, xdot } = if equilibrium {
-        model.linearize_equilibrium(q, u, &loads, &mut ws)?
+        model.linearize_equilibrium_driven(q, u, channels, &loads, &mut ws)?
     } else {
         model.linearize(q, qd, u, &loads, &mut ws)?
     };
+    let displacement_channels: Vec<usize> = (channels.iter().enumerate())
+        .filter(|(_, c)| **c != Channel::Tension)
+        .map(|(k, _)| k)
+        .collect();
     let t_d = model.damping_time();
     let poles = poles(&a);
 
@@ -476,6 +526,7 @@ fn on_model<P: StrainParam>(
         output_positions,
         output_tip_rotation,
         output_tendon_lengths,
+        displacement_channels,
         relaxation_poles: relaxation_poles(&poles, t_d),
         unstable_poles: poles
             .iter()

@@ -216,10 +216,7 @@ fn modes_hold_the_taut_displacement_driven_tendons() {
 /// the whole tendon and one beyond what the rod can take are refused too.
 #[test]
 fn displacements_are_refused_where_they_cannot_be_honoured() {
-    for cmd in [
-        vec!["linearize", "single-tendon"],
-        vec!["dataset", "single-tendon", "--samples", "2", "--out"],
-    ] {
+    for cmd in [vec!["dataset", "single-tendon", "--samples", "2", "--out"]] {
         let out = scratch(&format!("drive-refused-{}", cmd[0]));
         let mut args = cmd.clone();
         if args.last() == Some(&"--out") {
@@ -480,4 +477,42 @@ fn displacement_runs_are_refused_where_they_cannot_be_honoured() {
         &["--input (column 0, t = 0.05 s)", "0.3", "rest length"],
     );
     assert!(!out.exists());
+}
+
+/// `linearize` about a displacement-driven equilibrium takes the motor's displacement as the
+/// tendon's input through its thread: the settled tip response per millimetre wound in is the
+/// difference of two `statics` drives 0.1 mm apart; without the thread's stiffness it is refused.
+#[test]
+fn linearize_takes_the_displacement_as_the_input_through_the_thread() {
+    let (stdout, lin) = run_json(
+        "linearize",
+        "drive-lin",
+        &["single-tendon", "--displacement", "0.004", "--set", THREAD],
+    );
+    assert!(stdout.contains("per mm wound in"), "{stdout}");
+    assert_eq!(lin["displacement_channels"], serde_json::json!([0]));
+    let gain: Vec<f64> = (0..3)
+        .map(|i| lin["static_gain"][i][0].as_f64().unwrap())
+        .collect();
+    let tip = |d: &str| {
+        let (_, j) = run_json(
+            "statics",
+            &format!("drive-lin-{d}"),
+            &["single-tendon", "--displacement", d, "--set", THREAD],
+        );
+        f64s(&j["tip_position"])
+    };
+    let (hi, lo) = (tip("0.0041"), tip("0.0039"));
+    for i in [0, 2] {
+        let fd = (hi[i] - lo[i]) / 0.0002;
+        assert!(
+            (gain[i] - fd).abs() < 1e-3 * fd.abs().max(1.0),
+            "component {i}: {} vs {fd} m/m",
+            gain[i]
+        );
+    }
+    expect_error(
+        &["linearize", "single-tendon", "--displacement", "0.004"],
+        &["tendons[0].axial_stiffness", "missing"],
+    );
 }

@@ -18,6 +18,13 @@
 //!   its central difference is exact for any step, up to rounding.
 //! * `∂ε/∂u = −B(q)`, the actuation matrix (tendon forces are linear in the tensions).
 //!
+//! A tendon driven by its displacement through an elastic thread
+//! ([`crate::solve::dynamics::drive`]: `u_k = −(ℓ_k(q) − ℓ_k,rest + δ_k) / c_k` while taut) enters
+//! with its displacement `δ_k` as the input ([`Model::linearize_equilibrium_driven`]): `∂ε/∂q`
+//! gains `B_k ∇ℓ_kᵀ / c_k` (the thread's stiffness) and `B`'s column is `−M⁻¹ B_k / c_k` (a
+//! metre wound in pulls `1/c_k` newtons more); a slack one's column is zero, as is its stiffness
+//! (to first order its motor moves nothing).
+//!
 //! The analytic forward recursions of `∂η/∂q`, `∂η̇/∂q` (§9.3) would replace the `2n` residual pairs
 //! of the inertial part; away from rest its difference has a relative truncation error of order
 //! `h² ≈ 4e-11` (tested against differences of the accelerations).
@@ -30,6 +37,17 @@ use nalgebra::{DMatrix, DVector};
 /// Relative step of the central differences of the inertial part in `q`: `h_j = H (1 + |q_j|)`,
 /// near `ε_mach^{1/3}`, which balances truncation (`h²`) and rounding (`ε_mach / h`).
 pub const LINEARIZATION_STEP: f64 = 6e-6;
+
+/// How an actuator's channel enters a linearization about a driven equilibrium
+/// ([`Model::linearize_equilibrium_driven`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Channel {
+    /// Its tension \[N\].
+    Tension,
+    /// Its motor's displacement \[m\], through the elastic thread; `taut` unless the tendon is
+    /// slack at the operating point (then its column and stiffness are zero).
+    Displacement { taut: bool },
+}
 
 /// `ẋ = f(x, u)` linearized at a state: `δẋ = A δx + B δu` with `x = [q; q̇]`.
 #[derive(Debug, Clone, PartialEq)]
@@ -129,7 +147,7 @@ impl<P: StrainParam> Model<P> {
         loads: &PreparedLoads,
         ws: &mut Workspace,
     ) -> Result<StateSpace, DynamicsError> {
-        self.linearize_holding(q, qd, u, loads, ws, false)
+        self.linearize_holding(q, qd, u, loads, ws, false, &[])
     }
 
     /// [`Self::linearize`] about a static equilibrium `q` at rest, with `q̈ = 0` held in the
@@ -145,9 +163,27 @@ impl<P: StrainParam> Model<P> {
         ws: &mut Workspace,
     ) -> Result<StateSpace, DynamicsError> {
         let rest = DVector::zeros(self.n_dof());
-        self.linearize_holding(q, &rest, u, loads, ws, true)
+        self.linearize_holding(q, &rest, u, loads, ws, true, &[])
     }
 
+    /// [`Self::linearize_equilibrium`] with some tendons driven by their displacement through
+    /// their elastic threads (module documentation): `channels[k]` says how actuator `k` enters,
+    /// `u` holds every tension at the equilibrium (those the displacements need included). The
+    /// input of a displacement channel is `δ_k` \[m\]. A displacement channel of a tendon
+    /// without an axial stiffness is [`DynamicsError::InextensibleDrive`].
+    pub fn linearize_equilibrium_driven(
+        &self,
+        q: &DVector<f64>,
+        u: &[f64],
+        channels: &[Channel],
+        loads: &PreparedLoads,
+        ws: &mut Workspace,
+    ) -> Result<StateSpace, DynamicsError> {
+        let rest = DVector::zeros(self.n_dof());
+        self.linearize_holding(q, &rest, u, loads, ws, true, channels)
+    }
+
+    #[allow(clippy::too_many_arguments)]
     fn linearize_holding(
         &self,
         q: &DVector<f64>,
@@ -156,6 +192,7 @@ impl<P: StrainParam> Model<P> {
         loads: &PreparedLoads,
         ws: &mut Workspace,
         still: bool,
+        channels: &[Channel],
     ) -> Result<StateSpace, DynamicsError> {
         let n = self.n_dof();
         let na = self.n_actuators();
@@ -170,7 +207,37 @@ impl<P: StrainParam> Model<P> {
         let mut de_dqd = DMatrix::zeros(n, n);
         self.residual_jacobians(q, qd, &held, u, loads, ws, &mut de_dq, &mut de_dqd);
 
-        let actuation = self.actuation_matrix(q, ws);
+        let mut actuation = self.actuation_matrix(q, ws);
+        // displacement channels: the threads' stiffness in ∂ε/∂q, and B's column per metre
+        if !channels.is_empty() && channels.len() != na {
+            return Err(DynamicsError::ChannelCount {
+                expected: na,
+                got: channels.len(),
+            });
+        }
+        if channels.iter().any(|c| *c != Channel::Tension) {
+            let compliance = self.tendon_compliances();
+            let grad = self.tendon_length_jacobian(q, ws);
+            for (k, channel) in channels.iter().enumerate() {
+                let Channel::Displacement { taut } = *channel else {
+                    continue;
+                };
+                if compliance[k] <= 0.0 {
+                    return Err(DynamicsError::InextensibleDrive { tendon: k });
+                }
+                if taut {
+                    de_dq.ger(
+                        1.0 / compliance[k],
+                        &actuation.column(k),
+                        &grad.column(k),
+                        1.0,
+                    );
+                    actuation.column_mut(k).scale_mut(-1.0 / compliance[k]);
+                } else {
+                    actuation.column_mut(k).fill(0.0);
+                }
+            }
+        }
         let mut mass = self.mass_matrix(q, ws);
         cholesky_factor_in_place(&mut mass)?;
 

@@ -32,7 +32,7 @@ pub use cholesky::{
     cholesky_factor_in_place, cholesky_solve_factored, cholesky_solve_in_place, CHOLESKY_BLOCK,
     MASS_PIVOT_FLOOR,
 };
-pub use linearize::{StateSpace, LINEARIZATION_STEP};
+pub use linearize::{Channel, StateSpace, LINEARIZATION_STEP};
 
 #[derive(Debug, Clone, Error, PartialEq)]
 pub enum DynamicsError {
@@ -48,6 +48,13 @@ pub enum DynamicsError {
         rank: usize,
         count: usize,
     },
+    /// A tendon driven by its displacement without an axial stiffness: an inextensible one held
+    /// at its length is a constraint, which the motion's equations do not impose.
+    /// Channels given for a linearization that are not one per actuator.
+    #[error("{got} channels given for {expected} actuators")]
+    ChannelCount { expected: usize, got: usize },
+    #[error("tendons[{tendon}].axial_stiffness is missing: a tendon driven by its displacement in a motion is an elastic thread whose stretch carries the motor's displacement to the rod; give its axial stiffness EA in N")]
+    InextensibleDrive { tendon: usize },
 }
 
 /// Points per blocked product in [`Model::assemble_mass`].

@@ -91,7 +91,7 @@ impl Built {
             Some(k) => Err(ScenarioError::invalid(
                 format!("tendons[{k}].displacement"),
                 format!(
-                    "{what} drives tendons by their tension only (a tendon held at its length is a constraint on the motion, not modelled); `gvsrom statics` (Python: `Robot.statics()`) finds the tension that holds this displacement at rest: give it with `--tension` (`u`)"
+                    "{what} drives tendons by their tension only (its samples and sweeps are tensions); `gvsrom statics` (Python: `Robot.statics()`) finds the tension that holds this displacement at rest: give it with `--tension` (`u`)"
                 ),
             )),
         }

@@ -123,9 +123,15 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
     writeln!(
         out,
         "system     δẋ = A δx + B δu, δy = C δx: x = [q; q̇] ({n_states} states), u {}, y {y}; linearized in {:.2} ms",
-        match lin.n_actuators {
-            0 => "empty (no tendons: B has no columns)".to_string(),
-            k => format!("the {} [N]", plural(k, "tendon tension")),
+        match (lin.n_actuators, lin.displacement_channels.len()) {
+            (0, _) => "empty (no tendons: B has no columns)".to_string(),
+            (k, 0) => format!("the {} [N]", plural(k, "tendon tension")),
+            (k, d) => format!(
+                "per tendon its tension [N], or its motor's displacement [m] through the thread (tendon{} {}: {} of {k})",
+                if d == 1 { "" } else { "s" },
+                (lin.displacement_channels.iter().map(|j| j.to_string()).collect::<Vec<_>>()).join(", "),
+                plural(d, "displacement channel")
+            ),
         },
         lin.time_s * 1e3
     )?;
@@ -187,6 +193,15 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
             plural(lin.unstable_poles, "pole")
         )?;
     }
+    // a displacement channel's gain is per metre wound in: shown per millimetre, as mm/mm or
+    // mrad/mm
+    let driven = |k: usize| lin.displacement_channels.contains(&k);
+    let per = |k: usize| if driven(k) { 1.0 } else { 1e3 };
+    let unit = |k: usize| if driven(k) { "  per mm wound in" } else { "" };
+    let (input, unit_in) = match lin.displacement_channels.is_empty() {
+        true => ("newton of tension", "N"),
+        false => ("unit input", "N, or per mm where marked"),
+    };
     match &lin.static_gain {
         _ if lin.n_actuators == 0 => {}
         Some(g) => {
@@ -197,35 +212,37 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
                 };
                 writeln!(
                     out,
-                    "gain       settled {at} displacement per newton of tension, −C A⁻¹ B (world x, y, z) [mm/N]"
+                    "gain       settled {at} displacement per {input}, −C A⁻¹ B (world x, y, z) [mm/{unit_in}]"
                 )?;
                 for k in 0..lin.n_actuators {
-                    let col: Vec<f64> =
-                        g[3 * o..3 * o + 3].iter().map(|row| row[k] * 1e3).collect();
-                    writeln!(out, "  tendon {:<3} {}", k + 1, fmt_vec(&col, 4))?;
+                    let col: Vec<f64> = g[3 * o..3 * o + 3]
+                        .iter()
+                        .map(|row| row[k] * per(k))
+                        .collect();
+                    writeln!(out, "  tendon {:<3} {}{}", k + 1, fmt_vec(&col, 4), unit(k))?;
                 }
             }
             let mut rows = &g[3 * lin.outputs.len()..];
             if lin.output_tip_rotation.is_some() {
                 writeln!(
                     out,
-                    "gain       settled tip rotation per newton of tension, −C A⁻¹ B (about world x, y, z) [mrad/N]"
+                    "gain       settled tip rotation per {input}, −C A⁻¹ B (about world x, y, z) [mrad/{unit_in}]"
                 )?;
                 for k in 0..lin.n_actuators {
-                    let col: Vec<f64> = rows[..3].iter().map(|row| row[k] * 1e3).collect();
-                    writeln!(out, "  tendon {:<3} {}", k + 1, fmt_vec(&col, 4))?;
+                    let col: Vec<f64> = rows[..3].iter().map(|row| row[k] * per(k)).collect();
+                    writeln!(out, "  tendon {:<3} {}{}", k + 1, fmt_vec(&col, 4), unit(k))?;
                 }
                 rows = &rows[3..];
             }
             if !rows.is_empty() {
                 writeln!(
                     out,
-                    "gain       settled change of each tendon length per newton of tension, −C A⁻¹ B (tendons' compliance, lengths 1…{}) [mm/N]",
+                    "gain       settled change of each tendon length per {input}, −C A⁻¹ B (tendons' compliance, lengths 1…{}) [mm/{unit_in}]",
                     rows.len()
                 )?;
                 for k in 0..lin.n_actuators {
-                    let col: Vec<f64> = rows.iter().map(|row| row[k] * 1e3).collect();
-                    writeln!(out, "  tendon {:<3} {}", k + 1, fmt_vec(&col, 4))?;
+                    let col: Vec<f64> = rows.iter().map(|row| row[k] * per(k)).collect();
+                    writeln!(out, "  tendon {:<3} {}{}", k + 1, fmt_vec(&col, 4), unit(k))?;
                 }
             }
         }
