@@ -242,6 +242,24 @@ impl CallableInput {
             l.grown = false;
             (l.abs.clone(), l.at.clone())
         };
+        // a displacement channel [m]: shorter than its tendon; its tension, found from the
+        // thread's stretch, is checked as the run goes
+        if let Err(e) =
+            gvsrom::simulate::check_channel_displacements(built, &abs, &|k| format!("u[{k}]"))
+        {
+            // the channel refused: the first displacement not below its tendon's length
+            let rest = built.model.tendon_rest_lengths();
+            let k = (0..abs.len())
+                .find(|&k| built.displacement[k].is_some() && !(abs[k] < rest[k]))
+                .unwrap_or(0);
+            let message = format!("{}: {e}", self.named(at[k]));
+            let mut slot = self.error.lock().unwrap_or_else(PoisonError::into_inner);
+            slot.get_or_insert_with(|| Failure::refused(invalid(message)));
+            return false;
+        }
+        let abs: Vec<f64> = (abs.iter().zip(&built.displacement))
+            .map(|(a, d)| if d.is_some() { 0.0 } else { *a })
+            .collect();
         match gvsrom::plausibility::check(built, &abs, 1.0) {
             Ok(()) => true,
             Err(e) => {

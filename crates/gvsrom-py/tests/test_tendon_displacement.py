@@ -107,6 +107,10 @@ def test_a_run_on_an_elastic_thread_settles_where_statics_puts_it():
     # a displacement past the tendon's length is refused before the run
     with pytest.raises(gvsrom.GvsromError, match=r"column 0.*rest length"):
         robot.simulate(1.0, input=[[0.0, 0.0], [0.5, 0.3]])
+    # a callable's displacement the rod cannot take ends the run where the thread pulls past
+    # the rod's elastic range (20 cm of a 200 N thread: 160 N at once)
+    with pytest.raises(gvsrom.IntegrationError, match=r"tendons\[0\]\.displacement: at t = 0 s its thread pulls.*beyond the tension limit"):
+        robot.simulate(0.2, input=lambda t: [0.2])
     # the stepper's entry for the driven tendon is its displacement too
     stepper = robot.stepper(0.1)
     with pytest.raises(gvsrom.GvsromError, match=r"u\[0\].*rest length"):

@@ -379,6 +379,29 @@ fn a_run_driven_by_displacement_settles_on_the_statics_drive() {
         serde_json::json!([0.004]),
         "{input}"
     );
+    assert_eq!(input["tensions"], serde_json::json!([null]), "{input}");
+    // started at the drive's equilibrium, the arm stays there, and the record has its tension
+    let still = scratch("drive-thread-still");
+    run_ok(&[
+        "simulate",
+        "single-tendon",
+        "--displacement",
+        "0.004",
+        "--set",
+        THREAD,
+        "--from-equilibrium",
+        "--duration",
+        "0.2",
+        "--out",
+        path_str(&still),
+    ]);
+    let (_, tip) = common::npy(&still.join("tip_position.npy"));
+    let last = &tip[tip.len() - 3..];
+    assert!(dist(last, &target) < 1e-9, "{last:?} vs {target:?}");
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(still.join("meta.json")).unwrap()).unwrap();
+    let start = meta["input"]["start_tensions"][0].as_f64().unwrap();
+    assert!(((start - u_eq) / u_eq).abs() < 1e-9, "{start} vs {u_eq}");
 }
 
 /// Undamped and frictionless, a tendon held at a constant displacement is a spring that does no
@@ -477,6 +500,26 @@ fn displacement_runs_are_refused_where_they_cannot_be_honoured() {
         &["--input (column 0, t = 0.05 s)", "0.3", "rest length"],
     );
     assert!(!out.exists());
+    // a displacement the rod cannot take ends the run where its thread pulls past the rod's
+    // elastic range (here at once: 20 cm of a 200 N thread is 160 N), as statics refuses it
+    let far = scratch("drive-run-far");
+    let args = [
+        "simulate",
+        "single-tendon",
+        "--displacement",
+        "0.2",
+        "--set",
+        THREAD,
+    ];
+    let mut args = args.to_vec();
+    args.extend(["--duration", "0.5", "--out", path_str(&far)]);
+    expect_error(
+        &args,
+        &[
+            "tendons[0].displacement: at t = 0 s its thread pulls -159.9",
+            "beyond the tension limit |u| = 48.4591 N",
+        ],
+    );
 }
 
 /// `linearize` about a displacement-driven equilibrium takes the motor's displacement as the

@@ -344,6 +344,8 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
         let what = opts.input.describe().unwrap_or_default();
         ScenarioError::invalid(option, format!("{what}{at} {e}"))
     })?;
+    // the tensions at a driven equilibrium start: those the displacements need
+    let mut start_tensions = None;
     let initial = match &opts.start {
         Start::Rest => InitialState::Rest,
         // the equilibrium `gvsrom statics` finds under the scenario's tensions and loads (with a
@@ -358,6 +360,9 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
                     format!("the start, the static equilibrium under the scenario's tensions and loads, failed: {e:#}"),
                 )
             })?;
+            if built.displacement_driven() {
+                start_tensions = Some(report.u.clone());
+            }
             InitialState::Given {
                 q: DVector::from_vec(report.q),
                 qd: DVector::zeros(built.n_dof()),
@@ -365,7 +370,10 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
         }
         Start::State { q, qd } => initial_state(built, q, qd)?,
     };
-    let input = input_record(built, opts)?;
+    let mut input = input_record(built, opts)?;
+    if let Some(u) = start_tensions {
+        input["start_tensions"] = serde_json::json!(u);
+    }
     Ok(Plan {
         t_out,
         signal,

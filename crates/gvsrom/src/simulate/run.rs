@@ -172,6 +172,19 @@ pub fn non_physical_state(built: &Built, x: &[f64], s: &Sample<'_>) -> Option<St
     ))
 }
 
+/// The first displacement-driven tendon whose thread pulls beyond `limits` (per tendon, from
+/// [`crate::plausibility::tension_limits`]) at the sample `s`, as the message that ends the run.
+fn thread_beyond_limits(built: &Built, limits: &[f64], s: &Sample<'_>) -> Option<String> {
+    let k = (0..limits.len())
+        .find(|&k| built.displacement[k].is_some() && !(s.u[k].abs() <= limits[k]))?;
+    Some(format!(
+        "tendons[{k}].displacement: at t = {} s its thread pulls {} N, beyond the tension limit |u| = {} N (the rod's elastic range): the displacement asks more than the rod can take (`gvsrom statics` refuses it at rest too)",
+        s.t,
+        crate::build::significant(s.u[k]),
+        crate::build::significant(limits[k]),
+    ))
+}
+
 /// `run` with the samples delivered to any [`SampleSink`].
 pub fn run_into(
     built: &Built,
@@ -209,10 +222,21 @@ pub fn run_into(
             // constant displacements keep the threads' springs conservative
             None => EnergyMonitor::new(&built.model, plan.constant_displacements(built)),
         });
+    // the tension each displacement-driven tendon may carry: where the rod leaves its elastic
+    // range (as the statics drive bounds it)
+    let limits = match built.displacement_driven() {
+        true => crate::plausibility::tension_limits(built),
+        false => vec![],
+    };
     let mut sink = |s: &Sample<'_>| {
         // a state no elastic rod holds (a diverged integration, a load the estimate underrated)
         // ends the run before it is written: its samples would be taken for a motion
         if let Some(msg) = non_physical_state(built, &x, s) {
+            non_physical = Some(msg.clone());
+            return ControlFlow::Break(msg);
+        }
+        // a displacement whose thread pulls beyond the rod's elastic range: no motion of the rod
+        if let Some(msg) = thread_beyond_limits(built, &limits, s) {
             non_physical = Some(msg.clone());
             return ControlFlow::Break(msg);
         }
