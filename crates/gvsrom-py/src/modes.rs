@@ -32,9 +32,11 @@ impl Robot {
     ///     ``dominant_strain`` (list of k names), ``tip_displacement`` and ``tip_rotation``
     ///     (k, 3) world axes, ``centerline_x`` (c,) and ``centerline`` (c, 3) the equilibrium's
     ///     centreline, ``centerline_shape`` (k, c, 3) its displacement per unit modal coordinate
-    ///     (world axes), ``all_frequencies_hz`` (n_dof,; one fewer per held tendon), ``q0``
-    ///     (n_dof,), ``u`` (the tensions, those found for displacement drives), ``held_tendons``
-    ///     (list of int: the taut tendons driven by displacement, held at their lengths),
+    ///     (world axes), ``all_frequencies_hz`` (n_dof,; one fewer per inextensible held
+    ///     tendon), ``q0`` (n_dof,), ``u`` (the tensions, those found for displacement drives),
+    ///     ``held_tendons`` (list of int: the taut tendons driven by displacement, held by their
+    ///     locked motors), ``held_by_threads`` (list of int: those of them held through an
+    ///     elastic thread, ``axial_stiffness``, a spring rather than a constraint),
     ///     ``strain_x`` (n_points,), ``equilibrium_tip_position`` (3,),
     ///     ``equilibrium_residual_norm``, ``model_extrapolated`` (list of str: how the reduced
     ///     model was used outside its training, ``extrapolate=True``; empty otherwise).
@@ -118,6 +120,7 @@ fn report_dict<'py>(py: Python<'py>, r: &ModesReport) -> PyResult<Bound<'py, PyD
     d.set_item("q0", vector(py, &r.q0))?;
     d.set_item("u", vector(py, &r.u))?;
     d.set_item("held_tendons", r.held_tendons.clone())?;
+    d.set_item("held_by_threads", r.held_by_threads.clone())?;
     d.set_item("strain_x", vector(py, &r.strain_x))?;
     d.set_item(
         "equilibrium_tip_position",

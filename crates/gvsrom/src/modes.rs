@@ -110,18 +110,23 @@ pub struct ModesReport {
     pub scenario: String,
     /// Tendon tensions u \[N\] of the equilibrium (those found for displacement drives).
     pub u: Vec<f64>,
-    /// The tendons held at their lengths (taut and driven by displacement: their motors locked),
-    /// whose lengths the modes keep ([`Model::held_modes`]): `n_dof − held` modes. Empty when
-    /// every tendon is driven by tension.
+    /// The tendons held by their motors (taut and driven by displacement: the motors locked)
+    /// ([`Model::held_modes`]): an inextensible one keeps its length, a constraint; one with an
+    /// elastic thread ([`ModesReport::held_by_threads`]) is the spring its thread is.
+    /// `n_dof − (inextensible held)` modes. Empty when every tendon is driven by tension.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub held_tendons: Vec<usize>,
+    /// Of [`ModesReport::held_tendons`], those held through an elastic thread
+    /// (`tendons[k].axial_stiffness`): springs, not constraints.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub held_by_threads: Vec<usize>,
     pub n_dof: usize,
     pub n_points: usize,
     /// The equilibrium `q₀` and its statics report's tip position and residual.
     pub q0: Vec<f64>,
     pub equilibrium_tip_position: [f64; 3],
     pub equilibrium_residual_norm: f64,
-    /// Frequencies of all `n_dof` modes (`n_dof − held` with held tendons), ascending \[Hz\].
+    /// Frequencies of all `n_dof` modes (one fewer per inextensible held tendon), ascending \[Hz\].
     pub all_frequencies_hz: Vec<f64>,
     /// `‖K_T − K_Tᵀ‖_F / ‖K_T‖_F`: above [`gvs::dynamics::SYMMETRY_TOLERANCE`] (tendon friction,
     /// follower loads) the modes are the eigenpairs of the non-symmetric `M⁻¹ K_T`, whose shapes
@@ -300,6 +305,9 @@ fn modes_on<P: StrainParam>(
         scenario: built.name.clone(),
         u: eq.u.clone(),
         held_tendons: held.to_vec(),
+        held_by_threads: (held.iter().copied())
+            .filter(|&k| model.tendons[k].axial_stiffness.is_some())
+            .collect(),
         n_dof: n,
         n_points: model.disc.n_points(),
         q0: eq.q.clone(),

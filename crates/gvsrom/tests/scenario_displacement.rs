@@ -184,7 +184,9 @@ fn modes_hold_the_taut_displacement_driven_tendons() {
     let drives = "--displacement=0.01,-0.01,0,-0.01,-0.01,-0.01";
     let (stdout, held) = run_json("modes", "drive-modes-held", &["six-tendon", drives]);
     assert!(
-        stdout.contains("held       tendons 0, 1, 2 at their length"),
+        stdout.contains(
+            "held       by the locked motors (driven by displacement): tendons 0, 1, 2 at their length: 3 constraints"
+        ),
         "{stdout}"
     );
     let held_tendons: Vec<u64> = (held["held_tendons"].as_array().unwrap().iter())
@@ -519,6 +521,40 @@ fn displacement_runs_are_refused_where_they_cannot_be_honoured() {
             "tendons[0].displacement: at t = 0 s its thread pulls -159.9",
             "beyond the tension limit |u| = 48.4591 N",
         ],
+    );
+}
+
+/// A tendon held through an elastic thread is a spring, not a constraint: `modes` keeps all 33
+/// modes of the IV-A arm, lists it in `held_by_threads`, and its first frequency lies between the
+/// free arm's at the same tension and the inextensible tendon's held one.
+#[test]
+fn modes_hold_an_elastic_thread_as_a_spring() {
+    let args = ["single-tendon", "--displacement", "0.004", "--set", THREAD];
+    let (stdout, thread) = run_json("modes", "drive-modes-thread", &args);
+    assert!(
+        stdout.contains(
+            "tendon 0 through its elastic thread (axial_stiffness): spring, no constraint"
+        ),
+        "{stdout}"
+    );
+    assert_eq!(thread["held_by_threads"], serde_json::json!([0]));
+    let all = f64s(&thread["all_frequencies_hz"]);
+    assert_eq!(all.len(), 33);
+    let u = format!("--tension={}", f64s(&thread["u"])[0]);
+    let (_, free) = run_json("modes", "drive-modes-free", &["single-tendon", &u]);
+    let (_, rigid) = run_json(
+        "modes",
+        "drive-modes-rigid",
+        &["single-tendon", "--displacement", "0.004"],
+    );
+    let (f, r) = (
+        f64s(&free["all_frequencies_hz"])[0],
+        f64s(&rigid["all_frequencies_hz"])[0],
+    );
+    assert!(
+        f < all[0] && all[0] < r,
+        "free {f} < thread {} < rigid {r}",
+        all[0]
     );
 }
 

@@ -130,15 +130,36 @@ pub(super) fn modes_cmd(args: &ModesArgs, out: &mut impl Write) -> Result<()> {
         fmt_vec(&eq.tip_position, 6)
     )?;
     if !report.held_tendons.is_empty() {
-        let held: Vec<String> = report.held_tendons.iter().map(|k| k.to_string()).collect();
+        let (threads, rigid): (Vec<usize>, Vec<usize>) =
+            (report.held_tendons.iter()).partition(|k| report.held_by_threads.contains(k));
+        let list = |ks: &[usize]| {
+            let names: Vec<String> = ks.iter().map(|k| k.to_string()).collect();
+            let noun = if ks.len() == 1 { "tendon" } else { "tendons" };
+            format!("{noun} {}", names.join(", "))
+        };
+        let mut parts = vec![];
+        if !rigid.is_empty() {
+            parts.push(format!(
+                "{} at {} length: {} constraint{}",
+                list(&rigid),
+                if rigid.len() == 1 { "its" } else { "their" },
+                rigid.len(),
+                if rigid.len() == 1 { "" } else { "s" },
+            ));
+        }
+        if !threads.is_empty() {
+            parts.push(format!(
+                "{} through {} elastic thread{} (axial_stiffness): spring{}, no constraint",
+                list(&threads),
+                if threads.len() == 1 { "its" } else { "their" },
+                if threads.len() == 1 { "" } else { "s" },
+                if threads.len() == 1 { "" } else { "s" },
+            ));
+        }
         writeln!(
             out,
-            "held       {} {} at {} length (driven by displacement, the motor locked): {} constraint{}, tensions u = [{}] N",
-            if held.len() == 1 { "tendon" } else { "tendons" },
-            held.join(", "),
-            if held.len() == 1 { "its" } else { "their" },
-            held.len(),
-            if held.len() == 1 { "" } else { "s" },
+            "held       by the locked motors (driven by displacement): {}; tensions u = [{}] N",
+            parts.join("; "),
             (report.u.iter().map(|u| gvsrom::build::significant(*u)))
                 .collect::<Vec<_>>()
                 .join(", ")
