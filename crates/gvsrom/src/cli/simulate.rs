@@ -22,7 +22,9 @@ pub struct SimulateArgs {
     pub sample_rate: f64,
 
     /// Actuation from a CSV file with columns `t, u_1, …, u_na` (held piecewise constant; see
-    /// `--interpolate`). Without an input option the scenario's tensions are held constant.
+    /// `--interpolate`): each tendon's tension [N], or, for a tendon driven by its displacement
+    /// (`--displacement` with its thread's `axial_stiffness`), its motor's displacement [m].
+    /// Without an input option the scenario's tensions (and displacements) are held constant.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["steps", "babble"])]
     pub input: Option<PathBuf>,
 
@@ -164,7 +166,23 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
         args.babble.as_deref(),
         args.seed,
     )?;
-    let signal = input.describe().map(|d| match args.from_equilibrium {
+    // a driven tendon's column is its motor's displacement, its tension found as the run goes
+    let driven: Vec<String> = (0..built.displacement.len())
+        .filter(|&k| built.displacement[k].is_some())
+        .map(|k| k.to_string())
+        .collect();
+    let input_description = input.describe().map(|d| match driven.len() {
+        0 => d,
+        1 => format!(
+            "{d} (tendon {}'s channel its displacement δ [m]; u.npy holds the tensions found)",
+            driven[0]
+        ),
+        _ => format!(
+            "{d} (tendons {}'s channels their displacements δ [m]; u.npy holds the tensions found)",
+            driven.join(", ")
+        ),
+    });
+    let signal = input_description.map(|d| match args.from_equilibrium {
         true if built.displacement_driven() => {
             format!("{d}, from the equilibrium under the scenario's drives")
         }

@@ -192,10 +192,17 @@ fn tensions(tr: &Trajectory, caption: &str, sink: &mut Sink) -> Result<(), Figur
     }
     let input = tr.input.as_ref();
     let smooth = input.is_some_and(|i| i["interpolation"] == "linear" || i["signal"] == "function");
+    // a tendon driven by its displacement: its tension follows the motion, no held input
+    let driven = |j: usize| {
+        input.is_some_and(|i| {
+            (i["displacement_channels"].as_array())
+                .is_some_and(|d| d.iter().any(|k| k.as_u64() == Some(j as u64)))
+        })
+    };
     let series = (0..*na)
         .map(|j| {
             let at = |k: usize| u[k * na + j];
-            let (t, y): (Vec<f64>, Vec<f64>) = match smooth {
+            let (t, y): (Vec<f64>, Vec<f64>) = match smooth || driven(j) {
                 true => (tr.t.clone(), (0..n).map(at).collect()),
                 // held: a corner where the value changes, then on to the last sample
                 false => {
