@@ -36,7 +36,8 @@ impl Robot {
     /// interpolate : bool
     ///     Interpolate ``input`` rows linearly.
     /// from_equilibrium : bool
-    ///     Start at the static equilibrium under the scenario's tensions (else straight at rest).
+    ///     Start at the static equilibrium under the scenario's tensions and displacements (else
+    ///     straight at rest).
     /// q0, qd0 : array_like of float, shape (n,), optional
     ///     Start at this state instead (``qd0`` zeros if not given): the coordinates of the model
     ///     that runs (the reduced model's with one attached; an autoencoder's inside its training
@@ -77,7 +78,8 @@ impl Robot {
     ///     Finite differences of the right-hand side for the integrator's Jacobian instead of the
     ///     structured analytic one (``--fd-jacobian``; the NDF and the fixed step).
     /// controller : callable, optional
-    ///     A sampled-data controller ``controller(t, q, qd) -> tensions``: called at ``t = 0`` and
+    ///     A sampled-data controller ``controller(t, q, qd) -> tensions`` (a displacement [m] for a
+    ///     tendon the scenario drives by its displacement): called at ``t = 0`` and
     ///     every ``1 / control_rate`` seconds with the state there (``q``, ``qd``: the coordinates
     ///     of the model that runs, new arrays), its tensions held until the next call (a
     ///     zero-order hold, as a digital controller drives a robot). The closed loop is one
@@ -116,7 +118,8 @@ impl Robot {
     ///     callable ``input`` returned), empty otherwise; for a conservative run (no damping,
     ///     tendon friction, loads or schedule; constant tensions) ``energy_balance``, a dict of
     ///     ``initial``, ``last``, ``largest_gain``, ``largest_loss``, ``kinetic_max`` [J] of
-    ///     ``T + U_e + U_g − Σ u ℓ`` over the samples, with a ``UserWarning`` when it rose by more
+    ///     ``T + U_e + U_g − Σ u ℓ`` over the samples (a thread held at a constant displacement
+    ///     counts its ``½ (ℓ − ℓ*)² / c`` in place of ``−u ℓ``), with a ``UserWarning`` when it rose by more
     ///     than 1 % of the largest kinetic energy (the integration added energy); with ``out``,
     ///     ``out``: the directory written.
     ///

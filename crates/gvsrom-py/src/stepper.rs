@@ -166,8 +166,9 @@ impl Stepper {
     /// ------
     /// GvsromError
     ///     For tensions of the wrong count, not finite, beyond the rod's elastic range or outside
-    ///     a reduced model's training (without ``extrapolate``): checked before the run sees
-    ///     them, so the run stays where it was and the next ``step`` goes on from there. Also
+    ///     a reduced model's training (without ``extrapolate``), or a displacement not below its
+    ///     tendon's rest length: checked before the run sees them, so the run stays where it
+    ///     was and the next ``step`` goes on from there. Also
     ///     once the run has ended (closed, past its horizon, or its integration failed).
     fn step<'py>(
         &mut self,

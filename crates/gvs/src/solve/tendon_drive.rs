@@ -153,7 +153,7 @@ pub fn solve_driven_within<P: StrainParam>(
                     return Err(ModelError::invalid(
                         field,
                         format!(
-                            "a displacement of {delta} m: accepted within ±{:.6} m, the tendon's rest length (a tendon cannot be wound in by its whole length)",
+                            "a displacement of {delta} m: accepted of magnitude below {:.6} m, the tendon's rest length (a tendon cannot be wound in by its whole length)",
                             rest[k]
                         ),
                     )

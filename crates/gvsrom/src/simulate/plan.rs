@@ -475,7 +475,7 @@ pub fn check_channel_displacements(
                 field(k),
                 v,
                 format!(
-                    "a displacement in m within ±{:.6} m, the tendon's rest length",
+                    "a displacement in m of magnitude below {:.6} m, the tendon's rest length",
                     rest[k]
                 ),
             ));
