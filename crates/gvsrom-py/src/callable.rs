@@ -250,7 +250,9 @@ impl CallableInput {
             // the channel refused: the first displacement not below its tendon's length
             let rest = built.model.tendon_rest_lengths();
             let k = (0..abs.len())
-                .find(|&k| built.displacement[k].is_some() && !(abs[k] < rest[k]))
+                .find(|&k| {
+                    built.displacement[k].is_some() && (!abs[k].is_finite() || abs[k] >= rest[k])
+                })
                 .unwrap_or(0);
             let message = format!("{}: {e}", self.named(at[k]));
             let mut slot = self.error.lock().unwrap_or_else(PoisonError::into_inner);

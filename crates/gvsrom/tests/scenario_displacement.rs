@@ -218,7 +218,8 @@ fn modes_hold_the_taut_displacement_driven_tendons() {
 /// the whole tendon and one beyond what the rod can take are refused too.
 #[test]
 fn displacements_are_refused_where_they_cannot_be_honoured() {
-    for cmd in [vec!["dataset", "single-tendon", "--samples", "2", "--out"]] {
+    {
+        let cmd = vec!["dataset", "single-tendon", "--samples", "2", "--out"];
         let out = scratch(&format!("drive-refused-{}", cmd[0]));
         let mut args = cmd.clone();
         if args.last() == Some(&"--out") {

@@ -39,7 +39,7 @@ mod run;
 mod writer;
 
 pub use buffer::*;
-pub use energy::{not_conservative, EnergyBalance, GAIN_NOTE, LOSS_NOTE};
+pub use energy::{not_conservative, EnergyBalance, ThreadSprings, GAIN_NOTE, LOSS_NOTE};
 pub use integrator::*;
 pub use options::*;
 pub use plan::*;

@@ -175,8 +175,9 @@ pub fn non_physical_state(built: &Built, x: &[f64], s: &Sample<'_>) -> Option<St
 /// The first displacement-driven tendon whose thread pulls beyond `limits` (per tendon, from
 /// [`crate::plausibility::tension_limits`]) at the sample `s`, as the message that ends the run.
 fn thread_beyond_limits(built: &Built, limits: &[f64], s: &Sample<'_>) -> Option<String> {
-    let k = (0..limits.len())
-        .find(|&k| built.displacement[k].is_some() && !(s.u[k].abs() <= limits[k]))?;
+    let k = (0..limits.len()).find(|&k| {
+        built.displacement[k].is_some() && (!s.u[k].is_finite() || s.u[k].abs() > limits[k])
+    })?;
     Some(format!(
         "tendons[{k}].displacement: at t = {} s its thread pulls {} N, beyond the tension limit |u| = {} N (the rod's elastic range): the displacement asks more than the rod can take (`gvsrom statics` refuses it at rest too)",
         s.t,
