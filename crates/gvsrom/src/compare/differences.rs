@@ -106,6 +106,8 @@ pub fn differences(reference: &Trajectory, run: &Trajectory) -> Differences {
                 "signal",
                 "start",
                 "start_tensions",
+                "start_displacements",
+                "displacement_channels",
                 "start_q",
                 "start_qd",
                 "load_schedule",
@@ -182,6 +184,12 @@ fn input_name(path: &str) -> String {
     }
     if let Some(k) = path.strip_prefix("start_tensions").and_then(index) {
         return format!("tendons[{k}].tension (the starting equilibrium's)");
+    }
+    if let Some(k) = path.strip_prefix("displacements").and_then(index) {
+        return format!("tendons[{k}].displacement");
+    }
+    if let Some(k) = path.strip_prefix("start_displacements").and_then(index) {
+        return format!("tendons[{k}].displacement (the starting equilibrium's)");
     }
     format!("input.{path}")
 }
