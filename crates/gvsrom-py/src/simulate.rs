@@ -110,7 +110,9 @@ impl Robot {
     ///     ``tip_rotation`` (k, 3, 3), ``strain`` (k, p, 6), ``strain_x`` (p,), ``centerline``
     ///     (k, c, 3), ``centerline_x`` (c,), ``tendon_paths`` (k, n_a, c, 3: each tendon's thread
     ///     at ``centerline_x`` clamped to its span), ``tendon_lengths`` (k, n_a: each tendon's
-    ///     length [m] along its thread; at rest :attr:`Robot.tendon_rest_lengths`),
+    ///     length [m] along its thread; at rest :attr:`Robot.tendon_rest_lengths`), with a tendon
+    ///     driven by its displacement ``displacement`` (k, n_a: the displacements [m] its motor
+    ///     was commanded, NaN for a tendon driven by its tension),
     ///     ``body_positions`` (k, n_b, 2, 3: each rigid body's section and centre of mass), ``steps``,
     ///     ``failed_steps``, ``wall_time_s``, and
     ///     ``model_extrapolated`` (list of str): how the reduced model was used outside what it
@@ -411,6 +413,9 @@ fn trajectory<'py>(
         "tendon_lengths",
         shaped(py, b.tendon_lengths.clone(), [k, na])?,
     )?;
+    if built.displacement_driven() {
+        d.set_item("displacement", shaped(py, b.displacement.clone(), [k, na])?)?;
+    }
     let nb = built.model.bodies().len();
     d.set_item(
         "body_positions",

@@ -103,6 +103,9 @@ def test_a_run_on_an_elastic_thread_settles_where_statics_puts_it():
     np.testing.assert_allclose(run["tip_position"][-1], eq.tip_position, atol=1e-6 * 0.25)
     ramp = robot.simulate(4.0, sample_rate=10, input=[[0.0, 0.0], [1.0, 0.004]], interpolate=True)
     assert ramp["u"][0, 0] == 0.0, "no displacement yet: the thread is at its length"
+    # the commanded displacements are kept: the ramp, then held
+    np.testing.assert_allclose(ramp["displacement"][:11, 0], np.linspace(0.0, 0.004, 11), atol=1e-15)
+    assert (ramp["displacement"][10:, 0] == 0.004).all()
     np.testing.assert_allclose(ramp["tip_position"][-1], eq.tip_position, atol=1e-6 * 0.25)
     # a displacement past the tendon's length is refused before the run
     with pytest.raises(gvsrom.GvsromError, match=r"column 0.*rest length"):

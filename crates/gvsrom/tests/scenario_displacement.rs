@@ -355,6 +355,10 @@ fn a_run_driven_by_displacement_settles_on_the_statics_drive() {
     assert!(dist(last, &target) < 1e-6 * 0.25, "{last:?} vs {target:?}");
     let (shape, u) = common::npy(&out.join("u.npy"));
     assert_eq!(shape, [41, 1]);
+    // the displacement commanded, held
+    let (shape, commanded) = common::npy(&out.join("displacement.npy"));
+    assert_eq!(shape, [41, 1]);
+    assert!(commanded.iter().all(|&d| d == 0.004), "{commanded:?}");
     assert!(
         ((u[40] - u_eq) / u_eq).abs() < 1e-4,
         "u = {} vs {u_eq}",

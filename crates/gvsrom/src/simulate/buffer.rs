@@ -30,6 +30,10 @@ pub struct TrajectoryBuffer {
     /// `samples × bodies × 2 × 3`: each rigid body's section and centre of mass \[m\]
     /// (`body_positions.npy`).
     pub body_positions: Vec<f64>,
+    /// `samples × tendons`: the commanded displacements \[m\] (NaN for a tendon driven by its
+    /// tension; `displacement.npy`), empty unless a tendon is driven by its displacement.
+    pub displacement: Vec<f64>,
+    driven: Vec<bool>,
     shape: Centerline,
 }
 
@@ -48,6 +52,8 @@ impl TrajectoryBuffer {
             tendon_paths: vec![],
             tendon_lengths: vec![],
             body_positions: vec![],
+            displacement: vec![],
+            driven: built.drive_flags(),
             shape: Centerline::new(built),
         }
     }
@@ -71,6 +77,10 @@ impl SampleSink for TrajectoryBuffer {
         self.tendon_paths.extend_from_slice(&self.shape.tendons);
         self.tendon_lengths.extend_from_slice(&self.shape.lengths);
         self.body_positions.extend_from_slice(&self.shape.bodies);
+        if self.driven.iter().any(|&d| d) {
+            self.displacement
+                .extend(super::writer::commanded(&self.driven, s));
+        }
         self.t.push(s.t);
         self.q.extend_from_slice(s.q);
         self.qd.extend_from_slice(s.qd);

@@ -76,6 +76,16 @@ impl SampleSink for TrajectoryWriter {
     }
 }
 
+/// The displacements \[m\] the motors were commanded, one per tendon per sample (NaN for a
+/// tendon driven by its tension): written only when a tendon is driven by its displacement, whose
+/// tension `u.npy` holds as found from its thread's stretch.
+pub const DISPLACEMENT_FILE: &str = "displacement.npy";
+
+/// The commanded displacement of each tendon `driven` at the sample `s` (NaN for the others).
+pub fn commanded<'s>(driven: &'s [bool], s: &'s Sample<'_>) -> impl Iterator<Item = f64> + 's {
+    (driven.iter().zip(s.input)).map(|(&d, &v)| if d { v } else { f64::NAN })
+}
+
 /// Why [`run_to_dir`] could not run or write a trajectory.
 #[derive(Debug, thiserror::Error)]
 pub enum TrajectoryError {
@@ -170,6 +180,10 @@ pub struct TrajectoryWriter {
     tendon_paths: Option<(NpyRows, NpyRows)>,
     /// `body_positions.npy`, with bodies only.
     body_positions: Option<NpyRows>,
+    /// `displacement.npy`, with a tendon driven by its displacement only.
+    displacement: Option<NpyRows>,
+    /// Per tendon, whether it is driven by its displacement.
+    driven: Vec<bool>,
     shape: Centerline,
     provenance: Option<serde_json::Value>,
 }
@@ -217,6 +231,13 @@ impl TrajectoryWriter {
                     .map_err(|e| dir.io_error("create the trajectory files", e))?,
             ),
         };
+        let displacement = match built.displacement_driven() {
+            false => None,
+            true => Some(
+                NpyRows::new(&mut dir, DISPLACEMENT_FILE, &[na])
+                    .map_err(|e| dir.io_error("create the trajectory files", e))?,
+            ),
+        };
         Ok(TrajectoryWriter {
             dir,
             t,
@@ -229,6 +250,8 @@ impl TrajectoryWriter {
             centerline,
             tendon_paths,
             body_positions,
+            displacement,
+            driven: built.drive_flags(),
             shape,
             provenance: None,
         })
@@ -259,6 +282,9 @@ impl TrajectoryWriter {
         }
         if let Some(bodies) = &mut self.body_positions {
             bodies.push(self.shape.bodies.iter().copied())?;
+        }
+        if let Some(d) = &mut self.displacement {
+            d.push(commanded(&self.driven, s))?;
         }
         self.t.push([s.t])?;
         self.q.push(s.q.iter().copied())?;
@@ -299,6 +325,8 @@ impl TrajectoryWriter {
             centerline,
             tendon_paths,
             body_positions,
+            displacement,
+            driven: _,
             shape,
             provenance,
         } = self;
@@ -306,7 +334,10 @@ impl TrajectoryWriter {
         let arrays = [t, q, qd, u, tip_position, tip_rotation, strain, centerline];
         (|| -> std::io::Result<()> {
             let tendons = tendon_paths.into_iter().flat_map(|(p, l)| [p, l]);
-            for a in arrays.into_iter().chain(tendons).chain(body_positions) {
+            for a in (arrays.into_iter().chain(tendons))
+                .chain(body_positions)
+                .chain(displacement)
+            {
                 a.finish(&mut dir)?;
             }
             crate::npy::write_array(

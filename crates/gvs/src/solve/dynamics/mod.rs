@@ -360,6 +360,9 @@ pub struct Sample<'a> {
     /// Tensions `u(t)`: the actuation's, and a displacement-driven tendon's from its stretch at
     /// this `q` ([`drive`]).
     pub u: &'a [f64],
+    /// The actuation's channels at `t` as it gave them: `u` for a tension channel, the
+    /// displacement \[m\] for a displacement-driven tendon ([`drive`]).
+    pub input: &'a [f64],
     /// Tip pose `g(L)`.
     pub tip: &'a Pose,
     /// Strain `ξ` at the computational points.
@@ -554,6 +557,7 @@ pub fn simulate_streaming_interruptible<P: StrainParam>(
     let mut out_ws = model.workspace();
     let mut qbuf = DVector::zeros(n);
     let mut ubuf = vec![0.0; model.n_actuators()];
+    let mut cbuf = vec![0.0; model.n_actuators()];
     let mut samples = 0;
     let mut t_last = None;
     let mut record = |t: f64, y: &DVector<f64>| {
@@ -563,7 +567,8 @@ pub fn simulate_streaming_interruptible<P: StrainParam>(
         }
         qbuf.copy_from(&y.rows(0, n));
         model.forward(&qbuf, &mut out_ws, false);
-        actuation.eval(t, &mut ubuf);
+        actuation.eval(t, &mut cbuf);
+        ubuf.copy_from_slice(&cbuf);
         // a driven tendon's sample is its tension, not the displacement asked
         if let Some(s) = &mut springs {
             s.tensions_after_forward(model, &out_ws, &mut ubuf);
@@ -575,6 +580,7 @@ pub fn simulate_streaming_interruptible<P: StrainParam>(
             q: &y.as_slice()[..n],
             qd: &y.as_slice()[n..],
             u: &ubuf,
+            input: &cbuf,
             tip: out_ws.g.last().unwrap(),
             strain: &out_ws.xi[..model.disc.n_points()],
         })
