@@ -160,7 +160,29 @@ fn residuals_mass_matrix_and_statics_jacobian_do_not_allocate() {
             [0; 6],
             "allocations of: statics residual, dynamics residual, forward pass with Jacobians, mass matrix, statics Jacobian, iteration parts M, D, K (n = {n})"
         );
+        // what a displacement-driven tendon's thread needs (`gvs::solve::dynamics::drive`): the
+        // strains and tendon lengths at q for its tension, ∂ℓ/∂q and B for its stiffness
+        let na = m.n_actuators();
+        let (mut lengths, mut unit) = (vec![0.0; na], vec![0.0; na]);
+        let (mut grad, mut b) = (DMatrix::zeros(n, na), DMatrix::zeros(n, na));
+        let mut col = DVector::zeros(n);
+        m.forward(&q, &mut ws, false);
+        m.tendon_length_jacobian_after_forward(&mut ws, &mut grad, &mut col);
+        m.actuation_matrix_after_forward(&mut ws, &mut b, &mut unit, &mut col);
+        let thread = allocations();
+        m.strains_at(&q, &mut ws);
+        m.tendon_lengths_after_forward(&ws, &mut lengths);
+        m.forward(&q, &mut ws, false);
+        m.tendon_length_jacobian_after_forward(&mut ws, &mut grad, &mut col);
+        m.actuation_matrix_after_forward(&mut ws, &mut b, &mut unit, &mut col);
+        assert_eq!(
+            allocations() - thread,
+            0,
+            "allocations of a thread's tension and stiffness: strains, tendon lengths, ∂ℓ/∂q, B"
+        );
+        assert!(lengths.iter().all(|l| *l > 0.0) && grad.amax() > 0.0 && b.amax() > 0.0);
         // the counter does see allocations
+        let before = allocations();
         drop(std::hint::black_box(vec![0u8; 8]));
         assert_eq!(allocations() - before, 1);
         // D is symmetric (it allocates: after the count)
