@@ -17,7 +17,10 @@ impl Robot {
     /// state ``x = [q; q̇]``, the tendon tensions ``u`` [N] and the output ``y``, the tip position
     /// or the positions at ``outputs`` (world axes, m). ``A`` keeps every term of the dynamics
     /// (gvs-spec §9.3), the inertial ones that vanish at rest included. With a reduced model
-    /// attached, its ``2r``-state linearization.
+    /// attached, its ``2r``-state linearization. About the equilibrium of a scenario that drives
+    /// a tendon by its ``displacement`` through an elastic thread (``axial_stiffness``), that
+    /// tendon's input is its motor's displacement [m] (the dict's ``displacement_channels``):
+    /// ``A`` holds the thread's stiffness, ``B``'s column is per metre wound in.
     ///
     /// Parameters
     /// ----------
@@ -141,6 +144,7 @@ fn report_dict<'py>(py: Python<'py>, r: &Linearization) -> PyResult<Bound<'py, P
     let x0: Vec<f64> = r.q.iter().chain(&r.qd).copied().collect();
     d.set_item("x0", vector(py, &x0))?;
     d.set_item("u", vector(py, &r.u))?;
+    d.set_item("displacement_channels", r.displacement_channels.clone())?;
     d.set_item("xdot", vector(py, &r.xdot))?;
     d.set_item("tip_position", vector(py, &r.tip_position))?;
     d.set_item("outputs", vector(py, &r.outputs))?;

@@ -114,6 +114,10 @@ def test_a_run_on_an_elastic_thread_settles_where_statics_puts_it():
     # the rod's elastic range (20 cm of a 200 N thread: 160 N at once)
     with pytest.raises(gvsrom.IntegrationError, match=r"tendons\[0\]\.displacement: at t = 0 s its thread pulls.*beyond the tension limit"):
         robot.simulate(0.2, input=lambda t: [0.2])
+    # linearized, the driven tendon's input is its displacement: the settled tip rises per metre
+    lin = robot.linearize()
+    assert lin["displacement_channels"] == [0]
+    assert lin["static_gain"][2, 0] > 1.0, "a millimetre wound in lifts the tip by more"
     # the stepper's entry for the driven tendon is its displacement too
     stepper = robot.stepper(0.1)
     with pytest.raises(gvsrom.GvsromError, match=r"u\[0\].*rest length"):
