@@ -108,7 +108,7 @@ def test_a_run_on_an_elastic_thread_settles_where_statics_puts_it():
     assert (ramp["displacement"][10:, 0] == 0.004).all()
     np.testing.assert_allclose(ramp["tip_position"][-1], eq.tip_position, atol=1e-6 * 0.25)
     # a displacement past the tendon's length is refused before the run
-    with pytest.raises(gvsrom.GvsromError, match=r"column 0.*rest length"):
+    with pytest.raises(gvsrom.GvsromError, match=r"tendon 0.s displacement at t = 0.5 s.*rest length"):
         robot.simulate(1.0, input=[[0.0, 0.0], [0.5, 0.3]])
     # a callable's displacement the rod cannot take ends the run where the thread pulls past
     # the rod's elastic range (20 cm of a 200 N thread: 160 N at once)

@@ -504,7 +504,11 @@ fn displacement_runs_are_refused_where_they_cannot_be_honoured() {
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     expect_error(
         &args,
-        &["--input (column 0, t = 0.05 s)", "0.3", "rest length"],
+        &[
+            "--input (tendon 0's displacement at t = 0.05 s)",
+            "0.3",
+            "rest length",
+        ],
     );
     assert!(!out.exists());
     // a displacement the rod cannot take ends the run where its thread pulls past the rod's

@@ -451,7 +451,7 @@ fn check_displacements(
     for (t, row) in signal.times.iter().zip(&signal.values) {
         check_channel_displacements(built, row, &|k| match option {
             "displacement" => format!("tendons[{k}].displacement"),
-            o => format!("{o} (column {k}, t = {t} s)"),
+            o => format!("{o} (tendon {k}'s displacement at t = {t} s)"),
         })?;
     }
     Ok(())
