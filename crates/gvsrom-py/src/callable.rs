@@ -139,7 +139,7 @@ impl CallableInput {
             .map_err(|e| Failure::refused(invalid(format!("{named}: {e}"))))?;
         if let Some(k) = u.iter().position(|x| !x.is_finite()) {
             return Err(Failure::refused(invalid(format!(
-                "{named} returned u[{k}] = {}: expected finite tensions [N]",
+                "{named} returned u[{k}] = {}: expected finite values (tensions [N], or displacements [m] for tendons driven by their displacement)",
                 u[k]
             ))));
         }

@@ -182,7 +182,7 @@ impl Stepper {
             .map_err(|e| invalid(format!("`u`: {e}")))?;
         if let Some(k) = u.iter().position(|x| !x.is_finite()) {
             return Err(invalid(format!(
-                "`u[{k}]` = {}: expected finite tensions [N]",
+                "`u[{k}]` = {}: expected finite values (tensions [N], or displacements [m] for tendons driven by their displacement)",
                 u[k]
             )));
         }
