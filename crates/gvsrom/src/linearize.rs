@@ -386,15 +386,7 @@ pub fn about_equilibrium(
 ) -> Result<(StaticsReport, Linearization), LinearizeError> {
     crate::simulate::require_mass(built)?;
     // a tendon driven by its displacement is an input through its elastic thread
-    for (k, d) in built.displacement.iter().enumerate() {
-        if d.is_some() && built.model.tendons[k].axial_stiffness.is_none() {
-            return Err(ScenarioError::invalid(
-                format!("tendons[{k}].axial_stiffness"),
-                "missing: linearized, a tendon driven by its displacement is an elastic thread whose stretch carries the motor's displacement to the rod; give its axial stiffness EA in N (Young's modulus times the thread's section: about 20000 for a 0.5 mm Dyneema line) — an inextensible tendon held at its length is a constraint the state-space model does not impose",
-            )
-            .into());
-        }
-    }
+    built.require_threads("the state-space model")?;
     let eq = statics::solve(built)?;
     statics::check_reduced(built, &eq)?;
     let q = DVector::from_column_slice(&eq.q);

@@ -83,6 +83,25 @@ impl Built {
             .collect()
     }
 
+    /// Refuses a tendon driven by its displacement without its thread's axial stiffness, for
+    /// `what` (`"a motion"`, `"the state-space model"`): there the thread's stretch is what carries
+    /// the motor's displacement to the rod (`gvs::solve::dynamics::drive`), and an inextensible
+    /// tendon held at its length is a constraint `what` does not impose.
+    pub fn require_threads(&self, what: &str) -> Result<(), ScenarioError> {
+        let missing = (0..self.displacement.len()).find(|&k| {
+            self.displacement[k].is_some() && self.model.tendons[k].axial_stiffness.is_none()
+        });
+        match missing {
+            None => Ok(()),
+            Some(k) => Err(ScenarioError::invalid(
+                format!("tendons[{k}].axial_stiffness"),
+                format!(
+                    "missing: in {what} a tendon driven by its displacement is an elastic thread whose stretch carries the motor's displacement to the rod; give its axial stiffness EA in N (Young's modulus times the thread's section: about 20000 for a 0.5 mm Dyneema line) — an inextensible tendon held at its length is a constraint {what} does not impose"
+                ),
+            )),
+        }
+    }
+
     /// Refuses a scenario with a displacement-driven tendon for `what` (a command that drives
     /// tendons by tension only): the error names the tendon and how to find its tension.
     pub fn tension_driven_for(&self, what: &str) -> Result<(), ScenarioError> {

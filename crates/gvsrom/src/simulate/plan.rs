@@ -404,14 +404,7 @@ fn check_drives(built: &Built, opts: &SimulateOptions) -> Result<(), ScenarioErr
             ),
         ));
     }
-    for (k, d) in built.displacement.iter().enumerate() {
-        if d.is_some() && built.model.tendons[k].axial_stiffness.is_none() {
-            return Err(ScenarioError::invalid(
-                format!("tendons[{k}].axial_stiffness"),
-                "missing: in dynamics a tendon driven by its displacement is an elastic thread whose stretch carries the motor's displacement to the rod; give its axial stiffness EA in N (Young's modulus times the thread's section: about 20000 for a 0.5 mm Dyneema line) — an inextensible tendon held at its length is a constraint the integrators do not impose",
-            ));
-        }
-    }
+    built.require_threads("a motion")?;
     match &opts.input {
         InputSource::Steps { .. } | InputSource::Babble { .. } => {
             let option = match &opts.input {
