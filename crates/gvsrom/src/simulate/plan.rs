@@ -329,6 +329,8 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
         };
         let largest = (signal.times.iter().zip(&signal.values))
             .flat_map(|(t, v)| v.iter().enumerate().map(move |(k, u)| (*t, k, *u)))
+            // a displacement channel holds metres, not a tension
+            .filter(|(_, k, _)| built.displacement.get(*k).is_none_or(Option::is_none))
             // the first time it is reached
             .fold(None::<(f64, usize, f64)>, |best, x| match best {
                 Some(b) if b.2.abs() >= x.2.abs() => Some(b),
