@@ -195,7 +195,7 @@ impl CallableInput {
             return true;
         }
         let times: Vec<f64> = values.iter().map(|(t, _)| *t).collect();
-        let verdict = r.check_signal(&times, |t| {
+        let verdict = r.check_signal(&times, &built.drive_flags(), |t| {
             let at = values.iter().find(|(tv, _)| tv.to_bits() == t.to_bits());
             at.map_or_else(Vec::new, |(_, u)| u.clone())
         });

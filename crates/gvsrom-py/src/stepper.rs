@@ -206,7 +206,7 @@ impl Stepper {
         gvsrom::plausibility::check(built, &abs, 1.0).map_err(|e| refused(&e))?;
         if let Some(model) = &built.reduced {
             let notes = model
-                .check_signal(&[t], |_| u.clone())
+                .check_signal(&[t], &built.drive_flags(), |_| u.clone())
                 .map_err(|e| refused(&e))?;
             if let (Some(n), false) = (notes.first(), self.warned) {
                 warn(py, &format!("extrapolating (--extrapolate): {n} (further values outside the training are not warned of)"))?;

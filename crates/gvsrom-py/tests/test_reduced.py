@@ -481,6 +481,29 @@ def test_a_failed_reduced_run_raises_with_the_samples_it_computed(ae_model):
 
 
 
+def test_a_reduced_model_runs_a_tendon_driven_by_displacement(pod_model):
+    # the thread of the IV-A arm (EA = 200 N) wound in by 4 mm: its tension found as the run goes
+    # (−3.2 N at the straight start, inside the sweep's [−6, 0]) settles, with the tip, on the
+    # reduced statics drive; 12 mm pulls −9.6 N at once, outside: the run stops there, or with
+    # extrapolate goes on and says so
+    driven = (gvsrom.Scenario.preset("single-tendon").set("tendons.0.tension", 0)
+              .set("tendons.0.displacement", 0.004).set("tendons.0.axial_stiffness", 200.0).build())
+    reduced = driven.with_model(pod_model)
+    eq = reduced.statics()
+    run = reduced.simulate(4.0, sample_rate=10)
+    assert run["q"].shape == (41, 2)
+    rest = driven.tendon_rest_lengths[0]
+    assert run["u"][0, 0] == pytest.approx(-0.004 * 200.0 / rest, rel=1e-9)
+    assert run["u"][-1, 0] == pytest.approx(eq.u[0], rel=1e-4)
+    np.testing.assert_allclose(run["tip_position"][-1], eq.tip_position, atol=1e-5 * 0.25)
+    assert not any("tension" in s for s in run["model_extrapolated"])
+    with pytest.raises(gvsrom.IntegrationError, match=r"at t = 0\.0000 s the threads .* not trained for: "
+                       r"tendons\.0\.tension = -9\.59.* \(found\) lies outside the training inputs \[-6, 0\]"):
+        reduced.simulate(0.2, input=lambda t: [0.012])
+    far = driven.with_model(pod_model, extrapolate=True).simulate(0.2, input=lambda t: [0.012])
+    assert any("(found) lies outside the training inputs [-6, 0]" in s for s in far["model_extrapolated"])
+
+
 def test_a_pickled_robot_is_the_same_robot_in_another_process(dataset, pod_model, tmp_path):
     # multiprocessing pickles what it sends: a robot is rebuilt from its scenario and its model's
     # directory; in a worker process it solves as it does here

@@ -135,8 +135,7 @@ fn a_reduced_model_is_driven_by_displacement_too() {
     );
     assert_eq!(f64s(&in_toml["u"]), f64s(&reduced["u"]));
     // the thread's stiffness is no physics the model was trained on: statics uses it (part of
-    // the displacement is now stretch, so the rod bends less and pulls less), `simulate`
-    // refuses the drive
+    // the displacement is now stretch, so the rod bends less and pulls less)
     let mut elastic = with_model.clone();
     elastic.extend(["--set", THREAD]);
     let (_, thread) = run_json("statics", "drive-pod-thread", &elastic);
@@ -145,6 +144,8 @@ fn a_reduced_model_is_driven_by_displacement_too() {
         "{:?} vs {ur}",
         f64s(&thread["u"])
     );
+    // in motion from the straight rod the thread first carries the whole 4 mm, −3.2 N, beyond
+    // the sweep: the run stops at its first sample, naming the tension found
     let run = scratch("drive-pod-run");
     let mut run_args = vec!["simulate"];
     run_args.extend(&elastic);
@@ -152,11 +153,13 @@ fn a_reduced_model_is_driven_by_displacement_too() {
     expect_error(
         &run_args,
         &[
-            "tendons[0].displacement",
-            "runs tendons driven by their tension only in dynamics",
+            "at t = 0.0000 s the threads of the tendons driven by displacement pull with tensions the model was not trained for",
+            "tendons.0.tension = -3.19",
+            "(found) lies outside the training inputs [-3, 0]",
+            "--extrapolate",
+            "the 1 sample before it was written",
         ],
     );
-    assert!(!run.exists());
     // 12 mm needs about -4.4 N, outside the sweep's [-3, 0]: refused, naming the tension found
     expect_error(
         &[
@@ -172,6 +175,133 @@ fn a_reduced_model_is_driven_by_displacement_too() {
             "tendons.0.tension = -4.",
             "(found) lies outside the training inputs [-3, 0]",
         ],
+    );
+}
+
+/// A reduced model runs a tendon driven by displacement as the full model does: the IV-A arm
+/// wound in by 4 mm over 0.5 s through its thread, on a POD-4 of a tension sweep wide enough
+/// for the overshoot (−4.2 N), follows the full model's run within 1.5 % L and settles on its
+/// tip and tension. Wound in by 12 mm, the tensions found leave the sweep: without
+/// `--extrapolate` the run stops there; with it, it goes on and its record says so.
+#[test]
+fn a_reduced_model_runs_a_displacement_drive_and_checks_the_tensions_found() {
+    let data = sweep_dataset("drive-rom-data", "-5:0", 13);
+    let model = scratch("drive-rom-model");
+    run_ok(&[
+        "pod",
+        path_str(&data),
+        "--modes",
+        "4",
+        "--out",
+        path_str(&model),
+    ]);
+    let ramp = scratch("drive-rom-ramp.csv");
+    std::fs::write(&ramp, "t,d0\n0,0\n0.5,0.004\n4,0.004\n").unwrap();
+    let args = [
+        "simulate",
+        "single-tendon",
+        "--set",
+        "tendons.0.tension=0",
+        "--set",
+        "tendons.0.displacement=0",
+        "--set",
+        THREAD,
+        "--input",
+        path_str(&ramp),
+        "--duration",
+        "4",
+        "--sample-rate",
+        "50",
+    ];
+    let run = |name: &str, extra: &[&str]| {
+        let out = scratch(name);
+        let mut a = args.to_vec();
+        a.extend(extra);
+        a.extend(["--out", path_str(&out)]);
+        run_ok(&a);
+        let (_, tip) = common::npy(&out.join("tip_position.npy"));
+        let (_, u) = common::npy(&out.join("u.npy"));
+        (out, tip, u)
+    };
+    let (_, tip_full, u_full) = run("drive-rom-full", &[]);
+    let (out, tip_rom, u_rom) = run("drive-rom-reduced", &["--model", path_str(&model)]);
+    assert_eq!(tip_rom.len(), 201 * 3);
+    let worst = (0..201)
+        .map(|i| dist(&tip_rom[3 * i..3 * i + 3], &tip_full[3 * i..3 * i + 3]))
+        .fold(0.0, f64::max);
+    assert!(worst < 0.015 * 0.25, "largest tip difference {worst} m");
+    assert!(
+        u_full.iter().any(|&u| u < -3.5),
+        "the overshoot the sweep covers"
+    );
+    // each run settles on its own model's statics drive: the reduced one within its reduction
+    // error of the full one
+    let statics = ["single-tendon", "--displacement", "0.004", "--set", THREAD];
+    let (_, eq_full) = run_json("statics", "drive-rom-eq-full", &statics);
+    let mut with_model = statics.to_vec();
+    with_model.extend(["--model", path_str(&model)]);
+    let (_, eq_rom) = run_json("statics", "drive-rom-eq-reduced", &with_model);
+    for (tip, u, eq) in [(&tip_full, &u_full, &eq_full), (&tip_rom, &u_rom, &eq_rom)] {
+        let target = f64s(&eq["tip_position"]);
+        let end = dist(&tip[600..], &target);
+        assert!(end < 1e-5 * 0.25, "settled {end} m from its statics");
+        let u_eq = f64s(&eq["u"])[0];
+        assert!(
+            ((u[200] - u_eq) / u_eq).abs() < 1e-4,
+            "u {} vs {u_eq}",
+            u[200]
+        );
+    }
+    let apart = dist(
+        &f64s(&eq_rom["tip_position"]),
+        &f64s(&eq_full["tip_position"]),
+    );
+    assert!(apart < 5e-4 * 0.25, "the POD's statics {apart} m off");
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("meta.json")).unwrap()).unwrap();
+    assert!(
+        !meta["model_extrapolated"].to_string().contains("tension"),
+        "{}",
+        meta["model_extrapolated"]
+    );
+    // 12 mm: beyond the sweep as soon as the thread pulls past −5 N
+    let far = scratch("drive-rom-far.csv");
+    std::fs::write(&far, "t,d0\n0,0\n0.5,0.012\n4,0.012\n").unwrap();
+    let mut refused = args.to_vec();
+    refused[9] = path_str(&far);
+    let stopped = scratch("drive-rom-stopped");
+    let mut a = refused.clone();
+    a.extend(["--model", path_str(&model), "--out", path_str(&stopped)]);
+    expect_error(
+        &a,
+        &[
+            "the threads of the tendons driven by displacement pull with tensions the model was not trained for",
+            "(found) lies outside the training inputs [-5, 0]",
+            "marked partial",
+        ],
+    );
+    let extrapolated = scratch("drive-rom-extrapolated");
+    let mut a = refused.clone();
+    a.extend([
+        "--model",
+        path_str(&model),
+        "--extrapolate",
+        "--out",
+        path_str(&extrapolated),
+    ]);
+    let stdout = run_ok(&a);
+    assert!(
+        stdout.contains("pull with tensions the model was not trained for"),
+        "{stdout}"
+    );
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(extrapolated.join("meta.json")).unwrap())
+            .unwrap();
+    assert!(
+        (meta["model_extrapolated"].to_string())
+            .contains("(found) lies outside the training inputs [-5, 0]"),
+        "{}",
+        meta["model_extrapolated"]
     );
 }
 
@@ -462,7 +592,7 @@ fn an_undamped_run_at_a_held_displacement_keeps_its_energy() {
 }
 
 /// What a run cannot honour with a displacement drive is refused before anything is written,
-/// naming the field: an inextensible thread, a reduced model, random tension steps, and an input
+/// naming the field: an inextensible thread, random tension steps, and an input
 /// whose displacement exceeds the tendon.
 #[test]
 fn displacement_runs_are_refused_where_they_cannot_be_honoured() {

@@ -111,7 +111,7 @@ impl Reduced {
     pub fn found_tensions_outside(&self, u: &[f64]) -> Vec<String> {
         let mut outside = vec![];
         for (k, &v) in u.iter().enumerate() {
-            let param = format!("tendons.{k}.tension");
+            let param = tension_param(k);
             match (self.input_range.iter()).find(|r| r.parameter == param) {
                 Some(r) if !inside(r, v) => outside.push(format!(
                     "{param} = {} (found) lies outside the training inputs [{}, {}]",
@@ -140,13 +140,28 @@ impl Reduced {
     /// ([`signal_outside`]) and, if each tension lies in its range, against the training inputs as
     /// a whole ([`JointInputs`], the farthest time named): an error listing how it lies outside, or
     /// with `--extrapolate` those sentences, to be printed and recorded with the run.
+    ///
+    /// A channel `k` with `driven[k]` is the displacement of a tendon driven by it, no tension:
+    /// it is not checked here, nor are the inputs as a whole when one is — the tensions such a
+    /// tendon pulls with are known only as the run finds them, and are checked then
+    /// ([`Self::found_tensions_outside`]). An empty `driven` drives every tendon by its tension.
     pub fn check_signal(
         &self,
         times: &[f64],
+        driven: &[bool],
         mut u_at: impl FnMut(f64) -> Vec<f64>,
     ) -> Result<Vec<String>, ScenarioError> {
-        let mut outside = signal_outside(&self.input_range, &self.held_tensions, times, &mut u_at);
-        if let (true, Some(joint)) = (outside.is_empty(), &self.joint) {
+        let is_driven = |k: usize| driven.get(k).copied().unwrap_or(false);
+        let ranges: Vec<InputRange> = (self.input_range.iter())
+            .filter(|r| !(0..driven.len()).any(|k| is_driven(k) && r.parameter == tension_param(k)))
+            .cloned()
+            .collect();
+        let held: Vec<Option<f64>> = (self.held_tensions.iter().enumerate())
+            .map(|(k, h)| if is_driven(k) { None } else { *h })
+            .collect();
+        let mut outside = signal_outside(&ranges, &held, times, &mut u_at);
+        let any_driven = driven.iter().any(|&d| d);
+        if let (true, false, Some(joint)) = (outside.is_empty(), any_driven, &self.joint) {
             let farthest = (times.iter())
                 .filter_map(|&t| joint.outside(&u_at(t)).map(|(d, why)| (d, t, why)))
                 // the first time of the largest distance
@@ -249,6 +264,11 @@ impl Reduced {
             )
         })
     }
+}
+
+/// The name of tendon `k`'s tension as a training input ([`InputRange::parameter`]).
+fn tension_param(k: usize) -> String {
+    format!("tendons.{k}.tension")
 }
 
 /// The tendon tensions of an input signal against the model's training ranges: `u_at(t)` gives

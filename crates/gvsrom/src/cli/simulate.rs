@@ -363,8 +363,9 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
             };
             writeln!(
                 out,
-                "trajectory {} ({samples} samples{partial})",
-                dir.display()
+                "trajectory {} ({}{partial})",
+                dir.display(),
+                super::print::plural(samples, "sample")
             )?;
             Some((dir, samples))
         }
@@ -372,12 +373,14 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
     };
     let kept = match &written {
         Some((dir, n)) => format!(
-            "the {n} samples before it were written to `{}`, marked partial",
+            "the {} before it {} written to `{}`, marked partial",
+            super::print::plural(*n, "sample"),
+            if *n == 1 { "was" } else { "were" },
             dir.display()
         ),
         None => format!(
-            "{} samples computed; nothing was written (no --out)",
-            sm.samples
+            "{} computed; nothing was written (no --out)",
+            super::print::plural(sm.samples, "sample")
         ),
     };
     match &outcome.ending {

@@ -249,7 +249,8 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
                 times.sort_by(f64::total_cmp);
             }
             let mut u = vec![0.0; signal.channels()];
-            r.check_signal(&times, |t| {
+            // a displacement channel's tensions are checked as the run finds them
+            r.check_signal(&times, &built.drive_flags(), |t| {
                 // just before a knot: the knot's own value, the left limit of a linear signal
                 let k = signal.times.partition_point(|&tk| tk < t.next_up());
                 match signal.times.get(k) {
@@ -390,22 +391,14 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
 
 /// A run with tendons driven by their displacement (`tendons[k].displacement`; the law in
 /// `gvs::solve::dynamics::drive`): each such tendon needs its thread's axial stiffness (an
-/// inextensible one is a constraint the integrators do not impose), the full model runs it (a
-/// reduced model was trained on tensions), and its input channel is a displacement, which random
-/// tension steps and babbling are not.
+/// inextensible one is a constraint the integrators do not impose), and its input channel is a
+/// displacement, which random tension steps and babbling are not. A reduced model runs it as the
+/// full model does, the tensions its threads pull with checked against its training as the run
+/// finds them (`super::run`).
 fn check_drives(built: &Built, opts: &SimulateOptions) -> Result<(), ScenarioError> {
     let Some(first) = built.displacement.iter().position(Option::is_some) else {
         return Ok(());
     };
-    if let Some(r) = &built.reduced {
-        return Err(ScenarioError::invalid(
-            format!("tendons[{first}].displacement"),
-            format!(
-                "`{}` runs tendons driven by their tension only in dynamics (it was trained on tensions, and the tensions a displacement needs are known only as the run goes); run the full model, or give the tension (`gvsrom statics --model` finds the one that holds this displacement at rest)",
-                r.path.display()
-            ),
-        ));
-    }
     built.require_threads("a motion")?;
     match &opts.input {
         InputSource::Steps { .. } | InputSource::Babble { .. } => {

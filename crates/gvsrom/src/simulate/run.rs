@@ -40,12 +40,14 @@ pub struct Outcome {
     /// tendon's found from its thread's stretch.
     pub last_u: Vec<f64>,
     /// The run failed because a reduced trajectory left its training region (the decoder would
-    /// extrapolate), not because the integrator did.
+    /// extrapolate), or its displacement drives needed tensions the model was not trained for,
+    /// not because the integrator did.
     pub left_training_region: bool,
     /// The wall time of every timed run \[s\]: this one's, then those of [`Outcome::time_again`].
     pub wall_times_s: Vec<f64>,
     /// How the run used its reduced model outside what the model was made from, found while it
-    /// ran: a POD trajectory that left its training encodings (the first time).
+    /// ran: a POD trajectory that left its training encodings, tensions found for displacement
+    /// drives outside the training inputs under `--extrapolate` (the first time of each).
     pub model_extrapolated: Vec<String>,
     /// The energy balance over the samples, for a conservative run (no damping, no tendon
     /// friction, no point or distributed loads, no load schedule, constant tensions;
@@ -200,6 +202,10 @@ pub fn run_into(
     let mut off_manifold = None;
     let mut non_physical = None;
     let mut off_data = None::<String>;
+    // a reduced model's tensions found for displacement drives, outside its training
+    let mut off_inputs = None::<String>;
+    let mut found_outside = None::<String>;
+    let found_tensions_checked = built.displacement_driven();
     let x: Vec<f64> = built.model.disc.points.iter().map(|p| p.x).collect();
     // `control` is called from the sink and from the integrator's per-attempt poll, never nested
     let control = std::cell::RefCell::new(control);
@@ -269,6 +275,14 @@ pub fn run_into(
             off_manifold = Some(msg.clone());
             return ControlFlow::Break(msg);
         }
+        // A reduced model answers for the tensions it was trained on: those the threads of
+        // displacement-driven tendons pull with are known only now
+        if let (true, Some(r)) = (found_tensions_checked, &built.reduced) {
+            if let Some(msg) = found_tensions_off_training(r, s, &mut found_outside) {
+                off_inputs = Some(msg.clone());
+                return ControlFlow::Break(msg);
+            }
+        }
         // A POD basis is linear and defined everywhere: leaving its data is noted, not refused
         if off_data.is_none() {
             off_data = (built.reduced.as_ref().and_then(|r| r.data_range_violation(s.q))).map(|v| {
@@ -334,8 +348,9 @@ pub fn run_into(
             ),
         ));
     }
-    let left_training_region = summary.error.is_some() && off_manifold.is_some();
-    let off_manifold = off_manifold.or(non_physical);
+    let left_training_region =
+        summary.error.is_some() && (off_manifold.is_some() || off_inputs.is_some());
+    let off_manifold = off_manifold.or(off_inputs).or(non_physical);
     let ending = match (&summary.error, off_manifold, interrupted.into_inner()) {
         (None, _, _) => Ending::Complete,
         (Some(_), Some(error), _) => Ending::Failed { error },
@@ -357,6 +372,34 @@ pub fn run_into(
         last_tip,
         last_u,
         left_training_region,
-        model_extrapolated: off_data.into_iter().collect(),
+        model_extrapolated: off_data.into_iter().chain(found_outside).collect(),
     })
+}
+
+/// The tensions of sample `s` of a reduced model's run with tendons driven by displacement,
+/// found from their threads' stretch, against the model's training
+/// (`Reduced::found_tensions_outside`): outside it, the message that ends the run, or, with
+/// `--extrapolate`, `None` with the first such sample's sentence kept in `noted`.
+fn found_tensions_off_training(
+    r: &crate::build::reduced::Reduced,
+    s: &Sample<'_>,
+    noted: &mut Option<String>,
+) -> Option<String> {
+    let outside = r.found_tensions_outside(s.u);
+    if outside.is_empty() {
+        return None;
+    }
+    let sentence = format!(
+        "at t = {:.4} s the threads of the tendons driven by displacement pull with tensions the model was not trained for: {}",
+        s.t,
+        outside.join("; ")
+    );
+    if r.extrapolate {
+        noted.get_or_insert(sentence);
+        return None;
+    }
+    Some(format!(
+        "{sentence}; `{}` answers only inside its training (wind the displacement in more slowly, start --from-equilibrium, or pass --extrapolate to use it anyway, its answer then marked an extrapolation)",
+        r.path.display()
+    ))
 }
