@@ -65,7 +65,7 @@ impl Robot {
             }
         })?;
         let d = report_dict(py, &report)?;
-        let extrapolated = (built.reduced.as_ref()).map_or(vec![], |r| r.extrapolated.clone());
+        let extrapolated = built.model_extrapolated(&report.u);
         d.set_item("model_extrapolated", extrapolated)?;
         Ok(d)
     }

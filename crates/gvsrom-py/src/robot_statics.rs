@@ -69,7 +69,7 @@ impl Robot {
                 let report = py
                     .detach(|| statics::solve_as_built(&built))
                     .map_err(errors::any)?;
-                let extrapolated = built.reduced.map(|r| r.extrapolated).unwrap_or_default();
+                let extrapolated = built.model_extrapolated(&report.u);
                 Ok((report, extrapolated))
             }
         }
@@ -136,7 +136,7 @@ impl Robot {
             let report = py
                 .detach(|| statics::solve_as_built(&built))
                 .map_err(errors::any)?;
-            let extrapolated = built.reduced.map(|r| r.extrapolated).unwrap_or_default();
+            let extrapolated = built.model_extrapolated(&report.u);
             return Statics::new(py, &report, extrapolated);
         }
         let (report, extrapolated) = self.solve(py, u, attached.as_ref())?;

@@ -500,8 +500,16 @@ def test_a_reduced_model_runs_a_tendon_driven_by_displacement(pod_model):
     with pytest.raises(gvsrom.IntegrationError, match=r"at t = 0\.0000 s the threads .* not trained for: "
                        r"tendons\.0\.tension = -9\.59.* \(found\) lies outside the training inputs \[-6, 0\]"):
         reduced.simulate(0.2, input=lambda t: [0.012])
-    far = driven.with_model(pod_model, extrapolate=True).simulate(0.2, input=lambda t: [0.012])
+    loose = driven.with_model(pod_model, extrapolate=True)
+    far = loose.simulate(0.2, input=lambda t: [0.012])
     assert any("(found) lies outside the training inputs [-6, 0]" in s for s in far["model_extrapolated"])
+    # in statics too: 20 mm of the inextensible tendon needs −8.7 N, answered with extrapolate
+    # and said so
+    inextensible = gvsrom.Scenario.preset("single-tendon").build()
+    eq = inextensible.with_model(pod_model, extrapolate=True).statics(displacement=[0.02])
+    assert eq.u[0] < -6.0
+    assert any(s.startswith("the tensions the displacements need: tendons.0.tension = -8.")
+               for s in eq.model_extrapolated), eq.model_extrapolated
 
 
 def test_a_pickled_robot_is_the_same_robot_in_another_process(dataset, pod_model, tmp_path):

@@ -176,6 +176,25 @@ fn a_reduced_model_is_driven_by_displacement_too() {
             "(found) lies outside the training inputs [-3, 0]",
         ],
     );
+    // with --extrapolate it answers, and its record says how: the answer is an extrapolation
+    let (_, far) = run_json(
+        "statics",
+        "drive-pod-far",
+        &[
+            "single-tendon",
+            "--displacement",
+            "0.012",
+            "--model",
+            path_str(&model),
+            "--extrapolate",
+        ],
+    );
+    let noted = far["model_extrapolated"].to_string();
+    assert!(
+        noted.contains("the tensions the displacements need: tendons.0.tension = -4.")
+            && noted.contains("(found) lies outside the training inputs [-3, 0]"),
+        "{noted}"
+    );
 }
 
 /// A reduced model runs a tendon driven by displacement as the full model does: the IV-A arm

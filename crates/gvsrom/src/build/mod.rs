@@ -69,6 +69,24 @@ impl Built {
         self.displacement.iter().any(Option::is_some)
     }
 
+    /// How this scenario's answer at the tensions `u` used its reduced model outside its
+    /// training (`--extrapolate`): the sentences of attaching it, then, for tensions found for
+    /// displacement drives, how they lie outside it (`Reduced::found_tensions_outside`; without
+    /// `--extrapolate` such tensions are refused). Empty for the full model.
+    pub fn model_extrapolated(&self, u: &[f64]) -> Vec<String> {
+        let Some(r) = &self.reduced else {
+            return vec![];
+        };
+        let mut out = r.extrapolated.clone();
+        if self.displacement_driven() && r.extrapolate {
+            out.extend(
+                (r.found_tensions_outside(u).into_iter())
+                    .map(|s| format!("the tensions the displacements need: {s}")),
+            );
+        }
+        out
+    }
+
     /// Per tendon, whether it is driven by its displacement.
     pub fn drive_flags(&self) -> Vec<bool> {
         self.displacement.iter().map(Option::is_some).collect()

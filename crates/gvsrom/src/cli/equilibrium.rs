@@ -66,6 +66,7 @@ pub(super) fn statics_cmd(args: &StaticsArgs, out: &mut impl Write) -> Result<()
     };
     print_model(&r.scenario, &args.scenario, &r.built, None, out)?;
     let run = statics::run(&r.built, args.repeat, args.compare)?;
+    warn_found_extrapolated(&r.built, &run.report.u);
     print_solution(&run.report, out)?;
     if let (Some(full), Some(c)) = (&run.full, &run.comparison) {
         writeln!(
@@ -117,6 +118,7 @@ pub(super) fn modes_cmd(args: &ModesArgs, out: &mut impl Write) -> Result<()> {
         )?;
     }
     let (eq, report) = modes::compute(built, count)?;
+    warn_found_extrapolated(built, &report.u);
     writeln!(
         out,
         "solved     equilibrium in {} and {}, ‖R‖∞ = {} (as `gvsrom statics`)",
@@ -225,7 +227,7 @@ pub(super) fn modes_cmd(args: &ModesArgs, out: &mut impl Write) -> Result<()> {
         let doc = modes::ModesJson {
             report: &report,
             model: args.model.as_ref().map(|p| p.display().to_string()),
-            model_extrapolated: (built.reduced.as_ref()).map_or(vec![], |r| r.extrapolated.clone()),
+            model_extrapolated: built.model_extrapolated(&report.u),
             provenance: Some(&provenance),
         };
         let path = json.commit_json(&doc)?;

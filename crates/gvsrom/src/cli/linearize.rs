@@ -82,6 +82,7 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
     print_model(scenario, &args.scenario, built, None, out)?;
     print_motion_note(built, out)?;
     let (eq, mut lin) = linearize::about_equilibrium(built, &outputs)?;
+    super::print::warn_found_extrapolated(built, &lin.u);
     if let Some(h) = args.sample_time {
         lin.discretize(h)?;
     }
@@ -266,7 +267,7 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
         let doc = linearize::LinearizationJson {
             report: &lin,
             model: args.model.as_ref().map(|p| p.display().to_string()),
-            model_extrapolated: (built.reduced.as_ref()).map_or(vec![], |r| r.extrapolated.clone()),
+            model_extrapolated: built.model_extrapolated(&lin.u),
             provenance: Some(&provenance),
         };
         let path = json.commit_json(&doc)?;

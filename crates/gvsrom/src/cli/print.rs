@@ -38,6 +38,16 @@ pub(super) fn speed_words(speedup: f64) -> String {
     }
 }
 
+/// Warns of the tensions found for displacement drives at `u` that lie outside the reduced
+/// model's training, under `--extrapolate` (`Built::model_extrapolated` past what attaching it
+/// said): the answer is an extrapolation, and its JSON says so.
+pub(super) fn warn_found_extrapolated(built: &gvsrom::Built, u: &[f64]) {
+    let attached = built.reduced.as_ref().map_or(0, |r| r.extrapolated.len());
+    for s in built.model_extrapolated(u).iter().skip(attached) {
+        gvsrom::progress::stderr_line(format_args!("warning: extrapolating (--extrapolate): {s}"));
+    }
+}
+
 pub(super) fn plural(n: usize, word: &str) -> String {
     if n == 1 {
         format!("{n} {word}")

@@ -328,11 +328,7 @@ impl StaticsRun {
         StaticsJson {
             report: &self.report,
             model: built.reduced.as_ref().map(|r| r.path.display().to_string()),
-            model_extrapolated: built
-                .reduced
-                .as_ref()
-                .map(|r| r.extrapolated.clone())
-                .unwrap_or_default(),
+            model_extrapolated: built.model_extrapolated(&self.report.u),
             comparison: self.comparison.clone(),
             provenance: Some(provenance),
         }
