@@ -371,6 +371,7 @@ mod tests {
                     radius_start: 0.01,
                     radius_end: 0.01,
                     material: None,
+                    section: None,
                 })
                 .collect(),
         }

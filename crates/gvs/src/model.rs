@@ -109,12 +109,7 @@ impl<P: StrainParam> Model<P> {
         let props = disc
             .points
             .iter()
-            .map(|p| {
-                SectionProps::circular(
-                    rod.material_of(p.div),
-                    rod.divisions[p.div].radius_at(p.x_bar),
-                )
-            })
+            .map(|p| rod.divisions[p.div].props_at(rod.material_of(p.div), p.x_bar))
             .collect::<Vec<_>>();
         let xi_star = vec![V6::new(0.0, 0.0, 0.0, 1.0, 0.0, 0.0); disc.n_sites()];
         let tendon_points: Vec<Vec<usize>> = tendons

@@ -1,7 +1,10 @@
-//! Rod geometry and constitutive data (gvs-spec §3): linearly tapered circular sections per division,
-//! material (E, ν, ρ, damping constant η), and the per-point cross-section matrices
-//! `Es = diag(GJ, EI_y, EI_z, EA, GA, GA)`, `Ms = ρ diag(J, I_y, I_z, A, A, A)`,
-//! `Ds = η diag(J, 3I_y, 3I_z, 3A, A, A)` with `G = E / (2(1+ν))` and `J = I_y + I_z` (SoRoSim `MEG`).
+//! Rod geometry and constitutive data (gvs-spec §3): linearly tapered sections per division
+//! (circular, or rectangular and elliptical: [`Section`]), material (E, ν, ρ, damping constant η),
+//! and the per-point cross-section matrices
+//! `Es = diag(GJ_t, EI_y, EI_z, EA, GA, GA)`, `Ms = ρ diag(J, I_y, I_z, A, A, A)`,
+//! `Ds = η diag(J_t, 3I_y, 3I_z, 3A, A, A)` with `G = E / (2(1+ν))`, `J = I_y + I_z` the polar
+//! moment and `J_t` the torsion constant (SoRoSim `MEG`, which takes `J_t = J`; the two are equal
+//! for a circle, see [`SectionProps::of`]).
 
 use crate::error::{check_positive, check_range, ModelError};
 use crate::lie::V6;
@@ -60,22 +63,124 @@ impl Material {
     }
 }
 
-/// One division of the rod: length and a circular section tapering linearly from `radius_start` to
-/// `radius_end` over the normalized division coordinate `X̄ ∈ [0, 1]` (spec §3.1).
+/// One division of the rod: length and a section tapering linearly over the normalized division
+/// coordinate `X̄ ∈ [0, 1]` (spec §3.1): a circle from `radius_start` to `radius_end`, or the
+/// rectangle or ellipse of [`DivisionGeometry::section`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct DivisionGeometry {
     pub length: f64,
+    /// The circle's radius at `X̄ = 0` \[m\]; with a [`Section`], its circumscribed radius
+    /// ([`Section::circumradius`]), the farthest the section reaches from the axis.
     pub radius_start: f64,
+    /// The same at `X̄ = 1`.
     pub radius_end: f64,
     /// The division's own material where it differs from the rod's (a stiff base and a soft tip,
     /// SoRoSim's material per link); `None`: the rod's ([`Rod::material_of`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<Material>,
+    /// A rectangular or elliptical section in place of the circle; `None` (the default, not
+    /// written): the circle of the radii.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub section: Option<Section>,
 }
 
 impl DivisionGeometry {
+    /// A division of section `section` (its radii the circumscribed ones).
+    pub fn with_section(length: f64, section: Section) -> Self {
+        DivisionGeometry {
+            length,
+            radius_start: section.circumradius(0.0),
+            radius_end: section.circumradius(1.0),
+            material: None,
+            section: Some(section),
+        }
+    }
+
+    /// The radius at `X̄` (the circumscribed radius of a [`Section`]): the farthest the section
+    /// reaches from the axis.
     pub fn radius_at(&self, x_bar: f64) -> f64 {
         self.radius_start + x_bar * (self.radius_end - self.radius_start)
+    }
+
+    /// The section's properties at `X̄` for `material`.
+    pub fn props_at(&self, material: &Material, x_bar: f64) -> SectionProps {
+        match &self.section {
+            None => SectionProps::circular(material, self.radius_at(x_bar)),
+            Some(s) => {
+                let (w, h) = s.extents_at(x_bar);
+                SectionProps::of(material, s.shape, w, h)
+            }
+        }
+    }
+
+    /// The gauge of the section at `X̄` at the point `(y, z)` of the section plane: ≤ 1 inside
+    /// (the circle's `√(y² + z²)/r`, the rectangle's `max(2|y|/w, 2|z|/h)`, the ellipse's
+    /// `√((2y/w)² + (2z/h)²)`), growing linearly along each ray from the axis.
+    pub fn gauge_at(&self, x_bar: f64, y: f64, z: f64) -> f64 {
+        match &self.section {
+            None => y.hypot(z) / self.radius_at(x_bar),
+            Some(s) => {
+                let (w, h) = s.extents_at(x_bar);
+                let (a, b) = (2.0 * y / w, 2.0 * z / h);
+                match s.shape {
+                    Shape::Rectangle => a.abs().max(b.abs()),
+                    Shape::Ellipse => a.hypot(b),
+                }
+            }
+        }
+    }
+
+    /// What the section at `X̄` is, for a message: "radius 0.01 m", "0.03 × 0.01 m rectangle".
+    pub fn describe_at(&self, x_bar: f64) -> String {
+        match &self.section {
+            None => format!("radius {} m", self.radius_at(x_bar)),
+            Some(s) => {
+                let (w, h) = s.extents_at(x_bar);
+                let shape = match s.shape {
+                    Shape::Rectangle => "rectangle",
+                    Shape::Ellipse => "ellipse",
+                };
+                format!("{w} × {h} m {shape} (width along y, height along z)")
+            }
+        }
+    }
+}
+
+/// The shape of a non-circular section.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Shape {
+    /// A solid `w × h` rectangle.
+    Rectangle,
+    /// A solid ellipse of full axes `w` and `h`.
+    Ellipse,
+}
+
+/// A rectangular or elliptical section whose width `w` (along the section's `y` axis) and height
+/// `h` (along `z`) taper linearly over the division, `[start, end]` \[m\].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Section {
+    pub shape: Shape,
+    pub width: [f64; 2],
+    pub height: [f64; 2],
+}
+
+impl Section {
+    /// `(w, h)` at `X̄`.
+    pub fn extents_at(&self, x_bar: f64) -> (f64, f64) {
+        let at = |[a, b]: [f64; 2]| a + x_bar * (b - a);
+        (at(self.width), at(self.height))
+    }
+
+    /// The farthest the section at `X̄` reaches from the axis: the rectangle's half diagonal,
+    /// the ellipse's larger half axis. At `X̄ = 0` or 1 exactly; between them the linear
+    /// interpolation of these bounds the section (the distance is convex in the extents).
+    pub fn circumradius(&self, x_bar: f64) -> f64 {
+        let (w, h) = self.extents_at(x_bar);
+        match self.shape {
+            Shape::Rectangle => 0.5 * w.hypot(h),
+            Shape::Ellipse => 0.5 * w.max(h),
+        }
     }
 }
 
@@ -97,6 +202,7 @@ impl Rod {
                 radius_start,
                 radius_end,
                 material: None,
+                section: None,
             }],
         }
     }
@@ -135,6 +241,28 @@ impl Rod {
                 "m",
             )?;
             check_positive(&format!("rod.divisions[{j}].radius_end"), d.radius_end, "m")?;
+            if let Some(s) = &d.section {
+                for (name, v) in [("width", s.width), ("height", s.height)] {
+                    for (end, x) in ["start", "end"].iter().zip(v) {
+                        check_positive(
+                            &format!("rod.divisions[{j}].section.{name}_{end}"),
+                            x,
+                            "m",
+                        )?;
+                    }
+                }
+                for (end, x_bar, r) in [("start", 0.0, d.radius_start), ("end", 1.0, d.radius_end)]
+                {
+                    let c = s.circumradius(x_bar);
+                    if (r - c).abs() > 1e-12 * c {
+                        return Err(ModelError::value(
+                            format!("rod.divisions[{j}].radius_{end}"),
+                            r,
+                            format!("the section's circumscribed radius {c} m (`DivisionGeometry::with_section`)"),
+                        ));
+                    }
+                }
+            }
         }
         Ok(())
     }
@@ -161,6 +289,7 @@ impl Rod {
 /// Diagonals of the cross-section matrices at one point.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SectionProps {
+    /// The farthest the section reaches from its axis \[m\] (a circle's radius).
     pub radius: f64,
     pub area: f64,
     /// diag of `Es` [N·m², N·m², N·m², N, N, N].
@@ -172,23 +301,77 @@ pub struct SectionProps {
 }
 
 impl SectionProps {
-    /// Circular section of radius r: `A = πr²`, `I = πr⁴/4`, `J = 2I` (spec §3.1–3.2).
+    /// Circular section of radius r: `A = πr²`, `I = πr⁴/4`, `J = J_t = 2I` (spec §3.1–3.2).
     pub fn circular(material: &Material, r: f64) -> Self {
         let a = PI * r * r;
         let i = PI * r.powi(4) / 4.0;
-        let j = 2.0 * i;
+        Self::from_moments(material, r, a, i, i, 2.0 * i)
+    }
+
+    /// A solid `shape` of width `w` (along `y`) and height `h` (along `z`):
+    ///
+    /// - rectangle: `A = wh`, `I_y = ∫z² dA = wh³/12`, `I_z = hw³/12`, and the Saint-Venant
+    ///   torsion constant `J_t = a b³ [1/3 − (64/π⁵)(b/a) Σ_{n odd} tanh(nπa/2b)/n⁵]`, `a ≥ b`
+    ///   the longer and shorter side (Timoshenko & Goodier §109: 0.1406 a⁴ for a square, against
+    ///   the polar moment's 0.1667 a⁴; `a b³/3` for a thin strip);
+    /// - ellipse of half axes `a = w/2`, `b = h/2`: `A = πab`, `I_y = πab³/4`, `I_z = πa³b/4`,
+    ///   `J_t = πa³b³/(a² + b²)` (exact; the circle's `πr⁴/2` for `a = b`).
+    ///
+    /// The rotary inertia of torsion is the polar moment `J = I_y + I_z`; its stiffness and damping
+    /// take `J_t` (SoRoSim takes `J` for both, which overrates a flat section's torsional stiffness:
+    /// 1.19× for a square, 3.2× for 3:1, 7.4× for a 5:1 strip).
+    pub fn of(material: &Material, shape: Shape, w: f64, h: f64) -> Self {
+        let (area, iy, iz, jt) = match shape {
+            Shape::Rectangle => (
+                w * h,
+                w * h.powi(3) / 12.0,
+                h * w.powi(3) / 12.0,
+                rectangle_torsion_constant(w, h),
+            ),
+            Shape::Ellipse => {
+                let (a, b) = (0.5 * w, 0.5 * h);
+                (
+                    PI * a * b,
+                    PI * a * b.powi(3) / 4.0,
+                    PI * a.powi(3) * b / 4.0,
+                    PI * a.powi(3) * b.powi(3) / (a * a + b * b),
+                )
+            }
+        };
+        let reach = match shape {
+            Shape::Rectangle => 0.5 * w.hypot(h),
+            Shape::Ellipse => 0.5 * w.max(h),
+        };
+        Self::from_moments(material, reach, area, iy, iz, jt)
+    }
+
+    /// `Es`, `Ms`, `Ds` of a section of area `a`, second moments `iy = ∫z² dA`, `iz = ∫y² dA` and
+    /// torsion constant `jt` (spec §3.2; the polar moment `iy + iz` in `Ms`).
+    fn from_moments(material: &Material, reach: f64, a: f64, iy: f64, iz: f64, jt: f64) -> Self {
         let e = material.youngs_modulus;
         let g = material.shear_modulus();
         let rho = material.density;
         let eta = material.damping;
         SectionProps {
-            radius: r,
+            radius: reach,
             area: a,
-            es: V6::new(g * j, e * i, e * i, e * a, g * a, g * a),
-            ms: V6::new(j, i, i, a, a, a) * rho,
-            ds: V6::new(j, 3.0 * i, 3.0 * i, 3.0 * a, a, a) * eta,
+            es: V6::new(g * jt, e * iy, e * iz, e * a, g * a, g * a),
+            ms: V6::new(iy + iz, iy, iz, a, a, a) * rho,
+            ds: V6::new(jt, 3.0 * iy, 3.0 * iz, 3.0 * a, a, a) * eta,
         }
     }
+}
+
+/// The Saint-Venant torsion constant of a solid `w × h` rectangle: with `a ≥ b` its sides,
+/// `J_t = a b³ [1/3 − (64/π⁵)(b/a) Σ_{n = 1, 3, 5, …} tanh(nπa/(2b))/n⁵]` (the series'
+/// terms fall as `n⁻⁵`: 400 of them leave < 1e-13 of the sum).
+pub fn rectangle_torsion_constant(w: f64, h: f64) -> f64 {
+    let (a, b) = (w.max(h), w.min(h));
+    let sum: f64 = (0..400)
+        .map(|i| (2 * i + 1) as f64)
+        .map(|n| (n * PI * a / (2.0 * b)).tanh() / n.powi(5))
+        .sum();
+    a * b.powi(3) * (1.0 / 3.0 - 64.0 / PI.powi(5) * (b / a) * sum)
 }
 
 #[cfg(test)]
@@ -280,6 +463,209 @@ mod tests {
         for k in 0..6 {
             assert!(rel(s.ds[k], 3.0 * 3e3 / 2e6 * s.es[k]) < 1e-14, "ds[{k}]");
         }
+    }
+
+    /// The Saint-Venant torsion constant of a `w × h` rectangle from Prandtl's stress function,
+    /// independently of the series: `∇²φ = −2` inside, `φ = 0` on the boundary, `J_t = 2∫φ dA`,
+    /// by second-order finite differences on `n × n` cells solved by conjugate gradients, then
+    /// Richardson-extrapolated from `n` and `2n` (error `O(h⁴)`).
+    fn prandtl_torsion_constant(w: f64, h: f64, n: usize) -> f64 {
+        let solve = |n: usize| {
+            let (hx, hy) = (w / n as f64, h / n as f64);
+            let m = n - 1; // interior nodes per side
+            let apply = |x: &[f64], out: &mut [f64]| {
+                for i in 0..m {
+                    for j in 0..m {
+                        let at = |a: isize, b: isize| {
+                            if a < 0 || b < 0 || a >= m as isize || b >= m as isize {
+                                0.0
+                            } else {
+                                x[a as usize * m + b as usize]
+                            }
+                        };
+                        let (a, b) = (i as isize, j as isize);
+                        let c = x[i * m + j];
+                        // −∇²: symmetric positive definite
+                        out[i * m + j] = (2.0 * c - at(a - 1, b) - at(a + 1, b)) / (hx * hx)
+                            + (2.0 * c - at(a, b - 1) - at(a, b + 1)) / (hy * hy);
+                    }
+                }
+            };
+            let rhs = vec![2.0; m * m];
+            let mut x = vec![0.0; m * m];
+            let (mut r, mut p, mut ap) = (rhs.clone(), rhs.clone(), vec![0.0; m * m]);
+            let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+            let mut rr = dot(&r, &r);
+            for _ in 0..10 * m * m {
+                apply(&p, &mut ap);
+                let alpha = rr / dot(&p, &ap);
+                for k in 0..m * m {
+                    x[k] += alpha * p[k];
+                    r[k] -= alpha * ap[k];
+                }
+                let next = dot(&r, &r);
+                if next < 1e-26 * dot(&rhs, &rhs) {
+                    break;
+                }
+                for k in 0..m * m {
+                    p[k] = r[k] + next / rr * p[k];
+                }
+                rr = next;
+            }
+            2.0 * x.iter().sum::<f64>() * hx * hy
+        };
+        let (coarse, fine) = (solve(n), solve(2 * n));
+        fine + (fine - coarse) / 3.0
+    }
+
+    #[test]
+    fn rectangle_torsion_constant_matches_prandtls_stress_function_and_the_tables() {
+        // the series against an independent solution of the Poisson problem, square to strip
+        for (w, h) in [(1.0, 1.0), (2.0, 1.0), (0.3, 1.5)] {
+            let series = rectangle_torsion_constant(w, h);
+            let prandtl = prandtl_torsion_constant(w, h, 40);
+            assert!(
+                rel(series, prandtl) < 2e-4,
+                "{w} × {h}: series {series}, Prandtl {prandtl}"
+            );
+        }
+        // Timoshenko & Goodier's table of J_t / (a b³), a/b = 1, 2, 5, 10, to its three digits
+        for (ratio, k) in [(1.0, 0.141), (2.0, 0.229), (5.0, 0.291), (10.0, 0.312)] {
+            let j = rectangle_torsion_constant(ratio, 1.0) / ratio;
+            assert!((j - k).abs() < 6e-4, "a/b = {ratio}: {j} against {k}");
+        }
+        // the thin strip: a b³/3 (1 − 0.630 b/a)
+        let j = rectangle_torsion_constant(100.0, 1.0) / 100.0;
+        assert!(rel(j, (1.0 - 0.630 / 100.0) / 3.0) < 1e-4, "{j}");
+        // symmetric in its sides
+        assert_eq!(
+            rectangle_torsion_constant(0.3, 0.1),
+            rectangle_torsion_constant(0.1, 0.3)
+        );
+    }
+
+    #[test]
+    fn rectangle_and_ellipse_moments_match_quadrature_of_their_areas() {
+        let m = Material {
+            youngs_modulus: 2e6,
+            poisson_ratio: 0.3,
+            density: 1200.0,
+            damping: 3e3,
+        };
+        let (e, g) = (2e6, 2e6 / 2.6);
+        let (w, h) = (0.04, 0.01);
+        // area, ∫z² dA, ∫y² dA by the midpoint rule on a fine grid over the bounding box
+        let moments = |inside: &dyn Fn(f64, f64) -> bool| {
+            let n = 2000;
+            let (dy, dz) = (w / n as f64, h / n as f64);
+            let mut a = [0.0; 3];
+            for i in 0..n {
+                for j in 0..n {
+                    let (y, z) = (
+                        -w / 2.0 + (i as f64 + 0.5) * dy,
+                        -h / 2.0 + (j as f64 + 0.5) * dz,
+                    );
+                    if inside(y, z) {
+                        a[0] += dy * dz;
+                        a[1] += z * z * dy * dz;
+                        a[2] += y * y * dy * dz;
+                    }
+                }
+            }
+            a
+        };
+        let rect = SectionProps::of(&m, Shape::Rectangle, w, h);
+        let [a, iy, iz] = moments(&|_, _| true);
+        let got = [rect.area, rect.es[1] / e, rect.es[2] / e];
+        for (k, (x, y)) in got.iter().zip([a, iy, iz]).enumerate() {
+            assert!(rel(*x, y) < 1e-6, "[A, I_y, I_z][{k}] = {x} against {y}");
+        }
+        assert!(rect.es[1] < rect.es[2], "flat along y: stiffer about z");
+        assert!(
+            rel(rect.ms[0], 1200.0 * (iy + iz)) < 1e-6,
+            "rotary inertia: the polar moment"
+        );
+        let jt = rectangle_torsion_constant(w, h);
+        assert!(rel(rect.es[0], g * jt) < 1e-14 && rel(rect.ds[0], 3e3 * jt) < 1e-14);
+        assert!(
+            jt < 0.5 * (iy + iz),
+            "a 4:1 strip twists far more easily than its polar moment says"
+        );
+        assert!(rel(rect.radius, 0.5 * w.hypot(h)) < 1e-14);
+        let ell = SectionProps::of(&m, Shape::Ellipse, w, h);
+        let [a, iy, iz] = moments(&|y, z| (2.0 * y / w).powi(2) + (2.0 * z / h).powi(2) <= 1.0);
+        assert!(
+            rel(ell.area, a) < 1e-3
+                && rel(ell.es[1], e * iy) < 1e-3
+                && rel(ell.es[2], e * iz) < 1e-3
+        );
+        assert!(rel(ell.ms[1], 1200.0 * iy) < 1e-3 && rel(ell.ds[2], 3.0 * 3e3 * iz) < 1e-3);
+        // an ellipse of equal axes is the circle, torsion included
+        let r = 0.013;
+        let (circle, round) = (
+            SectionProps::circular(&m, r),
+            SectionProps::of(&m, Shape::Ellipse, 2.0 * r, 2.0 * r),
+        );
+        for k in 0..6 {
+            assert!(rel(round.es[k], circle.es[k]) < 1e-14, "es[{k}]");
+            assert!(rel(round.ms[k], circle.ms[k]) < 1e-14, "ms[{k}]");
+            assert!(rel(round.ds[k], circle.ds[k]) < 1e-14, "ds[{k}]");
+        }
+    }
+
+    #[test]
+    fn a_sectioned_division_tapers_and_holds_its_tendons_inside() {
+        let s = Section {
+            shape: Shape::Rectangle,
+            width: [0.04, 0.02],
+            height: [0.01, 0.01],
+        };
+        let d = DivisionGeometry::with_section(0.5, s);
+        assert!(rel(d.radius_at(0.0), 0.5 * 0.04f64.hypot(0.01)) < 1e-14);
+        assert_eq!(s.extents_at(0.5), (0.03, 0.01));
+        // the corner is inside, just beyond the short side is not
+        assert!(d.gauge_at(0.0, 0.02, 0.005) <= 1.0 + 1e-12);
+        assert!(d.gauge_at(0.0, 0.0, 0.0051) > 1.0);
+        assert!(
+            d.gauge_at(1.0, 0.0101, 0.0) > 1.0,
+            "the width tapers to 2 cm"
+        );
+        let e = DivisionGeometry::with_section(
+            0.5,
+            Section {
+                shape: Shape::Ellipse,
+                ..s
+            },
+        );
+        assert!(e.gauge_at(0.0, 0.02 * 0.8, 0.005 * 0.6) <= 1.0 + 1e-12);
+        assert!(
+            e.gauge_at(0.0, 0.02, 0.005) > 1.0,
+            "the box's corner is outside the ellipse"
+        );
+        let rod = Rod {
+            material: Material {
+                youngs_modulus: 1e6,
+                poisson_ratio: 0.5,
+                density: 1000.0,
+                damping: 0.0,
+            },
+            divisions: vec![d],
+        };
+        rod.validate().unwrap();
+        let mut bad = rod.clone();
+        bad.divisions[0].section.as_mut().unwrap().height[1] = -0.01;
+        let e = bad.validate().unwrap_err().to_string();
+        assert!(
+            e.contains("rod.divisions[0].section.height_end") && e.contains("-0.01"),
+            "{e}"
+        );
+        let mut bad = rod.clone();
+        bad.divisions[0].radius_end = 0.01;
+        let e = bad.validate().unwrap_err().to_string();
+        assert!(
+            e.contains("rod.divisions[0].radius_end") && e.contains("circumscribed"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -344,6 +344,7 @@ fn capstan_curvature_holds_across_a_division_junction() {
         radius_start: r,
         radius_end: r,
         material: None,
+        section: None,
     };
     let rod = Rod {
         material: mat(e, 0.0),

@@ -81,6 +81,7 @@ fn fem_model() -> Model<LinearBasis> {
         radius_start,
         radius_end,
         material: None,
+        section: None,
     };
     let rod = Rod {
         material: material(0.0),

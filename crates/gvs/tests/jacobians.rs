@@ -300,12 +300,14 @@ fn statics_jacobian_matches_finite_differences_two_divisions_half_tendon() {
                 radius_start: 0.02,
                 radius_end: 0.015,
                 material: None,
+                section: None,
             },
             DivisionGeometry {
                 length: 0.3,
                 radius_start: 0.015,
                 radius_end: 0.01,
                 material: None,
+                section: None,
             },
         ],
     };

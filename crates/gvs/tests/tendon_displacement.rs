@@ -40,6 +40,7 @@ fn two_division_rod(tendons: Vec<Tendon>) -> Model<LinearBasis> {
                 radius_start: R,
                 radius_end: R,
                 material: None,
+                section: None,
             })
             .collect(),
     };

@@ -42,6 +42,7 @@ fn rod_model(
                 radius_start: R,
                 radius_end: R,
                 material: None,
+                section: None,
             })
             .collect(),
     };

@@ -93,12 +93,14 @@ fn rod() -> Rod {
                 radius_start: 0.018,
                 radius_end: 0.014,
                 material: None,
+                section: None,
             },
             DivisionGeometry {
                 length: 0.10,
                 radius_start: 0.014,
                 radius_end: 0.009,
                 material: None,
+                section: None,
             },
         ],
     }

@@ -213,11 +213,14 @@ impl Tendon {
             }
             x0 += d.length;
         }
+        // a rectangle or an ellipse is no cone along the span, nor turned into itself by a
+        // helix: its widest excursion between
+        if rod.divisions.iter().any(|d| d.section.is_some()) {
+            xs.push(self.widest_excursion(rod).0);
+        }
         for x in xs {
-            let r = radius_at(rod, x);
             let d = self.offset(x);
-            let dn = (d[1] * d[1] + d[2] * d[2]).sqrt();
-            if dn > r * (1.0 + 1e-9) {
+            if let Some(accepted) = outside_section(rod, x, &d) {
                 let which = if (x - self.x_start).abs() < 1e-12 {
                     "offset_start"
                 } else {
@@ -225,8 +228,8 @@ impl Tendon {
                 };
                 return Err(ModelError::value(
                     f(which),
-                    dn,
-                    format!("an offset of norm <= the section radius {r} m at X = {x} m (the tendon must stay inside the rod)"),
+                    d[1].hypot(d[2]),
+                    format!("{accepted} at X = {x} m (the tendon must stay inside the rod)"),
                 ));
             }
         }
@@ -238,6 +241,50 @@ impl Tendon {
     /// Samples per knot interval at which a custom path is checked to stay inside the rod (the
     /// cubic between two knots may bulge beyond both).
     pub const PATH_SAMPLES: usize = 32;
+
+    /// Samples per helical turn of [`Self::widest_excursion`].
+    pub const SAMPLES_PER_TURN: usize = 64;
+
+    /// Where the routed (oblique or helical) tendon's offset reaches farthest toward or beyond
+    /// the rod's section over its span: `(X, g)` with `g` the section's gauge there
+    /// ([`crate::rod::DivisionGeometry::gauge_at`], ≤ 1 inside; the larger side at a junction).
+    /// The span is sampled at [`Self::PATH_SAMPLES`] points per division and
+    /// [`Self::SAMPLES_PER_TURN`] per helical turn, with the division junctions, and each local
+    /// maximum is refined by a golden-section search between its neighbours: a helix whose turns
+    /// are commensurate with the samples is found where it leaves a rectangle all the same.
+    pub fn widest_excursion(&self, rod: &Rod) -> (f64, f64) {
+        let gauge = |x: f64| {
+            let d = self.offset(x);
+            section_gauge(rod, x, d[1], d[2])
+        };
+        let span = self.x_end - self.x_start;
+        let n = Self::PATH_SAMPLES * rod.divisions.len()
+            + (Self::SAMPLES_PER_TURN as f64 * self.turns.abs()).ceil() as usize;
+        let mut xs: Vec<f64> = (0..=n)
+            .map(|i| self.x_start + span * i as f64 / n as f64)
+            .collect();
+        let mut x0 = 0.0;
+        for d in &rod.divisions {
+            x0 += d.length;
+            if x0 > self.x_start && x0 < self.x_end {
+                xs.push(x0);
+            }
+        }
+        xs.sort_by(f64::total_cmp);
+        let g: Vec<f64> = xs.iter().map(|&x| gauge(x)).collect();
+        let mut best = (xs[0], g[0]);
+        for i in 0..xs.len() {
+            let mut here = (xs[i], g[i]);
+            let (lo, hi) = (i.saturating_sub(1), (i + 1).min(xs.len() - 1));
+            if g[i] >= g[lo] && g[i] >= g[hi] && lo < hi {
+                here = golden_max(&gauge, xs[lo], xs[hi], here);
+            }
+            if here.1 > best.1 {
+                best = here;
+            }
+        }
+        best
+    }
 
     /// A custom path: its knots ([`path::check`]); its ends are the tendon's
     /// `x_start`, `x_end`, `offset_start` and `offset_end`; no `turns`; and the curve stays inside
@@ -295,10 +342,9 @@ impl Tendon {
             }
         }
         for (x, i) in xs {
-            let r = radius_at(rod, x);
             let d = self.offset(x);
-            let dn = (d[1] * d[1] + d[2] * d[2]).sqrt();
-            if dn > r * (1.0 + 1e-9) {
+            let dn = d[1].hypot(d[2]);
+            if let Some(accepted) = outside_section(rod, x, &d) {
                 let knot = knots.iter().position(|k| k[0] == x);
                 let (field, place) = match knot {
                     Some(k) => (format!("path[{k}]"), "at this knot".to_string()),
@@ -315,7 +361,7 @@ impl Tendon {
                 return Err(ModelError::value(
                     f(&field),
                     dn,
-                    format!("an offset of norm <= the section radius {r} m at X = {x} m: the tendon leaves the rod {place}"),
+                    format!("{accepted} at X = {x} m: the tendon leaves the rod {place}"),
                 ));
             }
         }
@@ -323,15 +369,70 @@ impl Tendon {
     }
 }
 
-/// Smallest radius of the rod at `x` (both sides at a division junction).
-fn radius_at(rod: &Rod, x: f64) -> f64 {
-    let mut x0 = 0.0;
-    let mut r = f64::INFINITY;
-    for d in &rod.divisions {
-        if x >= x0 - 1e-12 && x <= x0 + d.length + 1e-12 {
-            r = r.min(d.radius_at(((x - x0) / d.length).clamp(0.0, 1.0)));
+/// The largest of `f` on `[a, b]` near a local maximum `start = (x, f(x))` inside it, by 60
+/// golden-section steps (the interval shrinks by 1e-12); `start` if none is larger.
+fn golden_max(f: &dyn Fn(f64) -> f64, a: f64, b: f64, start: (f64, f64)) -> (f64, f64) {
+    let r = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut a, mut b) = (a, b);
+    let (mut c, mut d) = (b - r * (b - a), a + r * (b - a));
+    let (mut fc, mut fd) = (f(c), f(d));
+    for _ in 0..60 {
+        if fc > fd {
+            (b, d, fd) = (d, c, fc);
+            c = b - r * (b - a);
+            fc = f(c);
+        } else {
+            (a, c, fc) = (c, d, fd);
+            d = a + r * (b - a);
+            fd = f(d);
         }
-        x0 += d.length;
     }
-    r
+    let found = if fc > fd { (c, fc) } else { (d, fd) };
+    if found.1 > start.1 {
+        found
+    } else {
+        start
+    }
+}
+
+/// The rod's section gauge of the offset `(y, z)` at `x`
+/// ([`crate::rod::DivisionGeometry::gauge_at`]; the larger of both sides at a junction).
+pub fn section_gauge(rod: &Rod, x: f64, y: f64, z: f64) -> f64 {
+    let mut x0 = 0.0;
+    let mut g = f64::NEG_INFINITY;
+    for div in &rod.divisions {
+        if x >= x0 - 1e-12 && x <= x0 + div.length + 1e-12 {
+            g = g.max(div.gauge_at(((x - x0) / div.length).clamp(0.0, 1.0), y, z));
+        }
+        x0 += div.length;
+    }
+    g
+}
+
+/// `None` if the offset `d` lies inside the rod's section at `x` (both sides at a division
+/// junction; [`crate::rod::DivisionGeometry::gauge_at`] ≤ 1 + 1e-9); else what is accepted
+/// there: "an offset of norm <= the section radius r m", or "an offset inside the section (…)".
+fn outside_section(rod: &Rod, x: f64, d: &V3) -> Option<String> {
+    let mut x0 = 0.0;
+    let mut worst: Option<(f64, String)> = None;
+    for div in &rod.divisions {
+        if x >= x0 - 1e-12 && x <= x0 + div.length + 1e-12 {
+            let x_bar = ((x - x0) / div.length).clamp(0.0, 1.0);
+            let g = div.gauge_at(x_bar, d[1], d[2]);
+            if g > 1.0 + 1e-9 && worst.as_ref().is_none_or(|(w, _)| g > *w) {
+                let accepted = match div.section {
+                    None => format!(
+                        "an offset of norm <= the section radius {} m",
+                        div.radius_at(x_bar)
+                    ),
+                    Some(_) => {
+                        format!("an offset inside the section, a {}", div.describe_at(x_bar))
+                    }
+                };
+                worst = Some((g, accepted));
+            }
+        }
+        x0 += div.length;
+    }
+    worst.map(|(_, a)| a)
 }

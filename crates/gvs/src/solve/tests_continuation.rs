@@ -136,6 +136,7 @@ fn six_tendon() -> Model<crate::strain::LinearBasis> {
         radius_start,
         radius_end,
         material: None,
+        section: None,
     };
     let rod = Rod {
         material,

@@ -4,6 +4,7 @@ use super::Built;
 use crate::scenario::{BasisKind, Scenario};
 use gvs::error::fmt_value;
 use gvs::loads::Frame;
+use gvs::rod::Shape;
 use gvs::strain::FemDegree;
 
 /// A one-line description of the scenario as built (after `--set` and `--tension`), for the
@@ -14,12 +15,29 @@ pub fn describe(s: &Scenario, built: &Built) -> String {
     let m = &built.model;
     let g = &m.rod.divisions;
     // tapered within a division; a step in radius between uniform divisions is "stepped"
-    let tapered = g.iter().any(|d| d.radius_start != d.radius_end);
-    let stepped = g.windows(2).any(|w| w[0].radius_end != w[1].radius_start);
+    let tapered = g.iter().any(|d| match &d.section {
+        None => d.radius_start != d.radius_end,
+        Some(s) => s.width[0] != s.width[1] || s.height[0] != s.height[1],
+    });
+    let stepped = g.windows(2).any(|w| {
+        w[0].radius_end != w[1].radius_start
+            || w[0].section.map(|s| s.shape) != w[1].section.map(|s| s.shape)
+            || w[0].section.map(|s| (s.width[1], s.height[1]))
+                != w[1].section.map(|s| (s.width[0], s.height[0]))
+    });
+    let shapes: Vec<Option<Shape>> = g.iter().map(|d| d.section.map(|s| s.shape)).collect();
+    let shape = match shapes.first() {
+        Some(first) if shapes.iter().all(|s| s == first) => match first {
+            None => "",
+            Some(Shape::Rectangle) => " rectangular",
+            Some(Shape::Ellipse) => " elliptical",
+        },
+        _ => " mixed-section",
+    };
     // from the model, so that a reference strain given as the straight rod is not called one
     let precurved = (0..m.disc.n_sites()).any(|site| m.xi_star(site) != super::rod::STRAIGHT);
     let mut parts = vec![format!(
-        "{} m {}{} rod{}",
+        "{} m {}{shape}{} rod{}",
         m.rod.length(),
         match (tapered, stepped) {
             (true, _) => "tapered",

@@ -2,9 +2,9 @@
 
 use super::limits::*;
 use crate::error::ScenarioError;
-use crate::scenario::{DivisionSpec, Scenario};
+use crate::scenario::{DivisionSpec, Scenario, SectionShapeSpec};
 use gvs::lie::{Pose, M3, V3};
-use gvs::rod::{DivisionGeometry, Material};
+use gvs::rod::{DivisionGeometry, Material, Section, Shape};
 
 pub(super) fn material(s: &Scenario) -> Result<Material, ScenarioError> {
     let m = &s.material;
@@ -77,52 +77,121 @@ pub(super) fn geometry(j: usize, d: &DivisionSpec) -> Result<DivisionGeometry, S
     let f = |n: &str| format!("divisions[{j}].{n}");
     positive(&f("length"), d.length, "m")?;
     let length = in_range(&f("length"), d.length, DIVISION_LENGTH_RANGE, "m")?;
-    let (r0, r1) = match (d.radius, d.radius_start, d.radius_end) {
-        (Some(r), None, None) => (
-            positive(&f("radius"), r, "m")?,
-            positive(&f("radius"), r, "m")?,
-        ),
-        (None, Some(a), Some(b)) => (
-            positive(&f("radius_start"), a, "m")?,
-            positive(&f("radius_end"), b, "m")?,
-        ),
-        (Some(_), _, _) => return Err(ScenarioError::invalid(
-            f("radius"),
-            "give either `radius` (uniform) or `radius_start` and `radius_end` (tapered), not both",
-        )),
+    let shape = match d.section.unwrap_or(SectionShapeSpec::Circle) {
+        SectionShapeSpec::Circle => None,
+        SectionShapeSpec::Rectangle => Some(Shape::Rectangle),
+        SectionShapeSpec::Ellipse => Some(Shape::Ellipse),
+    };
+    let name = match shape {
+        None => "circle",
+        Some(Shape::Rectangle) => "rectangle",
+        Some(Shape::Ellipse) => "ellipse",
+    };
+    // a key of the other shape is named before a pair of this one's is checked
+    let radius_key = (["radius", "radius_start", "radius_end"].into_iter())
+        .zip([d.radius, d.radius_start, d.radius_end])
+        .find_map(|(n, v)| v.map(|_| n));
+    if let (Some(_), Some(given)) = (shape, radius_key) {
+        let article = if name == "ellipse" { "an" } else { "a" };
+        return Err(ScenarioError::invalid(
+            f(given),
+            format!("{article} {name} has a `width` and a `height`, no radius: drop `{given}`"),
+        ));
+    }
+    let radius = tapered(j, "radius", d.radius, d.radius_start, d.radius_end)?;
+    let width = tapered(j, "width", d.width, d.width_start, d.width_end)?;
+    let height = tapered(j, "height", d.height, d.height_start, d.height_end)?;
+    let Some(shape) = shape else {
+        if let Some(name) = [("width", width), ("height", height)]
+            .iter()
+            .find_map(|(n, v)| v.map(|_| *n))
+        {
+            return Err(ScenarioError::invalid(
+                f(name),
+                format!("a circular section has a radius, no {name}: give `section = \"rectangle\"` or `\"ellipse\"` with `width` and `height`, or drop `{name}`"),
+            ));
+        }
+        let Some((r0, r1)) = radius else {
+            return Err(ScenarioError::invalid(
+                f("radius"),
+                "missing: give `radius` or `radius_start` and `radius_end` [m] (or a `section` of another shape)",
+            ));
+        };
+        return Ok(DivisionGeometry {
+            length,
+            radius_start: r0,
+            radius_end: r1,
+            material: None,
+            section: None,
+        });
+    };
+    let (Some(w), Some(h)) = (width, height) else {
+        let missing = if width.is_none() { "width" } else { "height" };
+        let article = if name == "ellipse" { "an" } else { "a" };
+        return Err(ScenarioError::invalid(
+            f(missing),
+            format!("missing: {article} {name} needs `width` (along the section's y axis) and `height` (along z) [m], each uniform or as `_start` and `_end`"),
+        ));
+    };
+    Ok(DivisionGeometry::with_section(
+        length,
+        Section {
+            shape,
+            width: [w.0, w.1],
+            height: [h.0, h.1],
+        },
+    ))
+}
+
+/// A dimension of division `j` given uniform (`name`) or tapered (`name_start`, `name_end`), each
+/// positive: `None` if none of them is given.
+fn tapered(
+    j: usize,
+    name: &str,
+    uniform: Option<f64>,
+    start: Option<f64>,
+    end: Option<f64>,
+) -> Result<Option<(f64, f64)>, ScenarioError> {
+    let f = |n: &str| format!("divisions[{j}].{n}");
+    let (s, e) = (format!("{name}_start"), format!("{name}_end"));
+    Ok(Some(match (uniform, start, end) {
+        (Some(r), None, None) => (positive(&f(name), r, "m")?, positive(&f(name), r, "m")?),
+        (None, Some(a), Some(b)) => (positive(&f(&s), a, "m")?, positive(&f(&e), b, "m")?),
+        (Some(_), _, _) => {
+            return Err(ScenarioError::invalid(
+                f(name),
+                format!("give either `{name}` (uniform) or `{s}` and `{e}` (tapered), not both"),
+            ))
+        }
         (None, Some(_), None) => {
             return Err(ScenarioError::invalid(
-                f("radius_end"),
-                "missing: `radius_start` needs `radius_end`",
+                f(&e),
+                format!("missing: `{s}` needs `{e}`"),
             ))
         }
         (None, None, Some(_)) => {
             return Err(ScenarioError::invalid(
-                f("radius_start"),
-                "missing: `radius_end` needs `radius_start`",
+                f(&s),
+                format!("missing: `{e}` needs `{s}`"),
             ))
         }
-        (None, None, None) => {
-            return Err(ScenarioError::invalid(
-                f("radius"),
-                "missing: give `radius` or `radius_start` and `radius_end` [m]",
-            ))
-        }
-    };
-    Ok(DivisionGeometry {
-        length,
-        radius_start: r0,
-        radius_end: r1,
-        material: None,
-    })
+        (None, None, None) => return Ok(None),
+    }))
 }
 
-/// Checks the radii of division `j` lie in `[MIN_RADIUS, L]`, `L` the rod's total length.
+/// Checks the radii (or widths and heights) of division `j` lie in `[MIN_RADIUS, L]`, `L` the
+/// rod's total length.
 pub(super) fn radius_range(j: usize, d: &DivisionSpec, l: f64) -> Result<(), ScenarioError> {
     let pairs = [
         ("radius", d.radius),
         ("radius_start", d.radius_start),
         ("radius_end", d.radius_end),
+        ("width", d.width),
+        ("width_start", d.width_start),
+        ("width_end", d.width_end),
+        ("height", d.height),
+        ("height_start", d.height_start),
+        ("height_end", d.height_end),
     ];
     for (name, r) in pairs {
         if let Some(r) = r {

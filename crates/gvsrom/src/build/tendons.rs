@@ -5,26 +5,47 @@ use crate::error::ScenarioError;
 use crate::scenario::StrainMode;
 use crate::scenario::TendonSpec;
 use gvs::actuation::{tendon_local, Tendon, DEFAULT_FRICTION_SMOOTHING};
+use gvs::error::fmt_value;
 use gvs::model::Model;
-use gvs::rod::Rod;
+use gvs::rod::{DivisionGeometry, Rod};
 use gvs::strain::LinearBasis;
 
-/// Radius at `x` on the side given: `after = true` takes the division starting at `x` at a junction.
-pub(super) fn radius_at(rod: &Rod, x: f64, after: bool) -> f64 {
+/// The division at `x` and `X̄` there, on the side given: `after = true` takes the division
+/// starting at `x` at a junction.
+fn division_at(rod: &Rod, x: f64, after: bool) -> Option<(&DivisionGeometry, f64)> {
     let starts = rod.division_starts();
     let tol = 1e-12 * rod.length();
     let mut found = None;
     for (j, d) in rod.divisions.iter().enumerate() {
         let (x0, x1) = (starts[j], starts[j] + d.length);
         if x >= x0 - tol && x <= x1 + tol {
-            let r = d.radius_at(((x - x0) / d.length).clamp(0.0, 1.0));
-            found = Some(r);
+            found = Some((d, ((x - x0) / d.length).clamp(0.0, 1.0)));
             if !after {
                 break;
             }
         }
     }
-    found.unwrap_or(f64::NAN)
+    found
+}
+
+/// How far the section at `x` reaches from the axis in the direction `θ` from `y` toward `z`
+/// (the radius of a circle), on the side given ([`division_at`]).
+pub(super) fn reach_at(rod: &Rod, x: f64, after: bool, theta: f64) -> f64 {
+    let (s, c) = theta.sin_cos();
+    division_at(rod, x, after).map_or(f64::NAN, |(d, x_bar)| 1.0 / d.gauge_at(x_bar, c, s))
+}
+
+/// The section's gauge of the offset `(y, z)` at `x` (> 1 outside; both sides at a junction) and
+/// what the section there is, for a message.
+fn gauge_at(rod: &Rod, x: f64, y: f64, z: f64) -> (f64, String) {
+    let sides = [division_at(rod, x, false), division_at(rod, x, true)];
+    let gauges = sides
+        .iter()
+        .flatten()
+        .map(|(d, x_bar)| (d.gauge_at(*x_bar, y, z), d.describe_at(*x_bar)));
+    gauges
+        .reduce(|a, b| if b.0 > a.0 { b } else { a })
+        .unwrap_or((f64::NAN, String::new()))
 }
 
 pub(super) fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, ScenarioError> {
@@ -107,8 +128,8 @@ pub(super) fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, Scen
                 ));
             }
             let (s, co) = theta.sin_cos();
-            let r0 = radius_at(rod, x_start, true) * c;
-            let r1 = radius_at(rod, x_end, false) * c;
+            let r0 = reach_at(rod, x_start, true, theta) * c;
+            let r1 = reach_at(rod, x_end, false, theta) * c;
             ([r0 * co, r0 * s], [r1 * co, r1 * s])
         }
     };
@@ -128,39 +149,54 @@ pub(super) fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, Scen
         path: Vec::new(),
         axial_stiffness: t.axial_stiffness,
     };
-    // |d(X)| is convex along the span and r(X) linear per division: checking the span's ends and
-    // the division junctions inside it covers the whole path.
-    let mut checks = vec![(x_start, radius_at(rod, x_start, true), "offset_start", "")];
+    // For circles |d(X)| is convex along the span and r(X) linear per division: checking the
+    // span's ends and the division junctions inside it covers the whole path. A rectangle or an
+    // ellipse is searched between them too (a helix turns the offset toward its narrow side).
+    let sectioned = rod.divisions.iter().any(|d| d.section.is_some());
+    let mut checks = vec![(x_start, "offset_start", "")];
     let starts = rod.division_starts();
     for &xj in starts.iter().skip(1) {
         if xj > x_start && xj < x_end {
-            let r = radius_at(rod, xj, true).min(radius_at(rod, xj, false));
-            checks.push((
-                xj,
-                r,
-                "offset_end",
-                " (a division junction inside the span)",
-            ));
+            checks.push((xj, "offset_end", " (a division junction inside the span)"));
         }
     }
-    checks.push((x_end, radius_at(rod, x_end, false), "offset_end", ""));
-    for (x, r, which, note) in checks {
-        let dn = tendon.offset(x).norm();
-        if dn > r * (1.0 + 1e-9) {
-            let (field, how) = if polar {
-                (
+    checks.push((x_end, "offset_end", ""));
+    if sectioned {
+        let (x, _) = tendon.widest_excursion(rod);
+        checks.push((
+            x,
+            "offset_end",
+            " (where the path reaches farthest from the axis)",
+        ));
+    }
+    for (x, which, note) in checks {
+        let d = tendon.offset(x);
+        let dn = d.norm();
+        let (gauge, section) = gauge_at(rod, x, d[1], d[2]);
+        if gauge > 1.0 + 1e-9 {
+            let (field, how) = match (polar, tendon.turns != 0.0) {
+                (true, false) => (
                     f("angle_deg"),
                     "the straight path between the surface points at x_start and x_end",
-                )
-            } else {
-                (f(which), "the tendon")
-            };
-            return Err(ScenarioError::invalid(
-                field,
-                format!(
-                    "{how} leaves the cross-section at X = {x} m{note}: offset norm {dn} m > radius {r} m (accepted: |offset| <= r(X) along the whole span)"
                 ),
-            ));
+                (true, true) => (
+                    f("angle_deg"),
+                    "the helix from the surface point at x_start",
+                ),
+                (false, _) => (f(which), "the tendon"),
+            };
+            let (x, dn) = (fmt_value(x), fmt_value(dn));
+            let message = match sectioned {
+                false => format!(
+                    "{how} leaves the cross-section at X = {x} m{note}: offset norm {dn} m > {section} (accepted: |offset| <= r(X) along the whole span)"
+                ),
+                true => format!(
+                    "{how} leaves the cross-section at X = {x} m{note}: offset [{}, {}] m outside the {section} (accepted: offsets inside the section along the whole span)",
+                    fmt_value(d[1]),
+                    fmt_value(d[2])
+                ),
+            };
+            return Err(ScenarioError::invalid(field, message));
         }
     }
     Ok(tendon)

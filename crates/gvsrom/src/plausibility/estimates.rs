@@ -49,11 +49,12 @@ fn vec3(v: &[f64]) -> String {
 struct Interval {
     a: f64,
     b: f64,
+    /// The weaker of `EI_y`, `EI_z`.
     ei: [f64; 2],
     ea: [f64; 2],
     /// `min(EA, GA)`.
     ea_ga: [f64; 2],
-    /// `πr²`.
+    /// The section's area.
     area: [f64; 2],
     /// ρ of its division's material.
     density: f64,
@@ -67,18 +68,18 @@ fn grid(built: &Subject<'_>) -> Vec<Interval> {
         .zip(rod.division_starts())
         .zip(rod.materials())
     {
-        let (e, g) = (material.youngs_modulus, material.shear_modulus());
         for i in 0..per_div {
             let (t0, t1) = (i as f64 / per_div as f64, (i + 1) as f64 / per_div as f64);
-            let r = [d.radius_at(t0), d.radius_at(t1)];
-            let area = r.map(|r| PI * r * r);
+            // the section's weaker bending axis, its extension, and the weaker of extension and
+            // shear
+            let s = [d.props_at(material, t0), d.props_at(material, t1)];
             out.push(Interval {
                 a: x0 + t0 * d.length,
                 b: x0 + t1 * d.length,
-                ei: r.map(|r| e * PI * r.powi(4) / 4.0),
-                ea: area.map(|a| e * a),
-                ea_ga: area.map(|a| e.min(g) * a),
-                area,
+                ei: s.map(|s| s.es[1].min(s.es[2])),
+                ea: s.map(|s| s.es[3]),
+                ea_ga: s.map(|s| s.es[3].min(s.es[4])),
+                area: s.map(|s| s.area),
                 density: material.density,
             });
         }

@@ -31,5 +31,5 @@ pub use tensions::tensions_for;
 pub use types::{
     default_pulse_axis, BaseSpec, BasisKind, BasisSpec, BodySpec, DistributedKind,
     DistributedLoadSpec, DivisionSpec, InertiaSpec, LoadsSpec, MaterialSpec, ModeOrders,
-    OutputSpec, PointLoadSpec, QuadratureSpec, Scenario, StrainMode, TendonSpec,
+    OutputSpec, PointLoadSpec, QuadratureSpec, Scenario, SectionShapeSpec, StrainMode, TendonSpec,
 };

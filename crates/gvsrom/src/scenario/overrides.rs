@@ -57,12 +57,62 @@ pub fn apply_override(table: &mut Table, spec: &str) -> Result<(), ScenarioError
         return Err(err("the path must start with a key".into()));
     };
     let value = parse_value(raw);
+    let shape = section_shape(&segs, &value);
     let mut root = Value::Table(std::mem::take(table));
     let r = set_at(&mut root, &segs, 0, value);
     if let Value::Table(t) = root {
         *table = t;
     }
-    r.map_err(err)
+    r.map_err(err)?;
+    if let Some((j, shape)) = shape {
+        drop_other_shape(table, j, &shape);
+    }
+    Ok(())
+}
+
+/// The keys that size a circular section, and those that size a rectangle or an ellipse.
+const CIRCLE_KEYS: [&str; 3] = ["radius", "radius_start", "radius_end"];
+const BOX_KEYS: [&str; 6] = [
+    "width",
+    "width_start",
+    "width_end",
+    "height",
+    "height_start",
+    "height_end",
+];
+
+/// `Some((j, shape))` for an override of `divisions.j.section` to a string.
+fn section_shape(segs: &[Seg], value: &Value) -> Option<(usize, String)> {
+    match (segs, value) {
+        ([Seg::Key(d), Seg::Index(j), Seg::Key(k)], Value::String(shape))
+            if d == "divisions" && k == "section" =>
+        {
+            Some((*j, shape.clone()))
+        }
+        _ => None,
+    }
+}
+
+/// An override of a division's `section` replaces the description of the section it had: a
+/// rectangle or an ellipse drops the circle's radii, a circle the rectangle's widths and heights
+/// (`--set divisions.0.section=rectangle --set divisions.0.width=0.03 --set
+/// divisions.0.height=0.01` on a preset of circular sections). An unknown shape keeps both, for
+/// the format's error to name it.
+fn drop_other_shape(table: &mut Table, j: usize, shape: &str) {
+    let dropped: &[&str] = match shape {
+        "rectangle" | "ellipse" => &CIRCLE_KEYS,
+        "circle" => &BOX_KEYS,
+        _ => return,
+    };
+    let division = (table.get_mut("divisions"))
+        .and_then(Value::as_array_mut)
+        .and_then(|a| a.get_mut(j))
+        .and_then(Value::as_table_mut);
+    if let Some(d) = division {
+        for k in dropped {
+            d.remove(*k);
+        }
+    }
 }
 
 fn set_at(node: &mut Value, segs: &[Seg], depth: usize, value: Value) -> Result<(), String> {

@@ -100,6 +100,25 @@ pub struct DivisionSpec {
     pub radius_start: Option<f64>,
     #[serde(default)]
     pub radius_end: Option<f64>,
+    /// The section's shape: `"circle"` (the default: `radius`), `"rectangle"` or `"ellipse"`
+    /// (`width` along the section's y axis and `height` along z, each uniform or tapered by its
+    /// `_start` and `_end`); not written when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub section: Option<SectionShapeSpec>,
+    /// Uniform width \[m\] of a rectangle or an ellipse (its extent along y).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub width: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub width_start: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub width_end: Option<f64>,
+    /// Uniform height \[m\] of a rectangle or an ellipse (its extent along z).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub height: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub height_start: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub height_end: Option<f64>,
     pub basis: BasisSpec,
     /// Default: Legendre → `gauss = max(order) + 1`, at least 5 (SoRoSim), or `3 (max(order) + 1)`
     /// above order 3 (what the Z4 kinematics needs); FEM → the basis's elements with 2 (linear) or
@@ -115,6 +134,15 @@ pub struct DivisionSpec {
     /// replace the rod's); not written when absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<DivisionMaterialSpec>,
+}
+
+/// A division's section shape (`divisions[j].section`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SectionShapeSpec {
+    Circle,
+    Rectangle,
+    Ellipse,
 }
 
 /// A strain component, in the engine's order `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]`.
@@ -221,7 +249,8 @@ pub struct QuadratureSpec {
 
 /// A tendon (gvs-spec §7.6–7.7). Its offset `d(X) = [0, y, z]` is interpolated linearly from
 /// `offset_start` at `x_start` to `offset_end` at `x_end`; or, with `angle_deg`, the two end
-/// offsets are `radial_fraction · r(X) · (cos θ, sin θ)` (on the surface for fraction 1).
+/// offsets are `radial_fraction · r(X, θ) · (cos θ, sin θ)`, `r(X, θ)` how far the section
+/// reaches in that direction (on the surface for fraction 1).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TendonSpec {

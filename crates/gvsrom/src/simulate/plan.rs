@@ -394,7 +394,7 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
 /// inextensible one is a constraint the integrators do not impose), and its input channel is a
 /// displacement, which random tension steps and babbling are not. A reduced model runs it as the
 /// full model does, the tensions its threads pull with checked against its training as the run
-/// finds them (`super::run`).
+/// finds them (`Reduced::found_tensions_outside` at every sample).
 fn check_drives(built: &Built, opts: &SimulateOptions) -> Result<(), ScenarioError> {
     let Some(first) = built.displacement.iter().position(Option::is_some) else {
         return Ok(());

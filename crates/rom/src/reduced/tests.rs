@@ -144,12 +144,14 @@ fn two_division_legendre() -> (Discretization, LinearBasis) {
                 radius_start: 0.02,
                 radius_end: 0.015,
                 material: None,
+                section: None,
             },
             gvs::rod::DivisionGeometry {
                 length: 0.1,
                 radius_start: 0.015,
                 radius_end: 0.01,
                 material: None,
+                section: None,
             },
         ],
     };

@@ -26,6 +26,7 @@ fn rod_with_tendons(ea1: Option<f64>) -> Model<LinearBasis> {
             radius_start: 0.01,
             radius_end: 0.01,
             material: None,
+            section: None,
         }],
     };
     let disc =

@@ -20,6 +20,7 @@ fn disc(lengths: &[f64], q: Quadrature) -> Discretization {
                 radius_start: 0.01,
                 radius_end: 0.01,
                 material: None,
+                section: None,
             })
             .collect(),
     };
