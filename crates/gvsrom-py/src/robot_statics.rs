@@ -45,7 +45,8 @@ impl Robot {
             let report = py
                 .detach(|| statics::solve_as_built(&self.built))
                 .map_err(errors::any)?;
-            return Ok((report, vec![]));
+            let extrapolated = self.built.model_extrapolated(&report.u);
+            return Ok((report, extrapolated));
         }
         match attached.or(self.attached.as_ref()) {
             None => {

@@ -169,7 +169,9 @@ impl Stepper {
     ///     a reduced model's training (without ``extrapolate``), or a displacement not below its
     ///     tendon's rest length: checked before the run sees them, so the run stays where it
     ///     was and the next ``step`` goes on from there. Also
-    ///     once the run has ended (closed, past its horizon, or its integration failed).
+    ///     once the run has ended (closed, past its horizon, or its integration failed — with a
+    ///     reduced model, also where a tension found for a displacement leaves its training:
+    ///     that is known only as the run goes, and ends it).
     fn step<'py>(
         &mut self,
         py: Python<'py>,

@@ -497,7 +497,7 @@ def test_a_reduced_model_runs_a_tendon_driven_by_displacement(pod_model):
     assert run["u"][-1, 0] == pytest.approx(eq.u[0], rel=1e-4)
     np.testing.assert_allclose(run["tip_position"][-1], eq.tip_position, atol=1e-5 * 0.25)
     assert not any("tension" in s for s in run["model_extrapolated"])
-    with pytest.raises(gvsrom.IntegrationError, match=r"at t = 0\.0000 s the threads .* not trained for: "
+    with pytest.raises(gvsrom.IntegrationError, match=r"at t = 0\.0000 s the tensions found from the threads .* outside the model's training: "
                        r"tendons\.0\.tension = -9\.59.* \(found\) lies outside the training inputs \[-6, 0\]"):
         reduced.simulate(0.2, input=lambda t: [0.012])
     loose = driven.with_model(pod_model, extrapolate=True)
@@ -510,6 +510,12 @@ def test_a_reduced_model_runs_a_tendon_driven_by_displacement(pod_model):
     assert eq.u[0] < -6.0
     assert any(s.startswith("the tensions the displacements need: tendons.0.tension = -8.")
                for s in eq.model_extrapolated), eq.model_extrapolated
+    # the same drive given by the scenario, solved with no arguments, says so too
+    scenario_driven = (gvsrom.Scenario.preset("single-tendon").set("tendons.0.tension", 0)
+                       .set("tendons.0.displacement", 0.02).build())
+    again = scenario_driven.with_model(pod_model, extrapolate=True).statics()
+    assert again.u[0] == pytest.approx(eq.u[0], rel=1e-9)
+    assert again.model_extrapolated == eq.model_extrapolated
 
 
 def test_a_pickled_robot_is_the_same_robot_in_another_process(dataset, pod_model, tmp_path):

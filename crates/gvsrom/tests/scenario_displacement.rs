@@ -153,11 +153,11 @@ fn a_reduced_model_is_driven_by_displacement_too() {
     expect_error(
         &run_args,
         &[
-            "at t = 0.0000 s the threads of the tendons driven by displacement pull with tensions the model was not trained for",
+            "at t = 0.0000 s the tensions found from the threads of the tendons driven by displacement lie outside the model's training",
             "tendons.0.tension = -3.19",
             "(found) lies outside the training inputs [-3, 0]",
             "--extrapolate",
-            "the 1 sample before it was written",
+            "the 0 samples before it were written",
         ],
     );
     // 12 mm needs about -4.4 N, outside the sweep's [-3, 0]: refused, naming the tension found
@@ -198,8 +198,8 @@ fn a_reduced_model_is_driven_by_displacement_too() {
 }
 
 /// A reduced model runs a tendon driven by displacement as the full model does: the IV-A arm
-/// wound in by 4 mm over 0.5 s through its thread, on a POD-4 of a tension sweep wide enough
-/// for the overshoot (−4.2 N), follows the full model's run within 1.5 % L and settles on its
+/// stepped by 4 mm at 0.5 s through its thread (a held CSV), on a POD-4 of a tension sweep wide
+/// enough for the step's −4.2 N, follows the full model's run within 1.5 % L and settles on its
 /// tip and tension. Wound in by 12 mm, the tensions found leave the sweep: without
 /// `--extrapolate` the run stops there; with it, it goes on and its record says so.
 #[test]
@@ -294,7 +294,7 @@ fn a_reduced_model_runs_a_displacement_drive_and_checks_the_tensions_found() {
     expect_error(
         &a,
         &[
-            "the threads of the tendons driven by displacement pull with tensions the model was not trained for",
+            "the tensions found from the threads of the tendons driven by displacement lie outside the model's training",
             "(found) lies outside the training inputs [-5, 0]",
             "marked partial",
         ],
@@ -310,7 +310,7 @@ fn a_reduced_model_runs_a_displacement_drive_and_checks_the_tensions_found() {
     ]);
     let stdout = run_ok(&a);
     assert!(
-        stdout.contains("pull with tensions the model was not trained for"),
+        stdout.contains("lie outside the model's training: tendons.0.tension"),
         "{stdout}"
     );
     let meta: serde_json::Value =
@@ -751,5 +751,80 @@ fn linearize_takes_the_displacement_as_the_input_through_the_thread() {
     expect_error(
         &["linearize", "single-tendon", "--displacement", "0.004"],
         &["tendons[0].axial_stiffness", "missing"],
+    );
+}
+
+/// With tendons driven both ways on a reduced model, the run checks the tensions found for the
+/// displacement-driven ones: a given tension outside the training is the input's (named before
+/// the run, never as "found"), and under `--extrapolate` each driven tendon that leaves the
+/// training is recorded, not only the first sentence.
+#[test]
+fn a_reduced_run_with_mixed_drives_records_each_found_tension_outside() {
+    let data = scratch("drive-mixed-data");
+    run_ok(&[
+        "dataset",
+        "six-tendon",
+        "--random",
+        "tendons.*.tension=-10:0",
+        "--samples",
+        "200",
+        "--out",
+        path_str(&data),
+    ]);
+    let model = scratch("drive-mixed-model");
+    run_ok(&[
+        "pod",
+        path_str(&data),
+        "--modes",
+        "8",
+        "--out",
+        path_str(&model),
+    ]);
+    // tendon 0 given −12 N from t = 0.5 s, tendon 2 wound in by 30 mm through a thread
+    let csv = scratch("drive-mixed.csv");
+    std::fs::write(
+        &csv,
+        "t,u0,u1,u2,u3,u4,u5\n0,0,0,0,0,0,0\n0.5,-12,0,0.03,0,0,0\n2,-12,0,0.03,0,0,0\n",
+    )
+    .unwrap();
+    let out = scratch("drive-mixed-run");
+    let mut args = vec!["simulate", "six-tendon"];
+    args.extend([
+        "--set",
+        "tendons.2.tension=0",
+        "--set",
+        "tendons.2.displacement=0",
+        "--set",
+        "tendons.2.axial_stiffness=2000",
+        "--input",
+        path_str(&csv),
+        "--duration",
+        "2",
+        "--model",
+        path_str(&model),
+    ]);
+    // without --extrapolate the given −12 N is refused before the run, as an input
+    let mut refused = args.clone();
+    refused.extend(["--out", path_str(&out)]);
+    expect_error(
+        &refused,
+        &[
+            "the input signal's tendons.0.tension reaches -12",
+            "outside the training inputs",
+        ],
+    );
+    assert!(!out.exists());
+    args.extend(["--extrapolate", "--out", path_str(&out)]);
+    run_ok(&args);
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("meta.json")).unwrap()).unwrap();
+    let noted = meta["model_extrapolated"].to_string();
+    assert!(
+        !noted.contains("tendons.0.tension = -12"),
+        "given, not found: {noted}"
+    );
+    assert!(
+        noted.contains("from the threads of the tendons driven by displacement lie outside the model's training: tendons.2.tension = -"),
+        "{noted}"
     );
 }

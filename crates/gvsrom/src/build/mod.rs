@@ -80,7 +80,7 @@ impl Built {
         let mut out = r.extrapolated.clone();
         if self.displacement_driven() && r.extrapolate {
             out.extend(
-                (r.found_tensions_outside(u).into_iter())
+                (r.found_tensions_outside(u, &self.drive_flags()).into_iter())
                     .map(|s| format!("the tensions the displacements need: {s}")),
             );
         }

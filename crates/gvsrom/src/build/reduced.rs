@@ -105,32 +105,39 @@ impl Reduced {
             && self.joint.as_ref().is_none_or(|j| j.outside(u).is_none())
     }
 
-    /// How the tensions `u` a solve found for displacement drives lie outside what training saw,
-    /// one sentence each (empty: inside): a tension outside its training range, one training held
-    /// at another value, or, each inside, their combination far from the training inputs.
-    pub fn found_tensions_outside(&self, u: &[f64]) -> Vec<String> {
+    /// How the tensions `u` a solve found for the displacement drives (`driven[k]`) lie outside
+    /// what training saw, one sentence each (empty: inside): a found tension outside its training
+    /// range, or one training held at another value; or, every tension inside (the given ones
+    /// too, which were checked as inputs), their combination far from the training inputs.
+    pub fn found_tensions_outside(&self, u: &[f64], driven: &[bool]) -> Vec<String> {
         let mut outside = vec![];
+        let mut given_inside = true;
         for (k, &v) in u.iter().enumerate() {
             let param = tension_param(k);
-            match (self.input_range.iter()).find(|r| r.parameter == param) {
-                Some(r) if !inside(r, v) => outside.push(format!(
+            let found = driven.get(k).copied().unwrap_or(false);
+            let sentence = match (self.input_range.iter()).find(|r| r.parameter == param) {
+                Some(r) if !inside(r, v) => format!(
                     "{param} = {} (found) lies outside the training inputs [{}, {}]",
                     super::significant(v),
-                    fmt_value(r.min),
-                    fmt_value(r.max)
-                )),
-                Some(_) => {}
+                    super::significant(r.min),
+                    super::significant(r.max)
+                ),
+                Some(_) => continue,
                 None => match self.held_tensions.get(k) {
-                    Some(Some(h)) if !at_held(v, *h) => outside.push(format!(
+                    Some(Some(h)) if !at_held(v, *h) => format!(
                         "{param} = {} (found), but training held it at {}",
                         super::significant(v),
                         fmt_value(*h)
-                    )),
-                    _ => {}
+                    ),
+                    _ => continue,
                 },
+            };
+            match found {
+                true => outside.push(sentence),
+                false => given_inside = false,
             }
         }
-        if let (true, Some(joint)) = (outside.is_empty(), &self.joint) {
+        if let (true, true, Some(joint)) = (outside.is_empty(), given_inside, &self.joint) {
             outside.extend(joint.outside(u).map(|(_, why)| why));
         }
         outside

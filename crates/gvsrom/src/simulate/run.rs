@@ -204,8 +204,8 @@ pub fn run_into(
     let mut off_data = None::<String>;
     // a reduced model's tensions found for displacement drives, outside its training
     let mut off_inputs = None::<String>;
-    let mut found_outside = None::<String>;
-    let found_tensions_checked = built.displacement_driven();
+    let mut found_outside = Vec::<String>::new();
+    let found_tensions_checked = built.displacement_driven().then(|| built.drive_flags());
     let x: Vec<f64> = built.model.disc.points.iter().map(|p| p.x).collect();
     // `control` is called from the sink and from the integrator's per-attempt poll, never nested
     let control = std::cell::RefCell::new(control);
@@ -247,6 +247,15 @@ pub fn run_into(
             non_physical = Some(msg.clone());
             return ControlFlow::Break(msg);
         }
+        // A reduced model answers for the tensions it was trained on: those the threads of
+        // displacement-driven tendons pull with are known only now (checked at each sample,
+        // which is not written if they lie outside)
+        if let (Some(driven), Some(r)) = (&found_tensions_checked, &built.reduced) {
+            if let Some(msg) = found_tensions_off_training(r, driven, s, &mut found_outside) {
+                off_inputs = Some(msg.clone());
+                return ControlFlow::Break(msg);
+            }
+        }
         if let Some(e) = energy.as_mut() {
             match &built.reduced {
                 Some(r) => e.push(&r.model, &built.loads.gravity, s),
@@ -274,14 +283,6 @@ pub fn run_into(
             );
             off_manifold = Some(msg.clone());
             return ControlFlow::Break(msg);
-        }
-        // A reduced model answers for the tensions it was trained on: those the threads of
-        // displacement-driven tendons pull with are known only now
-        if let (true, Some(r)) = (found_tensions_checked, &built.reduced) {
-            if let Some(msg) = found_tensions_off_training(r, s, &mut found_outside) {
-                off_inputs = Some(msg.clone());
-                return ControlFlow::Break(msg);
-            }
         }
         // A POD basis is linear and defined everywhere: leaving its data is noted, not refused
         if off_data.is_none() {
@@ -376,30 +377,41 @@ pub fn run_into(
     })
 }
 
-/// The tensions of sample `s` of a reduced model's run with tendons driven by displacement,
-/// found from their threads' stretch, against the model's training
+/// The tensions of sample `s` of a reduced model's run with the tendons `driven` by
+/// displacement, found from their threads' stretch, against the model's training
 /// (`Reduced::found_tensions_outside`): outside it, the message that ends the run, or, with
-/// `--extrapolate`, `None` with the first such sample's sentence kept in `noted`.
+/// `--extrapolate`, `None` with the sentence kept in `noted` — the first sample of each way of
+/// lying outside (a tendon's range, the inputs together).
 fn found_tensions_off_training(
     r: &crate::build::reduced::Reduced,
+    driven: &[bool],
     s: &Sample<'_>,
-    noted: &mut Option<String>,
+    noted: &mut Vec<String>,
 ) -> Option<String> {
-    let outside = r.found_tensions_outside(s.u);
+    let outside = r.found_tensions_outside(s.u, driven);
     if outside.is_empty() {
         return None;
     }
-    let sentence = format!(
-        "at t = {:.4} s the threads of the tendons driven by displacement pull with tensions the model was not trained for: {}",
-        s.t,
-        outside.join("; ")
+    let at = format!(
+        "at t = {:.4} s the tensions found from the threads of the tendons driven by displacement lie outside the model's training: ",
+        s.t
     );
     if r.extrapolate {
-        noted.get_or_insert(sentence);
+        for why in outside {
+            // one sentence per way: `tendons.k.tension = …`, or the inputs together
+            let kind = match why.starts_with("tendons.") {
+                true => why.split(" = ").next().unwrap_or(&why).to_string(),
+                false => "the inputs together".to_string(),
+            };
+            if !noted.iter().any(|n| n.contains(&format!(": {kind}"))) {
+                noted.push(format!("{at}{why}"));
+            }
+        }
         return None;
     }
     Some(format!(
-        "{sentence}; `{}` answers only inside its training (wind the displacement in more slowly, start --from-equilibrium, or pass --extrapolate to use it anyway, its answer then marked an extrapolation)",
+        "{at}{}; `{}` answers only inside its training (wind the displacement in more slowly, start --from-equilibrium, or pass --extrapolate to use it anyway, its answer then marked an extrapolation)",
+        outside.join("; "),
         r.path.display()
     ))
 }

@@ -191,7 +191,7 @@ pub fn check_reduced(built: &Built, report: &StaticsReport) -> Result<(), Scenar
         // tensions found for displacement drives: inside the training inputs, as given ones
         // must be (with --extrapolate, said when the model was attached)
         let outside = match built.displacement_driven() && !r.extrapolate {
-            true => r.found_tensions_outside(&report.u),
+            true => r.found_tensions_outside(&report.u, &built.drive_flags()),
             false => vec![],
         };
         if !outside.is_empty() {
