@@ -166,12 +166,11 @@ impl Stepper {
     /// ------
     /// GvsromError
     ///     For tensions of the wrong count, not finite, beyond the rod's elastic range or outside
-    ///     a reduced model's training (without ``extrapolate``), or a displacement not below its
-    ///     tendon's rest length: checked before the run sees them, so the run stays where it
-    ///     was and the next ``step`` goes on from there. Also
-    ///     once the run has ended (closed, past its horizon, or its integration failed — with a
-    ///     reduced model, also where a tension found for a displacement leaves its training:
-    ///     that is known only as the run goes, and ends it).
+    ///     a reduced model's training (without ``extrapolate``; for a displacement, the tension
+    ///     its thread pulls with as the period starts), or a displacement not below its tendon's
+    ///     rest length: checked before the run sees them, so the run stays where it was and the
+    ///     next ``step`` goes on from there. Also once the run has ended (closed, past its
+    ///     horizon, or its integration failed).
     fn step<'py>(
         &mut self,
         py: Python<'py>,
@@ -213,6 +212,25 @@ impl Stepper {
             if let (Some(n), false) = (notes.first(), self.warned) {
                 warn(py, &format!("extrapolating (--extrapolate): {n} (further values outside the training are not warned of)"))?;
                 self.warned = true;
+            }
+        }
+        // the tensions the threads of displacement-driven tendons pull with as the period starts
+        // (the run's first sample of it), against a reduced model's training: refused as a given
+        // tension is, or with `extrapolate` warned of
+        if let (Some(model), true) = (&built.reduced, built.displacement_driven()) {
+            let found = built.found_tensions(&self.q, &u);
+            if let Some(n) = model
+                .found_tensions_outside(&found, &built.drive_flags())
+                .first()
+            {
+                let why = format!("the tensions found from the threads of the tendons driven by displacement lie outside the model's training: {n}");
+                if !model.extrapolate {
+                    return Err(refused(&format!("{why} (extrapolate=True uses it anyway)")));
+                }
+                if !self.warned {
+                    warn(py, &format!("extrapolating (extrapolate=True): at t = {t} s {why} (further values outside the training are not warned of)"))?;
+                    self.warned = true;
+                }
             }
         }
         let sent = (self.running.as_ref()).is_some_and(|r| r.tensions.send(Some(u)).is_ok());

@@ -500,7 +500,17 @@ def test_a_reduced_model_runs_a_tendon_driven_by_displacement(pod_model):
     with pytest.raises(gvsrom.IntegrationError, match=r"at t = 0\.0000 s the tensions found from the threads .* outside the model's training: "
                        r"tendons\.0\.tension = -9\.59.* \(found\) lies outside the training inputs \[-6, 0\]"):
         reduced.simulate(0.2, input=lambda t: [0.012])
+    # the stepper refuses such a step before the run sees it, or with extrapolate warns of it
+    stepper = reduced.stepper(0.05)
+    with pytest.raises(gvsrom.GvsromError, match=r"`step\(u\)` at t = 0 s: the tensions found from the threads"
+                       r".*tendons\.0\.tension = -9\.59.*the run goes on from there"):
+        stepper.step([0.012])
+    q, _ = stepper.step([0.004])
+    assert stepper.t == pytest.approx(0.05)
+    stepper.close()
     loose = driven.with_model(pod_model, extrapolate=True)
+    with pytest.warns(UserWarning, match=r"at t = 0 s the tensions found from the threads.*-9\.59"):
+        loose.stepper(0.05).step([0.012])
     far = loose.simulate(0.2, input=lambda t: [0.012])
     assert any("(found) lies outside the training inputs [-6, 0]" in s for s in far["model_extrapolated"])
     # in statics too: 20 mm of the inextensible tendon needs −8.7 N, answered with extrapolate

@@ -87,6 +87,36 @@ impl Built {
         out
     }
 
+    /// The tensions \[N\] at the coordinates `q` of the model that runs (the reduced one if
+    /// attached) under the actuation `channels`: each displacement-driven tendon's found from its
+    /// thread's stretch (`gvs::solve::dynamics::drive::thread_tension`; an inextensible one's
+    /// stays 0, unknown without the solve), the others the tensions given.
+    pub fn found_tensions(&self, q: &[f64], channels: &[f64]) -> Vec<f64> {
+        use gvs::solve::dynamics::drive::thread_tension;
+        let q = nalgebra::DVector::from_column_slice(q);
+        let (lengths, rest, c) = match &self.reduced {
+            Some(r) => {
+                let m = &r.model;
+                let l = m.tendon_lengths(&q, &mut m.workspace());
+                (l, m.tendon_rest_lengths(), m.tendon_compliances())
+            }
+            None => {
+                let m = &self.model;
+                let l = m.tendon_lengths(&q, &mut m.workspace());
+                (l, m.tendon_rest_lengths(), m.tendon_compliances())
+            }
+        };
+        (channels.iter().enumerate())
+            .map(|(k, &v)| match (self.displacement.get(k), c.get(k)) {
+                (Some(Some(_)), Some(&ck)) if ck > 0.0 => {
+                    thread_tension(lengths[k], rest[k], v, ck)
+                }
+                (Some(Some(_)), _) => 0.0,
+                _ => v,
+            })
+            .collect()
+    }
+
     /// Per tendon, whether it is driven by its displacement.
     pub fn drive_flags(&self) -> Vec<bool> {
         self.displacement.iter().map(Option::is_some).collect()

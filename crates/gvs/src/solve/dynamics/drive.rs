@@ -29,6 +29,13 @@ use crate::model::{Model, Workspace};
 use crate::strain::StrainParam;
 use nalgebra::{DMatrix, DVector};
 
+/// The tension \[N\] of a thread of compliance `c` \[m/N\] over a path of length `length` \[m\],
+/// its motor having wound it in by `delta` \[m\] from its rest length `rest` \[m\]:
+/// `min(0, −(ℓ − (ℓ_rest − δ))/c)` (the module documentation), negative while it pulls.
+pub fn thread_tension(length: f64, rest: f64, delta: f64, c: f64) -> f64 {
+    (-(length - (rest - delta)) / c).min(0.0)
+}
+
 /// An actuation whose channels `k` with `driven[k]` are displacements `δ_k(t)` \[m\] of their
 /// tendons' motors, the others tensions: the wrapper that tells the dynamics so
 /// ([`Actuation::displacement_driven`]).
@@ -150,8 +157,7 @@ impl TendonSprings {
     ) {
         model.tendon_lengths_after_forward(ws, &mut self.lengths);
         for (i, &k) in self.d.iter().enumerate() {
-            let target = self.rest[i] - u[k];
-            u[k] = (-(self.lengths[k] - target) / self.c[i]).min(0.0);
+            u[k] = thread_tension(self.lengths[k], self.rest[i], u[k], self.c[i]);
         }
     }
 
