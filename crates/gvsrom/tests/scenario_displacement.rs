@@ -91,12 +91,10 @@ fn paid_out_tendons_go_slack_and_are_reported() {
     assert!(stdout.contains("paid out 10 mm"), "{stdout}");
 }
 
-/// A POD model of the IV-A arm's tension sweep, driven by displacement: its tension and tip are
-/// the full model's within the reduction's error.
-#[test]
-fn a_reduced_model_is_driven_by_displacement_too() {
-    let data = sweep_dataset("drive-pod-data", "-3:0", 13);
-    let model = scratch("drive-pod-model");
+/// A POD-4 of the IV-A arm's tension sweep over `range` (13 equilibria), in `{name}-model`.
+fn pod_of_sweep(name: &str, range: &str) -> std::path::PathBuf {
+    let data = sweep_dataset(&format!("{name}-data"), range, 13);
+    let model = scratch(&format!("{name}-model"));
     run_ok(&[
         "pod",
         path_str(&data),
@@ -105,6 +103,14 @@ fn a_reduced_model_is_driven_by_displacement_too() {
         "--out",
         path_str(&model),
     ]);
+    model
+}
+
+/// A POD model of the IV-A arm's tension sweep, driven by displacement: its tension and tip are
+/// the full model's within the reduction's error.
+#[test]
+fn a_reduced_model_is_driven_by_displacement_too() {
+    let model = pod_of_sweep("drive-pod", "-3:0");
     let args = ["single-tendon", "--displacement", "0.004"];
     let (_, full) = run_json("statics", "drive-pod-full", &args);
     let mut with_model = args.to_vec();
@@ -204,16 +210,7 @@ fn a_reduced_model_is_driven_by_displacement_too() {
 /// `--extrapolate` the run stops there; with it, it goes on and its record says so.
 #[test]
 fn a_reduced_model_runs_a_displacement_drive_and_checks_the_tensions_found() {
-    let data = sweep_dataset("drive-rom-data", "-5:0", 13);
-    let model = scratch("drive-rom-model");
-    run_ok(&[
-        "pod",
-        path_str(&data),
-        "--modes",
-        "4",
-        "--out",
-        path_str(&model),
-    ]);
+    let model = pod_of_sweep("drive-rom", "-5:0");
     let ramp = scratch("drive-rom-ramp.csv");
     std::fs::write(&ramp, "t,d0\n0,0\n0.5,0.004\n4,0.004\n").unwrap();
     let args = [
