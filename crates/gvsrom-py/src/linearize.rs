@@ -130,7 +130,7 @@ impl Robot {
             lin.discretize(h).map_err(to_py)?;
         }
         let d = report_dict(py, &lin)?;
-        let extrapolated = self.built.model_extrapolated(&lin.u);
+        let extrapolated = crate::robot::model_extrapolated(py, &self.built, &lin.u)?;
         d.set_item("model_extrapolated", extrapolated)?;
         Ok(d)
     }

@@ -65,7 +65,7 @@ impl Robot {
             }
         })?;
         let d = report_dict(py, &report)?;
-        let extrapolated = built.model_extrapolated(&report.u);
+        let extrapolated = crate::robot::model_extrapolated(py, built, &report.u)?;
         d.set_item("model_extrapolated", extrapolated)?;
         Ok(d)
     }

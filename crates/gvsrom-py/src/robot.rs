@@ -99,6 +99,22 @@ fn same_content(a: &gvsrom::provenance::DirOrigin, b: &gvsrom::provenance::DirOr
     a.meta_sha256 == b.meta_sha256 && a.sha256 == b.sha256
 }
 
+/// How an answer of `built` at the tensions `u` used its reduced model outside its training
+/// ([`gvsrom::Built::model_extrapolated`]), the tensions found for displacement drives among it
+/// warned of as the command line warns of them (the attach's sentences were, when it was built).
+pub fn model_extrapolated(
+    py: Python<'_>,
+    built: &gvsrom::Built,
+    u: &[f64],
+) -> PyResult<Vec<String>> {
+    let all = built.model_extrapolated(u);
+    let attached = built.reduced.as_ref().map_or(0, |r| r.extrapolated.len());
+    for s in all.iter().skip(attached) {
+        warn(py, &format!("extrapolating (--extrapolate): {s}"))?;
+    }
+    Ok(all)
+}
+
 /// A `UserWarning` in Python, the command line's flags spelled as keyword arguments
 /// ([`errors::python_spelling`]).
 pub fn warn(py: Python<'_>, message: &str) -> PyResult<()> {

@@ -45,7 +45,7 @@ impl Robot {
             let report = py
                 .detach(|| statics::solve_as_built(&self.built))
                 .map_err(errors::any)?;
-            let extrapolated = self.built.model_extrapolated(&report.u);
+            let extrapolated = crate::robot::model_extrapolated(py, &self.built, &report.u)?;
             return Ok((report, extrapolated));
         }
         match attached.or(self.attached.as_ref()) {
@@ -70,7 +70,7 @@ impl Robot {
                 let report = py
                     .detach(|| statics::solve_as_built(&built))
                     .map_err(errors::any)?;
-                let extrapolated = built.model_extrapolated(&report.u);
+                let extrapolated = crate::robot::model_extrapolated(py, &built, &report.u)?;
                 Ok((report, extrapolated))
             }
         }
@@ -137,7 +137,7 @@ impl Robot {
             let report = py
                 .detach(|| statics::solve_as_built(&built))
                 .map_err(errors::any)?;
-            let extrapolated = built.model_extrapolated(&report.u);
+            let extrapolated = crate::robot::model_extrapolated(py, &built, &report.u)?;
             return Statics::new(py, &report, extrapolated);
         }
         let (report, extrapolated) = self.solve(py, u, attached.as_ref())?;
