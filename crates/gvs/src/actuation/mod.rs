@@ -21,7 +21,7 @@
 
 use crate::error::{check_range, ModelError};
 use crate::lie::V3;
-use crate::rod::Rod;
+use crate::rod::{DivisionGeometry, Rod};
 use serde::{Deserialize, Serialize};
 
 mod local;
@@ -255,7 +255,7 @@ impl Tendon {
     pub fn widest_excursion(&self, rod: &Rod) -> (f64, f64) {
         let gauge = |x: f64| {
             let d = self.offset(x);
-            section_gauge(rod, x, d[1], d[2])
+            section_gauge(rod, x, d[1], d[2]).map_or(f64::NAN, |(g, _, _)| g)
         };
         let span = self.x_end - self.x_start;
         let n = Self::PATH_SAMPLES * rod.divisions.len()
@@ -396,43 +396,34 @@ fn golden_max(f: &dyn Fn(f64) -> f64, a: f64, b: f64, start: (f64, f64)) -> (f64
 }
 
 /// The rod's section gauge of the offset `(y, z)` at `x`
-/// ([`crate::rod::DivisionGeometry::gauge_at`]; the larger of both sides at a junction).
-pub fn section_gauge(rod: &Rod, x: f64, y: f64, z: f64) -> f64 {
+/// ([`crate::rod::DivisionGeometry::gauge_at`], ≤ 1 inside), with the division and `X̄` it was
+/// taken in: at a division junction, the side where it is larger. `None` for `x` off the rod.
+pub fn section_gauge(rod: &Rod, x: f64, y: f64, z: f64) -> Option<(f64, &DivisionGeometry, f64)> {
     let mut x0 = 0.0;
-    let mut g = f64::NEG_INFINITY;
-    for div in &rod.divisions {
-        if x >= x0 - 1e-12 && x <= x0 + div.length + 1e-12 {
-            g = g.max(div.gauge_at(((x - x0) / div.length).clamp(0.0, 1.0), y, z));
-        }
-        x0 += div.length;
-    }
-    g
-}
-
-/// `None` if the offset `d` lies inside the rod's section at `x` (both sides at a division
-/// junction; [`crate::rod::DivisionGeometry::gauge_at`] ≤ 1 + 1e-9); else what is accepted
-/// there: "an offset of norm <= the section radius r m", or "an offset inside the section (…)".
-fn outside_section(rod: &Rod, x: f64, d: &V3) -> Option<String> {
-    let mut x0 = 0.0;
-    let mut worst: Option<(f64, String)> = None;
+    let mut worst: Option<(f64, &DivisionGeometry, f64)> = None;
     for div in &rod.divisions {
         if x >= x0 - 1e-12 && x <= x0 + div.length + 1e-12 {
             let x_bar = ((x - x0) / div.length).clamp(0.0, 1.0);
-            let g = div.gauge_at(x_bar, d[1], d[2]);
-            if g > 1.0 + 1e-9 && worst.as_ref().is_none_or(|(w, _)| g > *w) {
-                let accepted = match div.section {
-                    None => format!(
-                        "an offset of norm <= the section radius {} m",
-                        div.radius_at(x_bar)
-                    ),
-                    Some(_) => {
-                        format!("an offset inside the section, a {}", div.describe_at(x_bar))
-                    }
-                };
-                worst = Some((g, accepted));
+            let g = div.gauge_at(x_bar, y, z);
+            if worst.is_none_or(|(w, _, _)| g > w) {
+                worst = Some((g, div, x_bar));
             }
         }
         x0 += div.length;
     }
-    worst.map(|(_, a)| a)
+    worst
+}
+
+/// `None` if the offset `d` lies inside the rod's section at `x` ([`section_gauge`] ≤ 1 + 1e-9);
+/// else what is accepted there: "an offset of norm <= the section radius r m", or "an offset
+/// inside the section (…)".
+fn outside_section(rod: &Rod, x: f64, d: &V3) -> Option<String> {
+    let (g, div, x_bar) = section_gauge(rod, x, d[1], d[2])?;
+    (g > 1.0 + 1e-9).then(|| match div.section {
+        None => format!(
+            "an offset of norm <= the section radius {} m",
+            div.radius_at(x_bar)
+        ),
+        Some(_) => format!("an offset inside the section, a {}", div.describe_at(x_bar)),
+    })
 }

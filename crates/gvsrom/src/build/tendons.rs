@@ -35,17 +35,13 @@ pub(super) fn reach_at(rod: &Rod, x: f64, after: bool, theta: f64) -> f64 {
     division_at(rod, x, after).map_or(f64::NAN, |(d, x_bar)| 1.0 / d.gauge_at(x_bar, c, s))
 }
 
-/// The section's gauge of the offset `(y, z)` at `x` (> 1 outside; both sides at a junction) and
-/// what the section there is, for a message.
+/// The section's gauge of the offset `(y, z)` at `x` (> 1 outside; the larger side at a
+/// junction, [`gvs::actuation::section_gauge`]) and what the section there is, for a message.
 fn gauge_at(rod: &Rod, x: f64, y: f64, z: f64) -> (f64, String) {
-    let sides = [division_at(rod, x, false), division_at(rod, x, true)];
-    let gauges = sides
-        .iter()
-        .flatten()
-        .map(|(d, x_bar)| (d.gauge_at(*x_bar, y, z), d.describe_at(*x_bar)));
-    gauges
-        .reduce(|a, b| if b.0 > a.0 { b } else { a })
-        .unwrap_or((f64::NAN, String::new()))
+    gvs::actuation::section_gauge(rod, x, y, z)
+        .map_or((f64::NAN, String::new()), |(g, d, x_bar)| {
+            (g, d.describe_at(x_bar))
+        })
 }
 
 pub(super) fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, ScenarioError> {
