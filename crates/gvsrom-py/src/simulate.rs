@@ -331,7 +331,7 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
     let outcome = outcome.map_err(err)?;
     match &outcome.ending {
         Ending::Complete => {}
-        Ending::Failed { error } => {
+        Ending::Failed { error, .. } => {
             let partial = trajectory(py, built, &buffer, &outcome)?;
             partial.set_item("model_extrapolated", extrapolated)?;
             if let Some(dir) = &written {

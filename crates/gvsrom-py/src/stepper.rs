@@ -450,7 +450,7 @@ pub fn start(robot: Py<Robot>, py: Python<'_>, a: Args) -> PyResult<Stepper> {
                 Ok(o) => match o.ending {
                     simulate::Ending::Complete => "it reached its horizon".to_string(),
                     simulate::Ending::Interrupted { reason } => reason,
-                    simulate::Ending::Failed { error } => error,
+                    simulate::Ending::Failed { error, .. } => error,
                 },
                 Err(e) => e.to_string(),
             }

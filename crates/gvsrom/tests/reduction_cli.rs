@@ -623,6 +623,10 @@ fn a_reduced_trajectory_leaving_the_training_region_stops_with_the_reason() {
             .is_some_and(|e| e.contains("left the training region")),
         "{meta}"
     );
+    assert_eq!(
+        meta["reason"], "the reduced model left its training region",
+        "{meta}"
+    );
     // the full range lets the same run finish
     run_ok(&[&release[..], &[s(ae_small())]].concat());
 }

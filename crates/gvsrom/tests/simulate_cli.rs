@@ -529,6 +529,11 @@ fn a_state_no_elastic_rod_holds_ends_the_run_naming_it_and_the_load() {
     let meta: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out_dir.join("meta.json")).unwrap()).unwrap();
     assert_eq!(meta["complete"], false, "{msg}");
+    // the reason names the stop, not a failed integration
+    assert_eq!(
+        meta["reason"], "the state left the rod's elastic range",
+        "{meta}"
+    );
     // every sample written is inside the bounds: the tip within the rod's reach
     let tip = npy_values(&out_dir.join("tip_position.npy"));
     let reach = tip
@@ -553,6 +558,12 @@ fn a_state_no_elastic_rod_holds_ends_the_run_naming_it_and_the_load() {
             "the state left the rod's elastic range",
             "marked incomplete",
         ],
+    );
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(ds.join("meta.json")).unwrap()).unwrap();
+    assert_eq!(
+        meta["reason"], "the state left the rod's elastic range",
+        "{meta}"
     );
 }
 

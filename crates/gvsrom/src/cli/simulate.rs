@@ -400,7 +400,7 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
             }
             .into()),
         },
-        Ending::Failed { error } => anyhow::bail!("{error} ({kept})"),
+        Ending::Failed { error, .. } => anyhow::bail!("{error} ({kept})"),
         Ending::Interrupted { reason } => Err(Interrupted {
             signal: signal.load(Ordering::SeqCst) as i32,
             message: format!("{reason} at t = {t_last} s; {kept}"),

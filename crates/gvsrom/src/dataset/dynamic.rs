@@ -11,7 +11,7 @@ use super::{
 use crate::build::Built;
 use crate::error::ScenarioError;
 use crate::output::OutputDir;
-use crate::simulate::{self, InputSource, SimulateOptions, Start};
+use crate::simulate::{self, Failure, InputSource, SimulateOptions, Start};
 use gvs::solve::dynamics::{
     simulate_streaming_interruptible, IntegratorOptions, OdeJacobian, SimulationError,
 };
@@ -194,15 +194,12 @@ pub fn run(
     }
     let n = rows.len();
     let failed = match (&summary_run.error, &stopped, non_physical) {
-        (Some(_), None, Some(v)) => Some(v),
-        (Some(e), None, None) => Some(e.to_string()),
+        (Some(_), None, Some(v)) => Some((v, Failure::LeftElasticRange)),
+        (Some(e), None, None) => Some((e.to_string(), Failure::Integration)),
         _ => None,
     };
-    let reason = stopped.clone().or_else(|| {
-        failed
-            .as_ref()
-            .map(|_| "the integration failed".to_string())
-    });
+    let reason = (stopped.clone()).or_else(|| failed.as_ref().map(|(_, f)| f.reason().to_string()));
+    let failed = failed.map(|(e, _)| e);
     let mut meta = Meta {
         kind: "dynamics".into(),
         scenario: built.name.clone(),

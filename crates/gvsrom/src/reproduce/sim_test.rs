@@ -145,7 +145,7 @@ pub fn simulate_test(
             let mut outcome = written.outcome;
             let reason = match &outcome.ending {
                 Ending::Complete => None,
-                Ending::Failed { error } => Some(error.clone()),
+                Ending::Failed { error, .. } => Some(error.clone()),
                 Ending::Interrupted { reason } => Some(reason.clone()),
             };
             if let (None, Some(r)) = (model, &reason) {

@@ -25,8 +25,31 @@ pub enum Ending {
     /// Stopped on request after the last sample delivered: an interrupt, or the actuation itself
     /// (a controller that raised, `gvs::inputs::Actuation::observe`), with its reason.
     Interrupted { reason: String },
-    /// The integrator failed; the samples before the failure were delivered.
-    Failed { error: String },
+    /// The run failed (`failure` says why); the samples before the failure were delivered.
+    Failed { error: String, failure: Failure },
+}
+
+/// Why a run failed: what the meta's `reason` records.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Failure {
+    /// The integrator gave up (a step below its minimum, Newton's iteration diverged).
+    Integration,
+    /// A reduced trajectory left its training region, or its displacement drives needed tensions
+    /// the model was not trained for.
+    LeftTrainingRegion,
+    /// The state left the rod's elastic range, or a driven thread pulled beyond it.
+    LeftElasticRange,
+}
+
+impl Failure {
+    /// The sentence recorded as the run's `reason`.
+    pub fn reason(self) -> &'static str {
+        match self {
+            Failure::Integration => "the integration failed",
+            Failure::LeftTrainingRegion => "the reduced model left its training region",
+            Failure::LeftElasticRange => "the state left the rod's elastic range",
+        }
+    }
 }
 
 /// The result of `run`: the summary of the streamed simulation and the last sample's tip.
@@ -351,10 +374,13 @@ pub fn run_into(
     }
     let left_training_region =
         summary.error.is_some() && (off_manifold.is_some() || off_inputs.is_some());
-    let off_manifold = off_manifold.or(off_inputs).or(non_physical);
-    let ending = match (&summary.error, off_manifold, interrupted.into_inner()) {
+    let stopped_by = (off_manifold
+        .or(off_inputs)
+        .map(|e| (e, Failure::LeftTrainingRegion)))
+    .or(non_physical.map(|e| (e, Failure::LeftElasticRange)));
+    let ending = match (&summary.error, stopped_by, interrupted.into_inner()) {
         (None, _, _) => Ending::Complete,
-        (Some(_), Some(error), _) => Ending::Failed { error },
+        (Some(_), Some((error, failure)), _) => Ending::Failed { error, failure },
         (Some(_), None, Some(reason)) => Ending::Interrupted { reason },
         // the actuation stopped the run (a controller's error, `Actuation::observe`): its reason
         (Some(OdeError::Stopped { reason, .. }), None, None) => Ending::Interrupted {
@@ -362,6 +388,7 @@ pub fn run_into(
         },
         (Some(e), None, None) => Ending::Failed {
             error: e.to_string(),
+            failure: Failure::Integration,
         },
     };
     let energy = energy.and_then(|e| e.finish(summary.samples));

@@ -367,11 +367,9 @@ impl TrajectoryWriter {
         let (complete, reason, error) = match &outcome.ending {
             Ending::Complete => (true, None, None),
             Ending::Interrupted { reason } => (false, Some(reason.clone()), None),
-            Ending::Failed { error } => (
-                false,
-                Some("the integration failed".into()),
-                Some(error.clone()),
-            ),
+            Ending::Failed { error, failure } => {
+                (false, Some(failure.reason().into()), Some(error.clone()))
+            }
         };
         let meta = Meta {
             scenario: &built.name,
