@@ -48,6 +48,8 @@ pub fn parse_table(source_name: &str, text: &str) -> Result<Table, ScenarioError
 pub fn from_table(table: Table) -> Result<Scenario, ScenarioError> {
     let value = Value::Table(table);
     check_finite(&value, &mut Vec::new())?;
+    // kept for a second reading of a misnamed enum (`name_expected`)
+    let original = value.clone();
     serde_path_to_error::deserialize::<_, Scenario>(value).map_err(|e| {
         let mut field = e.path().to_string();
         let message = e
@@ -55,6 +57,10 @@ pub fn from_table(table: Table) -> Result<Scenario, ScenarioError> {
             .message()
             .replace("expected usize", "expected an integer >= 0")
             .replace("expected f64", "expected a number");
+        let message = match message == ENUM_NOT_A_STRING {
+            true => name_expected(original, e.path()).unwrap_or(message),
+            false => message,
+        };
         // Inside tagged tables (`kind = ...`) the path stops at the table: add the unknown key.
         if let Some(key) = message
             .strip_prefix("unknown field `")
@@ -123,6 +129,43 @@ fn array_length_message(field: &str, message: String) -> String {
         .unwrap_or("?");
     let values = if given == "1" { "value" } else { "values" };
     format!("{given} {values} given; expected {form}")
+}
+
+/// toml's message for a value that is not a string where a name (an enum) is read: it names
+/// neither the value given nor the names accepted.
+const ENUM_NOT_A_STRING: &str = "invalid type: unit variant, expected string only";
+
+/// The message for a key at `path` that takes a name (`section = "rectangle"`) but was given
+/// another value (`section = 3`): the value, and the names accepted, learned by reading the
+/// scenario again with an empty name in its place (serde then lists the names). `None` if the
+/// path cannot be followed or the second reading says something else.
+fn name_expected(mut root: Value, path: &serde_path_to_error::Path) -> Option<String> {
+    use serde_path_to_error::Segment;
+    let mut at = &mut root;
+    for seg in path.iter() {
+        at = match (seg, at) {
+            (Segment::Map { key }, Value::Table(t)) => t.get_mut(key)?,
+            (Segment::Seq { index }, Value::Array(a)) => a.get_mut(*index)?,
+            _ => return None,
+        };
+    }
+    let given = match at {
+        Value::String(_) => return None,
+        Value::Integer(i) => format!("the integer {i}"),
+        Value::Float(x) => format!("the number {x}"),
+        Value::Boolean(b) => format!("`{b}`"),
+        Value::Datetime(d) => format!("the date {d}"),
+        Value::Array(_) => "a list".to_string(),
+        Value::Table(_) => "a table".to_string(),
+    };
+    *at = Value::String(String::new());
+    let again = serde_path_to_error::deserialize::<_, Scenario>(root).err()?;
+    let names = (again.path().to_string() == path.to_string())
+        .then(|| again.inner().message())?
+        .split_once("expected ")?
+        .1
+        .to_string();
+    Some(format!("{given} given; expected a name in quotes, {names}"))
 }
 
 /// Rejects NaN and ±inf anywhere in the tree (TOML allows `nan` and `inf`).

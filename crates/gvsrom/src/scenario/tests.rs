@@ -2,6 +2,7 @@
 //! errors, non-finite numbers, syntax errors.
 
 use super::*;
+use crate::error::ScenarioError;
 use gvs::discretize::MagnusOrder;
 use gvs::solve::statics::StaticsOptions;
 
@@ -227,6 +228,44 @@ fn a_required_key_missing_at_the_top_level_is_named_not_the_path_dot() {
         .to_string();
     assert!(
         e.contains("`material`") && e.contains("top level") && !e.contains("`.`"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_key_taking_a_name_given_another_value_names_the_value_and_the_names() {
+    // toml's own message ("invalid type: unit variant, expected string only") names neither
+    let cases = [
+        (
+            "divisions.0.section=3",
+            "divisions[0].section",
+            "the integer 3 given; expected a name in quotes, one of `circle`, `rectangle`, `ellipse`",
+        ),
+        (
+            "divisions.0.basis.kind=true",
+            "divisions[0].basis.kind",
+            "`true` given; expected a name in quotes, `legendre` or `fem`",
+        ),
+        (
+            "divisions.0.basis.modes=[[1]]",
+            "divisions[0].basis.modes[0]",
+            "a list given; expected a name in quotes, one of `torsion`, `bend_y`, `bend_z`, `elongation`, `shear_y`, `shear_z`",
+        ),
+    ];
+    for (set, key, expected) in cases {
+        match Scenario::from_toml("t", MINIMAL, &[set.into()]) {
+            Err(ScenarioError::Format { field, message }) => {
+                assert_eq!((field.as_str(), message.as_str()), (key, expected), "{set}")
+            }
+            other => panic!("{set}: {other:?}"),
+        }
+    }
+    // a misspelt name keeps serde's message, which lists the names
+    let e = Scenario::from_toml("t", MINIMAL, &["divisions.0.section=\"square\"".into()])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("unknown variant `square`, expected one of `circle`"),
         "{e}"
     );
 }
