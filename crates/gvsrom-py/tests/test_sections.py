@@ -39,3 +39,16 @@ def test_a_section_without_its_sizes_is_refused_naming_the_field():
     with pytest.raises(gvsrom.GvsromError, match=r"divisions\[0\]\.height.*missing"):
         gvsrom.Scenario.preset("soft-beam").set("divisions.0.section", "rectangle").set(
             "divisions.0.width", 0.03).build()
+
+
+def test_a_tube_bends_by_the_stiffness_its_bore_removes():
+    # a bore of radius r_i leaves (r⁴ − r_i⁴)/r⁴ of the circle's bending stiffness: under the
+    # same moment the Galerkin strain is the circle's divided by it, exactly
+    circle = gvsrom.Scenario.preset("soft-beam").build().statics().strain[:, 1]
+    r, r_i = 0.015, 0.01
+    tube = gvsrom.Scenario.preset("soft-beam").set("divisions.0.inner_radius", r_i)
+    assert "inner_radius = 0.01" in tube.to_toml()
+    strain = tube.build().statics().strain[:, 1]
+    np.testing.assert_allclose(strain, circle / (1 - (r_i / r) ** 4), rtol=1e-9, atol=1e-10)
+    with pytest.raises(gvsrom.GvsromError, match=r"divisions\[0\]\.inner_radius.*0\.015"):
+        gvsrom.Scenario.preset("soft-beam").set("divisions.0.inner_radius", 0.015).build()

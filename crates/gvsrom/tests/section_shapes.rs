@@ -1,5 +1,5 @@
-//! Rectangular and elliptical sections (`divisions[j].section`) against the closed forms of a
-//! slender cantilever: tip deflections under a small tip force along each section axis
+//! Rectangular and elliptical sections (`divisions[j].section`) and circular tubes
+//! (`inner_radius`) against the closed forms of a slender cantilever: tip deflections under a small tip force along each section axis
 //! (`FL³/3EI + FL/GA`, shear factor 1 as the model's), the twist under a tip torque (`TL/GJ_t`,
 //! the Saint-Venant torsion constant, not the polar moment), and the vibration frequencies —
 //! Euler–Bernoulli bending about each axis and the fixed-free shaft's torsion
@@ -77,6 +77,18 @@ fn ellipse(w: f64, h: f64) -> Moments {
         iy: PI * a * b.powi(3) / 4.0,
         iz: PI * a.powi(3) * b / 4.0,
         jt: PI * a.powi(3) * b.powi(3) / (a * a + b * b),
+    }
+}
+
+/// A circular tube of outer radius `r` and inner radius `r_i`: `A = π(r² − r_i²)`,
+/// `I = π(r⁴ − r_i⁴)/4`, `J_t = 2I`.
+fn tube(r: f64, r_i: f64) -> Moments {
+    let i = PI * (r.powi(4) - r_i.powi(4)) / 4.0;
+    Moments {
+        a: PI * (r * r - r_i * r_i),
+        iy: i,
+        iz: i,
+        jt: 2.0 * i,
     }
 }
 
@@ -315,4 +327,113 @@ fn a_preset_takes_another_section_by_overrides() {
         ],
         &["divisions[0].radius", "missing"],
     );
+}
+
+#[test]
+fn a_tubular_cantilever_bends_and_twists_as_its_closed_forms() {
+    check_statics(
+        "tube-statics",
+        "tubular",
+        "radius = 0.01\ninner_radius = 0.008",
+        &tube(0.01, 0.008),
+    );
+}
+
+/// The tube's modes: its first bending frequency `(β₁L)² √(EI/(ρAL⁴))` rises above the solid
+/// rod's by `√((r² + r_i²)/r²)` (the bore takes more mass than stiffness: 1.28× here), and its first
+/// torsional one `(π/2L) √(G/ρ)` is the solid rod's (stiffness and rotary inertia both scale
+/// with the polar moment).
+#[test]
+fn a_tubular_cantilever_vibrates_at_its_bending_and_torsion_frequencies() {
+    let (r, r_i) = (0.01, 0.008);
+    let m = tube(r, r_i);
+    let toml = scenario("tube-modes", "radius = 0.01\ninner_radius = 0.008", 8);
+    let (_, modes) = run_json("modes", "tube-modes", &[path_str(&toml), "--count", "8"]);
+    let list = modes["modes"].as_array().unwrap();
+    let freq = |energy: &str| {
+        list.iter()
+            .find(|m| m["dominant_strain"].as_str() == Some(energy))
+            .map(|m| m["frequency_hz"].as_f64().unwrap())
+            .unwrap_or_else(|| panic!("no {energy} mode in {list:?}"))
+    };
+    let bend =
+        1.875_104_068_7f64.powi(2) / (2.0 * PI) * (E * m.iy / (RHO * m.a * L.powi(4))).sqrt();
+    let solid = bend / ((r * r + r_i * r_i) / (r * r)).sqrt();
+    assert!(rel(bend / solid, 1.28) < 1e-3, "{bend} / {solid}");
+    // the model is a Timoshenko rod: below Euler–Bernoulli by its rotary inertia and shear,
+    // 1.5e-3 at this radius of gyration (k/L = 0.013; 3e-3 for the rectangle's wide side above)
+    for axis in ["bend_y", "bend_z"] {
+        let f = freq(axis);
+        assert!(f < bend && rel(f, bend) < 3e-3, "{axis} {f} against {bend}");
+    }
+    let torsion = (PI / (2.0 * L)) * (G / RHO).sqrt() / (2.0 * PI);
+    let ft = freq("torsion");
+    assert!(rel(ft, torsion) < 1e-4, "torsion {ft} against {torsion}");
+}
+
+/// A tube's bore: refused outside its outer radius, in a rectangle, negative, half tapered; a
+/// tendon may run through it; `--set divisions.0.section=rectangle` drops it with the radii.
+#[test]
+fn a_tube_is_checked_and_a_preset_takes_one_by_overrides() {
+    let cases: [(&str, &[&str]); 5] = [
+        (
+            "radius = 0.01\ninner_radius = 0.01",
+            &["divisions[0].inner_radius", "0.01", "[0, 0.01)"],
+        ),
+        (
+            "radius_start = 0.01\nradius_end = 0.005\ninner_radius_start = 0.004\ninner_radius_end = 0.006",
+            &["divisions[0].inner_radius_end", "0.006", "[0, 0.005)"],
+        ),
+        (
+            "radius = 0.01\ninner_radius = -0.001",
+            &["divisions[0].inner_radius", "-0.001", ">= 0"],
+        ),
+        (
+            "section = \"rectangle\"\nwidth = 0.03\nheight = 0.01\ninner_radius = 0.002",
+            &["divisions[0].inner_radius", "a rectangle is solid"],
+        ),
+        (
+            "radius = 0.01\ninner_radius_start = 0.002",
+            &["divisions[0].inner_radius_end", "missing"],
+        ),
+    ];
+    for (i, (section, needles)) in cases.iter().enumerate() {
+        let toml = scenario(&format!("bad-tube-{i}"), section, 4);
+        expect_error(&["check", path_str(&toml)], needles);
+    }
+    // a tendon through the bore (on spacer discs) is inside the section
+    let path = scenario("tube-tendon-bore", "radius = 0.01\ninner_radius = 0.008", 4);
+    let mut text = std::fs::read_to_string(&path).unwrap();
+    text.push_str(
+        "\n[[tendons]]\ntension = -1e-4\noffset_start = [0.0, 0.004]\noffset_end = [0.0, 0.004]\n",
+    );
+    std::fs::write(&path, text).unwrap();
+    common::run_ok(&["check", path_str(&path)]);
+    // a preset's circle becomes a tube, written in the record; an override of the shape drops it
+    let (stdout, eq) = run_json(
+        "statics",
+        "soft-beam-tube",
+        &["soft-beam", "--set", "divisions.0.inner_radius=0.005"],
+    );
+    assert!(stdout.contains("0.8 m uniform tubular rod"), "{stdout}");
+    let toml = eq["provenance"]["scenario_toml"].as_str().unwrap();
+    assert!(toml.contains("inner_radius = 0.005"), "{toml}");
+    let (stdout, eq) = run_json(
+        "statics",
+        "soft-beam-tube-to-rectangle",
+        &[
+            "soft-beam",
+            "--set",
+            "divisions.0.inner_radius=0.005",
+            "--set",
+            "divisions.0.section=rectangle",
+            "--set",
+            "divisions.0.width=0.03",
+            "--set",
+            "divisions.0.height=0.02",
+        ],
+    );
+    assert!(stdout.contains("0.8 m uniform rectangular rod"), "{stdout}");
+    let toml = eq["provenance"]["scenario_toml"].as_str().unwrap();
+    assert!(!toml.contains("radius"), "{toml}");
 }

@@ -1,10 +1,11 @@
 //! Rod geometry and constitutive data (gvs-spec §3): linearly tapered sections per division
-//! (circular, or rectangular and elliptical: [`Section`]), material (E, ν, ρ, damping constant η),
+//! (circular, or rectangular, elliptical and tubular: [`Section`]), material (E, ν, ρ, damping
+//! constant η),
 //! and the per-point cross-section matrices
 //! `Es = diag(GJ_t, EI_y, EI_z, EA, GA, GA)`, `Ms = ρ diag(J, I_y, I_z, A, A, A)`,
 //! `Ds = η diag(J_t, 3I_y, 3I_z, 3A, A, A)` with `G = E / (2(1+ν))`, `J = I_y + I_z` the polar
 //! moment and `J_t` the torsion constant (SoRoSim `MEG`, which takes `J_t = J`; the two are equal
-//! for a circle, see [`SectionProps::of`]).
+//! for a circle and a tube, see [`SectionProps::rectangle`]).
 
 mod section;
 
@@ -108,10 +109,7 @@ impl DivisionGeometry {
     pub fn props_at(&self, material: &Material, x_bar: f64) -> SectionProps {
         match &self.section {
             None => SectionProps::circular(material, self.radius_at(x_bar)),
-            Some(s) => {
-                let (w, h) = s.extents_at(x_bar);
-                SectionProps::of(material, s.shape, w, h)
-            }
+            Some(s) => s.props_at(material, x_bar),
         }
     }
 
@@ -126,7 +124,7 @@ impl DivisionGeometry {
                 let (a, b) = (2.0 * y / w, 2.0 * z / h);
                 match s.shape {
                     Shape::Rectangle => a.abs().max(b.abs()),
-                    Shape::Ellipse => a.hypot(b),
+                    Shape::Ellipse | Shape::Tube { .. } => a.hypot(b),
                 }
             }
         }
@@ -141,6 +139,10 @@ impl DivisionGeometry {
                 let shape = match s.shape {
                     Shape::Rectangle => "rectangle",
                     Shape::Ellipse => "ellipse",
+                    Shape::Tube { .. } => {
+                        let r_i = s.inner_radius_at(x_bar);
+                        return format!("tube of radius {} m and inner radius {r_i} m", 0.5 * w);
+                    }
                 };
                 format!("{w} × {h} m {shape} (width along y, height along z)")
             }
@@ -213,6 +215,27 @@ impl Rod {
                             x,
                             "m",
                         )?;
+                    }
+                }
+                if let Shape::Tube { inner_radius } = s.shape {
+                    let outer = [0.5 * s.width[0], 0.5 * s.width[1]];
+                    if s.height != s.width {
+                        return Err(ModelError::invalid(
+                            format!("rod.divisions[{j}].section.height"),
+                            format!(
+                                "{:?} m: a tube's outer diameter, equal to `width` {:?} m",
+                                s.height, s.width
+                            ),
+                        ));
+                    }
+                    for ((end, r_i), r) in ["start", "end"].iter().zip(inner_radius).zip(outer) {
+                        if !(r_i >= 0.0 && r_i < r) {
+                            return Err(ModelError::value(
+                                format!("rod.divisions[{j}].section.inner_radius_{end}"),
+                                r_i,
+                                format!("a radius in [0, {r}) m: inside the outer radius"),
+                            ));
+                        }
                     }
                 }
                 for (end, x_bar, r) in [("start", 0.0, d.radius_start), ("end", 1.0, d.radius_end)]
@@ -340,6 +363,53 @@ mod tests {
         let e = rod.validate().unwrap_err().to_string();
         assert!(
             e.contains("rod.divisions[0].length") && e.contains("-0.2"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_tube_is_refused_with_its_bore_outside_or_its_sides_unequal() {
+        let tube = |inner_radius: [f64; 2], height: [f64; 2]| Rod {
+            material: Material {
+                youngs_modulus: 1e6,
+                poisson_ratio: 0.5,
+                density: 1000.0,
+                damping: 0.0,
+            },
+            divisions: vec![DivisionGeometry::with_section(
+                0.5,
+                Section {
+                    shape: Shape::Tube { inner_radius },
+                    width: [0.02, 0.01],
+                    height,
+                },
+            )],
+        };
+        tube([0.008, 0.0], [0.02, 0.01]).validate().unwrap();
+        let e = tube([0.008, 0.005], [0.02, 0.01])
+            .validate()
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("rod.divisions[0].section.inner_radius_end")
+                && e.contains("0.005")
+                && e.contains("[0, 0.005)"),
+            "{e}"
+        );
+        let e = tube([-0.001, 0.0], [0.02, 0.01])
+            .validate()
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("inner_radius_start") && e.contains("-0.001"),
+            "{e}"
+        );
+        let e = tube([0.008, 0.0], [0.02, 0.02])
+            .validate()
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("section.height") && e.contains("outer diameter"),
             "{e}"
         );
     }

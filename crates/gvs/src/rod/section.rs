@@ -6,18 +6,22 @@ use crate::lie::V6;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
-/// The shape of a non-circular section.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+/// The shape of a section other than the solid circle.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Shape {
     /// A solid `w × h` rectangle.
     Rectangle,
     /// A solid ellipse of full axes `w` and `h`.
     Ellipse,
+    /// A circular tube of outer diameter `w = h` and inner radius `inner_radius` `[start, end]`
+    /// \[m\], tapering linearly like the outer one.
+    Tube { inner_radius: [f64; 2] },
 }
 
-/// A rectangular or elliptical section whose width `w` (along the section's `y` axis) and height
-/// `h` (along `z`) taper linearly over the division, `[start, end]` \[m\].
+/// A rectangular, elliptical or tubular section whose width `w` (along the section's `y` axis)
+/// and height `h` (along `z`) taper linearly over the division, `[start, end]` \[m\] (a tube's
+/// outer diameter, `w = h`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Section {
     pub shape: Shape,
@@ -32,14 +36,37 @@ impl Section {
         (at(self.width), at(self.height))
     }
 
+    /// A tube's inner radius at `X̄` (0 for a solid section).
+    pub fn inner_radius_at(&self, x_bar: f64) -> f64 {
+        match self.shape {
+            Shape::Tube {
+                inner_radius: [a, b],
+            } => a + x_bar * (b - a),
+            _ => 0.0,
+        }
+    }
+
     /// The farthest the section at `X̄` reaches from the axis: the rectangle's half diagonal,
-    /// the ellipse's larger half axis. At `X̄ = 0` or 1 exactly; between them the linear
-    /// interpolation of these bounds the section (the distance is convex in the extents).
+    /// the ellipse's larger half axis, the tube's outer radius. At `X̄ = 0` or 1 exactly; between
+    /// them the linear interpolation of these bounds the section (the distance is convex in the
+    /// extents).
     pub fn circumradius(&self, x_bar: f64) -> f64 {
         let (w, h) = self.extents_at(x_bar);
         match self.shape {
             Shape::Rectangle => 0.5 * w.hypot(h),
-            Shape::Ellipse => 0.5 * w.max(h),
+            Shape::Ellipse | Shape::Tube { .. } => 0.5 * w.max(h),
+        }
+    }
+
+    /// The section's properties at `X̄` for `material`.
+    pub fn props_at(&self, material: &Material, x_bar: f64) -> SectionProps {
+        let (w, h) = self.extents_at(x_bar);
+        match self.shape {
+            Shape::Rectangle => SectionProps::rectangle(material, w, h),
+            Shape::Ellipse => SectionProps::ellipse(material, w, h),
+            Shape::Tube { .. } => {
+                SectionProps::tube(material, 0.5 * w, self.inner_radius_at(x_bar))
+            }
         }
     }
 }
@@ -66,41 +93,40 @@ impl SectionProps {
         Self::from_moments(material, r, a, i, i, 2.0 * i)
     }
 
-    /// A solid `shape` of width `w` (along `y`) and height `h` (along `z`):
-    ///
-    /// - rectangle: `A = wh`, `I_y = ∫z² dA = wh³/12`, `I_z = hw³/12`, and the Saint-Venant
-    ///   torsion constant `J_t = a b³ [1/3 − (64/π⁵)(b/a) Σ_{n odd} tanh(nπa/2b)/n⁵]`, `a ≥ b`
-    ///   the longer and shorter side (Timoshenko & Goodier §109: 0.1406 a⁴ for a square, against
-    ///   the polar moment's 0.1667 a⁴; `a b³/3` for a thin strip);
-    /// - ellipse of half axes `a = w/2`, `b = h/2`: `A = πab`, `I_y = πab³/4`, `I_z = πa³b/4`,
-    ///   `J_t = πa³b³/(a² + b²)` (exact; the circle's `πr⁴/2` for `a = b`).
+    /// A solid rectangle of width `w` (along `y`) and height `h` (along `z`): `A = wh`,
+    /// `I_y = ∫z² dA = wh³/12`, `I_z = hw³/12`, and the Saint-Venant torsion constant
+    /// `J_t = a b³ [1/3 − (64/π⁵)(b/a) Σ_{n odd} tanh(nπa/2b)/n⁵]`, `a ≥ b` the longer and
+    /// shorter side ([`rectangle_torsion_constant`]; Timoshenko & Goodier §109: 0.1406 a⁴ for a
+    /// square, against the polar moment's 0.1667 a⁴; `a b³/3` for a thin strip).
     ///
     /// The rotary inertia of torsion is the polar moment `J = I_y + I_z`; its stiffness and damping
     /// take `J_t` (SoRoSim takes `J` for both, which overrates a flat section's torsional stiffness:
     /// 1.19× for a square, 3.2× for 3:1, 7.4× for a 5:1 strip).
-    pub fn of(material: &Material, shape: Shape, w: f64, h: f64) -> Self {
-        let (area, iy, iz, jt) = match shape {
-            Shape::Rectangle => (
-                w * h,
-                w * h.powi(3) / 12.0,
-                h * w.powi(3) / 12.0,
-                rectangle_torsion_constant(w, h),
-            ),
-            Shape::Ellipse => {
-                let (a, b) = (0.5 * w, 0.5 * h);
-                (
-                    PI * a * b,
-                    PI * a * b.powi(3) / 4.0,
-                    PI * a.powi(3) * b / 4.0,
-                    PI * a.powi(3) * b.powi(3) / (a * a + b * b),
-                )
-            }
-        };
-        let reach = match shape {
-            Shape::Rectangle => 0.5 * w.hypot(h),
-            Shape::Ellipse => 0.5 * w.max(h),
-        };
-        Self::from_moments(material, reach, area, iy, iz, jt)
+    pub fn rectangle(material: &Material, w: f64, h: f64) -> Self {
+        let (area, iy, iz) = (w * h, w * h.powi(3) / 12.0, h * w.powi(3) / 12.0);
+        let jt = rectangle_torsion_constant(w, h);
+        Self::from_moments(material, 0.5 * w.hypot(h), area, iy, iz, jt)
+    }
+
+    /// A solid ellipse of full axes `w` (along `y`) and `h` (along `z`), half axes `a = w/2`,
+    /// `b = h/2`: `A = πab`, `I_y = πab³/4`, `I_z = πa³b/4`, `J_t = πa³b³/(a² + b²)` (exact; the
+    /// circle's `πr⁴/2` for `a = b`), the polar moment in the rotary inertia as for
+    /// [`SectionProps::rectangle`].
+    pub fn ellipse(material: &Material, w: f64, h: f64) -> Self {
+        let (a, b) = (0.5 * w, 0.5 * h);
+        let area = PI * a * b;
+        let (iy, iz) = (PI * a * b.powi(3) / 4.0, PI * a.powi(3) * b / 4.0);
+        let jt = PI * a.powi(3) * b.powi(3) / (a * a + b * b);
+        Self::from_moments(material, a.max(b), area, iy, iz, jt)
+    }
+
+    /// A circular tube of outer radius `r` and inner radius `r_i < r`: `A = π(r² − r_i²)`,
+    /// `I = π(r⁴ − r_i⁴)/4`, `J = J_t = 2I` (the Saint-Venant torsion constant of a concentric
+    /// tube is its polar moment, exactly: its sections stay plane). `r_i = 0` is the solid circle.
+    pub fn tube(material: &Material, r: f64, r_i: f64) -> Self {
+        let a = PI * (r * r - r_i * r_i);
+        let i = PI * (r.powi(4) - r_i.powi(4)) / 4.0;
+        Self::from_moments(material, r, a, i, i, 2.0 * i)
     }
 
     /// `Es`, `Ms`, `Ds` of a section of area `a`, second moments `iy = ∫z² dA`, `iz = ∫y² dA` and
@@ -332,7 +358,7 @@ mod tests {
             }
             a
         };
-        let rect = SectionProps::of(&m, Shape::Rectangle, w, h);
+        let rect = SectionProps::rectangle(&m, w, h);
         let [a, iy, iz] = moments(&|_, _| true);
         let got = [rect.area, rect.es[1] / e, rect.es[2] / e];
         for (k, (x, y)) in got.iter().zip([a, iy, iz]).enumerate() {
@@ -350,7 +376,7 @@ mod tests {
             "a 4:1 strip twists far more easily than its polar moment says"
         );
         assert!(rel(rect.radius, 0.5 * w.hypot(h)) < 1e-14);
-        let ell = SectionProps::of(&m, Shape::Ellipse, w, h);
+        let ell = SectionProps::ellipse(&m, w, h);
         let [a, iy, iz] = moments(&|y, z| (2.0 * y / w).powi(2) + (2.0 * z / h).powi(2) <= 1.0);
         assert!(
             rel(ell.area, a) < 1e-3
@@ -362,12 +388,90 @@ mod tests {
         let r = 0.013;
         let (circle, round) = (
             SectionProps::circular(&m, r),
-            SectionProps::of(&m, Shape::Ellipse, 2.0 * r, 2.0 * r),
+            SectionProps::ellipse(&m, 2.0 * r, 2.0 * r),
         );
         for k in 0..6 {
             assert!(rel(round.es[k], circle.es[k]) < 1e-14, "es[{k}]");
             assert!(rel(round.ms[k], circle.ms[k]) < 1e-14, "ms[{k}]");
             assert!(rel(round.ds[k], circle.ds[k]) < 1e-14, "ds[{k}]");
         }
+    }
+
+    #[test]
+    fn tube_moments_match_quadrature_of_the_annulus_and_the_thin_wall_limit() {
+        let m = Material {
+            youngs_modulus: 2e6,
+            poisson_ratio: 0.3,
+            density: 1200.0,
+            damping: 3e3,
+        };
+        let (e, g) = (2e6, 2e6 / 2.6);
+        let (r, r_i) = (0.01, 0.006);
+        // area and ∫z² dA over the annulus by the midpoint rule in polar coordinates
+        // (∫∫ ρ³ sin²θ dρ dθ), independent of the closed form's π(r⁴ − r_i⁴)/4
+        let (n_r, n_t) = (400, 400);
+        let (dr, dt) = ((r - r_i) / n_r as f64, 2.0 * PI / n_t as f64);
+        let (mut a, mut iy) = (0.0, 0.0);
+        for i in 0..n_r {
+            let rho = r_i + (i as f64 + 0.5) * dr;
+            for k in 0..n_t {
+                let th = (k as f64 + 0.5) * dt;
+                a += rho * dr * dt;
+                iy += (rho * th.sin()).powi(2) * rho * dr * dt;
+            }
+        }
+        let t = SectionProps::tube(&m, r, r_i);
+        assert!(rel(t.area, a) < 1e-5, "A = {} against {a}", t.area);
+        assert!(rel(t.es[1], e * iy) < 1e-5 && rel(t.es[2], e * iy) < 1e-5);
+        // torsion: the polar moment, in stiffness, inertia and damping
+        assert!(rel(t.es[0], g * 2.0 * iy) < 1e-5 && rel(t.ms[0], 1200.0 * 2.0 * iy) < 1e-5);
+        assert!(rel(t.ds[0], 3e3 * 2.0 * iy) < 1e-5 && rel(t.ds[1], 3.0 * 3e3 * iy) < 1e-5);
+        assert!(rel(t.es[3], e * a) < 1e-5 && rel(t.ms[4], 1200.0 * a) < 1e-5);
+        assert_eq!(t.radius, r);
+        // the bore removes the stiffness of the core: (r⁴ − r_i⁴)/r⁴ of the solid circle's
+        let solid = SectionProps::circular(&m, r);
+        assert!(rel(t.es[1] / solid.es[1], 1.0 - (r_i / r).powi(4)) < 1e-14);
+        // r_i = 0 is the solid circle, entry by entry
+        let zero = SectionProps::tube(&m, r, 0.0);
+        for k in 0..6 {
+            assert!(rel(zero.es[k], solid.es[k]) < 1e-14, "es[{k}]");
+            assert!(rel(zero.ms[k], solid.ms[k]) < 1e-14, "ms[{k}]");
+            assert!(rel(zero.ds[k], solid.ds[k]) < 1e-14, "ds[{k}]");
+        }
+        // a thin wall of thickness w around the mean radius R: A → 2πRw, I → πR³w, J → 2πR³w
+        let (big_r, w) = (0.01, 1e-5);
+        let thin = SectionProps::tube(&m, big_r + w / 2.0, big_r - w / 2.0);
+        assert!(rel(thin.area, 2.0 * PI * big_r * w) < 1e-9);
+        assert!(rel(thin.es[1], e * PI * big_r.powi(3) * w) < 1e-6);
+        assert!(rel(thin.es[0], g * 2.0 * PI * big_r.powi(3) * w) < 1e-6);
+    }
+
+    #[test]
+    fn a_tube_tapers_its_bore_and_reaches_its_outer_radius() {
+        let m = Material {
+            youngs_modulus: 1e6,
+            poisson_ratio: 0.5,
+            density: 1000.0,
+            damping: 0.0,
+        };
+        let s = Section {
+            shape: Shape::Tube {
+                inner_radius: [0.008, 0.002],
+            },
+            width: [0.02, 0.01],
+            height: [0.02, 0.01],
+        };
+        assert_eq!(s.circumradius(0.0), 0.01);
+        assert_eq!(s.circumradius(1.0), 0.005);
+        assert!(rel(s.inner_radius_at(0.5), 0.005) < 1e-14);
+        let mid = s.props_at(&m, 0.5);
+        let expected = SectionProps::tube(&m, 0.0075, 0.005);
+        assert!(rel(mid.es[1], expected.es[1]) < 1e-14 && rel(mid.area, expected.area) < 1e-14);
+        // a solid section has no bore
+        let solid = Section {
+            shape: Shape::Ellipse,
+            ..s
+        };
+        assert_eq!(solid.inner_radius_at(0.5), 0.0);
     }
 }

@@ -17,20 +17,31 @@ pub fn describe(s: &Scenario, built: &Built) -> String {
     // tapered within a division; a step in radius between uniform divisions is "stepped"
     let tapered = g.iter().any(|d| match &d.section {
         None => d.radius_start != d.radius_end,
-        Some(s) => s.width[0] != s.width[1] || s.height[0] != s.height[1],
+        Some(s) => {
+            s.width[0] != s.width[1]
+                || s.height[0] != s.height[1]
+                || s.inner_radius_at(0.0) != s.inner_radius_at(1.0)
+        }
     });
     let stepped = g.windows(2).any(|w| {
         w[0].radius_end != w[1].radius_start
-            || w[0].section.map(|s| s.shape) != w[1].section.map(|s| s.shape)
-            || w[0].section.map(|s| (s.width[1], s.height[1]))
-                != w[1].section.map(|s| (s.width[0], s.height[0]))
+            || w[0].section.map(|s| std::mem::discriminant(&s.shape))
+                != w[1].section.map(|s| std::mem::discriminant(&s.shape))
+            || w[0]
+                .section
+                .map(|s| (s.width[1], s.height[1], s.inner_radius_at(1.0)))
+                != w[1]
+                    .section
+                    .map(|s| (s.width[0], s.height[0], s.inner_radius_at(0.0)))
     });
     let shapes: Vec<Option<Shape>> = g.iter().map(|d| d.section.map(|s| s.shape)).collect();
+    let kind = |s: &Option<Shape>| s.map(|s| std::mem::discriminant(&s));
     let shape = match shapes.first() {
-        Some(first) if shapes.iter().all(|s| s == first) => match first {
+        Some(first) if shapes.iter().all(|s| kind(s) == kind(first)) => match first {
             None => "",
             Some(Shape::Rectangle) => " rectangular",
             Some(Shape::Ellipse) => " elliptical",
+            Some(Shape::Tube { .. }) => " tubular",
         },
         _ => " mixed-section",
     };

@@ -86,6 +86,8 @@ pub(super) fn geometry(j: usize, d: &DivisionSpec) -> Result<DivisionGeometry, S
         None => "circle",
         Some(Shape::Rectangle) => "rectangle",
         Some(Shape::Ellipse) => "ellipse",
+        // a tube is a circle given an inner radius, below
+        Some(Shape::Tube { .. }) => "tube",
     };
     // a key of the other shape is named before a pair of this one's is checked
     let radius_key = (["radius", "radius_start", "radius_end"].into_iter())
@@ -101,6 +103,14 @@ pub(super) fn geometry(j: usize, d: &DivisionSpec) -> Result<DivisionGeometry, S
     let radius = tapered(j, "radius", d.radius, d.radius_start, d.radius_end)?;
     let width = tapered(j, "width", d.width, d.width_start, d.width_end)?;
     let height = tapered(j, "height", d.height, d.height_start, d.height_end)?;
+    let inner = inner_radius(j, d)?;
+    if let (Some(_), Some((given, _))) = (shape, inner) {
+        let article = if name == "ellipse" { "an" } else { "a" };
+        return Err(ScenarioError::invalid(
+            f(given),
+            format!("{article} {name} is solid: an inner radius makes a circular section a tube; drop `{given}`"),
+        ));
+    }
     let Some(shape) = shape else {
         if let Some(name) = [("width", width), ("height", height)]
             .iter()
@@ -117,13 +127,41 @@ pub(super) fn geometry(j: usize, d: &DivisionSpec) -> Result<DivisionGeometry, S
                 "missing: give `radius` or `radius_start` and `radius_end` [m] (or a `section` of another shape)",
             ));
         };
-        return Ok(DivisionGeometry {
+        let Some((_, [i0, i1])) = inner.filter(|(_, r)| *r != [0.0; 2]) else {
+            return Ok(DivisionGeometry {
+                length,
+                radius_start: r0,
+                radius_end: r1,
+                material: None,
+                section: None,
+            });
+        };
+        // a tube: its bore inside the outer radius at both ends (so all along, both linear)
+        let uniform = d.inner_radius.is_some();
+        for (end, r_i, r) in [("start", i0, r0), ("end", i1, r1)] {
+            if r_i >= r {
+                let key = if uniform {
+                    "inner_radius".to_string()
+                } else {
+                    format!("inner_radius_{end}")
+                };
+                return Err(ScenarioError::value(
+                    f(&key),
+                    r_i,
+                    format!("a radius in [0, {r}) m: less than the outer radius at the division's {end}"),
+                ));
+            }
+        }
+        return Ok(DivisionGeometry::with_section(
             length,
-            radius_start: r0,
-            radius_end: r1,
-            material: None,
-            section: None,
-        });
+            Section {
+                shape: Shape::Tube {
+                    inner_radius: [i0, i1],
+                },
+                width: [2.0 * r0, 2.0 * r1],
+                height: [2.0 * r0, 2.0 * r1],
+            },
+        ));
     };
     let (Some(w), Some(h)) = (width, height) else {
         let missing = if width.is_none() { "width" } else { "height" };
@@ -141,6 +179,49 @@ pub(super) fn geometry(j: usize, d: &DivisionSpec) -> Result<DivisionGeometry, S
             height: [h.0, h.1],
         },
     ))
+}
+
+/// The inner radius of division `j`'s tube, uniform (`inner_radius`) or tapered
+/// (`inner_radius_start`, `inner_radius_end`), each `>= 0` \[m\], with the first key given: `None`
+/// if none is.
+fn inner_radius(
+    j: usize,
+    d: &DivisionSpec,
+) -> Result<Option<(&'static str, [f64; 2])>, ScenarioError> {
+    let keys = ["inner_radius", "inner_radius_start", "inner_radius_end"];
+    let values = [d.inner_radius, d.inner_radius_start, d.inner_radius_end];
+    let Some(given) = keys.iter().zip(values).find_map(|(k, v)| v.map(|_| *k)) else {
+        return Ok(None);
+    };
+    for (k, v) in keys.iter().zip(values) {
+        if let Some(v) = v {
+            non_negative(&format!("divisions[{j}].{k}"), v, "m")?;
+        }
+    }
+    let f = |n: &str| format!("divisions[{j}].{n}");
+    let pair = match values {
+        [Some(r), None, None] => [r, r],
+        [None, Some(a), Some(b)] => [a, b],
+        [Some(_), _, _] => {
+            return Err(ScenarioError::invalid(
+                f("inner_radius"),
+                "give either `inner_radius` (uniform) or `inner_radius_start` and `inner_radius_end` (tapered), not both",
+            ))
+        }
+        [None, Some(_), None] => {
+            return Err(ScenarioError::invalid(
+                f("inner_radius_end"),
+                "missing: `inner_radius_start` needs `inner_radius_end`",
+            ))
+        }
+        [None, None, _] => {
+            return Err(ScenarioError::invalid(
+                f("inner_radius_start"),
+                "missing: `inner_radius_end` needs `inner_radius_start`",
+            ))
+        }
+    };
+    Ok(Some((given, pair)))
 }
 
 /// A dimension of division `j` given uniform (`name`) or tapered (`name_start`, `name_end`), each

@@ -70,8 +70,16 @@ pub fn apply_override(table: &mut Table, spec: &str) -> Result<(), ScenarioError
     Ok(())
 }
 
-/// The keys that size a circular section, and those that size a rectangle or an ellipse.
-const CIRCLE_KEYS: [&str; 3] = ["radius", "radius_start", "radius_end"];
+/// The keys that size a circular section (a tube's bore too), and those that size a rectangle or
+/// an ellipse.
+const CIRCLE_KEYS: [&str; 6] = [
+    "radius",
+    "radius_start",
+    "radius_end",
+    "inner_radius",
+    "inner_radius_start",
+    "inner_radius_end",
+];
 const BOX_KEYS: [&str; 6] = [
     "width",
     "width_start",
@@ -94,7 +102,7 @@ fn section_shape(segs: &[Seg], value: &Value) -> Option<(usize, String)> {
 }
 
 /// An override of a division's `section` replaces the description of the section it had: a
-/// rectangle or an ellipse drops the circle's radii, a circle the rectangle's widths and heights
+/// rectangle or an ellipse drops the circle's radii (and a tube's inner radii), a circle the rectangle's widths and heights
 /// (`--set divisions.0.section=rectangle --set divisions.0.width=0.03 --set
 /// divisions.0.height=0.01` on a preset of circular sections). An unknown shape keeps both, for
 /// the format's error to name it.

@@ -100,6 +100,14 @@ pub struct DivisionSpec {
     pub radius_start: Option<f64>,
     #[serde(default)]
     pub radius_end: Option<f64>,
+    /// The inner radius \[m\] of a circular section: a tube (`0 <= inner_radius < radius`; 0 or
+    /// absent, the default and not written: solid). Uniform, or tapered by `_start` and `_end`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inner_radius: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inner_radius_start: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inner_radius_end: Option<f64>,
     /// The section's shape: `"circle"` (the default: `radius`), `"rectangle"` or `"ellipse"`
     /// (`width` along the section's y axis and `height` along z, each uniform or tapered by its
     /// `_start` and `_end`); not written when absent.
