@@ -329,11 +329,19 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
         return Err(with_samples_before(py, failure, before, extrapolated, dir)?);
     }
     let outcome = outcome.map_err(err)?;
+    // what the run found of the model's use beyond its data, kept with a failed run's samples too
+    if !matches!(outcome.ending, Ending::Interrupted { .. }) {
+        for o in &outcome.model_extrapolated {
+            warn(py, o)?;
+            extrapolated.push(o.clone());
+        }
+    }
     match &outcome.ending {
         Ending::Complete => {}
-        Ending::Failed { error, .. } => {
+        Ending::Failed { error, failure } => {
             let partial = trajectory(py, built, &buffer, &outcome)?;
             partial.set_item("model_extrapolated", extrapolated)?;
+            partial.set_item("reason", failure.reason())?;
             if let Some(dir) = &written {
                 partial.set_item("out", dir)?;
             }
@@ -350,10 +358,6 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
             ));
         }
         Ending::Interrupted { reason } => return Err(invalid(reason.clone())),
-    }
-    for o in &outcome.model_extrapolated {
-        warn(py, o)?;
-        extrapolated.push(o.clone());
     }
     let d = trajectory(py, built, &buffer, &outcome)?;
     d.set_item("model_extrapolated", extrapolated)?;

@@ -478,6 +478,7 @@ def test_a_failed_reduced_run_raises_with_the_samples_it_computed(ae_model):
     span = hi - lo
     assert (tr["q"][:, 0] >= lo - span).all() and (tr["q"][:, 0] <= hi + span).all()
     assert "energy_balance" not in tr
+    assert tr["reason"] == "the reduced model left its training region"
 
 
 

@@ -49,7 +49,9 @@ class ConvergenceError(GvsromError):
 class IntegrationError(GvsromError):
     """A simulation that stopped early: its integrator failed, or a callable ``input`` or
     ``controller`` returned a value refused after the start; ``trajectory`` holds the samples
-    computed before."""
+    computed before. When the run itself failed, ``trajectory["reason"]`` says why, as the
+    ``reason`` of a written run's ``meta.json``: "the integration failed", "the reduced model left
+    its training region" or "the state left the rod's elastic range"."""
 
     trajectory: dict[str, Any]
 
