@@ -531,7 +531,7 @@ fn a_state_no_elastic_rod_holds_ends_the_run_naming_it_and_the_load() {
     assert_eq!(meta["complete"], false, "{msg}");
     // the reason names the stop, not a failed integration
     assert_eq!(
-        meta["reason"], "the state left the rod's elastic range",
+        meta["reason"], "the run left the rod's elastic range",
         "{meta}"
     );
     // every sample written is inside the bounds: the tip within the rod's reach
@@ -562,7 +562,12 @@ fn a_state_no_elastic_rod_holds_ends_the_run_naming_it_and_the_load() {
     let meta: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(ds.join("meta.json")).unwrap()).unwrap();
     assert_eq!(
-        meta["reason"], "the state left the rod's elastic range",
+        meta["reason"], "the run left the rod's elastic range",
+        "{meta}"
+    );
+    assert!(
+        (meta["error"].as_str())
+            .is_some_and(|e| e.starts_with("the state left the rod's elastic range at t = ")),
         "{meta}"
     );
 }

@@ -68,7 +68,7 @@ impl Material {
 
 /// One division of the rod: length and a section tapering linearly over the normalized division
 /// coordinate `X̄ ∈ [0, 1]` (spec §3.1): a circle from `radius_start` to `radius_end`, or the
-/// rectangle or ellipse of [`DivisionGeometry::section`].
+/// rectangle, ellipse or tube of [`DivisionGeometry::section`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct DivisionGeometry {
     pub length: f64,
@@ -81,8 +81,8 @@ pub struct DivisionGeometry {
     /// SoRoSim's material per link); `None`: the rod's ([`Rod::material_of`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<Material>,
-    /// A rectangular or elliptical section in place of the circle; `None` (the default, not
-    /// written): the circle of the radii.
+    /// A rectangular, elliptical or tubular section in place of the solid circle; `None` (the
+    /// default, not written): the circle of the radii.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub section: Option<Section>,
 }
@@ -230,6 +230,7 @@ impl Rod {
                     }
                     for ((end, r_i), r) in ["start", "end"].iter().zip(inner_radius).zip(outer) {
                         if !(r_i >= 0.0 && r_i < r) {
+                            // (a wall thinner than the scenario's 1e-7 m is a model's to allow)
                             return Err(ModelError::value(
                                 format!("rod.divisions[{j}].section.inner_radius_{end}"),
                                 r_i,

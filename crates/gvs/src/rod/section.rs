@@ -123,9 +123,12 @@ impl SectionProps {
     /// A circular tube of outer radius `r` and inner radius `r_i < r`: `A = π(r² − r_i²)`,
     /// `I = π(r⁴ − r_i⁴)/4`, `J = J_t = 2I` (the Saint-Venant torsion constant of a concentric
     /// tube is its polar moment, exactly: its sections stay plane). `r_i = 0` is the solid circle.
+    /// (Factored as `π(r − r_i)(r + r_i)` and `π(r − r_i)(r + r_i)(r² + r_i²)/4`, which keep their
+    /// precision for a thin wall, where `r² − r_i²` cancels.)
     pub fn tube(material: &Material, r: f64, r_i: f64) -> Self {
-        let a = PI * (r * r - r_i * r_i);
-        let i = PI * (r.powi(4) - r_i.powi(4)) / 4.0;
+        let wall = (r - r_i) * (r + r_i);
+        let a = PI * wall;
+        let i = PI * wall * (r * r + r_i * r_i) / 4.0;
         Self::from_moments(material, r, a, i, i, 2.0 * i)
     }
 

@@ -51,7 +51,7 @@ class IntegrationError(GvsromError):
     ``controller`` returned a value refused after the start; ``trajectory`` holds the samples
     computed before. When the run itself failed, ``trajectory["reason"]`` says why, as the
     ``reason`` of a written run's ``meta.json``: "the integration failed", "the reduced model left
-    its training region" or "the state left the rod's elastic range"."""
+    its training region" or "the run left the rod's elastic range"."""
 
     trajectory: dict[str, Any]
 

@@ -136,19 +136,26 @@ pub(super) fn geometry(j: usize, d: &DivisionSpec) -> Result<DivisionGeometry, S
                 section: None,
             });
         };
-        // a tube: its bore inside the outer radius at both ends (so all along, both linear)
+        // a tube: its wall at least MIN_RADIUS thick at both ends (so all along, both linear)
         let uniform = d.inner_radius.is_some();
         for (end, r_i, r) in [("start", i0, r0), ("end", i1, r1)] {
-            if r_i >= r {
-                let key = if uniform {
-                    "inner_radius".to_string()
-                } else {
-                    format!("inner_radius_{end}")
+            if r_i > r - MIN_RADIUS {
+                let key = match uniform {
+                    true => "inner_radius".to_string(),
+                    false => format!("inner_radius_{end}"),
+                };
+                let outer = match d.radius {
+                    Some(_) => format!("`radius` = {r} m"),
+                    None => format!("the outer radius {r} m at the division's {end}"),
                 };
                 return Err(ScenarioError::value(
                     f(&key),
                     r_i,
-                    format!("a radius in [0, {r}) m: less than the outer radius at the division's {end}"),
+                    format!(
+                        "a radius in [0, {}] m: a wall of at least {} m inside {outer}",
+                        num(r - MIN_RADIUS),
+                        num(MIN_RADIUS)
+                    ),
                 ));
             }
         }

@@ -199,7 +199,15 @@ pub fn run(
         _ => None,
     };
     let reason = (stopped.clone()).or_else(|| failed.as_ref().map(|(_, f)| f.reason().to_string()));
-    let failed = failed.map(|(e, _)| e);
+    // the error as printed: an integrator's message says where it failed; the elastic range's
+    // check names its time itself
+    let failed = failed.map(|(e, f)| match f {
+        Failure::Integration => format!(
+            "the integration failed at t = {}: {e}",
+            summary_run.t_last.unwrap_or(0.0)
+        ),
+        _ => e,
+    });
     let mut meta = Meta {
         kind: "dynamics".into(),
         scenario: built.name.clone(),
@@ -233,6 +241,7 @@ pub fn run(
         chunk_done: vec![true; n.div_ceil(n.max(1))],
         complete: reason.is_none(),
         reason: reason.clone(),
+        error: failed.clone(),
         counts: Counts::default(),
         failures: vec![],
         crate_version: env!("CARGO_PKG_VERSION").into(),
@@ -259,8 +268,7 @@ pub fn run(
     let path = dir.commit(&meta)?;
     if let Some(e) = failed {
         return Err(DatasetError::Plan(format!(
-            "the integration failed at t = {}: {e} (the {n} samples before it were written to `{}`, marked incomplete)",
-            summary_run.t_last.unwrap_or(0.0),
+            "{e} (the {n} samples before it were written to `{}`, marked incomplete)",
             path.display()
         )));
     }

@@ -213,6 +213,9 @@ pub struct Meta {
     pub complete: bool,
     /// Why an incomplete dataset stopped.
     pub reason: Option<String>,
+    /// A dynamic dataset's run that failed: the full message (`reason` says which kind).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
     pub counts: Counts,
     pub failures: Vec<Failure>,
     pub crate_version: String,
@@ -497,6 +500,7 @@ pub fn run(args: &DatasetRequest, interrupt: &AtomicUsize) -> Result<Outcome, Da
         chunk_done: vec![false; n_chunks],
         complete: false,
         reason: None,
+        error: None,
         counts: Counts::default(),
         failures: vec![],
         crate_version: env!("CARGO_PKG_VERSION").into(),

@@ -100,8 +100,9 @@ pub struct DivisionSpec {
     pub radius_start: Option<f64>,
     #[serde(default)]
     pub radius_end: Option<f64>,
-    /// The inner radius \[m\] of a circular section: a tube (`0 <= inner_radius < radius`; 0 or
-    /// absent, the default and not written: solid). Uniform, or tapered by `_start` and `_end`.
+    /// The inner radius \[m\] of a circular section: a tube (`0 <= inner_radius`, a wall of at
+    /// least 1e-7 m; 0 builds the solid circle). Uniform, or tapered by `_start` and `_end`;
+    /// absent (the default) it is not written.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inner_radius: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]

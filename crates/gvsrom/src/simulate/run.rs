@@ -37,7 +37,8 @@ pub enum Failure {
     /// A reduced trajectory left its training region, or its displacement drives needed tensions
     /// the model was not trained for.
     LeftTrainingRegion,
-    /// The state left the rod's elastic range, or a driven thread pulled beyond it.
+    /// The state left the rod's elastic range, or a driven thread pulled beyond the tension that
+    /// keeps it there.
     LeftElasticRange,
 }
 
@@ -47,7 +48,7 @@ impl Failure {
         match self {
             Failure::Integration => "the integration failed",
             Failure::LeftTrainingRegion => "the reduced model left its training region",
-            Failure::LeftElasticRange => "the state left the rod's elastic range",
+            Failure::LeftElasticRange => "the run left the rod's elastic range",
         }
     }
 }
