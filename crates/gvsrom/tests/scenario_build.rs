@@ -835,3 +835,24 @@ fn a_division_material_equal_to_the_rods_changes_nothing_and_a_bad_one_names_its
         assert!(e.contains(field), "{material}: {e}");
     }
 }
+
+/// A tendon placed on the surface (`angle_deg`) that ends where its division ends is fixed to
+/// that division's end face: a next division of a smaller radius is no limit to it (the
+/// six-tendon arm's short tendons end at X = 0.3 m, where a base of end radius 16 mm would meet
+/// the tip's 15 mm). A tendon that runs on across the step must fit the smaller side.
+#[test]
+fn a_tendon_ending_at_a_step_is_held_to_its_own_division_only() {
+    let build = |set: &str| {
+        let s = presets::load("six-tendon", &[set.to_string()]).expect("preset loads");
+        gvsrom::build(&s).map(|_| ()).map_err(|e| e.to_string())
+    };
+    build("divisions.0.radius_end=0.016").expect("the short tendons end on the 16 mm face");
+    // the long ones run from 20 mm at X = 0 to 10 mm at X = 0.6: 15 mm at the junction
+    let e = build("divisions.1.radius_start=0.01").unwrap_err();
+    assert!(
+        e.contains("tendons[0].angle_deg")
+            && e.contains("X = 0.3 m")
+            && e.contains("offset norm 0.015 m > radius 0.01 m"),
+        "{e}"
+    );
+}

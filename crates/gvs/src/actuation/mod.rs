@@ -220,7 +220,7 @@ impl Tendon {
         }
         for x in xs {
             let d = self.offset(x);
-            if let Some(accepted) = outside_section(rod, x, &d) {
+            if let Some(accepted) = outside_section(rod, (self.x_start, self.x_end), x, &d) {
                 let which = if (x - self.x_start).abs() < 1e-12 {
                     "offset_start"
                 } else {
@@ -255,7 +255,8 @@ impl Tendon {
     pub fn widest_excursion(&self, rod: &Rod) -> (f64, f64) {
         let gauge = |x: f64| {
             let d = self.offset(x);
-            section_gauge(rod, x, d[1], d[2]).map_or(f64::NAN, |(g, _, _)| g)
+            let span = (self.x_start, self.x_end);
+            section_gauge_over(rod, span, x, d[1], d[2]).map_or(f64::NAN, |(g, _, _)| g)
         };
         let span = self.x_end - self.x_start;
         let n = Self::PATH_SAMPLES * rod.divisions.len()
@@ -344,7 +345,7 @@ impl Tendon {
         for (x, i) in xs {
             let d = self.offset(x);
             let dn = d[1].hypot(d[2]);
-            if let Some(accepted) = outside_section(rod, x, &d) {
+            if let Some(accepted) = outside_section(rod, (self.x_start, self.x_end), x, &d) {
                 let knot = knots.iter().position(|k| k[0] == x);
                 let (field, place) = match knot {
                     Some(k) => (format!("path[{k}]"), "at this knot".to_string()),
@@ -399,10 +400,27 @@ fn golden_max(f: &dyn Fn(f64) -> f64, a: f64, b: f64, start: (f64, f64)) -> (f64
 /// ([`crate::rod::DivisionGeometry::gauge_at`], ≤ 1 inside), with the division and `X̄` it was
 /// taken in: at a division junction, the side where it is larger. `None` for `x` off the rod.
 pub fn section_gauge(rod: &Rod, x: f64, y: f64, z: f64) -> Option<(f64, &DivisionGeometry, f64)> {
+    section_gauge_over(rod, (0.0, rod.length()), x, y, z)
+}
+
+/// [`section_gauge`] for a tendon spanning `span = (x_start, x_end)`: at a junction, only the
+/// divisions the span enters count. A tendon that ends where a division ends is fixed to that
+/// division's end face, not to the next one's start (a step in the radius there is no limit).
+pub fn section_gauge_over(
+    rod: &Rod,
+    span: (f64, f64),
+    x: f64,
+    y: f64,
+    z: f64,
+) -> Option<(f64, &DivisionGeometry, f64)> {
     let mut x0 = 0.0;
     let mut worst: Option<(f64, &DivisionGeometry, f64)> = None;
     for div in &rod.divisions {
-        if x >= x0 - 1e-12 && x <= x0 + div.length + 1e-12 {
+        let x1 = x0 + div.length;
+        // the division overlaps the span by more than a rounding (or the span is a point in it)
+        let entered = (x0 < span.1 - 1e-12 && x1 > span.0 + 1e-12)
+            || (span.1 - span.0 <= 1e-12 && x0 <= span.0 && span.0 <= x1);
+        if entered && x >= x0 - 1e-12 && x <= x1 + 1e-12 {
             let x_bar = ((x - x0) / div.length).clamp(0.0, 1.0);
             let g = div.gauge_at(x_bar, y, z);
             if worst.is_none_or(|(w, _, _)| g > w) {
@@ -414,11 +432,11 @@ pub fn section_gauge(rod: &Rod, x: f64, y: f64, z: f64) -> Option<(f64, &Divisio
     worst
 }
 
-/// `None` if the offset `d` lies inside the rod's section at `x` ([`section_gauge`] ≤ 1 + 1e-9);
-/// else what is accepted there: "an offset of norm <= the section radius r m", or "an offset
-/// inside the section (…)".
-fn outside_section(rod: &Rod, x: f64, d: &V3) -> Option<String> {
-    let (g, div, x_bar) = section_gauge(rod, x, d[1], d[2])?;
+/// `None` if the offset `d` of a tendon spanning `span` lies inside the rod's section at `x`
+/// ([`section_gauge_over`] ≤ 1 + 1e-9); else what is accepted there: "an offset of norm <= the
+/// section radius r m", or "an offset inside the section (…)".
+fn outside_section(rod: &Rod, span: (f64, f64), x: f64, d: &V3) -> Option<String> {
+    let (g, div, x_bar) = section_gauge_over(rod, span, x, d[1], d[2])?;
     (g > 1.0 + 1e-9).then(|| match div.section {
         None => format!(
             "an offset of norm <= the section radius {} m",

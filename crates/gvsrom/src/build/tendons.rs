@@ -35,10 +35,11 @@ pub(super) fn reach_at(rod: &Rod, x: f64, after: bool, theta: f64) -> f64 {
     division_at(rod, x, after).map_or(f64::NAN, |(d, x_bar)| 1.0 / d.gauge_at(x_bar, c, s))
 }
 
-/// The section's gauge of the offset `(y, z)` at `x` (> 1 outside; the larger side at a
-/// junction, [`gvs::actuation::section_gauge`]) and what the section there is, for a message.
-fn gauge_at(rod: &Rod, x: f64, y: f64, z: f64) -> (f64, String) {
-    gvs::actuation::section_gauge(rod, x, y, z)
+/// The section's gauge of the offset `(y, z)` at `x` of a tendon spanning `span` (> 1 outside;
+/// the larger side of a junction the span enters, [`gvs::actuation::section_gauge_over`]) and
+/// what the section there is, for a message.
+fn gauge_at(rod: &Rod, span: (f64, f64), x: f64, y: f64, z: f64) -> (f64, String) {
+    gvs::actuation::section_gauge_over(rod, span, x, y, z)
         .map_or((f64::NAN, String::new()), |(g, d, x_bar)| {
             (g, d.describe_at(x_bar))
         })
@@ -168,7 +169,8 @@ pub(super) fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, Scen
     for (x, which, note) in checks {
         let d = tendon.offset(x);
         let dn = d.norm();
-        let (gauge, section) = gauge_at(rod, x, d[1], d[2]);
+        let span = (tendon.x_start, tendon.x_end);
+        let (gauge, section) = gauge_at(rod, span, x, d[1], d[2]);
         if gauge > 1.0 + 1e-9 {
             let (field, how) = match (polar, tendon.turns != 0.0) {
                 (true, false) => (
