@@ -123,7 +123,9 @@ impl Robot {
     ///     ``T + U_e + U_g − Σ u ℓ`` over the samples (a thread held at a constant displacement
     ///     counts its ``½ (ℓ − ℓ*)² / c`` in place of ``−u ℓ``), with a ``UserWarning`` when it rose by more
     ///     than 1 % of the largest kinetic energy (the integration added energy); with ``out``,
-    ///     ``out``: the directory written.
+    ///     ``out``: the directory written. Started ``from_equilibrium`` at an equilibrium that
+    ///     diverges (no stable one found), the run warns (``UserWarning``) and the dict holds its
+    ///     ``start_divergence``, the eigenvalue ω² < 0 [1/s²].
     ///
     /// Raises
     /// ------
@@ -246,6 +248,9 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
     for o in &plan.model_extrapolated {
         warn(py, &format!("extrapolating (--extrapolate): {o}"))?;
     }
+    if let Some(w2) = plan.start_divergence {
+        warn(py, &simulate::unstable_start_note(w2))?;
+    }
     crate::robot::warn_motion_note(py, built)?;
     // as `simulate --out`'s `model_extrapolated`: the scenario's, then the input's
     let mut extrapolated: Vec<String> = (built.reduced.iter())
@@ -361,6 +366,9 @@ pub fn run<'py>(robot: &Robot, py: Python<'py>, a: Args<'_>) -> PyResult<Bound<'
     }
     let d = trajectory(py, built, &buffer, &outcome)?;
     d.set_item("model_extrapolated", extrapolated)?;
+    if let Some(w2) = plan.start_divergence {
+        d.set_item("start_divergence", w2)?;
+    }
     if let Some(dir) = &written {
         d.set_item("out", dir)?;
     }

@@ -106,3 +106,36 @@ def test_a_constant_tension_is_named_in_a_note_instead_of_a_figure(robot, tmp_pa
     figures = gvsrom.plot(tmp_path / "run", tmp_path / "figs")
     assert "tensions: held at -2 N over the run (not drawn)" in figures["notes"], figures["notes"]
     assert not any(f.startswith("tensions") for f in figures["figures"])
+
+
+
+_EULER_COLUMN = """
+name = "euler-column"
+[material]
+youngs_modulus = 1e6
+poisson_ratio = 0.45
+density = 1000.0
+damping = 0
+[[divisions]]
+length = 0.5
+radius = 0.01
+basis = { kind = "legendre", modes = ["bend_y", "bend_z", "elongation", "shear_y", "shear_z"], order = 4 }
+[loads]
+gravity = [0, 0, 0]
+[[loads.point]]
+x = 0.5
+force = [-5.0, 0, 0]
+frame = "global"
+"""
+
+
+def test_a_run_from_a_diverging_equilibrium_warns_and_records_it(tmp_path):
+    # 5 N along the axis, 64× the Euler load π² EI / 4L² = 0.078 N: the straight equilibrium is
+    # the one found, and it diverges
+    robot = gvsrom.Scenario.from_toml(_EULER_COLUMN).build()
+    with pytest.warns(UserWarning, match=r"the equilibrium the run starts from diverges"):
+        tr = robot.simulate(0.05, from_equilibrium=True, out=tmp_path / "run")
+    assert tr["start_divergence"] < 0
+    meta = json.loads((tmp_path / "run" / "meta.json").read_text())
+    assert meta["start_divergence"] == tr["start_divergence"]
+    assert "start_divergence" not in robot.simulate(0.05)

@@ -675,6 +675,8 @@ fn displacement_runs_are_refused_where_they_cannot_be_honoured() {
         &[
             "tendons[0].displacement: at t = 0 s its thread pulls -159.9",
             "beyond the tension limit |u| = 48.4591 N",
+            "the rod has not moved yet",
+            "start `--from-equilibrium`",
         ],
     );
 }

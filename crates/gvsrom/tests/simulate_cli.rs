@@ -784,3 +784,62 @@ fn a_signal_beyond_the_elastic_range_is_refused_naming_the_file_the_tension_and_
     );
     assert!(!e.contains("t = 1 s"), "{e}");
 }
+
+/// A straight cantilever under an axial compression of 5 N, 64× its Euler load
+/// (`π² EI / 4L²` = 0.078 N), keeps a straight equilibrium, and it diverges: a run started there
+/// says so (stderr and `meta.json`'s `start_divergence`), instead of showing a rod at rest.
+#[test]
+fn a_run_from_a_diverging_equilibrium_says_so() {
+    let toml = common::scratch("euler-column.toml");
+    std::fs::write(
+        &toml,
+        r#"name = "euler-column"
+[material]
+youngs_modulus = 1e6
+poisson_ratio = 0.45
+density = 1000.0
+damping = 0
+[[divisions]]
+length = 0.5
+radius = 0.01
+basis = { kind = "legendre", modes = ["bend_y", "bend_z", "elongation", "shear_y", "shear_z"], order = 4 }
+[loads]
+gravity = [0, 0, 0]
+[[loads.point]]
+x = 0.5
+force = [-5.0, 0, 0]
+frame = "global"
+"#,
+    )
+    .unwrap();
+    let out = common::scratch("euler-column-run");
+    let (_, stderr) = common::run_ok_with_stderr(&[
+        "simulate",
+        common::s(&toml),
+        "--from-equilibrium",
+        "--duration",
+        "0.05",
+        "--out",
+        common::s(&out),
+    ]);
+    assert!(
+        stderr.contains("warning: the equilibrium the run starts from diverges")
+            && stderr.contains("1/s² < 0"),
+        "{stderr}"
+    );
+    let meta = common::json(&out.join("meta.json"));
+    let w2 = meta["start_divergence"].as_f64().unwrap();
+    assert!(w2 < 0.0, "{meta}");
+    // from rest (no equilibrium solved) nothing is said
+    let rest = common::scratch("euler-column-rest");
+    let (_, stderr) = common::run_ok_with_stderr(&[
+        "simulate",
+        common::s(&toml),
+        "--duration",
+        "0.05",
+        "--out",
+        common::s(&rest),
+    ]);
+    assert!(!stderr.contains("diverges"), "{stderr}");
+    assert!(common::json(&rest.join("meta.json"))["start_divergence"].is_null());
+}

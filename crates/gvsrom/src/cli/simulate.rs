@@ -217,6 +217,10 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
     for o in &prepared.plan.model_extrapolated {
         gvsrom::progress::stderr_line(format_args!("warning: extrapolating (--extrapolate): {o}"));
     }
+    if let Some(w2) = prepared.plan.start_divergence {
+        let note = simulate::unstable_start_note(w2);
+        gvsrom::progress::stderr_line(format_args!("warning: {note}"));
+    }
     let provenance = prepared.record(r.provenance.clone().seed("input", args.seed), &choice);
     let (opts, plan, light) = (&prepared.opts, &prepared.plan, &prepared.note);
     let mut writer = match &args.out {
@@ -352,6 +356,7 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
     for o in &outcome.model_extrapolated {
         writeln!(out, "note       {o}")?;
     }
+
     let written = match writer {
         Some(w) => {
             let samples = w.samples();

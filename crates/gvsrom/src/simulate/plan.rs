@@ -114,6 +114,9 @@ pub struct Plan {
     pub model_extrapolated: Vec<String>,
     /// A function input, which the run evaluates in place of `signal`.
     pub function: Option<InputFunction>,
+    /// `Some(ω²)` \[1/s²\] < 0 when the run starts from an equilibrium (`--from-equilibrium`)
+    /// that diverges, no stable one having been found ([`super::unstable_start_note`]).
+    pub start_divergence: Option<f64>,
 }
 
 impl Plan {
@@ -349,6 +352,7 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
     })?;
     // the tensions at a driven equilibrium start: those the displacements need
     let mut start_tensions = None;
+    let mut start_divergence = None;
     let initial = match &opts.start {
         Start::Rest => InitialState::Rest,
         // the equilibrium `gvsrom statics` finds under the scenario's tensions and loads (with a
@@ -366,6 +370,7 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
             if built.displacement_driven() {
                 start_tensions = Some(report.u.clone());
             }
+            start_divergence = report.divergence;
             InitialState::Given {
                 q: DVector::from_vec(report.q),
                 qd: DVector::zeros(built.n_dof()),
@@ -386,6 +391,7 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
         input,
         model_extrapolated,
         function,
+        start_divergence,
     })
 }
 

@@ -178,6 +178,15 @@ fn check_start_mass<P: StrainParam>(
     ))
 }
 
+/// What to tell of a run that started from an equilibrium that diverges (`ω²` = `w2` < 0,
+/// [`gvs::solve::dynamics::RunSummary::start_divergence`]).
+pub fn unstable_start_note(w2: f64) -> String {
+    format!(
+        "the equilibrium the run starts from diverges (M⁻¹K_T has the real eigenvalue ω² = {} 1/s² < 0) and no stable one was found: the rod leaves it at the smallest disturbance, or stays only by symmetry and round-off",
+        gvs::error::fmt_sci(w2, 3)
+    )
+}
+
 /// The reason a sample `s` of a run on `built` (points at the abscissae `x`) is no state of an
 /// elastic rod ([`crate::plausibility::state_violation`]), with the run's largest load; `None` for
 /// a physical one. It ends a simulation and a dynamic dataset alike.
@@ -199,13 +208,20 @@ pub fn non_physical_state(built: &Built, x: &[f64], s: &Sample<'_>) -> Option<St
 }
 
 /// The first displacement-driven tendon whose thread pulls beyond `limits` (per tendon, from
-/// [`crate::plausibility::tension_limits`]) at the sample `s`, as the message that ends the run.
-fn thread_beyond_limits(built: &Built, limits: &[f64], s: &Sample<'_>) -> Option<String> {
+/// [`crate::plausibility::tension_limits`]) at the sample `s` of a run starting at `t0`, as the
+/// message that ends the run.
+fn thread_beyond_limits(built: &Built, limits: &[f64], t0: f64, s: &Sample<'_>) -> Option<String> {
     let k = (0..limits.len()).find(|&k| {
         built.displacement[k].is_some() && (!s.u[k].is_finite() || s.u[k].abs() > limits[k])
     })?;
+    // at the first sample the rod has not moved: the thread takes the motor's whole displacement
+    // as stretch, however little the rod would need at rest
+    let why = match s.t <= t0 {
+        true => "the rod has not moved yet, so the thread's stretch is the motor's whole displacement: wind it in over time (an `--input` ramp) or start `--from-equilibrium` (`gvsrom statics` says whether the rod takes the displacement at rest, and at what tension)",
+        false => "the displacement asks more than the rod can take, or winds in faster than the rod follows (`gvsrom statics` gives the tension it needs at rest, or refuses it)",
+    };
     Some(format!(
-        "tendons[{k}].displacement: at t = {} s its thread pulls {} N, beyond the tension limit |u| = {} N (the rod's elastic range): the displacement asks more than the rod can take (`gvsrom statics` refuses it at rest too)",
+        "tendons[{k}].displacement: at t = {} s its thread pulls {} N, beyond the tension limit |u| = {} N (the rod's elastic range): {why}",
         s.t,
         crate::build::significant(s.u[k]),
         crate::build::significant(limits[k]),
@@ -255,6 +271,7 @@ pub fn run_into(
         });
     // the tension each displacement-driven tendon may carry: where the rod leaves its elastic
     // range (as the statics drive bounds it)
+    let t_start = plan.t_out.first().copied().unwrap_or(0.0);
     let limits = match built.displacement_driven() {
         true => crate::plausibility::tension_limits(built),
         false => vec![],
@@ -267,7 +284,7 @@ pub fn run_into(
             return ControlFlow::Break(msg);
         }
         // a displacement whose thread pulls beyond the rod's elastic range: no motion of the rod
-        if let Some(msg) = thread_beyond_limits(built, &limits, s) {
+        if let Some(msg) = thread_beyond_limits(built, &limits, t_start, s) {
             non_physical = Some(msg.clone());
             return ControlFlow::Break(msg);
         }

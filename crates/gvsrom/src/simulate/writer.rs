@@ -410,6 +410,7 @@ impl TrajectoryWriter {
             centerline_x: shape.x,
             tendon_rest_lengths: built.model.tendon_rest_lengths(),
             energy_balance: outcome.energy,
+            start_divergence: plan.start_divergence.or(sm.start_divergence),
             provenance,
         };
         dir.commit(meta)
@@ -470,6 +471,10 @@ pub(super) struct Meta<'a> {
     /// The total energy over the samples of a conservative run ([`super::EnergyBalance`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     energy_balance: Option<super::EnergyBalance>,
+    /// `ω²` \[1/s²\] < 0 of the equilibrium a `--from-equilibrium` run started from, when it
+    /// diverges (no stable one was found): [`super::unstable_start_note`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    start_divergence: Option<f64>,
     /// How the run was made ([`crate::provenance::Provenance`]), when the caller recorded it.
     #[serde(skip_serializing_if = "Option::is_none")]
     provenance: Option<serde_json::Value>,

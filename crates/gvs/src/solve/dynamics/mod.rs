@@ -383,6 +383,11 @@ pub struct RunSummary {
     /// [`OdeError::Stopped`] when the sample callback asked to stop. The samples before it were
     /// delivered.
     pub error: Option<OdeError>,
+    /// `Some(ω²)` \[1/s²\] if the run started from an equilibrium
+    /// ([`InitialState::Equilibrium`]) that diverges, and no stable one was found: the most
+    /// negative real eigenvalue of `M⁻¹ K_T`. The rod leaves such a start at the smallest
+    /// disturbance, or rests there only by symmetry and round-off.
+    pub start_divergence: Option<f64>,
 }
 
 /// Whether [`simulate`] runs the fixed-step method of `options` on `model` in second-order form
@@ -490,6 +495,7 @@ pub fn simulate_streaming_interruptible<P: StrainParam>(
             ModelError::invalid("sample_times", "at least one sample time is required").into(),
         );
     }
+    let mut start_divergence = None;
     let (q0, qd0) = match initial {
         InitialState::Rest => (model.param.rest_coordinates(), DVector::zeros(n)),
         InitialState::Given { q, qd } => {
@@ -522,6 +528,7 @@ pub fn simulate_streaming_interruptible<P: StrainParam>(
                 },
             )
             .solve_interruptible(u, loads, None, stop)?;
+            start_divergence = sol.divergence;
             (sol.q, DVector::zeros(n))
         }
     };
@@ -626,5 +633,6 @@ pub fn simulate_streaming_interruptible<P: StrainParam>(
         stats,
         wall_time_s,
         error,
+        start_divergence,
     })
 }
