@@ -831,6 +831,9 @@ fn bad_tolerances_of_a_dynamic_dataset_are_refused_before_an_earlier_dataset_is_
         // looser than the motion allows: percents of the length off, passing as a normal run
         ("--rtol", "0.5"),
         ("--atol", "100"),
+        // a dynamic dataset runs on one thread, but a thread count no machine has is an error
+        ("--threads", "0"),
+        ("--threads", "5000"),
     ];
     for (opt, value) in bad {
         expect_error(

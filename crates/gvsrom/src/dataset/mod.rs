@@ -419,6 +419,13 @@ pub fn run(args: &DatasetRequest, interrupt: &AtomicUsize) -> Result<Outcome, Da
         )));
     }
     let seed = args.seed.unwrap_or(0);
+    // checked for every dataset (a dynamic one runs on one thread, whatever it is given)
+    if args.threads == Some(0) || args.threads.is_some_and(|t| t > 1024) {
+        return Err(plan_err(format!(
+            "--threads {}: expected an integer in [1, 1024]",
+            args.threads.unwrap_or(0)
+        )));
+    }
     // a plan over displacements: refused before a sample builds (with its tension, "both given")
     if let Some(path) = (args.sweep.iter().chain(&args.grid).chain(&args.random))
         .find(|p| p.split('=').next().unwrap_or("").ends_with("displacement"))
@@ -453,12 +460,6 @@ pub fn run(args: &DatasetRequest, interrupt: &AtomicUsize) -> Result<Outcome, Da
         return Err(plan_err(format!(
             "--chunk-size {}: expected an integer in [1, {MAX_CHUNK_SIZE}]",
             args.chunk_size
-        )));
-    }
-    if args.threads == Some(0) || args.threads.is_some_and(|t| t > 1024) {
-        return Err(plan_err(format!(
-            "--threads {}: expected an integer in [1, 1024]",
-            args.threads.unwrap_or(0)
         )));
     }
     check_plan(&plan, &table, &built)?;

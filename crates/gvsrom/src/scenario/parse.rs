@@ -59,7 +59,7 @@ pub fn from_table(table: Table) -> Result<Scenario, ScenarioError> {
             .replace("expected f64", "expected a number");
         let message = match message == ENUM_NOT_A_STRING {
             true => name_expected(original, e.path()).unwrap_or(message),
-            false => message,
+            false => without_type_names(message),
         };
         // Inside tagged tables (`kind = ...`) the path stops at the table: add the unknown key.
         if let Some(key) = message
@@ -129,6 +129,17 @@ fn array_length_message(field: &str, message: String) -> String {
         .unwrap_or("?");
     let values = if given == "1" { "value" } else { "values" };
     format!("{given} {values} given; expected {form}")
+}
+
+/// serde's "expected struct MaterialSpec" names a Rust type: the user wrote a TOML table there.
+fn without_type_names(message: String) -> String {
+    match message.split_once("expected struct ") {
+        Some((before, rest)) => {
+            let after = rest.trim_start_matches(|c: char| c.is_alphanumeric() || c == '_');
+            format!("{before}expected a table (`[…]` or `{{ key = value, … }}`){after}")
+        }
+        None => message,
+    }
 }
 
 /// toml's message for a value that is not a string where a name (an enum) is read: it names

@@ -260,6 +260,17 @@ fn a_key_taking_a_name_given_another_value_names_the_value_and_the_names() {
             other => panic!("{set}: {other:?}"),
         }
     }
+    // a value where a table belongs: no Rust type name
+    match Scenario::from_toml("t", MINIMAL, &["divisions.0.basis=3".into()]) {
+        Err(ScenarioError::Format { field, message }) => assert_eq!(
+            (field.as_str(), message.as_str()),
+            (
+                "divisions[0].basis",
+                "invalid type: integer `3`, expected a table (`[…]` or `{ key = value, … }`)"
+            )
+        ),
+        other => panic!("{other:?}"),
+    }
     // a misspelt name keeps serde's message, which lists the names
     let e = Scenario::from_toml("t", MINIMAL, &["divisions.0.section=\"square\"".into()])
         .unwrap_err()
