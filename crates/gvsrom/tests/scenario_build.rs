@@ -379,6 +379,22 @@ fn a_tendon_loading_components_the_basis_lacks_is_named() {
     assert_eq!(warnings(&["tendons.0.turns=0.5"]), w);
     let all = r#"divisions.0.basis.modes=["torsion", "bend_y", "bend_z", "elongation", "shear_y", "shear_z"]"#;
     assert!(warnings(&["tendons.0.turns=0.5", "divisions.0.basis.order=4", all]).is_empty());
+    // divisions lacking different components are named each with its own (the six-tendon arm's
+    // tendon 0 on the surface at 0°, tapered: bend_z, elongation and shear_y at rest)
+    let set: Vec<String> = [
+        r#"divisions.0.basis.modes=["torsion", "bend_y", "bend_z", "elongation", "shear_z"]"#,
+        r#"divisions.1.basis.modes=["torsion", "bend_y", "bend_z", "shear_z"]"#,
+    ]
+    .map(String::from)
+    .to_vec();
+    let s = presets::load("six-tendon", &set).expect("preset loads");
+    let w = gvsrom::build::uncovered_tendon_components(&gvsrom::build(&s).unwrap().model);
+    assert!(
+        w[0].starts_with(
+            "tendons[0] also loads shear_y in division 0; elongation, shear_y in division 1, which those bases lack"
+        ),
+        "{w:?}"
+    );
 }
 
 #[test]

@@ -354,8 +354,8 @@ pub fn uncovered_tendon_components(model: &Model<LinearBasis>) -> Vec<String> {
     }
     let mut out = vec![];
     for (k, td) in model.tendons.iter().enumerate() {
-        let mut missing = [false; 6];
-        let mut divisions = std::collections::BTreeSet::new();
+        // per division, the components its basis lacks that the tendon loads there
+        let mut missing = std::collections::BTreeMap::<usize, [bool; 6]>::new();
         for &i in model.tendon_points(k) {
             let p = disc.points[i];
             if p.weight <= 0.0 {
@@ -366,25 +366,50 @@ pub fn uncovered_tendon_components(model: &Model<LinearBasis>) -> Vec<String> {
             let scale = phi_a.amax();
             for a in 0..6 {
                 if !has[p.div][a] && phi_a[a].abs() > 1e-9 * scale {
-                    missing[a] = true;
-                    divisions.insert(p.div);
+                    missing.entry(p.div).or_default()[a] = true;
                 }
             }
         }
-        if missing.iter().any(|m| *m) {
-            let names: Vec<&str> = StrainMode::ALL
-                .iter()
-                .filter(|m| missing[m.index()])
-                .map(|m| m.name())
-                .collect();
-            let divs: Vec<String> = divisions.iter().map(|j| j.to_string()).collect();
-            out.push(format!(
-                "tendons[{k}] also loads {}, which the basis of division {} lacks: that part of its load is dropped (add the mode{} to the basis to keep it)",
-                names.join(", "),
-                divs.join(", "),
-                if names.len() == 1 { "" } else { "s" }
-            ));
+        if missing.is_empty() {
+            continue;
         }
+        let names = |m: &[bool; 6]| {
+            (StrainMode::ALL.iter())
+                .filter(|mode| m[mode.index()])
+                .map(|mode| mode.name())
+                .collect::<Vec<_>>()
+        };
+        let all = missing.values().fold([false; 6], |mut acc, m| {
+            (0..6).for_each(|a| acc[a] |= m[a]);
+            acc
+        });
+        // one list when every division lacks the same, else division by division
+        let what = match missing.values().all(|m| *m == all) {
+            true => {
+                let divs: Vec<String> = missing.keys().map(|j| j.to_string()).collect();
+                let (s, verb) = if divs.len() == 1 {
+                    ("", "lacks")
+                } else {
+                    ("s", "lack")
+                };
+                format!(
+                    "{}, which the basis of division{s} {} {verb}",
+                    names(&all).join(", "),
+                    divs.join(", ")
+                )
+            }
+            false => {
+                let parts: Vec<String> = (missing.iter())
+                    .map(|(j, m)| format!("{} in division {j}", names(m).join(", ")))
+                    .collect();
+                format!("{}, which those bases lack", parts.join("; "))
+            }
+        };
+        let modes = names(&all).len();
+        out.push(format!(
+            "tendons[{k}] also loads {what}: that part of its load is dropped (add the mode{} to the basis to keep it)",
+            if modes == 1 { "" } else { "s" }
+        ));
     }
     out
 }
