@@ -12,6 +12,7 @@ mod loads;
 pub mod reduced;
 mod resolve;
 mod rod;
+mod tendon_warnings;
 mod tendons;
 
 pub use describe::{body_lines, describe, drive_words, significant, wrench_count, wrench_frames};
@@ -19,7 +20,10 @@ pub use limits::*;
 pub use loads::loads;
 pub use reduced::Reduced;
 pub use resolve::{resolve, Request, Resolved};
-pub use tendons::{tendon_ends_inside_divisions, uncovered_tendon_components};
+pub use tendon_warnings::{
+    tendon_ends_inside_divisions, uncovered_tendon_components, under_resolved_helices,
+    MIN_POINTS_PER_TURN,
+};
 
 use basis::{basis, fem_alignment, kinematics_resolution, quadrature};
 use rod::{base_pose, division_material, geometry, material, radius_range, reference_strain};
@@ -387,11 +391,13 @@ pub fn under_integrated_divisions(s: &Scenario) -> Vec<String> {
 }
 
 /// The warnings of a built model alone: tendon loads the basis cannot hold
-/// ([`uncovered_tendon_components`]) and tendon ends inside divisions
-/// ([`tendon_ends_inside_divisions`]).
+/// ([`uncovered_tendon_components`]), tendon ends inside divisions
+/// ([`tendon_ends_inside_divisions`]) and helices sampled by too few points
+/// ([`under_resolved_helices`]).
 pub fn model_warnings(model: &Model<LinearBasis>) -> Vec<String> {
     let mut w = uncovered_tendon_components(model);
     w.extend(tendon_ends_inside_divisions(model));
+    w.extend(under_resolved_helices(model));
     w
 }
 
