@@ -247,6 +247,15 @@ impl<P: StrainParam> Model<P> {
         self.param.n_dof()
     }
 
+    /// The smallest force scale of the statics convergence test \[N·m²\]: the rod's largest
+    /// bending stiffness `EI`, the generalized force that bends it by about a radian. It scales
+    /// with the rod as its loads' generalized forces do (`s⁴` for every length scaled by `s` and
+    /// forces by `s²`), and it keeps a projection that vanishes (a decoder's spurious straight
+    /// rod, a load the basis cannot hold) from asking a residual below round-off.
+    pub fn residual_floor(&self) -> f64 {
+        (self.props.iter()).fold(0.0, |m, p| m.max(p.es[1]).max(p.es[2]))
+    }
+
     pub fn n_actuators(&self) -> usize {
         self.tendons.len()
     }

@@ -31,7 +31,8 @@ impl<P: StrainParam> Model<P> {
 
     /// Statics residual `R(q) = −K₁(q) + F(q) + B(q)u` (paper eq. 9) into `r`.
     ///
-    /// Also sets `ws.residual_scale = max(‖K₁‖∞, ‖F + Bu‖∞)`, the scale of the convergence test.
+    /// Also sets `ws.residual_scale = max(‖K₁‖∞, ‖F + Bu‖∞, EI_max)`, the scale of the
+    /// convergence test ([`Self::residual_floor`]).
     pub fn statics_residual(
         &self,
         q: &DVector<f64>,
@@ -96,9 +97,10 @@ impl<P: StrainParam> Model<P> {
             }
         }
         *r += &ws.rtmp;
-        // relative to the forces themselves, in whatever units the rod's size gives them: a floor
-        // of 1 (gvs-spec §8.3) would call a micrometre rod's every state converged
-        ws.residual_scale = ext.max(ws.rtmp.amax());
+        // relative to the forces at play, in whatever units the rod's size gives them (a floor of
+        // 1, gvs-spec §8.3, would call a micrometre rod's every state converged), at least the
+        // rod's own bending stiffness
+        ws.residual_scale = ext.max(ws.rtmp.amax()).max(self.residual_floor());
     }
 
     /// `r += Σ_s Ψ_q,sᵀ y_s` ([`StrainParam::project`]).

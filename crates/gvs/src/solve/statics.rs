@@ -2,9 +2,10 @@
 //! dogleg trust region with the analytic Jacobian, optional load ramping and warm starts.
 //!
 //! **Stopping rule** (spec §8.3, physical units, no magnifier): converged when
-//! `‖R‖∞ ≤ ftol · max(‖K₁‖∞, ‖F + Bu‖∞)` (default `ftol = 1e-10`): relative to the forces at
-//! play, without the spec's floor of 1 in the max, which is an absolute force that would call a
-//! micrometre rod's straight start converged under any load (docs/assumptions.md).
+//! `‖R‖∞ ≤ ftol · max(‖K₁‖∞, ‖F + Bu‖∞, EI_max)` (default `ftol = 1e-10`): relative to the forces
+//! at play, the spec's floor of 1 in the max replaced by the rod's largest bending stiffness
+//! ([`crate::model::Model::residual_floor`]), since an absolute force would call a micrometre
+//! rod's straight start converged under any load (docs/assumptions.md).
 //!
 //! **Jacobian** ([`StaticsJacobian`]): analytic (spec §8.2) by default; a model with at most
 //! [`DIFFERENCE_MAX_DOF`] coordinates (a small reduced model) takes forward differences instead,

@@ -83,8 +83,8 @@ impl<P: StrainParam> ParametrizedSystem for StaticsPath<'_, '_, P> {
         r.axpy(lambda, r_lambda, 1.0);
         self.residual_evaluations += 2;
         self.at = Some(x.clone());
-        // the statics scale max(‖K₁‖∞, ‖F + Bu‖∞) at λ (`Model::statics_residual`)
-        self.r0.amax().max(lambda.abs() * r_lambda.amax())
+        // the statics scale max(‖K₁‖∞, ‖F + Bu‖∞, EI_max) at λ (`Model::statics_residual`)
+        (self.r0.amax().max(lambda.abs() * r_lambda.amax())).max(m.residual_floor())
     }
     fn jacobian(&mut self, x: &DVector<f64>, lambda: f64, jac: &mut DMatrix<f64>) {
         self.scaled.scale_from(&self.full, lambda);
