@@ -122,6 +122,16 @@ pub fn vec1(a: &In1<'_>) -> Vec<f64> {
     a.as_array().iter().copied().collect()
 }
 
+/// Whether `ob` is a Python `bool` or a NumPy `bool_`: a number to Python (`True + 1 == 2`), never
+/// a tension, an abscissa or a count to gvsrom.
+fn is_bool(ob: Borrowed<'_, '_, PyAny>) -> bool {
+    ob.is_instance_of::<pyo3::types::PyBool>()
+        || ob
+            .get_type()
+            .name()
+            .is_ok_and(|n| n == "bool" || n == "bool_")
+}
+
 /// `ob` as one real number (a float, an int, a NumPy scalar or 0-d array), if it is one. An array
 /// of at least one dimension is not, even of one element (NumPy before 2.4 turns that into a number
 /// with only a deprecation warning).
@@ -143,7 +153,7 @@ impl<'a, 'py> FromPyObject<'a, 'py> for Abscissae {
 
     fn extract(ob: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
         const WHAT: &str = "one abscissa [m] or a 1-D array-like of them";
-        if ob.is_instance_of::<pyo3::types::PyBool>() {
+        if is_bool(ob) {
             return Err(PyTypeError::new_err(format!(
                 "expected {WHAT}; got a `bool`"
             )));
@@ -176,6 +186,11 @@ impl<'a, 'py> FromPyObject<'a, 'py> for Tensions<'py> {
     /// number with a deprecation warning); anything else that is a real number is one; the rest
     /// is read as an array-like, whose error says what is accepted.
     fn extract(ob: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        if is_bool(ob) {
+            return Err(PyTypeError::new_err(
+                "expected tensions [N]: one real number for every tendon, or a 1-D array-like of one per tendon; got a `bool`",
+            ));
+        }
         if let Some(x) = one_number(ob) {
             return Ok(Tensions::Scalar(x));
         }
@@ -225,7 +240,25 @@ pub fn finite(name: &str, v: DVector<f64>) -> PyResult<DVector<f64>> {
 /// raises a bare `OverflowError` "int too big to convert" for an int past `i128`, which says
 /// nothing of what is accepted. No count, size, index or seed of gvsrom reaches `u64::MAX`, so
 /// this says so; pyo3 names the argument in the exception's note.
+///
+/// A float of a whole value (`modes(2.0)`) is that number; any other float, and a `bool`, is a
+/// `TypeError` saying what is accepted.
 pub fn whole(ob: &Bound<'_, PyAny>) -> PyResult<i128> {
+    if is_bool(ob.as_borrowed()) {
+        return Err(PyTypeError::new_err(
+            "expected a whole number; got a `bool`",
+        ));
+    }
+    if ob.is_instance_of::<pyo3::types::PyFloat>() {
+        let x: f64 = ob.extract()?;
+        return match x.is_finite() && x.fract() == 0.0 && x.abs() <= u64::MAX as f64 {
+            true => Ok(x as i128),
+            false => Err(PyTypeError::new_err(format!(
+                "expected a whole number; got {}",
+                ob.repr()?
+            ))),
+        };
+    }
     match ob.extract::<i128>() {
         Err(_) if ob.is_instance_of::<pyo3::types::PyInt>() => Err(invalid(format!(
             "{}: too large, expected a whole number ≤ {}",

@@ -35,7 +35,7 @@ use std::path::PathBuf;
 /// tip_rotation : numpy.ndarray, shape (N, 3, 3)
 /// status : numpy.ndarray of uint8, shape (N,)
 ///     0 ok, 1 failed, 2 not computed.
-/// iterations : numpy.ndarray of uint32, shape (N,)
+/// iterations : numpy.ndarray of int64, shape (N,)
 ///     The statics solver's iterations per sample (0 in a dynamic dataset: no solve).
 /// residual : numpy.ndarray, shape (N,)
 ///     ‖R‖∞ (generalized forces) at each equilibrium; NaN where nothing was solved (failed samples, and every row
@@ -97,7 +97,7 @@ pub struct Dataset {
     /// 0 ok, 1 failed, 2 not computed (uint8), shape (N,).
     #[pyo3(get)]
     status: Py<PyAny>,
-    /// Statics solver iterations (uint32), shape (N,); 0 in a dynamic dataset.
+    /// Statics solver iterations (int64; the file holds them as uint32), shape (N,); 0 in a dynamic dataset.
     #[pyo3(get)]
     iterations: Py<PyAny>,
     /// ‖R‖∞ at the equilibria, shape (N,); NaN where nothing was solved (failed samples, every row
@@ -206,7 +206,10 @@ pub fn load_dataset(py: Python<'_>, path: PathBuf) -> PyResult<Dataset> {
         tip_position: held(shaped(py, d.tip_position, [n, 3])?)?,
         tip_rotation: held(shaped(py, d.tip_rotation, [n, 3, 3])?)?,
         status: held(PyArray::from_vec(py, d.status).into_any())?,
-        iterations: held(PyArray::from_vec(py, d.iterations).into_any())?,
+        // int64 as `StaticsBatch.iterations`: the file's u32 wraps around in arithmetic
+        iterations: held(
+            PyArray::from_vec(py, d.iterations.iter().map(|&i| i64::from(i)).collect()).into_any(),
+        )?,
         residual: held(PyArray::from_vec(py, d.residual).into_any())?,
         strain_x: held(PyArray::from_vec(py, d.strain_x).into_any())?,
         t: d.t

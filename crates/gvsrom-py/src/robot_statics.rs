@@ -156,7 +156,8 @@ impl Robot {
     /// Parameters
     /// ----------
     /// U : array_like of float, shape (m, n_actuators)
-    ///     One row of tensions [N] per equilibrium.
+    ///     One row of tensions [N] per equilibrium. Every tendon is driven by its tension here,
+    ///     also one the scenario drives by its displacement (as ``statics(u)`` with ``u`` given).
     /// warm_start : bool
     ///     Start each solve from a neighbouring row's solution (default).
     ///

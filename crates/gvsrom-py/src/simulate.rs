@@ -107,7 +107,8 @@ impl Robot {
     /// dict
     ///     ``t`` (k,), ``q``/``qd`` (k, n), ``u`` (k, n_a: the tensions, a displacement-driven
     ///     tendon's found from its thread's stretch), ``tip_position`` (k, 3),
-    ///     ``tip_rotation`` (k, 3, 3), ``strain`` (k, p, 6), ``strain_x`` (p,), ``centerline``
+    ///     ``tip_rotation`` (k, 3, 3), ``strain`` (k, p, 6), ``strain_x`` (p,),
+    ///     ``strain_reference`` (p, 6: the stress-free strain ξ*), ``centerline``
     ///     (k, c, 3), ``centerline_x`` (c,), ``tendon_paths`` (k, n_a, c, 3: each tendon's thread
     ///     at ``centerline_x`` clamped to its span), ``tendon_lengths`` (k, n_a: each tendon's
     ///     length [m] along its thread; at rest :attr:`Robot.tendon_rest_lengths`), with a tendon

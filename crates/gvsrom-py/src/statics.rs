@@ -253,8 +253,11 @@ impl Statics {
     }
 }
 
-/// Many static equilibria (:meth:`Robot.statics_batch`): the fields of :class:`Statics` stacked
-/// along a first axis of length m.
+/// Many static equilibria (:meth:`Robot.statics_batch`): the arrays below, those of
+/// :class:`Statics` stacked along a first axis of length m. Of :class:`Statics`'s other fields it
+/// has none (the tendon paths, body positions, drives, load stages, ``to_dict``): solve the rows
+/// of interest with :meth:`Robot.statics` for those. A missing value is NaN here, where
+/// :class:`Statics` gives None.
 ///
 /// Attributes
 /// ----------

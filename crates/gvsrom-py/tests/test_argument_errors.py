@@ -223,3 +223,17 @@ def test_deepcopy_takes_its_memo_by_the_stubs_name():
     assert s.__deepcopy__(memo={}).to_toml() == s.to_toml()
     assert copy.deepcopy(s).to_toml() == s.to_toml()
 
+
+
+def test_a_bool_is_no_tension_nor_count_and_a_whole_float_is_a_count():
+    robot = gvsrom.Scenario.preset("single-tendon").build()
+    # True is 1 to Python: as a tension it would pull +1 N, as a point index take point 1
+    for bad in (True, np.bool_(False)):
+        with pytest.raises(TypeError, match=r"tensions \[N\].*got a `bool`"):
+            robot.statics(bad)
+        with pytest.raises(TypeError, match=r"whole number; got a `bool`"):
+            robot.modes(bad)
+    with pytest.raises(TypeError, match=r"whole number; got 2\.5"):
+        robot.modes(2.5)
+    # a float of a whole value is that count
+    assert len(robot.modes(2.0)["frequency_hz"]) == 2

@@ -60,7 +60,9 @@ def test_load_dataset_reads_the_files_and_the_metadata(sweep):
     assert ds.parameters == ["tendons.0.tension"]
     for name in FILES:
         np.testing.assert_array_equal(getattr(ds, name), np.load(ds.path / f"{name}.npy"), err_msg=name)
-    assert ds.status.dtype == np.uint8 and ds.iterations.dtype == np.uint32
+    # the iteration counts as int64, as StaticsBatch's (the file's u32 would wrap in arithmetic)
+    assert ds.status.dtype == np.uint8 and ds.iterations.dtype == np.int64
+    assert (ds.iterations - 1000 < 0).all()
     assert ds.strain.shape == (7, ds.n_points * len(ds.components))
     np.testing.assert_array_equal(ds.inputs[:, 0], np.linspace(-6, 0, 7))
     assert ds.meta["samples"] == 7 and ds.meta["counts"]["ok"] == 7
