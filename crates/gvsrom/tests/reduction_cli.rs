@@ -1039,3 +1039,22 @@ fn a_one_snapshot_pod_is_plotted_without_its_empty_energy_panel() {
         "{out}"
     );
 }
+
+/// Snapshots of one input value (`-1:-1`) do not differ: `train` refuses them naming the dataset,
+/// before anything is written, where a model trained on them was unstable in statics and failed
+/// in motion at once.
+#[test]
+fn train_refuses_snapshots_that_do_not_differ() {
+    let ds = sweep_dataset("constant-sweep", "-1:-1", 3);
+    let out = scratch("constant-model");
+    expect_error(
+        &["train", s(&ds), "--epochs", "5", "--out", s(&out)],
+        &[
+            "DATASET",
+            "constant-sweep",
+            "the 3 usable snapshots do not differ",
+            "--sweep",
+        ],
+    );
+    assert!(!out.exists());
+}

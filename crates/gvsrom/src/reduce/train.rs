@@ -50,6 +50,46 @@ pub struct TrainSummary {
 /// With `init` the training starts from that model's weights and scaling (`--init`, [`StartModel`]):
 /// its architecture, decoder form and loss must be `options`' and `loss`.
 #[allow(clippy::too_many_arguments)]
+/// Snapshots that do not differ (a sweep of one value, `LO:LO`) give an autoencoder nothing to
+/// learn: its standardization divides by a spread of 0 and the model trained on them is no
+/// model (on the IV-A arm, an unstable reduced statics and a run that fails at once). Refused,
+/// naming the datasets, when every feature's spread over the rows `x` (`rows × features`) is
+/// within 1e-12 of the snapshots' size.
+fn refuse_constant_snapshots<P: AsRef<Path>>(
+    x: &[f64],
+    rows: usize,
+    features: usize,
+    datasets: &[P],
+) -> Result<(), anyhow::Error> {
+    if rows == 0 || features == 0 {
+        return Ok(());
+    }
+    let size = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let spread = (0..features)
+        .map(|f| {
+            let column = (0..rows).map(|r| x[r * features + f]);
+            let (lo, hi) = column.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(v), hi.max(v))
+            });
+            hi - lo
+        })
+        .fold(0.0f64, f64::max);
+    if spread > 1e-12 * size && spread > 0.0 {
+        return Ok(());
+    }
+    let names: Vec<String> = (datasets.iter())
+        .map(|d| format!("`{}`", d.as_ref().display()))
+        .collect();
+    Err(invalid(
+        "DATASET",
+        format!(
+            "{}: the {rows} usable snapshots do not differ (largest spread {spread:.3e} against their size {size:.3e}), so an autoencoder has nothing to learn from them; sample the inputs over a range (e.g. `--sweep tendons.0.tension=-6:0`)",
+            names.join(", ")
+        ),
+    )
+    .into())
+}
+
 pub fn train<P: AsRef<Path>>(
     datasets: &[P],
     init: Option<&StartModel>,
@@ -105,6 +145,7 @@ pub fn train<P: AsRef<Path>>(
         )
         .into());
     }
+    refuse_constant_snapshots(x, rows, features, datasets)?;
     let dir = OutputDir::create("--out", out, crate::reduced_model::MODEL_FORMAT, force)?;
     // the zero-strain anchor of trajectory data: the straight rod, where simulations from rest
     // start, joins the training rows so that a latent point decodes to it

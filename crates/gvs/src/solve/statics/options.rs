@@ -24,6 +24,9 @@ pub const MIN_FTOL: f64 = 1e-14;
 pub const MAX_FTOL: f64 = 1e-3;
 /// Smallest `solver.xtol` accepted: `ε`; a step below `ε (1 + ‖q‖∞)` does not change `q`.
 pub const MIN_XTOL: f64 = f64::EPSILON;
+/// Largest `solver.xtol` accepted: a step of 0.1 % of the state is progress, not a stall (with
+/// `xtol = 1e300` every solve stalled at its first step and the error blamed the load).
+pub const MAX_XTOL: f64 = 1e-3;
 
 /// Largest number of coordinates for which [`StaticsJacobian::Auto`] takes forward differences.
 ///
@@ -101,7 +104,7 @@ impl Default for StaticsOptions {
 impl StaticsOptions {
     /// Checks every option against its accepted range: `ramp_steps` in [1, [`MAX_RAMP_STEPS`]],
     /// `min_increment` in [[`MIN_INCREMENT_FLOOR`], 1], `ftol` in [[`MIN_FTOL`], [`MAX_FTOL`]],
-    /// `xtol` ≥ [`MIN_XTOL`], `max_iterations` in [1, [`MAX_ITERATIONS`]].
+    /// `xtol` in [[`MIN_XTOL`], [`MAX_XTOL`]], `max_iterations` in [1, [`MAX_ITERATIONS`]].
     pub fn validate(&self) -> Result<(), ModelError> {
         if !(1..=MAX_RAMP_STEPS).contains(&self.ramp_steps) {
             return Err(ModelError::value(
@@ -128,8 +131,8 @@ impl StaticsOptions {
             "solver.xtol",
             self.xtol,
             Some((MIN_XTOL, true)),
-            None,
-            &format!("a finite number >= {MIN_XTOL:e} (the machine epsilon)"),
+            Some((MAX_XTOL, true)),
+            &format!("a number in [{MIN_XTOL:e} (the machine epsilon), {MAX_XTOL:e}]: a larger one takes a step that still makes progress for a stall"),
         )?;
         if !(1..=MAX_ITERATIONS).contains(&self.max_iterations) {
             return Err(ModelError::value(
