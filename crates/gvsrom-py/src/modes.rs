@@ -30,7 +30,8 @@ impl Robot {
     ///     [1/s²] (negative: unstable), ``shape`` (k, n_dof), ``strain`` (k, n_points, 6) the
     ///     modal strain per unit modal coordinate, ``strain_energy_share`` (k, 6),
     ///     ``dominant_strain`` (list of k names), ``tip_displacement`` and ``tip_rotation``
-    ///     (k, 3) world axes, ``centerline_x`` (c,) and ``centerline`` (c, 3) the equilibrium's
+    ///     (k, 3) world axes per unit modal coordinate (``tip_rotation`` a small-rotation vector
+    ///     [rad], not the (3, 3) matrix of a statics or a trajectory), ``centerline_x`` (c,) and ``centerline`` (c, 3) the equilibrium's
     ///     centreline, ``centerline_shape`` (k, c, 3) its displacement per unit modal coordinate
     ///     (world axes), ``all_frequencies_hz`` (n_dof,; one fewer per inextensible held
     ///     tendon), ``q0`` (n_dof,), ``u`` (the tensions, those found for displacement drives),

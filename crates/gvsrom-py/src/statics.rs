@@ -39,7 +39,10 @@ use pyo3::types::PyDict;
 ///     The reference strain ξ* at the points (the unloaded rod's; ``[0, 0, 0, 1, 0, 0]`` straight).
 /// tendon_paths : tuple of numpy.ndarray, each shape (m_k, 3)
 ///     Each tendon's thread ``r + R d(X)`` in the world frame [m], from its start to its end (at
-///     its ends and at the ``centerline_x`` between them).
+///     its ends and at the ``centerline_x`` between them): tendons of different spans have
+///     different ``m_k``. A trajectory's ``tendon_paths`` (:meth:`Robot.simulate`) is one array
+///     (k, n_actuators, c, 3) at every ``centerline_x`` instead, clamped to each span (a short
+///     tendon's last point repeated).
 /// tendon_lengths : numpy.ndarray, shape (n_actuators,)
 ///     Each tendon's length [m] along its thread, ``∫ ‖t_u‖ dX`` over its span: what an encoder on
 ///     its actuator reads, up to a constant.

@@ -326,7 +326,7 @@ fn grid_per_axis(samples: usize, d: usize) -> Result<usize, String> {
         .find(|&k| pow(k) > samples as u128)
         .unwrap_or(m + 1);
     Err(format!(
-        "--samples {samples}: a grid over {d} parameters needs a perfect {d}-th power; nearest: {} ({below}^{d}) or {} ({above}^{d})",
+        "--samples {samples}: a grid over {d} parameters needs the same number of values along each, a count n^{d}; nearest: {} ({below}^{d}) or {} ({above}^{d})",
         pow(below),
         pow(above)
     ))
