@@ -42,14 +42,6 @@ pub struct TrainSummary {
     pub warnings: Vec<String>,
 }
 
-/// Trains an autoencoder on the snapshots of `datasets` (one, or several of one scenario: their
-/// rows in order) and saves it at `out`. `progress(epoch, train, validation)` is called after every
-/// epoch; `Break` stops training early (the best weights so far are kept and saved, marked by the
-/// stop reason). With `kinetic_weight` κ > 0 (and a rate term) the errors are also measured in
-/// the kinetic-energy norm of each row's own mass matrix (`reduce::kinetic`, [`rom::nn::metric`]).
-/// With `init` the training starts from that model's weights and scaling (`--init`, [`StartModel`]):
-/// its architecture, decoder form and loss must be `options`' and `loss`.
-#[allow(clippy::too_many_arguments)]
 /// Snapshots that do not differ (a sweep of one value, `LO:LO`) give an autoencoder nothing to
 /// learn: its standardization divides by a spread of 0 and the model trained on them is no
 /// model (on the IV-A arm, an unstable reduced statics and a run that fails at once). Refused,
@@ -90,6 +82,14 @@ fn refuse_constant_snapshots<P: AsRef<Path>>(
     .into())
 }
 
+/// Trains an autoencoder on the snapshots of `datasets` (one, or several of one scenario: their
+/// rows in order) and saves it at `out`. `progress(epoch, train, validation)` is called after every
+/// epoch; `Break` stops training early (the best weights so far are kept and saved, marked by the
+/// stop reason). With `kinetic_weight` κ > 0 (and a rate term) the errors are also measured in
+/// the kinetic-energy norm of each row's own mass matrix (`reduce::kinetic`, [`rom::nn::metric`]).
+/// With `init` the training starts from that model's weights and scaling (`--init`, [`StartModel`]):
+/// its architecture, decoder form and loss must be `options`' and `loss`.
+#[allow(clippy::too_many_arguments)]
 pub fn train<P: AsRef<Path>>(
     datasets: &[P],
     init: Option<&StartModel>,
