@@ -241,6 +241,17 @@ fn a_start_the_training_cannot_improve_on_is_reported_naming_it() {
         &["--init", "was not improved on", "not beaten in 3 epochs"],
     );
     assert!(!out.exists(), "nothing is written");
+    // with an L-BFGS fine-tune, that polishes the start's own weights, which Adam left unbeaten
+    let polished = scratch("init-no-gain-polished");
+    let mut args = continuation(&polished, &["--learning-rate", "1e-300"]);
+    let at = args.iter().position(|a| a == "--lbfgs-iterations").unwrap();
+    args[at + 1] = "20".into();
+    run_ok(&strs(&args));
+    let (start, more) = (training(first()), training(&polished));
+    assert!(
+        more["final_train_loss"].as_f64().unwrap() < start["final_train_loss"].as_f64().unwrap(),
+        "{start} → {more}"
+    );
 }
 
 /// Progress lines are best effort: a stderr whose reader went away must not stop the training.

@@ -269,8 +269,9 @@ pub(crate) fn fit(
         (opts.epochs, opts.learning_rate, lambda, opts.lr_reductions),
         (false, opts.lr_decay),
     );
-    let resumable =
-        matches!(stop, StopReason::EpochLimit | StopReason::EarlyStopping) && t.out.best_epoch > 0;
+    // also when no Adam epoch beat the initial weights: the fine-tune then starts from them (a
+    // start model polished before, `--init`, whose minimum Adam's first steps climb out of)
+    let resumable = matches!(stop, StopReason::EpochLimit | StopReason::EarlyStopping);
     if resumable && !matches!(opts.fine_tune, FineTune::None) {
         copy_layers(p.layers, &t.best);
         t.since_best = 0;
