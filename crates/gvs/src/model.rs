@@ -69,6 +69,8 @@ pub struct Model<P: StrainParam> {
     /// Base pose `g(0)`.
     pub base: Pose,
     pub(crate) props: Vec<SectionProps>,
+    /// [`Model::residual_floor`], of the `props` (fixed with them at construction).
+    residual_floor: f64,
     xi_star: Vec<V6>,
     tendon_points: Vec<Vec<usize>>,
     /// Per tendon, the length of its span each of its points stands for ([`tendon_weight_list`]).
@@ -137,6 +139,7 @@ impl<P: StrainParam> Model<P> {
                 (dy_slot[i], slots) = (slots, slots + 1);
             }
         }
+        let residual_floor = (props.iter()).fold(0.0, |m: f64, p| m.max(p.es[1]).max(p.es[2]));
         let mut m = Model {
             rod,
             disc,
@@ -144,6 +147,7 @@ impl<P: StrainParam> Model<P> {
             tendons,
             base: Pose::identity(),
             props,
+            residual_floor,
             xi_star,
             tendon_points,
             tendon_weights,
@@ -253,7 +257,7 @@ impl<P: StrainParam> Model<P> {
     /// forces by `s²`), and it keeps a projection that vanishes (a decoder's spurious straight
     /// rod, a load the basis cannot hold) from asking a residual below round-off.
     pub fn residual_floor(&self) -> f64 {
-        (self.props.iter()).fold(0.0, |m, p| m.max(p.es[1]).max(p.es[2]))
+        self.residual_floor
     }
 
     pub fn n_actuators(&self) -> usize {
