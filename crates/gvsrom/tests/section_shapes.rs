@@ -47,6 +47,23 @@ frame = "global"
     path
 }
 
+/// [`scenario`] `name` of `section` (order 4) with a tendon of `tendon`'s keys (tension −1e-4 N).
+fn with_tendon(name: &str, section: &str, tendon: &str) -> std::path::PathBuf {
+    let path = scenario(name, section, 4);
+    let mut text = std::fs::read_to_string(&path).unwrap();
+    text.push_str(&format!("\n[[tendons]]\ntension = -1e-4\n{tendon}\n"));
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// Each `(section, needles)`: `gvsrom check` of [`scenario`] `{prefix}-{i}` fails naming them.
+fn expect_section_errors(prefix: &str, cases: &[(&str, &[&str])]) {
+    for (i, (section, needles)) in cases.iter().enumerate() {
+        let toml = scenario(&format!("{prefix}-{i}"), section, 4);
+        expect_error(&["check", path_str(&toml)], needles);
+    }
+}
+
 /// `(A, I_y = ∫z² dA, I_z = ∫y² dA, J_t)` of the section, from the textbook formulas (the
 /// rectangle's torsion constant from Timoshenko & Goodier's series, written out here again).
 struct Moments {
@@ -220,20 +237,13 @@ fn sections_are_checked_and_hold_their_tendons() {
             &["section", "square"],
         ),
     ];
-    for (i, (section, needles)) in cases.iter().enumerate() {
-        let toml = scenario(&format!("bad-section-{i}"), section, 4);
-        expect_error(&["check", path_str(&toml)], needles);
-    }
+    expect_section_errors("bad-section", &cases);
     let tendon = |name: &str, tendon: &str| {
-        let path = scenario(
+        with_tendon(
             name,
             "section = \"rectangle\"\nwidth = 0.03\nheight = 0.01",
-            4,
-        );
-        let mut text = std::fs::read_to_string(&path).unwrap();
-        text.push_str(&format!("\n[[tendons]]\ntension = -1e-4\n{tendon}\n"));
-        std::fs::write(&path, text).unwrap();
-        path
+            tendon,
+        )
     };
     // at 90° on the surface: the rectangle's half height, not its circumscribed radius
     let on_top = tendon("rect-tendon-top", "angle_deg = 90.0");
@@ -428,17 +438,13 @@ fn a_tube_is_checked_and_a_preset_takes_one_by_overrides() {
             &["divisions[0].inner_radius_end", "missing"],
         ),
     ];
-    for (i, (section, needles)) in cases.iter().enumerate() {
-        let toml = scenario(&format!("bad-tube-{i}"), section, 4);
-        expect_error(&["check", path_str(&toml)], needles);
-    }
+    expect_section_errors("bad-tube", &cases);
     // a tendon through the bore (on spacer discs) is inside the section
-    let path = scenario("tube-tendon-bore", "radius = 0.01\ninner_radius = 0.008", 4);
-    let mut text = std::fs::read_to_string(&path).unwrap();
-    text.push_str(
-        "\n[[tendons]]\ntension = -1e-4\noffset_start = [0.0, 0.004]\noffset_end = [0.0, 0.004]\n",
+    let path = with_tendon(
+        "tube-tendon-bore",
+        "radius = 0.01\ninner_radius = 0.008",
+        "offset_start = [0.0, 0.004]\noffset_end = [0.0, 0.004]",
     );
-    std::fs::write(&path, text).unwrap();
     common::run_ok(&["check", path_str(&path)]);
     // a preset's circle becomes a tube, written in the record; an override of the shape drops it
     let (stdout, eq) = run_json(

@@ -256,7 +256,7 @@ impl Tendon {
         let gauge = |x: f64| {
             let d = self.offset(x);
             let span = (self.x_start, self.x_end);
-            section_gauge_over(rod, span, x, d[1], d[2]).map_or(f64::NAN, |(g, _, _)| g)
+            section_gauge(rod, span, x, d[1], d[2]).map_or(f64::NAN, |(g, _, _)| g)
         };
         let span = self.x_end - self.x_start;
         let n = Self::PATH_SAMPLES * rod.divisions.len()
@@ -396,17 +396,12 @@ fn golden_max(f: &dyn Fn(f64) -> f64, a: f64, b: f64, start: (f64, f64)) -> (f64
     }
 }
 
-/// The rod's section gauge of the offset `(y, z)` at `x`
-/// ([`crate::rod::DivisionGeometry::gauge_at`], ≤ 1 inside), with the division and `X̄` it was
-/// taken in: at a division junction, the side where it is larger. `None` for `x` off the rod.
-pub fn section_gauge(rod: &Rod, x: f64, y: f64, z: f64) -> Option<(f64, &DivisionGeometry, f64)> {
-    section_gauge_over(rod, (0.0, rod.length()), x, y, z)
-}
-
-/// [`section_gauge`] for a tendon spanning `span = (x_start, x_end)`: at a junction, only the
-/// divisions the span enters count. A tendon that ends where a division ends is fixed to that
-/// division's end face, not to the next one's start (a step in the radius there is no limit).
-pub fn section_gauge_over(
+/// The rod's section gauge of the offset `(y, z)` at `x` of a tendon spanning
+/// `span = (x_start, x_end)` ([`crate::rod::DivisionGeometry::gauge_at`], ≤ 1 inside), with the
+/// division and `X̄` it was taken in. At a division junction, the larger of the sides the span
+/// enters: a tendon that ends where a division ends is fixed to that division's end face, not to
+/// the next one's start (a step in the radius there is no limit). `None` for `x` off the rod.
+pub fn section_gauge(
     rod: &Rod,
     span: (f64, f64),
     x: f64,
@@ -433,10 +428,10 @@ pub fn section_gauge_over(
 }
 
 /// `None` if the offset `d` of a tendon spanning `span` lies inside the rod's section at `x`
-/// ([`section_gauge_over`] ≤ 1 + 1e-9); else what is accepted there: "an offset of norm <= the
+/// ([`section_gauge`] ≤ 1 + 1e-9); else what is accepted there: "an offset of norm <= the
 /// section radius r m", or "an offset inside the section (…)".
 fn outside_section(rod: &Rod, span: (f64, f64), x: f64, d: &V3) -> Option<String> {
-    let (g, div, x_bar) = section_gauge_over(rod, span, x, d[1], d[2])?;
+    let (g, div, x_bar) = section_gauge(rod, span, x, d[1], d[2])?;
     (g > 1.0 + 1e-9).then(|| match div.section {
         None => format!(
             "an offset of norm <= the section radius {} m",

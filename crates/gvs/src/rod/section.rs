@@ -169,6 +169,17 @@ mod tests {
         ((a - b) / b).abs()
     }
 
+    /// E = 2 MPa, ν = 0.3 (G = E/2.6), ρ = 1200 kg/m³, η = 3 kPa·s: every factor of `Es`, `Ms`
+    /// and `Ds` distinct from 1 and from each other.
+    fn stiff_material() -> Material {
+        Material {
+            youngs_modulus: 2e6,
+            poisson_ratio: 0.3,
+            density: 1200.0,
+            damping: 3e3,
+        }
+    }
+
     #[test]
     fn section_values_match_spec_table() {
         // gvs-spec §3.4, single-actuator base and tip, six-actuator base.
@@ -205,12 +216,7 @@ mod tests {
     fn every_stiffness_inertia_and_damping_entry_matches_its_closed_form() {
         // gvs-spec §3.4 for a solid circle of radius r: A = πr², I = πr⁴/4, J = 2I;
         // Ms = ρ diag(J, I, I, A, A, A), Ds = η diag(J, 3I, 3I, 3A, A, A) (§3.4), entry by entry
-        let m = Material {
-            youngs_modulus: 2e6,
-            poisson_ratio: 0.3,
-            density: 1200.0,
-            damping: 3e3,
-        };
+        let m = stiff_material();
         let r = 0.015;
         let s = SectionProps::circular(&m, r);
         let a = PI * r * r;
@@ -333,12 +339,7 @@ mod tests {
 
     #[test]
     fn rectangle_and_ellipse_moments_match_quadrature_of_their_areas() {
-        let m = Material {
-            youngs_modulus: 2e6,
-            poisson_ratio: 0.3,
-            density: 1200.0,
-            damping: 3e3,
-        };
+        let m = stiff_material();
         let (e, g) = (2e6, 2e6 / 2.6);
         let (w, h) = (0.04, 0.01);
         // area, ∫z² dA, ∫y² dA by the midpoint rule on a fine grid over the bounding box
@@ -402,12 +403,7 @@ mod tests {
 
     #[test]
     fn tube_moments_match_quadrature_of_the_annulus_and_the_thin_wall_limit() {
-        let m = Material {
-            youngs_modulus: 2e6,
-            poisson_ratio: 0.3,
-            density: 1200.0,
-            damping: 3e3,
-        };
+        let m = stiff_material();
         let (e, g) = (2e6, 2e6 / 2.6);
         let (r, r_i) = (0.01, 0.006);
         // area and ∫z² dA over the annulus by the midpoint rule in polar coordinates

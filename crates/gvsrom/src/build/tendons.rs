@@ -33,10 +33,10 @@ pub(super) fn reach_at(rod: &Rod, x: f64, after: bool, theta: f64) -> f64 {
 }
 
 /// The section's gauge of the offset `(y, z)` at `x` of a tendon spanning `span` (> 1 outside;
-/// the larger side of a junction the span enters, [`gvs::actuation::section_gauge_over`]) and
+/// the larger side of a junction the span enters, [`gvs::actuation::section_gauge`]) and
 /// what the section there is, for a message.
 fn gauge_at(rod: &Rod, span: (f64, f64), x: f64, y: f64, z: f64) -> (f64, String) {
-    gvs::actuation::section_gauge_over(rod, span, x, y, z)
+    gvs::actuation::section_gauge(rod, span, x, y, z)
         .map_or((f64::NAN, String::new()), |(g, d, x_bar)| {
             (g, d.describe_at(x_bar))
         })
