@@ -14,7 +14,7 @@
 //! A body needs a computational point at its `x` (the front-ends add it to the discretization's
 //! extra points, as for point loads).
 
-use crate::error::{check_range, fmt_sci, fmt_value, ModelError};
+use crate::error::{check_range, fmt_rounded, fmt_sci, fmt_value, ModelError};
 use crate::lie::{tilde, M3, M6, V3, V6};
 use nalgebra::SymmetricEigen;
 use serde::{Deserialize, Serialize};
@@ -71,13 +71,13 @@ impl RigidBody {
     /// Checks the body's data, naming the fields `bodies[k].…`; `length` is the rod's.
     pub fn validate(&self, k: usize, length: f64) -> Result<(), ModelError> {
         let f = |n: &str| format!("bodies[{k}].{n}");
-        check_range(
-            &f("x"),
-            self.x,
-            Some((0.0, true)),
-            Some((length * (1.0 + 1e-12), true)),
-            &format!("an abscissa in [0, {length}] m"),
-        )?;
+        if crate::rod::abscissa_on(length, self.x).is_none() {
+            return Err(ModelError::value(
+                f("x"),
+                self.x,
+                format!("an abscissa in [0, {}] m", fmt_rounded(length)),
+            ));
+        }
         check_range(
             &f("mass"),
             self.mass,

@@ -20,7 +20,7 @@
 //! `[torsion, bend-y, bend-z, elongation, shear-y, shear-z]`; a planar model may keep only its active
 //! components, in the same order.
 
-use crate::error::{check_range, ModelError};
+use crate::error::{fmt_rounded, ModelError};
 use crate::rod::Rod;
 use serde::{Deserialize, Serialize};
 
@@ -161,13 +161,13 @@ impl Discretization {
         }
         let length = rod.length();
         for (k, &x) in extra_x.iter().enumerate() {
-            check_range(
-                &format!("discretization.extra_points[{k}]"),
-                x,
-                Some((0.0, true)),
-                Some((length, true)),
-                &format!("an abscissa in [0, {length}] m"),
-            )?;
+            if crate::rod::abscissa_on(length, x).is_none() {
+                return Err(ModelError::value(
+                    format!("discretization.extra_points[{k}]"),
+                    x,
+                    format!("an abscissa in [0, {}] m", fmt_rounded(length)),
+                ));
+            }
         }
         let div_start = rod.division_starts();
         let div_length: Vec<f64> = rod.divisions.iter().map(|d| d.length).collect();

@@ -42,6 +42,12 @@ pub fn fmt_value(v: f64) -> String {
     }
 }
 
+/// A computed number for a message (a sum of lengths, a product), rounded to 12 significant digits
+/// first so its last bit's rounding does not show: `0.7 + 0.2` reads `0.9`, not `0.8999999999999999`.
+pub fn fmt_rounded(v: f64) -> String {
+    fmt_value(format!("{v:.11e}").parse().unwrap_or(v))
+}
+
 /// `v` in exponent form with `digits` decimals, the exponent left out where it is 0: `1.0881e-2`,
 /// `1.0878` (not `1.0878e0`), `3.2000e5`.
 pub fn fmt_sci(v: f64, digits: usize) -> String {

@@ -102,7 +102,7 @@ impl Robot {
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         let q = self.coordinates(&q)?;
         let arrays::Abscissae { values: xs, one } = x;
-        gvsrom::linearize::check_abscissae("x", &xs, self.built.model.disc.length())
+        let xs = gvsrom::linearize::check_abscissae("x", &xs, self.built.model.disc.length())
             .map_err(|e| invalid(e.to_string()))?;
         let n = self.built.n_dof();
         let k = xs.len();

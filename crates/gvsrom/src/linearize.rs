@@ -25,7 +25,7 @@ use crate::build::Built;
 use crate::error::{ScenarioError, StaticsFailure};
 use crate::statics::{self, StaticsReport};
 use gvs::dynamics::{Channel, DynamicsError, StateSpace};
-use gvs::error::fmt_value;
+use gvs::error::{fmt_rounded, fmt_value};
 use gvs::model::Model;
 use gvs::strain::StrainParam;
 use gvs::ModelError;
@@ -50,13 +50,13 @@ pub enum LinearizeError {
         why: String,
         most: Option<f64>,
     },
-    #[error("{field} `{}`: expected abscissae along the rod, each finite and within [0, {}] m (0 the base, {} m the tip)", fmt_value(*value), fmt_value(*length), fmt_value(*length))]
+    #[error("{field} `{}`: expected abscissae along the rod, each finite and within [0, {}] m (0 the base, {} m the tip)", fmt_value(*value), fmt_rounded(*length), fmt_rounded(*length))]
     OutputAt {
         field: &'static str,
         value: f64,
         length: f64,
     },
-    #[error("{field}: no abscissa given; expected at least one (the tip is {} m)", fmt_value(*length))]
+    #[error("{field}: no abscissa given; expected at least one (the tip is {} m)", fmt_rounded(*length))]
     NoOutput { field: &'static str, length: f64 },
     #[error("--output-tendon-lengths: the rod has no tendons, so no tendon length to output; accepted with tendons only")]
     NoTendons,
@@ -315,9 +315,9 @@ impl Outputs {
     /// The positions at the abscissae `xs` \[m\] (world axes, 3 rows of `C` each, in this order),
     /// each finite and within `[0, L]`; at least one.
     pub fn at(built: &Built, xs: &[f64]) -> Result<Self, LinearizeError> {
-        check_abscissae("--output-at", xs, built.model.disc.length())?;
+        let xs = check_abscissae("--output-at", xs, built.model.disc.length())?;
         Ok(Outputs {
-            xs: xs.to_vec(),
+            xs,
             tip_orientation: false,
             tendon_lengths: false,
         })
@@ -362,20 +362,26 @@ impl Outputs {
     }
 }
 
-/// Checks the abscissae `xs` of option `field` (at least one, each finite and within `[0, length]`):
-/// where positions along the rod are read.
-pub fn check_abscissae(field: &'static str, xs: &[f64], length: f64) -> Result<(), LinearizeError> {
+/// The abscissae `xs` of option `field` (at least one, each finite and within `[0, length]`; one
+/// past the tip by the rounding of the divisions' summed lengths is the tip,
+/// [`gvs::rod::abscissa_on`]): where positions along the rod are read.
+pub fn check_abscissae(
+    field: &'static str,
+    xs: &[f64],
+    length: f64,
+) -> Result<Vec<f64>, LinearizeError> {
     if xs.is_empty() {
         return Err(LinearizeError::NoOutput { field, length });
     }
-    match (xs.iter()).find(|x| !(x.is_finite() && (0.0..=length).contains(*x))) {
-        Some(&value) => Err(LinearizeError::OutputAt {
-            field,
-            value,
-            length,
-        }),
-        None => Ok(()),
-    }
+    xs.iter()
+        .map(|&value| {
+            gvs::rod::abscissa_on(length, value).ok_or(LinearizeError::OutputAt {
+                field,
+                value,
+                length,
+            })
+        })
+        .collect()
 }
 
 /// Solves the equilibrium of `built` (as `gvsrom statics` does, with the reduced model if one is

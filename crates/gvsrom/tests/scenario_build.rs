@@ -910,3 +910,78 @@ fn a_helix_sampled_by_too_few_points_is_named_with_the_points_that_resolve_it() 
     // a straight tendon is never warned about
     assert!(gvsrom::build::under_resolved_helices(&built(&[]).model).is_empty());
 }
+
+/// Divisions of 0.7 + 0.2 m sum to 0.8999999999999999 m in floating point: the tip is still 0.9 m for
+/// every key that takes an abscissa (a point load, a distributed load's end, a body, a tendon's end,
+/// a linearization's output), and the messages and summary print 0.9, not the sum's last bit.
+#[test]
+fn a_rod_whose_division_lengths_sum_below_their_decimal_takes_loads_at_its_tip() {
+    let rod = r#"
+        name = "two-division"
+        [material]
+        youngs_modulus = 1e6
+        poisson_ratio = 0.5
+        density = 1000
+        [[divisions]]
+        length = 0.7
+        radius = 0.01
+        basis = { kind = "legendre", modes = ["bend_y", "elongation", "shear_z"], order = 2 }
+        [[divisions]]
+        length = 0.2
+        radius = 0.01
+        basis = { kind = "legendre", modes = ["bend_y", "elongation", "shear_z"], order = 2 }
+        [loads]
+        gravity = [0, 0, 0]
+    "#;
+    let sum: f64 = [0.7, 0.2].iter().sum();
+    assert!(sum < 0.9, "the premise: the sum rounds below 0.9");
+    // an end moment at x = 0.9 bends both divisions onto one circle, κ = M/EI, tip at L = 0.9
+    let ei = 1e6 * std::f64::consts::PI * 0.01f64.powi(4) / 4.0;
+    let kappa = 0.01 / ei;
+    let r = run_text(
+        rod,
+        &["loads.point.0.x=0.9", "loads.point.0.moment=[0, 0.01, 0]"],
+    );
+    let expected = [
+        (kappa * 0.9).sin() / kappa,
+        0.0,
+        -(1.0 - (kappa * 0.9).cos()) / kappa,
+    ];
+    for i in 0..3 {
+        assert!(
+            (r.tip_position[i] - expected[i]).abs() < 1e-9,
+            "{:?} vs {expected:?}",
+            r.tip_position
+        );
+    }
+    let build = |overrides: &[&str]| {
+        let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+        let s = Scenario::from_toml("test", rod, &overrides).expect("scenario parses");
+        gvsrom::build(&s).map(|b| (gvsrom::build::describe(&s, &b), b))
+    };
+    let (summary, built) = build(&[
+        "loads.distributed.0.kind=uniform",
+        "loads.distributed.0.x_start=0.5",
+        "loads.distributed.0.x_end=0.9",
+        "loads.distributed.0.force=[0, 0, -1]",
+        "bodies.0.x=0.9",
+        "bodies.0.mass=0.01",
+        "tendons.0.offset_start=[0, 0.005]",
+        "tendons.0.offset_end=[0, 0.005]",
+        "tendons.0.x_end=0.9",
+    ])
+    .expect("every abscissa 0.9 is the tip");
+    assert!(summary.contains("0.9 m uniform"), "{summary}");
+    if let Err(e) = gvsrom::linearize::Outputs::at(&built, &[0.9]) {
+        panic!("the tip is a linearization's output: {e}");
+    }
+    // past the tip is still refused, naming the rod's length as 0.9 m
+    let e = build(&["loads.point.0.x=0.91", "loads.point.0.force=[0, 0, 1]"])
+        .map(|_| ())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("loads.point[0].x") && e.contains("[0, 0.9] m"),
+        "{e}"
+    );
+}

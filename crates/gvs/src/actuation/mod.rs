@@ -19,7 +19,7 @@
 //! contributing beyond `X_e`: its termination load is the jump of the internal wrench, no extra point
 //! load is added (spec §7.6).
 
-use crate::error::{check_range, ModelError};
+use crate::error::{check_range, fmt_rounded, ModelError};
 use crate::lie::V3;
 use crate::rod::{DivisionGeometry, Rod};
 use serde::{Deserialize, Serialize};
@@ -163,14 +163,14 @@ impl Tendon {
             self.x_start,
             Some((0.0, true)),
             Some((l, false)),
-            &format!("an abscissa in [0, {l}) m"),
+            &format!("an abscissa in [0, {}) m", fmt_rounded(l)),
         )?;
         check_range(
             &f("x_end"),
             self.x_end,
             Some((self.x_start, false)),
             Some((l * (1.0 + 1e-12), true)),
-            &format!("an abscissa in ({}, {l}] m", self.x_start),
+            &format!("an abscissa in ({}, {}] m", self.x_start, fmt_rounded(l)),
         )?;
         check_range(
             &f("friction"),

@@ -158,6 +158,13 @@ pub struct Rod {
     pub divisions: Vec<DivisionGeometry>,
 }
 
+/// `x` as an abscissa of a rod of `length`: `x` itself in `[0, L]`, `L` for an `x` past the end by
+/// at most the rounding of the divisions' summed lengths (`1e-12 L`: `0.7 + 0.2` is
+/// `0.8999999999999999`, and `x = 0.9` is the tip), `None` otherwise (NaN included).
+pub fn abscissa_on(length: f64, x: f64) -> Option<f64> {
+    (x >= 0.0 && x <= length * (1.0 + 1e-12)).then(|| x.min(length))
+}
+
 impl Rod {
     /// A single-division rod with a linear taper.
     pub fn tapered(material: Material, length: f64, radius_start: f64, radius_end: f64) -> Self {
@@ -258,6 +265,11 @@ impl Rod {
     /// Total length `L = Σ ℓ_j`.
     pub fn length(&self) -> f64 {
         self.divisions.iter().map(|d| d.length).sum()
+    }
+
+    /// `x` as an abscissa of this rod; see [`abscissa_on`].
+    pub fn abscissa(&self, x: f64) -> Option<f64> {
+        abscissa_on(self.length(), x)
     }
 
     /// Abscissa of the start of each division.

@@ -49,7 +49,7 @@ pub fn describe(s: &Scenario, built: &Built) -> String {
     let precurved = (0..m.disc.n_sites()).any(|site| m.xi_star(site) != super::rod::STRAIGHT);
     let mut parts = vec![format!(
         "{} m {}{shape}{} rod{}",
-        m.rod.length(),
+        gvs::error::fmt_rounded(m.rod.length()),
         match (tapered, stepped) {
             (true, _) => "tapered",
             (false, true) => "stepped",

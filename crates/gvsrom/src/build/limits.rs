@@ -2,6 +2,7 @@
 //! outside.
 
 use crate::error::ScenarioError;
+use gvs::error::fmt_rounded;
 
 /// Largest Legendre order per mode accepted (higher orders are numerically pointless here).
 pub const MAX_LEGENDRE_ORDER: usize = 50;
@@ -58,6 +59,18 @@ pub(crate) fn num(v: f64) -> String {
     } else {
         format!("{v:e}")
     }
+}
+
+/// `x` as an abscissa of a rod of length `l` ([`gvs::rod::abscissa_on`]: `[0, L]`, an end past
+/// `L` by the rounding of the divisions' summed lengths is `L`), else an error naming `field`.
+pub(super) fn on_rod(field: &str, x: f64, l: f64) -> Result<f64, ScenarioError> {
+    gvs::rod::abscissa_on(l, x).ok_or_else(|| {
+        ScenarioError::value(
+            field,
+            x,
+            format!("an abscissa in [0, {}] m", fmt_rounded(l)),
+        )
+    })
 }
 
 /// `v` in the closed range `[lo, hi]`, else an error naming `field` and the range.

@@ -3,6 +3,7 @@
 use super::limits::*;
 use crate::error::ScenarioError;
 use crate::scenario::{default_pulse_axis, DistributedKind, Scenario};
+use gvs::error::fmt_rounded;
 use gvs::loads::{DistributedWrench, Loads, PointWrench};
 
 pub(super) fn wrench(moment: [f64; 3], force: [f64; 3]) -> [f64; 6] {
@@ -33,14 +34,7 @@ pub fn loads(s: &Scenario, l: f64) -> Result<Loads, ScenarioError> {
     let mut point = Vec::new();
     for (k, p) in spec.point.iter().enumerate() {
         let f = |n: &str| format!("loads.point[{k}].{n}");
-        let x = finite(&f("x"), p.x)?;
-        if !(0.0..=l).contains(&x) {
-            return Err(ScenarioError::value(
-                f("x"),
-                x,
-                format!("an abscissa in [0, {l}] m"),
-            ));
-        }
+        let x = on_rod(&f("x"), finite(&f("x"), p.x)?, l)?;
         for (name, v) in [("force", p.force), ("moment", p.moment)] {
             for (i, c) in v.iter().enumerate() {
                 finite(&f(&format!("{name}[{i}]")), *c)?;
@@ -79,17 +73,20 @@ pub fn loads(s: &Scenario, l: f64) -> Result<Loads, ScenarioError> {
                     return Err(ScenarioError::value(
                         f("x_start"),
                         x_start,
-                        format!("an abscissa in [0, {l}) m"),
+                        format!("an abscissa in [0, {}) m", fmt_rounded(l)),
                     ));
                 }
                 let x_end = finite(&f("x_end"), d.x_end.unwrap_or(l))?;
-                if !(x_end > x_start && x_end <= l) {
-                    return Err(ScenarioError::value(
-                        f("x_end"),
-                        x_end,
-                        format!("an abscissa in ({x_start}, {l}] m"),
-                    ));
-                }
+                let x_end = match gvs::rod::abscissa_on(l, x_end) {
+                    Some(x) if x > x_start => x,
+                    _ => {
+                        return Err(ScenarioError::value(
+                            f("x_end"),
+                            x_end,
+                            format!("an abscissa in ({x_start}, {}] m", fmt_rounded(l)),
+                        ))
+                    }
+                };
                 let force = d.force.unwrap_or_default();
                 let moment = d.moment.unwrap_or_default();
                 for (name, v) in [("force", force), ("moment", moment)] {
@@ -128,13 +125,7 @@ pub fn loads(s: &Scenario, l: f64) -> Result<Loads, ScenarioError> {
                     &f("center"),
                     required("center", d.center, "the pulse's centre X [m]")?,
                 )?;
-                if !(0.0..=l).contains(&center) {
-                    return Err(ScenarioError::value(
-                        f("center"),
-                        center,
-                        format!("an abscissa in [0, {l}] m"),
-                    ));
-                }
+                let center = on_rod(&f("center"), center, l)?;
                 let width = positive(
                     &f("width"),
                     required("width", d.width, "the base width [m]")?,

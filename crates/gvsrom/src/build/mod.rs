@@ -314,7 +314,8 @@ pub fn build(s: &Scenario) -> Result<Built, ScenarioError> {
         .bodies
         .iter()
         .map(|b| RigidBody {
-            x: b.x,
+            // a tip body at 0.9 m on divisions of 0.7 + 0.2 m sits at their sum, 0.8999999999999999
+            x: gvs::rod::abscissa_on(length, b.x).unwrap_or(b.x),
             mass: b.mass,
             center: b.center,
             inertia: b.inertia.tensor(),

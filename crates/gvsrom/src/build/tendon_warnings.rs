@@ -23,8 +23,8 @@ pub fn tendon_ends_inside_divisions(model: &Model<LinearBasis>) -> Vec<String> {
                 x > a + tol && x < a + l - tol
             });
             if let Some(j) = inside {
-                // to the picometre: 0.15, not 0.15000000000000002
-                let m = |v: f64| (v * 1e12).round() / 1e12;
+                // 0.15, not 0.15000000000000002
+                let m = gvs::error::fmt_rounded;
                 let (a, b) = (disc.div_start[j], disc.div_start[j] + disc.div_length[j]);
                 out.push(format!(
                     "tendons[{k}].{field} = {x} m lies inside divisions[{j}] ([{}, {}] m): the strain jumps there, which the division's continuous basis only smooths over (ringing around it); split the division at {x} m (two [[divisions]] of lengths {} and {} m) for an exact jump",

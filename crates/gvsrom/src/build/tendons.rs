@@ -4,7 +4,7 @@ use super::limits::*;
 use crate::error::ScenarioError;
 use crate::scenario::TendonSpec;
 use gvs::actuation::{Tendon, DEFAULT_FRICTION_SMOOTHING};
-use gvs::error::fmt_value;
+use gvs::error::{fmt_rounded, fmt_value};
 use gvs::rod::{DivisionGeometry, Rod};
 
 /// The division at `x` and `X̄` there, on the side given: `after = true` takes the division
@@ -53,18 +53,23 @@ pub(super) fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, Scen
         return Err(ScenarioError::value(
             f("x_start"),
             x_start,
-            format!("an abscissa in [0, {l}) m"),
+            format!("an abscissa in [0, {}) m", fmt_rounded(l)),
         ));
     }
     let x_end = finite(&f("x_end"), t.x_end.unwrap_or(l))?;
-    if !(x_end > x_start && x_end <= l * (1.0 + 1e-12)) {
-        return Err(ScenarioError::value(
-            f("x_end"),
-            x_end,
-            format!("an abscissa in ({x_start}, {l}] m (after x_start)"),
-        ));
-    }
-    let x_end = x_end.min(l);
+    let x_end = match gvs::rod::abscissa_on(l, x_end) {
+        Some(x) if x > x_start => x,
+        _ => {
+            return Err(ScenarioError::value(
+                f("x_end"),
+                x_end,
+                format!(
+                    "an abscissa in ({x_start}, {}] m (after x_start)",
+                    fmt_rounded(l)
+                ),
+            ))
+        }
+    };
     let (friction, friction_smoothing) = friction(k, t, l)?;
     let explicit = t.offset_start.is_some() || t.offset_end.is_some();
     let polar = t.angle_deg.is_some() || t.radial_fraction.is_some();
@@ -213,7 +218,7 @@ fn friction(k: usize, t: &TendonSpec, l: f64) -> Result<(f64, f64), ScenarioErro
         &f("friction_smoothing"),
         t.friction_smoothing.unwrap_or(DEFAULT_FRICTION_SMOOTHING),
         (0.0, most),
-        &format!("rad/m (a curvature scale, at most 200 rad over the rod's {l} m: above, it smooths the friction away; 0 = no smoothing)"),
+        &format!("rad/m (a curvature scale, at most 200 rad over the rod's {} m: above, it smooths the friction away; 0 = no smoothing)", fmt_rounded(l)),
     )?;
     Ok((friction, smoothing))
 }
@@ -274,14 +279,20 @@ fn path_tendon(
         return Err(ScenarioError::value(
             f("path[0][0]"),
             first[0],
-            format!("an abscissa in [0, {l}) m (the tendon's start)"),
+            format!(
+                "an abscissa in [0, {}) m (the tendon's start)",
+                fmt_rounded(l)
+            ),
         ));
     }
     if last[0].is_nan() || last[0] > l * (1.0 + 1e-12) {
         return Err(ScenarioError::value(
             f(&format!("path[{}][0]", path.len() - 1)),
             last[0],
-            format!("an abscissa <= the rod's length {l} m (the tendon's end)"),
+            format!(
+                "an abscissa <= the rod's length {} m (the tendon's end)",
+                fmt_rounded(l)
+            ),
         ));
     }
     let (friction, friction_smoothing) = friction(k, t, l)?;
