@@ -124,7 +124,8 @@ pub struct ScenarioArgs {
     /// Override a scenario value by its TOML path; repeatable. The value is read as TOML (number,
     /// bool, array, quoted string; a bare word is a string). Examples: `--set tendons.0.tension=-2`,
     /// `--set loads.distributed.0.magnitude=3`, `--set divisions.0.basis.order=6`,
-    /// `--set solver.ramp_steps=3`, `--set loads.gravity=[0,0,0]`.
+    /// `--set solver.ramp_steps=3`, `--set loads.gravity=[0,0,0]`; `*` stands for every entry of
+    /// a list: `--set 'tendons.*.friction=0'`.
     #[arg(long = "set", value_name = "PATH=VALUE")]
     pub set: Vec<String>,
 

@@ -2,7 +2,7 @@
 //! types: missing tables on the path are created, a list index may append one entry, and every
 //! error names the path and what is there instead.
 
-use super::path::{parse_path, render_path, Seg};
+use super::path::{lookup, parse_path, render_path, Seg};
 use crate::error::ScenarioError;
 use toml::{Table, Value};
 
@@ -46,6 +46,18 @@ pub fn apply_override(table: &mut Table, spec: &str) -> Result<(), ScenarioError
     let (path, raw) = spec
         .split_once('=')
         .ok_or_else(|| err("expected `path=value`, e.g. `tendons.0.tension=-2`".into()))?;
+    if let Some(each) = every_entry(table, path.trim()).map_err(&err)? {
+        // applied to a copy, so that a failing entry leaves the scenario as it was
+        let mut changed = table.clone();
+        for p in each {
+            apply_override(&mut changed, &format!("{p}={raw}")).map_err(|e| match e {
+                ScenarioError::Override { message, .. } => err(format!("{p}: {message}")),
+                other => other,
+            })?;
+        }
+        *table = changed;
+        return Ok(());
+    }
     let segs = parse_path(path.trim()).map_err(&err)?;
     if segs.len() > MAX_OVERRIDE_SEGMENTS {
         return Err(err(format!(
@@ -68,6 +80,47 @@ pub fn apply_override(table: &mut Table, spec: &str) -> Result<(), ScenarioError
         drop_other_shape(table, j, &shape);
     }
     Ok(())
+}
+
+/// The paths a `*` segment stands for, as in a dataset's plans: every entry of the list before
+/// it (`tendons.*.tension` is `tendons.0.tension`, `tendons.1.tension`, …); `None` for a path
+/// without one. The first `*` is expanded here, any later one by each path's own override.
+fn every_entry(table: &Table, path: &str) -> Result<Option<Vec<String>>, String> {
+    let parts: Vec<&str> = path.split('.').collect();
+    let Some(i) = parts.iter().position(|p| *p == "*" || *p == "[*]") else {
+        return Ok(None);
+    };
+    let prefix = parts[..i].join(".");
+    if prefix.is_empty() {
+        return Err("`*` must follow the path of a list (e.g. `tendons.*.tension`)".into());
+    }
+    let n = match lookup(table, &parse_path(&prefix)?) {
+        Some(Value::Array(a)) if !a.is_empty() => a.len(),
+        Some(Value::Array(_)) => {
+            return Err(format!(
+                "the list `{prefix}` is empty: `*` stands for every entry of a list"
+            ))
+        }
+        Some(_) => {
+            return Err(format!(
+                "`{prefix}` is not a list: `*` stands for every entry of a list"
+            ))
+        }
+        None => {
+            return Err(format!(
+                "the scenario has no list `{prefix}` for `*` to stand for"
+            ))
+        }
+    };
+    let rest = parts[i + 1..].join(".");
+    Ok(Some(
+        (0..n)
+            .map(|k| match rest.is_empty() {
+                true => format!("{prefix}.{k}"),
+                false => format!("{prefix}.{k}.{rest}"),
+            })
+            .collect(),
+    ))
 }
 
 /// The keys that size a circular section (a tube's bore too), and those that size a rectangle or

@@ -38,9 +38,17 @@ impl Scenario {
 
 /// TOML text → table; syntax errors carry line and column.
 pub fn parse_table(source_name: &str, text: &str) -> Result<Table, ScenarioError> {
-    text.parse::<Table>().map_err(|e| ScenarioError::Syntax {
-        source_name: source_name.to_string(),
-        message: one_line(&e.to_string()),
+    text.parse::<Table>().map_err(|e| {
+        let mut message = one_line(&e.to_string());
+        // toml names neither the key given twice nor what is wrong with it: its span does
+        let key = e.span().and_then(|span| text.get(span)).map(str::trim);
+        if let (true, Some(key)) = (message.ends_with("duplicate key"), key) {
+            message = format!("{message} `{key}` (each key once per table)");
+        }
+        ScenarioError::Syntax {
+            source_name: source_name.to_string(),
+            message,
+        }
     })
 }
 

@@ -194,6 +194,43 @@ fn syntax_error_is_one_line_with_position() {
 }
 
 #[test]
+fn a_star_in_an_override_stands_for_every_entry_of_the_list() {
+    let two = format!(
+        "{MINIMAL}\n[[tendons]]\noffset_start = [0, 0.002]\noffset_end = [0, 0.002]\ntension = -1\n"
+    );
+    let s = Scenario::from_toml("t", &two, &["tendons.*.tension=-2.5".into()]).unwrap();
+    assert_eq!(s.tendons.len(), 2);
+    assert!(s.tendons.iter().all(|t| t.tension == -2.5));
+    for (spec, named) in [
+        ("material.*.x=1", "`material` is not a list"),
+        ("bodies.*.mass=1", "no list `bodies`"),
+        ("*.x=1", "must follow the path of a list"),
+    ] {
+        let e = Scenario::from_toml("t", &two, &[spec.into()])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(spec) && e.contains(named), "{spec}: {e}");
+    }
+    // one entry refused refuses the override, naming the entry's path
+    let e = Scenario::from_toml("t", &two, &["tendons.*.tension.x=1".into()])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("tendons.0.tension"), "{e}");
+}
+
+#[test]
+fn a_key_given_twice_is_named_with_its_line() {
+    let text = "[solver]\nramp_steps = 1\nramp_steps = 2\n";
+    let e = Scenario::from_toml("twice.toml", text, &[])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("line 3") && e.contains("duplicate key `ramp_steps`"),
+        "{e}"
+    );
+}
+
+#[test]
 fn override_numbers_toml_does_not_write_are_read_as_numbers() {
     // `1e999` overflows: it is refused as not finite, not as "invalid type: string"
     let e = Scenario::from_toml("t", MINIMAL, &["tendons.0.tension=1e999".into()])
