@@ -168,7 +168,24 @@ fn runs_that_start_apart_are_said_to_with_the_offset() {
         "the equilibrium sags far from the straight rod: {note}"
     );
     assert!(start <= tip(&stdout, "max ") + 1e-3, "{stdout}");
-    assert!(note.contains("--from-equilibrium"), "{note}");
+    assert!(
+        note.contains("with --from-equilibrium each starts at its own model's equilibrium"),
+        "{note}"
+    );
+    // both from their equilibria: the advice is not to start them so, but what separates them
+    let stiffer = simulate(
+        "cmp-start-eq-stiffer",
+        &["--from-equilibrium", "--set", "material.youngs_modulus=2e6"],
+    );
+    let both = compare_anyway(&settled, &stiffer);
+    let note = (both.lines())
+        .find(|l| l.starts_with("note       the runs start "))
+        .unwrap_or_else(|| panic!("no start note: {both}"));
+    assert!(
+        note.contains("each run starts at its own model's equilibrium")
+            && !note.contains("with --from-equilibrium"),
+        "{note}"
+    );
     // the JSON report holds it too
     let json = scratch("cmp-start.json");
     let out = gvsrom(&[

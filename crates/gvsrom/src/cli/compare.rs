@@ -97,9 +97,17 @@ pub(super) fn compare_cmd(args: &CompareArgs, out: &mut impl Write) -> Result<()
         c.tip_mean, c.tip_max, c.tip_max_t, c.tip_end, reference.length
     )?;
     if c.starts_apart() {
+        // both start alike (the inputs compared equal, `start` among them), or were compared anyway
+        let from_equilibrium = [&reference, &run].iter().all(|r| {
+            (r.input.as_ref()).and_then(|i| i.get("start")) == Some(&"equilibrium".into())
+        });
+        let why = match from_equilibrium {
+            true => "each run starts at its own model's equilibrium under the starting tensions, so a reduced model's static error there is part of every error above (`gvsrom statics --model … --compare` measures it alone)",
+            false => "a reduced model's rest can decode away from the full model's straight rod (simulate prints it on its `start` line); with --from-equilibrium each starts at its own model's equilibrium instead, where only the reduced model's static error separates them",
+        };
         writeln!(
             out,
-            "note       the runs start {:.3} % of the length apart (their tips at t = {} s), and that offset is part of every error above: a reduced model's rest can decode away from the full model's (simulate prints it on its `start` line); start both with --from-equilibrium to compare from one state",
+            "note       the runs start {:.3} % of the length apart (their tips at t = {} s), and that offset is part of every error above: {why}",
             c.tip_start, reference.t[0]
         )?;
     }

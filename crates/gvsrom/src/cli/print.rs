@@ -27,6 +27,16 @@ pub(super) fn fmt_g(v: &[f64]) -> String {
     format!("[{}]", items.join(", "))
 }
 
+/// `x` with `prec` decimals, or where those would show none of its digits (a run of 1e-6 s, a
+/// real-time factor of 2e-4), to 2 significant digits: `0.250`, `1e-6`, `0.00021`.
+pub(super) fn fmt_fixed(x: f64, prec: usize) -> String {
+    if x == 0.0 || !x.is_finite() || x.abs() >= 10f64.powi(1 - prec as i32) {
+        format!("{x:.prec$}")
+    } else {
+        gvs::error::fmt_value(format!("{x:.1e}").parse().unwrap_or(x))
+    }
+}
+
 /// "3.2× faster" or, below 1, "1.4× slower" (not "0.7× faster").
 pub(super) fn speed_words(speedup: f64) -> String {
     if !(speedup.is_finite() && speedup > 0.0) {
@@ -84,7 +94,7 @@ pub(super) fn print_model(
         m.n_dof(),
         m.disc.n_points(),
         plural(m.rod.divisions.len(), "division"),
-        m.rod.length(),
+        gvs::error::fmt_rounded(m.rod.length()),
         m.disc.order
     )?;
     if let Some(r) = &built.reduced {
@@ -274,6 +284,18 @@ mod tests {
         }
         assert_eq!(plural(1, "thread"), "1 thread");
         assert_eq!(plural(2, "thread"), "2 threads");
+    }
+
+    #[test]
+    fn a_number_too_small_for_its_decimals_keeps_two_digits() {
+        assert_eq!(fmt_fixed(0.25, 3), "0.250");
+        assert_eq!(fmt_fixed(0.0, 3), "0.000");
+        assert_eq!(fmt_fixed(0.01, 3), "0.010");
+        assert_eq!(fmt_fixed(1e-6, 3), "1e-6");
+        assert_eq!(fmt_fixed(0.0051234, 3), "0.0051");
+        assert_eq!(fmt_fixed(5.6e-5, 1), "5.6e-5");
+        assert_eq!(fmt_fixed(0.21, 1), "0.21");
+        assert_eq!(fmt_fixed(4.23, 1), "4.2");
     }
 
     #[test]

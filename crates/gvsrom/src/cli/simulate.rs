@@ -242,7 +242,7 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
         if off > 1e-6 {
             writeln!(
                 out,
-                "start      the reduced model's rest coordinates decode to max |ξ − ξ*| = {off:.3e} at the points, not to the straight rod the full model starts from (--from-equilibrium starts both at the scenario's equilibrium)"
+                "start      the reduced model's rest coordinates decode to max |ξ − ξ*| = {off:.3e} at the points, not to the straight rod the full model starts from (with --from-equilibrium each model starts at its own equilibrium under the starting tensions)"
             )?;
         }
     }
@@ -287,11 +287,12 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
             outcome.median_wall_time_s()
         ),
     };
+    let t_shown = fmt_fixed(t_last, 3);
     writeln!(
         out,
-        "simulated  {t_last:.3} s in {:.3} s wall time{timed} (real-time factor {:.1}), {} steps ({} failed, {} of them in Newton), {} RHS and {} Jacobian evaluations",
-        sm.wall_time_s,
-        outcome.real_time_factor(),
+        "simulated  {t_shown} s in {} s wall time{timed} (real-time factor {}), {} steps ({} failed, {} of them in Newton), {} RHS and {} Jacobian evaluations",
+        fmt_fixed(sm.wall_time_s, 3),
+        fmt_fixed(outcome.real_time_factor(), 1),
         sm.stats.steps,
         sm.stats.failed_steps,
         sm.stats.newton_failures,
@@ -301,7 +302,7 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
     if let Some(g) = &outcome.last_tip {
         writeln!(
             out,
-            "tip        position {} m at t = {t_last:.3} s",
+            "tip        position {} m at t = {t_shown} s",
             fmt_vec(&[g.pos[0], g.pos[1], g.pos[2]], 6),
         )?;
     }
@@ -318,7 +319,7 @@ pub(super) fn simulate_cmd(args: &SimulateArgs, out: &mut impl Write) -> Result<
             .collect();
         writeln!(
             out,
-            "tensions   u = [{}] N at t = {t_last:.3} s, the driven tendons' from their threads' stretch{}",
+            "tensions   u = [{}] N at t = {t_shown} s, the driven tendons' from their threads' stretch{}",
             u.join(", "),
             match slack.len() {
                 0 => String::new(),
