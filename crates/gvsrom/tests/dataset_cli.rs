@@ -957,3 +957,47 @@ fn a_dataset_of_a_tendon_the_basis_cannot_hold_warns() {
         "{stderr}"
     );
 }
+
+#[test]
+fn a_value_set_that_the_plan_varies_is_refused_naming_both() {
+    for (set, plan) in [
+        ("tendons.0.tension=-1", "tendons.0.tension=-6:0"),
+        ("tendons[0].tension=-1", "tendons.0.tension=-6:0"),
+        ("tendons.*.tension=-1", "tendons.0.tension=-6:0"),
+    ] {
+        let out = scratch("set-varied");
+        expect_error(
+            &[
+                "dataset",
+                "single-tendon",
+                "--sweep",
+                plan,
+                "--samples",
+                "2",
+                "--set",
+                set,
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            &[
+                &format!("--set {set}"),
+                "the plan varies `tendons.0.tension` (--sweep tendons.0.tension)",
+            ],
+        );
+        assert!(!out.exists(), "nothing written for a refused plan");
+    }
+    // a value the plan does not vary is set
+    let out = scratch("set-other");
+    run_ok(&[
+        "dataset",
+        "single-tendon",
+        "--sweep",
+        "tendons.0.tension=-6:0",
+        "--samples",
+        "2",
+        "--set",
+        "tendons.0.friction=0",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+}

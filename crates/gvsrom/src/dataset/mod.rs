@@ -293,6 +293,39 @@ fn legacy_q_order() -> String {
     "fem-mode-major".into()
 }
 
+/// A `--set` of a value the plan varies would be replaced at every sample: refused, naming both
+/// (`--set tendons.0.tension=-1` with `--sweep tendons.0.tension=-6:0` gave the sweep's inputs).
+fn refuse_set_varied(set: &[String], plan: &Plan) -> Result<(), DatasetError> {
+    // `tendons[0].tension` and `tendons.0.tension` alike; `*` matches any one segment
+    let segments = |path: &str| -> Vec<String> {
+        (path.trim().replace('[', ".").replace(']', ""))
+            .split('.')
+            .filter(|s| !s.is_empty())
+            .map(str::to_string)
+            .collect()
+    };
+    for spec in set {
+        let Some((path, _)) = spec.split_once('=') else {
+            continue;
+        };
+        let set_path = segments(path);
+        let varied = plan.parameters.iter().find(|p| {
+            let param = segments(&p.path);
+            param.len() == set_path.len()
+                && (param.iter().zip(&set_path)).all(|(a, b)| a == b || b == "*")
+        });
+        if let Some(p) = varied {
+            return Err(plan_err(format!(
+                "--set {spec}: the plan varies `{}` ({} {}), which would replace the value set at every sample; drop one of them",
+                p.path,
+                plan.kind.option(),
+                p.path
+            )));
+        }
+    }
+    Ok(())
+}
+
 fn plan_err(e: String) -> DatasetError {
     DatasetError::Plan(e)
 }
@@ -456,6 +489,7 @@ pub fn run(args: &DatasetRequest, interrupt: &AtomicUsize) -> Result<Outcome, Da
         &table,
     )
     .map_err(plan_err)?;
+    refuse_set_varied(&args.set, &plan)?;
     if !(1..=MAX_CHUNK_SIZE).contains(&args.chunk_size) {
         return Err(plan_err(format!(
             "--chunk-size {}: expected an integer in [1, {MAX_CHUNK_SIZE}]",

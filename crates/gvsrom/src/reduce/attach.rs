@@ -7,6 +7,7 @@ use crate::build::{Built, Reduced, Resolved};
 use crate::dataset::Layout;
 use crate::error::ScenarioError;
 use crate::reduced_model::{same_abscissae, ModelWeights, ReducedModel};
+use gvs::error::fmt_rounded;
 use gvs::model::Model;
 use gvs::strain::{LinearBasis, StrainParam};
 use nalgebra::DVector;
@@ -81,13 +82,18 @@ fn point_difference(built: &Built, model_x: &[f64], x: &[f64]) -> Option<String>
             .map(|(k, _)| format!("bodies[{k}].x"));
         loads.chain(bodies).collect()
     };
+    // a few points named; of another discretization (148 points against 102) the first ones
     let list = |xs: &[f64], named: bool| -> String {
-        let items: Vec<String> = (xs.iter())
+        const SHOWN: usize = 4;
+        let mut items: Vec<String> = (xs.iter().take(SHOWN))
             .map(|&v| match (named, sources(v)) {
-                (true, s) if !s.is_empty() => format!("{v} m ({})", s.join(", ")),
-                _ => format!("{v} m"),
+                (true, s) if !s.is_empty() => format!("{} m ({})", fmt_rounded(v), s.join(", ")),
+                _ => format!("{} m", fmt_rounded(v)),
             })
             .collect();
+        if xs.len() > SHOWN {
+            items.push(format!("… ({} in all)", xs.len()));
+        }
         format!(
             "{} at X = {}",
             if xs.len() == 1 { "a point" } else { "points" },
