@@ -34,9 +34,10 @@ impl<'py, D: Dimension> Deref for Real<'py, D> {
     }
 }
 
-/// Kinds of NumPy dtype converted to `float64` without loss of meaning: booleans, integers,
-/// floats.
-const REAL_KINDS: &[u8] = b"biuf";
+/// Kinds of NumPy dtype converted to `float64` without loss of meaning: integers, floats. A
+/// boolean is a number to NumPy (`True` is 1) but never a tension, a coordinate or a time here:
+/// `[True]` as tensions would pull +1 N.
+const REAL_KINDS: &[u8] = b"iuf";
 
 impl<'a, 'py, D: Dimension + 'py> FromPyObject<'a, 'py> for Real<'py, D> {
     type Error = PyErr;
@@ -130,6 +131,17 @@ fn is_bool(ob: Borrowed<'_, '_, PyAny>) -> bool {
             .get_type()
             .name()
             .is_ok_and(|n| n == "bool" || n == "bool_")
+        || (ob.cast::<PyUntypedArray>()).is_ok_and(|a| a.ndim() == 0 && a.dtype().kind() == b'b')
+}
+
+/// A real-number argument (`#[pyo3(from_py_with = arrays::real)]`: a duration, a period): a
+/// `bool` is refused (`simulate(True)` would run for 1 s); pyo3 names the argument in the
+/// exception's note.
+pub fn real(ob: &Bound<'_, PyAny>) -> PyResult<f64> {
+    if is_bool(ob.as_borrowed()) {
+        return Err(PyTypeError::new_err("expected a real number; got a `bool`"));
+    }
+    ob.extract()
 }
 
 /// `ob` as one real number (a float, an int, a NumPy scalar or 0-d array), if it is one. An array

@@ -34,7 +34,7 @@ create_exception!(
     gvsrom,
     IntegrationError,
     GvsromError,
-    "A simulation that stopped early: its integrator failed, or a callable `input` or `controller` returned a value refused after the start; `trajectory` holds the samples computed before, as `simulate` returns them."
+    "A simulation that stopped early: its integrator failed, or a callable `input` or `controller` returned a value refused after the start; `trajectory` holds the samples computed before, as `simulate` returns them. When the run itself failed, `trajectory[\"reason\"]` says why, as the `reason` of a written run's `meta.json`: \"the integration failed\", \"the reduced model left its training region\" or \"the run left the rod's elastic range\"."
 );
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

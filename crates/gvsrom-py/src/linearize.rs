@@ -50,7 +50,8 @@ impl Robot {
     /// Returns
     /// -------
     /// dict
-    ///     ``A`` (2n, 2n), ``B`` (2n, n_actuators), ``C`` (3k, 2n) for k outputs, ``outputs``
+    ///     ``A`` (2n, 2n), ``B`` (2n, n_actuators), ``C`` (3k, 2n) for k outputs, ``D``
+    ///     (C's rows, n_actuators) zeros (no output depends on the tensions directly), ``outputs``
     ///     (k,) their abscissae, ``output_positions`` (k, 3), ``output_tip_rotation`` (3, 3)
     ///     the tip's rotation with ``tip_orientation`` (``None`` otherwise), ``output_tendon_lengths``
     ///     (n_actuators,) with ``tendon_lengths`` (empty otherwise; ``C`` has 3k rows, 3 more
@@ -140,7 +141,11 @@ fn report_dict<'py>(py: Python<'py>, r: &Linearization) -> PyResult<Bound<'py, P
     let d = PyDict::new(py);
     d.set_item("A", matrix(py, &r.a_matrix())?)?;
     d.set_item("B", matrix(py, &r.b_matrix())?)?;
-    d.set_item("C", matrix(py, &r.c_matrix())?)?;
+    let c = r.c_matrix();
+    d.set_item("C", matrix(py, &c)?)?;
+    // no feedthrough: positions and lengths depend on the state alone
+    let feedthrough = nalgebra::DMatrix::zeros(c.nrows(), r.u.len());
+    d.set_item("D", matrix(py, &feedthrough)?)?;
     let x0: Vec<f64> = r.q.iter().chain(&r.qd).copied().collect();
     d.set_item("x0", vector(py, &x0))?;
     d.set_item("u", vector(py, &r.u))?;

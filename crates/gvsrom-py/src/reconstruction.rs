@@ -52,10 +52,26 @@ impl Model {
 }
 
 /// The ``dataset`` argument of [`Model::reconstruction`]: a loaded dataset or a directory.
-#[derive(FromPyObject)]
 pub enum DatasetArg<'py> {
     Loaded(Bound<'py, crate::datasets::Dataset>),
     Dir(PathBuf),
+}
+
+impl<'a, 'py> FromPyObject<'a, 'py> for DatasetArg<'py> {
+    type Error = PyErr;
+
+    /// Else a `TypeError` saying what is accepted (not pyo3's account of its enum's variants).
+    fn extract(ob: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        if let Ok(d) = ob.extract::<Bound<'py, crate::datasets::Dataset>>() {
+            return Ok(DatasetArg::Loaded(d));
+        }
+        ob.extract::<PathBuf>().map(DatasetArg::Dir).map_err(|_| {
+            pyo3::exceptions::PyTypeError::new_err(format!(
+                "invalid `dataset`: got a {}; accepted: a Dataset or a dataset directory (str or os.PathLike)",
+                ob.get_type().name().map_or("value".to_string(), |n| n.to_string())
+            ))
+        })
+    }
 }
 
 /// A model's reconstruction errors on a dataset (``Model.reconstruction``).

@@ -50,6 +50,9 @@ pub struct Robot {
     /// tensions the model checks instead of the scenario's): built on the first such run and kept,
     /// so that a control loop of short runs does not read and check the model at every call.
     signal_built: OnceLock<Built>,
+    /// Each tendon's tension limit on its own (`plausibility::tension_limits`), computed at the
+    /// first quantity given tensions: past it a quantity's tensions get the statics' verdict.
+    tension_limits: OnceLock<Vec<f64>>,
 }
 
 /// Builds `scenario` and attaches `attached` as `gvsrom … --model DIR` does, warning in Python
@@ -61,37 +64,48 @@ pub fn build_with(
     tensions_from_signal: bool,
 ) -> PyResult<Built> {
     let built = py
-        .detach(|| -> anyhow::Result<Built> {
-            let mut built = gvsrom::build(&scenario.scenario)?;
-            if let Some(a) = attached {
-                let options = AttachOptions {
-                    extrapolate: a.extrapolate,
-                    tensions_from_signal,
-                };
-                reduce::attach_source(
-                    &mut built,
-                    &scenario.src,
-                    &scenario.overrides,
-                    &a.dir,
-                    options,
-                )?;
-                if let (Some(loaded), Some(r)) = (&a.loaded, &built.reduced) {
-                    if !same_content(loaded, &r.origin) {
-                        anyhow::bail!(
-                            "model `{}`: the directory changed since `load_model` read it (it was written again): load it again to use what it holds now",
-                            a.dir.display()
-                        );
-                    }
-                }
-            }
-            Ok(built)
-        })
+        .detach(|| attach_to(scenario, attached, tensions_from_signal))
         .map_err(errors::any)?;
     for w in built.reduced.iter().flat_map(|r| &r.warnings) {
         warn(py, w)?;
     }
     Ok(built)
 }
+
+/// [`build_with`] without Python: the scenario built, and `attached` attached to it.
+fn attach_to(
+    scenario: &Scenario,
+    attached: Option<&Attached>,
+    tensions_from_signal: bool,
+) -> anyhow::Result<Built> {
+    let mut built = gvsrom::build(&scenario.scenario)?;
+    if let Some(a) = attached {
+        let options = AttachOptions {
+            extrapolate: a.extrapolate,
+            tensions_from_signal,
+        };
+        reduce::attach_source(
+            &mut built,
+            &scenario.src,
+            &scenario.overrides,
+            &a.dir,
+            options,
+        )?;
+        if let (Some(loaded), Some(r)) = (&a.loaded, &built.reduced) {
+            if !same_content(loaded, &r.origin) {
+                anyhow::bail!(
+                    "model `{}`: the directory changed since `load_model` read it (it was written again): load it again to use what it holds now",
+                    a.dir.display()
+                );
+            }
+        }
+    }
+    Ok(built)
+}
+
+/// What follows a model's refusal of the robot's own tensions where the rest of the scenario lies
+/// inside its training (a model trained on motion under tensions the preset never holds).
+const TENSIONS_OUTSIDE: &str = "the model was trained for this scenario except its tensions, which a robot uses wherever no `u` is given (statics(), linearize(), modes(), the quantities, a simulation without input): set tensions inside the training before attaching it, e.g. scenario.set(\"tendons.*.tension\", -5.0), or one tendon by its index";
 
 /// Whether two readings of a directory found the same content (the manifest's hashes; a directory
 /// without recorded hashes cannot tell, and passes).
@@ -134,7 +148,18 @@ pub fn warn_motion_note(py: Python<'_>, built: &gvsrom::Built) -> PyResult<()> {
 
 impl Robot {
     pub fn new(py: Python<'_>, scenario: Scenario, attached: Option<Attached>) -> PyResult<Robot> {
-        let built = build_with(py, &scenario, attached.as_ref(), false)?;
+        let built = match build_with(py, &scenario, attached.as_ref(), false) {
+            // refused for the scenario's own tensions alone: say which way leads on
+            Err(e)
+                if attached.is_some()
+                    && py
+                        .detach(|| attach_to(&scenario, attached.as_ref(), true))
+                        .is_ok() =>
+            {
+                return Err(invalid(format!("{}; {TENSIONS_OUTSIDE}", e.value(py))));
+            }
+            other => other?,
+        };
         for w in gvsrom::build::warnings(&scenario.scenario, &built) {
             warn(py, &w)?;
         }
@@ -144,6 +169,7 @@ impl Robot {
             attached,
             workspaces: WorkspaceCache::default(),
             signal_built: OnceLock::new(),
+            tension_limits: OnceLock::new(),
         })
     }
 
@@ -257,6 +283,14 @@ impl Robot {
         let u = gvsrom::scenario::tensions_for(self.built.model.n_actuators(), &u.values())
             .map_err(err)?;
         let u = arrays::finite("u", u.into())?.as_slice().to_vec();
+        // tensions far beyond the rod's elastic range are refused as statics refuses them (1e300
+        // N gave an elastic force of inf): checked in full only past a tendon's own limit
+        let limits =
+            (self.tension_limits).get_or_init(|| gvsrom::plausibility::tension_limits(&self.built));
+        if u.iter().zip(limits).any(|(v, lim)| v.abs() > *lim) {
+            let u_abs: Vec<f64> = u.iter().map(|v| v.abs()).collect();
+            gvsrom::plausibility::check(&self.built, &u_abs, 1.0).map_err(err)?;
+        }
         if let (Some(r), Some(a)) = (&self.built.reduced, &self.attached) {
             if !r.extrapolate && !r.covers_tensions(&self.built.u, &u) {
                 // attaching the model to the scenario at `u` gives its verdict and reasons

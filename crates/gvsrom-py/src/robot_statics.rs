@@ -77,6 +77,60 @@ impl Robot {
     }
 }
 
+impl Robot {
+    /// [`Robot::statics_batch`] with a reduced model attached: each row checked against the
+    /// model's training and solved as `statics(U[k])` solves it (from the model's own initial
+    /// guess at its tensions), the rows in parallel.
+    fn reduced_batch(&self, py: Python<'_>, rows: &[Vec<f64>]) -> PyResult<StaticsBatch> {
+        let (Some(r), Some(a)) = (&self.built.reduced, &self.attached) else {
+            return Err(invalid("statics_batch: no reduced model attached"));
+        };
+        let mut extrapolating = vec![];
+        for (k, u) in rows.iter().enumerate() {
+            if r.covers_tensions(&self.built.u, u) {
+                continue;
+            }
+            match r.extrapolate {
+                true => extrapolating.push(k.to_string()),
+                // attaching the model to the scenario at `u` gives its verdict and reasons
+                false => {
+                    if let Err(e) = self.rebuilt_with(py, Some(u), a) {
+                        return Err(invalid(format!("U[{k}]: {}", e.value(py))));
+                    }
+                }
+            }
+        }
+        if !extrapolating.is_empty() {
+            crate::robot::warn(
+                py,
+                &format!(
+                    "extrapolating (extrapolate=True): the tensions of rows [{}] lie outside the model's training (statics(U[k]) says how, in its model_extrapolated)",
+                    extrapolating.join(", ")
+                ),
+            )?;
+        }
+        let built = &self.built;
+        let (results, caught) = interrupt::run(py, |flag| {
+            rows.par_iter()
+                .map(|u| {
+                    (flag.load(Ordering::SeqCst) == 0).then(|| statics::solve_checked(built, u))
+                })
+                .collect::<Option<Vec<_>>>()
+        });
+        if let Some(e) = caught {
+            return Err(e);
+        }
+        let Some(results) = results else {
+            return Err(invalid("statics_batch was stopped before it finished"));
+        };
+        let mut reports = Vec::with_capacity(results.len());
+        for (k, r) in results.into_iter().enumerate() {
+            reports.push(r.map_err(|e| errors::any(e.context(format!("U[{k}]"))))?);
+        }
+        StaticsBatch::new(py, &reports, built)
+    }
+}
+
 #[pymethods]
 impl Robot {
     /// Static equilibrium under tendon tensions ``u``, as ``gvsrom statics`` solves it (same
@@ -151,7 +205,10 @@ impl Robot {
     /// solution of its chunk (the scenario's load ramp from straight if that fails). Row ``k``
     /// equals ``statics(U[k])`` to the solver's tolerance, and the dataset's sample ``k`` of the
     /// same tensions exactly. With ``warm_start=False`` every row is solved from straight, as
-    /// ``statics(U[k])`` solves it (the same numbers; 1.2–1.4× the time on IV-A's sweep).
+    /// ``statics(U[k])`` solves it (the same numbers; 1.2–1.4× the time on IV-A's sweep). With a
+    /// reduced model attached (``with_model``) every row is solved as ``statics(U[k])`` solves
+    /// it, from the model's own initial guess, and checked against the model's training as it
+    /// is (``warm_start`` does not apply).
     ///
     /// Parameters
     /// ----------
@@ -169,9 +226,9 @@ impl Robot {
     /// Raises
     /// ------
     /// GvsromError, ConvergenceError
-    ///     For the first row that fails, named ``U[k]``; a ``GvsromError`` for a robot with a
-    ///     reduced model attached (``with_model``): the batch solves the full model, so call
-    ///     ``statics(u)`` per row instead.
+    ///     For the first row that fails, named ``U[k]``, or, with a reduced model attached, whose
+    ///     tensions lie outside its training (unless attached with ``extrapolate``: a
+    ///     ``UserWarning`` then names those rows).
     #[allow(non_snake_case)]
     #[pyo3(signature = (U, warm_start=true))]
     fn statics_batch(
@@ -180,11 +237,6 @@ impl Robot {
         U: In2<'_>,
         warm_start: bool,
     ) -> PyResult<StaticsBatch> {
-        if self.attached.is_some() {
-            return Err(invalid(
-                "statics_batch solves the full model; call statics(u) per row with a reduced model",
-            ));
-        }
         let na = self.built.model.n_actuators();
         let rows = arrays::rows("U", &U, na, "one tension per tendon")?;
         let rows = rows
@@ -196,6 +248,9 @@ impl Robot {
                     .map_err(|e| invalid(format!("U[{k}]: {e}")))
             })
             .collect::<PyResult<Vec<_>>>()?;
+        if self.attached.is_some() {
+            return self.reduced_batch(py, &rows);
+        }
         let built = &self.built;
         let (results, caught) = interrupt::run(py, |flag| {
             let stop =

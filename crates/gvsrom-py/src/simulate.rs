@@ -144,8 +144,8 @@ impl Robot {
     fn simulate<'py>(
         &self,
         py: Python<'py>,
-        duration: f64,
-        sample_rate: f64,
+        #[pyo3(from_py_with = arrays::real)] duration: f64,
+        #[pyo3(from_py_with = arrays::real)] sample_rate: f64,
         input: Option<Bound<'_, PyAny>>,
         interpolate: bool,
         from_equilibrium: bool,

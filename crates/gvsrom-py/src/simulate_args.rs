@@ -116,10 +116,24 @@ impl Args<'_> {
             ));
         }
         let random = a.steps.is_some() || a.babble.is_some();
-        if random && (a.input.is_some() || a.controller.is_some()) {
+        let given = [&a.steps, &a.babble].iter().filter(|v| v.is_some()).count()
+            + usize::from(a.input.is_some() || a.controller.is_some());
+        if given > 1 {
             return Err(invalid(
                 "`input`, `controller`, `steps` and `babble` each give the tensions: give at most one",
             ));
+        }
+        for (name, v, names) in [
+            ("steps", &a.steps, "[lo, hi, period]"),
+            ("babble", &a.babble, "[lo, hi, hold_min, hold_max]"),
+        ] {
+            let n = names.matches(',').count() + 1;
+            if let Some(v) = v.as_ref().filter(|v| v.len() != n) {
+                return Err(invalid(format!(
+                    "`{name}` takes {n} values {names}, got {}",
+                    v.len()
+                )));
+            }
         }
         let input = match (&a.input, &callable) {
             (None, Some(c)) => InputSource::Feedback {

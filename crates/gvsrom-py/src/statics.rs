@@ -281,7 +281,9 @@ impl Statics {
 ///     straight rod was found; a ``UserWarning`` names the rows), NaN for a stable one.
 /// buckled : numpy.ndarray, shape (m,)
 ///     ``ω² < 0`` [1/s²] of the diverging equilibrium a row's rod was released from onto its
-///     stable one (:attr:`Statics.buckled`), NaN for a row that did not buckle.
+///     stable one (:attr:`Statics.buckled`), NaN for a row that did not buckle. A row
+///     warm-started from a buckled neighbour starts on the buckled branch and is NaN too (its
+///     equilibrium is the same; ``warm_start=False`` releases every row from straight).
 /// solve_time_s : numpy.ndarray, shape (m,)
 ///     Each solve's own wall-clock time [s] (the solves run in parallel).
 #[pyclass(module = "gvsrom", frozen, get_all)]

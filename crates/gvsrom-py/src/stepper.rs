@@ -341,7 +341,7 @@ impl Robot {
     fn stepper(
         slf: Py<Self>,
         py: Python<'_>,
-        dt: f64,
+        #[pyo3(from_py_with = arrays::real)] dt: f64,
         horizon: Option<f64>,
         q0: Option<arrays::In1<'_>>,
         qd0: Option<arrays::In1<'_>>,
@@ -351,9 +351,18 @@ impl Robot {
         atol: Option<f64>,
         fixed_step: Option<f64>,
     ) -> PyResult<Stepper> {
-        if !(dt.is_finite() && dt > 0.0) {
+        // a period from a microsecond (the shortest run) to an hour (the longest default horizon)
+        if !(dt.is_finite() && (simulate::MIN_DURATION..=3600.0).contains(&dt)) {
             return Err(invalid(format!(
-                "invalid value for `dt`: {} (expected a finite number > 0 s, the control period)",
+                "invalid value for `dt`: {} (expected the control period in [{}, 3600] s)",
+                gvs::error::fmt_value(dt),
+                gvs::error::fmt_value(simulate::MIN_DURATION),
+            )));
+        }
+        if let Some(h) = fixed_step.filter(|&h| h > dt) {
+            return Err(invalid(format!(
+                "invalid value for `fixed_step`: {} (expected a step ≤ dt = {} s: the integrator restarts at every period, so a longer step would be cut to the period)",
+                gvs::error::fmt_value(h),
                 gvs::error::fmt_value(dt)
             )));
         }

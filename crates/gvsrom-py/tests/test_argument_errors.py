@@ -237,3 +237,57 @@ def test_a_bool_is_no_tension_nor_count_and_a_whole_float_is_a_count():
         robot.modes(2.5)
     # a float of a whole value is that count
     assert len(robot.modes(2.0)["frequency_hz"]) == 2
+
+
+def test_booleans_are_no_tensions_states_or_times_in_any_container():
+    robot = gvsrom.Scenario.preset("single-tendon").build()
+    for bad in ([True], np.array([True]), np.array(True)):
+        with pytest.raises(TypeError, match=r"bool"):
+            robot.statics(bad)
+    with pytest.raises(TypeError, match=r"bool"):
+        robot.mass_matrix(np.zeros(robot.n_dof, dtype=bool))
+    with pytest.raises(TypeError, match=r"real number; got a `bool`"):
+        robot.simulate(True)
+    with pytest.raises(TypeError, match=r"real number; got a `bool`"):
+        robot.stepper(True)
+    with pytest.raises(gvsrom.GvsromError, match=r"returned `\[True\]`: expected 1 tension"):
+        robot.simulate(0.02, input=lambda t: [True])
+    # integers are numbers
+    assert robot.statics(np.array([-2])).u.tolist() == [-2.0]
+
+
+def test_tensions_far_beyond_the_elastic_range_are_refused_by_every_quantity():
+    robot = gvsrom.Scenario.preset("six-tendon").build()
+    n, z = robot.n_dof, np.zeros(robot.n_dof)
+    expected = message(lambda: robot.statics([1e300] * 6))
+    assert "far beyond the rod's elastic range" in expected
+    for call in (lambda: robot.statics_residual(z, [1e300] * 6),
+                 lambda: robot.statics_jacobian(z, [-1e300] * 6),
+                 lambda: robot.energy(z, z, [1.7e308] * 6),
+                 lambda: robot.accelerations(z, z, [-1e300] * 6)):
+        assert "far beyond the rod's elastic range" in message(call)
+    # within the range, a quantity answers
+    assert np.isfinite(robot.statics_residual(z, [-5.0] * 6)).all()
+
+
+def test_a_steppers_period_and_step_are_named_as_given():
+    robot = gvsrom.Scenario.preset("single-tendon").build()
+    for dt in (1e-300, 1e300):
+        assert "`dt`" in message(lambda: robot.stepper(dt))
+    assert "`fixed_step`: 0.02 (expected a step ≤ dt = 0.01 s" in message(
+        lambda: robot.stepper(0.01, fixed_step=0.02))
+
+
+def test_random_inputs_are_named_as_python_arguments():
+    robot = gvsrom.Scenario.preset("single-tendon").build()
+    text = message(lambda: robot.simulate(0.02, steps=[-1, 0, 0.01], babble=[-1, 0, 0.01, 0.02]))
+    assert "give at most one" in text and "`steps`" in text and "`babble`" in text, text
+    text = message(lambda: robot.simulate(0.02, steps=[-1, 0]))
+    assert "`steps` takes 3 values [lo, hi, period], got 2" in text, text
+
+
+def test_a_reconstruction_of_no_dataset_says_what_is_accepted(tmp_path, dataset):
+    model = gvsrom.pod(dataset, 1, tmp_path / "pod")
+    with pytest.raises(TypeError, match=r"invalid `dataset`: got a NoneType; accepted: a Dataset"):
+        model.reconstruction(None)
+    assert model.reconstruction(dataset).rows == 4

@@ -31,6 +31,7 @@ def test_linearize_equals_the_cli_json(gvsrom_bin, tmp_path):
     np.testing.assert_allclose(lin["poles"], poles, rtol=1e-12)
     assert lin["about"] == "equilibrium" and lin["unstable_poles"] == 0
     assert lin["A"].shape == (56, 56) and lin["B"].shape == (56, 6) and lin["C"].shape == (3, 56)
+    np.testing.assert_array_equal(lin["D"], np.zeros((3, 6)))
 
 
 def accelerations_fd(robot, q, qd, u, h=1e-4):

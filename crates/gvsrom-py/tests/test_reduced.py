@@ -93,14 +93,57 @@ def test_a_combination_of_tensions_training_never_came_near_is_refused_with_the_
                          "--model", str(model.path))
     assert "never came near this combination" in expected
     # the preset's own tensions are that corner: the robot is built on the line
-    scenario = gvsrom.Scenario.preset("six-tendon-no-gravity").set("tendons.0.tension", -2.0)
-    for k in range(1, 6):
-        scenario = scenario.set(f"tendons.{k}.tension", -2.0)
+    scenario = gvsrom.Scenario.preset("six-tendon-no-gravity").set("tendons.*.tension", -2.0)
+    assert scenario.tensions == [-2.0] * 6
     robot = scenario.build().with_model(model)
     robot.statics(u=[-4.5] * 6)
     with pytest.raises(gvsrom.GvsromError) as e:
         robot.statics(u=[-10.0, 0, 0, 0, 0, 0])
     assert str(e.value) == expected
+
+
+def test_a_model_refused_for_the_scenarios_tensions_alone_says_how_to_attach_it(pod_model):
+    # trained on [-6, 0] N: a scenario holding -20 N is refused, and told to set its tensions
+    far = gvsrom.Scenario.preset("single-tendon").set("tendons.*.tension", -20.0)
+    with pytest.raises(gvsrom.GvsromError) as e:
+        far.build().with_model(pod_model)
+    message = str(e.value)
+    assert "tendons.0.tension = -20" in message and "extrapolate=True" in message, message
+    assert "set tensions inside the training before attaching it" in message, message
+    robot = far.set("tendons.*.tension", -3.0).build().with_model(pod_model)
+    assert robot.tensions.tolist() == [-3.0]
+    # a scenario outside the training in more than its tensions gets no such advice
+    soft = far.set("material.youngs_modulus", 1e5)
+    with pytest.raises(gvsrom.GvsromError) as e:
+        soft.build().with_model(pod_model)
+    assert "material.youngs_modulus" in str(e.value)
+    assert "set tensions inside the training" not in str(e.value)
+
+
+@pytest.mark.parametrize("which", ["pod_model", "ae_model"])
+def test_a_batch_on_a_reduced_model_is_its_statics_row_by_row(request, which):
+    model = request.getfixturevalue(which)
+    robot = gvsrom.Scenario.preset("single-tendon").build().with_model(model)
+    U = np.array([[-1.0], [-3.0], [-5.5]])
+    batch = robot.statics_batch(U)
+    assert batch.q.shape == (3, robot.n_dof)
+    for k, u in enumerate(U):
+        one = robot.statics(u=u)
+        np.testing.assert_array_equal(batch.q[k], one.q)
+        np.testing.assert_array_equal(batch.tip_position[k], one.tip_position)
+        np.testing.assert_array_equal(batch.strain[k], one.strain)
+    # a row outside the training is refused as statics(u) refuses it, named
+    with pytest.raises(gvsrom.GvsromError) as one:
+        robot.statics(u=[-20.0])
+    with pytest.raises(gvsrom.GvsromError) as many:
+        robot.statics_batch([[-2.0], [-20.0]])
+    assert str(many.value) == "U[1]: " + str(one.value)
+    # extrapolating, the rows outside are named in a warning, and solved
+    loose = gvsrom.Scenario.preset("single-tendon").build().with_model(model, extrapolate=True)
+    with pytest.warns(UserWarning, match=r"rows \[1\] lie outside the model's training"):
+        far = loose.statics_batch([[-2.0], [-7.0]])
+    with pytest.warns(UserWarning, match="lies outside the training inputs"):
+        np.testing.assert_array_equal(far.q[1], loose.statics(u=[-7.0]).q)
 
 
 def test_reduced_model_quantities_hold_as_the_full_models(ae_model):
@@ -420,6 +463,13 @@ def test_meta_is_the_verified_meta_json(dataset, ae_model):
                       (gvsrom.load_dataset(dataset), dataset)):
         with open(os.path.join(d, "meta.json")) as f:
             assert loaded.meta == json.load(f)
+
+def test_meta_tells_adam_epochs_from_fine_tuning_iterations(ae_model):
+    # 40 Adam epochs without early stopping (patience 0), then at most 20 L-BFGS iterations
+    t = ae_model.meta["training"]
+    fine = t["fine_tune_iterations_run"]
+    assert 1 <= fine <= 20, t
+    assert t["epochs_run"] - fine == 40, t
 
 
 def _cli_defaults(gvsrom_bin, command):

@@ -142,7 +142,12 @@ pub struct TrainingMeta {
     /// The weight `κ` of the kinetic-energy norm (`--kinetic-weight`; absent: none).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub kinetic_weight: Option<f64>,
+    /// Adam epochs and L-BFGS fine-tuning iterations run, together (`best_epoch` counts both).
     pub epochs_run: usize,
+    /// Of `epochs_run`, the L-BFGS fine-tuning iterations (absent in models written before it
+    /// was recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fine_tune_iterations_run: Option<usize>,
     pub best_epoch: usize,
     pub stop: String,
     pub final_train_loss: f64,

@@ -303,6 +303,7 @@ pub fn train<P: AsRef<Path>>(
             rate_weight: Some(options.rate_weight),
             kinetic_weight: (kinetic_weight > 0.0).then_some(kinetic_weight),
             epochs_run: report.epochs_run,
+            fine_tune_iterations_run: Some(report.fine_tune_epochs_run),
             best_epoch: report.best_epoch,
             stop: format!("{:?}", report.stop),
             final_train_loss: report.final_train_loss,

@@ -174,11 +174,22 @@ impl InputSource {
                 }
             }
             (None, None, None) => InputSource::Constant,
-            _ => {
+            (input, steps, babble) => {
+                let given: Vec<&str> = [
+                    ("--input", input.is_some()),
+                    ("--steps", steps.is_some()),
+                    ("--babble", babble.is_some()),
+                ]
+                .into_iter()
+                .filter_map(|(name, set)| set.then_some(name))
+                .collect();
                 return Err(ScenarioError::invalid(
-                    "--input/--steps/--babble",
-                    "give at most one input option",
-                ))
+                    given[1],
+                    format!(
+                        "`{}` is given too: give at most one input option of `--input`, `--steps` and `--babble`",
+                        given[0]
+                    ),
+                ));
             }
         })
     }

@@ -180,7 +180,7 @@ pub fn plan(built: &Built, opts: &SimulateOptions) -> Result<Plan, ScenarioError
             return Err(ScenarioError::invalid(
                 "--fixed-step",
                 format!(
-                    "{} s is longer than the run itself (--duration {} s), which would then be one step of its duration, not of H; use a step ≤ the duration",
+                    "{} s is longer than the run itself (--duration {} s), which would then be one step of its duration, not of the step given; use a step ≤ the duration",
                     gvs::error::fmt_value(h),
                     gvs::error::fmt_value(opts.duration)
                 ),
