@@ -137,13 +137,39 @@ impl Signal {
         }
     }
 
-    /// Times in `(t0, t1)` where `u` or its derivative jumps.
+    /// Times in `(t0, t1)` where `u` or its derivative jumps: the knots where a held value
+    /// changes, or where the slope of a linear one does by more than 1e-6 of itself (the value is
+    /// held before the first knot and after the last). A knot that changes nothing (rows of one value sampled at 1 kHz) is
+    /// none: the integrator restarts at every breakpoint, which costs far more than a step.
     pub fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
-        let mut b: Vec<f64> = self
-            .times
-            .iter()
-            .copied()
-            .filter(|&t| t > t0 && t < t1)
+        let n = self.times.len();
+        let slope = |a: usize, b: usize, j: usize| -> f64 {
+            match (a < n, b < n) {
+                (true, true) if self.times[b] > self.times[a] => {
+                    (self.values[b][j] - self.values[a][j]) / (self.times[b] - self.times[a])
+                }
+                _ => 0.0, // held before the first knot and after the last
+            }
+        };
+        let jumps = |k: usize| -> bool {
+            let channels = self.values[k].len();
+            match self.interpolation {
+                Interpolation::Hold => k > 0 && self.values[k] != self.values[k - 1],
+                Interpolation::Linear => {
+                    // a step (a time given twice) jumps where its two values differ
+                    let step = k > 0 && self.times[k] == self.times[k - 1];
+                    let before = if k == 0 { n } else { k - 1 };
+                    // slopes of rows on one line differ in their rounding only (1e-13 relative
+                    // for `linspace`): a corner of 1e-6 of the slope is none the integrator sees
+                    let corner = |a: f64, b: f64| (a - b).abs() > 1e-6 * a.abs().max(b.abs());
+                    (step && self.values[k] != self.values[k - 1])
+                        || (0..channels).any(|j| corner(slope(before, k, j), slope(k, k + 1, j)))
+                }
+            }
+        };
+        let mut b: Vec<f64> = (0..n)
+            .filter(|&k| self.times[k] > t0 && self.times[k] < t1 && jumps(k))
+            .map(|k| self.times[k])
             .collect();
         b.dedup();
         b
@@ -309,6 +335,45 @@ mod tests {
         r.eval(0.0, &mut u);
         assert_eq!(u[0], 0.0);
         assert_eq!(s.breakpoints(0.0, 10.0), vec![1.0, 2.0]);
+    }
+
+    #[test]
+    fn knots_that_change_nothing_are_no_breakpoints() {
+        // 1 kHz rows of one held value, then a switch at 0.5 s: one breakpoint
+        let times: Vec<f64> = (0..1000).map(|k| k as f64 * 1e-3).collect();
+        let values: Vec<Vec<f64>> = (times.iter())
+            .map(|&t| vec![if t < 0.5 { -1.0 } else { -2.0 }, 3.0])
+            .collect();
+        let held = Signal {
+            times: times.clone(),
+            values: values.clone(),
+            interpolation: Interpolation::Hold,
+        };
+        assert_eq!(held.breakpoints(0.0, 1.0), vec![0.5]);
+        // interpolated, the same rows ramp from -1 to -2 over [0.499, 0.5]: its two corners
+        let linear = Signal {
+            interpolation: Interpolation::Linear,
+            ..held
+        };
+        assert_eq!(linear.breakpoints(0.0, 1.0), vec![times[499], times[500]]);
+        // a ramp sampled at its knots: corners at its start and end only, where the value is
+        // held before the first knot and after the last
+        let ramp = Signal {
+            times: vec![0.5, 1.0, 1.5, 2.0],
+            values: vec![vec![0.0], vec![1.0], vec![2.0], vec![3.0]],
+            interpolation: Interpolation::Linear,
+        };
+        assert_eq!(ramp.breakpoints(0.0, 3.0), vec![0.5, 2.0]);
+        // rows of a ramp as NumPy's linspace rounds them: on one line to the rounding
+        let n = 1000;
+        let line = Signal {
+            times: (0..n).map(|k| k as f64 / (n - 1) as f64).collect(),
+            values: (0..n)
+                .map(|k| vec![-3.0 * k as f64 / (n - 1) as f64])
+                .collect(),
+            interpolation: Interpolation::Linear,
+        };
+        assert_eq!(line.breakpoints(-1.0, 2.0), vec![0.0, 1.0]);
     }
 
     #[test]

@@ -217,3 +217,18 @@ def test_an_undamped_run_the_integrator_damps_strongly_warns_with_the_balance():
     assert any("dissipated" in m and "tighten rtol" in m for m in messages), messages
     b = tr["energy_balance"]
     assert b["largest_loss"] > 0.1 * b["kinetic_max"] > 0.0
+
+
+def test_rows_that_change_nothing_restart_nothing():
+    # 5000 held rows of one value are the 2-row run exactly, rows on one line interpolated the
+    # ramp between its ends (the integrator restarts only where the input jumps or bends: 20 000 such rows took > 60 s)
+    robot = gvsrom.Scenario.preset("single-tendon").build()
+    t = np.linspace(0.0, 0.3, 5000)
+    held = robot.simulate(0.3, input=np.c_[t, -np.ones_like(t)])
+    two = robot.simulate(0.3, input=np.array([[0.0, -1.0], [0.3, -1.0]]))
+    np.testing.assert_array_equal(held["q"], two["q"])
+    ramp = robot.simulate(0.3, input=np.c_[t, -10 * t], interpolate=True)
+    ends = robot.simulate(0.3, input=np.array([[0.0, 0.0], [0.3, -3.0]]), interpolate=True)
+    # the same steps; u between the rows rounds otherwise than between the ends (2e-10 in q)
+    np.testing.assert_allclose(ramp["q"], ends["q"], rtol=0, atol=1e-8 * np.abs(ends["q"]).max())
+    assert (held["steps"], ramp["steps"]) == (two["steps"], ends["steps"])
