@@ -125,7 +125,8 @@ const RENAMED: [(&str, &str); 6] = [
 ];
 
 /// Flags of the command line that are switches, spelled `name=True` in Python.
-const SWITCHES: [&str; 7] = [
+const SWITCHES: [&str; 8] = [
+    "allow-different",
     "fd-jacobian",
     "force",
     "resume",
@@ -199,10 +200,13 @@ fn keyword(flag: &str) -> Option<String> {
 
 /// The command line's positional arguments (their value names, upper case) and the Python
 /// argument of the same meaning.
-const POSITIONAL: [(&str, &str); 4] = [
+const POSITIONAL: [(&str, &str); 6] = [
     ("SCENARIO", "scenario"),
     ("DATASET", "dataset"),
     ("MODEL", "model"),
+    // `gvsrom compare REFERENCE RUN`
+    ("REFERENCE", "reference"),
+    ("RUN", "run"),
     // `gvsrom plot INPUT` is `gvsrom.plot(output, …)`
     ("INPUT", "output"),
 ];

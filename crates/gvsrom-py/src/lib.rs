@@ -7,6 +7,7 @@
 
 mod arrays;
 mod callable;
+mod compare;
 mod datasets;
 mod dynamics_quantities;
 mod errors;
@@ -63,5 +64,6 @@ fn _gvsrom(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(datasets::load_dataset, m)?)?;
     m.add_function(wrap_pyfunction!(reproduce::reproduce, m)?)?;
     m.add_function(wrap_pyfunction!(plot::plot, m)?)?;
+    m.add_function(wrap_pyfunction!(compare::compare, m)?)?;
     Ok(())
 }

@@ -219,8 +219,10 @@ impl Robot {
             [k, rows, 6] if rows == p => Some(k),
             _ => {
                 let dims: Vec<String> = shape.iter().map(usize::to_string).collect();
+                // NumPy's spelling: a 1-tuple keeps its comma
+                let comma = if dims.len() == 1 { "," } else { "" };
                 return Err(invalid(format!(
-                    "`strain` has shape ({}); expected ({p}, 6) or (k, {p}, 6): the 6 strain components at each of the {p} points, as `Statics.strain` gives them",
+                    "`strain` has shape ({}{comma}); expected ({p}, 6) or (k, {p}, 6): the 6 strain components at each of the {p} points, as `Statics.strain` gives them",
                     dims.join(", ")
                 )));
             }

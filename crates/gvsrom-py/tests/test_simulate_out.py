@@ -139,3 +139,26 @@ def test_a_run_from_a_diverging_equilibrium_warns_and_records_it(tmp_path):
     meta = json.loads((tmp_path / "run" / "meta.json").read_text())
     assert meta["start_divergence"] == tr["start_divergence"]
     assert "start_divergence" not in robot.simulate(0.05)
+
+
+def test_compare_measures_a_run_as_the_command_line_does(gvsrom_bin, robot, tmp_path):
+    fine = robot.simulate(0.1, sample_rate=100, input=np.array([[0.0, -3.0]]), rtol=1e-8, out=tmp_path / "fine")
+    loose = robot.simulate(0.1, sample_rate=100, input=np.array([[0.0, -3.0]]), rtol=1e-2, out=tmp_path / "loose")
+    c = gvsrom.compare(tmp_path / "fine", tmp_path / "loose")
+    p = run_cli(gvsrom_bin, "compare", str(tmp_path / "fine"), str(tmp_path / "loose"), "--json",
+                str(tmp_path / "c.json"))
+    assert p.returncode == 0, p.stderr
+    cli = json.loads((tmp_path / "c.json").read_text())
+    assert c["comparison"] == cli["comparison"] and c["differ"] == cli["differ"] == []
+    # the tip error in % of the length, against the arrays themselves
+    tip = np.linalg.norm(fine["tip_position"] - loose["tip_position"], axis=1) / 0.25 * 100
+    assert abs(c["comparison"]["tip_max"] - tip.max()) < 1e-9 * max(1.0, tip.max())
+    assert c["comparison"]["samples"] == len(fine["t"]) == 11
+    # runs of other inputs are refused, naming the Python arguments, unless allowed
+    robot.simulate(0.1, sample_rate=100, input=np.array([[0.0, -2.0]]), out=tmp_path / "other")
+    with pytest.raises(gvsrom.GvsromError) as e:
+        gvsrom.compare(tmp_path / "fine", tmp_path / "other")
+    text = str(e.value)
+    assert "invalid `run`" in text and "allow_different=True" in text, text
+    anyway = gvsrom.compare(tmp_path / "fine", tmp_path / "other", allow_different=True)
+    assert anyway["differ"], anyway

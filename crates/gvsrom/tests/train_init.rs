@@ -159,7 +159,11 @@ fn a_start_that_does_not_fit_is_refused_by_name() {
     ];
     let e = expect_error(&args, &["--init", "was learned on", "single-tendon"]);
     // another discretization altogether: a few of its points, not all 148 (5.9 kB of them)
-    assert!(e.contains(" in all)") && e.len() < 700, "{} bytes: {e}", e.len());
+    assert!(
+        e.contains(" in all)") && e.len() < 700,
+        "{} bytes: {e}",
+        e.len()
+    );
     assert!(!out.exists());
 }
 

@@ -359,11 +359,16 @@ pub(super) fn range_check(field: &str, lo: f64, hi: f64) -> Result<(), ScenarioE
     }
 }
 
+/// The most rows of an input given as rows (Python's `input=`) its record lists as they are
+/// (every row is in its hash, `sha256` of the rows' little-endian f64 values `t, u_1, …`).
+pub const MAX_ROWS_RECORDED: usize = 16;
+
 /// The run's input as `meta.json` records it (`"input"`), for `gvsrom compare` to tell runs with
 /// other inputs apart: the signal's specification — `"constant"` with the tensions, `"csv"` with
-/// the file, its SHA-256 and the interpolation, `"steps"` or `"babble"` with their parameters and
-/// seed —, the start (`"rest"`, or `"equilibrium"` with the tensions it is solved under) and the
-/// load schedule (file and SHA-256, or null).
+/// the file, its SHA-256 and the interpolation, `"rows"` with their SHA-256 (and up to
+/// [`MAX_ROWS_RECORDED`] of them), `"steps"` or `"babble"` with their parameters and seed —, the
+/// start (`"rest"`, or `"equilibrium"` with the tensions it is solved under) and the load schedule
+/// (file and SHA-256, or null).
 pub fn input_record(
     built: &Built,
     opts: &SimulateOptions,
@@ -397,14 +402,28 @@ pub fn input_record(
             });
             v
         }
-        InputSource::Rows(signal) => json!({
-            "signal": "rows",
-            "rows": signal.times.len(),
-            "interpolation": match signal.interpolation {
-                Interpolation::Hold => "hold",
-                Interpolation::Linear => "linear",
-            },
-        }),
+        // the rows by their content (as a file by its hash), and a few of them as they are
+        InputSource::Rows(signal) => {
+            let bytes: Vec<u8> = (signal.times.iter().zip(&signal.values))
+                .flat_map(|(t, v)| std::iter::once(t).chain(v))
+                .flat_map(|x| x.to_le_bytes())
+                .collect();
+            let mut v = json!({
+                "signal": "rows",
+                "rows": signal.times.len(),
+                "interpolation": match signal.interpolation {
+                    Interpolation::Hold => "hold",
+                    Interpolation::Linear => "linear",
+                },
+                "sha256": crate::provenance::sha256_hex(&bytes),
+            });
+            if signal.times.len() <= MAX_ROWS_RECORDED {
+                v["values"] = json!((signal.times.iter().zip(&signal.values))
+                    .map(|(t, u)| std::iter::once(*t).chain(u.iter().copied()).collect())
+                    .collect::<Vec<Vec<f64>>>());
+            }
+            v
+        }
         InputSource::Steps {
             lo,
             hi,
