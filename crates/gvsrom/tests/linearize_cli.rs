@@ -582,3 +582,52 @@ fn zero_order_hold_composes_as_two_half_samples_and_refuses_a_bad_sample_time() 
         );
     }
 }
+
+/// The IV-A arm as a horizontal column (no gravity, no tension) compressed by a world-fixed end
+/// force near its buckling load (0.14266 N, where `modes`' ω² changes sign): K_T nearly singular,
+/// the slowest pole near 0 and the gain ∝ 1/|λ| ill-conditioned, which the output says; beyond
+/// the load the gain is no settled displacement; at half the load neither is said.
+#[test]
+fn a_gain_near_the_buckling_load_is_said_to_be_ill_conditioned() {
+    let run = |force: f64| -> String {
+        let load =
+            format!("loads.point=[{{x = 0.25, force = [{force}, 0, 0], frame = \"global\"}}]");
+        let out = gvsrom(&[
+            "linearize",
+            "single-tendon",
+            "--tension",
+            "0",
+            "--set",
+            "loads.gravity=[0, 0, 0]",
+            "--set",
+            &load,
+            "--set",
+            "solver.check_stability=false",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let below = run(-0.1426);
+    assert!(below.contains("A is nearly singular"), "{below}");
+    assert!(
+        below.contains("gain       settled tip displacement"),
+        "{below}"
+    );
+    let beyond = run(-0.1427);
+    assert!(beyond.contains("A is nearly singular"), "{beyond}");
+    assert!(
+        beyond.contains("gain       equilibrium's tip displacement")
+            && beyond.contains("not a settled displacement"),
+        "{beyond}"
+    );
+    let half = run(-0.0713);
+    assert!(!half.contains("nearly singular"), "{half}");
+    assert!(
+        half.contains("gain       settled tip displacement"),
+        "{half}"
+    );
+}

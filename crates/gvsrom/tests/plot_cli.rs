@@ -654,3 +654,28 @@ fn figures_record_how_they_were_made_and_what_they_drew_by_its_hashes() {
         "{p}"
     );
 }
+
+/// A linearization with many output points draws the gain of a spread of them, says so, and
+/// keeps its figure within the image size (41 points drew one 16 700 px high and plot failed).
+#[test]
+fn the_gain_of_many_output_points_is_drawn_at_twelve_of_them() {
+    let lin = scratch("many-points.json");
+    let xs: Vec<String> = (0..=40)
+        .map(|i| format!("{}", 0.25 * i as f64 / 40.0))
+        .collect();
+    run_ok(&[
+        "linearize",
+        "single-tendon",
+        "--output-at",
+        &xs.join(","),
+        "--json",
+        s(&lin),
+    ]);
+    let out = scratch("many-points-figures");
+    let stdout = run_ok(&["plot", s(&lin), "--out", s(&out)]);
+    assert!(
+        stdout.contains("static_gain: 12 of the 41 output points drawn"),
+        "{stdout}"
+    );
+    assert!(out.join("static_gain.png").is_file() && out.join("poles.png").is_file());
+}

@@ -102,7 +102,7 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
         None => "the tip position".to_string(),
         Some(_) => format!(
             "the positions at X = {} m",
-            (lin.outputs.iter().map(|x| gvs::error::fmt_value(*x)))
+            (lin.outputs.iter().map(|x| gvs::error::fmt_rounded(*x)))
                 .collect::<Vec<_>>()
                 .join(", ")
         ),
@@ -141,7 +141,7 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
             writeln!(
                 out,
                 "output     X = {} m at {} m",
-                gvs::error::fmt_value(*x),
+                gvs::error::fmt_rounded(*x),
                 fmt_vec(p, 6)
             )?;
         }
@@ -190,15 +190,36 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
     if lin.unstable_poles > 0 {
         writeln!(
             out,
-            "note       {} with Re λ > 0: the equilibrium is unstable",
+            "note       {} with Re λ > 0: the equilibrium is unstable (no motion settles there: the gain below is the equilibrium's sensitivity, not a settled displacement)",
             plural(lin.unstable_poles, "pole")
         )?;
+    }
+    // a pole near 0 makes A nearly singular (a limit point, the onset of buckling): the gain,
+    // ∝ 1/|λ|, is then ill-conditioned (a compressed column 0.04 % below its buckling load gave
+    // 147 m/N on a 0.25 m rod)
+    let mut magnitudes: Vec<f64> = (lin.poles.iter()).map(|p| p.re.hypot(p.im)).collect();
+    magnitudes.sort_by(f64::total_cmp);
+    // the next pole of another size: a round rod's two bending planes give equal ones
+    let next = (magnitudes.first()).and_then(|&s| magnitudes.iter().find(|&&m| m > 2.0 * s));
+    if let (Some(&slowest), Some(&next)) = (magnitudes.first(), next) {
+        if slowest < 1e-3 * next && lin.n_actuators > 0 {
+            writeln!(
+                out,
+                "note       the slowest pole, |λ| = {}, lies below 1e-3 of the next ({}): A is nearly singular (the equilibrium is near a limit point or the onset of buckling), so the gain, ∝ 1/|λ|, is ill-conditioned",
+                gvsrom::build::significant(slowest),
+                gvsrom::build::significant(next)
+            )?;
+        }
     }
     // a displacement channel's gain is per metre wound in: shown per millimetre, as mm/mm or
     // mrad/mm
     let driven = |k: usize| lin.displacement_channels.contains(&k);
     let per = |k: usize| if driven(k) { 1.0 } else { 1e3 };
     let unit = |k: usize| if driven(k) { "  per mm wound in" } else { "" };
+    let settled = match lin.unstable_poles {
+        0 => "settled",
+        _ => "equilibrium's",
+    };
     let (input, unit_in) = match lin.displacement_channels.is_empty() {
         true => ("newton of tension", "N"),
         false => ("unit input", "N, or per mm where marked"),
@@ -209,11 +230,11 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
             for (o, x) in lin.outputs.iter().enumerate() {
                 let at = match args.output_at {
                     None => "tip".to_string(),
-                    Some(_) => format!("X = {} m", gvs::error::fmt_value(*x)),
+                    Some(_) => format!("X = {} m", gvs::error::fmt_rounded(*x)),
                 };
                 writeln!(
                     out,
-                    "gain       settled {at} displacement per {input}, −C A⁻¹ B (world x, y, z) [mm/{unit_in}]"
+                    "gain       {settled} {at} displacement per {input}, −C A⁻¹ B (world x, y, z) [mm/{unit_in}]"
                 )?;
                 for k in 0..lin.n_actuators {
                     let col: Vec<f64> = g[3 * o..3 * o + 3]
@@ -227,7 +248,7 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
             if lin.output_tip_rotation.is_some() {
                 writeln!(
                     out,
-                    "gain       settled tip rotation per {input}, −C A⁻¹ B (about world x, y, z) [mrad/{unit_in}]"
+                    "gain       {settled} tip rotation per {input}, −C A⁻¹ B (about world x, y, z) [mrad/{unit_in}]"
                 )?;
                 for k in 0..lin.n_actuators {
                     let col: Vec<f64> = rows[..3].iter().map(|row| row[k] * per(k)).collect();
@@ -238,7 +259,7 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
             if !rows.is_empty() {
                 writeln!(
                     out,
-                    "gain       settled change of each tendon length per {input}, −C A⁻¹ B (tendons' compliance, lengths 1…{}) [mm/{unit_in}]",
+                    "gain       {settled} change of each tendon length per {input}, −C A⁻¹ B (tendons' compliance, lengths 1…{}) [mm/{unit_in}]",
                     rows.len()
                 )?;
                 for k in 0..lin.n_actuators {

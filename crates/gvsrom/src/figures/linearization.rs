@@ -187,7 +187,10 @@ fn is_unstable(p: &PoleDoc) -> bool {
     p.damping_ratio < -crate::linearize::UNSTABLE_RATIO
 }
 
-/// `static_gain`: one panel per output point, the x, y and z rows against the tendon number, then
+/// Most output points whose gain `static_gain` draws, one panel each.
+const MAX_GAIN_POINTS: usize = 12;
+
+/// `static_gain`: one panel per output point (at most [`MAX_GAIN_POINTS`], spread over them), the x, y and z rows against the tendon number, then
 /// one of the tip's rotation and one of the tendon lengths' rows if they are outputs.
 fn static_gain(
     doc: &LinearizationDoc,
@@ -203,10 +206,27 @@ fn static_gain(
             .map(|a| format!("{prefix}world {a}"))
             .to_vec()
     };
-    let mut panels: Vec<Figure> = (0..n_points)
+    // of many output points, a spread of them (41 points drew a figure 16 700 px high, refused)
+    let drawn: Vec<usize> = match n_points <= MAX_GAIN_POINTS {
+        true => (0..n_points).collect(),
+        false => {
+            let last = (n_points - 1) as f64;
+            let step = last / (MAX_GAIN_POINTS - 1) as f64;
+            let mut picks: Vec<usize> = (0..MAX_GAIN_POINTS)
+                .map(|i| (i as f64 * step).round() as usize)
+                .collect();
+            picks.dedup();
+            sink.note(format!(
+                "static_gain: {} of the {n_points} output points drawn, evenly spread from the first to the last (the JSON holds every row)",
+                picks.len()
+            ));
+            picks
+        }
+    };
+    let mut panels: Vec<Figure> = (drawn.iter().copied())
         .map(|o| {
             let at = match &points {
-                Some(xs) => format!("X = {} m", gvs::error::fmt_value(xs[o])),
+                Some(xs) => format!("X = {} m", gvs::error::fmt_rounded(xs[o])),
                 None => "the tip".to_string(),
             };
             let title = format!("settled displacement of {at}");
