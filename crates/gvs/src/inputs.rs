@@ -161,7 +161,11 @@ impl Signal {
                     let before = if k == 0 { n } else { k - 1 };
                     // slopes of rows on one line differ in their rounding only (1e-13 relative
                     // for `linspace`): a corner of 1e-6 of the slope is none the integrator sees
-                    let corner = |a: f64, b: f64| (a - b).abs() > 1e-6 * a.abs().max(b.abs());
+                    // (an infinite slope, of knots 1e-308 apart, is a corner)
+                    let corner = |a: f64, b: f64| {
+                        let (d, tol) = ((a - b).abs(), 1e-6 * a.abs().max(b.abs()));
+                        d > tol || !d.is_finite()
+                    };
                     (step && self.values[k] != self.values[k - 1])
                         || (0..channels).any(|j| corner(slope(before, k, j), slope(k, k + 1, j)))
                 }

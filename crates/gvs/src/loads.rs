@@ -5,7 +5,7 @@
 //! Wrenches are 6-vectors `[m; f]` (moment first). A *local* (follower) wrench is expressed in the
 //! cross-section frame and turns with it; a *global* one keeps its world components.
 
-use crate::error::{check_finite, check_range, fmt_value, ModelError};
+use crate::error::{check_finite, check_range, fmt_rounded, fmt_value, ModelError};
 use crate::lie::{V3, V6};
 use serde::{Deserialize, Serialize};
 
@@ -167,14 +167,15 @@ impl DistributedWrench {
                     x_start,
                     Some((0.0, true)),
                     Some((length, false)),
-                    &format!("an abscissa in [0, {length}) m"),
+                    &format!("an abscissa in [0, {}) m", fmt_rounded(length)),
                 )?;
                 check_range(
                     &f("x_end"),
                     x_end,
                     Some((x_start, false)),
-                    Some((length, true)),
-                    &format!("an abscissa in ({x_start}, {length}] m"),
+                    // the end of divisions summed (0.7 + 0.2 m) is its decimal (0.9 m)
+                    Some((length * (1.0 + 1e-12), true)),
+                    &format!("an abscissa in ({x_start}, {}] m", fmt_rounded(length)),
                 )?;
                 for (i, v) in density.iter().enumerate() {
                     check_finite(&f(&format!("density[{i}]")), *v)?;
@@ -191,8 +192,8 @@ impl DistributedWrench {
                     &f("center"),
                     center,
                     Some((0.0, true)),
-                    Some((length, true)),
-                    &format!("an abscissa in [0, {length}] m"),
+                    Some((length * (1.0 + 1e-12), true)),
+                    &format!("an abscissa in [0, {}] m", fmt_rounded(length)),
                 )?;
                 check_range(
                     &f("width"),
@@ -250,8 +251,8 @@ impl Loads {
                 &format!("loads.point[{k}].x"),
                 p.x,
                 Some((0.0, true)),
-                Some((length, true)),
-                &format!("an abscissa in [0, {length}] m"),
+                Some((length * (1.0 + 1e-12), true)),
+                &format!("an abscissa in [0, {}] m", fmt_rounded(length)),
             )?;
             for (i, v) in p.wrench.iter().enumerate() {
                 check_finite(&format!("loads.point[{k}].wrench[{i}]"), *v)?;

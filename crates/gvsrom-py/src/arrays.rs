@@ -144,6 +144,14 @@ pub fn real(ob: &Bound<'_, PyAny>) -> PyResult<f64> {
     ob.extract()
 }
 
+/// [`real`] of an optional argument (`None` stays `None`).
+pub fn real_or_none(ob: &Bound<'_, PyAny>) -> PyResult<Option<f64>> {
+    match ob.is_none() {
+        true => Ok(None),
+        false => real(ob).map(Some),
+    }
+}
+
 /// `ob` as one real number (a float, an int, a NumPy scalar or 0-d array), if it is one. An array
 /// of at least one dimension is not, even of one element (NumPy before 2.4 turns that into a number
 /// with only a deprecation warning).

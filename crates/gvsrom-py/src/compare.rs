@@ -51,5 +51,13 @@ pub fn compare<'py>(
         })
         .map_err(errors::any)?;
     let json = py.import("json").map_err(|e| invalid(e.to_string()))?;
-    json.call_method1("loads", (text,))
+    let report = json.call_method1("loads", (text,))?;
+    // how the runs differ, named as Python names them (`reference`, `run`, `allow_different`)
+    for key in ["differ", "unknown"] {
+        let spelled: Vec<String> = (report.get_item(key)?.extract::<Vec<String>>()?.iter())
+            .map(|s| errors::python_spelling(s))
+            .collect();
+        report.set_item(key, spelled)?;
+    }
+    Ok(report)
 }

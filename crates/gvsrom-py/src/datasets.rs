@@ -369,8 +369,8 @@ pub fn dataset(
     #[pyo3(from_py_with = crate::arrays::whole_or_none)] threads: Option<i128>,
     force: bool,
     resume: bool,
-    duration: Option<f64>,
-    sample_rate: Option<f64>,
+    #[pyo3(from_py_with = crate::arrays::real_or_none)] duration: Option<f64>,
+    #[pyo3(from_py_with = crate::arrays::real_or_none)] sample_rate: Option<f64>,
     input: Option<PathBuf>,
     interpolate: bool,
     steps: Option<Vec<f64>>,
@@ -385,7 +385,10 @@ pub fn dataset(
     let chunk_size = size("chunk_size", chunk_size, 1)?;
     let threads = threads.map(|v| size("threads", v, 1)).transpose()?;
     let (scenario, mut overrides) = scenario_arg(scenario)?;
-    overrides.extend(crate::arrays::strings("set", set)?);
+    // the values given here, not the scenario's own (the base its plan varies)
+    let given = crate::arrays::strings("set", set)?;
+    overrides.extend(given.iter().cloned());
+    crate::simulate_args::random_counts(steps.as_deref(), babble.as_deref())?;
     dynamic_only(
         duration,
         &[
@@ -432,6 +435,7 @@ pub fn dataset(
         atol: atol.unwrap_or(gvsrom::simulate::DEFAULT_ATOL),
         stop_after_chunks: None,
     };
+    gvsrom::dataset::refuse_set_varied(&given, &args).map_err(|e| errors::any(e.into()))?;
     let (outcome, caught) = crate::interrupt::run(py, |flag| gvsrom::dataset::run(&args, &flag));
     let outcome = outcome.map_err(|e| errors::any(e.into()))?;
     if let Some(message) = outcome.interruption_message() {

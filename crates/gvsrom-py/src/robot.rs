@@ -105,7 +105,7 @@ fn attach_to(
 
 /// What follows a model's refusal of the robot's own tensions where the rest of the scenario lies
 /// inside its training (a model trained on motion under tensions the preset never holds).
-const TENSIONS_OUTSIDE: &str = "the model was trained for this scenario except its tensions, which a robot uses wherever no `u` is given (statics(), linearize(), modes(), the quantities, a simulation without input): set tensions inside the training before attaching it, e.g. scenario.set(\"tendons.*.tension\", -5.0), or one tendon by its index";
+const TENSIONS_OUTSIDE: &str = "the model was trained for this scenario except its tensions, which a robot uses wherever no `u` is given (statics(), linearize(), modes(), the quantities, a simulation without input): set tensions inside the training inputs above before attaching it (scenario.set(\"tendons.*.tension\", u) for all, or one tendon by its index)";
 
 /// Whether two readings of a directory found the same content (the manifest's hashes; a directory
 /// without recorded hashes cannot tell, and passes).

@@ -123,18 +123,7 @@ impl Args<'_> {
                 "`input`, `controller`, `steps` and `babble` each give the tensions: give at most one",
             ));
         }
-        for (name, v, names) in [
-            ("steps", &a.steps, "[lo, hi, period]"),
-            ("babble", &a.babble, "[lo, hi, hold_min, hold_max]"),
-        ] {
-            let n = names.matches(',').count() + 1;
-            if let Some(v) = v.as_ref().filter(|v| v.len() != n) {
-                return Err(invalid(format!(
-                    "`{name}` takes {n} values {names}, got {}",
-                    v.len()
-                )));
-            }
-        }
+        random_counts(a.steps.as_deref(), a.babble.as_deref())?;
         let input = match (&a.input, &callable) {
             (None, Some(c)) => InputSource::Feedback {
                 law: ControlLaw(c.clone()),
@@ -211,6 +200,24 @@ pub fn error_norm(name: &str) -> PyResult<ErrorNormChoice> {
             )))
         }
     })
+}
+
+/// `steps` and `babble` of 3 and 4 values, named as Python names them (the command line's
+/// message counts comma-separated values).
+pub fn random_counts(steps: Option<&[f64]>, babble: Option<&[f64]>) -> PyResult<()> {
+    for (name, v, names) in [
+        ("steps", steps, "[lo, hi, period]"),
+        ("babble", babble, "[lo, hi, hold_min, hold_max]"),
+    ] {
+        let n = names.matches(',').count() + 1;
+        if let Some(v) = v.filter(|v| v.len() != n) {
+            return Err(invalid(format!(
+                "`{name}` takes {n} values {names}, got {}",
+                v.len()
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// `method`: the integrator (`--method`).

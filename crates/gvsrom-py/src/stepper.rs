@@ -342,7 +342,7 @@ impl Robot {
         slf: Py<Self>,
         py: Python<'_>,
         #[pyo3(from_py_with = arrays::real)] dt: f64,
-        horizon: Option<f64>,
+        #[pyo3(from_py_with = arrays::real_or_none)] horizon: Option<f64>,
         q0: Option<arrays::In1<'_>>,
         qd0: Option<arrays::In1<'_>>,
         from_equilibrium: bool,
@@ -357,6 +357,12 @@ impl Robot {
                 "invalid value for `dt`: {} (expected the control period in [{}, 3600] s)",
                 gvs::error::fmt_value(dt),
                 gvs::error::fmt_value(simulate::MIN_DURATION),
+            )));
+        }
+        if let Some(h) = fixed_step.filter(|&h| !(h.is_finite() && h > 0.0)) {
+            return Err(invalid(format!(
+                "invalid value for `fixed_step`: {} (expected a finite step > 0 s, at most dt)",
+                gvs::error::fmt_value(h)
             )));
         }
         if let Some(h) = fixed_step.filter(|&h| h > dt) {

@@ -250,6 +250,8 @@ def test_booleans_are_no_tensions_states_or_times_in_any_container():
         robot.simulate(True)
     with pytest.raises(TypeError, match=r"real number; got a `bool`"):
         robot.stepper(True)
+    with pytest.raises(TypeError, match=r"real number; got a `bool`"):
+        robot.stepper(0.01, horizon=True)
     with pytest.raises(gvsrom.GvsromError, match=r"returned `\[True\]`: expected 1 tension"):
         robot.simulate(0.02, input=lambda t: [True])
     # integers are numbers
@@ -276,6 +278,8 @@ def test_a_steppers_period_and_step_are_named_as_given():
         assert "`dt`" in message(lambda: robot.stepper(dt))
     assert "`fixed_step`: 0.02 (expected a step ≤ dt = 0.01 s" in message(
         lambda: robot.stepper(0.01, fixed_step=0.02))
+    for h in (0.0, float("nan")):
+        assert "`fixed_step`" in message(lambda: robot.stepper(0.01, fixed_step=h))
 
 
 def test_random_inputs_are_named_as_python_arguments():
@@ -284,6 +288,8 @@ def test_random_inputs_are_named_as_python_arguments():
     assert "give at most one" in text and "`steps`" in text and "`babble`" in text, text
     text = message(lambda: robot.simulate(0.02, steps=[-1, 0]))
     assert "`steps` takes 3 values [lo, hi, period], got 2" in text, text
+    text = message(lambda: gvsrom.dataset("single-tendon", "never", duration=0.1, babble=[-1, 0]))
+    assert "`babble` takes 4 values [lo, hi, hold_min, hold_max], got 2" in text, text
 
 
 def test_a_reconstruction_of_no_dataset_says_what_is_accepted(tmp_path, dataset):

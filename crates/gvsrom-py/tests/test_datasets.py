@@ -271,3 +271,15 @@ def test_a_single_override_may_be_a_str(tmp_path):
         gvsrom.dataset("single-tendon", tmp_path / "c", sweep="tendons.0.tension=-6:0", samples=2,
                        set=3)
 
+
+
+def test_a_value_set_with_the_plan_that_varies_it_is_refused_but_a_scenarios_own_is_its_base(
+        tmp_path):
+    # set= beside a sweep of the same value would be replaced at every sample: refused
+    with pytest.raises(gvsrom.GvsromError, match=r"set tendons.0.tension=-1: the plan varies"):
+        gvsrom.dataset("single-tendon", tmp_path / "both", sweep="tendons.0.tension=-6:0",
+                       samples=2, set=["tendons.0.tension=-1"])
+    # a Scenario carrying a tension is the base its plan varies
+    base = gvsrom.Scenario.preset("single-tendon").set("tendons.0.tension", -1.0)
+    ds = gvsrom.dataset(base, tmp_path / "base", sweep="tendons.0.tension=-6:0", samples=2)
+    assert ds.inputs[:, 0].tolist() == [-6.0, 0.0]

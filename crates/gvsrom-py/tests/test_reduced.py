@@ -109,7 +109,7 @@ def test_a_model_refused_for_the_scenarios_tensions_alone_says_how_to_attach_it(
         far.build().with_model(pod_model)
     message = str(e.value)
     assert "tendons.0.tension = -20" in message and "extrapolate=True" in message, message
-    assert "set tensions inside the training before attaching it" in message, message
+    assert "set tensions inside the training inputs above before attaching it" in message, message
     robot = far.set("tendons.*.tension", -3.0).build().with_model(pod_model)
     assert robot.tensions.tolist() == [-3.0]
     # a scenario outside the training in more than its tensions gets no such advice

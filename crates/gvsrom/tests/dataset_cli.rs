@@ -964,6 +964,8 @@ fn a_value_set_that_the_plan_varies_is_refused_naming_both() {
         ("tendons.0.tension=-1", "tendons.0.tension=-6:0"),
         ("tendons[0].tension=-1", "tendons.0.tension=-6:0"),
         ("tendons.*.tension=-1", "tendons.0.tension=-6:0"),
+        ("tendons.00.tension=-1", "tendons.*.tension=-6:0"),
+        ("loads.gravity=[0, 0, -1]", "loads.gravity.2=-9:0"),
     ] {
         let out = scratch("set-varied");
         expect_error(
@@ -981,7 +983,10 @@ fn a_value_set_that_the_plan_varies_is_refused_naming_both() {
             ],
             &[
                 &format!("--set {set}"),
-                "the plan varies `tendons.0.tension` (--sweep tendons.0.tension)",
+                &format!(
+                    "the plan varies `{}` (--sweep {plan})",
+                    plan.split('=').next().unwrap()
+                ),
             ],
         );
         assert!(!out.exists(), "nothing written for a refused plan");

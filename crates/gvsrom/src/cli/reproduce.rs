@@ -53,7 +53,9 @@ pub(super) fn reproduce_cmd(args: &ReproduceArgs, out: &mut impl Write) -> Resul
 
 pub(super) fn dataset_cmd(args: &DatasetArgs, out: &mut impl Write) -> Result<()> {
     let signal = interrupt_flag();
-    let outcome = gvsrom::dataset::run(&args.request(), &signal)?;
+    let request = args.request();
+    gvsrom::dataset::refuse_set_varied(&args.set, &request)?;
+    let outcome = gvsrom::dataset::run(&request, &signal)?;
     for w in &outcome.warnings {
         gvsrom::progress::stderr_line(format_args!("warning: {w}"));
     }

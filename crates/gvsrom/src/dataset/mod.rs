@@ -295,32 +295,44 @@ fn legacy_q_order() -> String {
 
 /// A `--set` of a value the plan varies would be replaced at every sample: refused, naming both
 /// (`--set tendons.0.tension=-1` with `--sweep tendons.0.tension=-6:0` gave the sweep's inputs).
-fn refuse_set_varied(set: &[String], plan: &Plan) -> Result<(), DatasetError> {
-    // `tendons[0].tension` and `tendons.0.tension` alike; `*` matches any one segment
+/// `set` holds the values given with the plan (not those a Python `Scenario` carries, the base
+/// its plan varies); a `*` of either matches any entry, and a value set is varied when the plan
+/// varies it or a value inside it (`loads.gravity` against `loads.gravity.2`).
+pub fn refuse_set_varied(set: &[String], request: &DatasetRequest) -> Result<(), DatasetError> {
+    // `tendons[0].tension`, `tendons.0.tension` and `tendons.00.tension` alike
     let segments = |path: &str| -> Vec<String> {
         (path.trim().replace('[', ".").replace(']', ""))
             .split('.')
             .filter(|s| !s.is_empty())
-            .map(str::to_string)
+            .map(|s| match s.parse::<usize>() {
+                Ok(k) => k.to_string(),
+                Err(_) => s.to_string(),
+            })
             .collect()
     };
+    let plans = [
+        ("--sweep", &request.sweep),
+        ("--grid", &request.grid),
+        ("--random", &request.random),
+    ];
     for spec in set {
         let Some((path, _)) = spec.split_once('=') else {
             continue;
         };
         let set_path = segments(path);
-        let varied = plan.parameters.iter().find(|p| {
-            let param = segments(&p.path);
-            param.len() == set_path.len()
-                && (param.iter().zip(&set_path)).all(|(a, b)| a == b || b == "*")
-        });
-        if let Some(p) = varied {
-            return Err(plan_err(format!(
-                "--set {spec}: the plan varies `{}` ({} {}), which would replace the value set at every sample; drop one of them",
-                p.path,
-                plan.kind.option(),
-                p.path
-            )));
+        for (option, specs) in plans {
+            for plan in specs.iter() {
+                let varied = plan.split_once('=').map_or(plan.as_str(), |(p, _)| p);
+                let param = segments(varied);
+                let inside = param.len() >= set_path.len()
+                    && (param.iter().zip(&set_path)).all(|(a, b)| a == b || a == "*" || b == "*");
+                if inside {
+                    return Err(plan_err(format!(
+                        "--set {spec}: the plan varies `{}` ({option} {plan}), which would replace the value set at every sample; drop one of them",
+                        varied.trim()
+                    )));
+                }
+            }
         }
     }
     Ok(())
@@ -489,7 +501,6 @@ pub fn run(args: &DatasetRequest, interrupt: &AtomicUsize) -> Result<Outcome, Da
         &table,
     )
     .map_err(plan_err)?;
-    refuse_set_varied(&args.set, &plan)?;
     if !(1..=MAX_CHUNK_SIZE).contains(&args.chunk_size) {
         return Err(plan_err(format!(
             "--chunk-size {}: expected an integer in [1, {MAX_CHUNK_SIZE}]",

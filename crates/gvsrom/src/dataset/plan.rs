@@ -103,10 +103,11 @@ fn canonical(segs: &[Seg]) -> String {
 
 /// Expands `path` (with at most one `*` segment) against the scenario `table`.
 fn expand(kind: PlanKind, spec: &str, path: &str, table: &Table) -> Result<Vec<Vec<Seg>>, String> {
-    let parts: Vec<&str> = path.split('.').collect();
-    let stars: Vec<usize> = (0..parts.len())
-        .filter(|&i| parts[i] == "*" || parts[i] == "[*]")
-        .collect();
+    // `tendons[*].tension` as `tendons.*.tension`, as an index may be written either way
+    let starred = path.replace("[*]", ".*");
+    let path = starred.as_str();
+    let parts: Vec<&str> = path.split('.').filter(|p| !p.is_empty()).collect();
+    let stars: Vec<usize> = (0..parts.len()).filter(|&i| parts[i] == "*").collect();
     let parse = |p: &str| parse_path(p).map_err(|e| bad(kind, spec, e));
     match stars.as_slice() {
         [] => Ok(vec![parse(path)?]),

@@ -86,8 +86,10 @@ pub fn apply_override(table: &mut Table, spec: &str) -> Result<(), ScenarioError
 /// it (`tendons.*.tension` is `tendons.0.tension`, `tendons.1.tension`, …); `None` for a path
 /// without one. The first `*` is expanded here, any later one by each path's own override.
 fn every_entry(table: &Table, path: &str) -> Result<Option<Vec<String>>, String> {
-    let parts: Vec<&str> = path.split('.').collect();
-    let Some(i) = parts.iter().position(|p| *p == "*" || *p == "[*]") else {
+    // `tendons[*].tension` as `tendons.*.tension`, as an index may be written either way
+    let path = path.replace("[*]", ".*");
+    let parts: Vec<&str> = path.split('.').filter(|p| !p.is_empty()).collect();
+    let Some(i) = parts.iter().position(|p| *p == "*") else {
         return Ok(None);
     };
     let prefix = parts[..i].join(".");

@@ -198,9 +198,11 @@ fn a_star_in_an_override_stands_for_every_entry_of_the_list() {
     let two = format!(
         "{MINIMAL}\n[[tendons]]\noffset_start = [0, 0.002]\noffset_end = [0, 0.002]\ntension = -1\n"
     );
-    let s = Scenario::from_toml("t", &two, &["tendons.*.tension=-2.5".into()]).unwrap();
-    assert_eq!(s.tendons.len(), 2);
-    assert!(s.tendons.iter().all(|t| t.tension == -2.5));
+    for star in ["tendons.*.tension=-2.5", "tendons[*].tension=-2.5"] {
+        let s = Scenario::from_toml("t", &two, &[star.into()]).unwrap();
+        assert_eq!(s.tendons.len(), 2);
+        assert!(s.tendons.iter().all(|t| t.tension == -2.5), "{star}");
+    }
     for (spec, named) in [
         ("material.*.x=1", "`material` is not a list"),
         ("bodies.*.mass=1", "no list `bodies`"),
