@@ -13,6 +13,21 @@ use pyo3::prelude::*;
 use rayon::prelude::*;
 use std::sync::atomic::Ordering;
 
+/// The rows a parallel batch solved, or why it did not finish (a Ctrl-C, a panic caught, the
+/// first row that failed, named `U[k]`: a `ConvergenceError` for a solve that did not converge).
+fn batch_reports<E: Into<anyhow::Error>>(
+    results: Option<Vec<Result<StaticsReport, E>>>,
+    caught: Option<PyErr>,
+) -> PyResult<Vec<StaticsReport>> {
+    if let Some(e) = caught {
+        return Err(e);
+    }
+    let results = results.ok_or_else(|| invalid("statics_batch was stopped before it finished"))?;
+    (results.into_iter().enumerate())
+        .map(|(k, r)| r.map_err(|e| errors::any(e.into().context(format!("U[{k}]")))))
+        .collect()
+}
+
 impl Robot {
     /// The equilibrium under `u` with this robot's reduced model as attached, without building
     /// the scenario again: `None` if `u` is not accepted as it is (a bad count or value, a tension
@@ -117,17 +132,7 @@ impl Robot {
                 })
                 .collect::<Option<Vec<_>>>()
         });
-        if let Some(e) = caught {
-            return Err(e);
-        }
-        let Some(results) = results else {
-            return Err(invalid("statics_batch was stopped before it finished"));
-        };
-        let mut reports = Vec::with_capacity(results.len());
-        for (k, r) in results.into_iter().enumerate() {
-            reports.push(r.map_err(|e| errors::any(e.context(format!("U[{k}]"))))?);
-        }
-        StaticsBatch::new(py, &reports, built)
+        StaticsBatch::new(py, &batch_reports(results, caught)?, built)
     }
 }
 
@@ -263,22 +268,6 @@ impl Robot {
                     .collect::<Option<Vec<_>>>()
             }
         });
-        if let Some(e) = caught {
-            return Err(e);
-        }
-        let Some(results) = results else {
-            return Err(invalid("statics_batch was stopped before it finished"));
-        };
-        let mut reports = Vec::with_capacity(results.len());
-        for (k, r) in results.into_iter().enumerate() {
-            match r {
-                Ok(report) => reports.push(report),
-                Err(f) => {
-                    let message = format!("U[{k}]: {f}");
-                    return Err(errors::statics_with_message(py, &f, &message));
-                }
-            }
-        }
-        StaticsBatch::new(py, &reports, built)
+        StaticsBatch::new(py, &batch_reports(results, caught)?, built)
     }
 }

@@ -92,3 +92,11 @@ def test_ctrl_c_stops_a_batch(sigint_raises, warm_start):
     with pytest.raises(KeyboardInterrupt):
         robot.statics_batch(U, warm_start=warm_start)
     assert time.monotonic() - t0 < 10.0
+
+
+@pytest.mark.parametrize("warm_start", [True, False])
+def test_a_row_that_does_not_converge_is_a_convergence_error_naming_it(warm_start):
+    robot = gvsrom.Scenario.preset("single-tendon").set("solver.max_iterations", 1).build()
+    with pytest.raises(gvsrom.ConvergenceError, match=r"^U\[\d\]: statics did not converge") as e:
+        robot.statics_batch(np.array([[-1.0], [-5.0]]), warm_start=warm_start)
+    assert e.value.iterations >= 1 and e.value.residual_norm > 0

@@ -73,6 +73,27 @@ pub(super) fn on_rod(field: &str, x: f64, l: f64) -> Result<f64, ScenarioError> 
     })
 }
 
+/// `x_end` as the end of a span starting at `x_start` on a rod of length `l`: after `x_start`
+/// and on the rod ([`on_rod`]'s tolerance at the tip), else an error naming `field`.
+pub(super) fn span_end(
+    field: &str,
+    x_end: f64,
+    x_start: f64,
+    l: f64,
+) -> Result<f64, ScenarioError> {
+    match gvs::rod::abscissa_on(l, x_end) {
+        Some(x) if x > x_start => Ok(x),
+        _ => Err(ScenarioError::value(
+            field,
+            x_end,
+            format!(
+                "an abscissa in ({x_start}, {}] m (after x_start)",
+                fmt_rounded(l)
+            ),
+        )),
+    }
+}
+
 /// `v` in the closed range `[lo, hi]`, else an error naming `field` and the range.
 pub(super) fn in_range(
     field: &str,

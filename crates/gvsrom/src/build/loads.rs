@@ -77,16 +77,7 @@ pub fn loads(s: &Scenario, l: f64) -> Result<Loads, ScenarioError> {
                     ));
                 }
                 let x_end = finite(&f("x_end"), d.x_end.unwrap_or(l))?;
-                let x_end = match gvs::rod::abscissa_on(l, x_end) {
-                    Some(x) if x > x_start => x,
-                    _ => {
-                        return Err(ScenarioError::value(
-                            f("x_end"),
-                            x_end,
-                            format!("an abscissa in ({x_start}, {}] m", fmt_rounded(l)),
-                        ))
-                    }
-                };
+                let x_end = span_end(&f("x_end"), x_end, x_start, l)?;
                 let force = d.force.unwrap_or_default();
                 let moment = d.moment.unwrap_or_default();
                 for (name, v) in [("force", force), ("moment", moment)] {

@@ -57,19 +57,7 @@ pub(super) fn tendon(k: usize, t: &TendonSpec, rod: &Rod) -> Result<Tendon, Scen
         ));
     }
     let x_end = finite(&f("x_end"), t.x_end.unwrap_or(l))?;
-    let x_end = match gvs::rod::abscissa_on(l, x_end) {
-        Some(x) if x > x_start => x,
-        _ => {
-            return Err(ScenarioError::value(
-                f("x_end"),
-                x_end,
-                format!(
-                    "an abscissa in ({x_start}, {}] m (after x_start)",
-                    fmt_rounded(l)
-                ),
-            ))
-        }
-    };
+    let x_end = span_end(&f("x_end"), x_end, x_start, l)?;
     let (friction, friction_smoothing) = friction(k, t, l)?;
     let explicit = t.offset_start.is_some() || t.offset_end.is_some();
     let polar = t.angle_deg.is_some() || t.radial_fraction.is_some();
