@@ -139,8 +139,9 @@ impl Signal {
 
     /// Times in `(t0, t1)` where `u` or its derivative jumps: the knots where a held value
     /// changes, or where the slope of a linear one does by more than 1e-6 of itself (the value is
-    /// held before the first knot and after the last). A knot that changes nothing (rows of one value sampled at 1 kHz) is
-    /// none: the integrator restarts at every breakpoint, which costs far more than a step.
+    /// held before the first knot and after the last). A knot that changes nothing (rows of one
+    /// value sampled at 1 kHz) is none: the integrator restarts at every breakpoint, which costs
+    /// far more than a step.
     pub fn breakpoints(&self, t0: f64, t1: f64) -> Vec<f64> {
         let n = self.times.len();
         let slope = |a: usize, b: usize, j: usize| -> f64 {
