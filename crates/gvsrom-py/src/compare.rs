@@ -29,7 +29,8 @@ use std::path::PathBuf;
 ///     the length: ``tip_mean``, ``tip_max``, ``tip_max_t``, ``tip_end``, ``tip_start``; the
 ///     strain errors; the tendons' length errors in mm), ``speed_ratio`` (the run's simulated
 ///     time per wall time over the reference's, ``None`` if it cannot be told), ``differ``,
-///     ``unknown`` and ``provenance`` (both runs' hashes).
+///     ``unknown``, ``warnings`` (a run written before gvsrom recorded content hashes, also
+///     raised as a ``UserWarning``) and ``provenance`` (both runs' hashes).
 ///
 /// Raises
 /// ------
@@ -44,16 +45,22 @@ pub fn compare<'py>(
     run: PathBuf,
     allow_different: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let text = py
-        .detach(|| -> anyhow::Result<String> {
+    let (text, warnings) = py
+        .detach(|| -> anyhow::Result<(String, Vec<String>)> {
             let compared = gvsrom::compare::run(&reference, &run, allow_different)?;
-            Ok(serde_json::to_string(&compared.report()?)?)
+            Ok((
+                serde_json::to_string(&compared.report()?)?,
+                compared.warnings,
+            ))
         })
         .map_err(errors::any)?;
+    for w in &warnings {
+        crate::robot::warn(py, w)?;
+    }
     let json = py.import("json").map_err(|e| invalid(e.to_string()))?;
     let report = json.call_method1("loads", (text,))?;
     // how the runs differ, named as Python names them (`reference`, `run`, `allow_different`)
-    for key in ["differ", "unknown"] {
+    for key in ["differ", "unknown", "warnings"] {
         let spelled: Vec<String> = (report.get_item(key)?.extract::<Vec<String>>()?.iter())
             .map(|s| errors::python_spelling(s))
             .collect();

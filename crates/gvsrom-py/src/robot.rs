@@ -252,14 +252,28 @@ impl Robot {
         let Some(u) = u else {
             return Ok(None);
         };
+        let u = self.given_tensions(&u.values())?;
         let mut scenario = self.scenario.clone();
-        scenario.scenario.set_tensions(&u.values()).map_err(err)?;
+        scenario.scenario.set_tensions(&u).map_err(err)?;
         Ok(Some(build_with(
             py,
             &scenario,
             self.attached.as_ref(),
             false,
         )?))
+    }
+
+    /// Tensions `u` as a Python caller gives them: one for every tendon or one per tendon, each
+    /// finite; errors name `u` (the library names the scenario's `tendons`).
+    pub(crate) fn given_tensions(&self, u: &[f64]) -> PyResult<Vec<f64>> {
+        let n = self.built.model.n_actuators();
+        let u = gvsrom::scenario::tensions_for(n, u).map_err(|e| match e {
+            gvsrom::error::ScenarioError::Invalid { message, .. } => {
+                invalid(format!("`u`: {message}"))
+            }
+            other => err(other),
+        })?;
+        Ok(arrays::finite("u", u.into())?.as_slice().to_vec())
     }
 
     /// Tensions of a model quantity: the scenario's, or `u` (one per tendon or one for all),
@@ -280,9 +294,7 @@ impl Robot {
             }
             return Ok(self.built.u.clone());
         };
-        let u = gvsrom::scenario::tensions_for(self.built.model.n_actuators(), &u.values())
-            .map_err(err)?;
-        let u = arrays::finite("u", u.into())?.as_slice().to_vec();
+        let u = self.given_tensions(&u.values())?;
         // tensions far beyond the rod's elastic range are refused as statics refuses them (1e300
         // N gave an elastic force of inf): checked in full only past a tendon's own limit
         let limits =

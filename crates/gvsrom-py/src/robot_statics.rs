@@ -55,6 +55,8 @@ impl Robot {
         u: Option<Vec<f64>>,
         attached: Option<&Attached>,
     ) -> PyResult<(StaticsReport, Vec<String>)> {
+        // named as the caller's `u` (a count or a NaN), then checked as the command line checks it
+        let u = u.map(|u| self.given_tensions(&u)).transpose()?;
         if u.is_none() && attached.is_none() && self.built.displacement_driven() {
             // the tendons driven by displacement: their tensions are found
             let report = py

@@ -297,3 +297,13 @@ def test_a_reconstruction_of_no_dataset_says_what_is_accepted(tmp_path, dataset)
     with pytest.raises(TypeError, match=r"invalid `dataset`: got a NoneType; accepted: a Dataset"):
         model.reconstruction(None)
     assert model.reconstruction(dataset).rows == 4
+
+
+def test_tensions_of_the_wrong_count_or_not_finite_are_named_u_everywhere():
+    robot = gvsrom.Scenario.preset("six-tendon").build()
+    z = np.zeros(robot.n_dof)
+    for call in (lambda u: robot.statics(u), lambda u: robot.statics_residual(z, u),
+                 lambda u: robot.linearize(u=u)):
+        assert message(lambda: call([-1.0] * 5)).startswith(
+            "`u`: 5 tensions given for 6 tendons"), call
+        assert message(lambda: call([np.nan] * 6)).startswith("`u[0]` = NaN"), call

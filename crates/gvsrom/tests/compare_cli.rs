@@ -299,3 +299,41 @@ fn a_trajectory_without_or_with_a_damaged_reference_strain_is_read_as_written() 
         &["strain_reference.npy", "not a finite number"],
     );
 }
+
+/// A run written before gvsrom recorded content hashes is compared, with a warning that its files
+/// could not be checked (an edited tip of such a run had been compared silently).
+#[test]
+fn a_run_without_content_hashes_is_compared_with_a_warning() {
+    let reference = simulate("cmp-unhashed-ref", &[]);
+    let old = scratch("cmp-unhashed-run");
+    std::fs::create_dir_all(&old).unwrap();
+    for entry in std::fs::read_dir(&reference).unwrap() {
+        let entry = entry.unwrap();
+        std::fs::copy(entry.path(), old.join(entry.file_name())).unwrap();
+    }
+    let meta_path = old.join("meta.json");
+    let mut meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&meta_path).unwrap()).unwrap();
+    let manifest = meta["gvsrom"].as_object_mut().unwrap();
+    manifest.remove("sha256");
+    manifest.remove("meta_sha256");
+    std::fs::write(&meta_path, serde_json::to_string_pretty(&meta).unwrap()).unwrap();
+    let (stdout, stderr) = common::run_ok_with_stderr(&[
+        "compare",
+        reference.to_str().unwrap(),
+        old.to_str().unwrap(),
+    ]);
+    assert!(stdout.contains("tip error"), "{stdout}");
+    assert!(
+        stderr.contains("warning: RUN `")
+            && stderr.contains("written before gvsrom recorded content hashes"),
+        "{stderr}"
+    );
+    // the hashed runs compare without one
+    let (_, quiet) = common::run_ok_with_stderr(&[
+        "compare",
+        reference.to_str().unwrap(),
+        reference.to_str().unwrap(),
+    ]);
+    assert!(!quiet.contains("warning"), "{quiet}");
+}

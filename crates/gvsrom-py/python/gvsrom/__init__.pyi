@@ -878,7 +878,8 @@ def compare(reference: _Path, run: _Path, allow_different: bool = False) -> dict
         the length: ``tip_mean``, ``tip_max``, ``tip_max_t``, ``tip_end``, ``tip_start``; the
         strain errors; the tendons' length errors in mm), ``speed_ratio`` (the run's simulated
         time per wall time over the reference's, ``None`` if it cannot be told), ``differ``,
-        ``unknown`` and ``provenance`` (both runs' hashes).
+        ``unknown``, ``warnings`` (a run written before gvsrom recorded content hashes, also
+        raised as a ``UserWarning``) and ``provenance`` (both runs' hashes).
 
     Raises
     ------

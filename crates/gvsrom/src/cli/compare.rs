@@ -37,6 +37,9 @@ pub(super) fn compare_cmd(args: &CompareArgs, out: &mut impl Write) -> Result<()
         None => None,
     };
     let compared = gvsrom::compare::run(&args.reference, &args.run, args.allow_different)?;
+    for w in &compared.warnings {
+        gvsrom::progress::stderr_line(format_args!("warning: {w}"));
+    }
     let (reference, run, diffs, c) = (
         &compared.reference,
         &compared.run,

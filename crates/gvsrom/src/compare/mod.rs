@@ -143,6 +143,8 @@ pub struct Report {
     pub speed_ratio: Option<f64>,
     pub differ: Vec<String>,
     pub unknown: Vec<String>,
+    /// What could not be checked ([`Compared::warnings`]).
+    pub warnings: Vec<String>,
     pub provenance: crate::provenance::Provenance,
 }
 
@@ -155,6 +157,9 @@ pub struct Compared {
     pub comparison: Comparison,
     /// [`speed_ratio`] of the run over the reference.
     pub speed_ratio: Option<f64>,
+    /// What could not be checked: a run written before gvsrom recorded content hashes, whose
+    /// files may have been edited since (`pod` and `--model` warn of such outputs alike).
+    pub warnings: Vec<String>,
 }
 
 /// `gvsrom compare REFERENCE RUN`: loads both trajectories, refuses them unless they ran the same
@@ -177,12 +182,23 @@ pub fn run(reference: &Path, run: &Path, allow_different: bool) -> Result<Compar
     }
     let comparison = compare(&reference, &run)?;
     let speed_ratio = speed_ratio(&reference, &run);
+    let warnings = [("REFERENCE", &reference), ("RUN", &run)]
+        .iter()
+        .filter(|(_, t)| t.origin.sha256.is_empty())
+        .map(|(field, t)| {
+            format!(
+                "{field} `{}` was written before gvsrom recorded content hashes: its files could not be checked for edits",
+                t.dir.display()
+            )
+        })
+        .collect();
     Ok(Compared {
         reference,
         run,
         differences: diffs,
         comparison,
         speed_ratio,
+        warnings,
     })
 }
 
@@ -196,6 +212,7 @@ impl Compared {
             comparison: self.comparison.clone(),
             differ: self.differences.differ.clone(),
             unknown: self.differences.unknown.clone(),
+            warnings: self.warnings.clone(),
             provenance: crate::provenance::Provenance::of_command()
                 .compared(&self.reference.origin, &self.run.origin),
         })
