@@ -140,7 +140,7 @@ fn static_gain_of_a_straight_tendon_is_the_uniform_moments_closed_form() {
     assert!(rel(g[2][0], gz) < 1e-9, "δz/δu = {} vs {gz}", g[2][0]);
     assert!(rel(g[0][0], gx) < 1e-9, "δx/δu = {} vs {gx}", g[0][0]);
     assert!(g[1][0].abs() < 1e-12 * gz.abs(), "δy/δu = {}", g[1][0]);
-    assert!(stdout.contains("  tendon 1"), "{stdout}");
+    assert!(stdout.contains("  tendon 0"), "{stdout}");
 }
 
 #[test]

@@ -241,7 +241,7 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
                         .iter()
                         .map(|row| row[k] * per(k))
                         .collect();
-                    writeln!(out, "  tendon {:<3} {}{}", k + 1, fmt_vec(&col, 4), unit(k))?;
+                    writeln!(out, "  tendon {:<3} {}{}", k, fmt_vec(&col, 4), unit(k))?;
                 }
             }
             let mut rows = &g[3 * lin.outputs.len()..];
@@ -252,19 +252,19 @@ pub(super) fn linearize_cmd(args: &LinearizeArgs, out: &mut impl Write) -> Resul
                 )?;
                 for k in 0..lin.n_actuators {
                     let col: Vec<f64> = rows[..3].iter().map(|row| row[k] * per(k)).collect();
-                    writeln!(out, "  tendon {:<3} {}{}", k + 1, fmt_vec(&col, 4), unit(k))?;
+                    writeln!(out, "  tendon {:<3} {}{}", k, fmt_vec(&col, 4), unit(k))?;
                 }
                 rows = &rows[3..];
             }
             if !rows.is_empty() {
                 writeln!(
                     out,
-                    "gain       {settled} change of each tendon length per {input}, −C A⁻¹ B (tendons' compliance, lengths 1…{}) [mm/{unit_in}]",
-                    rows.len()
+                    "gain       {settled} change of each tendon length per {input}, −C A⁻¹ B (tendons' compliance, lengths 0…{}) [mm/{unit_in}]",
+                    rows.len() - 1
                 )?;
                 for k in 0..lin.n_actuators {
                     let col: Vec<f64> = rows.iter().map(|row| row[k] * per(k)).collect();
-                    writeln!(out, "  tendon {:<3} {}{}", k + 1, fmt_vec(&col, 4), unit(k))?;
+                    writeln!(out, "  tendon {:<3} {}{}", k, fmt_vec(&col, 4), unit(k))?;
                 }
             }
         }

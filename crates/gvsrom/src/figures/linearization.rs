@@ -190,8 +190,9 @@ fn is_unstable(p: &PoleDoc) -> bool {
 /// Most output points whose gain `static_gain` draws, one panel each.
 const MAX_GAIN_POINTS: usize = 12;
 
-/// `static_gain`: one panel per output point (at most [`MAX_GAIN_POINTS`], spread over them), the x, y and z rows against the tendon number, then
-/// one of the tip's rotation and one of the tendon lengths' rows if they are outputs.
+/// `static_gain`: one panel per output point (at most [`MAX_GAIN_POINTS`], spread over them), the
+/// x, y and z rows against the tendon number, then one of the tip's rotation and one of the tendon
+/// lengths' rows if they are outputs.
 fn static_gain(
     doc: &LinearizationDoc,
     g: &[Vec<f64>],
@@ -239,7 +240,7 @@ fn static_gain(
         panels.push(gain_panel(doc, title, "mrad/N", rows, world("about ")));
     }
     if lengths > 0 {
-        let names = (1..=lengths).map(|j| format!("length {j}")).collect();
+        let names = (0..lengths).map(|j| format!("length {j}")).collect();
         let title = "settled change of the tendon lengths (the tendons' compliance)".to_string();
         panels.push(gain_panel(
             doc,
@@ -271,10 +272,11 @@ fn gain_panel(
     rows: &[Vec<f64>],
     names: Vec<String>,
 ) -> Figure {
-    let tendons: Vec<f64> = (1..=doc.n_actuators).map(|k| k as f64).collect();
+    // numbered from 0, as the scenario's `tendons[k]` and every other figure and message
+    let tendons: Vec<f64> = (0..doc.n_actuators).map(|k| k as f64).collect();
     let margin = Series::new(
         "",
-        vec![0.5, doc.n_actuators as f64 + 0.5],
+        vec![-0.5, doc.n_actuators as f64 - 0.5],
         vec![0.0, 0.0],
         SeriesStyle::Bounds,
     );

@@ -216,7 +216,7 @@ fn tensions(tr: &Trajectory, caption: &str, sink: &mut Sink) -> Result<(), Figur
                     pts.into_iter().unzip()
                 }
             };
-            Series::new(format!("tendon {}", j + 1), t, y, SeriesStyle::Line)
+            Series::new(format!("tendon {j}"), t, y, SeriesStyle::Line)
                 .with_color(palette::EXTRA[j % palette::EXTRA.len()])
         })
         .collect();
@@ -246,13 +246,8 @@ fn tendon_lengths(tr: &Trajectory, caption: &str, sink: &mut Sink) -> Result<(),
                     None => 1e3 * lengths[k * na + j],
                 })
                 .collect();
-            Series::new(
-                format!("tendon {}", j + 1),
-                tr.t.clone(),
-                y,
-                SeriesStyle::Line,
-            )
-            .with_color(palette::EXTRA[j % palette::EXTRA.len()])
+            Series::new(format!("tendon {j}"), tr.t.clone(), y, SeriesStyle::Line)
+                .with_color(palette::EXTRA[j % palette::EXTRA.len()])
         })
         .collect();
     let (title, y_label) = match rest {
