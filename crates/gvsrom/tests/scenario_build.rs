@@ -916,23 +916,14 @@ fn a_helix_sampled_by_too_few_points_is_named_with_the_points_that_resolve_it() 
 /// a linearization's output), and the messages and summary print 0.9, not the sum's last bit.
 #[test]
 fn a_rod_whose_division_lengths_sum_below_their_decimal_takes_loads_at_its_tip() {
-    let rod = r#"
-        name = "two-division"
-        [material]
-        youngs_modulus = 1e6
-        poisson_ratio = 0.5
-        density = 1000
-        [[divisions]]
-        length = 0.7
-        radius = 0.01
-        basis = { kind = "legendre", modes = ["bend_y", "elongation", "shear_z"], order = 2 }
-        [[divisions]]
-        length = 0.2
-        radius = 0.01
-        basis = { kind = "legendre", modes = ["bend_y", "elongation", "shear_z"], order = 2 }
-        [loads]
-        gravity = [0, 0, 0]
-    "#;
+    // the uniform rod as two divisions of its section
+    let division = UNIFORM_ROD.split("[[divisions]]").nth(1).unwrap();
+    let division = division.split("[loads]").next().unwrap();
+    let rod = &format!(
+        "{}\n[[divisions]]{}",
+        UNIFORM_ROD.replace("length = 0.5", "length = 0.7"),
+        division.replace("length = 0.5", "length = 0.2")
+    );
     let sum: f64 = [0.7, 0.2].iter().sum();
     assert!(sum < 0.9, "the premise: the sum rounds below 0.9");
     // an end moment at x = 0.9 bends both divisions onto one circle, κ = M/EI, tip at L = 0.9

@@ -13,7 +13,7 @@
 //!   after parameter, from one SplitMix64 stream seeded by `--seed`, so the values never depend on
 //!   the thread count.
 
-use crate::scenario::{lookup, parse_path, Seg};
+use crate::scenario::{every_entry, parse_path, Seg};
 use gvs::inputs::SplitMix64;
 use serde::{Deserialize, Serialize};
 use toml::{Table, Value};
@@ -101,58 +101,21 @@ fn canonical(segs: &[Seg]) -> String {
         .join(".")
 }
 
-/// Expands `path` (with at most one `*` segment) against the scenario `table`.
+/// Expands `path` (with at most one `*` segment) against the scenario `table`
+/// ([`every_entry`], as `--set` expands it).
 fn expand(kind: PlanKind, spec: &str, path: &str, table: &Table) -> Result<Vec<Vec<Seg>>, String> {
-    // `tendons[*].tension` as `tendons.*.tension`, as an index may be written either way
-    let starred = path.replace("[*]", ".*");
-    let path = starred.as_str();
-    let parts: Vec<&str> = path.split('.').filter(|p| !p.is_empty()).collect();
-    let stars: Vec<usize> = (0..parts.len()).filter(|&i| parts[i] == "*").collect();
     let parse = |p: &str| parse_path(p).map_err(|e| bad(kind, spec, e));
-    match stars.as_slice() {
-        [] => Ok(vec![parse(path)?]),
-        [i] => {
-            let prefix = parts[..*i].join(".");
-            let suffix = parts[i + 1..].join(".");
-            if prefix.is_empty() {
-                return Err(bad(kind, spec, "`*` must follow the path of a list"));
-            }
-            let pre = parse(&prefix)?;
-            let n = match lookup(table, &pre) {
-                Some(Value::Array(a)) if !a.is_empty() => a.len(),
-                Some(Value::Array(_)) => {
-                    return Err(bad(kind, spec, format!("the list `{prefix}` is empty")))
-                }
-                Some(_) => {
-                    return Err(bad(
-                        kind,
-                        spec,
-                        format!("`{prefix}` is not a list: `*` stands for every entry of a list"),
-                    ))
-                }
-                None => {
-                    return Err(bad(
-                        kind,
-                        spec,
-                        format!("unknown parameter path: the scenario has no list `{prefix}`"),
-                    ))
-                }
-            };
-            let post = if suffix.is_empty() {
-                vec![]
-            } else {
-                parse(&suffix)?
-            };
-            Ok((0..n)
-                .map(|k| {
-                    let mut s = pre.clone();
-                    s.push(Seg::Index(k));
-                    s.extend(post.iter().cloned());
-                    s
-                })
-                .collect())
-        }
-        _ => Err(bad(kind, spec, "at most one `*` per path")),
+    let stars = path
+        .replace("[*]", ".*")
+        .split('.')
+        .filter(|p| *p == "*")
+        .count();
+    if stars > 1 {
+        return Err(bad(kind, spec, "at most one `*` per path"));
+    }
+    match every_entry(table, path).map_err(|e| bad(kind, spec, e))? {
+        None => Ok(vec![parse(path)?]),
+        Some(paths) => paths.iter().map(|p| parse(p)).collect(),
     }
 }
 

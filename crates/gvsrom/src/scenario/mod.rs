@@ -26,7 +26,7 @@ mod types;
 pub use input_file::{check_regular_file, read_error};
 pub use overrides::{apply_override, MAX_OVERRIDE_SEGMENTS};
 pub use parse::{from_table, parse_table};
-pub use path::{lookup, number_at, parse_path, render_path, Seg};
+pub use path::{every_entry, lookup, number_at, parse_path, render_path, Seg};
 pub use tensions::tensions_for;
 pub use types::{
     default_pulse_axis, BaseSpec, BasisKind, BasisSpec, BodySpec, DistributedKind,

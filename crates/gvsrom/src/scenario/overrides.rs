@@ -2,7 +2,7 @@
 //! types: missing tables on the path are created, a list index may append one entry, and every
 //! error names the path and what is there instead.
 
-use super::path::{lookup, parse_path, render_path, Seg};
+use super::path::{every_entry, parse_path, render_path, Seg};
 use crate::error::ScenarioError;
 use toml::{Table, Value};
 
@@ -80,49 +80,6 @@ pub fn apply_override(table: &mut Table, spec: &str) -> Result<(), ScenarioError
         drop_other_shape(table, j, &shape);
     }
     Ok(())
-}
-
-/// The paths a `*` segment stands for, as in a dataset's plans: every entry of the list before
-/// it (`tendons.*.tension` is `tendons.0.tension`, `tendons.1.tension`, …); `None` for a path
-/// without one. The first `*` is expanded here, any later one by each path's own override.
-fn every_entry(table: &Table, path: &str) -> Result<Option<Vec<String>>, String> {
-    // `tendons[*].tension` as `tendons.*.tension`, as an index may be written either way
-    let path = path.replace("[*]", ".*");
-    let parts: Vec<&str> = path.split('.').filter(|p| !p.is_empty()).collect();
-    let Some(i) = parts.iter().position(|p| *p == "*") else {
-        return Ok(None);
-    };
-    let prefix = parts[..i].join(".");
-    if prefix.is_empty() {
-        return Err("`*` must follow the path of a list (e.g. `tendons.*.tension`)".into());
-    }
-    let n = match lookup(table, &parse_path(&prefix)?) {
-        Some(Value::Array(a)) if !a.is_empty() => a.len(),
-        Some(Value::Array(_)) => {
-            return Err(format!(
-                "the list `{prefix}` is empty: `*` stands for every entry of a list"
-            ))
-        }
-        Some(_) => {
-            return Err(format!(
-                "`{prefix}` is not a list: `*` stands for every entry of a list"
-            ))
-        }
-        None => {
-            return Err(format!(
-                "the scenario has no list `{prefix}` for `*` to stand for"
-            ))
-        }
-    };
-    let rest = parts[i + 1..].join(".");
-    Ok(Some(
-        (0..n)
-            .map(|k| match rest.is_empty() {
-                true => format!("{prefix}.{k}"),
-                false => format!("{prefix}.{k}.{rest}"),
-            })
-            .collect(),
-    ))
 }
 
 /// The keys that size a circular section (a tube's bore too), and those that size a rectangle or

@@ -91,3 +91,47 @@ pub fn lookup<'a>(table: &'a Table, path: &[Seg]) -> Option<&'a Value> {
     }
     Some(node)
 }
+
+/// The paths a `*` segment stands for, in `--set` and in a dataset's plans: every entry of the
+/// list before it (`tendons.*.tension`, or `tendons[*].tension`, is `tendons.0.tension`,
+/// `tendons.1.tension`, …); `None` for a path without one. Only the first `*` is expanded (an
+/// override expands a later one by each path's own override).
+pub fn every_entry(table: &Table, path: &str) -> Result<Option<Vec<String>>, String> {
+    // `tendons[*].tension` as `tendons.*.tension`, as an index may be written either way
+    let path = path.replace("[*]", ".*");
+    let parts: Vec<&str> = path.split('.').filter(|p| !p.is_empty()).collect();
+    let Some(i) = parts.iter().position(|p| *p == "*") else {
+        return Ok(None);
+    };
+    let prefix = parts[..i].join(".");
+    if prefix.is_empty() {
+        return Err("`*` must follow the path of a list (e.g. `tendons.*.tension`)".into());
+    }
+    let n = match lookup(table, &parse_path(&prefix)?) {
+        Some(Value::Array(a)) if !a.is_empty() => a.len(),
+        Some(Value::Array(_)) => {
+            return Err(format!(
+                "the list `{prefix}` is empty: `*` stands for every entry of a list"
+            ))
+        }
+        Some(_) => {
+            return Err(format!(
+                "`{prefix}` is not a list: `*` stands for every entry of a list"
+            ))
+        }
+        None => {
+            return Err(format!(
+                "the scenario has no list `{prefix}` for `*` to stand for"
+            ))
+        }
+    };
+    let rest = parts[i + 1..].join(".");
+    Ok(Some(
+        (0..n)
+            .map(|k| match rest.is_empty() {
+                true => format!("{prefix}.{k}"),
+                false => format!("{prefix}.{k}.{rest}"),
+            })
+            .collect(),
+    ))
+}
